@@ -1,0 +1,80 @@
+#pragma once
+/// @file allan.hpp
+/// Allan-type variances of a PhaseSeries: fully overlapping AVAR (the workhorse), non-overlapping
+/// AVAR and modified AVAR, on a chosen τ grid, with noise identification, equivalent degrees of
+/// freedom and χ² confidence bounds as Stable32 computes them (NIST SP 1065; Greenhall & Riley 2003).
+///
+/// For exact pulse data the second differences C(k+2m) − 2C(k+m) + C(k) are formed in int64
+/// (modular) arithmetic and squared exactly; the pulse weight enters only at the end.
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rwcalc/series.hpp"
+
+namespace rwcalc {
+
+enum class Estimator { Overlapping, NonOverlapping, Modified };
+
+/// τ grid: octave (m = 1, 2, 4, …; default), decade (Stable32's 1, 2, 4 per decade: m = 1, 2, 4,
+/// 10, 20, 40, …), dense[:P] (P log-spaced distinct cluster sizes per decade; default P = 20),
+/// all (every m), or an explicit list of τ in seconds (each a whole number of samples).
+struct TauGrid {
+  enum class Kind { Octave, Decade, Dense, All, Explicit } kind = Kind::Octave;
+  int per_decade = 20;             ///< for Dense
+  std::vector<double> taus_s;      ///< for Explicit
+  std::int64_t max_m = 0;          ///< optional cap on m (0: the estimator's own limit)
+  /// Parse "octave", "decade", "dense", "dense:P", "all", or "1,2,5" (seconds). Throws UsageError.
+  static TauGrid parse(std::string_view spec);
+};
+
+/// Largest cluster size the estimator accepts for `points` phase points (at least one term).
+std::int64_t max_cluster_size(Estimator est, std::size_t points);
+
+/// The cluster sizes m of a grid for a record of `points` phase points sampled every tau0_s.
+/// Throws UsageError for an explicit τ that is not a whole number of samples or out of range.
+std::vector<std::int64_t> cluster_sizes(const TauGrid& grid, Estimator est, std::size_t points,
+                                        double tau0_s);
+
+struct AllanOptions {
+  Estimator estimator = Estimator::Overlapping;
+  TauGrid grid;
+  double confidence = 0.683;  ///< two-sided confidence of the bounds (Stable32's default)
+  bool noise_id = true;       ///< identify α per τ (else use `alpha` for all)
+  int alpha = 0;              ///< noise exponent used when noise_id is false
+  unsigned threads = 0;       ///< 0: all hardware threads
+};
+
+struct AllanPoint {
+  std::int64_t m = 0;        ///< averaging factor (cluster size)
+  double tau_s = 0;          ///< τ = m·τ0, s
+  std::int64_t n = 0;        ///< number of terms in the sum
+  int alpha = 0;             ///< identified noise exponent of S_y(f) ∝ f^α (+2 … −2)
+  double edf = 0;            ///< equivalent degrees of freedom (Greenhall–Riley)
+  double var = 0;            ///< σ²(τ), deviation units squared
+  double dev = 0;            ///< σ(τ)
+  double dev_low = 0;        ///< lower confidence bound of σ
+  double dev_high = 0;       ///< upper confidence bound of σ
+};
+
+struct AllanResult {
+  Estimator estimator = Estimator::Overlapping;
+  std::string unit;          ///< unit of the deviations: "deg/h" or "1"
+  double tau0_s = 0;
+  std::size_t points_in = 0; ///< phase points of the record
+  double confidence = 0.683;
+  std::vector<AllanPoint> points;
+};
+
+/// Compute the chosen variance on the grid, with α, EDF and bounds. Throws AnalysisError when the
+/// record is too short for even one τ.
+AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options = {});
+
+/// The raw variance at one cluster size (no noise id/EDF); returns σ² and sets `terms`.
+double allan_variance(const PhaseSeries& x, std::int64_t m, Estimator est, std::int64_t* terms = nullptr);
+
+std::string_view to_string(Estimator e);
+Estimator parse_estimator(std::string_view s);  ///< "oadev"|"overlapping", "adev"|"nonoverlapping", "mdev"|"modified"
+
+}  // namespace rwcalc

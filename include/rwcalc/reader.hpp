@@ -1,0 +1,78 @@
+#pragma once
+/// @file reader.hpp
+/// Reading gyro and clock recordings into a PhaseSeries without losing or bending a sample.
+///
+/// Text, one sample per line. Accepted: `#` comment lines; metadata lines `# key: value`
+/// (rate_hz, scale_arcsec_per_pulse, temperature_c, serial, and any other key, kept verbatim);
+/// an optional header row naming the columns; delimiters comma, semicolon, tab or blanks
+/// (detected from the first data line); a decimal comma where the delimiter is not a comma;
+/// CRLF line ends; a UTF-8 BOM; gzip (by content, whatever the name); "-" for standard input.
+/// Any malformed line is an InputError naming the file and the line; nothing is skipped silently.
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rwcalc/series.hpp"
+
+namespace rwcalc {
+
+/// What the selected column holds.
+enum class InputMode {
+  Pulses,   ///< per-sample pulse increments (integers): the GL-2D format; default
+  Counter,  ///< a cumulative counter reading that wraps at 2^counter_bits
+  Angle,    ///< cumulative angle or phase samples, in angle_unit
+  Rate,     ///< rate samples, in rate_unit (or dimensionless frequency for clocks)
+};
+enum class AngleUnit { Arcsec, Deg, Rad, Second };
+enum class RateUnit { DegPerHour, DegPerSecond, RadPerSecond, Unitless };
+
+struct ReadOptions {
+  InputMode mode = InputMode::Pulses;
+  /// Column holding the samples: a header name, or a 1-based index as text ("2"). Empty: the
+  /// column named "pulses" (or counter/angle/phase/rate/gyro by mode), else the only non-time
+  /// column, else an error asking for --column.
+  std::string column;
+  std::optional<double> rate_hz;       ///< --rate; overrides metadata; checked against a time column
+  std::optional<double> scale_arcsec;  ///< --scale: pulse weight, ″; overrides metadata
+  int counter_bits = 32;               ///< wrap width of Counter mode (1..64)
+  AngleUnit angle_unit = AngleUnit::Arcsec;
+  RateUnit rate_unit = RateUnit::DegPerHour;
+  /// Allowed deviation of a time-column step from 1/rate, as a fraction of the period.
+  double time_tolerance = 0.01;
+};
+
+/// Where the sample rate came from (reported in outputs).
+enum class RateSource { Option, Metadata, TimeColumn, Default };
+
+struct Recording {
+  std::string source;  ///< the path as given ("-" for stdin)
+  PhaseSeries phase;   ///< the cumulative angle/phase, ready for the estimators
+  double rate_hz = 400.0;
+  RateSource rate_source = RateSource::Default;
+  std::size_t samples = 0;  ///< data lines read (samples of the selected column)
+  std::map<std::string, std::string> metadata;  ///< every `# key: value` line
+  std::optional<double> temperature_c;  ///< mean of a temperature_c column, else metadata
+  std::string column_name;              ///< the column that was read
+  InputMode mode = InputMode::Pulses;
+  /// Rate samples in deviation units (°/h for gyro), one per sample; handy for block statistics.
+  [[nodiscard]] std::vector<double> rates() const;
+};
+
+/// Read a file (or "-" for stdin). Throws InputError (file, line, message) on any malformed input.
+Recording read_recording(const std::string& path, const ReadOptions& options = {});
+
+/// Read from text already in memory (used by tests, fuzzers and stdin); `name` labels errors.
+Recording read_recording_text(std::string_view text, const std::string& name,
+                              const ReadOptions& options = {});
+
+/// Parse names used on the command line; throw UsageError on anything else.
+InputMode parse_input_mode(std::string_view s);
+AngleUnit parse_angle_unit(std::string_view s);
+RateUnit parse_rate_unit(std::string_view s);
+std::string_view to_string(InputMode m);
+std::string_view to_string(RateSource s);
+
+}  // namespace rwcalc

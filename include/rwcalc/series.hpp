@@ -1,0 +1,59 @@
+#pragma once
+/// @file series.hpp
+/// The phase series every estimator works on: the cumulative angle (gyro) or phase (clock),
+/// sampled every τ0.
+///
+/// Gyro pulse data keep their exact integer cumulative counts C_0 = 0, C_1 … C_M; the angle is
+/// θ_k = q·C_k with q the pulse weight in arcseconds, applied only at the last step. All other
+/// inputs are converted once into a floating phase in "phase units": arcseconds for gyro data
+/// (so deviations come out in ″/s = °/h), seconds or the input's own unit for clock data
+/// (deviations dimensionless, "input units per second").
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace rwcalc {
+
+enum class PhaseKind {
+  Gyro,   ///< phase in arcseconds; deviations in °/h
+  Clock,  ///< phase in the input's unit (s for time error); deviations in input units per second
+};
+
+struct PhaseSeries {
+  double tau0_s = 0.0025;  ///< sample period, s
+  PhaseKind kind = PhaseKind::Gyro;
+  /// Exact cumulative pulse counts C_0..C_M (C_0 = 0). Used when not empty. Differences are
+  /// computed with wrap-around (modular) int64 arithmetic, so any offset gives identical results.
+  std::vector<std::int64_t> counts;
+  double arcsec_per_count = 0.92;  ///< pulse weight q, ″ per count
+  /// Floating phase x_0..x_M in phase units, used when `counts` is empty.
+  std::vector<double> values;
+
+  [[nodiscard]] bool exact() const noexcept { return !counts.empty(); }
+  /// Number of phase points (samples + 1 for increment or rate data).
+  [[nodiscard]] std::size_t points() const noexcept { return exact() ? counts.size() : values.size(); }
+  /// Phase at index i in phase units.
+  [[nodiscard]] double at(std::size_t i) const noexcept {
+    return exact() ? static_cast<double>(counts[i]) * arcsec_per_count : values[i];
+  }
+  /// Phase difference x_j − x_i in phase units, exact for counts.
+  [[nodiscard]] double diff(std::size_t j, std::size_t i) const noexcept {
+    if (exact()) {
+      const auto d = static_cast<std::int64_t>(static_cast<std::uint64_t>(counts[j]) -
+                                               static_cast<std::uint64_t>(counts[i]));
+      return static_cast<double>(d) * arcsec_per_count;
+    }
+    return values[j] - values[i];
+  }
+  /// Record length T = (points − 1)·τ0, s.
+  [[nodiscard]] double duration_s() const noexcept {
+    return points() > 1 ? static_cast<double>(points() - 1) * tau0_s : 0.0;
+  }
+  /// Unit of the Allan deviation: "deg/h" for gyro data, "1" (input units per second) for clock data.
+  [[nodiscard]] std::string deviation_unit() const { return kind == PhaseKind::Gyro ? "deg/h" : "1"; }
+  /// Rate sample i (0-based, i < points−1) in deviation units: (x_{i+1} − x_i)/τ0.
+  [[nodiscard]] double rate(std::size_t i) const noexcept { return diff(i + 1, i) / tau0_s; }
+};
+
+}  // namespace rwcalc

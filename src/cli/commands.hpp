@@ -1,0 +1,45 @@
+#pragma once
+// Internal to the command-line layer: each sub-command registers itself on the CLI11 app and
+// returns a callable that runs it once parsing succeeded.
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <iosfwd>
+#include <optional>
+#include <string>
+
+#include "rwcalc/reader.hpp"
+
+namespace rwcalc::cli {
+
+/// Streams a command writes to.
+struct Io {
+  std::ostream& out;
+  std::ostream& err;
+};
+
+using Runner = std::function<int(Io&)>;
+
+/// Input options shared by every command that reads a recording (allan, analyze, batch, diagnose).
+struct InputArgs {
+  std::string input = "pulses";
+  std::string column;
+  std::optional<double> rate_hz;
+  std::optional<double> scale_arcsec;
+  int counter_bits = 32;
+  std::string angle_unit = "arcsec";
+  std::string rate_unit = "deg/h";
+  double time_tolerance = 0.01;
+  void add_to(CLI::App& app);
+  [[nodiscard]] ReadOptions options() const;  ///< throws UsageError on bad names
+};
+
+// One per sub-command (src/cli/cmd_*.cpp). Each adds its subcommand to `app` and sets `runner`.
+void register_allan(CLI::App& app, Runner& runner);
+void register_analyze(CLI::App& app, Runner& runner);
+void register_batch(CLI::App& app, Runner& runner);
+void register_merge(CLI::App& app, Runner& runner);
+void register_simulate(CLI::App& app, Runner& runner);
+void register_diagnose(CLI::App& app, Runner& runner);
+void register_report(CLI::App& app, Runner& runner);
+
+}  // namespace rwcalc::cli

@@ -1,0 +1,96 @@
+#include "test_support.hpp"
+
+#include <fmt/format.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "rwcalc/cli.hpp"
+
+namespace rwcalc::test {
+
+std::filesystem::path shared_data(const std::string& relative) {
+  return std::filesystem::path(RWCALC_SHARED_DIR) / "data" / relative;
+}
+
+std::filesystem::path source_path(const std::string& relative) {
+  return std::filesystem::path(RWCALC_SOURCE_DIR) / relative;
+}
+
+CliResult run_cli(const std::vector<std::string>& args) {
+  std::vector<const char*> argv{"rwcalc"};
+  for (const auto& a : args) argv.push_back(a.c_str());
+  std::ostringstream out, err;
+  CliResult r;
+  r.status = rwcalc::cli::run(static_cast<int>(argv.size()), argv.data(), out, err);
+  r.out = out.str();
+  r.err = err.str();
+  return r;
+}
+
+namespace {
+std::string shell_quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) {
+    if (c == '\'')
+      q += "'\\''";
+    else
+      q += c;
+  }
+  return q + "'";
+}
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+}  // namespace
+
+CliResult run_exe(const std::vector<std::string>& args, const std::string& stdin_text) {
+  TempDir tmp;
+  auto in_path = tmp.write("stdin.txt", stdin_text);
+  std::string cmd = shell_quote(RWCALC_EXE);
+  for (const auto& a : args) cmd += " " + shell_quote(a);
+  cmd += " <" + shell_quote(in_path.string()) + " >" + shell_quote((tmp.path() / "out").string()) +
+         " 2>" + shell_quote((tmp.path() / "err").string());
+  const int rc = std::system(cmd.c_str());
+  CliResult r;
+  r.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : 128 + WTERMSIG(rc);
+  r.out = slurp(tmp.path() / "out");
+  r.err = slurp(tmp.path() / "err");
+  return r;
+}
+
+TempDir::TempDir() {
+  std::random_device rd;
+  const auto base = std::filesystem::temp_directory_path();
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    auto candidate = base / fmt::format("rwcalc-test-{:016x}", (static_cast<unsigned long long>(rd()) << 32) ^ rd());
+    if (std::filesystem::create_directory(candidate)) {
+      path_ = candidate;
+      return;
+    }
+  }
+  throw std::runtime_error("cannot create a temporary directory");
+}
+
+TempDir::~TempDir() {
+  std::error_code ec;
+  std::filesystem::remove_all(path_, ec);
+}
+
+std::filesystem::path TempDir::write(const std::string& name, const std::string& content) const {
+  auto p = path_ / name;
+  std::ofstream out(p, std::ios::binary);
+  out << content;
+  return p;
+}
+
+}  // namespace rwcalc::test

@@ -1,0 +1,52 @@
+#pragma once
+// Helpers shared by the test binaries: locating reference data, running the CLI, temp files.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace rwcalc::test {
+
+/// Path of a file under ../shared/data (the read-only reference material).
+std::filesystem::path shared_data(const std::string& relative);
+
+/// Path of a file under the source tree (e.g. "data/gl2d/...").
+std::filesystem::path source_path(const std::string& relative);
+
+/// Skip the current test with a clear message when the shared reference file is absent.
+#define RWCALC_REQUIRE_SHARED(path)                                                          \
+  do {                                                                                       \
+    if (!std::filesystem::exists(path))                                                      \
+      GTEST_SKIP() << "reference data not found: " << (path)                                 \
+                   << " (the ../shared folder beside the checkout is absent)";               \
+  } while (0)
+
+struct CliResult {
+  int status = -1;
+  std::string out;
+  std::string err;
+};
+
+/// Run `rwcalc ARGS…` in-process through rwcalc::cli::run.
+CliResult run_cli(const std::vector<std::string>& args);
+
+/// Run the built executable as a separate process (argv[0] = rwcalc), optionally feeding stdin.
+CliResult run_exe(const std::vector<std::string>& args, const std::string& stdin_text = {});
+
+/// A fresh temporary directory removed when the object goes out of scope.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  [[nodiscard]] const std::filesystem::path& path() const { return path_; }
+  /// Write a file inside the directory and return its path.
+  std::filesystem::path write(const std::string& name, const std::string& content) const;
+
+ private:
+  std::filesystem::path path_;
+};
+
+}  // namespace rwcalc::test
