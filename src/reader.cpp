@@ -444,7 +444,18 @@ LineKind Reader::careful_line(std::string_view line) {
   const bool any_numeric =
       std::any_of(fields_.begin(), fields_.end(), [&](std::string_view f) { return looks_numeric(f, comma_ok); });
   const bool any_text = std::any_of(fields_.begin(), fields_.end(), [](std::string_view f) { return !f.empty(); });
-  if (!any_numeric && any_text) {
+  // Inside the data, an all-text line is a second header row when it repeats the header or has
+  // several fields; a lone word in a one-column file is just text in a numeric column.
+  auto repeats_header = [&] {
+    if (header_.empty() || fields_.size() != header_.size()) return false;
+    for (std::size_t c = 0; c < fields_.size(); ++c) {
+      std::string_view f = fields_[c];
+      if (f.size() >= 2 && f.front() == '"' && f.back() == '"') f = f.substr(1, f.size() - 2);
+      if (!iequals(trim(f), header_[c])) return false;
+    }
+    return true;
+  };
+  if (!any_numeric && any_text && (!layout_known_ || fields_.size() >= 2 || repeats_header())) {
     if (layout_known_)
       fail(line_, fmt::format("a second header row inside the data: {} (the first is at line {}); "
                               "were two files joined?",
