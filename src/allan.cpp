@@ -150,8 +150,8 @@ std::vector<std::int64_t> cluster_sizes(const TauGrid& grid, Estimator est, std:
 
 namespace {
 
-// Variance of one τ with the prefix sums for MVAR of counts prepared by the caller.
-double variance_at(const PhaseSeries& x, std::int64_t m, Estimator est, const std::vector<std::uint64_t>* prefix,
+// Variance of one τ; `prepared` holds the counts in their fast exact form (see PreparedCounts).
+double variance_at(const PhaseSeries& x, std::int64_t m, Estimator est, const detail::PreparedCounts* prepared,
                    std::int64_t* terms_out) {
   const std::size_t points = x.points();
   const std::int64_t n = term_count(est, m, points);
@@ -159,29 +159,25 @@ double variance_at(const PhaseSeries& x, std::int64_t m, Estimator est, const st
   if (n < 1) return 0.0;
   const double tau = static_cast<double>(m) * x.tau0_s;
   const double q = x.arcsec_per_count;
+  detail::PreparedCounts local;
+  if (x.exact() && !prepared) {
+    local = detail::prepare_counts(x.counts, est == Estimator::Modified);
+    prepared = &local;
+  }
   switch (est) {
     case Estimator::Overlapping:
     case Estimator::NonOverlapping: {
       const std::int64_t stride = est == Estimator::Overlapping ? 1 : m;
       if (x.exact())
-        return finish_counts(detail::second_diff_sumsq_counts(x.counts.data(), n, m, stride), q, tau,
-                             static_cast<double>(n));
+        return finish_counts(detail::second_diff_sumsq(*prepared, n, m, stride), q, tau, static_cast<double>(n));
       return detail::second_diff_sumsq_values(x.values.data(), n, m, stride) /
              (2.0 * tau * tau * static_cast<double>(n));
     }
     case Estimator::Modified: {
       const double md = static_cast<double>(m);
-      if (x.exact()) {
-        std::vector<std::uint64_t> local;
-        if (!prefix) {
-          local = detail::count_prefix_sums(x.counts);
-          prefix = &local;
-        }
-        return detail::modified_sumsq_counts(prefix->data(), n, m) * (q * q) /
-               (2.0 * md * md * tau * tau * static_cast<double>(n));
-      }
-      return detail::modified_sumsq_values(x.values.data(), n, m) /
-             (2.0 * md * md * tau * tau * static_cast<double>(n));
+      const double sumsq = x.exact() ? detail::modified_sumsq(*prepared, n, m) * (q * q)
+                                     : detail::modified_sumsq_values(x.values.data(), n, m);
+      return sumsq / (2.0 * md * md * tau * tau * static_cast<double>(n));
     }
   }
   return 0.0;
@@ -216,14 +212,14 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
   result.confidence = options.confidence;
   result.points.resize(ms.size());
 
-  std::vector<std::uint64_t> prefix;
-  if (est == Estimator::Modified && x.exact()) prefix = detail::count_prefix_sums(x.counts);
+  detail::PreparedCounts prepared;
+  if (x.exact()) prepared = detail::prepare_counts(x.counts, est == Estimator::Modified);
 
   auto work = [&](std::size_t i) {
     AllanPoint& p = result.points[i];
     p.m = ms[i];
     p.tau_s = static_cast<double>(p.m) * x.tau0_s;
-    p.var = variance_at(x, p.m, est, prefix.empty() ? nullptr : &prefix, &p.n);
+    p.var = variance_at(x, p.m, est, x.exact() ? &prepared : nullptr, &p.n);
     p.dev = std::sqrt(p.var);
     p.alpha = options.noise_id ? identify_noise(x, p.m, est, options.noise_id_domain) : options.alpha;
   };

@@ -24,49 +24,89 @@ namespace {
 constexpr std::size_t kMinAcfPoints = 30;
 constexpr int kMaxDifferences = 2;  // d_max for Allan-type (two-sample) variances
 
-/// Phase x_{k·m} − x_0 for k = 0 … ⌊(N−1)/m⌋, offset-free and exact for counts up to the scale.
+/// Decimated phase p_k = x_{k·m} − x_0, k = 0 … ⌊(N−1)/m⌋, in arbitrary units (the ACF and the
+/// B1 ratio do not depend on scale); offset-free and exact for counts.
 std::vector<double> decimated_phase(const PhaseSeries& x, std::int64_t m) {
-  const std::size_t count = (x.points() - 1) / static_cast<std::size_t>(m) + 1;
+  const auto um = static_cast<std::size_t>(m);
+  const std::size_t count = (x.points() - 1) / um + 1;
   std::vector<double> z(count);
-  for (std::size_t k = 0; k < count; ++k) z[k] = x.diff(k * static_cast<std::size_t>(m), 0);
+  if (x.exact()) {
+    const std::int64_t* c = x.counts.data();
+    const auto c0 = static_cast<std::uint64_t>(c[0]);
+    for (std::size_t k = 0; k < count; ++k)
+      z[k] = static_cast<double>(static_cast<std::int64_t>(static_cast<std::uint64_t>(c[k * um]) - c0));
+  } else {
+    const double* v = x.values.data();
+    for (std::size_t k = 0; k < count; ++k) z[k] = v[k * um] - v[0];
+  }
   return z;
 }
 
-/// Frequencies averaged over m samples, ȳ_k = (x_{(k+1)m} − x_{km})/(mτ0), k < ⌊(N−1)/m⌋.
+/// Averaged frequencies ȳ_k ∝ p_{k+1} − p_k (k < ⌊(N−1)/m⌋), same arbitrary units.
 std::vector<double> averaged_frequency(const PhaseSeries& x, std::int64_t m) {
-  const auto um = static_cast<std::size_t>(m);
-  const std::size_t count = (x.points() - 1) / um;
-  std::vector<double> y(count);
-  const double scale = 1.0 / (static_cast<double>(m) * x.tau0_s);
-  for (std::size_t k = 0; k < count; ++k) y[k] = x.diff((k + 1) * um, k * um) * scale;
+  std::vector<double> y = decimated_phase(x, m);
+  for (std::size_t i = 0; i + 1 < y.size(); ++i) y[i] = y[i + 1] - y[i];
+  y.pop_back();
   return y;
 }
 
-/// Lag-1 autocorrelation r1 = Σ(z_i − z̄)(z_{i+1} − z̄) / Σ(z_i − z̄)² (Riley & Greenhall eq. 2).
-double lag1_autocorrelation(const std::vector<double>& z) {
-  const auto n = static_cast<double>(z.size());
-  double mean = 0;
-  for (double v : z) mean += v;
-  mean /= n;
-  double num = 0, den = 0;
-  for (std::size_t i = 0; i < z.size(); ++i) {
-    const double a = z[i] - mean;
-    den += a * a;
-    if (i + 1 < z.size()) num += a * (z[i + 1] - mean);
+/// Value i of the level-th difference of p (level 0: p itself).
+inline double difference(const double* p, int level, std::size_t i) {
+  switch (level) {
+    case 0: return p[i];
+    case 1: return p[i + 1] - p[i];
+    case 2: return (p[i + 2] - p[i + 1]) - (p[i + 1] - p[i]);
+    default: return ((p[i + 3] - p[i + 2]) - (p[i + 2] - p[i + 1])) - ((p[i + 2] - p[i + 1]) - (p[i + 1] - p[i]));
   }
-  return den > 0 ? num / den : 0.0;
 }
 
-/// Lag-1 ACF method: difference until δ = r1/(1 + r1) < 0.25 (or d_max); p = −round(2δ) − 2d.
-/// Returns p, the exponent of the analysed series' own spectrum (α for frequency, α − 2 for phase).
-int acf_exponent(std::vector<double> z) {
+/// Lag-1 autocorrelation r1 = Σ(z_i − z̄)(z_{i+1} − z̄) / Σ(z_i − z̄)² (Riley & Greenhall eq. 2) of
+/// the level-th difference z of p, without forming z: the mean of a difference follows from its
+/// end points, and the sums run in four independent lanes (branch-free, vectorisable).
+double lag1_autocorrelation(const std::vector<double>& pv, int level) {
+  const double* p = pv.data();
+  const std::size_t len = pv.size() - static_cast<std::size_t>(level);  // points of z
+  if (pv.size() <= static_cast<std::size_t>(level) + 1) return 0.0;
+  double mean = 0;
+  if (level == 0) {
+    double lane[4] = {};
+    std::size_t i = 0;
+    for (; i + 4 <= len; i += 4)
+      for (int j = 0; j < 4; ++j) lane[j] += p[i + j];
+    for (; i < len; ++i) lane[0] += p[i];
+    mean = (lane[0] + lane[1] + lane[2] + lane[3]) / static_cast<double>(len);
+  } else {
+    mean = (difference(p, level - 1, len) - difference(p, level - 1, 0)) / static_cast<double>(len);
+  }
+  double num[4] = {}, den[4] = {};
+  std::size_t i = 0;
+  // Pairs (z_i, z_{i+1}) for i < len − 1; den over all i < len.
+  for (; i + 4 < len; i += 4) {
+    for (int j = 0; j < 4; ++j) {
+      const double a = difference(p, level, i + j) - mean;
+      const double b = difference(p, level, i + j + 1) - mean;
+      den[j] += a * a;
+      num[j] += a * b;
+    }
+  }
+  for (; i < len; ++i) {
+    const double a = difference(p, level, i) - mean;
+    den[0] += a * a;
+    if (i + 1 < len) num[0] += a * (difference(p, level, i + 1) - mean);
+  }
+  const double n_sum = num[0] + num[1] + num[2] + num[3];
+  const double d_sum = den[0] + den[1] + den[2] + den[3];
+  return d_sum > 0 ? n_sum / d_sum : 0.0;
+}
+
+/// Lag-1 ACF method on the decimated phase p, starting at difference level `base` (0: phase data,
+/// 1: frequency data): difference until δ = r1/(1 + r1) < 0.25 or d = d_max; p = −round(2δ) − 2d.
+/// Returns p, the exponent of the analysed series' own spectrum.
+int acf_exponent(const std::vector<double>& phase, int base) {
   for (int d = 0;; ++d) {
-    const double r1 = lag1_autocorrelation(z);
+    const double r1 = lag1_autocorrelation(phase, base + d);
     const double delta = r1 / (1.0 + r1);
-    if (delta < 0.25 || d >= kMaxDifferences || z.size() < 3)
-      return -static_cast<int>(std::lround(2.0 * delta)) - 2 * d;
-    for (std::size_t i = 0; i + 1 < z.size(); ++i) z[i] = z[i + 1] - z[i];
-    z.pop_back();
+    if (delta < 0.25 || d >= kMaxDifferences) return -static_cast<int>(std::lround(2.0 * delta)) - 2 * d;
   }
 }
 
@@ -123,8 +163,10 @@ int noise_id_b1(const PhaseSeries& x, std::int64_t m, Estimator est) {
     // tell them apart, which it uses for the modified variance only.
     if (est != Estimator::Modified) return 1;
     // R(n) = MVAR/AVAR tells white (1/m) from flicker PM (NIST TN 1337 Table 2, f_h = 1/(2τ0)).
+    // y is in phase units per cluster: bring AVAR to deviation units before the ratio.
+    const double unit = (x.exact() ? x.arcsec_per_count : 1.0) / (static_cast<double>(m) * x.tau0_s);
     const double mvar = allan_variance(x, m, Estimator::Modified);
-    const double rn = mvar / avar;
+    const double rn = mvar / (avar * unit * unit);
     const double md = static_cast<double>(m);
     const double r_flicker = 3.37 / (1.04 + 3.0 * std::log(std::numbers::pi * md));
     const double r_white = 1.0 / md;
@@ -220,13 +262,12 @@ double binomial(int n, int k) {
 
 int identify_noise(const PhaseSeries& x, std::int64_t m, Estimator est, NoiseIdDomain domain) {
   if (m < 1 || x.points() < 3 || static_cast<std::size_t>(m) > x.points() - 1) return 0;
-  if (domain == NoiseIdDomain::Phase) {
-    std::vector<double> z = decimated_phase(x, m);
-    if (z.size() >= kMinAcfPoints) return std::clamp(acf_exponent(std::move(z)) + 2, -2, 2);
-  } else {
-    std::vector<double> y = averaged_frequency(x, m);
-    if (y.size() >= kMinAcfPoints) return std::clamp(acf_exponent(std::move(y)), -2, 2);
-  }
+  // Points at τ: phase samples for phase data, averaged frequencies (one fewer) for frequency data.
+  const std::size_t phase_points = (x.points() - 1) / static_cast<std::size_t>(m) + 1;
+  if (domain == NoiseIdDomain::Phase && phase_points >= kMinAcfPoints)
+    return std::clamp(acf_exponent(decimated_phase(x, m), 0) + 2, -2, 2);
+  if (domain == NoiseIdDomain::Frequency && phase_points - 1 >= kMinAcfPoints)
+    return std::clamp(acf_exponent(decimated_phase(x, m), 1), -2, 2);
   return noise_id_b1(x, m, est);
 }
 
