@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <algorithm>
 #include <random>
 
 #include "rwcalc/allan.hpp"
@@ -206,6 +207,38 @@ TEST(AllanEngine, JsonCarriesUnitAndEveryPointField) {
     EXPECT_LT(p.at("dev_low").get<double>(), p.at("dev").get<double>());
     EXPECT_GT(p.at("dev_high").get<double>(), p.at("dev").get<double>());
   }
+}
+
+}  // namespace
+}  // namespace rwcalc
+
+namespace rwcalc {
+namespace {
+
+TEST(AllanReport, TableAndCsvCarryUnitsHeaderAndOneRowPerTau) {
+  PhaseSeries c;
+  c.tau0_s = 0.0025;
+  std::mt19937_64 rng(8);
+  std::uniform_int_distribution<int> d(0, 2);
+  std::int64_t run = 0;
+  for (int i = 0; i < 20001; ++i) c.counts.push_back(run += d(rng));
+  const AllanResult r = compute_allan(c);
+  const std::string table = format_allan_table(r, {"run.txt", 20000, 400.0, "default"});
+  for (const char* s : {"run.txt", "overlapping Allan", "confidence: 0.683", "1″/s = 1 °/h", "samples: 20000",
+                        "rate: 400 Hz (default)", "AF", "τ (s)", "terms", "EDF", "σ_min", "σ_max", "°/h"})
+    EXPECT_NE(table.find(s), std::string::npos) << s << "\n" << table;
+  EXPECT_EQ(table.find("nan"), std::string::npos);
+  const std::string csv = format_allan_csv(r);
+  EXPECT_TRUE(csv.starts_with("af,tau_s,n,alpha,edf,dev_low_deg_h,dev_deg_h,dev_high_deg_h\n")) << csv;
+  EXPECT_EQ(static_cast<std::size_t>(std::count(csv.begin(), csv.end(), '\n')), r.points.size() + 1);
+  PhaseSeries clock;
+  clock.kind = PhaseKind::Clock;
+  clock.tau0_s = 1;
+  for (int i = 0; i < 100; ++i) clock.values.push_back(std::sin(i * 0.7) * 1e-9);
+  const AllanResult rc = compute_allan(clock);
+  EXPECT_EQ(unit_label(rc), "input units/s");
+  EXPECT_NE(format_allan_table(rc, {"clock.txt", 100, 1.0, ""}).find("input units per second"), std::string::npos);
+  EXPECT_TRUE(format_allan_csv(rc).starts_with("af,tau_s,n,alpha,edf,dev_low_1,dev_1,dev_high_1\n"));
 }
 
 }  // namespace

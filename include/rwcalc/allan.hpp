@@ -99,6 +99,22 @@ double allan_variance(const PhaseSeries& x, std::int64_t m, Estimator est, std::
 /// "tau_s", "n", "alpha", "edf", "dev", "dev_low", "dev_high"}]}.
 nlohmann::json to_json(const AllanResult& r);
 
+/// What the report header says about the record.
+struct AllanReportInfo {
+  std::string source;        ///< file name as given
+  std::size_t samples = 0;   ///< samples read
+  double rate_hz = 0;        ///< sample rate, Hz
+  std::string rate_source;   ///< where the rate came from ("option", "metadata", …); may be empty
+};
+
+/// Human-readable table: a header block (source, estimator, confidence, unit convention, samples,
+/// rate) and columns AF, τ (s), terms, α, EDF, σ_min, σ, σ_max with the deviation unit.
+std::string format_allan_table(const AllanResult& r, const AllanReportInfo& info);
+/// CSV with a header row naming each column and its unit.
+std::string format_allan_csv(const AllanResult& r);
+/// Unit label of the deviations for people: "°/h" for gyro data, "input units/s" otherwise.
+std::string unit_label(const AllanResult& r);
+
 /// "oadev", "adev" or "mdev".
 std::string_view to_string(Estimator e);
 /// Human name: "overlapping Allan", "non-overlapping Allan", "modified Allan".
