@@ -44,10 +44,12 @@ std::string string_at(const json& j, std::string_view key) {
   return c.is_string() ? c.get<std::string>() : std::string();
 }
 
-/// A fitted coefficient: {value, sigma, low95, high95, resolved}.
+/// A fitted coefficient: {value, sigma, low95, high95, resolved[, estimate, in_model]}. When not
+/// resolved, `value` is the 95 % upper bound; `estimate` is the model's own value (may be 0).
 struct Coefficient {
   std::optional<double> value;
   std::optional<double> high95;
+  double model = 0;  ///< what the fitted model curve uses
   bool resolved = false;
 };
 
@@ -58,6 +60,13 @@ Coefficient coefficient(const json& fit, std::string_view key) {
   r.high95 = number_at(c, "high95");
   const auto& res = child(c, "resolved");
   r.resolved = res.is_boolean() ? res.get<bool>() : r.value.has_value();
+  const auto& in_model = child(c, "in_model");
+  if (in_model.is_boolean() && !in_model.get<bool>())
+    r.model = 0;  // left out of the model by the term selection
+  else if (const auto est = number_at(c, "estimate"))
+    r.model = *est;
+  else
+    r.model = r.resolved ? r.value.value_or(0.0) : 0.0;
   return r;
 }
 
@@ -152,20 +161,27 @@ bool is_gyro(const json& allan) {
   return unit.empty() || unit == "deg/h";
 }
 
-/// GOST RV 52339 limits for B (°/h) by class, as the seed paper reports them; a table in the
-/// JSON (`verdict.limits: [{class, B_deg_per_h}]`) takes precedence.
+/// The class limits for B (°/h) by class: `verdict.classes` with `verdict.B.limits` (the limits
+/// the verdict applied, tolerance included), else the GOST RV 52339 table as the seed paper
+/// reports it.
 std::vector<std::pair<int, double>> b_limits(const json& analysis) {
   std::vector<std::pair<int, double>> r;
-  const auto& limits = child(child(analysis, "verdict"), "limits");
-  if (limits.is_array()) {
-    for (const auto& l : limits) {
-      const auto cls = number_at(l, "class");
-      const auto b = number_at(l, "B_deg_per_h");
-      if (cls && b && *b > 0) r.emplace_back(static_cast<int>(*cls), *b);
-    }
+  const auto& verdict = child(analysis, "verdict");
+  const auto& classes = child(verdict, "classes");
+  const auto& limits = child(child(verdict, "B"), "limits");
+  if (classes.is_array() && limits.is_array() && classes.size() == limits.size()) {
+    for (std::size_t i = 0; i < classes.size(); ++i)
+      if (classes[i].is_number() && limits[i].is_number() && limits[i].get<double>() > 0)
+        r.emplace_back(classes[i].get<int>(), limits[i].get<double>());
   }
   if (r.empty()) r = {{1, 0.005}, {2, 0.008}, {3, 0.015}};
   return r;
+}
+
+/// " (+50 % tolerance)" when the verdict widened the B limits by the paper's heading-gyro rule.
+std::string tolerance_note(const json& analysis) {
+  const auto t = number_at(child(analysis, "verdict"), "tolerance_pct");
+  return t && *t > 0 ? fmt::format(" (+{:g} % tolerance)", *t) : std::string();
 }
 
 /// √(2 ln2/π): the flicker floor of σ per unit B.
@@ -220,11 +236,11 @@ void add_class_floors(const json& analysis, std::string& vars, PlotCommand& plot
   static constexpr std::array<const char*, 3> kDash{"2", "4", "3"};
   std::size_t i = 0;
   for (const auto& [cls, b] : b_limits(analysis)) {
-    vars += fmt::format("B_class{} = {:.6g}   # °/h, GOST RV 52339 class {} limit for B\n", cls, b, cls);
+    vars += fmt::format("B_class{} = {:.6g}   # °/h, class {} limit for B\n", cls, b, cls);
     plot.add(fmt::format("sB(x, B_class{0}) w l lw 1.3 dt {1} lc rgb '#d62728' t {2}", cls,
                          kDash[i % kDash.size()],
-                         q(fmt::format("class {} limit B = {} °/h (floor {} °/h)", cls, show(b),
-                                       show(kFloorPerB * b)))));
+                         q(fmt::format("class {} limit B = {} °/h{} (floor {} °/h)", cls, show(b),
+                                       tolerance_note(analysis), show(kFloorPerB * b)))));
     ++i;
   }
 }
@@ -321,24 +337,24 @@ Figure analysis_figure(const json& analysis, const PlotOptions& options) {
 
   if (gyro && fit.is_object()) {
     vars += kTermFunctions;
-    vars += "# Fitted coefficients (0 where the fit returned none):\n";
+    vars += "# Coefficients of the fitted model (0 for a term the fit left out):\n";
     std::string model = "model(t) = sqrt(0";
     std::vector<std::string> term_lines;
     for (std::size_t i = 0; i < kTerms.size(); ++i) {
       const auto& t = kTerms[i];
       const auto c = coefficient(fit, t.key);
-      const double v = c.value.value_or(0.0);
-      vars += fmt::format("{} = {:.8g}   # {}\n", t.var, v, t.unit);
+      vars += fmt::format("{} = {:.8g}   # {}\n", t.var, c.model, t.unit);
       model += fmt::format(" + {}(t, {})**2", t.fn, t.var);
+      const double v = c.value.value_or(0.0);
       if (c.resolved && v > 0) {
         term_lines.push_back(fmt::format("{}(x, {}) w l lw 1.4 lc rgb '{}' t {}", t.fn, t.var, t.colour,
                                          q(fmt::format("{} = {} {}", t.label, show(v), t.unit))));
-      } else if (c.high95 && *c.high95 > 0) {
+      } else if (const double bound = c.high95.value_or(v); !c.resolved && bound > 0) {
         // An unresolved term is only bounded: draw the bound, dashed.
-        vars += fmt::format("{}_up95 = {:.8g}   # {}, 95 % upper bound\n", t.var, *c.high95, t.unit);
+        vars += fmt::format("{}_up95 = {:.8g}   # {}, 95 % upper bound\n", t.var, bound, t.unit);
         term_lines.push_back(fmt::format("{}(x, {}_up95) w l lw 1.2 dt 3 lc rgb '{}' t {}", t.fn, t.var,
                                          t.colour,
-                                         q(fmt::format("{} < {} {} (95 %)", t.label, show(*c.high95), t.unit))));
+                                         q(fmt::format("{} < {} {} (95 %)", t.label, show(bound), t.unit))));
       }
     }
     vars += model + ")\n";
@@ -471,12 +487,18 @@ Figure batch_direct_figure(const json& runs, const PlotOptions& options) {
     blocks += block;
     tmax = std::max(tmax, run_tmax);
     const auto colour = temperature_colour(child(run, "temperature_c"), i);
-    const auto slope = number_at(direct, "slope");
-    const auto intercept = number_at(direct, "intercept");
     const auto n_val = number_at(direct, "value");
+    const auto& resolved = child(direct, "resolved");
+    const bool n_resolved = !resolved.is_boolean() || resolved.get<bool>();
+    auto slope = number_at(direct, "slope_arcsec2_per_s");
+    if (!slope) slope = number_at(direct, "slope");
+    // Without a stated slope, the regression's slope follows from N: D(t) = a + (60·N)²·t.
+    if (!slope && n_val && n_resolved) slope = std::pow(60 * *n_val, 2);
+    auto intercept = number_at(direct, "intercept_arcsec2");
+    if (!intercept) intercept = number_at(direct, "intercept");
     // One key entry per run: the points carry the label, the line shares their colour.
     std::string label = run_label(run, i);
-    if (n_val) label += fmt::format(": N = {} °/√h", show(*n_val));
+    if (n_val) label += fmt::format(": N {} {} °/√h", n_resolved ? "=" : "<", show(*n_val));
     plot.add(fmt::format("${} u 1:2 w p pt {} ps 0.8 lc rgb '{}' t {}", name, kPointTypes[i % kPointTypes.size()],
                          colour, q(label)));
     if (slope) {

@@ -93,6 +93,9 @@ TEST(PlotScript, AnalysisFigureHasDataModelTermsAndClassFloors) {
   EXPECT_EQ(f.series, 9);
   EXPECT_NE(f.script.find("$allan << EOD"), std::string::npos);
   EXPECT_NE(f.script.find("K_up95 = 0.0008"), std::string::npos) << f.script;
+  // The model curve uses the fit's own estimates: an unresolved term left out of it counts 0.
+  EXPECT_NE(f.script.find("\nK = 0   #"), std::string::npos);
+  EXPECT_NE(f.script.find("\nN = 0.0009   #"), std::string::npos);
   EXPECT_NE(f.script.find("rate random walk K < 0.0008 °/h/√h (95 %)"), std::string::npos);
   EXPECT_EQ(f.script.find("rate ramp R"), std::string::npos);
   for (const char* s : {"class 1 limit B = 0.005 °/h (floor 0.003321 °/h)", "class 2 limit B = 0.008 °/h",
@@ -109,9 +112,11 @@ TEST(PlotScript, AnalysisFigureHasDataModelTermsAndClassFloors) {
 
 TEST(PlotScript, ClassTableFromTheJsonReplacesTheBuiltInOne) {
   auto a = fixture_analysis({});
-  a["verdict"]["limits"] = json::array({{{"class", 1}, {"B_deg_per_h", 0.004}}, {{"class", 2}, {"B_deg_per_h", 0.02}}});
+  a["verdict"]["classes"] = {1, 2};
+  a["verdict"]["B"]["limits"] = {0.004, 0.02};
+  a["verdict"]["tolerance_pct"] = 50;
   const auto f = rwcalc::analysis_figure(a, {});
-  EXPECT_NE(f.script.find("class 1 limit B = 0.004 °/h"), std::string::npos);
+  EXPECT_NE(f.script.find("class 1 limit B = 0.004 °/h (+50 % tolerance)"), std::string::npos);
   EXPECT_NE(f.script.find("class 2 limit B = 0.02 °/h"), std::string::npos);
   EXPECT_EQ(f.script.find("class 3 limit"), std::string::npos);
   EXPECT_EQ(f.series, 2 + 4 + 2);  // measured, model, Q N B K (resolved; R has no bound), two floors

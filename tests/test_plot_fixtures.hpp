@@ -35,15 +35,16 @@ inline double fixture_sigma(const FixtureCoefficients& c, double tau) {
   return std::sqrt(v);
 }
 
-inline nlohmann::json fixture_coefficient(double value, double rel_sigma, bool resolved = true) {
+/// A coefficient object as `rwcalc analyze --json` writes it. Unresolved: `value` is the 95 %
+/// upper bound (here `bound`), the model's estimate is 0.
+inline nlohmann::json fixture_coefficient(double value, double rel_sigma, bool resolved = true, double bound = 0) {
+  if (!resolved)
+    return {{"value", bound}, {"sigma", bound / (2 * 1.96)}, {"low95", 0.0}, {"high95", bound},
+            {"resolved", false}, {"estimate", 0.0}, {"in_model", false}, {"fitted", true}};
   const double s = value * rel_sigma;
-  if (!resolved)  // an unresolved term: no estimate, a 95 % upper bound only
-    return {{"value", 0.0}, {"sigma", 0.0}, {"low95", 0.0}, {"high95", rel_sigma}, {"resolved", false}};
-  return {{"value", value},
-          {"sigma", s},
-          {"low95", std::max(0.0, value - 1.96 * s)},
-          {"high95", value + 1.96 * s},
-          {"resolved", resolved}};
+  return {{"value", value},        {"sigma", s},         {"low95", std::max(0.0, value - 1.96 * s)},
+          {"high95", value + 1.96 * s}, {"resolved", true}, {"estimate", value},
+          {"in_model", true},      {"fitted", true}};
 }
 
 /// One `rwcalc analyze --json` object.
@@ -70,7 +71,8 @@ inline nlohmann::json fixture_analysis(const FixtureCoefficients& c, unsigned se
                       {"dev_low", dev * std::max(0.05, 1 - rel)},
                       {"dev_high", dev * (1 + 1.4 * rel)}});
   }
-  json direct = fixture_coefficient(c.N * 1.05, 0.2);
+  json direct = fixture_coefficient(c.N, 0.2);
+  direct["intercept_arcsec2"] = 2 * c.Q * c.Q;
   if (with_direct_curve) {
     json curve = json::array();
     const double slope = std::pow(60 * c.N, 2), intercept = 2 * c.Q * c.Q;
@@ -79,8 +81,7 @@ inline nlohmann::json fixture_analysis(const FixtureCoefficients& c, unsigned se
       curve.push_back({{"t_s", t}, {"var_arcsec2", (intercept + slope * t) * (1 + 0.1 * z(rng))}});
     }
     direct["curve"] = curve;
-    direct["slope"] = slope;
-    direct["intercept"] = intercept;
+    direct["slope_arcsec2_per_s"] = slope;
   }
   const auto class_of = [](double v, double l1, double l2, double l3) -> json {
     if (v <= l1) return 1;
@@ -88,12 +89,29 @@ inline nlohmann::json fixture_analysis(const FixtureCoefficients& c, unsigned se
     if (v <= l3) return 3;
     return nullptr;
   };
-  json verdict = {{"class_B", class_of(c.B, 0.005, 0.008, 0.015)},
-                  {"class_N", class_of(c.N, 0.0010, 0.0015, 0.0030)},
-                  {"p_class", 0.83}};
-  verdict["class"] = verdict["class_B"].is_null() || verdict["class_N"].is_null()
-                         ? json(nullptr)
-                         : json(std::max(verdict["class_B"].get<int>(), verdict["class_N"].get<int>()));
+  const json class_B = class_of(c.B, 0.005, 0.008, 0.015), class_N = class_of(c.N, 0.0010, 0.0015, 0.0030);
+  const json cls = class_B.is_null() || class_N.is_null() ? json(nullptr)
+                                                           : json(std::max(class_B.get<int>(), class_N.get<int>()));
+  auto param = [](double v, const char* unit, const json& k, std::vector<double> limits) {
+    return json{{"value", v}, {"unit", unit}, {"resolved", true}, {"class", k}, {"class_strict", k},
+                {"limits", limits}, {"p_class", 0.8}};
+  };
+  json verdict = {{"class_B", class_B},
+                  {"class_N", class_N},
+                  {"class", cls},
+                  {"p_class", 0.83},
+                  {"p_class_B", 0.86},
+                  {"p_class_N", 0.9},
+                  {"statement", cls.is_null() ? std::string("outside class 3 (P=0.83)")
+                                              : "class " + std::to_string(cls.get<int>()) + " (P=0.83)"},
+                  {"tolerance_pct", 0.0},
+                  {"tolerance_changed", false},
+                  {"b_estimate", "fit"},
+                  {"table", "GOST RV 52339-2005 (as reported by Bolotnov & Fomin 2021)"},
+                  {"classes", {1, 2, 3}},
+                  {"p_is", {0.05, 0.83, 0.1, 0.02}},
+                  {"B", param(c.B, "deg/h", class_B, {0.005, 0.008, 0.015})},
+                  {"N", param(c.N, "deg/sqrt(h)", class_N, {0.0010, 0.0015, 0.0030})}};
   return {{"source", "gl2d_" + std::to_string(static_cast<int>(c.temperature_c)) + "C.csv"},
           {"samples", samples},
           {"rate_hz", rate},
@@ -109,7 +127,7 @@ inline nlohmann::json fixture_analysis(const FixtureCoefficients& c, unsigned se
             {"N_deg_per_sqrt_h", fixture_coefficient(c.N, 0.15)},
             {"B_deg_per_h", fixture_coefficient(c.B, 0.2)},
             {"K_deg_per_h_per_sqrt_h", c.K_resolved ? fixture_coefficient(c.K, 0.4)
-                                                    : fixture_coefficient(0, 2 * c.K, false)},
+                                                    : fixture_coefficient(0, 0, false, 2 * c.K)},
             {"R_deg_per_h2", fixture_coefficient(0, 0, false)},  // unresolved, no bound: not drawn
             {"chi2_per_dof", 1.08}}},
           {"methods", {{"N_direct_deg_per_sqrt_h", direct}, {"B_100s_deg_per_h", fixture_coefficient(c.B * 0.95, 0.25)}}},
