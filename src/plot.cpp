@@ -533,18 +533,25 @@ namespace {
 
 struct BandRow {
   double tau = 0, dev = 0, low = 0, high = 0;
+  double median = 0;  ///< the ensemble's median σ (0 when not given)
 };
 
-std::vector<BandRow> band_rows(const json& model) {
+/// The band of the base or the extended model: `base_model.band` / `extended_model.band`, or the
+/// top-level `band` / `band_extended` that `rwcalc diagnose --json` writes.
+const json& band_of(const json& diagnosis, bool extended) {
+  const auto& nested = child(child(diagnosis, extended ? "extended_model" : "base_model"), "band");
+  return nested.is_array() ? nested : child(diagnosis, extended ? "band_extended" : "band");
+}
+
+std::vector<BandRow> band_rows(const json& band) {
   std::vector<BandRow> rows;
-  const auto& band = child(model, "band");
   if (!band.is_array()) return rows;
   for (const auto& p : band) {
     const auto tau = number_at(p, "tau_s");
     const auto lo = number_at(p, "band_low");
     const auto hi = number_at(p, "band_high");
     if (!tau || !lo || !hi || *tau <= 0 || *lo <= 0 || *hi <= 0) continue;
-    rows.push_back({*tau, number_at(p, "dev").value_or(0.0), *lo, *hi});
+    rows.push_back({*tau, number_at(p, "dev").value_or(0.0), *lo, *hi, number_at(p, "median").value_or(0.0)});
   }
   std::sort(rows.begin(), rows.end(), [](const BandRow& a, const BandRow& b) { return a.tau < b.tau; });
   return rows;
@@ -567,19 +574,19 @@ std::string band_label(const char* what, const json& model, const std::vector<Ba
 }  // namespace
 
 Figure diagnosis_figure(const json& diagnosis, const PlotOptions& options) {
-  const auto base = band_rows(child(diagnosis, "base_model"));
-  const auto ext = band_rows(child(diagnosis, "extended_model"));
+  const auto base = band_rows(band_of(diagnosis, false));
+  const auto ext = band_rows(band_of(diagnosis, true));
   if (base.empty())
-    throw AnalysisError("the diagnosis has no simulated band (base_model.band with tau_s, band_low, band_high): "
-                        "nothing to plot");
+    throw AnalysisError("the diagnosis has no simulated band (band or base_model.band, with tau_s, band_low, "
+                        "band_high): nothing to plot");
   std::string blocks;
   PlotCommand plot;
   double xlo = std::numeric_limits<double>::infinity(), xhi = 0;
   double ylo = std::numeric_limits<double>::infinity(), yhi = 0;
   auto add_band = [&](const char* name, const std::vector<BandRow>& rows) {
-    blocks += fmt::format("${} << EOD\n# tau_s dev band_low band_high\n", name);
+    blocks += fmt::format("${} << EOD\n# tau_s dev band_low band_high median\n", name);
     for (const auto& r : rows) {
-      blocks += fmt::format("{:.10g} {:.10g} {:.10g} {:.10g}\n", r.tau, r.dev, r.low, r.high);
+      blocks += fmt::format("{:.10g} {:.10g} {:.10g} {:.10g} {:.10g}\n", r.tau, r.dev, r.low, r.high, r.median);
       xlo = std::min(xlo, r.tau);
       xhi = std::max(xhi, r.tau);
       ylo = std::min({ylo, r.low, r.dev > 0 ? r.dev : r.low});
@@ -590,6 +597,8 @@ Figure diagnosis_figure(const json& diagnosis, const PlotOptions& options) {
   add_band("base", base);
   plot.add(fmt::format("$base u 1:3:4 w filledcurves fs transparent solid 0.30 noborder lc rgb '#1f77b4' t {}",
                        q(band_label("base", child(diagnosis, "base_model"), base))));
+  if (std::all_of(base.begin(), base.end(), [](const BandRow& r) { return r.median > 0; }))
+    plot.add("$base u 1:5 w l lw 1.2 dt 2 lc rgb '#1f77b4' t 'base model, simulated median'");
   if (!ext.empty()) {
     add_band("extended", ext);
     plot.add(fmt::format(
@@ -659,8 +668,10 @@ PlotResult plot_batch(const json& batch, const PlotOptions& options) {
 
 PlotResult plot_diagnosis(const json& diagnosis, const PlotOptions& options) {
   PlotResult r;
-  if (child(child(diagnosis, "extended_model"), "band").is_null())
-    r.notes.emplace_back("the diagnosis has no extended model band (extended_model.band): only the base model is drawn");
+  if (!band_of(diagnosis, true).is_array() || band_of(diagnosis, true).empty())
+    r.notes.emplace_back(
+        "the diagnosis has no extended model band (band_extended or extended_model.band): only the base model is "
+        "drawn");
   write_outputs({diagnosis_figure(diagnosis, options)}, options, r);
   return r;
 }

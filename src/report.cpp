@@ -383,7 +383,7 @@ std::string diagnosis_html(const json& d, std::size_t index, const json& run, Fi
     }
     s += "</table>\n";
   }
-  if (figures && at(at(d, "base_model"), "band").is_array()) {
+  if (figures && (at(at(d, "base_model"), "band").is_array() || at(d, "band").is_array())) {
     PlotOptions po;
     s += figure_html(fmt::format("fig-run{}-diagnosis", index + 1), {diagnosis_figure(d, po)},
                      fmt::format("{}: measured Allan deviation against the simulated bands of the base and the "

@@ -130,7 +130,7 @@ TEST(PlotScript, MissingAllanPointsIsAnAnalysisError) {
   EXPECT_THROW(rwcalc::analysis_figure(a, {}), rwcalc::AnalysisError);
   EXPECT_THROW(rwcalc::plot_batch(json{{"runs", json::array()}}, {}), rwcalc::AnalysisError);
   json d = fixture_diagnosis();
-  d["base_model"].erase("band");
+  d.erase("band");
   EXPECT_THROW(rwcalc::diagnosis_figure(d, {}), rwcalc::AnalysisError);
 }
 
@@ -284,22 +284,26 @@ TEST(PlotRender, DiagnosisShowsBothBandsTheMeasurementAndWhereItLeaves) {
   TempDir dir;
   rwcalc::PlotOptions o;
   o.output = (dir.path() / "diag.svg").string();
-  auto r = rwcalc::plot_diagnosis(fixture_diagnosis(), o);
-  auto svg = slurp(o.output);
-  EXPECT_EQ(xml_problem(svg), "");
-  EXPECT_EQ(svg_series(svg).size(), 4u);
-  EXPECT_EQ(r.series, 4);
-  EXPECT_NE(svg.find("findings: sinusoid"), std::string::npos);
-  // The fixture's sinusoid lifts σ out of the base band at 2 of the 20 octave τ.
-  EXPECT_NE(svg.find("18 of 20 τ inside"), std::string::npos);
-  EXPECT_NE(svg.find("20 of 20 τ inside"), std::string::npos);
-
   o.force = true;
-  r = rwcalc::plot_diagnosis(fixture_diagnosis(/*with_extended=*/false), o);
-  svg = slurp(o.output);
-  EXPECT_EQ(svg_series(svg).size(), 3u);
-  ASSERT_EQ(r.notes.size(), 1u);
-  EXPECT_NE(r.notes[0].find("extended_model.band"), std::string::npos);
+  for (bool nested : {false, true}) {
+    auto r = rwcalc::plot_diagnosis(fixture_diagnosis(true, nested), o);
+    auto svg = slurp(o.output);
+    EXPECT_EQ(xml_problem(svg), "");
+    // base band, base median, extended band, measurement, the points outside the base band
+    EXPECT_EQ(svg_series(svg).size(), 5u);
+    EXPECT_EQ(r.series, 5);
+    EXPECT_NE(svg.find("findings: sinusoid"), std::string::npos);
+    // The fixture's sinusoid lifts σ out of the base band at 2 of the 20 octave τ.
+    EXPECT_NE(svg.find("18 of 20 τ inside"), std::string::npos);
+    EXPECT_NE(svg.find("20 of 20 τ inside"), std::string::npos);
+    EXPECT_TRUE(r.notes.empty());
+
+    r = rwcalc::plot_diagnosis(fixture_diagnosis(/*with_extended=*/false, nested), o);
+    svg = slurp(o.output);
+    EXPECT_EQ(svg_series(svg).size(), 4u);
+    ASSERT_EQ(r.notes.size(), 1u);
+    EXPECT_NE(r.notes[0].find("band_extended"), std::string::npos);
+  }
 }
 
 TEST(PlotRender, PngAndPdfByExtension) {

@@ -155,8 +155,10 @@ inline nlohmann::json fixture_batch(bool with_direct_curve = true) {
 }
 
 /// A diagnosis of a run with a sinusoid the base model misses: the measurement leaves the base
-/// band around τ = 0.371/f0 and lies inside the extended model's band.
-inline nlohmann::json fixture_diagnosis(bool with_extended = true) {
+/// band around τ = 0.371/f0 and lies inside the extended model's band. Layout of
+/// `rwcalc diagnose --json` (top-level "band" and "band_extended"), or with `nested` the bands
+/// inside "base_model" / "extended_model".
+inline nlohmann::json fixture_diagnosis(bool with_extended = true, bool nested = false) {
   using nlohmann::json;
   FixtureCoefficients c;
   const double f0 = 0.0125, amp = 0.03;  // Hz, °/h peak
@@ -168,15 +170,27 @@ inline nlohmann::json fixture_diagnosis(bool with_extended = true) {
     const double measured = std::sqrt(model * model + sin_var);
     const double ext = measured;  // the extended model follows the measurement
     const double w = 0.05 + 0.3 * std::sqrt(tau / 1500);
-    base_band.push_back({{"tau_s", tau}, {"dev", measured}, {"band_low", model * (1 - w)}, {"band_high", model * (1 + w)}});
-    ext_band.push_back({{"tau_s", tau}, {"dev", measured}, {"band_low", ext * (1 - w)}, {"band_high", ext * (1 + w)}});
+    base_band.push_back({{"tau_s", tau}, {"dev", measured}, {"band_low", model * (1 - w)},
+                         {"band_high", model * (1 + w)}, {"median", model}});
+    ext_band.push_back({{"tau_s", tau}, {"dev", measured}, {"band_low", ext * (1 - w)},
+                        {"band_high", ext * (1 + w)}, {"median", ext}});
   }
-  json d = {{"base_model", {{"band_level", 0.9}, {"band", base_band}}},
-            {"findings", json::array({{{"effect", "sinusoid"}, {"frequency_hz", f0}, {"amplitude_deg_per_h", amp}}})},
+  json d = {{"source", "gl2d_25C.csv"},
+            {"units", {{"dev", "deg/h"}, {"tau", "s"}, {"band", "2.5-97.5 % quantiles of the simulated ADEV"}}},
+            {"base_model", {{"misfit_per_point", 14.2}}},
+            {"findings", json::array({{{"effect", "sinusoid"}, {"frequency_hz", f0}, {"amplitude_deg_per_h", amp},
+                                       {"evidence", "PSD line 40 times the background"}}})},
+            {"extended_model", {{"sinusoids", json::array({{{"frequency_hz", f0}, {"amplitude_deg_per_h", amp}}})}}},
             {"gain",
              {{"misfit_base", 14.2}, {"misfit_extended", 1.1}, {"coverage_base", 0.55}, {"coverage_extended", 1.0},
               {"holdout_misfit_base", 12.0}, {"holdout_misfit_extended", 1.4}}}};
-  if (with_extended) d["extended_model"] = {{"band_level", 0.9}, {"band", ext_band}};
+  if (nested) {
+    d["base_model"]["band"] = base_band;
+    if (with_extended) d["extended_model"]["band"] = ext_band;
+  } else {
+    d["band"] = base_band;
+    if (with_extended) d["band_extended"] = ext_band;
+  }
   return d;
 }
 

@@ -219,7 +219,7 @@ TEST(ReportFigures, EveryFigureIsInlineValidSvgWithItsSeries) {
   for (const auto& [id, svg] : figs) EXPECT_EQ(xml_problem(svg), "") << id;
   EXPECT_EQ(svg_series(figs.at("fig-batch-allan")).size(), 8u);
   EXPECT_EQ(svg_series(figs.at("fig-batch-direct")).size(), 10u);
-  EXPECT_EQ(svg_series(figs.at("fig-run2-diagnosis")).size(), 4u);
+  EXPECT_EQ(svg_series(figs.at("fig-run2-diagnosis")).size(), 5u);
   for (int i = 1; i <= 5; ++i) {
     const auto id = fmt::format("fig-run{}-allan", i);
     ASSERT_TRUE(figs.count(id)) << id;
@@ -230,7 +230,9 @@ TEST(ReportFigures, EveryFigureIsInlineValidSvgWithItsSeries) {
   for (int n = 1; n <= 8; ++n) EXPECT_NE(html.find(fmt::format("<b>Fig. {}.</b>", n)), std::string::npos) << n;
   for (const char* id : {"id=\"run2-diagnosis\"", "id=\"run2-findings\"", "id=\"run2-gain\""})
     EXPECT_NE(html.find(id), std::string::npos) << id;
-  EXPECT_NE(html.find("amplitude_deg_per_h = 0.03 °/h; frequency_hz = 0.0125 Hz"), std::string::npos);
+  EXPECT_NE(html.find("amplitude_deg_per_h = 0.03 °/h; evidence = PSD line 40 times the background; "
+                      "frequency_hz = 0.0125 Hz"),
+            std::string::npos);
 }
 
 TEST(ReportFigures, SingleRunHasNoOverlayAndMissingCurvesAreSaid) {
