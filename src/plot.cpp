@@ -233,7 +233,7 @@ struct PlotCommand {
 
 /// Class-limit floor lines (0.6643·B_limit) as plot elements; `vars` receives their definitions.
 void add_class_floors(const json& analysis, std::string& vars, PlotCommand& plot) {
-  static constexpr std::array<const char*, 3> kDash{"2", "4", "3"};
+  static constexpr std::array<const char*, 3> kDash{"2", "4", "5"};  // dots (3) mark upper bounds
   std::size_t i = 0;
   for (const auto& [cls, b] : b_limits(analysis)) {
     vars += fmt::format("B_class{} = {:.6g}   # °/h, class {} limit for B\n", cls, b, cls);
