@@ -121,18 +121,33 @@ std::pair<double, double> decade_range(double lo, double hi) {
   return {a, b};
 }
 
-/// The key below the plot area in two columns (filled top to bottom), so it never hides data
-/// and leaves the plot its full width.
-std::string key_below(std::size_t series) {
-  const std::size_t rows = std::max<std::size_t>(1, (series + 1) / 2);
+/// The key below the plot area, filled top to bottom in two columns (one when the labels are
+/// long), so it never hides data and leaves the plot its full width.
+std::string key_below(std::size_t series, std::size_t longest_label) {
+  const std::size_t columns = longest_label > 52 ? 1 : 2;
+  const std::size_t rows = std::max<std::size_t>(1, (series + columns - 1) / columns);
   return fmt::format("set key outside below center vertical maxrows {} Left reverse noenhanced samplen 2.5 "
                      "spacing 1.05 width 2 height 1 nobox\n",
                      rows);
 }
 
+/// Characters (UTF-8 code points) of the longest key title among plot elements (" t '…'").
+std::size_t longest_title(const std::vector<std::string>& elements) {
+  std::size_t longest = 0;
+  for (const auto& e : elements) {
+    const auto p = e.rfind(" t '");
+    if (p == std::string::npos) continue;
+    std::size_t n = 0;
+    for (std::size_t i = p + 4; i < e.size(); ++i)
+      if ((static_cast<unsigned char>(e[i]) & 0xC0) != 0x80) ++n;
+    longest = std::max(longest, n);
+  }
+  return longest;
+}
+
 /// The look shared by all log-log Allan figures.
 std::string loglog_preamble(const std::string& title, const std::string& ylabel, double xmin, double xmax,
-                            double ymin, double ymax, std::size_t series) {
+                            double ymin, double ymax, const std::vector<std::string>& elements) {
   std::string s;
   s += "set encoding utf8\n";
   s += fmt::format("set title {} noenhanced\n", q(title));
@@ -144,7 +159,7 @@ std::string loglog_preamble(const std::string& title, const std::string& ylabel,
   s += "set xlabel 'τ (s)' offset 0,0.7\n";  // clear of the key below
   s += fmt::format("set ylabel {}\n", q(ylabel));
   s += fmt::format("set xrange [{:.6g}:{:.6g}]\nset yrange [{:.6g}:{:.6g}]\n", xmin, xmax, ymin, ymax);
-  s += key_below(series);
+  s += key_below(elements.size(), longest_title(elements));
   s += "set samples 250\n";
   return s;
 }
@@ -380,7 +395,7 @@ Figure analysis_figure(const json& analysis, const PlotOptions& options) {
   f.name = "allan";
   f.height_px = options.height_px;
   f.script = loglog_preamble(options.title.empty() ? default_analysis_title(analysis) : options.title,
-                             allan_ylabel(allan), xmin, xmax, ylo, yhi, plot.elements.size());
+                             allan_ylabel(allan), xmin, xmax, ylo, yhi, plot.elements);
   append_allan_block(f.script, "allan", rows);
   f.script += vars;
   f.script += plot.text();
@@ -450,7 +465,7 @@ Figure batch_allan_figure(const json& runs, const PlotOptions& options) {
   f.name = "batch-allan";
   f.height_px = options.height_px;
   f.script = loglog_preamble(options.title.empty() ? "Allan deviation at each test temperature" : options.title,
-                             ylabel, x0, x1, y0, y1, plot.elements.size());
+                             ylabel, x0, x1, y0, y1, plot.elements);
   f.script += blocks + vars + plot.text();
   f.series = static_cast<int>(plot.elements.size());
   return f;
@@ -565,9 +580,9 @@ std::string band_label(const char* what, const json& model, const std::vector<Ba
     inside += (r.dev >= r.low && r.dev <= r.high) ? 1 : 0;
   }
   const auto level = number_at(model, "band_level");
-  std::string s = fmt::format("{} model, simulated {} band", what,
-                              level ? fmt::format("{:g} %", *level * 100) : std::string("ensemble"));
-  if (measured > 0) s += fmt::format(" ({} of {} τ inside)", inside, measured);
+  std::string s = fmt::format("{} model: simulated {}band", what,
+                              level ? fmt::format("{:g} % ", *level * 100) : std::string());
+  if (measured > 0) s += fmt::format(", {} of {} τ inside", inside, measured);
   return s;
 }
 
@@ -598,7 +613,7 @@ Figure diagnosis_figure(const json& diagnosis, const PlotOptions& options) {
   plot.add(fmt::format("$base u 1:3:4 w filledcurves fs transparent solid 0.30 noborder lc rgb '#1f77b4' t {}",
                        q(band_label("base", child(diagnosis, "base_model"), base))));
   if (std::all_of(base.begin(), base.end(), [](const BandRow& r) { return r.median > 0; }))
-    plot.add("$base u 1:5 w l lw 1.2 dt 2 lc rgb '#1f77b4' t 'base model, simulated median'");
+    plot.add("$base u 1:5 w l lw 1.2 dt 2 lc rgb '#1f77b4' t 'base model: simulated median'");
   if (!ext.empty()) {
     add_band("extended", ext);
     plot.add(fmt::format(
@@ -635,7 +650,7 @@ Figure diagnosis_figure(const json& diagnosis, const PlotOptions& options) {
   Figure f;
   f.name = "diagnosis";
   f.height_px = options.height_px;
-  f.script = loglog_preamble(title, "Allan deviation σ(τ) (°/h)", x0, x1, y0, y1, plot.elements.size());
+  f.script = loglog_preamble(title, "Allan deviation σ(τ) (°/h)", x0, x1, y0, y1, plot.elements);
   f.script += blocks + plot.text();
   f.series = static_cast<int>(plot.elements.size());
   return f;
