@@ -171,7 +171,8 @@ h2 { font-size: 1.25em; border-bottom: 1px solid #ccc; padding-bottom: 0.2em; ma
 h3 { font-size: 1.05em; margin-top: 1.2em; }
 .meta { color: #555; }
 table { border-collapse: collapse; margin: 0.6em 0 1em; font-size: 0.95em; }
-th, td { border: 1px solid #bbb; padding: 0.3em 0.6em; text-align: left; vertical-align: top; }
+th, td { border: 1px solid #bbb; padding: 0.3em 0.6em; text-align: left; vertical-align: top;
+         overflow-wrap: break-word; }
 th { background: #f0f0f0; }
 td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
 caption { caption-side: top; text-align: left; font-weight: bold; padding-bottom: 0.3em; }
@@ -275,6 +276,12 @@ std::string json_value_html(const json& v) {
   if (v.is_string()) return esc(v.get<std::string>());
   if (v.is_number_float()) return g(v.get<double>(), 6);
   if (v.is_null()) return kNotAvailable;
+  if (v.is_array()) {
+    // Lists (e.g. the input files) one item after another, so long lists wrap.
+    std::string s;
+    for (const auto& e : v) s += (s.empty() ? "" : ", ") + json_value_html(e);
+    return s;
+  }
   return esc(v.dump());
 }
 
