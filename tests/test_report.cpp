@@ -42,7 +42,7 @@ rwcalc::ReportInput batch_input(bool with_direct_curve = true) {
 rwcalc::ReportOptions no_figures() {
   rwcalc::ReportOptions o;
   o.figures = false;
-  o.settings = {{"input", "pulses"}, {"latitude_deg", 55.75}};
+  o.settings = {{"input", "pulses"}, {"latitude_deg", 55.75}, {"files", {"a.csv", "b.csv"}}};
   o.generated = "2026-01-01 00:00 UTC";
   return o;
 }
@@ -123,6 +123,7 @@ TEST(Report, IsWellFormedAndHasEveryTableAndSection) {
   EXPECT_NE(html.find("@media print"), std::string::npos);
   EXPECT_NE(html.find("generated 2026-01-01 00:00 UTC"), std::string::npos);
   EXPECT_NE(html.find("<tr><th>latitude_deg</th><td>55.75</td></tr>"), std::string::npos);
+  EXPECT_NE(html.find("<tr><th>files</th><td>a.csv, b.csv</td></tr>"), std::string::npos);
   EXPECT_NE(html.find("Figures were left out"), std::string::npos);
   EXPECT_EQ(html.find("<figure"), std::string::npos);
   // Never a NaN or a bare JSON null in the page.
