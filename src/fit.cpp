@@ -272,7 +272,8 @@ double c_from_coefficient(Term t, double value) {
 std::vector<FitPoint> fit_points(const AllanResult& allan) {
   std::vector<FitPoint> pts;
   pts.reserve(allan.points.size());
-  for (const auto& p : allan.points) pts.push_back({p.tau_s, p.var, p.edf});
+  const bool ovl = allan.estimator == Estimator::Overlapping;
+  for (const auto& p : allan.points) pts.push_back({p.tau_s, p.var, p.edf, ovl ? p.m : 0, ovl ? p.n : 0});
   return pts;
 }
 
@@ -300,7 +301,7 @@ double FitResult::cdf(Term t, double value) const {
   const Profiler prof{pr, d_hat, deviance};
   const double v = c_from_coefficient(t, value) / pr.scale[i];
   const double dd = prof.delta(i, v);
-  const double r = std::sqrt(dd / options.dispersion);
+  const double r = std::sqrt(dd / phi[static_cast<std::size_t>(i)]);
   return normal_cdf(v >= d_hat[i] ? r : -r);
 }
 
@@ -332,6 +333,128 @@ Eigen::MatrixXd fisher_info(const Problem& pr, const Eigen::VectorXd& mu) {
 
 }  // namespace
 
+namespace {
+
+/// Covariance of the fit-scale estimates: sandwich I⁻¹ (GᵀWΣWG) I⁻¹ over the terms in `set`, and
+/// each term's inflation over the independent-points I⁻¹. Σ is the covariance of the AV points
+/// (empty: independent with variance 2μ²/ν, where the sandwich equals I⁻¹).
+struct Sandwich {
+  Eigen::MatrixXd cov;      // over `set`, scaled parameters
+  std::vector<double> phi;  // per member of `set`
+};
+
+Sandwich sandwich(const Problem& pr, const Eigen::VectorXd& mu, const std::vector<int>& set,
+                  const Eigen::MatrixXd& sigma_y) {
+  Sandwich sw;
+  const auto k = static_cast<Eigen::Index>(set.size());
+  if (k == 0) return sw;
+  Eigen::MatrixXd g(pr.g.rows(), k);
+  for (Eigen::Index q = 0; q < k; ++q) g.col(q) = pr.g.col(set[static_cast<std::size_t>(q)]);
+  const Eigen::VectorXd w = pr.nu.array() / (2.0 * mu.array().square());
+  const Eigen::MatrixXd gw = g.array().colwise() * w.array();
+  const Eigen::MatrixXd info = g.transpose() * gw;
+  const Eigen::MatrixXd inv = info.inverse();
+  if (sigma_y.size() == 0) {
+    sw.cov = inv;
+  } else {
+    const Eigen::MatrixXd meat = gw.transpose() * sigma_y * gw;
+    sw.cov = inv * meat * inv;
+  }
+  for (Eigen::Index q = 0; q < k; ++q) {
+    const double r = inv(q, q) > 0 ? sw.cov(q, q) / inv(q, q) : 1.0;
+    sw.phi.push_back(std::isfinite(r) ? std::max(1.0, r) : 1.0);
+  }
+  return sw;
+}
+
+/// Σ_y: the model covariance of the points plus the model-error floor 2μ²/edf_cap on the diagonal.
+Eigen::MatrixXd point_covariance(std::span<const FitPoint> pts, const Vec5& c, const Eigen::VectorXd& mu,
+                                 double edf_cap) {
+  Eigen::MatrixXd s = av_covariance(pts, c);
+  for (Eigen::Index r = 0; r < s.rows(); ++r) s(r, r) += 2.0 * mu[r] * mu[r] / edf_cap;
+  return s;
+}
+
+}  // namespace
+
+Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix<double, kTermCount, 1>& c) {
+  const auto j = static_cast<Eigen::Index>(pts.size());
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(j, j);
+  if (j == 0) return cov;
+  const double tau0 = pts[0].tau_s / static_cast<double>(pts[0].m);
+  const double cq = c[0];
+  // Generalized structure function of the continuous terms, ″², at lag u samples.
+  auto s_cont = [&](double u) {
+    if (u <= 0) return 0.0;
+    const double t = u * tau0;
+    return c[1] * t - c[2] / std::numbers::pi * t * t * std::log(t) - c[3] * t * t * t / 6.0;
+  };
+  constexpr std::array<double, 3> kw{1.0, -2.0, 1.0};
+  for (Eigen::Index a = 0; a < j; ++a) {
+    for (Eigen::Index b = a; b < j; ++b) {
+      const auto& pa = pts[static_cast<std::size_t>(a)];
+      const auto& pb = pts[static_cast<std::size_t>(b)];
+      const std::int64_t ma = pa.m, mb = pb.m, na = pa.terms, nb = pb.terms;
+      if (ma <= 0 || mb <= 0 || na <= 0 || nb <= 0) continue;
+      const std::int64_t mn = std::min(ma, mb), mx = std::max(ma, mb);
+      if (mx > 16 * mn) continue;
+      const std::array<std::int64_t, 3> oa{0, ma, 2 * ma}, ob{0, mb, 2 * mb};
+      // Cov(z^a_i, z^b_{i+h}) = −½ Σ a_k b_l S(o_k − h − p_l), continuous part.
+      auto gamma_c = [&](double h) {
+        double g = 0;
+        for (int k = 0; k < 3; ++k)
+          for (int l = 0; l < 3; ++l)
+            g += kw[static_cast<std::size_t>(k)] * kw[static_cast<std::size_t>(l)] *
+                 s_cont(std::abs(static_cast<double>(oa[static_cast<std::size_t>(k)]) - h -
+                                 static_cast<double>(ob[static_cast<std::size_t>(l)])));
+        return -0.5 * g;
+      };
+      auto count = [&](double h) {
+        const double hi = std::min(static_cast<double>(na), static_cast<double>(nb) - h);
+        const double lo = std::max(0.0, -h);
+        return std::max(0.0, hi - lo);
+      };
+      // The continuous part varies on the scale of the smaller cluster: step through the lags
+      // (exactly, one by one, for small clusters) over the support plus the flicker tail.
+      const std::int64_t step = std::max<std::int64_t>(1, mn / 16);
+      const std::int64_t lo = -(2 * mb + 4 * mx), hi = 2 * ma + 4 * mx;
+      double total = 0;
+      for (std::int64_t h = lo; h <= hi; h += step) {
+        const double hc = static_cast<double>(h) + (step > 1 ? 0.5 * static_cast<double>(step) : 0.0);
+        const double g = gamma_c(hc);
+        total += static_cast<double>(step) * count(hc) * g * g;
+      }
+      // White angle noise: exact additions at the few lags where sample indices coincide.
+      if (cq > 0) {
+        std::array<std::int64_t, 9> lags{};
+        int nl = 0;
+        for (int k = 0; k < 3; ++k)
+          for (int l = 0; l < 3; ++l) {
+            const std::int64_t h = oa[static_cast<std::size_t>(k)] - ob[static_cast<std::size_t>(l)];
+            if (std::find(lags.begin(), lags.begin() + nl, h) == lags.begin() + nl) lags[static_cast<std::size_t>(nl++)] = h;
+          }
+        for (int q = 0; q < nl; ++q) {
+          const std::int64_t h = lags[static_cast<std::size_t>(q)];
+          double gq = 0;
+          for (int k = 0; k < 3; ++k)
+            for (int l = 0; l < 3; ++l)
+              if (oa[static_cast<std::size_t>(k)] == h + ob[static_cast<std::size_t>(l)])
+                gq += kw[static_cast<std::size_t>(k)] * kw[static_cast<std::size_t>(l)];
+          gq *= cq;
+          const double hd = static_cast<double>(h);
+          const double gc = gamma_c(hd);
+          // The grid already holds (about) gc²; add the cross term and the Q² term.
+          total += count(hd) * (2.0 * gc * gq + gq * gq);
+        }
+      }
+      const double ta = pa.tau_s, tb = pb.tau_s;
+      const double v = 2.0 * total / (4.0 * ta * ta * tb * tb * static_cast<double>(na) * static_cast<double>(nb));
+      cov(a, b) = cov(b, a) = v;
+    }
+  }
+  return cov;
+}
+
 FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options) {
   if (!(options.dispersion > 0) || !(options.confidence > 0 && options.confidence < 1) ||
       !(options.edf_cap > 0))
@@ -361,14 +484,50 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
         j, options.min_edf, options.tau_min_s, options.tau_max_s, n_enabled, n_enabled + 1));
 
   const double z = normal_quantile(0.5 + options.confidence / 2.0);
-  const double thr = options.dispersion * chi2_quantile(options.confidence, 1.0);
+  const double chi2_1 = chi2_quantile(options.confidence, 1.0);
+  const bool use_cov = options.model_covariance &&
+                       std::all_of(res.used.begin(), res.used.end(), [](const FitPoint& p) { return p.m > 0 && p.terms > 0; });
+  res.model_covariance = use_cov;
 
-  // 1. The full model (all enabled terms).
-  const Problem full_pr = make_problem(res.used, options);
-  const IrlsResult full = irls(full_pr, full_pr.enabled_mask, Vec5::Zero(), true);
+  // 1. The full model (all enabled terms) with the estimator's own EDFs.
+  Problem full_pr = make_problem(res.used, options);
+  IrlsResult full = irls(full_pr, full_pr.enabled_mask, Vec5::Zero(), true);
   if (!std::isfinite(full.dev) || !full.d.allFinite()) throw AnalysisError("the noise-model fit did not converge");
 
-  // 2. Term selection: a droppable term whose removal raises the scaled deviance by less than the
+  // 2. Model-based EDFs and point covariance, then the full model again.
+  Eigen::MatrixXd sigma_y;
+  if (use_cov) {
+    Vec5 c0;
+    for (int i = 0; i < P; ++i) c0[i] = full.d[i] * full_pr.scale[i];
+    const Eigen::VectorXd mu0 = full_pr.g * full.d;
+    const Eigen::MatrixXd cov0 = av_covariance(res.used, c0);
+    for (int r = 0; r < j; ++r) {
+      const double v = cov0(r, r);
+      if (v > 0 && std::isfinite(v)) res.used[static_cast<std::size_t>(r)].edf = 2.0 * mu0[r] * mu0[r] / v;
+    }
+    full_pr = make_problem(res.used, options);
+    Vec5 d1;
+    for (int i = 0; i < P; ++i) d1[i] = c0[i] / full_pr.scale[i];
+    full = irls(full_pr, full_pr.enabled_mask, d1, false);
+    if (!std::isfinite(full.dev) || !full.d.allFinite()) throw AnalysisError("the noise-model fit did not converge");
+    Vec5 c1;
+    for (int i = 0; i < P; ++i) c1[i] = full.d[i] * full_pr.scale[i];
+    sigma_y = point_covariance(res.used, c1, full_pr.g * full.d, options.edf_cap);
+  }
+  auto phis = [&](const Problem& pr, const IrlsResult& fit, const std::vector<int>& set) {
+    return sandwich(pr, pr.g * fit.d, set, sigma_y);
+  };
+
+  // Inflation of every enabled term in the full model (at the boundary too).
+  std::vector<int> full_set;
+  for (int i = 0; i < P; ++i)
+    if (options.enabled[static_cast<std::size_t>(i)]) full_set.push_back(i);
+  const Sandwich sw_full = phis(full_pr, full, full_set);
+  std::array<double, P> phi_full{1, 1, 1, 1, 1};
+  for (std::size_t q = 0; q < full_set.size(); ++q)
+    phi_full[static_cast<std::size_t>(full_set[q])] = sw_full.phi[q] * options.dispersion;
+
+  // 3. Term selection: a droppable term whose removal raises the scaled deviance by less than the
   //    χ²₁ quantile is left out of the model; it is reported as an upper bound from the full model.
   FitOptions final_opt = options;
   IrlsResult best = full;
@@ -379,10 +538,10 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
       FitOptions trial = final_opt;
       trial.enabled[static_cast<std::size_t>(i)] = false;
       const Problem tp = make_problem(res.used, trial);
-      Vec5 start = best.d;
+      Vec5 start = best.d;  // column scales do not depend on the enabled terms
       start[i] = 0;
       const IrlsResult r = irls(tp, tp.enabled_mask, start, false);
-      if (std::isfinite(r.dev) && (r.dev - best.dev) / options.dispersion < chi2_quantile(options.confidence, 1.0)) {
+      if (std::isfinite(r.dev) && (r.dev - best.dev) / phi_full[static_cast<std::size_t>(i)] < chi2_1) {
         final_opt = trial;
         best = r;
         dropped[static_cast<std::size_t>(i)] = true;
@@ -392,7 +551,6 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
   res.options = final_opt;
 
   const Problem pr = make_problem(res.used, final_opt);
-  // Polish the selected model (the trial fits started from the previous solution).
   best = irls(pr, pr.enabled_mask, best.d, false);
   if (!std::isfinite(best.dev) || !best.d.allFinite()) throw AnalysisError("the noise-model fit did not converge");
   res.iterations = best.iterations + full.iterations;
@@ -401,7 +559,7 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
   const Eigen::VectorXd mu = pr.g * best.d;
   res.model.assign(mu.data(), mu.data() + mu.size());
 
-  // Goodness of fit.
+  // Goodness of fit (points taken as independent with their EDFs; see docs).
   int active = 0;
   for (int i = 0; i < P; ++i) active += best.d[i] > 0 ? 1 : 0;
   res.dof = j - active;
@@ -417,31 +575,35 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
                           boost::math::chi_squared_distribution<double>(res.dof), chi2))
                     : 1.0;
 
-  // Fisher information of the active terms, inflated by the calibrated dispersion.
-  const Eigen::MatrixXd info_all = fisher_info(pr, mu);
+  // Covariance of the active terms (sandwich) and each term's inflation.
   std::vector<int> act;
   for (int i = 0; i < P; ++i)
     if (best.d[i] > 0) act.push_back(i);
   res.cov_c.setZero();
-  if (!act.empty()) {
-    const auto k = static_cast<Eigen::Index>(act.size());
-    Eigen::MatrixXd ia(k, k);
-    for (Eigen::Index r = 0; r < k; ++r)
-      for (Eigen::Index q = 0; q < k; ++q)
-        ia(r, q) = info_all(act[static_cast<std::size_t>(r)], act[static_cast<std::size_t>(q)]);
-    const Eigen::MatrixXd cov = options.dispersion * ia.inverse();
-    for (Eigen::Index r = 0; r < k; ++r)
-      for (Eigen::Index q = 0; q < k; ++q) {
-        const int a = act[static_cast<std::size_t>(r)];
-        const int b = act[static_cast<std::size_t>(q)];
-        res.cov_c(a, b) = cov(r, q) * pr.scale[a] * pr.scale[b];
-      }
+  const Sandwich sw = phis(pr, best, act);
+  for (std::size_t r = 0; r < act.size(); ++r) {
+    res.phi[static_cast<std::size_t>(act[r])] = sw.phi[r] * options.dispersion;
+    for (std::size_t q = 0; q < act.size(); ++q)
+      res.cov_c(act[r], act[q]) = sw.cov(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(q)) *
+                                  options.dispersion * pr.scale[act[r]] * pr.scale[act[q]];
+  }
+  // Terms at the boundary in the selected model: inflation from the model with the term added.
+  for (int i = 0; i < P; ++i) {
+    if (best.d[i] > 0 || !final_opt.enabled[static_cast<std::size_t>(i)]) {
+      if (dropped[static_cast<std::size_t>(i)]) res.phi[static_cast<std::size_t>(i)] = phi_full[static_cast<std::size_t>(i)];
+      continue;
+    }
+    std::vector<int> set = act;
+    set.push_back(i);
+    const Sandwich s1 = phis(pr, best, set);
+    res.phi[static_cast<std::size_t>(i)] = s1.phi.back() * options.dispersion;
   }
   res.corr_NQ = res.log_correlation(Term::N, Term::Q);
   res.corr_NB = res.log_correlation(Term::N, Term::B);
 
-  // 3. Profile-likelihood intervals on the coefficient scale t = √d.
+  // 4. Profile-likelihood intervals on the coefficient scale t = √d.
   const Profiler prof{pr, best.d, best.dev};
+  const Eigen::MatrixXd info_all = fisher_info(pr, mu);
   const Eigen::MatrixXd info_full = fisher_info(full_pr, full_pr.g * full.d);
   const Profiler prof_full{full_pr, full.d, full.dev};
   for (int i = 0; i < P; ++i) {
@@ -450,11 +612,13 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
     co.enabled = options.enabled[static_cast<std::size_t>(i)];
     co.in_model = final_opt.enabled[static_cast<std::size_t>(i)];
     if (!co.enabled) continue;
+    const double phi = res.phi[static_cast<std::size_t>(i)];
+    const double thr = phi * chi2_1;
     if (dropped[static_cast<std::size_t>(i)]) {
       // Upper bound from the full model's profile.
       const double kf = kCoefScale[static_cast<std::size_t>(i)] * std::sqrt(full_pr.scale[i]);
       const double t_hat = std::sqrt(full.d[i]);
-      const double t_up = upper_root(prof_full, i, t_hat, std::max(fisher_step(info_full, i, z, options.dispersion), t_hat), thr);
+      const double t_up = upper_root(prof_full, i, t_hat, std::max(fisher_step(info_full, i, z, phi), t_hat), thr);
       co.resolved = false;
       co.estimate = kf * t_hat;
       co.low = 0;
@@ -474,7 +638,7 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
           co.resolved = true;
         }
       }
-      double step = fisher_step(info_all, i, z, options.dispersion);
+      double step = fisher_step(info_all, i, z, phi);
       if (t_hat > 0 && res.cov_c(i, i) > 0)
         step = std::max(step, z * std::sqrt(res.cov_c(i, i)) / pr.scale[i] / (2.0 * t_hat));
       const double t_up = upper_root(prof, i, t_hat, step, thr);

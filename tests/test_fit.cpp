@@ -254,3 +254,70 @@ TEST(SlopeReadout, ReadsTheLinesWhereOneTermDominates) {
 
 }  // namespace
 }  // namespace rwcalc
+
+namespace rwcalc {
+namespace {
+
+/// Exact EDF of the overlapping AVAR for discrete white rate (ARW) by direct summation: z_i is the
+/// difference of two adjacent m-sums of white rate, Var(Σz²) = Σ_h (M − |h|)·2γ(h)².
+double brute_force_wfm_edf(std::int64_t m, std::int64_t n_phase) {
+  const std::int64_t big_m = n_phase - 2 * m;
+  std::vector<double> w(static_cast<std::size_t>(2 * m), 1.0);
+  for (std::int64_t k = 0; k < m; ++k) w[static_cast<std::size_t>(k)] = -1.0;
+  const auto len = static_cast<std::int64_t>(w.size());
+  double var = 0;
+  for (std::int64_t h = -(len - 1); h < len; ++h) {
+    double g = 0;
+    for (std::int64_t k = 0; k < len; ++k)
+      if (k + h >= 0 && k + h < len) g += w[static_cast<std::size_t>(k)] * w[static_cast<std::size_t>(k + h)];
+    var += static_cast<double>(big_m - std::abs(h)) * 2.0 * g * g;
+  }
+  const double e = static_cast<double>(big_m) * 2.0 * static_cast<double>(m);
+  return 2.0 * e * e / var;
+}
+
+TEST(AvCovariance, DiagonalIsTheExactEdfForWhiteRate) {
+  // 1001 phase points as in Stable32's PHASE.DAT. The model covariance is exact for discrete white
+  // rate increments; Greenhall–Riley's tabulated EDFs (782, 540.7, 306.1, 166.0, 86.37, 43.35,
+  // 21.24, 9.551; noise-models §4.2) assume a slightly different continuous-time model at small m
+  // and agree with the exact values from m ≈ 32 on.
+  const std::array<double, 8> greenhall{782.0, 540.7, 306.1, 166.0, 86.37, 43.35, 21.24, 9.551};
+  std::vector<FitPoint> pts;
+  Eigen::Matrix<double, kTermCount, 1> c = Eigen::Matrix<double, kTermCount, 1>::Zero();
+  c[1] = 2.0;  // N² in (°/h)²·s
+  for (int k = 0; k < 8; ++k) {
+    const std::int64_t m = std::int64_t{1} << k;
+    const double tau = static_cast<double>(m);
+    pts.push_back({tau, c[1] / tau, 0, m, 1001 - 2 * m});
+  }
+  const Eigen::MatrixXd cov = av_covariance(pts, c);
+  for (int k = 0; k < 8; ++k) {
+    const double nu = 2.0 * pts[k].var * pts[k].var / cov(k, k);
+    EXPECT_NEAR(nu / brute_force_wfm_edf(pts[k].m, 1001), 1.0, 0.01) << "m = " << pts[k].m;
+    if (pts[k].m >= 32) {
+      EXPECT_NEAR(nu / greenhall[static_cast<std::size_t>(k)], 1.0, 0.04) << "m = " << pts[k].m;
+    }
+  }
+  // Neighbouring octaves are positively correlated, distant ones much less.
+  const double r01 = cov(3, 4) / std::sqrt(cov(3, 3) * cov(4, 4));
+  const double r03 = cov(3, 6) / std::sqrt(cov(3, 3) * cov(6, 6));
+  EXPECT_GT(r01, 0.2);
+  EXPECT_LT(r03, r01);
+}
+
+TEST(AvCovariance, WhiteAngleNoiseMatchesItsClosedForm) {
+  // White angle noise (Q): σ̂² = Σz²/(2τ²M) with z a fixed-weight sum of 3 samples, lag-structured:
+  // Var(z) = 6Q², Cov lag m: −4Q², lag 2m: Q². Var(σ̂²) = 2(36 + 2·16 + 2·1)Q⁴·M/(4τ⁴M²) for M ≫ m.
+  std::vector<FitPoint> pts;
+  Eigen::Matrix<double, kTermCount, 1> c = Eigen::Matrix<double, kTermCount, 1>::Zero();
+  c[0] = 0.5;
+  const std::int64_t m = 4, terms = 100000;
+  const double tau = 0.01;
+  pts.push_back({tau, 3 * c[0] / (tau * tau), 0, m, terms});
+  const Eigen::MatrixXd cov = av_covariance(pts, c);
+  const double expect = 2.0 * (36 + 32 + 2) * c[0] * c[0] / (4 * std::pow(tau, 4) * terms);
+  EXPECT_NEAR(cov(0, 0) / expect, 1.0, 1e-3);
+}
+
+}  // namespace
+}  // namespace rwcalc

@@ -19,12 +19,17 @@
 ///   D = Σ ν_j [σ̂²_j/σ²_j − 1 − ln(σ̂²_j/σ²_j)],
 /// by iteratively reweighted non-negative least squares (weights ν/σ⁴ from the model, never from
 /// the data). Neighbouring overlapping-AV points are correlated while the deviance treats them as
-/// independent; the information is therefore divided by a dispersion factor calibrated by
-/// simulation (docs/analysis.md). Intervals are profile-likelihood intervals on that scaled
-/// deviance, never negative; a term whose lower 95 % bound is 0 is reported as an upper bound.
+/// independent. So, for the overlapping estimator, the covariance matrix of the AV points is
+/// computed from the fitted model itself (Gaussian fourth moments of the second differences, via
+/// the generalized structure function of each term; noise-models §4.4 extended to pairs of τ), its
+/// diagonal gives model-based EDFs for a second fit, and a sandwich covariance gives each term's
+/// variance inflation φ_i over the independent-points information. Intervals are profile-likelihood
+/// intervals of the deviance scaled by φ_i, never negative; a term whose lower bound is 0 is
+/// reported as an upper bound.
 #include <Eigen/Dense>
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <span>
@@ -58,6 +63,8 @@ struct FitPoint {
   double tau_s = 0;
   double var = 0;
   double edf = 0;
+  std::int64_t m = 0;      ///< cluster size (0: unknown, no model covariance)
+  std::int64_t terms = 0;  ///< second differences in the overlapping estimator (0: unknown)
 };
 
 /// Options of the fit. The defaults are the documented ones.
@@ -74,9 +81,12 @@ struct FitOptions {
   std::array<bool, kTermCount> enabled{true, true, true, true, true};
   /// Two-sided confidence of the intervals.
   double confidence = 0.95;
-  /// Variance inflation for the correlation of neighbouring overlapping AV points, calibrated by
-  /// simulation (tests/slow_coverage_fit.cpp, docs/analysis.md). 1 would trust the EDF fully.
-  double dispersion = 1.6;
+  /// Extra variance inflation on top of the model-based one (1: none). Used alone when the
+  /// points carry no cluster sizes (then the AV points are taken as independent).
+  double dispersion = 1.0;
+  /// Use the model-based covariance of the AV points (EDFs and sandwich inflation) when the
+  /// points carry cluster sizes and term counts.
+  bool model_covariance = true;
   /// Term selection: a term marked droppable whose removal raises the scaled deviance by less
   /// than the χ²₁ quantile at `confidence` is left out of the model used for the other terms'
   /// intervals (backward elimination in the order R, K, Q); it is reported as the upper bound of
@@ -108,9 +118,13 @@ struct FitResult {
   double p_value = 1;          ///< P(χ²_dof ≥ chi2)
   double corr_NQ = 0;          ///< correlation of the N² and Q² estimates
   double corr_NB = 0;          ///< correlation of the N² and B² estimates
+  /// Variance inflation of each term's estimate caused by the correlation of the AV points
+  /// (sandwich / independent-points information, ≥ 1), times options.dispersion.
+  std::array<double, kTermCount> phi{1, 1, 1, 1, 1};
+  bool model_covariance = false;  ///< the model-based AV covariance was used
   int iterations = 0;
   FitOptions options;
-  std::vector<FitPoint> used;  ///< the points fitted (τ ascending)
+  std::vector<FitPoint> used;  ///< the points fitted (τ ascending; edf = the EDF the fit used)
   std::vector<double> model;   ///< model σ² at those points, (°/h)²
 
   [[nodiscard]] const Coefficient& operator[](Term t) const { return coef[static_cast<int>(t)]; }
@@ -124,7 +138,13 @@ struct FitResult {
   [[nodiscard]] double log_correlation(Term a, Term b) const;
 };
 
-/// The points of an Allan result usable for a fit (σ² > 0 is checked by fit_noise).
+/// Covariance matrix, (°/h)⁴, of overlapping-AV estimates at the given points (each needs m and
+/// terms) for Gaussian noise following the model with fit-scale squared coefficients c (the ramp,
+/// being deterministic, adds none). Pairs more than four octaves apart are set to 0.
+Eigen::MatrixXd av_covariance(std::span<const FitPoint> points, const Eigen::Matrix<double, kTermCount, 1>& c);
+
+/// The points of an Allan result usable for a fit (σ² > 0 is checked by fit_noise); cluster sizes
+/// and term counts are filled for the overlapping estimator only.
 std::vector<FitPoint> fit_points(const AllanResult& allan);
 
 /// Fit the model. Throws AnalysisError when fewer than (enabled terms + 1) points remain in the
