@@ -1,13 +1,290 @@
-// Placeholder registration for 'rwcalc simulate' (replaced by the command's implementation).
+// 'rwcalc simulate': write simulated gyro pulse records (docs/simulation.md).
+#include <fmt/format.h>
+
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
 #include "cli/commands.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/output.hpp"
+#include "rwcalc/pulse_writer.hpp"
+#include "rwcalc/simulate.hpp"
+#include "rwcalc/units.hpp"
 
 namespace rwcalc::cli {
 
+namespace {
+
+struct SimulateArgs {
+  std::string output;
+  std::string truth;
+  std::string from;
+  double duration_s = 7200.0;
+  double rate_hz = units::gl2d_rate_hz;
+  double scale_arcsec = units::gl2d_arcsec_per_pulse;
+  std::uint64_t seed = 1;
+  std::optional<double> temperature_c;
+  bool force = false;
+  int runs = 1;
+  double arw = 0, bi = 0, rrw = 0, ramp = 0, bias = 0;
+  double latitude = units::moscow_latitude_deg;
+  bool no_earth_rate = false;
+  std::vector<std::string> sinusoids, gauss_markov, bias_steps, warmups;
+  double lowpass = 0.0;
+  bool white_readout = false;
+  double white_angle = 0.0;
+  std::optional<double> temp_bias;
+  std::string temp_profile;
+};
+
+// Split "a:b[:c]" into numbers; `min_n`..`max_n` fields. Errors name the option.
+std::vector<double> fields(const std::string& option, const std::string& text, std::size_t min_n, std::size_t max_n,
+                           const char* form) {
+  std::vector<double> v;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t colon = text.find(':', start);
+    const std::string part = text.substr(start, colon == std::string::npos ? std::string::npos : colon - start);
+    double x = 0.0;
+    const auto* b = part.data();
+    const auto* e = part.data() + part.size();
+    auto [ptr, ec] = std::from_chars(b, e, x);
+    if (part.empty() || ec != std::errc() || ptr != e || !std::isfinite(x))
+      throw UsageError(fmt::format("{}: '{}' is not of the form {}", option, text, form));
+    v.push_back(x);
+    if (colon == std::string::npos) break;
+    start = colon + 1;
+  }
+  if (v.size() < min_n || v.size() > max_n)
+    throw UsageError(fmt::format("{}: '{}' is not of the form {}", option, text, form));
+  return v;
+}
+
+// FILE with _001 inserted before the extension (everything from the first dot of the name).
+std::string numbered(const std::string& path, int index, int runs) {
+  const std::filesystem::path p(path);
+  const std::string name = p.filename().string();
+  std::size_t dot = name.find('.', 1);
+  if (dot == std::string::npos) dot = name.size();
+  const int width = std::max(3, static_cast<int>(std::to_string(runs).size()));
+  const std::string numbered_name = fmt::format("{}_{:0{}}{}", name.substr(0, dot), index, width, name.substr(dot));
+  return (p.parent_path() / numbered_name).string();
+}
+
+std::string g(double v) { return fmt::format("{}", v); }
+
+Metadata metadata_of(const NoiseModel& m, const SimulationSettings& s) {
+  Metadata md;
+  md.emplace_back("generator", fmt::format("rwcalc simulate {}", RWCALC_VERSION));
+  md.emplace_back("rate_hz", g(s.rate_hz));
+  md.emplace_back("scale_arcsec_per_pulse", g(s.scale_arcsec));
+  if (s.temperature_c) md.emplace_back("temperature_c", g(*s.temperature_c));
+  md.emplace_back("seed", fmt::format("{}", s.seed));
+  md.emplace_back("samples", fmt::format("{}", s.samples()));
+  md.emplace_back("duration_s", g(s.duration_s));
+  md.emplace_back("readout", m.readout == ReadoutMode::White ? "white" : "counting");
+  auto term = [&](const char* key, double v) {
+    if (v != 0.0) md.emplace_back(key, g(v));
+  };
+  term("arw_deg_per_sqrt_h", m.arw_deg_per_sqrt_h);
+  term("bias_instability_deg_per_h", m.bias_instability_deg_per_h);
+  term("rrw_deg_per_h_per_sqrt_h", m.rrw_deg_per_h_per_sqrt_h);
+  term("ramp_deg_per_h2", m.ramp_deg_per_h2);
+  term("bias_deg_per_h", m.bias_deg_per_h);
+  term("earth_rate_deg_per_h", m.earth_rate_deg_per_h);
+  term("white_angle_arcsec", m.white_angle_arcsec);
+  term("lowpass_tc_s", m.lowpass_tc_s);
+  for (const auto& x : m.sinusoids)
+    md.emplace_back("sinusoid", fmt::format("frequency_hz={} amplitude_deg_per_h={} phase_rad={}", x.f_hz, x.amp_deg_per_h, x.phase_rad));
+  for (const auto& x : m.gauss_markov)
+    md.emplace_back("gauss_markov", fmt::format("sigma_deg_per_h={} correlation_time_s={}", x.sigma_deg_per_h, x.tc_s));
+  for (const auto& x : m.bias_steps)
+    md.emplace_back("bias_step", fmt::format("time_s={} size_deg_per_h={}", x.t_s, x.size_deg_per_h));
+  for (const auto& x : m.warmups)
+    md.emplace_back("warmup", fmt::format("amplitude_deg_per_h={} time_constant_s={}", x.amp_deg_per_h, x.tc_s));
+  if (m.temperature_bias) {
+    const auto& tb = *m.temperature_bias;
+    const auto& p = tb.profile;
+    md.emplace_back("temperature_bias",
+                    p.kind == TemperatureProfile::Kind::Ramp
+                        ? fmt::format("coefficient_deg_per_h_per_c={} profile=ramp start_c={} end_c={}", tb.coefficient_deg_per_h_per_c, p.start_c, p.end_c)
+                        : fmt::format("coefficient_deg_per_h_per_c={} profile=cycle amplitude_c={} period_s={}", tb.coefficient_deg_per_h_per_c, p.amp_c, p.period_s));
+  }
+  return md;
+}
+
+nlohmann::json read_json_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, 0, "cannot open the file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  try {
+    return nlohmann::json::parse(ss.str());
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(path, 0, fmt::format("not valid JSON: {}", e.what()));
+  }
+}
+
+int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
+  auto given = [&](const char* name) { return sub.count(name) > 0; };
+  SimulationSettings s;
+  NoiseModel m;
+  if (!a.from.empty()) {
+    s.scale_arcsec = a.scale_arcsec;
+    m = model_from_analysis_json(read_json_file(a.from), a.from, s);
+  }
+  if (a.from.empty() || given("--duration")) s.duration_s = a.duration_s;
+  if (a.from.empty() || given("--rate")) s.rate_hz = a.rate_hz;
+  if (a.from.empty() || given("--scale")) s.scale_arcsec = a.scale_arcsec;
+  if (a.temperature_c) s.temperature_c = a.temperature_c;
+  s.seed = a.seed;
+  if (!std::isfinite(s.duration_s) || s.duration_s <= 0) throw UsageError(fmt::format("--duration must be > 0 s, got {}", s.duration_s));
+  if (!std::isfinite(s.rate_hz) || s.rate_hz <= 0) throw UsageError(fmt::format("--rate must be > 0 Hz, got {}", s.rate_hz));
+  if (!std::isfinite(s.scale_arcsec) || s.scale_arcsec <= 0) throw UsageError(fmt::format("--scale must be > 0 arcsec, got {}", s.scale_arcsec));
+  if (s.samples() < 2) throw UsageError(fmt::format("--duration {} s at --rate {} Hz gives fewer than 2 samples", s.duration_s, s.rate_hz));
+
+  auto nonneg = [](const char* opt, double v) {
+    if (!std::isfinite(v) || v < 0) throw UsageError(fmt::format("{} must be >= 0, got {}", opt, v));
+    return v;
+  };
+  if (a.from.empty() || given("--arw")) m.arw_deg_per_sqrt_h = nonneg("--arw", a.arw);
+  if (a.from.empty() || given("--bias-instability")) m.bias_instability_deg_per_h = nonneg("--bias-instability", a.bi);
+  if (a.from.empty() || given("--rrw")) m.rrw_deg_per_h_per_sqrt_h = nonneg("--rrw", a.rrw);
+  if (a.from.empty() || given("--ramp")) m.ramp_deg_per_h2 = a.ramp;
+  if (a.from.empty() || given("--bias")) m.bias_deg_per_h = a.bias;
+  if (a.from.empty() || given("--latitude") || given("--no-earth-rate")) {
+    if (!std::isfinite(a.latitude) || std::abs(a.latitude) > 90.0)
+      throw UsageError(fmt::format("--latitude must be within -90..90 deg, got {}", a.latitude));
+    m.earth_rate_deg_per_h = a.no_earth_rate ? 0.0 : earth_rate_at(a.latitude);
+  }
+  if (a.white_readout) m.readout = ReadoutMode::White;
+  if (a.from.empty() || given("--white-angle")) m.white_angle_arcsec = nonneg("--white-angle", a.white_angle);
+  if (a.from.empty() || given("--lowpass")) m.lowpass_tc_s = nonneg("--lowpass", a.lowpass);
+  for (const auto& t : a.sinusoids) {
+    const auto v = fields("--sinusoid", t, 2, 3, "F_HZ:AMP_DEG_PER_H[:PHASE_RAD]");
+    if (v[0] <= 0) throw UsageError(fmt::format("--sinusoid: the frequency must be > 0 Hz in '{}'", t));
+    m.sinusoids.push_back({v[0], v[1], v.size() > 2 ? v[2] : 0.0});
+  }
+  for (const auto& t : a.gauss_markov) {
+    const auto v = fields("--gauss-markov", t, 2, 2, "SIGMA_DEG_PER_H:TC_S");
+    if (v[0] < 0 || v[1] <= 0) throw UsageError(fmt::format("--gauss-markov: need sigma >= 0 and TC_S > 0 in '{}'", t));
+    m.gauss_markov.push_back({v[0], v[1]});
+  }
+  for (const auto& t : a.bias_steps) {
+    const auto v = fields("--bias-step", t, 2, 2, "T_S:SIZE_DEG_PER_H");
+    if (v[0] < 0) throw UsageError(fmt::format("--bias-step: the time must be >= 0 s in '{}'", t));
+    m.bias_steps.push_back({v[0], v[1]});
+  }
+  for (const auto& t : a.warmups) {
+    const auto v = fields("--warmup", t, 2, 2, "AMP_DEG_PER_H:TC_S");
+    if (v[1] <= 0) throw UsageError(fmt::format("--warmup: the time constant must be > 0 s in '{}'", t));
+    m.warmups.push_back({v[0], v[1]});
+  }
+  if (a.temp_bias) {
+    if (!std::isfinite(*a.temp_bias)) throw UsageError("--temp-bias must be finite");
+    if (a.temp_profile.empty()) throw UsageError("--temp-bias needs --temp-profile ramp:START_C:END_C or cycle:AMP_C:PERIOD_S");
+    TemperatureBias tb;
+    tb.coefficient_deg_per_h_per_c = *a.temp_bias;
+    const auto colon = a.temp_profile.find(':');
+    const std::string kind = a.temp_profile.substr(0, colon);
+    const std::string rest = colon == std::string::npos ? "" : a.temp_profile.substr(colon + 1);
+    if (kind == "ramp") {
+      const auto v = fields("--temp-profile", rest, 2, 2, "ramp:START_C:END_C");
+      tb.profile = {TemperatureProfile::Kind::Ramp, v[0], v[1], 0.0, 0.0};
+    } else if (kind == "cycle") {
+      const auto v = fields("--temp-profile", rest, 2, 2, "cycle:AMP_C:PERIOD_S");
+      if (v[1] <= 0) throw UsageError("--temp-profile: the cycle period must be > 0 s");
+      tb.profile = {TemperatureProfile::Kind::Cycle, 0.0, 0.0, v[0], v[1]};
+    } else {
+      throw UsageError(fmt::format("--temp-profile: '{}' is neither ramp:START_C:END_C nor cycle:AMP_C:PERIOD_S", a.temp_profile));
+    }
+    m.temperature_bias = tb;
+  } else if (!a.temp_profile.empty()) {
+    throw UsageError("--temp-profile needs --temp-bias COEF_DEG_PER_H_PER_C");
+  }
+  if (a.runs < 1) throw UsageError(fmt::format("--runs must be >= 1, got {}", a.runs));
+  if (a.output == "-" && a.runs > 1) throw UsageError("--runs > 1 needs a file name for -o");
+
+  Simulator sim(m, s);
+  PhaseSeries series;
+  for (int r = 1; r <= a.runs; ++r) {
+    SimulationSettings sr = s;
+    sr.seed = s.seed + static_cast<std::uint64_t>(r - 1);
+    const std::string path = a.runs > 1 ? numbered(a.output, r, a.runs) : a.output;
+    sim.run(sr.seed, series);
+    write_pulse_file(path, metadata_of(m, sr), series, a.force);
+    if (!a.truth.empty()) {
+      nlohmann::json t;
+      t["model"] = m;
+      t["settings"] = sr;
+      t["seed"] = sr.seed;
+      t["pulse_file"] = std::filesystem::path(path).filename().string();
+      t["quantization_q_arcsec"] = readout_q_arcsec(m.readout, sr.scale_arcsec);
+      const std::string tpath = a.runs > 1 ? numbered(a.truth, r, a.runs) : a.truth;
+      write_file_atomic(tpath, t.dump(2) + "\n", a.force);
+    }
+    if (path != "-")
+      io.out << fmt::format("wrote {} ({} samples, {} s at {} Hz, seed {})\n", path, sr.samples(), sr.duration_s, sr.rate_hz, sr.seed);
+  }
+  return 0;
+}
+
+}  // namespace
+
 void register_simulate(CLI::App& app, Runner& runner) {
-  auto* sub = app.add_subcommand("simulate", "(not yet available)");
-  sub->callback([&runner] {
-    runner = [](Io&) -> int { throw AnalysisError("'rwcalc simulate' is not available in this build"); };
+  auto args = std::make_shared<SimulateArgs>();
+  auto* sub = app.add_subcommand(
+      "simulate",
+      "Simulate a gyro pulse record (exact discrete-time noise terms, counted in whole pulses) and write it as a "
+      "GL-2D pulse file (.gz compresses). Rates are in deg/h (= arcsec/s).");
+  auto& a = *args;
+  sub->add_option("-o,--output", a.output, "Output pulse file (FILE.csv or FILE.csv.gz; - for stdout)")->required();
+  sub->add_option("--truth", a.truth, "Also write the ground truth (model JSON, seed, settings) to this file");
+  sub->add_option("--from", a.from, "Take the model from 'rwcalc analyze --json' or 'rwcalc diagnose --json' output");
+  sub->add_option("--duration", a.duration_s, "Record length, s")->capture_default_str()->group("Record");
+  sub->add_option("--rate", a.rate_hz, "Sample rate, Hz")->capture_default_str()->group("Record");
+  sub->add_option("--scale", a.scale_arcsec, "Pulse weight q, arcsec per pulse")->capture_default_str()->group("Record");
+  sub->add_option("--seed", a.seed, "Seed of the random streams (same seed, same file)")->capture_default_str()->group("Record");
+  sub->add_option("--temperature", a.temperature_c, "Nominal temperature written as metadata, deg C")->group("Record");
+  sub->add_flag("--force", a.force, "Overwrite existing files")->group("Record");
+  sub->add_option("--runs", a.runs, "Write K realisations FILE_001… with seeds seed, seed+1, …")->capture_default_str()->group("Record");
+  sub->add_option("--arw", a.arw, "Angle random walk N, deg/sqrt(h)")->group("Noise terms");
+  sub->add_option("--bias-instability", a.bi, "Bias instability B (flicker rate noise), deg/h")->group("Noise terms");
+  sub->add_option("--rrw", a.rrw, "Rate random walk K, deg/h/sqrt(h)")->group("Noise terms");
+  sub->add_option("--ramp", a.ramp, "Rate ramp R, deg/h^2")->group("Noise terms");
+  sub->add_option("--bias", a.bias, "Constant bias, deg/h")->group("Noise terms");
+  sub->add_option("--latitude", a.latitude, "Latitude for the vertical Earth rate 15.041*sin(lat) deg/h, deg")
+      ->capture_default_str()->group("Noise terms");
+  sub->add_flag("--no-earth-rate", a.no_earth_rate, "Do not add the Earth rate")->group("Noise terms");
+  sub->add_flag("--white-readout", a.white_readout,
+                "Dither-like read-out: a fresh uniform phase per sample makes count errors white (Q = q/sqrt(6)); "
+                "default: counting with sawtooth errors")->group("Noise terms");
+  sub->add_option("--white-angle", a.white_angle, "Extra white angle noise before counting, rms arcsec")->group("Noise terms");
+  sub->add_option("--sinusoid", a.sinusoids, "Sinusoidal rate F_HZ:AMP_DEG_PER_H[:PHASE_RAD] (Hz, deg/h, rad); repeatable")
+      ->group("Extended terms");
+  sub->add_option("--gauss-markov", a.gauss_markov, "Gauss-Markov rate SIGMA_DEG_PER_H:TC_S (deg/h, s); repeatable")
+      ->group("Extended terms");
+  sub->add_option("--bias-step", a.bias_steps, "Bias step T_S:SIZE_DEG_PER_H (s from start, deg/h); repeatable")
+      ->group("Extended terms");
+  sub->add_option("--warmup", a.warmups, "Warm-up transient AMP_DEG_PER_H:TC_S, rate amp*exp(-t/tc) (deg/h, s); repeatable")
+      ->group("Extended terms");
+  sub->add_option("--lowpass", a.lowpass, "First-order low-pass of the sensed rate inside the sensor, time constant s")
+      ->group("Extended terms");
+  sub->add_option("--temp-bias", a.temp_bias, "Temperature-driven bias coefficient, deg/h per deg C (needs --temp-profile)")
+      ->group("Extended terms");
+  sub->add_option("--temp-profile", a.temp_profile,
+                  "Temperature during the record: ramp:START_C:END_C (linear) or cycle:AMP_C:PERIOD_S (about --temperature); "
+                  "bias = coef*(T(t) - T_nominal), T_nominal = --temperature (ramp: else START_C; cycle: else 0)")
+      ->group("Extended terms");
+  sub->callback([&runner, args, sub] {
+    runner = [args, sub](Io& io) -> int { return run_simulate(*args, *sub, io); };
   });
 }
 

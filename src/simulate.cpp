@@ -1,0 +1,459 @@
+// Exact discrete-time simulation of gyro pulse records (noise-models.md §3; docs/simulation.md).
+#include "rwcalc/simulate.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <numbers>
+#include <unsupported/Eigen/FFT>
+
+#include "rwcalc/error.hpp"
+#include "rwcalc/random.hpp"
+#include "rwcalc/units.hpp"
+
+namespace rwcalc {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// Random stream numbers: one per term, so terms never share draws.
+enum Stream : std::uint64_t {
+  kArwStream = 1,
+  kRrwStream = 2,
+  kFlickerStream = 3,
+  kReadoutStream = 4,
+  kWhiteAngleStream = 5,
+  kGaussMarkovStream0 = 16,  // + index of the process
+};
+
+// x − 2(1 − e^{−x}) + (1 − e^{−2x})/2 without cancellation (x ≥ 0).
+double gm_angle_var_factor(double x) {
+  if (x < 0.5) {
+    // Series Σ_{n≥3} (−1)^{n+1}(2^{n−1} − 2) xⁿ/n!.
+    double sum = 0.0, term = x * x / 2.0;  // x^n/n! for n = 2
+    double p2 = 2.0;                        // 2^{n−1} for n = 2
+    for (int n = 3; n < 40; ++n) {
+      term *= x / n;
+      p2 *= 2.0;
+      sum += ((n % 2) ? 1.0 : -1.0) * (p2 - 2.0) * term;
+      if (std::abs(term * p2) < 1e-18 * std::abs(sum)) break;
+    }
+    return sum;
+  }
+  return x - 2.0 * (-std::expm1(-x)) + 0.5 * (-std::expm1(-2.0 * x));
+}
+
+// 1 − (3 − 4e^{−x} + e^{−2x})/(2x) without cancellation (x > 0).
+double gm_avar_factor(double x) {
+  if (x < 0.5) {
+    double sum = 0.0, term = x;  // x^n/n! for n = 1
+    double p2 = 2.0;             // 2^n
+    for (int n = 2; n < 40; ++n) {
+      term *= x / n;
+      p2 *= 2.0;
+      if (n < 3) continue;
+      sum += -((n % 2) ? -1.0 : 1.0) * (p2 - 4.0) * term / (2.0 * x);
+      if (std::abs(term * p2) < 1e-18 * std::abs(sum) * x) break;
+    }
+    return sum;
+  }
+  return 1.0 - (3.0 - 4.0 * std::exp(-x) + std::exp(-2.0 * x)) / (2.0 * x);
+}
+
+// Smallest 2^a·3^b·5^c ≥ n that is even (kissfft handles radices 2, 3, 5 efficiently).
+std::size_t good_fft_size(std::size_t n) {
+  std::size_t best = std::numeric_limits<std::size_t>::max();
+  for (std::size_t p5 = 1; p5 < 2 * n + 10; p5 *= 5)
+    for (std::size_t p35 = p5; p35 < 2 * n + 10; p35 *= 3) {
+      std::size_t s = p35;
+      while (s < n) s *= 2;
+      if (s % 2) s *= 2;
+      best = std::min(best, s);
+    }
+  return best;
+}
+
+void check_finite_nonneg(double v, const char* what) {
+  if (!std::isfinite(v) || v < 0.0) throw UsageError(fmt::format("{} must be a finite value >= 0, got {}", what, v));
+}
+void check_finite(double v, const char* what) {
+  if (!std::isfinite(v)) throw UsageError(fmt::format("{} must be finite, got {}", what, v));
+}
+void check_positive(double v, const char* what) {
+  if (!std::isfinite(v) || v <= 0.0) throw UsageError(fmt::format("{} must be a finite value > 0, got {}", what, v));
+}
+
+// Exact discretisation (Van Loan, closed form) of dε = −ε/Tc dt + w dt, dθ = ε dt with w white of
+// two-sided PSD qc²: ε' = φε + u1, Δθ = Tc(1−φ)ε + u2, (u1, u2) Gaussian with the Cholesky
+// factor below. Used for Gauss–Markov rates and for low-pass-filtered white rate.
+struct GmStep {
+  double phi = 0.0, gain = 0.0;    // φ, Tc(1−φ)
+  double l11 = 0.0, l21 = 0.0, l22 = 0.0;
+  double sigma0 = 0.0;             // stationary σ of ε
+  GmStep() = default;
+  GmStep(double qc2, double tc, double tau0) {
+    const double x = tau0 / tc;
+    const double one_m_phi = -std::expm1(-x);
+    const double one_m_phi2 = -std::expm1(-2.0 * x);
+    phi = 1.0 - one_m_phi;
+    gain = tc * one_m_phi;
+    const double v11 = qc2 * tc / 2.0 * one_m_phi2;
+    const double v12 = qc2 * tc * tc * one_m_phi * one_m_phi / 2.0;
+    const double v22 = qc2 * tc * tc * tc * gm_angle_var_factor(x);
+    l11 = std::sqrt(v11);
+    l21 = l11 > 0 ? v12 / l11 : 0.0;
+    l22 = std::sqrt(std::max(0.0, v22 - l21 * l21));
+    sigma0 = std::sqrt(qc2 * tc / 2.0);
+  }
+};
+
+// Temperature-driven bias angle at time t, ″.
+double temperature_angle(const TemperatureBias& tb, double t, double t_nominal, double record_s) {
+  const auto& p = tb.profile;
+  const double c = tb.coefficient_deg_per_h_per_c;
+  if (p.kind == TemperatureProfile::Kind::Ramp) {
+    const double slope = record_s > 0 ? (p.end_c - p.start_c) / record_s : 0.0;
+    return c * ((p.start_c - t_nominal) * t + slope * t * t / 2.0);
+  }
+  const double w = 2.0 * kPi / p.period_s;
+  return c * p.amp_c * (1.0 - std::cos(w * t)) / w;
+}
+
+}  // namespace
+
+std::size_t SimulationSettings::samples() const {
+  const double n = std::round(duration_s * rate_hz);
+  return n > 0 && std::isfinite(n) ? static_cast<std::size_t>(n) : 0;
+}
+
+double earth_rate_at(double latitude_deg) {
+  return units::earth_rate_deg_per_h * std::sin(latitude_deg * kPi / 180.0);
+}
+
+double readout_q_arcsec(ReadoutMode mode, double scale_arcsec) {
+  return mode == ReadoutMode::White ? scale_arcsec / std::sqrt(6.0) : scale_arcsec / std::sqrt(12.0);
+}
+
+void validate(const NoiseModel& m, const SimulationSettings& s) {
+  check_positive(s.duration_s, "duration_s");
+  check_positive(s.rate_hz, "rate_hz");
+  check_positive(s.scale_arcsec, "scale_arcsec");
+  if (s.samples() < 2) throw UsageError(fmt::format("the record must hold at least 2 samples (duration {} s at {} Hz)", s.duration_s, s.rate_hz));
+  if (s.samples() > (std::size_t{1} << 31)) throw UsageError("the record is too long (more than 2^31 samples)");
+  if (s.temperature_c) check_finite(*s.temperature_c, "temperature_c");
+  check_finite_nonneg(m.arw_deg_per_sqrt_h, "arw_deg_per_sqrt_h");
+  check_finite_nonneg(m.bias_instability_deg_per_h, "bias_instability_deg_per_h");
+  check_finite_nonneg(m.rrw_deg_per_h_per_sqrt_h, "rrw_deg_per_h_per_sqrt_h");
+  check_finite(m.ramp_deg_per_h2, "ramp_deg_per_h2");
+  check_finite(m.bias_deg_per_h, "bias_deg_per_h");
+  check_finite(m.earth_rate_deg_per_h, "earth_rate_deg_per_h");
+  check_finite_nonneg(m.white_angle_arcsec, "white_angle_arcsec");
+  check_finite_nonneg(m.lowpass_tc_s, "lowpass_tc_s");
+  for (const auto& x : m.sinusoids) {
+    check_positive(x.f_hz, "sinusoid frequency_hz");
+    check_finite(x.amp_deg_per_h, "sinusoid amplitude_deg_per_h");
+    check_finite(x.phase_rad, "sinusoid phase_rad");
+  }
+  for (const auto& x : m.gauss_markov) {
+    check_finite_nonneg(x.sigma_deg_per_h, "gauss_markov sigma_deg_per_h");
+    check_positive(x.tc_s, "gauss_markov correlation_time_s");
+  }
+  for (const auto& x : m.bias_steps) {
+    check_finite_nonneg(x.t_s, "bias_step time_s");
+    check_finite(x.size_deg_per_h, "bias_step size_deg_per_h");
+  }
+  for (const auto& x : m.warmups) {
+    check_finite(x.amp_deg_per_h, "warmup amplitude_deg_per_h");
+    check_positive(x.tc_s, "warmup time_constant_s");
+  }
+  if (m.temperature_bias) {
+    const auto& tb = *m.temperature_bias;
+    check_finite(tb.coefficient_deg_per_h_per_c, "temperature_bias coefficient_deg_per_h_per_c");
+    check_finite(tb.profile.start_c, "temperature profile start_c");
+    check_finite(tb.profile.end_c, "temperature profile end_c");
+    check_finite(tb.profile.amp_c, "temperature profile amp_c");
+    if (tb.profile.kind == TemperatureProfile::Kind::Cycle) check_positive(tb.profile.period_s, "temperature profile period_s");
+  }
+}
+
+double flicker_avar(double b, std::size_t m) {
+  // AV(m) = (2B²/(π m²)) ∫_0^{π/2} sin⁴(mu)/sin³(u) du: the discrete Kasdin spectrum
+  // B²τ0/(2 sin πfτ0) through the Allan transfer function of m-sample means.
+  const double floor = 2.0 * b * b * std::numbers::ln2 / kPi;
+  if (m > (std::size_t{1} << 16)) return floor;
+  static constexpr double kX[8] = {-0.9602898564975363, -0.7966664774136267, -0.5255324099163290, -0.1834346424956498,
+                                   0.1834346424956498,  0.5255324099163290,  0.7966664774136267,  0.9602898564975363};
+  static constexpr double kW[8] = {0.1012285362903763, 0.2223810344533745, 0.3137066378926775, 0.3626837833783620,
+                                   0.3626837833783620, 0.3137066378926775, 0.2223810344533745, 0.1012285362903763};
+  const double md = static_cast<double>(m);
+  const std::size_t panels = 8 * m;
+  const double h = (kPi / 2.0) / static_cast<double>(panels);
+  double sum = 0.0;
+  for (std::size_t p = 0; p < panels; ++p) {
+    const double mid = (static_cast<double>(p) + 0.5) * h;
+    for (int i = 0; i < 8; ++i) {
+      const double u = mid + 0.5 * h * kX[i];
+      const double s = std::sin(md * u);
+      const double su = std::sin(u);
+      sum += kW[i] * (s * s * s * s) / (su * su * su);
+    }
+  }
+  return 2.0 * b * b / (kPi * md * md) * sum * 0.5 * h;
+}
+
+double theoretical_avar(const NoiseModel& model, double tau0, double q, std::size_t m) {
+  const double tau = static_cast<double>(m) * tau0;
+  const double n_s = units::sqrt_s_per_sqrt_h * model.arw_deg_per_sqrt_h;     // ″/√s
+  const double k_s = model.rrw_deg_per_h_per_sqrt_h / units::sqrt_s_per_sqrt_h;  // ″/s/√s
+  const double r_s = model.ramp_deg_per_h2 / units::seconds_per_hour;        // ″/s²
+  double av = n_s * n_s / tau + k_s * k_s * tau / 3.0 + r_s * r_s * tau * tau / 2.0;
+  if (model.bias_instability_deg_per_h > 0) av += flicker_avar(model.bias_instability_deg_per_h, m);
+  for (const auto& s : model.sinusoids) {
+    const double x = kPi * s.f_hz * tau;
+    const double v = std::sin(x) * std::sin(x) / x;
+    av += s.amp_deg_per_h * s.amp_deg_per_h * v * v;
+  }
+  for (const auto& g : model.gauss_markov) {
+    const double qc2 = 2.0 * g.sigma_deg_per_h * g.sigma_deg_per_h / g.tc_s;
+    const double x = tau / g.tc_s;
+    av += qc2 * g.tc_s * gm_avar_factor(x) / x;
+  }
+  double white_angle2 = model.white_angle_arcsec * model.white_angle_arcsec;
+  if (model.readout == ReadoutMode::White) white_angle2 += q * q / 6.0;
+  av += 3.0 * white_angle2 / (tau * tau);
+  return av;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+struct Simulator::Impl {
+  NoiseModel model;
+  SimulationSettings settings;
+  std::size_t n = 0;      // samples
+  double tau0 = 0.0;
+  double q = 0.0;
+  std::vector<double> inc;  // angle increment of each interval, ″ (index k−1 for interval k)
+  std::vector<double> work;
+  // Flicker: the Kasdin filter's spectrum, computed once per length.
+  std::size_t fft_size = 0;
+  Eigen::FFT<double> fft;
+  std::vector<std::complex<double>> filter_spectrum, spectrum;
+  std::vector<double> flicker;
+  std::vector<GmStep> gm_steps;
+  GmStep lowpass_arw;
+
+  Impl(NoiseModel m, SimulationSettings s) : model(std::move(m)), settings(std::move(s)) {
+    validate(model, settings);
+    n = settings.samples();
+    tau0 = settings.tau0_s();
+    q = settings.scale_arcsec;
+    inc.resize(n);
+    fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
+    if (model.bias_instability_deg_per_h > 0) prepare_flicker();
+    for (const auto& g : model.gauss_markov)
+      gm_steps.emplace_back(2.0 * g.sigma_deg_per_h * g.sigma_deg_per_h / g.tc_s, g.tc_s, tau0);
+    if (model.lowpass_tc_s > 0 && model.arw_deg_per_sqrt_h > 0) {
+      // Low-passed white rate u (PSD N²) is y with dy = (u − y)/τf dt: a Gauss–Markov process
+      // with Tc = τf and qc = N/τf, whose exact angle is the (ε, ∫ε) pair.
+      const double n_s = units::sqrt_s_per_sqrt_h * model.arw_deg_per_sqrt_h;
+      lowpass_arw = GmStep(n_s * n_s / (model.lowpass_tc_s * model.lowpass_tc_s), model.lowpass_tc_s, tau0);
+    }
+  }
+
+  void prepare_flicker() {
+    // Circular convolution of length L ≥ 2n with a filter of L − n + 1 ≥ n + 1 taps gives, on
+    // the first n outputs, the linear convolution of the filter with an i.i.d. sequence that
+    // starts L − n samples before the record: no wrap-around, filter longer than the record.
+    fft_size = good_fft_size(2 * n);
+    const std::size_t taps = fft_size - n + 1;
+    std::vector<double> h(fft_size, 0.0);
+    h[0] = 1.0;
+    for (std::size_t k = 1; k < taps; ++k) h[k] = h[k - 1] * (0.5 + static_cast<double>(k) - 1.0) / static_cast<double>(k);
+    fft.fwd(filter_spectrum, h);
+    spectrum.resize(filter_spectrum.size());
+    flicker.resize(fft_size);
+  }
+
+  // Flicker rate samples x_0..x_{n−1}, ″/s, added to inc as x·τ0. The white input's DFT is
+  // drawn directly (its bins are independent complex normals), which saves the forward FFT.
+  void add_flicker(std::uint64_t seed) {
+    Rng rng(seed, kFlickerStream);
+    const double b = model.bias_instability_deg_per_h;  // Q_d = B²
+    const double len = static_cast<double>(fft_size);
+    const double s_edge = b * std::sqrt(len);
+    const double s_mid = b * std::sqrt(len / 2.0);
+    const std::size_t half = fft_size / 2;
+    spectrum[0] = filter_spectrum[0] * s_edge * rng.normal();
+    for (std::size_t k = 1; k < half; ++k) {
+      const double re = rng.normal(), im = rng.normal();
+      spectrum[k] = filter_spectrum[k] * std::complex<double>(s_mid * re, s_mid * im);
+    }
+    spectrum[half] = filter_spectrum[half] * s_edge * rng.normal();
+    fft.inv(flicker.data(), spectrum.data(), static_cast<Eigen::Index>(fft_size));
+    for (std::size_t k = 0; k < n; ++k) inc[k] += flicker[k] * tau0;
+  }
+
+  void add_deterministic() {
+    const double omega = model.bias_deg_per_h + model.earth_rate_deg_per_h;  // ″/s
+    const double r_s = model.ramp_deg_per_h2 / units::seconds_per_hour;      // ″/s²
+    const double ramp_unit = 0.5 * r_s * tau0 * tau0;
+    for (std::size_t k = 0; k < n; ++k) inc[k] = omega * tau0 + ramp_unit * (2.0 * static_cast<double>(k) + 1.0);
+    auto add_angle = [&](auto&& angle) {
+      double prev = angle(0.0);
+      for (std::size_t k = 0; k < n; ++k) {
+        const double cur = angle(static_cast<double>(k + 1) * tau0);
+        inc[k] += cur - prev;
+        prev = cur;
+      }
+    };
+    for (const auto& s : model.sinusoids) {
+      const double a = s.amp_deg_per_h / (2.0 * kPi * s.f_hz);
+      const double w = 2.0 * kPi * s.f_hz;
+      add_angle([&](double t) { return a * std::sin(w * t + s.phase_rad); });
+    }
+    for (const auto& st : model.bias_steps) {
+      const auto first = static_cast<std::size_t>(std::max(0.0, std::floor(st.t_s / tau0)));
+      for (std::size_t k = first; k < n; ++k) {
+        const double t1 = static_cast<double>(k) * tau0, t2 = t1 + tau0;
+        inc[k] += st.size_deg_per_h * (t2 - std::max(t1, st.t_s));
+      }
+    }
+    for (const auto& w : model.warmups) {
+      const double decay = -std::expm1(-tau0 / w.tc_s);
+      for (std::size_t k = 0; k < n; ++k)
+        inc[k] += w.amp_deg_per_h * w.tc_s * std::exp(-static_cast<double>(k) * tau0 / w.tc_s) * decay;
+    }
+    if (model.temperature_bias) {
+      const auto& tb = *model.temperature_bias;
+      const double nominal = settings.temperature_c.value_or(
+          tb.profile.kind == TemperatureProfile::Kind::Ramp ? tb.profile.start_c : 0.0);
+      const double record = static_cast<double>(n) * tau0;
+      add_angle([&](double t) { return temperature_angle(tb, t, nominal, record); });
+    }
+  }
+
+  void add_rrw(std::uint64_t seed) {
+    // Exact two-state step: Ω' = Ω + w1, Δθ = Ωτ0 + w2, Cov = K²[[τ0, τ0²/2], [τ0²/2, τ0³/3]].
+    const double k_s = model.rrw_deg_per_h_per_sqrt_h / units::sqrt_s_per_sqrt_h;
+    const double l11 = k_s * std::sqrt(tau0);
+    const double l21 = k_s * tau0 * std::sqrt(tau0) / 2.0;
+    const double l22 = k_s * tau0 * std::sqrt(tau0) / std::sqrt(12.0);
+    Rng rng(seed, kRrwStream);
+    double omega = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+      const double z1 = rng.normal(), z2 = rng.normal();
+      inc[k] += omega * tau0 + l21 * z1 + l22 * z2;
+      omega += l11 * z1;
+    }
+  }
+
+  void add_gm(std::uint64_t seed, std::size_t index, const GmStep& st) {
+    Rng rng(seed, kGaussMarkovStream0 + index);
+    double eps = st.sigma0 * rng.normal();  // stationary start
+    for (std::size_t k = 0; k < n; ++k) {
+      const double z1 = rng.normal(), z2 = rng.normal();
+      inc[k] += st.gain * eps + st.l21 * z1 + st.l22 * z2;
+      eps = st.phi * eps + st.l11 * z1;
+    }
+  }
+
+  // First-order low-pass of the sensed rate, exact for a rate constant over each sample:
+  // y_k = φy_{k−1} + (1−φ)r_k and ∫y = r_kτ0 − τf(y_k − y_{k−1}). Starts in steady state.
+  void lowpass_increments() {
+    const double tf = model.lowpass_tc_s;
+    const double phi = std::exp(-tau0 / tf);
+    double y = inc[0] / tau0;
+    for (std::size_t k = 0; k < n; ++k) {
+      const double r = inc[k] / tau0;
+      const double y_new = phi * y + (1.0 - phi) * r;
+      inc[k] = r * tau0 - tf * (y_new - y);
+      y = y_new;
+    }
+  }
+
+  void run(std::uint64_t seed, PhaseSeries& out) {
+    add_deterministic();
+    if (model.rrw_deg_per_h_per_sqrt_h > 0) add_rrw(seed);
+    if (model.bias_instability_deg_per_h > 0) add_flicker(seed);
+    for (std::size_t i = 0; i < gm_steps.size(); ++i)
+      if (model.gauss_markov[i].sigma_deg_per_h > 0) add_gm(seed, i, gm_steps[i]);
+    if (model.lowpass_tc_s > 0) lowpass_increments();
+    if (model.arw_deg_per_sqrt_h > 0) {
+      if (model.lowpass_tc_s > 0) {
+        add_gm(seed, std::numeric_limits<std::uint32_t>::max(), lowpass_arw);
+      } else {
+        Rng rng(seed, kArwStream);
+        const double s = units::sqrt_s_per_sqrt_h * model.arw_deg_per_sqrt_h * std::sqrt(tau0);
+        for (std::size_t k = 0; k < n; ++k) inc[k] += s * rng.normal();
+      }
+    }
+    quantize(seed, out);
+  }
+
+  // Count whole pulses. The angle is carried as whole pulses `whole` plus a fraction in [0, 1),
+  // so its resolution does not degrade as the count grows.
+  void quantize(std::uint64_t seed, PhaseSeries& out) {
+    out.kind = PhaseKind::Gyro;
+    out.tau0_s = tau0;
+    out.arcsec_per_count = q;
+    out.values.clear();
+    out.counts.resize(n + 1);
+    Rng readout(seed, kReadoutStream);
+    Rng white(seed, kWhiteAngleStream);
+    const bool dither = model.readout == ReadoutMode::White;
+    const double wa = model.white_angle_arcsec / q;
+    const double inv_q = 1.0 / q;
+    const double phase0 = readout.uniform();
+    std::int64_t whole = 0;
+    double frac = 0.0;
+    auto count = [&](double extra) {
+      const double u = dither ? readout.uniform() : phase0;
+      const double y = frac + u + extra;  // extra: white angle noise in pulses (not accumulated)
+      return whole + static_cast<std::int64_t>(std::floor(y));
+    };
+    const double e0 = wa > 0 ? wa * white.normal() : 0.0;
+    const std::int64_t c0 = count(e0);
+    out.counts[0] = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      frac += inc[k] * inv_q;
+      const double fl = std::floor(frac);
+      whole += static_cast<std::int64_t>(fl);
+      frac -= fl;
+      const double e = wa > 0 ? wa * white.normal() : 0.0;
+      out.counts[k + 1] = count(e) - c0;
+    }
+  }
+};
+
+Simulator::Simulator(NoiseModel model, SimulationSettings settings)
+    : impl_(std::make_unique<Impl>(std::move(model), std::move(settings))) {}
+Simulator::~Simulator() = default;
+Simulator::Simulator(Simulator&&) noexcept = default;
+Simulator& Simulator::operator=(Simulator&&) noexcept = default;
+
+void Simulator::run(std::uint64_t seed, PhaseSeries& out) { impl_->run(seed, out); }
+const NoiseModel& Simulator::model() const noexcept { return impl_->model; }
+const SimulationSettings& Simulator::settings() const noexcept { return impl_->settings; }
+
+PhaseSeries simulate(const NoiseModel& model, const SimulationSettings& settings) {
+  Simulator sim(model, settings);
+  PhaseSeries out;
+  sim.run(settings.seed, out);
+  return out;
+}
+
+std::vector<std::int64_t> pulse_increments(const PhaseSeries& series) {
+  std::vector<std::int64_t> c;
+  if (series.counts.size() < 2) return c;
+  c.resize(series.counts.size() - 1);
+  for (std::size_t k = 0; k + 1 < series.counts.size(); ++k)
+    c[k] = static_cast<std::int64_t>(static_cast<std::uint64_t>(series.counts[k + 1]) -
+                                     static_cast<std::uint64_t>(series.counts[k]));
+  return c;
+}
+
+}  // namespace rwcalc
