@@ -246,16 +246,18 @@ Verdict decide(const EstimateInput& B, const EstimateInput& N, double rho_BN, co
   return v;
 }
 
-std::string Verdict::statement() const {
+std::string describe_class(const std::vector<double>& p_is, const std::optional<int>& cls,
+                           const std::vector<int>& classes, double decisive) {
   ClassTable t;
-  for (int c : class_numbers) t.classes.push_back({c, 0, 0, 0});
-  return statement_of(p_is, cls, t, decisive_threshold);
+  for (int c : classes) t.classes.push_back({c, 0, 0, 0});
+  if (p_is.size() != t.classes.size() + 1) throw UsageError("class probabilities do not match the class table");
+  return statement_of(p_is, cls, t, decisive);
 }
 
+std::string Verdict::statement() const { return describe_class(p_is, cls, class_numbers, decisive_threshold); }
+
 std::string Verdict::statement(const ParameterVerdict& p) const {
-  ClassTable t;
-  for (int c : class_numbers) t.classes.push_back({c, 0, 0, 0});
-  return statement_of(p.p_is, p.cls, t, decisive_threshold);
+  return describe_class(p.p_is, p.cls, class_numbers, decisive_threshold);
 }
 
 nlohmann::json to_json(const Verdict& v) {

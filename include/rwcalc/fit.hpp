@@ -81,9 +81,11 @@ struct FitOptions {
   std::array<bool, kTermCount> enabled{true, true, true, true, true};
   /// Two-sided confidence of the intervals.
   double confidence = 0.95;
-  /// Extra variance inflation on top of the model-based one (1: none). Used alone when the
-  /// points carry no cluster sizes (then the AV points are taken as independent).
-  double dispersion = 1.0;
+  /// Extra variance inflation on top of the model-based one, for the heavier-than-normal tails of
+  /// the few-EDF long-τ points (the profile deviance is not exactly χ²₁ there); calibrated by
+  /// simulation (tests/slow_coverage_fit.cpp, docs/analysis.md). Used alone when the points carry
+  /// no cluster sizes (then the AV points are taken as independent).
+  double dispersion = 1.3;
   /// Use the model-based covariance of the AV points (EDFs and sandwich inflation) when the
   /// points carry cluster sizes and term counts.
   bool model_covariance = true;

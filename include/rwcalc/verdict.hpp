@@ -113,6 +113,12 @@ Verdict decide(const EstimateInput& B, const EstimateInput& N, double rho_BN, co
 /// P(X ≤ a, Y ≤ b) for standard bivariate normal with correlation rho (a, b may be ±∞).
 double bivariate_normal_cdf(double a, double b, double rho);
 
+/// "class 1 (P=0.97)", "class 2 or 3 (P=0.55/0.45)", "outside class 3 (P=0.80)": the stated
+/// class with its probability, and its more probable neighbour when below `decisive`. p_is holds
+/// P(class = k) for each class of `classes` and then P(beyond the last).
+std::string describe_class(const std::vector<double>& p_is, const std::optional<int>& cls,
+                           const std::vector<int>& classes, double decisive = 0.9);
+
 /// Describe a class ("1", "2", … or "none").
 std::string class_label(const std::optional<int>& c);
 
