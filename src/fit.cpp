@@ -362,7 +362,7 @@ Sandwich sandwich(const Problem& pr, const Eigen::VectorXd& mu, const std::vecto
   }
   for (Eigen::Index q = 0; q < k; ++q) {
     const double r = inv(q, q) > 0 ? sw.cov(q, q) / inv(q, q) : 1.0;
-    sw.phi.push_back(std::isfinite(r) ? std::max(1.0, r) : 1.0);
+    sw.phi.push_back(std::isfinite(r) && r > 0 ? r : 1.0);
   }
   return sw;
 }

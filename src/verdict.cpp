@@ -29,12 +29,6 @@ double norm_quantile(double p) {
   return boost::math::quantile(boost::math::normal_distribution<double>(), p);
 }
 
-std::optional<int> class_of(double value, const std::vector<double>& limits, const ClassTable& t) {
-  for (std::size_t k = 0; k < limits.size(); ++k)
-    if (value <= limits[k]) return t.classes[k].cls;
-  return std::nullopt;
-}
-
 /// Index of an outcome among (classes…, beyond).
 std::size_t outcome_index(const std::optional<int>& cls, const ClassTable& t) {
   if (!cls) return t.classes.size();
@@ -56,8 +50,15 @@ ParameterVerdict decide_one(const std::string& name, const std::string& unit, co
     strict.push_back(lim);
     p.limit.push_back(is_b ? lim * (1.0 + tol_pct / 100.0) : lim);
   }
-  p.cls = class_of(e.value, p.limit, t);
-  p.cls_strict = class_of(e.value, strict, t);
+  // The stated class is the one holding the median of the confidence distribution (for a resolved
+  // estimate, the estimate itself; for an upper bound, usually the best class consistent with it).
+  auto median_class = [&](const std::vector<double>& limits) -> std::optional<int> {
+    for (std::size_t k = 0; k < limits.size(); ++k)
+      if (e.cdf(limits[k]) >= 0.5) return t.classes[k].cls;
+    return std::nullopt;
+  };
+  p.cls = median_class(p.limit);
+  p.cls_strict = median_class(strict);
   double prev = 0;
   for (double lim : p.limit) {
     const double f = std::clamp(e.cdf(lim), prev, 1.0);  // keep it monotone

@@ -76,7 +76,7 @@ struct FitOptions {
   /// Model-error floor: each point's EDF enters as 1/(1/ν + 1/edf_cap), i.e. a relative model
   /// uncertainty of √(2/edf_cap) on σ² (4.5 % on σ², 2.2 % on σ, for the default 1000).
   /// Keeps points with 10⁵ EDF at short τ from forcing the fit through small model defects.
-  double edf_cap = 1000.0;
+  double edf_cap = 1.0e4;
   /// Which terms are fitted (false: held at 0 and reported as not fitted).
   std::array<bool, kTermCount> enabled{true, true, true, true, true};
   /// Two-sided confidence of the intervals.
