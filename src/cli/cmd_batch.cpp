@@ -1,13 +1,59 @@
-// Placeholder registration for 'rwcalc batch' (replaced by the command's implementation).
+// 'rwcalc batch FILES…': analyse many runs in parallel and print the paper's Tables 1 and 2, the
+// overall verdict over the temperature range and the trends; or one JSON line per run (--jsonl)
+// for 'rwcalc merge'.
+#include <fmt/format.h>
+
+#include <memory>
+#include <ostream>
+
+#include "cli/analyze_args.hpp"
+#include "cli/batch_format.hpp"
 #include "cli/commands.hpp"
+#include "rwcalc/batch.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/output.hpp"
 
 namespace rwcalc::cli {
 
+namespace {
+
+struct BatchCmd {
+  std::vector<std::string> files;
+  InputArgs input;
+  AnalyzeArgs analysis;
+  std::optional<double> temperature;
+  TableFormat format;
+  unsigned jobs = 0;
+  std::string output = "-";
+  bool force = false;
+};
+
+}  // namespace
+
 void register_batch(CLI::App& app, Runner& runner) {
-  auto* sub = app.add_subcommand("batch", "(not yet available)");
-  sub->callback([&runner] {
-    runner = [](Io&) -> int { throw AnalysisError("'rwcalc batch' is not available in this build"); };
+  auto cmd = std::make_shared<BatchCmd>();
+  auto* sub = app.add_subcommand("batch",
+                                 "Analyse many runs (in parallel): Table 1 (N and B by each method per "
+                                 "temperature), Table 2 (classes), overall verdict and temperature trends");
+  sub->add_option("FILES", cmd->files, "Recordings")->required();
+  cmd->input.add_to(*sub);
+  cmd->analysis.add_to(*sub);
+  sub->add_option("--temperature", cmd->temperature, "Temperature, °C (only with a single file)");
+  cmd->format.add_to(*sub);
+  sub->add_option("-j,--jobs", cmd->jobs, "Files analysed in parallel (default: hardware threads)");
+  sub->add_option("-o,--output", cmd->output, "Write to FILE instead of standard output")->capture_default_str();
+  sub->add_flag("--force", cmd->force, "Overwrite an existing output file");
+  sub->callback([cmd, &runner] {
+    runner = [cmd](Io& io) -> int {
+      AnalysisOptions opt = cmd->analysis.options();
+      if (cmd->temperature) {
+        if (cmd->files.size() != 1) throw UsageError("--temperature applies to a single file; name the temperature in each file instead");
+        opt.temperature_c = cmd->temperature;
+      }
+      const auto runs = analyze_files(cmd->files, cmd->input.options(), opt, cmd->jobs);
+      emit(io, cmd->format.render(runs), cmd->output, cmd->force);
+      return 0;
+    };
   });
 }
 

@@ -1,13 +1,42 @@
-// Placeholder registration for 'rwcalc merge' (replaced by the command's implementation).
+// 'rwcalc merge LINES.jsonl…': the batch tables and overall verdict from JSON lines written by
+// 'rwcalc batch --jsonl', e.g. on many machines (GNU parallel, a Slurm job array).
+#include <memory>
+
+#include "cli/batch_format.hpp"
 #include "cli/commands.hpp"
-#include "rwcalc/error.hpp"
 
 namespace rwcalc::cli {
 
+namespace {
+
+struct MergeCmd {
+  std::vector<std::string> files;
+  TableFormat format;
+  std::string output = "-";
+  bool force = false;
+};
+
+}  // namespace
+
 void register_merge(CLI::App& app, Runner& runner) {
-  auto* sub = app.add_subcommand("merge", "(not yet available)");
-  sub->callback([&runner] {
-    runner = [](Io&) -> int { throw AnalysisError("'rwcalc merge' is not available in this build"); };
+  auto cmd = std::make_shared<MergeCmd>();
+  auto* sub = app.add_subcommand("merge",
+                                 "Build the batch tables and overall verdict from JSON lines written by "
+                                 "'rwcalc batch --jsonl' (runs analysed on many machines)");
+  sub->add_option("LINES", cmd->files, "JSON-lines files")->required();
+  cmd->format.add_to(*sub);
+  sub->add_option("-o,--output", cmd->output, "Write to FILE instead of standard output")->capture_default_str();
+  sub->add_flag("--force", cmd->force, "Overwrite an existing output file");
+  sub->callback([cmd, &runner] {
+    runner = [cmd](Io& io) -> int {
+      std::vector<nlohmann::json> runs;
+      for (const auto& f : cmd->files) {
+        auto part = read_json_lines(f);
+        for (auto& r : part) runs.push_back(std::move(r));
+      }
+      emit(io, cmd->format.render(runs), cmd->output, cmd->force);
+      return 0;
+    };
   });
 }
 

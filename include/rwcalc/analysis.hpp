@@ -1,0 +1,74 @@
+#pragma once
+/// @file analysis.hpp
+/// The whole `rwcalc analyze` pipeline: a Recording → Allan variance (octave τ) → five-term fit
+/// with uncertainties → the paper's cross-checks → Earth rate and bias → class verdict, with its
+/// JSON form and the readable report.
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "rwcalc/allan.hpp"
+#include "rwcalc/fit.hpp"
+#include "rwcalc/methods.hpp"
+#include "rwcalc/reader.hpp"
+#include "rwcalc/verdict.hpp"
+
+namespace rwcalc {
+
+struct AnalysisOptions {
+  AllanOptions allan;        ///< default: overlapping AVAR on the octave grid
+  FitOptions fit;
+  MethodOptions methods;
+  VerdictOptions verdict;
+  double latitude_deg = 55.75;                 ///< for the vertical Earth rate Ω_E·sin(lat)
+  std::optional<double> earth_rate_deg_per_h;  ///< overrides the latitude
+  std::optional<double> temperature_c;         ///< overrides the recording's temperature
+};
+
+struct AnalysisResult {
+  std::string source;
+  std::size_t samples = 0;
+  double rate_hz = 0;
+  double duration_s = 0;
+  std::string column;
+  double arcsec_per_count = 0;    ///< pulse weight (0 when the input was not pulses/counter)
+  std::optional<double> temperature_c;
+  std::string temperature_source; ///< "option", "column or metadata", "file name", or ""
+  double mean_rate_deg_per_h = 0;
+  double earth_rate_deg_per_h = 0;
+  double latitude_deg = 0;        ///< NaN-free: the latitude used (0 when the rate was given)
+  bool earth_rate_given = false;
+  double bias_deg_per_h = 0;      ///< mean − expected Earth rate
+  AllanResult allan;
+  FitResult fit;
+  SlopeReadout slope;
+  double slope_B_sigma = 0;       ///< standard error of σ_min/0.6643 from the EDF at σ_min
+  DirectNResult direct;
+  BlockSpreadResult avg100;
+  double N_direct_discrepancy_sigma = 0;  ///< (N_direct − N_fit)/σ
+  double B_100s_discrepancy_sigma = 0;    ///< (spread − B_fit)/σ (not like for like, see docs)
+  double B_100s_vs_model_sigma = 0;       ///< (spread − its expectation under the fit)/σ
+  Verdict verdict;
+};
+
+/// Run the pipeline. Throws UsageError for clock data, AnalysisError when the record is too short
+/// or holds no noise.
+AnalysisResult analyze(const Recording& rec, const AnalysisOptions& options = {});
+
+/// The JSON object of `rwcalc analyze --json` (keys in docs/analysis.md).
+nlohmann::json to_json(const AnalysisResult& r);
+
+/// The readable report.
+std::string format_report(const AnalysisResult& r);
+
+/// Temperature from a file name: m50C → −50, p25C → 25, -50C, +25C, _0C (°C). Empty if none.
+std::optional<double> temperature_from_name(std::string_view path);
+
+/// Vertical Earth rate at a latitude, °/h.
+double vertical_earth_rate(double latitude_deg);
+
+/// JSON of an Allan result (the object `rwcalc allan --json` prints).
+nlohmann::json allan_json(const AllanResult& a);
+
+}  // namespace rwcalc

@@ -1,0 +1,366 @@
+// The analyze pipeline and its outputs (JSON and the readable report).
+#include "rwcalc/analysis.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <numbers>
+
+#include "rwcalc/error.hpp"
+#include "rwcalc/units.hpp"
+
+namespace rwcalc {
+
+namespace {
+
+constexpr double kZ95 = 1.959963984540054;
+
+nlohmann::json coef_json(const Coefficient& c) {
+  return {{"value", c.value},       {"sigma", c.sigma},       {"low95", c.low},
+          {"high95", c.high},       {"resolved", c.resolved}, {"estimate", c.estimate},
+          {"in_model", c.in_model}, {"fitted", c.enabled}};
+}
+
+nlohmann::json method_json(const MethodEstimate& m) {
+  if (!m.valid) return nullptr;
+  return {{"value", m.value}, {"sigma", m.sigma}, {"low95", m.low}, {"high95", m.high}, {"resolved", m.resolved}};
+}
+
+nlohmann::json opt_num(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
+
+/// A number with a sensible count of significant digits (never NaN: callers ensure finiteness).
+std::string num(double v, int sig = 4) { return fmt::format("{:.{}g}", v, sig); }
+
+std::string coef_line(const Coefficient& c, std::string_view name, std::string_view unit) {
+  if (!c.enabled) return fmt::format("  {:<2} not fitted\n", name);
+  if (!c.resolved)
+    return fmt::format("  {:<2} < {} {:<14} (not resolved: 95 % upper bound{})\n", name, num(c.value, 3), unit,
+                       c.in_model ? "" : "; left out of the model");
+  return fmt::format("  {:<2} {} {:<14} ± {}  [{}, {}] (95 %)\n", name, num(c.value), unit, num(c.sigma, 2),
+                     num(c.low, 3), num(c.high, 3));
+}
+
+std::string verdict_param_line(const Verdict& v, const ParameterVerdict& p) {
+  std::string s = fmt::format("  {} = {}{} {}: {}", p.parameter, p.resolved ? "" : "< ", num(p.value, 3), p.unit,
+                              v.statement(p));
+  if (p.cls != p.cls_strict)
+    s += fmt::format("  [with the +{:g} % tolerance; strict: class {}]", v.tolerance_pct, class_label(p.cls_strict));
+  s += "\n    P(meets class):";
+  for (std::size_t k = 0; k < p.limit.size(); ++k)
+    s += fmt::format(" {} ≤ {}: {:.2f};", v.class_numbers[k], num(p.limit[k], 3), p.p_meets[k]);
+  s += "\n    margin to limit:";
+  for (std::size_t k = 0; k < p.limit.size(); ++k)
+    s += fmt::format(" class {} {:+.0f} %;", v.class_numbers[k], p.margin_pct[k]);
+  s += "\n";
+  return s;
+}
+
+}  // namespace
+
+double vertical_earth_rate(double latitude_deg) {
+  return units::earth_rate_deg_per_h * std::sin(latitude_deg * std::numbers::pi / 180.0);
+}
+
+std::optional<double> temperature_from_name(std::string_view path) {
+  const auto slash = path.find_last_of("/\\");
+  const std::string_view name = slash == std::string_view::npos ? path : path.substr(slash + 1);
+  auto alnum = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) != 0; };
+  for (std::size_t i = 0; i < name.size(); ++i) {
+    if (!std::isdigit(static_cast<unsigned char>(name[i]))) continue;
+    if (i > 0 && std::isdigit(static_cast<unsigned char>(name[i - 1]))) continue;
+    std::size_t j = i;
+    while (j < name.size() && std::isdigit(static_cast<unsigned char>(name[j]))) ++j;
+    if (j + 1 < name.size() && name[j] == '.' && std::isdigit(static_cast<unsigned char>(name[j + 1]))) {
+      ++j;
+      while (j < name.size() && std::isdigit(static_cast<unsigned char>(name[j]))) ++j;
+    }
+    if (j >= name.size() || name[j] != 'C') continue;
+    if (j + 1 < name.size() && alnum(name[j + 1])) continue;
+    double sign = 1.0;
+    std::size_t before = i;  // index of the first character of the token
+    if (i > 0) {
+      const char s = name[i - 1];
+      if (s == 'm' || s == 'p') {
+        sign = s == 'm' ? -1.0 : 1.0;
+        before = i - 1;
+        if (before > 0 && alnum(name[before - 1])) continue;  // "…xm50C" is not a temperature
+      } else if (s == '-' || s == '+') {
+        sign = s == '-' ? -1.0 : 1.0;
+        before = i - 1;
+      } else if (alnum(s)) {
+        continue;
+      }
+    }
+    (void)before;
+    return sign * std::stod(std::string(name.substr(i, j - i)));
+  }
+  return std::nullopt;
+}
+
+nlohmann::json allan_json(const AllanResult& a) {
+  nlohmann::json pts = nlohmann::json::array();
+  for (const auto& p : a.points)
+    pts.push_back({{"m", p.m},
+                   {"tau_s", p.tau_s},
+                   {"n", p.n},
+                   {"alpha", p.alpha},
+                   {"edf", p.edf},
+                   {"var", p.var},
+                   {"dev", p.dev},
+                   {"dev_low", p.dev_low},
+                   {"dev_high", p.dev_high}});
+  return {{"estimator", std::string(to_string(a.estimator))},
+          {"unit", a.unit},
+          {"tau0_s", a.tau0_s},
+          {"points_in", a.points_in},
+          {"confidence", a.confidence},
+          {"points", pts}};
+}
+
+AnalysisResult analyze(const Recording& rec, const AnalysisOptions& options) {
+  if (rec.phase.kind != PhaseKind::Gyro)
+    throw UsageError(fmt::format("{}: analyze needs gyro data (pulses, counter, angle in arcsec/deg/rad, or rate in "
+                                 "deg/h, deg/s, rad/s); this input is clock data",
+                                 rec.source));
+  AnalysisResult r;
+  r.source = rec.source;
+  r.samples = rec.samples;
+  r.rate_hz = rec.rate_hz;
+  r.duration_s = rec.phase.duration_s();
+  r.column = rec.column_name;
+  r.arcsec_per_count = rec.phase.exact() ? rec.phase.arcsec_per_count : 0.0;
+  if (options.temperature_c) {
+    r.temperature_c = options.temperature_c;
+    r.temperature_source = "option";
+  } else if (rec.temperature_c) {
+    r.temperature_c = rec.temperature_c;
+    r.temperature_source = rec.metadata.count("temperature_c") ? "metadata" : "column";
+  } else if (auto t = temperature_from_name(rec.source)) {
+    r.temperature_c = t;
+    r.temperature_source = "file name";
+  }
+  const std::size_t pts = rec.phase.points();
+  if (pts < 3) throw AnalysisError(fmt::format("{}: the record holds {} sample(s); far too short to analyse", rec.source, rec.samples));
+
+  // Earth rate and bias.
+  r.mean_rate_deg_per_h = rec.phase.diff(pts - 1, 0) / r.duration_s;
+  r.earth_rate_given = options.earth_rate_deg_per_h.has_value();
+  r.latitude_deg = r.earth_rate_given ? 0.0 : options.latitude_deg;
+  r.earth_rate_deg_per_h = r.earth_rate_given ? *options.earth_rate_deg_per_h : vertical_earth_rate(options.latitude_deg);
+  r.bias_deg_per_h = r.mean_rate_deg_per_h - r.earth_rate_deg_per_h;
+
+  // Allan variance, fit, classic readout.
+  r.allan = compute_allan(rec.phase, options.allan);
+  try {
+    r.fit = fit_noise(fit_points(r.allan), options.fit);
+  } catch (const AnalysisError& e) {
+    throw AnalysisError(fmt::format("{}: {}", rec.source, e.what()));
+  }
+  r.slope = slope_readout(r.allan);
+  for (const auto& p : r.allan.points)
+    if (p.tau_s == r.slope.tau_min_s && p.edf > 0 && r.slope.B) r.slope_B_sigma = *r.slope.B / std::sqrt(2.0 * p.edf);
+
+  // Cross-checks.
+  r.direct = direct_n(rec.phase, options.methods);
+  r.avg100 = block_spread(rec.phase, options.methods.block_s);
+  attach_expectation(r.avg100, r.fit);
+  const auto& fn = r.fit[Term::N];
+  const auto& fb = r.fit[Term::B];
+  if (r.direct.N.valid)
+    r.N_direct_discrepancy_sigma = discrepancy_sigma(r.direct.N.value, r.direct.N.sigma, fn.value, fn.sigma);
+  if (r.avg100.spread.valid) {
+    r.B_100s_discrepancy_sigma = discrepancy_sigma(r.avg100.spread.value, r.avg100.spread.sigma, fb.value, fb.sigma);
+    if (r.avg100.expected > 0)
+      r.B_100s_vs_model_sigma = discrepancy_sigma(r.avg100.spread.value, r.avg100.spread.sigma, r.avg100.expected,
+                                                  r.avg100.expected_sigma);
+  }
+
+  // Verdict.
+  const FitResult& fit = r.fit;
+  auto from_fit = [&fit](Term t) {
+    EstimateInput e;
+    const auto& c = fit[t];
+    e.value = c.value;
+    e.low = c.low;
+    e.high = c.high;
+    e.resolved = c.resolved;
+    e.cdf = [&fit, t](double x) { return fit.cdf(t, x); };
+    return e;
+  };
+  EstimateInput b_in;
+  double rho = 0;
+  switch (options.verdict.b_estimate) {
+    case BEstimate::Fit:
+      b_in = from_fit(Term::B);
+      rho = fit.log_correlation(Term::B, Term::N);
+      break;
+    case BEstimate::SigmaMin:
+      if (!r.slope.B) throw AnalysisError(fmt::format("{}: no Allan deviation minimum to read B from", rec.source));
+      b_in = lognormal_estimate(*r.slope.B, r.slope_B_sigma);
+      break;
+    case BEstimate::Avg100:
+      if (!r.avg100.spread.valid)
+        throw AnalysisError(fmt::format("{}: the record is shorter than three {:g}-s blocks; use --b-estimate fit",
+                                        rec.source, options.methods.block_s));
+      b_in = lognormal_estimate(r.avg100.spread.value, r.avg100.spread.sigma);
+      break;
+  }
+  r.verdict = decide(b_in, from_fit(Term::N), rho, options.verdict);
+  return r;
+}
+
+nlohmann::json to_json(const AnalysisResult& r) {
+  using nlohmann::json;
+  const auto& f = r.fit;
+  json fit = {{"Q_arcsec", coef_json(f[Term::Q])},
+              {"N_deg_per_sqrt_h", coef_json(f[Term::N])},
+              {"B_deg_per_h", coef_json(f[Term::B])},
+              {"K_deg_per_h_per_sqrt_h", coef_json(f[Term::K])},
+              {"R_deg_per_h2", coef_json(f[Term::R])},
+              {"chi2_per_dof", f.chi2_per_dof},
+              {"chi2", f.chi2},
+              {"dof", f.dof},
+              {"p_value", f.p_value},
+              {"corr_NQ", f.corr_NQ},
+              {"corr_NB", f.corr_NB},
+              {"points", f.used.size()},
+              {"tau_min_s", f.used.empty() ? 0.0 : f.used.front().tau_s},
+              {"tau_max_s", f.used.empty() ? 0.0 : f.used.back().tau_s},
+              {"dispersion", f.options.dispersion},
+              {"edf_cap", f.options.edf_cap},
+              {"confidence", f.options.confidence}};
+  json n_direct = method_json(r.direct.N);
+  if (!n_direct.is_null()) {
+    n_direct["discrepancy_sigma"] = r.N_direct_discrepancy_sigma;
+    n_direct["intercept_arcsec2"] = r.direct.intercept_arcsec2;
+    n_direct["t_min_s"] = r.direct.points.front().t_s;
+    n_direct["t_max_s"] = r.direct.points.back().t_s;
+  }
+  json b100 = method_json(r.avg100.spread);
+  if (!b100.is_null()) {
+    b100["blocks"] = r.avg100.blocks;
+    b100["block_s"] = r.avg100.block_s;
+    b100["expected"] = r.avg100.expected;
+    b100["expected_sigma"] = r.avg100.expected_sigma;
+    b100["discrepancy_sigma"] = r.B_100s_discrepancy_sigma;
+    b100["discrepancy_model_sigma"] = r.B_100s_vs_model_sigma;
+  }
+  return {{"source", r.source},
+          {"samples", r.samples},
+          {"rate_hz", r.rate_hz},
+          {"duration_s", r.duration_s},
+          {"temperature_c", opt_num(r.temperature_c)},
+          {"temperature_source", r.temperature_source},
+          {"mean_rate_deg_per_h", r.mean_rate_deg_per_h},
+          {"earth_rate_deg_per_h", r.earth_rate_deg_per_h},
+          {"latitude_deg", r.earth_rate_given ? json(nullptr) : json(r.latitude_deg)},
+          {"bias_deg_per_h", r.bias_deg_per_h},
+          {"allan", allan_json(r.allan)},
+          {"fit", fit},
+          {"slope_readout",
+           {{"N_deg_per_sqrt_h", opt_num(r.slope.N)},
+            {"tau_N_s", r.slope.tau_N_s},
+            {"B_deg_per_h", opt_num(r.slope.B)},
+            {"B_sigma", r.slope_B_sigma},
+            {"sigma_min_deg_per_h", r.slope.sigma_min},
+            {"tau_min_s", r.slope.tau_min_s},
+            {"K_deg_per_h_per_sqrt_h", opt_num(r.slope.K)},
+            {"tau_K_s", r.slope.tau_K_s}}},
+          {"methods", {{"N_direct_deg_per_sqrt_h", n_direct}, {"B_100s_deg_per_h", b100}}},
+          {"verdict", to_json(r.verdict)},
+          {"conventions",
+           {{"Q", "rms white angle error, sigma^2 = 3 Q^2/tau^2 (IEEE 952); the paper's eq. (2) Q is sqrt(3) Q"},
+            {"N", "sigma^2 = N^2/tau; N = sigma at tau = 1 h"},
+            {"B", "sigma^2 = (2 ln2/pi) B^2, floor 0.6643 B (the paper prints B where B^2 is meant)"},
+            {"K", "sigma^2 = K^2 tau/3; K = sigma at tau = 3 h"},
+            {"R", "sigma^2 = R^2 tau^2/2"},
+            {"deviation_unit", "deg/h (1 arcsec/s = 1 deg/h)"},
+            {"intervals", "95 % profile-likelihood; resolved=false: value is the 95 % upper bound"}}}};
+}
+
+std::string format_report(const AnalysisResult& r) {
+  std::string s;
+  s += fmt::format("rwcalc analyze: {}\n\n", r.source);
+  s += "Data\n";
+  s += fmt::format("  {} samples at {:g} Hz (tau0 = {:g} ms), {:.1f} s ({:.2f} h), column '{}'", r.samples, r.rate_hz,
+                   1000.0 / r.rate_hz, r.duration_s, r.duration_s / 3600.0, r.column);
+  if (r.arcsec_per_count > 0) s += fmt::format(", pulse weight {:g} arcsec", r.arcsec_per_count);
+  s += "\n";
+  s += r.temperature_c ? fmt::format("  temperature {:g} °C (from {})\n", *r.temperature_c, r.temperature_source)
+                       : std::string("  temperature unknown\n");
+  s += fmt::format("  mean rate {:.4f} °/h; expected vertical Earth rate {:.4f} °/h ({}); bias {:+.4f} °/h\n\n",
+                   r.mean_rate_deg_per_h, r.earth_rate_deg_per_h,
+                   r.earth_rate_given ? std::string("given") : fmt::format("latitude {:g}°", r.latitude_deg),
+                   r.bias_deg_per_h);
+
+  s += fmt::format("Allan deviation ({}, bounds at {:g} %; * = used in the fit)\n", to_string(r.allan.estimator),
+                   100.0 * r.allan.confidence);
+  s += fmt::format("  {:>11} {:>12} {:>12} {:>12} {:>10} {:>4} {:>12}\n", "tau (s)", "sigma (°/h)", "low (°/h)",
+                   "high (°/h)", "EDF", "α", "model (°/h)");
+  for (const auto& p : r.allan.points) {
+    const bool used = std::any_of(r.fit.used.begin(), r.fit.used.end(), [&](const FitPoint& u) { return u.tau_s == p.tau_s; });
+    s += fmt::format("  {:>11.5g} {:>12.5g} {:>12.5g} {:>12.5g} {:>10.4g} {:>4} {:>12.5g}{}\n", p.tau_s, p.dev, p.dev_low,
+                     p.dev_high, p.edf, p.alpha, std::sqrt(r.fit.model_var(p.tau_s)), used ? " *" : "");
+  }
+  s += "\n";
+
+  const auto& f = r.fit;
+  s += fmt::format("Noise coefficients (Gamma-deviance fit of {} octave points, tau {:g}..{:g} s; 95 % profile intervals)\n",
+                   f.used.size(), f.used.front().tau_s, f.used.back().tau_s);
+  s += coef_line(f[Term::Q], "Q", "arcsec");
+  s += coef_line(f[Term::N], "N", "°/√h");
+  s += coef_line(f[Term::B], "B", "°/h");
+  s += coef_line(f[Term::K], "K", "°/h/√h");
+  s += coef_line(f[Term::R], "R", "°/h²");
+  s += fmt::format("  chi2/dof = {:.2f} (dof {}, p = {:.3g}); corr(N,Q) = {:+.2f}, corr(N,B) = {:+.2f}\n", f.chi2_per_dof,
+                   f.dof, f.p_value, f.corr_NQ, f.corr_NB);
+  s += fmt::format("  (uncertainties include a x{:g} variance inflation for correlated overlapping AV points)\n\n",
+                   f.options.dispersion);
+
+  s += "Classic slope-line readout (single-term lines; biased where terms overlap)\n";
+  s += r.slope.N ? fmt::format("  N = {} °/√h (−½ line through tau = {:.3g} s, read at 1 h)\n", num(*r.slope.N, 3), r.slope.tau_N_s)
+                 : std::string("  N: no part of the curve has slope −½\n");
+  if (r.slope.B)
+    s += fmt::format("  B = sigma_min/0.6643 = {} ± {} °/h (sigma_min {} °/h at tau = {:.4g} s)\n", num(*r.slope.B, 3),
+                     num(r.slope_B_sigma, 2), num(r.slope.sigma_min, 3), r.slope.tau_min_s);
+  s += r.slope.K ? fmt::format("  K = {} °/h/√h (+½ line through tau = {:.3g} s, read at 3 h)\n", num(*r.slope.K, 3), r.slope.tau_K_s)
+                 : std::string("  K: no part of the curve has slope +½\n");
+  s += "\n";
+
+  s += "Cross-checks (the paper's methods)\n";
+  if (r.direct.N.valid)
+    s += fmt::format("  N direct (angle variance vs interval, {:g}..{:g} s): {}{} ± {} °/√h; vs AV fit {:+.1f} sigma\n",
+                     r.direct.points.front().t_s, r.direct.points.back().t_s, r.direct.N.resolved ? "" : "< ",
+                     num(r.direct.N.value, 3), num(r.direct.N.sigma, 2), r.N_direct_discrepancy_sigma);
+  else
+    s += "  N direct: record too short\n";
+  if (r.avg100.spread.valid) {
+    s += fmt::format("  spread of {:g}-s mean rates ({} blocks): {} ± {} °/h; vs B (fit) {:+.1f} sigma\n", r.avg100.block_s,
+                     r.avg100.blocks, num(r.avg100.spread.value, 3), num(r.avg100.spread.sigma, 2),
+                     r.B_100s_discrepancy_sigma);
+    if (r.avg100.expected > 0)
+      s += fmt::format("    expected from the fitted model (all terms): {} ± {} °/h; measured vs expected {:+.1f} sigma\n",
+                       num(r.avg100.expected, 3), num(r.avg100.expected_sigma, 2), r.B_100s_vs_model_sigma);
+  } else {
+    s += "  100-s averaging: record too short\n";
+  }
+  s += "\n";
+
+  const auto& v = r.verdict;
+  s += fmt::format("Verdict ({}; B from {}{})\n", v.table_name, v.b_estimate,
+                   v.tolerance_pct > 0 ? fmt::format("; heading-gyro tolerance +{:g} % on B", v.tolerance_pct)
+                                       : std::string("; strict limits"));
+  s += verdict_param_line(v, v.B);
+  s += verdict_param_line(v, v.N);
+  s += fmt::format("  overall: {}", v.statement());
+  if (v.cls != v.cls_strict) s += fmt::format("  [with the tolerance; strict: class {}]", class_label(v.cls_strict));
+  s += "\n\n";
+  s += "Conventions: Q = rms white angle error, sigma² = 3Q²/tau² (IEEE 952; the paper's eq. (2) Q is √3·Q);\n"
+       "  N = sigma(1 h) of the −½ line; B from sigma² = (2 ln2/π)·B², floor 0.6643·B (the paper prints B for B²);\n"
+       "  K = sigma(3 h) of the +½ line; R from sigma² = R²tau²/2; 1 °/h = 1 arcsec/s.\n";
+  return s;
+}
+
+}  // namespace rwcalc

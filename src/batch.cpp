@@ -1,0 +1,349 @@
+// Batch analysis over files (threads), JSON-lines merge, and the Table 1 / Table 2 layout.
+#include "rwcalc/batch.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <exception>
+#include <fstream>
+#include <mutex>
+#include <thread>
+
+#include "rwcalc/error.hpp"
+
+namespace rwcalc {
+
+namespace {
+
+using nlohmann::json;
+
+std::optional<int> opt_int(const json& j) {
+  if (j.is_null()) return std::nullopt;
+  return j.get<int>();
+}
+
+json opt_json(const std::optional<int>& c) { return c ? json(*c) : json(nullptr); }
+
+/// The worse of two classes (empty = outside every class is the worst).
+std::optional<int> worse(const std::optional<int>& a, const std::optional<int>& b) {
+  if (!a || !b) return std::nullopt;
+  return std::max(*a, *b);
+}
+
+/// Overall class and probabilities over runs for one verdict object path (B, N or overall).
+json combine(const std::vector<json>& runs, const std::vector<int>& classes, const char* param) {
+  std::optional<int> cls = classes.front();
+  std::optional<int> strict = classes.front();
+  std::vector<double> p_meets(classes.size(), 1.0);
+  for (const auto& r : runs) {
+    const json& v = r.at("verdict");
+    const json& src = param ? v.at(param) : v;
+    const auto c = opt_int(param ? src.at("class") : v.at("class"));
+    const auto cs = opt_int(src.at("class_strict"));
+    cls = worse(cls, c);
+    strict = worse(strict, cs);
+    const auto pm = src.at("p_meets").get<std::vector<double>>();
+    if (pm.size() != classes.size()) throw InputError(r.value("source", "?"), 0, "runs use different class tables");
+    for (std::size_t k = 0; k < classes.size(); ++k) p_meets[k] *= pm[k];
+  }
+  std::vector<double> p_is;
+  double prev = 0;
+  for (double p : p_meets) {
+    const double f = std::clamp(p, prev, 1.0);
+    p_is.push_back(f - prev);
+    prev = f;
+  }
+  p_is.push_back(1.0 - prev);
+  std::size_t s = classes.size();
+  for (std::size_t k = 0; k < classes.size(); ++k)
+    if (cls && classes[k] == *cls) s = k;
+  return {{"class", opt_json(cls)},     {"class_strict", opt_json(strict)},
+          {"p_meets", p_meets},         {"p_is", p_is},
+          {"p_class", p_is[s]},         {"statement", describe_class(p_is, cls, classes)}};
+}
+
+struct Series {
+  const char* key;
+  const char* label;
+  const char* unit;
+  std::vector<std::string> path;
+};
+
+const std::vector<Series>& series_list() {
+  static const std::vector<Series> s{
+      {"N_fit", "N (AV fit)", "deg/sqrt(h)", {"fit", "N_deg_per_sqrt_h"}},
+      {"N_direct", "N (direct)", "deg/sqrt(h)", {"methods", "N_direct_deg_per_sqrt_h"}},
+      {"B_fit", "B (AV fit)", "deg/h", {"fit", "B_deg_per_h"}},
+      {"B_100s", "100-s spread", "deg/h", {"methods", "B_100s_deg_per_h"}},
+  };
+  return s;
+}
+
+const json* lookup(const json& run, const std::vector<std::string>& path) {
+  const json* j = &run;
+  for (const auto& k : path) {
+    if (!j->is_object() || !j->contains(k)) return nullptr;
+    j = &(*j)[k];
+  }
+  return j->is_null() ? nullptr : j;
+}
+
+/// Weighted linear trend with temperature and the worst case over the runs.
+json trend(const std::vector<json>& runs, const Series& s) {
+  double sw = 0, st = 0, sv = 0, stt = 0, stv = 0;
+  int n = 0;
+  json worst = nullptr;
+  for (const auto& r : runs) {
+    const json* e = lookup(r, s.path);
+    if (!e) continue;
+    const double v = e->at("value").get<double>();
+    if (worst.is_null() || v > worst.at("value").get<double>())
+      worst = {{"value", v}, {"high95", e->at("high95")}, {"resolved", e->at("resolved")},
+               {"temperature_c", r.at("temperature_c")}, {"source", r.at("source")}};
+    if (r.at("temperature_c").is_null() || !e->at("resolved").get<bool>()) continue;
+    const double sig = e->at("sigma").get<double>();
+    if (!(sig > 0)) continue;
+    const double t = r.at("temperature_c").get<double>();
+    const double w = 1.0 / (sig * sig);
+    sw += w;
+    st += w * t;
+    sv += w * v;
+    stt += w * t * t;
+    stv += w * t * v;
+    ++n;
+  }
+  json out = {{"label", s.label}, {"unit", s.unit}, {"worst", worst}, {"runs_in_trend", n}};
+  const double det = sw * stt - st * st;
+  if (n >= 3 && det > 0) {
+    const double b = (sw * stv - st * sv) / det;
+    const double tm = st / sw;
+    const double a = sv / sw;  // value at the weighted mean temperature
+    out["slope_per_10C"] = 10.0 * b;
+    out["slope_per_10C_sigma"] = 10.0 * std::sqrt(sw / det);
+    out["value_at_mean_temperature"] = a;
+    out["mean_temperature_c"] = tm;
+  }
+  return out;
+}
+
+std::string cell(const json& run, const std::vector<std::string>& path, int digits = 2) {
+  const json* e = lookup(run, path);
+  if (!e) return "n/a";
+  const double v = e->at("value").get<double>();
+  const double sg = e->at("sigma").get<double>();
+  if (!e->at("resolved").get<bool>()) return fmt::format("< {:.{}g}", v, digits + 1);
+  return fmt::format("{:.{}g} ± {:.{}g}", v, digits + 1, sg, 1 + (sg < 0.15 * v ? 1 : 0));
+}
+
+std::string temp_cell(const json& run) {
+  return run.at("temperature_c").is_null() ? std::string("?") : fmt::format("{:+g}", run.at("temperature_c").get<double>());
+}
+
+std::string class_cell(const json& v) { return v.is_null() ? std::string("none") : fmt::format("{}", v.get<int>()); }
+
+}  // namespace
+
+std::vector<json> analyze_files(const std::vector<std::string>& files, const ReadOptions& read,
+                                const AnalysisOptions& options, unsigned jobs) {
+  if (files.empty()) throw UsageError("batch: no input files");
+  if (jobs == 0) jobs = std::max(1u, std::thread::hardware_concurrency());
+  jobs = std::min<unsigned>(jobs, static_cast<unsigned>(files.size()));
+  AnalysisOptions opt = options;
+  if (jobs > 1) opt.allan.threads = 1;  // parallel over files, not inside each
+  std::vector<json> out(files.size());
+  std::vector<std::exception_ptr> errors(files.size());
+  std::atomic<std::size_t> next{0};
+  auto worker = [&] {
+    for (std::size_t i = next++; i < files.size(); i = next++) {
+      try {
+        const Recording rec = read_recording(files[i], read);
+        out[i] = to_json(analyze(rec, opt));
+      } catch (...) {
+        errors[i] = std::current_exception();
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < jobs; ++t) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    if (!errors[i]) continue;
+    try {
+      std::rethrow_exception(errors[i]);
+    } catch (const InputError&) {
+      throw;  // already names the file
+    } catch (const AnalysisError& e) {
+      const std::string w = e.what();
+      throw AnalysisError(w.rfind(files[i], 0) == 0 ? w : fmt::format("{}: {}", files[i], w));
+    }
+  }
+  return out;
+}
+
+json summarize_runs(std::vector<json> runs, const std::string& source) {
+  if (runs.empty()) throw InputError(source, 0, "no runs to summarize");
+  for (const auto& r : runs)
+    for (const char* k : {"source", "temperature_c", "fit", "methods", "verdict"})
+      if (!r.is_object() || !r.contains(k))
+        throw InputError(source, 0, fmt::format("a run lacks the key \"{}\" of `rwcalc analyze --json`", k));
+  std::stable_sort(runs.begin(), runs.end(), [](const json& a, const json& b) {
+    const bool na = a.at("temperature_c").is_null(), nb = b.at("temperature_c").is_null();
+    if (na != nb) return nb;
+    if (na) return a.at("source").get<std::string>() < b.at("source").get<std::string>();
+    return a.at("temperature_c").get<double>() < b.at("temperature_c").get<double>();
+  });
+  std::vector<int> classes;
+  try {
+    classes = runs.front().at("verdict").at("classes").get<std::vector<int>>();
+    for (const auto& r : runs)
+      if (r.at("verdict").at("classes").get<std::vector<int>>() != classes)
+        throw InputError(source, 0, "runs were judged against different class tables");
+    json overall = combine(runs, classes, nullptr);
+    overall["class_B"] = combine(runs, classes, "B").at("class");
+    overall["class_N"] = combine(runs, classes, "N").at("class");
+    overall["B"] = combine(runs, classes, "B");
+    overall["N"] = combine(runs, classes, "N");
+    overall["tolerance_pct"] = runs.front().at("verdict").value("tolerance_pct", 0.0);
+    overall["tolerance_changed"] = overall.at("class") != overall.at("class_strict") ||
+                                   overall["B"].at("class") != overall["B"].at("class_strict");
+    overall["b_estimate"] = runs.front().at("verdict").value("b_estimate", "fit");
+    overall["table"] = runs.front().at("verdict").value("table", "");
+    overall["classes"] = classes;
+    overall["runs"] = runs.size();
+    json trends = json::object();
+    for (const auto& s : series_list()) trends[s.key] = trend(runs, s);
+    return {{"runs", runs}, {"overall", overall}, {"trends", trends}};
+  } catch (const json::exception& e) {
+    throw InputError(source, 0, fmt::format("malformed run object: {}", e.what()));
+  }
+}
+
+std::vector<json> read_json_lines(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, 0, "cannot open the file");
+  std::vector<json> out;
+  std::string line;
+  std::size_t no = 0;
+  while (std::getline(in, line)) {
+    ++no;
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    try {
+      out.push_back(json::parse(line));
+    } catch (const json::parse_error& e) {
+      throw InputError(path, no, fmt::format("not a JSON line: {}", e.what()));
+    }
+    if (!out.back().is_object() || !out.back().contains("verdict"))
+      throw InputError(path, no, "not an analyze object (no \"verdict\"); write it with `rwcalc batch --jsonl`");
+  }
+  if (out.empty()) throw InputError(path, 0, "no JSON lines");
+  return out;
+}
+
+std::string format_batch_text(const json& summary) {
+  const auto& runs = summary.at("runs");
+  const auto& ov = summary.at("overall");
+  std::string s;
+  s += fmt::format("rwcalc batch: {} run(s); class table {}; B from {}{}\n\n", runs.size(), ov.value("table", ""),
+                   ov.value("b_estimate", "fit"),
+                   ov.value("tolerance_pct", 0.0) > 0
+                       ? fmt::format("; +{:g} % heading-gyro tolerance on B", ov.value("tolerance_pct", 0.0))
+                       : std::string("; strict limits"));
+  s += "Table 1: coefficients (±1 sigma; \"< x\": 95 % upper bound)\n";
+  s += fmt::format("  {:>6}  {:<22} {:<22} {:<22} {:<22} {}\n", "T, °C", "N (AV), °/√h", "N direct, °/√h", "B (AV), °/h",
+                   "100-s spread, °/h", "file");
+  for (const auto& r : runs)
+    s += fmt::format("  {:>6}  {:<22} {:<22} {:<22} {:<22} {}\n", temp_cell(r), cell(r, {"fit", "N_deg_per_sqrt_h"}),
+                     cell(r, {"methods", "N_direct_deg_per_sqrt_h"}), cell(r, {"fit", "B_deg_per_h"}),
+                     cell(r, {"methods", "B_100s_deg_per_h"}), r.at("source").get<std::string>());
+  s += "\nTable 2: class per parameter (probability of the stated class)\n";
+  s += fmt::format("  {:>6}  {:<30} {:<30} {}\n", "T, °C", "by N", "by B", "overall");
+  for (const auto& r : runs) {
+    const auto& v = r.at("verdict");
+    std::string o = v.value("statement", class_cell(v.at("class")));
+    if (v.value("tolerance_changed", false)) o += fmt::format(" [tolerance; strict {}]", class_cell(v.at("class_strict")));
+    s += fmt::format("  {:>6}  {:<30} {:<30} {}\n", temp_cell(r), v.value("statement_N", class_cell(v.at("class_N"))),
+                     v.value("statement_B", class_cell(v.at("class_B"))), o);
+  }
+  s += fmt::format("\nOverall over the runs: {}", ov.at("statement").get<std::string>());
+  if (ov.value("tolerance_changed", false))
+    s += fmt::format("  [with the +{:g} % tolerance on B; strict: class {}]", ov.value("tolerance_pct", 0.0),
+                     class_cell(ov.at("class_strict")));
+  s += fmt::format("\n  by N: {}; by B: {}\n", ov.at("N").at("statement").get<std::string>(),
+                   ov.at("B").at("statement").get<std::string>());
+  s += "\nTrend with temperature (weighted linear fit) and worst case\n";
+  for (const auto& [key, t] : summary.at("trends").items()) {
+    s += fmt::format("  {:<14}", t.at("label").get<std::string>());
+    if (t.contains("slope_per_10C"))
+      s += fmt::format(" {:+.3g} ± {:.2g} {} per 10 °C;", t.at("slope_per_10C").get<double>(),
+                       t.at("slope_per_10C_sigma").get<double>(), t.at("unit").get<std::string>());
+    else
+      s += " no trend (fewer than 3 runs with temperature);";
+    if (!t.at("worst").is_null()) {
+      const auto& w = t.at("worst");
+      s += fmt::format(" worst {}{:.3g} {} at {} °C", w.at("resolved").get<bool>() ? "" : "< ", w.at("value").get<double>(),
+                       t.at("unit").get<std::string>(),
+                       w.at("temperature_c").is_null() ? std::string("?") : fmt::format("{:+g}", w.at("temperature_c").get<double>()));
+    }
+    s += "\n";
+  }
+  s += "\nConventions: Q, N, B, K, R as in IEEE 952 (B from sigma² = (2 ln2/π)B²); intervals 95 % profile likelihood.\n";
+  return s;
+}
+
+std::string format_batch_markdown(const json& summary) {
+  const auto& runs = summary.at("runs");
+  const auto& ov = summary.at("overall");
+  std::string s;
+  s += "| T, °C | N (AV), °/√h | N direct, °/√h | B (AV), °/h | 100-s spread, °/h | class by N | class by B | class |\n";
+  s += "|---|---|---|---|---|---|---|---|\n";
+  for (const auto& r : runs) {
+    const auto& v = r.at("verdict");
+    s += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", temp_cell(r), cell(r, {"fit", "N_deg_per_sqrt_h"}),
+                     cell(r, {"methods", "N_direct_deg_per_sqrt_h"}), cell(r, {"fit", "B_deg_per_h"}),
+                     cell(r, {"methods", "B_100s_deg_per_h"}), v.value("statement_N", ""), v.value("statement_B", ""),
+                     v.value("statement", ""));
+  }
+  s += fmt::format("| overall | | | | | {} | {} | {} |\n", ov.at("N").at("statement").get<std::string>(),
+                   ov.at("B").at("statement").get<std::string>(), ov.at("statement").get<std::string>());
+  return s;
+}
+
+std::string format_batch_csv(const json& summary) {
+  std::string s =
+      "source,temperature_c,N_fit,N_fit_sigma,N_fit_resolved,N_direct,N_direct_sigma,B_fit,B_fit_sigma,B_fit_resolved,"
+      "B_100s,B_100s_sigma,class_N,class_B,class,p_class\n";
+  auto val = [](const json& r, std::vector<std::string> path, const char* k) -> std::string {
+    const json* e = lookup(r, path);
+    if (!e) return "";
+    const json& x = e->at(k);
+    if (x.is_boolean()) return x.get<bool>() ? "true" : "false";
+    return fmt::format("{:.6g}", x.get<double>());
+  };
+  auto cls = [](const json& c) { return c.is_null() ? std::string("") : fmt::format("{}", c.get<int>()); };
+  auto csv_escape = [](const std::string& x) {
+    if (x.find_first_of(",\"\n") == std::string::npos) return x;
+    std::string o = "\"";
+    for (char ch : x) o += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+    return o + "\"";
+  };
+  for (const auto& r : summary.at("runs")) {
+    const auto& v = r.at("verdict");
+    s += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4f}\n", csv_escape(r.at("source").get<std::string>()),
+                     r.at("temperature_c").is_null() ? std::string("") : fmt::format("{:g}", r.at("temperature_c").get<double>()),
+                     val(r, {"fit", "N_deg_per_sqrt_h"}, "value"), val(r, {"fit", "N_deg_per_sqrt_h"}, "sigma"),
+                     val(r, {"fit", "N_deg_per_sqrt_h"}, "resolved"), val(r, {"methods", "N_direct_deg_per_sqrt_h"}, "value"),
+                     val(r, {"methods", "N_direct_deg_per_sqrt_h"}, "sigma"), val(r, {"fit", "B_deg_per_h"}, "value"),
+                     val(r, {"fit", "B_deg_per_h"}, "sigma"), val(r, {"fit", "B_deg_per_h"}, "resolved"),
+                     val(r, {"methods", "B_100s_deg_per_h"}, "value"), val(r, {"methods", "B_100s_deg_per_h"}, "sigma"),
+                     cls(v.at("class_N")), cls(v.at("class_B")), cls(v.at("class")), v.at("p_class").get<double>());
+  }
+  const auto& ov = summary.at("overall");
+  s += fmt::format("overall,,,,,,,,,,,,{},{},{},{:.4f}\n", cls(ov.at("class_N")), cls(ov.at("class_B")), cls(ov.at("class")),
+                   ov.at("p_class").get<double>());
+  return s;
+}
+
+}  // namespace rwcalc

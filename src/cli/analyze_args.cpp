@@ -1,0 +1,102 @@
+#include "cli/analyze_args.hpp"
+
+#include <fmt/format.h>
+
+#include <charconv>
+#include <cmath>
+#include <limits>
+
+#include "rwcalc/error.hpp"
+
+namespace rwcalc::cli {
+
+namespace {
+
+/// "A:B" with either side optional → {a, b}; defaults for empty sides.
+std::pair<double, double> parse_range(const std::string& spec, const char* what, double lo_default, double hi_default) {
+  const auto colon = spec.find(':');
+  if (colon == std::string::npos) throw UsageError(fmt::format("{} must be TMIN:TMAX in seconds, got '{}'", what, spec));
+  auto num = [&](std::string s, double def) {
+    if (s.empty()) return def;
+    double v = 0;
+    const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (r.ec != std::errc() || r.ptr != s.data() + s.size() || !std::isfinite(v) || v < 0)
+      throw UsageError(fmt::format("{}: '{}' is not a non-negative number of seconds", what, s));
+    return v;
+  };
+  const double a = num(spec.substr(0, colon), lo_default);
+  const double b = num(spec.substr(colon + 1), hi_default);
+  if (!(a < b)) throw UsageError(fmt::format("{}: TMIN must be below TMAX (got '{}')", what, spec));
+  return {a, b};
+}
+
+}  // namespace
+
+void AnalyzeArgs::add_to(CLI::App& app) {
+  app.add_option("--fit-range", fit_range, "Tau range of the fit, TMIN:TMAX in s (either may be empty; default: all)")
+      ->group("Fit");
+  app.add_option("--min-edf", min_edf, "Leave out AV points with fewer equivalent degrees of freedom")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str()
+      ->group("Fit");
+  app.add_option("--terms", terms, "Terms to fit, a subset of QNBKR")->capture_default_str()->group("Fit");
+  app.add_flag("--all-terms", keep_all_terms,
+               "Keep every fitted term in the model (default: K, R, Q not supported by the data are "
+               "left out and reported as upper bounds)")
+      ->group("Fit");
+  app.add_option("--latitude", latitude_deg, "Latitude for the vertical Earth rate, degrees")
+      ->check(CLI::Range(-90.0, 90.0))
+      ->capture_default_str()
+      ->group("Earth rate");
+  app.add_option("--earth-rate", earth_rate, "Expected sensed Earth rate, deg/h (overrides --latitude)")
+      ->group("Earth rate");
+  app.add_option("--b-estimate", b_estimate, "B estimate the verdict uses: fit, sigma-min or avg100")
+      ->capture_default_str()
+      ->group("Verdict");
+  app.add_option("--tolerance", tolerance_pct,
+                 "Accept a B up to PCT % above a class limit (the paper's heading-gyro rule, e.g. 50)")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str()
+      ->group("Verdict");
+  app.add_option("--limits", limits_file, "Class table as JSON (default: GOST RV 52339)")->group("Verdict");
+  app.add_option("--block", block_s, "Block length of the averaging cross-check, s")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str()
+      ->group("Cross-checks");
+  app.add_option("--direct-range", direct_range, "Interval lengths of the direct N method, TMIN:TMAX in s")
+      ->capture_default_str()
+      ->group("Cross-checks");
+}
+
+AnalysisOptions AnalyzeArgs::options() const {
+  AnalysisOptions o;
+  if (!fit_range.empty()) {
+    const auto [a, b] = parse_range(fit_range, "--fit-range", 0.0, std::numeric_limits<double>::infinity());
+    o.fit.tau_min_s = a;
+    o.fit.tau_max_s = b;
+  }
+  o.fit.min_edf = min_edf;
+  o.fit.enabled = {false, false, false, false, false};
+  if (terms.empty()) throw UsageError("--terms: give at least one of Q, N, B, K, R");
+  for (char c : terms) {
+    const std::string names = "QNBKR";
+    const auto p = names.find(static_cast<char>(std::toupper(static_cast<unsigned char>(c))));
+    if (p == std::string::npos) throw UsageError(fmt::format("--terms: unknown term '{}' (use Q, N, B, K, R)", c));
+    o.fit.enabled[p] = true;
+  }
+  if (!o.fit.enabled[1] || !o.fit.enabled[2]) throw UsageError("--terms must include N and B (the verdict needs both)");
+  o.fit.select_terms = !keep_all_terms;
+  o.latitude_deg = latitude_deg;
+  o.earth_rate_deg_per_h = earth_rate;
+  o.verdict.b_estimate = parse_b_estimate(b_estimate);
+  o.verdict.tolerance_pct = tolerance_pct;
+  if (!limits_file.empty()) o.verdict.table = ClassTable::load(limits_file);
+  o.methods.block_s = block_s;
+  const auto [dl, dh] = parse_range(direct_range, "--direct-range", 1.0, 100.0);
+  if (!(dl > 0)) throw UsageError("--direct-range: TMIN must be positive");
+  o.methods.direct_t_min_s = dl;
+  o.methods.direct_t_max_s = dh;
+  return o;
+}
+
+}  // namespace rwcalc::cli

@@ -1,0 +1,29 @@
+#pragma once
+// Options shared by 'rwcalc analyze' and 'rwcalc batch': fit range and terms, cross-check
+// settings, Earth rate, and the verdict's class table, B estimate and tolerance.
+#include <CLI/CLI.hpp>
+#include <optional>
+#include <string>
+
+#include "rwcalc/analysis.hpp"
+
+namespace rwcalc::cli {
+
+struct AnalyzeArgs {
+  std::string fit_range;            ///< "TMIN:TMAX" (s; either side may be empty)
+  double min_edf = 1.0;
+  std::string terms = "QNBKR";
+  bool keep_all_terms = false;
+  double latitude_deg = 55.75;
+  std::optional<double> earth_rate;
+  std::string b_estimate = "fit";
+  double tolerance_pct = 0;
+  std::string limits_file;
+  double block_s = 100.0;
+  std::string direct_range = "1:100";
+  void add_to(CLI::App& app);
+  /// Throws UsageError on malformed values; InputError for a bad limits file.
+  [[nodiscard]] AnalysisOptions options() const;
+};
+
+}  // namespace rwcalc::cli

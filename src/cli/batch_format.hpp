@@ -1,0 +1,47 @@
+#pragma once
+// Output formats shared by 'rwcalc batch' and 'rwcalc merge' (same tables from the same objects).
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "cli/commands.hpp"
+#include "rwcalc/batch.hpp"
+#include "rwcalc/output.hpp"
+
+namespace rwcalc::cli {
+
+struct TableFormat {
+  bool json = false, csv = false, markdown = false, jsonl = false;
+  inline void add_to(CLI::App& app) {
+    auto* g = app.add_option_group("Output format", "default: the readable tables");
+    g->add_flag("--json", json, "{\"runs\": [analyze objects], \"overall\": {...}, \"trends\": {...}}");
+    g->add_flag("--csv", csv, "One CSV row per run, then the overall row");
+    g->add_flag("--markdown", markdown, "The table in Markdown");
+    g->add_flag("--jsonl", jsonl, "One analyze JSON object per line (input of 'rwcalc merge')");
+    g->require_option(0, 1);
+  }
+  [[nodiscard]] inline std::string render(const std::vector<nlohmann::json>& runs) const {
+    if (jsonl) {
+      std::string s;
+      for (const auto& r : runs) s += r.dump() + "\n";
+      return s;
+    }
+    const nlohmann::json summary = summarize_runs(runs);
+    if (json) return summary.dump(2) + "\n";
+    if (csv) return format_batch_csv(summary);
+    if (markdown) return format_batch_markdown(summary);
+    return format_batch_text(summary);
+  }
+};
+
+
+inline void emit(Io& io, const std::string& text, const std::string& output, bool force) {
+  if (output == "-")
+    io.out << text;
+  else
+    write_file_atomic(output, text, force);
+}
+
+
+}  // namespace rwcalc::cli
