@@ -1,15 +1,14 @@
 #include "rwcalc/error.hpp"
 
+#include <fmt/format.h>
+
 #include <utility>
 
 namespace rwcalc {
 
 namespace {
 std::string format_input_error(const std::string& file, std::size_t line, const std::string& message) {
-  std::string s = file;
-  if (line > 0) s += ":" + std::to_string(line);
-  s += ": " + message;
-  return s;
+  return line > 0 ? fmt::format("{}:{}: {}", file, line, message) : fmt::format("{}: {}", file, message);
 }
 }  // namespace
 

@@ -5,14 +5,18 @@
 /// Text, one sample per line. Accepted: `#` comment lines; metadata lines `# key: value`
 /// (rate_hz, scale_arcsec_per_pulse, temperature_c, serial, and any other key, kept verbatim);
 /// an optional header row naming the columns; delimiters comma, semicolon, tab or blanks
-/// (detected from the first data line); a decimal comma where the delimiter is not a comma;
-/// CRLF line ends; a UTF-8 BOM; gzip (by content, whatever the name); "-" for standard input.
-/// Any malformed line is an InputError naming the file and the line; nothing is skipped silently.
+/// (detected from the header or the first data line); a decimal comma where the delimiter is not
+/// a comma; CRLF line ends; a UTF-8 BOM; gzip (by content, whatever the name); "-" for standard
+/// input. Blank lines are skipped (they carry no sample). Any other malformed line is an
+/// InputError naming the file and the line; nothing is skipped silently. docs/input-formats.md
+/// is the user-facing description.
+#include <cstddef>
 #include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "rwcalc/series.hpp"
@@ -26,7 +30,9 @@ enum class InputMode {
   Angle,    ///< cumulative angle or phase samples, in angle_unit
   Rate,     ///< rate samples, in rate_unit (or dimensionless frequency for clocks)
 };
+/// Unit of Angle input. Second means clock phase (time error) in seconds.
 enum class AngleUnit { Arcsec, Deg, Rad, Second };
+/// Unit of Rate input. Unitless means dimensionless clock frequency (fractional frequency).
 enum class RateUnit { DegPerHour, DegPerSecond, RadPerSecond, Unitless };
 
 struct ReadOptions {
@@ -35,8 +41,8 @@ struct ReadOptions {
   /// column named "pulses" (or counter/angle/phase/rate/gyro by mode), else the only non-time
   /// column, else an error asking for --column.
   std::string column;
-  std::optional<double> rate_hz;       ///< --rate; overrides metadata; checked against a time column
-  std::optional<double> scale_arcsec;  ///< --scale: pulse weight, ″; overrides metadata
+  std::optional<double> rate_hz;       ///< --rate, Hz; overrides metadata; checked against a time column
+  std::optional<double> scale_arcsec;  ///< --scale: pulse weight, ″ per pulse; overrides metadata
   int counter_bits = 32;               ///< wrap width of Counter mode (1..64)
   AngleUnit angle_unit = AngleUnit::Arcsec;
   RateUnit rate_unit = RateUnit::DegPerHour;
@@ -50,21 +56,35 @@ enum class RateSource { Option, Metadata, TimeColumn, Default };
 struct Recording {
   std::string source;  ///< the path as given ("-" for stdin)
   PhaseSeries phase;   ///< the cumulative angle/phase, ready for the estimators
-  double rate_hz = 400.0;
+  double rate_hz = 400.0;  ///< sample rate, Hz (phase.tau0_s = 1/rate_hz)
   RateSource rate_source = RateSource::Default;
   std::size_t samples = 0;  ///< data lines read (samples of the selected column)
   std::map<std::string, std::string> metadata;  ///< every `# key: value` line
-  std::optional<double> temperature_c;  ///< mean of a temperature_c column, else metadata
-  std::string column_name;              ///< the column that was read
+  std::optional<double> temperature_c;  ///< mean of a temperature_c column, else metadata, °C
+  std::string column_name;              ///< the column that was read (header name or "column N")
+  std::optional<std::string> time_column;  ///< the time column that was checked, if any
   InputMode mode = InputMode::Pulses;
-  /// Rate samples in deviation units (°/h for gyro), one per sample; handy for block statistics.
+  /// Counter input: how many times the counter wrapped (a backwards step counts as a wrap).
+  std::size_t counter_wraps = 0;
+  /// Where each run of consecutive data lines starts: (sample index, 1-based line number), sorted
+  /// by sample index. A new run starts after a comment or blank line inside the data.
+  std::vector<std::pair<std::size_t, std::size_t>> line_runs;
+
+  /// Rate samples in deviation units (°/h for gyro), one per phase increment; handy for block
+  /// statistics and outlier detection. Index i is the increment x_{i+1} − x_i.
   [[nodiscard]] std::vector<double> rates() const;
+  /// 1-based line number of data sample k (0-based), 0 if k is out of range.
+  [[nodiscard]] std::size_t line_of_sample(std::size_t k) const noexcept;
+  /// 1-based line number of the data line that produced rate sample i (see rates()): sample i for
+  /// pulse and rate input, sample i+1 (the later reading) for counter and angle input.
+  [[nodiscard]] std::size_t line_of_rate(std::size_t i) const noexcept;
 };
 
 /// Read a file (or "-" for stdin). Throws InputError (file, line, message) on any malformed input.
 Recording read_recording(const std::string& path, const ReadOptions& options = {});
 
 /// Read from text already in memory (used by tests, fuzzers and stdin); `name` labels errors.
+/// The text may be gzip-compressed (detected by its magic bytes).
 Recording read_recording_text(std::string_view text, const std::string& name,
                               const ReadOptions& options = {});
 
@@ -74,5 +94,7 @@ AngleUnit parse_angle_unit(std::string_view s);
 RateUnit parse_rate_unit(std::string_view s);
 std::string_view to_string(InputMode m);
 std::string_view to_string(RateSource s);
+std::string_view to_string(AngleUnit u);
+std::string_view to_string(RateUnit u);
 
 }  // namespace rwcalc

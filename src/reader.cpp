@@ -1,0 +1,1046 @@
+// The recording reader: one pass over the bytes in memory with a hand-written scanner.
+//
+// Every line goes first through a fast path that accepts only the plain form of a data line (the
+// detected delimiter, simple numbers, LF or CRLF). Anything else — comments, blank lines, decimal
+// commas, exponents, stray text — falls to the careful path, which either accepts the line with
+// the same values the fast path would give or throws an InputError that names file, line and the
+// offending text. The two paths parse numbers to identical doubles (both correctly rounded).
+#include "rwcalc/reader.hpp"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "reader_detail.hpp"
+#include "rwcalc/error.hpp"
+#include "rwcalc/units.hpp"
+
+namespace rwcalc {
+
+namespace {
+
+using detail::is_digit;
+using detail::scan_double_fast;
+using detail::scan_int_fast;
+using detail::TextBuffer;
+
+enum class Delim { Comma, Semicolon, Tab, Blanks };
+
+std::string_view delim_name(Delim d) {
+  switch (d) {
+    case Delim::Comma: return "comma";
+    case Delim::Semicolon: return "semicolon";
+    case Delim::Tab: return "tab";
+    case Delim::Blanks: return "blanks";
+  }
+  return "?";
+}
+
+constexpr std::size_t kQuoteLimit = 40;
+
+// The offending text for a message: at most ~40 characters, non-printable bytes escaped.
+std::string quoted(std::string_view s) {
+  std::string out = "'";
+  const std::size_t n = std::min(s.size(), kQuoteLimit);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    if (c < 0x20 || c == 0x7f)
+      out += fmt::format("\\x{:02x}", c);
+    else
+      out += static_cast<char>(c);
+  }
+  if (s.size() > n) out += fmt::format("...' ({} characters)", s.size());
+  else out += "'";
+  return out;
+}
+
+std::string_view trim(std::string_view s, bool tabs = true) {
+  auto blank = [tabs](char c) { return c == ' ' || (tabs && c == '\t'); };
+  while (!s.empty() && blank(s.front())) s.remove_prefix(1);
+  while (!s.empty() && blank(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+bool iequals(std::string_view a, std::string_view b) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+           return (x | 0x20) == (y | 0x20) && ((x >= 'A' && x <= 'Z') || (x >= 'a' && x <= 'z') || x == y);
+         });
+}
+
+// A field with the decimal comma turned into a point, when that reading applies: exactly one
+// comma, no point, and the delimiter is not a comma.
+std::string_view normalise_decimal(std::string_view f, bool comma_ok, std::string& scratch) {
+  if (!comma_ok) return f;
+  const auto c = f.find(',');
+  if (c == std::string_view::npos || f.find(',', c + 1) != std::string_view::npos ||
+      f.find('.') != std::string_view::npos)
+    return f;
+  scratch.assign(f);
+  scratch[c] = '.';
+  return scratch;
+}
+
+// Does the field read as a number (even one out of range, or NaN/Inf)? Decides header rows.
+bool looks_numeric(std::string_view f, bool comma_ok) {
+  std::string scratch;
+  f = normalise_decimal(f, comma_ok, scratch);
+  if (!f.empty() && f.front() == '+') f.remove_prefix(1);
+  if (f.empty()) return false;
+  double v = 0;
+  const auto r = std::from_chars(f.data(), f.data() + f.size(), v);
+  return r.ptr == f.data() + f.size() && r.ec != std::errc::invalid_argument;
+}
+
+// Thrown inside the reader when the time column must be read again in full.
+struct NeedTimes {};
+
+enum class Role : unsigned char { Skip, Value, Time, Temperature };
+
+// What the careful path made of a line.
+enum class LineKind { Blank, Comment, Header, Data };
+
+struct Sample {
+  std::int64_t integer = 0;  // pulses, or a counter reading's bit pattern
+  double real = 0.0;         // angle / rate sample
+  double time = 0.0;
+  double temperature = 0.0;
+};
+
+const char* const kTimeNames[] = {"time_s", "time", "t", "t_s", "timestamp", "time_sec"};
+const char* const kTemperatureNames[] = {"temperature_c", "temperature", "temp_c", "temp", "t_c"};
+
+std::vector<std::string_view> value_names(InputMode m) {
+  switch (m) {
+    case InputMode::Pulses: return {"pulses", "pulse", "counts", "count"};
+    case InputMode::Counter: return {"counter", "count", "counts", "pulses"};
+    case InputMode::Angle: return {"angle", "phase"};
+    case InputMode::Rate: return {"rate", "gyro", "frequency", "freq"};
+  }
+  return {};
+}
+
+class Reader {
+ public:
+  Reader(const TextBuffer& buf, std::string name, const ReadOptions& options)
+      : name_(std::move(name)), opt_(options), begin_(buf.data()), end_(buf.data() + buf.size()) {}
+
+  Recording run(bool store_times);
+
+ private:
+  [[noreturn]] void fail(std::size_t line, const std::string& message) const {
+    throw InputError(name_, line, message);
+  }
+  [[nodiscard]] bool integer_mode() const {
+    return opt_.mode == InputMode::Pulses || opt_.mode == InputMode::Counter;
+  }
+
+  std::size_t check_bytes(const char* text);  // returns the number of '\n'
+  LineKind careful_line(std::string_view line);
+  void metadata_line(std::string_view body);
+  void detect_delimiter(std::string_view line);
+  void split(std::string_view line);
+  void check_foreign_delimiters(std::string_view line) const;
+  void establish_layout();
+  void parse_field(std::string_view field, Role role, Sample& s) const;
+  void push(const Sample& s);
+  template <bool Integer>
+  bool fast_line(const char*& p);
+  template <bool Integer>
+  void scan(const char* p);
+
+  std::size_t line_of_sample(std::size_t k) const;
+  void finish_rate();
+  void check_time_column();
+  void build_phase(Recording& rec);
+
+  std::string name_;
+  const ReadOptions& opt_;
+  const char* begin_;
+  const char* end_;
+  std::size_t line_ = 0;
+  std::size_t content_lines_ = 0;  // non-blank lines seen by the careful path
+
+  // Layout, fixed by the header row or the first data line.
+  bool layout_known_ = false;
+  Delim delim_ = Delim::Blanks;
+  std::size_t ncols_ = 0;
+  std::vector<std::string> header_;
+  std::size_t header_line_ = 0;
+  std::size_t layout_line_ = 0;  // line that fixed the delimiter
+  std::vector<Role> roles_;
+  std::size_t value_col_ = 0;
+  std::optional<std::size_t> time_col_, temp_col_;
+  std::array<bool, 256> stop_{};  // bytes that end an unselected field in the fast path
+  std::int64_t counter_lo_ = 0, counter_max_ = 0;  // accepted reading range
+
+  std::vector<std::string_view> fields_;  // scratch for the careful path
+  mutable std::string scratch_;
+
+  // Collected data.
+  std::vector<std::int64_t> ints_;  // pulses/counter: slot 0 reserved for C_0
+  std::vector<double> reals_;       // angle: samples; rate: slot 0 reserved for x_0
+  // The time column is checked from running statistics (first, last, smallest and largest step),
+  // so a long record needs no second array; only when a step is out of tolerance is the file read
+  // again keeping every time stamp, to name the first bad line.
+  bool store_times_ = false;
+  std::vector<double> times_;       // every time stamp (only when store_times_)
+  std::vector<double> head_times_;  // the first kHeadTimes stamps: the rate estimate
+  static constexpr std::size_t kHeadTimes = 102;
+  double t_first_ = 0, t_prev_ = 0;
+  double min_dt_ = std::numeric_limits<double>::infinity(), max_dt_ = -std::numeric_limits<double>::infinity();
+  std::size_t n_times_ = 0;
+  void track_time(double t) {
+    if (store_times_) times_.push_back(t);
+    if (n_times_ == 0) {
+      t_first_ = t;
+    } else {
+      const double dt = t - t_prev_;
+      min_dt_ = std::min(min_dt_, dt);
+      max_dt_ = std::max(max_dt_, dt);
+    }
+    if (n_times_ < kHeadTimes) head_times_.push_back(t);
+    t_prev_ = t;
+    ++n_times_;
+  }
+  long double temp_sum_ = 0;
+  std::size_t temp_n_ = 0;
+  std::size_t samples_ = 0;
+  std::size_t first_data_line_ = 0, last_data_line_ = 0;
+  bool new_run_ = true;
+  std::vector<std::pair<std::size_t, std::size_t>> runs_;
+
+  // Metadata and the rate.
+  std::map<std::string, std::string> metadata_;
+  std::optional<double> meta_rate_, meta_scale_, meta_temp_;
+  std::size_t meta_rate_line_ = 0;
+  double rate_hz_ = units::gl2d_rate_hz;
+  RateSource rate_source_ = RateSource::Default;
+};
+
+// ---- bytes ---------------------------------------------------------------------------------------
+
+std::size_t Reader::check_bytes(const char* text) {
+  // Binary data: NUL and other control bytes (tab, LF and CR excepted). Checked, and the lines
+  // counted, in one pass of branch-free blocks the compiler vectorises; a block that trips is
+  // searched again for the first bad byte.
+  constexpr std::size_t kBlock = 255;  // an 8-bit line counter cannot overflow within a block
+  std::size_t lines = 0;
+  for (const char* b = text; b < end_; b += kBlock) {
+    const char* e = end_ - b > static_cast<std::ptrdiff_t>(kBlock) ? b + kBlock : end_;
+    unsigned char bad = 0, nl = 0;
+    for (const char* q = b; q < e; ++q) {
+      const auto c = static_cast<unsigned char>(*q);
+      nl = static_cast<unsigned char>(nl + (c == '\n'));
+      bad |= static_cast<unsigned char>(((c < 0x20) & (c != '\t') & (c != '\n') & (c != '\r')) | (c == 0x7f));
+    }
+    lines += nl;
+    if (!bad) continue;
+    for (const char* q = b; q < e; ++q) {
+      const auto c = static_cast<unsigned char>(*q);
+      if ((c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7f) {
+        const auto line = 1 + static_cast<std::size_t>(std::count(text, q, '\n'));
+        const char* ls = q;
+        while (ls > text && ls[-1] != '\n') --ls;
+        fail(line, fmt::format("binary data (byte 0x{:02x} at column {}): this is not a text recording; "
+                               "a compressed file other than gzip?",
+                               c, q - ls + 1));
+      }
+    }
+  }
+  return lines;
+}
+
+// ---- careful path ------------------------------------------------------------------------------
+
+void Reader::metadata_line(std::string_view body) {
+  // "# key: value" with key = letter/underscore then letters, digits, '_', '.', '-'.
+  body = trim(body);
+  std::size_t k = 0;
+  auto key_char = [](char c, bool first) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_' ||
+           (!first && ((c >= '0' && c <= '9') || c == '.' || c == '-'));
+  };
+  while (k < body.size() && key_char(body[k], k == 0)) ++k;
+  if (k == 0) return;
+  std::size_t c = k;
+  while (c < body.size() && (body[c] == ' ' || body[c] == '\t')) ++c;
+  if (c >= body.size() || body[c] != ':') return;
+  const std::string key(body.substr(0, k));
+  const std::string value(trim(body.substr(c + 1)));
+
+  auto number = [&](bool positive) {
+    std::string scratch;
+    std::string_view v = normalise_decimal(value, true, scratch);
+    if (!v.empty() && v.front() == '+') v.remove_prefix(1);
+    double x = 0;
+    const auto r = std::from_chars(v.data(), v.data() + v.size(), x);
+    if (v.empty() || r.ec != std::errc() || r.ptr != v.data() + v.size() || !std::isfinite(x) ||
+        (positive && !(x > 0)))
+      fail(line_, fmt::format("metadata {}: {} is not a {}number", key, quoted(value),
+                              positive ? "positive " : ""));
+    return x;
+  };
+  auto set_known = [&](std::optional<double>& slot, bool positive) {
+    const double x = number(positive);
+    if (slot && *slot != x)
+      fail(line_, fmt::format("metadata {} given twice with different values ({} and {})", key,
+                              quoted(metadata_[key]), quoted(value)));
+    slot = x;
+  };
+  if (key == "rate_hz") {
+    set_known(meta_rate_, true);
+    meta_rate_line_ = line_;
+  } else if (key == "scale_arcsec_per_pulse") {
+    set_known(meta_scale_, true);
+  } else if (key == "temperature_c") {
+    set_known(meta_temp_, false);
+  }
+  auto [it, inserted] = metadata_.try_emplace(key, value);
+  if (!inserted && it->second != value) it->second += "; " + value;  // nothing is dropped
+}
+
+void Reader::detect_delimiter(std::string_view line) {
+  // Tab, then semicolon, then comma; a comma whose pieces contain blanks is a decimal comma in a
+  // blank-separated line ("0,0025 3").
+  if (line.find('\t') != std::string_view::npos) {
+    delim_ = Delim::Tab;
+  } else if (line.find(';') != std::string_view::npos) {
+    delim_ = Delim::Semicolon;
+  } else if (line.find(',') != std::string_view::npos) {
+    delim_ = Delim::Comma;
+    std::size_t start = 0;
+    for (;;) {
+      const auto e = line.find(',', start);
+      const auto piece = trim(line.substr(start, e == std::string_view::npos ? e : e - start));
+      if (piece.find_first_of(" \t") != std::string_view::npos) delim_ = Delim::Blanks;
+      if (e == std::string_view::npos) break;
+      start = e + 1;
+    }
+  } else {
+    delim_ = Delim::Blanks;
+  }
+  layout_line_ = line_;
+}
+
+void Reader::check_foreign_delimiters(std::string_view line) const {
+  std::string_view foreign;
+  switch (delim_) {
+    case Delim::Comma: foreign = ";\t"; break;
+    case Delim::Semicolon: foreign = "\t"; break;
+    case Delim::Tab: foreign = ";"; break;
+    case Delim::Blanks: foreign = ";"; break;
+  }
+  const auto at = line.find_first_of(foreign);
+  if (at == std::string_view::npos) return;
+  fail(line_, fmt::format("mixed delimiters: the file is {}-separated (from line {}) but this line "
+                          "has a {} at column {}: {}",
+                          delim_name(delim_), layout_line_, line[at] == '\t' ? "tab" : "semicolon",
+                          at + 1, quoted(line)));
+}
+
+void Reader::split(std::string_view line) {
+  fields_.clear();
+  if (delim_ == Delim::Blanks) {
+    std::size_t i = 0;
+    while (i < line.size()) {
+      while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+      if (i >= line.size()) break;
+      const std::size_t s = i;
+      while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
+      fields_.push_back(line.substr(s, i - s));
+    }
+    return;
+  }
+  const char d = delim_ == Delim::Comma ? ',' : delim_ == Delim::Semicolon ? ';' : '\t';
+  std::size_t start = 0;
+  for (;;) {
+    const auto e = line.find(d, start);
+    fields_.push_back(trim(line.substr(start, e == std::string_view::npos ? e : e - start), false));
+    if (e == std::string_view::npos) break;
+    start = e + 1;
+  }
+}
+
+void Reader::parse_field(std::string_view f, Role role, Sample& s) const {
+  const std::string col_label =
+      role == Role::Value ? fmt::format("column {}", value_col_ + 1)
+      : role == Role::Time ? fmt::format("time column {}", *time_col_ + 1)
+                           : fmt::format("temperature column {}", *temp_col_ + 1);
+  const std::string col = header_.empty() ? col_label
+                          : role == Role::Value ? "column '" + header_[value_col_] + "'"
+                          : role == Role::Time  ? "time column '" + header_[*time_col_] + "'"
+                                                : "temperature column '" + header_[*temp_col_] + "'";
+  if (f.empty()) fail(line_, fmt::format("empty field in {}", col));
+  std::string_view t = f;
+  if (t.size() > 1 && t.front() == '+' && t[1] != '-' && t[1] != '+') t.remove_prefix(1);
+  if (role == Role::Value && integer_mode()) {
+    std::int64_t v = 0;
+    auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+    if (r.ec == std::errc() && r.ptr == t.data() + t.size()) {
+      if (opt_.mode == InputMode::Counter && (v < counter_lo_ || v > counter_max_))
+        fail(line_, fmt::format("counter reading {} does not fit a {}-bit counter", quoted(f),
+                                opt_.counter_bits));
+      s.integer = v;
+      return;
+    }
+    if (opt_.mode == InputMode::Counter && opt_.counter_bits == 64 && t.front() != '-') {
+      std::uint64_t u = 0;
+      r = std::from_chars(t.data(), t.data() + t.size(), u);
+      if (r.ec == std::errc() && r.ptr == t.data() + t.size()) {
+        s.integer = static_cast<std::int64_t>(u);  // same residue modulo 2^64
+        return;
+      }
+    }
+    {
+      double d = 0;
+      std::string scratch;
+      const std::string_view n = normalise_decimal(t, delim_ != Delim::Comma, scratch);
+      const auto rd = std::from_chars(n.data(), n.data() + n.size(), d);
+      if (rd.ptr == n.data() + n.size() && rd.ec == std::errc() && !std::isfinite(d))
+        fail(line_, fmt::format("non-finite value in {}: {}", col, quoted(f)));
+    }
+    const bool digits_only =
+        std::all_of(t.begin() + (t.front() == '-'), t.end(), [](char c) { return is_digit(c); }) &&
+        t.size() > static_cast<std::size_t>(t.front() == '-');
+    if (digits_only)
+      fail(line_, fmt::format("number out of range of a 64-bit integer in {}: {}", col, quoted(f)));
+    if (looks_numeric(f, delim_ != Delim::Comma))
+      fail(line_, fmt::format("{} counts must be integers: {} in {}",
+                              opt_.mode == InputMode::Pulses ? "pulse" : "counter", quoted(f), col));
+    fail(line_, fmt::format("not a number in {}: {}", col, quoted(f)));
+  }
+  std::string_view n = normalise_decimal(t, delim_ != Delim::Comma, scratch_);
+  double v = 0;
+  const auto r = std::from_chars(n.data(), n.data() + n.size(), v);
+  if (r.ptr != n.data() + n.size() || r.ec == std::errc::invalid_argument)
+    fail(line_, fmt::format("not a number in {}: {}", col, quoted(f)));
+  if (r.ec == std::errc::result_out_of_range)
+    fail(line_, fmt::format("number out of range in {}: {}", col, quoted(f)));
+  if (!std::isfinite(v)) fail(line_, fmt::format("non-finite value in {}: {}", col, quoted(f)));
+  (role == Role::Value ? s.real : role == Role::Time ? s.time : s.temperature) = v;
+}
+
+LineKind Reader::careful_line(std::string_view line) {
+  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+  if (const auto cr = line.find('\r'); cr != std::string_view::npos)
+    fail(line_, fmt::format("stray carriage return (CR) at column {} inside the line", cr + 1));
+  const std::string_view t = trim(line);
+  if (t.empty()) return LineKind::Blank;
+  ++content_lines_;
+  if (t.front() == '#') {
+    metadata_line(t.substr(1));
+    return LineKind::Comment;
+  }
+  if (!layout_known_ && header_.empty()) detect_delimiter(t);
+  check_foreign_delimiters(t);
+  split(t);
+  const bool comma_ok = delim_ != Delim::Comma;
+  const bool any_numeric =
+      std::any_of(fields_.begin(), fields_.end(), [&](std::string_view f) { return looks_numeric(f, comma_ok); });
+  const bool any_text = std::any_of(fields_.begin(), fields_.end(), [](std::string_view f) { return !f.empty(); });
+  // Inside the data, an all-text line is a second header row when it repeats the header or has
+  // several fields; a lone word in a one-column file is just text in a numeric column.
+  auto repeats_header = [&] {
+    if (header_.empty() || fields_.size() != header_.size()) return false;
+    for (std::size_t c = 0; c < fields_.size(); ++c) {
+      std::string_view f = fields_[c];
+      if (f.size() >= 2 && f.front() == '"' && f.back() == '"') f = f.substr(1, f.size() - 2);
+      if (!iequals(trim(f), header_[c])) return false;
+    }
+    return true;
+  };
+  if (!any_numeric && any_text && (!layout_known_ || fields_.size() >= 2 || repeats_header())) {
+    if (layout_known_)
+      fail(line_, fmt::format("a second header row inside the data: {} (the first is at line {}); "
+                              "were two files joined?",
+                              quoted(t), header_line_ ? header_line_ : first_data_line_));
+    if (!header_.empty())
+      fail(line_, fmt::format("a second header row {} (the first is at line {}); only one is allowed",
+                              quoted(t), header_line_));
+    for (auto f : fields_) {
+      if (f.size() >= 2 && f.front() == '"' && f.back() == '"') f = f.substr(1, f.size() - 2);
+      header_.emplace_back(trim(f));
+    }
+    header_line_ = line_;
+    return LineKind::Header;
+  }
+  if (!layout_known_) {
+    ncols_ = header_.empty() ? fields_.size() : header_.size();
+    establish_layout();
+  }
+  if (fields_.size() != ncols_)
+    fail(line_, fmt::format("wrong number of columns: expected {} ({}-separated, as line {} has), found {}: {}",
+                            ncols_, delim_name(delim_), header_line_ ? header_line_ : first_data_line_,
+                            fields_.size(), quoted(t)));
+  Sample s;
+  for (std::size_t c = 0; c < ncols_; ++c)
+    if (roles_[c] != Role::Skip) parse_field(fields_[c], roles_[c], s);
+  push(s);
+  return LineKind::Data;
+}
+
+void Reader::establish_layout() {
+  layout_known_ = true;
+  first_data_line_ = line_;
+  const std::size_t where = header_line_ ? header_line_ : line_;
+  auto find_name = [&](auto&& names, std::optional<std::size_t> exclude) -> std::optional<std::size_t> {
+    for (std::string_view want : names)
+      for (std::size_t c = 0; c < header_.size(); ++c)
+        if (c != exclude && iequals(header_[c], want)) return c;
+    return std::nullopt;
+  };
+  auto list_columns = [&] {
+    std::string s;
+    for (std::size_t c = 0; c < ncols_; ++c) {
+      if (c) s += ", ";
+      s += header_.empty() ? std::to_string(c + 1) : quoted(header_[c]);
+      if (s.size() > 200) {
+        s += ", ...";
+        break;
+      }
+    }
+    return s;
+  };
+
+  const std::string& want = opt_.column;
+  if (!want.empty()) {
+    if (std::all_of(want.begin(), want.end(), [](char c) { return is_digit(c); })) {
+      std::size_t idx = 0;
+      std::from_chars(want.data(), want.data() + want.size(), idx);
+      if (idx < 1 || idx > ncols_)
+        fail(where, fmt::format("--column {} is out of range: the file has {} column{}", want, ncols_,
+                                ncols_ == 1 ? "" : "s"));
+      value_col_ = idx - 1;
+    } else if (header_.empty()) {
+      fail(where, fmt::format("--column '{}' names a column but the file has no header row; give a "
+                              "1-based index instead",
+                              want));
+    } else if (auto c = find_name(std::array{std::string_view(want)}, std::nullopt)) {
+      value_col_ = *c;
+    } else {
+      fail(header_line_, fmt::format("no column named '{}'; the columns are {}", want, list_columns()));
+    }
+  }
+  if (header_.empty()) {
+    // Headerless layouts: [value], [time, value], [time, value, temperature].
+    if (want.empty()) {
+      if (ncols_ > 3)
+        fail(where, fmt::format("{} columns and no header row: choose the column with --column", ncols_));
+      value_col_ = ncols_ == 1 ? 0 : 1;
+    }
+    if ((ncols_ == 2 || ncols_ == 3) && value_col_ == 1) time_col_ = 0;
+    if (ncols_ == 3 && value_col_ == 1) temp_col_ = 2;
+  } else {
+    time_col_ = find_name(kTimeNames, std::nullopt);
+    if (time_col_ && want.empty() && ncols_ == 1) time_col_.reset();
+    if (want.empty()) {
+      auto c = find_name(value_names(opt_.mode), time_col_);
+      if (!c) {
+        temp_col_ = find_name(kTemperatureNames, time_col_);
+        std::vector<std::size_t> rest;
+        for (std::size_t k = 0; k < ncols_; ++k)
+          if (k != time_col_ && k != temp_col_) rest.push_back(k);
+        if (rest.size() != 1)
+          fail(header_line_, fmt::format("cannot tell which column holds the {} samples; choose one with "
+                                         "--column (the columns are {})",
+                                         to_string(opt_.mode), list_columns()));
+        c = rest.front();
+      }
+      value_col_ = *c;
+    }
+    if (time_col_ == value_col_) time_col_.reset();
+    temp_col_.reset();
+    if (auto tc = find_name(kTemperatureNames, time_col_); tc && tc != value_col_) temp_col_ = tc;
+  }
+  roles_.assign(ncols_, Role::Skip);
+  roles_[value_col_] = Role::Value;
+  if (time_col_) roles_[*time_col_] = Role::Time;
+  if (temp_col_) roles_[*temp_col_] = Role::Temperature;
+
+  // Bytes that end an unselected field in the fast path: its delimiter, the line end, and the
+  // other delimiters (which the careful path reports as mixed).
+  stop_.fill(false);
+  for (char c : {'\n', '\r', ';', '\t'}) stop_[static_cast<unsigned char>(c)] = true;
+  if (delim_ == Delim::Comma) stop_[','] = true;
+  if (delim_ == Delim::Blanks) stop_[' '] = true;
+
+  if (opt_.mode == InputMode::Counter) {
+    const int b = opt_.counter_bits;
+    counter_lo_ = b >= 64 ? std::numeric_limits<std::int64_t>::min() : -(std::int64_t{1} << (b - 1));
+    counter_max_ = b >= 63 ? std::numeric_limits<std::int64_t>::max() : (std::int64_t{1} << b) - 1;
+  }
+}
+
+void Reader::push(const Sample& s) {
+  if (new_run_) {
+    runs_.emplace_back(samples_, line_);
+    new_run_ = false;
+  }
+  if (integer_mode())
+    ints_.push_back(s.integer);
+  else
+    reals_.push_back(s.real);
+  if (time_col_) track_time(s.time);
+  if (temp_col_) {
+    temp_sum_ += s.temperature;
+    ++temp_n_;
+  }
+  last_data_line_ = line_;
+  ++samples_;
+}
+
+// ---- fast path -----------------------------------------------------------------------------------
+
+template <bool Integer>
+bool Reader::fast_line(const char*& p) {
+  const bool blanks = delim_ == Delim::Blanks;
+  const char dc = delim_ == Delim::Comma ? ',' : delim_ == Delim::Semicolon ? ';' : delim_ == Delim::Tab ? '\t' : ' ';
+  const bool comma_ok = delim_ != Delim::Comma;
+  const char* q = p;
+  Sample s;
+  for (std::size_t c = 0; c < ncols_; ++c) {
+    while (*q == ' ' || (blanks && *q == '\t')) ++q;
+    switch (roles_[c]) {
+      case Role::Value:
+        if constexpr (Integer) {
+          q = scan_int_fast(q, s.integer);
+          if (!q) return false;
+          if (opt_.mode == InputMode::Counter && (s.integer < counter_lo_ || s.integer > counter_max_))
+            return false;
+        } else {
+          const char* e = scan_double_fast(q, s.real, comma_ok);
+          if (!e) {
+            // Long mantissas (full-precision doubles): std::from_chars, still no copy.
+            const auto r = std::from_chars(q, end_, s.real);
+            if (r.ec != std::errc() || !std::isfinite(s.real)) return false;
+            e = r.ptr;
+          }
+          q = e;
+        }
+        break;
+      case Role::Time:
+      case Role::Temperature: {
+        double& v = roles_[c] == Role::Time ? s.time : s.temperature;
+        const char* e = scan_double_fast(q, v, comma_ok);
+        if (!e) {
+          const auto r = std::from_chars(q, end_, v);
+          if (r.ec != std::errc() || !std::isfinite(v)) return false;
+          e = r.ptr;
+        }
+        q = e;
+        break;
+      }
+      case Role::Skip:
+        while (!stop_[static_cast<unsigned char>(*q)]) ++q;
+        break;
+    }
+    if (c + 1 < ncols_) {
+      if (blanks) {
+        if (*q != ' ' && *q != '\t') return false;
+      } else {
+        while (*q == ' ') ++q;
+        if (*q != dc) return false;
+        ++q;
+      }
+    }
+  }
+  while (*q == ' ' || (blanks && *q == '\t')) ++q;
+  if (*q == '\r') ++q;
+  if (*q != '\n') return false;
+  if (new_run_) {
+    runs_.emplace_back(samples_, line_);
+    new_run_ = false;
+  }
+  if constexpr (Integer)
+    ints_.push_back(s.integer);
+  else
+    reals_.push_back(s.real);
+  if (time_col_) track_time(s.time);
+  if (temp_col_) {
+    temp_sum_ += s.temperature;
+    ++temp_n_;
+  }
+  ++samples_;
+  p = q + 1;
+  return true;
+}
+
+template <bool Integer>
+void Reader::scan(const char* p) {
+  while (p < end_) {
+    ++line_;
+    if (layout_known_ && fast_line<Integer>(p)) continue;
+    const char* eol = static_cast<const char*>(std::memchr(p, '\n', static_cast<std::size_t>(end_ - p)));
+    if (careful_line(std::string_view(p, static_cast<std::size_t>(eol - p))) != LineKind::Data)
+      new_run_ = true;
+    else
+      last_data_line_ = line_;
+    p = eol + 1;
+  }
+  if (samples_ > 0 && runs_.empty()) runs_.emplace_back(0, first_data_line_);
+}
+
+// ---- after the scan -----------------------------------------------------------------------------
+
+std::size_t Reader::line_of_sample(std::size_t k) const {
+  auto it = std::upper_bound(runs_.begin(), runs_.end(), k,
+                             [](std::size_t v, const auto& run) { return v < run.first; });
+  if (it == runs_.begin()) return 0;
+  --it;
+  return it->second + (k - it->first);
+}
+
+void Reader::finish_rate() {
+  if (opt_.rate_hz) {
+    rate_hz_ = *opt_.rate_hz;
+    rate_source_ = RateSource::Option;
+  } else if (meta_rate_) {
+    rate_hz_ = *meta_rate_;
+    rate_source_ = RateSource::Metadata;
+  } else if (time_col_) {
+    // Candidate period: the median of the first steps (robust to one bad step); refined by the
+    // whole span when that agrees, so long records give the rate to many digits.
+    const std::vector<double>& h = head_times_;
+    const std::size_t k = h.size() - 1;
+    std::vector<double> steps(k);
+    for (std::size_t i = 0; i < k; ++i) steps[i] = h[i + 1] - h[i];
+    std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(k / 2), steps.end());
+    const double candidate = steps[k / 2];
+    if (!(candidate > 0)) {
+      for (std::size_t i = 1; i < h.size(); ++i)
+        if (!(h[i] > h[i - 1]))
+          fail(line_of_sample(i), fmt::format("the time column does not increase: {} s at line {}, then {} s",
+                                              h[i - 1], line_of_sample(i - 1), h[i]));
+    }
+    const double span = (t_prev_ - t_first_) / static_cast<double>(n_times_ - 1);
+    const double period = std::abs(span - candidate) <= opt_.time_tolerance * candidate ? span : candidate;
+    double rate = 1.0 / period;
+    // A rate within 1 ppm of a whole number of Hz is that number (time stamps are printed rounded).
+    if (rate >= 1 && std::abs(rate - std::round(rate)) <= 1e-6 * rate) rate = std::round(rate);
+    rate_hz_ = rate;
+    rate_source_ = RateSource::TimeColumn;
+  }
+}
+
+void Reader::check_time_column() {
+  if (!time_col_ || n_times_ < 2) return;
+  const double period = 1.0 / rate_hz_;
+  const double tol = opt_.time_tolerance * period;
+  const double lo = period - tol, hi = period + tol;
+  if (min_dt_ >= lo && max_dt_ <= hi) return;
+  if (!store_times_) throw NeedTimes{};
+  const std::size_t n = times_.size();
+  const double* t = times_.data();
+  // Branch-free check in blocks; locate the first bad step only when a block trips.
+  constexpr std::size_t kBlock = 4096;
+  for (std::size_t b = 1; b < n; b += kBlock) {
+    const std::size_t e = std::min(n, b + kBlock);
+    bool bad = false;
+    for (std::size_t i = b; i < e; ++i) bad |= !((t[i] - t[i - 1]) >= lo && (t[i] - t[i - 1]) <= hi);
+    if (!bad) continue;
+    for (std::size_t i = b; i < e; ++i) {
+      const double dt = t[i] - t[i - 1];
+      if (dt >= lo && dt <= hi) continue;
+      const std::size_t line = line_of_sample(i), prev = line_of_sample(i - 1);
+      const std::string tcol = header_.empty() ? "column 1" : "'" + header_[*time_col_] + "'";
+      if (rate_source_ == RateSource::Option || rate_source_ == RateSource::Metadata) {
+        const double est = (t[n - 1] - t[0]) / static_cast<double>(n - 1);
+        if (std::abs(est - period) > tol)
+          fail(line, fmt::format("the sample rate {} Hz (from {}) is inconsistent with the time column {}, "
+                                 "which steps by {} s (~{:.6g} Hz), e.g. {} s at line {} then {} s",
+                                 rate_hz_, rate_source_ == RateSource::Option ? "--rate" : fmt::format("metadata at line {}", meta_rate_line_),
+                                 tcol, est, 1.0 / est, t[i - 1], prev, t[i]));
+      }
+      if (dt == 0)
+        fail(line, fmt::format("repeated time stamp {} s (also at line {}); no resampling is done", t[i], prev));
+      if (dt < 0)
+        fail(line, fmt::format("time goes backwards: {} s at line {}, then {} s", t[i - 1], prev, t[i]));
+      if (dt > period)
+        fail(line, fmt::format("gap in the time column: {} s at line {}, then {} s (a step of {:.6g} periods of "
+                               "{} s; tolerance {}); no resampling is done",
+                               t[i - 1], prev, t[i], dt / period, period, opt_.time_tolerance));
+      fail(line, fmt::format("time step too short: {} s at line {}, then {} s (a step of {:.6g} periods of {} s; "
+                             "tolerance {})",
+                             t[i - 1], prev, t[i], dt / period, period, opt_.time_tolerance));
+    }
+  }
+  fail(0, "the time column does not step by the sample period");  // not reached: a step tripped above
+}
+
+void Reader::build_phase(Recording& rec) {
+  PhaseSeries& ph = rec.phase;
+  ph.tau0_s = 1.0 / rate_hz_;
+  const bool clock = (opt_.mode == InputMode::Angle && opt_.angle_unit == AngleUnit::Second) ||
+                     (opt_.mode == InputMode::Rate && opt_.rate_unit == RateUnit::Unitless);
+  ph.kind = clock ? PhaseKind::Clock : PhaseKind::Gyro;
+  constexpr auto kLimit = static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
+
+  switch (opt_.mode) {
+    case InputMode::Pulses: {
+      // C_0 = 0, C_k = Σ c_i, wrapping modulo 2^64 (PhaseSeries differences are modular, so an offset
+      // never matters). Every second difference stays exact while Σ|c_i| < 2^63; beyond that the
+      // record is refused.
+      std::vector<std::int64_t>& c = ints_;
+      std::uint64_t acc = 0, mag = 0;
+      for (std::size_t i = 1; i < c.size(); ++i) {
+        const auto v = static_cast<std::uint64_t>(c[i]);
+        acc += v;
+        mag += c[i] < 0 ? (~v + 1) : v;
+        c[i] = static_cast<std::int64_t>(acc);
+        if (mag > kLimit) [[unlikely]]
+          fail(line_of_sample(i - 1),
+               "pulse counts too large to be summed exactly: the sum of |counts| exceeds 2^63-1 here");
+      }
+      ph.counts = std::move(c);
+      break;
+    }
+    case InputMode::Counter: {
+      // Unwrap: each step is (R_k − R_{k−1}) mod 2^B in [0, 2^B), so a backwards step counts as a wrap.
+      std::vector<std::int64_t>& c = ints_;
+      const int b = opt_.counter_bits;
+      const std::uint64_t mask = b >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << b) - 1;
+      std::uint64_t prev = static_cast<std::uint64_t>(c[0]) & mask, acc = 0, total = 0;
+      std::size_t wraps = 0;
+      c[0] = 0;
+      for (std::size_t i = 1; i < c.size(); ++i) {
+        const std::uint64_t r = static_cast<std::uint64_t>(c[i]) & mask;
+        const std::uint64_t step = (r - prev) & mask;
+        wraps += r < prev;
+        prev = r;
+        acc += step;
+        c[i] = static_cast<std::int64_t>(acc);
+        if (step > kLimit - total) [[unlikely]]
+          fail(line_of_sample(i), fmt::format("the unwrapped counter advances by more than 2^63-1 counts here "
+                                              "(a backwards step counts as a wrap of the {}-bit counter)",
+                                              b));
+        total += step;
+      }
+      rec.counter_wraps = wraps;
+      ph.counts = std::move(c);
+      break;
+    }
+    case InputMode::Angle: {
+      double f = 1.0;
+      switch (opt_.angle_unit) {
+        case AngleUnit::Arcsec: case AngleUnit::Second: f = 1.0; break;
+        case AngleUnit::Deg: f = units::arcsec_per_deg; break;
+        case AngleUnit::Rad: f = units::arcsec_per_rad; break;
+      }
+      if (f != 1.0)
+        for (double& v : reals_) v *= f;
+      ph.values = std::move(reals_);
+      break;
+    }
+    case InputMode::Rate: {
+      double f = 1.0;  // to ″/s (= °/h) for gyro data
+      switch (opt_.rate_unit) {
+        case RateUnit::DegPerHour: case RateUnit::Unitless: f = 1.0; break;
+        case RateUnit::DegPerSecond: f = units::arcsec_per_deg; break;
+        case RateUnit::RadPerSecond: f = units::arcsec_per_rad; break;
+      }
+      // SP 1065 phase from frequency: x_0 = 0, x_j = τ0·Σ_{i<j} y_i, accumulated in long double.
+      std::vector<double>& x = reals_;
+      const long double k = static_cast<long double>(ph.tau0_s) * f;
+      long double acc = 0;
+      for (std::size_t i = 1; i < x.size(); ++i) {
+        acc += static_cast<long double>(x[i]) * k;
+        x[i] = static_cast<double>(acc);
+      }
+      ph.values = std::move(x);
+      break;
+    }
+  }
+}
+
+Recording Reader::run(bool store_times) {
+  store_times_ = store_times;
+  const char* p = begin_;
+  if (end_ - p >= 3 && static_cast<unsigned char>(p[0]) == 0xEF && static_cast<unsigned char>(p[1]) == 0xBB &&
+      static_cast<unsigned char>(p[2]) == 0xBF)
+    p += 3;
+  // Room for every line at once: one '\n' per line.
+  const std::size_t lines = check_bytes(p);
+  // Slot 0 holds C_0 = 0 (pulses) or x_0 = 0 (rate); counter and angle samples are points already.
+  if (integer_mode()) {
+    ints_.reserve(lines + 1);
+    detail::prefault(ints_.data(), ints_.capacity() * sizeof(std::int64_t));
+    if (opt_.mode == InputMode::Pulses) ints_.push_back(0);
+  } else {
+    reals_.reserve(lines + 1);
+    detail::prefault(reals_.data(), reals_.capacity() * sizeof(double));
+    if (opt_.mode == InputMode::Rate) reals_.push_back(0.0);
+  }
+  if (store_times_) times_.reserve(lines);
+
+  // Header region and the first data line go through the careful path; it fixes the layout.
+  if (integer_mode())
+    scan<true>(p);
+  else
+    scan<false>(p);
+
+  if (samples_ == 0) {
+    if (header_line_)
+      fail(header_line_, "no samples: the file has a header row but no data lines");
+    fail(0, content_lines_ == 0 ? "empty file: no samples"
+                                : "no samples: the file holds only comments and blank lines");
+  }
+  if (samples_ < 2)
+    fail(first_data_line_, "only one sample; at least 2 are needed");
+
+  finish_rate();
+  check_time_column();
+
+  Recording rec;
+  rec.samples = samples_;
+  build_phase(rec);
+  rec.phase.arcsec_per_count = opt_.scale_arcsec ? *opt_.scale_arcsec
+                               : meta_scale_     ? *meta_scale_
+                                                 : units::gl2d_arcsec_per_pulse;
+  rec.rate_hz = rate_hz_;
+  rec.rate_source = rate_source_;
+  rec.metadata = std::move(metadata_);
+  if (temp_n_ > 0)
+    rec.temperature_c = static_cast<double>(temp_sum_ / static_cast<long double>(temp_n_));
+  else if (meta_temp_)
+    rec.temperature_c = meta_temp_;
+  rec.column_name = header_.empty() ? fmt::format("column {}", value_col_ + 1) : header_[value_col_];
+  if (time_col_) rec.time_column = header_.empty() ? std::string("column 1") : header_[*time_col_];
+  rec.mode = opt_.mode;
+  rec.line_runs = std::move(runs_);
+  return rec;
+}
+
+void validate(const ReadOptions& o) {
+  if (o.rate_hz && !(std::isfinite(*o.rate_hz) && *o.rate_hz > 0))
+    throw UsageError(fmt::format("--rate must be a positive number of Hz, got {}", *o.rate_hz));
+  if (o.scale_arcsec && !(std::isfinite(*o.scale_arcsec) && *o.scale_arcsec > 0))
+    throw UsageError(fmt::format("--scale must be a positive number of arcsec, got {}", *o.scale_arcsec));
+  if (o.counter_bits < 1 || o.counter_bits > 64)
+    throw UsageError(fmt::format("--counter-bits must be 1..64, got {}", o.counter_bits));
+  if (!(o.time_tolerance >= 0 && o.time_tolerance < 1))
+    throw UsageError(fmt::format("--time-tolerance must be in [0, 1), got {}", o.time_tolerance));
+}
+
+Recording read_buffer(TextBuffer& buf, const std::string& source, const ReadOptions& options) {
+  // Classic Mac line ends (CR only, no LF before the sentinel): read CR as the line end.
+  if (buf.size() > 1 && !std::memchr(buf.data(), '\n', buf.size() - 1) && std::memchr(buf.data(), '\r', buf.size()))
+    std::replace(buf.data(), buf.data() + buf.size(), '\r', '\n');
+  Recording rec;
+  try {
+    rec = Reader(buf, detail::display_name(source), options).run(false);
+  } catch (const NeedTimes&) {
+    // A time step is out of tolerance: read again keeping every stamp to name the first bad line.
+    rec = Reader(buf, detail::display_name(source), options).run(true);
+  }
+  rec.source = source;
+  return rec;
+}
+
+}  // namespace
+
+// ---- public API ------------------------------------------------------------------------------------
+
+Recording read_recording(const std::string& path, const ReadOptions& options) {
+  validate(options);
+  TextBuffer buf = detail::load_source(path);
+  return read_buffer(buf, path, options);
+}
+
+Recording read_recording_text(std::string_view text, const std::string& name, const ReadOptions& options) {
+  validate(options);
+  TextBuffer buf = detail::load_text(text, detail::display_name(name));
+  return read_buffer(buf, name, options);
+}
+
+std::vector<double> Recording::rates() const {
+  const std::size_t n = phase.points() > 0 ? phase.points() - 1 : 0;
+  std::vector<double> r(n);
+  for (std::size_t i = 0; i < n; ++i) r[i] = phase.rate(i);
+  return r;
+}
+
+std::size_t Recording::line_of_sample(std::size_t k) const noexcept {
+  if (k >= samples) return 0;
+  auto it = std::upper_bound(line_runs.begin(), line_runs.end(), k,
+                             [](std::size_t v, const auto& run) { return v < run.first; });
+  if (it == line_runs.begin()) return 0;
+  --it;
+  return it->second + (k - it->first);
+}
+
+std::size_t Recording::line_of_rate(std::size_t i) const noexcept {
+  const bool readings = mode == InputMode::Counter || mode == InputMode::Angle;
+  return line_of_sample(readings ? i + 1 : i);
+}
+
+InputMode parse_input_mode(std::string_view s) {
+  if (s == "pulses") return InputMode::Pulses;
+  if (s == "counter") return InputMode::Counter;
+  if (s == "angle") return InputMode::Angle;
+  if (s == "rate") return InputMode::Rate;
+  throw UsageError(fmt::format("unknown --input '{}': expected pulses, counter, angle or rate", s));
+}
+
+AngleUnit parse_angle_unit(std::string_view s) {
+  if (s == "arcsec") return AngleUnit::Arcsec;
+  if (s == "deg") return AngleUnit::Deg;
+  if (s == "rad") return AngleUnit::Rad;
+  if (s == "s") return AngleUnit::Second;
+  throw UsageError(fmt::format("unknown --angle-unit '{}': expected arcsec, deg, rad or s", s));
+}
+
+RateUnit parse_rate_unit(std::string_view s) {
+  if (s == "deg/h") return RateUnit::DegPerHour;
+  if (s == "deg/s") return RateUnit::DegPerSecond;
+  if (s == "rad/s") return RateUnit::RadPerSecond;
+  if (s == "1") return RateUnit::Unitless;
+  throw UsageError(fmt::format("unknown --rate-unit '{}': expected deg/h, deg/s, rad/s or 1", s));
+}
+
+std::string_view to_string(InputMode m) {
+  switch (m) {
+    case InputMode::Pulses: return "pulses";
+    case InputMode::Counter: return "counter";
+    case InputMode::Angle: return "angle";
+    case InputMode::Rate: return "rate";
+  }
+  return "?";
+}
+
+std::string_view to_string(RateSource s) {
+  switch (s) {
+    case RateSource::Option: return "option";
+    case RateSource::Metadata: return "metadata";
+    case RateSource::TimeColumn: return "time column";
+    case RateSource::Default: return "default";
+  }
+  return "?";
+}
+
+std::string_view to_string(AngleUnit u) {
+  switch (u) {
+    case AngleUnit::Arcsec: return "arcsec";
+    case AngleUnit::Deg: return "deg";
+    case AngleUnit::Rad: return "rad";
+    case AngleUnit::Second: return "s";
+  }
+  return "?";
+}
+
+std::string_view to_string(RateUnit u) {
+  switch (u) {
+    case RateUnit::DegPerHour: return "deg/h";
+    case RateUnit::DegPerSecond: return "deg/s";
+    case RateUnit::RadPerSecond: return "rad/s";
+    case RateUnit::Unitless: return "1";
+  }
+  return "?";
+}
+
+}  // namespace rwcalc

@@ -1,0 +1,111 @@
+#pragma once
+// Internal to the reader: loading raw bytes (files, stdin, gzip) and the number scanners shared by
+// the fast and the careful line parsers.
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+
+namespace rwcalc::detail {
+
+/// Bytes of a recording held in memory. Always ends with '\n' (appended when the input does not),
+/// so the scanners can run without bounds checks: every field scan stops at the final newline.
+class TextBuffer {
+ public:
+  TextBuffer() = default;
+  /// Buffer of `size` bytes plus room for the sentinel newline; contents uninitialised.
+  explicit TextBuffer(std::size_t capacity);
+  [[nodiscard]] char* data() noexcept { return data_.get(); }
+  [[nodiscard]] const char* data() const noexcept { return data_.get(); }
+  [[nodiscard]] std::size_t size() const noexcept { return size_; }
+  [[nodiscard]] std::size_t capacity() const noexcept { return capacity_; }
+  void set_size(std::size_t n) noexcept { size_ = n; }
+  /// Grow the capacity (keeping the first size() bytes).
+  void reserve(std::size_t capacity);
+  /// Append the sentinel newline if the text does not already end with one.
+  void terminate();
+  [[nodiscard]] std::string_view view() const noexcept { return {data_.get(), size_}; }
+
+ private:
+  std::unique_ptr<char[]> data_;
+  std::size_t size_ = 0;
+  std::size_t capacity_ = 0;
+};
+
+/// Name used in messages for a path ("<stdin>" for "-").
+std::string display_name(const std::string& path);
+
+/// Read a whole file (or stdin for "-") into memory, inflating gzip data. Throws InputError
+/// (line 0) for a missing, unreadable or non-regular path and for corrupt or truncated gzip.
+TextBuffer load_source(const std::string& path);
+
+/// Copy in-memory text, inflating it when it starts with the gzip magic bytes.
+TextBuffer load_text(std::string_view text, const std::string& name);
+
+/// True when the bytes start with the gzip magic 1f 8b.
+bool is_gzip(std::string_view bytes) noexcept;
+
+/// Inflate a complete gzip stream (one or more members). Throws InputError naming `name`.
+TextBuffer inflate_gzip(std::string_view bytes, const std::string& name);
+
+/// Ask the kernel to map the pages of a fresh buffer in one call (where supported): first-touch page
+/// faults otherwise dominate reading a large recording. A hint only; failures are ignored.
+void prefault(void* data, std::size_t bytes) noexcept;
+
+// ---- number scanners ---------------------------------------------------------------------------
+
+inline bool is_digit(char c) noexcept { return static_cast<unsigned char>(c - '0') < 10; }
+
+/// Fast path for a plain integer "[-]d…d" of at most 18 digits at p. Returns the end of the number,
+/// or nullptr when the text is not of that simple form (the careful parser then decides).
+inline const char* scan_int_fast(const char* p, std::int64_t& out) noexcept {
+  const bool neg = *p == '-';
+  p += neg;
+  const char* start = p;
+  std::uint64_t v = 0;
+  while (is_digit(*p)) {
+    v = v * 10 + static_cast<std::uint64_t>(*p - '0');
+    ++p;
+  }
+  const auto n = p - start;
+  if (n == 0 || n > 18) return nullptr;
+  out = neg ? -static_cast<std::int64_t>(v) : static_cast<std::int64_t>(v);
+  return p;
+}
+
+/// Fast path for a plain decimal "[-]d…d[.d…d]" whose digits form an integer ≤ 2^53 with at most
+/// 22 fraction digits (a decimal comma stands for the point when comma_ok). Then m / 10^k of two exact doubles is the correctly rounded value, the same
+/// double std::from_chars gives (Clinger's fast path). Returns nullptr for anything else.
+inline const char* scan_double_fast(const char* p, double& out, bool comma_ok) noexcept {
+  static constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                      1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                      1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+  const bool neg = *p == '-';
+  p += neg;
+  const char* start = p;
+  std::uint64_t m = 0;
+  while (is_digit(*p)) {
+    m = m * 10 + static_cast<std::uint64_t>(*p - '0');
+    ++p;
+  }
+  auto digits = p - start;
+  std::ptrdiff_t frac = 0;
+  if (*p == '.' || (comma_ok && *p == ',')) {
+    ++p;
+    const char* f = p;
+    while (is_digit(*p)) {
+      m = m * 10 + static_cast<std::uint64_t>(*p - '0');
+      ++p;
+    }
+    frac = p - f;
+    digits += frac;
+  }
+  if (digits == 0 || digits > 19 || frac > 22 || m > (std::uint64_t{1} << 53)) return nullptr;
+  if (*p == 'e' || *p == 'E') return nullptr;
+  const double v = static_cast<double>(m) / kPow10[frac];
+  out = neg ? -v : v;
+  return p;
+}
+
+}  // namespace rwcalc::detail

@@ -1,0 +1,176 @@
+// Getting the bytes of a recording into memory: regular files with read(2), standard input, and
+// gzip data inflated with zlib into a growing buffer. One allocation per file, no iostreams.
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <sys/mman.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <limits>
+
+#include "reader_detail.hpp"
+#include "rwcalc/error.hpp"
+
+namespace rwcalc::detail {
+
+void prefault(void* data, std::size_t bytes) noexcept {
+#ifdef MADV_POPULATE_WRITE
+  constexpr std::size_t kMin = std::size_t{1} << 20;  // small buffers: not worth a system call
+  if (!data || bytes < kMin) return;
+  const auto page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
+  const auto a = reinterpret_cast<std::uintptr_t>(data);
+  const std::uintptr_t start = (a + page - 1) & ~(page - 1);
+  const std::uintptr_t end = (a + bytes) & ~(page - 1);
+  if (end > start) (void)::madvise(reinterpret_cast<void*>(start), end - start, MADV_POPULATE_WRITE);
+#else
+  (void)data;
+  (void)bytes;
+#endif
+}
+
+TextBuffer::TextBuffer(std::size_t capacity)
+    : data_(std::make_unique_for_overwrite<char[]>(capacity + 1)), capacity_(capacity) {
+  prefault(data_.get(), capacity);
+}
+
+void TextBuffer::reserve(std::size_t capacity) {
+  if (capacity <= capacity_) return;
+  auto bigger = std::make_unique_for_overwrite<char[]>(capacity + 1);
+  prefault(bigger.get() + size_, capacity - size_);
+  if (size_ > 0) std::memcpy(bigger.get(), data_.get(), size_);
+  data_ = std::move(bigger);
+  capacity_ = capacity;
+}
+
+void TextBuffer::terminate() {
+  if (size_ > 0 && data_[size_ - 1] == '\n') return;
+  if (!data_) reserve(0);
+  data_[size_++] = '\n';  // capacity + 1 bytes are always allocated
+  capacity_ = std::max(capacity_, size_);
+}
+
+std::string display_name(const std::string& path) { return path == "-" ? "<stdin>" : path; }
+
+bool is_gzip(std::string_view bytes) noexcept {
+  return bytes.size() >= 2 && static_cast<unsigned char>(bytes[0]) == 0x1f &&
+         static_cast<unsigned char>(bytes[1]) == 0x8b;
+}
+
+namespace {
+
+class FileDescriptor {
+ public:
+  explicit FileDescriptor(int fd) : fd_(fd) {}
+  ~FileDescriptor() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  FileDescriptor(const FileDescriptor&) = delete;
+  FileDescriptor& operator=(const FileDescriptor&) = delete;
+  [[nodiscard]] int get() const noexcept { return fd_; }
+
+ private:
+  int fd_;
+};
+
+[[noreturn]] void fail_errno(const std::string& name, const char* what, int err) {
+  throw InputError(name, 0, std::string(what) + ": " + std::strerror(err));
+}
+
+// Read everything from fd into buf, starting at buf.size(), growing as needed.
+void read_all(int fd, TextBuffer& buf, const std::string& name) {
+  for (;;) {
+    if (buf.size() == buf.capacity()) buf.reserve(std::max<std::size_t>(buf.capacity() * 2, 1 << 16));
+    const ssize_t n = ::read(fd, buf.data() + buf.size(), buf.capacity() - buf.size());
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      fail_errno(name, "cannot read", errno);
+    }
+    if (n == 0) return;
+    buf.set_size(buf.size() + static_cast<std::size_t>(n));
+  }
+}
+
+}  // namespace
+
+TextBuffer inflate_gzip(std::string_view bytes, const std::string& name) {
+  z_stream zs{};
+  // 16 + MAX_WBITS: gzip wrapper only (the caller checked the magic bytes).
+  if (inflateInit2(&zs, 16 + MAX_WBITS) != Z_OK) throw InputError(name, 0, "cannot initialise zlib");
+  struct Guard {
+    z_stream* z;
+    ~Guard() { inflateEnd(z); }
+  } guard{&zs};
+
+  // zlib counts in uInt; feed input and output in chunks so files over 4 GiB work too.
+  constexpr std::size_t kChunk = std::size_t{1} << 30;
+  const auto* in_begin = reinterpret_cast<const Bytef*>(bytes.data());
+  zs.next_in = const_cast<Bytef*>(in_begin);
+  zs.avail_in = 0;
+  auto consumed = [&] { return static_cast<std::size_t>(zs.next_in - in_begin); };
+
+  TextBuffer out(std::max<std::size_t>(bytes.size() * 4, 1 << 16));
+  for (;;) {
+    if (zs.avail_in == 0) zs.avail_in = static_cast<uInt>(std::min(kChunk, bytes.size() - consumed()));
+    if (out.size() == out.capacity()) out.reserve(out.capacity() * 2);
+    zs.next_out = reinterpret_cast<Bytef*>(out.data() + out.size());
+    zs.avail_out = static_cast<uInt>(std::min(kChunk, out.capacity() - out.size()));
+    const std::size_t room = zs.avail_out;
+    const int rc = inflate(&zs, Z_NO_FLUSH);
+    out.set_size(out.size() + (room - zs.avail_out));
+    if (rc == Z_OK) continue;
+    if (rc == Z_STREAM_END) {
+      const std::size_t pos = consumed();
+      if (pos == bytes.size()) break;
+      // Concatenated gzip members (as `cat a.gz b.gz` makes) are one stream, as gzip reads them.
+      if (!is_gzip(bytes.substr(pos)))
+        throw InputError(name, 0, "unexpected bytes after the end of the gzip data");
+      inflateReset(&zs);
+      continue;
+    }
+    if (rc == Z_BUF_ERROR && zs.avail_in == 0 && consumed() == bytes.size())
+      throw InputError(name, 0,
+                       "truncated gzip data: the compressed stream ends before its end marker (" +
+                           std::to_string(out.size()) + " bytes decompressed); the file is incomplete");
+    if (rc == Z_BUF_ERROR) continue;  // needs more output room or input: the loop provides both
+    throw InputError(name, 0, std::string("corrupt gzip data: ") + (zs.msg ? zs.msg : "inflate failed"));
+  }
+  out.terminate();
+  return out;
+}
+
+TextBuffer load_text(std::string_view text, const std::string& name) {
+  if (is_gzip(text)) return inflate_gzip(text, name);
+  TextBuffer buf(text.size());
+  if (!text.empty()) std::memcpy(buf.data(), text.data(), text.size());
+  buf.set_size(text.size());
+  buf.terminate();
+  return buf;
+}
+
+TextBuffer load_source(const std::string& path) {
+  const std::string name = display_name(path);
+  TextBuffer raw;
+  if (path == "-") {
+    raw.reserve(1 << 20);
+    read_all(STDIN_FILENO, raw, name);
+  } else {
+    if (path.empty()) throw InputError("(empty path)", 0, "no input file given");
+    FileDescriptor fd(::open(path.c_str(), O_RDONLY | O_CLOEXEC));
+    if (fd.get() < 0) fail_errno(name, "cannot open", errno);
+    struct stat st {};
+    if (::fstat(fd.get(), &st) != 0) fail_errno(name, "cannot stat", errno);
+    if (S_ISDIR(st.st_mode)) throw InputError(name, 0, "is a directory, not a recording");
+    // Regular files: one read of the known size; pipes and devices grow as they go.
+    // One spare byte lets the final read(2) see end-of-file without growing the buffer.
+    raw.reserve(S_ISREG(st.st_mode) ? static_cast<std::size_t>(st.st_size) + 1 : std::size_t{1} << 20);
+    read_all(fd.get(), raw, name);
+  }
+  if (is_gzip(raw.view())) return inflate_gzip(raw.view(), name);
+  raw.terminate();
+  return raw;
+}
+
+}  // namespace rwcalc::detail
