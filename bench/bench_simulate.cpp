@@ -4,27 +4,16 @@
 
 #include <atomic>
 
+#include "bench_inputs.hpp"
 #include "rwcalc/simulate.hpp"
 
 namespace {
 
 using namespace rwcalc;
 
-NoiseModel gl2d_model() {
-  NoiseModel m;
-  m.arw_deg_per_sqrt_h = 0.00098;
-  m.bias_instability_deg_per_h = 0.0081;
-  m.earth_rate_deg_per_h = earth_rate_at(55.75);
-  m.readout = ReadoutMode::White;
-  return m;
-}
+NoiseModel gl2d_model_local() { return bench::gl2d_model(); }
 
-SimulationSettings two_hours() {
-  SimulationSettings s;
-  s.duration_s = 7200.0;
-  s.rate_hz = 400.0;
-  return s;
-}
+SimulationSettings two_hours() { return bench::gl2d_settings(); }
 
 void run_model(benchmark::State& state, const NoiseModel& m) {
   Simulator sim(m, two_hours());
@@ -37,11 +26,11 @@ void run_model(benchmark::State& state, const NoiseModel& m) {
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(two_hours().samples()));
 }
 
-void BM_SimulateGl2dExact(benchmark::State& state) { run_model(state, gl2d_model()); }
+void BM_SimulateGl2dExact(benchmark::State& state) { run_model(state, gl2d_model_local()); }
 BENCHMARK(BM_SimulateGl2dExact)->Unit(benchmark::kMillisecond);
 
 void BM_SimulateNoFlicker(benchmark::State& state) {
-  auto m = gl2d_model();
+  auto m = gl2d_model_local();
   m.bias_instability_deg_per_h = 0;
   run_model(state, m);
 }
@@ -67,7 +56,7 @@ BENCHMARK(BM_SimulateCountingReadout)->Unit(benchmark::kMillisecond);
 namespace {
 
 void BM_SimulateGl2dEnsemblePath(benchmark::State& state) {
-  Simulator sim(gl2d_model(), two_hours(), SimulationPath::Ensemble);
+  Simulator sim(gl2d_model_local(), two_hours(), SimulationPath::Ensemble);
   PhaseSeries out;
   std::uint64_t seed = 1;
   for (auto _ : state) {
@@ -82,7 +71,7 @@ BENCHMARK(BM_SimulateGl2dEnsemblePath)->Unit(benchmark::kMillisecond);
 void BM_Ensemble50Gl2d(benchmark::State& state) {
   for (auto _ : state) {
     std::atomic<std::int64_t> sink{0};
-    simulate_ensemble(gl2d_model(), two_hours(), 50,
+    simulate_ensemble(gl2d_model_local(), two_hours(), 50,
                       [&](std::size_t, const PhaseSeries& p) { sink += p.counts.back(); });
     benchmark::DoNotOptimize(sink.load());
   }
