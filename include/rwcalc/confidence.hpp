@@ -5,24 +5,41 @@
 /// Greenhall, EFTF 2004).
 #include <cstddef>
 #include <cstdint>
-#include <span>
+
+#include "rwcalc/allan.hpp"
+#include "rwcalc/series.hpp"
 
 namespace rwcalc {
 
-/// Lag-1 autocorrelation noise identification (Riley & Greenhall 2004) of a phase series at
-/// averaging factor m, for a variance of difference order d (2: Allan). Returns α rounded to an
-/// integer in [−2, 2]. Where too few points remain for the lag-1 method, falls back to the B1
-/// bias-ratio method as Stable32 does. `is_phase` is true for phase data.
-int identify_noise(std::span<const double> phase, std::int64_t m, int d = 2);
+/// Power-law noise exponent α (S_y(f) ∝ f^α, +2 white PM/quantization … −2 random-walk FM) of
+/// `x` at averaging factor m, identified as Stable32 does:
+///  - lag-1 autocorrelation (Riley & Greenhall 2004) of the series decimated to τ = mτ0 (phase
+///    samples x[0], x[m], … or m-averaged frequencies, per `domain`) when at least 30 such points
+///    remain; differencing up to d_max = 2 times;
+///  - otherwise the B1 ratio (standard variance / Allan variance of the m-averaged frequencies)
+///    against its expected values (Howe, Beard, Greenhall & Riley 2000) for N = the estimator's
+///    number of terms, μ = −2 read as flicker PM except for MVAR, where the R(n) = MVAR/AVAR ratio
+///    tells white from flicker PM.
+/// (compute_allan also carries the previous τ's α over to the longest τ of a run, as Stable32.)
+/// Returns an integer in [−2, 2]; 0 (white FM) when the data are constant or too short to tell.
+int identify_noise(const PhaseSeries& x, std::int64_t m, Estimator est,
+                   NoiseIdDomain domain = NoiseIdDomain::Phase);
 
-/// Greenhall–Riley EDF. alpha: noise exponent; d: 1 first difference, 2 Allan, 3 Hadamard;
-/// m: averaging factor; n_phase: number of phase points; overlapping: stride 1 (true) or m;
-/// modified: filter factor 1 (true) or m.
+/// Greenhall–Riley EDF. alpha: noise exponent (+2 … −4, α + 2d > 1); d: 1 first difference,
+/// 2 Allan, 3 Hadamard; m: averaging factor; n_phase: number of phase points; overlapping:
+/// stride 1 (true) or m; modified: filter factor 1 (true) or m. Uses the exact BasicSum up to
+/// J = 100 terms and the paper's asymptotic tables beyond, as Stable32 and allantools do.
+/// Returns 0 when m leaves no term.
 double edf_greenhall(int alpha, int d, std::int64_t m, std::size_t n_phase, bool overlapping,
                      bool modified);
 
-/// Two-sided χ² interval of a deviation: returns {low, high} of σ for a measured variance `var`,
-/// EDF `edf` and confidence `p` (e.g. 0.683). Exact χ² quantiles (Boost.Math).
+/// EDF of an estimator at cluster size m (edf_greenhall with d = 2 and the estimator's stride and
+/// filter).
+double edf_for(Estimator est, int alpha, std::int64_t m, std::size_t n_phase);
+
+/// Two-sided χ² interval of a deviation: {low, high} of σ for a measured variance `var`,
+/// EDF `edf` and confidence `p` (e.g. 0.683): σ² ∈ [ν·var/χ²_ν((1+p)/2), ν·var/χ²_ν((1−p)/2)].
+/// Exact χ² quantiles (Boost.Math).
 struct DevInterval {
   double low;
   double high;

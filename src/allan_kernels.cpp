@@ -1,0 +1,396 @@
+// Hot loops of the Allan-variance estimators. Written as plain loops over contiguous arrays with
+// several independent accumulators so that the compiler vectorises them; built for AVX2 and for
+// the baseline ISA, the better one chosen at load time (function multiversioning).
+#include "allan_kernels.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
+#define RWCALC_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define RWCALC_CLONES
+#endif
+#if defined(__x86_64__) && defined(__GNUC__)
+#define RWCALC_X86_DISPATCH 1
+#include <immintrin.h>
+#else
+#define RWCALC_X86_DISPATCH 0
+#endif
+
+namespace rwcalc::detail {
+
+namespace {
+
+constexpr int kLanes = 8;
+// Block length and magnitude limit of the exact floating path: with |d| ≤ 2^21 every square is an
+// integer ≤ 2^42 and a block of 1024 sums to ≤ 2^52, so every partial sum is an exactly
+// representable integer and the block total is exact whatever the summation order.
+constexpr std::int64_t kBlock = 1024;
+constexpr std::uint64_t kHalfRange = std::uint64_t{1} << 21;
+
+// int64 → double without a scalar conversion instruction: exact for |d| < 2^51 (the magic
+// constant 1.5·2^52 puts d in the mantissa). Out-of-range blocks are redone exactly anyway.
+inline double to_double_small(std::uint64_t d) {
+  constexpr std::uint64_t kMagicBits = 0x4338000000000000ULL;  // bit pattern of 1.5·2^52
+  constexpr double kMagic = 6755399441055744.0;
+  return std::bit_cast<double>(d + kMagicBits) - kMagic;
+}
+
+inline std::int64_t second_diff(const std::int64_t* c, std::int64_t k, std::int64_t m) {
+  const auto a = static_cast<std::uint64_t>(c[k]);
+  const auto b = static_cast<std::uint64_t>(c[k + m]);
+  const auto e = static_cast<std::uint64_t>(c[k + 2 * m]);
+  return static_cast<std::int64_t>(e - 2 * b + a);
+}
+
+u128 exact_block(const std::int64_t* c, std::int64_t k0, std::int64_t len, std::int64_t m,
+                 std::int64_t stride) {
+  u128 s = 0;
+  for (std::int64_t i = 0; i < len; ++i) {
+    const i128 d = second_diff(c, k0 + i * stride, m);
+    s += static_cast<u128>(d * d);
+  }
+  return s;
+}
+
+RWCALC_CLONES
+bool block_sumsq_contiguous(const std::int64_t* __restrict a, const std::int64_t* __restrict b,
+                            const std::int64_t* __restrict e, std::int64_t len, double* out) {
+  double acc[kLanes] = {};
+  std::uint64_t range[kLanes] = {};
+  std::int64_t i = 0;
+  for (; i + kLanes <= len; i += kLanes) {
+    for (int j = 0; j < kLanes; ++j) {
+      const std::uint64_t d = static_cast<std::uint64_t>(e[i + j]) - 2 * static_cast<std::uint64_t>(b[i + j]) +
+                              static_cast<std::uint64_t>(a[i + j]);
+      range[j] |= d + kHalfRange;
+      const double v = to_double_small(d);
+      acc[j] += v * v;
+    }
+  }
+  for (; i < len; ++i) {
+    const std::uint64_t d =
+        static_cast<std::uint64_t>(e[i]) - 2 * static_cast<std::uint64_t>(b[i]) + static_cast<std::uint64_t>(a[i]);
+    range[0] |= d + kHalfRange;
+    const double v = to_double_small(d);
+    acc[0] += v * v;
+  }
+  std::uint64_t r = 0;
+  double s = 0;
+  for (int j = 0; j < kLanes; ++j) {
+    r |= range[j];
+    s += acc[j];
+  }
+  *out = s;
+  return (r >> 22) == 0;  // every d + 2^21 < 2^22, i.e. −2^21 ≤ d < 2^21
+}
+
+}  // namespace
+
+u128 second_diff_sumsq_counts(const std::int64_t* c, std::int64_t n, std::int64_t m, std::int64_t stride) {
+  u128 total = 0;
+  if (stride != 1) {  // non-overlapping: few terms, strided; exact 128-bit path
+    return exact_block(c, 0, n, m, stride);
+  }
+  for (std::int64_t k0 = 0; k0 < n; k0 += kBlock) {
+    const std::int64_t len = std::min(kBlock, n - k0);
+    double s = 0;
+    if (block_sumsq_contiguous(c + k0, c + k0 + m, c + k0 + 2 * m, len, &s))
+      total += static_cast<std::uint64_t>(s);
+    else
+      total += exact_block(c, k0, len, m, 1);
+  }
+  return total;
+}
+
+RWCALC_CLONES
+double second_diff_sumsq_values(const double* x, std::int64_t n, std::int64_t m, std::int64_t stride) {
+  double acc[kLanes] = {};
+  if (stride == 1) {
+    const double* __restrict a = x;
+    const double* __restrict b = x + m;
+    const double* __restrict e = x + 2 * m;
+    std::int64_t i = 0;
+    for (; i + kLanes <= n; i += kLanes) {
+      for (int j = 0; j < kLanes; ++j) {
+        const double d = e[i + j] - 2.0 * b[i + j] + a[i + j];
+        acc[j] += d * d;
+      }
+    }
+    for (; i < n; ++i) {
+      const double d = e[i] - 2.0 * b[i] + a[i];
+      acc[0] += d * d;
+    }
+  } else {
+    for (std::int64_t i = 0; i < n; ++i) {
+      const std::int64_t k = i * stride;
+      const double d = x[k + 2 * m] - 2.0 * x[k + m] + x[k];
+      acc[i % kLanes] += d * d;
+    }
+  }
+  double s = 0;
+  for (double v : acc) s += v;
+  return s;
+}
+
+RWCALC_CLONES
+double modified_sumsq_counts(const std::uint64_t* prefix, std::int64_t n, std::int64_t m) {
+  const std::uint64_t* __restrict p0 = prefix;
+  const std::uint64_t* __restrict p1 = prefix + m;
+  const std::uint64_t* __restrict p2 = prefix + 2 * m;
+  const std::uint64_t* __restrict p3 = prefix + 3 * m;
+  double acc[kLanes] = {};
+  std::int64_t i = 0;
+  for (; i + kLanes <= n; i += kLanes) {
+    for (int j = 0; j < kLanes; ++j) {
+      // S_j = P[j+3m] − 3P[j+2m] + 3P[j+m] − P[j]: exact modulo 2^64, hence exact as int64.
+      const std::uint64_t s = p3[i + j] - 3 * p2[i + j] + 3 * p1[i + j] - p0[i + j];
+      const double v = static_cast<double>(static_cast<std::int64_t>(s));
+      acc[j] += v * v;
+    }
+  }
+  for (; i < n; ++i) {
+    const std::uint64_t s = p3[i] - 3 * p2[i] + 3 * p1[i] - p0[i];
+    const double v = static_cast<double>(static_cast<std::int64_t>(s));
+    acc[0] += v * v;
+  }
+  double s = 0;
+  for (double v : acc) s += v;
+  return s;
+}
+
+double modified_sumsq_values(const double* x, std::int64_t n, std::int64_t m) {
+  // Running sums S_{j+1} = S_j + z_{j+m} − z_j in up to kLanes interleaved segments, each started
+  // from a direct O(m) sum, so the dependency chains run side by side and rounding drift stays
+  // short. Fewer segments when m is large compared with the number of terms.
+  auto z = [x, m](std::int64_t i) { return x[i + 2 * m] - 2.0 * x[i + m] + x[i]; };
+  const std::int64_t lanes = std::clamp<std::int64_t>(n / (4 * m), 1, kLanes);
+  const std::int64_t seg = (n + lanes - 1) / lanes;
+  double acc[kLanes] = {};
+  double s[kLanes] = {};
+  std::int64_t start[kLanes] = {}, stop[kLanes] = {};
+  for (std::int64_t j = 0; j < lanes; ++j) {
+    start[j] = std::min(n, j * seg);
+    stop[j] = std::min(n, start[j] + seg);
+    if (start[j] < stop[j])
+      for (std::int64_t i = start[j]; i < start[j] + m; ++i) s[j] += z(i);
+  }
+  for (std::int64_t t = 0; t < seg; ++t) {
+    for (std::int64_t j = 0; j < lanes; ++j) {
+      const std::int64_t jj = start[j] + t;
+      if (jj >= stop[j]) continue;
+      acc[j] += s[j] * s[j];
+      if (jj + 1 < stop[j]) s[j] += z(jj + m) - z(jj);
+    }
+  }
+  double total = 0;
+  for (double v : acc) total += v;
+  return total;
+}
+
+std::vector<std::uint64_t> count_prefix_sums(const std::vector<std::int64_t>& c) {
+  std::vector<std::uint64_t> p;
+  p.reserve(c.size() + 1);
+  std::uint64_t run = 0;
+  p.push_back(run);
+  for (std::int64_t v : c) {
+    run += static_cast<std::uint64_t>(v);
+    p.push_back(run);
+  }
+  return p;
+}
+
+namespace {
+
+// GCC/Clang vector extensions: four lanes of double, four of int32; the AVX2 clone maps them
+// onto single instructions (vcvtdq2pd, vmaxpd, vfmadd…), the baseline clone onto SSE2 pairs.
+typedef double v4d __attribute__((vector_size(32)));
+typedef std::int32_t v4i __attribute__((vector_size(16)));
+
+// A macro rather than a function: a function returning v4d would be compiled for the baseline ISA.
+#define RWCALC_LOAD_V4D(p) __builtin_convertvector(load_v4i(p), v4d)
+inline v4i load_v4i(const std::int32_t* p) {
+  v4i v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+bool block_sumsq_i32_generic(const std::int32_t* __restrict a, const std::int32_t* __restrict b,
+                     const std::int32_t* __restrict e, std::int64_t len, double* out) {
+  v4d acc0 = {}, acc1 = {}, mx0 = {}, mx1 = {};
+  std::int64_t i = 0;
+  for (; i + 8 <= len; i += 8) {
+    // |values| < 2^30, so d is an exact double; d² is exact while |d| ≤ 2^21 (checked below).
+    const v4d d0 = RWCALC_LOAD_V4D(e + i) - 2.0 * RWCALC_LOAD_V4D(b + i) + RWCALC_LOAD_V4D(a + i);
+    const v4d d1 = RWCALC_LOAD_V4D(e + i + 4) - 2.0 * RWCALC_LOAD_V4D(b + i + 4) + RWCALC_LOAD_V4D(a + i + 4);
+    const v4d s0 = d0 * d0, s1 = d1 * d1;
+    acc0 += s0;
+    acc1 += s1;
+    mx0 = mx0 > s0 ? mx0 : s0;
+    mx1 = mx1 > s1 ? mx1 : s1;
+  }
+  double s = 0, top = 0;
+  for (int j = 0; j < 4; ++j) {
+    s += acc0[j] + acc1[j];
+    top = std::max({top, mx0[j], mx1[j]});
+  }
+  for (; i < len; ++i) {
+    const double d = static_cast<double>(e[i]) - 2.0 * static_cast<double>(b[i]) + static_cast<double>(a[i]);
+    top = std::max(top, d * d);
+    s += d * d;
+  }
+  *out = s;
+  return top <= static_cast<double>(kHalfRange) * static_cast<double>(kHalfRange);
+}
+
+#if RWCALC_X86_DISPATCH
+// The same block with AVX2 intrinsics: GCC's generic tuning splits the int32 → double vector
+// conversion into halves, which doubles the cost of the loop. Four accumulators hide the add
+// latency. d = fma(−2, b, e + a) is exact: every step is an integer below 2^33.
+__attribute__((target("avx2,fma"))) bool block_sumsq_i32_avx2(const std::int32_t* __restrict a,
+                                                              const std::int32_t* __restrict b,
+                                                              const std::int32_t* __restrict e,
+                                                              std::int64_t len, double* out) {
+  const __m256d minus2 = _mm256_set1_pd(-2.0);
+  __m256d acc[4], mx[4];
+  for (int j = 0; j < 4; ++j) acc[j] = mx[j] = _mm256_setzero_pd();
+#define RWCALC_LOAD4(p) _mm256_cvtepi32_pd(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)))
+  std::int64_t i = 0;
+  for (; i + 16 <= len; i += 16) {
+    for (int j = 0; j < 4; ++j) {
+      const std::int64_t o = i + 4 * j;
+      const __m256d d = _mm256_fmadd_pd(minus2, RWCALC_LOAD4(b + o), _mm256_add_pd(RWCALC_LOAD4(e + o), RWCALC_LOAD4(a + o)));
+      const __m256d sq = _mm256_mul_pd(d, d);
+      acc[j] = _mm256_add_pd(acc[j], sq);
+      mx[j] = _mm256_max_pd(mx[j], sq);
+    }
+  }
+#undef RWCALC_LOAD4
+  alignas(32) double lanes[4], tops[4];
+  _mm256_store_pd(lanes, _mm256_add_pd(_mm256_add_pd(acc[0], acc[1]), _mm256_add_pd(acc[2], acc[3])));
+  _mm256_store_pd(tops, _mm256_max_pd(_mm256_max_pd(mx[0], mx[1]), _mm256_max_pd(mx[2], mx[3])));
+  double s = lanes[0] + lanes[1] + lanes[2] + lanes[3];
+  double top = std::max({tops[0], tops[1], tops[2], tops[3]});
+  for (; i < len; ++i) {
+    const double d = static_cast<double>(e[i]) - 2.0 * static_cast<double>(b[i]) + static_cast<double>(a[i]);
+    top = std::max(top, d * d);
+    s += d * d;
+  }
+  *out = s;
+  return top <= static_cast<double>(kHalfRange) * static_cast<double>(kHalfRange);
+}
+#endif
+
+bool block_sumsq_i32(const std::int32_t* a, const std::int32_t* b, const std::int32_t* e, std::int64_t len,
+                     double* out) {
+#if RWCALC_X86_DISPATCH
+  static const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  if (avx2) return block_sumsq_i32_avx2(a, b, e, len, out);
+#endif
+  return block_sumsq_i32_generic(a, b, e, len, out);
+}
+
+u128 exact_block_i32(const std::int32_t* c, std::int64_t k0, std::int64_t len, std::int64_t m, std::int64_t stride) {
+  u128 s = 0;
+  for (std::int64_t i = 0; i < len; ++i) {
+    const std::int64_t k = k0 + i * stride;
+    const std::int64_t d = std::int64_t{c[k + 2 * m]} - 2 * std::int64_t{c[k + m]} + std::int64_t{c[k]};
+    s += static_cast<u128>(static_cast<i128>(d) * d);
+  }
+  return s;
+}
+
+RWCALC_CLONES
+double modified_sumsq_f64_prefix(const double* prefix, std::int64_t n, std::int64_t m) {
+  const double* __restrict p0 = prefix;
+  const double* __restrict p1 = prefix + m;
+  const double* __restrict p2 = prefix + 2 * m;
+  const double* __restrict p3 = prefix + 3 * m;
+  double acc[kLanes] = {};
+  std::int64_t i = 0;
+  for (; i + kLanes <= n; i += kLanes) {
+    for (int j = 0; j < kLanes; ++j) {
+      const double s = (p3[i + j] - p0[i + j]) - 3.0 * (p2[i + j] - p1[i + j]);  // exact integers
+      acc[j] += s * s;
+    }
+  }
+  for (; i < n; ++i) {
+    const double s = (p3[i] - p0[i]) - 3.0 * (p2[i] - p1[i]);
+    acc[0] += s * s;
+  }
+  double t = 0;
+  for (double v : acc) t += v;
+  return t;
+}
+
+}  // namespace
+
+PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_prefix) {
+  PreparedCounts p;
+  p.raw = &c;
+  if (c.empty()) return p;
+  const auto c0 = static_cast<std::uint64_t>(c[0]);
+  constexpr std::int64_t kLimit = std::int64_t{1} << 30;
+  // One branch-free (vectorisable) pass: offsets, their range, and the int32 copy; the copy is
+  // dropped if the range turns out too wide.
+  std::int64_t lo = 0, hi = 0;
+  p.rel32.assign(c.size(), 0);
+  std::int32_t* __restrict out = p.rel32.data();
+  const std::int64_t* __restrict in = c.data();
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    const auto r = static_cast<std::int64_t>(static_cast<std::uint64_t>(in[i]) - c0);
+    lo = r < lo ? r : lo;
+    hi = r > hi ? r : hi;
+    out[i] = static_cast<std::int32_t>(r);
+  }
+  const bool small = lo > -kLimit && hi < kLimit;
+  const std::int64_t top = std::max(-lo, hi);
+  if (!small) {
+    p.rel32.clear();
+    p.rel32.shrink_to_fit();
+  }
+  if (need_prefix) {
+    // Prefix sums and S = (P3 − P0) − 3(P2 − P1) stay exact doubles while 8·max|C − C0|·(N+1) < 2^53.
+    const double bound = 8.0 * static_cast<double>(top) * static_cast<double>(c.size() + 1);
+    if (small && bound < 9007199254740992.0) {
+      p.prefix_f64.resize(c.size() + 1);
+      double run = 0;
+      p.prefix_f64[0] = 0;
+      for (std::size_t i = 0; i < c.size(); ++i) {
+        run += static_cast<double>(p.rel32[i]);
+        p.prefix_f64[i + 1] = run;
+      }
+    } else {
+      p.prefix_u64 = count_prefix_sums(c);
+    }
+  }
+  return p;
+}
+
+u128 second_diff_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m, std::int64_t stride) {
+  if (c.rel32.empty()) return second_diff_sumsq_counts(c.raw->data(), n, m, stride);
+  const std::int32_t* r = c.rel32.data();
+  if (stride != 1) return exact_block_i32(r, 0, n, m, stride);
+  u128 total = 0;
+  for (std::int64_t k0 = 0; k0 < n; k0 += kBlock) {
+    const std::int64_t len = std::min(kBlock, n - k0);
+    double s = 0;
+    if (block_sumsq_i32(r + k0, r + k0 + m, r + k0 + 2 * m, len, &s))
+      total += static_cast<std::uint64_t>(s);
+    else
+      total += exact_block_i32(r, k0, len, m, 1);
+  }
+  return total;
+}
+
+double modified_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m) {
+  if (!c.prefix_f64.empty()) return modified_sumsq_f64_prefix(c.prefix_f64.data(), n, m);
+  if (!c.prefix_u64.empty()) return modified_sumsq_counts(c.prefix_u64.data(), n, m);
+  const std::vector<std::uint64_t> p = count_prefix_sums(*c.raw);
+  return modified_sumsq_counts(p.data(), n, m);
+}
+
+}  // namespace rwcalc::detail

@@ -1,0 +1,46 @@
+// Text and CSV renderings of an Allan-variance result (the JSON form is to_json in allan.cpp).
+#include <fmt/format.h>
+
+#include "rwcalc/allan.hpp"
+
+namespace rwcalc {
+
+std::string unit_label(const AllanResult& r) { return r.unit == "deg/h" ? "°/h" : "input units/s"; }
+
+std::string format_allan_table(const AllanResult& r, const AllanReportInfo& info) {
+  const std::string u = unit_label(r);
+  std::string out;
+  out += fmt::format("# rwcalc allan: {}\n", info.source.empty() ? "-" : info.source);
+  out += fmt::format("# estimator: {} deviation ({})\n", long_name(r.estimator), to_string(r.estimator));
+  out += fmt::format("# confidence: {:g} (two-sided chi-square bounds, Greenhall-Riley EDF, lag-1 ACF noise id)\n",
+                     r.confidence);
+  if (r.unit == "deg/h")
+    out += "# units: deviations in °/h (convention 1″/s = 1 °/h exactly); τ in s\n";
+  else
+    out += "# units: deviations in input units per second (dimensionless for phase in s); τ in s\n";
+  out += fmt::format("# samples: {}   phase points: {}   τ0: {:g} s", info.samples, r.points_in, r.tau0_s);
+  if (info.rate_hz > 0)
+    out += fmt::format("   rate: {:g} Hz{}", info.rate_hz,
+                       info.rate_source.empty() ? "" : fmt::format(" ({})", info.rate_source));
+  out += "\n";
+  out += "# α: noise exponent of S(f) ∝ f^α: +2 white angle/PM, +1 flicker PM, 0 white rate/FM, −1 flicker FM, −2 random walk\n";
+  const std::string dev_hdr = fmt::format("σ ({})", u);
+  out += fmt::format("{:>9} {:>13} {:>10} {:>3} {:>11} {:>13} {:>13} {:>13}\n", "AF", "τ (s)", "terms", "α", "EDF",
+                     "σ_min", dev_hdr.size() <= 13 ? dev_hdr : std::string("σ"), "σ_max");
+  for (const AllanPoint& p : r.points)
+    out += fmt::format("{:>9} {:>13.6g} {:>10} {:>3} {:>11.5g} {:>13.5e} {:>13.5e} {:>13.5e}\n", p.m, p.tau_s, p.n,
+                       p.alpha, p.edf, p.dev_low, p.dev, p.dev_high);
+  if (dev_hdr.size() > 13) out += fmt::format("# σ_min, σ, σ_max in {}\n", u);
+  return out;
+}
+
+std::string format_allan_csv(const AllanResult& r) {
+  const std::string u = r.unit == "deg/h" ? "deg_h" : "1";
+  std::string out = fmt::format("af,tau_s,n,alpha,edf,dev_low_{0},dev_{0},dev_high_{0}\n", u);
+  for (const AllanPoint& p : r.points)
+    out += fmt::format("{},{:.17g},{},{},{:.10g},{:.10g},{:.10g},{:.10g}\n", p.m, p.tau_s, p.n, p.alpha, p.edf,
+                       p.dev_low, p.dev, p.dev_high);
+  return out;
+}
+
+}  // namespace rwcalc

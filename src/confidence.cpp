@@ -1,0 +1,356 @@
+// Noise identification (lag-1 autocorrelation, B1 and R(n) ratios), Greenhall–Riley EDF and
+// χ² confidence bounds, following Stable32's choices so that its tables are reproduced.
+#include "rwcalc/confidence.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <boost/math/distributions/chi_squared.hpp>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <vector>
+
+#include "rwcalc/error.hpp"
+
+namespace rwcalc {
+
+namespace {
+
+// ---- Noise identification -------------------------------------------------------------------
+
+// Stable32 uses the lag-1 autocorrelation when at least this many points remain at τ.
+constexpr std::size_t kMinAcfPoints = 30;
+constexpr int kMaxDifferences = 2;  // d_max for Allan-type (two-sample) variances
+
+/// Decimated phase p_k = x_{k·m} − x_0, k = 0 … ⌊(N−1)/m⌋, in arbitrary units (the ACF and the
+/// B1 ratio do not depend on scale); offset-free and exact for counts.
+std::vector<double> decimated_phase(const PhaseSeries& x, std::int64_t m) {
+  const auto um = static_cast<std::size_t>(m);
+  const std::size_t count = (x.points() - 1) / um + 1;
+  std::vector<double> z(count);
+  if (x.exact()) {
+    const std::int64_t* c = x.counts.data();
+    const auto c0 = static_cast<std::uint64_t>(c[0]);
+    for (std::size_t k = 0; k < count; ++k)
+      z[k] = static_cast<double>(static_cast<std::int64_t>(static_cast<std::uint64_t>(c[k * um]) - c0));
+  } else {
+    const double* v = x.values.data();
+    for (std::size_t k = 0; k < count; ++k) z[k] = v[k * um] - v[0];
+  }
+  return z;
+}
+
+/// Averaged frequencies ȳ_k ∝ p_{k+1} − p_k (k < ⌊(N−1)/m⌋), same arbitrary units.
+std::vector<double> averaged_frequency(const PhaseSeries& x, std::int64_t m) {
+  std::vector<double> y = decimated_phase(x, m);
+  for (std::size_t i = 0; i + 1 < y.size(); ++i) y[i] = y[i + 1] - y[i];
+  y.pop_back();
+  return y;
+}
+
+/// Value i of the level-th difference of p (level 0: p itself).
+inline double difference(const double* p, int level, std::size_t i) {
+  switch (level) {
+    case 0: return p[i];
+    case 1: return p[i + 1] - p[i];
+    case 2: return (p[i + 2] - p[i + 1]) - (p[i + 1] - p[i]);
+    default: return ((p[i + 3] - p[i + 2]) - (p[i + 2] - p[i + 1])) - ((p[i + 2] - p[i + 1]) - (p[i + 1] - p[i]));
+  }
+}
+
+/// Lag-1 autocorrelation r1 = Σ(z_i − z̄)(z_{i+1} − z̄) / Σ(z_i − z̄)² (Riley & Greenhall eq. 2) of
+/// the level-th difference z of p, without forming z: the mean of a difference follows from its
+/// end points, and the sums run in four independent lanes (branch-free, vectorisable).
+double lag1_autocorrelation(const std::vector<double>& pv, int level) {
+  const double* p = pv.data();
+  const std::size_t len = pv.size() - static_cast<std::size_t>(level);  // points of z
+  if (pv.size() <= static_cast<std::size_t>(level) + 1) return 0.0;
+  double mean = 0;
+  if (level == 0) {
+    double lane[4] = {};
+    std::size_t i = 0;
+    for (; i + 4 <= len; i += 4)
+      for (int j = 0; j < 4; ++j) lane[j] += p[i + j];
+    for (; i < len; ++i) lane[0] += p[i];
+    mean = (lane[0] + lane[1] + lane[2] + lane[3]) / static_cast<double>(len);
+  } else {
+    mean = (difference(p, level - 1, len) - difference(p, level - 1, 0)) / static_cast<double>(len);
+  }
+  double num[4] = {}, den[4] = {};
+  std::size_t i = 0;
+  // Pairs (z_i, z_{i+1}) for i < len − 1; den over all i < len.
+  for (; i + 4 < len; i += 4) {
+    for (int j = 0; j < 4; ++j) {
+      const double a = difference(p, level, i + j) - mean;
+      const double b = difference(p, level, i + j + 1) - mean;
+      den[j] += a * a;
+      num[j] += a * b;
+    }
+  }
+  for (; i < len; ++i) {
+    const double a = difference(p, level, i) - mean;
+    den[0] += a * a;
+    if (i + 1 < len) num[0] += a * (difference(p, level, i + 1) - mean);
+  }
+  const double n_sum = num[0] + num[1] + num[2] + num[3];
+  const double d_sum = den[0] + den[1] + den[2] + den[3];
+  return d_sum > 0 ? n_sum / d_sum : 0.0;
+}
+
+/// Lag-1 ACF method on the decimated phase p, starting at difference level `base` (0: phase data,
+/// 1: frequency data): difference until δ = r1/(1 + r1) < 0.25 or d = d_max; p = −round(2δ) − 2d.
+/// Returns p, the exponent of the analysed series' own spectrum.
+int acf_exponent(const std::vector<double>& phase, int base) {
+  for (int d = 0;; ++d) {
+    const double r1 = lag1_autocorrelation(phase, base + d);
+    const double delta = r1 / (1.0 + r1);
+    if (delta < 0.25 || d >= kMaxDifferences) return -static_cast<int>(std::lround(2.0 * delta)) - 2 * d;
+  }
+}
+
+/// Expected B1 = (standard variance)/(Allan variance) for N averages and phase exponent μ
+/// (Howe, Beard, Greenhall & Riley, PTTI 2000, Table 3). μ = 2 … −2 ↔ α = −3 … +1/+2.
+double b1_expected(double n, int mu) {
+  switch (mu) {
+    case 2: return n * (n + 1.0) / 6.0;
+    case 1: return n / 2.0;
+    case 0: return n * std::log(n) / (2.0 * (n - 1.0) * std::numbers::ln2);
+    case -1: return 1.0;
+    case -2: return (n * n - 1.0) / (1.5 * n * (n - 1.0));
+    default: return n * (1.0 - std::pow(n, mu)) / (2.0 * (n - 1.0) * (1.0 - std::pow(2.0, mu)));
+  }
+}
+
+/// μ from a measured B1: the largest μ whose boundary with μ − 1 the ratio exceeds. Boundaries are
+/// geometric means of neighbouring expectations, except the arithmetic mean between μ = 2 and 1.
+int b1_mu(double measured, double n) {
+  for (int mu = 2; mu > -2; --mu) {
+    const double hi = b1_expected(n, mu), lo = b1_expected(n, mu - 1);
+    const double boundary = mu == 2 ? 0.5 * (hi + lo) : std::sqrt(hi * lo);
+    if (measured > boundary) return mu;
+  }
+  return -2;
+}
+
+double sample_variance(const std::vector<double>& y) {
+  double mean = 0;
+  for (double v : y) mean += v;
+  mean /= static_cast<double>(y.size());
+  double s = 0;
+  for (double v : y) s += (v - mean) * (v - mean);
+  return s / static_cast<double>(y.size() - 1);
+}
+
+double nonoverlapping_avar(const std::vector<double>& y) {
+  double s = 0;
+  for (std::size_t i = 0; i + 1 < y.size(); ++i) s += (y[i + 1] - y[i]) * (y[i + 1] - y[i]);
+  return 0.5 * s / static_cast<double>(y.size() - 1);
+}
+
+// The expectations are taken for N = the estimator's number of terms at this τ (not the number of
+// averages): that is what reproduces every α of Stable32's tables in the B1 region.
+int noise_id_b1(const PhaseSeries& x, std::int64_t m, Estimator est) {
+  const std::vector<double> y = averaged_frequency(x, m);
+  if (y.size() < 2) return 0;
+  const double avar = nonoverlapping_avar(y);
+  if (!(avar > 0)) return 0;
+  const double b1 = sample_variance(y) / avar;
+  const int mu = b1_mu(b1, static_cast<double>(term_count(est, m, x.points())));
+  if (mu == -2) {
+    // μ = −2 covers white and flicker PM; Stable32 reports flicker PM (α = 1) unless R(n) can
+    // tell them apart, which it uses for the modified variance only.
+    if (est != Estimator::Modified) return 1;
+    // R(n) = MVAR/AVAR tells white (1/m) from flicker PM (NIST TN 1337 Table 2, f_h = 1/(2τ0)).
+    // y is in phase units per cluster: bring AVAR to deviation units before the ratio.
+    const double unit = (x.exact() ? x.arcsec_per_count : 1.0) / (static_cast<double>(m) * x.tau0_s);
+    const double mvar = allan_variance(x, m, Estimator::Modified);
+    const double rn = mvar / (avar * unit * unit);
+    const double md = static_cast<double>(m);
+    const double r_flicker = 3.37 / (1.04 + 3.0 * std::log(std::numbers::pi * md));
+    const double r_white = 1.0 / md;
+    return rn > std::sqrt(r_flicker * r_white) ? 1 : 2;
+  }
+  return std::clamp(-mu - 1, -2, 2);  // μ = 1, 0, −1 ↔ α = −2, −1, 0 (μ = 2: α = −3, clamped)
+}
+
+// ---- Greenhall–Riley EDF --------------------------------------------------------------------
+
+using Real = long double;  // the BasicSum differences cancel heavily for large F
+
+Real sw(Real t, int alpha) {
+  const Real at = std::fabs(t);
+  switch (alpha) {
+    case 2: return -at;
+    case 1: return t == 0 ? 0 : t * t * std::log(at);
+    case 0: return at * at * at;
+    case -1: return t == 0 ? 0 : t * t * t * t * std::log(at);
+    case -2: return at * at * at * at * at;
+    case -3: return t == 0 ? 0 : t * t * t * t * t * t * std::log(at);
+    case -4: return at * at * at * at * at * at * at;
+    default: throw AnalysisError(fmt::format("EDF: unsupported noise exponent alpha = {}", alpha));
+  }
+}
+
+constexpr Real kInfinite = std::numeric_limits<Real>::infinity();
+
+Real sx(Real t, Real f, int alpha) {
+  if (std::isinf(f)) return sw(t, alpha + 2);
+  return f * f * (2 * sw(t, alpha) - sw(t - 1 / f, alpha) - sw(t + 1 / f, alpha));
+}
+
+Real sz(Real t, Real f, int alpha, int d) {
+  switch (d) {
+    case 1: return 2 * sx(t, f, alpha) - sx(t - 1, f, alpha) - sx(t + 1, f, alpha);
+    case 2:
+      return 6 * sx(t, f, alpha) - 4 * sx(t - 1, f, alpha) - 4 * sx(t + 1, f, alpha) + sx(t - 2, f, alpha) +
+             sx(t + 2, f, alpha);
+    case 3:
+      return 20 * sx(t, f, alpha) - 15 * sx(t - 1, f, alpha) - 15 * sx(t + 1, f, alpha) +
+             6 * sx(t - 2, f, alpha) + 6 * sx(t + 2, f, alpha) - sx(t - 3, f, alpha) - sx(t + 3, f, alpha);
+    default: throw AnalysisError(fmt::format("EDF: unsupported difference order d = {}", d));
+  }
+}
+
+Real basic_sum(Real j_terms, Real m_terms, Real s, Real f, int alpha, int d) {
+  const Real z0 = sz(0, f, alpha, d);
+  const Real zj = sz(j_terms / s, f, alpha, d);
+  Real sum = z0 * z0 + (1 - j_terms / m_terms) * zj * zj;
+  const auto jn = static_cast<std::int64_t>(j_terms);
+  for (std::int64_t j = 1; j < jn; ++j) {
+    const Real z = sz(static_cast<Real>(j) / s, f, alpha, d);
+    sum += 2 * (1 - static_cast<Real>(j) / m_terms) * z * z;
+  }
+  return sum;
+}
+
+struct A01 {
+  double a0, a1;
+};
+
+// Asymptotic coefficients 1/EDF ≈ (a0 − a1/r)/r (Greenhall & Riley 2003, Tables 1 and 2); rows
+// α = +2 … −4, columns d = 1, 2, 3. Zeros mark combinations outside α + 2d > 1.
+constexpr std::array<std::array<A01, 3>, 7> kTable1 = {{
+    {{{2.0 / 3, 1.0 / 3}, {7.0 / 9, 0.5}, {22.0 / 25, 2.0 / 3}}},
+    {{{0.840, 0.345}, {0.997, 0.616}, {1.141, 0.843}}},
+    {{{1.079, 0.368}, {1.033, 0.607}, {1.184, 0.848}}},
+    {{{0, 0}, {1.048, 0.534}, {1.180, 0.816}}},
+    {{{0, 0}, {1.302, 0.535}, {1.175, 0.777}}},
+    {{{0, 0}, {0, 0}, {1.194, 0.703}}},
+    {{{0, 0}, {0, 0}, {1.489, 0.702}}},
+}};
+constexpr std::array<std::array<A01, 3>, 7> kTable2 = {{
+    {{{1.5, 0.5}, {35.0 / 18, 1.0}, {231.0 / 100, 1.5}}},
+    {{{78.6, 25.2}, {790.0, 410.0}, {9950.0, 6520.0}}},
+    {{{2.0 / 3, 1.0 / 6}, {2.0 / 3, 1.0 / 3}, {7.0 / 9, 0.5}}},
+    {{{0, 0}, {0.852, 0.375}, {0.997, 0.617}}},
+    {{{0, 0}, {1.079, 0.368}, {1.033, 0.607}}},
+    {{{0, 0}, {0, 0}, {1.053, 0.553}}},
+    {{{0, 0}, {0, 0}, {1.302, 0.535}}},
+}};
+// Table 3 (α = +1): sz(0)² ≈ (b0 + b1·ln m)², d = 1, 2, 3.
+constexpr std::array<A01, 3> kTable3 = {{{6.0, 4.0}, {15.23, 12.0}, {47.8, 40.0}}};
+
+double binomial(int n, int k) {
+  double r = 1;
+  for (int i = 1; i <= k; ++i) r = r * (n - k + i) / i;
+  return r;
+}
+
+}  // namespace
+
+int identify_noise(const PhaseSeries& x, std::int64_t m, Estimator est, NoiseIdDomain domain) {
+  if (m < 1 || x.points() < 3 || static_cast<std::size_t>(m) > x.points() - 1) return 0;
+  // Points at τ: phase samples for phase data, averaged frequencies (one fewer) for frequency data.
+  const std::size_t phase_points = (x.points() - 1) / static_cast<std::size_t>(m) + 1;
+  if (domain == NoiseIdDomain::Phase && phase_points >= kMinAcfPoints)
+    return std::clamp(acf_exponent(decimated_phase(x, m), 0) + 2, -2, 2);
+  if (domain == NoiseIdDomain::Frequency && phase_points - 1 >= kMinAcfPoints)
+    return std::clamp(acf_exponent(decimated_phase(x, m), 1), -2, 2);
+  return noise_id_b1(x, m, est);
+}
+
+double edf_greenhall(int alpha, int d, std::int64_t m, std::size_t n_phase, bool overlapping,
+                     bool modified) {
+  if (d < 1 || d > 3) throw AnalysisError(fmt::format("EDF: unsupported difference order d = {}", d));
+  if (alpha + 2 * d <= 1 || alpha > 2 || alpha < -4)
+    throw AnalysisError(fmt::format("EDF: noise exponent alpha = {} not allowed with d = {}", alpha, d));
+  const Real mr = static_cast<Real>(m);
+  const Real f = modified ? 1 : mr;                 // filter factor
+  const Real s = overlapping ? mr : 1;              // stride factor
+  const Real l = mr / f + mr * d;                   // filter length in phase samples
+  const Real nr = static_cast<Real>(n_phase);
+  if (nr < l) return 0;
+  const Real m_terms = 1 + std::floor(s * (nr - l) / mr);
+  const Real j_terms = std::min(m_terms, (d + 1) * s);
+  constexpr Real kJmax = 100;
+  const Real r = m_terms / s;
+  const A01 t1 = kTable1[static_cast<std::size_t>(2 - alpha)][static_cast<std::size_t>(d - 1)];
+  const A01 t2 = kTable2[static_cast<std::size_t>(2 - alpha)][static_cast<std::size_t>(d - 1)];
+  Real inv = 0;
+  auto direct = [&](Real ff) {
+    const Real z0 = sz(0, ff, alpha, d);
+    return basic_sum(j_terms, m_terms, s, ff, alpha, d) / (z0 * z0 * m_terms);
+  };
+  if (modified) {  // case 1: modified variances, all α
+    if (j_terms <= kJmax) {
+      inv = direct(1);
+    } else if (r > d + 1) {
+      inv = (t1.a0 - t1.a1 / r) / r;
+    } else {
+      const Real z0 = sz(0, 1, alpha, d);
+      inv = basic_sum(kJmax, kJmax, kJmax / r, 1, alpha, d) / (z0 * z0 * kJmax);
+    }
+  } else if (alpha <= 0) {  // case 2: unmodified, α ≤ 0
+    if (j_terms <= kJmax) {
+      inv = direct(mr * (d + 1) <= kJmax ? mr : kInfinite);
+    } else if (r > d + 1) {
+      inv = (t2.a0 - t2.a1 / r) / r;
+    } else {
+      const Real z0 = sz(0, kInfinite, alpha, d);
+      inv = basic_sum(kJmax, kJmax, kJmax / r, kInfinite, alpha, d) / (z0 * z0 * kJmax);
+    }
+  } else if (alpha == 1) {  // case 3: unmodified, flicker PM
+    const A01 t3 = kTable3[static_cast<std::size_t>(d - 1)];
+    const Real b = t3.a0 + t3.a1 * std::log(mr);
+    if (j_terms <= kJmax) {
+      inv = direct(mr);
+    } else if (r > d + 1) {
+      inv = (t2.a0 - t2.a1 / r) / (b * b * r);
+    } else {
+      const Real mp = kJmax / r;
+      inv = basic_sum(kJmax, kJmax, mp, mp, 1, d) / (b * b * kJmax);
+    }
+  } else {  // case 4: unmodified, white PM
+    if (std::ceil(r) > d) {
+      const Real a0 = binomial(4 * d, 2 * d) / std::pow(binomial(2 * d, d), 2);
+      const Real a1 = d / 2.0L;
+      inv = (a0 - a1 / r) / m_terms;
+    } else {
+      inv = direct(mr);  // very few terms: the exact sum is short
+    }
+  }
+  if (!(inv > 0)) return 0;
+  return static_cast<double>(1 / inv);
+}
+
+double edf_for(Estimator est, int alpha, std::int64_t m, std::size_t n_phase) {
+  switch (est) {
+    case Estimator::Overlapping: return edf_greenhall(alpha, 2, m, n_phase, true, false);
+    case Estimator::NonOverlapping: return edf_greenhall(alpha, 2, m, n_phase, false, false);
+    case Estimator::Modified: return edf_greenhall(alpha, 2, m, n_phase, true, true);
+  }
+  return 0;
+}
+
+DevInterval chi2_interval(double var, double edf, double p) {
+  if (!(p > 0 && p < 1)) throw UsageError(fmt::format("confidence must lie strictly between 0 and 1, got {}", p));
+  if (!(edf > 0) || !(var >= 0)) return {0.0, 0.0};
+  const boost::math::chi_squared dist(edf);
+  const double chi_hi = boost::math::quantile(dist, 0.5 * (1 + p));
+  const double chi_lo = boost::math::quantile(dist, 0.5 * (1 - p));
+  return {std::sqrt(edf * var / chi_hi), std::sqrt(edf * var / chi_lo)};
+}
+
+}  // namespace rwcalc

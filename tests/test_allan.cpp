@@ -1,0 +1,245 @@
+// Properties of the Allan engine that need no reference file: exactness and offset invariance of
+// the integer path, agreement with the textbook definitions, τ grids, limits and error paths.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <algorithm>
+#include <random>
+
+#include "rwcalc/allan.hpp"
+#include "rwcalc/error.hpp"
+
+namespace rwcalc {
+namespace {
+
+/// Cumulative counts from per-sample increments, starting at `offset` (wrapping like a counter).
+PhaseSeries counts_from(const std::vector<std::int64_t>& inc, std::int64_t offset, double q = 0.92,
+                        double tau0 = 0.0025) {
+  PhaseSeries s;
+  s.tau0_s = tau0;
+  s.arcsec_per_count = q;
+  s.counts.resize(inc.size() + 1);
+  auto run = static_cast<std::uint64_t>(offset);
+  s.counts[0] = offset;
+  for (std::size_t i = 0; i < inc.size(); ++i) {
+    run += static_cast<std::uint64_t>(inc[i]);
+    s.counts[i + 1] = static_cast<std::int64_t>(run);
+  }
+  return s;
+}
+
+std::vector<std::int64_t> random_increments(std::size_t n, std::int64_t spread, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<std::int64_t> d(-spread, spread);
+  std::vector<std::int64_t> v(n);
+  for (auto& x : v) x = d(rng);
+  return v;
+}
+
+/// Textbook definitions, directly from the phase, in long double.
+long double brute_force(const PhaseSeries& x, std::int64_t m, Estimator est) {
+  const auto n = static_cast<std::int64_t>(x.points());
+  auto ph = [&](std::int64_t i) { return static_cast<long double>(x.diff(static_cast<std::size_t>(i), 0)); };
+  const long double tau = static_cast<long double>(m) * x.tau0_s;
+  long double sum = 0;
+  std::int64_t terms = 0;
+  if (est == Estimator::Modified) {
+    for (std::int64_t j = 0; j + 3 * m <= n; ++j, ++terms) {
+      long double s = 0;
+      for (std::int64_t i = j; i < j + m; ++i) s += ph(i + 2 * m) - 2 * ph(i + m) + ph(i);
+      sum += s * s;
+    }
+    return sum / (2.0L * m * m * tau * tau * terms);
+  }
+  const std::int64_t stride = est == Estimator::Overlapping ? 1 : m;
+  for (std::int64_t k = 0; k + 2 * m < n; k += stride, ++terms) {
+    const long double d = ph(k + 2 * m) - 2 * ph(k + m) + ph(k);
+    sum += d * d;
+  }
+  return sum / (2.0L * tau * tau * terms);
+}
+
+TEST(AllanCounts, OffsetNear2To62GivesBitIdenticalResults) {
+  const auto inc = random_increments(20000, 3, 1);
+  const PhaseSeries at_zero = counts_from(inc, 0);
+  for (std::int64_t offset : {std::int64_t{1} << 62, (std::int64_t{1} << 62) + 123456789,
+                              std::numeric_limits<std::int64_t>::max() - 5000}) {  // last one wraps
+    const PhaseSeries shifted = counts_from(inc, offset);
+    for (Estimator est : {Estimator::Overlapping, Estimator::NonOverlapping, Estimator::Modified}) {
+      AllanOptions o;
+      o.estimator = est;
+      o.grid = TauGrid::parse("dense:5");
+      const AllanResult a = compute_allan(at_zero, o), b = compute_allan(shifted, o);
+      ASSERT_EQ(a.points.size(), b.points.size());
+      for (std::size_t i = 0; i < a.points.size(); ++i) {
+        SCOPED_TRACE(std::string(to_string(est)) + " m " + std::to_string(a.points[i].m));
+        EXPECT_EQ(a.points[i].var, b.points[i].var);  // to the last bit
+        EXPECT_EQ(a.points[i].alpha, b.points[i].alpha);
+        EXPECT_EQ(a.points[i].dev_low, b.points[i].dev_low);
+        EXPECT_EQ(a.points[i].dev_high, b.points[i].dev_high);
+      }
+    }
+  }
+}
+
+TEST(AllanCounts, MatchesTextbookDefinitionsAndFloatingPath) {
+  const auto inc = random_increments(3000, 2, 2);
+  const PhaseSeries c = counts_from(inc, 42);
+  PhaseSeries v;
+  v.tau0_s = c.tau0_s;
+  for (std::size_t i = 0; i < c.points(); ++i) v.values.push_back(c.diff(i, 0));
+  for (Estimator est : {Estimator::Overlapping, Estimator::NonOverlapping, Estimator::Modified}) {
+    for (std::int64_t m : {std::int64_t{1}, std::int64_t{2}, std::int64_t{3}, std::int64_t{7}, std::int64_t{64},
+                           std::int64_t{500}, max_cluster_size(est, c.points())}) {
+      SCOPED_TRACE(std::string(to_string(est)) + " m " + std::to_string(m));
+      const long double want = brute_force(c, m, est);
+      EXPECT_NEAR(allan_variance(c, m, est) / static_cast<double>(want), 1.0, 1e-13);
+      EXPECT_NEAR(allan_variance(v, m, est) / static_cast<double>(want), 1.0, 1e-11);
+    }
+  }
+}
+
+TEST(AllanCounts, LargeSecondDifferencesTakeTheExact128BitPath) {
+  // Increments of ±2^40 give second differences far beyond the 2^21 fast-path limit.
+  const auto inc = random_increments(5000, std::int64_t{1} << 40, 3);
+  const PhaseSeries c = counts_from(inc, -(std::int64_t{1} << 62), 1.0, 1.0);
+  for (std::int64_t m : {1, 4, 33, 1000}) {
+    const long double want = brute_force(c, m, Estimator::Overlapping);
+    EXPECT_NEAR(allan_variance(c, m, Estimator::Overlapping) / static_cast<double>(want), 1.0, 1e-15) << m;
+  }
+}
+
+TEST(AllanCounts, WhiteAngleNoiseHasTheExpectedLevel) {
+  // A white angle θ_k uniform on {−1, 0, 1} counts (σθ² = 2/3): its second difference has variance
+  // 6σθ² at every m, so AVAR = 3σθ²/τ² (quantization-like slope −1 in ADEV).
+  std::mt19937_64 rng(4);
+  std::uniform_int_distribution<int> d(-1, 1);
+  PhaseSeries s;
+  s.tau0_s = 1.0;
+  s.arcsec_per_count = 1.0;
+  const int n = 400000;
+  for (int i = 0; i < n; ++i) s.counts.push_back(d(rng));
+  const double sigma_theta2 = 2.0 / 3.0;
+  for (std::int64_t m : {1, 10, 100}) {
+    const double want = 3.0 * sigma_theta2 / static_cast<double>(m * m);
+    EXPECT_NEAR(allan_variance(s, m, Estimator::Overlapping) / want, 1.0, 0.02) << m;
+  }
+}
+
+TEST(AllanEngine, ThreadCountDoesNotChangeTheResult) {
+  const PhaseSeries c = counts_from(random_increments(50000, 5, 5), 7);
+  AllanOptions o;
+  o.grid = TauGrid::parse("dense:10");
+  o.threads = 1;
+  const AllanResult one = compute_allan(c, o);
+  o.threads = 2;
+  const AllanResult two = compute_allan(c, o);
+  ASSERT_EQ(one.points.size(), two.points.size());
+  for (std::size_t i = 0; i < one.points.size(); ++i) {
+    EXPECT_EQ(one.points[i].var, two.points[i].var);
+    EXPECT_EQ(one.points[i].edf, two.points[i].edf);
+  }
+}
+
+TEST(TauGrids, OctaveDecadeDenseAllAndLimits) {
+  const std::size_t n = 1001;  // m ≤ 500 for AVAR, ≤ 333 for MVAR
+  EXPECT_EQ(max_cluster_size(Estimator::Overlapping, n), 500);
+  EXPECT_EQ(max_cluster_size(Estimator::Modified, n), 333);
+  EXPECT_EQ(term_count(Estimator::Overlapping, 500, n), 1);
+  EXPECT_EQ(term_count(Estimator::NonOverlapping, 2, n), 499);
+  EXPECT_EQ(term_count(Estimator::Modified, 333, n), 3);
+  EXPECT_EQ(max_cluster_size(Estimator::Overlapping, 2), 0);
+  using V = std::vector<std::int64_t>;
+  EXPECT_EQ(cluster_sizes(TauGrid::parse("octave"), Estimator::Overlapping, n, 1.0),
+            (V{1, 2, 4, 8, 16, 32, 64, 128, 256}));
+  EXPECT_EQ(cluster_sizes(TauGrid::parse("decade"), Estimator::Overlapping, n, 1.0),
+            (V{1, 2, 4, 10, 20, 40, 100, 200, 400}));
+  const V dense = cluster_sizes(TauGrid::parse("dense:20"), Estimator::Overlapping, n, 1.0);
+  EXPECT_TRUE(std::is_sorted(dense.begin(), dense.end()));
+  EXPECT_EQ(std::adjacent_find(dense.begin(), dense.end()), dense.end());  // distinct
+  EXPECT_EQ(dense.front(), 1);
+  EXPECT_LE(dense.back(), 500);
+  EXPECT_GT(dense.size(), 40u);
+  EXPECT_EQ(cluster_sizes(TauGrid::parse("all"), Estimator::Modified, n, 1.0).size(), 333u);
+  TauGrid capped = TauGrid::parse("octave");
+  capped.max_m = 100;
+  EXPECT_EQ(cluster_sizes(capped, Estimator::Overlapping, n, 1.0).back(), 64);
+}
+
+TEST(TauGrids, ExplicitSecondsMustBeWholeSamplesAndInRange) {
+  const TauGrid g = TauGrid::parse("0.01, 1,0.0025");
+  EXPECT_EQ(cluster_sizes(g, Estimator::Overlapping, 100001, 0.0025), (std::vector<std::int64_t>{1, 4, 400}));
+  EXPECT_THROW(cluster_sizes(TauGrid::parse("0.003"), Estimator::Overlapping, 100001, 0.0025), UsageError);
+  EXPECT_THROW(cluster_sizes(TauGrid::parse("1000"), Estimator::Overlapping, 100001, 0.0025), UsageError);
+  for (const char* bad : {"", "fast", "1,,2", "1,x", "-1", "0", "dense:0", "dense:x", "nan", "inf"})
+    EXPECT_THROW(TauGrid::parse(bad), UsageError) << bad;
+}
+
+TEST(AllanEngine, ErrorPaths) {
+  PhaseSeries two;
+  two.values = {0.0, 1.0};
+  EXPECT_THROW(compute_allan(two), AnalysisError);
+  PhaseSeries ok;
+  ok.values = {0.0, 1.0, 0.5, 2.0, 1.0};
+  AllanOptions o;
+  o.confidence = 1.0;
+  EXPECT_THROW(compute_allan(ok, o), UsageError);
+  o.confidence = 0.683;
+  o.noise_id = false;
+  o.alpha = 5;
+  EXPECT_THROW(compute_allan(ok, o), UsageError);
+  EXPECT_THROW(parse_estimator("hdev"), UsageError);
+  EXPECT_EQ(parse_estimator("mdev"), Estimator::Modified);
+}
+
+TEST(AllanEngine, JsonCarriesUnitAndEveryPointField) {
+  const PhaseSeries c = counts_from(random_increments(5000, 2, 6), 0);
+  const nlohmann::json j = to_json(compute_allan(c));
+  EXPECT_EQ(j.at("unit"), "deg/h");
+  EXPECT_EQ(j.at("estimator"), "oadev");
+  EXPECT_DOUBLE_EQ(j.at("tau0_s").get<double>(), 0.0025);
+  ASSERT_FALSE(j.at("points").empty());
+  for (const auto& p : j.at("points")) {
+    for (const char* key : {"af", "tau_s", "n", "alpha", "edf", "dev", "dev_low", "dev_high"})
+      EXPECT_TRUE(p.contains(key)) << key;
+    EXPECT_LT(p.at("dev_low").get<double>(), p.at("dev").get<double>());
+    EXPECT_GT(p.at("dev_high").get<double>(), p.at("dev").get<double>());
+  }
+}
+
+}  // namespace
+}  // namespace rwcalc
+
+namespace rwcalc {
+namespace {
+
+TEST(AllanReport, TableAndCsvCarryUnitsHeaderAndOneRowPerTau) {
+  PhaseSeries c;
+  c.tau0_s = 0.0025;
+  std::mt19937_64 rng(8);
+  std::uniform_int_distribution<int> d(0, 2);
+  std::int64_t run = 0;
+  for (int i = 0; i < 20001; ++i) c.counts.push_back(run += d(rng));
+  const AllanResult r = compute_allan(c);
+  const std::string table = format_allan_table(r, {"run.txt", 20000, 400.0, "default"});
+  for (const char* s : {"run.txt", "overlapping Allan", "confidence: 0.683", "1″/s = 1 °/h", "samples: 20000",
+                        "rate: 400 Hz (default)", "AF", "τ (s)", "terms", "EDF", "σ_min", "σ_max", "°/h"})
+    EXPECT_NE(table.find(s), std::string::npos) << s << "\n" << table;
+  EXPECT_EQ(table.find("nan"), std::string::npos);
+  const std::string csv = format_allan_csv(r);
+  EXPECT_TRUE(csv.starts_with("af,tau_s,n,alpha,edf,dev_low_deg_h,dev_deg_h,dev_high_deg_h\n")) << csv;
+  EXPECT_EQ(static_cast<std::size_t>(std::count(csv.begin(), csv.end(), '\n')), r.points.size() + 1);
+  PhaseSeries clock;
+  clock.kind = PhaseKind::Clock;
+  clock.tau0_s = 1;
+  for (int i = 0; i < 100; ++i) clock.values.push_back(std::sin(i * 0.7) * 1e-9);
+  const AllanResult rc = compute_allan(clock);
+  EXPECT_EQ(unit_label(rc), "input units/s");
+  EXPECT_NE(format_allan_table(rc, {"clock.txt", 100, 1.0, ""}).find("input units per second"), std::string::npos);
+  EXPECT_TRUE(format_allan_csv(rc).starts_with("af,tau_s,n,alpha,edf,dev_low_1,dev_1,dev_high_1\n"));
+}
+
+}  // namespace
+}  // namespace rwcalc

@@ -1,0 +1,121 @@
+// Noise identification, Greenhall–Riley EDF and χ² bounds against published numbers and against
+// synthetic power-law noises whose exponent is known.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "rwcalc/confidence.hpp"
+#include "rwcalc/error.hpp"
+
+namespace rwcalc {
+namespace {
+
+TEST(Edf, GreenhallRileyOverlappingAllanOnPhaseDat) {
+  // noise-models.md §4.2: α = 0, N = 1001, m = 1 … 128 (Stable32's PHASE.DAT OADEV bounds).
+  const double want[] = {782.0, 540.7, 306.1, 166.0, 86.37, 43.35, 21.24, 9.551};
+  std::int64_t m = 1;
+  for (double w : want) {
+    const double edf = edf_greenhall(0, 2, m, 1001, true, false);
+    EXPECT_NEAR(edf / w, 1.0, 6e-4) << "m " << m << " edf " << edf;
+    m *= 2;
+  }
+}
+
+TEST(Edf, AsymptotesAndTheWhitePmClosedFormAreContinuous) {
+  // Large records: J > 100 uses the tables; EDF ≈ r/a0 with r = T/τ (WFM a0 = 2/3 → 1.5 T/τ).
+  const std::size_t n = 1440001;
+  const double edf = edf_greenhall(0, 2, 1000, n, true, false);
+  EXPECT_NEAR(edf, 2158, 2);  // noise-models.md §4.2 table (WFM, m = 1000)
+  EXPECT_NEAR(edf_greenhall(-1, 2, 1000, n, true, false), 1688, 2);
+  EXPECT_NEAR(edf_greenhall(-2, 2, 1000, n, true, false), 1333, 2);
+  EXPECT_NEAR(edf_greenhall(2, 2, 1000, n, true, false), 7.40e5, 0.01e5);
+  // EDF never exceeds the number of terms by much and is positive everywhere.
+  for (int alpha = -2; alpha <= 2; ++alpha)
+    for (std::int64_t m : {1, 3, 50, 200, 5000, 400000}) {
+      for (bool ovl : {false, true})
+        for (bool mod : {false, true}) {
+          if (mod && !ovl) continue;
+          const double e = edf_greenhall(alpha, 2, m, n, ovl, mod);
+          EXPECT_GT(e, 0) << alpha << " " << m;
+          EXPECT_TRUE(std::isfinite(e));
+        }
+    }
+  EXPECT_THROW(edf_greenhall(-3, 1, 4, 100, true, false), AnalysisError);  // α + 2d ≤ 1
+  EXPECT_EQ(edf_greenhall(0, 2, 600, 1001, true, false), 0.0);              // no term left
+}
+
+TEST(Chi2, IntervalBracketsTheEstimateAndNarrowsWithEdf) {
+  const DevInterval a = chi2_interval(4.0, 10, 0.683);
+  EXPECT_LT(a.low, 2.0);
+  EXPECT_GT(a.high, 2.0);
+  const DevInterval b = chi2_interval(4.0, 1e6, 0.683);
+  // For large ν the relative 1-σ half-width of σ is ≈ 1/√(2ν).
+  EXPECT_NEAR((b.high - b.low) / 2.0 / 2.0, 1.0 / std::sqrt(2e6), 1e-5);
+  const DevInterval c = chi2_interval(4.0, 10, 0.95);
+  EXPECT_LT(c.low, a.low);
+  EXPECT_GT(c.high, a.high);
+  EXPECT_THROW(chi2_interval(1.0, 10, 1.5), UsageError);
+  const DevInterval z = chi2_interval(0.0, 10, 0.683);
+  EXPECT_EQ(z.low, 0.0);
+  EXPECT_EQ(z.high, 0.0);
+}
+
+/// Phase series of a pure power-law noise: white PM (α = 2), white FM (0) or random-walk FM (−2).
+PhaseSeries power_law(int alpha, std::size_t n, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g;
+  PhaseSeries s;
+  s.tau0_s = 1.0;
+  s.kind = PhaseKind::Clock;
+  double x = 0, y = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (alpha == 2) {
+      s.values.push_back(g(rng));
+    } else if (alpha == 0) {
+      s.values.push_back(x);
+      x += g(rng);
+    } else {
+      s.values.push_back(x);
+      y += g(rng);
+      x += y;
+    }
+  }
+  return s;
+}
+
+TEST(NoiseId, PowerLawsAreRecognisedInBothDomainsAndByB1) {
+  for (int alpha : {2, 0, -2}) {
+    const PhaseSeries x = power_law(alpha, 20000, 11 + static_cast<unsigned>(alpha + 2));
+    for (std::int64_t m : {1, 8, 64}) {  // lag-1 ACF (≥ 30 points at τ)
+      EXPECT_EQ(identify_noise(x, m, Estimator::Overlapping, NoiseIdDomain::Phase), alpha) << alpha << " m " << m;
+      EXPECT_EQ(identify_noise(x, m, Estimator::Overlapping, NoiseIdDomain::Frequency), alpha) << alpha;
+    }
+  }
+}
+
+TEST(NoiseId, FewPointsFallBackToTheB1Ratio) {
+  // 24 averages at τ: below Stable32's 30-point threshold, so the B1 ratio decides. With so few
+  // points the ratio is noisy; over nine independent records most must come out right. (White and
+  // flicker PM share B1's μ = −2; for MVAR the R(n) ratio separates them.)
+  for (int alpha : {2, 0, -2}) {
+    int right = 0;
+    for (unsigned seed = 0; seed < 9; ++seed) {
+      const PhaseSeries x = power_law(alpha, 24 * 50 + 1, 100 + seed);
+      const Estimator est = alpha == 2 ? Estimator::Modified : Estimator::NonOverlapping;
+      const int got = identify_noise(x, 50, est);
+      // Random-walk FM is told from white FM, not always from flicker FM, with 24 points.
+      right += alpha == -2 ? got <= -1 : got == alpha;
+    }
+    EXPECT_GE(right, 6) << "alpha " << alpha;
+  }
+}
+
+TEST(NoiseId, ConstantDataFallBackToWhiteFm) {
+  PhaseSeries s;
+  s.values.assign(100, 3.0);
+  EXPECT_EQ(identify_noise(s, 10, Estimator::Overlapping), 0);
+}
+
+}  // namespace
+}  // namespace rwcalc
