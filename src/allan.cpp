@@ -200,7 +200,7 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
   const std::size_t points = x.points();
   if (max_cluster_size(est, points) < 1)
     throw AnalysisError(fmt::format("the record has {} phase point(s); the {} variance needs at least {}",
-                                    points, long_name(est), est == Estimator::Modified ? 3 : 3));
+                                    points, long_name(est), 3));
   const std::vector<std::int64_t> ms = cluster_sizes(options.grid, est, points, x.tau0_s);
   if (ms.empty()) throw AnalysisError("no cluster size of the τ grid fits this record");
 

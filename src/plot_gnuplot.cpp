@@ -1,0 +1,245 @@
+// Running gnuplot: the terminal preamble of a script, the subprocess, and the output file.
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "rwcalc/error.hpp"
+#include "rwcalc/plot.hpp"
+
+extern char** environ;
+
+namespace rwcalc {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string lower(std::string_view s) {
+  std::string r(s);
+  std::transform(r.begin(), r.end(), r.begin(), [](unsigned char c) { return std::tolower(c); });
+  return r;
+}
+
+/// A gnuplot single-quoted string literal (no escapes inside; a quote is doubled).
+std::string gp_string(std::string_view s) {
+  std::string r = "'";
+  for (char c : s) {
+    if (c == '\'') r += '\'';
+    r += c;
+  }
+  return r + "'";
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// A private temporary directory, removed with everything in it.
+class ScratchDir {
+ public:
+  ScratchDir() {
+    std::string templ = (fs::temp_directory_path() / "rwcalc-plot-XXXXXX").string();
+    if (mkdtemp(templ.data()) == nullptr)
+      throw OutputError(fmt::format("cannot create a temporary directory for gnuplot: {}",
+                                    std::strerror(errno)));
+    path_ = templ;
+  }
+  ~ScratchDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  [[nodiscard]] const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+struct ProcessResult {
+  bool started = false;
+  int spawn_errno = 0;
+  int status = -1;  ///< exit status, or 128 + signal
+  std::string err;  ///< what the process wrote to stderr
+};
+
+/// Run `command args…` with stdin from /dev/null and stdout+stderr captured in `log`.
+ProcessResult run_process(const std::string& command, const std::vector<std::string>& args,
+                          const fs::path& log) {
+  ProcessResult r;
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                   0600);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  std::vector<std::string> storage{command};
+  storage.insert(storage.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& s : storage) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  const int rc = posix_spawnp(&pid, command.c_str(), &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) {
+    r.spawn_errno = rc;
+    return r;
+  }
+  r.started = true;
+  int wstatus = 0;
+  while (waitpid(pid, &wstatus, 0) < 0) {
+    if (errno != EINTR) {
+      r.status = -1;
+      return r;
+    }
+  }
+  r.status = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : 128 + WTERMSIG(wstatus);
+  r.err = slurp(log);
+  return r;
+}
+
+std::string missing_gnuplot_message(const std::string& command, int err) {
+  return fmt::format(
+      "cannot run gnuplot ('{}': {}): plots need gnuplot; install it (Debian: apt-get install "
+      "gnuplot-nox) or name the binary in the environment variable RWCALC_GNUPLOT",
+      command, std::strerror(err));
+}
+
+/// Keep gnuplot's message short enough for a terminal: its last few lines carry the error.
+std::string tail_lines(const std::string& text, int lines) {
+  std::size_t pos = text.size();
+  while (pos > 0 && (text[pos - 1] == '\n' || text[pos - 1] == '\r')) --pos;
+  std::size_t end = pos;
+  for (int i = 0; i < lines && pos > 0; ++i) {
+    const auto nl = text.rfind('\n', pos - 1);
+    if (nl == std::string::npos) {
+      pos = 0;
+      break;
+    }
+    pos = nl;
+  }
+  auto s = text.substr(pos, end - pos);
+  while (!s.empty() && s.front() == '\n') s.erase(s.begin());
+  return s;
+}
+
+}  // namespace
+
+PlotFormat plot_format_for(std::string_view path) {
+  const auto ext = lower(fs::path(std::string(path)).extension().string());
+  if (ext == ".svg") return PlotFormat::Svg;
+  if (ext == ".png") return PlotFormat::Png;
+  if (ext == ".pdf") return PlotFormat::Pdf;
+  throw UsageError(fmt::format("{}: unknown figure format '{}'; name the file .svg, .png or .pdf",
+                               path, ext.empty() ? std::string("(no extension)") : ext));
+}
+
+std::string gnuplot_command() {
+  const char* env = std::getenv("RWCALC_GNUPLOT");
+  if (env != nullptr && *env != '\0') return env;
+  return "gnuplot";
+}
+
+bool gnuplot_available() {
+  ScratchDir dir;
+  const auto r = run_process(gnuplot_command(), {"--version"}, dir.path() / "log");
+  return r.started && r.status == 0;
+}
+
+std::string full_script(const std::vector<Figure>& figures, PlotFormat format, int width_px,
+                        const std::string& output_path) {
+  int height = 0;
+  for (const auto& f : figures) height += f.height_px;
+  width_px = std::clamp(width_px, 200, 8000);
+  height = std::clamp(height, 150, 16000);
+  std::string s;
+  s += fmt::format("# Generated by rwcalc {}. Run: gnuplot THIS_FILE\n", RWCALC_VERSION);
+  s += "# Data are inline ($name << EOD blocks); coefficients are named variables: edit and re-run.\n";
+  s += "set encoding utf8\n";
+  switch (format) {
+    case PlotFormat::Svg:
+      s += fmt::format("set terminal svg size {},{} fixed enhanced font 'Helvetica,13' linewidth 1.2 "
+                       "background '#ffffff'\n",
+                       width_px, height);
+      break;
+    case PlotFormat::Png:
+      // pngcairo draws anti-aliased lines; the plain gd png terminal is the fallback.
+      s += fmt::format(
+          "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) {{\n"
+          "  set terminal pngcairo size {0},{1} enhanced font 'Helvetica,11' linewidth 1.2 "
+          "background '#ffffff'\n"
+          "}} else {{\n"
+          "  set terminal png size {0},{1} enhanced font 'Helvetica,11' background '#ffffff'\n"
+          "}}\n",
+          width_px, height);
+      break;
+    case PlotFormat::Pdf:
+      s += fmt::format("set terminal pdfcairo size {:.2f}in,{:.2f}in enhanced font 'Helvetica,9' "
+                       "linewidth 1.2 background '#ffffff'\n",
+                       width_px / 96.0, height / 96.0);
+      break;
+  }
+  s += fmt::format("set output {}\n", gp_string(output_path));
+  const bool multi = figures.size() > 1;
+  if (multi) {
+    // Panels stacked top to bottom, each as tall as its figure asks (placed by origin/size).
+    s += "set multiplot\n";
+  }
+  double top = 1.0;
+  for (std::size_t i = 0; i < figures.size(); ++i) {
+    const auto& f = figures[i];
+    s += fmt::format("\n# ---- panel {}: {} ----\n", i + 1, f.name);
+    if (multi) {
+      const double frac = static_cast<double>(f.height_px) / height;
+      s += "reset\n";
+      s += fmt::format("set origin 0,{:.4f}\nset size 1,{:.4f}\n", top - frac, frac);
+      top -= frac;
+    }
+    s += f.script;
+  }
+  if (multi) s += "unset multiplot\n";
+  s += "set output\n";
+  return s;
+}
+
+std::string render_figures(const std::vector<Figure>& figures, PlotFormat format, int width_px) {
+  ScratchDir dir;
+  const auto ext = format == PlotFormat::Svg ? ".svg" : format == PlotFormat::Png ? ".png" : ".pdf";
+  const fs::path out = dir.path() / (std::string("figure") + ext);
+  const fs::path script = dir.path() / "figure.gp";
+  {
+    std::ofstream f(script, std::ios::binary);
+    f << full_script(figures, format, width_px, out.string());
+    if (!f) throw OutputError(fmt::format("{}: cannot write the gnuplot script", script.string()));
+  }
+  const auto command = gnuplot_command();
+  const auto r = run_process(command, {script.string()}, dir.path() / "gnuplot.log");
+  if (!r.started) throw OutputError(missing_gnuplot_message(command, r.spawn_errno));
+  if (r.status != 0) {
+    // A shell wrapper reports a missing binary as 127.
+    if (r.status == 127) throw OutputError(missing_gnuplot_message(command, ENOENT));
+    throw OutputError(fmt::format("gnuplot ('{}') failed with status {}: {}", command, r.status,
+                                  tail_lines(r.err, 4)));
+  }
+  std::error_code ec;
+  if (!fs::exists(out, ec) || fs::file_size(out, ec) == 0)
+    throw OutputError(fmt::format("gnuplot ('{}') produced no figure: {}", command, tail_lines(r.err, 4)));
+  return slurp(out);
+}
+
+}  // namespace rwcalc

@@ -1,0 +1,521 @@
+// The HTML test report: tables from the analysis JSON, figures by gnuplot, all in one file.
+#include "rwcalc/report.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <optional>
+
+#include "rwcalc/error.hpp"
+#include "rwcalc/output.hpp"
+#include "rwcalc/plot.hpp"
+
+namespace rwcalc {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+std::string base64_encode(std::string_view bytes) {
+  static constexpr char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  std::size_t i = 0;
+  for (; i + 2 < bytes.size(); i += 3) {
+    const unsigned v = (static_cast<unsigned char>(bytes[i]) << 16) | (static_cast<unsigned char>(bytes[i + 1]) << 8) |
+                       static_cast<unsigned char>(bytes[i + 2]);
+    out += kAlphabet[(v >> 18) & 63];
+    out += kAlphabet[(v >> 12) & 63];
+    out += kAlphabet[(v >> 6) & 63];
+    out += kAlphabet[v & 63];
+  }
+  if (i < bytes.size()) {
+    unsigned v = static_cast<unsigned char>(bytes[i]) << 16;
+    if (i + 1 < bytes.size()) v |= static_cast<unsigned char>(bytes[i + 1]) << 8;
+    out += kAlphabet[(v >> 18) & 63];
+    out += kAlphabet[(v >> 12) & 63];
+    out += i + 1 < bytes.size() ? kAlphabet[(v >> 6) & 63] : '=';
+    out += '=';
+  }
+  return out;
+}
+
+namespace {
+
+// ---- JSON access: absent or null is "not available", never 0 -------------------------------
+
+const json& at(const json& j, std::string_view key) {
+  static const json null_json;
+  if (!j.is_object()) return null_json;
+  const auto it = j.find(key);
+  return it == j.end() ? null_json : *it;
+}
+
+std::optional<double> num(const json& j) {
+  if (!j.is_number()) return std::nullopt;
+  const double v = j.get<double>();
+  return std::isfinite(v) ? std::optional<double>(v) : std::nullopt;
+}
+
+std::optional<double> num(const json& j, std::string_view key) { return num(at(j, key)); }
+
+std::string str(const json& j, std::string_view key) {
+  const auto& v = at(j, key);
+  return v.is_string() ? v.get<std::string>() : std::string();
+}
+
+// ---- HTML text -----------------------------------------------------------------------------
+
+std::string esc(std::string_view s) {
+  std::string r;
+  r.reserve(s.size());
+  for (char c : s) {
+    switch (c) {
+      case '&': r += "&amp;"; break;
+      case '<': r += "&lt;"; break;
+      case '>': r += "&gt;"; break;
+      case '"': r += "&quot;"; break;
+      case '\'': r += "&#39;"; break;
+      default: r += c;
+    }
+  }
+  return r;
+}
+
+std::string g(double v, int digits = 3) { return fmt::format("{:.{}g}", v, digits); }
+
+constexpr const char* kNotAvailable = "<span class=\"na\">—</span>";
+
+/// A coefficient cell: "value ± σ" with the 95 % interval below, or "< bound" when unresolved.
+std::string coef_cell(const json& c) {
+  const auto v = num(c, "value");
+  if (!v) return kNotAvailable;
+  const auto& resolved = at(c, "resolved");
+  if (resolved.is_boolean() && !resolved.get<bool>())
+    return fmt::format("&lt; {} <span class=\"ci\">95 % upper bound</span>", g(*v));
+  std::string s = g(*v);
+  if (const auto sigma = num(c, "sigma"); sigma && *sigma > 0) s += fmt::format(" ± {}", g(*sigma, 2));
+  const auto lo = num(c, "low95"), hi = num(c, "high95");
+  if (lo && hi) s += fmt::format(" <span class=\"ci\">[{}, {}]</span>", g(*lo), g(*hi));
+  return s;
+}
+
+std::string temperature_text(const json& t) {
+  const auto v = num(t);
+  if (!v) return "not given";
+  return fmt::format("{}{:g} °C", *v > 0 ? "+" : *v < 0 ? "−" : "", std::fabs(*v));
+}
+
+std::string class_text(const json& c) {
+  if (c.is_number_integer()) return fmt::format("{}", c.get<int>());
+  if (c.is_null()) return "outside";
+  return kNotAvailable;
+}
+
+std::string source_name(const json& a) {
+  const auto s = str(a, "source");
+  return s.empty() ? std::string("(unnamed run)") : fs::path(s).filename().string();
+}
+
+/// Class limits of one parameter ("B" or "N") as the verdict applied them, else GOST RV 52339.
+std::vector<std::pair<int, double>> limits_of(const json& analysis, const char* parameter) {
+  std::vector<std::pair<int, double>> r;
+  const auto& verdict = at(analysis, "verdict");
+  const auto& classes = at(verdict, "classes");
+  const auto& limits = at(at(verdict, parameter), "limits");
+  if (classes.is_array() && limits.is_array() && classes.size() == limits.size())
+    for (std::size_t i = 0; i < classes.size(); ++i)
+      if (classes[i].is_number_integer() && num(limits[i])) r.emplace_back(classes[i].get<int>(), *num(limits[i]));
+  if (r.empty()) {
+    if (std::string_view(parameter) == "B")
+      r = {{1, 0.005}, {2, 0.008}, {3, 0.015}};
+    else
+      r = {{1, 0.0010}, {2, 0.0015}, {3, 0.0030}};
+  }
+  return r;
+}
+
+/// The class an estimate's reported value falls in (no probability): for the cross-check methods.
+std::string class_by_value(const json& estimate, const std::vector<std::pair<int, double>>& limits) {
+  const auto v = num(estimate, "value");
+  if (!v) return kNotAvailable;
+  for (const auto& [cls, limit] : limits)
+    if (*v <= limit) return fmt::format("{}", cls);
+  return "outside";
+}
+
+// ---- figures -------------------------------------------------------------------------------
+
+struct FigureCounter {
+  int next = 1;
+};
+
+std::string figure_html(const std::string& id, const std::vector<Figure>& figures, const std::string& caption,
+                        FigureCounter& counter) {
+  const auto svg = render_figures(figures, PlotFormat::Svg, 960);
+  return fmt::format(
+      "<figure id=\"{0}\">\n<img alt=\"{1}\" src=\"data:image/svg+xml;base64,{2}\"/>\n"
+      "<figcaption><b>Fig. {3}.</b> {1}</figcaption>\n</figure>\n",
+      id, esc(caption), base64_encode(svg), counter.next++);
+}
+
+// ---- the page ------------------------------------------------------------------------------
+
+constexpr const char* kStyle = R"(
+body { font-family: "DejaVu Sans", Helvetica, Arial, sans-serif; font-size: 14px; color: #222;
+       max-width: 1100px; margin: 1.5em auto; padding: 0 1em; line-height: 1.4; }
+h1 { font-size: 1.6em; margin-bottom: 0.2em; }
+h2 { font-size: 1.25em; border-bottom: 1px solid #ccc; padding-bottom: 0.2em; margin-top: 1.6em; }
+h3 { font-size: 1.05em; margin-top: 1.2em; }
+.meta { color: #555; }
+table { border-collapse: collapse; margin: 0.6em 0 1em; font-size: 0.95em; }
+th, td { border: 1px solid #bbb; padding: 0.3em 0.6em; text-align: left; vertical-align: top;
+         overflow-wrap: break-word; }
+th { background: #f0f0f0; }
+td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
+caption { caption-side: top; text-align: left; font-weight: bold; padding-bottom: 0.3em; }
+.ci { display: block; color: #666; font-size: 0.85em; }
+.na { color: #999; }
+.verdict { font-size: 1.15em; padding: 0.6em 0.9em; border-left: 5px solid #2c7bb6; background: #f4f8fb; }
+.note { color: #7a4b00; background: #fff6e0; padding: 0.3em 0.6em; border-left: 4px solid #e6a000; }
+figure { margin: 1em 0; }
+figure img { width: 100%; max-width: 960px; height: auto; border: 1px solid #eee; }
+figcaption { color: #444; font-size: 0.92em; }
+footer { margin-top: 2em; color: #777; font-size: 0.85em; border-top: 1px solid #ddd; padding-top: 0.5em; }
+@media print {
+  body { max-width: none; margin: 0; font-size: 11px; }
+  h2 { page-break-after: avoid; }
+  table, figure, .verdict { page-break-inside: avoid; }
+  figure img { max-width: 100%; border: none; }
+  a { color: inherit; text-decoration: none; }
+}
+)";
+
+std::vector<std::size_t> order_by_temperature(const std::vector<json>& analyses) {
+  std::vector<std::size_t> idx(analyses.size());
+  for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = i;
+  std::stable_sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) {
+    const auto ta = num(analyses[a], "temperature_c"), tb = num(analyses[b], "temperature_c");
+    if (ta && tb) return *ta < *tb;
+    return ta.has_value() && !tb.has_value();
+  });
+  return idx;
+}
+
+/// Worst (highest) class over runs; null when any run is outside the table or unclassified.
+json worst_class(const std::vector<json>& analyses, const char* key) {
+  int worst = 0;
+  for (const auto& a : analyses) {
+    const auto& c = at(at(a, "verdict"), key);
+    if (!c.is_number_integer()) return nullptr;
+    worst = std::max(worst, c.get<int>());
+  }
+  return worst > 0 ? json(worst) : json(nullptr);
+}
+
+std::string table1(const std::vector<json>& a, const std::vector<std::size_t>& order) {
+  std::string s =
+      "<table id=\"table1\">\n<caption>Table 1. Noise coefficients per temperature: value ± standard error "
+      "[95 % interval]</caption>\n<tr><th>run</th><th>temperature</th><th>N by Allan variance (°/√h)</th>"
+      "<th>N direct method (°/√h)</th><th>B by Allan variance (°/h)</th><th>B by 100-s averaging (°/h)</th></tr>\n";
+  for (auto i : order) {
+    const auto& run = a[i];
+    const auto& fit = at(run, "fit");
+    const auto& methods = at(run, "methods");
+    s += fmt::format("<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
+                     "<td class=\"num\">{}</td><td class=\"num\">{}</td></tr>\n",
+                     esc(source_name(run)), temperature_text(at(run, "temperature_c")),
+                     coef_cell(at(fit, "N_deg_per_sqrt_h")), coef_cell(at(methods, "N_direct_deg_per_sqrt_h")),
+                     coef_cell(at(fit, "B_deg_per_h")), coef_cell(at(methods, "B_100s_deg_per_h")));
+  }
+  return s + "</table>\n";
+}
+
+std::string table2(const std::vector<json>& a, const std::vector<std::size_t>& order, const json& overall) {
+  std::string s =
+      "<table id=\"table2\">\n<caption>Table 2. Accuracy class per parameter (1 best; “outside”: beyond the "
+      "last class)</caption>\n<tr><th>run</th><th>temperature</th><th>class by N (AV)</th>"
+      "<th>class by N direct</th><th>class by B (verdict estimate)</th><th>class by B 100-s</th>"
+      "<th>class</th><th>verdict with probability</th></tr>\n";
+  for (auto i : order) {
+    const auto& run = a[i];
+    const auto& v = at(run, "verdict");
+    const auto& methods = at(run, "methods");
+    std::string statement = esc(str(v, "statement"));
+    if (statement.empty()) {
+      const auto p = num(v, "p_class");
+      statement = p ? fmt::format("class {} (P = {:.2f})", class_text(at(v, "class")), *p) : kNotAvailable;
+    }
+    if (const auto& changed = at(v, "tolerance_changed"); changed.is_boolean() && changed.get<bool>())
+      statement += fmt::format(" <span class=\"note\">changed by the +{:g} % B tolerance</span>",
+                               num(v, "tolerance_pct").value_or(0.0));
+    s += fmt::format(
+        "<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
+        "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\"><b>{}</b></td><td>{}</td></tr>\n",
+        esc(source_name(run)), temperature_text(at(run, "temperature_c")), class_text(at(v, "class_N")),
+        class_by_value(at(methods, "N_direct_deg_per_sqrt_h"), limits_of(run, "N")), class_text(at(v, "class_B")),
+        class_by_value(at(methods, "B_100s_deg_per_h"), limits_of(run, "B")), class_text(at(v, "class")),
+        statement);
+  }
+  s += fmt::format(
+      "<tr><th colspan=\"2\">over the temperature range</th><td class=\"num\"><b>{}</b></td><td></td>"
+      "<td class=\"num\"><b>{}</b></td><td></td><td class=\"num\"><b>{}</b></td><td>worst case over the runs</td></tr>\n",
+      class_text(at(overall, "class_N")), class_text(at(overall, "class_B")), class_text(at(overall, "class")));
+  s += "</table>\n<p class=\"meta\">Classes by N direct and by B 100-s compare the reported value with the class "
+       "limits only (no probability); the verdict uses the estimates named in the settings.</p>\n";
+  return s;
+}
+
+std::string kv_row(std::string_view key, const std::string& value_html) {
+  return fmt::format("<tr><th>{}</th><td>{}</td></tr>\n", esc(key), value_html);
+}
+
+std::string json_value_html(const json& v) {
+  if (v.is_string()) return esc(v.get<std::string>());
+  if (v.is_number_float()) return g(v.get<double>(), 6);
+  if (v.is_null()) return kNotAvailable;
+  if (v.is_array()) {
+    // Lists (e.g. the input files) one item after another, so long lists wrap.
+    std::string s;
+    for (const auto& e : v) s += (s.empty() ? "" : ", ") + json_value_html(e);
+    return s;
+  }
+  return esc(v.dump());
+}
+
+std::string run_summary(const json& run, std::size_t index) {
+  std::string s = fmt::format("<table class=\"run\" id=\"run{}-data\">\n<caption>Data and rates</caption>\n", index + 1);
+  s += kv_row("file", esc(str(run, "source")));
+  if (const auto n = num(run, "samples")) s += kv_row("samples", fmt::format("{:.0f}", *n));
+  if (const auto r = num(run, "rate_hz")) s += kv_row("sample rate", fmt::format("{:g} Hz", *r));
+  if (const auto d = num(run, "duration_s")) s += kv_row("duration", fmt::format("{:.1f} s ({:.2f} h)", *d, *d / 3600));
+  s += kv_row("temperature", temperature_text(at(run, "temperature_c")));
+  if (const auto m = num(run, "mean_rate_deg_per_h")) s += kv_row("mean rate", fmt::format("{:.5g} °/h", *m));
+  if (const auto e = num(run, "earth_rate_deg_per_h")) s += kv_row("expected Earth rate", fmt::format("{:.5g} °/h", *e));
+  if (const auto b = num(run, "bias_deg_per_h")) s += kv_row("bias (mean − Earth rate)", fmt::format("{:.4g} °/h", *b));
+  s += "</table>\n";
+
+  const auto& fit = at(run, "fit");
+  s += fmt::format("<table class=\"run\" id=\"run{}-fit\">\n<caption>Allan-variance fit "
+                   "σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)B² + K²τ/3 + R²τ²/2</caption>\n"
+                   "<tr><th>term</th><th>value ± standard error [95 %]</th><th>unit</th></tr>\n",
+                   index + 1);
+  static constexpr std::array<std::array<const char*, 3>, 5> kTerms{{{"Q_arcsec", "Q quantization", "″"},
+                                                                     {"N_deg_per_sqrt_h", "N angle random walk", "°/√h"},
+                                                                     {"B_deg_per_h", "B bias instability", "°/h"},
+                                                                     {"K_deg_per_h_per_sqrt_h", "K rate random walk", "°/h/√h"},
+                                                                     {"R_deg_per_h2", "R rate ramp", "°/h²"}}};
+  for (const auto& [key, name, unit] : kTerms)
+    s += fmt::format("<tr><td>{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n", name, coef_cell(at(fit, key)), unit);
+  if (const auto c = num(fit, "chi2_per_dof")) {
+    std::string gof = fmt::format("χ²/dof = {:.3g}", *c);
+    if (const auto p = num(fit, "p_value")) gof += fmt::format(", p = {:.3g}", *p);
+    if (const auto lo = num(fit, "tau_min_s"), hi = num(fit, "tau_max_s"); lo && hi)
+      gof += fmt::format("; τ fitted {:g}–{:g} s", *lo, *hi);
+    s += fmt::format("<tr><td>goodness of fit</td><td colspan=\"2\">{}</td></tr>\n", gof);
+  }
+  s += "</table>\n";
+  const auto& v = at(run, "verdict");
+  if (v.is_object()) {
+    s += "<p>Verdict: <b>";
+    s += esc(str(v, "statement").empty() ? "class " + class_text(at(v, "class")) : str(v, "statement"));
+    s += "</b>";
+    if (auto sb = str(v, "statement_B"); !sb.empty()) s += "; by B: " + esc(sb);
+    if (auto sn = str(v, "statement_N"); !sn.empty()) s += "; by N: " + esc(sn);
+    s += ".</p>\n";
+  }
+  return s;
+}
+
+std::string number_with_unit_key(std::string_view key, const json& v) {
+  // Keys carry their unit as a suffix (frequency_hz, amplitude_deg_per_h, time_s…).
+  static constexpr std::array<std::pair<const char*, const char*>, 9> kUnits{{{"_deg_per_h_per_sqrt_h", "°/h/√h"},
+                                                                             {"_deg_per_sqrt_h", "°/√h"},
+                                                                             {"_deg_per_h2", "°/h²"},
+                                                                             {"_deg_per_h", "°/h"},
+                                                                             {"_arcsec", "″"},
+                                                                             {"_hz", "Hz"},
+                                                                             {"_s", "s"},
+                                                                             {"_c", "°C"},
+                                                                             {"_pct", "%"}}};
+  if (!v.is_number()) return json_value_html(v);
+  for (const auto& [suffix, unit] : kUnits) {
+    const std::string_view sfx(suffix);
+    if (key.size() > sfx.size() && key.substr(key.size() - sfx.size()) == sfx)
+      return fmt::format("{} {}", g(v.get<double>(), 4), unit);
+  }
+  return g(v.get<double>(), 4);
+}
+
+std::string diagnosis_html(const json& d, std::size_t index, const json& run, FigureCounter& counter, bool figures) {
+  std::string s = fmt::format("<h3 id=\"run{}-diagnosis\">Diagnosis: what the noise model misses</h3>\n", index + 1);
+  const auto& findings = at(d, "findings");
+  if (!findings.is_array() || findings.empty()) {
+    s += "<p>No finding: the five-term model's simulations explain the measurement.</p>\n";
+  } else {
+    s += fmt::format("<table id=\"run{}-findings\">\n<caption>Findings</caption>\n<tr><th>effect</th>"
+                     "<th>parameters</th></tr>\n",
+                     index + 1);
+    for (const auto& f : findings) {
+      std::string params;
+      if (f.is_object()) {
+        for (const auto& [k, v] : f.items()) {
+          if (k == "effect" || v.is_object() || v.is_array()) continue;
+          params += fmt::format("{}{} = {}", params.empty() ? "" : "; ", esc(k), number_with_unit_key(k, v));
+        }
+      }
+      s += fmt::format("<tr><td>{}</td><td>{}</td></tr>\n", esc(str(f, "effect")), params);
+    }
+    s += "</table>\n";
+  }
+  const auto& gain = at(d, "gain");
+  if (gain.is_object()) {
+    s += fmt::format("<table id=\"run{}-gain\">\n<caption>Gain of the extended model</caption>\n"
+                     "<tr><th>measure</th><th>base model</th><th>extended model</th></tr>\n",
+                     index + 1);
+    static constexpr std::array<std::array<const char*, 3>, 3> kRows{
+        {{"Allan-variance misfit (EDF-weighted)", "misfit_base", "misfit_extended"},
+         {"share of measured τ inside the simulated band", "coverage_base", "coverage_extended"},
+         {"out-of-sample misfit (fit on one part, predict the other)", "holdout_misfit_base",
+          "holdout_misfit_extended"}}};
+    for (const auto& [name, base, ext] : kRows) {
+      auto cell = [&](const char* key) {
+        const auto v = num(gain, key);
+        return v ? g(*v, 4) : std::string(kNotAvailable);
+      };
+      s += fmt::format("<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>\n", name, cell(base),
+                       cell(ext));
+    }
+    s += "</table>\n";
+  }
+  if (figures && (at(at(d, "base_model"), "band").is_array() || at(d, "band").is_array())) {
+    PlotOptions po;
+    s += figure_html(fmt::format("fig-run{}-diagnosis", index + 1), {diagnosis_figure(d, po)},
+                     fmt::format("{}: measured Allan deviation against the simulated bands of the base and the "
+                                 "extended model",
+                                 source_name(run)),
+                     counter);
+  }
+  return s;
+}
+
+}  // namespace
+
+std::string report_html(const ReportInput& input, const ReportOptions& options) {
+  const auto& a = input.analyses;
+  if (a.empty()) throw AnalysisError("a report needs at least one analysed run");
+  const auto order = order_by_temperature(a);
+  json overall = input.overall;
+  if (!overall.is_object())
+    overall = {{"class_B", worst_class(a, "class_B")}, {"class_N", worst_class(a, "class_N")},
+               {"class", worst_class(a, "class")}};
+  FigureCounter counter;
+
+  std::string h;
+  h += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\"/>\n";
+  h += "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"/>\n";
+  h += fmt::format("<meta name=\"generator\" content=\"rwcalc {}\"/>\n", RWCALC_VERSION);
+  h += fmt::format("<title>{}</title>\n<style>{}</style>\n</head>\n<body>\n", esc(options.title), kStyle);
+  h += fmt::format("<h1>{}</h1>\n<p class=\"meta\">rwcalc {} · {} run{}", esc(options.title), RWCALC_VERSION,
+                   a.size(), a.size() == 1 ? "" : "s");
+  if (!options.generated.empty()) h += " · generated " + esc(options.generated);
+  h += "</p>\n";
+
+  // Verdict first: it is what the report is for.
+  h += "<h2 id=\"verdict\">Verdict</h2>\n";
+  h += fmt::format("<p class=\"verdict\">Overall class over {}: <b>{}</b> (by B: {}, by N: {}).</p>\n",
+                   a.size() == 1 ? "the run" : "the temperature range", class_text(at(overall, "class")),
+                   class_text(at(overall, "class_B")), class_text(at(overall, "class_N")));
+  h += "<ul>\n";
+  for (auto i : order) {
+    const auto& v = at(a[i], "verdict");
+    std::string st = str(v, "statement");
+    if (st.empty()) st = "class " + class_text(at(v, "class"));
+    h += fmt::format("<li>{} ({}): {}</li>\n", esc(source_name(a[i])), temperature_text(at(a[i], "temperature_c")),
+                     esc(st));
+  }
+  h += "</ul>\n";
+  const auto& v0 = at(a[order.front()], "verdict");
+  if (const auto t = num(v0, "tolerance_pct"); t && *t > 0)
+    h += fmt::format("<p class=\"note\">The seed paper's heading-gyro rule is applied: a B up to {:g} % above a "
+                     "class limit is accepted for that class.</p>\n",
+                     *t);
+  h += "<p class=\"meta\">P is the probability, from the estimates' uncertainty, that the true class is the one "
+       "stated; where it is low the runner-up class is named.";
+  if (auto table = str(v0, "table"); !table.empty()) h += " Class table: " + esc(table) + ".";
+  h += "</p>\n";
+
+  h += "<h2 id=\"tables\">Tables 1 and 2</h2>\n";
+  h += table1(a, order);
+  h += table2(a, order, overall);
+
+  if (options.figures && a.size() > 1) {
+    json runs = json::array();
+    for (const auto& r : a) runs.push_back(r);
+    PlotOptions po;
+    h += "<h2 id=\"figures\">Figures over the temperature range</h2>\n";
+    h += figure_html("fig-batch-allan", {batch_allan_figure(runs, po)},
+                     "Allan deviation at each temperature with 68 % confidence bars and the class limits for B drawn "
+                     "at their floor levels 0.6643·B",
+                     counter);
+    auto direct = batch_direct_figure(runs, po);
+    if (direct.series > 0)
+      h += figure_html("fig-batch-direct", {direct},
+                       "Direct method: variance of the angle accumulated over t, Earth rate removed, with the "
+                       "regression line per temperature (slope (60·N)² ″²/s)",
+                       counter);
+    else
+      h += "<p class=\"note\">The direct-method curves are not in the analysis results, so the angle-variance "
+           "figure is left out.</p>\n";
+  }
+
+  h += "<h2 id=\"runs\">Runs</h2>\n";
+  for (auto i : order) {
+    const auto& run = a[i];
+    h += fmt::format("<h3 id=\"run{}\">{} at {}</h3>\n", i + 1, esc(source_name(run)),
+                     temperature_text(at(run, "temperature_c")));
+    h += run_summary(run, i);
+    if (options.figures)
+      h += figure_html(fmt::format("fig-run{}-allan", i + 1), {analysis_figure(run, PlotOptions{})},
+                       fmt::format("{}: Allan deviation with confidence bars, the fitted model and its terms, and "
+                                   "the class limits for B",
+                                   source_name(run)),
+                       counter);
+    if (i < input.diagnoses.size() && input.diagnoses[i].is_object())
+      h += diagnosis_html(input.diagnoses[i], i, run, counter, options.figures);
+  }
+  if (!options.figures)
+    h += "<p class=\"note\">Figures were left out of this report (--no-figures).</p>\n";
+
+  h += "<h2 id=\"settings\">Settings and conventions</h2>\n<table id=\"settings-table\">\n";
+  h += kv_row("rwcalc version", RWCALC_VERSION);
+  if (options.settings.is_object())
+    for (const auto& [k, v] : options.settings.items()) h += kv_row(k, json_value_html(v));
+  if (auto b = str(v0, "b_estimate"); !b.empty()) h += kv_row("B estimate used by the verdict", esc(b));
+  const auto& conventions = at(a[order.front()], "conventions");
+  if (conventions.is_object())
+    for (const auto& [k, v] : conventions.items()) h += kv_row("convention: " + k, json_value_html(v));
+  h += "</table>\n";
+  h += fmt::format("<footer>Generated by rwcalc {}. Allan deviations in °/h (1″/s = 1 °/h); τ in s.</footer>\n",
+                   RWCALC_VERSION);
+  h += "</body>\n</html>\n";
+  return h;
+}
+
+std::string write_report(const std::string& dir, const ReportInput& input, const ReportOptions& options,
+                         bool force) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir))
+    throw OutputError(fmt::format("{}: cannot create the report directory: {}", dir,
+                                  ec ? ec.message() : std::string("not a directory")));
+  const auto path = (fs::path(dir) / "report.html").string();
+  if (!force && fs::exists(path, ec))
+    throw OutputError(fmt::format("{}: exists; use --force to overwrite it", path));
+  write_file_atomic(path, report_html(input, options), force);
+  return path;
+}
+
+}  // namespace rwcalc
