@@ -64,6 +64,13 @@ double gm_avar_factor(double x) {
   return 1.0 - (3.0 - 4.0 * std::exp(-x) + std::exp(-2.0 * x)) / (2.0 * x);
 }
 
+// floor(x) as an integer, bit-identical to std::floor for |x| < 2^62. Without SSE4.1 the
+// compiler turns std::floor into a library call; this is a truncation and a compare.
+inline std::int64_t floor_to_int(double x) noexcept {
+  const auto t = static_cast<std::int64_t>(x);
+  return static_cast<double>(t) > x ? t - 1 : t;
+}
+
 // Smallest 2^a·3^b·5^c ≥ n that is even (kissfft handles radices 2, 3, 5 efficiently).
 std::size_t good_fft_size(std::size_t n) {
   std::size_t best = std::numeric_limits<std::size_t>::max();
@@ -205,6 +212,39 @@ double flicker_avar(double b, std::size_t m) {
   return 2.0 * b * b / (kPi * md * md) * sum * 0.5 * h;
 }
 
+std::size_t flicker_decimation(double rate_hz) {
+  if (!(rate_hz >= 20.0) || !std::isfinite(rate_hz)) return 1;
+  return static_cast<std::size_t>(std::floor(rate_hz / 10.0));
+}
+
+double fast_flicker_avar(double b, std::size_t m, std::size_t decimation) {
+  if (m == 0) return 0.0;
+  const std::size_t d = std::max<std::size_t>(decimation, 1);
+  if (m > 256 * d) return flicker_avar(b, m);
+  // Structure function of the decimated Kasdin rate, D_x(h) = (4B²/π)·Σ_{j=1}^{h} 1/(2j−1)
+  // (the discrete PSD B²τd/(2 sin πfτd) integrated against 4 sin²(πfhτd); the j-th step is
+  // ∫_0^{π/2} sin((2j−1)u) du).
+  const std::size_t blocks = 2 * m / d + 3;
+  std::vector<double> sf(blocks + 1, 0.0);
+  for (std::size_t h = 1; h <= blocks; ++h) sf[h] = sf[h - 1] + 1.0 / (2.0 * static_cast<double>(h) - 1.0);
+  std::vector<double> c(blocks);
+  double total = 0.0;
+  for (std::size_t phase = 0; phase < d; ++phase) {
+    // Weights of the held blocks in (second window − first window), in samples.
+    std::fill(c.begin(), c.end(), 0.0);
+    for (std::size_t k = 0; k < 2 * m; ++k) c[(phase + k) / d] += k < m ? -1.0 : 1.0;
+    // E[(Σ c_j x_j)²] = −½ Σ_i Σ_j c_i c_j D_x(i − j) since Σ c_j = 0.
+    double sum = 0.0;
+    for (std::size_t i = 0; i < blocks; ++i) {
+      if (c[i] == 0.0) continue;
+      for (std::size_t j = i + 1; j < blocks; ++j) sum += c[i] * c[j] * sf[j - i];
+    }
+    total += -sum;  // −½·2·Σ_{i<j}
+  }
+  const double md = static_cast<double>(m);
+  return (4.0 * b * b / kPi) * total / static_cast<double>(d) / (2.0 * md * md);
+}
+
 double theoretical_avar(const NoiseModel& model, double tau0, double q, std::size_t m) {
   const double tau = static_cast<double>(m) * tau0;
   const double n_s = units::sqrt_s_per_sqrt_h * model.arw_deg_per_sqrt_h;     // ″/√s
@@ -233,7 +273,10 @@ double theoretical_avar(const NoiseModel& model, double tau0, double q, std::siz
 struct Simulator::Impl {
   NoiseModel model;
   SimulationSettings settings;
+  SimulationPath path = SimulationPath::Exact;
   std::size_t n = 0;      // samples
+  std::size_t flicker_n = 0;    // samples of the flicker rate (n, or ceil(n/D) when decimated)
+  std::size_t flicker_hold = 1; // samples each flicker rate value is held for (D)
   double tau0 = 0.0;
   double q = 0.0;
   std::vector<double> inc;  // angle increment of each interval, ″ (index k−1 for interval k)
@@ -246,9 +289,15 @@ struct Simulator::Impl {
   std::vector<GmStep> gm_steps;
   GmStep lowpass_arw;
 
-  Impl(NoiseModel m, SimulationSettings s) : model(std::move(m)), settings(std::move(s)) {
+  Impl(NoiseModel m, SimulationSettings s, SimulationPath p)
+      : model(std::move(m)), settings(std::move(s)), path(p) {
     validate(model, settings);
     n = settings.samples();
+    flicker_n = n;
+    if (path == SimulationPath::Ensemble) {
+      flicker_hold = std::min(flicker_decimation(settings.rate_hz), n);
+      flicker_n = (n + flicker_hold - 1) / flicker_hold;
+    }
     tau0 = settings.tau0_s();
     q = settings.scale_arcsec;
     inc.resize(n);
@@ -268,8 +317,8 @@ struct Simulator::Impl {
     // Circular convolution of length L ≥ 2n with a filter of L − n + 1 ≥ n + 1 taps gives, on
     // the first n outputs, the linear convolution of the filter with an i.i.d. sequence that
     // starts L − n samples before the record: no wrap-around, filter longer than the record.
-    fft_size = good_fft_size(2 * n);
-    const std::size_t taps = fft_size - n + 1;
+    fft_size = good_fft_size(2 * flicker_n);
+    const std::size_t taps = fft_size - flicker_n + 1;
     std::vector<double> h(fft_size, 0.0);
     h[0] = 1.0;
     for (std::size_t k = 1; k < taps; ++k) h[k] = h[k - 1] * (0.5 + static_cast<double>(k) - 1.0) / static_cast<double>(k);
@@ -280,6 +329,8 @@ struct Simulator::Impl {
 
   // Flicker rate samples x_0..x_{n−1}, ″/s, added to inc as x·τ0. The white input's DFT is
   // drawn directly (its bins are independent complex normals), which saves the forward FFT.
+  // On the Ensemble path x is the Kasdin sequence at τd = D·τ0 (Q_d = B² keeps the low-frequency
+  // PSD B²/(πf) of the exact path), held over each block of D samples.
   void add_flicker(std::uint64_t seed) {
     Rng rng(seed, kFlickerStream);
     const double b = model.bias_instability_deg_per_h;  // Q_d = B²
@@ -294,7 +345,14 @@ struct Simulator::Impl {
     }
     spectrum[half] = filter_spectrum[half] * s_edge * rng.normal();
     fft.inv(flicker.data(), spectrum.data(), static_cast<Eigen::Index>(fft_size));
-    for (std::size_t k = 0; k < n; ++k) inc[k] += flicker[k] * tau0;
+    if (flicker_hold == 1) {
+      for (std::size_t k = 0; k < n; ++k) inc[k] += flicker[k] * tau0;
+      return;
+    }
+    for (std::size_t j = 0, k = 0; j < flicker_n; ++j) {
+      const double step = flicker[j] * tau0;
+      for (const std::size_t end = std::min(n, k + flicker_hold); k < end; ++k) inc[k] += step;
+    }
   }
 
   void add_deterministic() {
@@ -413,24 +471,24 @@ struct Simulator::Impl {
     auto count = [&](double extra) {
       const double u = dither ? readout.uniform() : phase0;
       const double y = frac + u + extra;  // extra: white angle noise in pulses (not accumulated)
-      return whole + static_cast<std::int64_t>(std::floor(y));
+      return whole + floor_to_int(y);
     };
     const double e0 = wa > 0 ? wa * white.normal() : 0.0;
     const std::int64_t c0 = count(e0);
     out.counts[0] = 0;
     for (std::size_t k = 0; k < n; ++k) {
       frac += inc[k] * inv_q;
-      const double fl = std::floor(frac);
-      whole += static_cast<std::int64_t>(fl);
-      frac -= fl;
+      const std::int64_t fl = floor_to_int(frac);
+      whole += fl;
+      frac -= static_cast<double>(fl);
       const double e = wa > 0 ? wa * white.normal() : 0.0;
       out.counts[k + 1] = count(e) - c0;
     }
   }
 };
 
-Simulator::Simulator(NoiseModel model, SimulationSettings settings)
-    : impl_(std::make_unique<Impl>(std::move(model), std::move(settings))) {}
+Simulator::Simulator(NoiseModel model, SimulationSettings settings, SimulationPath path)
+    : impl_(std::make_unique<Impl>(std::move(model), std::move(settings), path)) {}
 Simulator::~Simulator() = default;
 Simulator::Simulator(Simulator&&) noexcept = default;
 Simulator& Simulator::operator=(Simulator&&) noexcept = default;
@@ -438,6 +496,7 @@ Simulator& Simulator::operator=(Simulator&&) noexcept = default;
 void Simulator::run(std::uint64_t seed, PhaseSeries& out) { impl_->run(seed, out); }
 const NoiseModel& Simulator::model() const noexcept { return impl_->model; }
 const SimulationSettings& Simulator::settings() const noexcept { return impl_->settings; }
+SimulationPath Simulator::path() const noexcept { return impl_->path; }
 
 PhaseSeries simulate(const NoiseModel& model, const SimulationSettings& settings) {
   Simulator sim(model, settings);

@@ -18,6 +18,7 @@
 ///    (= q/√12 of the counter's own error plus q/√12 of the dither angle; see docs/simulation.md).
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -132,6 +133,30 @@ void validate(const NoiseModel& model, const SimulationSettings& settings);
 /// Exact AV of the discrete (Kasdin) flicker with Q_d = B² at cluster size m, (°/h)².
 [[nodiscard]] double flicker_avar(double b_deg_per_h, std::size_t m);
 
+/// How a Simulator generates the flicker (bias-instability) rate.
+enum class SimulationPath {
+  /// Kasdin filter at τ0 over the whole record (an FFT of ≥ 2× the record): the reference,
+  /// used for every file `rwcalc simulate` writes. ~0.3–0.6 s per 2-h 400 Hz record.
+  Exact,
+  /// For ensembles: the Kasdin flicker is generated at the decimated period τd = D·τ0
+  /// (D = flicker_decimation(rate), ≈ 0.1 s) and held constant over each block of D samples,
+  /// integrated exactly into the angle. Its expected AV is fast_flicker_avar(): within 0.4 %
+  /// of the exact flicker AV for τ ≥ 10·τd, 2 % at 4·τd, 20 % low at τd (docs/performance.md).
+  /// Every other term is generated exactly as on the Exact path.
+  Ensemble,
+};
+
+/// Decimation D of the Ensemble path's flicker for a sample rate: the largest D with
+/// rate/D ≥ 10 Hz (1, i.e. no decimation, at rates below 20 Hz).
+[[nodiscard]] std::size_t flicker_decimation(double rate_hz);
+
+/// Expected AV (°/h)² at cluster size m of the Ensemble path's flicker with decimation D:
+/// the Kasdin structure function D_x(h) = (4B²/π)·Σ_{j≤|h|} 1/(2j−1) of the decimated rate,
+/// seen through the hold and the m-sample Allan filter, averaged over the D block phases of
+/// the overlapping estimator. Exact for D = 1 (then equal to flicker_avar). Cost O(D·(m/D)²):
+/// for m > 256·D it returns flicker_avar(B, m), from which it then differs by < 1e-4.
+[[nodiscard]] double fast_flicker_avar(double b_deg_per_h, std::size_t m, std::size_t decimation);
+
 /// Simulate one record. counts[0] = 0; counts.size() = samples + 1. Throws UsageError.
 PhaseSeries simulate(const NoiseModel& model, const SimulationSettings& settings);
 
@@ -139,7 +164,9 @@ PhaseSeries simulate(const NoiseModel& model, const SimulationSettings& settings
 /// spectrum and all buffers are made once and reused by every run.
 class Simulator {
  public:
-  Simulator(NoiseModel model, SimulationSettings settings);
+  /// Throws UsageError (validate). `path` chooses how the flicker term is generated.
+  explicit Simulator(NoiseModel model, SimulationSettings settings,
+                     SimulationPath path = SimulationPath::Exact);
   ~Simulator();
   Simulator(Simulator&&) noexcept;
   Simulator& operator=(Simulator&&) noexcept;
@@ -149,11 +176,34 @@ class Simulator {
 
   [[nodiscard]] const NoiseModel& model() const noexcept;
   [[nodiscard]] const SimulationSettings& settings() const noexcept;
+  [[nodiscard]] SimulationPath path() const noexcept;
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+class Progress;
+
+/// How simulate_ensemble runs.
+struct EnsembleOptions {
+  SimulationPath path = SimulationPath::Ensemble;
+  unsigned threads = 0;           ///< worker threads; 0: all hardware threads
+  Progress* progress = nullptr;   ///< advanced once per finished realisation (may be null)
+};
+
+/// Seed of realisation `run` of an ensemble whose base seed is `seed` (independent streams).
+[[nodiscard]] std::uint64_t ensemble_seed(std::uint64_t seed, std::size_t run) noexcept;
+
+/// Simulate `runs` realisations of one model, settings.seed being the base seed: realisation r
+/// uses ensemble_seed(settings.seed, r), so the result does not depend on the thread count.
+/// Each worker thread owns one Simulator and one PhaseSeries, reused for all its runs.
+/// `consume(r, series)` is called on the worker threads, concurrently for different r; the
+/// series is overwritten after it returns. The first exception (from the simulator or
+/// `consume`) stops the remaining runs and is rethrown.
+void simulate_ensemble(const NoiseModel& model, const SimulationSettings& settings, std::size_t runs,
+                       const std::function<void(std::size_t run, const PhaseSeries& series)>& consume,
+                       const EnsembleOptions& options = {});
 
 /// Per-sample pulse increments c_k = C_k − C_{k−1}, k = 1..M, of an exact series.
 [[nodiscard]] std::vector<std::int64_t> pulse_increments(const PhaseSeries& series);

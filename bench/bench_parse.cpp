@@ -1,0 +1,56 @@
+// Reading: parse the text of a 2-h 400 Hz GL-2D pulse file already in memory (the floor of
+// `rwcalc analyze` is reading and parsing ~6 MB), and the cumulative sums it ends with.
+#include <benchmark/benchmark.h>
+
+#include <numeric>
+
+#include "bench_inputs.hpp"
+#include "rwcalc/reader.hpp"
+
+namespace {
+
+using namespace rwcalc;
+
+void BM_ParsePulseFile2h(benchmark::State& state) {
+  const std::string& text = bench::gl2d_text();
+  for (auto _ : state) {
+    auto rec = read_recording_text(text, "gl2d.csv");
+    benchmark::DoNotOptimize(rec.phase.counts.data());
+  }
+  state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(text.size()));
+  state.SetItemsProcessed(state.iterations() * 2'880'000);
+}
+BENCHMARK(BM_ParsePulseFile2h)->Unit(benchmark::kMillisecond);
+
+// Cumulative sum of int64 increments into counts (wrap-around arithmetic, as PhaseSeries keeps them).
+void BM_CumulativeSum2h(benchmark::State& state) {
+  const auto inc = pulse_increments(bench::gl2d_series());
+  std::vector<std::int64_t> c(inc.size() + 1);
+  for (auto _ : state) {
+    c[0] = 0;
+    std::uint64_t acc = 0;
+    for (std::size_t k = 0; k < inc.size(); ++k) {
+      acc += static_cast<std::uint64_t>(inc[k]);
+      c[k + 1] = static_cast<std::int64_t>(acc);
+    }
+    benchmark::DoNotOptimize(c.data());
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(inc.size()));
+}
+BENCHMARK(BM_CumulativeSum2h)->Unit(benchmark::kMillisecond);
+
+// Exact prefix sums of the counts in double (what MVAR's moving sums need), for comparison.
+void BM_PrefixSumOfCounts2h(benchmark::State& state) {
+  const auto& c = bench::gl2d_series().counts;
+  std::vector<double> s(c.size() + 1);
+  for (auto _ : state) {
+    s[0] = 0;
+    double acc = 0;
+    for (std::size_t k = 0; k < c.size(); ++k) s[k + 1] = acc += static_cast<double>(c[k]);
+    benchmark::DoNotOptimize(s.data());
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(c.size()));
+}
+BENCHMARK(BM_PrefixSumOfCounts2h)->Unit(benchmark::kMillisecond);
+
+}  // namespace

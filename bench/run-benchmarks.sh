@@ -1,0 +1,213 @@
+#!/usr/bin/env bash
+# End-to-end benchmark of rwcalc against the targets of docs/performance.md (issue "Speed and
+# scale"): builds the `bench` preset if needed, generates the standard inputs with
+# `rwcalc simulate` (cached under the build directory), times whole processes (median of
+# --repeat runs, wall clock; peak RSS from /usr/bin/time -v) and prints ONE table with every
+# target and the measured figure beside it, plus the NumPy baseline of the same estimator.
+#
+# Usage: bench/run-benchmarks.sh [--repeat N] [--build-dir DIR] [--no-build] [--skip-24h]
+#                                [--skip-tau-all] [--kernels]
+#   --repeat N      runs per measurement (default 5; the median is reported)
+#   --build-dir D   build directory of the bench preset (default build-bench)
+#   --no-build      use the existing build as it is
+#   --skip-24h      skip the 24-h 1 kHz record (its text file takes ~1 min to generate once)
+#   --skip-tau-all  skip `allan --tau all` and its growth with N
+#   --kernels       also run the Google Benchmark kernels (bench_*) after the table
+# Needs: cmake, g++, GNU time (/usr/bin/time; Debian package `time`), python3 with numpy
+# (Debian python3-numpy) for the baseline rows. Commands this build lacks show "not available".
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+repeat=5 build="$here/build-bench" do_build=1 skip24=0 skipall=0 kernels=0
+while (($#)); do
+  case "$1" in
+    --repeat) repeat="$2"; shift 2 ;;
+    --build-dir) build="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
+    --no-build) do_build=0; shift ;;
+    --skip-24h) skip24=1; shift ;;
+    --skip-tau-all) skipall=1; shift ;;
+    --kernels) kernels=1; shift ;;
+    -h|--help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "run-benchmarks.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
+  esac
+done
+[[ "$repeat" =~ ^[1-9][0-9]*$ ]] || { echo "run-benchmarks.sh: --repeat needs a positive integer" >&2; exit 2; }
+[[ -x /usr/bin/time ]] || { echo "run-benchmarks.sh: GNU time is missing: apt-get install -y time" >&2; exit 2; }
+
+# ---- build ------------------------------------------------------------------------------------
+if ((do_build)); then
+  if [[ ! -f "$build/CMakeCache.txt" ]]; then
+    cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release -DRWCALC_BUILD_BENCH=ON -DRWCALC_BUILD_TESTS=OFF >/dev/null
+  fi
+  cmake --build "$build" -j2 >/dev/null
+fi
+rw="$build/rwcalc"
+[[ -x "$rw" ]] || { echo "run-benchmarks.sh: $rw not built" >&2; exit 2; }
+py=""
+for p in /usr/bin/python3 python3; do
+  if command -v "$p" >/dev/null && "$p" -c 'import numpy' 2>/dev/null; then py="$p"; break; fi
+done
+
+# ---- inputs (cached; regenerated only when missing) -------------------------------------------
+inputs="$build/bench-inputs"
+mkdir -p "$inputs"
+tmp="$(mktemp -d)"
+trap 'rm -rf "$tmp"' EXIT
+gl2d() {  # gl2d NAME TEMP N B SEED [DURATION_S]: one GL-2D-like run, as scripts/make-gl2d-data.sh
+  local f="$inputs/gl2d_$1${6:+_$6s}.csv"
+  [[ -s "$f" ]] || "$rw" simulate -o "$f" --force --duration "${6:-7200}" --rate 400 --scale 0.92 --latitude 55.75 \
+    --white-readout --arw "$3" --bias-instability "$4" --temperature "$2" --seed "$5" >/dev/null
+  echo "$f"
+}
+echo "generating inputs in $inputs (cached) ..." >&2
+run2h="$(gl2d p50C 50 0.00098 0.0081 52339150)"
+five=("$(gl2d m50C -50 0.00085 0.0083 52339050)" "$(gl2d m25C -25 0.00079 0.0076 52339025)"
+      "$(gl2d 0C 0 0.00081 0.0073 52339000)" "$(gl2d p25C 25 0.00090 0.0078 52339125)" "$run2h")
+day="$inputs/day_1kHz.csv"
+if ((!skip24)) && [[ ! -s "$day" ]]; then
+  # 24 h at 1 kHz = 86.4 M samples (~180 MB of text). ARW + RRW + white read-out: the exact
+  # flicker FFT of 173 M points would need ~7 GB to generate, and analyze time does not depend
+  # on which noise the samples carry.
+  echo "generating the 24-h 1 kHz record (once) ..." >&2
+  "$rw" simulate -o "$day" --force --duration 86400 --rate 1000 --scale 0.92 --latitude 55.75 \
+    --white-readout --arw 0.001 --rrw 0.0005 --seed 86400 >/dev/null
+fi
+
+# ---- measurement helpers ----------------------------------------------------------------------
+calc() { awk "BEGIN { print $1 }"; }  # arithmetic without bc
+loadavg() { cut -d' ' -f1 /proc/loadavg; }
+# measure N CMD...: run CMD N times; sets med_s (median wall s), rss_mb (largest peak RSS, MB),
+# status (exit status of the last failing run, else 0).
+measure() {
+  local n="$1"; shift
+  local times=() t0 t1 rss=0 r
+  status=0
+  for ((i = 0; i < n; i++)); do
+    t0=$EPOCHREALTIME
+    if /usr/bin/time -v -o "$tmp/time.txt" "$@" >"$tmp/out.txt" 2>"$tmp/err.txt"; then :; else status=$?; fi
+    t1=$EPOCHREALTIME
+    times+=("$(calc "$t1 - $t0")")
+    r=$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$tmp/time.txt")
+    ((r > rss)) && rss=$r
+    ((status)) && break
+  done
+  med_s=$(printf '%s\n' "${times[@]}" | sort -g | awk '{a[NR]=$1} END {print (NR%2 ? a[(NR+1)/2] : (a[NR/2]+a[NR/2+1])/2)}')
+  rss_mb=$(calc "$rss / 1024")
+}
+# available SUBCOMMAND: true when this build implements it.
+available() { "$rw" "$1" --help >/dev/null 2>&1 && ! "$rw" "$1" --help 2>&1 | grep -q "not yet available"; }
+has_option() { "$rw" "$1" --help 2>&1 | grep -q -- "$2"; }
+
+rows=()
+row() { rows+=("$(printf '| %s | %s | %s | %s | %s | %s |' "$@")"); }
+fmt_ms() { printf '%.0f ms' "$(calc "$1 * 1000")"; }
+fmt_s() { printf '%.2f s' "$1"; }
+fmt_mb() { printf '%.0f MB' "$1"; }
+verdict() { if awk "BEGIN { exit !($1) }"; then echo "met"; else echo "**missed**"; fi; }
+failed() { echo "failed (exit $status: $(head -c 120 "$tmp/err.txt" | tr '\n|' '  '))"; }
+
+# ---- the targets ------------------------------------------------------------------------------
+echo "measuring (median of $repeat runs each) ..." >&2
+if available analyze; then
+  l=$(loadavg); measure "$repeat" "$rw" analyze "$run2h" --json
+  if ((status)); then row "analyze 2-h 400 Hz, default grid" "≤ 30 ms, ≤ 64 MB" "$(failed)" "" "" "$l"
+  else row "analyze 2-h 400 Hz, default grid" "≤ 30 ms, ≤ 64 MB" "$(fmt_ms "$med_s")" "$(fmt_mb "$rss_mb")" \
+      "$(verdict "$med_s <= 0.030 && $rss_mb <= 64")" "$l"; fi
+  if has_option analyze --tau; then
+    l=$(loadavg); measure "$repeat" "$rw" analyze "$run2h" --json --tau dense
+    if ((status)); then row "analyze 2-h, dense grid (20/decade to N/10)" "≤ 80 ms" "$(failed)" "" "" "$l"
+    else row "analyze 2-h, dense grid (20/decade to N/10)" "≤ 80 ms" "$(fmt_ms "$med_s")" "$(fmt_mb "$rss_mb")" \
+        "$(verdict "$med_s <= 0.080")" "$l"; fi
+  else
+    row "analyze 2-h, dense grid (20/decade to N/10)" "≤ 80 ms" "not available (no --tau)" "" "" ""
+  fi
+  if ((!skip24)); then
+    l=$(loadavg); measure "$repeat" "$rw" analyze "$day" --json
+    if ((status)); then row "analyze 24-h 1 kHz (86.4 M samples)" "≤ 3 s, ≤ 1.5 GB" "$(failed)" "" "" "$l"
+    else row "analyze 24-h 1 kHz (86.4 M samples)" "≤ 3 s, ≤ 1.5 GB" "$(fmt_s "$med_s")" "$(fmt_mb "$rss_mb")" \
+        "$(verdict "$med_s <= 3 && $rss_mb <= 1536")" "$l"; fi
+  fi
+else
+  row "analyze 2-h 400 Hz, default grid" "≤ 30 ms, ≤ 64 MB" "not available" "" "" ""
+  row "analyze 2-h, dense grid (20/decade to N/10)" "≤ 80 ms" "not available" "" "" ""
+  ((skip24)) || row "analyze 24-h 1 kHz (86.4 M samples)" "≤ 3 s, ≤ 1.5 GB" "not available" "" "" ""
+fi
+
+if available batch; then
+  l=$(loadavg); measure "$repeat" "$rw" batch "${five[@]}" --json --jobs 1; s1=$med_s; st1=$status
+  measure "$repeat" "$rw" batch "${five[@]}" --json --jobs 2; s2=$med_s
+  if ((st1 || status)); then row "batch of five 2-h runs, --jobs 2 vs 1" "≥ 1.7×" "$(failed)" "" "" "$l"
+  else
+    sp=$(calc "$s1 / $s2")
+    row "batch of five 2-h runs, --jobs 2 vs 1" "≥ 1.7×" "$(printf '%.2f× (%s → %s)' "$sp" "$(fmt_ms "$s1")" "$(fmt_ms "$s2")")" \
+      "$(fmt_mb "$rss_mb")" "$(verdict "$sp >= 1.7")" "$l"
+  fi
+else
+  row "batch of five 2-h runs, --jobs 2 vs 1" "≥ 1.7×" "not available" "" "" ""
+fi
+
+if available diagnose; then
+  l=$(loadavg); measure "$repeat" "$rw" diagnose "$run2h" --json --runs 50
+  if ((status)); then row "diagnose, 50-run ensemble of 2-h records" "≤ 10 s" "$(failed)" "" "" "$l"
+  else row "diagnose, 50-run ensemble of 2-h records" "≤ 10 s" "$(fmt_s "$med_s")" "$(fmt_mb "$rss_mb")" \
+      "$(verdict "$med_s <= 10")" "$l"; fi
+else
+  row "diagnose, 50-run ensemble of 2-h records" "≤ 10 s" "not available" "" "" ""
+fi
+
+if available allan; then
+  l=$(loadavg); measure "$repeat" "$rw" allan "$run2h" --json
+  if ((status)); then row "allan 2-h, octave grid (21 τ)" "(vs NumPy)" "$(failed)" "" "" "$l"
+  else row "allan 2-h, octave grid (21 τ)" "(vs NumPy)" "$(fmt_ms "$med_s")" "$(fmt_mb "$rss_mb")" "" "$l"; allan_oct=$med_s; fi
+  l=$(loadavg); measure "$repeat" "$rw" allan "$run2h" --json --tau dense
+  if ((status)); then row "allan 2-h, dense grid" "(vs NumPy)" "$(failed)" "" "" "$l"
+  else row "allan 2-h, dense grid" "(vs NumPy)" "$(fmt_ms "$med_s")" "$(fmt_mb "$rss_mb")" "" "$l"; allan_dense=$med_s; fi
+  if ((!skipall)); then
+    # Growth with N: the same model at 1/8, 1/4, 1/2 and the full 2 h; one run each (capped).
+    prev="" growth=""
+    for dur in 900 1800 3600 7200; do
+      f="$run2h"; ((dur < 7200)) && f="$(gl2d p50C 50 0.00098 0.0081 52339150 "$dur")"
+      l=$(loadavg); measure 1 timeout 900 "$rw" allan "$f" --json --tau all
+      if ((status)); then growth+=" ${dur}s: exit $status;"; break; fi
+      growth+=" $((dur * 400 / 1000))k: $(fmt_s "$med_s");"
+      if [[ -n "$prev" ]]; then expo=$(calc "log($med_s / $prev) / log(2)"); fi
+      prev=$med_s; last_rss=$rss_mb
+    done
+    if [[ -n "$prev" && $status -eq 0 ]]; then
+      row "allan --tau all, 2-h (every m to N/2)" "seconds; state growth" "$(fmt_s "$prev")" "$(fmt_mb "$last_rss")" \
+        "$(printf 'N^%.2f:%s' "${expo:-0}" "$growth")" "$l"
+    else
+      row "allan --tau all, 2-h (every m to N/2)" "seconds; state growth" "not measured:$growth" "" "" "$l"
+    fi
+  fi
+else
+  row "allan 2-h, octave grid (21 τ)" "(vs NumPy)" "not available" "" "" ""
+  ((skipall)) || row "allan --tau all, 2-h (every m to N/2)" "seconds; state growth" "not available" "" "" ""
+fi
+
+if [[ -n "$py" ]]; then
+  for g in octave dense; do
+    l=$(loadavg); measure "$repeat" "$py" "$here/bench/numpy_oavar.py" "$run2h" --grid "$g"
+    ref=""; [[ $g == octave && -n "${allan_oct:-}" ]] && ref=$(printf 'rwcalc %.0f× faster' "$(calc "$med_s / $allan_oct")")
+    [[ $g == dense && -n "${allan_dense:-}" ]] && ref=$(printf 'rwcalc %.0f× faster' "$(calc "$med_s / $allan_dense")")
+    stage=$(grep -o 'load .*' "$tmp/err.txt" || true)
+    row "NumPy baseline OADEV 2-h, $g grid" "baseline ($stage)" "$(fmt_ms "$med_s")" "$(fmt_mb "$rss_mb")" "$ref" "$l"
+  done
+else
+  row "NumPy baseline OADEV 2-h" "baseline" "not available (no numpy)" "" "" ""
+fi
+l=$(loadavg); measure "$repeat" cat "$run2h"
+row "floor: cat of the 2-h file ($(du -k "$run2h" | cut -f1) kB)" "—" "$(fmt_ms "$med_s")" "$(fmt_mb "$rss_mb")" "" "$l"
+
+# ---- the table --------------------------------------------------------------------------------
+echo
+echo "$("$rw" --version 2>/dev/null | head -1) — $(date -u '+%Y-%m-%d %H:%M UTC'); $(nproc) cores," \
+  "$(sed -n 's/^model name\s*: //p' /proc/cpuinfo | head -1); median of $repeat runs; load = 1-min load average"
+echo
+echo "| target | limit | measured | peak RSS | result | load |"
+echo "|---|---|---|---|---|---|"
+printf '%s\n' "${rows[@]}"
+
+if ((kernels)); then
+  echo
+  for b in "$build"/bench/bench_*; do [[ -x "$b" ]] && "$b" --benchmark_min_time=0.2 2>/dev/null; done
+fi
