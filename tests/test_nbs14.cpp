@@ -94,7 +94,9 @@ TEST(Nbs14, ThousandPointThroughComputeAllanWithExplicitGrid) {
     for (const Reference& r : load_references()) {
       if (r.dataset != "nbs14_1000point" || r.statistic != stat) continue;
       for (const AllanPoint& p : res.points) {
-        if (p.m == r.tau) EXPECT_LE(rel_err(p.dev, r.value), kTol) << stat << " " << r.tau;
+        if (p.m == r.tau) {
+          EXPECT_LE(rel_err(p.dev, r.value), kTol) << stat << " " << r.tau;
+        }
       }
     }
   }

@@ -153,8 +153,11 @@ TEST(Outliers, SingleSpikeOfAdis16405RunFourGyroX) {
   // Everything flagged is a rare event: a handful in a million samples. Around the glitch the
   // record is disturbed for ~10 samples; elsewhere only excursions beyond 2.5 °/s (7σ) are flagged.
   EXPECT_LT(out.size(), 30u);
-  for (const auto& x : out)
-    if (x.index + 10 < 404608 || x.index > 404608 + 10) EXPECT_GT(std::abs(x.value / 3600.0 - 0.4), 2.5) << x.index;
+  for (const auto& x : out) {
+    if (x.index + 10 < 404608 || x.index > 404608 + 10) {
+      EXPECT_GT(std::abs(x.value / 3600.0 - 0.4), 2.5) << x.index;
+    }
+  }
 }
 
 TEST(Outliers, XsensContaminatedRecordGrossErrorsAreFound) {
