@@ -221,8 +221,16 @@ int run_report(const ReportCmd& c, Io& io) {
   // A single saved batch keeps the verdict it computed; otherwise the verdict over all runs.
   if (saved.overalls.size() == 1 && recordings.empty() && saved_files.size() == 1 + saved.diagnoses.size())
     in.overall = saved.overalls.front();
-  else
-    in.overall = summarize_runs(in.analyses, "report")["overall"];
+  else {
+    try {
+      in.overall = summarize_runs(in.analyses, "report")["overall"];
+    } catch (const InputError& e) {
+      // Saved results without the verdict's class probabilities (older or hand-made JSON): the
+      // report still states the worst class over the runs, without a combined probability.
+      io.err << "rwcalc: note: no combined verdict over the runs (" << e.what()
+             << "); the report states the worst class over the runs\n";
+    }
+  }
 
   ReportOptions ro;
   if (!c.title.empty()) ro.title = c.title;
