@@ -205,6 +205,17 @@ TEST_F(ReportOfGl2d, SavedBatchJsonGivesTheSameTablesAndVerdict) {
   EXPECT_EQ(verdict(html), verdict(html_));
   EXPECT_NE(html.find("Figures were left out"), std::string::npos);
   EXPECT_NE(html.find("<tr><th>saved results</th>"), std::string::npos);
+  // The same runs as JSON lines ('rwcalc batch --jsonl'): the verdict is computed again, equal.
+  std::string lines;
+  const json batch = json::parse(slurp(dir() / "batch.json"));
+  for (const auto& run : batch["runs"]) lines += run.dump() + "\n";
+  TempDir tmp;
+  const auto jsonl = tmp.write("runs.jsonl", lines);
+  const auto r2 = run_cli({"report", jsonl.string(), "-o", (tmp.path() / "out").string(), "--no-figures"});
+  ASSERT_EQ(r2.status, 0) << r2.err;
+  const auto html2 = slurp(tmp.path() / "out" / "report.html");
+  for (const char* id : {"table1", "table2"}) EXPECT_EQ(element(html2, "table", id), element(html_, "table", id)) << id;
+  EXPECT_EQ(verdict(html2), verdict(html_));
 }
 
 // ---- saved analysis and diagnosis JSON (no analysis, no gnuplot) ------------------------------------
