@@ -250,6 +250,8 @@ TEST(ReportCli, SavedAnalysisAndDiagnosisJsonAreCombined) {
 TEST(ReportCli, DiagnoseIsAClearUsageErrorInThisBuild) {
   TempDir dir;
   const auto out = dir.path() / "out";
+  // Reported first, whether gnuplot is installed or not.
+  ScopedEnv env("RWCALC_GNUPLOT", "/nonexistent/gnuplot");
   const auto r = run_cli(cat({"report"}, cat(gl2d_all(), {"-o", out.string(), "--diagnose"})));
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("diagnosis is not available in this build"), std::string::npos) << r.err;

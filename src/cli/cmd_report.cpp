@@ -197,14 +197,14 @@ int run_report(const ReportCmd& c, Io& io) {
   }
   if (c.diagnose && recordings.empty())
     throw UsageError("--diagnose needs recordings; saved diagnoses are given as 'rwcalc diagnose --json' files");
+  const ReadOptions read = c.input.options();
+  std::vector<json> diagnoses;
+  if (c.diagnose) diagnoses = diagnose_recordings(recordings, read, opt);
   // Fail before the analysis: an existing report without --force, no gnuplot for the figures.
   const auto target = (fs::path(c.dir) / "report.html").string();
   std::error_code ec;
   if (!c.force && fs::exists(target, ec)) throw OutputError(fmt::format("{}: exists; use --force to overwrite it", target));
   if (!c.no_figures) require_gnuplot();
-  const ReadOptions read = c.input.options();
-  std::vector<json> diagnoses;
-  if (c.diagnose) diagnoses = diagnose_recordings(recordings, read, opt);
 
   Saved saved;
   for (const auto& f : saved_files) load_saved(f, saved);
