@@ -235,6 +235,13 @@ nlohmann::json to_json(const AnalysisResult& r) {
   if (!n_direct.is_null()) {
     n_direct["discrepancy_sigma"] = r.N_direct_discrepancy_sigma;
     n_direct["intercept_arcsec2"] = r.direct.intercept_arcsec2;
+    n_direct["slope_arcsec2_per_s"] = r.direct.slope_arcsec2_per_s;
+    // The points of the regression (the seed paper's Fig. 2): interval length, number of
+    // intervals and the variance of the angle over them, Earth rate and bias removed.
+    nlohmann::json curve = nlohmann::json::array();
+    for (const auto& p : r.direct.points)
+      curve.push_back({{"t_s", p.t_s}, {"intervals", p.intervals}, {"var_arcsec2", p.var_arcsec2}});
+    n_direct["curve"] = std::move(curve);
     n_direct["t_min_s"] = r.direct.points.front().t_s;
     n_direct["t_max_s"] = r.direct.points.back().t_s;
   }

@@ -100,6 +100,7 @@ DirectNResult direct_n(const PhaseSeries& x, const MethodOptions& o) {
   const LineFit full = fit_line(r.points);
   if (!full.ok) return r;
   r.intercept_arcsec2 = full.a;
+  r.slope_arcsec2_per_s = full.b;
 
   // Standard error of the slope from contiguous segments (each analysed like the whole record,
   // with the same interval lengths; a segment keeps those with ≥ 10 intervals).

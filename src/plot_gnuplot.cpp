@@ -161,6 +161,17 @@ bool gnuplot_available() {
   return r.started && r.status == 0;
 }
 
+void require_gnuplot() {
+  ScratchDir dir;
+  const auto command = gnuplot_command();
+  const auto r = run_process(command, {"--version"}, dir.path() / "log");
+  if (!r.started) throw OutputError(missing_gnuplot_message(command, r.spawn_errno));
+  if (r.status == 127) throw OutputError(missing_gnuplot_message(command, ENOENT));
+  if (r.status != 0)
+    throw OutputError(fmt::format("gnuplot ('{}') does not run: '{} --version' failed with status {}: {}", command,
+                                  command, r.status, tail_lines(r.err, 4)));
+}
+
 std::string full_script(const std::vector<Figure>& figures, PlotFormat format, int width_px,
                         const std::string& output_path) {
   int height = 0;

@@ -428,6 +428,13 @@ std::string report_html(const ReportInput& input, const ReportOptions& options) 
   h += fmt::format("<p class=\"verdict\">Overall class over {}: <b>{}</b> (by B: {}, by N: {}).</p>\n",
                    a.size() == 1 ? "the run" : "the temperature range", class_text(at(overall, "class")),
                    class_text(at(overall, "class_B")), class_text(at(overall, "class_N")));
+  // The batch's combined verdict states its probability (the product of the runs' probabilities).
+  if (const auto st = str(overall, "statement"); !st.empty()) {
+    h += "<p id=\"verdict-probability\">Over all runs: <b>" + esc(st) + "</b>";
+    if (const auto b = str(at(overall, "B"), "statement"); !b.empty()) h += "; by B: " + esc(b);
+    if (const auto n = str(at(overall, "N"), "statement"); !n.empty()) h += "; by N: " + esc(n);
+    h += ".</p>\n";
+  }
   h += "<ul>\n";
   for (auto i : order) {
     const auto& v = at(a[i], "verdict");

@@ -50,6 +50,12 @@ TEST(DirectN, AgreesWithTheTruthOnPureArw) {
     EXPECT_LT(std::abs(r.N.value - 0.05), 4.0 * r.N.sigma) << seed;
     inside += (r.N.low <= 0.05 && 0.05 <= r.N.high) ? 1 : 0;
     EXPECT_NEAR(r.intercept_arcsec2, 0.0, 5.0 * 60 * 60 * 0.05 * 0.05);  // no white angle noise
+    // The regression's slope is N² in ″²/s, the points are the ones it was fitted to.
+    EXPECT_NEAR(std::sqrt(r.slope_arcsec2_per_s) / 60.0, r.N.value, 1e-12 * r.N.value);
+    ASSERT_GE(r.points.size(), 3u);
+    // At t = 1 s (1800 intervals, 3 % standard error) the line passes through the point.
+    EXPECT_NEAR(r.points.front().var_arcsec2 / (r.intercept_arcsec2 + r.slope_arcsec2_per_s * r.points.front().t_s),
+                1.0, 0.2);
   }
   EXPECT_GE(inside, 8);
 }

@@ -8,6 +8,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <set>
@@ -316,6 +317,49 @@ inline std::set<std::string> svg_series(std::string_view svg) {
     ids.insert(std::string(svg.substr(p + key.size(), end - p - key.size())));
   }
   return ids;
+}
+
+// ---- checks on the HTML report ----------------------------------------------------------------
+
+/// Standard base64 (RFC 4648) decoding; stops at the first character outside the alphabet.
+inline std::string base64_decode(std::string_view s) {
+  auto val = [](char c) -> int {
+    if (c >= 'A' && c <= 'Z') return c - 'A';
+    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+    if (c >= '0' && c <= '9') return c - '0' + 52;
+    return c == '+' ? 62 : c == '/' ? 63 : -1;
+  };
+  std::string out;
+  unsigned acc = 0;
+  int bits = 0;
+  for (char c : s) {
+    const int v = val(c);
+    if (v < 0) break;
+    acc = (acc << 6) | static_cast<unsigned>(v);
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out += static_cast<char>((acc >> bits) & 0xFF);
+    }
+  }
+  return out;
+}
+
+/// figure id → decoded SVG of every inline figure (parsed by hand: std::regex recurses per
+/// character and overflows the stack on a long base64 string).
+inline std::map<std::string, std::string> inline_figures(const std::string& html) {
+  std::map<std::string, std::string> figs;
+  const std::string open = "<figure id=\"", data = "src=\"data:image/svg+xml;base64,";
+  for (auto p = html.find(open); p != std::string::npos; p = html.find(open, p + 1)) {
+    const auto id_end = html.find('"', p + open.size());
+    const auto id = html.substr(p + open.size(), id_end - p - open.size());
+    const auto img = html.find("<img ", id_end);
+    const auto src = html.find(data, img);
+    if (img == std::string::npos || src == std::string::npos || html.find("</figure>", id_end) < src) continue;
+    const auto b0 = src + data.size();
+    figs[id] = base64_decode(std::string_view(html).substr(b0, html.find('"', b0) - b0));
+  }
+  return figs;
 }
 
 }  // namespace rwcalc::test

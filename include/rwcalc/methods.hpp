@@ -48,6 +48,7 @@ struct DirectPoint {
 struct DirectNResult {
   MethodEstimate N;              ///< °/√h
   double intercept_arcsec2 = 0;  ///< a of s²(t) = a + b·t (2Q² for white angle noise)
+  double slope_arcsec2_per_s = 0; ///< b of s²(t) = a + b·t, ″²/s (= (60·N)² with N in °/√h)
   std::vector<DirectPoint> points;
   int segments_used = 0;
 };

@@ -102,6 +102,10 @@ std::string gnuplot_command();
 /// True when the gnuplot command can be run (it answers `--version`).
 bool gnuplot_available();
 
+/// Throws OutputError, saying how to install gnuplot or name it in RWCALC_GNUPLOT, when the
+/// gnuplot command cannot be run: lets a command fail before its analysis rather than after.
+void require_gnuplot();
+
 /// Colour of a run at `temperature_c` as "#rrggbb": a fixed cold-to-hot scale (blue at −50 °C,
 /// red at +50 °C), so the same temperature has the same colour in every figure. Runs without a
 /// temperature get a categorical colour by `index`.

@@ -7,6 +7,7 @@
 
 #include "cli/analyze_args.hpp"
 #include "cli/commands.hpp"
+#include "cli/plot_args.hpp"
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/output.hpp"
@@ -22,7 +23,7 @@ struct AnalyzeCmd {
   std::optional<double> temperature;
   bool json = false;
   std::string output = "-";
-  std::string plot;
+  PlotArgs plot;
   bool force = false;
 };
 
@@ -40,19 +41,21 @@ void register_analyze(CLI::App& app, Runner& runner) {
   sub->add_option("--temperature", cmd->temperature, "Temperature of the run, °C (overrides the file)");
   sub->add_flag("--json", cmd->json, "Print the JSON object instead of the report");
   sub->add_option("-o,--output", cmd->output, "Write to FILE instead of standard output")->capture_default_str();
-  sub->add_flag("--force", cmd->force, "Overwrite an existing output file");
-  sub->add_option("--plot", cmd->plot, "Also draw the AV plot with the fit into FILE (where plotting is built in)");
+  sub->add_flag("--force", cmd->force, "Overwrite existing output, figure and script files");
+  cmd->plot.add_to(*sub,
+                   "the Allan deviation with its confidence bars, the fitted model, each term's line and the "
+                   "class limits for B");
   sub->callback([cmd, &runner] {
     runner = [cmd](Io& io) -> int {
-      if (!cmd->plot.empty()) {
-        // Hook for the plot command: a function taking the analyze JSON and the target file.
-        throw UsageError("--plot: plotting is not available in this build");
-      }
       AnalysisOptions opt = cmd->analysis.options();
       opt.temperature_c = cmd->temperature;
+      // Figure problems (format, existing files, no gnuplot) are reported before the analysis.
+      cmd->plot.check(cmd->force);
       const Recording rec = read_recording(cmd->file, cmd->input.options());
       const AnalysisResult res = analyze(rec, opt);
-      const std::string text = cmd->json ? to_json(res).dump(2) + "\n" : format_report(res);
+      const nlohmann::json j = to_json(res);
+      cmd->plot.draw_analysis(j, cmd->force, io);
+      const std::string text = cmd->json ? j.dump(2) + "\n" : format_report(res);
       if (cmd->output == "-")
         io.out << text;
       else

@@ -9,6 +9,7 @@
 #include "cli/analyze_args.hpp"
 #include "cli/batch_format.hpp"
 #include "cli/commands.hpp"
+#include "cli/plot_args.hpp"
 #include "rwcalc/batch.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/output.hpp"
@@ -26,6 +27,7 @@ struct BatchCmd {
   unsigned jobs = 0;
   std::string output = "-";
   bool force = false;
+  PlotArgs plot;
 };
 
 }  // namespace
@@ -42,7 +44,10 @@ void register_batch(CLI::App& app, Runner& runner) {
   cmd->format.add_to(*sub);
   sub->add_option("-j,--jobs", cmd->jobs, "Files analysed in parallel (default: hardware threads)");
   sub->add_option("-o,--output", cmd->output, "Write to FILE instead of standard output")->capture_default_str();
-  sub->add_flag("--force", cmd->force, "Overwrite an existing output file");
+  sub->add_flag("--force", cmd->force, "Overwrite existing output, figure and script files");
+  cmd->plot.add_to(*sub,
+                   "the paper's Fig. 1 (the Allan deviations of all runs overlaid) above Fig. 2 (the direct "
+                   "method's angle variance against t with its regression line per run)");
   sub->callback([cmd, &runner] {
     runner = [cmd](Io& io) -> int {
       AnalysisOptions opt = cmd->analysis.options();
@@ -50,7 +55,9 @@ void register_batch(CLI::App& app, Runner& runner) {
         if (cmd->files.size() != 1) throw UsageError("--temperature applies to a single file; name the temperature in each file instead");
         opt.temperature_c = cmd->temperature;
       }
+      cmd->plot.check(cmd->force);
       const auto runs = analyze_files(cmd->files, cmd->input.options(), opt, cmd->jobs);
+      if (cmd->plot.any()) cmd->plot.draw_batch(nlohmann::json{{"runs", runs}}, cmd->force, io);
       emit(io, cmd->format.render(runs), cmd->output, cmd->force);
       return 0;
     };

@@ -1,13 +1,271 @@
-// Placeholder registration for 'rwcalc report' (replaced by the command's implementation).
+// 'rwcalc report FILES… -o DIR': one self-contained HTML test report (DIR/report.html) with the
+// run summaries, the seed paper's Tables 1 and 2, the verdict, the figures, the settings and the
+// version. FILES are recordings (analysed here, in parallel) and/or saved results: the JSON of
+// 'rwcalc analyze --json', 'rwcalc batch --json' or 'rwcalc diagnose --json', or the JSON lines
+// of 'rwcalc batch --jsonl'.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <ostream>
+#include <sstream>
+
+#include "cli/analyze_args.hpp"
 #include "cli/commands.hpp"
+#include "rwcalc/batch.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/plot.hpp"
+#include "rwcalc/report.hpp"
 
 namespace rwcalc::cli {
 
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+struct ReportCmd {
+  std::vector<std::string> files;
+  InputArgs input;
+  AnalyzeArgs analysis;
+  std::optional<double> temperature;
+  std::string dir;
+  std::string title;
+  unsigned jobs = 0;
+  bool diagnose = false;
+  bool no_figures = false;
+  bool force = false;
+};
+
+/// The diagnoses of the recordings, one per file in file order (null where none is made).
+/// The diagnosis is not part of this build: asking for it is a usage error, reported before any
+/// analysis. This is the one place to connect it.
+std::vector<json> diagnose_recordings(const std::vector<std::string>& recordings, const ReadOptions& /*read*/,
+                                      const AnalysisOptions& /*options*/) {
+  if (recordings.empty()) return {};
+  throw UsageError("--diagnose: diagnosis is not available in this build");
+}
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+bool is_json_path(const std::string& path) {
+  const auto ext = lower(fs::path(path).extension().string());
+  return ext == ".json" || ext == ".jsonl";
+}
+
+/// Line (1-based) of byte offset `pos` in `text`.
+std::size_t line_of(const std::string& text, std::size_t pos) {
+  pos = std::min(pos, text.size());
+  return 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(pos), '\n'));
+}
+
+/// What the saved results hold.
+struct Saved {
+  std::vector<json> analyses;
+  std::vector<std::pair<std::string, json>> diagnoses;  ///< file, object
+  std::vector<json> overalls;                           ///< batch verdicts, one per batch file
+};
+
+void load_saved(const std::string& path, Saved& saved) {
+  if (lower(fs::path(path).extension().string()) == ".jsonl") {
+    for (auto& a : read_json_lines(path)) saved.analyses.push_back(std::move(a));
+    return;
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, 0, "cannot open the file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw InputError(path, line_of(text, e.byte > 0 ? e.byte - 1 : 0), fmt::format("not valid JSON: {}", e.what()));
+  }
+  if (!j.is_object())
+    throw InputError(path, 1, "expected a JSON object from 'rwcalc analyze --json', 'batch --json' or 'diagnose --json'");
+  if (j.contains("runs")) {
+    if (!j["runs"].is_array() || j["runs"].empty()) throw InputError(path, 0, "\"runs\" is not a non-empty array");
+    for (const auto& r : j["runs"]) {
+      if (!r.is_object() || !r.contains("verdict") || !r.contains("allan"))
+        throw InputError(path, 0, "an element of \"runs\" is not an analyze object (no \"allan\" or \"verdict\")");
+      saved.analyses.push_back(r);
+    }
+    if (j.contains("overall") && j["overall"].is_object()) saved.overalls.push_back(j["overall"]);
+  } else if (j.contains("allan") && j.contains("verdict")) {
+    saved.analyses.push_back(std::move(j));
+  } else if (j.contains("band") || j.contains("base_model")) {
+    saved.diagnoses.emplace_back(path, std::move(j));
+  } else {
+    throw InputError(path, 0,
+                     "not an rwcalc result: expected the JSON of 'rwcalc analyze --json' (\"allan\", \"verdict\"), "
+                     "'batch --json' (\"runs\") or 'diagnose --json' (\"band\")");
+  }
+}
+
+std::string file_name(const json& j) {
+  const auto& s = j.contains("source") && j["source"].is_string() ? j["source"].get_ref<const std::string&>()
+                                                                   : std::string();
+  return fs::path(s).filename().string();
+}
+
+/// Attach each saved diagnosis to the analysis with the same source (by file name), or to the
+/// only run.
+void attach_saved_diagnoses(const Saved& saved, const std::vector<json>& analyses, std::vector<json>& diagnoses) {
+  for (const auto& [path, d] : saved.diagnoses) {
+    std::optional<std::size_t> target;
+    const auto name = file_name(d);
+    for (std::size_t i = 0; i < analyses.size() && !name.empty(); ++i)
+      if (file_name(analyses[i]) == name) {
+        target = i;
+        break;
+      }
+    if (!target && analyses.size() == 1) target = 0;
+    if (!target)
+      throw InputError(path, 0,
+                       fmt::format("the diagnosis of '{}' matches no run of the report; give the run's recording or "
+                                   "its analysis JSON too",
+                                   name.empty() ? std::string("(no source)") : name));
+    diagnoses.resize(analyses.size());
+    if (diagnoses[*target].is_object())
+      throw InputError(path, 0, fmt::format("a second diagnosis for '{}'", file_name(analyses[*target])));
+    diagnoses[*target] = d;
+  }
+}
+
+/// The options behind the report, shown in its settings table.
+json settings_of(const ReportCmd& c, const std::vector<std::string>& recordings, const std::vector<std::string>& saved) {
+  json s = json::object();
+  if (!recordings.empty()) s["recordings"] = recordings;
+  if (!saved.empty()) s["saved results"] = saved;
+  if (recordings.empty()) return s;  // the analysis options below apply to recordings only
+  const auto& in = c.input;
+  s["input"] = in.input;
+  if (!in.column.empty()) s["column"] = in.column;
+  if (in.rate_hz) s["rate (Hz)"] = *in.rate_hz;
+  if (in.scale_arcsec) s["pulse weight (″)"] = *in.scale_arcsec;
+  if (in.input == "counter") s["counter bits"] = in.counter_bits;
+  if (in.input == "angle") s["angle unit"] = in.angle_unit;
+  if (in.input == "rate") s["rate unit"] = in.rate_unit;
+  const auto& a = c.analysis;
+  s["fit range (s)"] = a.fit_range.empty() ? std::string("all τ") : a.fit_range;
+  s["minimum EDF"] = a.min_edf;
+  s["terms"] = a.terms;
+  s["term selection"] = a.keep_all_terms ? "all fitted terms kept" : "unsupported K, R, Q left out (upper bounds)";
+  if (a.earth_rate)
+    s["Earth rate (°/h)"] = *a.earth_rate;
+  else
+    s["latitude (°)"] = a.latitude_deg;
+  s["B estimate"] = a.b_estimate;
+  s["tolerance on B (%)"] = a.tolerance_pct;
+  s["class table"] = a.limits_file.empty() ? std::string("GOST RV 52339 (built in)") : a.limits_file;
+  s["averaging block (s)"] = a.block_s;
+  s["direct method t range (s)"] = a.direct_range;
+  if (c.temperature) s["temperature (°C)"] = *c.temperature;
+  return s;
+}
+
+std::string utc_now() {
+  const auto now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S UTC", &tm);
+  return buf;
+}
+
+int run_report(const ReportCmd& c, Io& io) {
+  if (c.dir.empty())
+    throw UsageError("report: -o DIR is required (the directory that receives report.html; created when missing)");
+  std::vector<std::string> recordings, saved_files;
+  for (const auto& f : c.files) (is_json_path(f) ? saved_files : recordings).push_back(f);
+  AnalysisOptions opt = c.analysis.options();
+  if (c.temperature) {
+    if (recordings.size() != 1)
+      throw UsageError("--temperature applies to a single recording; name the temperature in each file instead");
+    opt.temperature_c = c.temperature;
+  }
+  if (c.diagnose && recordings.empty())
+    throw UsageError("--diagnose needs recordings; saved diagnoses are given as 'rwcalc diagnose --json' files");
+  const ReadOptions read = c.input.options();
+  std::vector<json> diagnoses;
+  if (c.diagnose) diagnoses = diagnose_recordings(recordings, read, opt);
+  // Fail before the analysis: an existing report without --force, no gnuplot for the figures.
+  const auto target = (fs::path(c.dir) / "report.html").string();
+  std::error_code ec;
+  if (!c.force && fs::exists(target, ec)) throw OutputError(fmt::format("{}: exists; use --force to overwrite it", target));
+  if (!c.no_figures) require_gnuplot();
+
+  Saved saved;
+  for (const auto& f : saved_files) load_saved(f, saved);
+  ReportInput in;
+  if (!recordings.empty()) in.analyses = analyze_files(recordings, read, opt, c.jobs);
+  diagnoses.resize(in.analyses.size());
+  for (auto& a : saved.analyses) in.analyses.push_back(std::move(a));
+  if (in.analyses.empty())
+    throw UsageError("report: no run to report; give recordings or saved analyses (the diagnoses need their runs)");
+  diagnoses.resize(in.analyses.size());
+  attach_saved_diagnoses(saved, in.analyses, diagnoses);
+  if (std::any_of(diagnoses.begin(), diagnoses.end(), [](const json& d) { return d.is_object(); }))
+    in.diagnoses = std::move(diagnoses);
+  // A single saved batch keeps the verdict it computed; otherwise the verdict over all runs.
+  if (saved.overalls.size() == 1 && recordings.empty() && saved_files.size() == 1 + saved.diagnoses.size())
+    in.overall = saved.overalls.front();
+  else {
+    try {
+      in.overall = summarize_runs(in.analyses, "report")["overall"];
+    } catch (const InputError& e) {
+      // Saved results without the verdict's class probabilities (older or hand-made JSON): the
+      // report still states the worst class over the runs, without a combined probability.
+      io.err << "rwcalc: note: no combined verdict over the runs (" << e.what()
+             << "); the report states the worst class over the runs\n";
+    }
+  }
+
+  ReportOptions ro;
+  if (!c.title.empty()) ro.title = c.title;
+  ro.settings = settings_of(c, recordings, saved_files);
+  ro.figures = !c.no_figures;
+  ro.generated = utc_now();
+  const auto path = write_report(c.dir, in, ro, c.force);
+  io.out << fmt::format("report written to {} ({} run(s){})\n", path, in.analyses.size(),
+                        c.no_figures ? ", no figures" : "");
+  return 0;
+}
+
+}  // namespace
+
 void register_report(CLI::App& app, Runner& runner) {
-  auto* sub = app.add_subcommand("report", "(not yet available)");
-  sub->callback([&runner] {
-    runner = [](Io&) -> int { throw AnalysisError("'rwcalc report' is not available in this build"); };
+  auto cmd = std::make_shared<ReportCmd>();
+  auto* sub = app.add_subcommand(
+      "report",
+      "A self-contained HTML test report (DIR/report.html): run summaries, Tables 1 and 2, the verdict with its "
+      "probability, figures inline, the settings and the version");
+  sub->add_option("FILES", cmd->files,
+                  "Recordings, and/or saved results: .json of 'analyze --json', 'batch --json' or 'diagnose "
+                  "--json', .jsonl of 'batch --jsonl'")
+      ->required();
+  sub->add_option("-o,--output", cmd->dir, "Directory for report.html (created when missing); required");
+  cmd->input.add_to(*sub);
+  cmd->analysis.add_to(*sub);
+  sub->add_option("--temperature", cmd->temperature, "Temperature, °C (only with a single recording)");
+  sub->add_option("-j,--jobs", cmd->jobs, "Recordings analysed in parallel (default: hardware threads)");
+  sub->add_option("--title", cmd->title, "Title of the report");
+  sub->add_flag("--diagnose", cmd->diagnose, "Also diagnose each recording (what the noise model misses)");
+  sub->add_flag("--no-figures", cmd->no_figures, "Tables only (needs no gnuplot)");
+  sub->add_flag("--force", cmd->force, "Replace an existing report.html");
+  sub->callback([cmd, &runner] {
+    runner = [cmd](Io& io) -> int { return run_report(*cmd, io); };
   });
 }
 

@@ -1,0 +1,63 @@
+#include "cli/plot_args.hpp"
+
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <ostream>
+
+#include "rwcalc/error.hpp"
+#include "rwcalc/plot.hpp"
+
+namespace rwcalc::cli {
+
+namespace {
+
+PlotOptions plot_options(const PlotArgs& a, bool force) {
+  PlotOptions o;
+  o.output = a.plot;
+  o.script = a.script;
+  o.force = force;
+  return o;
+}
+
+void tell(const PlotArgs& a, const PlotResult& r, Io& io) {
+  for (const auto& note : r.notes) io.err << "rwcalc: note: " << note << "\n";
+  if (!a.plot.empty()) io.err << fmt::format("rwcalc: figure written to {} ({} data series)\n", a.plot, r.series);
+  if (!a.script.empty()) io.err << fmt::format("rwcalc: gnuplot script written to {}\n", a.script);
+}
+
+}  // namespace
+
+void PlotArgs::add_to(CLI::App& app, const std::string& what) {
+  app.add_option("--plot", plot,
+                 fmt::format("Draw {} into FILE with gnuplot; the format follows the extension: .svg, .png or .pdf", what))
+      ->group("Figures");
+  app.add_option("--plot-script", script,
+                 "Write the gnuplot script of the figure (data inline) to FILE; alone it needs no gnuplot")
+      ->group("Figures");
+}
+
+void PlotArgs::check(bool force) const {
+  if (!plot.empty()) plot_format_for(plot);  // UsageError for an unknown extension
+  if (!plot.empty() && !script.empty() &&
+      std::filesystem::absolute(plot).lexically_normal() == std::filesystem::absolute(script).lexically_normal())
+    throw UsageError(fmt::format("--plot and --plot-script name the same file '{}'", plot));
+  std::error_code ec;
+  for (const auto* path : {&plot, &script})
+    if (!path->empty() && !force && std::filesystem::exists(*path, ec))
+      throw OutputError(fmt::format("{}: exists; use --force to overwrite it", *path));
+  if (!plot.empty()) require_gnuplot();
+}
+
+void PlotArgs::draw_analysis(const nlohmann::json& analysis, bool force, Io& io) const {
+  if (!any()) return;
+  tell(*this, plot_analysis(analysis, plot_options(*this, force)), io);
+}
+
+void PlotArgs::draw_batch(const nlohmann::json& batch, bool force, Io& io) const {
+  if (!any()) return;
+  tell(*this, plot_batch(batch, plot_options(*this, force)), io);
+}
+
+}  // namespace rwcalc::cli
