@@ -397,7 +397,6 @@ Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix
       const std::int64_t ma = pa.m, mb = pb.m, na = pa.terms, nb = pb.terms;
       if (ma <= 0 || mb <= 0 || na <= 0 || nb <= 0) continue;
       const std::int64_t mn = std::min(ma, mb), mx = std::max(ma, mb);
-      if (mx > 16 * mn) continue;
       const std::array<std::int64_t, 3> oa{0, ma, 2 * ma}, ob{0, mb, 2 * mb};
       // Cov(z^a_i, z^b_{i+h}) = −½ Σ a_k b_l S(o_k − h − p_l), continuous part.
       auto gamma_c = [&](double h) {
@@ -414,15 +413,43 @@ Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix
         const double lo = std::max(0.0, -h);
         return std::max(0.0, hi - lo);
       };
-      // The continuous part varies on the scale of the smaller cluster: step through the lags
-      // (exactly, one by one, for small clusters) over the support plus the flicker tail.
-      const std::int64_t step = std::max<std::int64_t>(1, mn / 16);
-      const std::int64_t lo = -(2 * mb + 4 * mx), hi = 2 * ma + 4 * mx;
-      double total = 0;
-      for (std::int64_t h = lo; h <= hi; h += step) {
-        const double hc = static_cast<double>(h) + (step > 1 ? 0.5 * static_cast<double>(step) : 0.0);
+      // Σ_h count(h)·γ(h)² over the integer lags. γ is smooth between its kinks h = o_k − p_l
+      // (where a structure-function argument crosses 0) and varies there on the scale of the
+      // smaller cluster, farther away on the scale of the distance to the nearest kink. So each
+      // stretch between kinks is summed with blocks that are single lags (or mn/16) next to a
+      // kink and grow geometrically towards the middle of the stretch; each block contributes
+      // its length times the summand at its centre. Pairs of any τ ratio are covered (the
+      // correlation of white-angle-dominated points decays slowly with the ratio).
+      const std::int64_t lo = -(2 * mb + 4 * mx), hi = 2 * ma + 4 * mx + 1;
+      std::array<std::int64_t, 11> knots{};
+      int nk = 0;
+      knots[static_cast<std::size_t>(nk++)] = lo;
+      knots[static_cast<std::size_t>(nk++)] = hi;
+      for (int k = 0; k < 3; ++k)
+        for (int l = 0; l < 3; ++l) knots[static_cast<std::size_t>(nk++)] = oa[static_cast<std::size_t>(k)] - ob[static_cast<std::size_t>(l)];
+      std::sort(knots.begin(), knots.begin() + nk);
+      const std::int64_t s0 = std::max<std::int64_t>(1, mn / 16);
+      auto block = [&](std::int64_t start, std::int64_t len) {
+        const double hc = static_cast<double>(start) + 0.5 * static_cast<double>(len - 1);
         const double g = gamma_c(hc);
-        total += static_cast<double>(step) * count(hc) * g * g;
+        return static_cast<double>(len) * count(hc) * g * g;
+      };
+      double total = 0;
+      for (int q = 0; q + 1 < nk; ++q) {
+        const std::int64_t left = knots[static_cast<std::size_t>(q)], right = knots[static_cast<std::size_t>(q + 1)];
+        if (right <= left) continue;
+        // Lags left .. right−1, graded towards both ends.
+        const std::int64_t mid = left + (right - left) / 2;
+        for (std::int64_t h = left; h < mid;) {
+          const std::int64_t len = std::min(mid - h, std::max(s0, (h - left) / 4));
+          total += block(h, len);
+          h += len;
+        }
+        for (std::int64_t h = right; h > mid;) {
+          const std::int64_t len = std::min(h - mid, std::max(s0, (right - h) / 4));
+          total += block(h - len, len);
+          h -= len;
+        }
       }
       // White angle noise: exact additions at the few lags where sample indices coincide.
       if (cq > 0) {

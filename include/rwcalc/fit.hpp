@@ -142,7 +142,7 @@ struct FitResult {
 
 /// Covariance matrix, (°/h)⁴, of overlapping-AV estimates at the given points (each needs m and
 /// terms) for Gaussian noise following the model with fit-scale squared coefficients c (the ramp,
-/// being deterministic, adds none). Pairs more than four octaves apart are set to 0.
+/// being deterministic, adds none). All pairs are covered (summed over lags on a mesh graded towards the kinks of the lag covariance).
 Eigen::MatrixXd av_covariance(std::span<const FitPoint> points, const Eigen::Matrix<double, kTermCount, 1>& c);
 
 /// The points of an Allan result usable for a fit (σ² > 0 is checked by fit_noise); cluster sizes
