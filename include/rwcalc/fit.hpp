@@ -91,7 +91,7 @@ struct FitOptions {
   /// 0). The profile deviance of a term estimated from a few EDF (B from the long-τ points) has
   /// heavier tails than χ²₁; well-determined terms (N from 10³+ EDF) are not affected. Calibrated
   /// by simulation (tests/slow_coverage_fit.cpp, docs/analysis.md).
-  double edf_inflation = 2.4;
+  double edf_inflation = 3.0;
   /// Use the model-based covariance of the AV points (EDFs and sandwich inflation) when the
   /// points carry cluster sizes and term counts.
   bool model_covariance = true;
