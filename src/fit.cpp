@@ -370,11 +370,14 @@ Sandwich sandwich(const Problem& pr, const Eigen::VectorXd& mu, const std::vecto
 
 /// "No floor": the EDF cap used when the residuals call for none.
 constexpr double kNoFloor = 1e12;
+/// The largest estimated floor: a relative uncertainty of √(2/10⁴) = 1.4 % on σ² (the data then
+/// depart from the five-term model far more than any floor can describe; χ²/dof says so).
+constexpr double kMinCap = 1e4;
 
 /// The model-error floor as an EDF cap 2/s²: s² ≥ 0 solves Σ r²/(2/ν + s²) = J − p for the
-/// relative residuals r = (σ̂² − μ)/μ (Paule–Mandel), 0 when the residuals are already within
-/// their sampling scatter. The points' correlation is ignored here (positively correlated
-/// points scatter less about a fit than independent ones, so this errs towards no floor).
+/// relative residuals r = (σ̂² − μ)/μ (Paule–Mandel), none when the residuals are already within
+/// their sampling scatter, at most kMinCap's. The points' correlation is ignored here (positively
+/// correlated points scatter less about a fit than independent ones, so this errs towards no floor).
 double model_error_cap(const Problem& pr, const Eigen::VectorXd& mu, int p) {
   const auto j = pr.y.size();
   const double target = static_cast<double>(std::max<Eigen::Index>(1, j - p));
@@ -393,7 +396,7 @@ double model_error_cap(const Problem& pr, const Eigen::VectorXd& mu, int p) {
     const double m = 0.5 * (lo + hi);
     (x2(m) > target ? lo : hi) = m;
   }
-  return std::min(kNoFloor, 2.0 / hi);
+  return std::clamp(2.0 / hi, kMinCap, kNoFloor);
 }
 
 /// Σ_y: the model covariance of the points plus the model-error floor 2μ²/edf_cap on the diagonal.

@@ -23,8 +23,9 @@
 /// computed from the fitted model itself (Gaussian fourth moments of the second differences, via
 /// the generalized structure function of each term; noise-models §4.4 extended to pairs of τ), its
 /// diagonal gives model-based EDFs for a second fit, and a sandwich covariance gives each term's
-/// variance inflation φ_i over the independent-points information. Intervals are profile-likelihood
-/// intervals of the deviance scaled by φ_i, never negative; a term whose lower bound is 0 is
+/// variance inflation φ_i over the independent-points information, times a small-EDF factor
+/// 1 + a/ν_i (ν_i the term's own effective EDF). A model-error floor is estimated from the
+/// residuals. Intervals are profile-likelihood intervals of the deviance scaled by φ_i, never negative; a term whose lower bound is 0 is
 /// reported as an upper bound.
 #include <Eigen/Dense>
 #include <array>
@@ -76,9 +77,10 @@ struct FitOptions {
   /// Model-error floor: each point's EDF enters as 1/(1/ν + 1/edf_cap), i.e. a relative model
   /// uncertainty of √(2/edf_cap) on σ². 0 (default): estimated from the residuals of the fit
   /// (Paule–Mandel: the smallest floor that brings Σ r²/(2/ν + 2/edf_cap) down to the residual
-  /// degrees of freedom; none when the residuals are within their sampling scatter), so that
-  /// points with 10⁵ EDF at short τ do not force the fit through real model defects while data
-  /// that follow the model keep their full weight.
+  /// degrees of freedom, r the relative residuals; none when the residuals are within their
+  /// sampling scatter; at most the floor of edf_cap = 10⁴, 1.4 % on σ²), so that data following
+  /// the model keep their full weight while points with 10⁵ EDF at short τ do not force the fit
+  /// through real model defects.
   double edf_cap = 0;
   /// Which terms are fitted (false: held at 0 and reported as not fitted).
   std::array<bool, kTermCount> enabled{true, true, true, true, true};
@@ -148,7 +150,8 @@ struct FitResult {
 
 /// Covariance matrix, (°/h)⁴, of overlapping-AV estimates at the given points (each needs m and
 /// terms) for Gaussian noise following the model with fit-scale squared coefficients c (the ramp,
-/// being deterministic, adds none). All pairs are covered (summed over lags on a mesh graded towards the kinks of the lag covariance).
+/// being deterministic, adds none). All pairs of τ are covered (lags summed on a mesh graded
+/// towards the kinks of the lag covariance).
 Eigen::MatrixXd av_covariance(std::span<const FitPoint> points, const Eigen::Matrix<double, kTermCount, 1>& c);
 
 /// The points of an Allan result usable for a fit (σ² > 0 is checked by fit_noise); cluster sizes
