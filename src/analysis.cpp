@@ -229,7 +229,10 @@ nlohmann::json to_json(const AnalysisResult& r) {
               {"tau_min_s", f.used.empty() ? 0.0 : f.used.front().tau_s},
               {"tau_max_s", f.used.empty() ? 0.0 : f.used.back().tau_s},
               {"dispersion", f.options.dispersion},
+              {"edf_inflation", f.options.edf_inflation},
               {"edf_cap", f.options.edf_cap},
+              {"phi_N", f.phi[static_cast<std::size_t>(Term::N)]},
+              {"phi_B", f.phi[static_cast<std::size_t>(Term::B)]},
               {"confidence", f.options.confidence}};
   json n_direct = method_json(r.direct.N);
   if (!n_direct.is_null()) {
