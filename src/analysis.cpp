@@ -229,7 +229,10 @@ nlohmann::json to_json(const AnalysisResult& r) {
               {"tau_min_s", f.used.empty() ? 0.0 : f.used.front().tau_s},
               {"tau_max_s", f.used.empty() ? 0.0 : f.used.back().tau_s},
               {"dispersion", f.options.dispersion},
+              {"edf_inflation", f.options.edf_inflation},
               {"edf_cap", f.options.edf_cap},
+              {"phi_N", f.phi[static_cast<std::size_t>(Term::N)]},
+              {"phi_B", f.phi[static_cast<std::size_t>(Term::B)]},
               {"confidence", f.options.confidence}};
   json n_direct = method_json(r.direct.N);
   if (!n_direct.is_null()) {
@@ -323,8 +326,8 @@ std::string format_report(const AnalysisResult& r) {
   s += coef_line(f[Term::R], "R", "°/h²");
   s += fmt::format("  chi2/dof = {:.2f} (dof {}, p = {:.3g}); corr(N,Q) = {:+.2f}, corr(N,B) = {:+.2f}\n", f.chi2_per_dof,
                    f.dof, f.p_value, f.corr_NQ, f.corr_NB);
-  s += fmt::format("  (uncertainties include a x{:g} variance inflation for correlated overlapping AV points)\n\n",
-                   f.options.dispersion);
+  s += fmt::format("  (variance inflation for correlated AV points and few EDF: N x{:.2f}, B x{:.2f})\n\n",
+                   f.phi[static_cast<std::size_t>(Term::N)], f.phi[static_cast<std::size_t>(Term::B)]);
 
   s += "Classic slope-line readout (single-term lines; biased where terms overlap)\n";
   s += r.slope.N ? fmt::format("  N = {} °/√h (−½ line through tau = {:.3g} s, read at 1 h)\n", num(*r.slope.N, 3), r.slope.tau_N_s)

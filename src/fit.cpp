@@ -47,7 +47,7 @@ Problem make_problem(std::span<const FitPoint> pts, const FitOptions& o) {
   for (Eigen::Index r = 0; r < j; ++r) {
     const auto& p = pts[static_cast<std::size_t>(r)];
     pr.y[r] = p.var;
-    pr.nu[r] = 1.0 / (1.0 / p.edf + 1.0 / o.edf_cap);
+    pr.nu[r] = o.edf_cap > 0 ? 1.0 / (1.0 / p.edf + 1.0 / o.edf_cap) : p.edf;
     for (int i = 0; i < P; ++i) pr.g(r, i) = term_basis(kAllTerms[static_cast<std::size_t>(i)], p.tau_s);
   }
   for (int i = 0; i < P; ++i) {
@@ -341,6 +341,7 @@ namespace {
 struct Sandwich {
   Eigen::MatrixXd cov;      // over `set`, scaled parameters
   std::vector<double> phi;  // per member of `set`
+  std::vector<double> extra;  // the part of phi beyond the sandwich ratio (small-EDF factor)
 };
 
 Sandwich sandwich(const Problem& pr, const Eigen::VectorXd& mu, const std::vector<int>& set,
@@ -367,11 +368,43 @@ Sandwich sandwich(const Problem& pr, const Eigen::VectorXd& mu, const std::vecto
   return sw;
 }
 
+/// "No floor": the EDF cap used when the residuals call for none.
+constexpr double kNoFloor = 1e12;
+/// The largest estimated floor: a relative uncertainty of √(2/10⁴) = 1.4 % on σ² (the data then
+/// depart from the five-term model far more than any floor can describe; χ²/dof says so).
+constexpr double kMinCap = 1e4;
+
+/// The model-error floor as an EDF cap 2/s²: s² ≥ 0 solves Σ r²/(2/ν + s²) = J − p for the
+/// relative residuals r = (σ̂² − μ)/μ (Paule–Mandel), none when the residuals are already within
+/// their sampling scatter, at most kMinCap's. The points' correlation is ignored here (positively
+/// correlated points scatter less about a fit than independent ones, so this errs towards no floor).
+double model_error_cap(const Problem& pr, const Eigen::VectorXd& mu, int p) {
+  const auto j = pr.y.size();
+  const double target = static_cast<double>(std::max<Eigen::Index>(1, j - p));
+  auto x2 = [&](double s2) {
+    double x = 0;
+    for (Eigen::Index r = 0; r < j; ++r) {
+      const double q = (pr.y[r] - mu[r]) / mu[r];
+      x += q * q / (2.0 / pr.nu[r] + s2);
+    }
+    return x;
+  };
+  if (!(x2(0.0) > target)) return kNoFloor;
+  double lo = 0, hi = 1e-6;
+  while (x2(hi) > target && hi < 1e6) hi *= 4;
+  for (int it = 0; it < 100; ++it) {
+    const double m = 0.5 * (lo + hi);
+    (x2(m) > target ? lo : hi) = m;
+  }
+  return std::clamp(2.0 / hi, kMinCap, kNoFloor);
+}
+
 /// Σ_y: the model covariance of the points plus the model-error floor 2μ²/edf_cap on the diagonal.
 Eigen::MatrixXd point_covariance(std::span<const FitPoint> pts, const Vec5& c, const Eigen::VectorXd& mu,
                                  double edf_cap) {
   Eigen::MatrixXd s = av_covariance(pts, c);
-  for (Eigen::Index r = 0; r < s.rows(); ++r) s(r, r) += 2.0 * mu[r] * mu[r] / edf_cap;
+  if (edf_cap > 0)
+    for (Eigen::Index r = 0; r < s.rows(); ++r) s(r, r) += 2.0 * mu[r] * mu[r] / edf_cap;
   return s;
 }
 
@@ -397,7 +430,6 @@ Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix
       const std::int64_t ma = pa.m, mb = pb.m, na = pa.terms, nb = pb.terms;
       if (ma <= 0 || mb <= 0 || na <= 0 || nb <= 0) continue;
       const std::int64_t mn = std::min(ma, mb), mx = std::max(ma, mb);
-      if (mx > 16 * mn) continue;
       const std::array<std::int64_t, 3> oa{0, ma, 2 * ma}, ob{0, mb, 2 * mb};
       // Cov(z^a_i, z^b_{i+h}) = −½ Σ a_k b_l S(o_k − h − p_l), continuous part.
       auto gamma_c = [&](double h) {
@@ -414,15 +446,43 @@ Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix
         const double lo = std::max(0.0, -h);
         return std::max(0.0, hi - lo);
       };
-      // The continuous part varies on the scale of the smaller cluster: step through the lags
-      // (exactly, one by one, for small clusters) over the support plus the flicker tail.
-      const std::int64_t step = std::max<std::int64_t>(1, mn / 16);
-      const std::int64_t lo = -(2 * mb + 4 * mx), hi = 2 * ma + 4 * mx;
-      double total = 0;
-      for (std::int64_t h = lo; h <= hi; h += step) {
-        const double hc = static_cast<double>(h) + (step > 1 ? 0.5 * static_cast<double>(step) : 0.0);
+      // Σ_h count(h)·γ(h)² over the integer lags. γ is smooth between its kinks h = o_k − p_l
+      // (where a structure-function argument crosses 0) and varies there on the scale of the
+      // smaller cluster, farther away on the scale of the distance to the nearest kink. So each
+      // stretch between kinks is summed with blocks that are single lags (or mn/16) next to a
+      // kink and grow geometrically towards the middle of the stretch; each block contributes
+      // its length times the summand at its centre. Pairs of any τ ratio are covered (the
+      // correlation of white-angle-dominated points decays slowly with the ratio).
+      const std::int64_t lo = -(2 * mb + 4 * mx), hi = 2 * ma + 4 * mx + 1;
+      std::array<std::int64_t, 11> knots{};
+      int nk = 0;
+      knots[static_cast<std::size_t>(nk++)] = lo;
+      knots[static_cast<std::size_t>(nk++)] = hi;
+      for (int k = 0; k < 3; ++k)
+        for (int l = 0; l < 3; ++l) knots[static_cast<std::size_t>(nk++)] = oa[static_cast<std::size_t>(k)] - ob[static_cast<std::size_t>(l)];
+      std::sort(knots.begin(), knots.begin() + nk);
+      const std::int64_t s0 = std::max<std::int64_t>(1, mn / 16);
+      auto block = [&](std::int64_t start, std::int64_t len) {
+        const double hc = static_cast<double>(start) + 0.5 * static_cast<double>(len - 1);
         const double g = gamma_c(hc);
-        total += static_cast<double>(step) * count(hc) * g * g;
+        return static_cast<double>(len) * count(hc) * g * g;
+      };
+      double total = 0;
+      for (int q = 0; q + 1 < nk; ++q) {
+        const std::int64_t left = knots[static_cast<std::size_t>(q)], right = knots[static_cast<std::size_t>(q + 1)];
+        if (right <= left) continue;
+        // Lags left .. right−1, graded towards both ends.
+        const std::int64_t mid = left + (right - left) / 2;
+        for (std::int64_t h = left; h < mid;) {
+          const std::int64_t len = std::min(mid - h, std::max(s0, (h - left) / 4));
+          total += block(h, len);
+          h += len;
+        }
+        for (std::int64_t h = right; h > mid;) {
+          const std::int64_t len = std::min(h - mid, std::max(s0, (right - h) / 4));
+          total += block(h - len, len);
+          h -= len;
+        }
       }
       // White angle noise: exact additions at the few lags where sample indices coincide.
       if (cq > 0) {
@@ -457,7 +517,7 @@ Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix
 
 FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options) {
   if (!(options.dispersion > 0) || !(options.confidence > 0 && options.confidence < 1) ||
-      !(options.edf_cap > 0))
+      !(options.edf_cap >= 0) || !(options.edf_inflation >= 0))
     throw UsageError("fit options: dispersion and EDF cap must be positive, confidence in (0, 1)");
   FitResult res;
   int n_enabled = 0;
@@ -493,6 +553,7 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
   Problem full_pr = make_problem(res.used, options);
   IrlsResult full = irls(full_pr, full_pr.enabled_mask, Vec5::Zero(), true);
   if (!std::isfinite(full.dev) || !full.d.allFinite()) throw AnalysisError("the noise-model fit did not converge");
+  FitOptions opt = options;  // edf_cap: the one in force (estimated when options.edf_cap is 0)
 
   // 2. Model-based EDFs and point covariance, then the full model again.
   Eigen::MatrixXd sigma_y;
@@ -505,17 +566,40 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
       const double v = cov0(r, r);
       if (v > 0 && std::isfinite(v)) res.used[static_cast<std::size_t>(r)].edf = 2.0 * mu0[r] * mu0[r] / v;
     }
-    full_pr = make_problem(res.used, options);
+    full_pr = make_problem(res.used, opt);
     Vec5 d1;
     for (int i = 0; i < P; ++i) d1[i] = c0[i] / full_pr.scale[i];
     full = irls(full_pr, full_pr.enabled_mask, d1, false);
     if (!std::isfinite(full.dev) || !full.d.allFinite()) throw AnalysisError("the noise-model fit did not converge");
+  }
+  // Model-error floor: estimated from the residuals unless fixed by the options.
+  if (!(options.edf_cap > 0)) {
+    opt.edf_cap = model_error_cap(full_pr, full_pr.g * full.d, std::popcount(full_pr.enabled_mask));
+    if (opt.edf_cap < kNoFloor) {
+      const Vec5 c_prev = full.d.cwiseProduct(full_pr.scale);
+      full_pr = make_problem(res.used, opt);
+      full = irls(full_pr, full_pr.enabled_mask, c_prev.cwiseQuotient(full_pr.scale), false);
+      if (!std::isfinite(full.dev) || !full.d.allFinite()) throw AnalysisError("the noise-model fit did not converge");
+    }
+  }
+  if (use_cov) {
     Vec5 c1;
     for (int i = 0; i < P; ++i) c1[i] = full.d[i] * full_pr.scale[i];
-    sigma_y = point_covariance(res.used, c1, full_pr.g * full.d, options.edf_cap);
+    sigma_y = point_covariance(res.used, c1, full_pr.g * full.d, opt.edf_cap);
   }
   auto phis = [&](const Problem& pr, const IrlsResult& fit, const std::vector<int>& set) {
-    return sandwich(pr, pr.g * fit.d, set, sigma_y);
+    Sandwich sw = sandwich(pr, pr.g * fit.d, set, sigma_y);
+    // Each term's inflation: the sandwich ratio times the small-EDF factor 1 + a/ν_i, ν_i the
+    // term's own effective EDF 2ĉ²/Var(ĉ) (at most 1 + a: a term at the boundary).
+    for (std::size_t q = 0; q < set.size(); ++q) {
+      const int i = set[q];
+      const double v = sw.cov(static_cast<Eigen::Index>(q), static_cast<Eigen::Index>(q));
+      const double nu = v > 0 ? 2.0 * fit.d[i] * fit.d[i] / v : 0.0;
+      const double f = options.dispersion * (1.0 + options.edf_inflation / std::max(nu, 1.0));
+      sw.phi[q] *= f;
+      sw.extra.push_back(f);
+    }
+    return sw;
   };
 
   // Inflation of every enabled term in the full model (at the boundary too).
@@ -525,11 +609,11 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
   const Sandwich sw_full = phis(full_pr, full, full_set);
   std::array<double, P> phi_full{1, 1, 1, 1, 1};
   for (std::size_t q = 0; q < full_set.size(); ++q)
-    phi_full[static_cast<std::size_t>(full_set[q])] = sw_full.phi[q] * options.dispersion;
+    phi_full[static_cast<std::size_t>(full_set[q])] = sw_full.phi[q];
 
   // 3. Term selection: a droppable term whose removal raises the scaled deviance by less than the
   //    χ²₁ quantile is left out of the model; it is reported as an upper bound from the full model.
-  FitOptions final_opt = options;
+  FitOptions final_opt = opt;
   IrlsResult best = full;
   std::array<bool, P> dropped{};
   if (options.select_terms) {
@@ -582,10 +666,10 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
   res.cov_c.setZero();
   const Sandwich sw = phis(pr, best, act);
   for (std::size_t r = 0; r < act.size(); ++r) {
-    res.phi[static_cast<std::size_t>(act[r])] = sw.phi[r] * options.dispersion;
+    res.phi[static_cast<std::size_t>(act[r])] = sw.phi[r];
     for (std::size_t q = 0; q < act.size(); ++q)
       res.cov_c(act[r], act[q]) = sw.cov(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(q)) *
-                                  options.dispersion * pr.scale[act[r]] * pr.scale[act[q]];
+                                  std::sqrt(sw.extra[r] * sw.extra[q]) * pr.scale[act[r]] * pr.scale[act[q]];
   }
   // Terms at the boundary in the selected model: inflation from the model with the term added.
   for (int i = 0; i < P; ++i) {
@@ -596,7 +680,7 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
     std::vector<int> set = act;
     set.push_back(i);
     const Sandwich s1 = phis(pr, best, set);
-    res.phi[static_cast<std::size_t>(i)] = s1.phi.back() * options.dispersion;
+    res.phi[static_cast<std::size_t>(i)] = s1.phi.back();
   }
   res.corr_NQ = res.log_correlation(Term::N, Term::Q);
   res.corr_NB = res.log_correlation(Term::N, Term::B);

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <vector>
 
@@ -317,6 +318,48 @@ TEST(AvCovariance, WhiteAngleNoiseMatchesItsClosedForm) {
   const Eigen::MatrixXd cov = av_covariance(pts, c);
   const double expect = 2.0 * (36 + 32 + 2) * c[0] * c[0] / (4 * std::pow(tau, 4) * terms);
   EXPECT_NEAR(cov(0, 0) / expect, 1.0, 1e-3);
+}
+
+TEST(AvCovariance, WhiteAngleCorrelationReachesDistantOctaves) {
+  // White angle noise: z at m = 1 and at M = 64 share single samples; each z_M sample meets three
+  // z_1 terms, Σ Cov² = s⁴·(1 + 4 + 1)·(1 + 4 + 1) per z_M term, so Cov(σ̂²_1, σ̂²_M) =
+  // 2·36·s⁴/(4 τ1² τM² n) and the correlation is 72/140 ≈ 0.51 however far apart the octaves are.
+  Eigen::Matrix<double, kTermCount, 1> c = Eigen::Matrix<double, kTermCount, 1>::Zero();
+  c[0] = 0.3;
+  const double tau0 = 0.01;
+  const std::int64_t n = 200000;
+  std::vector<FitPoint> pts;
+  for (std::int64_t m : {std::int64_t{1}, std::int64_t{64}})
+    pts.push_back({static_cast<double>(m) * tau0, 3 * c[0] / std::pow(m * tau0, 2), 0, m, n});
+  const Eigen::MatrixXd cov = av_covariance(pts, c);
+  const double ta = pts[0].tau_s, tb = pts[1].tau_s;
+  const double expect = 72.0 * c[0] * c[0] / (4 * ta * ta * tb * tb * static_cast<double>(n));
+  EXPECT_NEAR(cov(0, 1) / expect, 1.0, 0.01);
+  EXPECT_NEAR(cov(0, 1) / std::sqrt(cov(0, 0) * cov(1, 1)), 72.0 / 140.0, 0.01);
+}
+
+TEST(Fit, ModelErrorFloorOnlyWhereTheResidualsCallForIt) {
+  Truth tr;
+  // Points that follow the model: no floor, full weight.
+  const FitResult exact = fit_noise(octave_points(tr));
+  EXPECT_GE(exact.options.edf_cap, 1e11);
+  // A ±1 % ripple on σ² (a model defect far above the sampling scatter of the 10⁵-EDF short-τ
+  // points): a floor is estimated (the Paule–Mandel sum spreads it over all residual degrees of
+  // freedom, so it comes out below the ripple), and the interval of Q, which those points
+  // determine, widens accordingly.
+  auto pts = octave_points(tr);
+  for (std::size_t k = 0; k < pts.size(); ++k) pts[k].var *= (k % 2 == 0 ? 1.01 : 0.99);
+  const FitResult rippled = fit_noise(pts);
+  const double s = std::sqrt(2.0 / rippled.options.edf_cap);  // relative floor on σ²
+  std::printf("floor %.4f; Q interval %g (exact %g)\n", s, rippled[Term::Q].high - rippled[Term::Q].low,
+              exact[Term::Q].high - exact[Term::Q].low);
+  EXPECT_GT(s, 0.003);
+  EXPECT_LE(s, 0.0142);
+  EXPECT_GT(rippled[Term::Q].high - rippled[Term::Q].low, 1.3 * (exact[Term::Q].high - exact[Term::Q].low));
+  // A fixed floor is used as given.
+  FitOptions fixed;
+  fixed.edf_cap = 5e3;
+  EXPECT_EQ(fit_noise(pts, fixed).options.edf_cap, 5e3);
 }
 
 }  // namespace

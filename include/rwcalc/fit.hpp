@@ -23,8 +23,9 @@
 /// computed from the fitted model itself (Gaussian fourth moments of the second differences, via
 /// the generalized structure function of each term; noise-models §4.4 extended to pairs of τ), its
 /// diagonal gives model-based EDFs for a second fit, and a sandwich covariance gives each term's
-/// variance inflation φ_i over the independent-points information. Intervals are profile-likelihood
-/// intervals of the deviance scaled by φ_i, never negative; a term whose lower bound is 0 is
+/// variance inflation φ_i over the independent-points information, times a small-EDF factor
+/// 1 + a/ν_i (ν_i the term's own effective EDF). A model-error floor is estimated from the
+/// residuals. Intervals are profile-likelihood intervals of the deviance scaled by φ_i, never negative; a term whose lower bound is 0 is
 /// reported as an upper bound.
 #include <Eigen/Dense>
 #include <array>
@@ -74,18 +75,25 @@ struct FitOptions {
   /// Points with fewer EDF are left out of the fit (they are still listed in the AV table).
   double min_edf = 1.0;
   /// Model-error floor: each point's EDF enters as 1/(1/ν + 1/edf_cap), i.e. a relative model
-  /// uncertainty of √(2/edf_cap) on σ² (4.5 % on σ², 2.2 % on σ, for the default 1000).
-  /// Keeps points with 10⁵ EDF at short τ from forcing the fit through small model defects.
-  double edf_cap = 1.0e4;
+  /// uncertainty of √(2/edf_cap) on σ². 0 (default): estimated from the residuals of the fit
+  /// (Paule–Mandel: the smallest floor that brings Σ r²/(2/ν + 2/edf_cap) down to the residual
+  /// degrees of freedom, r the relative residuals; none when the residuals are within their
+  /// sampling scatter; at most the floor of edf_cap = 10⁴, 1.4 % on σ²), so that data following
+  /// the model keep their full weight while points with 10⁵ EDF at short τ do not force the fit
+  /// through real model defects.
+  double edf_cap = 0;
   /// Which terms are fitted (false: held at 0 and reported as not fitted).
   std::array<bool, kTermCount> enabled{true, true, true, true, true};
   /// Two-sided confidence of the intervals.
   double confidence = 0.95;
-  /// Extra variance inflation on top of the model-based one, for the heavier-than-normal tails of
-  /// the few-EDF long-τ points (the profile deviance is not exactly χ²₁ there); calibrated by
-  /// simulation (tests/slow_coverage_fit.cpp, docs/analysis.md). Used alone when the points carry
-  /// no cluster sizes (then the AV points are taken as independent).
-  double dispersion = 1.3;
+  /// Constant variance inflation on top of the model-based one (1: none).
+  double dispersion = 1.0;
+  /// Small-EDF inflation a: each term's profile deviance is scaled by 1 + a/ν_i on top of its
+  /// sandwich inflation, ν_i = 2ĉ²/Var(ĉ) being the term's own effective EDF (1 + a for a term at
+  /// 0). The profile deviance of a term estimated from a few EDF (B from the long-τ points) has
+  /// heavier tails than χ²₁; well-determined terms (N from 10³+ EDF) are not affected. Calibrated
+  /// by simulation (tests/slow_coverage_fit.cpp, docs/analysis.md).
+  double edf_inflation = 3.0;
   /// Use the model-based covariance of the AV points (EDFs and sandwich inflation) when the
   /// points carry cluster sizes and term counts.
   bool model_covariance = true;
@@ -121,7 +129,7 @@ struct FitResult {
   double corr_NQ = 0;          ///< correlation of the N² and Q² estimates
   double corr_NB = 0;          ///< correlation of the N² and B² estimates
   /// Variance inflation of each term's estimate caused by the correlation of the AV points
-  /// (sandwich / independent-points information, ≥ 1), times options.dispersion.
+  /// (sandwich / independent-points information, ≥ 1), times options.dispersion·(1 + edf_inflation/ν_i).
   std::array<double, kTermCount> phi{1, 1, 1, 1, 1};
   bool model_covariance = false;  ///< the model-based AV covariance was used
   int iterations = 0;
@@ -142,7 +150,8 @@ struct FitResult {
 
 /// Covariance matrix, (°/h)⁴, of overlapping-AV estimates at the given points (each needs m and
 /// terms) for Gaussian noise following the model with fit-scale squared coefficients c (the ramp,
-/// being deterministic, adds none). Pairs more than four octaves apart are set to 0.
+/// being deterministic, adds none). All pairs of τ are covered (lags summed on a mesh graded
+/// towards the kinks of the lag covariance).
 Eigen::MatrixXd av_covariance(std::span<const FitPoint> points, const Eigen::Matrix<double, kTermCount, 1>& c);
 
 /// The points of an Allan result usable for a fit (σ² > 0 is checked by fit_noise); cluster sizes
