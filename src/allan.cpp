@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "allan_kernels.hpp"
+#include "noise_id.hpp"
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
 
@@ -221,7 +222,9 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
     p.tau_s = static_cast<double>(p.m) * x.tau0_s;
     p.var = variance_at(x, p.m, est, x.exact() ? &prepared : nullptr, &p.n);
     p.dev = std::sqrt(p.var);
-    p.alpha = options.noise_id ? identify_noise(x, p.m, est, options.noise_id_domain) : options.alpha;
+    p.alpha = options.noise_id ? detail::identify_noise(x, p.m, est, options.noise_id_domain,
+                                                        prepared.rel32.empty() ? nullptr : prepared.rel32.data())
+                               : options.alpha;
   };
   // EDF and bounds once every α is known: Stable32 does not identify the noise at the longest τ of
   // a run (too few points) but carries the previous τ's α over.
