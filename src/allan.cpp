@@ -7,12 +7,14 @@
 #include <algorithm>
 #include <atomic>
 #include <charconv>
+#include <cstdio>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <thread>
 
 #include "allan_kernels.hpp"
 #include "noise_id.hpp"
+#include "timing.hpp"
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
 
@@ -214,18 +216,41 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
   result.points.resize(ms.size());
 
   detail::PreparedCounts prepared;
-  if (x.exact()) prepared = detail::prepare_counts(x.counts, est == Estimator::Modified);
+  if (x.exact()) {
+    detail::ScopedTimer t("allan: prepare counts");
+    prepared = detail::prepare_counts(x.counts, est == Estimator::Modified);
+  }
 
+  const bool timing = detail::timing_enabled();
+  std::atomic<std::int64_t> ns_sums{0}, ns_noise{0};
   auto work = [&](std::size_t i) {
     AllanPoint& p = result.points[i];
     p.m = ms[i];
     p.tau_s = static_cast<double>(p.m) * x.tau0_s;
+    const std::int64_t t0 = timing ? detail::cpu_ns(true) : 0;
     p.var = variance_at(x, p.m, est, x.exact() ? &prepared : nullptr, &p.n);
     p.dev = std::sqrt(p.var);
+    const std::int64_t t1 = timing ? detail::cpu_ns(true) : 0;
     p.alpha = options.noise_id ? detail::identify_noise(x, p.m, est, options.noise_id_domain,
                                                         prepared.rel32.empty() ? nullptr : prepared.rel32.data())
                                : options.alpha;
+    if (timing) {
+      const std::int64_t t2 = detail::cpu_ns(true);
+      ns_sums += t1 - t0;
+      ns_noise += t2 - t1;
+    }
   };
+  struct Report {
+    const bool& on;
+    std::atomic<std::int64_t>& sums;
+    std::atomic<std::int64_t>& noise;
+    std::size_t taus;
+    ~Report() {
+      if (on)
+        std::fprintf(stderr, "timing: allan: %zu variance sums %8.2f ms cpu; noise id %8.2f ms cpu\n", taus,
+                     static_cast<double>(sums.load()) * 1e-6, static_cast<double>(noise.load()) * 1e-6);
+    }
+  } report{timing, ns_sums, ns_noise, ms.size()};
   // EDF and bounds once every α is known: Stable32 does not identify the noise at the longest τ of
   // a run (too few points) but carries the previous τ's α over.
   auto finish = [&](AllanPoint& p) {

@@ -38,6 +38,7 @@ std::vector<std::uint64_t> count_prefix_sums(const std::vector<std::int64_t>& c)
 struct PreparedCounts {
   const std::vector<std::int64_t>* raw = nullptr;
   std::vector<std::int32_t> rel32;      ///< C_k − C_0, when small enough
+  bool small29 = false;                 ///< every |C_k − C_0| < 2^29: second differences fit int32
   std::vector<double> prefix_f64;       ///< Σ_{i<k} (C_i − C_0), exact integers (MVAR), when small enough
   std::vector<std::uint64_t> prefix_u64;  ///< modular prefix sums of C (MVAR) otherwise
 };

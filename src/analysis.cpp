@@ -9,6 +9,7 @@
 #include <numbers>
 
 #include "rwcalc/error.hpp"
+#include "timing.hpp"
 #include "rwcalc/units.hpp"
 
 namespace rwcalc {
@@ -152,8 +153,12 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& options) {
   r.bias_deg_per_h = r.mean_rate_deg_per_h - r.earth_rate_deg_per_h;
 
   // Allan variance, fit, classic readout.
-  r.allan = compute_allan(rec.phase, options.allan);
+  {
+    detail::ScopedTimer t("analyze: allan");
+    r.allan = compute_allan(rec.phase, options.allan);
+  }
   try {
+    detail::ScopedTimer t("analyze: fit");
     r.fit = fit_noise(fit_points(r.allan), options.fit);
   } catch (const AnalysisError& e) {
     throw AnalysisError(fmt::format("{}: {}", rec.source, e.what()));
@@ -163,9 +168,13 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& options) {
     if (p.tau_s == r.slope.tau_min_s && p.edf > 0 && r.slope.B) r.slope_B_sigma = *r.slope.B / std::sqrt(2.0 * p.edf);
 
   // Cross-checks.
-  r.direct = direct_n(rec.phase, options.methods);
-  r.avg100 = block_spread(rec.phase, options.methods.block_s);
-  attach_expectation(r.avg100, r.fit);
+  {
+    detail::ScopedTimer t("analyze: cross-checks");
+    r.direct = direct_n(rec.phase, options.methods);
+    r.avg100 = block_spread(rec.phase, options.methods.block_s);
+    attach_expectation(r.avg100, r.fit);
+  }
+  detail::ScopedTimer verdict_timer("analyze: verdict");
   const auto& fn = r.fit[Term::N];
   const auto& fb = r.fit[Term::B];
   if (r.direct.N.valid)

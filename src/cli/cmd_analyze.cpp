@@ -10,6 +10,7 @@
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/output.hpp"
+#include "timing.hpp"
 
 namespace rwcalc::cli {
 
@@ -50,9 +51,16 @@ void register_analyze(CLI::App& app, Runner& runner) {
       }
       AnalysisOptions opt = cmd->analysis.options();
       opt.temperature_c = cmd->temperature;
-      const Recording rec = read_recording(cmd->file, cmd->input.options());
+      detail::ScopedTimer total("analyze command");
+      const Recording rec = [&] {
+        detail::ScopedTimer t("read");
+        return read_recording(cmd->file, cmd->input.options());
+      }();
       const AnalysisResult res = analyze(rec, opt);
-      const std::string text = cmd->json ? to_json(res).dump(2) + "\n" : format_report(res);
+      const std::string text = [&] {
+        detail::ScopedTimer t("format");
+        return cmd->json ? to_json(res).dump(2) + "\n" : format_report(res);
+      }();
       if (cmd->output == "-")
         io.out << text;
       else
