@@ -148,6 +148,12 @@ std::vector<std::int64_t> cluster_sizes(const TauGrid& grid, Estimator est, std:
       ms.erase(std::unique(ms.begin(), ms.end()), ms.end());
       break;
   }
+  if (grid.with_octave && grid.kind != TauGrid::Kind::Octave) {
+    const std::int64_t top = max_cluster_size(est, points);
+    for (std::int64_t m = 1; m <= top; m *= 2) ms.push_back(m);
+    std::sort(ms.begin(), ms.end());
+    ms.erase(std::unique(ms.begin(), ms.end()), ms.end());
+  }
   return ms;
 }
 

@@ -153,18 +153,33 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& options) {
   r.bias_deg_per_h = r.mean_rate_deg_per_h - r.earth_rate_deg_per_h;
 
   // Allan variance, fit, classic readout.
+  // A finer grid (--tau) is reported in full, but the fit and the slope readout use its octave
+  // points, so the coefficients and the verdict do not depend on the grid.
+  AllanOptions aopt = options.allan;
+  const bool octave = aopt.grid.kind == TauGrid::Kind::Octave;
+  if (!octave) {
+    aopt.grid.with_octave = true;
+    if (aopt.grid.kind == TauGrid::Kind::Dense && aopt.grid.max_m == 0)
+      aopt.grid.max_m = std::max<std::int64_t>(1, static_cast<std::int64_t>(pts / 10));  // dense to N/10
+  }
   {
     detail::ScopedTimer t("analyze: allan");
-    r.allan = compute_allan(rec.phase, options.allan);
+    r.allan = compute_allan(rec.phase, aopt);
   }
+  AllanResult octave_points;
+  if (!octave) {
+    octave_points = r.allan;
+    std::erase_if(octave_points.points, [](const AllanPoint& p) { return (p.m & (p.m - 1)) != 0; });
+  }
+  const AllanResult& fitted = octave ? r.allan : octave_points;
   try {
     detail::ScopedTimer t("analyze: fit");
-    r.fit = fit_noise(fit_points(r.allan), options.fit);
+    r.fit = fit_noise(fit_points(fitted), options.fit);
   } catch (const AnalysisError& e) {
     throw AnalysisError(fmt::format("{}: {}", rec.source, e.what()));
   }
-  r.slope = slope_readout(r.allan);
-  for (const auto& p : r.allan.points)
+  r.slope = slope_readout(fitted);
+  for (const auto& p : fitted.points)
     if (p.tau_s == r.slope.tau_min_s && p.edf > 0 && r.slope.B) r.slope_B_sigma = *r.slope.B / std::sqrt(2.0 * p.edf);
 
   // Cross-checks.
