@@ -86,6 +86,9 @@ struct AllanResult {
   double tau0_s = 0;
   std::size_t points_in = 0; ///< phase points of the record
   double confidence = 0.683;
+  /// 0, or the smallest m whose variance came from the FFT path of the `all` grid (floating-point,
+  /// relative departure from the exact sum ~1e-12 on gyro records; see docs/performance.md).
+  std::int64_t fft_from_m = 0;
   std::vector<AllanPoint> points;
 };
 
