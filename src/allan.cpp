@@ -227,14 +227,15 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
   result.confidence = options.confidence;
   result.points.resize(ms.size());
 
-  detail::PreparedCounts prepared;
-  if (x.exact()) {
-    detail::ScopedTimer t("allan: prepare counts");
-    prepared = detail::prepare_counts(x.counts, est == Estimator::Modified);
-  }
 
   unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
   threads = static_cast<unsigned>(std::min<std::size_t>(threads, ms.size()));
+
+  detail::PreparedCounts prepared;
+  if (x.exact()) {
+    detail::ScopedTimer t("allan: prepare counts");
+    prepared = detail::prepare_counts(x.counts, est == Estimator::Modified, threads);
+  }
 
   // Every m of a long record: the sums above kAllExactBelow come from FFT autocorrelations
   // (allan_all.hpp), O(N log² N) instead of O(N²); below it the exact kernel as everywhere else.

@@ -7,6 +7,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <thread>
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
 #define RWCALC_CLONES __attribute__((target_clones("avx2", "default")))
@@ -366,7 +367,7 @@ double modified_sumsq_f64_prefix(const double* prefix, std::int64_t n, std::int6
 
 }  // namespace
 
-PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_prefix) {
+PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_prefix, unsigned threads) {
   PreparedCounts p;
   p.raw = &c;
   if (c.empty()) return p;
@@ -374,15 +375,32 @@ PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_pref
   constexpr std::int64_t kLimit = std::int64_t{1} << 30;
   // One branch-free (vectorisable) pass: offsets, their range, and the int32 copy; the copy is
   // dropped if the range turns out too wide.
+  p.rel32.resize(c.size());
+  auto pass = [&c, c0, &p](std::size_t begin, std::size_t end, std::int64_t& lo_out, std::int64_t& hi_out) {
+    std::int64_t lo = 0, hi = 0;
+    std::int32_t* __restrict out = p.rel32.data();
+    const std::int64_t* __restrict in = c.data();
+    for (std::size_t i = begin; i < end; ++i) {
+      const auto r = static_cast<std::int64_t>(static_cast<std::uint64_t>(in[i]) - c0);
+      lo = r < lo ? r : lo;
+      hi = r > hi ? r : hi;
+      out[i] = static_cast<std::int32_t>(r);
+    }
+    lo_out = lo;
+    hi_out = hi;
+  };
   std::int64_t lo = 0, hi = 0;
-  p.rel32.assign(c.size(), 0);
-  std::int32_t* __restrict out = p.rel32.data();
-  const std::int64_t* __restrict in = c.data();
-  for (std::size_t i = 0; i < c.size(); ++i) {
-    const auto r = static_cast<std::int64_t>(static_cast<std::uint64_t>(in[i]) - c0);
-    lo = r < lo ? r : lo;
-    hi = r > hi ? r : hi;
-    out[i] = static_cast<std::int32_t>(r);
+  if (threads > 1 && c.size() >= (std::size_t{1} << 20)) {  // long records: the two halves side by side
+    std::int64_t lo2 = 0, hi2 = 0;
+    const std::size_t mid = c.size() / 2;
+    {
+      std::jthread helper([&] { pass(mid, c.size(), lo2, hi2); });
+      pass(0, mid, lo, hi);
+    }
+    lo = std::min(lo, lo2);
+    hi = std::max(hi, hi2);
+  } else {
+    pass(0, c.size(), lo, hi);
   }
   const bool small = lo > -kLimit && hi < kLimit;
   const std::int64_t top = std::max(-lo, hi);

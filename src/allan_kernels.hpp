@@ -42,7 +42,7 @@ struct PreparedCounts {
   std::vector<double> prefix_f64;       ///< Σ_{i<k} (C_i − C_0), exact integers (MVAR), when small enough
   std::vector<std::uint64_t> prefix_u64;  ///< modular prefix sums of C (MVAR) otherwise
 };
-PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_prefix);
+PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_prefix, unsigned threads = 1);
 u128 second_diff_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m, std::int64_t stride);
 double modified_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m);
 
