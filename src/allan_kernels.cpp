@@ -3,6 +3,8 @@
 // the baseline ISA, the better one chosen at load time (function multiversioning).
 #include "allan_kernels.hpp"
 
+#include "reader_detail.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -375,7 +377,8 @@ PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_pref
   constexpr std::int64_t kLimit = std::int64_t{1} << 30;
   // One branch-free (vectorisable) pass: offsets, their range, and the int32 copy; the copy is
   // dropped if the range turns out too wide.
-  p.rel32.resize(c.size());
+  p.rel32.resize(c.size());  // uninitialised: the pages are mapped in one call, then written once
+  prefault(p.rel32.data(), p.rel32.size() * sizeof(std::int32_t));
   auto pass = [&c, c0, &p](std::size_t begin, std::size_t end, std::int64_t& lo_out, std::int64_t& hi_out) {
     std::int64_t lo = 0, hi = 0;
     std::int32_t* __restrict out = p.rel32.data();
