@@ -263,7 +263,9 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
     p.m = ms[i];
     p.tau_s = static_cast<double>(p.m) * x.tau0_s;
     const std::int64_t t0 = timing ? detail::cpu_ns(true) : 0;
-    if (!fft_sums.empty() && p.m >= kAllExactBelow) {
+    // (analyze's fitted octave points stay exact on the `all` grid too.)
+    const bool octave_kept = options.grid.with_octave && (p.m & (p.m - 1)) == 0;
+    if (!fft_sums.empty() && p.m >= kAllExactBelow && !octave_kept) {
       p.n = term_count(est, p.m, points);
       const double scale = x.exact() ? q * q : 1.0;
       p.var = p.n > 0 ? fft_sums[static_cast<std::size_t>(p.m)] * scale /

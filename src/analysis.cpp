@@ -8,6 +8,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
 #include "timing.hpp"
 #include "rwcalc/units.hpp"
@@ -170,6 +171,17 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& options) {
   if (!octave) {
     octave_points = r.allan;
     std::erase_if(octave_points.points, [](const AllanPoint& p) { return (p.m & (p.m - 1)) != 0; });
+    // As on the octave grid itself: the longest τ carries the previous τ's α (Stable32), and its
+    // EDF and bounds follow from that α.
+    auto& op = octave_points.points;
+    if (aopt.noise_id && op.size() > 1 && op.back().alpha != op[op.size() - 2].alpha) {
+      AllanPoint& last = op.back();
+      last.alpha = op[op.size() - 2].alpha;
+      last.edf = edf_for(aopt.estimator, last.alpha, last.m, octave_points.points_in);
+      const DevInterval ci = chi2_interval(last.var, last.edf, aopt.confidence);
+      last.dev_low = ci.low;
+      last.dev_high = ci.high;
+    }
   }
   const AllanResult& fitted = octave ? r.allan : octave_points;
   try {
