@@ -7,8 +7,8 @@
 #include <algorithm>
 #include <atomic>
 #include <charconv>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -226,7 +226,6 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
   result.points_in = points;
   result.confidence = options.confidence;
   result.points.resize(ms.size());
-
 
   unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
   threads = static_cast<unsigned>(std::min<std::size_t>(threads, ms.size()));
