@@ -8,10 +8,14 @@
 #include <atomic>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "allan_all.hpp"
 #include "allan_kernels.hpp"
+#include "noise_id.hpp"
+#include "timing.hpp"
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
 
@@ -36,6 +40,11 @@ double parse_number(std::string_view s, std::string_view spec) {
                                  s, spec));
   return v;
 }
+
+// `--tau all` on records of at least kAllFftMinPoints: cluster sizes from kAllExactBelow on take
+// their sums from the FFT path (allan_all.hpp); smaller ones, and every other grid, stay exact.
+constexpr std::int64_t kAllExactBelow = 1024;
+constexpr std::size_t kAllFftMinPoints = std::size_t{1} << 15;
 
 // The sums for one τ with exact data: the pulse weight and τ enter only here.
 double finish_counts(detail::u128 sumsq, double q, double tau, double denom) {
@@ -145,6 +154,12 @@ std::vector<std::int64_t> cluster_sizes(const TauGrid& grid, Estimator est, std:
       ms.erase(std::unique(ms.begin(), ms.end()), ms.end());
       break;
   }
+  if (grid.with_octave && grid.kind != TauGrid::Kind::Octave) {
+    const std::int64_t top = max_cluster_size(est, points);
+    for (std::int64_t m = 1; m <= top; m *= 2) ms.push_back(m);
+    std::sort(ms.begin(), ms.end());
+    ms.erase(std::unique(ms.begin(), ms.end()), ms.end());
+  }
   return ms;
 }
 
@@ -212,17 +227,74 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
   result.confidence = options.confidence;
   result.points.resize(ms.size());
 
-  detail::PreparedCounts prepared;
-  if (x.exact()) prepared = detail::prepare_counts(x.counts, est == Estimator::Modified);
+  unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  threads = static_cast<unsigned>(std::min<std::size_t>(threads, ms.size()));
 
+  detail::PreparedCounts prepared;
+  if (x.exact()) {
+    detail::ScopedTimer t("allan: prepare counts");
+    prepared = detail::prepare_counts(x.counts, est == Estimator::Modified, threads);
+  }
+
+  // Every m of a long record: the sums above kAllExactBelow come from FFT autocorrelations
+  // (allan_all.hpp), O(N log² N) instead of O(N²); below it the exact kernel as everywhere else.
+  std::vector<double> fft_sums;
+  if (options.grid.kind == TauGrid::Kind::All && est == Estimator::Overlapping && ms.back() >= kAllExactBelow &&
+      points >= kAllFftMinPoints) {
+    detail::ScopedTimer t("allan: all-τ FFT sums");
+    std::vector<double> phase(points);
+    if (x.exact()) {
+      const auto c0 = static_cast<std::uint64_t>(x.counts[0]);
+      for (std::size_t k = 0; k < points; ++k)
+        phase[k] = static_cast<double>(static_cast<std::int64_t>(static_cast<std::uint64_t>(x.counts[k]) - c0));
+    } else {
+      phase = x.values;
+    }
+    fft_sums = detail::all_oavar_sumsq_fft(std::move(phase), ms.back(), threads);
+    result.fft_from_m = kAllExactBelow;
+  }
+  const double q = x.arcsec_per_count;
+
+  const bool timing = detail::timing_enabled();
+  std::atomic<std::int64_t> ns_sums{0}, ns_noise{0};
   auto work = [&](std::size_t i) {
     AllanPoint& p = result.points[i];
     p.m = ms[i];
     p.tau_s = static_cast<double>(p.m) * x.tau0_s;
-    p.var = variance_at(x, p.m, est, x.exact() ? &prepared : nullptr, &p.n);
+    const std::int64_t t0 = timing ? detail::cpu_ns(true) : 0;
+    // (analyze's fitted octave points stay exact on the `all` grid too.)
+    const bool octave_kept = options.grid.with_octave && (p.m & (p.m - 1)) == 0;
+    if (!fft_sums.empty() && p.m >= kAllExactBelow && !octave_kept) {
+      p.n = term_count(est, p.m, points);
+      const double scale = x.exact() ? q * q : 1.0;
+      p.var = p.n > 0 ? fft_sums[static_cast<std::size_t>(p.m)] * scale /
+                            (2.0 * p.tau_s * p.tau_s * static_cast<double>(p.n))
+                      : 0.0;
+    } else {
+      p.var = variance_at(x, p.m, est, x.exact() ? &prepared : nullptr, &p.n);
+    }
     p.dev = std::sqrt(p.var);
-    p.alpha = options.noise_id ? identify_noise(x, p.m, est, options.noise_id_domain) : options.alpha;
+    const std::int64_t t1 = timing ? detail::cpu_ns(true) : 0;
+    p.alpha = options.noise_id ? detail::identify_noise(x, p.m, est, options.noise_id_domain,
+                                                        prepared.rel32.empty() ? nullptr : prepared.rel32.data())
+                               : options.alpha;
+    if (timing) {
+      const std::int64_t t2 = detail::cpu_ns(true);
+      ns_sums += t1 - t0;
+      ns_noise += t2 - t1;
+    }
   };
+  struct Report {
+    const bool& on;
+    std::atomic<std::int64_t>& sums;
+    std::atomic<std::int64_t>& noise;
+    std::size_t taus;
+    ~Report() {
+      if (on)
+        std::fprintf(stderr, "timing: allan: %zu variance sums %8.2f ms cpu; noise id %8.2f ms cpu\n", taus,
+                     static_cast<double>(sums.load()) * 1e-6, static_cast<double>(noise.load()) * 1e-6);
+    }
+  } report{timing, ns_sums, ns_noise, ms.size()};
   // EDF and bounds once every α is known: Stable32 does not identify the noise at the longest τ of
   // a run (too few points) but carries the previous τ's α over.
   auto finish = [&](AllanPoint& p) {
@@ -231,41 +303,44 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
     p.dev_low = ci.low;
     p.dev_high = ci.high;
   };
-  auto finish_all = [&] {
+  if (threads <= 1) {
+    for (std::size_t i = 0; i < ms.size(); ++i) work(i);
     if (options.noise_id && result.points.size() > 1)
       result.points.back().alpha = result.points[result.points.size() - 2].alpha;
     for (AllanPoint& p : result.points) finish(p);
-  };
-
-  unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
-  threads = static_cast<unsigned>(std::min<std::size_t>(threads, ms.size()));
-  if (threads <= 1) {
-    for (std::size_t i = 0; i < ms.size(); ++i) work(i);
-    finish_all();
     return result;
   }
-  // Largest m first would not help: cost per τ is ~N for every m. Hand out indices dynamically.
-  std::atomic<std::size_t> next{0};
-  std::exception_ptr failure;
-  std::atomic<bool> failed{false};
-  auto loop = [&] {
-    for (std::size_t i; (i = next.fetch_add(1)) < ms.size();) {
-      if (failed.load()) return;
-      try {
-        work(i);
-      } catch (...) {
-        if (!failed.exchange(true)) failure = std::current_exception();
-        return;
+  // Indices handed out dynamically, in chunks so that grids of a million τ (`all`) do not contend
+  // on the counter; the result does not depend on which thread did what.
+  auto parallel = [&](auto&& fn) {
+    const std::size_t count = ms.size();
+    const std::size_t chunk = std::clamp<std::size_t>(count / (64 * threads), 1, 256);
+    std::atomic<std::size_t> next{0};
+    std::exception_ptr failure;
+    std::atomic<bool> failed{false};
+    auto loop = [&] {
+      for (std::size_t i0; (i0 = next.fetch_add(chunk)) < count;) {
+        if (failed.load()) return;
+        try {
+          for (std::size_t i = i0; i < std::min(count, i0 + chunk); ++i) fn(i);
+        } catch (...) {
+          if (!failed.exchange(true)) failure = std::current_exception();
+          return;
+        }
       }
-    }
+    };
+    std::vector<std::jthread> pool;
+    pool.reserve(threads - 1);
+    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(loop);
+    loop();
+    pool.clear();  // joins
+    if (failure) std::rethrow_exception(failure);
   };
-  std::vector<std::jthread> pool;
-  pool.reserve(threads - 1);
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(loop);
-  loop();
-  pool.clear();  // joins
-  if (failure) std::rethrow_exception(failure);
-  finish_all();
+  // Largest m first would not help: cost per τ is ~N for every m.
+  parallel(work);
+  if (options.noise_id && result.points.size() > 1)
+    result.points.back().alpha = result.points[result.points.size() - 2].alpha;
+  parallel([&](std::size_t i) { finish(result.points[i]); });
   return result;
 }
 
@@ -280,12 +355,14 @@ nlohmann::json to_json(const AllanResult& r) {
                    {"dev", p.dev},
                    {"dev_low", p.dev_low},
                    {"dev_high", p.dev_high}});
-  return {{"unit", r.unit},
-          {"estimator", std::string(to_string(r.estimator))},
-          {"confidence", r.confidence},
-          {"tau0_s", r.tau0_s},
-          {"phase_points", r.points_in},
-          {"points", std::move(pts)}};
+  nlohmann::json j = {{"unit", r.unit},
+                      {"estimator", std::string(to_string(r.estimator))},
+                      {"confidence", r.confidence},
+                      {"tau0_s", r.tau0_s},
+                      {"phase_points", r.points_in},
+                      {"points", std::move(pts)}};
+  if (r.fft_from_m > 0) j["fft_from_af"] = r.fft_from_m;  // sums from this m on: FFT path, not exact
+  return j;
 }
 
 std::string_view to_string(Estimator e) {

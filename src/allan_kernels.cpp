@@ -3,10 +3,13 @@
 // the baseline ISA, the better one chosen at load time (function multiversioning).
 #include "allan_kernels.hpp"
 
+#include "reader_detail.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <thread>
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
 #define RWCALC_CLONES __attribute__((target_clones("avx2", "default")))
@@ -284,6 +287,44 @@ __attribute__((target("avx2,fma"))) bool block_sumsq_i32_avx2(const std::int32_t
 }
 #endif
 
+#if RWCALC_X86_DISPATCH
+// All-integer block for offsets below 2^29 in magnitude: d = e + a − 2b cannot leave int32
+// (|d| < 2^31), so it is formed in 32-bit lanes, eight at a time, and squared exactly into 64-bit
+// lanes (vpmuldq on the even and the shifted odd lanes). Exact while every |d| < 2^26: a lane then
+// holds at most len/8 squares below 2^52 (len ≤ 1024 keeps the sum below 2^62).
+__attribute__((target("avx2"))) bool block_sumsq_i29_avx2(const std::int32_t* __restrict a,
+                                                          const std::int32_t* __restrict b,
+                                                          const std::int32_t* __restrict e, std::int64_t len,
+                                                          std::uint64_t* out) {
+  __m256i acc0 = _mm256_setzero_si256(), acc1 = _mm256_setzero_si256(), top = _mm256_setzero_si256();
+  std::int64_t i = 0;
+  for (; i + 8 <= len; i += 8) {
+    const __m256i va = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(a + i));
+    const __m256i vb = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(b + i));
+    const __m256i ve = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(e + i));
+    const __m256i d = _mm256_sub_epi32(_mm256_add_epi32(ve, va), _mm256_add_epi32(vb, vb));
+    top = _mm256_max_epu32(top, _mm256_abs_epi32(d));
+    const __m256i hi = _mm256_srli_epi64(d, 32);
+    acc0 = _mm256_add_epi64(acc0, _mm256_mul_epi32(d, d));
+    acc1 = _mm256_add_epi64(acc1, _mm256_mul_epi32(hi, hi));
+  }
+  alignas(32) std::uint64_t lanes[4];
+  alignas(32) std::uint32_t tops[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(lanes), _mm256_add_epi64(acc0, acc1));
+  _mm256_store_si256(reinterpret_cast<__m256i*>(tops), top);
+  std::uint64_t s = lanes[0] + lanes[1] + lanes[2] + lanes[3];
+  std::uint32_t t = 0;
+  for (std::uint32_t v : tops) t = std::max(t, v);
+  for (; i < len; ++i) {
+    const std::int64_t d = std::int64_t{e[i]} + std::int64_t{a[i]} - 2 * std::int64_t{b[i]};
+    t = std::max(t, static_cast<std::uint32_t>(d < 0 ? -d : d));
+    s += static_cast<std::uint64_t>(d * d);
+  }
+  *out = s;
+  return t < (std::uint32_t{1} << 26);
+}
+#endif
+
 bool block_sumsq_i32(const std::int32_t* a, const std::int32_t* b, const std::int32_t* e, std::int64_t len,
                      double* out) {
 #if RWCALC_X86_DISPATCH
@@ -328,7 +369,7 @@ double modified_sumsq_f64_prefix(const double* prefix, std::int64_t n, std::int6
 
 }  // namespace
 
-PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_prefix) {
+PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_prefix, unsigned threads) {
   PreparedCounts p;
   p.raw = &c;
   if (c.empty()) return p;
@@ -336,18 +377,37 @@ PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_pref
   constexpr std::int64_t kLimit = std::int64_t{1} << 30;
   // One branch-free (vectorisable) pass: offsets, their range, and the int32 copy; the copy is
   // dropped if the range turns out too wide.
+  p.rel32.resize(c.size());  // uninitialised: the pages are mapped in one call, then written once
+  prefault(p.rel32.data(), p.rel32.size() * sizeof(std::int32_t));
+  auto pass = [&c, c0, &p](std::size_t begin, std::size_t end, std::int64_t& lo_out, std::int64_t& hi_out) {
+    std::int64_t lo = 0, hi = 0;
+    std::int32_t* __restrict out = p.rel32.data();
+    const std::int64_t* __restrict in = c.data();
+    for (std::size_t i = begin; i < end; ++i) {
+      const auto r = static_cast<std::int64_t>(static_cast<std::uint64_t>(in[i]) - c0);
+      lo = r < lo ? r : lo;
+      hi = r > hi ? r : hi;
+      out[i] = static_cast<std::int32_t>(r);
+    }
+    lo_out = lo;
+    hi_out = hi;
+  };
   std::int64_t lo = 0, hi = 0;
-  p.rel32.assign(c.size(), 0);
-  std::int32_t* __restrict out = p.rel32.data();
-  const std::int64_t* __restrict in = c.data();
-  for (std::size_t i = 0; i < c.size(); ++i) {
-    const auto r = static_cast<std::int64_t>(static_cast<std::uint64_t>(in[i]) - c0);
-    lo = r < lo ? r : lo;
-    hi = r > hi ? r : hi;
-    out[i] = static_cast<std::int32_t>(r);
+  if (threads > 1 && c.size() >= (std::size_t{1} << 20)) {  // long records: the two halves side by side
+    std::int64_t lo2 = 0, hi2 = 0;
+    const std::size_t mid = c.size() / 2;
+    {
+      std::jthread helper([&] { pass(mid, c.size(), lo2, hi2); });
+      pass(0, mid, lo, hi);
+    }
+    lo = std::min(lo, lo2);
+    hi = std::max(hi, hi2);
+  } else {
+    pass(0, c.size(), lo, hi);
   }
   const bool small = lo > -kLimit && hi < kLimit;
   const std::int64_t top = std::max(-lo, hi);
+  p.small29 = top < (std::int64_t{1} << 29);
   if (!small) {
     p.rel32.clear();
     p.rel32.shrink_to_fit();
@@ -375,6 +435,20 @@ u128 second_diff_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m, 
   const std::int32_t* r = c.rel32.data();
   if (stride != 1) return exact_block_i32(r, 0, n, m, stride);
   u128 total = 0;
+#if RWCALC_X86_DISPATCH
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (avx2 && c.small29) {
+    for (std::int64_t k0 = 0; k0 < n; k0 += kBlock) {
+      const std::int64_t len = std::min(kBlock, n - k0);
+      std::uint64_t s = 0;
+      if (block_sumsq_i29_avx2(r + k0, r + k0 + m, r + k0 + 2 * m, len, &s))
+        total += s;
+      else
+        total += exact_block_i32(r, k0, len, m, 1);
+    }
+    return total;
+  }
+#endif
   for (std::int64_t k0 = 0; k0 < n; k0 += kBlock) {
     const std::int64_t len = std::min(kBlock, n - k0);
     double s = 0;

@@ -6,6 +6,8 @@
 // uint64 → int64 arithmetic, so the result does not depend on the counter's offset.
 #include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <utility>
 #include <vector>
 
 namespace rwcalc::detail {
@@ -35,13 +37,34 @@ std::vector<std::uint64_t> count_prefix_sums(const std::vector<std::int64_t>& c)
 /// exactly with one instruction; the squares are still summed exactly (blocks checked against
 /// 2^21, redone in 128 bits when larger). Otherwise the int64 path is used. Offsets from C_0 are
 /// formed modulo 2^64, so any counter offset gives the same numbers.
+/// Allocator that leaves new elements uninitialised (every element is written right after).
+template <class T>
+struct UninitAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = UninitAllocator<U>;
+  };
+  UninitAllocator() = default;
+  template <class U>
+  UninitAllocator(const UninitAllocator<U>&) noexcept {}
+  template <class U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... A>
+  void construct(U* p, A&&... a) {
+    ::new (static_cast<void*>(p)) U(std::forward<A>(a)...);
+  }
+};
+
 struct PreparedCounts {
   const std::vector<std::int64_t>* raw = nullptr;
-  std::vector<std::int32_t> rel32;      ///< C_k − C_0, when small enough
+  std::vector<std::int32_t, UninitAllocator<std::int32_t>> rel32;  ///< C_k − C_0, when small enough
+  bool small29 = false;                 ///< every |C_k − C_0| < 2^29: second differences fit int32
   std::vector<double> prefix_f64;       ///< Σ_{i<k} (C_i − C_0), exact integers (MVAR), when small enough
   std::vector<std::uint64_t> prefix_u64;  ///< modular prefix sums of C (MVAR) otherwise
 };
-PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_prefix);
+PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_prefix, unsigned threads = 1);
 u128 second_diff_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m, std::int64_t stride);
 double modified_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m);
 

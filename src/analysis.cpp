@@ -8,7 +8,9 @@
 #include <cmath>
 #include <numbers>
 
+#include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
+#include "timing.hpp"
 #include "rwcalc/units.hpp"
 
 namespace rwcalc {
@@ -152,20 +154,54 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& options) {
   r.bias_deg_per_h = r.mean_rate_deg_per_h - r.earth_rate_deg_per_h;
 
   // Allan variance, fit, classic readout.
-  r.allan = compute_allan(rec.phase, options.allan);
+  // A finer grid (--tau) is reported in full, but the fit and the slope readout use its octave
+  // points, so the coefficients and the verdict do not depend on the grid.
+  AllanOptions aopt = options.allan;
+  const bool octave = aopt.grid.kind == TauGrid::Kind::Octave;
+  if (!octave) {
+    aopt.grid.with_octave = true;
+    if (aopt.grid.kind == TauGrid::Kind::Dense && aopt.grid.max_m == 0)
+      aopt.grid.max_m = std::max<std::int64_t>(1, static_cast<std::int64_t>(pts / 10));  // dense to N/10
+  }
+  {
+    detail::ScopedTimer t("analyze: allan");
+    r.allan = compute_allan(rec.phase, aopt);
+  }
+  AllanResult octave_points;
+  if (!octave) {
+    octave_points = r.allan;
+    std::erase_if(octave_points.points, [](const AllanPoint& p) { return (p.m & (p.m - 1)) != 0; });
+    // As on the octave grid itself: the longest τ carries the previous τ's α (Stable32), and its
+    // EDF and bounds follow from that α.
+    auto& op = octave_points.points;
+    if (aopt.noise_id && op.size() > 1 && op.back().alpha != op[op.size() - 2].alpha) {
+      AllanPoint& last = op.back();
+      last.alpha = op[op.size() - 2].alpha;
+      last.edf = edf_for(aopt.estimator, last.alpha, last.m, octave_points.points_in);
+      const DevInterval ci = chi2_interval(last.var, last.edf, aopt.confidence);
+      last.dev_low = ci.low;
+      last.dev_high = ci.high;
+    }
+  }
+  const AllanResult& fitted = octave ? r.allan : octave_points;
   try {
-    r.fit = fit_noise(fit_points(r.allan), options.fit);
+    detail::ScopedTimer t("analyze: fit");
+    r.fit = fit_noise(fit_points(fitted), options.fit);
   } catch (const AnalysisError& e) {
     throw AnalysisError(fmt::format("{}: {}", rec.source, e.what()));
   }
-  r.slope = slope_readout(r.allan);
-  for (const auto& p : r.allan.points)
+  r.slope = slope_readout(fitted);
+  for (const auto& p : fitted.points)
     if (p.tau_s == r.slope.tau_min_s && p.edf > 0 && r.slope.B) r.slope_B_sigma = *r.slope.B / std::sqrt(2.0 * p.edf);
 
   // Cross-checks.
-  r.direct = direct_n(rec.phase, options.methods);
-  r.avg100 = block_spread(rec.phase, options.methods.block_s);
-  attach_expectation(r.avg100, r.fit);
+  {
+    detail::ScopedTimer t("analyze: cross-checks");
+    r.direct = direct_n(rec.phase, options.methods);
+    r.avg100 = block_spread(rec.phase, options.methods.block_s);
+    attach_expectation(r.avg100, r.fit);
+  }
+  detail::ScopedTimer verdict_timer("analyze: verdict");
   const auto& fn = r.fit[Term::N];
   const auto& fb = r.fit[Term::B];
   if (r.direct.N.valid)

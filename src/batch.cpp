@@ -149,9 +149,13 @@ std::vector<json> analyze_files(const std::vector<std::string>& files, const Rea
                                 const AnalysisOptions& options, unsigned jobs) {
   if (files.empty()) throw UsageError("batch: no input files");
   if (jobs == 0) jobs = std::max(1u, std::thread::hardware_concurrency());
-  jobs = std::min<unsigned>(jobs, static_cast<unsigned>(files.size()));
+  // `jobs` threads in all: files go to min(jobs, files) workers, and each run's τ loop may use all
+  // `jobs` threads too. While every worker is busy the τ threads only share the cores; when the
+  // last runs are in flight and a worker has nothing left to read, the τ work of the others
+  // spreads onto its core, so the batch does not wait on one thread for the last file.
   AnalysisOptions opt = options;
-  if (jobs > 1) opt.allan.threads = 1;  // parallel over files, not inside each
+  opt.allan.threads = jobs;
+  jobs = std::min<unsigned>(jobs, static_cast<unsigned>(files.size()));
   std::vector<json> out(files.size());
   std::vector<std::exception_ptr> errors(files.size());
   std::atomic<std::size_t> next{0};

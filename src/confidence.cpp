@@ -12,6 +12,7 @@
 #include <numbers>
 #include <vector>
 
+#include "noise_id.hpp"
 #include "rwcalc/error.hpp"
 
 namespace rwcalc {
@@ -50,64 +51,99 @@ std::vector<double> averaged_frequency(const PhaseSeries& x, std::int64_t m) {
   return y;
 }
 
-/// Value i of the level-th difference of p (level 0: p itself).
-inline double difference(const double* p, int level, std::size_t i) {
+/// Value i of the level-th difference of p (level 0: p itself); p(i) gives the decimated phase.
+template <class P>
+inline __attribute__((always_inline)) double difference(const P& p, int level, std::size_t i) {
   switch (level) {
-    case 0: return p[i];
-    case 1: return p[i + 1] - p[i];
-    case 2: return (p[i + 2] - p[i + 1]) - (p[i + 1] - p[i]);
-    default: return ((p[i + 3] - p[i + 2]) - (p[i + 2] - p[i + 1])) - ((p[i + 2] - p[i + 1]) - (p[i + 1] - p[i]));
+    case 0: return p(i);
+    case 1: return p(i + 1) - p(i);
+    case 2: return (p(i + 2) - p(i + 1)) - (p(i + 1) - p(i));
+    default: return ((p(i + 3) - p(i + 2)) - (p(i + 2) - p(i + 1))) - ((p(i + 2) - p(i + 1)) - (p(i + 1) - p(i)));
   }
 }
 
 /// Lag-1 autocorrelation r1 = Σ(z_i − z̄)(z_{i+1} − z̄) / Σ(z_i − z̄)² (Riley & Greenhall eq. 2) of
-/// the level-th difference z of p, without forming z: the mean of a difference follows from its
-/// end points, and the sums run in four independent lanes (branch-free, vectorisable).
-double lag1_autocorrelation(const std::vector<double>& pv, int level) {
-  const double* p = pv.data();
-  const std::size_t len = pv.size() - static_cast<std::size_t>(level);  // points of z
-  if (pv.size() <= static_cast<std::size_t>(level) + 1) return 0.0;
+/// the Level-th difference z of the `count` decimated phase points p(0) … p(count − 1), without
+/// forming z or p: the mean of a difference follows from its end points, and the sums run in four
+/// independent lanes (branch-free, vectorisable).
+template <int Level, class P>
+double lag1_autocorrelation(const P& p, std::size_t count) {
+  if (count <= static_cast<std::size_t>(Level) + 1) return 0.0;
+  const std::size_t len = count - static_cast<std::size_t>(Level);  // points of z
   double mean = 0;
-  if (level == 0) {
+  if constexpr (Level == 0) {
     double lane[4] = {};
     std::size_t i = 0;
     for (; i + 4 <= len; i += 4)
-      for (int j = 0; j < 4; ++j) lane[j] += p[i + j];
-    for (; i < len; ++i) lane[0] += p[i];
+      for (int j = 0; j < 4; ++j) lane[j] += p(i + static_cast<std::size_t>(j));
+    for (; i < len; ++i) lane[0] += p(i);
     mean = (lane[0] + lane[1] + lane[2] + lane[3]) / static_cast<double>(len);
   } else {
-    mean = (difference(p, level - 1, len) - difference(p, level - 1, 0)) / static_cast<double>(len);
+    mean = (difference(p, Level - 1, len) - difference(p, Level - 1, 0)) / static_cast<double>(len);
   }
   double num[4] = {}, den[4] = {};
   std::size_t i = 0;
   // Pairs (z_i, z_{i+1}) for i < len − 1; den over all i < len.
   for (; i + 4 < len; i += 4) {
     for (int j = 0; j < 4; ++j) {
-      const double a = difference(p, level, i + j) - mean;
-      const double b = difference(p, level, i + j + 1) - mean;
+      const auto k = i + static_cast<std::size_t>(j);
+      const double a = difference(p, Level, k) - mean;
+      const double b = difference(p, Level, k + 1) - mean;
       den[j] += a * a;
       num[j] += a * b;
     }
   }
   for (; i < len; ++i) {
-    const double a = difference(p, level, i) - mean;
+    const double a = difference(p, Level, i) - mean;
     den[0] += a * a;
-    if (i + 1 < len) num[0] += a * (difference(p, level, i + 1) - mean);
+    if (i + 1 < len) num[0] += a * (difference(p, Level, i + 1) - mean);
   }
   const double n_sum = num[0] + num[1] + num[2] + num[3];
   const double d_sum = den[0] + den[1] + den[2] + den[3];
   return d_sum > 0 ? n_sum / d_sum : 0.0;
 }
 
+template <class P>
+double lag1_autocorrelation(const P& p, std::size_t count, int level) {
+  switch (level) {
+    case 0: return lag1_autocorrelation<0>(p, count);
+    case 1: return lag1_autocorrelation<1>(p, count);
+    case 2: return lag1_autocorrelation<2>(p, count);
+    default: return lag1_autocorrelation<3>(p, count);
+  }
+}
+
 /// Lag-1 ACF method on the decimated phase p, starting at difference level `base` (0: phase data,
 /// 1: frequency data): difference until δ = r1/(1 + r1) < 0.25 or d = d_max; p = −round(2δ) − 2d.
 /// Returns p, the exponent of the analysed series' own spectrum.
-int acf_exponent(const std::vector<double>& phase, int base) {
+template <class P>
+int acf_exponent(const P& phase, std::size_t count, int base) {
   for (int d = 0;; ++d) {
-    const double r1 = lag1_autocorrelation(phase, base + d);
+    const double r1 = lag1_autocorrelation(phase, count, base + d);
     const double delta = r1 / (1.0 + r1);
     if (delta < 0.25 || d >= kMaxDifferences) return -static_cast<int>(std::lround(2.0 * delta)) - 2 * d;
   }
+}
+
+/// The ACF method on the phase decimated by m, read in place (no copy): p(k) = x_{k·m} − x_0 as
+/// decimated_phase() forms it, bit for bit.
+int acf_exponent_at(const PhaseSeries& x, std::int64_t m, std::size_t count, int base, const std::int32_t* rel32) {
+  const auto um = static_cast<std::size_t>(m);
+  if (rel32) {
+    if (um == 1) return acf_exponent([rel32](std::size_t k) { return static_cast<double>(rel32[k]); }, count, base);
+    return acf_exponent([rel32, um](std::size_t k) { return static_cast<double>(rel32[k * um]); }, count, base);
+  }
+  if (x.exact()) {
+    const std::int64_t* c = x.counts.data();
+    const auto c0 = static_cast<std::uint64_t>(c[0]);
+    return acf_exponent(
+        [c, c0, um](std::size_t k) {
+          return static_cast<double>(static_cast<std::int64_t>(static_cast<std::uint64_t>(c[k * um]) - c0));
+        },
+        count, base);
+  }
+  const double* v = x.values.data();
+  return acf_exponent([v, um](std::size_t k) { return v[k * um] - v[0]; }, count, base);
 }
 
 /// Expected B1 = (standard variance)/(Allan variance) for N averages and phase exponent μ
@@ -261,15 +297,24 @@ double binomial(int n, int k) {
 }  // namespace
 
 int identify_noise(const PhaseSeries& x, std::int64_t m, Estimator est, NoiseIdDomain domain) {
+  return detail::identify_noise(x, m, est, domain, nullptr);
+}
+
+namespace detail {
+
+int identify_noise(const PhaseSeries& x, std::int64_t m, Estimator est, NoiseIdDomain domain,
+                   const std::int32_t* rel32) {
   if (m < 1 || x.points() < 3 || static_cast<std::size_t>(m) > x.points() - 1) return 0;
   // Points at τ: phase samples for phase data, averaged frequencies (one fewer) for frequency data.
   const std::size_t phase_points = (x.points() - 1) / static_cast<std::size_t>(m) + 1;
   if (domain == NoiseIdDomain::Phase && phase_points >= kMinAcfPoints)
-    return std::clamp(acf_exponent(decimated_phase(x, m), 0) + 2, -2, 2);
+    return std::clamp(acf_exponent_at(x, m, phase_points, 0, rel32) + 2, -2, 2);
   if (domain == NoiseIdDomain::Frequency && phase_points - 1 >= kMinAcfPoints)
-    return std::clamp(acf_exponent(decimated_phase(x, m), 1), -2, 2);
+    return std::clamp(acf_exponent_at(x, m, phase_points, 1, rel32), -2, 2);
   return noise_id_b1(x, m, est);
 }
+
+}  // namespace detail
 
 double edf_greenhall(int alpha, int d, std::int64_t m, std::size_t n_phase, bool overlapping,
                      bool modified) {

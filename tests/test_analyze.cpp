@@ -105,6 +105,46 @@ TEST(AnalyzeCli, LimitsFileChangesTheVerdict) {
   EXPECT_GT(j["verdict"]["p_class"].get<double>(), 0.999);
 }
 
+TEST(AnalyzeCli, DenseGridIsReportedButTheFitKeepsTheOctavePoints) {
+  const auto oct = run_cli({"analyze", gl2d("gl2d_p50C.csv.gz"), "--json"});
+  const auto dense = run_cli({"analyze", gl2d("gl2d_p50C.csv.gz"), "--json", "--tau", "dense"});
+  ASSERT_EQ(oct.status, 0) << oct.err;
+  ASSERT_EQ(dense.status, 0) << dense.err;
+  const json a = json::parse(oct.out), b = json::parse(dense.out);
+  // Same coefficients, cross-checks and verdict, bit for bit.
+  for (const char* k : {"fit", "slope_readout", "methods", "verdict"}) EXPECT_EQ(a[k], b[k]) << k;
+  // Every octave point is there with the same numbers; the dense points lie between them, at
+  // least 15 per decade up to N/10 (beyond it only the octave points continue).
+  const auto& pa = a["allan"]["points"];
+  const auto& pb = b["allan"]["points"];
+  const auto n = pb.size();
+  ASSERT_GT(n, pa.size() + 80);
+  std::size_t found = 0, beyond = 0;
+  const auto points = b["allan"]["points_in"].get<std::int64_t>();
+  for (const auto& p : pb) {
+    const auto m = p["m"].get<std::int64_t>();
+    if (m > points / 10) {
+      ++beyond;
+      EXPECT_EQ(m & (m - 1), 0) << "beyond N/10 only octave points, got m = " << m;
+    }
+    for (const auto& q : pa)
+      if (q["m"] == p["m"]) {
+        EXPECT_EQ(q, p);
+        ++found;
+      }
+  }
+  EXPECT_EQ(found, pa.size());
+  EXPECT_GE(beyond, 1u);
+  for (std::size_t i = 1; i < n; ++i) EXPECT_LT(pb[i - 1]["m"].get<std::int64_t>(), pb[i]["m"].get<std::int64_t>());
+  EXPECT_EQ(run_cli({"analyze", gl2d("gl2d_p50C.csv.gz"), "--tau", "dense:0"}).status, 2);
+  // A grid whose longest τ is not an octave point: the fit's last point still carries the
+  // previous octave α, as on the octave grid.
+  const auto dec = run_cli({"analyze", gl2d("gl2d_p50C.csv.gz"), "--json", "--tau", "decade"});
+  ASSERT_EQ(dec.status, 0) << dec.err;
+  const json c = json::parse(dec.out);
+  for (const char* k : {"fit", "slope_readout", "verdict"}) EXPECT_EQ(a[k], c[k]) << k;
+}
+
 class BatchCli : public ::testing::Test {
  protected:
   static std::vector<std::string> files() {
@@ -155,6 +195,24 @@ TEST_F(BatchCli, JsonLinesMergeToTheSameTablesAndTheToleranceGivesClass2) {
   EXPECT_EQ(d.out, md.out);
   const auto csv = run_cli({"merge", (dir.path() / "runs.jsonl").string(), "--csv"});
   EXPECT_EQ(std::count(csv.out.begin(), csv.out.end(), '\n'), 7);  // header, 5 runs, overall
+}
+
+TEST_F(BatchCli, ThreadCountDoesNotChangeTheResult) {
+  std::vector<std::string> one = {"batch"}, two = {"batch"};
+  for (const auto& f : files()) {
+    one.push_back(f);
+    two.push_back(f);
+  }
+  for (const char* a : {"--json", "--jobs"}) {
+    one.emplace_back(a);
+    two.emplace_back(a);
+  }
+  one.emplace_back("1");
+  two.emplace_back("3");
+  const auto r1 = run_cli(one), r2 = run_cli(two);
+  ASSERT_EQ(r1.status, 0) << r1.err;
+  ASSERT_EQ(r2.status, 0) << r2.err;
+  EXPECT_EQ(r1.out, r2.out);
 }
 
 TEST_F(BatchCli, MergeErrors) {

@@ -31,6 +31,10 @@ struct TauGrid {
   int per_decade = 20;             ///< for Dense
   std::vector<double> taus_s;      ///< for Explicit, s
   std::int64_t max_m = 0;          ///< optional cap on m (0: the estimator's own limit)
+  /// Also every octave cluster size (1, 2, 4, … up to the estimator's limit, whatever max_m):
+  /// analyze reports a finer grid but fits the octave points, so its coefficients do not depend
+  /// on the grid.
+  bool with_octave = false;
   /// Parse "octave", "decade", "dense", "dense:P", "all", or "1,2,5" (seconds). Throws UsageError.
   static TauGrid parse(std::string_view spec);
 };
@@ -82,6 +86,9 @@ struct AllanResult {
   double tau0_s = 0;
   std::size_t points_in = 0; ///< phase points of the record
   double confidence = 0.683;
+  /// 0, or the smallest m whose variance came from the FFT path of the `all` grid (floating-point,
+  /// relative departure from the exact sum ~1e-12 on gyro records; see docs/performance.md).
+  std::int64_t fft_from_m = 0;
   std::vector<AllanPoint> points;
 };
 

@@ -44,6 +44,11 @@ void AnalyzeArgs::add_to(CLI::App& app) {
                "Keep every fitted term in the model (default: K, R, Q not supported by the data are "
                "left out and reported as upper bounds)")
       ->group("Fit");
+  app.add_option("--tau", tau,
+                 "Tau grid of the reported Allan deviation: octave, decade, dense[:P] (P per decade, default 20, "
+                 "up to N/10), all, or a list of seconds; the fit always uses the octave points")
+      ->capture_default_str()
+      ->group("Fit");
   app.add_option("--latitude", latitude_deg, "Latitude for the vertical Earth rate, degrees")
       ->check(CLI::Range(-90.0, 90.0))
       ->capture_default_str()
@@ -75,6 +80,7 @@ AnalysisOptions AnalyzeArgs::options() const {
     o.fit.tau_min_s = a;
     o.fit.tau_max_s = b;
   }
+  o.allan.grid = TauGrid::parse(tau);
   o.fit.min_edf = min_edf;
   o.fit.enabled = {false, false, false, false, false};
   if (terms.empty()) throw UsageError("--terms: give at least one of Q, N, B, K, R");

@@ -21,6 +21,7 @@ struct AnalyzeArgs {
   std::string limits_file;
   double block_s = 100.0;
   std::string direct_range = "1:100";
+  std::string tau = "octave";       ///< τ grid of the reported AV (the fit uses its octave points)
   void add_to(CLI::App& app);
   /// Throws UsageError on malformed values; InputError for a bad limits file.
   [[nodiscard]] AnalysisOptions options() const;

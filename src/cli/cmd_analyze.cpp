@@ -11,6 +11,7 @@
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/output.hpp"
+#include "timing.hpp"
 
 namespace rwcalc::cli {
 
@@ -51,11 +52,19 @@ void register_analyze(CLI::App& app, Runner& runner) {
       opt.temperature_c = cmd->temperature;
       // Figure problems (format, existing files, no gnuplot) are reported before the analysis.
       cmd->plot.check(cmd->force);
-      const Recording rec = read_recording(cmd->file, cmd->input.options());
+      detail::ScopedTimer total("analyze command");
+      const Recording rec = [&] {
+        detail::ScopedTimer t("read");
+        return read_recording(cmd->file, cmd->input.options());
+      }();
       const AnalysisResult res = analyze(rec, opt);
-      const nlohmann::json j = to_json(res);
-      cmd->plot.draw_analysis(j, cmd->force, io);
-      const std::string text = cmd->json ? j.dump(2) + "\n" : format_report(res);
+      const std::string text = [&] {
+        detail::ScopedTimer t("format");
+        if (!cmd->json && !cmd->plot.any()) return format_report(res);
+        const nlohmann::json j = to_json(res);
+        cmd->plot.draw_analysis(j, cmd->force, io);
+        return cmd->json ? j.dump(2) + "\n" : format_report(res);
+      }();
       if (cmd->output == "-")
         io.out << text;
       else

@@ -1,0 +1,54 @@
+#pragma once
+// Stage timers for profiling whole commands: with RWCALC_TIMING=1 in the environment each
+// ScopedTimer prints "timing: NAME W ms wall" to stderr when it ends; otherwise it costs one
+// cached getenv. CPU times are those of the whole process (all threads) or of the calling thread,
+// so they do not grow when the machine is shared. Internal; docs/performance.md shows what the stages cost.
+#include <time.h>
+
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+
+namespace rwcalc::detail {
+
+inline bool timing_enabled() {
+  static const bool on = [] {
+    const char* v = std::getenv("RWCALC_TIMING");
+    return v && *v && *v != '0';
+  }();
+  return on;
+}
+
+/// CPU time in ns of the process (all threads) or of the calling thread.
+inline std::int64_t cpu_ns(bool thread = false) {
+  timespec ts{};
+  clock_gettime(thread ? CLOCK_THREAD_CPUTIME_ID : CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return std::int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec;
+}
+
+class ScopedTimer {
+ public:
+  explicit ScopedTimer(const char* name) : name_(name), on_(timing_enabled()) {
+    if (on_) {
+      start_ = std::chrono::steady_clock::now();
+      cpu_ = cpu_ns();
+    }
+  }
+  ~ScopedTimer() {
+    if (!on_) return;
+    const std::chrono::duration<double, std::milli> d = std::chrono::steady_clock::now() - start_;
+    std::fprintf(stderr, "timing: %-28s %8.2f ms wall %8.2f ms cpu\n", name_, d.count(),
+                 static_cast<double>(cpu_ns() - cpu_) * 1e-6);
+  }
+  ScopedTimer(const ScopedTimer&) = delete;
+  ScopedTimer& operator=(const ScopedTimer&) = delete;
+
+ private:
+  const char* name_;
+  bool on_;
+  std::chrono::steady_clock::time_point start_;
+  std::int64_t cpu_ = 0;
+};
+
+}  // namespace rwcalc::detail
