@@ -98,6 +98,19 @@ PhaseSeries cleaned(const PhaseSeries& x, const NoiseModel& det, double t0) {
 
 bool is_deterministic(const std::string& e) { return e == "sinusoid" || e == "bias_step" || e == "warmup_transient"; }
 
+/// The better of the best bias step and the best warm-up on the block means (lower RSS), as the
+/// deterministic terms of a model: the candidate the base fit is made without.
+NoiseModel mean_candidate(const Decimated& d) {
+  const auto st = step_detect(d);
+  const auto w = warmup_detect(d);
+  NoiseModel c;
+  if (st.rss <= w.rss)
+    c.bias_steps.push_back({st.t_s, st.size});
+  else
+    c.warmups.push_back({w.amp, w.tc});
+  return c;
+}
+
 /// Everything needed to estimate named effects on one stretch of data.
 struct Stretch {
   const Recording* rec = nullptr;   ///< the stretch as a recording
@@ -117,6 +130,7 @@ struct Extension {
 /// mid-τ shape fit of a stochastic term, whose Q/N/B/K corrections also enter the model.
 Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std::string>& effects, double f_hint,
                  const AnalysisOptions& aopt) {
+  (void)aopt;
   Extension x;
   NoiseModel det;
   for (const auto& e : effects) {
@@ -143,33 +157,35 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
     x.findings.push_back(std::move(f));
   }
   x.model = base;
-  bool refit = !det.sinusoids.empty() || !det.bias_steps.empty() || !det.warmups.empty();
-  if (refit) {
-    const Recording clean = with_series(*s.rec, cleaned(s.rec->phase, det, 0.0));
-    const AnalysisResult a = analyze(clean, aopt);
-    const NoiseModel b2 = base_model(a, s.rec->phase);
-    x.model.arw_deg_per_sqrt_h = b2.arw_deg_per_sqrt_h;
-    x.model.bias_instability_deg_per_h = b2.bias_instability_deg_per_h;
-    x.model.rrw_deg_per_h_per_sqrt_h = b2.rrw_deg_per_h_per_sqrt_h;
-    x.model.ramp_deg_per_h2 = b2.ramp_deg_per_h2;
-    x.model.white_angle_arcsec = b2.white_angle_arcsec;
-    x.model.bias_deg_per_h = b2.bias_deg_per_h;
-  }
   x.model.sinusoids = det.sinusoids;
   x.model.bias_steps = det.bias_steps;
   x.model.warmups = det.warmups;
+  // Re-fit: the mid-τ AV of the data without the named deterministic terms (and without the
+  // mean-shape candidate when no step or transient was named, as for the base fit) against the
+  // base ensemble gives the corrections of N², B², K² — jointly with the bump of a stochastic term.
+  NoiseModel det_mid = det;
+  if (det.bias_steps.empty() && det.warmups.empty()) {
+    const NoiseModel c = mean_candidate(s.dec);
+    det_mid.bias_steps = c.bias_steps;
+    det_mid.warmups = c.warmups;
+  }
+  Decimated dm = s.dec;
+  subtract_deterministic(dm, det_mid);
+  const auto v = decimated_avar(dm, s.ref.grid);
+  auto apply = [&](double& coef, Term t, double dc) {
+    coef = coefficient_from_c(t, std::max(0.0, c_from_coefficient(t, coef) + dc));
+  };
+  const bool stochastic = std::any_of(effects.begin(), effects.end(), [](const std::string& e) { return !is_deterministic(e); });
+  if (!stochastic && !x.findings.empty()) {
+    const auto dc = power_law_corrections(v, s.ref);
+    apply(x.model.arw_deg_per_sqrt_h, Term::N, dc[1]);
+    apply(x.model.bias_instability_deg_per_h, Term::B, dc[2]);
+    apply(x.model.rrw_deg_per_h_per_sqrt_h, Term::K, dc[3]);
+  }
   for (const auto& e : effects) {
     if (is_deterministic(e)) continue;
-    Decimated d = s.dec;
-    subtract_deterministic(d, det);
-    const auto v = decimated_avar(d, s.ref.grid);
     const double c_n = c_from_coefficient(Term::N, base.arw_deg_per_sqrt_h);
     const ShapeEstimate est = shape_detect(v, s.ref, c_n);
-    // Corrections of N², B², K² (fit scale) from the joint fit; Q stays with the read-out.
-    auto apply = [&](double& coef, Term t, double dc) {
-      const double c = std::max(0.0, c_from_coefficient(t, coef) + dc);
-      coef = coefficient_from_c(t, c);
-    };
     apply(x.model.bias_instability_deg_per_h, Term::B, est.dc[2]);
     apply(x.model.rrw_deg_per_h_per_sqrt_h, Term::K, est.dc[3]);
     Finding f;
@@ -233,6 +249,32 @@ NoiseModel calibrated(const NoiseModel& m0, const SimulationSettings& settings, 
   apply(m.bias_instability_deg_per_h, Term::B, dc[2]);
   apply(m.rrw_deg_per_h_per_sqrt_h, Term::K, dc[3]);
   return m;
+}
+
+/// The base model of a stretch: the five-term fit of the data without the mean-shape candidate
+/// (a step or a transient left in would be taken up into K, R or B, and the ensemble's wander
+/// would then hide it), calibrated on the mid-τ AV by a pilot ensemble. The simulated mean rate
+/// stays the measured one, so the counting read-out is reproduced.
+struct RobustBase {
+  NoiseModel model;
+  NoiseModel candidate;
+  Decimated clean;   ///< the decimated angle without the candidate
+};
+
+RobustBase robust_base(const Recording& rec, const AnalysisResult& original, const AnalysisOptions& aopt,
+                       const Decimated& dec, const SimulationSettings& settings, std::size_t pilot_runs,
+                       const std::vector<std::int64_t>& octave_m, const std::vector<std::size_t>& grid,
+                       const DiagnoseOptions& opt) {
+  RobustBase b;
+  b.candidate = mean_candidate(dec);
+  const Recording clean = with_series(rec, cleaned(rec.phase, b.candidate, 0.0));
+  const AnalysisResult a = analyze(clean, aopt);
+  NoiseModel m0 = base_model(a, rec.phase);
+  m0.bias_deg_per_h = original.mean_rate_deg_per_h - original.earth_rate_deg_per_h;
+  b.clean = dec;
+  subtract_deterministic(b.clean, b.candidate);
+  b.model = calibrated(m0, settings, pilot_runs, octave_m, b.clean, grid, opt);
+  return b;
 }
 
 struct Timer {
@@ -300,10 +342,13 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   full.dec = decimate(x);
   const auto grid = mid_tau_grid(full.dec);
   const std::size_t pilot_runs = std::max<std::size_t>(10, opt.runs / 2);
+  NoiseModel candidate;
   {
     SimulationSettings sp = r.settings;
     sp.seed = opt.seed + 1000;
-    r.base = calibrated(base_model(r.analysis, x), sp, pilot_runs, octave_m, full.dec, grid, opt);
+    const RobustBase rb = robust_base(rec, r.analysis, aopt, full.dec, sp, pilot_runs, octave_m, grid, opt);
+    r.base = rb.model;
+    candidate = rb.candidate;
   }
   timer.mark("pilot calibration");
 
@@ -353,11 +398,10 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   if (d_step.named) effects.push_back("bias_step");
   if (d_warm.named) effects.push_back("warmup_transient");
 
-  // Mid-τ shapes on the measurement without the deterministic findings.
-  NoiseModel det;
+  // Mid-τ shapes on the measurement without the mean-shape candidate (as the base fit) and a
+  // named sinusoid.
+  NoiseModel det = candidate;
   if (d_sin.named) det.sinusoids.push_back({sin.f_hz, sin.amp, sin.phase});
-  if (d_step.named) det.bias_steps.push_back({step.t_s, step.size});
-  if (d_warm.named) det.warmups.push_back({warm.amp, warm.tc});
   Decimated dclean = full.dec;
   subtract_deterministic(dclean, det);
   const auto mid_meas = decimated_avar(dclean, grid);
@@ -408,9 +452,9 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   if (r.findings.empty()) {
     r.extended_band = r.base_band;
   } else {
-    SimulationSettings s2 = r.settings;
-    s2.seed = opt.seed + 1;
-    const auto ext_runs = run_ensemble(r.extended, s2, opt.runs, octave_m, grid, false, opt);
+    // Common random numbers: the extended ensemble reuses the base ensemble's seeds, so the two
+    // bands differ by the model change, not by sampling noise.
+    const auto ext_runs = run_ensemble(r.extended, r.settings, opt.runs, octave_m, grid, false, opt);
     r.extended_band = make_band(r.analysis.allan.points, ext_runs, opt.band_level);
   }
   timer.mark("extended model");
@@ -441,7 +485,8 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     st.analysis = &a_fit;
     st.dec = decimate(fit_rec.phase);
     const auto hgrid = mid_tau_grid(st.dec);
-    const NoiseModel b_fit = calibrated(base_model(a_fit, x), sh, r.holdout_runs, om, st.dec, hgrid, opt);
+    const NoiseModel b_fit =
+        robust_base(fit_rec, a_fit, aopt, st.dec, sh, r.holdout_runs, om, hgrid, opt).model;
     sh.seed += 50;
     const double dt = (static_cast<double>(pa) - static_cast<double>(fa)) * x.tau0_s;
     const auto b_runs = run_ensemble(b_fit, sh, r.holdout_runs, om, hgrid, false, opt);
@@ -453,7 +498,6 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     st.ref = make_reference(hgrid, st.dec.tau_d, b_runs);
     st.runs = r.holdout_runs;
     const Extension e = extend(st, b_fit, effects, f_hint, aopt);
-    sh.seed += 100;
     const auto e_runs = run_ensemble(shifted(e.model, dt), sh, r.holdout_runs, om, hgrid, false, opt);
     he += band_misfit(make_band(a_pred.points, e_runs, opt.band_level), r.holdout_runs);
   }

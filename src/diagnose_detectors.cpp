@@ -271,20 +271,21 @@ StepEstimate step_detect(const Decimated& d) {
   const double sig = std::max(diff_sigma(y), 1e-12);
   std::vector<double> cs(n + 1, 0.0);
   for (std::size_t i = 0; i < n; ++i) cs[i + 1] = cs[i] + y[i];
+  // Likelihood ratio of one change of the mean at block k against none (white noise of the
+  // level σ̂ seen in the block-to-block differences): n/(k(n−k))·(S_k − k·ȳ)²/σ̂², maximised over k.
   double best = 0;
-  std::size_t ibest = n / 2, wbest = 20;
-  for (const std::size_t w : {std::size_t{20}, std::size_t{60}, std::size_t{180}}) {
-    if (2 * w > n) continue;
-    for (std::size_t i = w; i + w <= n; ++i) {
-      const double diff = (cs[i + w] - cs[i]) / double(w) - (cs[i] - cs[i - w]) / double(w);
-      const double z = std::abs(diff) / (sig * std::sqrt(2.0 / double(w)));
-      if (z > best) {
-        best = z;
-        ibest = i;
-        wbest = w;
-      }
+  std::size_t ibest = n / 2;
+  const double ybar = cs[n] / static_cast<double>(n);
+  for (std::size_t k = 3; k + 3 <= n; ++k) {
+    const double dk = static_cast<double>(k), dn = static_cast<double>(n);
+    const double u = cs[k] - dk * ybar;
+    const double lr = dn / (dk * (dn - dk)) * u * u / (sig * sig);
+    if (lr > best) {
+      best = lr;
+      ibest = k;
     }
   }
+  const std::size_t wbest = std::min<std::size_t>({ibest, n - ibest, 180});
   e.statistic = best;
   // Refine the time on 1-s block means: the split minimising the two-level RSS in the window.
   const std::size_t pb1 = per_block_for(d, 1.0);
@@ -391,7 +392,9 @@ WarmupEstimate warmup_detect(const Decimated& d) {
   e.rss = ls_rss(y, {column(e.tc)}, &coef, &inv);
   e.amp = coef(2);
   e.amp_sigma = sig * std::sqrt(inv(2, 2));
-  e.statistic = std::max(0.0, (rss0 - e.rss) / (sig * sig));
+  // F-type statistic: the residual variance, not the white level, normalises the drop, so that
+  // wander the base fit took up into K or R does not hide the transient.
+  e.statistic = std::max(0.0, (rss0 - e.rss) / (e.rss / static_cast<double>(n - 4)));
   // Time-constant range: Δ RSS/σ̂² ≤ 1 on a fine profile around the optimum.
   double tl = e.tc, th = e.tc;
   for (int g = -40; g <= 40; ++g) {
