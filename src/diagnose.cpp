@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 
 #include "rwcalc/diagnose_detectors.hpp"
 #include "rwcalc/error.hpp"
@@ -98,6 +99,13 @@ PhaseSeries cleaned(const PhaseSeries& x, const NoiseModel& det, double t0) {
 
 bool is_deterministic(const std::string& e) { return e == "sinusoid" || e == "bias_step" || e == "warmup_transient"; }
 
+/// Fit-scale squared coefficients of a model (Q free: the read-out is simulated).
+std::array<double, 4> c_of(const NoiseModel& m) {
+  return {-std::numeric_limits<double>::infinity(), c_from_coefficient(Term::N, m.arw_deg_per_sqrt_h),
+          c_from_coefficient(Term::B, m.bias_instability_deg_per_h),
+          c_from_coefficient(Term::K, m.rrw_deg_per_h_per_sqrt_h)};
+}
+
 /// The better of the best bias step and the best warm-up on the block means (lower RSS), as the
 /// deterministic terms of a model: the candidate the base fit is made without.
 NoiseModel mean_candidate(const Decimated& d) {
@@ -177,15 +185,14 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
   };
   const bool stochastic = std::any_of(effects.begin(), effects.end(), [](const std::string& e) { return !is_deterministic(e); });
   if (!stochastic && !x.findings.empty()) {
-    const auto dc = power_law_corrections(v, s.ref);
+    const auto dc = power_law_corrections(v, s.ref, c_of(base));
     apply(x.model.arw_deg_per_sqrt_h, Term::N, dc[1]);
     apply(x.model.bias_instability_deg_per_h, Term::B, dc[2]);
     apply(x.model.rrw_deg_per_h_per_sqrt_h, Term::K, dc[3]);
   }
   for (const auto& e : effects) {
     if (is_deterministic(e)) continue;
-    const double c_n = c_from_coefficient(Term::N, base.arw_deg_per_sqrt_h);
-    const ShapeEstimate est = shape_detect(v, s.ref, c_n);
+    const ShapeEstimate est = shape_detect(v, s.ref, c_of(base));
     apply(x.model.bias_instability_deg_per_h, Term::B, est.dc[2]);
     apply(x.model.rrw_deg_per_h_per_sqrt_h, Term::K, est.dc[3]);
     Finding f;
@@ -240,7 +247,7 @@ NoiseModel calibrated(const NoiseModel& m0, const SimulationSettings& settings, 
                       const std::vector<std::size_t>& grid, const DiagnoseOptions& opt) {
   const auto pilot = run_ensemble(m0, settings, runs, octave_m, grid, false, opt);
   const auto ref = make_reference(grid, dec.tau_d, pilot);
-  const auto dc = power_law_corrections(decimated_avar(dec, grid), ref);
+  const auto dc = power_law_corrections(decimated_avar(dec, grid), ref, c_of(m0));
   NoiseModel m = m0;
   auto apply = [&](double& coef, Term t, double d) {
     coef = coefficient_from_c(t, std::max(0.0, c_from_coefficient(t, coef) + d));
@@ -405,12 +412,12 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   Decimated dclean = full.dec;
   subtract_deterministic(dclean, det);
   const auto mid_meas = decimated_avar(dclean, grid);
-  const double c_n_base = c_from_coefficient(Term::N, r.base.arw_deg_per_sqrt_h);
-  const auto gm = shape_detect(mid_meas, full.ref, c_n_base);
+  const auto c_base = c_of(r.base);
+  const auto gm = shape_detect(mid_meas, full.ref, c_base);
   std::vector<double> e_gm;
   for (const auto& br : base_runs) {
     const auto loo = leave_one_out(full.ref, br.mid_var, opt.runs);
-    e_gm.push_back(shape_detect(br.mid_var, loo, c_n_base).statistic);
+    e_gm.push_back(shape_detect(br.mid_var, loo, c_base).statistic);
   }
   DetectorResult d_gm = calibrate("gauss_markov", gm.statistic, e_gm);
   // The bump is a low-pass of the white rate noise when no white noise is left beside it.

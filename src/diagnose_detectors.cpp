@@ -67,12 +67,12 @@ std::vector<double> block_rates(const Decimated& d, std::size_t per_block) {
 }
 
 std::vector<std::size_t> mid_tau_grid(const Decimated& d) {
-  // 10 per decade from 1 s to a sixth of the record.
+  // 10 per decade from 1 s to a third of the record.
   std::vector<std::size_t> g;
   const double T = d.duration();
   for (int i = 0;; ++i) {
     const double tau = std::pow(10.0, i / 10.0);
-    if (tau > T / 6.0) break;
+    if (tau > T / 3.0) break;
     const auto m = static_cast<std::size_t>(std::max(1L, std::lround(tau / d.tau_d)));
     if (g.empty() || m > g.back()) g.push_back(m);
   }
@@ -509,57 +509,85 @@ MidTauProblem mid_tau_problem(const std::vector<double>& v, const MidTauReferenc
 
 }  // namespace
 
-std::array<double, 4> power_law_corrections(const std::vector<double>& v, const MidTauReference& ref) {
+namespace {
+
+/// Weighted least squares of the mid-τ problem with the corrections of N², B², K² constrained so
+/// that the corrected coefficients c_base + Δc stay ≥ 0 (active set: a correction that would make
+/// its coefficient negative is held at −c_base and the rest re-fitted). `shape` (optional) is a
+/// further, unconstrained column. Q² is free (the read-out is simulated, not fitted).
+struct ConstrainedFit {
+  double chi2 = 0;
+  std::array<double, 4> dc{0, 0, 0, 0};
+  double a = 0, a_var = 0;  ///< shape coefficient (column as given) and its variance
+  double dn_var = 0;        ///< variance of ΔN² when N is free, fit scale²
+};
+
+ConstrainedFit constrained_fit(const MidTauProblem& p, const std::array<double, 4>& c_base,
+                               const std::vector<double>* shape) {
+  ConstrainedFit f;
+  std::array<bool, 4> fixed{false, false, false, false};
+  for (int iter = 0; iter < 4; ++iter) {
+    std::vector<double> y = p.y;
+    std::vector<std::vector<double>> cols;
+    std::vector<std::size_t> idx;
+    for (std::size_t t = 0; t < 4; ++t) {
+      if (fixed[t]) {
+        for (std::size_t i = 0; i < y.size(); ++i) y[i] += c_base[t] * p.cols[t][i] * p.colscale[t];
+      } else {
+        cols.push_back(p.cols[t]);
+        idx.push_back(t);
+      }
+    }
+    if (shape) cols.push_back(*shape);
+    const WlsOut o = wls(y, p.w, cols);
+    f.chi2 = o.chi2;
+    for (std::size_t t = 0; t < 4; ++t) f.dc[t] = fixed[t] ? -c_base[t] : 0.0;
+    for (std::size_t k = 0; k < idx.size(); ++k) {
+      f.dc[idx[k]] = o.coef(static_cast<Eigen::Index>(k)) / p.colscale[idx[k]];
+      if (idx[k] == 1) f.dn_var = o.inv(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)) /
+                                  (p.colscale[1] * p.colscale[1]);
+    }
+    if (shape) {
+      const auto last = static_cast<Eigen::Index>(idx.size());
+      f.a = o.coef(last);
+      f.a_var = o.inv(last, last);
+    }
+    // The most negative constrained coefficient, if any, goes to its bound.
+    std::size_t worst = 4;
+    double worst_v = 0;
+    for (std::size_t t = 1; t < 4; ++t) {
+      if (fixed[t]) continue;
+      const double total = c_base[t] + f.dc[t];
+      const double rel = total / std::max(std::abs(c_base[t]) + std::abs(f.dc[t]), 1e-300);
+      if (total < 0 && rel < worst_v) {
+        worst_v = rel;
+        worst = t;
+      }
+    }
+    if (worst == 4) break;
+    fixed[worst] = true;
+  }
+  return f;
+}
+
+}  // namespace
+
+std::array<double, 4> power_law_corrections(const std::vector<double>& v, const MidTauReference& ref,
+                                            const std::array<double, 4>& c_base) {
   std::array<double, 4> dc{0, 0, 0, 0};
   const MidTauProblem p = mid_tau_problem(v, ref);
   if (p.y.size() < 6) return dc;
-  const WlsOut o = wls(p.y, p.w, p.cols);
-  for (std::size_t c = 0; c < 4; ++c) dc[c] = o.coef(static_cast<Eigen::Index>(c)) / p.colscale[c];
-  return dc;
+  return constrained_fit(p, c_base, nullptr).dc;
 }
 
-ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& ref, double c_n_base) {
+ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& ref,
+                           const std::array<double, 4>& c_base) {
   ShapeEstimate e;
   MidTauProblem p = mid_tau_problem(v, ref);
   if (p.y.size() < 8) return e;
-  const double n_scale = p.colscale[1];
-  // Fit with the Q, N, B, K corrections and optionally the shape column; when the remaining white
-  // rate noise c_N,base + ΔN² would be negative, ΔN² is held at −c_N,base (no ARW left).
-  struct Fit {
-    double chi2 = 0;
-    std::array<double, 4> dc{0, 0, 0, 0};
-    double a = 0, a_var = 0;     // shape coefficient (normalised column) and its variance
-    double dn_var = 0;           // variance of ΔN² (unconstrained fit), fit scale²
-  };
-  auto fit = [&](const std::vector<double>* shape) {
-    Fit f;
-    auto cols = p.cols;
-    if (shape) cols.push_back(*shape);
-    WlsOut o = wls(p.y, p.w, cols);
-    f.dn_var = o.inv(1, 1) / (n_scale * n_scale);
-    double dn = o.coef(1) / n_scale;
-    if (c_n_base + dn < 0) {
-      std::vector<double> y2 = p.y;
-      for (std::size_t i = 0; i < y2.size(); ++i) y2[i] += c_n_base * p.cols[1][i] * n_scale;
-      auto c2 = cols;
-      c2.erase(c2.begin() + 1);
-      WlsOut o2 = wls(y2, p.w, c2);
-      f.chi2 = o2.chi2;
-      f.dc = {o2.coef(0) / p.colscale[0], -c_n_base, o2.coef(1) / p.colscale[2], o2.coef(2) / p.colscale[3]};
-      if (shape) {
-        f.a = o2.coef(3);
-        f.a_var = o2.inv(3, 3);
-      }
-      return f;
-    }
-    f.chi2 = o.chi2;
-    for (std::size_t c = 0; c < 4; ++c) f.dc[c] = o.coef(static_cast<Eigen::Index>(c)) / p.colscale[c];
-    if (shape) {
-      f.a = o.coef(4);
-      f.a_var = o.inv(4, 4);
-    }
-    return f;
-  };
+  const double c_n_base = c_base[1];
+  using Fit = ConstrainedFit;
+  auto fit = [&](const std::vector<double>* shape) { return constrained_fit(p, c_base, shape); };
   const Fit null = fit(nullptr);
   const double lt_lo = std::log(std::max(p.tau.front() / 3.0, 0.3)), lt_hi = std::log(p.tau.back() / 2.0);
   const int G = 48;

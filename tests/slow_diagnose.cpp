@@ -109,7 +109,7 @@ Tally run_effect(const std::string& effect, std::size_t n, std::uint64_t seed0,
     std::cout << fmt::format("{} case {:2}: truth {} -> {} {} | misfit {:.2f}->{:.2f} holdout {:.2f}->{:.2f} ({:.1f} s)\n",
                              effect, i, truth.dump(), names(r), est ? est->dump() : "", r.gain.misfit_base,
                              r.gain.misfit_extended, r.gain.holdout_misfit_base, r.gain.holdout_misfit_extended,
-                             r.seconds);
+                             r.seconds) << std::flush;
   }
   std::cout << fmt::format("{}: named {}/{}, recovered within tolerance {}/{}, gain in sample {}/{}, out of sample {}/{}\n",
                            effect, t.named, t.n, t.recovered, t.n, t.gain_in, t.named, t.gain_out, t.named);
@@ -207,7 +207,7 @@ TEST(DiagnoseAcceptance, NoEffectNamesNone) {
   for (std::size_t i = 0; i < n; ++i) {
     const auto r = run_case(gl2d(), 9000 + 13 * i);
     none += r.findings.empty();
-    std::cout << fmt::format("none case {:2}: {} ({:.1f} s)\n", i, names(r), r.seconds);
+    std::cout << fmt::format("none case {:2}: {} ({:.1f} s)\n", i, names(r), r.seconds) << std::flush;
   }
   std::cout << fmt::format("no effect: none named in {}/{}\n", none, n);
   EXPECT_GE(static_cast<double>(none), 0.95 * static_cast<double>(n));

@@ -90,11 +90,15 @@ enum class Shape { GaussMarkov, Lowpass };
 /// A low-passed white rate is a Gauss–Markov process: white(τ) + lowpass(τ) = GM(τ)/(2τf).
 double shape_avar(Shape s, double tau, double time);
 /// Fit `v` (measured mid-τ AV) against the reference plus Q, N, B, K corrections plus a
-/// Gauss–Markov bump; `c_n_base` is the reference model's N² on the fit scale ((60·N)²).
-ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& ref, double c_n_base);
+/// Gauss–Markov bump; `c_base` holds the reference model's Q², N², B², K² on the fit scale: the
+/// corrected N², B², K² are kept ≥ 0 (Q² is free).
+ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& ref,
+                           const std::array<double, 4>& c_base);
 /// Corrections of the fit-scale Q², N², B², K² that bring the reference to `v` (weighted least
-/// squares with the ensemble's variances): the calibration of the base model by a pilot ensemble.
-std::array<double, 4> power_law_corrections(const std::vector<double>& v, const MidTauReference& ref);
+/// squares with the ensemble's variances, corrected N², B², K² kept ≥ 0): the calibration of the
+/// base model by a pilot ensemble.
+std::array<double, 4> power_law_corrections(const std::vector<double>& v, const MidTauReference& ref,
+                                            const std::array<double, 4>& c_base);
 /// `v_j` being one ensemble member, its statistic against the leave-one-out reference.
 MidTauReference leave_one_out(const MidTauReference& ref, const std::vector<double>& v, std::size_t runs);
 
