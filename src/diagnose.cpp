@@ -99,6 +99,19 @@ PhaseSeries cleaned(const PhaseSeries& x, const NoiseModel& det, double t0) {
 
 bool is_deterministic(const std::string& e) { return e == "sinusoid" || e == "bias_step" || e == "warmup_transient"; }
 
+/// The five-term analysis; when the default pulse-data fit range leaves too few Allan points (a
+/// short record or half record), it is widened to τ ≥ 1 s, then to all τ.
+AnalysisResult analyze_for_base(const Recording& rec, const AnalysisOptions& aopt) {
+  try {
+    return analyze(rec, aopt);
+  } catch (const AnalysisError&) {
+    if (!(aopt.fit.tau_min_s > 0)) throw;
+    AnalysisOptions wider = aopt;
+    wider.fit.tau_min_s = aopt.fit.tau_min_s > 1.0 ? 1.0 : 0.0;
+    return analyze_for_base(rec, wider);
+  }
+}
+
 /// Fit-scale squared coefficients of a model (Q free: the read-out is simulated).
 std::array<double, 4> c_of(const NoiseModel& m) {
   return {-std::numeric_limits<double>::infinity(), c_from_coefficient(Term::N, m.arw_deg_per_sqrt_h),
@@ -275,7 +288,7 @@ RobustBase robust_base(const Recording& rec, const AnalysisResult& original, con
   RobustBase b;
   b.candidate = mean_candidate(dec);
   const Recording clean = with_series(rec, cleaned(rec.phase, b.candidate, 0.0));
-  const AnalysisResult a = analyze(clean, aopt);
+  const AnalysisResult a = analyze_for_base(clean, aopt);
   NoiseModel m0 = base_model(a, rec.phase);
   m0.bias_deg_per_h = original.mean_rate_deg_per_h - original.earth_rate_deg_per_h;
   b.clean = dec;
@@ -333,7 +346,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   // would distort the five-term fit, so the base fit starts at 20 s unless a range was given.
   AnalysisOptions aopt = opt.analysis;
   if (rec.phase.exact() && aopt.fit.tau_min_s <= 0) aopt.fit.tau_min_s = kPulseFitTauMin;
-  r.analysis = analyze(rec, aopt);
+  r.analysis = analyze_for_base(rec, aopt);
   timer.mark("base fit");
   const PhaseSeries& x = rec.phase;
   const std::size_t n = x.points() - 1;
@@ -480,7 +493,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     const std::size_t pa = dir == 0 ? h : 0, pb = dir == 0 ? 2 * h : h;
     const Recording fit_rec = with_series(rec, slice(x, fa, fb));
     const Recording pred_rec = with_series(rec, slice(x, pa, pb));
-    const AnalysisResult a_fit = analyze(fit_rec, aopt);
+    const AnalysisResult a_fit = analyze_for_base(fit_rec, aopt);
     AllanOptions ao = opt.analysis.allan;
     const AllanResult a_pred = compute_allan(pred_rec.phase, ao);
     const auto om = octave_of(a_pred);

@@ -84,7 +84,8 @@ TEST_F(DiagnoseCli, JsonHasTheDocumentedKeysAndFindsTheSinusoid) {
 TEST_F(DiagnoseCli, ReportCarriesUnitsAndTheFinding) {
   const auto r = run_cli({"diagnose", record_, "--runs", "10"});
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.out.find("sinusoid: frequency_hz ="), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("  sinusoid:"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("frequency_hz = 0.05"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find(" Hz"), std::string::npos);
   EXPECT_NE(r.out.find("°/h"), std::string::npos);
   EXPECT_NE(r.out.find("out-of-sample misfit"), std::string::npos);
