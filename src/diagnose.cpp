@@ -41,10 +41,15 @@ NoiseModel base_model(const AnalysisResult& a, const PhaseSeries& x) {
   m.bias_deg_per_h = a.mean_rate_deg_per_h - a.earth_rate_deg_per_h;
   const double q_fit = term_value(a.fit, Term::Q);
   if (x.exact()) {
-    // Pulse data: the same counting read-out; extra white angle noise only when the fitted Q
-    // clearly exceeds the counter's own level q/√12.
-    m.readout = ReadoutMode::Counting;
-    const double q_read = x.arcsec_per_count / std::sqrt(12.0);
+    // Pulse data: which read-out? A dithered (white) read-out gives σ(τ0) ≈ √(1/2)·q/τ0 = 0.71·q/τ0;
+    // plain counting of a rate of a few pulses per sample or less gives far less (0.18·q/τ0 at
+    // 13.5 pulses/s and 400 Hz). The boundary 0.45·q/τ0 separates them.
+    const double q = x.arcsec_per_count;
+    const bool white = !a.allan.points.empty() && a.allan.points.front().m == 1 &&
+                       a.allan.points.front().dev * x.tau0_s / q > 0.45;
+    m.readout = white ? ReadoutMode::White : ReadoutMode::Counting;
+    // Extra white angle noise only when the fitted Q clearly exceeds the read-out's own level.
+    const double q_read = readout_q_arcsec(m.readout, q);
     if (q_fit > 1.2 * q_read) m.white_angle_arcsec = std::sqrt(q_fit * q_fit - q_read * q_read);
   } else {
     m.readout = ReadoutMode::White;
