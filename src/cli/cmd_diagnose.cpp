@@ -1,13 +1,100 @@
-// Placeholder registration for 'rwcalc diagnose' (replaced by the command's implementation).
+// 'rwcalc diagnose FILE': compare the measurement with simulations of its fitted five-term model,
+// name what the model misses, extend the model and measure the gain (docs/diagnosis.md).
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <memory>
+#include <ostream>
+
+#include "cli/analyze_args.hpp"
 #include "cli/commands.hpp"
+#include "rwcalc/diagnose.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/output.hpp"
+#include "rwcalc/plot.hpp"
+#include "rwcalc/progress.hpp"
 
 namespace rwcalc::cli {
 
+namespace {
+
+struct DiagnoseCmd {
+  std::string file;
+  InputArgs input;
+  AnalyzeArgs analysis;
+  std::optional<double> temperature;
+  bool json = false;
+  std::size_t runs = 50;
+  std::uint64_t seed = 1;
+  double alpha = 0.01;
+  unsigned threads = 0;
+  std::string output = "-";
+  std::string plot;
+  std::string plot_script;
+  bool force = false;
+};
+
+}  // namespace
+
 void register_diagnose(CLI::App& app, Runner& runner) {
-  auto* sub = app.add_subcommand("diagnose", "(not yet available)");
-  sub->callback([&runner] {
-    runner = [](Io&) -> int { throw AnalysisError("'rwcalc diagnose' is not available in this build"); };
+  auto cmd = std::make_shared<DiagnoseCmd>();
+  auto* sub = app.add_subcommand(
+      "diagnose",
+      "Where simulations of the fitted five-term model depart from the measurement, the named cause "
+      "(sinusoid, Gauss–Markov, bias step, warm-up transient, low-pass), the extended model and its gain");
+  sub->add_option("FILE", cmd->file, "Recording to diagnose ('-' for standard input)")->required();
+  cmd->input.add_to(*sub);
+  cmd->analysis.add_to(*sub);
+  sub->add_option("--temperature", cmd->temperature, "Temperature of the run, °C (overrides the file)");
+  sub->add_flag("--json", cmd->json, "Print the JSON object instead of the report");
+  sub->add_option("--runs", cmd->runs, "Simulated records per ensemble (at least 10)")
+      ->check(CLI::Range(10, 100000))
+      ->capture_default_str();
+  sub->add_option("--seed", cmd->seed, "Base seed of the simulations")->capture_default_str();
+  sub->add_option("--false-alarm", cmd->alpha, "False-alarm probability of each of the five detectors")
+      ->check(CLI::Range(1e-6, 0.2))
+      ->capture_default_str();
+  sub->add_option("--threads", cmd->threads, "Simulation threads (default: hardware threads)");
+  sub->add_option("-o,--output", cmd->output, "Write to FILE instead of standard output")->capture_default_str();
+  sub->add_flag("--force", cmd->force, "Overwrite existing output files");
+  sub->add_option("--plot", cmd->plot, "Also draw the measurement against both bands into FILE (.svg, .png, .pdf)");
+  sub->add_option("--plot-script", cmd->plot_script, "Also write the figure's gnuplot script (data inline) to FILE");
+  sub->callback([cmd, &runner] {
+    runner = [cmd](Io& io) -> int {
+      if (!cmd->plot.empty()) (void)plot_format_for(cmd->plot);  // reject a bad extension before the work
+      // Refuse to overwrite before the simulations rather than after them.
+      for (const std::string* path : {&cmd->output, &cmd->plot, &cmd->plot_script})
+        if (!path->empty() && *path != "-" && !cmd->force && std::filesystem::exists(*path))
+          throw OutputError(fmt::format("{} exists; use --force to overwrite it", *path));
+      DiagnoseOptions opt;
+      opt.analysis = cmd->analysis.options();
+      opt.analysis.temperature_c = cmd->temperature;
+      opt.runs = cmd->runs;
+      opt.seed = cmd->seed;
+      opt.alpha = cmd->alpha;
+      opt.threads = cmd->threads;
+      const Recording rec = read_recording(cmd->file, cmd->input.options());
+      const std::size_t hold = std::max<std::size_t>(10, cmd->runs / 2);
+      Progress progress("simulating", static_cast<std::uint64_t>(2 * cmd->runs + 7 * hold));
+      opt.progress = &progress;
+      const DiagnoseResult res = diagnose(rec, opt);
+      progress.finish();
+      const nlohmann::json j = to_json(res);
+      const std::string text = cmd->json ? j.dump(2) + "\n" : format_report(res);
+      if (cmd->output == "-")
+        io.out << text;
+      else
+        write_file_atomic(cmd->output, text, cmd->force);
+      if (!cmd->plot.empty() || !cmd->plot_script.empty()) {
+        PlotOptions po;
+        po.output = cmd->plot;
+        po.script = cmd->plot_script;
+        po.force = cmd->force;
+        const PlotResult pr = plot_diagnosis(j, po);
+        for (const auto& note : pr.notes) io.err << "note: " << note << "\n";
+      }
+      return 0;
+    };
   });
 }
 

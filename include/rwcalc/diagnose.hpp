@@ -1,0 +1,111 @@
+#pragma once
+/// @file diagnose.hpp
+/// `rwcalc diagnose`: where the fitted five-term model's simulations depart from the measurement,
+/// which effect causes it, the extended model and its gain (docs/diagnosis.md).
+///
+/// Steps: (1) fit the five-term model (analysis.hpp) and simulate an ensemble of records from it
+/// with the data's length, rate, pulse weight and read-out (SimulationPath::Ensemble); (2) compare
+/// the measured Allan deviation with the ensemble's band per τ, and run one dedicated detector per
+/// effect whose statistic is computed identically on the measurement and on every ensemble record,
+/// so that the detection threshold is the ensemble's (1 − α) quantile (Gumbel tail); (3) estimate
+/// the parameters of each detected effect by least squares on the statistic that carries it;
+/// (4) add them to the model, re-fit, re-simulate, and measure the gain in- and out-of-sample.
+#include <cstddef>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rwcalc/analysis.hpp"
+#include "rwcalc/simulate.hpp"
+
+namespace rwcalc {
+
+class Progress;
+
+struct DiagnoseOptions {
+  AnalysisOptions analysis;          ///< the base fit (as `rwcalc analyze`)
+  std::size_t runs = 50;             ///< ensemble size K of each simulated band
+  std::size_t holdout_runs = 0;      ///< ensemble size of the out-of-sample check (0: max(10, K/2))
+  std::uint64_t seed = 1;            ///< base seed of every ensemble
+  double band_level = 0.95;          ///< central probability of the band (2.5–97.5 %)
+  double alpha = 0.01;               ///< false-alarm level of each detector (five detectors: ≤ 5 %)
+  unsigned threads = 0;              ///< simulation threads (0: all)
+  Progress* progress = nullptr;      ///< advanced once per simulated record (may be null)
+};
+
+/// One τ of a band: the measured deviation against the ensemble's quantiles.
+struct BandPoint {
+  double tau_s = 0;
+  double dev = 0;        ///< measured σ(τ), °/h
+  double edf = 0;        ///< EDF of the measured point
+  double low = 0;        ///< ensemble (1 − level)/2 quantile of σ, °/h
+  double high = 0;       ///< ensemble (1 + level)/2 quantile of σ, °/h
+  double median = 0;     ///< ensemble median of σ, °/h
+  double mean_var = 0;   ///< ensemble mean of σ², (°/h)²
+};
+
+/// One detector's verdict: its statistic on the measurement against the ensemble calibration.
+struct DetectorResult {
+  std::string effect;
+  double statistic = 0;      ///< on the measurement
+  double threshold = 0;      ///< the ensemble's (1 − α) quantile (never below the ensemble maximum)
+  double ensemble_max = 0;
+  double ensemble_median = 0;
+  bool fired = false;        ///< statistic > threshold
+  bool named = false;        ///< kept as a finding (a competing explanation may win)
+  std::string note;          ///< why it was not named although it fired
+};
+
+/// A named effect: parameters (the JSON keys add_finding reads), 1σ uncertainties and evidence.
+struct Finding {
+  std::string effect;
+  nlohmann::json params;       ///< e.g. {"frequency_hz": …, "amplitude_deg_per_h": …}
+  nlohmann::json uncertainty;  ///< same keys, standard errors
+  nlohmann::json evidence;     ///< statistic, threshold, where it shows
+};
+
+struct Gain {
+  double misfit_base = 0, misfit_extended = 0;      ///< EDF-weighted AV misfit (≈ 1 when the model fits)
+  double coverage_base = 0, coverage_extended = 0;  ///< share of measured τ inside the band
+  double holdout_misfit_base = 0, holdout_misfit_extended = 0;  ///< out of sample (two halves)
+};
+
+struct DiagnoseResult {
+  AnalysisResult analysis;         ///< the base fit
+  SimulationSettings settings;     ///< length, rate, pulse weight of the simulations
+  NoiseModel base;
+  NoiseModel extended;
+  std::vector<BandPoint> base_band;
+  std::vector<BandPoint> extended_band;
+  std::vector<DetectorResult> detectors;
+  std::vector<Finding> findings;
+  Gain gain;
+  std::size_t runs = 0;
+  std::size_t holdout_runs = 0;
+  std::uint64_t seed = 0;
+  double band_level = 0.95;
+  double alpha = 0.01;
+  double seconds = 0;              ///< wall time of the diagnosis, s
+};
+
+/// Run the diagnosis. Throws UsageError for clock data, AnalysisError when the record is too
+/// short (the detectors need at least 20 min of data) or cannot be fitted.
+DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& options = {});
+
+/// The JSON object of `rwcalc diagnose --json` (docs/diagnosis.md).
+nlohmann::json to_json(const DiagnoseResult& r);
+
+/// The readable report (units on every number).
+std::string format_report(const DiagnoseResult& r);
+
+/// Measured-versus-ensemble misfit on a band: mean over τ of ν·(r − 1 − ln r), r = σ̂²/E σ², with
+/// ν the measured EDF combined with the ensemble's own sampling error and a 1000-EDF model floor.
+/// About 1 per point when the model is right.
+double band_misfit(const std::vector<BandPoint>& band, std::size_t runs);
+
+/// Share of the band's τ whose measured σ lies inside [low, high].
+double band_coverage(const std::vector<BandPoint>& band);
+
+}  // namespace rwcalc

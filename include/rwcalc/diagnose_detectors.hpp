@@ -1,0 +1,130 @@
+#pragma once
+/// @file diagnose_detectors.hpp
+/// The building blocks of the diagnosis (diagnose.hpp): the angle decimated to about 10 Hz that
+/// every detector reads, the detector statistics and their least-squares estimators, the
+/// ensemble band and the Gumbel calibration of the thresholds. docs/diagnosis.md explains each.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "rwcalc/allan.hpp"
+#include "rwcalc/diagnose.hpp"
+#include "rwcalc/series.hpp"
+#include "rwcalc/simulate.hpp"
+
+namespace rwcalc::diag {
+
+/// The angle decimated to about 10 Hz: θ_j = x(jD) − x(0), ″ (gyro phase units).
+struct Decimated {
+  double tau_d = 0.1;               ///< decimated period, s
+  std::vector<double> theta;        ///< θ_0 = 0 … θ_L
+  [[nodiscard]] double duration() const { return theta.size() > 1 ? tau_d * double(theta.size() - 1) : 0.0; }
+};
+
+/// Decimation factor for a sample rate (rate/D ≈ 10 Hz; 1 below 20 Hz).
+std::size_t decimation(double rate_hz);
+Decimated decimate(const PhaseSeries& x, std::size_t first = 0, std::size_t last = 0);
+
+/// Mean rates over blocks of `per_block` decimated periods, °/h.
+std::vector<double> block_rates(const Decimated& d, std::size_t per_block);
+
+/// Dense τ grid of the mid-τ detectors (cluster sizes in decimated periods).
+std::vector<std::size_t> mid_tau_grid(const Decimated& d);
+/// Overlapping AV of the decimated angle at those cluster sizes, (°/h)².
+std::vector<double> decimated_avar(const Decimated& d, const std::vector<std::size_t>& grid);
+
+// ---- deterministic effects -----------------------------------------------------------------
+
+struct SinusoidEstimate {
+  double statistic = 0;   ///< max over f of periodogram / local level
+  double f_hz = 0, amp = 0, phase = 0;
+  double f_sigma = 0, amp_sigma = 0;
+};
+/// Periodogram line search on 0.5-s block rates. `f_hint` > 0 restricts the search to ±3 bins.
+SinusoidEstimate sinusoid_detect(const Decimated& d, double f_hint = 0, bool estimate = true);
+
+struct StepEstimate {
+  double statistic = 0;   ///< max local two-window |z|
+  double t_s = 0, size = 0, t_sigma = 0, size_sigma = 0;
+  double rss = 0;         ///< RSS of level + trend + step on 10-s block means, (°/h)²
+};
+StepEstimate step_detect(const Decimated& d);
+
+struct WarmupEstimate {
+  double statistic = 0;   ///< (RSS(level+trend) − RSS(+exp))/σ̂² on 10-s block means
+  double amp = 0, tc = 0, amp_sigma = 0, tc_sigma = 0;
+  double rss = 0;
+};
+WarmupEstimate warmup_detect(const Decimated& d);
+
+/// Angle (″) at time t of the deterministic terms of a model that a finding adds (sinusoids,
+/// steps, warm-ups), relative to t = 0.
+double deterministic_angle(const NoiseModel& m, double t);
+/// Subtract the deterministic findings of `m` from the decimated angle (t0: time of θ_0).
+void subtract_deterministic(Decimated& d, const NoiseModel& m, double t0 = 0);
+
+// ---- stochastic effects in the mid-τ Allan variance -----------------------------------------
+
+/// Ensemble reference of the mid-τ AV: mean and variance over the runs per τ.
+struct MidTauReference {
+  std::vector<std::size_t> grid;
+  std::vector<double> tau;
+  std::vector<double> mean, var;
+};
+
+struct ShapeEstimate {
+  double statistic = 0;   ///< χ² drop when a Gauss–Markov bump joins the free Q, N, B, K corrections
+  double scale = 0, scale_sigma = 0;   ///< its variance σ², (°/h)², and standard error
+  double time = 0, time_low = 0, time_high = 0;  ///< its correlation time and the Δχ² = 1 range, s
+  std::array<double, 4> dc{0, 0, 0, 0};  ///< corrections of the fit-scale Q², N², B², K² at the optimum
+  /// White rate noise left beside the bump, c_N,base + ΔN² ≥ 0 (fit scale, (°/h)²·s), and its
+  /// standard error. A bump with no white noise left is a low-pass of the white noise.
+  double white_rest = 0, white_rest_sigma = 0;
+};
+enum class Shape { GaussMarkov, Lowpass };
+/// AV of a unit-variance Gauss–Markov process (Shape::GaussMarkov, time = Tc) or minus the AV
+/// removed from a unit white rate (°/h·√s)² by a first-order low-pass (Shape::Lowpass, time = τf).
+/// A low-passed white rate is a Gauss–Markov process: white(τ) + lowpass(τ) = GM(τ)/(2τf).
+double shape_avar(Shape s, double tau, double time);
+/// Fit `v` (measured mid-τ AV) against the reference plus Q, N, B, K corrections plus a
+/// Gauss–Markov bump; `c_base` holds the reference model's Q², N², B², K² on the fit scale: the
+/// corrected N², B², K² are kept ≥ 0 (Q² is free).
+ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& ref,
+                           const std::array<double, 4>& c_base);
+/// Corrections of the fit-scale Q², N², B², K² that bring the reference to `v` (weighted least
+/// squares with the ensemble's variances, corrected N², B², K² kept ≥ 0): the calibration of the
+/// base model by a pilot ensemble.
+std::array<double, 4> power_law_corrections(const std::vector<double>& v, const MidTauReference& ref,
+                                            const std::array<double, 4>& c_base);
+/// `v_j` being one ensemble member, its statistic against the leave-one-out reference.
+MidTauReference leave_one_out(const MidTauReference& ref, const std::vector<double>& v, std::size_t runs);
+
+// ---- calibration, bands ---------------------------------------------------------------------
+
+/// (1 − α) quantile of a maximum-type statistic from ensemble values (Gumbel fit by moments),
+/// never below the largest ensemble value.
+double gumbel_threshold(const std::vector<double>& values, double alpha);
+double quantile(std::vector<double> v, double p);
+
+/// Per-run Allan variances at the octave cluster sizes and the mid-τ grid, plus detector
+/// statistics when `with_detectors`.
+struct RunStats {
+  std::vector<double> octave_var;
+  std::vector<double> mid_var;
+  double sin_stat = 0, step_stat = 0, warm_stat = 0;
+};
+
+/// Simulate `runs` records of `model` and collect their statistics.
+std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSettings& settings, std::size_t runs,
+                                   const std::vector<std::int64_t>& octave_m, const std::vector<std::size_t>& mid_grid,
+                                   bool with_detectors, const DiagnoseOptions& options);
+
+/// The band from the ensemble's octave variances and the measured points.
+std::vector<BandPoint> make_band(const std::vector<AllanPoint>& measured, const std::vector<RunStats>& runs,
+                                 double level);
+MidTauReference make_reference(const std::vector<std::size_t>& grid, double tau_d, const std::vector<RunStats>& runs);
+
+}  // namespace rwcalc::diag

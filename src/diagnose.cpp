@@ -1,0 +1,682 @@
+// The diagnosis pipeline: base fit → ensemble band and detector calibration → findings →
+// extended model → its band and the gain, in and out of sample; JSON and the readable report.
+#include "rwcalc/diagnose.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+
+#include "rwcalc/diagnose_detectors.hpp"
+#include "rwcalc/error.hpp"
+#include "rwcalc/fit.hpp"
+
+namespace rwcalc {
+
+using nlohmann::json;
+using namespace diag;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kPulseFitTauMin = 20.0;  ///< s, start of the base fit for pulse data
+
+double term_value(const FitResult& f, Term t) {
+  const auto& c = f[t];
+  return (c.enabled && c.in_model) ? c.estimate : 0.0;
+}
+
+/// The five-term model of an analysis, read out like the data.
+NoiseModel base_model(const AnalysisResult& a, const PhaseSeries& x) {
+  NoiseModel m;
+  m.arw_deg_per_sqrt_h = term_value(a.fit, Term::N);
+  m.bias_instability_deg_per_h = term_value(a.fit, Term::B);
+  m.rrw_deg_per_h_per_sqrt_h = term_value(a.fit, Term::K);
+  m.ramp_deg_per_h2 = term_value(a.fit, Term::R);
+  m.earth_rate_deg_per_h = a.earth_rate_deg_per_h;
+  m.bias_deg_per_h = a.mean_rate_deg_per_h - a.earth_rate_deg_per_h;
+  const double q_fit = term_value(a.fit, Term::Q);
+  if (x.exact()) {
+    // Pulse data: which read-out? A dithered (white) read-out gives σ(τ0) ≈ √(1/2)·q/τ0 = 0.71·q/τ0;
+    // plain counting of a rate of a few pulses per sample or less gives far less (0.18·q/τ0 at
+    // 13.5 pulses/s and 400 Hz). The boundary 0.45·q/τ0 separates them.
+    const double q = x.arcsec_per_count;
+    const bool white = !a.allan.points.empty() && a.allan.points.front().m == 1 &&
+                       a.allan.points.front().dev * x.tau0_s / q > 0.45;
+    m.readout = white ? ReadoutMode::White : ReadoutMode::Counting;
+    // Extra white angle noise only when the fitted Q clearly exceeds the read-out's own level.
+    const double q_read = readout_q_arcsec(m.readout, q);
+    if (q_fit > 1.2 * q_read) m.white_angle_arcsec = std::sqrt(q_fit * q_fit - q_read * q_read);
+  } else {
+    m.readout = ReadoutMode::White;
+    m.white_angle_arcsec = q_fit;
+  }
+  return m;
+}
+
+/// Pulse weight of the simulations: the data's for pulse data; a negligible one otherwise.
+double sim_scale(const PhaseSeries& x, const AnalysisResult& a) {
+  if (x.exact()) return x.arcsec_per_count;
+  return std::max(1e-6, 1e-3 * term_value(a.fit, Term::Q));
+}
+
+PhaseSeries slice(const PhaseSeries& x, std::size_t a, std::size_t b) {
+  PhaseSeries s;
+  s.tau0_s = x.tau0_s;
+  s.kind = x.kind;
+  s.arcsec_per_count = x.arcsec_per_count;
+  if (x.exact())
+    s.counts.assign(x.counts.begin() + static_cast<std::ptrdiff_t>(a), x.counts.begin() + static_cast<std::ptrdiff_t>(b) + 1);
+  else
+    s.values.assign(x.values.begin() + static_cast<std::ptrdiff_t>(a), x.values.begin() + static_cast<std::ptrdiff_t>(b) + 1);
+  return s;
+}
+
+Recording with_series(const Recording& rec, PhaseSeries s) {
+  Recording r;
+  r.source = rec.source;
+  r.rate_hz = rec.rate_hz;
+  r.rate_source = rec.rate_source;
+  r.samples = s.points() - 1;
+  r.temperature_c = rec.temperature_c;
+  r.column_name = rec.column_name;
+  r.mode = s.exact() ? rec.mode : InputMode::Angle;
+  r.phase = std::move(s);
+  return r;
+}
+
+/// The series with the deterministic terms of `det` (time origin t0) removed: floating phase.
+PhaseSeries cleaned(const PhaseSeries& x, const NoiseModel& det, double t0) {
+  PhaseSeries s;
+  s.tau0_s = x.tau0_s;
+  s.kind = x.kind;
+  s.arcsec_per_count = x.arcsec_per_count;
+  s.values.resize(x.points());
+  const double a0 = deterministic_angle(det, t0);
+  for (std::size_t i = 0; i < x.points(); ++i)
+    s.values[i] = x.diff(i, 0) - (deterministic_angle(det, t0 + static_cast<double>(i) * x.tau0_s) - a0);
+  return s;
+}
+
+bool is_deterministic(const std::string& e) { return e == "sinusoid" || e == "bias_step" || e == "warmup_transient"; }
+
+/// The five-term analysis; when the default pulse-data fit range leaves too few Allan points (a
+/// short record or half record), it is widened to τ ≥ 1 s, then to all τ.
+AnalysisResult analyze_for_base(const Recording& rec, const AnalysisOptions& aopt) {
+  try {
+    return analyze(rec, aopt);
+  } catch (const AnalysisError&) {
+    if (!(aopt.fit.tau_min_s > 0)) throw;
+    AnalysisOptions wider = aopt;
+    wider.fit.tau_min_s = aopt.fit.tau_min_s > 1.0 ? 1.0 : 0.0;
+    return analyze_for_base(rec, wider);
+  }
+}
+
+/// Fit-scale squared coefficients of a model (Q free: the read-out is simulated).
+std::array<double, 4> c_of(const NoiseModel& m) {
+  return {-std::numeric_limits<double>::infinity(), c_from_coefficient(Term::N, m.arw_deg_per_sqrt_h),
+          c_from_coefficient(Term::B, m.bias_instability_deg_per_h),
+          c_from_coefficient(Term::K, m.rrw_deg_per_h_per_sqrt_h)};
+}
+
+/// The better of the best bias step and the best warm-up on the block means (lower RSS), as the
+/// deterministic terms of a model: the candidate the base fit is made without.
+NoiseModel mean_candidate(const Decimated& d) {
+  const auto st = step_detect(d);
+  const auto w = warmup_detect(d);
+  NoiseModel c;
+  if (st.rss <= w.rss)
+    c.bias_steps.push_back({st.t_s, st.size});
+  else
+    c.warmups.push_back({w.amp, w.tc});
+  return c;
+}
+
+/// Everything needed to estimate named effects on one stretch of data.
+struct Stretch {
+  const Recording* rec = nullptr;   ///< the stretch as a recording
+  const AnalysisResult* analysis = nullptr;
+  Decimated dec;                    ///< its decimated angle
+  MidTauReference ref;              ///< mid-τ AV reference of its base model's ensemble
+  std::size_t runs = 0;
+};
+
+struct Extension {
+  NoiseModel model;                 ///< extended model (time origin: the stretch start)
+  std::vector<Finding> findings;    ///< parameters only (no evidence)
+};
+
+/// Estimate the named effects on a stretch and build the extended model: deterministic terms by
+/// least squares on their statistic, removed before the re-fit of the five terms and before the
+/// mid-τ shape fit of a stochastic term, whose Q/N/B/K corrections also enter the model.
+Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std::string>& effects, double f_hint,
+                 const AnalysisOptions& aopt) {
+  (void)aopt;
+  Extension x;
+  NoiseModel det;
+  for (const auto& e : effects) {
+    Finding f;
+    f.effect = e;
+    if (e == "sinusoid") {
+      const auto est = sinusoid_detect(s.dec, f_hint);
+      det.sinusoids.push_back({est.f_hz, est.amp, est.phase});
+      f.params = {{"frequency_hz", est.f_hz}, {"amplitude_deg_per_h", est.amp}, {"phase_rad", est.phase}};
+      f.uncertainty = {{"frequency_hz", est.f_sigma}, {"amplitude_deg_per_h", est.amp_sigma}};
+    } else if (e == "bias_step") {
+      const auto est = step_detect(s.dec);
+      det.bias_steps.push_back({est.t_s, est.size});
+      f.params = {{"time_s", est.t_s}, {"size_deg_per_h", est.size}};
+      f.uncertainty = {{"time_s", est.t_sigma}, {"size_deg_per_h", est.size_sigma}};
+    } else if (e == "warmup_transient") {
+      const auto est = warmup_detect(s.dec);
+      det.warmups.push_back({est.amp, est.tc});
+      f.params = {{"amplitude_deg_per_h", est.amp}, {"time_constant_s", est.tc}};
+      f.uncertainty = {{"amplitude_deg_per_h", est.amp_sigma}, {"time_constant_s", est.tc_sigma}};
+    } else {
+      continue;
+    }
+    x.findings.push_back(std::move(f));
+  }
+  x.model = base;
+  x.model.sinusoids = det.sinusoids;
+  x.model.bias_steps = det.bias_steps;
+  x.model.warmups = det.warmups;
+  // Re-fit: the mid-τ AV of the data without the named deterministic terms (and without the
+  // mean-shape candidate when no step or transient was named, as for the base fit) against the
+  // base ensemble gives the corrections of N², B², K² — jointly with the bump of a stochastic term.
+  NoiseModel det_mid = det;
+  if (det.bias_steps.empty() && det.warmups.empty()) {
+    const NoiseModel c = mean_candidate(s.dec);
+    det_mid.bias_steps = c.bias_steps;
+    det_mid.warmups = c.warmups;
+  }
+  Decimated dm = s.dec;
+  subtract_deterministic(dm, det_mid);
+  const auto v = decimated_avar(dm, s.ref.grid);
+  auto apply = [&](double& coef, Term t, double dc) {
+    coef = coefficient_from_c(t, std::max(0.0, c_from_coefficient(t, coef) + dc));
+  };
+  const bool stochastic = std::any_of(effects.begin(), effects.end(), [](const std::string& e) { return !is_deterministic(e); });
+  if (!stochastic && !x.findings.empty()) {
+    const auto dc = power_law_corrections(v, s.ref, c_of(base));
+    apply(x.model.arw_deg_per_sqrt_h, Term::N, dc[1]);
+    apply(x.model.bias_instability_deg_per_h, Term::B, dc[2]);
+    apply(x.model.rrw_deg_per_h_per_sqrt_h, Term::K, dc[3]);
+  }
+  for (const auto& e : effects) {
+    if (is_deterministic(e)) continue;
+    const ShapeEstimate est = shape_detect(v, s.ref, c_of(base));
+    apply(x.model.bias_instability_deg_per_h, Term::B, est.dc[2]);
+    apply(x.model.rrw_deg_per_h_per_sqrt_h, Term::K, est.dc[3]);
+    Finding f;
+    f.effect = e;
+    const double tc = std::max(est.time, 1e-3);
+    if (e == "gauss_markov") {
+      x.model.arw_deg_per_sqrt_h = coefficient_from_c(Term::N, est.white_rest);
+      const double sigma = std::sqrt(std::max(est.scale, 0.0));
+      x.model.gauss_markov.push_back({sigma, tc});
+      f.params = {{"sigma_deg_per_h", sigma}, {"correlation_time_s", est.time}};
+      f.uncertainty = {{"sigma_deg_per_h", sigma > 0 ? est.scale_sigma / (2 * sigma) : 0.0},
+                       {"correlation_time_s", 0.5 * (est.time_high - est.time_low)}};
+    } else {
+      // A low-passed white rate of PSD N² is the Gauss–Markov bump with 2σ²·Tc = N², τf = Tc.
+      const double c_white = 2.0 * std::max(est.scale, 0.0) * tc + est.white_rest;
+      x.model.arw_deg_per_sqrt_h = coefficient_from_c(Term::N, c_white);
+      x.model.lowpass_tc_s = tc;
+      f.params = {{"time_constant_s", est.time}};
+      f.uncertainty = {{"time_constant_s", 0.5 * (est.time_high - est.time_low)}};
+    }
+    x.findings.push_back(std::move(f));
+  }
+  return x;
+}
+
+/// Shift a model's time origin by dt (the model then describes the record from t = dt on).
+NoiseModel shifted(NoiseModel m, double dt) {
+  for (auto& s : m.sinusoids) s.phase_rad = std::fmod(s.phase_rad + 2 * kPi * s.f_hz * dt, 2 * kPi);
+  std::vector<BiasStep> steps;
+  for (const auto& st : m.bias_steps) {
+    if (st.t_s - dt > 0) steps.push_back({st.t_s - dt, st.size_deg_per_h});
+    // A step before the window is a constant offset (no AV); one after it cannot be known.
+  }
+  m.bias_steps = steps;
+  std::vector<Warmup> w;
+  if (dt >= 0)
+    for (const auto& x : m.warmups) w.push_back({x.amp_deg_per_h * std::exp(-dt / x.tc_s), x.tc_s});
+  m.warmups = w;  // a transient is not extrapolated backwards in time
+  return m;
+}
+
+std::vector<std::int64_t> octave_of(const AllanResult& a) {
+  std::vector<std::int64_t> m;
+  for (const auto& p : a.points) m.push_back(p.m);
+  return m;
+}
+
+/// Calibrate N, B, K of a five-term model by a pilot ensemble: the weighted least-squares
+/// corrections that bring the pilot's mean mid-τ AV onto the measured one (`dec`).
+NoiseModel calibrated(const NoiseModel& m0, const SimulationSettings& settings, std::size_t runs,
+                      const std::vector<std::int64_t>& octave_m, const Decimated& dec,
+                      const std::vector<std::size_t>& grid, const DiagnoseOptions& opt) {
+  const auto pilot = run_ensemble(m0, settings, runs, octave_m, grid, false, opt);
+  const auto ref = make_reference(grid, dec.tau_d, pilot);
+  const auto dc = power_law_corrections(decimated_avar(dec, grid), ref, c_of(m0));
+  NoiseModel m = m0;
+  auto apply = [&](double& coef, Term t, double d) {
+    coef = coefficient_from_c(t, std::max(0.0, c_from_coefficient(t, coef) + d));
+  };
+  apply(m.arw_deg_per_sqrt_h, Term::N, dc[1]);
+  apply(m.bias_instability_deg_per_h, Term::B, dc[2]);
+  apply(m.rrw_deg_per_h_per_sqrt_h, Term::K, dc[3]);
+  return m;
+}
+
+/// The base model of a stretch: the five-term fit of the data without the mean-shape candidate
+/// (a step or a transient left in would be taken up into K, R or B, and the ensemble's wander
+/// would then hide it), calibrated on the mid-τ AV by a pilot ensemble. The simulated mean rate
+/// stays the measured one, so the counting read-out is reproduced.
+struct RobustBase {
+  NoiseModel model;
+  NoiseModel candidate;
+  Decimated clean;   ///< the decimated angle without the candidate
+};
+
+RobustBase robust_base(const Recording& rec, const AnalysisResult& original, const AnalysisOptions& aopt,
+                       const Decimated& dec, const SimulationSettings& settings, std::size_t pilot_runs,
+                       const std::vector<std::int64_t>& octave_m, const std::vector<std::size_t>& grid,
+                       const DiagnoseOptions& opt) {
+  RobustBase b;
+  b.candidate = mean_candidate(dec);
+  const Recording clean = with_series(rec, cleaned(rec.phase, b.candidate, 0.0));
+  const AnalysisResult a = analyze_for_base(clean, aopt);
+  NoiseModel m0 = base_model(a, rec.phase);
+  m0.bias_deg_per_h = original.mean_rate_deg_per_h - original.earth_rate_deg_per_h;
+  b.clean = dec;
+  subtract_deterministic(b.clean, b.candidate);
+  b.model = calibrated(m0, settings, pilot_runs, octave_m, b.clean, grid, opt);
+  return b;
+}
+
+struct Timer {
+  std::chrono::steady_clock::time_point t0 = std::chrono::steady_clock::now();
+  bool on = std::getenv("RWCALC_DIAGNOSE_TIMING") != nullptr;
+  void mark(const char* what) {
+    if (!on) return;
+    const auto t = std::chrono::steady_clock::now();
+    std::fprintf(stderr, "[diagnose] %-28s %7.3f s\n", what, std::chrono::duration<double>(t - t0).count());
+    t0 = t;
+  }
+};
+
+json band_json(const std::vector<BandPoint>& band) {
+  json a = json::array();
+  for (const auto& b : band)
+    a.push_back({{"tau_s", b.tau_s}, {"dev", b.dev}, {"band_low", b.low}, {"band_high", b.high}, {"median", b.median},
+                 {"edf", b.edf}});
+  return a;
+}
+
+double finite_or(double v, double d = 0.0) { return std::isfinite(v) ? v : d; }
+
+json clean_json(json j) {
+  if (j.is_number_float()) return finite_or(j.get<double>());
+  if (j.is_object() || j.is_array())
+    for (auto& v : j) v = clean_json(v);
+  return j;
+}
+
+}  // namespace
+
+DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
+  const auto t_start = std::chrono::steady_clock::now();
+  if (rec.phase.kind != PhaseKind::Gyro)
+    throw UsageError("diagnose needs gyro data (clock phase/frequency cannot be simulated as a gyro)");
+  if (opt.runs < 10) throw UsageError(fmt::format("--runs must be at least 10 (got {})", opt.runs));
+  const double T = rec.phase.duration_s();
+  if (T < 1200.0)
+    throw AnalysisError(fmt::format("{}: the record lasts {:.4g} s; the diagnosis needs at least 1200 s", rec.source, T));
+  DiagnoseResult r;
+  r.runs = opt.runs;
+  r.holdout_runs = opt.holdout_runs ? opt.holdout_runs : std::max<std::size_t>(10, opt.runs / 2);
+  r.seed = opt.seed;
+  r.band_level = opt.band_level;
+  r.alpha = opt.alpha;
+  Timer timer;
+  // Pulse data: the counting read-out is simulated exactly, and its structured AV at short τ
+  // would distort the five-term fit, so the base fit starts at 20 s unless a range was given.
+  AnalysisOptions aopt = opt.analysis;
+  if (rec.phase.exact() && aopt.fit.tau_min_s <= 0) aopt.fit.tau_min_s = kPulseFitTauMin;
+  r.analysis = analyze_for_base(rec, aopt);
+  timer.mark("base fit");
+  const PhaseSeries& x = rec.phase;
+  const std::size_t n = x.points() - 1;
+  r.settings.rate_hz = 1.0 / x.tau0_s;
+  r.settings.duration_s = static_cast<double>(n) * x.tau0_s;
+  r.settings.scale_arcsec = sim_scale(x, r.analysis);
+  r.settings.seed = opt.seed;
+  r.settings.temperature_c = r.analysis.temperature_c;
+  const auto octave_m = octave_of(r.analysis.allan);
+  Stretch full;
+  full.rec = &rec;
+  full.analysis = &r.analysis;
+  full.dec = decimate(x);
+  const auto grid = mid_tau_grid(full.dec);
+  const std::size_t pilot_runs = std::max<std::size_t>(10, opt.runs / 2);
+  NoiseModel candidate;
+  {
+    SimulationSettings sp = r.settings;
+    sp.seed = opt.seed + 1000;
+    const RobustBase rb = robust_base(rec, r.analysis, aopt, full.dec, sp, pilot_runs, octave_m, grid, opt);
+    r.base = rb.model;
+    candidate = rb.candidate;
+  }
+  timer.mark("pilot calibration");
+
+  // 1. The base model's ensemble: band and detector calibration.
+  const auto base_runs = run_ensemble(r.base, r.settings, opt.runs, octave_m, grid, true, opt);
+  r.base_band = make_band(r.analysis.allan.points, base_runs, opt.band_level);
+  full.ref = make_reference(grid, full.dec.tau_d, base_runs);
+  full.runs = opt.runs;
+  timer.mark("base ensemble");
+
+  // 2. Detectors on the measurement.
+  const auto sin = sinusoid_detect(full.dec);
+  const auto step = step_detect(full.dec);
+  const auto warm = warmup_detect(full.dec);
+  auto calibrate = [&](const std::string& effect, double stat, const std::vector<double>& ens) {
+    DetectorResult d;
+    d.effect = effect;
+    d.statistic = stat;
+    d.threshold = gumbel_threshold(ens, opt.alpha);
+    d.ensemble_max = ens.empty() ? 0.0 : *std::max_element(ens.begin(), ens.end());
+    d.ensemble_median = quantile(ens, 0.5);
+    d.fired = stat > d.threshold;
+    d.named = d.fired;
+    return d;
+  };
+  std::vector<double> e_sin, e_step, e_warm;
+  for (const auto& br : base_runs) {
+    e_sin.push_back(br.sin_stat);
+    e_step.push_back(br.step_stat);
+    e_warm.push_back(br.warm_stat);
+  }
+  DetectorResult d_sin = calibrate("sinusoid", sin.statistic, e_sin);
+  DetectorResult d_step = calibrate("bias_step", step.statistic, e_step);
+  DetectorResult d_warm = calibrate("warmup_transient", warm.statistic, e_warm);
+  if (d_step.fired && d_warm.fired) {
+    // One change of the mean: keep the shape that fits the block means better.
+    if (warm.rss < step.rss) {
+      d_step.named = false;
+      d_step.note = "the warm-up transient explains the block means better";
+    } else {
+      d_warm.named = false;
+      d_warm.note = "the bias step explains the block means better";
+    }
+  }
+  std::vector<std::string> effects;
+  if (d_sin.named) effects.push_back("sinusoid");
+  if (d_step.named) effects.push_back("bias_step");
+  if (d_warm.named) effects.push_back("warmup_transient");
+
+  // Mid-τ shapes on the measurement without the mean-shape candidate (as the base fit) and a
+  // named sinusoid.
+  NoiseModel det = candidate;
+  if (d_sin.named) det.sinusoids.push_back({sin.f_hz, sin.amp, sin.phase});
+  Decimated dclean = full.dec;
+  subtract_deterministic(dclean, det);
+  const auto mid_meas = decimated_avar(dclean, grid);
+  const auto c_base = c_of(r.base);
+  const auto gm = shape_detect(mid_meas, full.ref, c_base);
+  std::vector<double> e_gm;
+  for (const auto& br : base_runs) {
+    const auto loo = leave_one_out(full.ref, br.mid_var, opt.runs);
+    e_gm.push_back(shape_detect(br.mid_var, loo, c_base).statistic);
+  }
+  DetectorResult d_gm = calibrate("gauss_markov", gm.statistic, e_gm);
+  // The bump is a low-pass of the white rate noise when no white noise is left beside it.
+  const bool lowpass = gm.white_rest < 2.0 * gm.white_rest_sigma;
+  if (d_gm.fired && lowpass) {
+    d_gm.effect = "lowpass";
+    d_gm.note = fmt::format("no white rate noise left beside the bump ({:.3g} ± {:.2g} (°/h)²·s): a low-pass of it",
+                            gm.white_rest, gm.white_rest_sigma);
+  }
+  if (d_gm.named) effects.push_back(lowpass ? "lowpass" : "gauss_markov");
+  if (!d_gm.fired) d_gm.effect = "gauss_markov_or_lowpass";
+  r.detectors = {d_sin, d_step, d_warm, d_gm};
+  timer.mark("detectors");
+
+  // 3–4. Extended model: parameters, re-fit, re-simulation.
+  const double f_hint = d_sin.named ? sin.f_hz : 0.0;
+  Extension ext = extend(full, r.base, effects, f_hint, aopt);
+  r.extended = ext.model;
+  for (auto& f : ext.findings) {
+    const auto& d = *std::find_if(r.detectors.begin(), r.detectors.end(),
+                                  [&](const DetectorResult& dd) { return dd.effect == f.effect; });
+    f.evidence = {{"statistic", d.statistic},
+                  {"threshold", d.threshold},
+                  {"ensemble_max", d.ensemble_max},
+                  {"ensemble_median", d.ensemble_median},
+                  {"false_alarm_level", opt.alpha}};
+    if (f.effect == "sinusoid")
+      f.evidence["detector"] = "periodogram peak of the 0.5-s block-mean rates over its local median level";
+    else if (f.effect == "bias_step")
+      f.evidence["detector"] = "largest two-window change of the 10-s block-mean rates, in units of its standard error";
+    else if (f.effect == "warmup_transient")
+      f.evidence["detector"] = "drop of the residual sum of squares of the 10-s block means when an exponential is added";
+    else if (f.effect == "gauss_markov")
+      f.evidence["detector"] = "χ² drop of the mid-τ Allan variance when a Gauss–Markov bump is added";
+    else
+      f.evidence["detector"] = "χ² drop of the mid-τ Allan variance when a low-pass deficit is added";
+    r.findings.push_back(std::move(f));
+  }
+  if (r.findings.empty()) {
+    r.extended_band = r.base_band;
+  } else {
+    // Common random numbers: the extended ensemble reuses the base ensemble's seeds, so the two
+    // bands differ by the model change, not by sampling noise.
+    const auto ext_runs = run_ensemble(r.extended, r.settings, opt.runs, octave_m, grid, false, opt);
+    r.extended_band = make_band(r.analysis.allan.points, ext_runs, opt.band_level);
+  }
+  timer.mark("extended model");
+
+  // 5. Gain in sample.
+  r.gain.misfit_base = band_misfit(r.base_band, opt.runs);
+  r.gain.misfit_extended = band_misfit(r.extended_band, opt.runs);
+  r.gain.coverage_base = band_coverage(r.base_band);
+  r.gain.coverage_extended = band_coverage(r.extended_band);
+
+  // Out of sample: fit on one half, predict the other, both ways.
+  const std::size_t h = n / 2;
+  double hb = 0, he = 0;
+  for (int dir = 0; dir < 2; ++dir) {
+    const std::size_t fa = dir == 0 ? 0 : h, fb = dir == 0 ? h : 2 * h;
+    const std::size_t pa = dir == 0 ? h : 0, pb = dir == 0 ? 2 * h : h;
+    const Recording fit_rec = with_series(rec, slice(x, fa, fb));
+    const Recording pred_rec = with_series(rec, slice(x, pa, pb));
+    const AnalysisResult a_fit = analyze_for_base(fit_rec, aopt);
+    AllanOptions ao = opt.analysis.allan;
+    const AllanResult a_pred = compute_allan(pred_rec.phase, ao);
+    const auto om = octave_of(a_pred);
+    SimulationSettings sh = r.settings;
+    sh.duration_s = static_cast<double>(h) * x.tau0_s;
+    sh.seed = opt.seed + 10 + static_cast<std::uint64_t>(dir);
+    Stretch st;
+    st.rec = &fit_rec;
+    st.analysis = &a_fit;
+    st.dec = decimate(fit_rec.phase);
+    const auto hgrid = mid_tau_grid(st.dec);
+    const NoiseModel b_fit =
+        robust_base(fit_rec, a_fit, aopt, st.dec, sh, r.holdout_runs, om, hgrid, opt).model;
+    sh.seed += 50;
+    const double dt = (static_cast<double>(pa) - static_cast<double>(fa)) * x.tau0_s;
+    const auto b_runs = run_ensemble(b_fit, sh, r.holdout_runs, om, hgrid, false, opt);
+    hb += band_misfit(make_band(a_pred.points, b_runs, opt.band_level), r.holdout_runs);
+    if (effects.empty()) {
+      he += band_misfit(make_band(a_pred.points, b_runs, opt.band_level), r.holdout_runs);
+      continue;
+    }
+    st.ref = make_reference(hgrid, st.dec.tau_d, b_runs);
+    st.runs = r.holdout_runs;
+    const Extension e = extend(st, b_fit, effects, f_hint, aopt);
+    const auto e_runs = run_ensemble(shifted(e.model, dt), sh, r.holdout_runs, om, hgrid, false, opt);
+    he += band_misfit(make_band(a_pred.points, e_runs, opt.band_level), r.holdout_runs);
+  }
+  timer.mark("out-of-sample check");
+  r.gain.holdout_misfit_base = hb / 2;
+  r.gain.holdout_misfit_extended = he / 2;
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  return r;
+}
+
+json to_json(const DiagnoseResult& r) {
+  json j;
+  j["source"] = r.analysis.source;
+  j["samples"] = r.analysis.samples;
+  j["rate_hz"] = r.settings.rate_hz;
+  j["duration_s"] = r.settings.duration_s;
+  j["scale_arcsec_per_pulse"] = r.settings.scale_arcsec;
+  j["temperature_c"] = r.analysis.temperature_c ? json(*r.analysis.temperature_c) : json(nullptr);
+  j["runs"] = r.runs;
+  j["holdout_runs"] = r.holdout_runs;
+  j["seed"] = r.seed;
+  j["false_alarm_level_per_detector"] = r.alpha;
+  j["simulation_path"] = "ensemble";
+  json base;
+  to_json(base, r.base);
+  base["band"] = band_json(r.base_band);
+  base["band_level"] = r.band_level;
+  base["misfit"] = r.gain.misfit_base;
+  base["coverage"] = r.gain.coverage_base;
+  base["fit"] = {{"Q_arcsec", r.analysis.fit[Term::Q].estimate},
+                 {"N_deg_per_sqrt_h", r.analysis.fit[Term::N].estimate},
+                 {"B_deg_per_h", r.analysis.fit[Term::B].estimate},
+                 {"K_deg_per_h_per_sqrt_h", r.analysis.fit[Term::K].estimate},
+                 {"R_deg_per_h2", r.analysis.fit[Term::R].estimate},
+                 {"chi2_per_dof", r.analysis.fit.chi2_per_dof}};
+  // "fit" would make model_from_analysis_json read the fitted coefficients instead of this
+  // model, so it is kept under a different key.
+  base["fitted_coefficients"] = base["fit"];
+  base.erase("fit");
+  j["base_model"] = base;
+  json det = json::array();
+  for (const auto& d : r.detectors) {
+    json o = {{"effect", d.effect},         {"statistic", d.statistic},   {"threshold", d.threshold},
+              {"ensemble_max", d.ensemble_max}, {"ensemble_median", d.ensemble_median}, {"fired", d.fired},
+              {"named", d.named}};
+    if (!d.note.empty()) o["note"] = d.note;
+    det.push_back(o);
+  }
+  j["detectors"] = det;
+  json fnd = json::array();
+  for (const auto& f : r.findings) {
+    json o = {{"effect", f.effect}};
+    for (const auto& [k, v] : f.params.items()) o[k] = v;
+    o["uncertainty"] = f.uncertainty;
+    o["evidence"] = f.evidence;
+    fnd.push_back(o);
+  }
+  j["findings"] = fnd;
+  json ext;
+  to_json(ext, r.extended);
+  ext["band"] = band_json(r.extended_band);
+  ext["band_level"] = r.band_level;
+  ext["misfit"] = r.gain.misfit_extended;
+  ext["coverage"] = r.gain.coverage_extended;
+  j["extended_model"] = ext;
+  j["gain"] = {{"misfit_base", r.gain.misfit_base},
+               {"misfit_extended", r.gain.misfit_extended},
+               {"coverage_base", r.gain.coverage_base},
+               {"coverage_extended", r.gain.coverage_extended},
+               {"holdout_misfit_base", r.gain.holdout_misfit_base},
+               {"holdout_misfit_extended", r.gain.holdout_misfit_extended}};
+  j["seconds"] = r.seconds;
+  return clean_json(j);
+}
+
+namespace {
+
+std::string unit_of(const std::string& key) {
+  if (key.ends_with("_hz")) return "Hz";
+  if (key.ends_with("_deg_per_h")) return "°/h";
+  if (key.ends_with("_s")) return "s";
+  if (key.ends_with("_rad")) return "rad";
+  return "";
+}
+
+}  // namespace
+
+std::string format_report(const DiagnoseResult& r) {
+  std::string s;
+  s += fmt::format("Diagnosis of {}\n", r.analysis.source);
+  s += fmt::format("  record: {:.0f} s at {:g} Hz, pulse weight {:g}″; ensemble of {} simulated records per model "
+                   "(seed {}), band {:g} % per τ\n\n",
+                   r.settings.duration_s, r.settings.rate_hz, r.settings.scale_arcsec, r.runs, r.seed,
+                   r.band_level * 100);
+  const auto& m = r.base;
+  s += fmt::format("Base model (five-term fit): N = {:.4g} °/√h, B = {:.4g} °/h, K = {:.4g} °/h/√h, R = {:.4g} °/h², "
+                   "white angle {:.4g}″, {} read-out, Earth rate {:.4g} °/h, bias {:.4g} °/h\n",
+                   m.arw_deg_per_sqrt_h, m.bias_instability_deg_per_h, m.rrw_deg_per_h_per_sqrt_h, m.ramp_deg_per_h2,
+                   m.white_angle_arcsec, m.readout == ReadoutMode::Counting ? "counting" : "white",
+                   m.earth_rate_deg_per_h, m.bias_deg_per_h);
+  std::size_t outside = 0;
+  std::string rows;
+  for (const auto& b : r.base_band) {
+    if (b.dev >= b.low && b.dev <= b.high) continue;
+    ++outside;
+    if (b.dev > b.high)
+      rows += fmt::format("    τ = {:>9.4g} s: σ = {:.4g} °/h, {:.1f} % above the band's upper edge {:.4g} °/h\n",
+                          b.tau_s, b.dev, 100 * (b.dev / b.high - 1), b.high);
+    else
+      rows += fmt::format("    τ = {:>9.4g} s: σ = {:.4g} °/h, {:.1f} % below the band's lower edge {:.4g} °/h\n",
+                          b.tau_s, b.dev, 100 * (1 - b.dev / b.low), b.low);
+  }
+  s += fmt::format("  measured Allan deviation inside the base band at {} of {} τ\n", r.base_band.size() - outside,
+                   r.base_band.size());
+  s += rows;
+  s += "\nDetectors (statistic on the measurement against the ensemble-calibrated threshold, "
+       + fmt::format("false-alarm level {:g} % each):\n", r.alpha * 100);
+  for (const auto& d : r.detectors)
+    s += fmt::format("  {:<17} statistic {:>9.3f} (dimensionless), threshold {:>8.3f}, ensemble max {:>8.3f}: {}{}\n",
+                     d.effect, d.statistic, d.threshold, d.ensemble_max,
+                     d.named ? "FOUND" : (d.fired ? "fired, not named" : "not found"),
+                     d.note.empty() ? "" : " (" + d.note + ")");
+  s += "\nFindings:\n";
+  if (r.findings.empty()) s += "  none: the base model's simulations explain the measurement\n";
+  for (const auto& f : r.findings) {
+    s += fmt::format("  {}:", f.effect);
+    for (const auto& [k, v] : f.params.items()) {
+      if (!v.is_number()) continue;
+      const double u = f.uncertainty.contains(k) ? f.uncertainty[k].get<double>() : -1;
+      const std::string unit = unit_of(k);
+      if (u >= 0)
+        s += fmt::format(" {} = {:.4g} ± {:.2g} {}", k, v.get<double>(), u, unit);
+      else
+        s += fmt::format(" {} = {:.4g} {}", k, v.get<double>(), unit);
+      s += ";";
+    }
+    s.pop_back();
+    s += "\n";
+  }
+  const auto& e = r.extended;
+  s += fmt::format("\nExtended model: N = {:.4g} °/√h, B = {:.4g} °/h, K = {:.4g} °/h/√h, R = {:.4g} °/h², "
+                   "{} extra term(s)\n",
+                   e.arw_deg_per_sqrt_h, e.bias_instability_deg_per_h, e.rrw_deg_per_h_per_sqrt_h, e.ramp_deg_per_h2,
+                   r.findings.size());
+  s += "\nGain (misfit: mean EDF-weighted Gamma deviance per τ, about 1 (dimensionless) when the model fits):\n";
+  s += fmt::format("  {:<44} {:>10} {:>10}\n", "", "base", "extended");
+  s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", "Allan-variance misfit (dimensionless)", r.gain.misfit_base,
+                   r.gain.misfit_extended);
+  s += fmt::format("  {:<44} {:>9.1f}% {:>9.1f}%\n", "measured τ inside the simulated band", 100 * r.gain.coverage_base,
+                   100 * r.gain.coverage_extended);
+  s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", "out-of-sample misfit (dimensionless)",
+                   r.gain.holdout_misfit_base, r.gain.holdout_misfit_extended);
+  s += fmt::format("\n  ({:.1f} s)\n", r.seconds);
+  return s;
+}
+
+}  // namespace rwcalc

@@ -1,0 +1,128 @@
+// The simulated ensemble of a model: per-record statistics (octave AV, mid-τ AV, detector
+// statistics), the band of σ per τ, and the measured-versus-ensemble misfit and coverage.
+#include <algorithm>
+#include <cmath>
+
+#include "allan_kernels.hpp"
+#include "rwcalc/diagnose_detectors.hpp"
+#include "rwcalc/allan.hpp"
+
+namespace rwcalc {
+
+namespace diag {
+
+std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSettings& settings, std::size_t runs,
+                                   const std::vector<std::int64_t>& octave_m, const std::vector<std::size_t>& mid_grid,
+                                   bool with_detectors, const DiagnoseOptions& options) {
+  std::vector<RunStats> out(runs);
+  EnsembleOptions eo;
+  eo.path = SimulationPath::Ensemble;
+  eo.threads = options.threads;
+  eo.progress = options.progress;
+  simulate_ensemble(
+      model, settings, runs,
+      [&](std::size_t r, const PhaseSeries& s) {
+        RunStats& st = out[r];
+        st.octave_var.resize(octave_m.size());
+        if (s.exact()) {
+          // The counts prepared once for all cluster sizes (allan_variance would redo it per m).
+          const auto prepared = detail::prepare_counts(s.counts, false);
+          const double q = s.arcsec_per_count;
+          for (std::size_t i = 0; i < octave_m.size(); ++i) {
+            const std::int64_t m = octave_m[i];
+            const std::int64_t n = term_count(Estimator::Overlapping, m, s.points());
+            if (n < 1) continue;
+            const double tau = static_cast<double>(m) * s.tau0_s;
+            const auto sum = static_cast<double>(detail::second_diff_sumsq(prepared, n, m, 1));
+            st.octave_var[i] = sum * q * q / (2.0 * tau * tau * static_cast<double>(n));
+          }
+        } else {
+          for (std::size_t i = 0; i < octave_m.size(); ++i)
+            st.octave_var[i] = allan_variance(s, octave_m[i], Estimator::Overlapping);
+        }
+        const Decimated d = decimate(s);
+        st.mid_var = decimated_avar(d, mid_grid);
+        if (with_detectors) {
+          st.sin_stat = sinusoid_detect(d, 0.0, false).statistic;
+          st.step_stat = step_detect(d).statistic;
+          st.warm_stat = warmup_detect(d).statistic;
+        }
+      },
+      eo);
+  return out;
+}
+
+std::vector<BandPoint> make_band(const std::vector<AllanPoint>& measured, const std::vector<RunStats>& runs,
+                                 double level) {
+  std::vector<BandPoint> band;
+  for (std::size_t i = 0; i < measured.size(); ++i) {
+    std::vector<double> dev;
+    double mean = 0;
+    for (const auto& r : runs) {
+      if (i >= r.octave_var.size() || !(r.octave_var[i] > 0)) continue;
+      dev.push_back(std::sqrt(r.octave_var[i]));
+      mean += r.octave_var[i];
+    }
+    if (dev.size() < 3 || !(measured[i].dev > 0)) continue;
+    BandPoint b;
+    b.tau_s = measured[i].tau_s;
+    b.dev = measured[i].dev;
+    b.edf = measured[i].edf;
+    b.low = quantile(dev, 0.5 - level / 2);
+    b.high = quantile(dev, 0.5 + level / 2);
+    b.median = quantile(dev, 0.5);
+    b.mean_var = mean / static_cast<double>(dev.size());
+    band.push_back(b);
+  }
+  return band;
+}
+
+MidTauReference make_reference(const std::vector<std::size_t>& grid, double tau_d, const std::vector<RunStats>& runs) {
+  MidTauReference ref;
+  ref.grid = grid;
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    double m = 0, m2 = 0;
+    std::size_t k = 0;
+    for (const auto& r : runs) {
+      if (i >= r.mid_var.size() || !(r.mid_var[i] > 0)) continue;
+      m += r.mid_var[i];
+      m2 += r.mid_var[i] * r.mid_var[i];
+      ++k;
+    }
+    ref.tau.push_back(static_cast<double>(grid[i]) * tau_d);
+    if (k < 3) {
+      ref.mean.push_back(0);
+      ref.var.push_back(0);
+      continue;
+    }
+    const double mean = m / double(k);
+    ref.mean.push_back(mean);
+    ref.var.push_back(std::max((m2 - double(k) * mean * mean) / double(k - 1), 0.0));
+  }
+  return ref;
+}
+
+}  // namespace diag
+
+double band_misfit(const std::vector<BandPoint>& band, std::size_t runs) {
+  double s = 0;
+  std::size_t n = 0;
+  const double K = static_cast<double>(std::max<std::size_t>(runs, 1));
+  for (const auto& b : band) {
+    if (!(b.mean_var > 0) || !(b.dev > 0) || !(b.edf > 0)) continue;
+    const double nu = 1.0 / (1.0 / b.edf + 1.0 / (K * b.edf) + 1.0 / 1000.0);
+    const double r = b.dev * b.dev / b.mean_var;
+    s += nu * (r - 1.0 - std::log(r));
+    ++n;
+  }
+  return n ? s / static_cast<double>(n) : 0.0;
+}
+
+double band_coverage(const std::vector<BandPoint>& band) {
+  if (band.empty()) return 0.0;
+  std::size_t in = 0;
+  for (const auto& b : band) in += (b.dev >= b.low && b.dev <= b.high) ? 1 : 0;
+  return static_cast<double>(in) / static_cast<double>(band.size());
+}
+
+}  // namespace rwcalc

@@ -1,0 +1,678 @@
+// The diagnosis detectors: periodogram line search (sinusoid), local two-window change point
+// (bias step), exponential on the early block means (warm-up), and the mid-τ Allan-variance shape
+// fits (Gauss–Markov bump, low-pass deficit). Each returns its statistic and, by least squares
+// on the same data, the effect's parameters.
+#include <unsupported/Eigen/FFT>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <numeric>
+
+#include "rwcalc/diagnose_detectors.hpp"
+
+namespace rwcalc::diag {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+/// White-noise σ of a series from its first differences (rms / √2). Not the median absolute
+/// difference: block means of pulse counts are quantized, and most differences can be 0.
+double diff_sigma(const std::vector<double>& y) {
+  if (y.size() < 3) return 0.0;
+  double s = 0;
+  for (std::size_t i = 0; i + 1 < y.size(); ++i) s += (y[i + 1] - y[i]) * (y[i + 1] - y[i]);
+  return std::sqrt(s / static_cast<double>(y.size() - 1) / 2.0);
+}
+
+std::size_t per_block_for(const Decimated& d, double seconds) {
+  return std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(seconds / d.tau_d)));
+}
+
+}  // namespace
+
+std::size_t decimation(double rate_hz) {
+  if (rate_hz < 20.0) return 1;
+  return static_cast<std::size_t>(std::floor(rate_hz / 10.0));
+}
+
+Decimated decimate(const PhaseSeries& x, std::size_t first, std::size_t last) {
+  Decimated d;
+  if (last == 0 || last >= x.points()) last = x.points() - 1;
+  const std::size_t D = decimation(1.0 / x.tau0_s);
+  d.tau_d = static_cast<double>(D) * x.tau0_s;
+  const std::size_t n = (last - first) / D;
+  d.theta.resize(n + 1);
+  for (std::size_t j = 0; j <= n; ++j) d.theta[j] = x.diff(first + j * D, first);
+  return d;
+}
+
+std::vector<double> block_rates(const Decimated& d, std::size_t per_block) {
+  const std::size_t L = d.theta.size() - 1;
+  const std::size_t nb = L / per_block;
+  std::vector<double> r(nb);
+  const double T = static_cast<double>(per_block) * d.tau_d;
+  for (std::size_t i = 0; i < nb; ++i) r[i] = (d.theta[(i + 1) * per_block] - d.theta[i * per_block]) / T;
+  return r;
+}
+
+std::vector<std::size_t> mid_tau_grid(const Decimated& d) {
+  // 10 per decade from 1 s to a third of the record.
+  std::vector<std::size_t> g;
+  const double T = d.duration();
+  for (int i = 0;; ++i) {
+    const double tau = std::pow(10.0, i / 10.0);
+    if (tau > T / 3.0) break;
+    const auto m = static_cast<std::size_t>(std::max(1L, std::lround(tau / d.tau_d)));
+    if (g.empty() || m > g.back()) g.push_back(m);
+  }
+  return g;
+}
+
+std::vector<double> decimated_avar(const Decimated& d, const std::vector<std::size_t>& grid) {
+  std::vector<double> v(grid.size(), 0.0);
+  const std::size_t P = d.theta.size();
+  const double* th = d.theta.data();
+  for (std::size_t g = 0; g < grid.size(); ++g) {
+    const std::size_t m = grid[g];
+    if (P <= 2 * m) break;
+    const std::size_t terms = P - 2 * m;
+    double s = 0;
+    for (std::size_t k = 0; k < terms; ++k) {
+      const double e = th[k + 2 * m] - 2.0 * th[k + m] + th[k];
+      s += e * e;
+    }
+    const double tau = static_cast<double>(m) * d.tau_d;
+    v[g] = s / (2.0 * tau * tau * static_cast<double>(terms));
+  }
+  return v;
+}
+
+// ---- sinusoid --------------------------------------------------------------------------------
+
+SinusoidEstimate sinusoid_detect(const Decimated& d, double f_hint, bool estimate) {
+  SinusoidEstimate e;
+  const std::size_t pb = per_block_for(d, 0.5);
+  std::vector<double> y = block_rates(d, pb);
+  const std::size_t n = y.size();
+  if (n < 64) return e;
+  const double tb = static_cast<double>(pb) * d.tau_d;
+  const double T = tb * static_cast<double>(n);
+  // Remove the level and the linear trend.
+  {
+    double st = 0, sy = 0, stt = 0, sty = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double t = static_cast<double>(i) - 0.5 * static_cast<double>(n - 1);
+      st += t;
+      sy += y[i];
+      stt += t * t;
+      sty += t * y[i];
+    }
+    const double b = sty / stt, a = sy / static_cast<double>(n);
+    for (std::size_t i = 0; i < n; ++i) y[i] -= a + b * (static_cast<double>(i) - 0.5 * static_cast<double>(n - 1));
+  }
+  std::size_t nfft = 1;
+  while (nfft < 2 * n) nfft <<= 1;
+  std::vector<double> buf(nfft, 0.0);
+  double w2 = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double w = 0.5 - 0.5 * std::cos(2.0 * kPi * (static_cast<double>(i) + 0.5) / static_cast<double>(n));
+    buf[i] = w * y[i];
+    w2 += w * w;
+  }
+  Eigen::FFT<double> fft;
+  std::vector<std::complex<double>> spec;
+  fft.fwd(spec, buf);
+  const std::size_t half = nfft / 2;
+  std::vector<double> P(half + 1);
+  for (std::size_t k = 0; k <= half; ++k) P[k] = std::norm(spec[k]);
+  const double df = 1.0 / (static_cast<double>(nfft) * tb);
+  const double pad = static_cast<double>(nfft) / static_cast<double>(n);  // padded bins per true bin
+  auto kf = [&](double f) { return static_cast<std::size_t>(std::lround(f / df)); };
+  std::size_t k_lo = std::max<std::size_t>(kf(4.0 / T), 1);
+  std::size_t k_hi = std::min(kf(std::min(0.25, 0.4 / tb)), half - 1);
+  if (f_hint > 0) {
+    k_lo = std::max<std::size_t>(1, kf(std::max(f_hint - 3.0 / T, 0.0)));
+    k_hi = std::min(half - 1, kf(f_hint + 3.0 / T));
+  }
+  if (k_lo >= k_hi) return e;
+  const auto gap = static_cast<std::size_t>(std::ceil(3.0 * pad));
+  // Local level: the median of the periodogram over ±24 true bins around k (one value per true
+  // bin, the main lobe left out), / ln 2 (the median of an exponential variable).
+  auto level = [&](std::size_t k) {
+    const auto W = static_cast<std::size_t>(24.0 * pad);
+    const auto stepb = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(pad)));
+    std::vector<double> v;
+    v.reserve(64);
+    const std::size_t a = k > W ? k - W : 1, b = std::min(half, k + W);
+    for (std::size_t j = a; j <= b; j += stepb) {
+      if (j + gap >= k && j <= k + gap) continue;
+      v.push_back(P[j]);
+    }
+    return median_of(std::move(v)) / std::log(2.0);
+  };
+  double best = 0, best_level = 0;
+  std::size_t kbest = k_lo;
+  const std::size_t stride = std::max<std::size_t>(1, static_cast<std::size_t>(pad));
+  double lev = 0;
+  for (std::size_t k = k_lo; k <= k_hi; ++k) {
+    if ((k - k_lo) % (4 * stride) == 0) lev = level(k);
+    if (lev <= 0) continue;
+    const double r = P[k] / lev;
+    if (r > best) {
+      best = r;
+      kbest = k;
+      best_level = lev;
+    }
+  }
+  e.statistic = best;
+  if (!estimate) return e;
+  // Least-squares sinusoid on the (untapered, detrended) block rates around the peak.
+  auto fit_at = [&](double f, double& a, double& b) {
+    Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
+    Eigen::Vector2d r = Eigen::Vector2d::Zero();
+    const double w = 2.0 * kPi * f;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double t = (static_cast<double>(i) + 0.5) * tb;
+      const double c = std::cos(w * t), s = std::sin(w * t);
+      A(0, 0) += c * c;
+      A(0, 1) += c * s;
+      A(1, 1) += s * s;
+      r(0) += c * y[i];
+      r(1) += s * y[i];
+    }
+    A(1, 0) = A(0, 1);
+    const Eigen::Vector2d x = A.ldlt().solve(r);
+    a = x(0);
+    b = x(1);
+    return x.dot(r);  // explained sum of squares
+  };
+  const double f0 = static_cast<double>(kbest) * df;
+  double fbest = f0, ebest = -1;
+  for (int i = -30; i <= 30; ++i) {
+    const double f = f0 + static_cast<double>(i) * (1.0 / T) / 20.0;
+    if (f <= 0) continue;
+    double a, b;
+    const double ex = fit_at(f, a, b);
+    if (ex > ebest) {
+      ebest = ex;
+      fbest = f;
+    }
+  }
+  // Golden refinement in ±1/(20T).
+  double lo = fbest - 1.0 / (20.0 * T), hi = fbest + 1.0 / (20.0 * T);
+  for (int it = 0; it < 30; ++it) {
+    const double m1 = lo + 0.382 * (hi - lo), m2 = lo + 0.618 * (hi - lo);
+    double a, b;
+    if (fit_at(m1, a, b) > fit_at(m2, a, b))
+      hi = m2;
+    else
+      lo = m1;
+  }
+  fbest = 0.5 * (lo + hi);
+  double a = 0, b = 0;
+  fit_at(fbest, a, b);
+  // Block averaging attenuates the rate amplitude by sinc(π f tb); the block mean sits at its centre.
+  const double x = kPi * fbest * tb;
+  const double att = x > 1e-9 ? std::sin(x) / x : 1.0;
+  e.f_hz = fbest;
+  e.amp = std::hypot(a, b) / att;
+  e.phase = std::atan2(-b, a);
+  // One-sided PSD of the noise at the line (Hann-windowed periodogram scaled to (°/h)²/Hz).
+  const double S = 2.0 * tb * best_level / w2;
+  e.amp_sigma = std::sqrt(S / T) / att;
+  e.f_sigma = std::sqrt(6.0 * S / (e.amp * e.amp * T * T * T)) / (2.0 * kPi);
+  return e;
+}
+
+// ---- bias step -------------------------------------------------------------------------------
+
+namespace {
+
+/// RSS of y ~ level + trend + Σ extra columns, by least squares; returns RSS and the coefficients.
+double ls_rss(const std::vector<double>& y, const std::vector<std::vector<double>>& extra, Eigen::VectorXd* coef = nullptr,
+              Eigen::MatrixXd* inv = nullptr) {
+  const auto n = static_cast<Eigen::Index>(y.size());
+  const auto p = static_cast<Eigen::Index>(2 + extra.size());
+  Eigen::MatrixXd X(n, p);
+  Eigen::VectorXd Y(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    X(i, 0) = 1.0;
+    X(i, 1) = (static_cast<double>(i) - 0.5 * static_cast<double>(n - 1)) / static_cast<double>(n);
+    for (std::size_t c = 0; c < extra.size(); ++c) X(i, static_cast<Eigen::Index>(2 + c)) = extra[c][static_cast<std::size_t>(i)];
+    Y(i) = y[static_cast<std::size_t>(i)];
+  }
+  const Eigen::MatrixXd XtX = X.transpose() * X;
+  const Eigen::VectorXd b = XtX.ldlt().solve(X.transpose() * Y);
+  if (coef) *coef = b;
+  if (inv) *inv = XtX.inverse();
+  return (Y - X * b).squaredNorm();
+}
+
+}  // namespace
+
+StepEstimate step_detect(const Decimated& d) {
+  StepEstimate e;
+  const std::size_t pb = per_block_for(d, 10.0);
+  const std::vector<double> y = block_rates(d, pb);
+  const std::size_t n = y.size();
+  if (n < 40) return e;
+  const double tb = static_cast<double>(pb) * d.tau_d;
+  const double sig = std::max(diff_sigma(y), 1e-12);
+  std::vector<double> cs(n + 1, 0.0);
+  for (std::size_t i = 0; i < n; ++i) cs[i + 1] = cs[i] + y[i];
+  // Likelihood ratio of one change of the mean at block k against none (white noise of the
+  // level σ̂ seen in the block-to-block differences): n/(k(n−k))·(S_k − k·ȳ)²/σ̂², maximised over k.
+  double best = 0;
+  std::size_t ibest = n / 2;
+  const double ybar = cs[n] / static_cast<double>(n);
+  for (std::size_t k = 3; k + 3 <= n; ++k) {
+    const double dk = static_cast<double>(k), dn = static_cast<double>(n);
+    const double u = cs[k] - dk * ybar;
+    const double lr = dn / (dk * (dn - dk)) * u * u / (sig * sig);
+    if (lr > best) {
+      best = lr;
+      ibest = k;
+    }
+  }
+  const std::size_t wbest = std::min<std::size_t>({ibest, n - ibest, 180});
+  e.statistic = best;
+  // Refine the time on 1-s block means: the split minimising the two-level RSS in the window.
+  const std::size_t pb1 = per_block_for(d, 1.0);
+  const std::vector<double> y1 = block_rates(d, pb1);
+  const double t1 = static_cast<double>(pb1) * d.tau_d;
+  const std::size_t n1 = y1.size();
+  std::vector<double> c1(n1 + 1, 0.0), c2(n1 + 1, 0.0);
+  for (std::size_t i = 0; i < n1; ++i) {
+    c1[i + 1] = c1[i] + y1[i];
+    c2[i + 1] = c2[i] + y1[i] * y1[i];
+  }
+  const auto center = static_cast<std::size_t>(static_cast<double>(ibest) * tb / t1);
+  const std::size_t W = std::max<std::size_t>(10, static_cast<std::size_t>(static_cast<double>(wbest) * tb / t1));
+  const std::size_t search = static_cast<std::size_t>(2.0 * tb / t1) + 2;
+  double rss_best = std::numeric_limits<double>::infinity();
+  std::size_t split = center;
+  auto seg_rss = [&](std::size_t a, std::size_t b) {
+    const double s = c1[b] - c1[a], s2 = c2[b] - c2[a];
+    return s2 - s * s / double(b - a);
+  };
+  std::vector<std::pair<std::size_t, double>> profile;
+  for (std::size_t s = center > search ? center - search : 1; s <= std::min(n1 - 1, center + search); ++s) {
+    const std::size_t a = s > W ? s - W : 0, b = std::min(n1, s + W);
+    if (s - a < 2 || b - s < 2) continue;
+    const double r = seg_rss(a, s) + seg_rss(s, b);
+    profile.emplace_back(s, r);
+    if (r < rss_best) {
+      rss_best = r;
+      split = s;
+    }
+  }
+  const double ts = static_cast<double>(split) * t1;
+  e.t_s = ts;
+  // Size: the difference of the means over up to 30 min on each side.
+  const auto Ws = static_cast<std::size_t>(std::min<double>(1800.0 / t1, static_cast<double>(n1)));
+  const std::size_t a = split > Ws ? split - Ws : 0, b = std::min(n1, split + Ws);
+  const double m1 = (c1[split] - c1[a]) / double(split - a), m2 = (c1[b] - c1[split]) / double(b - split);
+  e.size = m2 - m1;
+  const double sig1 = diff_sigma(y1);
+  e.size_sigma = sig * std::sqrt(tb / (double(split - a) * t1) + tb / (double(b - split) * t1));
+  // Time uncertainty: the range of splits whose RSS is within σ₁² (Δχ² = 1) of the best.
+  double lo = ts, hi = ts;
+  for (const auto& [s, r] : profile)
+    if (r - rss_best <= sig1 * sig1) {
+      lo = std::min(lo, static_cast<double>(s) * t1);
+      hi = std::max(hi, static_cast<double>(s) * t1);
+    }
+  e.t_sigma = std::max(0.5 * (hi - lo), t1);
+  // RSS of level + trend + step on the 10-s block means (for the comparison with a warm-up).
+  std::vector<double> stepcol(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double t0 = static_cast<double>(i) * tb, t2 = t0 + tb;
+    stepcol[i] = std::clamp((t2 - ts) / tb, 0.0, 1.0);
+  }
+  e.rss = ls_rss(y, {stepcol});
+  return e;
+}
+
+// ---- warm-up ---------------------------------------------------------------------------------
+
+WarmupEstimate warmup_detect(const Decimated& d) {
+  WarmupEstimate e;
+  const std::size_t pb = per_block_for(d, 10.0);
+  const std::vector<double> y = block_rates(d, pb);
+  const std::size_t n = y.size();
+  if (n < 40) return e;
+  const double tb = static_cast<double>(pb) * d.tau_d;
+  const double T = tb * static_cast<double>(n);
+  const double sig = std::max(diff_sigma(y), 1e-12);
+  const double rss0 = ls_rss(y, {});
+  auto column = [&](double tc) {
+    std::vector<double> c(n);
+    const double f = tc / tb * -std::expm1(-tb / tc);  // block mean of exp(−t/tc) over [0, tb]
+    for (std::size_t i = 0; i < n; ++i) c[i] = std::exp(-static_cast<double>(i) * tb / tc) * f;
+    return c;
+  };
+  auto rss_at = [&](double tc) { return ls_rss(y, {column(tc)}); };
+  const double lt_lo = std::log(2.0 * tb), lt_hi = std::log(T / 3.0);
+  const int G = 40;
+  double best = std::numeric_limits<double>::infinity(), lbest = lt_lo;
+  std::vector<std::pair<double, double>> prof;
+  for (int g = 0; g <= G; ++g) {
+    const double lt = lt_lo + (lt_hi - lt_lo) * g / G;
+    const double r = rss_at(std::exp(lt));
+    prof.emplace_back(lt, r);
+    if (r < best) {
+      best = r;
+      lbest = lt;
+    }
+  }
+  const double step = (lt_hi - lt_lo) / G;
+  double lo = lbest - step, hi = lbest + step;
+  for (int it = 0; it < 25; ++it) {
+    const double m1 = lo + 0.382 * (hi - lo), m2 = lo + 0.618 * (hi - lo);
+    if (rss_at(std::exp(m1)) < rss_at(std::exp(m2)))
+      hi = m2;
+    else
+      lo = m1;
+  }
+  lbest = 0.5 * (lo + hi);
+  Eigen::VectorXd coef;
+  Eigen::MatrixXd inv;
+  e.tc = std::exp(lbest);
+  e.rss = ls_rss(y, {column(e.tc)}, &coef, &inv);
+  e.amp = coef(2);
+  e.amp_sigma = sig * std::sqrt(inv(2, 2));
+  // F-type statistic: the residual variance, not the white level, normalises the drop, so that
+  // wander the base fit took up into K or R does not hide the transient.
+  e.statistic = std::max(0.0, (rss0 - e.rss) / (e.rss / static_cast<double>(n - 4)));
+  // Time-constant range: Δ RSS/σ̂² ≤ 1 on a fine profile around the optimum.
+  double tl = e.tc, th = e.tc;
+  for (int g = -40; g <= 40; ++g) {
+    const double lt = lbest + g * 0.025;
+    if (lt < lt_lo - 1 || lt > lt_hi + 1) continue;
+    if ((rss_at(std::exp(lt)) - e.rss) / (sig * sig) <= 1.0) {
+      tl = std::min(tl, std::exp(lt));
+      th = std::max(th, std::exp(lt));
+    }
+  }
+  e.tc_sigma = std::max(0.5 * (th - tl), 0.0);
+  return e;
+}
+
+double deterministic_angle(const NoiseModel& m, double t) {
+  double a = 0;
+  for (const auto& s : m.sinusoids) {
+    const double w = 2.0 * kPi * s.f_hz;
+    a += s.amp_deg_per_h / w * (std::sin(w * t + s.phase_rad) - std::sin(s.phase_rad));
+  }
+  for (const auto& st : m.bias_steps) a += st.size_deg_per_h * std::max(0.0, t - st.t_s);
+  for (const auto& w : m.warmups) a += w.amp_deg_per_h * w.tc_s * -std::expm1(-t / w.tc_s);
+  return a;
+}
+
+void subtract_deterministic(Decimated& d, const NoiseModel& m, double t0) {
+  if (m.sinusoids.empty() && m.bias_steps.empty() && m.warmups.empty()) return;
+  const double a0 = deterministic_angle(m, t0);
+  for (std::size_t j = 0; j < d.theta.size(); ++j)
+    d.theta[j] -= deterministic_angle(m, t0 + static_cast<double>(j) * d.tau_d) - a0;
+}
+
+// ---- mid-τ shapes ----------------------------------------------------------------------------
+
+double shape_avar(Shape s, double tau, double time) {
+  const double x = tau / time;
+  // (T/(2τ))(3 − 4e^{−x} + e^{−2x}), with a series for small x.
+  double h;
+  if (x < 1e-3)
+    h = 1.0 - x * x / 3.0;
+  else
+    h = (3.0 - 4.0 * std::exp(-x) + std::exp(-2.0 * x)) / (2.0 * x);
+  if (s == Shape::GaussMarkov) {
+    // σ² = 1: AVAR = (2T/τ)[1 − h]
+    return 2.0 / x * (1.0 - h);
+  }
+  // Low-pass of a unit white rate: the AV removed is (1/τ)·h.
+  return -h / tau;
+}
+
+namespace {
+
+struct WlsOut {
+  double chi2 = 0;
+  Eigen::VectorXd coef;
+  Eigen::MatrixXd inv;
+};
+
+WlsOut wls(const std::vector<double>& y, const std::vector<double>& w, const std::vector<std::vector<double>>& cols) {
+  const auto n = static_cast<Eigen::Index>(y.size());
+  const auto p = static_cast<Eigen::Index>(cols.size());
+  Eigen::MatrixXd X(n, p);
+  Eigen::VectorXd Y(n), W(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    for (Eigen::Index c = 0; c < p; ++c) X(i, c) = cols[static_cast<std::size_t>(c)][static_cast<std::size_t>(i)];
+    Y(i) = y[static_cast<std::size_t>(i)];
+    W(i) = w[static_cast<std::size_t>(i)];
+  }
+  const Eigen::MatrixXd XtW = X.transpose() * W.asDiagonal();
+  const Eigen::MatrixXd A = XtW * X;
+  WlsOut o;
+  o.inv = A.completeOrthogonalDecomposition().pseudoInverse();
+  o.coef = o.inv * (XtW * Y);
+  const Eigen::VectorXd r = Y - X * o.coef;
+  o.chi2 = (r.array().square() * W.array()).sum();
+  return o;
+}
+
+}  // namespace
+
+namespace {
+
+/// The measured-minus-reference mid-τ AV, its weights (1/ensemble variance) and the Q, N, B, K
+/// basis columns (normalised; `colscale` holds the factors).
+struct MidTauProblem {
+  std::vector<double> y, w, tau;
+  std::vector<std::vector<double>> cols{4};
+  std::array<double, 4> colscale{1, 1, 1, 1};
+};
+
+MidTauProblem mid_tau_problem(const std::vector<double>& v, const MidTauReference& ref) {
+  MidTauProblem p;
+  for (std::size_t i = 0; i < ref.tau.size() && i < v.size(); ++i) {
+    if (!(ref.var[i] > 0) || !(v[i] > 0)) continue;
+    const double t = ref.tau[i];
+    p.y.push_back(v[i] - ref.mean[i]);
+    p.w.push_back(1.0 / ref.var[i]);
+    p.tau.push_back(t);
+    p.cols[0].push_back(3.0 / (t * t));
+    p.cols[1].push_back(1.0 / t);
+    p.cols[2].push_back(2.0 * std::log(2.0) / kPi);
+    p.cols[3].push_back(t / 3.0);
+  }
+  for (std::size_t c = 0; c < 4; ++c) {
+    double m = 0;
+    for (double x : p.cols[c]) m = std::max(m, std::abs(x));
+    p.colscale[c] = m > 0 ? m : 1.0;
+    for (double& x : p.cols[c]) x /= p.colscale[c];
+  }
+  return p;
+}
+
+}  // namespace
+
+namespace {
+
+/// Weighted least squares of the mid-τ problem with the corrections of N², B², K² constrained so
+/// that the corrected coefficients c_base + Δc stay ≥ 0 (active set: a correction that would make
+/// its coefficient negative is held at −c_base and the rest re-fitted). `shape` (optional) is a
+/// further, unconstrained column. Q² is free (the read-out is simulated, not fitted).
+struct ConstrainedFit {
+  double chi2 = 0;
+  std::array<double, 4> dc{0, 0, 0, 0};
+  double a = 0, a_var = 0;  ///< shape coefficient (column as given) and its variance
+  double dn_var = 0;        ///< variance of ΔN² when N is free, fit scale²
+};
+
+ConstrainedFit constrained_fit(const MidTauProblem& p, const std::array<double, 4>& c_base,
+                               const std::vector<double>* shape) {
+  ConstrainedFit f;
+  std::array<bool, 4> fixed{false, false, false, false};
+  for (int iter = 0; iter < 4; ++iter) {
+    std::vector<double> y = p.y;
+    std::vector<std::vector<double>> cols;
+    std::vector<std::size_t> idx;
+    for (std::size_t t = 0; t < 4; ++t) {
+      if (fixed[t]) {
+        for (std::size_t i = 0; i < y.size(); ++i) y[i] += c_base[t] * p.cols[t][i] * p.colscale[t];
+      } else {
+        cols.push_back(p.cols[t]);
+        idx.push_back(t);
+      }
+    }
+    if (shape) cols.push_back(*shape);
+    const WlsOut o = wls(y, p.w, cols);
+    f.chi2 = o.chi2;
+    for (std::size_t t = 0; t < 4; ++t) f.dc[t] = fixed[t] ? -c_base[t] : 0.0;
+    for (std::size_t k = 0; k < idx.size(); ++k) {
+      f.dc[idx[k]] = o.coef(static_cast<Eigen::Index>(k)) / p.colscale[idx[k]];
+      if (idx[k] == 1) f.dn_var = o.inv(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)) /
+                                  (p.colscale[1] * p.colscale[1]);
+    }
+    if (shape) {
+      const auto last = static_cast<Eigen::Index>(idx.size());
+      f.a = o.coef(last);
+      f.a_var = o.inv(last, last);
+    }
+    // The most negative constrained coefficient, if any, goes to its bound.
+    std::size_t worst = 4;
+    double worst_v = 0;
+    for (std::size_t t = 1; t < 4; ++t) {
+      if (fixed[t]) continue;
+      const double total = c_base[t] + f.dc[t];
+      const double rel = total / std::max(std::abs(c_base[t]) + std::abs(f.dc[t]), 1e-300);
+      if (total < 0 && rel < worst_v) {
+        worst_v = rel;
+        worst = t;
+      }
+    }
+    if (worst == 4) break;
+    fixed[worst] = true;
+  }
+  return f;
+}
+
+}  // namespace
+
+std::array<double, 4> power_law_corrections(const std::vector<double>& v, const MidTauReference& ref,
+                                            const std::array<double, 4>& c_base) {
+  std::array<double, 4> dc{0, 0, 0, 0};
+  const MidTauProblem p = mid_tau_problem(v, ref);
+  if (p.y.size() < 6) return dc;
+  return constrained_fit(p, c_base, nullptr).dc;
+}
+
+ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& ref,
+                           const std::array<double, 4>& c_base) {
+  ShapeEstimate e;
+  MidTauProblem p = mid_tau_problem(v, ref);
+  if (p.y.size() < 8) return e;
+  const double c_n_base = c_base[1];
+  using Fit = ConstrainedFit;
+  auto fit = [&](const std::vector<double>* shape) { return constrained_fit(p, c_base, shape); };
+  const Fit null = fit(nullptr);
+  const double lt_lo = std::log(std::max(p.tau.front() / 3.0, 0.3)), lt_hi = std::log(p.tau.back() / 2.0);
+  const int G = 48;
+  double best_chi2 = null.chi2;
+  std::vector<std::pair<double, double>> prof;
+  Fit best;
+  bool have = false;
+  for (int g = 0; g <= G; ++g) {
+    const double T = std::exp(lt_lo + (lt_hi - lt_lo) * g / G);
+    std::vector<double> col(p.tau.size());
+    double m = 0;
+    for (std::size_t i = 0; i < p.tau.size(); ++i) {
+      col[i] = shape_avar(Shape::GaussMarkov, p.tau[i], T);
+      m = std::max(m, std::abs(col[i]));
+    }
+    if (!(m > 0)) continue;
+    for (double& x : col) x /= m;
+    Fit f = fit(&col);
+    double chi2 = f.a > 0 ? f.chi2 : null.chi2;  // the bump only adds variance
+    prof.emplace_back(T, chi2);
+    if (chi2 < best_chi2) {
+      best_chi2 = chi2;
+      best = f;
+      e.time = T;
+      e.scale = f.a / m;
+      e.scale_sigma = std::sqrt(std::max(0.0, f.a_var)) / m;
+      have = true;
+    }
+  }
+  e.statistic = std::max(0.0, null.chi2 - best_chi2);
+  e.dc = null.dc;
+  if (!have) return e;
+  e.dc = best.dc;
+  e.white_rest = std::max(0.0, c_n_base + best.dc[1]);
+  e.white_rest_sigma = std::sqrt(std::max(0.0, best.dn_var));
+  e.time_low = e.time_high = e.time;
+  for (const auto& [T, c] : prof)
+    if (c - best_chi2 <= 1.0) {
+      e.time_low = std::min(e.time_low, T);
+      e.time_high = std::max(e.time_high, T);
+    }
+  return e;
+}
+
+MidTauReference leave_one_out(const MidTauReference& ref, const std::vector<double>& v, std::size_t runs) {
+  MidTauReference r = ref;
+  if (runs < 3) return r;
+  const double K = static_cast<double>(runs);
+  for (std::size_t i = 0; i < r.mean.size() && i < v.size(); ++i) {
+    const double m = (K * ref.mean[i] - v[i]) / (K - 1);
+    // Sum of squares about the old mean, without v.
+    const double ss = ref.var[i] * (K - 1) - (v[i] - ref.mean[i]) * (v[i] - m);
+    r.mean[i] = m;
+    r.var[i] = std::max(ss / (K - 2), 1e-300);
+  }
+  return r;
+}
+
+// ---- calibration ------------------------------------------------------------------------------
+
+double quantile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const double pos = p * static_cast<double>(v.size() - 1);
+  const auto i = static_cast<std::size_t>(std::floor(pos));
+  const double f = pos - static_cast<double>(i);
+  if (i + 1 >= v.size()) return v.back();
+  return v[i] * (1 - f) + v[i + 1] * f;
+}
+
+double gumbel_threshold(const std::vector<double>& values, double alpha) {
+  if (values.empty()) return std::numeric_limits<double>::infinity();
+  double mean = 0, mx = values.front();
+  for (double x : values) {
+    mean += x;
+    mx = std::max(mx, x);
+  }
+  mean /= static_cast<double>(values.size());
+  double var = 0;
+  for (double x : values) var += (x - mean) * (x - mean);
+  var /= std::max<double>(1.0, static_cast<double>(values.size()) - 1.0);
+  const double beta = std::sqrt(var) * std::sqrt(6.0) / kPi;
+  const double u = mean - 0.5772156649 * beta;
+  const double q = u - beta * std::log(-std::log(1.0 - alpha));
+  return std::max(q, mx);
+}
+
+}  // namespace rwcalc::diag

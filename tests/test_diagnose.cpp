@@ -1,0 +1,142 @@
+// The diagnosis building blocks on synthetic series with known answers: decimation and block
+// rates, the periodogram line search, the change point, the warm-up exponential, the mid-τ shapes
+// against the simulator's exact Allan variance, the Gumbel calibration, misfit and coverage.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "rwcalc/diagnose.hpp"
+#include "rwcalc/diagnose_detectors.hpp"
+#include "rwcalc/simulate.hpp"
+
+namespace {
+
+using namespace rwcalc;
+using namespace rwcalc::diag;
+
+/// A decimated angle at 0.1 s from a rate function plus white rate noise of `sd` per 0.1 s.
+Decimated from_rate(double seconds, double sd, std::uint64_t seed, const std::function<double(double)>& rate) {
+  Decimated d;
+  d.tau_d = 0.1;
+  const auto n = static_cast<std::size_t>(seconds / d.tau_d);
+  d.theta.assign(n + 1, 0.0);
+  std::mt19937_64 g(seed);
+  std::normal_distribution<double> z(0.0, sd);
+  for (std::size_t j = 0; j < n; ++j) {
+    const double t = (static_cast<double>(j) + 0.5) * d.tau_d;
+    d.theta[j + 1] = d.theta[j] + (rate(t) + z(g)) * d.tau_d;
+  }
+  return d;
+}
+
+TEST(DiagnoseBlocks, DecimationAndBlockRates) {
+  EXPECT_EQ(decimation(400), 40u);
+  EXPECT_EQ(decimation(100), 10u);
+  EXPECT_EQ(decimation(10), 1u);
+  PhaseSeries x;
+  x.tau0_s = 0.0025;
+  x.arcsec_per_count = 0.5;
+  x.counts.resize(4001);
+  for (std::size_t i = 0; i < x.counts.size(); ++i) x.counts[i] = static_cast<std::int64_t>(3 * i);  // 600 ″/s
+  const auto d = decimate(x);
+  EXPECT_DOUBLE_EQ(d.tau_d, 0.1);
+  ASSERT_EQ(d.theta.size(), 101u);
+  const auto r = block_rates(d, 10);
+  ASSERT_EQ(r.size(), 10u);
+  for (double v : r) EXPECT_NEAR(v, 600.0, 1e-9);
+}
+
+TEST(DiagnoseBlocks, SinusoidLineSearchRecoversFrequencyAndAmplitude) {
+  const double f = 0.0371, a = 0.05;
+  const auto d = from_rate(7200, 0.3, 5, [&](double t) { return a * std::cos(2 * std::numbers::pi * f * t + 0.4); });
+  const auto e = sinusoid_detect(d);
+  EXPECT_NEAR(e.f_hz, f, 3 * e.f_sigma + 1e-6);
+  EXPECT_NEAR(e.amp, a, 3 * e.amp_sigma);
+  EXPECT_GT(e.amp_sigma, 0.0);
+  EXPECT_GT(e.statistic, 30.0);
+  // Without the line the statistic stays at the level of the largest of ~10⁴ exponential ratios.
+  const auto e0 = sinusoid_detect(from_rate(7200, 0.3, 6, [](double) { return 0.0; }));
+  EXPECT_LT(e0.statistic, 20.0);
+}
+
+TEST(DiagnoseBlocks, StepTimeAndSize) {
+  const auto d = from_rate(7200, 0.3, 7, [](double t) { return t > 3100 ? 0.03 : 0.0; });
+  const auto e = step_detect(d);
+  EXPECT_NEAR(e.t_s, 3100, 120);
+  EXPECT_NEAR(e.size, 0.03, 4 * e.size_sigma);
+  EXPECT_GT(e.statistic, 6);
+}
+
+TEST(DiagnoseBlocks, WarmupAmplitudeAndTimeConstant) {
+  const auto d = from_rate(7200, 0.3, 8, [](double t) { return -0.08 * std::exp(-t / 500.0); });
+  const auto e = warmup_detect(d);
+  EXPECT_NEAR(e.amp, -0.08, 4 * e.amp_sigma);
+  EXPECT_NEAR(e.tc, 500, 150);
+  EXPECT_GT(e.statistic, 20);
+}
+
+TEST(DiagnoseBlocks, DeterministicAngleMatchesTheSimulator) {
+  NoiseModel m;
+  m.sinusoids.push_back({0.01, 0.2, 0.3});
+  m.bias_steps.push_back({100, 0.5});
+  m.warmups.push_back({0.7, 50});
+  SimulationSettings s;
+  s.duration_s = 400;
+  s.rate_hz = 10;
+  s.scale_arcsec = 1e-6;
+  m.readout = ReadoutMode::White;
+  const auto x = simulate(m, s);
+  for (std::size_t i : {std::size_t{1}, std::size_t{1000}, std::size_t{2500}, std::size_t{4000}})
+    EXPECT_NEAR(x.diff(i, 0), deterministic_angle(m, static_cast<double>(i) * 0.1), 1e-5);
+}
+
+TEST(DiagnoseBlocks, GaussMarkovShapeMatchesTheoreticalAvar) {
+  NoiseModel m;
+  m.gauss_markov.push_back({1.0, 30.0});
+  for (std::size_t mm : {400u, 4000u, 40000u, 400000u}) {
+    const double tau = static_cast<double>(mm) * 0.0025;
+    const double exact = theoretical_avar(m, 0.0025, 0.92, mm);
+    EXPECT_NEAR(shape_avar(Shape::GaussMarkov, tau, 30.0), exact, 0.01 * exact) << tau;
+  }
+  // The low-pass removes the whole white-rate AV at τ ≪ τf and 1.5τf/τ² of it at τ ≫ τf.
+  EXPECT_NEAR(shape_avar(Shape::Lowpass, 0.01, 100.0), -1.0 / 0.01, 1e-3 / 0.01);
+  EXPECT_NEAR(shape_avar(Shape::Lowpass, 1e5, 10.0), -1.5 * 10.0 / 1e10, 1e-13);
+}
+
+TEST(DiagnoseBlocks, GumbelThresholdSitsInTheTail) {
+  std::mt19937_64 g(3);
+  std::extreme_value_distribution<double> ev(10.0, 2.0);
+  std::vector<double> v(2000);
+  for (double& x : v) x = ev(g);
+  const double q99 = 10.0 - 2.0 * std::log(-std::log(0.99));
+  // With 2000 values the threshold is the ensemble maximum or the fitted quantile, whichever is higher.
+  const double thr = gumbel_threshold(std::vector<double>(v.begin(), v.begin() + 50), 0.01);
+  EXPECT_GT(thr, quantile(v, 0.9));
+  EXPECT_NEAR(gumbel_threshold(v, 0.01), std::max(q99, *std::max_element(v.begin(), v.end())), 1.5);
+  EXPECT_NEAR(quantile({1, 2, 3, 4, 5}, 0.5), 3.0, 1e-12);
+  EXPECT_NEAR(quantile({1, 2, 3, 4, 5}, 0.25), 2.0, 1e-12);
+}
+
+TEST(DiagnoseBlocks, MisfitAndCoverage) {
+  std::vector<BandPoint> band(4);
+  for (std::size_t i = 0; i < band.size(); ++i) {
+    band[i].tau_s = std::pow(2.0, static_cast<double>(i));
+    band[i].mean_var = 1.0;
+    band[i].low = 0.9;
+    band[i].high = 1.1;
+    band[i].median = 1.0;
+    band[i].edf = 100;
+    band[i].dev = 1.0;
+  }
+  EXPECT_NEAR(band_misfit(band, 50), 0.0, 1e-12);
+  EXPECT_DOUBLE_EQ(band_coverage(band), 1.0);
+  band[2].dev = 1.3;
+  EXPECT_DOUBLE_EQ(band_coverage(band), 0.75);
+  const double r = 1.69;
+  const double nu = 1.0 / (1.0 / 100 + 1.0 / 5000 + 1.0 / 1000);
+  EXPECT_NEAR(band_misfit(band, 50), nu * (r - 1 - std::log(r)) / 4, 1e-9);
+}
+
+}  // namespace

@@ -1,0 +1,148 @@
+// `rwcalc diagnose` end to end: a simulated record with a strong sinusoid is diagnosed through
+// the CLI (JSON keys, the finding, the gain, the readable report), the figure is a well-formed
+// SVG, `rwcalc simulate --from` takes the extended model, and every error path has its status.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "rwcalc/plot.hpp"
+#include "test_plot_fixtures.hpp"
+#include "test_support.hpp"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using rwcalc::test::run_cli;
+using rwcalc::test::TempDir;
+
+namespace {
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// 30 min at 100 Hz of GL-2D-like noise with a 0.3 °/h sinusoid at 0.05 Hz.
+class DiagnoseCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new TempDir();
+    record_ = (dir_->path() / "sin.csv.gz").string();
+    const auto r = run_cli({"simulate", "-o", record_, "--duration", "1800", "--rate", "100", "--arw", "0.001",
+                            "--bias-instability", "0.005", "--sinusoid", "0.05:0.3", "--seed", "11"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto d = run_cli({"diagnose", record_, "--json", "--runs", "12", "--seed", "5"});
+    ASSERT_EQ(d.status, 0) << d.err;
+    json_ = new json(json::parse(d.out));
+  }
+  static void TearDownTestSuite() {
+    delete json_;
+    delete dir_;
+  }
+  static TempDir* dir_;
+  static std::string record_;
+  static json* json_;
+};
+TempDir* DiagnoseCli::dir_ = nullptr;
+std::string DiagnoseCli::record_;
+json* DiagnoseCli::json_ = nullptr;
+
+}  // namespace
+
+TEST_F(DiagnoseCli, JsonHasTheDocumentedKeysAndFindsTheSinusoid) {
+  const json& j = *json_;
+  for (const char* k : {"base_model", "findings", "extended_model", "gain", "detectors"}) ASSERT_TRUE(j.contains(k)) << k;
+  for (const char* m : {"base_model", "extended_model"}) {
+    ASSERT_TRUE(j[m]["band"].is_array());
+    ASSERT_FALSE(j[m]["band"].empty());
+    EXPECT_DOUBLE_EQ(j[m]["band_level"].get<double>(), 0.95);
+    for (const auto& row : j[m]["band"]) {
+      for (const char* k : {"tau_s", "dev", "band_low", "band_high", "median"}) ASSERT_TRUE(row.contains(k)) << k;
+      EXPECT_LE(row["band_low"].get<double>(), row["median"].get<double>());
+      EXPECT_LE(row["median"].get<double>(), row["band_high"].get<double>());
+    }
+  }
+  for (const char* k : {"misfit_base", "misfit_extended", "coverage_base", "coverage_extended", "holdout_misfit_base",
+                        "holdout_misfit_extended"})
+    ASSERT_TRUE(j["gain"][k].is_number()) << k;
+  ASSERT_EQ(j["findings"].size(), 1u) << j["findings"].dump();
+  const auto& f = j["findings"][0];
+  EXPECT_EQ(f["effect"], "sinusoid");
+  EXPECT_NEAR(f["frequency_hz"].get<double>(), 0.05, 1e-3);
+  EXPECT_NEAR(f["amplitude_deg_per_h"].get<double>(), 0.3, 0.06);
+  EXPECT_GT(f["uncertainty"]["amplitude_deg_per_h"].get<double>(), 0.0);
+  EXPECT_GT(f["evidence"]["statistic"].get<double>(), f["evidence"]["threshold"].get<double>());
+  ASSERT_EQ(j["extended_model"]["sinusoids"].size(), 1u);
+  EXPECT_LT(j["gain"]["misfit_extended"].get<double>(), j["gain"]["misfit_base"].get<double>());
+  EXPECT_GE(j["gain"]["coverage_extended"].get<double>(), j["gain"]["coverage_base"].get<double>());
+}
+
+TEST_F(DiagnoseCli, ReportCarriesUnitsAndTheFinding) {
+  const auto r = run_cli({"diagnose", record_, "--runs", "10"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("  sinusoid:"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("frequency_hz = 0.05"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(" Hz"), std::string::npos);
+  EXPECT_NE(r.out.find("°/h"), std::string::npos);
+  EXPECT_NE(r.out.find("out-of-sample misfit"), std::string::npos);
+  EXPECT_EQ(r.out.find("nan"), std::string::npos);
+}
+
+TEST_F(DiagnoseCli, SimulateTakesTheExtendedModel) {
+  const fs::path diag = dir_->path() / "diag.json";
+  { std::ofstream(diag) << json_->dump(); }
+  const fs::path out = dir_->path() / "again.csv";
+  const fs::path truth = dir_->path() / "truth.json";
+  const auto r = run_cli({"simulate", "--from", diag.string(), "-o", out.string(), "--truth", truth.string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json t = json::parse(slurp(truth));
+  EXPECT_NE(t.dump().find("\"sinusoids\":[{"), std::string::npos) << t.dump();
+}
+
+TEST_F(DiagnoseCli, PlotIsAWellFormedSvgWithBothBands) {
+  if (!rwcalc::gnuplot_available()) GTEST_SKIP() << "gnuplot not found: install gnuplot-nox to render";
+  const fs::path svg = dir_->path() / "diag.svg";
+  const fs::path script = dir_->path() / "diag.gp";
+  const auto r = run_cli({"diagnose", record_, "--runs", "10", "--json", "-o", (dir_->path() / "d.json").string(),
+                          "--plot", svg.string(), "--plot-script", script.string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string s = slurp(svg);
+  EXPECT_EQ(rwcalc::test::xml_problem(s), "");
+  EXPECT_GE(rwcalc::test::svg_series(s).size(), 4u);
+  EXPECT_NE(s.find("findings: sinusoid"), std::string::npos);
+  EXPECT_NE(slurp(script).find("$base << EOD"), std::string::npos);
+  // Existing outputs are not overwritten without --force.
+  const auto again = run_cli({"diagnose", record_, "--runs", "10", "--plot", svg.string()});
+  EXPECT_EQ(again.status, 3) << again.err;
+}
+
+TEST(DiagnoseCliErrors, BadInputUsageAndShortRecords) {
+  TempDir dir;
+  auto r = run_cli({"diagnose", (dir.path() / "missing.csv").string()});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("missing.csv"), std::string::npos);
+  const auto bad = dir.write("bad.csv", "pulses\n1\n2\nx\n");
+  r = run_cli({"diagnose", bad.string()});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("bad.csv"), std::string::npos);
+  EXPECT_NE(r.err.find(":4"), std::string::npos) << r.err;
+  const auto rec = (dir.path() / "short.csv").string();
+  ASSERT_EQ(run_cli({"simulate", "-o", rec, "--duration", "600", "--rate", "10", "--arw", "0.001"}).status, 0);
+  r = run_cli({"diagnose", rec, "--runs", "10"});
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("1200 s"), std::string::npos) << r.err;
+  r = run_cli({"diagnose", rec, "--runs", "3"});
+  EXPECT_EQ(r.status, 2);
+  r = run_cli({"diagnose", rec, "--plot", (dir.path() / "x.gif").string()});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("gif"), std::string::npos) << r.err;
+  const auto out = dir.write("exists.txt", "keep");
+  r = run_cli({"diagnose", rec, "-o", out.string()});
+  EXPECT_EQ(r.status, 3);
+  EXPECT_NE(r.err.find("--force"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(out), "keep");
+}
