@@ -247,15 +247,48 @@ TEST(ReportCli, SavedAnalysisAndDiagnosisJsonAreCombined) {
 
 // ---- error paths ------------------------------------------------------------------------------------
 
-TEST(ReportCli, DiagnoseIsAClearUsageErrorInThisBuild) {
+TEST(ReportCli, DiagnoseAddsEachRecordingsDiagnosisWithItsFigure) {
   TempDir dir;
   const auto out = dir.path() / "out";
-  // Reported first, whether gnuplot is installed or not.
-  ScopedEnv env("RWCALC_GNUPLOT", "/nonexistent/gnuplot");
-  const auto r = run_cli(cat({"report"}, cat(gl2d_all(), {"-o", out.string(), "--diagnose"})));
+  const auto rec = source_path("data/gl2d/gl2d_p25C.csv.gz").string();
+  const bool figures = rwcalc::gnuplot_available();
+  std::vector<std::string> args = {"report", rec, "-o", out.string(), "--diagnose", "--diagnose-runs", "10"};
+  if (!figures) args.emplace_back("--no-figures");
+  const auto r = run_cli(args);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto html = slurp(out / "report.html");
+  EXPECT_NE(html.find("id=\"run1-diagnosis\""), std::string::npos);
+  EXPECT_NE(html.find("id=\"run1-gain\""), std::string::npos);
+  // The same diagnosis as `rwcalc diagnose` with the same ensemble: its findings are the page's.
+  const auto d = run_cli({"diagnose", rec, "--json", "--runs", "10"});
+  ASSERT_EQ(d.status, 0) << d.err;
+  const auto j = nlohmann::json::parse(d.out);
+  if (j["findings"].empty()) {
+    EXPECT_NE(html.find("No finding"), std::string::npos);
+  } else {
+    EXPECT_NE(html.find("id=\"run1-findings\""), std::string::npos);
+    for (const auto& f : j["findings"])
+      EXPECT_NE(html.find("<td>" + f["effect"].get<std::string>() + "</td>"), std::string::npos) << f.dump();
+  }
+  if (figures) {
+    EXPECT_NE(html.find("fig-run1-diagnosis"), std::string::npos);
+  } else {
+    GTEST_LOG_(INFO) << "gnuplot not installed: the diagnosis figure is not checked";
+  }
+}
+
+TEST(ReportCli, DiagnoseNeedsRecordingsAndEnoughRuns) {
+  TempDir dir;
+  const auto out = dir.path() / "out";
+  auto r = run_cli({"report", source_path("data/gl2d/gl2d_p25C.csv.gz").string(), "-o", out.string(), "--diagnose",
+                    "--diagnose-runs", "5", "--no-figures"});
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("diagnosis is not available in this build"), std::string::npos) << r.err;
-  EXPECT_FALSE(fs::exists(out));
+  EXPECT_NE(r.err.find("--diagnose-runs"), std::string::npos) << r.err;
+  const auto a = dir.write("a.json", fixture_analysis({}).dump());
+  r = run_cli({"report", a.string(), "-o", out.string(), "--diagnose", "--no-figures"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--diagnose needs recordings"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out / "report.html"));
 }
 
 TEST(ReportCli, MissingOutputDirectoryOptionIsAUsageError) {

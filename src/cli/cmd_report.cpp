@@ -20,6 +20,8 @@
 #include "cli/analyze_args.hpp"
 #include "cli/commands.hpp"
 #include "rwcalc/batch.hpp"
+#include "rwcalc/diagnose.hpp"
+#include "rwcalc/reader.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/plot.hpp"
 #include "rwcalc/report.hpp"
@@ -40,17 +42,26 @@ struct ReportCmd {
   std::string title;
   unsigned jobs = 0;
   bool diagnose = false;
+  std::size_t diagnose_runs = 50;
+  std::uint64_t diagnose_seed = 1;
   bool no_figures = false;
   bool force = false;
 };
 
-/// The diagnoses of the recordings, one per file in file order (null where none is made).
-/// The diagnosis is not part of this build: asking for it is a usage error, reported before any
-/// analysis. This is the one place to connect it.
-std::vector<json> diagnose_recordings(const std::vector<std::string>& recordings, const ReadOptions& /*read*/,
-                                      const AnalysisOptions& /*options*/) {
-  if (recordings.empty()) return {};
-  throw UsageError("--diagnose: diagnosis is not available in this build");
+/// The diagnoses of the recordings, one per file in file order: each recording is read again and
+/// diagnosed as by `rwcalc diagnose FILE --runs K --seed N` with the report's analysis options.
+std::vector<json> diagnose_recordings(const std::vector<std::string>& recordings, const ReadOptions& read,
+                                      const AnalysisOptions& options, std::size_t runs, std::uint64_t seed) {
+  std::vector<json> out;
+  out.reserve(recordings.size());
+  for (const auto& f : recordings) {
+    DiagnoseOptions d;
+    d.analysis = options;
+    d.runs = runs;
+    d.seed = seed;
+    out.push_back(to_json(diagnose(read_recording(f, read), d)));
+  }
+  return out;
 }
 
 std::string lower(std::string s) {
@@ -198,8 +209,7 @@ int run_report(const ReportCmd& c, Io& io) {
   if (c.diagnose && recordings.empty())
     throw UsageError("--diagnose needs recordings; saved diagnoses are given as 'rwcalc diagnose --json' files");
   const ReadOptions read = c.input.options();
-  std::vector<json> diagnoses;
-  if (c.diagnose) diagnoses = diagnose_recordings(recordings, read, opt);
+  if (c.diagnose && c.diagnose_runs < 10) throw UsageError("--diagnose-runs: at least 10 simulated records are needed");
   // Fail before the analysis: an existing report without --force, no gnuplot for the figures.
   const auto target = (fs::path(c.dir) / "report.html").string();
   std::error_code ec;
@@ -208,6 +218,8 @@ int run_report(const ReportCmd& c, Io& io) {
 
   Saved saved;
   for (const auto& f : saved_files) load_saved(f, saved);
+  std::vector<json> diagnoses;
+  if (c.diagnose) diagnoses = diagnose_recordings(recordings, read, opt, c.diagnose_runs, c.diagnose_seed);
   ReportInput in;
   if (!recordings.empty()) in.analyses = analyze_files(recordings, read, opt, c.jobs);
   diagnoses.resize(in.analyses.size());
@@ -262,6 +274,9 @@ void register_report(CLI::App& app, Runner& runner) {
   sub->add_option("-j,--jobs", cmd->jobs, "Recordings analysed in parallel (default: hardware threads)");
   sub->add_option("--title", cmd->title, "Title of the report");
   sub->add_flag("--diagnose", cmd->diagnose, "Also diagnose each recording (what the noise model misses)");
+  sub->add_option("--diagnose-runs", cmd->diagnose_runs, "Simulated records per diagnosis ensemble")
+      ->capture_default_str();
+  sub->add_option("--diagnose-seed", cmd->diagnose_seed, "Seed of the diagnosis ensembles")->capture_default_str();
   sub->add_flag("--no-figures", cmd->no_figures, "Tables only (needs no gnuplot)");
   sub->add_flag("--force", cmd->force, "Replace an existing report.html");
   sub->callback([cmd, &runner] {
