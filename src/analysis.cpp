@@ -121,12 +121,73 @@ nlohmann::json allan_json(const AllanResult& a) {
           {"points", pts}};
 }
 
-AnalysisResult analyze(const Recording& rec, const AnalysisOptions& options) {
-  if (rec.phase.kind != PhaseKind::Gyro)
+OutlierAction parse_outlier_action(std::string_view s) {
+  if (s == "keep") return OutlierAction::Keep;
+  if (s == "remove") return OutlierAction::Remove;
+  if (s == "replace") return OutlierAction::Replace;
+  throw UsageError(fmt::format("--outliers: '{}' is not one of keep, remove, replace", s));
+}
+
+std::string_view to_string(OutlierAction a) {
+  switch (a) {
+    case OutlierAction::Keep: return "keep";
+    case OutlierAction::Remove: return "remove";
+    case OutlierAction::Replace: return "replace";
+  }
+  return "?";
+}
+
+namespace {
+
+// Detect outliers in the recording's rates and locate them in the input.
+std::vector<Outlier> detect_outliers(const Recording& rec, const AnalysisOptions& options, OutlierReport& rep) {
+  rep.action = options.outlier_action;
+  rep.threshold = options.outlier_threshold;
+  if (!(options.outlier_threshold > 0) || !std::isfinite(options.outlier_threshold))
+    throw UsageError(fmt::format("--outlier-threshold must be a positive number, got {}", options.outlier_threshold));
+  const std::vector<double> rates = rec.rates();
+  rep.scale_deg_per_h = outlier_scale(rates).scale;
+  std::vector<Outlier> found = find_outliers(rates, options.outlier_threshold);
+  rep.count = found.size();
+  // Rate sample i comes from data sample i (pulses, rate) or i+1 (counter, angle: the later reading).
+  const std::size_t shift = rec.samples > rates.size() ? 1 : 0;
+  for (std::size_t k = 0; k < found.size() && k < kMaxOutlierPositions; ++k) {
+    const auto& o = found[k];
+    rep.positions.push_back({o.index, static_cast<double>(o.index + shift) * rec.phase.tau0_s,
+                             rec.line_of_rate(o.index), o.value, o.robust_z});
+  }
+  if (options.outlier_action == OutlierAction::Remove) rep.removed = found.size();
+  if (options.outlier_action == OutlierAction::Replace) rep.replaced = found.size();
+  return found;
+}
+
+}  // namespace
+
+AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
+  if (read.phase.kind != PhaseKind::Gyro)
     throw UsageError(fmt::format("{}: analyze needs gyro data (pulses, counter, angle in arcsec/deg/rad, or rate in "
                                  "deg/h, deg/s, rad/s); this input is clock data",
-                                 rec.source));
+                                 read.source));
+  OutlierReport outliers;
+  Recording rec_storage;
+  const Recording* recp = &read;
+  if (read.phase.points() >= 3) {
+    const std::vector<Outlier> found = detect_outliers(read, options, outliers);
+    if (options.outlier_action != OutlierAction::Keep && !found.empty()) {
+      rec_storage.source = read.source;
+      rec_storage.phase = apply_outliers(read.phase, found, options.outlier_action);
+      rec_storage.rate_hz = read.rate_hz;
+      rec_storage.samples = read.samples - outliers.removed;
+      rec_storage.metadata = read.metadata;
+      rec_storage.temperature_c = read.temperature_c;
+      rec_storage.column_name = read.column_name;
+      rec_storage.mode = read.mode;
+      recp = &rec_storage;
+    }
+  }
+  const Recording& rec = *recp;
   AnalysisResult r;
+  r.outliers = std::move(outliers);
   r.source = rec.source;
   r.samples = rec.samples;
   r.rate_hz = rec.rate_hz;
@@ -247,6 +308,54 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& options) {
   return r;
 }
 
+namespace {
+
+nlohmann::json outliers_json(const OutlierReport& o) {
+  nlohmann::json pos = nlohmann::json::array();
+  for (const auto& p : o.positions)
+    pos.push_back({{"index", p.index}, {"time_s", p.time_s}, {"line", p.line}, {"value_deg_per_h", p.value},
+                   {"robust_z", p.robust_z}});
+  return {{"action", std::string(to_string(o.action))},
+          {"threshold_robust_z", o.threshold},
+          {"scale_deg_per_h", o.scale_deg_per_h},
+          {"count", o.count},
+          {"removed", o.removed},
+          {"replaced", o.replaced},
+          {"positions_listed", o.positions.size()},
+          {"positions", pos}};
+}
+
+constexpr std::size_t kReportOutliers = 20;
+
+std::string outliers_text(const OutlierReport& o) {
+  std::string s = fmt::format(
+      "Outliers (rate samples more than {:g} robust sigma from the median of their 6 neighbours; scale {} °/h)\n",
+      o.threshold, num(o.scale_deg_per_h, 3));
+  if (o.count == 0) return s + "  none found\n\n";
+  switch (o.action) {
+    case OutlierAction::Keep:
+      s += fmt::format("  {} found; KEPT in the analysis below (--outliers remove or replace to leave them out)\n", o.count);
+      break;
+    case OutlierAction::Remove:
+      s += fmt::format("  {} found; {} REMOVED: the samples after each one move one period earlier (a splice)\n", o.count,
+                       o.removed);
+      break;
+    case OutlierAction::Replace:
+      s += fmt::format("  {} found; {} REPLACED by the median of their four nearest good neighbours\n", o.count, o.replaced);
+      break;
+  }
+  s += fmt::format("  {:>10} {:>12} {:>10} {:>14} {:>9}\n", "sample", "time (s)", "line", "rate (°/h)", "z");
+  for (std::size_t k = 0; k < o.positions.size() && k < kReportOutliers; ++k) {
+    const auto& p = o.positions[k];
+    s += fmt::format("  {:>10} {:>12.6g} {:>10} {:>14.6g} {:>+9.1f}\n", p.index, p.time_s, p.line, p.value, p.robust_z);
+  }
+  if (o.count > kReportOutliers)
+    s += fmt::format("  … and {} more (the first {} are listed in --json)\n", o.count - kReportOutliers, o.positions.size());
+  return s + "\n";
+}
+
+}  // namespace
+
 nlohmann::json to_json(const AnalysisResult& r) {
   using nlohmann::json;
   const auto& f = r.fit;
@@ -315,6 +424,7 @@ nlohmann::json to_json(const AnalysisResult& r) {
             {"K_deg_per_h_per_sqrt_h", opt_num(r.slope.K)},
             {"tau_K_s", r.slope.tau_K_s}}},
           {"methods", {{"N_direct_deg_per_sqrt_h", n_direct}, {"B_100s_deg_per_h", b100}}},
+          {"outliers", outliers_json(r.outliers)},
           {"verdict", to_json(r.verdict)},
           {"conventions",
            {{"Q", "rms white angle error, sigma^2 = 3 Q^2/tau^2 (IEEE 952); the paper's eq. (2) Q is sqrt(3) Q"},
@@ -340,6 +450,7 @@ std::string format_report(const AnalysisResult& r) {
                    r.mean_rate_deg_per_h, r.earth_rate_deg_per_h,
                    r.earth_rate_given ? std::string("given") : fmt::format("latitude {:g}°", r.latitude_deg),
                    r.bias_deg_per_h);
+  s += outliers_text(r.outliers);
 
   s += fmt::format("Allan deviation ({}, bounds at {:g} %; * = used in the fit)\n", to_string(r.allan.estimator),
                    100.0 * r.allan.confidence);

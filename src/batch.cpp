@@ -271,6 +271,23 @@ std::string format_batch_text(const json& summary) {
     s += fmt::format("  {:>6}  {:<30} {:<30} {}\n", temp_cell(r), v.value("statement_N", class_cell(v.at("class_N"))),
                      v.value("statement_B", class_cell(v.at("class_B"))), o);
   }
+  // Outliers are never passed over in silence: one line per run that had any.
+  std::string outl;
+  for (const auto& r : runs) {
+    if (!r.contains("outliers")) continue;
+    const auto& o = r.at("outliers");
+    const auto n = o.value("count", std::size_t{0});
+    if (n == 0) continue;
+    const std::string action = o.value("action", std::string("keep"));
+    outl += fmt::format("  {}: {} outlier(s) {}", r.at("source").get<std::string>(), n,
+                        action == "keep" ? "kept" : action == "remove" ? "removed" : "replaced by the local median");
+    const auto& pos = o.at("positions");
+    for (std::size_t k = 0; k < pos.size() && k < 5; ++k)
+      outl += fmt::format("{} line {} ({:g} s)", k ? "," : ": at", pos[k].at("line").get<std::size_t>(),
+                          pos[k].at("time_s").get<double>());
+    outl += n > 5 ? ", …\n" : "\n";
+  }
+  if (!outl.empty()) s += "\nOutliers (see 'rwcalc analyze' for each; --outliers keep|remove|replace)\n" + outl;
   s += fmt::format("\nOverall over the runs: {}", ov.at("statement").get<std::string>());
   if (ov.value("tolerance_changed", false))
     s += fmt::format("  [with the +{:g} % tolerance on B; strict: class {}]", ov.value("tolerance_pct", 0.0),

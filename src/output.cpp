@@ -1,6 +1,8 @@
 #include "rwcalc/output.hpp"
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <stdio.h>
 #include <unistd.h>
 #include <zlib.h>
 
@@ -77,6 +79,22 @@ void write_file_atomic(const std::string& path, std::string_view content, bool f
     write_gzip(tmp, content, path);
   else
     write_plain(tmp, content, path);
+  if (!force) {
+    // Without --force the target must still be absent at the moment of the rename (it may have
+    // appeared while the content was written): move into place only if nothing is there.
+    if (::renameat2(AT_FDCWD, tmp.c_str(), AT_FDCWD, target.c_str(), RENAME_NOREPLACE) == 0) return;
+    const int err = errno;
+    if (err == EEXIST) {
+      std::error_code ec2;
+      fs::remove(tmp, ec2);
+      throw OutputError(fmt::format("{}: exists; use --force to overwrite it", path));
+    }
+    if (err != EINVAL && err != ENOSYS) {  // else: the file system cannot refuse; plain rename below
+      std::error_code ec2;
+      fs::remove(tmp, ec2);
+      throw OutputError(fmt::format("{}: cannot move the finished file into place: {}", path, std::strerror(err)));
+    }
+  }
   fs::rename(tmp, target, ec);
   if (ec) {
     std::error_code ec2;

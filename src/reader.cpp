@@ -780,6 +780,9 @@ void Reader::build_phase(Recording& rec) {
                      (opt_.mode == InputMode::Rate && opt_.rate_unit == RateUnit::Unitless);
   ph.kind = clock ? PhaseKind::Clock : PhaseKind::Gyro;
   constexpr auto kLimit = static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
+  // Floating phase beyond this (arcsec, or s for clocks) would overflow the squares of second
+  // differences (|Δ²x| ≤ 4·max|x|) in the Allan variance; no instrument comes near it.
+  constexpr double kMaxPhase = 1e150;
 
   switch (opt_.mode) {
     case InputMode::Pulses: {
@@ -834,6 +837,11 @@ void Reader::build_phase(Recording& rec) {
       }
       if (f != 1.0)
         for (double& v : reals_) v *= f;
+      for (std::size_t i = 0; i < reals_.size(); ++i)
+        if (!(std::abs(reals_[i]) <= kMaxPhase)) [[unlikely]]
+          fail(line_of_sample(i), fmt::format("angle out of range: {} is beyond ±{:g} arcsec, where the Allan "
+                                              "variance of the record would overflow",
+                                              quoted(fmt::format("{:g}", reals_[i] / f)), kMaxPhase));
       ph.values = std::move(reals_);
       break;
     }
@@ -849,8 +857,14 @@ void Reader::build_phase(Recording& rec) {
       const long double k = static_cast<long double>(ph.tau0_s) * f;
       long double acc = 0;
       for (std::size_t i = 1; i < x.size(); ++i) {
-        acc += static_cast<long double>(x[i]) * k;
+        const double y = x[i];
+        acc += static_cast<long double>(y) * k;
         x[i] = static_cast<double>(acc);
+        if (!(std::abs(acc) <= kMaxPhase)) [[unlikely]]
+          fail(line_of_sample(i - 1),
+               fmt::format("rate out of range: the accumulated phase reaches {:g} arcsec (beyond ±{:g}, where the "
+                           "Allan variance would overflow) at this sample, {}",
+                           static_cast<double>(acc), kMaxPhase, quoted(fmt::format("{:g}", y))));
       }
       ph.values = std::move(x);
       break;

@@ -11,6 +11,7 @@
 #include "rwcalc/allan.hpp"
 #include "rwcalc/fit.hpp"
 #include "rwcalc/methods.hpp"
+#include "rwcalc/outliers.hpp"
 #include "rwcalc/reader.hpp"
 #include "rwcalc/verdict.hpp"
 
@@ -24,7 +25,36 @@ struct AnalysisOptions {
   double latitude_deg = 55.75;                 ///< for the vertical Earth rate Ω_E·sin(lat)
   std::optional<double> earth_rate_deg_per_h;  ///< overrides the latitude
   std::optional<double> temperature_c;         ///< overrides the recording's temperature
+  /// Isolated outliers are always looked for and reported; this says what is done with them
+  /// before the analysis. Keep is the default: the data are analysed as read.
+  OutlierAction outlier_action = OutlierAction::Keep;
+  double outlier_threshold = kDefaultOutlierThreshold;  ///< robust z (see outliers.hpp)
 };
+
+/// One detected outlier, located in the input.
+struct OutlierPosition {
+  std::size_t index = 0;  ///< rate sample index (0-based; see Recording::rates)
+  double time_s = 0;      ///< time of its data line from the first sample, s (index of that line × τ0)
+  std::size_t line = 0;   ///< 1-based input line
+  double value = 0;       ///< the rate sample, °/h
+  double robust_z = 0;    ///< residual from the neighbour median over the robust scale
+};
+
+/// What outlier detection found and what was done about it.
+struct OutlierReport {
+  OutlierAction action = OutlierAction::Keep;
+  double threshold = kDefaultOutlierThreshold;
+  double scale_deg_per_h = 0;  ///< robust scale of the neighbour-median residuals, °/h
+  std::size_t count = 0;       ///< outliers found
+  std::size_t removed = 0;     ///< rate samples dropped (Remove)
+  std::size_t replaced = 0;    ///< rate samples replaced by their local median (Replace)
+  std::vector<OutlierPosition> positions;  ///< the first kMaxOutlierPositions, in input order
+};
+inline constexpr std::size_t kMaxOutlierPositions = 1000;
+
+/// Parse "keep", "remove" or "replace" (UsageError otherwise).
+OutlierAction parse_outlier_action(std::string_view s);
+std::string_view to_string(OutlierAction a);
 
 struct AnalysisResult {
   std::string source;
@@ -49,6 +79,7 @@ struct AnalysisResult {
   double N_direct_discrepancy_sigma = 0;  ///< (N_direct − N_fit)/σ
   double B_100s_discrepancy_sigma = 0;    ///< (spread − B_fit)/σ (not like for like, see docs)
   double B_100s_vs_model_sigma = 0;       ///< (spread − its expectation under the fit)/σ
+  OutlierReport outliers;
   Verdict verdict;
 };
 

@@ -10,4 +10,10 @@ namespace rwcalc::cli {
 /// Returns the process exit status (see error.hpp). Never throws.
 int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err);
 
+/// Parse argv exactly as run() does, but run no command: returns 0 when a command would run (or
+/// help/version was printed), else the exit status run() would give for the arguments. Never
+/// throws an rwcalc error; anything else escaping is what run() would report as an internal
+/// error (the argument-parsing fuzzer treats it as a finding).
+int parse_only(int argc, const char* const* argv, std::ostream& out, std::ostream& err);
+
 }  // namespace rwcalc::cli

@@ -71,6 +71,17 @@ void AnalyzeArgs::add_to(CLI::App& app) {
   app.add_option("--direct-range", direct_range, "Interval lengths of the direct N method, TMIN:TMAX in s")
       ->capture_default_str()
       ->group("Cross-checks");
+  app.add_option("--outliers", outliers,
+                 "Isolated outliers are always detected and reported (sample, time, line); then: keep "
+                 "(default: analyse the data as read), remove (drop them; later samples move one period "
+                 "earlier), or replace (by the median of the nearest good neighbours; keeps every sample)")
+      ->capture_default_str()
+      ->group("Outliers");
+  app.add_option("--outlier-threshold", outlier_threshold,
+                 "Detection threshold, robust sigma of the residual from the neighbour median")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str()
+      ->group("Outliers");
 }
 
 AnalysisOptions AnalyzeArgs::options() const {
@@ -102,6 +113,8 @@ AnalysisOptions AnalyzeArgs::options() const {
   if (!(dl > 0)) throw UsageError("--direct-range: TMIN must be positive");
   o.methods.direct_t_min_s = dl;
   o.methods.direct_t_max_s = dh;
+  o.outlier_action = parse_outlier_action(outliers);
+  o.outlier_threshold = outlier_threshold;
   return o;
 }
 

@@ -22,6 +22,8 @@ struct AnalyzeArgs {
   double block_s = 100.0;
   std::string direct_range = "1:100";
   std::string tau = "octave";       ///< τ grid of the reported AV (the fit uses its octave points)
+  std::string outliers = "keep";
+  double outlier_threshold = kDefaultOutlierThreshold;
   void add_to(CLI::App& app);
   /// Throws UsageError on malformed values; InputError for a bad limits file.
   [[nodiscard]] AnalysisOptions options() const;

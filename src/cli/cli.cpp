@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <exception>
+#include <optional>
 #include <ostream>
 #include <vector>
 
@@ -19,13 +20,12 @@ constexpr const char* kDescription =
     "simulation of gyro records and diagnosis of what the noise model misses.";
 }
 
-int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
-  CLI::App app{kDescription, "rwcalc"};
+namespace {
+
+void build_app(CLI::App& app, Runner& runner) {
   app.set_version_flag("-V,--version", std::string("rwcalc ") + RWCALC_VERSION);
   app.require_subcommand(1);
   app.fallthrough(false);
-
-  Runner runner;
   register_allan(app, runner);
   register_analyze(app, runner);
   register_batch(app, runner);
@@ -33,8 +33,12 @@ int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err)
   register_simulate(app, runner);
   register_diagnose(app, runner);
   register_report(app, runner);
+}
 
-  Io io{out, err};
+/// Parse argv into `app`. Returns the exit status to stop with (help, version, a parse error),
+/// or nothing when a command should run.
+std::optional<int> parse_args(CLI::App& app, int argc, const char* const* argv, std::ostream& out,
+                              std::ostream& err) {
   try {
     std::vector<std::string> args;
     for (int i = argc - 1; i > 0; --i) args.emplace_back(argv[i]);
@@ -62,6 +66,34 @@ int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err)
       err << "Run 'rwcalc " << app.get_subcommands().front()->get_name() << " --help' for its options.\n";
     return static_cast<int>(ExitCode::BadInput);
   }
+  return std::nullopt;
+}
+
+}  // namespace
+
+int parse_only(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  try {
+    CLI::App app{kDescription, "rwcalc"};
+    Runner runner;
+    build_app(app, runner);
+    if (const auto status = parse_args(app, argc, argv, out, err)) return *status;
+    if (!runner) {
+      err << "rwcalc: no command given; run 'rwcalc --help'\n";
+      return static_cast<int>(ExitCode::BadInput);
+    }
+    return 0;
+  } catch (const Error& e) {
+    err << "rwcalc: error: " << e.what() << "\n";
+    return static_cast<int>(e.code());
+  }
+}
+
+int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CLI::App app{kDescription, "rwcalc"};
+  Runner runner;
+  build_app(app, runner);
+  Io io{out, err};
+  if (const auto status = parse_args(app, argc, argv, out, err)) return *status;
 
   try {
     if (!runner) {
