@@ -21,7 +21,7 @@ TEST(Adis16405, OverlappingAdevOfGyroXMatchesPublishedReference) {
   for (double& v : rate) v *= 3600.0;  // deg/s → arcsec/s, so deviations come out in °/h
   const PhaseSeries x = frequency_series(rate, 0.01, PhaseKind::Gyro);
 
-  std::istringstream in(slurp(adis_dir() / "reference_avar_adis_av_run1.csv"));
+  std::istringstream in(read_text_gz(adis_dir() / "reference_avar_adis_av_run1.csv"));
   std::string line;
   AllanOptions o;
   o.grid.kind = TauGrid::Kind::Explicit;

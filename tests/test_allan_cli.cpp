@@ -17,7 +17,7 @@ std::filesystem::path phase_dat() { return shared_data("reference/nbs14_riley/st
 TEST(AllanCli, Adis16405GyroXThroughTheReaderMatchesThePublishedAv) {
   RWCALC_REQUIRE_SHARED(adis());
   const auto ref_path = shared_data("real/imudata_adis16405/reference_avar_adis_av_run1.csv");
-  std::istringstream in(slurp(ref_path));
+  std::istringstream in(read_text_gz(ref_path));
   std::string line, taus;
   std::vector<double> want;  // ADEV, °/h
   while (std::getline(in, line)) {

@@ -19,7 +19,7 @@
 namespace rwcalc::test {
 
 /// Whole file as text; transparently gunzips (zlib reads plain files as they are).
-inline std::string slurp(const std::filesystem::path& path) {
+inline std::string read_text_gz(const std::filesystem::path& path) {
   gzFile f = gzopen(path.c_str(), "rb");
   if (!f) throw std::runtime_error("cannot open " + path.string());
   std::string text;
@@ -34,7 +34,7 @@ inline std::string slurp(const std::filesystem::path& path) {
 /// non-numeric line (a header row) is skipped.
 inline std::vector<double> load_column(const std::filesystem::path& path, std::size_t column = 0) {
   std::vector<double> v;
-  std::istringstream in(slurp(path));
+  std::istringstream in(read_text_gz(path));
   std::string line;
   while (std::getline(in, line)) {
     if (line.empty() || line[0] == '#' || line == "\r") continue;
@@ -102,7 +102,7 @@ struct Stable32Table {
 
 inline Stable32Table load_stable32(const std::filesystem::path& path) {
   Stable32Table t;
-  std::istringstream in(slurp(path));
+  std::istringstream in(read_text_gz(path));
   std::string line;
   while (std::getline(in, line)) {
     if (line.find("Frequency Data Points") != std::string::npos) t.frequency_data = true;

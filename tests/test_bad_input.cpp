@@ -16,33 +16,14 @@
 
 #include "rwcalc/error.hpp"
 #include "rwcalc/reader.hpp"
+#include "bad_input_corpus.hpp"
 #include "test_support.hpp"
 
 namespace {
 
-struct Case {
-  std::string file, options;
-  int status = 0;
-  std::string fragment;
-  std::size_t line = 0;
-};
-
-void PrintTo(const Case& c, std::ostream* os) { *os << c.file << " [" << c.options << "]"; }
-
-std::vector<Case> load_manifest() {
-  std::vector<Case> cases;
-  std::ifstream in(rwcalc::test::source_path("tests/bad_input/MANIFEST.tsv"));
-  std::string row;
-  while (std::getline(in, row)) {
-    if (row.empty() || row[0] == '#') continue;
-    std::vector<std::string> f;
-    std::stringstream ss(row);
-    for (std::string cell; std::getline(ss, cell, '\t');) f.push_back(cell);
-    if (f.size() != 5) throw std::runtime_error("MANIFEST.tsv: bad row: " + row);
-    cases.push_back({f[0], f[1], std::stoi(f[2]), f[3], static_cast<std::size_t>(std::stoul(f[4]))});
-  }
-  return cases;
-}
+using rwcalc::test::bad_input_case_name;
+using rwcalc::test::BadInputCase;
+using rwcalc::test::load_bad_input_manifest;
 
 // The input options of a manifest row, written as on the command line.
 rwcalc::ReadOptions parse_options(const std::string& text) {
@@ -64,32 +45,14 @@ rwcalc::ReadOptions parse_options(const std::string& text) {
   return o;
 }
 
-class BadInput : public ::testing::TestWithParam<Case> {};
+class BadInput : public ::testing::TestWithParam<BadInputCase> {};
 
 TEST_P(BadInput, GivesItsDocumentedStatusAndMessage) {
-  const Case& c = GetParam();
-  rwcalc::test::TempDir tmp;
-  std::string path;
-  constexpr std::size_t kHuge = 5u << 20;  // a 5 MB line
-  if (c.file == "@missing") {
-    path = (tmp.path() / "no-such-recording.csv").string();
-  } else if (c.file == "@directory") {
-    path = tmp.path().string();
-  } else if (c.file == "@unreadable") {
-    if (::geteuid() == 0) GTEST_SKIP() << "running as root: permissions do not stop reading";
-    path = tmp.write("locked.csv", "1\n2\n").string();
-    ::chmod(path.c_str(), 0);
-  } else if (c.file == "@huge_digit_line") {
-    path = tmp.write("digits.csv", "pulses\n1\n" + std::string(kHuge, '7') + "\n2\n").string();
-  } else if (c.file == "@huge_float_line") {
-    path = tmp.write("float.csv", "rate\n0.5\n1" + std::string(kHuge, '0') + ".5\n2\n").string();
-  } else if (c.file == "@huge_text_line") {
-    path = tmp.write("text.csv", "pulses\n1\n" + std::string(kHuge, 'x') + "\n2\n").string();
-  } else if (c.file == "@huge_header_line") {
-    path = tmp.write("header.csv", std::string(kHuge, 'h') + "\n").string();
-  } else {
-    path = rwcalc::test::source_path("tests/bad_input/" + c.file).string();
-  }
+  const BadInputCase& c = GetParam();
+  const rwcalc::test::TempDir tmp;
+  const auto staged = rwcalc::test::stage_bad_input(c, tmp);
+  if (!staged) GTEST_SKIP() << "running as root: permissions do not stop reading";
+  const std::string& path = *staged;
   const auto options = parse_options(c.options);
   if (c.status == 0) {
     const auto r = rwcalc::read_recording(path, options);
@@ -111,21 +74,15 @@ TEST_P(BadInput, GivesItsDocumentedStatusAndMessage) {
   }
 }
 
-std::string case_name(const ::testing::TestParamInfo<Case>& info) {
-  std::string n;
-  for (char ch : info.param.file) n += std::isalnum(static_cast<unsigned char>(ch)) ? ch : '_';
-  return n;
-}
-
-INSTANTIATE_TEST_SUITE_P(Corpus, BadInput, ::testing::ValuesIn(load_manifest()), case_name);
+INSTANTIATE_TEST_SUITE_P(Corpus, BadInput, ::testing::ValuesIn(load_bad_input_manifest()), bad_input_case_name);
 
 TEST(BadInputCorpus, ManifestListsEveryCommittedFile) {
-  const auto cases = load_manifest();
+  const auto cases = load_bad_input_manifest();
   EXPECT_GE(cases.size(), 40u);
   for (const auto& entry : std::filesystem::directory_iterator(rwcalc::test::source_path("tests/bad_input"))) {
     const auto name = entry.path().filename().string();
     if (name == "MANIFEST.tsv") continue;
-    EXPECT_TRUE(std::any_of(cases.begin(), cases.end(), [&](const Case& c) { return c.file == name; }))
+    EXPECT_TRUE(std::any_of(cases.begin(), cases.end(), [&](const BadInputCase& c) { return c.file == name; }))
         << name << " is not in MANIFEST.tsv";
   }
 }

@@ -16,15 +16,9 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using rwcalc::test::run_cli;
 using rwcalc::test::TempDir;
+using rwcalc::test::slurp;
 
 namespace {
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 /// 30 min at 100 Hz of GL-2D-like noise with a 0.3 °/h sinusoid at 0.05 Hz.
 class DiagnoseCli : public ::testing::Test {

@@ -25,7 +25,7 @@ struct Reference {
 
 std::vector<Reference> load_references() {
   std::vector<Reference> refs;
-  std::istringstream in(slurp(nbs_dir() / "reference_values.csv"));
+  std::istringstream in(read_text_gz(nbs_dir() / "reference_values.csv"));
   std::string line;
   while (std::getline(in, line)) {
     if (line.empty() || line[0] == '#' || line.starts_with("dataset")) continue;

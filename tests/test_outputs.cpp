@@ -21,13 +21,7 @@ namespace {
 namespace fs = std::filesystem;
 using rwcalc::test::run_cli;
 using rwcalc::test::TempDir;
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using rwcalc::test::slurp;
 
 std::set<std::string> listing(const fs::path& dir) {
   std::set<std::string> names;

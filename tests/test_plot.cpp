@@ -23,46 +23,10 @@ using rwcalc::test::FixtureCoefficients;
 using rwcalc::test::svg_series;
 using rwcalc::test::TempDir;
 using rwcalc::test::xml_problem;
+using rwcalc::test::slurp;
+using rwcalc::test::ScopedEnv;
 
 namespace {
-
-#define REQUIRE_GNUPLOT()                                                                        \
-  do {                                                                                           \
-    if (!rwcalc::gnuplot_available())                                                            \
-      GTEST_SKIP() << "gnuplot not found ('" << rwcalc::gnuplot_command()                        \
-                   << "'): install gnuplot-nox to run the rendering tests";                     \
-  } while (0)
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-/// Sets an environment variable for the lifetime of the object, then restores it.
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, const char* value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    if (value)
-      setenv(name, value, 1);
-    else
-      unsetenv(name);
-  }
-  ~ScopedEnv() {
-    if (old_)
-      setenv(name_.c_str(), old_->c_str(), 1);
-    else
-      unsetenv(name_.c_str());
-  }
-  ScopedEnv(const ScopedEnv&) = delete;
-  ScopedEnv& operator=(const ScopedEnv&) = delete;
-
- private:
-  std::string name_;
-  std::optional<std::string> old_;
-};
 
 json k_unresolved_analysis() {
   FixtureCoefficients c;

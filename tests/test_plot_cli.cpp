@@ -25,56 +25,14 @@ using rwcalc::test::source_path;
 using rwcalc::test::svg_series;
 using rwcalc::test::TempDir;
 using rwcalc::test::xml_problem;
+using rwcalc::test::slurp;
+using rwcalc::test::ScopedEnv;
+using rwcalc::test::concat;
+using rwcalc::test::gl2d_runs;
 
 namespace {
 
-#define REQUIRE_GNUPLOT()                                                                        \
-  do {                                                                                           \
-    if (!rwcalc::gnuplot_available())                                                            \
-      GTEST_SKIP() << "gnuplot not found ('" << rwcalc::gnuplot_command()                        \
-                   << "'): install gnuplot-nox to run the plot rendering tests";                \
-  } while (0)
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 std::string gl2d(const std::string& name) { return source_path("data/gl2d/" + name).string(); }
-
-std::vector<std::string> gl2d_all() {
-  std::vector<std::string> f;
-  for (const char* t : {"m50C", "m25C", "0C", "p25C", "p50C"}) f.push_back(gl2d(std::string("gl2d_") + t + ".csv.gz"));
-  return f;
-}
-
-std::vector<std::string> cat(std::vector<std::string> a, const std::vector<std::string>& b) {
-  a.insert(a.end(), b.begin(), b.end());
-  return a;
-}
-
-/// Sets an environment variable for the lifetime of the object, then restores it.
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, const char* value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    setenv(name, value, 1);
-  }
-  ~ScopedEnv() {
-    if (old_)
-      setenv(name_.c_str(), old_->c_str(), 1);
-    else
-      unsetenv(name_.c_str());
-  }
-  ScopedEnv(const ScopedEnv&) = delete;
-  ScopedEnv& operator=(const ScopedEnv&) = delete;
-
- private:
-  std::string name_;
-  std::optional<std::string> old_;
-};
 
 /// Series the analysis figure must hold, from its JSON: the measurement, the model, one line per
 /// term that is resolved or has a 95 % bound, one floor per class limit of B.
@@ -194,7 +152,7 @@ TEST(BatchPlot, FiveTemperaturesOverlaidAndTheDirectMethodPanel) {
   TempDir dir;
   const auto svg_path = dir.path() / "batch.svg";
   const auto json_path = dir.path() / "batch.json";
-  const auto r = run_cli(cat({"batch"}, cat(gl2d_all(), {"--json", "-o", json_path.string(), "--plot",
+  const auto r = run_cli(concat({"batch"}, concat(gl2d_runs(), {"--json", "-o", json_path.string(), "--plot",
                                                          svg_path.string(), "-j", "2"})));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.err.find("note:"), std::string::npos) << "Fig. 2 must not be left out: " << r.err;
@@ -221,7 +179,7 @@ TEST(PlotCliErrors, MissingGnuplotFailsBeforeTheAnalysisWithAClearMessage) {
   ScopedEnv env("RWCALC_GNUPLOT", "/nonexistent/gnuplot");
   const auto svg = dir.path() / "a.svg";
   for (const auto& args : {std::vector<std::string>{"analyze", gl2d("gl2d_p25C.csv.gz"), "--plot", svg.string()},
-                           cat({"batch"}, cat(gl2d_all(), {"--plot", svg.string()}))}) {
+                           concat({"batch"}, concat(gl2d_runs(), {"--plot", svg.string()}))}) {
     const auto r = run_cli(args);
     EXPECT_EQ(r.status, 3) << args[0];
     EXPECT_NE(r.err.find("cannot run gnuplot ('/nonexistent/gnuplot'"), std::string::npos) << r.err;

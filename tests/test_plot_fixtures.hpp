@@ -1,9 +1,11 @@
 #pragma once
 // JSON objects shaped exactly like the output of `rwcalc analyze --json`, `rwcalc batch --json`
-// (issue 3, item 5) and `rwcalc diagnose --json` (docs/plots-and-reports.md), built from known
+// and `rwcalc diagnose --json` (docs/plots-and-reports.md), built from known
 // coefficients so the figures and the report can be tested without the analysis pipeline.
 // The Allan points follow the 5-term model of a GL-2D-like 2-h run (400 Hz, octave τ grid),
 // scattered by a seeded relative error of 1/√(n/m) so they look measured.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -16,6 +18,16 @@
 #include <string_view>
 #include <utility>
 #include <vector>
+
+#include "rwcalc/plot.hpp"
+
+/// Skip the current test with a clear message when gnuplot cannot be run.
+#define REQUIRE_GNUPLOT()                                                                        \
+  do {                                                                                           \
+    if (!rwcalc::gnuplot_available())                                                            \
+      GTEST_SKIP() << "gnuplot not found ('" << rwcalc::gnuplot_command()                        \
+                   << "'): install gnuplot-nox to run the figure rendering tests";              \
+  } while (0)
 
 namespace rwcalc::test {
 

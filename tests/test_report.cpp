@@ -26,13 +26,6 @@ using rwcalc::test::xml_problem;
 
 namespace {
 
-#define REQUIRE_GNUPLOT()                                                                        \
-  do {                                                                                           \
-    if (!rwcalc::gnuplot_available())                                                            \
-      GTEST_SKIP() << "gnuplot not found ('" << rwcalc::gnuplot_command()                        \
-                   << "'): install gnuplot-nox to run the report figure tests";                 \
-  } while (0)
-
 rwcalc::ReportInput batch_input(bool with_direct_curve = true) {
   const auto b = fixture_batch(with_direct_curve);
   rwcalc::ReportInput in;

@@ -28,26 +28,17 @@ using rwcalc::test::source_path;
 using rwcalc::test::svg_series;
 using rwcalc::test::TempDir;
 using rwcalc::test::xml_problem;
+using rwcalc::test::slurp;
+using rwcalc::test::ScopedEnv;
+using rwcalc::test::concat;
 
 namespace {
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 std::vector<std::string> gl2d_all() {
   std::vector<std::string> f;
   for (const char* t : {"p50C", "m25C", "0C", "m50C", "p25C"})  // not in temperature order
     f.push_back(source_path(std::string("data/gl2d/gl2d_") + t + ".csv.gz").string());
   return f;
-}
-
-std::vector<std::string> cat(std::vector<std::string> a, const std::vector<std::string>& b) {
-  a.insert(a.end(), b.begin(), b.end());
-  return a;
 }
 
 /// The element `<tag id="ID" …>…</tag>` (first closing tag of the same name).
@@ -64,26 +55,6 @@ std::size_t count(const std::string& s, const std::string& what) {
   return n;
 }
 
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, const char* value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    setenv(name, value, 1);
-  }
-  ~ScopedEnv() {
-    if (old_)
-      setenv(name_.c_str(), old_->c_str(), 1);
-    else
-      unsetenv(name_.c_str());
-  }
-  ScopedEnv(const ScopedEnv&) = delete;
-  ScopedEnv& operator=(const ScopedEnv&) = delete;
-
- private:
-  std::string name_;
-  std::optional<std::string> old_;
-};
-
 /// One report of the five GL-2D runs (with figures) and the batch JSON of the same runs, made
 /// once for the tests that read them.
 class ReportOfGl2d : public ::testing::Test {
@@ -91,9 +62,9 @@ class ReportOfGl2d : public ::testing::Test {
   static void SetUpTestSuite() {
     if (!rwcalc::gnuplot_available()) return;
     dir_ = std::make_unique<TempDir>();
-    report_ = run_cli(cat({"report"}, cat(gl2d_all(), {"-o", (dir_->path() / "out").string(), "--tolerance", "50",
+    report_ = run_cli(concat({"report"}, concat(gl2d_all(), {"-o", (dir_->path() / "out").string(), "--tolerance", "50",
                                                        "-j", "2", "--title", "GL-2D <temperature> test"})));
-    batch_ = run_cli(cat({"batch"}, cat(gl2d_all(), {"--json", "--tolerance", "50", "-o",
+    batch_ = run_cli(concat({"batch"}, concat(gl2d_all(), {"--json", "--tolerance", "50", "-o",
                                                      (dir_->path() / "batch.json").string(), "-j", "2"})));
   }
   static void TearDownTestSuite() { dir_.reset(); }
@@ -292,7 +263,7 @@ TEST(ReportCli, DiagnoseNeedsRecordingsAndEnoughRuns) {
 }
 
 TEST(ReportCli, MissingOutputDirectoryOptionIsAUsageError) {
-  const auto r = run_cli(cat({"report"}, gl2d_all()));
+  const auto r = run_cli(concat({"report"}, gl2d_all()));
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("-o DIR is required"), std::string::npos) << r.err;
   EXPECT_EQ(r.out, "");
@@ -317,7 +288,7 @@ TEST(ReportCli, MissingGnuplotFailsBeforeTheAnalysisAndNoFiguresNeedsNone) {
   TempDir dir;
   ScopedEnv env("RWCALC_GNUPLOT", "/nonexistent/gnuplot");
   const auto out = dir.path() / "out";
-  auto r = run_cli(cat({"report"}, cat(gl2d_all(), {"-o", out.string()})));
+  auto r = run_cli(concat({"report"}, concat(gl2d_all(), {"-o", out.string()})));
   EXPECT_EQ(r.status, 3);
   EXPECT_NE(r.err.find("cannot run gnuplot ('/nonexistent/gnuplot'"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("gnuplot-nox"), std::string::npos) << r.err;

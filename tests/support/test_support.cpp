@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <cstdlib>
 #include <cstdio>
 #include <fstream>
 #include <random>
@@ -20,6 +21,40 @@ std::filesystem::path shared_data(const std::string& relative) {
 
 std::filesystem::path source_path(const std::string& relative) {
   return std::filesystem::path(RWCALC_SOURCE_DIR) / relative;
+}
+
+std::string slurp(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::vector<std::string> gl2d_runs() {
+  std::vector<std::string> f;
+  for (const char* t : {"m50C", "m25C", "0C", "p25C", "p50C"})
+    f.push_back(source_path(std::string("data/gl2d/gl2d_") + t + ".csv.gz").string());
+  return f;
+}
+
+std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
+ScopedEnv::ScopedEnv(const char* name, const char* value) : name_(name) {
+  if (const char* old = std::getenv(name)) old_ = old;
+  if (value)
+    ::setenv(name, value, 1);
+  else
+    ::unsetenv(name);
+}
+
+ScopedEnv::~ScopedEnv() {
+  if (old_)
+    ::setenv(name_.c_str(), old_->c_str(), 1);
+  else
+    ::unsetenv(name_.c_str());
 }
 
 CliResult run_cli(const std::vector<std::string>& args) {
@@ -45,12 +80,6 @@ std::string shell_quote(const std::string& s) {
   return q + "'";
 }
 
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 }  // namespace
 
 CliResult run_exe(const std::vector<std::string>& args, const std::string& stdin_text) {

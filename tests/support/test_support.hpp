@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,29 @@ class TempDir {
 
  private:
   std::filesystem::path path_;
+};
+
+/// The whole content of a file (empty when it cannot be read).
+std::string slurp(const std::filesystem::path& path);
+
+/// The five shipped GL-2D runs (data/gl2d/), in temperature order −50 … +50 °C.
+std::vector<std::string> gl2d_runs();
+
+/// `a` followed by `b`: argument lists put together.
+std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b);
+
+/// Sets (or, with a null value, unsets) an environment variable for the lifetime of the object,
+/// then restores it.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const char* value);
+  ~ScopedEnv();
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  std::string name_;
+  std::optional<std::string> old_;
 };
 
 }  // namespace rwcalc::test
