@@ -172,7 +172,10 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   Recording rec_storage;
   const Recording* recp = &read;
   if (read.phase.points() >= 3) {
-    const std::vector<Outlier> found = detect_outliers(read, options, outliers);
+    const std::vector<Outlier> found = [&] {
+      detail::ScopedTimer t("analyze: outlier scan");
+      return detect_outliers(read, options, outliers);
+    }();
     if (options.outlier_action != OutlierAction::Keep && !found.empty()) {
       rec_storage.source = read.source;
       rec_storage.phase = apply_outliers(read.phase, found, options.outlier_action);
