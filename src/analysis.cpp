@@ -146,8 +146,9 @@ std::vector<Outlier> detect_outliers(const Recording& rec, const AnalysisOptions
   if (!(options.outlier_threshold > 0) || !std::isfinite(options.outlier_threshold))
     throw UsageError(fmt::format("--outlier-threshold must be a positive number, got {}", options.outlier_threshold));
   const std::vector<double> rates = rec.rates();
-  rep.scale_deg_per_h = outlier_scale(rates).scale;
-  std::vector<Outlier> found = find_outliers(rates, options.outlier_threshold);
+  const OutlierScale scale = outlier_scale(rates);
+  rep.scale_deg_per_h = scale.scale;
+  std::vector<Outlier> found = find_outliers(rates, options.outlier_threshold, scale);
   rep.count = found.size();
   // Rate sample i comes from data sample i (pulses, rate) or i+1 (counter, angle: the later reading).
   const std::size_t shift = rec.samples > rates.size() ? 1 : 0;

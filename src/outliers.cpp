@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <thread>
 
 namespace rwcalc {
 
@@ -81,34 +82,52 @@ OutlierScale outlier_scale(const std::vector<double>& rates) {
 }
 
 std::vector<Outlier> find_outliers(const std::vector<double>& rates, double threshold) {
+  return find_outliers(rates, threshold, outlier_scale(rates));
+}
+
+std::vector<Outlier> find_outliers(const std::vector<double>& rates, double threshold, const OutlierScale& s) {
   std::vector<Outlier> out;
   const std::size_t n = rates.size();
   if (n < kMinSamples) return out;
-  const OutlierScale s = outlier_scale(rates);
   if (!(s.scale > 0)) return out;  // a constant record has no outliers
   const double limit = threshold * s.scale;
   const double* y = rates.data();
-  auto test = [&](std::size_t i) {
+  auto test = [&](std::size_t i, std::vector<Outlier>& to) {
     const double r = residual(y, i, n);
-    if (std::abs(r) > limit) out.push_back({i, 0, y[i], r / s.scale});
+    if (std::abs(r) > limit) to.push_back({i, 0, y[i], r / s.scale});
   };
-  test(0);
-  test(1);
-  test(2);
   // Interior in blocks: a branch-free screen the compiler vectorises, then a look at blocks that trip.
   constexpr std::size_t kBlock = 1024;
+  auto screen = [&](std::size_t from, std::size_t to_end, std::vector<Outlier>& to) {
+    for (std::size_t b = from; b < to_end; b += kBlock) {
+      const std::size_t e = std::min(to_end, b + kBlock);
+      bool hit = false;
+      for (std::size_t i = b; i < e; ++i)
+        hit |= std::abs(interior_residual(y, i)) > limit;
+      if (hit)
+        for (std::size_t i = b; i < e; ++i) test(i, to);
+    }
+  };
+  test(0, out);
+  test(1, out);
+  test(2, out);
   const std::size_t end = n - 3;
-  for (std::size_t b = 3; b < end; b += kBlock) {
-    const std::size_t e = std::min(end, b + kBlock);
-    bool hit = false;
-    for (std::size_t i = b; i < e; ++i)
-      hit |= std::abs(interior_residual(y, i)) > limit;
-    if (hit)
-      for (std::size_t i = b; i < e; ++i) test(i);
+  // Long records: the second half of the interior on another thread (results joined in order).
+  constexpr std::size_t kParallelFrom = std::size_t{1} << 20;
+  if (end - 3 >= kParallelFrom && std::thread::hardware_concurrency() > 1) {
+    const std::size_t mid = 3 + ((end - 3) / 2 / kBlock) * kBlock;
+    std::vector<Outlier> second;
+    {
+      std::jthread worker([&] { screen(mid, end, second); });
+      screen(3, mid, out);
+    }
+    out.insert(out.end(), second.begin(), second.end());
+  } else {
+    screen(3, end, out);
   }
-  test(n - 3);
-  test(n - 2);
-  test(n - 1);
+  test(n - 3, out);
+  test(n - 2, out);
+  test(n - 1, out);
   return out;
 }
 

@@ -196,3 +196,28 @@ TEST(Outliers, XsensContaminatedRecordGrossErrorsAreFound) {
 }
 
 }  // namespace
+
+namespace {
+
+// A long record (the interior is screened on two threads): every planted spike is found once, in
+// index order, including those beside the split and at the ends.
+TEST(Outliers, LongRecordFindsEverySpikeOnceInOrder) {
+  const std::size_t n = (std::size_t{3} << 20) + 17;
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::vector<double> y(n);
+  for (auto& v : y) v = g(rng);
+  const std::size_t mid = 3 + ((n - 6) / 2 / 1024) * 1024;
+  std::vector<std::size_t> planted = {0, 5, 1000, n / 3, mid - 2, mid - 1, mid, mid + 3, n - 4, n - 1};
+  ASSERT_TRUE(std::is_sorted(planted.begin(), planted.end()));
+  for (std::size_t k = 0; k < planted.size(); ++k) y[planted[k]] += (k % 2 ? -1.0 : 1.0) * 40.0;
+  const auto out = find_outliers(y);
+  std::vector<std::size_t> idx;
+  for (const auto& o : out) idx.push_back(o.index);
+  EXPECT_EQ(idx, planted);
+  const auto again = find_outliers(y, rwcalc::kDefaultOutlierThreshold, rwcalc::outlier_scale(y));
+  ASSERT_EQ(again.size(), out.size());
+  for (std::size_t k = 0; k < out.size(); ++k) EXPECT_EQ(again[k].robust_z, out[k].robust_z);
+}
+
+}  // namespace

@@ -45,6 +45,9 @@ OutlierScale outlier_scale(const std::vector<double>& rates);
 std::vector<Outlier> find_outliers(const std::vector<double>& rates,
                                    double threshold = kDefaultOutlierThreshold);
 
+/// Same, with the robust scale already computed by outlier_scale(rates).
+std::vector<Outlier> find_outliers(const std::vector<double>& rates, double threshold, const OutlierScale& scale);
+
 /// Same, on a recording's rates, with the input line of each outlier filled in.
 std::vector<Outlier> find_outliers(const Recording& recording,
                                    double threshold = kDefaultOutlierThreshold);
