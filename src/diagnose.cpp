@@ -14,6 +14,7 @@
 #include "rwcalc/diagnose_detectors.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/fit.hpp"
+#include "timing.hpp"
 
 namespace rwcalc {
 
@@ -302,23 +303,24 @@ RobustBase robust_base(const Recording& rec, const AnalysisResult& original, con
   return b;
 }
 
-struct Timer {
-  std::chrono::steady_clock::time_point t0 = std::chrono::steady_clock::now();
-  bool on = std::getenv("RWCALC_DIAGNOSE_TIMING") != nullptr;
-  void mark(const char* what) {
-    if (!on) return;
-    const auto t = std::chrono::steady_clock::now();
-    std::fprintf(stderr, "[diagnose] %-28s %7.3f s\n", what, std::chrono::duration<double>(t - t0).count());
-    t0 = t;
-  }
-};
-
 json band_json(const std::vector<BandPoint>& band) {
   json a = json::array();
   for (const auto& b : band)
     a.push_back({{"tau_s", b.tau_s}, {"dev", b.dev}, {"band_low", b.low}, {"band_high", b.high}, {"median", b.median},
                  {"edf", b.edf}});
   return a;
+}
+
+/// A simulated model with its band and how well the measurement sits in it.
+json model_json(const NoiseModel& model, const std::vector<BandPoint>& band, double level, double misfit,
+                double coverage) {
+  json m;
+  to_json(m, model);
+  m["band"] = band_json(band);
+  m["band_level"] = level;
+  m["misfit"] = misfit;
+  m["coverage"] = coverage;
+  return m;
 }
 
 double finite_or(double v, double d = 0.0) { return std::isfinite(v) ? v : d; }
@@ -346,13 +348,13 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   r.seed = opt.seed;
   r.band_level = opt.band_level;
   r.alpha = opt.alpha;
-  Timer timer;
+  detail::LapTimer timer("diagnose");
   // Pulse data: the counting read-out is simulated exactly, and its structured AV at short τ
   // would distort the five-term fit, so the base fit starts at 20 s unless a range was given.
   AnalysisOptions aopt = opt.analysis;
   if (rec.phase.exact() && aopt.fit.tau_min_s <= 0) aopt.fit.tau_min_s = kPulseFitTauMin;
   r.analysis = analyze_for_base(rec, aopt);
-  timer.mark("base fit");
+  timer.lap("base fit");
   const PhaseSeries& x = rec.phase;
   const std::size_t n = x.points() - 1;
   r.settings.rate_hz = 1.0 / x.tau0_s;
@@ -375,14 +377,14 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     r.base = rb.model;
     candidate = rb.candidate;
   }
-  timer.mark("pilot calibration");
+  timer.lap("pilot calibration");
 
   // 1. The base model's ensemble: band and detector calibration.
   const auto base_runs = run_ensemble(r.base, r.settings, opt.runs, octave_m, grid, true, opt);
   r.base_band = make_band(r.analysis.allan.points, base_runs, opt.band_level);
   full.ref = make_reference(grid, full.dec.tau_d, base_runs);
   full.runs = opt.runs;
-  timer.mark("base ensemble");
+  timer.lap("base ensemble");
 
   // 2. Detectors on the measurement.
   const auto sin = sinusoid_detect(full.dec);
@@ -448,7 +450,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   if (d_gm.named) effects.push_back(lowpass ? "lowpass" : "gauss_markov");
   if (!d_gm.fired) d_gm.effect = "gauss_markov_or_lowpass";
   r.detectors = {d_sin, d_step, d_warm, d_gm};
-  timer.mark("detectors");
+  timer.lap("detectors");
 
   // 3–4. Extended model: parameters, re-fit, re-simulation.
   const double f_hint = d_sin.named ? sin.f_hz : 0.0;
@@ -482,7 +484,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     const auto ext_runs = run_ensemble(r.extended, r.settings, opt.runs, octave_m, grid, false, opt);
     r.extended_band = make_band(r.analysis.allan.points, ext_runs, opt.band_level);
   }
-  timer.mark("extended model");
+  timer.lap("extended model");
 
   // 5. Gain in sample.
   r.gain.misfit_base = band_misfit(r.base_band, opt.runs);
@@ -526,7 +528,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     const auto e_runs = run_ensemble(shifted(e.model, dt), sh, r.holdout_runs, om, hgrid, false, opt);
     he += band_misfit(make_band(a_pred.points, e_runs, opt.band_level), r.holdout_runs);
   }
-  timer.mark("out-of-sample check");
+  timer.lap("out-of-sample check");
   r.gain.holdout_misfit_base = hb / 2;
   r.gain.holdout_misfit_extended = he / 2;
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
@@ -546,22 +548,14 @@ json to_json(const DiagnoseResult& r) {
   j["seed"] = r.seed;
   j["false_alarm_level_per_detector"] = r.alpha;
   j["simulation_path"] = "ensemble";
-  json base;
-  to_json(base, r.base);
-  base["band"] = band_json(r.base_band);
-  base["band_level"] = r.band_level;
-  base["misfit"] = r.gain.misfit_base;
-  base["coverage"] = r.gain.coverage_base;
-  base["fit"] = {{"Q_arcsec", r.analysis.fit[Term::Q].estimate},
-                 {"N_deg_per_sqrt_h", r.analysis.fit[Term::N].estimate},
-                 {"B_deg_per_h", r.analysis.fit[Term::B].estimate},
-                 {"K_deg_per_h_per_sqrt_h", r.analysis.fit[Term::K].estimate},
-                 {"R_deg_per_h2", r.analysis.fit[Term::R].estimate},
-                 {"chi2_per_dof", r.analysis.fit.chi2_per_dof}};
-  // "fit" would make model_from_analysis_json read the fitted coefficients instead of this
-  // model, so it is kept under a different key.
-  base["fitted_coefficients"] = base["fit"];
-  base.erase("fit");
+  json base = model_json(r.base, r.base_band, r.band_level, r.gain.misfit_base, r.gain.coverage_base);
+  // Not under "fit": model_from_analysis_json would read those coefficients instead of this model.
+  base["fitted_coefficients"] = {{"Q_arcsec", r.analysis.fit[Term::Q].estimate},
+                                 {"N_deg_per_sqrt_h", r.analysis.fit[Term::N].estimate},
+                                 {"B_deg_per_h", r.analysis.fit[Term::B].estimate},
+                                 {"K_deg_per_h_per_sqrt_h", r.analysis.fit[Term::K].estimate},
+                                 {"R_deg_per_h2", r.analysis.fit[Term::R].estimate},
+                                 {"chi2_per_dof", r.analysis.fit.chi2_per_dof}};
   j["base_model"] = base;
   json det = json::array();
   for (const auto& d : r.detectors) {
@@ -581,13 +575,8 @@ json to_json(const DiagnoseResult& r) {
     fnd.push_back(o);
   }
   j["findings"] = fnd;
-  json ext;
-  to_json(ext, r.extended);
-  ext["band"] = band_json(r.extended_band);
-  ext["band_level"] = r.band_level;
-  ext["misfit"] = r.gain.misfit_extended;
-  ext["coverage"] = r.gain.coverage_extended;
-  j["extended_model"] = ext;
+  j["extended_model"] =
+      model_json(r.extended, r.extended_band, r.band_level, r.gain.misfit_extended, r.gain.coverage_extended);
   j["gain"] = {{"misfit_base", r.gain.misfit_base},
                {"misfit_extended", r.gain.misfit_extended},
                {"coverage_base", r.gain.coverage_base},

@@ -51,4 +51,29 @@ class ScopedTimer {
   std::int64_t cpu_ = 0;
 };
 
+/// Consecutive stages of one function: each lap(NAME) prints the time since the previous lap (or
+/// since construction) in the ScopedTimer format, under the same RWCALC_TIMING switch.
+class LapTimer {
+ public:
+  explicit LapTimer(const char* prefix) : prefix_(prefix), on_(timing_enabled()) { restart(); }
+  void lap(const char* name) {
+    if (!on_) return;
+    const std::chrono::duration<double, std::milli> d = std::chrono::steady_clock::now() - start_;
+    std::fprintf(stderr, "timing: %s: %-20s %8.2f ms wall %8.2f ms cpu\n", prefix_, name, d.count(),
+                 static_cast<double>(cpu_ns() - cpu_) * 1e-6);
+    restart();
+  }
+
+ private:
+  void restart() {
+    if (!on_) return;
+    start_ = std::chrono::steady_clock::now();
+    cpu_ = cpu_ns();
+  }
+  const char* prefix_;
+  bool on_;
+  std::chrono::steady_clock::time_point start_;
+  std::int64_t cpu_ = 0;
+};
+
 }  // namespace rwcalc::detail

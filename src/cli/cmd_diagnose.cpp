@@ -8,10 +8,10 @@
 
 #include "cli/analyze_args.hpp"
 #include "cli/commands.hpp"
+#include "cli/plot_args.hpp"
 #include "rwcalc/diagnose.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/output.hpp"
-#include "rwcalc/plot.hpp"
 #include "rwcalc/progress.hpp"
 
 namespace rwcalc::cli {
@@ -29,8 +29,7 @@ struct DiagnoseCmd {
   double alpha = 0.01;
   unsigned threads = 0;
   std::string output = "-";
-  std::string plot;
-  std::string plot_script;
+  PlotArgs plot;
   bool force = false;
 };
 
@@ -56,16 +55,14 @@ void register_diagnose(CLI::App& app, Runner& runner) {
       ->capture_default_str();
   sub->add_option("--threads", cmd->threads, "Simulation threads (default: hardware threads)");
   sub->add_option("-o,--output", cmd->output, "Write to FILE instead of standard output")->capture_default_str();
-  sub->add_flag("--force", cmd->force, "Overwrite existing output files");
-  sub->add_option("--plot", cmd->plot, "Also draw the measurement against both bands into FILE (.svg, .png, .pdf)");
-  sub->add_option("--plot-script", cmd->plot_script, "Also write the figure's gnuplot script (data inline) to FILE");
+  sub->add_flag("--force", cmd->force, "Overwrite existing output, figure and script files");
+  cmd->plot.add_to(*sub, "the measured Allan deviation against the simulated bands of the base and the extended model");
   sub->callback([cmd, &runner] {
     runner = [cmd](Io& io) -> int {
-      if (!cmd->plot.empty()) (void)plot_format_for(cmd->plot);  // reject a bad extension before the work
-      // Refuse to overwrite before the simulations rather than after them.
-      for (const std::string* path : {&cmd->output, &cmd->plot, &cmd->plot_script})
-        if (!path->empty() && *path != "-" && !cmd->force && std::filesystem::exists(*path))
-          throw OutputError(fmt::format("{} exists; use --force to overwrite it", *path));
+      // Refuse bad figure names and existing outputs before the simulations rather than after them.
+      cmd->plot.check(cmd->force);
+      if (cmd->output != "-" && !cmd->force && std::filesystem::exists(cmd->output))
+        throw OutputError(fmt::format("{} exists; use --force to overwrite it", cmd->output));
       DiagnoseOptions opt;
       opt.analysis = cmd->analysis.options();
       opt.analysis.temperature_c = cmd->temperature;
@@ -85,14 +82,7 @@ void register_diagnose(CLI::App& app, Runner& runner) {
         io.out << text;
       else
         write_file_atomic(cmd->output, text, cmd->force);
-      if (!cmd->plot.empty() || !cmd->plot_script.empty()) {
-        PlotOptions po;
-        po.output = cmd->plot;
-        po.script = cmd->plot_script;
-        po.force = cmd->force;
-        const PlotResult pr = plot_diagnosis(j, po);
-        for (const auto& note : pr.notes) io.err << "note: " << note << "\n";
-      }
+      cmd->plot.draw_diagnosis(j, cmd->force, io);
       return 0;
     };
   });

@@ -60,4 +60,9 @@ void PlotArgs::draw_batch(const nlohmann::json& batch, bool force, Io& io) const
   tell(*this, plot_batch(batch, plot_options(*this, force)), io);
 }
 
+void PlotArgs::draw_diagnosis(const nlohmann::json& diagnosis, bool force, Io& io) const {
+  if (!any()) return;
+  tell(*this, plot_diagnosis(diagnosis, plot_options(*this, force)), io);
+}
+
 }  // namespace rwcalc::cli

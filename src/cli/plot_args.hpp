@@ -1,5 +1,5 @@
 #pragma once
-// '--plot FILE' and '--plot-script FILE', shared by 'rwcalc analyze' and 'rwcalc batch': the
+// '--plot FILE' and '--plot-script FILE', shared by 'rwcalc analyze', 'batch' and 'diagnose': the
 // checks made before any analysis (format by extension, existing files without --force, gnuplot
 // present) and the drawing from the command's JSON object.
 #include <CLI/CLI.hpp>
@@ -24,6 +24,8 @@ struct PlotArgs {
   void draw_analysis(const nlohmann::json& analysis, bool force, Io& io) const;
   /// Draw Figs. 1 and 2 of a batch ({"runs": [...]}).
   void draw_batch(const nlohmann::json& batch, bool force, Io& io) const;
+  /// Draw the measurement against the base and extended bands of a `rwcalc diagnose --json` object.
+  void draw_diagnosis(const nlohmann::json& diagnosis, bool force, Io& io) const;
 };
 
 }  // namespace rwcalc::cli
