@@ -12,6 +12,10 @@
 #include <numbers>
 #include <vector>
 
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
+
 #include "noise_id.hpp"
 #include "rwcalc/error.hpp"
 
@@ -125,10 +129,128 @@ int acf_exponent(const P& phase, std::size_t count, int base) {
   }
 }
 
+#if defined(__x86_64__) || defined(__i386__)
+// lag1_autocorrelation<Level> on the int32 view, four z values per instruction: lane j takes the
+// terms k ≡ j (mod 4) exactly as the scalar loop's lanes do, the differences of integers are exact
+// in double whatever the order, and products and sums are separate roundings (no fused
+// multiply-add), so r1 is the scalar one bit for bit. p(k) = rel32[k·stride].
+// p(from) … p(from + n − 1) as doubles into w (stride 1: eight conversions per instruction).
+__attribute__((target("avx2"))) void load_decimated(const std::int32_t* rel32, std::size_t stride, std::size_t from,
+                                                    std::size_t n, double* w) {
+  std::size_t t = 0;
+  if (stride == 1) {
+    for (; t + 4 <= n; t += 4)
+      _mm256_storeu_pd(w + t, _mm256_cvtepi32_pd(_mm_loadu_si128(reinterpret_cast<const __m128i*>(rel32 + from + t))));
+  }
+  for (; t < n; ++t) w[t] = static_cast<double>(rel32[(from + t) * stride]);
+}
+
+template <int Level>
+__attribute__((target("avx2"))) double lag1_rel32_avx2(const std::int32_t* rel32, std::size_t stride,
+                                                       std::size_t count) {
+  auto p = [rel32, stride](std::size_t k) { return static_cast<double>(rel32[k * stride]); };
+  if (count <= static_cast<std::size_t>(Level) + 1) return 0.0;
+  const std::size_t len = count - static_cast<std::size_t>(Level);
+  // The decimated phase goes through a small buffer, a chunk at a time (each value converted once).
+  constexpr std::size_t kChunk = 2048;  // a multiple of 4: the lanes keep k ≡ j (mod 4)
+  constexpr std::size_t kExtra = static_cast<std::size_t>(Level) + 5;
+  alignas(32) double buf[kChunk + kExtra + 3];
+  double mean = 0;
+  if constexpr (Level == 0) {
+    __m256d lane = _mm256_setzero_pd();
+    std::size_t i = 0;
+    while (i + 4 <= len) {
+      const std::size_t stop = std::min(i + kChunk, len) & ~std::size_t{3};
+      load_decimated(rel32, stride, i, stop - i, buf);
+      for (std::size_t t = 0; i < stop; i += 4, t += 4) lane = _mm256_add_pd(lane, _mm256_loadu_pd(buf + t));
+    }
+    alignas(32) double l[4];
+    _mm256_store_pd(l, lane);
+    for (; i < len; ++i) l[0] += p(i);
+    mean = (l[0] + l[1] + l[2] + l[3]) / static_cast<double>(len);
+  } else {
+    mean = (difference(p, Level - 1, len) - difference(p, Level - 1, 0)) / static_cast<double>(len);
+  }
+  const __m256d vmean = _mm256_set1_pd(mean);
+  __m256d num = _mm256_setzero_pd(), den = _mm256_setzero_pd();
+  std::size_t i = 0;
+  while (i + 4 < len) {
+    // Iterations i … (multiples of 4, i + 4 < len) of this chunk read p(i) … p(i + Level + 4).
+    const std::size_t i0 = i;
+    const std::size_t last = std::min(i0 + kChunk, len - 1);  // i < last ⇔ i + 4 < len within the chunk
+    load_decimated(rel32, stride, i0, std::min(last - i0 + kExtra, count - i0), buf);
+    for (; i + 4 < len && i < i0 + kChunk; i += 4) {
+      const double* w = buf + (i - i0);
+      __m256d a, b;
+      const __m256d p0 = _mm256_loadu_pd(w), p1 = _mm256_loadu_pd(w + 1);
+      if constexpr (Level == 0) {
+        a = p0;
+        b = p1;
+      } else {
+        const __m256d p2 = _mm256_loadu_pd(w + 2);
+        const __m256d d0 = _mm256_sub_pd(p1, p0), d1 = _mm256_sub_pd(p2, p1);
+        if constexpr (Level == 1) {
+          a = d0;
+          b = d1;
+        } else {
+          const __m256d p3 = _mm256_loadu_pd(w + 3);
+          const __m256d d2 = _mm256_sub_pd(p3, p2);
+          const __m256d e0 = _mm256_sub_pd(d1, d0), e1 = _mm256_sub_pd(d2, d1);
+          if constexpr (Level == 2) {
+            a = e0;
+            b = e1;
+          } else {
+            const __m256d d3 = _mm256_sub_pd(_mm256_loadu_pd(w + 4), p3);
+            const __m256d e2 = _mm256_sub_pd(d3, d2);
+            a = _mm256_sub_pd(e1, e0);
+            b = _mm256_sub_pd(e2, e1);
+          }
+        }
+      }
+      a = _mm256_sub_pd(a, vmean);
+      b = _mm256_sub_pd(b, vmean);
+      den = _mm256_add_pd(den, _mm256_mul_pd(a, a));
+      num = _mm256_add_pd(num, _mm256_mul_pd(a, b));
+    }
+  }
+  alignas(32) double nu[4], de[4];
+  _mm256_store_pd(nu, num);
+  _mm256_store_pd(de, den);
+  for (; i < len; ++i) {
+    const double a = difference(p, Level, i) - mean;
+    de[0] += a * a;
+    if (i + 1 < len) nu[0] += a * (difference(p, Level, i + 1) - mean);
+  }
+  const double n_sum = nu[0] + nu[1] + nu[2] + nu[3];
+  const double d_sum = de[0] + de[1] + de[2] + de[3];
+  return d_sum > 0 ? n_sum / d_sum : 0.0;
+}
+
+/// acf_exponent() on the int32 view with the AVX2 sums (same result bit for bit).
+int acf_exponent_rel32_avx2(const std::int32_t* rel32, std::size_t stride, std::size_t count, int base) {
+  for (int d = 0;; ++d) {
+    double r1 = 0;
+    switch (base + d) {
+      case 0: r1 = lag1_rel32_avx2<0>(rel32, stride, count); break;
+      case 1: r1 = lag1_rel32_avx2<1>(rel32, stride, count); break;
+      case 2: r1 = lag1_rel32_avx2<2>(rel32, stride, count); break;
+      default: r1 = lag1_rel32_avx2<3>(rel32, stride, count); break;
+    }
+    const double delta = r1 / (1.0 + r1);
+    if (delta < 0.25 || d >= kMaxDifferences) return -static_cast<int>(std::lround(2.0 * delta)) - 2 * d;
+  }
+}
+#endif
+
 /// The ACF method on the phase decimated by m, read in place (no copy): p(k) = x_{k·m} − x_0 as
 /// decimated_phase() forms it, bit for bit.
 int acf_exponent_at(const PhaseSeries& x, std::int64_t m, std::size_t count, int base, const std::int32_t* rel32) {
   const auto um = static_cast<std::size_t>(m);
+#if defined(__x86_64__) || defined(__i386__)
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (rel32 && avx2)
+    return acf_exponent_rel32_avx2(rel32, um, count, base);
+#endif
   if (rel32) {
     if (um == 1) return acf_exponent([rel32](std::size_t k) { return static_cast<double>(rel32[k]); }, count, base);
     return acf_exponent([rel32, um](std::size_t k) { return static_cast<double>(rel32[k * um]); }, count, base);

@@ -221,3 +221,69 @@ TEST(Outliers, LongRecordFindsEverySpikeOnceInOrder) {
 }
 
 }  // namespace
+
+namespace {
+
+// The scan of a phase series (rates computed block by block) is the scan of its rates as a vector,
+// bit for bit: scale, indices, values and z, on exact counts and on a floating phase, on 1 and 2 threads.
+TEST(Outliers, PhaseSeriesScanEqualsVectorScan) {
+  std::mt19937_64 rng(21);
+  std::poisson_distribution<int> pulses(2.5);
+  rwcalc::PhaseSeries counts;
+  counts.tau0_s = 0.0025;
+  counts.arcsec_per_count = 0.92;
+  const std::size_t n = (std::size_t{1} << 20) + 4321;  // long enough for the two-thread screen
+  counts.counts.assign(1, 1000000007);                  // an offset: differences are what count
+  for (std::size_t i = 0; i < n; ++i) {
+    std::int64_t c = pulses(rng);
+    if (i % 99991 == 17 || i == 1 || i == n - 1) c += 60;  // glitches, two at the very ends
+    counts.counts.push_back(counts.counts.back() + c);
+  }
+  rwcalc::PhaseSeries floating;
+  floating.tau0_s = 0.01;
+  floating.kind = rwcalc::PhaseKind::Gyro;
+  auto y = gaussian(300001, 0.4, 22);
+  for (std::size_t i = 0; i < y.size(); i += 7919) y[i] += 30.0;
+  floating.values.assign(1, 5.0);
+  for (double v : y) floating.values.push_back(floating.values.back() + v * floating.tau0_s);
+
+  for (const rwcalc::PhaseSeries* ph : {&counts, &floating}) {
+    std::vector<double> rates(ph->points() - 1);
+    for (std::size_t i = 0; i < rates.size(); ++i) rates[i] = ph->rate(i);
+    const auto sv = rwcalc::outlier_scale(rates);
+    const auto sp = rwcalc::outlier_scale(*ph);
+    EXPECT_EQ(sv.scale, sp.scale);
+    EXPECT_EQ(sv.mad_sigma, sp.mad_sigma);
+    EXPECT_EQ(sv.resolution, sp.resolution);
+    const auto ov = find_outliers(rates, 8.0, sv);
+    EXPECT_FALSE(ov.empty());
+    for (unsigned threads : {1u, 2u}) {
+      const auto op = find_outliers(*ph, 8.0, sp, threads);
+      ASSERT_EQ(ov.size(), op.size()) << "threads " << threads;
+      for (std::size_t k = 0; k < ov.size(); ++k) {
+        EXPECT_EQ(ov[k].index, op[k].index);
+        EXPECT_EQ(ov[k].value, op[k].value);
+        EXPECT_EQ(ov[k].robust_z, op[k].robust_z);
+      }
+    }
+  }
+}
+
+// Short records (7 to 20 samples): edges and interior agree too.
+TEST(Outliers, PhaseSeriesScanEqualsVectorScanOnShortRecords) {
+  for (std::size_t n = 7; n <= 20; ++n) {
+    rwcalc::PhaseSeries ph;
+    ph.counts.assign(1, 0);
+    for (std::size_t i = 0; i < n; ++i) ph.counts.push_back(ph.counts.back() + (i == n / 2 ? 90 : 2 + (i % 3 == 0)));
+    std::vector<double> rates(n);
+    for (std::size_t i = 0; i < n; ++i) rates[i] = ph.rate(i);
+    const auto sv = rwcalc::outlier_scale(rates), sp = rwcalc::outlier_scale(ph);
+    EXPECT_EQ(sv.scale, sp.scale) << n;
+    EXPECT_EQ(sv.resolution, sp.resolution) << n;
+    const auto ov = find_outliers(rates, 8.0, sv), op = find_outliers(ph, 8.0, sp);
+    ASSERT_EQ(ov.size(), op.size()) << n;
+    for (std::size_t k = 0; k < ov.size(); ++k) EXPECT_EQ(ov[k].index, op[k].index) << n;
+  }
+}
+
+}  // namespace
