@@ -215,7 +215,7 @@ bool screen_block(const double* w, std::size_t len, double limit) {
 }
 
 template <class Src>
-OutlierScale scale_of(const Src& src) {
+OutlierScale scale_of(const Src& src, unsigned threads) {
   OutlierScale s;
   const std::size_t n = src.n;
   if (n < kMinSamples) return s;
@@ -233,19 +233,37 @@ OutlierScale scale_of(const Src& src) {
     if (i < 3) a.push_back(std::abs(residual(head, i, 7)));
     else a.push_back(std::abs(residual(tail, i - (n - 7), 7)));
   };
-  std::size_t next = 0;  // next subset index
-  while (next < 3 && next < n) {
-    add_edge(next);
-    next += stride;
-  }
-  std::vector<double> buf(kBlock + 2 * kHalo);
+  for (std::size_t i = 0; i < 3 && i < n; i += stride) add_edge(i);
   const std::size_t end = n - 3;  // interior [3, n − 3)
-  for (std::size_t b = 3; b < end; b += kBlock) {
-    const std::size_t e = std::min(end, b + kBlock);
-    const double* w = src.window(b, e, buf.data());
-    // Steps i in [b+1, e+1), i.e. the window's local [3, e − b + 4) with its previous sample.
-    res = min_step(w + kHalo, e - b + 1, res);
-    for (; next < e; next += stride) a.push_back(std::abs(interior_residual(w, next - b + kHalo)));
+  // Interior blocks [from, to): their steps i in [b+1, e+1) (the window's local [3, e − b + 4)
+  // with its previous sample) and the subset's indices among them.
+  auto blocks = [&](std::size_t from, std::size_t to, double& r, std::vector<double>& out) {
+    std::vector<double> buf(kBlock + 2 * kHalo);
+    std::size_t next = (from + stride - 1) / stride * stride;
+    for (std::size_t b = from; b < to; b += kBlock) {
+      const std::size_t e = std::min(to, b + kBlock);
+      const double* w = src.window(b, e, buf.data());
+      r = min_step(w + kHalo, e - b + 1, r);
+      for (; next < e; next += stride) out.push_back(std::abs(interior_residual(w, next - b + kHalo)));
+    }
+  };
+  // Long records: the second half of the interior on another thread (a minimum and a set of
+  // values: the same whatever the split).
+  constexpr std::size_t kParallelFrom = std::size_t{1} << 20;
+  if (threads == 0) threads = std::thread::hardware_concurrency();
+  if (end > 3 && end - 3 >= kParallelFrom && threads > 1) {
+    const std::size_t mid = 3 + ((end - 3) / 2 / kBlock) * kBlock;
+    double res2 = std::numeric_limits<double>::infinity();
+    std::vector<double> a2;
+    a2.reserve((end - mid) / stride + 1);
+    {
+      std::jthread worker([&] { blocks(mid, end, res2, a2); });
+      blocks(3, mid, res, a);
+    }
+    res = std::min(res, res2);
+    a.insert(a.end(), a2.begin(), a2.end());
+  } else {
+    blocks(3, end, res, a);
   }
   // Remaining steps of the tail: i in [max(4, n − 2), n) — locals of tail.
   {
@@ -255,7 +273,7 @@ OutlierScale scale_of(const Src& src) {
       res = std::min(res, d > 0 ? d : std::numeric_limits<double>::infinity());
     }
   }
-  for (; next < n; next += stride) add_edge(next);
+  for (std::size_t i = std::max<std::size_t>(3, (end + stride - 1) / stride * stride); i < n; i += stride) add_edge(i);
   s.resolution = std::isfinite(res) ? res : 0.0;
 
   auto mid = a.begin() + static_cast<std::ptrdiff_t>(a.size() / 2);
@@ -323,9 +341,11 @@ std::size_t rate_count(const PhaseSeries& phase) { return phase.points() > 0 ? p
 
 }  // namespace
 
-OutlierScale outlier_scale(const std::vector<double>& rates) { return scale_of(VectorRates{rates.data(), rates.size()}); }
+OutlierScale outlier_scale(const std::vector<double>& rates) { return scale_of(VectorRates{rates.data(), rates.size()}, 0); }
 
-OutlierScale outlier_scale(const PhaseSeries& phase) { return scale_of(PhaseRates{phase, rate_count(phase)}); }
+OutlierScale outlier_scale(const PhaseSeries& phase, unsigned threads) {
+  return scale_of(PhaseRates{phase, rate_count(phase)}, threads);
+}
 
 std::vector<Outlier> find_outliers(const std::vector<double>& rates, double threshold) {
   return find_outliers(rates, threshold, outlier_scale(rates));

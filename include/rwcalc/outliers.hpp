@@ -43,7 +43,8 @@ OutlierScale outlier_scale(const std::vector<double>& rates);
 
 /// The same scale for the rates of a phase series (the rates Recording::rates() gives), computed
 /// block by block without a copy of the whole record: bit-identical to outlier_scale(rates).
-OutlierScale outlier_scale(const PhaseSeries& phase);
+/// `threads`: 0 = all hardware threads; records of more than 2^20 samples use two when allowed.
+OutlierScale outlier_scale(const PhaseSeries& phase, unsigned threads = 0);
 
 /// Isolated outliers of `rates`, sorted by index; `line` is 0. Fewer than 7 samples: none.
 std::vector<Outlier> find_outliers(const std::vector<double>& rates,
