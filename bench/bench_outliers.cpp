@@ -3,8 +3,9 @@
 // first (what analyze did before: the copy alone is most of its cost).
 #include <benchmark/benchmark.h>
 
-#include "bench_inputs.hpp"
 #include "rwcalc/outliers.hpp"
+// after the library headers (pulse_writer.hpp's Metadata would shadow RateSource::Metadata)
+#include "bench_inputs.hpp"
 
 namespace {
 
