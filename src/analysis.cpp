@@ -146,9 +146,9 @@ std::vector<Outlier> detect_outliers(const Recording& rec, const AnalysisOptions
   if (!(options.outlier_threshold > 0) || !std::isfinite(options.outlier_threshold))
     throw UsageError(fmt::format("--outlier-threshold must be a positive number, got {}", options.outlier_threshold));
   // The rates are computed block by block from the phase (no copy of the whole record).
-  const OutlierScale scale = outlier_scale(rec.phase, options.allan.threads);
+  OutlierScale scale;
+  std::vector<Outlier> found = scan_outliers(rec.phase, options.outlier_threshold, scale, options.allan.threads);
   rep.scale_deg_per_h = scale.scale;
-  std::vector<Outlier> found = find_outliers(rec.phase, options.outlier_threshold, scale, options.allan.threads);
   rep.count = found.size();
   // Rate sample i comes from data sample i (pulses, rate) or i+1 (counter, angle: the later reading).
   const std::size_t shift = rec.samples > rec.phase.points() - 1 ? 1 : 0;

@@ -214,8 +214,10 @@ bool screen_block(const double* w, std::size_t len, double limit) {
   return hit;
 }
 
+// With `flagged`, the same pass also screens every interior block against a provisional limit
+// `pre` and lists the blocks (their first index) where some |residual| exceeds it.
 template <class Src>
-OutlierScale scale_of(const Src& src, unsigned threads) {
+OutlierScale scale_of(const Src& src, unsigned threads, double pre = 0, std::vector<std::size_t>* flagged = nullptr) {
   OutlierScale s;
   const std::size_t n = src.n;
   if (n < kMinSamples) return s;
@@ -237,7 +239,8 @@ OutlierScale scale_of(const Src& src, unsigned threads) {
   const std::size_t end = n - 3;  // interior [3, n − 3)
   // Interior blocks [from, to): their steps i in [b+1, e+1) (the window's local [3, e − b + 4)
   // with its previous sample) and the subset's indices among them.
-  auto blocks = [&](std::size_t from, std::size_t to, double& r, std::vector<double>& out) {
+  auto blocks = [&](std::size_t from, std::size_t to, double& r, std::vector<double>& out,
+                    std::vector<std::size_t>& hits) {
     std::vector<double> buf(kBlock + 2 * kHalo);
     std::size_t next = (from + stride - 1) / stride * stride;
     for (std::size_t b = from; b < to; b += kBlock) {
@@ -245,8 +248,10 @@ OutlierScale scale_of(const Src& src, unsigned threads) {
       const double* w = src.window(b, e, buf.data());
       r = min_step(w + kHalo, e - b + 1, r);
       for (; next < e; next += stride) out.push_back(std::abs(interior_residual(w, next - b + kHalo)));
+      if (flagged && screen_block(w, e - b, pre)) hits.push_back(b);
     }
   };
+  std::vector<std::size_t> hits1, hits2;
   // Long records: the second half of the interior on another thread (a minimum and a set of
   // values: the same whatever the split).
   constexpr std::size_t kParallelFrom = std::size_t{1} << 20;
@@ -257,13 +262,17 @@ OutlierScale scale_of(const Src& src, unsigned threads) {
     std::vector<double> a2;
     a2.reserve((end - mid) / stride + 1);
     {
-      std::jthread worker([&] { blocks(mid, end, res2, a2); });
-      blocks(3, mid, res, a);
+      std::jthread worker([&] { blocks(mid, end, res2, a2, hits2); });
+      blocks(3, mid, res, a, hits1);
     }
     res = std::min(res, res2);
     a.insert(a.end(), a2.begin(), a2.end());
   } else {
-    blocks(3, end, res, a);
+    blocks(3, end, res, a, hits1);
+  }
+  if (flagged) {
+    *flagged = std::move(hits1);
+    flagged->insert(flagged->end(), hits2.begin(), hits2.end());
   }
   // Remaining steps of the tail: i in [max(4, n − 2), n) — locals of tail.
   {
@@ -283,8 +292,11 @@ OutlierScale scale_of(const Src& src, unsigned threads) {
   return s;
 }
 
+// With `only`, the interior blocks outside that list (first indices, ascending) are known to hold
+// no residual beyond the limit and are not read again.
 template <class Src>
-std::vector<Outlier> outliers_of(const Src& src, double threshold, const OutlierScale& s, unsigned threads) {
+std::vector<Outlier> outliers_of(const Src& src, double threshold, const OutlierScale& s, unsigned threads,
+                                 const std::vector<std::size_t>* only = nullptr) {
   std::vector<Outlier> out;
   const std::size_t n = src.n;
   if (n < kMinSamples) return out;
@@ -320,7 +332,18 @@ std::vector<Outlier> outliers_of(const Src& src, double threshold, const Outlier
   // Long records: the second half of the interior on another thread (results joined in order).
   constexpr std::size_t kParallelFrom = std::size_t{1} << 20;
   if (threads == 0) threads = std::thread::hardware_concurrency();
-  if (end > 3 && end - 3 >= kParallelFrom && threads > 1) {
+  if (only) {
+    std::vector<double> buf(kBlock + 2 * kHalo);
+    for (const std::size_t b : *only) {
+      const std::size_t e = std::min(end, b + kBlock);
+      const double* w = src.window(b, e, buf.data());
+      for (std::size_t i = b; i < e; ++i) {
+        const std::size_t k = i - b + kHalo;
+        const double r = interior_residual(w, k);
+        if (std::abs(r) > limit) out.push_back({i, 0, w[k], r / s.scale});
+      }
+    }
+  } else if (end > 3 && end - 3 >= kParallelFrom && threads > 1) {
     const std::size_t mid = 3 + ((end - 3) / 2 / kBlock) * kBlock;
     std::vector<Outlier> second;
     {
@@ -358,6 +381,26 @@ std::vector<Outlier> find_outliers(const std::vector<double>& rates, double thre
 std::vector<Outlier> find_outliers(const PhaseSeries& phase, double threshold, const OutlierScale& s,
                                    unsigned threads) {
   return outliers_of(PhaseRates{phase, rate_count(phase)}, threshold, s, threads);
+}
+
+std::vector<Outlier> scan_outliers(const PhaseSeries& phase, double threshold, OutlierScale& scale, unsigned threads) {
+  const PhaseRates src{phase, rate_count(phase)};
+  // Exact counts: the limit is at least threshold × one count's rate step (the resolution of
+  // integer data), so one pass can compute the scale and screen every block against (just under)
+  // that bound; only the blocks that trip are read again, against the real limit. If the bound
+  // should exceed the real limit after all, or too many blocks trip (the spread, not the
+  // resolution, sets the scale), the ordinary screen runs instead: the result is the same.
+  const double pre = threshold * (phase.arcsec_per_count / phase.tau0_s) * (1.0 - 1.0 / 1048576.0);
+  if (!phase.exact() || src.n < kMinSamples || !(pre > 0) || !std::isfinite(pre)) {
+    scale = scale_of(src, threads);
+    return outliers_of(src, threshold, scale, threads);
+  }
+  std::vector<std::size_t> flagged;
+  scale = scale_of(src, threads, pre, &flagged);
+  const std::size_t blocks = (src.n - 6 + kBlock - 1) / kBlock;
+  if (threshold * scale.scale >= pre && flagged.size() <= blocks / 16)
+    return outliers_of(src, threshold, scale, threads, &flagged);
+  return outliers_of(src, threshold, scale, threads);
 }
 
 std::vector<Outlier> find_outliers(const Recording& recording, double threshold) {

@@ -287,3 +287,43 @@ TEST(Outliers, PhaseSeriesScanEqualsVectorScanOnShortRecords) {
 }
 
 }  // namespace
+
+namespace {
+
+// scan_outliers (scale and screen in one pass on exact counts) gives what the two calls give:
+// pulse counts whose scale is the resolution (the one-pass path), counts with a wide spread (the
+// spread sets the scale: the ordinary screen), with glitches in both, on 1 and 2 threads.
+TEST(Outliers, OnePassScanEqualsScaleThenScreen) {
+  std::mt19937_64 rng(31);
+  for (double mean : {0.05, 2.5, 400.0}) {
+    std::poisson_distribution<int> pulses(mean);
+    rwcalc::PhaseSeries ph;
+    ph.tau0_s = 0.0025;
+    ph.arcsec_per_count = 0.92;
+    ph.counts.assign(1, -77);
+    const std::size_t n = (std::size_t{1} << 20) + 999;
+    for (std::size_t i = 0; i < n; ++i) {
+      std::int64_t c = pulses(rng);
+      if (i % 65537 == 5 || i == 2 || i == n - 2) c += 20 + static_cast<std::int64_t>(mean) * 4;
+      ph.counts.push_back(ph.counts.back() + c);
+    }
+    for (unsigned threads : {1u, 2u}) {
+      const auto s2 = rwcalc::outlier_scale(ph, threads);
+      const auto o2 = find_outliers(ph, 8.0, s2, threads);
+      rwcalc::OutlierScale s1;
+      const auto o1 = rwcalc::scan_outliers(ph, 8.0, s1, threads);
+      EXPECT_EQ(s1.scale, s2.scale) << mean;
+      EXPECT_EQ(s1.mad_sigma, s2.mad_sigma) << mean;
+      EXPECT_EQ(s1.resolution, s2.resolution) << mean;
+      EXPECT_FALSE(o2.empty()) << mean;
+      ASSERT_EQ(o1.size(), o2.size()) << mean;
+      for (std::size_t k = 0; k < o1.size(); ++k) {
+        EXPECT_EQ(o1[k].index, o2[k].index);
+        EXPECT_EQ(o1[k].value, o2[k].value);
+        EXPECT_EQ(o1[k].robust_z, o2[k].robust_z);
+      }
+    }
+  }
+}
+
+}  // namespace

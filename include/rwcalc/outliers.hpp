@@ -59,6 +59,11 @@ std::vector<Outlier> find_outliers(const std::vector<double>& rates, double thre
 std::vector<Outlier> find_outliers(const PhaseSeries& phase, double threshold, const OutlierScale& scale,
                                    unsigned threads = 0);
 
+/// outlier_scale(phase, threads) and find_outliers(phase, threshold, scale, threads) in one call,
+/// with the same results; on exact counts usually in one pass over the record instead of two.
+std::vector<Outlier> scan_outliers(const PhaseSeries& phase, double threshold, OutlierScale& scale,
+                                   unsigned threads = 0);
+
 /// Same, on a recording's rates, with the input line of each outlier filled in.
 std::vector<Outlier> find_outliers(const Recording& recording,
                                    double threshold = kDefaultOutlierThreshold);
