@@ -1,6 +1,6 @@
 // The outlier scan of `analyze` on the 2-h record: the robust scale and the screen, reading the
-// rates block by block from the exact counts (no copy), against the scan of a rate vector made
-// first (what analyze did before: the copy alone is most of its cost).
+// rates block by block from the exact counts (no copy), in two passes or in one (scan_outliers,
+// what analyze runs), against the scan of a rate vector made first (what analyze did before).
 #include <benchmark/benchmark.h>
 
 #include "rwcalc/outliers.hpp"
@@ -29,6 +29,19 @@ void BM_OutlierScanCounts2h(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(p.points() - 1));
 }
 BENCHMARK(BM_OutlierScanCounts2h)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// What analyze runs: scale and screen in one pass (scan_outliers). Argument: threads.
+void BM_OutlierOnePassCounts2h(benchmark::State& state) {
+  const PhaseSeries& p = bench::gl2d_series();
+  const auto threads = static_cast<unsigned>(state.range(0));
+  for (auto _ : state) {
+    OutlierScale s;
+    auto out = scan_outliers(p, kDefaultOutlierThreshold, s, threads);
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(p.points() - 1));
+}
+BENCHMARK(BM_OutlierOnePassCounts2h)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_OutlierScaleCounts2h(benchmark::State& state) {
   const PhaseSeries& p = bench::gl2d_series();
