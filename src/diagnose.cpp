@@ -459,15 +459,17 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     e_gm.push_back(shape_detect(br.mid_var, loo, c_base).statistic);
   }
   DetectorResult d_gm = calibrate("gauss_markov", gm.statistic, e_gm);
-  // A Gauss–Markov rate adds variance around its peak. A fit that only lowers the mid-τ AV (the
-  // bump traded against less white noise: a deficit, e.g. after a sinusoid absorbed into the
-  // base N and B was removed) is not one. (A low-pass of the sensed rate before counting is a
+  // A Gauss–Markov rate adds variance around its peak, or keeps white rate noise beside it when
+  // the base fit has taken the bump into B. A fit that only lowers the mid-τ AV by trading the
+  // white noise for a bump (a deficit, e.g. after a sinusoid absorbed into the base N and B was
+  // removed) is not one. (A low-pass of the sensed rate before counting is a
   // Gauss–Markov rate, Tc = τf and 2σ²Tc = N², and is named as one.)
-  if (d_gm.fired && gm.excess < kGmMinExcess) {
+  if (d_gm.fired && gm.excess < kGmMinExcess && gm.white_rest < 2.0 * gm.white_rest_sigma) {
     d_gm.named = false;
     d_gm.note = fmt::format("the fitted shape raises the mid-τ Allan variance by at most {:.2g} ensemble standard "
-                            "deviations: a deficit, not a Gauss–Markov bump",
-                            gm.excess);
+                            "deviations and leaves no white rate noise ({:.3g} ± {:.2g} (°/h)²·s): a deficit, not a "
+                            "Gauss–Markov bump",
+                            gm.excess, gm.white_rest, gm.white_rest_sigma);
   }
   if (d_gm.named) effects.push_back("gauss_markov");
 

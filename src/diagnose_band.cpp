@@ -99,6 +99,27 @@ MidTauReference make_reference(const std::vector<std::size_t>& grid, double tau_
     ref.mean.push_back(mean);
     ref.var.push_back(std::max((m2 - double(k) * mean * mean) / double(k - 1), 0.0));
   }
+  // Correlation between grid points over the runs, shrunk toward the identity (few runs).
+  const std::size_t g = grid.size();
+  if (runs.size() >= 5) {
+    constexpr double kShrink = 0.2;
+    ref.corr.assign(g * g, 0.0);
+    for (std::size_t i = 0; i < g; ++i) {
+      for (std::size_t j = i; j < g; ++j) {
+        double c = 0;
+        std::size_t k = 0;
+        for (const auto& r : runs) {
+          if (i >= r.mid_var.size() || j >= r.mid_var.size() || !(r.mid_var[i] > 0) || !(r.mid_var[j] > 0)) continue;
+          c += (r.mid_var[i] - ref.mean[i]) * (r.mid_var[j] - ref.mean[j]);
+          ++k;
+        }
+        const double d = std::sqrt(ref.var[i] * ref.var[j]);
+        double rho = (k > 2 && d > 0) ? c / double(k - 1) / d : 0.0;
+        rho = i == j ? 1.0 : (1.0 - kShrink) * std::clamp(rho, -1.0, 1.0);
+        ref.corr[i * g + j] = ref.corr[j * g + i] = rho;
+      }
+    }
+  }
   return ref;
 }
 

@@ -482,6 +482,7 @@ namespace {
 /// basis columns (normalised; `colscale` holds the factors).
 struct MidTauProblem {
   std::vector<double> y, w, tau;
+  std::vector<std::size_t> index;  ///< grid index of each point
   std::vector<std::vector<double>> cols{4};
   std::array<double, 4> colscale{1, 1, 1, 1};
 };
@@ -491,6 +492,7 @@ MidTauProblem mid_tau_problem(const std::vector<double>& v, const MidTauReferenc
   for (std::size_t i = 0; i < ref.tau.size() && i < v.size(); ++i) {
     if (!(ref.var[i] > 0) || !(v[i] > 0)) continue;
     const double t = ref.tau[i];
+    p.index.push_back(i);
     p.y.push_back(v[i] - ref.mean[i]);
     p.w.push_back(1.0 / ref.var[i]);
     p.tau.push_back(t);
@@ -506,6 +508,40 @@ MidTauProblem mid_tau_problem(const std::vector<double>& v, const MidTauReferenc
     for (double& x : p.cols[c]) x /= p.colscale[c];
   }
   return p;
+}
+
+/// The problem decorrelated with the reference's correlation matrix: with C = D^½ R D^½ (D the
+/// variances) = L·Lᵀ, y and every column are replaced by L⁻¹y, L⁻¹x and the weights by 1, so that
+/// least squares minimise the generalised χ². Without a correlation matrix: unchanged.
+struct Whitener {
+  Eigen::MatrixXd L;
+  bool on = false;
+  std::vector<double> apply(const std::vector<double>& x) const {
+    if (!on) return x;
+    Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(x.data(), static_cast<Eigen::Index>(x.size()));
+    Eigen::VectorXd u = L.triangularView<Eigen::Lower>().solve(v);
+    return std::vector<double>(u.data(), u.data() + u.size());
+  }
+};
+
+Whitener whiten(MidTauProblem& p, const MidTauReference& ref) {
+  Whitener wh;
+  const std::size_t g = ref.grid.size();
+  const std::size_t n = p.y.size();
+  if (ref.corr.size() != g * g || n < 2) return wh;
+  Eigen::MatrixXd C(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
+  for (std::size_t a = 0; a < n; ++a)
+    for (std::size_t b = 0; b < n; ++b)
+      C(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) =
+          ref.corr[p.index[a] * g + p.index[b]] / std::sqrt(p.w[a] * p.w[b]);
+  Eigen::LLT<Eigen::MatrixXd> llt(C);
+  if (llt.info() != Eigen::Success) return wh;
+  wh.L = llt.matrixL();
+  wh.on = true;
+  p.y = wh.apply(p.y);
+  for (auto& c : p.cols) c = wh.apply(c);
+  std::fill(p.w.begin(), p.w.end(), 1.0);
+  return wh;
 }
 
 }  // namespace
@@ -584,8 +620,10 @@ std::array<double, 4> power_law_corrections(const std::vector<double>& v, const 
 ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& ref,
                            const std::array<double, 4>& c_base) {
   ShapeEstimate e;
-  MidTauProblem p = mid_tau_problem(v, ref);
-  if (p.y.size() < 8) return e;
+  const MidTauProblem p0 = mid_tau_problem(v, ref);
+  if (p0.y.size() < 8) return e;
+  MidTauProblem p = p0;
+  const Whitener wh = whiten(p, ref);
   const double c_n_base = c_base[1];
   using Fit = ConstrainedFit;
   auto fit = [&](const std::vector<double>* shape) { return constrained_fit(p, c_base, shape); };
@@ -606,6 +644,7 @@ ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& 
     }
     if (!(m > 0)) continue;
     for (double& x : col) x /= m;
+    col = wh.apply(col);
     Fit f = fit(&col);
     double chi2 = f.a > 0 ? f.chi2 : null.chi2;  // the bump only adds variance
     prof.emplace_back(T, chi2);
@@ -622,10 +661,10 @@ ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& 
   e.dc = null.dc;
   if (!have) return e;
   e.dc = best.dc;
-  for (std::size_t i = 0; i < p.tau.size(); ++i) {
-    double net = e.scale * shape_avar(Shape::GaussMarkov, p.tau[i], e.time);
-    for (std::size_t t = 0; t < 4; ++t) net += best.dc[t] * p.cols[t][i] * p.colscale[t];
-    e.excess = std::max(e.excess, net * std::sqrt(p.w[i]));
+  for (std::size_t i = 0; i < p0.tau.size(); ++i) {
+    double net = e.scale * shape_avar(Shape::GaussMarkov, p0.tau[i], e.time);
+    for (std::size_t t = 0; t < 4; ++t) net += best.dc[t] * p0.cols[t][i] * p0.colscale[t];
+    e.excess = std::max(e.excess, net * std::sqrt(p0.w[i]));
   }
   e.white_rest = std::max(0.0, c_n_base + best.dc[1]);
   e.white_rest_sigma = std::sqrt(std::max(0.0, best.dn_var));

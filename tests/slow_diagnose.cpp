@@ -187,7 +187,7 @@ TEST(DiagnoseAcceptance, DISABLED_WarmupTransient) {
 // RWCALC_DIAGNOSE_GM_RANGE=σlo:σhi:Tclo:Tchi measures another range (the limits quoted in the docs).
 // Measured: see docs/diagnosis.md.
 TEST(DiagnoseAcceptance, GaussMarkov) {
-  double r[4] = {0.02, 0.04, 30, 300};
+  double r[4] = {0.03, 0.05, 20, 80};
   if (const char* e = std::getenv("RWCALC_DIAGNOSE_GM_RANGE"))
     std::sscanf(e, "%lf:%lf:%lf:%lf", &r[0], &r[1], &r[2], &r[3]);
   const auto t = run_effect(

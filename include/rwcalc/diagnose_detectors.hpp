@@ -73,6 +73,9 @@ struct MidTauReference {
   std::vector<std::size_t> grid;
   std::vector<double> tau;
   std::vector<double> mean, var;
+  /// Correlation of the runs' AV between grid points (row-major, grid.size()²), shrunk toward the
+  /// identity (the overlapping AV at neighbouring τ is strongly correlated); empty: independent.
+  std::vector<double> corr;
 };
 
 struct ShapeEstimate {
