@@ -27,6 +27,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kPulseFitTauMin = 20.0;  ///< s, start of the base fit for pulse data
+constexpr double kGmMinPeakRatio = 0.6;  ///< bump AV at its peak / base AV there, to name a Gauss–Markov term
 constexpr double kGmMinExcess = 2.0;      ///< ensemble SDs a Gauss–Markov bump must raise the mid-τ AV by
 
 double term_value(const FitResult& f, Term t) {
@@ -456,7 +457,8 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   std::vector<double> e_gm;
   for (const auto& br : base_runs) {
     const auto loo = leave_one_out(full.ref, br.mid_var, opt.runs);
-    e_gm.push_back(shape_detect(br.mid_var, loo, c_base).statistic);
+    // Each record without its own mean-shape candidate, as the measurement.
+    e_gm.push_back(shape_detect(br.mid_var_clean.empty() ? br.mid_var : br.mid_var_clean, loo, c_base).statistic);
   }
   DetectorResult d_gm = calibrate("gauss_markov", gm.statistic, e_gm);
   // A Gauss–Markov rate adds variance around its peak, or keeps white rate noise beside it when
@@ -470,6 +472,14 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
                             "deviations and leaves no white rate noise ({:.3g} ± {:.2g} (°/h)²·s): a deficit, not a "
                             "Gauss–Markov bump",
                             gm.excess, gm.white_rest, gm.white_rest_sigma);
+  }
+  // A bump far below the local AV is a re-arrangement of the flicker or white noise (a flicker
+  // floor is a sum of Gauss–Markov terms): named only when it carries a sizeable share there.
+  if (d_gm.named && gm.peak_ratio < kGmMinPeakRatio) {
+    d_gm.named = false;
+    d_gm.note = fmt::format("the bump's Allan variance at its peak is {:.2g} of the base model's there (at least {:g} "
+                            "needed): not told apart from the flicker and white noise",
+                            gm.peak_ratio, kGmMinPeakRatio);
   }
   if (d_gm.named) effects.push_back("gauss_markov");
 

@@ -44,8 +44,18 @@ std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSett
         st.mid_var = decimated_avar(d, mid_grid);
         if (with_detectors) {
           st.sin_stat = sinusoid_detect(d, 0.0, false).statistic;
-          st.step_stat = step_detect(d).statistic;
-          st.warm_stat = warmup_detect(d).statistic;
+          const auto step = step_detect(d);
+          const auto warm = warmup_detect(d);
+          st.step_stat = step.statistic;
+          st.warm_stat = warm.statistic;
+          NoiseModel cand;
+          if (step.rss <= warm.rss)
+            cand.bias_steps.push_back({step.t_s, step.size});
+          else
+            cand.warmups.push_back({warm.amp, warm.tc});
+          Decimated dc = d;
+          subtract_deterministic(dc, cand);
+          st.mid_var_clean = decimated_avar(dc, mid_grid);
         }
       },
       eo);
@@ -99,11 +109,10 @@ MidTauReference make_reference(const std::vector<std::size_t>& grid, double tau_
     ref.mean.push_back(mean);
     ref.var.push_back(std::max((m2 - double(k) * mean * mean) / double(k - 1), 0.0));
   }
-  // Correlation between grid points over the runs, shrunk toward the identity (few runs).
+  // Covariance between grid points over the runs.
   const std::size_t g = grid.size();
   if (runs.size() >= 5) {
-    constexpr double kShrink = 0.2;
-    ref.corr.assign(g * g, 0.0);
+    ref.cov.assign(g * g, 0.0);
     for (std::size_t i = 0; i < g; ++i) {
       for (std::size_t j = i; j < g; ++j) {
         double c = 0;
@@ -113,10 +122,7 @@ MidTauReference make_reference(const std::vector<std::size_t>& grid, double tau_
           c += (r.mid_var[i] - ref.mean[i]) * (r.mid_var[j] - ref.mean[j]);
           ++k;
         }
-        const double d = std::sqrt(ref.var[i] * ref.var[j]);
-        double rho = (k > 2 && d > 0) ? c / double(k - 1) / d : 0.0;
-        rho = i == j ? 1.0 : (1.0 - kShrink) * std::clamp(rho, -1.0, 1.0);
-        ref.corr[i * g + j] = ref.corr[j * g + i] = rho;
+        ref.cov[i * g + j] = ref.cov[j * g + i] = k > 2 ? c / double(k - 1) : 0.0;
       }
     }
   }

@@ -19,6 +19,7 @@ namespace rwcalc::diag {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+constexpr double kCorrShrink = 0.2;  ///< weight of the identity in the mid-τ correlation matrix
 
 double median_of(std::vector<double> v) {
   if (v.empty()) return 0.0;
@@ -528,12 +529,17 @@ Whitener whiten(MidTauProblem& p, const MidTauReference& ref) {
   Whitener wh;
   const std::size_t g = ref.grid.size();
   const std::size_t n = p.y.size();
-  if (ref.corr.size() != g * g || n < 2) return wh;
+  if (ref.cov.size() != g * g || n < 2) return wh;
+  // Correlations shrunk toward the identity: the runs are fewer than the grid points.
+  const double shrink = kCorrShrink;
   Eigen::MatrixXd C(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
   for (std::size_t a = 0; a < n; ++a)
-    for (std::size_t b = 0; b < n; ++b)
-      C(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) =
-          ref.corr[p.index[a] * g + p.index[b]] / std::sqrt(p.w[a] * p.w[b]);
+    for (std::size_t b = 0; b < n; ++b) {
+      const std::size_t ia = p.index[a], ib = p.index[b];
+      const double d = std::sqrt(ref.var[ia] * ref.var[ib]);
+      double rho = a == b ? 1.0 : (d > 0 ? std::clamp(ref.cov[ia * g + ib] / d, -1.0, 1.0) * (1.0 - shrink) : 0.0);
+      C(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) = rho / std::sqrt(p.w[a] * p.w[b]);
+    }
   Eigen::LLT<Eigen::MatrixXd> llt(C);
   if (llt.info() != Eigen::Success) return wh;
   wh.L = llt.matrixL();
@@ -628,7 +634,9 @@ ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& 
   using Fit = ConstrainedFit;
   auto fit = [&](const std::vector<double>* shape) { return constrained_fit(p, c_base, shape); };
   const Fit null = fit(nullptr);
-  const double lt_lo = std::log(std::max(p.tau.front() / 3.0, 0.3)), lt_hi = std::log(p.tau.back() / 2.0);
+  // Correlation times from 3× the shortest τ (a bump peaking at the grid's first points is white
+  // rate noise there: not identifiable) to half the longest.
+  const double lt_lo = std::log(3.0 * p.tau.front()), lt_hi = std::log(p.tau.back() / 2.0);
   const int G = 48;
   double best_chi2 = null.chi2;
   std::vector<std::pair<double, double>> prof;
@@ -666,6 +674,14 @@ ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& 
     for (std::size_t t = 0; t < 4; ++t) net += best.dc[t] * p0.cols[t][i] * p0.colscale[t];
     e.excess = std::max(e.excess, net * std::sqrt(p0.w[i]));
   }
+  {
+    const double tp = 1.8926 * e.time;
+    std::size_t k = 0;
+    for (std::size_t i = 1; i < p0.tau.size(); ++i)
+      if (std::abs(std::log(p0.tau[i] / tp)) < std::abs(std::log(p0.tau[k] / tp))) k = i;
+    const double m = ref.mean[p0.index[k]];
+    e.peak_ratio = m > 0 ? e.scale * shape_avar(Shape::GaussMarkov, tp, e.time) / m : 0.0;
+  }
   e.white_rest = std::max(0.0, c_n_base + best.dc[1]);
   e.white_rest_sigma = std::sqrt(std::max(0.0, best.dn_var));
   e.time_low = e.time_high = e.time;
@@ -687,6 +703,17 @@ MidTauReference leave_one_out(const MidTauReference& ref, const std::vector<doub
     const double ss = ref.var[i] * (K - 1) - (v[i] - ref.mean[i]) * (v[i] - m);
     r.mean[i] = m;
     r.var[i] = std::max(ss / (K - 2), 1e-300);
+  }
+  // Covariance without the run: S' = S − K/(K − 1)·(v − m)(v − m)ᵀ.
+  const std::size_t g = ref.mean.size();
+  if (ref.cov.size() == g * g && v.size() >= g) {
+    for (std::size_t i = 0; i < g; ++i)
+      for (std::size_t j = 0; j < g; ++j) {
+        const double s = ref.cov[i * g + j] * (K - 1) - K / (K - 1) * (v[i] - ref.mean[i]) * (v[j] - ref.mean[j]);
+        r.cov[i * g + j] = s / (K - 2);
+      }
+  } else {
+    r.cov.clear();
   }
   return r;
 }

@@ -73,9 +73,9 @@ struct MidTauReference {
   std::vector<std::size_t> grid;
   std::vector<double> tau;
   std::vector<double> mean, var;
-  /// Correlation of the runs' AV between grid points (row-major, grid.size()²), shrunk toward the
-  /// identity (the overlapping AV at neighbouring τ is strongly correlated); empty: independent.
-  std::vector<double> corr;
+  /// Sample covariance of the runs' AV between grid points (row-major, grid.size()²; the
+  /// overlapping AV at neighbouring τ is strongly correlated); empty: treated as independent.
+  std::vector<double> cov;
 };
 
 struct ShapeEstimate {
@@ -90,6 +90,9 @@ struct ShapeEstimate {
   /// ensemble standard deviations: a Gauss–Markov term adds variance somewhere; a fit that only
   /// lowers the AV (a deficit) is not one.
   double excess = 0;
+  /// The bump's AV at its peak (τ = 1.89·Tc) over the reference's mean AV there: how far it stands
+  /// above the local Allan variance.
+  double peak_ratio = 0;
 };
 enum class Shape { GaussMarkov, Lowpass };
 /// AV of a unit-variance Gauss–Markov process (Shape::GaussMarkov, time = Tc) or minus the AV
@@ -144,6 +147,9 @@ double quantile(std::vector<double> v, double p);
 struct RunStats {
   std::vector<double> octave_var;
   std::vector<double> mid_var;
+  /// With detectors: the mid-τ AV after the record's own mean-shape candidate (the better of the
+  /// best step and the best warm-up) is removed, as it is from the measurement.
+  std::vector<double> mid_var_clean;
   double sin_stat = 0, step_stat = 0, warm_stat = 0;
 };
 
