@@ -155,6 +155,23 @@ OutputLowpassEstimate lowpass_of(const AllanResult& a, double duration) {
   return output_lowpass_detect(m, v, edf, a.tau0_s, duration);
 }
 
+/// Whether a floating series is whole multiples of one step (pulse counts given as numbers): its
+/// first 10⁵ increments are within 10⁻³ of integer multiples of the smallest non-zero one.
+bool on_lattice(const PhaseSeries& x) {
+  const std::size_t n = std::min<std::size_t>(x.points() - 1, 100000);
+  double step = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double d = std::abs(x.diff(i + 1, i));
+    if (d > 1e-9 && (step == 0 || d < step)) step = d;
+  }
+  if (!(step > 0)) return false;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double r = std::abs(x.diff(i + 1, i)) / step;
+    if (std::abs(r - std::round(r)) > 1e-3) return false;
+  }
+  return true;
+}
+
 /// Everything needed to estimate named effects on one stretch of data.
 struct Stretch {
   const Recording* rec = nullptr;   ///< the stretch as a recording
@@ -489,6 +506,8 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   d_lp.effect = "lowpass";
   if (x.exact()) {
     d_lp.note = "whole pulse counts: no filter in the output chain";
+  } else if (on_lattice(x)) {
+    d_lp.note = "the samples are whole multiples of one step (pulse counts as numbers): no filter in the output chain";
   } else {
     const auto lp = lowpass_of(r.analysis.allan, T);
     std::vector<std::int64_t> om;

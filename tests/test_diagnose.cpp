@@ -167,6 +167,34 @@ TEST(DiagnoseBlocks, LowpassFindingIsTheOutputChainFilter) {
   EXPECT_THROW(validate(m, SimulationSettings{}), UsageError);
 }
 
+TEST(DiagnoseBlocks, LowpassDetectorSkipsPulseCountsGivenAsNumbers) {
+  // A counting read-out written as angles (whole multiples of q): the read-out's sawtooth is not
+  // an output-chain filter, and the detector says why it did not run.
+  NoiseModel m;
+  m.arw_deg_per_sqrt_h = 0.001;
+  m.earth_rate_deg_per_h = 12.43;
+  SimulationSettings s;
+  s.duration_s = 1300;
+  s.rate_hz = 100;
+  s.seed = 5;
+  Recording rec;
+  rec.source = "counts-as-angle";
+  rec.phase = simulate(m, s);
+  PhaseSeries& x = rec.phase;
+  x.values.resize(x.counts.size());
+  for (std::size_t i = 0; i < x.counts.size(); ++i) x.values[i] = x.diff(i, 0);
+  x.counts.clear();
+  rec.rate_hz = 100;
+  rec.samples = x.points() - 1;
+  DiagnoseOptions o;
+  o.runs = 10;
+  const auto r = diagnose(rec, o);
+  ASSERT_EQ(r.detectors.size(), 5u);
+  EXPECT_EQ(r.detectors[4].effect, "lowpass");
+  EXPECT_FALSE(r.detectors[4].fired);
+  EXPECT_NE(r.detectors[4].note.find("multiples"), std::string::npos) << r.detectors[4].note;
+}
+
 TEST(DiagnoseBlocks, GumbelThresholdSitsInTheTail) {
   std::mt19937_64 g(3);
   std::extreme_value_distribution<double> ev(10.0, 2.0);
