@@ -155,21 +155,28 @@ OutputLowpassEstimate lowpass_of(const AllanResult& a, double duration) {
   return output_lowpass_detect(m, v, edf, a.tau0_s, duration);
 }
 
-/// Whether a floating series is whole multiples of one step (pulse counts given as numbers): its
-/// first 10⁵ increments are within 10⁻³ of integer multiples of the smallest non-zero one.
+/// Whether a floating series is pulse counts given as numbers: its first 10⁵ increments are
+/// within 10⁻³ of integer multiples of the smallest non-zero one, and that step is coarse against
+/// the increments' own scatter (at least half their standard deviation). A finely quantized
+/// read-out (an ADC's least significant bit far below the noise) is not counting.
 bool on_lattice(const PhaseSeries& x) {
   const std::size_t n = std::min<std::size_t>(x.points() - 1, 100000);
-  double step = 0;
+  if (n < 2) return false;
+  double step = 0, sum = 0, sum2 = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    const double d = std::abs(x.diff(i + 1, i));
-    if (d > 1e-9 && (step == 0 || d < step)) step = d;
+    const double d = x.diff(i + 1, i);
+    sum += d;
+    sum2 += d * d;
+    if (std::abs(d) > 1e-9 && (step == 0 || std::abs(d) < step)) step = std::abs(d);
   }
   if (!(step > 0)) return false;
   for (std::size_t i = 0; i < n; ++i) {
     const double r = std::abs(x.diff(i + 1, i)) / step;
     if (std::abs(r - std::round(r)) > 1e-3) return false;
   }
-  return true;
+  const double mean = sum / double(n);
+  const double sd = std::sqrt(std::max(0.0, sum2 / double(n) - mean * mean));
+  return step >= 0.5 * sd;
 }
 
 /// Everything needed to estimate named effects on one stretch of data.
@@ -507,7 +514,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   if (x.exact()) {
     d_lp.note = "whole pulse counts: no filter in the output chain";
   } else if (on_lattice(x)) {
-    d_lp.note = "the samples are whole multiples of one step (pulse counts as numbers): no filter in the output chain";
+    d_lp.note = "the samples are whole multiples of a step coarse against their scatter (pulse counts as numbers): no filter in the output chain";
   } else {
     const auto lp = lowpass_of(r.analysis.allan, T);
     std::vector<std::int64_t> om;
