@@ -137,14 +137,6 @@ __attribute__((target("avx2"))) void load_decimated(const std::int32_t* rel32, s
   if (stride == 1) {
     for (; t + 4 <= n; t += 4)
       _mm256_storeu_pd(w + t, _mm256_cvtepi32_pd(_mm_loadu_si128(reinterpret_cast<const __m128i*>(rel32 + from + t))));
-  } else if (stride >= 16) {
-    // One cache line per point, often beyond the page the hardware prefetcher follows: ask for the
-    // line kAhead points ahead (within the chunk) so that several misses are in flight at once.
-    constexpr std::size_t kAhead = 32;
-    for (; t + kAhead < n; ++t) {
-      __builtin_prefetch(rel32 + (from + t + kAhead) * stride);
-      w[t] = static_cast<double>(rel32[(from + t) * stride]);
-    }
   }
   for (; t < n; ++t) w[t] = static_cast<double>(rel32[(from + t) * stride]);
 }
