@@ -32,7 +32,7 @@ double modified_sumsq_values(const double* x, std::int64_t n, std::int64_t m);
 std::vector<std::uint64_t> count_prefix_sums(const std::vector<std::int64_t>& c);
 
 /// Cumulative counts prepared once for many cluster sizes. When every C_k − C_0 fits in ±2^30
-/// (any real gyro record: 2^30 pulses of 0.92″ are 274 000 revolutions) the counts are kept as
+/// (any real gyro record: 2^30 pulses of 0.92″ are 762 revolutions) the counts are kept as
 /// int32 offsets from C_0, which halves the memory traffic and lets the loops convert to double
 /// exactly with one instruction; the squares are still summed exactly (blocks checked against
 /// 2^21, redone in 128 bits when larger). Otherwise the int64 path is used. Offsets from C_0 are
