@@ -255,6 +255,30 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
   }
   const double q = x.arcsec_per_count;
 
+  // Overlapping sums of every τ of a grid in one sweep over the data per thread (the threads take
+  // every threads-th τ), when the counts allow the sweep kernel; exact, so the same bits as per τ.
+  std::vector<detail::u128> swept;
+  if (x.exact() && est == Estimator::Overlapping && options.grid.kind != TauGrid::Kind::All) {
+    detail::ScopedTimer t("allan: swept variance sums");
+    swept.resize(ms.size());
+    bool ok = false;
+    if (threads > 1) {
+      std::vector<char> oks(threads, 0);
+      {
+        std::vector<std::jthread> pool;
+        for (unsigned k = 1; k < threads; ++k)
+          pool.emplace_back([&, k] {
+            oks[k] = detail::second_diff_sumsq_sweep(prepared, points, ms.data(), ms.size(), k, threads, swept.data());
+          });
+        oks[0] = detail::second_diff_sumsq_sweep(prepared, points, ms.data(), ms.size(), 0, threads, swept.data());
+      }
+      ok = std::all_of(oks.begin(), oks.end(), [](char v) { return v != 0; });
+    } else {
+      ok = detail::second_diff_sumsq_sweep(prepared, points, ms.data(), ms.size(), 0, 1, swept.data());
+    }
+    if (!ok) swept.clear();
+  }
+
   const bool timing = detail::timing_enabled();
   std::atomic<std::int64_t> ns_sums{0}, ns_noise{0};
   auto work = [&](std::size_t i) {
@@ -270,6 +294,9 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
       p.var = p.n > 0 ? fft_sums[static_cast<std::size_t>(p.m)] * scale /
                             (2.0 * p.tau_s * p.tau_s * static_cast<double>(p.n))
                       : 0.0;
+    } else if (!swept.empty()) {
+      p.n = term_count(est, p.m, points);
+      p.var = p.n > 0 ? finish_counts(swept[i], q, p.tau_s, static_cast<double>(p.n)) : 0.0;
     } else {
       p.var = variance_at(x, p.m, est, x.exact() ? &prepared : nullptr, &p.n);
     }

@@ -325,6 +325,45 @@ __attribute__((target("avx2"))) bool block_sumsq_i29_avx2(const std::int32_t* __
 }
 #endif
 
+#if RWCALC_X86_DISPATCH
+// The same sum when every |C_k − C_0| < 2^24 (PreparedCounts::small24): then |d| ≤ |e| + |a| + 2|b| < 2^26
+// for every term, so the range check of block_sumsq_i29_avx2 is not needed; a 64-bit lane
+// holds up to 1024 squares below 2^52, and a block of 4096 terms sums to below 2^64 (blocks of 4096,
+// sixteen terms per iteration in four accumulators). The result is the exact integer sum, as above.
+constexpr std::int64_t kBlock24 = 4096;
+__attribute__((target("avx2"))) std::uint64_t block_sumsq_i24_avx2(const std::int32_t* __restrict a,
+                                                                   const std::int32_t* __restrict b,
+                                                                   const std::int32_t* __restrict e,
+                                                                   std::int64_t len) {
+  __m256i acc0 = _mm256_setzero_si256(), acc1 = _mm256_setzero_si256();
+  __m256i acc2 = _mm256_setzero_si256(), acc3 = _mm256_setzero_si256();
+#define RWCALC_LOAD8(p) _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p))
+  std::int64_t i = 0;
+  for (; i + 16 <= len; i += 16) {
+    const __m256i vb0 = RWCALC_LOAD8(b + i), vb1 = RWCALC_LOAD8(b + i + 8);
+    const __m256i d0 = _mm256_sub_epi32(_mm256_add_epi32(RWCALC_LOAD8(e + i), RWCALC_LOAD8(a + i)),
+                                        _mm256_add_epi32(vb0, vb0));
+    const __m256i d1 = _mm256_sub_epi32(_mm256_add_epi32(RWCALC_LOAD8(e + i + 8), RWCALC_LOAD8(a + i + 8)),
+                                        _mm256_add_epi32(vb1, vb1));
+    const __m256i h0 = _mm256_srli_epi64(d0, 32), h1 = _mm256_srli_epi64(d1, 32);
+    acc0 = _mm256_add_epi64(acc0, _mm256_mul_epi32(d0, d0));
+    acc1 = _mm256_add_epi64(acc1, _mm256_mul_epi32(h0, h0));
+    acc2 = _mm256_add_epi64(acc2, _mm256_mul_epi32(d1, d1));
+    acc3 = _mm256_add_epi64(acc3, _mm256_mul_epi32(h1, h1));
+  }
+#undef RWCALC_LOAD8
+  alignas(32) std::uint64_t lanes[4];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(lanes),
+                     _mm256_add_epi64(_mm256_add_epi64(acc0, acc1), _mm256_add_epi64(acc2, acc3)));
+  std::uint64_t s = lanes[0] + lanes[1] + lanes[2] + lanes[3];  // len ≤ 4096 squares < 2^52: < 2^64
+  for (; i < len; ++i) {
+    const std::int64_t d = std::int64_t{e[i]} + std::int64_t{a[i]} - 2 * std::int64_t{b[i]};
+    s += static_cast<std::uint64_t>(d * d);
+  }
+  return s;
+}
+#endif
+
 bool block_sumsq_i32(const std::int32_t* a, const std::int32_t* b, const std::int32_t* e, std::int64_t len,
                      double* out) {
 #if RWCALC_X86_DISPATCH
@@ -408,6 +447,7 @@ PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_pref
   const bool small = lo > -kLimit && hi < kLimit;
   const std::int64_t top = std::max(-lo, hi);
   p.small29 = top < (std::int64_t{1} << 29);
+  p.small24 = top < (std::int64_t{1} << 24);
   if (!small) {
     p.rel32.clear();
     p.rel32.shrink_to_fit();
@@ -437,6 +477,13 @@ u128 second_diff_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m, 
   u128 total = 0;
 #if RWCALC_X86_DISPATCH
   static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (avx2 && c.small24) {
+    for (std::int64_t k0 = 0; k0 < n; k0 += kBlock24) {
+      const std::int64_t len = std::min(kBlock24, n - k0);
+      total += block_sumsq_i24_avx2(r + k0, r + k0 + m, r + k0 + 2 * m, len);
+    }
+    return total;
+  }
   if (avx2 && c.small29) {
     for (std::int64_t k0 = 0; k0 < n; k0 += kBlock) {
       const std::int64_t len = std::min(kBlock, n - k0);
@@ -458,6 +505,32 @@ u128 second_diff_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m, 
       total += exact_block_i32(r, k0, len, m, 1);
   }
   return total;
+}
+
+bool second_diff_sumsq_sweep(const PreparedCounts& c, std::size_t points, const std::int64_t* ms,
+                             std::size_t count, std::size_t first, std::size_t step, u128* out) {
+#if RWCALC_X86_DISPATCH
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (!avx2 || !c.small24 || c.rel32.empty() || step == 0) return false;
+  const std::int32_t* r = c.rel32.data();
+  const auto np = static_cast<std::int64_t>(points);
+  std::int64_t longest = 0;
+  for (std::size_t i = first; i < count; i += step) {
+    out[i] = 0;
+    longest = std::max(longest, np - 2 * ms[i]);
+  }
+  for (std::int64_t k0 = 0; k0 < longest; k0 += kBlock24) {
+    for (std::size_t i = first; i < count; i += step) {
+      const std::int64_t m = ms[i], n = np - 2 * m;
+      if (k0 >= n) continue;
+      out[i] += block_sumsq_i24_avx2(r + k0, r + k0 + m, r + k0 + 2 * m, std::min(kBlock24, n - k0));
+    }
+  }
+  return true;
+#else
+  (void)c, (void)points, (void)ms, (void)count, (void)first, (void)step, (void)out;
+  return false;
+#endif
 }
 
 double modified_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m) {

@@ -32,7 +32,7 @@ double modified_sumsq_values(const double* x, std::int64_t n, std::int64_t m);
 std::vector<std::uint64_t> count_prefix_sums(const std::vector<std::int64_t>& c);
 
 /// Cumulative counts prepared once for many cluster sizes. When every C_k − C_0 fits in ±2^30
-/// (any real gyro record: 2^30 pulses of 0.92″ are 274 000 revolutions) the counts are kept as
+/// (any real gyro record: 2^30 pulses of 0.92″ are 762 revolutions) the counts are kept as
 /// int32 offsets from C_0, which halves the memory traffic and lets the loops convert to double
 /// exactly with one instruction; the squares are still summed exactly (blocks checked against
 /// 2^21, redone in 128 bits when larger). Otherwise the int64 path is used. Offsets from C_0 are
@@ -61,11 +61,20 @@ struct PreparedCounts {
   const std::vector<std::int64_t>* raw = nullptr;
   std::vector<std::int32_t, UninitAllocator<std::int32_t>> rel32;  ///< C_k − C_0, when small enough
   bool small29 = false;                 ///< every |C_k − C_0| < 2^29: second differences fit int32
+  bool small24 = false;                 ///< every |C_k − C_0| < 2^24: every |d| < 2^26, no per-block check
   std::vector<double> prefix_f64;       ///< Σ_{i<k} (C_i − C_0), exact integers (MVAR), when small enough
   std::vector<std::uint64_t> prefix_u64;  ///< modular prefix sums of C (MVAR) otherwise
 };
 PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_prefix, unsigned threads = 1);
 u128 second_diff_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m, std::int64_t stride);
 double modified_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m);
+
+/// Overlapping sums Σ_{k<N−2m} (C[k+2m] − 2C[k+m] + C[k])² for the cluster sizes ms[first],
+/// ms[first + step], … (ascending), all in one sweep over the data: each block of 4096 terms is
+/// taken for every m while it is in the core's cache, instead of streaming the whole int32 view once
+/// per m. Exact, so out[i] equals second_diff_sumsq(c, N − 2m, m, 1) bit for bit. Only for counts
+/// with every |C_k − C_0| < 2^24 on AVX2 machines; returns false (and writes nothing) otherwise.
+bool second_diff_sumsq_sweep(const PreparedCounts& c, std::size_t points, const std::int64_t* ms,
+                             std::size_t count, std::size_t first, std::size_t step, u128* out);
 
 }  // namespace rwcalc::detail

@@ -111,6 +111,67 @@ TEST(AllanCounts, LargeSecondDifferencesTakeTheExact128BitPath) {
   }
 }
 
+/// Σ (C[k+2m] − 2C[k+m] + C[k])² exactly in 128 bits, scaled as the engine scales it.
+double exact_oavar(const PhaseSeries& x, std::int64_t m) {
+  __extension__ typedef unsigned __int128 u128;
+  __extension__ typedef __int128 i128;
+  const auto n = static_cast<std::int64_t>(x.points()) - 2 * m;
+  u128 s = 0;
+  for (std::int64_t k = 0; k < n; ++k) {
+    const auto c = [&](std::int64_t i) { return static_cast<i128>(x.counts[static_cast<std::size_t>(i)]); };
+    const i128 d = c(k + 2 * m) - 2 * c(k + m) + c(k);
+    s += static_cast<u128>(d * d);
+  }
+  const double tau = static_cast<double>(m) * x.tau0_s;
+  return static_cast<double>(s) * (x.arcsec_per_count * x.arcsec_per_count) / (2.0 * tau * tau * static_cast<double>(n));
+}
+
+TEST(AllanCounts, EveryCountRangeGivesTheExactSum) {
+  // Ranges on either side of each kernel's limit (|C − C0| < 2^24: unchecked int32 lanes; < 2^29:
+  // checked int32 lanes; < 2^30: int32 offsets in double; beyond: int64), each record long enough for
+  // several blocks. The extreme one alternates ±(2^24 − 1), so every |d| is 4·(2^24 − 1) and a
+  // block's sum comes within a factor 1.0000002 of 2^64.
+  const std::int64_t v24 = (std::int64_t{1} << 24) - 1;
+  std::vector<PhaseSeries> records;
+  {
+    PhaseSeries s;
+    s.tau0_s = 0.0025;
+    s.arcsec_per_count = 0.92;
+    for (int i = 0; i < 20011; ++i) s.counts.push_back(1000 + (i == 0 ? 0 : i % 2 ? v24 : -v24));
+    records.push_back(s);
+  }
+  for (std::int64_t limit : {v24 - 7, v24 + 9, (std::int64_t{1} << 29) + 5, (std::int64_t{1} << 30) + 5}) {
+    std::mt19937_64 rng(static_cast<unsigned>(limit));
+    std::uniform_int_distribution<std::int64_t> d(-limit, limit);
+    PhaseSeries s;
+    s.tau0_s = 0.0025;
+    s.arcsec_per_count = 0.92;
+    s.counts.push_back(-77);
+    for (int i = 1; i < 20011; ++i) s.counts.push_back(-77 + (i % 97 ? d(rng) : (i % 2 ? limit - 1 : 1 - limit)));
+    records.push_back(s);
+  }
+  for (std::size_t r = 0; r < records.size(); ++r) {
+    for (std::int64_t m : {1, 2, 3, 5, 16, 17, 100, 4097, 9000}) {
+      SCOPED_TRACE("record " + std::to_string(r) + " m " + std::to_string(m));
+      EXPECT_EQ(allan_variance(records[r], m, Estimator::Overlapping), exact_oavar(records[r], m));
+    }
+    // A whole grid at once (one sweep over the data per thread when the range allows it).
+    for (unsigned threads : {1u, 2u, 3u}) {
+      AllanOptions o;
+      o.grid = TauGrid::parse("dense:7");
+      o.threads = threads;
+      const AllanResult a = compute_allan(records[r], o);
+      ASSERT_GT(a.points.size(), 20u);
+      for (const AllanPoint& p : a.points) {
+        SCOPED_TRACE("record " + std::to_string(r) + " grid m " + std::to_string(p.m) + " threads " +
+                     std::to_string(threads));
+        EXPECT_EQ(p.var, exact_oavar(records[r], p.m));
+        EXPECT_EQ(p.n, static_cast<std::int64_t>(records[r].points()) - 2 * p.m);
+      }
+    }
+  }
+}
+
 TEST(AllanCounts, WhiteAngleNoiseHasTheExpectedLevel) {
   // A white angle θ_k uniform on {−1, 0, 1} counts (σθ² = 2/3): its second difference has variance
   // 6σθ² at every m, so AVAR = 3σθ²/τ² (quantization-like slope −1 in ADEV).
