@@ -13,7 +13,7 @@ namespace diag {
 
 std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSettings& settings, std::size_t runs,
                                    const std::vector<std::int64_t>& octave_m, const std::vector<std::size_t>& mid_grid,
-                                   bool with_detectors, const DiagnoseOptions& options) {
+                                   bool with_detectors, const DiagnoseOptions& options, bool clean_mid) {
   std::vector<RunStats> out(runs);
   EnsembleOptions eo;
   eo.path = SimulationPath::Ensemble;
@@ -41,9 +41,9 @@ std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSett
             st.octave_var[i] = allan_variance(s, octave_m[i], Estimator::Overlapping);
         }
         const Decimated d = decimate(s);
-        st.mid_var = decimated_avar(d, mid_grid);
+        st.mid_var = decimated_avar(clean_mid ? without_own_candidates(d) : d, mid_grid);
         if (with_detectors) {
-          st.sin_stat = sinusoid_detect(d, 0.0, false).statistic;
+          st.sin_stat = sinusoid_detect(without_mean_shape(d), 0.0, false).statistic;
           st.step_stat = step_detect(d).statistic;
           st.warm_stat = warmup_detect(d).statistic;
         }

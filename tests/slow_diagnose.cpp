@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <functional>
 #include <iostream>
@@ -29,6 +30,16 @@ constexpr std::size_t kRuns = 20;
 std::size_t cases(std::size_t dflt) {
   if (const char* s = std::getenv("RWCALC_DIAGNOSE_CASES")) return static_cast<std::size_t>(std::atoi(s));
   return dflt;
+}
+
+/// The size range of the drawn effect (step size, warm-up amplitude), overridable as
+/// RWCALC_DIAGNOSE_RANGE="lo,hi" to measure the detection rate below the acceptance range.
+std::pair<double, double> size_range(double lo, double hi) {
+  if (const char* s = std::getenv("RWCALC_DIAGNOSE_RANGE")) {
+    double a = 0, b = 0;
+    if (std::sscanf(s, "%lf,%lf", &a, &b) == 2 && a > 0 && b >= a) return {a, b};
+  }
+  return {lo, hi};
 }
 
 NoiseModel gl2d() {
@@ -73,6 +84,17 @@ std::string names(const DiagnoseResult& r) {
   return s.empty() ? "none" : s;
 }
 
+/// Each detector's statistic against its threshold, for the log of a case.
+std::string evidence(const DiagnoseResult& r) {
+  std::string s = fmt::format(" base N {:.3g} B {:.3g} K {:.3g} R {:.3g};", r.base.arw_deg_per_sqrt_h,
+                              r.base.bias_instability_deg_per_h, r.base.rrw_deg_per_h_per_sqrt_h, r.base.ramp_deg_per_h2);
+  if (!r.findings.empty())
+    s += fmt::format(" ext N {:.3g} B {:.3g} K {:.3g};", r.extended.arw_deg_per_sqrt_h,
+                     r.extended.bias_instability_deg_per_h, r.extended.rrw_deg_per_h_per_sqrt_h);
+  for (const auto& d : r.detectors) s += fmt::format(" {}:{:.3g}/{:.3g}", d.effect.substr(0, 4), d.statistic, d.threshold);
+  return s;
+}
+
 double log_uniform(std::mt19937_64& g, double lo, double hi) {
   return std::exp(std::uniform_real_distribution<double>(std::log(lo), std::log(hi))(g));
 }
@@ -106,10 +128,10 @@ Tally run_effect(const std::string& effect, std::size_t n, std::uint64_t seed0,
       t.gain_in += gin;
       t.gain_out += gout;
     }
-    std::cout << fmt::format("{} case {:2}: truth {} -> {} {} | misfit {:.2f}->{:.2f} holdout {:.2f}->{:.2f} ({:.1f} s)\n",
+    std::cout << fmt::format("{} case {:2}: truth {} -> {} {} | misfit {:.2f}->{:.2f} holdout {:.2f}->{:.2f} ({:.1f} s) |{}\n",
                              effect, i, truth.dump(), names(r), est ? est->dump() : "", r.gain.misfit_base,
                              r.gain.misfit_extended, r.gain.holdout_misfit_base, r.gain.holdout_misfit_extended,
-                             r.seconds) << std::flush;
+                             r.seconds, evidence(r)) << std::flush;
   }
   std::cout << fmt::format("{}: named {}/{}, recovered within tolerance {}/{}, gain in sample {}/{}, out of sample {}/{}\n",
                            effect, t.named, t.n, t.recovered, t.n, t.gain_in, t.named, t.gain_out, t.named);
@@ -151,8 +173,8 @@ TEST(DiagnoseAcceptance, DISABLED_Sinusoid) {
 TEST(DiagnoseAcceptance, DISABLED_BiasStep) {
   const auto t = run_effect(
       "bias_step", cases(10), 2000,
-      [](std::mt19937_64& g, NoiseModel& m) {
-        BiasStep s{uniform(g, 0.15, 0.85) * 7200, sign(g) * log_uniform(g, 0.015, 0.05)};
+      [r = size_range(0.025, 0.08)](std::mt19937_64& g, NoiseModel& m) {
+        BiasStep s{uniform(g, 0.15, 0.85) * 7200, sign(g) * log_uniform(g, r.first, r.second)};
         m.bias_steps.push_back(s);
         return json{{"time_s", s.t_s}, {"size_deg_per_h", s.size_deg_per_h}};
       },
@@ -168,8 +190,8 @@ TEST(DiagnoseAcceptance, DISABLED_BiasStep) {
 TEST(DiagnoseAcceptance, DISABLED_WarmupTransient) {
   const auto t = run_effect(
       "warmup_transient", cases(10), 3000,
-      [](std::mt19937_64& g, NoiseModel& m) {
-        Warmup w{sign(g) * log_uniform(g, 0.03, 0.15), log_uniform(g, 120, 1200)};
+      [r = size_range(0.1, 0.4)](std::mt19937_64& g, NoiseModel& m) {
+        Warmup w{sign(g) * log_uniform(g, r.first, r.second), log_uniform(g, 180, 1800)};
         m.warmups.push_back(w);
         return json{{"amplitude_deg_per_h", w.amp_deg_per_h}, {"time_constant_s", w.tc_s}};
       },
@@ -226,7 +248,7 @@ TEST(DiagnoseAcceptance, DISABLED_NoEffectNamesNone) {
   for (std::size_t i = 0; i < n; ++i) {
     const auto r = run_case(gl2d(), 9000 + 13 * i);
     none += r.findings.empty();
-    std::cout << fmt::format("none case {:2}: {} ({:.1f} s)\n", i, names(r), r.seconds) << std::flush;
+    std::cout << fmt::format("none case {:2}: {} ({:.1f} s) |{}\n", i, names(r), r.seconds, evidence(r)) << std::flush;
   }
   std::cout << fmt::format("no effect: none named in {}/{}\n", none, n);
   EXPECT_GE(static_cast<double>(none), 0.95 * static_cast<double>(n));
