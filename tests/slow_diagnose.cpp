@@ -149,9 +149,9 @@ void expect_rates(const Tally& t) {
 }  // namespace
 
 // Ranges and tolerances are those of docs/diagnosis.md.
-// Measured (seeds 1000…, 10 cases, 20 runs): named and within tolerance 10/10; gain in and out of
-// sample 9/10 (the miss: a spurious low-pass finding beside the sinusoid made the extended model
-// worse). The every-case gain criterion is not met: disabled, not weakened.
+// Measured (seeds 1000…, 10 cases, 20 runs): named and within tolerance 10/10; gain in sample
+// 9/10, out of sample 8/10 (a spurious low-pass beside the sinusoid in 4/10: the base calibration
+// absorbs the line into N/B). The every-case gain criterion is not met: disabled, not weakened.
 TEST(DiagnoseAcceptance, DISABLED_Sinusoid) {
   const auto t = run_effect(
       "sinusoid", cases(10), 1000,
@@ -167,9 +167,10 @@ TEST(DiagnoseAcceptance, DISABLED_Sinusoid) {
   expect_rates(t);
 }
 
-// Measured (seeds 2000…, 10 cases, 20 runs): named 6/10, within tolerance 5/10 (steps below
-// ≈ 0.02 °/h missed), gain in sample 4/6, out of sample 3/6. Below the 90 % criterion: disabled,
-// not weakened.
+// Measured (seeds 2000…, 10 cases, 20 runs, |δ| 0.025–0.08 °/h): named and within tolerance
+// 10/10; gain in sample 7/10, out of sample 7/10 (a correct step added to a base whose B already
+// covers the data's long-τ AV overshoots there). Detection met, the every-case gain criterion
+// not: disabled, not weakened. Below the range (RWCALC_DIAGNOSE_RANGE=0.01,0.02): named 3/10.
 TEST(DiagnoseAcceptance, DISABLED_BiasStep) {
   const auto t = run_effect(
       "bias_step", cases(10), 2000,
@@ -185,8 +186,9 @@ TEST(DiagnoseAcceptance, DISABLED_BiasStep) {
   expect_rates(t);
 }
 
-// Measured (seeds 3000…, 10 cases, 20 runs): named 8/10, parameters within tolerance 6/10,
-// gain in and out of sample 6/8 each. Below the 90 % criterion: disabled, not weakened.
+// Measured (seeds 3000…, 10 cases, 20 runs, A 0.1–0.4 °/h, τw 180–1800 s): named 10/10,
+// within tolerance 9/10 (one A +31 % with τw +33 % at τw ≈ 1700 s), gain in sample 10/10, out of
+// sample 8/10. Detection met (90 %), the out-of-sample gain criterion not: disabled, not weakened.
 TEST(DiagnoseAcceptance, DISABLED_WarmupTransient) {
   const auto t = run_effect(
       "warmup_transient", cases(10), 3000,
@@ -237,10 +239,9 @@ TEST(DiagnoseAcceptance, DISABLED_Lowpass) {
   expect_rates(t);
 }
 
-// Measured (seeds 9000…, 20 cases, 20 runs): no finding in 12/20 (false bias_step 3, warmup 3,
-// sinusoid 1, low-pass 1). The base fit made without the mean-shape candidate leaves the
-// ensemble with less rate wander than a record whose own largest excursion was removed; with the
-// candidate left in (tried), 7/10 had no finding and no step of 0.017–0.046 °/h was found (0/6).
+// Measured (seeds 9000…, 20 cases, 20 runs): no finding in 17/20 (false low-pass 1, bias_step 1,
+// warm-up 1; each where the calibrated B came out low, 0–0.0026 °/h against the true 0.005, or the
+// fit put the wander into a ramp R). Before the like-with-like calibration with K held: 12/20.
 // Below the 95 % criterion: disabled, not weakened.
 TEST(DiagnoseAcceptance, DISABLED_NoEffectNamesNone) {
   const std::size_t n = cases(20);
