@@ -11,16 +11,19 @@ namespace {
 
 using namespace rwcalc;
 
+// Argument: parse threads (1: serial; 2: the second half of the text on another thread).
 void BM_ParsePulseFile2h(benchmark::State& state) {
   const std::string& text = bench::gl2d_text();
+  ReadOptions o;
+  o.threads = static_cast<unsigned>(state.range(0));
   for (auto _ : state) {
-    auto rec = read_recording_text(text, "gl2d.csv");
+    auto rec = read_recording_text(text, "gl2d.csv", o);
     benchmark::DoNotOptimize(rec.phase.counts.data());
   }
   state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(text.size()));
   state.SetItemsProcessed(state.iterations() * 2'880'000);
 }
-BENCHMARK(BM_ParsePulseFile2h)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ParsePulseFile2h)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // Cumulative sum of int64 increments into counts (wrap-around arithmetic, as PhaseSeries keeps them).
 void BM_CumulativeSum2h(benchmark::State& state) {

@@ -145,13 +145,13 @@ std::vector<Outlier> detect_outliers(const Recording& rec, const AnalysisOptions
   rep.threshold = options.outlier_threshold;
   if (!(options.outlier_threshold > 0) || !std::isfinite(options.outlier_threshold))
     throw UsageError(fmt::format("--outlier-threshold must be a positive number, got {}", options.outlier_threshold));
-  const std::vector<double> rates = rec.rates();
-  const OutlierScale scale = outlier_scale(rates);
+  // The rates are computed block by block from the phase (no copy of the whole record).
+  OutlierScale scale;
+  std::vector<Outlier> found = scan_outliers(rec.phase, options.outlier_threshold, scale, options.allan.threads);
   rep.scale_deg_per_h = scale.scale;
-  std::vector<Outlier> found = find_outliers(rates, options.outlier_threshold, scale);
   rep.count = found.size();
   // Rate sample i comes from data sample i (pulses, rate) or i+1 (counter, angle: the later reading).
-  const std::size_t shift = rec.samples > rates.size() ? 1 : 0;
+  const std::size_t shift = rec.samples > rec.phase.points() - 1 ? 1 : 0;
   for (std::size_t k = 0; k < found.size() && k < kMaxOutlierPositions; ++k) {
     const auto& o = found[k];
     rep.positions.push_back({o.index, static_cast<double>(o.index + shift) * rec.phase.tau0_s,
@@ -251,7 +251,9 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   const AllanResult& fitted = octave ? r.allan : octave_points;
   try {
     detail::ScopedTimer t("analyze: fit");
-    r.fit = fit_noise(fit_points(fitted), options.fit);
+    FitOptions fopt = options.fit;
+    if (fopt.threads == 0) fopt.threads = aopt.threads;  // the analysis' thread budget
+    r.fit = fit_noise(fit_points(fitted), fopt);
   } catch (const AnalysisError& e) {
     throw AnalysisError(fmt::format("{}: {}", rec.source, e.what()));
   }

@@ -149,12 +149,12 @@ std::vector<json> analyze_files(const std::vector<std::string>& files, const Rea
                                 const AnalysisOptions& options, unsigned jobs) {
   if (files.empty()) throw UsageError("batch: no input files");
   if (jobs == 0) jobs = std::max(1u, std::thread::hardware_concurrency());
-  // `jobs` threads in all: files go to min(jobs, files) workers, and each run's τ loop may use all
-  // `jobs` threads too. While every worker is busy the τ threads only share the cores; when the
-  // last runs are in flight and a worker has nothing left to read, the τ work of the others
-  // spreads onto its core, so the batch does not wait on one thread for the last file.
-  AnalysisOptions opt = options;
-  opt.allan.threads = jobs;
+  // `jobs` threads in all. Files go to min(jobs, files) workers; while at least `jobs` files are
+  // left (the one being picked included) every worker is busy, so each run reads and analyses on
+  // its own thread alone (no oversubscribed cores, and --jobs 1 is one thread). The last runs,
+  // picked when fewer files than workers are left, share out the threads of the workers that
+  // have nothing left to do (the read, the outlier screen and the τ loop then run on several).
+  const unsigned total = jobs;
   jobs = std::min<unsigned>(jobs, static_cast<unsigned>(files.size()));
   std::vector<json> out(files.size());
   std::vector<std::exception_ptr> errors(files.size());
@@ -162,7 +162,13 @@ std::vector<json> analyze_files(const std::vector<std::string>& files, const Rea
   auto worker = [&] {
     for (std::size_t i = next++; i < files.size(); i = next++) {
       try {
-        const Recording rec = read_recording(files[i], read);
+        const std::size_t left = files.size() - i;
+        const unsigned per_run = left >= total ? 1u : std::max(1u, total / static_cast<unsigned>(left));
+        ReadOptions ro = read;
+        ro.threads = per_run;
+        AnalysisOptions opt = options;
+        opt.allan.threads = per_run;
+        const Recording rec = read_recording(files[i], ro);
         out[i] = to_json(analyze(rec, opt));
       } catch (...) {
         errors[i] = std::current_exception();

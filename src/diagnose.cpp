@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include <boost/math/distributions/chi_squared.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -25,6 +27,8 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kPulseFitTauMin = 20.0;  ///< s, start of the base fit for pulse data
+constexpr double kGmMinPeakRatio = 0.6;  ///< bump AV at its peak / base AV there, to name a Gauss–Markov term
+constexpr double kGmMinExcess = 2.0;      ///< ensemble SDs a Gauss–Markov bump must raise the mid-τ AV by
 
 double term_value(const FitResult& f, Term t) {
   const auto& c = f[t];
@@ -103,7 +107,8 @@ PhaseSeries cleaned(const PhaseSeries& x, const NoiseModel& det, double t0) {
   return s;
 }
 
-bool is_deterministic(const std::string& e) { return e == "sinusoid" || e == "bias_step" || e == "warmup_transient"; }
+/// Effects fitted on the mid-τ AV jointly with the N, B, K corrections.
+bool is_mid_tau(const std::string& e) { return e == "gauss_markov"; }
 
 /// The five-term analysis; when the default pulse-data fit range leaves too few Allan points (a
 /// short record or half record), it is widened to τ ≥ 1 s, then to all τ.
@@ -123,6 +128,42 @@ std::array<double, 4> c_of(const NoiseModel& m) {
   return {-std::numeric_limits<double>::infinity(), c_from_coefficient(Term::N, m.arw_deg_per_sqrt_h),
           c_from_coefficient(Term::B, m.bias_instability_deg_per_h),
           c_from_coefficient(Term::K, m.rrw_deg_per_h_per_sqrt_h)};
+}
+
+/// The output-chain low-pass fit on the octave AV of an analysis (measured EDF).
+OutputLowpassEstimate lowpass_of(const AllanResult& a, double duration) {
+  std::vector<std::int64_t> m;
+  std::vector<double> v, edf;
+  for (const auto& p : a.points) {
+    m.push_back(p.m);
+    v.push_back(p.var);
+    edf.push_back(p.edf);
+  }
+  return output_lowpass_detect(m, v, edf, a.tau0_s, duration);
+}
+
+/// Whether a floating series is pulse counts given as numbers: its first 10⁵ increments are
+/// within 10⁻³ of integer multiples of the smallest non-zero one, and that step is coarse against
+/// the increments' own scatter (at least half their standard deviation). A finely quantized
+/// read-out (an ADC's least significant bit far below the noise) is not counting.
+bool on_lattice(const PhaseSeries& x) {
+  const std::size_t n = std::min<std::size_t>(x.points() - 1, 100000);
+  if (n < 2) return false;
+  double step = 0, sum = 0, sum2 = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double d = x.diff(i + 1, i);
+    sum += d;
+    sum2 += d * d;
+    if (std::abs(d) > 1e-9 && (step == 0 || std::abs(d) < step)) step = std::abs(d);
+  }
+  if (!(step > 0)) return false;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double r = std::abs(x.diff(i + 1, i)) / step;
+    if (std::abs(r - std::round(r)) > 1e-3) return false;
+  }
+  const double mean = sum / double(n);
+  const double sd = std::sqrt(std::max(0.0, sum2 / double(n) - mean * mean));
+  return step >= 0.5 * sd;
 }
 
 /// Everything needed to estimate named effects on one stretch of data.
@@ -147,6 +188,7 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
   (void)aopt;
   Extension x;
   NoiseModel det;
+  std::optional<OutputLowpassEstimate> lowpass;
   for (const auto& e : effects) {
     Finding f;
     f.effect = e;
@@ -165,6 +207,13 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
       det.warmups.push_back({est.amp, est.tc});
       f.params = {{"amplitude_deg_per_h", est.amp}, {"time_constant_s", est.tc}};
       f.uncertainty = {{"amplitude_deg_per_h", est.amp_sigma}, {"time_constant_s", est.tc_sigma}};
+    } else if (e == "lowpass") {
+      // The output-chain filter: its time constant and the white angle noise before it from the
+      // short-τ octave AV; N, B, K stay the mid-τ ones.
+      const auto est = lowpass_of(s.analysis->allan, s.rec->phase.duration_s());
+      f.params = {{"time_constant_s", est.tf}};
+      f.uncertainty = {{"time_constant_s", 0.5 * (est.tf_high - est.tf_low)}};
+      lowpass = est;
     } else {
       continue;
     }
@@ -174,6 +223,10 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
   x.model.sinusoids = det.sinusoids;
   x.model.bias_steps = det.bias_steps;
   x.model.warmups = det.warmups;
+  if (lowpass) {
+    x.model.output_lowpass_tc_s = lowpass->tf;
+    x.model.white_angle_arcsec = std::sqrt(std::max(0.0, lowpass->white_angle2));
+  }
   // Re-fit: the mid-τ AV of the data without the named deterministic terms (and without its own
   // candidates of the kinds not named, as the base ensemble's records) against the base ensemble
   // gives the corrections of N², B², K² — jointly with the bump of a stochastic term.
@@ -192,7 +245,7 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
   auto apply = [&](double& coef, Term t, double dc) {
     coef = coefficient_from_c(t, std::max(0.0, c_from_coefficient(t, coef) + dc));
   };
-  const bool stochastic = std::any_of(effects.begin(), effects.end(), [](const std::string& e) { return !is_deterministic(e); });
+  const bool stochastic = std::any_of(effects.begin(), effects.end(), is_mid_tau);
   if (!stochastic && !x.findings.empty()) {
     const auto dc = power_law_corrections(v, s.ref, c_of(base));
     apply(x.model.arw_deg_per_sqrt_h, Term::N, dc[1]);
@@ -200,28 +253,19 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
     apply(x.model.rrw_deg_per_h_per_sqrt_h, Term::K, dc[3]);
   }
   for (const auto& e : effects) {
-    if (is_deterministic(e)) continue;
+    if (!is_mid_tau(e)) continue;
     const ShapeEstimate est = shape_detect(v, s.ref, c_of(base));
     apply(x.model.bias_instability_deg_per_h, Term::B, est.dc[2]);
     apply(x.model.rrw_deg_per_h_per_sqrt_h, Term::K, est.dc[3]);
     Finding f;
     f.effect = e;
     const double tc = std::max(est.time, 1e-3);
-    if (e == "gauss_markov") {
-      x.model.arw_deg_per_sqrt_h = coefficient_from_c(Term::N, est.white_rest);
-      const double sigma = std::sqrt(std::max(est.scale, 0.0));
-      x.model.gauss_markov.push_back({sigma, tc});
-      f.params = {{"sigma_deg_per_h", sigma}, {"correlation_time_s", est.time}};
-      f.uncertainty = {{"sigma_deg_per_h", sigma > 0 ? est.scale_sigma / (2 * sigma) : 0.0},
-                       {"correlation_time_s", 0.5 * (est.time_high - est.time_low)}};
-    } else {
-      // A low-passed white rate of PSD N² is the Gauss–Markov bump with 2σ²·Tc = N², τf = Tc.
-      const double c_white = 2.0 * std::max(est.scale, 0.0) * tc + est.white_rest;
-      x.model.arw_deg_per_sqrt_h = coefficient_from_c(Term::N, c_white);
-      x.model.lowpass_tc_s = tc;
-      f.params = {{"time_constant_s", est.time}};
-      f.uncertainty = {{"time_constant_s", 0.5 * (est.time_high - est.time_low)}};
-    }
+    x.model.arw_deg_per_sqrt_h = coefficient_from_c(Term::N, est.white_rest);
+    const double sigma = std::sqrt(std::max(est.scale, 0.0));
+    x.model.gauss_markov.push_back({sigma, tc});
+    f.params = {{"sigma_deg_per_h", sigma}, {"correlation_time_s", est.time}};
+    f.uncertainty = {{"sigma_deg_per_h", sigma > 0 ? est.scale_sigma / (2 * sigma) : 0.0},
+                     {"correlation_time_s", 0.5 * (est.time_high - est.time_low)}};
     x.findings.push_back(std::move(f));
   }
   return x;
@@ -258,7 +302,8 @@ std::vector<std::int64_t> octave_of(const AllanResult& a) {
 NoiseModel calibrated(const NoiseModel& m0, const SimulationSettings& settings, std::size_t runs,
                       const std::vector<std::int64_t>& octave_m, const Decimated& dec,
                       const std::vector<std::size_t>& grid, const DiagnoseOptions& opt) {
-  const auto pilot = run_ensemble(m0, settings, runs, octave_m, grid, false, opt);
+  auto pilot = run_ensemble(m0, settings, runs, octave_m, grid, false, opt);
+  for (auto& p : pilot) p.mid_var = p.mid_var_clean;
   const auto ref = make_reference(grid, dec.tau_d, pilot);
   const auto dc = calibration_corrections(decimated_avar(dec, grid), ref, c_of(m0), dec.duration() / 6.0);
   NoiseModel m = m0;
@@ -430,19 +475,65 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   std::vector<double> e_gm;
   for (const auto& br : base_runs) {
     const auto loo = leave_one_out(full.ref, br.mid_var, opt.runs);
-    e_gm.push_back(shape_detect(br.mid_var, loo, c_base).statistic);
+    // Each record without its own mean-shape candidate, as the measurement.
+    e_gm.push_back(shape_detect(br.mid_var_clean.empty() ? br.mid_var : br.mid_var_clean, loo, c_base).statistic);
   }
   DetectorResult d_gm = calibrate("gauss_markov", gm.statistic, e_gm);
-  // The bump is a low-pass of the white rate noise when no white noise is left beside it.
-  const bool lowpass = gm.white_rest < 2.0 * gm.white_rest_sigma;
-  if (d_gm.fired && lowpass) {
-    d_gm.effect = "lowpass";
-    d_gm.note = fmt::format("no white rate noise left beside the bump ({:.3g} ± {:.2g} (°/h)²·s): a low-pass of it",
-                            gm.white_rest, gm.white_rest_sigma);
+  // A Gauss–Markov rate adds variance around its peak, or keeps white rate noise beside it when
+  // the base fit has taken the bump into B. A fit that only lowers the mid-τ AV by trading the
+  // white noise for a bump (a deficit, e.g. after a sinusoid absorbed into the base N and B was
+  // removed) is not one. (A low-pass of the sensed rate before counting is a
+  // Gauss–Markov rate, Tc = τf and 2σ²Tc = N², and is named as one.)
+  if (d_gm.fired && gm.excess < kGmMinExcess && gm.white_rest < 2.0 * gm.white_rest_sigma) {
+    d_gm.named = false;
+    d_gm.note = fmt::format("the fitted shape raises the mid-τ Allan variance by at most {:.2g} ensemble standard "
+                            "deviations and leaves no white rate noise ({:.3g} ± {:.2g} (°/h)²·s): a deficit, not a "
+                            "Gauss–Markov bump",
+                            gm.excess, gm.white_rest, gm.white_rest_sigma);
   }
-  if (d_gm.named) effects.push_back(lowpass ? "lowpass" : "gauss_markov");
-  if (!d_gm.fired) d_gm.effect = "gauss_markov_or_lowpass";
-  r.detectors = {d_sin, d_step, d_warm, d_gm};
+  // A bump far below the local AV is a re-arrangement of the flicker or white noise (a flicker
+  // floor is a sum of Gauss–Markov terms): named only when it carries a sizeable share there.
+  if (d_gm.named && gm.peak_ratio < kGmMinPeakRatio) {
+    d_gm.named = false;
+    d_gm.note = fmt::format("the bump's Allan variance at its peak is {:.2g} of the base model's there (at least {:g} "
+                            "needed): not told apart from the flicker and white noise",
+                            gm.peak_ratio, kGmMinPeakRatio);
+  }
+  if (d_gm.named) effects.push_back("gauss_markov");
+
+  // Output-chain low-pass: only floating (sub-pulse) data can have passed through one; whole
+  // pulse counts come straight from the counter.
+  DetectorResult d_lp;
+  d_lp.effect = "lowpass";
+  if (x.exact()) {
+    d_lp.note = "whole pulse counts: no filter in the output chain";
+  } else if (on_lattice(x)) {
+    d_lp.note = "the samples are whole multiples of a step coarse against their scatter (pulse counts as numbers): no filter in the output chain";
+  } else {
+    const auto lp = lowpass_of(r.analysis.allan, T);
+    std::vector<std::int64_t> om;
+    std::vector<double> edf;
+    for (const auto& p : r.analysis.allan.points) {
+      om.push_back(p.m);
+      edf.push_back(p.edf);
+    }
+    std::vector<double> e_lp;
+    for (const auto& br : base_runs)
+      e_lp.push_back(output_lowpass_detect(om, br.octave_var, edf, x.tau0_s, T).statistic);
+    d_lp = calibrate("lowpass", lp.statistic, e_lp);
+    // The simulated base records have no filter, and their statistic is often exactly 0: the
+    // threshold is at least the χ²(1) (1 − α) quantile, scaled by the best fit's χ² per degree of
+    // freedom when the measured shape is not fitted exactly.
+    const double dof = std::max(1.0, lp.points - 4.0);
+    const double floor =
+        boost::math::quantile(boost::math::chi_squared(1.0), 1.0 - opt.alpha) * std::max(1.0, lp.chi2 / dof);
+    if (d_lp.threshold < floor) {
+      d_lp.threshold = floor;
+      d_lp.fired = d_lp.named = lp.statistic > floor;
+    }
+    if (d_lp.named) effects.push_back("lowpass");
+  }
+  r.detectors = {d_sin, d_step, d_warm, d_gm, d_lp};
   timer.lap("detectors");
 
   // 3–4. Extended model: parameters, re-fit, re-simulation.
@@ -466,7 +557,8 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     else if (f.effect == "gauss_markov")
       f.evidence["detector"] = "χ² drop of the mid-τ Allan variance when a Gauss–Markov bump is added";
     else
-      f.evidence["detector"] = "χ² drop of the mid-τ Allan variance when a low-pass deficit is added";
+      f.evidence["detector"] =
+          "χ² drop of the short-τ Allan variance when white angle and rate noise pass through an output-chain low-pass";
     r.findings.push_back(std::move(f));
   }
   if (r.findings.empty()) {
@@ -509,7 +601,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
         robust_base(fit_rec, a_fit, aopt, st.dec, sh, r.holdout_runs, om, hgrid, opt).model;
     sh.seed += 50;
     const double dt = (static_cast<double>(pa) - static_cast<double>(fa)) * x.tau0_s;
-    const auto b_runs = run_ensemble(b_fit, sh, r.holdout_runs, om, hgrid, false, opt, !effects.empty());
+    const auto b_runs = run_ensemble(b_fit, sh, r.holdout_runs, om, hgrid, false, opt, false);
     hb += band_misfit(make_band(a_pred.points, b_runs, opt.band_level), r.holdout_runs);
     if (effects.empty()) {
       he += band_misfit(make_band(a_pred.points, b_runs, opt.band_level), r.holdout_runs);

@@ -41,11 +41,18 @@ std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSett
             st.octave_var[i] = allan_variance(s, octave_m[i], Estimator::Overlapping);
         }
         const Decimated d = decimate(s);
-        st.mid_var = decimated_avar(clean_mid ? without_own_candidates(d) : d, mid_grid);
-        if (with_detectors) {
-          st.sin_stat = sinusoid_detect(without_mean_shape(d), 0.0, false).statistic;
-          st.step_stat = step_detect(d).statistic;
-          st.warm_stat = warmup_detect(d).statistic;
+        st.mid_var = decimated_avar(d, mid_grid);
+        if (with_detectors || clean_mid) {
+          // The record without its own mean-shape candidate, as the measurement: the sinusoid
+          // statistic, the pilot calibration and the mid-τ shape statistic read it.
+          Decimated dc = d;
+          subtract_deterministic(dc, own_candidates(d));
+          st.mid_var_clean = decimated_avar(dc, mid_grid);
+          if (with_detectors) {
+            st.sin_stat = sinusoid_detect(dc, 0.0, false).statistic;
+            st.step_stat = step_detect(d).statistic;
+            st.warm_stat = warmup_detect(d).statistic;
+          }
         }
       },
       eo);
@@ -98,6 +105,23 @@ MidTauReference make_reference(const std::vector<std::size_t>& grid, double tau_
     const double mean = m / double(k);
     ref.mean.push_back(mean);
     ref.var.push_back(std::max((m2 - double(k) * mean * mean) / double(k - 1), 0.0));
+  }
+  // Covariance between grid points over the runs.
+  const std::size_t g = grid.size();
+  if (runs.size() >= 5) {
+    ref.cov.assign(g * g, 0.0);
+    for (std::size_t i = 0; i < g; ++i) {
+      for (std::size_t j = i; j < g; ++j) {
+        double c = 0;
+        std::size_t k = 0;
+        for (const auto& r : runs) {
+          if (i >= r.mid_var.size() || j >= r.mid_var.size() || !(r.mid_var[i] > 0) || !(r.mid_var[j] > 0)) continue;
+          c += (r.mid_var[i] - ref.mean[i]) * (r.mid_var[j] - ref.mean[j]);
+          ++k;
+        }
+        ref.cov[i * g + j] = ref.cov[j * g + i] = k > 2 ? c / double(k - 1) : 0.0;
+      }
+    }
   }
   return ref;
 }

@@ -10,6 +10,7 @@
 #include <complex>
 #include <limits>
 #include <numeric>
+#include <array>
 
 #include "rwcalc/diagnose_detectors.hpp"
 
@@ -18,6 +19,7 @@ namespace rwcalc::diag {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+constexpr double kCorrShrink = 0.2;  ///< weight of the identity in the mid-τ correlation matrix
 
 double median_of(std::vector<double> v) {
   if (v.empty()) return 0.0;
@@ -510,6 +512,7 @@ namespace {
 /// basis columns (normalised; `colscale` holds the factors).
 struct MidTauProblem {
   std::vector<double> y, w, tau;
+  std::vector<std::size_t> index;  ///< grid index of each point
   std::vector<std::vector<double>> cols{4};
   std::array<double, 4> colscale{1, 1, 1, 1};
 };
@@ -519,6 +522,7 @@ MidTauProblem mid_tau_problem(const std::vector<double>& v, const MidTauReferenc
   for (std::size_t i = 0; i < ref.tau.size() && i < v.size(); ++i) {
     if (!(ref.var[i] > 0) || !(v[i] > 0)) continue;
     const double t = ref.tau[i];
+    p.index.push_back(i);
     p.y.push_back(v[i] - ref.mean[i]);
     p.w.push_back(1.0 / ref.var[i]);
     p.tau.push_back(t);
@@ -534,6 +538,45 @@ MidTauProblem mid_tau_problem(const std::vector<double>& v, const MidTauReferenc
     for (double& x : p.cols[c]) x /= p.colscale[c];
   }
   return p;
+}
+
+/// The problem decorrelated with the reference's correlation matrix: with C = D^½ R D^½ (D the
+/// variances) = L·Lᵀ, y and every column are replaced by L⁻¹y, L⁻¹x and the weights by 1, so that
+/// least squares minimise the generalised χ². Without a correlation matrix: unchanged.
+struct Whitener {
+  Eigen::MatrixXd L;
+  bool on = false;
+  std::vector<double> apply(const std::vector<double>& x) const {
+    if (!on) return x;
+    Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(x.data(), static_cast<Eigen::Index>(x.size()));
+    Eigen::VectorXd u = L.triangularView<Eigen::Lower>().solve(v);
+    return std::vector<double>(u.data(), u.data() + u.size());
+  }
+};
+
+Whitener whiten(MidTauProblem& p, const MidTauReference& ref) {
+  Whitener wh;
+  const std::size_t g = ref.grid.size();
+  const std::size_t n = p.y.size();
+  if (ref.cov.size() != g * g || n < 2) return wh;
+  // Correlations shrunk toward the identity: the runs are fewer than the grid points.
+  const double shrink = kCorrShrink;
+  Eigen::MatrixXd C(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
+  for (std::size_t a = 0; a < n; ++a)
+    for (std::size_t b = 0; b < n; ++b) {
+      const std::size_t ia = p.index[a], ib = p.index[b];
+      const double d = std::sqrt(ref.var[ia] * ref.var[ib]);
+      double rho = a == b ? 1.0 : (d > 0 ? std::clamp(ref.cov[ia * g + ib] / d, -1.0, 1.0) * (1.0 - shrink) : 0.0);
+      C(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) = rho / std::sqrt(p.w[a] * p.w[b]);
+    }
+  Eigen::LLT<Eigen::MatrixXd> llt(C);
+  if (llt.info() != Eigen::Success) return wh;
+  wh.L = llt.matrixL();
+  wh.on = true;
+  p.y = wh.apply(p.y);
+  for (auto& c : p.cols) c = wh.apply(c);
+  std::fill(p.w.begin(), p.w.end(), 1.0);
+  return wh;
 }
 
 }  // namespace
@@ -624,13 +667,17 @@ std::array<double, 4> calibration_corrections(const std::vector<double>& v, cons
 ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& ref,
                            const std::array<double, 4>& c_base) {
   ShapeEstimate e;
-  MidTauProblem p = mid_tau_problem(v, ref);
-  if (p.y.size() < 8) return e;
+  const MidTauProblem p0 = mid_tau_problem(v, ref);
+  if (p0.y.size() < 8) return e;
+  MidTauProblem p = p0;
+  const Whitener wh = whiten(p, ref);
   const double c_n_base = c_base[1];
   using Fit = ConstrainedFit;
   auto fit = [&](const std::vector<double>* shape) { return constrained_fit(p, c_base, shape); };
   const Fit null = fit(nullptr);
-  const double lt_lo = std::log(std::max(p.tau.front() / 3.0, 0.3)), lt_hi = std::log(p.tau.back() / 2.0);
+  // Correlation times from 3× the shortest τ (a bump peaking at the grid's first points is white
+  // rate noise there: not identifiable) to half the longest.
+  const double lt_lo = std::log(3.0 * p.tau.front()), lt_hi = std::log(p.tau.back() / 2.0);
   const int G = 48;
   double best_chi2 = null.chi2;
   std::vector<std::pair<double, double>> prof;
@@ -646,6 +693,7 @@ ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& 
     }
     if (!(m > 0)) continue;
     for (double& x : col) x /= m;
+    col = wh.apply(col);
     Fit f = fit(&col);
     double chi2 = f.a > 0 ? f.chi2 : null.chi2;  // the bump only adds variance
     prof.emplace_back(T, chi2);
@@ -662,6 +710,19 @@ ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& 
   e.dc = null.dc;
   if (!have) return e;
   e.dc = best.dc;
+  for (std::size_t i = 0; i < p0.tau.size(); ++i) {
+    double net = e.scale * shape_avar(Shape::GaussMarkov, p0.tau[i], e.time);
+    for (std::size_t t = 0; t < 4; ++t) net += best.dc[t] * p0.cols[t][i] * p0.colscale[t];
+    e.excess = std::max(e.excess, net * std::sqrt(p0.w[i]));
+  }
+  {
+    const double tp = 1.8926 * e.time;
+    std::size_t k = 0;
+    for (std::size_t i = 1; i < p0.tau.size(); ++i)
+      if (std::abs(std::log(p0.tau[i] / tp)) < std::abs(std::log(p0.tau[k] / tp))) k = i;
+    const double m = ref.mean[p0.index[k]];
+    e.peak_ratio = m > 0 ? e.scale * shape_avar(Shape::GaussMarkov, tp, e.time) / m : 0.0;
+  }
   e.white_rest = std::max(0.0, c_n_base + best.dc[1]);
   e.white_rest_sigma = std::sqrt(std::max(0.0, best.dn_var));
   e.time_low = e.time_high = e.time;
@@ -684,7 +745,179 @@ MidTauReference leave_one_out(const MidTauReference& ref, const std::vector<doub
     r.mean[i] = m;
     r.var[i] = std::max(ss / (K - 2), 1e-300);
   }
+  // Covariance without the run: S' = S − K/(K − 1)·(v − m)(v − m)ᵀ.
+  const std::size_t g = ref.mean.size();
+  if (ref.cov.size() == g * g && v.size() >= g) {
+    for (std::size_t i = 0; i < g; ++i)
+      for (std::size_t j = 0; j < g; ++j) {
+        const double s = ref.cov[i * g + j] * (K - 1) - K / (K - 1) * (v[i] - ref.mean[i]) * (v[j] - ref.mean[j]);
+        r.cov[i * g + j] = s / (K - 2);
+      }
+  } else {
+    r.cov.clear();
+  }
   return r;
+}
+
+// ---- output-chain low-pass ---------------------------------------------------------------------
+
+double output_lowpass_angle_avar(std::size_t m, double tau0, double tf) {
+  const double tau = static_cast<double>(m) * tau0;
+  if (!(tf > 0)) return 3.0 / (tau * tau);
+  const double x = tau0 / tf;
+  const double one_m_phi = -std::expm1(-x);
+  const double phi_m = std::exp(-static_cast<double>(m) * x);
+  const double v = one_m_phi / (2.0 - one_m_phi);  // (1 − φ)/(1 + φ)
+  return v * (3.0 - 4.0 * phi_m + phi_m * phi_m) / (tau * tau);
+}
+
+double output_lowpass_rate_avar(std::size_t m, double tau0, double tf) {
+  const double md = static_cast<double>(m);
+  if (!(tf > 0)) return 1.0 / (md * tau0);
+  // Rate samples of variance 1/τ0 through the AR(1) filter: variance V, autocorrelation φ^k.
+  // AV = (Var of an m-sum − Cov of adjacent m-sums)/m².
+  const double x = tau0 / tf;
+  const double a = -std::expm1(-x);                 // 1 − φ
+  const double phi = 1.0 - a;
+  const double b = -std::expm1(-md * x);            // 1 − φ^m
+  const double V = (1.0 / tau0) * a / (2.0 - a);
+  const double var_sum = V * (md + 2.0 * phi * (md * a - b) / (a * a));
+  const double cov = V * phi * b * b / (a * a);
+  return (var_sum - cov) / (md * md);
+}
+
+namespace {
+
+/// Non-negative weighted least squares of y on up to three columns (all subsets; small p).
+struct NnFit {
+  double chi2 = std::numeric_limits<double>::infinity();
+  std::array<double, 3> c{0, 0, 0};
+};
+
+NnFit nn_fit3(const std::vector<double>& y, const std::vector<double>& w, const std::array<std::vector<double>, 3>& cols) {
+  NnFit best;
+  for (int mask = 1; mask < 8; ++mask) {
+    std::vector<std::vector<double>> cs;
+    std::vector<int> idx;
+    for (int c = 0; c < 3; ++c)
+      if (mask & (1 << c)) {
+        cs.push_back(cols[static_cast<std::size_t>(c)]);
+        idx.push_back(c);
+      }
+    const WlsOut o = wls(y, w, cs);
+    bool ok = true;
+    for (Eigen::Index k = 0; k < o.coef.size(); ++k) ok = ok && o.coef(k) >= 0 && std::isfinite(o.coef(k));
+    if (!ok || !(o.chi2 < best.chi2)) continue;
+    best.chi2 = o.chi2;
+    best.c = {0, 0, 0};
+    for (std::size_t k = 0; k < idx.size(); ++k) best.c[static_cast<std::size_t>(idx[k])] = o.coef(static_cast<Eigen::Index>(k));
+  }
+  if (!std::isfinite(best.chi2)) {
+    best.chi2 = 0;
+    for (std::size_t i = 0; i < y.size(); ++i) best.chi2 += w[i] * y[i] * y[i];
+  }
+  return best;
+}
+
+}  // namespace
+
+OutputLowpassEstimate output_lowpass_detect(const std::vector<std::int64_t>& m, const std::vector<double>& v,
+                                            const std::vector<double>& edf, double tau0, double duration) {
+  OutputLowpassEstimate e;
+  const double tau_cut = std::min(20.0, duration / 100.0);
+  std::vector<std::size_t> mm;
+  std::vector<double> y, w;
+  for (std::size_t i = 0; i < m.size() && i < v.size() && i < edf.size(); ++i) {
+    const double tau = static_cast<double>(m[i]) * tau0;
+    if (tau > tau_cut || !(v[i] > 0) || !(edf[i] > 0)) continue;
+    mm.push_back(static_cast<std::size_t>(m[i]));
+    y.push_back(v[i]);
+    w.push_back(edf[i] / (2.0 * v[i] * v[i]));
+  }
+  e.points = static_cast<double>(y.size());
+  if (y.size() < 5) return e;
+  // Columns scaled to unit maximum for the conditioning of the normal equations.
+  auto fit_at = [&](double tf, std::array<double, 2>* scale) {
+    std::array<std::vector<double>, 3> cols;
+    for (auto& c : cols) c.resize(y.size());
+    for (std::size_t i = 0; i < y.size(); ++i) {
+      cols[0][i] = output_lowpass_angle_avar(mm[i], tau0, tf);
+      cols[1][i] = output_lowpass_rate_avar(mm[i], tau0, tf);
+      cols[2][i] = 1.0;
+    }
+    std::array<double, 3> sc{1, 1, 1};
+    for (std::size_t c = 0; c < 2; ++c) {
+      sc[c] = *std::max_element(cols[c].begin(), cols[c].end());
+      for (double& x : cols[c]) x /= sc[c];
+    }
+    NnFit f = nn_fit3(y, w, cols);
+    if (scale) *scale = {f.c[0] / sc[0], f.c[1] / sc[1]};
+    return f.chi2;
+  };
+  const double chi0 = fit_at(0.0, nullptr);
+  const double lo = std::log(tau0 / 4.0), hi = std::log(std::max(tau_cut / 4.0, tau0));
+  const int G = 80;
+  std::vector<std::pair<double, double>> prof;
+  double best = chi0;
+  for (int g = 0; g <= G; ++g) {
+    const double tf = std::exp(lo + (hi - lo) * g / G);
+    std::array<double, 2> sc{0, 0};
+    const double c = fit_at(tf, &sc);
+    prof.emplace_back(tf, c);
+    if (c < best) {
+      best = c;
+      e.tf = tf;
+      e.white_angle2 = sc[0];
+      e.white_rate = sc[1];
+    }
+  }
+  e.statistic = std::max(0.0, chi0 - best);
+  if (!(e.tf > 0)) return e;
+  // Golden-section refinement of tf in log between the grid neighbours.
+  {
+    double a = std::log(e.tf) - (hi - lo) / G, b = std::log(e.tf) + (hi - lo) / G;
+    const double gr = (std::sqrt(5.0) - 1.0) / 2.0;
+    double c1 = b - gr * (b - a), c2 = a + gr * (b - a);
+    double f1 = fit_at(std::exp(c1), nullptr), f2 = fit_at(std::exp(c2), nullptr);
+    for (int it = 0; it < 30; ++it) {
+      if (f1 < f2) {
+        b = c2; c2 = c1; f2 = f1; c1 = b - gr * (b - a); f1 = fit_at(std::exp(c1), nullptr);
+      } else {
+        a = c1; c1 = c2; f1 = f2; c2 = a + gr * (b - a); f2 = fit_at(std::exp(c2), nullptr);
+      }
+    }
+    const double tf = std::exp(0.5 * (a + b));
+    std::array<double, 2> sc{0, 0};
+    const double c = fit_at(tf, &sc);
+    if (c < best) {
+      best = c;
+      e.tf = tf;
+      e.white_angle2 = sc[0];
+      e.white_rate = sc[1];
+      e.statistic = std::max(0.0, chi0 - best);
+    }
+  }
+  e.chi2 = best;
+  // Δχ² range, widened by the misfit per degree of freedom when the shape does not fit exactly.
+  const double dof = std::max(1.0, e.points - 4.0);
+  const double delta = std::max(1.0, best / dof);
+  e.tf_low = e.tf_high = e.tf;
+  // Curvature of χ² in ln tf at the optimum (steps of 2 %), else the grid profile.
+  const double h = 0.02;
+  const double fp = fit_at(e.tf * std::exp(h), nullptr), fm = fit_at(e.tf * std::exp(-h), nullptr);
+  const double curv = (fp - 2.0 * best + fm) / (h * h);
+  if (curv > 0) {
+    const double su = std::sqrt(2.0 * delta / curv);
+    e.tf_low = e.tf * std::exp(-su);
+    e.tf_high = e.tf * std::exp(su);
+  } else {
+    for (const auto& [tf, c] : prof)
+      if (c - best <= delta) {
+        e.tf_low = std::min(e.tf_low, tf);
+        e.tf_high = std::max(e.tf_high, tf);
+      }
+  }
+  return e;
 }
 
 // ---- calibration ------------------------------------------------------------------------------

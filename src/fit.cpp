@@ -11,6 +11,7 @@
 #include <boost/math/special_functions/digamma.hpp>
 #include <cmath>
 #include <numbers>
+#include <thread>
 
 #include "rwcalc/error.hpp"
 
@@ -401,8 +402,8 @@ double model_error_cap(const Problem& pr, const Eigen::VectorXd& mu, int p) {
 
 /// Σ_y: the model covariance of the points plus the model-error floor 2μ²/edf_cap on the diagonal.
 Eigen::MatrixXd point_covariance(std::span<const FitPoint> pts, const Vec5& c, const Eigen::VectorXd& mu,
-                                 double edf_cap) {
-  Eigen::MatrixXd s = av_covariance(pts, c);
+                                 double edf_cap, unsigned threads) {
+  Eigen::MatrixXd s = av_covariance(pts, c, false, threads);
   if (edf_cap > 0)
     for (Eigen::Index r = 0; r < s.rows(); ++r) s(r, r) += 2.0 * mu[r] * mu[r] / edf_cap;
   return s;
@@ -411,6 +412,11 @@ Eigen::MatrixXd point_covariance(std::span<const FitPoint> pts, const Vec5& c, c
 }  // namespace
 
 Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix<double, kTermCount, 1>& c) {
+  return av_covariance(pts, c, false, 1);
+}
+
+Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix<double, kTermCount, 1>& c,
+                              bool diagonal_only, unsigned threads) {
   const auto j = static_cast<Eigen::Index>(pts.size());
   Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(j, j);
   if (j == 0) return cov;
@@ -423,8 +429,9 @@ Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix
     return c[1] * t - c[2] / std::numbers::pi * t * t * std::log(t) - c[3] * t * t * t / 6.0;
   };
   constexpr std::array<double, 3> kw{1.0, -2.0, 1.0};
-  for (Eigen::Index a = 0; a < j; ++a) {
-    for (Eigen::Index b = a; b < j; ++b) {
+  // Row a of the upper triangle; rows go to the threads alternately (row a has j − a entries).
+  auto row = [&](Eigen::Index a) {
+    for (Eigen::Index b = a; b < (diagonal_only ? a + 1 : j); ++b) {
       const auto& pa = pts[static_cast<std::size_t>(a)];
       const auto& pb = pts[static_cast<std::size_t>(b)];
       const std::int64_t ma = pa.m, mb = pb.m, na = pa.terms, nb = pb.terms;
@@ -511,6 +518,15 @@ Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix
       const double v = 2.0 * total / (4.0 * ta * ta * tb * tb * static_cast<double>(na) * static_cast<double>(nb));
       cov(a, b) = cov(b, a) = v;
     }
+  };
+  if (threads == 0) threads = std::thread::hardware_concurrency();
+  if (threads > 1 && !diagonal_only && j >= 8) {
+    std::jthread other([&] {
+      for (Eigen::Index a = 1; a < j; a += 2) row(a);
+    });
+    for (Eigen::Index a = 0; a < j; a += 2) row(a);
+  } else {
+    for (Eigen::Index a = 0; a < j; ++a) row(a);
   }
   return cov;
 }
@@ -561,7 +577,7 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
     Vec5 c0;
     for (int i = 0; i < P; ++i) c0[i] = full.d[i] * full_pr.scale[i];
     const Eigen::VectorXd mu0 = full_pr.g * full.d;
-    const Eigen::MatrixXd cov0 = av_covariance(res.used, c0);
+    const Eigen::MatrixXd cov0 = av_covariance(res.used, c0, true, 1);  // only its diagonal is used
     for (int r = 0; r < j; ++r) {
       const double v = cov0(r, r);
       if (v > 0 && std::isfinite(v)) res.used[static_cast<std::size_t>(r)].edf = 2.0 * mu0[r] * mu0[r] / v;
@@ -585,7 +601,7 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
   if (use_cov) {
     Vec5 c1;
     for (int i = 0; i < P; ++i) c1[i] = full.d[i] * full_pr.scale[i];
-    sigma_y = point_covariance(res.used, c1, full_pr.g * full.d, opt.edf_cap);
+    sigma_y = point_covariance(res.used, c1, full_pr.g * full.d, opt.edf_cap, options.threads);
   }
   auto phis = [&](const Problem& pr, const IrlsResult& fit, const std::vector<int>& set) {
     Sandwich sw = sandwich(pr, pr.g * fit.d, set, sigma_y);

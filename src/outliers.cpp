@@ -6,6 +6,10 @@
 #include <limits>
 #include <thread>
 
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
+
 namespace rwcalc {
 
 namespace {
@@ -54,26 +58,233 @@ inline double residual(const double* y, std::size_t i, std::size_t n) {
   return y[i] - median6(y[nb[0]], y[nb[1]], y[nb[2]], y[nb[3]], y[nb[4]], y[nb[5]]);
 }
 
-}  // namespace
+// ---- rate sources ----------------------------------------------------------------------------
+// The scan reads the rates through a window of one block plus three samples either side: from a
+// vector in place, or computed block by block from a phase series (no copy of the whole record).
+// Both give the same doubles, so every result is the same whichever source is scanned.
 
-OutlierScale outlier_scale(const std::vector<double>& rates) {
-  OutlierScale s;
-  const std::size_t n = rates.size();
-  if (n < kMinSamples) return s;
-  const double* y = rates.data();
+constexpr std::size_t kBlock = 1024;
+constexpr std::size_t kHalo = 3;
 
-  // Resolution: the smallest non-zero step (branch-free, vectorisable).
-  double res = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 1; i < n; ++i) {
-    const double d = std::abs(y[i] - y[i - 1]);
+struct VectorRates {
+  const double* y;
+  std::size_t n;
+  // p with p[k] = rate(b − 3 + k) for k < e − b + 6; 3 ≤ b, e + 3 ≤ n.
+  const double* window(std::size_t b, [[maybe_unused]] std::size_t e, double* /*buf*/) const { return y + b - kHalo; }
+  void fill(std::size_t from, std::size_t to, double* out) const { std::copy(y + from, y + to, out); }
+};
+
+#if defined(__x86_64__) || defined(__i386__)
+// Rates of exact counts, four at a time: the int64 increments become doubles exactly (the
+// 1.5·2^52 bias trick, valid for |d| < 2^51), then (d·q)/τ0 as PhaseSeries::rate computes it
+// (same IEEE operations, no fused multiply-add), so the doubles are bit-identical. Returns false
+// when an increment is out of that range (the caller then takes the scalar path).
+__attribute__((target("avx2"))) bool count_rates_avx2(const std::int64_t* c, std::size_t from, std::size_t to,
+                                                      double q, double tau0, double* out) {
+  const __m256i bias_i = _mm256_set1_epi64x(0x4338000000000000LL);
+  const __m256d bias_d = _mm256_set1_pd(6755399441055744.0);  // 1.5·2^52
+  const __m256i half = _mm256_set1_epi64x(std::int64_t{1} << 51);
+  const __m256d vq = _mm256_set1_pd(q), vt = _mm256_set1_pd(tau0);
+  __m256i bad = _mm256_setzero_si256();
+  std::size_t i = from;
+  for (; i + 4 <= to; i += 4) {
+    const __m256i a = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + i + 1));
+    const __m256i b = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + i));
+    const __m256i d = _mm256_sub_epi64(a, b);
+    bad = _mm256_or_si256(bad, _mm256_srli_epi64(_mm256_add_epi64(d, half), 52));
+    const __m256d x = _mm256_sub_pd(_mm256_castsi256_pd(_mm256_add_epi64(d, bias_i)), bias_d);
+    _mm256_storeu_pd(out + (i - from), _mm256_div_pd(_mm256_mul_pd(x, vq), vt));
+  }
+  for (; i < to; ++i) {
+    const auto d = static_cast<std::int64_t>(static_cast<std::uint64_t>(c[i + 1]) - static_cast<std::uint64_t>(c[i]));
+    out[i - from] = static_cast<double>(d) * q / tau0;
+  }
+  return _mm256_testz_si256(bad, bad) != 0;
+}
+#endif
+
+bool have_avx2() {
+#if defined(__x86_64__) || defined(__i386__)
+  static const bool yes = __builtin_cpu_supports("avx2");
+  return yes;
+#else
+  return false;
+#endif
+}
+
+struct PhaseRates {
+  const PhaseSeries& ph;
+  std::size_t n;
+  void fill(std::size_t from, std::size_t to, double* out) const {
+    if (ph.exact()) {
+#if defined(__x86_64__) || defined(__i386__)
+      if (have_avx2() && count_rates_avx2(ph.counts.data(), from, to, ph.arcsec_per_count, ph.tau0_s, out)) return;
+#endif
+      for (std::size_t i = from; i < to; ++i) out[i - from] = ph.rate(i);
+    } else {
+      const double* x = ph.values.data();
+      for (std::size_t i = from; i < to; ++i) out[i - from] = (x[i + 1] - x[i]) / ph.tau0_s;
+    }
+  }
+  const double* window(std::size_t b, std::size_t e, double* buf) const {
+    fill(b - kHalo, e + kHalo, buf);
+    return buf;
+  }
+};
+
+// The first and the last seven rates (the samples whose neighbours are not centred).
+template <class Src>
+void edges(const Src& src, double head[7], double tail[7]) {
+  src.fill(0, 7, head);
+  src.fill(src.n - 7, src.n, tail);
+}
+
+#if defined(__x86_64__) || defined(__i386__)
+// Smallest non-zero |y_i − y_{i−1}| for i in [1, len) of w, four at a time (min is exact, so
+// the order does not matter).
+__attribute__((target("avx2"))) double min_step_avx2(const double* w, std::size_t len, double res) {
+  const __m256d inf = _mm256_set1_pd(std::numeric_limits<double>::infinity());
+  const __m256d zero = _mm256_setzero_pd();
+  const __m256d sign = _mm256_set1_pd(-0.0);
+  __m256d acc = _mm256_set1_pd(res);
+  std::size_t i = 1;
+  for (; i + 4 <= len; i += 4) {
+    const __m256d d = _mm256_andnot_pd(sign, _mm256_sub_pd(_mm256_loadu_pd(w + i), _mm256_loadu_pd(w + i - 1)));
+    acc = _mm256_min_pd(acc, _mm256_blendv_pd(inf, d, _mm256_cmp_pd(d, zero, _CMP_GT_OQ)));
+  }
+  alignas(32) double lanes[4];
+  _mm256_store_pd(lanes, acc);
+  for (double v : lanes) res = std::min(res, v);
+  for (; i < len; ++i) {
+    const double d = std::abs(w[i] - w[i - 1]);
     res = std::min(res, d > 0 ? d : std::numeric_limits<double>::infinity());
   }
-  s.resolution = std::isfinite(res) ? res : 0.0;
+  return res;
+}
 
+__attribute__((target("avx2"))) inline void s2(__m256d& a, __m256d& b) {
+  const __m256d lo = _mm256_min_pd(a, b);
+  b = _mm256_max_pd(a, b);
+  a = lo;
+}
+
+// Does any interior sample of the window (local indices [3, 3 + len)) have a residual beyond
+// `limit`? The median-of-six network on four samples at a time; only the yes/no is used, the
+// samples of a block that trips are tested again one by one.
+__attribute__((target("avx2"))) bool screen_avx2(const double* w, std::size_t len, double limit) {
+  const __m256d lim = _mm256_set1_pd(limit);
+  const __m256d sign = _mm256_set1_pd(-0.0);
+  const __m256d halfv = _mm256_set1_pd(0.5);
+  __m256d hit = _mm256_setzero_pd();
+  std::size_t k = kHalo;
+  for (; k + 4 <= kHalo + len; k += 4) {
+    __m256d a = _mm256_loadu_pd(w + k - 3), b = _mm256_loadu_pd(w + k - 2), c = _mm256_loadu_pd(w + k - 1);
+    __m256d d = _mm256_loadu_pd(w + k + 1), e = _mm256_loadu_pd(w + k + 2), f = _mm256_loadu_pd(w + k + 3);
+    s2(a, f); s2(b, d); s2(c, e);
+    s2(b, c); s2(d, e);
+    s2(a, d); s2(c, f);
+    s2(a, b); s2(c, d); s2(e, f);
+    s2(b, c); s2(d, e);
+    const __m256d r = _mm256_sub_pd(_mm256_loadu_pd(w + k), _mm256_mul_pd(halfv, _mm256_add_pd(c, d)));
+    hit = _mm256_or_pd(hit, _mm256_cmp_pd(_mm256_andnot_pd(sign, r), lim, _CMP_GT_OQ));
+  }
+  bool any = _mm256_movemask_pd(hit) != 0;
+  for (; k < kHalo + len; ++k) any |= std::abs(interior_residual(w, k)) > limit;
+  return any;
+}
+#endif
+
+double min_step(const double* w, std::size_t len, double res) {
+#if defined(__x86_64__) || defined(__i386__)
+  if (have_avx2()) return min_step_avx2(w, len, res);
+#endif
+  for (std::size_t i = 1; i < len; ++i) {
+    const double d = std::abs(w[i] - w[i - 1]);
+    res = std::min(res, d > 0 ? d : std::numeric_limits<double>::infinity());
+  }
+  return res;
+}
+
+bool screen_block(const double* w, std::size_t len, double limit) {
+#if defined(__x86_64__) || defined(__i386__)
+  if (have_avx2()) return screen_avx2(w, len, limit);
+#endif
+  bool hit = false;
+  for (std::size_t k = kHalo; k < kHalo + len; ++k) hit |= std::abs(interior_residual(w, k)) > limit;
+  return hit;
+}
+
+// With `flagged`, the same pass also screens every interior block against a provisional limit
+// `pre` and lists the blocks (their first index) where some |residual| exceeds it.
+template <class Src>
+OutlierScale scale_of(const Src& src, unsigned threads, double pre = 0, std::vector<std::size_t>* flagged = nullptr) {
+  OutlierScale s;
+  const std::size_t n = src.n;
+  if (n < kMinSamples) return s;
+  double head[7], tail[7];
+  edges(src, head, tail);
+
+  // Resolution: the smallest non-zero step, over i in [1, n).
+  double res = std::numeric_limits<double>::infinity();
+  res = min_step(head, 4, res);  // steps 1..3
+  // Robust scale: 1.4826 × the median |residual| of an evenly strided subset.
   const std::size_t stride = (n + kScaleSamples - 1) / kScaleSamples;
   std::vector<double> a;
   a.reserve(n / stride + 1);
-  for (std::size_t i = 0; i < n; i += stride) a.push_back(std::abs(residual(y, i, n)));
+  auto add_edge = [&](std::size_t i) {
+    if (i < 3) a.push_back(std::abs(residual(head, i, 7)));
+    else a.push_back(std::abs(residual(tail, i - (n - 7), 7)));
+  };
+  for (std::size_t i = 0; i < 3 && i < n; i += stride) add_edge(i);
+  const std::size_t end = n - 3;  // interior [3, n − 3)
+  // Interior blocks [from, to): their steps i in [b+1, e+1) (the window's local [3, e − b + 4)
+  // with its previous sample) and the subset's indices among them.
+  auto blocks = [&](std::size_t from, std::size_t to, double& r, std::vector<double>& out,
+                    std::vector<std::size_t>& hits) {
+    std::vector<double> buf(kBlock + 2 * kHalo);
+    std::size_t next = (from + stride - 1) / stride * stride;
+    for (std::size_t b = from; b < to; b += kBlock) {
+      const std::size_t e = std::min(to, b + kBlock);
+      const double* w = src.window(b, e, buf.data());
+      r = min_step(w + kHalo, e - b + 1, r);
+      for (; next < e; next += stride) out.push_back(std::abs(interior_residual(w, next - b + kHalo)));
+      if (flagged && screen_block(w, e - b, pre)) hits.push_back(b);
+    }
+  };
+  std::vector<std::size_t> hits1, hits2;
+  // Long records: the second half of the interior on another thread (a minimum and a set of
+  // values: the same whatever the split).
+  constexpr std::size_t kParallelFrom = std::size_t{1} << 20;
+  if (threads == 0) threads = std::thread::hardware_concurrency();
+  if (end > 3 && end - 3 >= kParallelFrom && threads > 1) {
+    const std::size_t mid = 3 + ((end - 3) / 2 / kBlock) * kBlock;
+    double res2 = std::numeric_limits<double>::infinity();
+    std::vector<double> a2;
+    a2.reserve((end - mid) / stride + 1);
+    {
+      std::jthread worker([&] { blocks(mid, end, res2, a2, hits2); });
+      blocks(3, mid, res, a, hits1);
+    }
+    res = std::min(res, res2);
+    a.insert(a.end(), a2.begin(), a2.end());
+  } else {
+    blocks(3, end, res, a, hits1);
+  }
+  if (flagged) {
+    *flagged = std::move(hits1);
+    flagged->insert(flagged->end(), hits2.begin(), hits2.end());
+  }
+  // Remaining steps of the tail: i in [max(4, n − 2), n) — locals of tail.
+  {
+    const std::size_t first = std::max<std::size_t>(4, n - 2);  // steps below were counted in blocks/head
+    for (std::size_t i = first; i < n; ++i) {
+      const double d = std::abs(tail[i - (n - 7)] - tail[i - 1 - (n - 7)]);
+      res = std::min(res, d > 0 ? d : std::numeric_limits<double>::infinity());
+    }
+  }
+  for (std::size_t i = std::max<std::size_t>(3, (end + stride - 1) / stride * stride); i < n; i += stride) add_edge(i);
+  s.resolution = std::isfinite(res) ? res : 0.0;
+
   auto mid = a.begin() + static_cast<std::ptrdiff_t>(a.size() / 2);
   std::nth_element(a.begin(), mid, a.end());
   s.mad_sigma = kMadToSigma * *mid;
@@ -81,40 +292,58 @@ OutlierScale outlier_scale(const std::vector<double>& rates) {
   return s;
 }
 
-std::vector<Outlier> find_outliers(const std::vector<double>& rates, double threshold) {
-  return find_outliers(rates, threshold, outlier_scale(rates));
-}
-
-std::vector<Outlier> find_outliers(const std::vector<double>& rates, double threshold, const OutlierScale& s) {
+// With `only`, the interior blocks outside that list (first indices, ascending) are known to hold
+// no residual beyond the limit and are not read again.
+template <class Src>
+std::vector<Outlier> outliers_of(const Src& src, double threshold, const OutlierScale& s, unsigned threads,
+                                 const std::vector<std::size_t>* only = nullptr) {
   std::vector<Outlier> out;
-  const std::size_t n = rates.size();
+  const std::size_t n = src.n;
   if (n < kMinSamples) return out;
   if (!(s.scale > 0)) return out;  // a constant record has no outliers
   const double limit = threshold * s.scale;
-  const double* y = rates.data();
-  auto test = [&](std::size_t i, std::vector<Outlier>& to) {
-    const double r = residual(y, i, n);
-    if (std::abs(r) > limit) to.push_back({i, 0, y[i], r / s.scale});
+  double head[7], tail[7];
+  edges(src, head, tail);
+  auto test_edge = [&](std::size_t i) {
+    const bool front = i < 3;
+    const double* w = front ? head : tail;
+    const std::size_t k = front ? i : i - (n - 7);
+    const double r = residual(w, k, 7);
+    if (std::abs(r) > limit) out.push_back({i, 0, w[k], r / s.scale});
   };
-  // Interior in blocks: a branch-free screen the compiler vectorises, then a look at blocks that trip.
-  constexpr std::size_t kBlock = 1024;
+  // Interior in blocks: a branch-free screen, then a sample-by-sample look at blocks that trip.
   auto screen = [&](std::size_t from, std::size_t to_end, std::vector<Outlier>& to) {
+    std::vector<double> buf(kBlock + 2 * kHalo);
     for (std::size_t b = from; b < to_end; b += kBlock) {
       const std::size_t e = std::min(to_end, b + kBlock);
-      bool hit = false;
-      for (std::size_t i = b; i < e; ++i)
-        hit |= std::abs(interior_residual(y, i)) > limit;
-      if (hit)
-        for (std::size_t i = b; i < e; ++i) test(i, to);
+      const double* w = src.window(b, e, buf.data());
+      if (!screen_block(w, e - b, limit)) continue;
+      for (std::size_t i = b; i < e; ++i) {
+        const std::size_t k = i - b + kHalo;
+        const double r = interior_residual(w, k);
+        if (std::abs(r) > limit) to.push_back({i, 0, w[k], r / s.scale});
+      }
     }
   };
-  test(0, out);
-  test(1, out);
-  test(2, out);
+  test_edge(0);
+  test_edge(1);
+  test_edge(2);
   const std::size_t end = n - 3;
   // Long records: the second half of the interior on another thread (results joined in order).
   constexpr std::size_t kParallelFrom = std::size_t{1} << 20;
-  if (end - 3 >= kParallelFrom && std::thread::hardware_concurrency() > 1) {
+  if (threads == 0) threads = std::thread::hardware_concurrency();
+  if (only) {
+    std::vector<double> buf(kBlock + 2 * kHalo);
+    for (const std::size_t b : *only) {
+      const std::size_t e = std::min(end, b + kBlock);
+      const double* w = src.window(b, e, buf.data());
+      for (std::size_t i = b; i < e; ++i) {
+        const std::size_t k = i - b + kHalo;
+        const double r = interior_residual(w, k);
+        if (std::abs(r) > limit) out.push_back({i, 0, w[k], r / s.scale});
+      }
+    }
+  } else if (end > 3 && end - 3 >= kParallelFrom && threads > 1) {
     const std::size_t mid = 3 + ((end - 3) / 2 / kBlock) * kBlock;
     std::vector<Outlier> second;
     {
@@ -125,14 +354,57 @@ std::vector<Outlier> find_outliers(const std::vector<double>& rates, double thre
   } else {
     screen(3, end, out);
   }
-  test(n - 3, out);
-  test(n - 2, out);
-  test(n - 1, out);
+  test_edge(n - 3);
+  test_edge(n - 2);
+  test_edge(n - 1);
   return out;
 }
 
+std::size_t rate_count(const PhaseSeries& phase) { return phase.points() > 0 ? phase.points() - 1 : 0; }
+
+}  // namespace
+
+OutlierScale outlier_scale(const std::vector<double>& rates) { return scale_of(VectorRates{rates.data(), rates.size()}, 0); }
+
+OutlierScale outlier_scale(const PhaseSeries& phase, unsigned threads) {
+  return scale_of(PhaseRates{phase, rate_count(phase)}, threads);
+}
+
+std::vector<Outlier> find_outliers(const std::vector<double>& rates, double threshold) {
+  return find_outliers(rates, threshold, outlier_scale(rates));
+}
+
+std::vector<Outlier> find_outliers(const std::vector<double>& rates, double threshold, const OutlierScale& s) {
+  return outliers_of(VectorRates{rates.data(), rates.size()}, threshold, s, 0);
+}
+
+std::vector<Outlier> find_outliers(const PhaseSeries& phase, double threshold, const OutlierScale& s,
+                                   unsigned threads) {
+  return outliers_of(PhaseRates{phase, rate_count(phase)}, threshold, s, threads);
+}
+
+std::vector<Outlier> scan_outliers(const PhaseSeries& phase, double threshold, OutlierScale& scale, unsigned threads) {
+  const PhaseRates src{phase, rate_count(phase)};
+  // Exact counts: the limit is at least threshold × one count's rate step (the resolution of
+  // integer data), so one pass can compute the scale and screen every block against (just under)
+  // that bound; only the blocks that trip are read again, against the real limit. If the bound
+  // should exceed the real limit after all, or too many blocks trip (the spread, not the
+  // resolution, sets the scale), the ordinary screen runs instead: the result is the same.
+  const double pre = threshold * (phase.arcsec_per_count / phase.tau0_s) * (1.0 - 1.0 / 1048576.0);
+  if (!phase.exact() || src.n < kMinSamples || !(pre > 0) || !std::isfinite(pre)) {
+    scale = scale_of(src, threads);
+    return outliers_of(src, threshold, scale, threads);
+  }
+  std::vector<std::size_t> flagged;
+  scale = scale_of(src, threads, pre, &flagged);
+  const std::size_t blocks = (src.n - 6 + kBlock - 1) / kBlock;
+  if (threshold * scale.scale >= pre && flagged.size() <= blocks / 16)
+    return outliers_of(src, threshold, scale, threads, &flagged);
+  return outliers_of(src, threshold, scale, threads);
+}
+
 std::vector<Outlier> find_outliers(const Recording& recording, double threshold) {
-  auto out = find_outliers(recording.rates(), threshold);
+  auto out = find_outliers(recording.phase, threshold, outlier_scale(recording.phase));
   for (auto& o : out) o.line = recording.line_of_rate(o.index);
   return out;
 }

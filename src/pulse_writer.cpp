@@ -37,7 +37,24 @@ std::string format_pulse_file(const Metadata& metadata, std::span<const std::int
 }
 
 std::string format_pulse_file(const Metadata& metadata, const PhaseSeries& series) {
-  if (!series.exact()) throw AnalysisError("a pulse file needs exact pulse counts");
+  if (!series.exact()) {
+    // A floating series (an output-chain filter gives sub-pulse resolution): the cumulative
+    // angle in ″ under the header `angle`, 6 decimals.
+    if (series.values.empty()) throw AnalysisError("the series to write is empty");
+    std::string text;
+    for (const auto& [key, value] : metadata) text += "# " + key + ": " + value + '\n';
+    text += "angle\n";
+    const std::size_t head = text.size();
+    text.resize(head + series.values.size() * 32);
+    char* p = text.data() + head;
+    char* const end = text.data() + text.size();
+    for (const double v : series.values) {
+      p = std::to_chars(p, end, v, std::chars_format::fixed, 6).ptr;
+      *p++ = '\n';
+    }
+    text.resize(static_cast<std::size_t>(p - text.data()));
+    return text;
+  }
   std::vector<std::int64_t> c(series.counts.size() - 1);
   for (std::size_t k = 0; k < c.size(); ++k)
     c[k] = static_cast<std::int64_t>(static_cast<std::uint64_t>(series.counts[k + 1]) -

@@ -14,6 +14,8 @@
 #include <cstring>
 #include <limits>
 #include <numbers>
+#include <stop_token>
+#include <thread>
 
 #include <fmt/format.h>
 
@@ -150,7 +152,18 @@ class Reader {
   void parse_field(std::string_view field, Role role, Sample& s) const;
   void push(const Sample& s);
   template <bool Integer>
+  const char* parse_fast(const char* p, Sample& s) const;  // end of the line, or nullptr
+  template <bool Integer>
   bool fast_line(const char*& p);
+  struct Chunk {
+    std::vector<std::int64_t> ints;
+    std::vector<double> reals, times, temps;
+    const char* stop = nullptr;  // where the chunk's fast path stopped
+  };
+  template <bool Integer>
+  void scan_chunk(const char* from, Chunk& out, std::stop_token stop) const;
+  template <bool Integer>
+  void merge_chunk(Chunk& c);
   template <bool Integer>
   void scan(const char* p);
 
@@ -164,6 +177,7 @@ class Reader {
   const char* begin_;
   const char* end_;
   std::size_t line_ = 0;
+  std::size_t lines_ = 0;          // '\n' in the text (from check_bytes)
   std::size_t content_lines_ = 0;  // non-blank lines seen by the careful path
 
   // Layout, fixed by the header row or the first data line.
@@ -598,27 +612,26 @@ void Reader::push(const Sample& s) {
 // ---- fast path -----------------------------------------------------------------------------------
 
 template <bool Integer>
-bool Reader::fast_line(const char*& p) {
+inline __attribute__((always_inline)) const char* Reader::parse_fast(const char* p, Sample& s) const {
   const bool blanks = delim_ == Delim::Blanks;
   const char dc = delim_ == Delim::Comma ? ',' : delim_ == Delim::Semicolon ? ';' : delim_ == Delim::Tab ? '\t' : ' ';
   const bool comma_ok = delim_ != Delim::Comma;
   const char* q = p;
-  Sample s;
   for (std::size_t c = 0; c < ncols_; ++c) {
     while (*q == ' ' || (blanks && *q == '\t')) ++q;
     switch (roles_[c]) {
       case Role::Value:
         if constexpr (Integer) {
           q = scan_int_fast(q, s.integer);
-          if (!q) return false;
+          if (!q) return nullptr;
           if (opt_.mode == InputMode::Counter && (s.integer < counter_lo_ || s.integer > counter_max_))
-            return false;
+            return nullptr;
         } else {
           const char* e = scan_double_fast(q, s.real, comma_ok);
           if (!e) {
             // Long mantissas (full-precision doubles): std::from_chars, still no copy.
             const auto r = std::from_chars(q, end_, s.real);
-            if (r.ec != std::errc() || !std::isfinite(s.real)) return false;
+            if (r.ec != std::errc() || !std::isfinite(s.real)) return nullptr;
             e = r.ptr;
           }
           q = e;
@@ -630,7 +643,7 @@ bool Reader::fast_line(const char*& p) {
         const char* e = scan_double_fast(q, v, comma_ok);
         if (!e) {
           const auto r = std::from_chars(q, end_, v);
-          if (r.ec != std::errc() || !std::isfinite(v)) return false;
+          if (r.ec != std::errc() || !std::isfinite(v)) return nullptr;
           e = r.ptr;
         }
         q = e;
@@ -642,17 +655,25 @@ bool Reader::fast_line(const char*& p) {
     }
     if (c + 1 < ncols_) {
       if (blanks) {
-        if (*q != ' ' && *q != '\t') return false;
+        if (*q != ' ' && *q != '\t') return nullptr;
       } else {
         while (*q == ' ') ++q;
-        if (*q != dc) return false;
+        if (*q != dc) return nullptr;
         ++q;
       }
     }
   }
   while (*q == ' ' || (blanks && *q == '\t')) ++q;
   if (*q == '\r') ++q;
-  if (*q != '\n') return false;
+  if (*q != '\n') return nullptr;
+  return q + 1;
+}
+
+template <bool Integer>
+bool Reader::fast_line(const char*& p) {
+  Sample s;
+  const char* next = parse_fast<Integer>(p, s);
+  if (!next) return false;
   if (new_run_) {
     runs_.emplace_back(samples_, line_);
     new_run_ = false;
@@ -667,21 +688,106 @@ bool Reader::fast_line(const char*& p) {
     ++temp_n_;
   }
   ++samples_;
-  p = q + 1;
+  p = next;
   return true;
+}
+
+// The second half of a long text, parsed on another thread while the first half is read: plain
+// data lines only, from `from` up to the first line the fast path does not take (or the end). It
+// keeps the values, time stamps and temperatures in order; merge_chunk() then adds them to the
+// record as the serial loop would have, and the serial loop goes on from where the chunk stopped
+// (that line gets the careful path: errors name the right line, and the earliest one wins).
+template <bool Integer>
+void Reader::scan_chunk(const char* from, Chunk& out, std::stop_token stop) const {
+  const char* p = from;
+  Sample s;
+  std::size_t k = 0;
+  while (p < end_) {
+    if ((++k & 0xfff) == 0 && stop.stop_requested()) break;
+    const char* next = parse_fast<Integer>(p, s);
+    if (!next) break;
+    if constexpr (Integer)
+      out.ints.push_back(s.integer);
+    else
+      out.reals.push_back(s.real);
+    if (time_col_) out.times.push_back(s.time);
+    if (temp_col_) out.temps.push_back(s.temperature);
+    p = next;
+  }
+  out.stop = p;
+}
+
+template <bool Integer>
+void Reader::merge_chunk(Chunk& c) {
+  const std::size_t k = Integer ? c.ints.size() : c.reals.size();
+  if (k == 0) return;
+  if (new_run_) {
+    runs_.emplace_back(samples_, line_ + 1);
+    new_run_ = false;
+  }
+  if constexpr (Integer)
+    ints_.insert(ints_.end(), c.ints.begin(), c.ints.end());
+  else
+    reals_.insert(reals_.end(), c.reals.begin(), c.reals.end());
+  if (time_col_)
+    for (double t : c.times) track_time(t);
+  if (temp_col_)
+    for (double t : c.temps) temp_sum_ += t;
+  if (temp_col_) temp_n_ += k;
+  samples_ += k;
+  line_ += k;
 }
 
 template <bool Integer>
 void Reader::scan(const char* p) {
-  while (p < end_) {
-    ++line_;
-    if (layout_known_ && fast_line<Integer>(p)) continue;
-    const char* eol = static_cast<const char*>(std::memchr(p, '\n', static_cast<std::size_t>(end_ - p)));
-    if (careful_line(std::string_view(p, static_cast<std::size_t>(eol - p))) != LineKind::Data)
-      new_run_ = true;
-    else
-      last_data_line_ = line_;
-    p = eol + 1;
+  // Texts of more than kParallelBytes are parsed in two halves once the layout is known: the
+  // second half on another thread, from the first line start after the middle.
+  constexpr std::ptrdiff_t kParallelBytes = std::ptrdiff_t{1} << 20;
+  const unsigned threads = opt_.threads ? opt_.threads : std::thread::hardware_concurrency();
+  bool may_split = threads > 1;
+  const char* limit = end_;
+  Chunk chunk;
+  std::jthread worker;
+  for (;;) {
+    while (p < limit) {
+      if (may_split && layout_known_) {
+        may_split = false;
+        if (end_ - p > kParallelBytes) {
+          const char* mid = p + (end_ - p) / 2;
+          const char* nl = static_cast<const char*>(std::memchr(mid, '\n', static_cast<std::size_t>(end_ - mid)));
+          if (nl && nl + 1 < end_) {
+            limit = nl + 1;
+            const auto share = static_cast<double>(end_ - limit) / static_cast<double>(end_ - begin_);
+            const auto expect = static_cast<std::size_t>(share * static_cast<double>(lines_) * 1.05) + 64;
+            worker = std::jthread([this, &chunk, expect, from = limit](std::stop_token st) {
+              // Room for the half's values, its pages mapped in one call on this thread.
+              if constexpr (Integer) {
+                chunk.ints.reserve(expect);
+                detail::prefault(chunk.ints.data(), expect * sizeof(std::int64_t));
+              } else {
+                chunk.reals.reserve(expect);
+                detail::prefault(chunk.reals.data(), expect * sizeof(double));
+              }
+              scan_chunk<Integer>(from, chunk, st);
+            });
+          }
+        }
+      }
+      ++line_;
+      if (layout_known_ && fast_line<Integer>(p)) continue;
+      const char* eol = static_cast<const char*>(std::memchr(p, '\n', static_cast<std::size_t>(end_ - p)));
+      if (careful_line(std::string_view(p, static_cast<std::size_t>(eol - p))) != LineKind::Data)
+        new_run_ = true;
+      else
+        last_data_line_ = line_;
+      p = eol + 1;
+    }
+    if (!worker.joinable()) break;
+    worker.join();  // p == limit: the first half is done
+    merge_chunk<Integer>(chunk);
+    p = chunk.stop;
+    chunk = Chunk{};
+    limit = end_;
   }
   if (samples_ > 0 && runs_.empty()) runs_.emplace_back(0, first_data_line_);
 }
@@ -880,6 +986,7 @@ Recording Reader::run(bool store_times) {
     p += 3;
   // Room for every line at once: one '\n' per line.
   const std::size_t lines = check_bytes(p);
+  lines_ = lines;
   // Slot 0 holds C_0 = 0 (pulses) or x_0 = 0 (rate); counter and angle samples are points already.
   if (integer_mode()) {
     ints_.reserve(lines + 1);

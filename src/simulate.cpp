@@ -160,6 +160,7 @@ void validate(const NoiseModel& m, const SimulationSettings& s) {
   check_finite(m.earth_rate_deg_per_h, "earth_rate_deg_per_h");
   check_finite_nonneg(m.white_angle_arcsec, "white_angle_arcsec");
   check_finite_nonneg(m.lowpass_tc_s, "lowpass_tc_s");
+  check_finite_nonneg(m.output_lowpass_tc_s, "output_lowpass_tc_s");
   for (const auto& x : m.sinusoids) {
     check_positive(x.f_hz, "sinusoid frequency_hz");
     check_finite(x.amp_deg_per_h, "sinusoid amplitude_deg_per_h");
@@ -450,6 +451,26 @@ struct Simulator::Impl {
       }
     }
     quantize(seed, out);
+    if (model.output_lowpass_tc_s > 0) output_lowpass(out);
+  }
+
+  // First-order low-pass in the output chain: the read-out's per-sample rate
+  // r_k = (C_k − C_{k−1})·q/τ0 goes through y_k = φy_{k−1} + (1 − φ)r_k, φ = e^{−τ0/Tf}, and the
+  // record is θ_k = θ_{k−1} + y_k·τ0 (″, floating). The filter starts in steady state at the
+  // record's mean rate.
+  void output_lowpass(PhaseSeries& out) const {
+    const double phi = std::exp(-tau0 / model.output_lowpass_tc_s);
+    out.values.resize(n + 1);
+    double y = out.diff(n, 0) / (static_cast<double>(n) * tau0);
+    double theta = 0.0;
+    out.values[0] = 0.0;
+    for (std::size_t k = 1; k <= n; ++k) {
+      const double r = out.diff(k, k - 1) / tau0;
+      y = phi * y + (1.0 - phi) * r;
+      theta += y * tau0;
+      out.values[k] = theta;
+    }
+    out.counts.clear();
   }
 
   // Count whole pulses. The angle is carried as whole pulses `whole` plus a fraction in [0, 1),

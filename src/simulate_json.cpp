@@ -44,7 +44,8 @@ void to_json(json& j, const NoiseModel& m) {
            {"earth_rate_deg_per_h", m.earth_rate_deg_per_h},
            {"readout", m.readout == ReadoutMode::White ? "white" : "counting"},
            {"white_angle_arcsec", m.white_angle_arcsec},
-           {"lowpass_tc_s", m.lowpass_tc_s}};
+           {"lowpass_tc_s", m.lowpass_tc_s},
+           {"output_lowpass_tc_s", m.output_lowpass_tc_s}};
   json s = json::array(), g = json::array(), st = json::array(), w = json::array();
   for (const auto& x : m.sinusoids)
     s.push_back({{"frequency_hz", x.f_hz}, {"amplitude_deg_per_h", x.amp_deg_per_h}, {"phase_rad", x.phase_rad}});
@@ -76,7 +77,9 @@ void add_finding(const json& f, NoiseModel& m) {
   } else if (effect == "warmup_transient" || effect == "warmup") {
     m.warmups.push_back({num(f, "amplitude_deg_per_h"), num(f, "time_constant_s")});
   } else if (effect == "lowpass") {
-    m.lowpass_tc_s = num(f, "time_constant_s");
+    // The low-pass diagnose names is the filter in the output chain (a low-pass of the sensed
+    // rate before counting is a Gauss–Markov rate and is named gauss_markov).
+    m.output_lowpass_tc_s = num(f, "time_constant_s");
   } else {
     throw UsageError(fmt::format("model JSON: unknown effect '{}'", effect));
   }
@@ -93,6 +96,7 @@ void from_json(const json& j, NoiseModel& m) {
   m.earth_rate_deg_per_h = num(j, "earth_rate_deg_per_h");
   m.white_angle_arcsec = num(j, "white_angle_arcsec");
   m.lowpass_tc_s = num(j, "lowpass_tc_s");
+  m.output_lowpass_tc_s = num(j, "output_lowpass_tc_s");
   if (j.contains("readout") && !j.at("readout").is_null()) {
     const auto r = j.at("readout").get<std::string>();
     if (r == "white")

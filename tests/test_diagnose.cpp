@@ -9,7 +9,10 @@
 
 #include "rwcalc/diagnose.hpp"
 #include "rwcalc/diagnose_detectors.hpp"
+#include "rwcalc/error.hpp"
 #include "rwcalc/simulate.hpp"
+
+#include <nlohmann/json.hpp>
 
 namespace {
 
@@ -103,6 +106,93 @@ TEST(DiagnoseBlocks, GaussMarkovShapeMatchesTheoreticalAvar) {
   // The low-pass removes the whole white-rate AV at τ ≪ τf and 1.5τf/τ² of it at τ ≫ τf.
   EXPECT_NEAR(shape_avar(Shape::Lowpass, 0.01, 100.0), -1.0 / 0.01, 1e-3 / 0.01);
   EXPECT_NEAR(shape_avar(Shape::Lowpass, 1e5, 10.0), -1.5 * 10.0 / 1e10, 1e-13);
+}
+
+TEST(DiagnoseBlocks, OutputLowpassAvarMatchesTheSimulatedFilter) {
+  // Without a filter: the white angle and white rate lines.
+  EXPECT_NEAR(output_lowpass_angle_avar(4, 0.01, 0.0), 3.0 / (0.04 * 0.04), 1e-9);
+  EXPECT_NEAR(output_lowpass_rate_avar(4, 0.01, 0.0), 1.0 / 0.04, 1e-12);
+  EXPECT_NEAR(output_lowpass_rate_avar(4, 0.01, 1e-9), 1.0 / 0.04, 1e-9);
+  // Far above τf the white rate passes (AV → 1/τ); the white angle keeps its variance (1 − φ)/(1 + φ).
+  EXPECT_NEAR(output_lowpass_rate_avar(100000, 0.01, 0.05) * 1000.0, 1.0, 1e-3);
+  const double phi = std::exp(-0.01 / 0.05);
+  EXPECT_NEAR(output_lowpass_angle_avar(100000, 0.01, 0.05) * 1000.0 * 1000.0 / 3.0, (1 - phi) / (1 + phi), 1e-9);
+  // The simulator's dithered read-out (white angle noise q²/6) through an output filter.
+  NoiseModel m;
+  m.earth_rate_deg_per_h = 12.43;
+  m.readout = ReadoutMode::White;
+  m.output_lowpass_tc_s = 0.05;
+  SimulationSettings s;
+  s.duration_s = 2000;
+  s.rate_hz = 100;
+  s.scale_arcsec = 0.92;
+  s.seed = 8;
+  const PhaseSeries x = simulate(m, s);
+  ASSERT_FALSE(x.exact());
+  ASSERT_EQ(x.points(), s.samples() + 1);
+  const double q2 = 0.92 * 0.92 / 6.0;
+  for (std::int64_t mm : {1, 2, 4, 16, 64}) {
+    const double expect = q2 * output_lowpass_angle_avar(static_cast<std::size_t>(mm), 0.01, 0.05);
+    EXPECT_NEAR(allan_variance(x, mm, Estimator::Overlapping), expect, 0.03 * expect) << mm;
+  }
+  // The detector recovers τf on it; on the unfiltered record the filter explains nothing.
+  std::vector<std::int64_t> ms;
+  std::vector<double> v, edf;
+  for (std::int64_t mm = 1; mm <= 1024; mm *= 2) {
+    ms.push_back(mm);
+    v.push_back(allan_variance(x, mm, Estimator::Overlapping));
+    edf.push_back(static_cast<double>(x.points()) / static_cast<double>(mm));
+  }
+  const auto est = output_lowpass_detect(ms, v, edf, 0.01, 2000);
+  EXPECT_NEAR(est.tf, 0.05, 0.005);
+  EXPECT_NEAR(est.white_angle2, q2, 0.1 * q2);
+  EXPECT_LT(est.tf_low, est.tf);
+  EXPECT_GT(est.tf_high, est.tf);
+  EXPECT_GT(est.statistic, 1000.0);
+  m.output_lowpass_tc_s = 0;
+  const PhaseSeries y = simulate(m, s);
+  for (std::size_t i = 0; i < ms.size(); ++i) v[i] = allan_variance(y, ms[i], Estimator::Overlapping);
+  EXPECT_LT(output_lowpass_detect(ms, v, edf, 0.01, 2000).statistic, 20.0);
+}
+
+TEST(DiagnoseBlocks, LowpassFindingIsTheOutputChainFilter) {
+  NoiseModel m;
+  add_finding(nlohmann::json{{"effect", "lowpass"}, {"time_constant_s", 0.02}}, m);
+  EXPECT_DOUBLE_EQ(m.output_lowpass_tc_s, 0.02);
+  EXPECT_DOUBLE_EQ(m.lowpass_tc_s, 0.0);
+  const nlohmann::json j = m;
+  EXPECT_DOUBLE_EQ(j.at("output_lowpass_tc_s").get<double>(), 0.02);
+  EXPECT_DOUBLE_EQ(j.get<NoiseModel>().output_lowpass_tc_s, 0.02);
+  m.output_lowpass_tc_s = -1.0;
+  EXPECT_THROW(validate(m, SimulationSettings{}), UsageError);
+}
+
+TEST(DiagnoseBlocks, LowpassDetectorSkipsPulseCountsGivenAsNumbers) {
+  // A counting read-out written as angles (whole multiples of q): the read-out's sawtooth is not
+  // an output-chain filter, and the detector says why it did not run.
+  NoiseModel m;
+  m.arw_deg_per_sqrt_h = 0.001;
+  m.earth_rate_deg_per_h = 12.43;
+  SimulationSettings s;
+  s.duration_s = 1300;
+  s.rate_hz = 100;
+  s.seed = 5;
+  Recording rec;
+  rec.source = "counts-as-angle";
+  rec.phase = simulate(m, s);
+  PhaseSeries& x = rec.phase;
+  x.values.resize(x.counts.size());
+  for (std::size_t i = 0; i < x.counts.size(); ++i) x.values[i] = x.diff(i, 0);
+  x.counts.clear();
+  rec.rate_hz = 100;
+  rec.samples = x.points() - 1;
+  DiagnoseOptions o;
+  o.runs = 10;
+  const auto r = diagnose(rec, o);
+  ASSERT_EQ(r.detectors.size(), 5u);
+  EXPECT_EQ(r.detectors[4].effect, "lowpass");
+  EXPECT_FALSE(r.detectors[4].fired);
+  EXPECT_NE(r.detectors[4].note.find("multiples"), std::string::npos) << r.detectors[4].note;
 }
 
 TEST(DiagnoseBlocks, GumbelThresholdSitsInTheTail) {

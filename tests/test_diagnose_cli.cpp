@@ -140,3 +140,33 @@ TEST(DiagnoseCliErrors, BadInputUsageAndShortRecords) {
   EXPECT_NE(r.err.find("--force"), std::string::npos) << r.err;
   EXPECT_EQ(slurp(out), "keep");
 }
+
+// An output-chain low-pass (τf = 0.05 s) on a dithered read-out at 100 Hz: `simulate` writes the
+// filtered angle, `diagnose --input angle` names `lowpass` with its time constant, and
+// `simulate --from` carries it in the extended model.
+TEST(DiagnoseCliLowpass, OutputChainFilterIsNamedAndSimulatedBack) {
+  TempDir dir;
+  const auto rec = (dir.path() / "lp.csv").string();
+  auto r = run_cli({"simulate", "-o", rec, "--duration", "1500", "--rate", "100", "--arw", "0.001",
+                    "--bias-instability", "0.005", "--white-readout", "--output-lowpass", "0.05", "--seed", "4"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(slurp(rec).find("\nangle\n"), std::string::npos);
+  const auto out = (dir.path() / "lp.json").string();
+  r = run_cli({"diagnose", rec, "--input", "angle", "--json", "--runs", "10", "--seed", "3", "-o", out});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(slurp(out));
+  const json* lp = nullptr;
+  for (const auto& f : j["findings"])
+    if (f["effect"] == "lowpass") lp = &f;
+  ASSERT_NE(lp, nullptr) << j["findings"].dump();
+  EXPECT_NEAR((*lp)["time_constant_s"].get<double>(), 0.05, 0.0125);
+  EXPECT_GT((*lp)["uncertainty"]["time_constant_s"].get<double>(), 0.0);
+  EXPECT_NEAR(j["extended_model"]["output_lowpass_tc_s"].get<double>(), (*lp)["time_constant_s"].get<double>(), 1e-12);
+  EXPECT_LT(j["gain"]["misfit_extended"].get<double>(), j["gain"]["misfit_base"].get<double>());
+  const auto again = (dir.path() / "again.csv").string();
+  r = run_cli({"simulate", "--from", out, "-o", again, "--duration", "1200"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string text = slurp(again);
+  EXPECT_NE(text.find("# output_lowpass_tc_s: "), std::string::npos);
+  EXPECT_NE(text.find("\nangle\n"), std::string::npos);
+}

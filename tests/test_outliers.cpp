@@ -221,3 +221,109 @@ TEST(Outliers, LongRecordFindsEverySpikeOnceInOrder) {
 }
 
 }  // namespace
+
+namespace {
+
+// The scan of a phase series (rates computed block by block) is the scan of its rates as a vector,
+// bit for bit: scale, indices, values and z, on exact counts and on a floating phase, on 1 and 2 threads.
+TEST(Outliers, PhaseSeriesScanEqualsVectorScan) {
+  std::mt19937_64 rng(21);
+  std::poisson_distribution<int> pulses(2.5);
+  rwcalc::PhaseSeries counts;
+  counts.tau0_s = 0.0025;
+  counts.arcsec_per_count = 0.92;
+  const std::size_t n = (std::size_t{1} << 20) + 4321;  // long enough for the two-thread screen
+  counts.counts.assign(1, 1000000007);                  // an offset: differences are what count
+  for (std::size_t i = 0; i < n; ++i) {
+    std::int64_t c = pulses(rng);
+    if (i % 99991 == 17 || i == 1 || i == n - 1) c += 60;  // glitches, two at the very ends
+    counts.counts.push_back(counts.counts.back() + c);
+  }
+  rwcalc::PhaseSeries floating;
+  floating.tau0_s = 0.01;
+  floating.kind = rwcalc::PhaseKind::Gyro;
+  auto y = gaussian(300001, 0.4, 22);
+  for (std::size_t i = 0; i < y.size(); i += 7919) y[i] += 30.0;
+  floating.values.assign(1, 5.0);
+  for (double v : y) floating.values.push_back(floating.values.back() + v * floating.tau0_s);
+
+  for (const rwcalc::PhaseSeries* ph : {&counts, &floating}) {
+    std::vector<double> rates(ph->points() - 1);
+    for (std::size_t i = 0; i < rates.size(); ++i) rates[i] = ph->rate(i);
+    const auto sv = rwcalc::outlier_scale(rates);
+    const auto sp = rwcalc::outlier_scale(*ph);
+    EXPECT_EQ(sv.scale, sp.scale);
+    EXPECT_EQ(sv.mad_sigma, sp.mad_sigma);
+    EXPECT_EQ(sv.resolution, sp.resolution);
+    const auto ov = find_outliers(rates, 8.0, sv);
+    EXPECT_FALSE(ov.empty());
+    for (unsigned threads : {1u, 2u}) {
+      const auto op = find_outliers(*ph, 8.0, sp, threads);
+      ASSERT_EQ(ov.size(), op.size()) << "threads " << threads;
+      for (std::size_t k = 0; k < ov.size(); ++k) {
+        EXPECT_EQ(ov[k].index, op[k].index);
+        EXPECT_EQ(ov[k].value, op[k].value);
+        EXPECT_EQ(ov[k].robust_z, op[k].robust_z);
+      }
+    }
+  }
+}
+
+// Short records (7 to 20 samples): edges and interior agree too.
+TEST(Outliers, PhaseSeriesScanEqualsVectorScanOnShortRecords) {
+  for (std::size_t n = 7; n <= 20; ++n) {
+    rwcalc::PhaseSeries ph;
+    ph.counts.assign(1, 0);
+    for (std::size_t i = 0; i < n; ++i) ph.counts.push_back(ph.counts.back() + (i == n / 2 ? 90 : 2 + (i % 3 == 0)));
+    std::vector<double> rates(n);
+    for (std::size_t i = 0; i < n; ++i) rates[i] = ph.rate(i);
+    const auto sv = rwcalc::outlier_scale(rates), sp = rwcalc::outlier_scale(ph);
+    EXPECT_EQ(sv.scale, sp.scale) << n;
+    EXPECT_EQ(sv.resolution, sp.resolution) << n;
+    const auto ov = find_outliers(rates, 8.0, sv), op = find_outliers(ph, 8.0, sp);
+    ASSERT_EQ(ov.size(), op.size()) << n;
+    for (std::size_t k = 0; k < ov.size(); ++k) EXPECT_EQ(ov[k].index, op[k].index) << n;
+  }
+}
+
+}  // namespace
+
+namespace {
+
+// scan_outliers (scale and screen in one pass on exact counts) gives what the two calls give:
+// pulse counts whose scale is the resolution (the one-pass path), counts with a wide spread (the
+// spread sets the scale: the ordinary screen), with glitches in both, on 1 and 2 threads.
+TEST(Outliers, OnePassScanEqualsScaleThenScreen) {
+  std::mt19937_64 rng(31);
+  for (double mean : {0.05, 2.5, 400.0}) {
+    std::poisson_distribution<int> pulses(mean);
+    rwcalc::PhaseSeries ph;
+    ph.tau0_s = 0.0025;
+    ph.arcsec_per_count = 0.92;
+    ph.counts.assign(1, -77);
+    const std::size_t n = (std::size_t{1} << 20) + 999;
+    for (std::size_t i = 0; i < n; ++i) {
+      std::int64_t c = pulses(rng);
+      if (i % 65537 == 5 || i == 2 || i == n - 2) c += 20 + static_cast<std::int64_t>(mean) * 4;
+      ph.counts.push_back(ph.counts.back() + c);
+    }
+    for (unsigned threads : {1u, 2u}) {
+      const auto s2 = rwcalc::outlier_scale(ph, threads);
+      const auto o2 = find_outliers(ph, 8.0, s2, threads);
+      rwcalc::OutlierScale s1;
+      const auto o1 = rwcalc::scan_outliers(ph, 8.0, s1, threads);
+      EXPECT_EQ(s1.scale, s2.scale) << mean;
+      EXPECT_EQ(s1.mad_sigma, s2.mad_sigma) << mean;
+      EXPECT_EQ(s1.resolution, s2.resolution) << mean;
+      EXPECT_FALSE(o2.empty()) << mean;
+      ASSERT_EQ(o1.size(), o2.size()) << mean;
+      for (std::size_t k = 0; k < o1.size(); ++k) {
+        EXPECT_EQ(o1[k].index, o2[k].index);
+        EXPECT_EQ(o1[k].value, o2[k].value);
+        EXPECT_EQ(o1[k].robust_z, o2[k].robust_z);
+      }
+    }
+  }
+}
+
+}  // namespace

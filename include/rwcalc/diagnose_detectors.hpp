@@ -85,6 +85,9 @@ struct MidTauReference {
   std::vector<std::size_t> grid;
   std::vector<double> tau;
   std::vector<double> mean, var;
+  /// Sample covariance of the runs' AV between grid points (row-major, grid.size()²; the
+  /// overlapping AV at neighbouring τ is strongly correlated); empty: treated as independent.
+  std::vector<double> cov;
 };
 
 struct ShapeEstimate {
@@ -95,6 +98,13 @@ struct ShapeEstimate {
   /// White rate noise left beside the bump, c_N,base + ΔN² ≥ 0 (fit scale, (°/h)²·s), and its
   /// standard error. A bump with no white noise left is a low-pass of the white noise.
   double white_rest = 0, white_rest_sigma = 0;
+  /// Largest rise of the fitted mid-τ AV (bump plus corrections) above the reference, in
+  /// ensemble standard deviations: a Gauss–Markov term adds variance somewhere; a fit that only
+  /// lowers the AV (a deficit) is not one.
+  double excess = 0;
+  /// The bump's AV at its peak (τ = 1.89·Tc) over the reference's mean AV there: how far it stands
+  /// above the local Allan variance.
+  double peak_ratio = 0;
 };
 enum class Shape { GaussMarkov, Lowpass };
 /// AV of a unit-variance Gauss–Markov process (Shape::GaussMarkov, time = Tc) or minus the AV
@@ -119,6 +129,29 @@ std::array<double, 4> calibration_corrections(const std::vector<double>& v, cons
 /// `v_j` being one ensemble member, its statistic against the leave-one-out reference.
 MidTauReference leave_one_out(const MidTauReference& ref, const std::vector<double>& v, std::size_t runs);
 
+// ---- output-chain low-pass in the short-τ Allan variance --------------------------------------
+
+/// Overlapping AV at cluster size m (sample period tau0) of unit white angle noise (σ_θ = 1 ″,
+/// 3/τ² unfiltered) after a first-order output-chain low-pass of time constant tf (0: none):
+/// ((1 − φ)/(1 + φ))·(3 − 4φ^m + φ^{2m})/τ², φ = e^{−τ0/tf}.
+double output_lowpass_angle_avar(std::size_t m, double tau0, double tf);
+/// The same for a unit white rate (AV 1/τ unfiltered, rate constant over each sample).
+double output_lowpass_rate_avar(std::size_t m, double tau0, double tf);
+
+struct OutputLowpassEstimate {
+  double statistic = 0;     ///< χ² drop of the short-τ octave AV when the output low-pass joins
+  double tf = 0, tf_low = 0, tf_high = 0;  ///< time constant, s, and its Δχ² range
+  double white_angle2 = 0;  ///< white angle variance before the filter, ″²
+  double white_rate = 0;    ///< white rate N² before the filter, (°/h)²·s
+  double points = 0;        ///< octave points used
+  double chi2 = 0;          ///< χ² of the best fit (with the filter)
+};
+/// Fit the octave AV `v` (cluster sizes `m`, EDF `edf`, τ ≤ min(20 s, T/100)) by white angle
+/// noise, white rate noise and a constant floor, all through a first-order output-chain low-pass
+/// of time constant tf (grid from τ0/4), against the same without the filter (weights EDF/(2v²)).
+OutputLowpassEstimate output_lowpass_detect(const std::vector<std::int64_t>& m, const std::vector<double>& v,
+                                            const std::vector<double>& edf, double tau0, double duration);
+
 // ---- calibration, bands ---------------------------------------------------------------------
 
 /// (1 − α) quantile of a maximum-type statistic from ensemble values (Gumbel fit by moments),
@@ -130,12 +163,15 @@ double quantile(std::vector<double> v, double p);
 /// statistics when `with_detectors`.
 struct RunStats {
   std::vector<double> octave_var;
-  std::vector<double> mid_var;     ///< of the record without its own candidates when `clean_mid`
+  std::vector<double> mid_var;
+  /// With detectors or `clean_mid`: the mid-τ AV after the record's own mean-shape candidate (the
+  /// better of the best step and the best warm-up) is removed, as it is from the measurement.
+  std::vector<double> mid_var_clean;
   double sin_stat = 0, step_stat = 0, warm_stat = 0;
 };
 
-/// Simulate `runs` records of `model` and collect their statistics; with `clean_mid` the mid-τ AV
-/// is that of each record without its own candidates (own_candidates), as on the measurement.
+/// Simulate `runs` records of `model` and collect their statistics; with `clean_mid` (or
+/// `with_detectors`) also the mid-τ AV of each record without its own candidate (own_candidates).
 std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSettings& settings, std::size_t runs,
                                    const std::vector<std::int64_t>& octave_m, const std::vector<std::size_t>& mid_grid,
                                    bool with_detectors, const DiagnoseOptions& options, bool clean_mid = true);

@@ -103,6 +103,9 @@ struct FitOptions {
   /// the full model. N and B, the verdict's parameters, are never dropped.
   bool select_terms = true;
   std::array<bool, kTermCount> droppable{true, false, false, true, true};
+  /// Threads for the point covariance (0: all hardware threads; at most two are used). The
+  /// result does not depend on it.
+  unsigned threads = 0;
 };
 
 /// One fitted coefficient in its IEEE unit (see term_unit).
@@ -153,6 +156,11 @@ struct FitResult {
 /// being deterministic, adds none). All pairs of τ are covered (lags summed on a mesh graded
 /// towards the kinks of the lag covariance).
 Eigen::MatrixXd av_covariance(std::span<const FitPoint> points, const Eigen::Matrix<double, kTermCount, 1>& c);
+/// Same; with `diagonal_only` only the variances (the off-diagonal entries stay 0: j of the
+/// j(j+1)/2 entries). The rows are computed on up to `threads` threads (0: all hardware threads,
+/// at most two); every entry is the same whatever the thread count.
+Eigen::MatrixXd av_covariance(std::span<const FitPoint> points, const Eigen::Matrix<double, kTermCount, 1>& c,
+                              bool diagonal_only, unsigned threads = 1);
 
 /// The points of an Allan result usable for a fit (σ² > 0 is checked by fit_noise); cluster sizes
 /// and term counts are filled for the overlapping estimator only.

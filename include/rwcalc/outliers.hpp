@@ -41,12 +41,28 @@ inline constexpr double kDefaultOutlierThreshold = 8.0;
 /// The robust scale of a rate record (see the file comment). Needs at least 7 samples (else 0).
 OutlierScale outlier_scale(const std::vector<double>& rates);
 
+/// The same scale for the rates of a phase series (the rates Recording::rates() gives), computed
+/// block by block without a copy of the whole record: bit-identical to outlier_scale(rates).
+/// `threads`: 0 = all hardware threads; records of more than 2^20 samples use two when allowed.
+OutlierScale outlier_scale(const PhaseSeries& phase, unsigned threads = 0);
+
 /// Isolated outliers of `rates`, sorted by index; `line` is 0. Fewer than 7 samples: none.
 std::vector<Outlier> find_outliers(const std::vector<double>& rates,
                                    double threshold = kDefaultOutlierThreshold);
 
 /// Same, with the robust scale already computed by outlier_scale(rates).
 std::vector<Outlier> find_outliers(const std::vector<double>& rates, double threshold, const OutlierScale& scale);
+
+/// Same, on the rates of a phase series, computed block by block (no copy of the record); the
+/// result is identical to find_outliers(rates, threshold, scale) on the rates as a vector.
+/// `threads`: 0 = all hardware threads; records of more than 2^20 samples use two when allowed.
+std::vector<Outlier> find_outliers(const PhaseSeries& phase, double threshold, const OutlierScale& scale,
+                                   unsigned threads = 0);
+
+/// outlier_scale(phase, threads) and find_outliers(phase, threshold, scale, threads) in one call,
+/// with the same results; on exact counts usually in one pass over the record instead of two.
+std::vector<Outlier> scan_outliers(const PhaseSeries& phase, double threshold, OutlierScale& scale,
+                                   unsigned threads = 0);
 
 /// Same, on a recording's rates, with the input line of each outlier filled in.
 std::vector<Outlier> find_outliers(const Recording& recording,

@@ -19,7 +19,9 @@ using Metadata = std::vector<std::pair<std::string, std::string>>;
 /// Render a pulse file to text (fast: one char buffer, std::to_chars; no streams per line).
 [[nodiscard]] std::string format_pulse_file(const Metadata& metadata, std::span<const std::int64_t> pulses);
 
-/// Render the increments of an exact series (counts) as a pulse file.
+/// Render the increments of an exact series (counts) as a pulse file; a floating series (values,
+/// e.g. after an output-chain low-pass) as the cumulative angle in ″ under the header `angle`
+/// (read back with `--input angle`).
 [[nodiscard]] std::string format_pulse_file(const Metadata& metadata, const PhaseSeries& series);
 
 /// Write a pulse file atomically (".gz" is gzip-compressed). Throws OutputError.

@@ -48,6 +48,9 @@ struct ReadOptions {
   RateUnit rate_unit = RateUnit::DegPerHour;
   /// Allowed deviation of a time-column step from 1/rate, as a fraction of the period.
   double time_tolerance = 0.01;
+  /// Threads for parsing a long text (0: all hardware threads; at most two are used, on texts of
+  /// more than 1 MB). The result does not depend on it.
+  unsigned threads = 0;
 };
 
 /// Where the sample rate came from (reported in outputs).

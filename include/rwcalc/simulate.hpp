@@ -95,8 +95,15 @@ struct NoiseModel {
   std::vector<GaussMarkov> gauss_markov;
   std::vector<BiasStep> bias_steps;
   std::vector<Warmup> warmups;
-  /// Time constant of a first-order low-pass of the sensed rate inside the sensor, s (0: none).
+  /// Time constant of a first-order low-pass of the sensed rate inside the sensor, before the
+  /// pulses are counted, s (0: none). Its Allan variance is that of a Gauss–Markov rate.
   double lowpass_tc_s = 0.0;
+  /// Time constant of a first-order low-pass in the output chain, s (0: none): the read-out's
+  /// per-sample rate (counted pulses·q/τ0) is filtered, as by a decimation or dither-stripping
+  /// filter, and the record is the integrated filtered rate, a floating angle with sub-pulse
+  /// resolution (PhaseSeries::values, no counts). This is what a `lowpass` finding of diagnose
+  /// names (docs/diagnosis.md).
+  double output_lowpass_tc_s = 0.0;
   std::optional<TemperatureBias> temperature_bias;
 };
 
@@ -157,7 +164,9 @@ enum class SimulationPath {
 /// for m > 256·D it returns flicker_avar(B, m), from which it then differs by < 1e-4.
 [[nodiscard]] double fast_flicker_avar(double b_deg_per_h, std::size_t m, std::size_t decimation);
 
-/// Simulate one record. counts[0] = 0; counts.size() = samples + 1. Throws UsageError.
+/// Simulate one record. counts[0] = 0; counts.size() = samples + 1; with an output-chain low-pass
+/// (NoiseModel::output_lowpass_tc_s) values[0] = 0, values.size() = samples + 1 in ″ and no counts.
+/// Throws UsageError.
 PhaseSeries simulate(const NoiseModel& model, const SimulationSettings& settings);
 
 /// Fast repeated simulation of one model at one length: FFT plans, the flicker filter
@@ -211,7 +220,7 @@ void simulate_ensemble(const NoiseModel& model, const SimulationSettings& settin
 // JSON form of the model (the "extended_model" of diagnose uses the same form):
 // {"arw_deg_per_sqrt_h", "bias_instability_deg_per_h", "rrw_deg_per_h_per_sqrt_h",
 //  "ramp_deg_per_h2", "bias_deg_per_h", "earth_rate_deg_per_h", "readout": "counting"|"white",
-//  "white_angle_arcsec", "lowpass_tc_s",
+//  "white_angle_arcsec", "lowpass_tc_s", "output_lowpass_tc_s",
 //  "sinusoids": [{"frequency_hz", "amplitude_deg_per_h", "phase_rad"}],
 //  "gauss_markov": [{"sigma_deg_per_h", "correlation_time_s"}],
 //  "bias_steps": [{"time_s", "size_deg_per_h"}],

@@ -38,6 +38,7 @@ struct SimulateArgs {
   bool no_earth_rate = false;
   std::vector<std::string> sinusoids, gauss_markov, bias_steps, warmups;
   double lowpass = 0.0;
+  double output_lowpass = 0.0;
   bool white_readout = false;
   double white_angle = 0.0;
   std::optional<double> temp_bias;
@@ -101,6 +102,7 @@ Metadata metadata_of(const NoiseModel& m, const SimulationSettings& s) {
   term("earth_rate_deg_per_h", m.earth_rate_deg_per_h);
   term("white_angle_arcsec", m.white_angle_arcsec);
   term("lowpass_tc_s", m.lowpass_tc_s);
+  term("output_lowpass_tc_s", m.output_lowpass_tc_s);
   for (const auto& x : m.sinusoids)
     md.emplace_back("sinusoid", fmt::format("frequency_hz={} amplitude_deg_per_h={} phase_rad={}", x.f_hz, x.amp_deg_per_h, x.phase_rad));
   for (const auto& x : m.gauss_markov)
@@ -167,6 +169,8 @@ int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
   if (a.white_readout) m.readout = ReadoutMode::White;
   if (a.from.empty() || given("--white-angle")) m.white_angle_arcsec = nonneg("--white-angle", a.white_angle);
   if (a.from.empty() || given("--lowpass")) m.lowpass_tc_s = nonneg("--lowpass", a.lowpass);
+  if (a.from.empty() || given("--output-lowpass"))
+    m.output_lowpass_tc_s = nonneg("--output-lowpass", a.output_lowpass);
   for (const auto& t : a.sinusoids) {
     const auto v = fields("--sinusoid", t, 2, 3, "F_HZ:AMP_DEG_PER_H[:PHASE_RAD]");
     if (v[0] <= 0) throw UsageError(fmt::format("--sinusoid: the frequency must be > 0 Hz in '{}'", t));
@@ -288,6 +292,10 @@ void register_simulate(CLI::App& app, Runner& runner) {
   sub->add_option("--warmup", a.warmups, "Warm-up transient AMP_DEG_PER_H:TC_S, rate amp*exp(-t/tc) (deg/h, s); repeatable")
       ->group("Extended terms");
   sub->add_option("--lowpass", a.lowpass, "First-order low-pass of the sensed rate inside the sensor, time constant s")
+      ->group("Extended terms");
+  sub->add_option("--output-lowpass", a.output_lowpass,
+                  "First-order low-pass of the counted rate in the output chain, time constant s; the file then holds "
+                  "the filtered angle in arcsec (column 'angle', read with --input angle)")
       ->group("Extended terms");
   sub->add_option("--temp-bias", a.temp_bias, "Temperature-driven bias coefficient, deg/h per deg C (needs --temp-profile)")
       ->group("Extended terms");

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Diagnose every run and gyro axis of the ADIS16405 recordings in ../shared/data/real/ and print one
+# Markdown table (docs/adis16405.md, "Diagnosis"): base model misfit and coverage, the named effects
+# with their parameters, the extended model's misfit and coverage, and the out-of-sample misfits.
+#
+# Usage: scripts/adis-diagnose.sh [RWCALC] [OUTDIR] [RUNS]
+#   RWCALC  the rwcalc binary (default build/rwcalc)
+#   OUTDIR  where the JSON of each diagnosis is written (default adis-diagnose/)
+#   RUNS    ensemble size (default 50)
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+rw="${1:-$here/build/rwcalc}"
+out="${2:-adis-diagnose}"
+runs="${3:-50}"
+data="$here/../shared/data/real/imudata_adis16405"
+[[ -x "$rw" ]] || { echo "adis-diagnose.sh: $rw is not an executable rwcalc" >&2; exit 2; }
+[[ -d "$data" ]] || { echo "adis-diagnose.sh: $data not found (the shared reference data)" >&2; exit 2; }
+command -v python3 >/dev/null || { echo "adis-diagnose.sh: python3 is needed for the table" >&2; exit 2; }
+mkdir -p "$out"
+for run in 1 2 3 4; do
+  for axis in x y z; do
+    "$rw" diagnose "$data/adis_16405_imu$run.csv.gz" --input rate --rate-unit deg/s --rate 100 \
+      --column "gyro_${axis}_dps" --earth-rate 0 --runs "$runs" --seed 1 --json -o "$out/run${run}_$axis.json" --force
+  done
+done
+python3 - "$out" <<'PY'
+import json, sys, pathlib
+out = pathlib.Path(sys.argv[1])
+def fmt_finding(f):
+    e = f["effect"]; u = f.get("uncertainty", {})
+    def v(k, unit, d=3):
+        s = f"{f[k]:.{d}g}"
+        if k in u: s += f" ± {u[k]:.2g}"
+        return s + f" {unit}"
+    if e == "sinusoid": return f"sinusoid {v('frequency_hz','Hz')}, {v('amplitude_deg_per_h','°/h')}"
+    if e == "gauss_markov": return f"Gauss–Markov σ {v('sigma_deg_per_h','°/h')}, Tc {v('correlation_time_s','s')}"
+    if e == "bias_step": return f"bias step {v('size_deg_per_h','°/h')} at {v('time_s','s')}"
+    if e == "warmup_transient": return f"warm-up {v('amplitude_deg_per_h','°/h')}, τw {v('time_constant_s','s')}"
+    if e == "lowpass": return f"low-pass τf {v('time_constant_s','s')}"
+    return e
+print("| run | axis | base misfit | base coverage | named effects | extended misfit | extended coverage | holdout misfit base → extended |")
+print("|---|---|---|---|---|---|---|---|")
+for run in (1, 2, 3, 4):
+    for axis in "xyz":
+        j = json.load(open(out / f"run{run}_{axis}.json"))
+        g = j["gain"]
+        names = "; ".join(fmt_finding(f) for f in j["findings"]) or "none"
+        print(f"| {run} | {axis.upper()} | {g['misfit_base']:.2f} | {100*g['coverage_base']:.0f} % | {names} | "
+              f"{g['misfit_extended']:.2f} | {100*g['coverage_extended']:.0f} % | "
+              f"{g['holdout_misfit_base']:.2f} → {g['holdout_misfit_extended']:.2f} |")
+PY
