@@ -166,12 +166,19 @@ bool on_lattice(const PhaseSeries& x) {
   return step >= 0.5 * sd;
 }
 
+/// The mid-τ reference of an ensemble's records without their own mean-shape candidate.
+MidTauReference clean_reference(const std::vector<std::size_t>& grid, double tau_d, std::vector<RunStats> runs) {
+  for (auto& r : runs) r.mid_var = r.mid_var_clean;
+  return make_reference(grid, tau_d, runs);
+}
+
 /// Everything needed to estimate named effects on one stretch of data.
 struct Stretch {
   const Recording* rec = nullptr;   ///< the stretch as a recording
   const AnalysisResult* analysis = nullptr;
   Decimated dec;                    ///< its decimated angle
   MidTauReference ref;              ///< mid-τ AV reference of its base model's ensemble
+  MidTauReference clean_ref;        ///< the same of its records without their own candidate
   std::size_t runs = 0;
 };
 
@@ -247,7 +254,9 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
   };
   const bool stochastic = std::any_of(effects.begin(), effects.end(), is_mid_tau);
   if (!stochastic && !x.findings.empty()) {
-    const auto dc = power_law_corrections(v, s.ref, c_of(base));
+    // Like the base calibration: the data without their candidate (or named terms) against the
+    // ensemble's records without their own candidate.
+    const auto dc = power_law_corrections(v, s.clean_ref.mean.empty() ? s.ref : s.clean_ref, c_of(base));
     apply(x.model.arw_deg_per_sqrt_h, Term::N, dc[1]);
     apply(x.model.bias_instability_deg_per_h, Term::B, dc[2]);
     apply(x.model.rrw_deg_per_h_per_sqrt_h, Term::K, dc[3]);
@@ -421,6 +430,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   const auto base_runs = run_ensemble(r.base, r.settings, opt.runs, octave_m, grid, true, opt);
   r.base_band = make_band(r.analysis.allan.points, base_runs, opt.band_level);
   full.ref = make_reference(grid, full.dec.tau_d, base_runs);
+  full.clean_ref = clean_reference(grid, full.dec.tau_d, base_runs);
   full.runs = opt.runs;
   timer.lap("base ensemble");
 
@@ -601,13 +611,14 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
         robust_base(fit_rec, a_fit, aopt, st.dec, sh, r.holdout_runs, om, hgrid, opt).model;
     sh.seed += 50;
     const double dt = (static_cast<double>(pa) - static_cast<double>(fa)) * x.tau0_s;
-    const auto b_runs = run_ensemble(b_fit, sh, r.holdout_runs, om, hgrid, false, opt, false);
+    const auto b_runs = run_ensemble(b_fit, sh, r.holdout_runs, om, hgrid, false, opt, !effects.empty());
     hb += band_misfit(make_band(a_pred.points, b_runs, opt.band_level), r.holdout_runs);
     if (effects.empty()) {
       he += band_misfit(make_band(a_pred.points, b_runs, opt.band_level), r.holdout_runs);
       continue;
     }
     st.ref = make_reference(hgrid, st.dec.tau_d, b_runs);
+    st.clean_ref = clean_reference(hgrid, st.dec.tau_d, b_runs);
     st.runs = r.holdout_runs;
     const Extension e = extend(st, b_fit, effects, f_hint, aopt);
     const auto e_runs = run_ensemble(shifted(e.model, dt), sh, r.holdout_runs, om, hgrid, false, opt, false);
