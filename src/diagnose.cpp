@@ -130,19 +130,6 @@ std::array<double, 4> c_of(const NoiseModel& m) {
           c_from_coefficient(Term::K, m.rrw_deg_per_h_per_sqrt_h)};
 }
 
-/// The better of the best bias step and the best warm-up on the block means (lower RSS), as the
-/// deterministic terms of a model: the candidate the base fit is made without.
-NoiseModel mean_candidate(const Decimated& d) {
-  const auto st = step_detect(d);
-  const auto w = warmup_detect(d);
-  NoiseModel c;
-  if (st.rss <= w.rss)
-    c.bias_steps.push_back({st.t_s, st.size});
-  else
-    c.warmups.push_back({w.amp, w.tc});
-  return c;
-}
-
 /// The output-chain low-pass fit on the octave AV of an analysis (measured EDF).
 OutputLowpassEstimate lowpass_of(const AllanResult& a, double duration) {
   std::vector<std::int64_t> m;
@@ -179,12 +166,19 @@ bool on_lattice(const PhaseSeries& x) {
   return step >= 0.5 * sd;
 }
 
+/// The mid-τ reference of an ensemble's records without their own mean-shape candidate.
+MidTauReference clean_reference(const std::vector<std::size_t>& grid, double tau_d, std::vector<RunStats> runs) {
+  for (auto& r : runs) r.mid_var = r.mid_var_clean;
+  return make_reference(grid, tau_d, runs);
+}
+
 /// Everything needed to estimate named effects on one stretch of data.
 struct Stretch {
   const Recording* rec = nullptr;   ///< the stretch as a recording
   const AnalysisResult* analysis = nullptr;
   Decimated dec;                    ///< its decimated angle
   MidTauReference ref;              ///< mid-τ AV reference of its base model's ensemble
+  MidTauReference clean_ref;        ///< the same of its records without their own candidate
   std::size_t runs = 0;
 };
 
@@ -206,7 +200,7 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
     Finding f;
     f.effect = e;
     if (e == "sinusoid") {
-      const auto est = sinusoid_detect(s.dec, f_hint);
+      const auto est = sinusoid_detect(without_mean_shape(s.dec), f_hint);
       det.sinusoids.push_back({est.f_hz, est.amp, est.phase});
       f.params = {{"frequency_hz", est.f_hz}, {"amplitude_deg_per_h", est.amp}, {"phase_rad", est.phase}};
       f.uncertainty = {{"frequency_hz", est.f_sigma}, {"amplitude_deg_per_h", est.amp_sigma}};
@@ -240,14 +234,17 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
     x.model.output_lowpass_tc_s = lowpass->tf;
     x.model.white_angle_arcsec = std::sqrt(std::max(0.0, lowpass->white_angle2));
   }
-  // Re-fit: the mid-τ AV of the data without the named deterministic terms (and without the
-  // mean-shape candidate when no step or transient was named, as for the base fit) against the
-  // base ensemble gives the corrections of N², B², K² — jointly with the bump of a stochastic term.
+  // Re-fit: the mid-τ AV of the data without the named deterministic terms (and without its own
+  // candidates of the kinds not named, as the base ensemble's records) against the base ensemble
+  // gives the corrections of N², B², K² — jointly with the bump of a stochastic term.
   NoiseModel det_mid = det;
-  if (det.bias_steps.empty() && det.warmups.empty()) {
-    const NoiseModel c = mean_candidate(s.dec);
-    det_mid.bias_steps = c.bias_steps;
-    det_mid.warmups = c.warmups;
+  {
+    const NoiseModel c = own_candidates(s.dec);
+    if (det.bias_steps.empty() && det.warmups.empty()) {
+      det_mid.bias_steps = c.bias_steps;
+      det_mid.warmups = c.warmups;
+    }
+    if (det.sinusoids.empty()) det_mid.sinusoids = c.sinusoids;
   }
   Decimated dm = s.dec;
   subtract_deterministic(dm, det_mid);
@@ -257,7 +254,9 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
   };
   const bool stochastic = std::any_of(effects.begin(), effects.end(), is_mid_tau);
   if (!stochastic && !x.findings.empty()) {
-    const auto dc = power_law_corrections(v, s.ref, c_of(base));
+    // Like the base calibration: the data without their candidate (or named terms) against the
+    // ensemble's records without their own candidate.
+    const auto dc = power_law_corrections(v, s.clean_ref.mean.empty() ? s.ref : s.clean_ref, c_of(base));
     apply(x.model.arw_deg_per_sqrt_h, Term::N, dc[1]);
     apply(x.model.bias_instability_deg_per_h, Term::B, dc[2]);
     apply(x.model.rrw_deg_per_h_per_sqrt_h, Term::K, dc[3]);
@@ -303,14 +302,19 @@ std::vector<std::int64_t> octave_of(const AllanResult& a) {
   return m;
 }
 
-/// Calibrate N, B, K of a five-term model by a pilot ensemble: the weighted least-squares
-/// corrections that bring the pilot's mean mid-τ AV onto the measured one (`dec`).
+/// Calibrate N and B of a five-term model by a pilot ensemble: the weighted least-squares
+/// corrections that bring the pilot's mean mid-τ AV onto the measured one (`dec`), from 1 s to
+/// T/6. Data and pilot records alike are taken without their own candidates (own_candidates), so
+/// the shrinking of the AV by that removal is the same on both sides. K stays at the base fit's
+/// value: over 1 s … T/6 of one record the trade between B and K is too loose, and a B pulled low
+/// makes a quiet model beside which the record's own wander looks like a step.
 NoiseModel calibrated(const NoiseModel& m0, const SimulationSettings& settings, std::size_t runs,
                       const std::vector<std::int64_t>& octave_m, const Decimated& dec,
                       const std::vector<std::size_t>& grid, const DiagnoseOptions& opt) {
-  const auto pilot = run_ensemble(m0, settings, runs, octave_m, grid, false, opt);
+  auto pilot = run_ensemble(m0, settings, runs, octave_m, grid, false, opt);
+  for (auto& p : pilot) p.mid_var = p.mid_var_clean;
   const auto ref = make_reference(grid, dec.tau_d, pilot);
-  const auto dc = power_law_corrections(decimated_avar(dec, grid), ref, c_of(m0));
+  const auto dc = calibration_corrections(decimated_avar(dec, grid), ref, c_of(m0), dec.duration() / 6.0);
   NoiseModel m = m0;
   auto apply = [&](double& coef, Term t, double d) {
     coef = coefficient_from_c(t, std::max(0.0, c_from_coefficient(t, coef) + d));
@@ -328,7 +332,6 @@ NoiseModel calibrated(const NoiseModel& m0, const SimulationSettings& settings, 
 struct RobustBase {
   NoiseModel model;
   NoiseModel candidate;
-  Decimated clean;   ///< the decimated angle without the candidate
 };
 
 RobustBase robust_base(const Recording& rec, const AnalysisResult& original, const AnalysisOptions& aopt,
@@ -336,14 +339,14 @@ RobustBase robust_base(const Recording& rec, const AnalysisResult& original, con
                        const std::vector<std::int64_t>& octave_m, const std::vector<std::size_t>& grid,
                        const DiagnoseOptions& opt) {
   RobustBase b;
-  b.candidate = mean_candidate(dec);
+  b.candidate = own_candidates(dec);
   const Recording clean = with_series(rec, cleaned(rec.phase, b.candidate, 0.0));
   const AnalysisResult a = analyze_for_base(clean, aopt);
   NoiseModel m0 = base_model(a, rec.phase);
   m0.bias_deg_per_h = original.mean_rate_deg_per_h - original.earth_rate_deg_per_h;
-  b.clean = dec;
-  subtract_deterministic(b.clean, b.candidate);
-  b.model = calibrated(m0, settings, pilot_runs, octave_m, b.clean, grid, opt);
+  Decimated dclean = dec;
+  subtract_deterministic(dclean, b.candidate);
+  b.model = calibrated(m0, settings, pilot_runs, octave_m, dclean, grid, opt);
   return b;
 }
 
@@ -427,11 +430,12 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   const auto base_runs = run_ensemble(r.base, r.settings, opt.runs, octave_m, grid, true, opt);
   r.base_band = make_band(r.analysis.allan.points, base_runs, opt.band_level);
   full.ref = make_reference(grid, full.dec.tau_d, base_runs);
+  full.clean_ref = clean_reference(grid, full.dec.tau_d, base_runs);
   full.runs = opt.runs;
   timer.lap("base ensemble");
 
   // 2. Detectors on the measurement.
-  const auto sin = sinusoid_detect(full.dec);
+  const auto sin = sinusoid_detect(without_mean_shape(full.dec));
   const auto step = step_detect(full.dec);
   const auto warm = warmup_detect(full.dec);
   auto calibrate = [&](const std::string& effect, double stat, const std::vector<double>& ens) {
@@ -469,8 +473,8 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   if (d_step.named) effects.push_back("bias_step");
   if (d_warm.named) effects.push_back("warmup_transient");
 
-  // Mid-τ shapes on the measurement without the mean-shape candidate (as the base fit) and a
-  // named sinusoid.
+  // Mid-τ shapes on the measurement without its own candidate, as every ensemble record, and
+  // without a named sinusoid.
   NoiseModel det = candidate;
   if (d_sin.named) det.sinusoids.push_back({sin.f_hz, sin.amp, sin.phase});
   Decimated dclean = full.dec;
@@ -572,7 +576,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   } else {
     // Common random numbers: the extended ensemble reuses the base ensemble's seeds, so the two
     // bands differ by the model change, not by sampling noise.
-    const auto ext_runs = run_ensemble(r.extended, r.settings, opt.runs, octave_m, grid, false, opt);
+    const auto ext_runs = run_ensemble(r.extended, r.settings, opt.runs, octave_m, grid, false, opt, false);
     r.extended_band = make_band(r.analysis.allan.points, ext_runs, opt.band_level);
   }
   timer.lap("extended model");
@@ -607,16 +611,17 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
         robust_base(fit_rec, a_fit, aopt, st.dec, sh, r.holdout_runs, om, hgrid, opt).model;
     sh.seed += 50;
     const double dt = (static_cast<double>(pa) - static_cast<double>(fa)) * x.tau0_s;
-    const auto b_runs = run_ensemble(b_fit, sh, r.holdout_runs, om, hgrid, false, opt);
+    const auto b_runs = run_ensemble(b_fit, sh, r.holdout_runs, om, hgrid, false, opt, !effects.empty());
     hb += band_misfit(make_band(a_pred.points, b_runs, opt.band_level), r.holdout_runs);
     if (effects.empty()) {
       he += band_misfit(make_band(a_pred.points, b_runs, opt.band_level), r.holdout_runs);
       continue;
     }
     st.ref = make_reference(hgrid, st.dec.tau_d, b_runs);
+    st.clean_ref = clean_reference(hgrid, st.dec.tau_d, b_runs);
     st.runs = r.holdout_runs;
     const Extension e = extend(st, b_fit, effects, f_hint, aopt);
-    const auto e_runs = run_ensemble(shifted(e.model, dt), sh, r.holdout_runs, om, hgrid, false, opt);
+    const auto e_runs = run_ensemble(shifted(e.model, dt), sh, r.holdout_runs, om, hgrid, false, opt, false);
     he += band_misfit(make_band(a_pred.points, e_runs, opt.band_level), r.holdout_runs);
   }
   timer.lap("out-of-sample check");

@@ -13,7 +13,7 @@ namespace diag {
 
 std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSettings& settings, std::size_t runs,
                                    const std::vector<std::int64_t>& octave_m, const std::vector<std::size_t>& mid_grid,
-                                   bool with_detectors, const DiagnoseOptions& options) {
+                                   bool with_detectors, const DiagnoseOptions& options, bool clean_mid) {
   std::vector<RunStats> out(runs);
   EnsembleOptions eo;
   eo.path = SimulationPath::Ensemble;
@@ -42,20 +42,17 @@ std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSett
         }
         const Decimated d = decimate(s);
         st.mid_var = decimated_avar(d, mid_grid);
-        if (with_detectors) {
-          st.sin_stat = sinusoid_detect(d, 0.0, false).statistic;
-          const auto step = step_detect(d);
-          const auto warm = warmup_detect(d);
-          st.step_stat = step.statistic;
-          st.warm_stat = warm.statistic;
-          NoiseModel cand;
-          if (step.rss <= warm.rss)
-            cand.bias_steps.push_back({step.t_s, step.size});
-          else
-            cand.warmups.push_back({warm.amp, warm.tc});
+        if (with_detectors || clean_mid) {
+          // The record without its own mean-shape candidate, as the measurement: the sinusoid
+          // statistic, the pilot calibration and the mid-τ shape statistic read it.
           Decimated dc = d;
-          subtract_deterministic(dc, cand);
+          subtract_deterministic(dc, own_candidates(d));
           st.mid_var_clean = decimated_avar(dc, mid_grid);
+          if (with_detectors) {
+            st.sin_stat = sinusoid_detect(dc, 0.0, false).statistic;
+            st.step_stat = step_detect(d).statistic;
+            st.warm_stat = warmup_detect(d).statistic;
+          }
         }
       },
       eo);

@@ -429,6 +429,35 @@ void subtract_deterministic(Decimated& d, const NoiseModel& m, double t0) {
     d.theta[j] -= deterministic_angle(m, t0 + static_cast<double>(j) * d.tau_d) - a0;
 }
 
+namespace {
+
+NoiseModel mean_shape_candidate(const Decimated& d) {
+  NoiseModel c;
+  const auto st = step_detect(d);
+  const auto w = warmup_detect(d);
+  if (st.rss <= w.rss)
+    c.bias_steps.push_back({st.t_s, st.size});
+  else
+    c.warmups.push_back({w.amp, w.tc});
+  return c;
+}
+
+}  // namespace
+
+Decimated without_mean_shape(const Decimated& d) {
+  Decimated c = d;
+  subtract_deterministic(c, mean_shape_candidate(d));
+  return c;
+}
+
+NoiseModel own_candidates(const Decimated& d) { return mean_shape_candidate(d); }
+
+Decimated without_own_candidates(const Decimated& d) {
+  Decimated c = d;
+  subtract_deterministic(c, own_candidates(d));
+  return c;
+}
+
 // ---- mid-τ shapes ----------------------------------------------------------------------------
 
 double shape_avar(Shape s, double tau, double time) {
@@ -566,7 +595,7 @@ struct ConstrainedFit {
 };
 
 ConstrainedFit constrained_fit(const MidTauProblem& p, const std::array<double, 4>& c_base,
-                               const std::vector<double>* shape) {
+                               const std::vector<double>* shape, std::array<bool, 4> free = {true, true, true, true}) {
   ConstrainedFit f;
   std::array<bool, 4> fixed{false, false, false, false};
   for (int iter = 0; iter < 4; ++iter) {
@@ -574,6 +603,7 @@ ConstrainedFit constrained_fit(const MidTauProblem& p, const std::array<double, 
     std::vector<std::vector<double>> cols;
     std::vector<std::size_t> idx;
     for (std::size_t t = 0; t < 4; ++t) {
+      if (!free[t]) continue;  // held at the reference's value: no correction
       if (fixed[t]) {
         for (std::size_t i = 0; i < y.size(); ++i) y[i] += c_base[t] * p.cols[t][i] * p.colscale[t];
       } else {
@@ -584,7 +614,7 @@ ConstrainedFit constrained_fit(const MidTauProblem& p, const std::array<double, 
     if (shape) cols.push_back(*shape);
     const WlsOut o = wls(y, p.w, cols);
     f.chi2 = o.chi2;
-    for (std::size_t t = 0; t < 4; ++t) f.dc[t] = fixed[t] ? -c_base[t] : 0.0;
+    for (std::size_t t = 0; t < 4; ++t) f.dc[t] = fixed[t] && free[t] ? -c_base[t] : 0.0;
     for (std::size_t k = 0; k < idx.size(); ++k) {
       f.dc[idx[k]] = o.coef(static_cast<Eigen::Index>(k)) / p.colscale[idx[k]];
       if (idx[k] == 1) f.dn_var = o.inv(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)) /
@@ -599,7 +629,7 @@ ConstrainedFit constrained_fit(const MidTauProblem& p, const std::array<double, 
     std::size_t worst = 4;
     double worst_v = 0;
     for (std::size_t t = 1; t < 4; ++t) {
-      if (fixed[t]) continue;
+      if (fixed[t] || !free[t]) continue;
       const double total = c_base[t] + f.dc[t];
       const double rel = total / std::max(std::abs(c_base[t]) + std::abs(f.dc[t]), 1e-300);
       if (total < 0 && rel < worst_v) {
@@ -621,6 +651,17 @@ std::array<double, 4> power_law_corrections(const std::vector<double>& v, const 
   const MidTauProblem p = mid_tau_problem(v, ref);
   if (p.y.size() < 6) return dc;
   return constrained_fit(p, c_base, nullptr).dc;
+}
+
+std::array<double, 4> calibration_corrections(const std::vector<double>& v, const MidTauReference& ref,
+                                              const std::array<double, 4>& c_base, double tau_max, bool n_free) {
+  std::array<double, 4> dc{0, 0, 0, 0};
+  std::vector<double> w = v;
+  for (std::size_t i = 0; i < w.size() && i < ref.tau.size(); ++i)
+    if (ref.tau[i] > tau_max) w[i] = 0.0;  // left out of the problem
+  const MidTauProblem p = mid_tau_problem(w, ref);
+  if (p.y.size() < 6) return dc;
+  return constrained_fit(p, c_base, nullptr, {true, n_free, true, false}).dc;
 }
 
 ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& ref,

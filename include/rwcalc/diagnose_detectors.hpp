@@ -66,6 +66,18 @@ double deterministic_angle(const NoiseModel& m, double t);
 /// Subtract the deterministic findings of `m` from the decimated angle (t0: time of θ_0).
 void subtract_deterministic(Decimated& d, const NoiseModel& m, double t0 = 0);
 
+/// A record's own candidate, as the deterministic terms of a model: the better (lower RSS on the
+/// 10-s block means) of the best bias step and the best warm-up transient. The base model is
+/// calibrated, and the mid-τ AV compared, on records without their own candidate — the
+/// measurement and every simulated record alike, so that the shrinking of the AV by the removal
+/// is the same on both sides.
+NoiseModel own_candidates(const Decimated& d);
+/// `d` without its own candidates.
+Decimated without_own_candidates(const Decimated& d);
+/// `d` without its own mean-shape candidate only: what the sinusoid detector reads (a step left
+/// in spreads over the low-frequency periodogram and can stand out as a line).
+Decimated without_mean_shape(const Decimated& d);
+
 // ---- stochastic effects in the mid-τ Allan variance -----------------------------------------
 
 /// Ensemble reference of the mid-τ AV: mean and variance over the runs per τ.
@@ -109,6 +121,11 @@ ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& 
 /// base model by a pilot ensemble.
 std::array<double, 4> power_law_corrections(const std::vector<double>& v, const MidTauReference& ref,
                                             const std::array<double, 4>& c_base);
+/// The pilot calibration of the base model: as power_law_corrections on τ ≤ tau_max, with K held
+/// at the reference model's value (Q², B² and, when `n_free`, N² corrected).
+std::array<double, 4> calibration_corrections(const std::vector<double>& v, const MidTauReference& ref,
+                                              const std::array<double, 4>& c_base, double tau_max,
+                                              bool n_free = true);
 /// `v_j` being one ensemble member, its statistic against the leave-one-out reference.
 MidTauReference leave_one_out(const MidTauReference& ref, const std::vector<double>& v, std::size_t runs);
 
@@ -147,16 +164,17 @@ double quantile(std::vector<double> v, double p);
 struct RunStats {
   std::vector<double> octave_var;
   std::vector<double> mid_var;
-  /// With detectors: the mid-τ AV after the record's own mean-shape candidate (the better of the
-  /// best step and the best warm-up) is removed, as it is from the measurement.
+  /// With detectors or `clean_mid`: the mid-τ AV after the record's own mean-shape candidate (the
+  /// better of the best step and the best warm-up) is removed, as it is from the measurement.
   std::vector<double> mid_var_clean;
   double sin_stat = 0, step_stat = 0, warm_stat = 0;
 };
 
-/// Simulate `runs` records of `model` and collect their statistics.
+/// Simulate `runs` records of `model` and collect their statistics; with `clean_mid` (or
+/// `with_detectors`) also the mid-τ AV of each record without its own candidate (own_candidates).
 std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSettings& settings, std::size_t runs,
                                    const std::vector<std::int64_t>& octave_m, const std::vector<std::size_t>& mid_grid,
-                                   bool with_detectors, const DiagnoseOptions& options);
+                                   bool with_detectors, const DiagnoseOptions& options, bool clean_mid = true);
 
 /// The band from the ensemble's octave variances and the measured points.
 std::vector<BandPoint> make_band(const std::vector<AllanPoint>& measured, const std::vector<RunStats>& runs,
