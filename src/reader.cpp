@@ -155,6 +155,9 @@ class Reader {
   const char* parse_fast(const char* p, Sample& s) const;  // end of the line, or nullptr
   template <bool Integer>
   bool fast_line(const char*& p);
+  template <class Vec>
+  static const char* int_lines(const char* p, const char* limit, Vec& out);
+  void int_run(const char*& p, const char* limit);
   struct Chunk {
     std::vector<std::int64_t> ints;
     std::vector<double> reals, times, temps;
@@ -191,6 +194,7 @@ class Reader {
   std::size_t value_col_ = 0;
   std::optional<std::size_t> time_col_, temp_col_;
   std::array<bool, 256> stop_{};  // bytes that end an unselected field in the fast path
+  bool int_lines_ok_ = false;     // one column of pulses: int_lines() may take the data lines
   std::int64_t counter_lo_ = 0, counter_max_ = 0;  // accepted reading range
 
   std::vector<std::string_view> fields_;  // scratch for the careful path
@@ -584,6 +588,8 @@ void Reader::establish_layout() {
   if (delim_ == Delim::Comma) stop_[','] = true;
   if (delim_ == Delim::Blanks) stop_[' '] = true;
 
+  int_lines_ok_ = ncols_ == 1 && opt_.mode == InputMode::Pulses;
+
   if (opt_.mode == InputMode::Counter) {
     const int b = opt_.counter_bits;
     counter_lo_ = b >= 64 ? std::numeric_limits<std::int64_t>::min() : -(std::int64_t{1} << (b - 1));
@@ -692,6 +698,35 @@ bool Reader::fast_line(const char*& p) {
   return true;
 }
 
+// The fastest path, for a file of one pulse column: a run of lines that are each one plain integer
+// of at most 7 digits (scan_int_line), the lines that start before `limit`, up to the first other
+// line, whose start it returns; that line then takes the per-line paths. Per line: no loop over
+// the digits, a few predictable branches, no copy.
+template <class Vec>
+inline const char* Reader::int_lines(const char* p, const char* limit, Vec& out) {
+  while (p < limit) {
+    std::int64_t v;
+    const char* next = detail::scan_int_line(p, v);
+    if (!next) break;
+    out.push_back(v);
+    p = next;
+  }
+  return p;
+}
+
+void Reader::int_run(const char*& p, const char* limit) {
+  const std::size_t before = ints_.size();
+  p = int_lines(p, limit, ints_);
+  const std::size_t k = ints_.size() - before;
+  if (k == 0) return;
+  if (new_run_) {
+    runs_.emplace_back(samples_, line_ + 1);
+    new_run_ = false;
+  }
+  samples_ += k;
+  line_ += k;
+}
+
 // The second half of a long text, parsed on another thread while the first half is read: plain
 // data lines only, from `from` up to the first line the fast path does not take (or the end). It
 // keeps the values, time stamps and temperatures in order; merge_chunk() then adds them to the
@@ -703,6 +738,16 @@ void Reader::scan_chunk(const char* from, Chunk& out, std::stop_token stop) cons
   Sample s;
   std::size_t k = 0;
   while (p < end_) {
+    if constexpr (Integer) {
+      if (int_lines_ok_) {
+        // Slices of 64 KiB, so that a stop request is seen soon; a line not of the plain form
+        // falls to parse_fast below.
+        if (stop.stop_requested()) break;
+        const char* slice = end_ - p > 65536 ? p + 65536 : end_;
+        p = int_lines(p, slice, out.ints);
+        if (p >= slice) continue;
+      }
+    }
     if ((++k & 0xfff) == 0 && stop.stop_requested()) break;
     const char* next = parse_fast<Integer>(p, s);
     if (!next) break;
@@ -771,6 +816,12 @@ void Reader::scan(const char* p) {
               scan_chunk<Integer>(from, chunk, st);
             });
           }
+        }
+      }
+      if constexpr (Integer) {
+        if (int_lines_ok_) {
+          int_run(p, limit);
+          if (p >= limit) break;
         }
       }
       ++line_;
