@@ -258,7 +258,9 @@ std::size_t Reader::check_bytes(const char* text) {
   // Binary data: NUL and other control bytes (tab, LF and CR excepted). Checked, and the lines
   // counted, in one pass of branch-free blocks the compiler vectorises; a block that trips is
   // searched again for the first bad byte.
-  constexpr std::size_t kBlock = 255;  // an 8-bit line counter cannot overflow within a block
+  // 240: a multiple of the vector width (no scalar tail per block) below 256, so an 8-bit line
+  // counter cannot overflow within a block.
+  constexpr std::size_t kBlock = 240;
   std::size_t lines = 0;
   for (const char* b = text; b < end_; b += kBlock) {
     const char* e = end_ - b > static_cast<std::ptrdiff_t>(kBlock) ? b + kBlock : end_;
