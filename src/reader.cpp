@@ -850,8 +850,11 @@ void Reader::merge_chunk(Chunk& c) {
       if (sum_pending() && c.mag <= kSumLimit - mag_) {
         // The chunk's running sums, offset by the sum so far: C_k without a second pass.
         const std::uint64_t base = acc_;
+        const std::size_t at = ints_.size();
+        ints_.insert(ints_.end(), c.ints.begin(), c.ints.begin() + static_cast<std::ptrdiff_t>(c.summed));
+        std::int64_t* d = ints_.data() + at;  // a copy, then a vectorised add: ~2 instructions per count
         for (std::size_t i = 0; i < c.summed; ++i)
-          ints_.push_back(static_cast<std::int64_t>(base + static_cast<std::uint64_t>(c.ints[i])));
+          d[i] = static_cast<std::int64_t>(base + static_cast<std::uint64_t>(d[i]));
         acc_ = base + c.acc;
         mag_ += c.mag;
         summed_ = ints_.size();
