@@ -155,8 +155,17 @@ class Reader {
   const char* parse_fast(const char* p, Sample& s) const;  // end of the line, or nullptr
   template <bool Integer>
   bool fast_line(const char*& p);
+  template <bool Sum, class Vec>
+  static const char* int_lines(const char* p, const char* limit, Vec& out, std::uint64_t& acc,
+                               std::uint64_t& mag);
+  void int_run(const char*& p, const char* limit);
+  bool sum_pending();
   struct Chunk {
     std::vector<std::int64_t> ints;
+    // Pulses: ints[0, summed) are already the running sums of the chunk's counts (from 0), acc the
+    // last of them and mag the sum of the |counts|; the rest are counts as read.
+    std::size_t summed = 0;
+    std::uint64_t acc = 0, mag = 0;
     std::vector<double> reals, times, temps;
     const char* stop = nullptr;  // where the chunk's fast path stopped
   };
@@ -191,6 +200,7 @@ class Reader {
   std::size_t value_col_ = 0;
   std::optional<std::size_t> time_col_, temp_col_;
   std::array<bool, 256> stop_{};  // bytes that end an unselected field in the fast path
+  bool int_lines_ok_ = false;     // one column of pulses: int_lines() may take the data lines
   std::int64_t counter_lo_ = 0, counter_max_ = 0;  // accepted reading range
 
   std::vector<std::string_view> fields_;  // scratch for the careful path
@@ -198,6 +208,11 @@ class Reader {
 
   // Collected data.
   std::vector<std::int64_t> ints_;  // pulses/counter: slot 0 reserved for C_0
+  // Pulses: ints_[0, summed_) already hold the cumulative counts C_k (summed while parsing, which
+  // spares build_phase a second pass over the whole array), acc_ = the last of them (mod 2^64),
+  // mag_ = Σ|c_i| over them; build_phase sums the rest.
+  std::size_t summed_ = 0;
+  std::uint64_t acc_ = 0, mag_ = 0;
   std::vector<double> reals_;       // angle: samples; rate: slot 0 reserved for x_0
   // The time column is checked from running statistics (first, last, smallest and largest step),
   // so a long record needs no second array; only when a step is out of tolerance is the file read
@@ -239,35 +254,52 @@ class Reader {
 
 // ---- bytes ---------------------------------------------------------------------------------------
 
-std::size_t Reader::check_bytes(const char* text) {
-  // Binary data: NUL and other control bytes (tab, LF and CR excepted). Checked, and the lines
-  // counted, in one pass of branch-free blocks the compiler vectorises; a block that trips is
-  // searched again for the first bad byte.
-  constexpr std::size_t kBlock = 255;  // an 8-bit line counter cannot overflow within a block
+// Lines ('\n') in [b, end) and whether a control byte other than tab, LF, CR (or DEL) occurs: in
+// blocks of 240 bytes (a multiple of the vector width, below 256 so that an 8-bit line counter
+// cannot overflow within a block), branch-free inside a block so the compiler vectorises it; an
+// AVX2 clone is chosen at run time where the processor has it. Stops after the first block that
+// trips, setting `bad` to its start (else nullptr).
+__attribute__((target_clones("avx2", "default"))) std::size_t count_lines_checked(const char* b, const char* end,
+                                                                                 const char*& bad) {
+  constexpr std::size_t kBlock = 240;
   std::size_t lines = 0;
-  for (const char* b = text; b < end_; b += kBlock) {
-    const char* e = end_ - b > static_cast<std::ptrdiff_t>(kBlock) ? b + kBlock : end_;
-    unsigned char bad = 0, nl = 0;
+  bad = nullptr;
+  for (; b < end; b += kBlock) {
+    const char* e = end - b > static_cast<std::ptrdiff_t>(kBlock) ? b + kBlock : end;
+    unsigned char trip = 0, nl = 0;
     for (const char* q = b; q < e; ++q) {
       const auto c = static_cast<unsigned char>(*q);
       nl = static_cast<unsigned char>(nl + (c == '\n'));
-      bad |= static_cast<unsigned char>(((c < 0x20) & (c != '\t') & (c != '\n') & (c != '\r')) | (c == 0x7f));
+      trip |= static_cast<unsigned char>(((c < 0x20) & (c != '\t') & (c != '\n') & (c != '\r')) | (c == 0x7f));
     }
     lines += nl;
-    if (!bad) continue;
-    for (const char* q = b; q < e; ++q) {
-      const auto c = static_cast<unsigned char>(*q);
-      if ((c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7f) {
-        const auto line = 1 + static_cast<std::size_t>(std::count(text, q, '\n'));
-        const char* ls = q;
-        while (ls > text && ls[-1] != '\n') --ls;
-        fail(line, fmt::format("binary data (byte 0x{:02x} at column {}): this is not a text recording; "
-                               "a compressed file other than gzip?",
-                               c, q - ls + 1));
-      }
+    if (trip) {
+      bad = b;
+      return lines;
     }
   }
   return lines;
+}
+
+std::size_t Reader::check_bytes(const char* text) {
+  // Binary data: NUL and other control bytes (tab, LF and CR excepted). Checked, and the lines
+  // counted, in one pass (count_lines_checked); the block that trips is searched again for the
+  // first bad byte.
+  const char* bad = nullptr;
+  const std::size_t lines = count_lines_checked(text, end_, bad);
+  if (!bad) return lines;
+  for (const char* q = bad; q < end_; ++q) {
+    const auto c = static_cast<unsigned char>(*q);
+    if ((c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7f) {
+      const auto line = 1 + static_cast<std::size_t>(std::count(text, q, '\n'));
+      const char* ls = q;
+      while (ls > text && ls[-1] != '\n') --ls;
+      fail(line, fmt::format("binary data (byte 0x{:02x} at column {}): this is not a text recording; "
+                             "a compressed file other than gzip?",
+                             c, q - ls + 1));
+    }
+  }
+  return lines;  // not reached: the block that tripped holds a bad byte
 }
 
 // ---- careful path ------------------------------------------------------------------------------
@@ -584,6 +616,8 @@ void Reader::establish_layout() {
   if (delim_ == Delim::Comma) stop_[','] = true;
   if (delim_ == Delim::Blanks) stop_[' '] = true;
 
+  int_lines_ok_ = ncols_ == 1 && opt_.mode == InputMode::Pulses;
+
   if (opt_.mode == InputMode::Counter) {
     const int b = opt_.counter_bits;
     counter_lo_ = b >= 64 ? std::numeric_limits<std::int64_t>::min() : -(std::int64_t{1} << (b - 1));
@@ -692,6 +726,75 @@ bool Reader::fast_line(const char*& p) {
   return true;
 }
 
+// The fastest path, for a file of one pulse column: a run of lines that are each one plain integer
+// of at most 7 digits (scan_int_line), the lines that start before `limit`, up to the first other
+// line, whose start it returns; that line then takes the per-line paths. Per line: no loop over
+// the digits, a few predictable branches, no copy.
+// Σ|c| may grow to this and no further (every second difference of the sums stays exact).
+constexpr auto kSumLimit = static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
+// Largest |count| int_lines accepts (7 digits): bounds Σ|c| over a run of lines before it starts.
+constexpr std::uint64_t kLineMax = 9'999'999;
+
+template <bool Sum, class Vec>
+inline const char* Reader::int_lines(const char* p, const char* limit, Vec& out, std::uint64_t& acc,
+                                     std::uint64_t& mag) {
+  std::uint64_t a = acc, m = mag;
+  while (p < limit) {
+    std::int64_t v;
+    const char* next = detail::scan_int_line(p, v);
+    if (!next) break;
+    if constexpr (Sum) {
+      // The running sum C_k and Σ|c|, as build_phase forms them (modulo 2^64).
+      const auto u = static_cast<std::uint64_t>(v);
+      const std::uint64_t sign = 0 - (u >> 63);
+      a += u;
+      m += (u ^ sign) - sign;
+      out.push_back(static_cast<std::int64_t>(a));
+    } else {
+      out.push_back(v);
+    }
+    p = next;
+  }
+  acc = a;
+  mag = m;
+  return p;
+}
+
+// Turn the counts read since the last summed run into cumulative counts. Stops where Σ|c| would
+// pass kSumLimit, leaving the rest to build_phase, which names that line.
+bool Reader::sum_pending() {
+  for (; summed_ < ints_.size(); ++summed_) {
+    const auto v = static_cast<std::uint64_t>(ints_[summed_]);
+    const std::uint64_t m = mag_ + (ints_[summed_] < 0 ? ~v + 1 : v);
+    if (m > kSumLimit) return false;
+    mag_ = m;
+    acc_ += v;
+    ints_[summed_] = static_cast<std::int64_t>(acc_);
+  }
+  return true;
+}
+
+void Reader::int_run(const char*& p, const char* limit) {
+  const std::size_t before = ints_.size();
+  // Sum while parsing when everything before is summed and Σ|c| cannot pass the limit in this run
+  // (a line has at least 2 bytes; any real record is many orders of magnitude below the bound).
+  if (sum_pending() && (kSumLimit - mag_) / kLineMax > static_cast<std::uint64_t>(limit - p)) {
+    p = int_lines<true>(p, limit, ints_, acc_, mag_);
+    summed_ = ints_.size();
+  } else {
+    std::uint64_t unused_acc = 0, unused_mag = 0;
+    p = int_lines<false>(p, limit, ints_, unused_acc, unused_mag);
+  }
+  const std::size_t k = ints_.size() - before;
+  if (k == 0) return;
+  if (new_run_) {
+    runs_.emplace_back(samples_, line_ + 1);
+    new_run_ = false;
+  }
+  samples_ += k;
+  line_ += k;
+}
+
 // The second half of a long text, parsed on another thread while the first half is read: plain
 // data lines only, from `from` up to the first line the fast path does not take (or the end). It
 // keeps the values, time stamps and temperatures in order; merge_chunk() then adds them to the
@@ -703,6 +806,22 @@ void Reader::scan_chunk(const char* from, Chunk& out, std::stop_token stop) cons
   Sample s;
   std::size_t k = 0;
   while (p < end_) {
+    if constexpr (Integer) {
+      if (int_lines_ok_) {
+        // Slices of 64 KiB, so that a stop request is seen soon; a line not of the plain form
+        // falls to parse_fast below.
+        if (stop.stop_requested()) break;
+        const char* slice = end_ - p > 65536 ? p + 65536 : end_;
+        if (out.summed == out.ints.size() && (kSumLimit - out.mag) / kLineMax > 65536) {
+          p = int_lines<true>(p, slice, out.ints, out.acc, out.mag);
+          out.summed = out.ints.size();
+        } else {
+          std::uint64_t unused_acc = 0, unused_mag = 0;
+          p = int_lines<false>(p, slice, out.ints, unused_acc, unused_mag);
+        }
+        if (p >= slice) continue;
+      }
+    }
     if ((++k & 0xfff) == 0 && stop.stop_requested()) break;
     const char* next = parse_fast<Integer>(p, s);
     if (!next) break;
@@ -725,9 +844,32 @@ void Reader::merge_chunk(Chunk& c) {
     runs_.emplace_back(samples_, line_ + 1);
     new_run_ = false;
   }
-  if constexpr (Integer)
-    ints_.insert(ints_.end(), c.ints.begin(), c.ints.end());
-  else
+  if constexpr (Integer) {
+    auto from = c.ints.begin();
+    if (c.summed > 0) {
+      if (sum_pending() && c.mag <= kSumLimit - mag_) {
+        // The chunk's running sums, offset by the sum so far: C_k without a second pass.
+        const std::uint64_t base = acc_;
+        const std::size_t at = ints_.size();
+        ints_.insert(ints_.end(), c.ints.begin(), c.ints.begin() + static_cast<std::ptrdiff_t>(c.summed));
+        std::int64_t* d = ints_.data() + at;  // a copy, then a vectorised add: ~2 instructions per count
+        for (std::size_t i = 0; i < c.summed; ++i)
+          d[i] = static_cast<std::int64_t>(base + static_cast<std::uint64_t>(d[i]));
+        acc_ = base + c.acc;
+        mag_ += c.mag;
+        summed_ = ints_.size();
+      } else {
+        // Back to the counts as read (exact modulo 2^64); build_phase sums them and names the line
+        // where Σ|c| passes the limit.
+        for (std::size_t i = c.summed; i-- > 1;)
+          c.ints[i] = static_cast<std::int64_t>(static_cast<std::uint64_t>(c.ints[i]) -
+                                                static_cast<std::uint64_t>(c.ints[i - 1]));
+        ints_.insert(ints_.end(), c.ints.begin(), c.ints.begin() + static_cast<std::ptrdiff_t>(c.summed));
+      }
+      from += static_cast<std::ptrdiff_t>(c.summed);
+    }
+    ints_.insert(ints_.end(), from, c.ints.end());
+  } else
     reals_.insert(reals_.end(), c.reals.begin(), c.reals.end());
   if (time_col_)
     for (double t : c.times) track_time(t);
@@ -771,6 +913,12 @@ void Reader::scan(const char* p) {
               scan_chunk<Integer>(from, chunk, st);
             });
           }
+        }
+      }
+      if constexpr (Integer) {
+        if (int_lines_ok_) {
+          int_run(p, limit);
+          if (p >= limit) break;
         }
       }
       ++line_;
@@ -895,9 +1043,10 @@ void Reader::build_phase(Recording& rec) {
       // C_0 = 0, C_k = Σ c_i, wrapping modulo 2^64 (PhaseSeries differences are modular, so an offset
       // never matters). Every second difference stays exact while Σ|c_i| < 2^63; beyond that the
       // record is refused.
+      // ints_[0, summed_) are summed already (while parsing); acc_ and mag_ carry on from there.
       std::vector<std::int64_t>& c = ints_;
-      std::uint64_t acc = 0, mag = 0;
-      for (std::size_t i = 1; i < c.size(); ++i) {
+      std::uint64_t acc = acc_, mag = mag_;
+      for (std::size_t i = std::max<std::size_t>(summed_, 1); i < c.size(); ++i) {
         const auto v = static_cast<std::uint64_t>(c[i]);
         acc += v;
         mag += c[i] < 0 ? (~v + 1) : v;
@@ -991,7 +1140,10 @@ Recording Reader::run(bool store_times) {
   if (integer_mode()) {
     ints_.reserve(lines + 1);
     detail::prefault(ints_.data(), ints_.capacity() * sizeof(std::int64_t));
-    if (opt_.mode == InputMode::Pulses) ints_.push_back(0);
+    if (opt_.mode == InputMode::Pulses) {
+      ints_.push_back(0);
+      summed_ = 1;
+    }
   } else {
     reals_.reserve(lines + 1);
     detail::prefault(reals_.data(), reals_.capacity() * sizeof(double));

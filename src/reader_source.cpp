@@ -32,14 +32,16 @@ void prefault(void* data, std::size_t bytes) noexcept {
 }
 
 TextBuffer::TextBuffer(std::size_t capacity)
-    : data_(std::make_unique_for_overwrite<char[]>(capacity + 1)), capacity_(capacity) {
+    : data_(std::make_unique_for_overwrite<char[]>(capacity + 1 + kPadding)), capacity_(capacity) {
   prefault(data_.get(), capacity);
+  std::memset(data_.get() + capacity + 1, 0, kPadding);
 }
 
 void TextBuffer::reserve(std::size_t capacity) {
   if (capacity <= capacity_) return;
-  auto bigger = std::make_unique_for_overwrite<char[]>(capacity + 1);
+  auto bigger = std::make_unique_for_overwrite<char[]>(capacity + 1 + kPadding);
   prefault(bigger.get() + size_, capacity - size_);
+  std::memset(bigger.get() + capacity + 1, 0, kPadding);
   if (size_ > 0) std::memcpy(bigger.get(), data_.get(), size_);
   data_ = std::move(bigger);
   capacity_ = capacity;
