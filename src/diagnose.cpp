@@ -180,12 +180,30 @@ struct Stretch {
   MidTauReference ref;              ///< mid-τ AV reference of its base model's ensemble
   MidTauReference clean_ref;        ///< the same of its records without their own candidate
   std::size_t runs = 0;
+  // For the extended model's own pilot calibration (all set, or none: no pilot).
+  const SimulationSettings* settings = nullptr;  ///< simulation settings of the stretch
+  const std::vector<std::int64_t>* octave_m = nullptr;
+  const DiagnoseOptions* opt = nullptr;
+  std::size_t pilot_runs = 0;
 };
 
 struct Extension {
   NoiseModel model;                 ///< extended model (time origin: the stretch start)
   std::vector<Finding> findings;    ///< parameters only (no evidence)
 };
+
+/// The mean over [0, T] of the rate added by a model's deterministic terms, °/h.
+double mean_rate_of(const NoiseModel& det, double T) {
+  if (!(T > 0)) return 0.0;
+  double a = 0;  // angle added over [0, T], (°/h)·s
+  for (const auto& x : det.sinusoids) {
+    const double w = 2.0 * kPi * x.f_hz;
+    if (w > 0) a += x.amp_deg_per_h / w * (std::sin(w * T + x.phase_rad) - std::sin(x.phase_rad));
+  }
+  for (const auto& x : det.bias_steps) a += x.size_deg_per_h * std::max(0.0, T - std::max(0.0, x.t_s));
+  for (const auto& x : det.warmups) a += x.amp_deg_per_h * x.tc_s * -std::expm1(-T / x.tc_s);
+  return a / T;
+}
 
 /// Estimate the named effects on a stretch and build the extended model: deterministic terms by
 /// least squares on their statistic, removed before the re-fit of the five terms and before the
@@ -227,6 +245,10 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
     x.findings.push_back(std::move(f));
   }
   x.model = base;
+  // The named terms keep the stretch's mean rate: the counting read-out's fine structure at short
+  // τ (the beat of the pulse rate against the sampling) depends on the rate in each part of the
+  // record, so the level before a step or under a transient must be the data's, not the mean's.
+  x.model.bias_deg_per_h -= mean_rate_of(det, s.rec->phase.duration_s());
   x.model.sinusoids = det.sinusoids;
   x.model.bias_steps = det.bias_steps;
   x.model.warmups = det.warmups;
@@ -253,13 +275,30 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
     coef = coefficient_from_c(t, std::max(0.0, c_from_coefficient(t, coef) + dc));
   };
   const bool stochastic = std::any_of(effects.begin(), effects.end(), is_mid_tau);
-  if (!stochastic && !x.findings.empty()) {
+  const bool deterministic = !det.sinusoids.empty() || !det.bias_steps.empty() || !det.warmups.empty();
+  const bool self_pilot = !stochastic && deterministic && s.settings && s.octave_m && s.opt && s.pilot_runs > 0;
+  if (!stochastic && !x.findings.empty() && !self_pilot) {
     // Like the base calibration: the data without their candidate (or named terms) against the
     // ensemble's records without their own candidate.
     const auto dc = power_law_corrections(v, s.clean_ref.mean.empty() ? s.ref : s.clean_ref, c_of(base));
     apply(x.model.arw_deg_per_sqrt_h, Term::N, dc[1]);
     apply(x.model.bias_instability_deg_per_h, Term::B, dc[2]);
     apply(x.model.rrw_deg_per_h_per_sqrt_h, Term::K, dc[3]);
+  }
+  if (self_pilot) {
+    // The extended model calibrated against its own pilot ensemble, the named terms included:
+    // the corrections of N², B² (K held, τ ≤ T/6, as for the base) that bring the pilot's mean
+    // mid-τ AV onto the data's. The re-fit above compares records without their candidates;
+    // what the named terms themselves add to the AV is only seen here, so the base B, which
+    // already covered the data's long-τ AV, gives back what the terms now explain.
+    SimulationSettings sp = *s.settings;
+    sp.seed += 2000;
+    const auto pilot = run_ensemble(x.model, sp, s.pilot_runs, *s.octave_m, s.ref.grid, false, *s.opt);
+    const auto ref = make_reference(s.ref.grid, s.dec.tau_d, pilot);
+    const auto dc = calibration_corrections(decimated_avar(s.dec, s.ref.grid), ref, c_of(x.model),
+                                            s.dec.duration() / 6.0);
+    apply(x.model.arw_deg_per_sqrt_h, Term::N, dc[1]);
+    apply(x.model.bias_instability_deg_per_h, Term::B, dc[2]);
   }
   for (const auto& e : effects) {
     if (!is_mid_tau(e)) continue;
@@ -285,8 +324,11 @@ NoiseModel shifted(NoiseModel m, double dt) {
   for (auto& s : m.sinusoids) s.phase_rad = std::fmod(s.phase_rad + 2 * kPi * s.f_hz * dt, 2 * kPi);
   std::vector<BiasStep> steps;
   for (const auto& st : m.bias_steps) {
-    if (st.t_s - dt > 0) steps.push_back({st.t_s - dt, st.size_deg_per_h});
-    // A step before the window is a constant offset (no AV); one after it cannot be known.
+    if (st.t_s - dt > 0)
+      steps.push_back({st.t_s - dt, st.size_deg_per_h});
+    else
+      m.bias_deg_per_h += st.size_deg_per_h;  // before the window: part of its constant rate
+    // (A step after the window cannot be known: the rate stays the level before it.)
   }
   m.bias_steps = steps;
   std::vector<Warmup> w;
@@ -548,6 +590,11 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
 
   // 3–4. Extended model: parameters, re-fit, re-simulation.
   const double f_hint = d_sin.named ? sin.f_hz : 0.0;
+  SimulationSettings ext_pilot = r.settings;
+  full.settings = &ext_pilot;
+  full.octave_m = &octave_m;
+  full.opt = &opt;
+  full.pilot_runs = pilot_runs;
   Extension ext = extend(full, r.base, effects, f_hint, aopt);
   r.extended = ext.model;
   for (auto& f : ext.findings) {
@@ -620,6 +667,10 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     st.ref = make_reference(hgrid, st.dec.tau_d, b_runs);
     st.clean_ref = clean_reference(hgrid, st.dec.tau_d, b_runs);
     st.runs = r.holdout_runs;
+    st.settings = &sh;
+    st.octave_m = &om;
+    st.opt = &opt;
+    st.pilot_runs = r.holdout_runs;
     const Extension e = extend(st, b_fit, effects, f_hint, aopt);
     const auto e_runs = run_ensemble(shifted(e.model, dt), sh, r.holdout_runs, om, hgrid, false, opt, false);
     he += band_misfit(make_band(a_pred.points, e_runs, opt.band_level), r.holdout_runs);
