@@ -859,17 +859,21 @@ OutputLowpassEstimate output_lowpass_detect(const std::vector<std::int64_t>& m, 
   const int G = 80;
   std::vector<std::pair<double, double>> prof;
   double best = chi0;
-  for (int g = 0; g <= G; ++g) {
-    const double tf = std::exp(lo + (hi - lo) * g / G);
+  // χ² at tf; the best so far (tf and the white scales of its fit) kept in e.
+  const auto consider = [&](double tf) {
     std::array<double, 2> sc{0, 0};
     const double c = fit_at(tf, &sc);
-    prof.emplace_back(tf, c);
     if (c < best) {
       best = c;
       e.tf = tf;
       e.white_angle2 = sc[0];
       e.white_rate = sc[1];
     }
+    return c;
+  };
+  for (int g = 0; g <= G; ++g) {
+    const double tf = std::exp(lo + (hi - lo) * g / G);
+    prof.emplace_back(tf, consider(tf));
   }
   e.statistic = std::max(0.0, chi0 - best);
   if (!(e.tf > 0)) return e;
@@ -886,16 +890,8 @@ OutputLowpassEstimate output_lowpass_detect(const std::vector<std::int64_t>& m, 
         a = c1; c1 = c2; f1 = f2; c2 = a + gr * (b - a); f2 = fit_at(std::exp(c2), nullptr);
       }
     }
-    const double tf = std::exp(0.5 * (a + b));
-    std::array<double, 2> sc{0, 0};
-    const double c = fit_at(tf, &sc);
-    if (c < best) {
-      best = c;
-      e.tf = tf;
-      e.white_angle2 = sc[0];
-      e.white_rate = sc[1];
-      e.statistic = std::max(0.0, chi0 - best);
-    }
+    consider(std::exp(0.5 * (a + b)));
+    e.statistic = std::max(0.0, chi0 - best);
   }
   e.chi2 = best;
   // Δχ² range, widened by the misfit per degree of freedom when the shape does not fit exactly.
