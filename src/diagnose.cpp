@@ -208,6 +208,25 @@ double mean_rate_of(const NoiseModel& det, double T) {
 /// Estimate the named effects on a stretch and build the extended model: deterministic terms by
 /// least squares on their statistic, removed before the re-fit of the five terms and before the
 /// mid-τ shape fit of a stochastic term, whose Q/N/B/K corrections also enter the model.
+/// Add a fit-scale correction to a coefficient (°/√h, °/h, …), the corrected square kept ≥ 0.
+void correct(double& coef, Term t, double dc) {
+  coef = coefficient_from_c(t, std::max(0.0, c_from_coefficient(t, coef) + dc));
+}
+
+/// The corrections of N², B² (K held, τ ≤ T/6) that bring the mean mid-τ AV of a pilot ensemble
+/// of `m` onto the AV of `dec`; `clean`: the pilot records are taken without their own
+/// mean-shape candidates, as `dec` is.
+std::array<double, 4> pilot_corrections(const NoiseModel& m, const SimulationSettings& settings, std::size_t runs,
+                                        const std::vector<std::int64_t>& octave_m, const Decimated& dec,
+                                        const std::vector<std::size_t>& grid, const DiagnoseOptions& opt,
+                                        bool clean) {
+  auto pilot = run_ensemble(m, settings, runs, octave_m, grid, false, opt);
+  if (clean)
+    for (auto& p : pilot) p.mid_var = p.mid_var_clean;
+  const auto ref = make_reference(grid, dec.tau_d, pilot);
+  return calibration_corrections(decimated_avar(dec, grid), ref, c_of(m), dec.duration() / 6.0);
+}
+
 Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std::string>& effects, double f_hint,
                  const AnalysisOptions& aopt) {
   (void)aopt;
@@ -271,9 +290,6 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
   Decimated dm = s.dec;
   subtract_deterministic(dm, det_mid);
   const auto v = decimated_avar(dm, s.ref.grid);
-  auto apply = [&](double& coef, Term t, double dc) {
-    coef = coefficient_from_c(t, std::max(0.0, c_from_coefficient(t, coef) + dc));
-  };
   const bool stochastic = std::any_of(effects.begin(), effects.end(), is_mid_tau);
   const bool deterministic = !det.sinusoids.empty() || !det.bias_steps.empty() || !det.warmups.empty();
   const bool self_pilot = !stochastic && deterministic && s.settings && s.octave_m && s.opt && s.pilot_runs > 0;
@@ -281,9 +297,9 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
     // Like the base calibration: the data without their candidate (or named terms) against the
     // ensemble's records without their own candidate.
     const auto dc = power_law_corrections(v, s.clean_ref.mean.empty() ? s.ref : s.clean_ref, c_of(base));
-    apply(x.model.arw_deg_per_sqrt_h, Term::N, dc[1]);
-    apply(x.model.bias_instability_deg_per_h, Term::B, dc[2]);
-    apply(x.model.rrw_deg_per_h_per_sqrt_h, Term::K, dc[3]);
+    correct(x.model.arw_deg_per_sqrt_h, Term::N, dc[1]);
+    correct(x.model.bias_instability_deg_per_h, Term::B, dc[2]);
+    correct(x.model.rrw_deg_per_h_per_sqrt_h, Term::K, dc[3]);
   }
   if (self_pilot) {
     // The extended model calibrated against its own pilot ensemble, the named terms included:
@@ -293,18 +309,15 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
     // already covered the data's long-τ AV, gives back what the terms now explain.
     SimulationSettings sp = *s.settings;
     sp.seed += 2000;
-    const auto pilot = run_ensemble(x.model, sp, s.pilot_runs, *s.octave_m, s.ref.grid, false, *s.opt);
-    const auto ref = make_reference(s.ref.grid, s.dec.tau_d, pilot);
-    const auto dc = calibration_corrections(decimated_avar(s.dec, s.ref.grid), ref, c_of(x.model),
-                                            s.dec.duration() / 6.0);
-    apply(x.model.arw_deg_per_sqrt_h, Term::N, dc[1]);
-    apply(x.model.bias_instability_deg_per_h, Term::B, dc[2]);
+    const auto dc = pilot_corrections(x.model, sp, s.pilot_runs, *s.octave_m, s.dec, s.ref.grid, *s.opt, false);
+    correct(x.model.arw_deg_per_sqrt_h, Term::N, dc[1]);
+    correct(x.model.bias_instability_deg_per_h, Term::B, dc[2]);
   }
   for (const auto& e : effects) {
     if (!is_mid_tau(e)) continue;
     const ShapeEstimate est = shape_detect(v, s.ref, c_of(base));
-    apply(x.model.bias_instability_deg_per_h, Term::B, est.dc[2]);
-    apply(x.model.rrw_deg_per_h_per_sqrt_h, Term::K, est.dc[3]);
+    correct(x.model.bias_instability_deg_per_h, Term::B, est.dc[2]);
+    correct(x.model.rrw_deg_per_h_per_sqrt_h, Term::K, est.dc[3]);
     Finding f;
     f.effect = e;
     const double tc = std::max(est.time, 1e-3);
@@ -353,17 +366,11 @@ std::vector<std::int64_t> octave_of(const AllanResult& a) {
 NoiseModel calibrated(const NoiseModel& m0, const SimulationSettings& settings, std::size_t runs,
                       const std::vector<std::int64_t>& octave_m, const Decimated& dec,
                       const std::vector<std::size_t>& grid, const DiagnoseOptions& opt) {
-  auto pilot = run_ensemble(m0, settings, runs, octave_m, grid, false, opt);
-  for (auto& p : pilot) p.mid_var = p.mid_var_clean;
-  const auto ref = make_reference(grid, dec.tau_d, pilot);
-  const auto dc = calibration_corrections(decimated_avar(dec, grid), ref, c_of(m0), dec.duration() / 6.0);
+  const auto dc = pilot_corrections(m0, settings, runs, octave_m, dec, grid, opt, true);
   NoiseModel m = m0;
-  auto apply = [&](double& coef, Term t, double d) {
-    coef = coefficient_from_c(t, std::max(0.0, c_from_coefficient(t, coef) + d));
-  };
-  apply(m.arw_deg_per_sqrt_h, Term::N, dc[1]);
-  apply(m.bias_instability_deg_per_h, Term::B, dc[2]);
-  apply(m.rrw_deg_per_h_per_sqrt_h, Term::K, dc[3]);
+  correct(m.arw_deg_per_sqrt_h, Term::N, dc[1]);
+  correct(m.bias_instability_deg_per_h, Term::B, dc[2]);
+  correct(m.rrw_deg_per_h_per_sqrt_h, Term::K, dc[3]);
   return m;
 }
 
