@@ -229,7 +229,6 @@ std::array<double, 4> pilot_corrections(const NoiseModel& m, const SimulationSet
 
 Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std::string>& effects, double f_hint,
                  const AnalysisOptions& aopt) {
-  (void)aopt;
   Extension x;
   NoiseModel det;
   std::optional<OutputLowpassEstimate> lowpass;
@@ -271,6 +270,23 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
   x.model.sinusoids = det.sinusoids;
   x.model.bias_steps = det.bias_steps;
   x.model.warmups = det.warmups;
+  if (!det.sinusoids.empty() && !lowpass) {
+    // The base fit's Q is the white angle noise of the data with the line in it: beyond its AV
+    // peak (τ ≈ 1/(2f)) a sinusoid's AV falls as 1/τ², the shape of white angle noise, and the fit
+    // from 20 s on takes it into Q. Simulated as extra white angle noise under a counting read-out
+    // it multiplies σ at τ0 (a misfit of hundreds at the high-EDF short τ for a 0.01–0.03 Hz line,
+    // for both models). The extended model carries the line itself, so its white angle noise is
+    // that of the five-term fit of the data without the named terms (and without the mean-shape
+    // candidate, as for the base).
+    NoiseModel rm = det;
+    if (det.bias_steps.empty() && det.warmups.empty()) {
+      const NoiseModel c = own_candidates(s.dec);
+      rm.bias_steps = c.bias_steps;
+      rm.warmups = c.warmups;
+    }
+    const Recording clean = with_series(*s.rec, cleaned(s.rec->phase, rm, 0.0));
+    x.model.white_angle_arcsec = base_model(analyze_for_base(clean, aopt), s.rec->phase).white_angle_arcsec;
+  }
   if (lowpass) {
     x.model.output_lowpass_tc_s = lowpass->tf;
     x.model.white_angle_arcsec = std::sqrt(std::max(0.0, lowpass->white_angle2));
