@@ -720,9 +720,6 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
         half_effects.push_back(e);
         continue;
       }
-      if (std::getenv("RWCALC_DIAG_DEBUG"))
-        std::fprintf(stderr, "holdout dir %d %s: stat %.3g thr %.3g median %.3g max %.3g\n", dir, e.c_str(), stat,
-                     gumbel_threshold(ens, opt.alpha), quantile(ens, 0.5), *std::max_element(ens.begin(), ens.end()));
       if (stat > gumbel_threshold(ens, opt.alpha)) half_effects.push_back(e);
     }
     if (half_effects.empty()) {
@@ -740,24 +737,6 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     const Extension e = extend(st, b_fit, half_effects, f_hint, aopt);
     const auto e_runs = run_ensemble(shifted(e.model, dt), sh, r.holdout_runs, om, hgrid, false, opt, false);
     he += band_misfit(make_band(a_pred.points, e_runs, opt.band_level), r.holdout_runs);
-    if (std::getenv("RWCALC_DIAG_DEBUG")) {
-      std::fprintf(stderr, "holdout dir %d: base %.3f ext %.3f | bN %.3g bB %.3g bK %.3g bR %.3g bias %.4f | eN %.3g eB %.3g eK %.3g bias %.4f wa %.3g",
-                   dir, band_misfit(make_band(a_pred.points, b_runs, opt.band_level), r.holdout_runs),
-                   band_misfit(make_band(a_pred.points, e_runs, opt.band_level), r.holdout_runs), b_fit.arw_deg_per_sqrt_h,
-                   b_fit.bias_instability_deg_per_h, b_fit.rrw_deg_per_h_per_sqrt_h, b_fit.ramp_deg_per_h2, b_fit.bias_deg_per_h,
-                   e.model.arw_deg_per_sqrt_h, e.model.bias_instability_deg_per_h, e.model.rrw_deg_per_h_per_sqrt_h,
-                   shifted(e.model, dt).bias_deg_per_h, e.model.white_angle_arcsec);
-      for (const auto& q : e.model.bias_steps) std::fprintf(stderr, " step %.1f %.4f", q.t_s, q.size_deg_per_h);
-      for (const auto& q : e.model.warmups) std::fprintf(stderr, " warm %.4f %.1f", q.amp_deg_per_h, q.tc_s);
-      for (const auto& q : e.model.sinusoids) std::fprintf(stderr, " sin %.5f %.4f", q.f_hz, q.amp_deg_per_h);
-      if (std::atoi(std::getenv("RWCALC_DIAG_DEBUG")) > 1) {
-        const auto bb = make_band(a_pred.points, b_runs, opt.band_level), eb = make_band(a_pred.points, e_runs, opt.band_level);
-        for (std::size_t k = 0; k < bb.size() && k < eb.size(); ++k)
-          std::fprintf(stderr, "\n   tau %8.3f edf %8.3g dev %.4g base %.4g D %.2f ext %.4g D %.2f", bb[k].tau_s, bb[k].edf, bb[k].dev,
-                       std::sqrt(bb[k].mean_var), band_misfit({bb[k]}, r.holdout_runs), std::sqrt(eb[k].mean_var), band_misfit({eb[k]}, r.holdout_runs));
-      }
-      std::fprintf(stderr, " | pred mean rate %.4f\n", pred_rec.phase.diff(pred_rec.phase.points() - 1, 0) / pred_rec.phase.duration_s() - a_fit.earth_rate_deg_per_h);
-    }
   }
   timer.lap("out-of-sample check");
   r.gain.holdout_misfit_base = hb / 2;
