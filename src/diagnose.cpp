@@ -180,7 +180,7 @@ struct Stretch {
   MidTauReference ref;              ///< mid-τ AV reference of its base model's ensemble
   MidTauReference clean_ref;        ///< the same of its records without their own candidate
   std::size_t runs = 0;
-  // For the extended model's own pilot calibration (all set, or none: no pilot).
+  // For the extended model's pilot calibration, like the base's (all set, or none: no pilot).
   const SimulationSettings* settings = nullptr;  ///< settings (and seed) of the base model's pilot ensemble
   const std::vector<std::int64_t>* octave_m = nullptr;
   const DiagnoseOptions* opt = nullptr;
@@ -205,9 +205,6 @@ double mean_rate_of(const NoiseModel& det, double T) {
   return a / T;
 }
 
-/// Estimate the named effects on a stretch and build the extended model: deterministic terms by
-/// least squares on their statistic, removed before the re-fit of the five terms and before the
-/// mid-τ shape fit of a stochastic term, whose Q/N/B/K corrections also enter the model.
 /// Add a fit-scale correction to a coefficient (°/√h, °/h, …), the corrected square kept ≥ 0.
 void correct(double& coef, Term t, double dc) {
   coef = coefficient_from_c(t, std::max(0.0, c_from_coefficient(t, coef) + dc));
@@ -231,6 +228,10 @@ NoiseModel calibrated(const NoiseModel& m0, const SimulationSettings& settings, 
                       const std::vector<std::int64_t>& octave_m, const Decimated& dec,
                       const std::vector<std::size_t>& grid, const DiagnoseOptions& opt);
 
+/// Estimate the named effects on a stretch and build the extended model: deterministic terms by
+/// least squares on their statistic, removed before the five-term fit and pilot calibration of
+/// the rest (as for the base) and before the mid-τ shape fit of a stochastic term, whose Q/N/B/K
+/// corrections also enter the model.
 Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std::string>& effects, double f_hint,
                  const AnalysisOptions& aopt) {
   Extension x;
