@@ -896,8 +896,8 @@ void Reader::merge_chunk(Chunk& c) {
 
 template <bool Integer>
 void Reader::scan(const char* p) {
-  // Texts of more than kParallelBytes are parsed in two halves once the layout is known: the
-  // second half on another thread, from the first line start after the middle.
+  // Texts of more than kParallelBytes are parsed in two parts once the layout is known: the
+  // second on another thread, from the first line start after 60 % of the rest.
   bool split_pending = may_split();
   const char* limit = end_;
   Chunk chunk;
@@ -907,7 +907,10 @@ void Reader::scan(const char* p) {
       if (split_pending && layout_known_) {
         split_pending = false;
         if (end_ - p > kParallelBytes) {
-          const char* mid = p + (end_ - p) / 2;
+          // The other thread takes the last 40 %: it starts later (its thread and the mapping
+          // of its buffer) and parses more slowly per byte; with halves, this thread waited
+          // ~2 ms for it on the 2-h file, with 60/40 neither waits.
+          const char* mid = p + (end_ - p) / 5 * 3;
           const char* nl = static_cast<const char*>(std::memchr(mid, '\n', static_cast<std::size_t>(end_ - mid)));
           if (nl && nl + 1 < end_) {
             limit = nl + 1;
