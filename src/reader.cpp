@@ -17,6 +17,10 @@
 #include <stop_token>
 #include <thread>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <fmt/format.h>
 
 #include "reader_detail.hpp"
@@ -753,10 +757,7 @@ template <bool Sum, class Vec>
 inline const char* Reader::int_lines(const char* p, const char* limit, Vec& out, std::uint64_t& acc,
                                      std::uint64_t& mag) {
   std::uint64_t a = acc, m = mag;
-  while (p < limit) {
-    std::int64_t v;
-    const char* next = detail::scan_int_line(p, v);
-    if (!next) break;
+  auto emit = [&](std::int64_t v) {
     if constexpr (Sum) {
       // The running sum C_k and Σ|c|, as build_phase forms them (modulo 2^64).
       const auto u = static_cast<std::uint64_t>(v);
@@ -767,6 +768,44 @@ inline const char* Reader::int_lines(const char* p, const char* limit, Vec& out,
     } else {
       out.push_back(v);
     }
+  };
+#if defined(__SSE2__)
+  // Windows of 64 bytes: the line ends come from one compare per 16 bytes, so where a line starts
+  // does not wait for the previous line's bytes to be read and tested (the scalar loop below is a
+  // chain of dependent loads, one per line); each line is then taken by scan_int_line as there,
+  // and must end at the newline found. Any other outcome leaves that line to the scalar loop.
+  while (limit - p >= 64) {
+    std::uint64_t nl = 0;
+    const __m128i lf = _mm_set1_epi8('\n');
+    for (int k = 0; k < 4; ++k) {
+      const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + 16 * k));
+      nl |= static_cast<std::uint64_t>(static_cast<std::uint32_t>(_mm_movemask_epi8(_mm_cmpeq_epi8(b, lf))))
+            << (16 * k);
+    }
+    const char* s = p;
+    bool stop = false;
+    for (; nl != 0; nl &= nl - 1) {
+      const char* e = p + __builtin_ctzll(nl);  // this line's newline
+      std::int64_t v;
+      if (detail::scan_int_line(s, v) != e + 1) {
+        stop = true;
+        break;
+      }
+      emit(v);
+      s = e + 1;
+    }
+    if (stop || s == p) {
+      p = s;
+      break;
+    }
+    p = s;  // the line the window cut goes into the next window
+  }
+#endif
+  while (p < limit) {
+    std::int64_t v;
+    const char* next = detail::scan_int_line(p, v);
+    if (!next) break;
+    emit(v);
     p = next;
   }
   acc = a;
