@@ -1290,7 +1290,7 @@ Recording read_recording(const std::string& path, const ReadOptions& options) {
   validate(options);
   TextBuffer buf = [&] {
     detail::ScopedTimer t("read: load");
-    return detail::load_source(path);
+    return detail::load_source(path, options.threads ? options.threads : std::thread::hardware_concurrency());
   }();
   return read_buffer(buf, path, options);
 }
