@@ -29,6 +29,7 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kPulseFitTauMin = 20.0;  ///< s, start of the base fit for pulse data
 constexpr double kGmMinPeakRatio = 0.6;  ///< bump AV at its peak / base AV there, to name a Gauss–Markov term
 constexpr double kGmMinExcess = 2.0;      ///< ensemble SDs a Gauss–Markov bump must raise the mid-τ AV by
+constexpr double kStepMinSide = 60.0;     ///< s of a half on each side of a known step to estimate its size there
 
 double term_value(const FitResult& f, Term t) {
   const auto& c = f[t];
@@ -185,6 +186,9 @@ struct Stretch {
   const std::vector<std::int64_t>* octave_m = nullptr;
   const DiagnoseOptions* opt = nullptr;
   std::size_t pilot_runs = 0;
+  /// A named step's time known from the whole record, in stretch time (< 0: estimate it on the
+  /// stretch). Only its size is then estimated on the stretch.
+  double step_time_s = -1;
 };
 
 struct Extension {
@@ -203,6 +207,30 @@ double mean_rate_of(const NoiseModel& det, double T) {
   for (const auto& x : det.bias_steps) a += x.size_deg_per_h * std::max(0.0, T - std::max(0.0, x.t_s));
   for (const auto& x : det.warmups) a += x.amp_deg_per_h * x.tc_s * -std::expm1(-T / x.tc_s);
   return a / T;
+}
+
+/// A bias step at a known time `ts` (time of θ_0 = 0): its size as the difference of the mean
+/// rates over up to 30 min on each side, as step_detect; σ from the 1-s block means' white level.
+StepEstimate step_at(const Decimated& d, double ts) {
+  StepEstimate e;
+  e.t_s = ts;
+  const double T = d.duration();
+  const double wa = std::min(1800.0, ts), wb = std::min(1800.0, T - ts);
+  if (!(wa > d.tau_d) || !(wb > d.tau_d)) return e;
+  auto theta_at = [&](double t) {  // linear interpolation of the decimated angle
+    const double u = std::clamp(t / d.tau_d, 0.0, static_cast<double>(d.theta.size() - 1));
+    const auto i = std::min(static_cast<std::size_t>(u), d.theta.size() - 2);
+    const double f = u - static_cast<double>(i);
+    return d.theta[i] + f * (d.theta[i + 1] - d.theta[i]);
+  };
+  const double th = theta_at(ts);
+  e.size = (theta_at(ts + wb) - th) / wb - (th - theta_at(ts - wa)) / wa;
+  const auto y1 = block_rates(d, std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(1.0 / d.tau_d))));
+  double s2 = 0;
+  for (std::size_t i = 0; i + 1 < y1.size(); ++i) s2 += (y1[i + 1] - y1[i]) * (y1[i + 1] - y1[i]);
+  const double sig1 = y1.size() > 2 ? std::sqrt(s2 / static_cast<double>(y1.size() - 1) / 2.0) : 0.0;
+  e.size_sigma = sig1 * std::sqrt(1.0 / wa + 1.0 / wb);
+  return e;
 }
 
 /// Add a fit-scale correction to a coefficient (°/√h, °/h, …), the corrected square kept ≥ 0.
@@ -246,7 +274,7 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
       f.params = {{"frequency_hz", est.f_hz}, {"amplitude_deg_per_h", est.amp}, {"phase_rad", est.phase}};
       f.uncertainty = {{"frequency_hz", est.f_sigma}, {"amplitude_deg_per_h", est.amp_sigma}};
     } else if (e == "bias_step") {
-      const auto est = step_detect(s.dec);
+      const auto est = s.step_time_s >= 0 ? step_at(s.dec, s.step_time_s) : step_detect(s.dec);
       det.bias_steps.push_back({est.t_s, est.size});
       f.params = {{"time_s", est.t_s}, {"size_deg_per_h", est.size}};
       f.uncertainty = {{"time_s", est.t_sigma}, {"size_deg_per_h", est.size_sigma}};
@@ -705,15 +733,26 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     // transient that lies in the predicted half cannot be estimated from the fitting half; a
     // re-estimate there would be the half's largest rate excursion, a spurious term.
     std::vector<std::string> half_effects;
+    // A step whose time, known from the whole record, lies inside the fitting half (at least
+    // kStepMinSide of data on each side) enters with that time, only its size estimated on the
+    // half: a step 350 s before the half's end is estimable from those 350 s even where the half's
+    // own detector, which also searches for the time, does not fire. A step in the predicted half
+    // stays out.
+    double step_time = -1;
+    if (!r.extended.bias_steps.empty()) {
+      const double t_local = r.extended.bias_steps.front().t_s - static_cast<double>(fa) * x.tau0_s;
+      if (t_local >= kStepMinSide && t_local <= static_cast<double>(h) * x.tau0_s - kStepMinSide) step_time = t_local;
+    }
     for (const auto& e : effects) {
       double stat = 0;
       std::vector<double> ens;
+      if (e == "bias_step") {
+        if (step_time >= 0) half_effects.push_back(e);
+        continue;
+      }
       if (e == "sinusoid") {
         stat = sinusoid_detect(without_mean_shape(st.dec), 0.0, false).statistic;
         for (const auto& br : b_runs) ens.push_back(br.sin_stat);
-      } else if (e == "bias_step") {
-        stat = step_detect(st.dec).statistic;
-        for (const auto& br : b_runs) ens.push_back(br.step_stat);
       } else if (e == "warmup_transient") {
         stat = warmup_detect(st.dec).statistic;
         for (const auto& br : b_runs) ens.push_back(br.warm_stat);
@@ -735,6 +774,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     st.octave_m = &om;
     st.opt = &opt;
     st.pilot_runs = r.holdout_runs;
+    st.step_time_s = step_time;
     const Extension e = extend(st, b_fit, half_effects, f_hint, aopt);
     const auto e_runs = run_ensemble(shifted(e.model, dt), sh, r.holdout_runs, om, hgrid, false, opt, false);
     he += band_misfit(make_band(a_pred.points, e_runs, opt.band_level), r.holdout_runs);

@@ -153,7 +153,13 @@ void expect_rates(const Tally& t) {
 // 8/10 (misfits 0.31 -> 0.59 and 0.112 -> 0.113: records the base already fits, well under 1 per
 // point), out of sample 9/10 (0.52 -> 0.63). The three lines at 0.011-0.025 Hz whose misfits were
 // 250-500 for both models (the base fit's Q had taken the line) now give 256 -> 0.12,
-// 351 -> 0.12, 512 -> 2.18. The every-case gain criterion is not met: disabled, not weakened.
+// 351 -> 0.12, 512 -> 2.18. On the first losing record the extended model is nearer the truth
+// (N 0.00097, B 0.0057 against the base's 0.00107, 0.0052; true 0.001, 0.005) and the data lie
+// high at 82-164 s, where N dominates; on the second the two models hardly differ (misfits
+// 0.1121 -> 0.1126). Re-measured after the step change: unchanged. Tried on the two losing records and not kept: calibrating the
+// extended model with its line against the data with the line (0.31 -> 0.80, 0.112 -> 0.168),
+// three times the pilot runs (0.31 -> 0.40, 0.112 -> 0.1125; out of sample 0.52 -> 0.54).
+// The every-case gain criterion is not met: disabled, not weakened.
 TEST(DiagnoseAcceptance, DISABLED_Sinusoid) {
   const auto t = run_effect(
       "sinusoid", cases(10), 1000,
@@ -170,12 +176,14 @@ TEST(DiagnoseAcceptance, DISABLED_Sinusoid) {
 }
 
 // Measured (seeds 2000…, 10 cases, 20 runs, |δ| 0.025–0.08 °/h): named and within tolerance
-// 10/10; gain in sample 10/10, out of sample 8/10: one tie (holdout 4.41 = 4.41, a 0.02 °/h step
-// 350 s before the middle that neither half's detector sees, so both half models are the bases)
-// and one loss (2.86 -> 3.18: the half model predicts the right rate level, -0.032 against the
-// base's -0.017 °/h, and still loses at the counting read-out's 5-20 s points). Detection and
-// in-sample gain met, the every-case out-of-sample gain not: disabled, not weakened. Below the
-// range (RWCALC_DIAGNOSE_RANGE=0.01,0.02): named 3/10.
+// 10/10; gain in sample 10/10, out of sample 9/10. A step inside the fitting half enters that
+// half's model at its whole-record time (the former tie, a 0.02 °/h step 350 s before the middle
+// that neither half's detector sees: 4.41 -> 2.44). One loss (2.86 -> 3.18): the half model
+// predicts the right rate level, -0.032 against the base's -0.017 °/h, but its N is 0.00086 °/√h
+// against the true 0.001, and the depth of the counting read-out's beat at 5-20 s depends on
+// how much the ARW dithers it (with N = 0.001: 2.86 -> 2.72). Detection and in-sample gain met,
+// the every-case out-of-sample gain not: disabled, not weakened. Below the range
+// (RWCALC_DIAGNOSE_RANGE=0.01,0.02): named 3/10.
 TEST(DiagnoseAcceptance, DISABLED_BiasStep) {
   const auto t = run_effect(
       "bias_step", cases(10), 2000,
