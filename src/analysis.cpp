@@ -187,8 +187,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
                       read.phase.kind == PhaseKind::Gyro;
   std::jthread scan_thread;
   std::exception_ptr scan_error;
-  if (beside) {
-    check_outlier_threshold(options);
+  auto start_scan = [&] {
     scan_thread = std::jthread([&] {
       try {
         detail::ScopedTimer t("analyze: outlier scan (beside)");
@@ -197,6 +196,9 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
         scan_error = std::current_exception();
       }
     });
+  };
+  if (beside) {
+    check_outlier_threshold(options);
   } else if (read.phase.points() >= 3) {
     const std::vector<Outlier> found = [&] {
       detail::ScopedTimer t("analyze: outlier scan");
@@ -257,6 +259,10 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
     detail::ScopedTimer t("analyze: allan");
     r.allan = compute_allan(rec.phase, aopt);
   }
+  // The scan beside the fit, the cross-checks and the verdict rather than beside the Allan stage:
+  // that stage splits its passes over the data evenly between its threads, so a third thread
+  // there leaves one of them waiting for a core while the other idles at the end of each pass.
+  if (beside) start_scan();
   AllanResult octave_points;
   if (!octave) {
     octave_points = r.allan;
