@@ -178,9 +178,10 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   OutlierReport outliers;
   Recording rec_storage;
   const Recording* recp = &read;
-  // Outliers that are only reported (the default) change nothing the Allan stage computes: then
-  // the scan runs on a thread of its own beside the Allan stage (joined before the result is
-  // assembled), filling the gaps the Allan stage leaves on the cores between its parallel phases.
+  // Outliers that are only reported (the default) change nothing the Allan stage or the fit
+  // computes: then the scan runs on a thread of its own, started once the Allan stage is done,
+  // beside the fit, the cross-checks and the verdict (joined before the result is assembled),
+  // filling the core the fit's covariance leaves.
   const unsigned budget = options.allan.threads ? options.allan.threads
                                                 : std::max(1u, std::thread::hardware_concurrency());
   const bool beside = options.outlier_action == OutlierAction::Keep && budget > 1 && read.phase.points() >= 3 &&
