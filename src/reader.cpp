@@ -14,6 +14,7 @@
 #include <cstring>
 #include <limits>
 #include <numbers>
+#include <stdexcept>
 #include <stop_token>
 #include <thread>
 
@@ -165,8 +166,8 @@ class Reader {
                                std::uint64_t& mag);
   void int_run(const char*& p, const char* limit);
   bool sum_pending();
-  // Texts of more than kParallelBytes are parsed in two halves once the layout is known: the
-  // second half on another thread, from the first line start after the middle.
+  // Texts of more than kParallelBytes are parsed in two parts once the layout is known: the
+  // second on another thread, from the first line start after kSplitNum/kSplitDen of the rest.
   static constexpr std::ptrdiff_t kParallelBytes = std::ptrdiff_t{1} << 20;
   // Where the text is split: the other thread takes the part after kSplitNum/kSplitDen of it.
   static constexpr std::ptrdiff_t kSplitNum = 11, kSplitDen = 20;
@@ -975,8 +976,10 @@ void Reader::scan(const char* p) {
               // The first part adds at most one value per line before `limit`: the second part's
               // values go right after that (ints_ holds one slot per line of the text, so both
               // fit and it is never reallocated). Each thread maps the pages it will write.
-              const char* unused = nullptr;
-              const std::size_t at = ints_.size() + count_lines_checked(p, limit, unused);
+              // (check_bytes() has passed every byte, so the count does not stop early.)
+              const char* bad = nullptr;
+              const std::size_t at = ints_.size() + count_lines_checked(p, limit, bad);
+              if (bad) throw std::logic_error("reader: byte check and line count disagree");
               chunk.ints.p = ints_.data() + at;
               const std::size_t room = ints_.capacity() - at;
               worker = std::jthread([this, &chunk, room, from = limit](std::stop_token st) {
