@@ -1,8 +1,9 @@
 // Allan-variance kernels on the 2-h 400 Hz GL-2D record (2.88 M samples, exact counts):
 // one overlapping AVAR per cluster size, whole grids (octave, dense) on one and on all threads,
-// MVAR, noise identification and EDF.
+// MVAR, noise identification and EDF, and the int32 view of the counts they read.
 #include <benchmark/benchmark.h>
 
+#include "../src/allan_kernels.hpp"
 #include "bench_inputs.hpp"
 #include "rwcalc/allan.hpp"
 #include "rwcalc/confidence.hpp"
@@ -19,6 +20,20 @@ void BM_OavarOneTau(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(x.points() - 2 * static_cast<std::size_t>(m)));
 }
 BENCHMARK(BM_OavarOneTau)->Arg(1)->Arg(64)->Arg(4096)->Arg(262144)->Unit(benchmark::kMillisecond);
+
+// The int32 view of the counts (offsets C_k − C_0 and their range; AVX2 where available) on
+// range(0) threads. Each iteration allocates the view afresh, as analyze does: the heap reuses the
+// previous iteration's pages, so this is the pass itself without the cost of fresh pages.
+void BM_PrepareCounts(benchmark::State& state) {
+  const auto& x = bench::gl2d_series();
+  const auto threads = static_cast<unsigned>(state.range(0));
+  for (auto _ : state) {
+    const auto p = detail::prepare_counts(x.counts, false, threads);
+    benchmark::DoNotOptimize(p.rel32.data());
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(x.points()));
+}
+BENCHMARK(BM_PrepareCounts)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_MvarOneTau(benchmark::State& state) {
   const auto& x = bench::gl2d_series();

@@ -178,17 +178,17 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   OutlierReport outliers;
   Recording rec_storage;
   const Recording* recp = &read;
-  // Outliers that are only reported (the default) change nothing the Allan stage computes: then
-  // the scan runs on a thread of its own beside the Allan stage (joined before the result is
-  // assembled), filling the gaps the Allan stage leaves on the cores between its parallel phases.
+  // Outliers that are only reported (the default) change nothing the Allan stage or the fit
+  // computes: then the scan runs on a thread of its own, started once the Allan stage is done,
+  // beside the fit, the cross-checks and the verdict (joined before the result is assembled),
+  // filling the core the fit's covariance leaves.
   const unsigned budget = options.allan.threads ? options.allan.threads
                                                 : std::max(1u, std::thread::hardware_concurrency());
   const bool beside = options.outlier_action == OutlierAction::Keep && budget > 1 && read.phase.points() >= 3 &&
                       read.phase.kind == PhaseKind::Gyro;
   std::jthread scan_thread;
   std::exception_ptr scan_error;
-  if (beside) {
-    check_outlier_threshold(options);
+  auto start_scan = [&] {
     scan_thread = std::jthread([&] {
       try {
         detail::ScopedTimer t("analyze: outlier scan (beside)");
@@ -197,6 +197,9 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
         scan_error = std::current_exception();
       }
     });
+  };
+  if (beside) {
+    check_outlier_threshold(options);
   } else if (read.phase.points() >= 3) {
     const std::vector<Outlier> found = [&] {
       detail::ScopedTimer t("analyze: outlier scan");
@@ -257,6 +260,10 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
     detail::ScopedTimer t("analyze: allan");
     r.allan = compute_allan(rec.phase, aopt);
   }
+  // The scan beside the fit, the cross-checks and the verdict rather than beside the Allan stage:
+  // that stage splits its passes over the data evenly between its threads, so a third thread
+  // there leaves one of them waiting for a core while the other idles at the end of each pass.
+  if (beside) start_scan();
   AllanResult octave_points;
   if (!octave) {
     octave_points = r.allan;

@@ -14,6 +14,7 @@
 #include <cstring>
 #include <limits>
 #include <numbers>
+#include <stdexcept>
 #include <stop_token>
 #include <thread>
 
@@ -165,9 +166,11 @@ class Reader {
                                std::uint64_t& mag);
   void int_run(const char*& p, const char* limit);
   bool sum_pending();
-  // Texts of more than kParallelBytes are parsed in two halves once the layout is known: the
-  // second half on another thread, from the first line start after the middle.
+  // Texts of more than kParallelBytes are parsed in two parts once the layout is known: the
+  // second on another thread, from the first line start after kSplitNum/kSplitDen of the rest.
   static constexpr std::ptrdiff_t kParallelBytes = std::ptrdiff_t{1} << 20;
+  // Where the text is split: the other thread takes the part after kSplitNum/kSplitDen of it.
+  static constexpr std::ptrdiff_t kSplitNum = 11, kSplitDen = 20;
   [[nodiscard]] bool may_split() const {
     const unsigned threads = opt_.threads ? opt_.threads : std::thread::hardware_concurrency();
     return threads > 1 && end_ - begin_ > kParallelBytes;
@@ -178,8 +181,21 @@ class Reader {
     else
       detail::prefault(reals_.data() + reals_.size(), (reals_.capacity() - reals_.size()) * sizeof(double));
   }
+  // The second part's integers, written by its thread straight into the room reserved in ints_
+  // past the most the first part can hold (one value per line): no buffer of their own, no pages
+  // mapped twice, and merge_chunk() offsets them where they are.
+  struct IntSink {
+    std::int64_t* p = nullptr;
+    std::size_t n = 0;
+    void push_back(std::int64_t v) noexcept { p[n++] = v; }
+    [[nodiscard]] std::size_t size() const noexcept { return n; }
+    [[nodiscard]] std::int64_t* data() const noexcept { return p; }
+    [[nodiscard]] std::int64_t* begin() const noexcept { return p; }
+    [[nodiscard]] std::int64_t* end() const noexcept { return p + n; }
+    std::int64_t& operator[](std::size_t i) const noexcept { return p[i]; }
+  };
   struct Chunk {
-    std::vector<std::int64_t> ints;
+    IntSink ints;
     // Pulses: ints[0, summed) are already the running sums of the chunk's counts (from 0), acc the
     // last of them and mag the sum of the |counts|; the rest are counts as read.
     std::size_t summed = 0;
@@ -901,13 +917,15 @@ void Reader::merge_chunk(Chunk& c) {
     auto from = c.ints.begin();
     if (c.summed > 0) {
       if (sum_pending() && c.mag <= kSumLimit - mag_) {
-        // The chunk's running sums, offset by the sum so far: C_k without a second pass.
+        // The chunk's running sums, offset by the sum so far where they are (a vectorised add):
+        // C_k without a second pass. They sit in ints_'s reserved room at its end, or after it
+        // when the first part held lines without a value; insert() then moves them down over that
+        // gap (an overlapping move), or has nothing to move.
         const std::uint64_t base = acc_;
-        const std::size_t at = ints_.size();
-        ints_.insert(ints_.end(), c.ints.begin(), c.ints.begin() + static_cast<std::ptrdiff_t>(c.summed));
-        std::int64_t* d = ints_.data() + at;  // a copy, then a vectorised add: ~2 instructions per count
+        std::int64_t* d = c.ints.data();
         for (std::size_t i = 0; i < c.summed; ++i)
           d[i] = static_cast<std::int64_t>(base + static_cast<std::uint64_t>(d[i]));
+        ints_.insert(ints_.end(), d, d + c.summed);
         acc_ = base + c.acc;
         mag_ += c.mag;
         summed_ = ints_.size();
@@ -936,7 +954,7 @@ void Reader::merge_chunk(Chunk& c) {
 template <bool Integer>
 void Reader::scan(const char* p) {
   // Texts of more than kParallelBytes are parsed in two parts once the layout is known: the
-  // second on another thread, from the first line start after 60 % of the rest.
+  // second on another thread, from the first line start after 55 % of the rest.
   bool split_pending = may_split();
   const char* limit = end_;
   Chunk chunk;
@@ -946,29 +964,42 @@ void Reader::scan(const char* p) {
       if (split_pending && layout_known_) {
         split_pending = false;
         if (end_ - p > kParallelBytes) {
-          // The other thread takes the last 40 %: it starts later (its thread and the mapping
-          // of its buffer) and parses more slowly per byte; with halves, this thread waited
-          // ~2 ms for it on the 2-h file, with 60/40 neither waits.
-          const char* mid = p + (end_ - p) / 5 * 3;
+          // The other thread takes the last 45 %: it starts later (its thread and the mapping
+          // of its pages) and parses more slowly per byte; with halves, this thread waited
+          // ~1 ms for it on the 2-h file, with 55/45 neither waits (60/40 while the other part
+          // had a buffer of its own, whose pages took it ~2 ms more to map).
+          const char* mid = p + (end_ - p) / kSplitDen * kSplitNum;
           const char* nl = static_cast<const char*>(std::memchr(mid, '\n', static_cast<std::size_t>(end_ - mid)));
           if (nl && nl + 1 < end_) {
             limit = nl + 1;
-            const auto share = static_cast<double>(end_ - limit) / static_cast<double>(end_ - begin_);
-            const auto expect = static_cast<std::size_t>(share * static_cast<double>(lines_) * 1.05) + 64;
-            worker = std::jthread([this, &chunk, expect, from = limit](std::stop_token st) {
-              // Room for the half's values, its pages mapped in one call on this thread.
-              if constexpr (Integer) {
-                chunk.ints.reserve(expect);
-                detail::prefault(chunk.ints.data(), expect * sizeof(std::int64_t));
-              } else {
+            if constexpr (Integer) {
+              // The first part adds at most one value per line before `limit`: the second part's
+              // values go right after that (ints_ holds one slot per line of the text, so both
+              // fit and it is never reallocated). Each thread maps the pages it will write.
+              // (check_bytes() has passed every byte, so the count does not stop early.)
+              const char* bad = nullptr;
+              const std::size_t at = ints_.size() + count_lines_checked(p, limit, bad);
+              if (bad) throw std::logic_error("reader: byte check and line count disagree");
+              chunk.ints.p = ints_.data() + at;
+              const std::size_t room = ints_.capacity() - at;
+              worker = std::jthread([this, &chunk, room, from = limit](std::stop_token st) {
+                detail::prefault(chunk.ints.p, room * sizeof(std::int64_t));
+                scan_chunk<Integer>(from, chunk, st);
+              });
+              detail::prefault(ints_.data() + ints_.size(), (at - ints_.size()) * sizeof(std::int64_t));
+            } else {
+              const auto share = static_cast<double>(end_ - limit) / static_cast<double>(end_ - begin_);
+              const auto expect = static_cast<std::size_t>(share * static_cast<double>(lines_) * 1.05) + 64;
+              worker = std::jthread([this, &chunk, expect, from = limit](std::stop_token st) {
+                // Room for the part's values, its pages mapped in one call on this thread.
                 chunk.reals.reserve(expect);
                 detail::prefault(chunk.reals.data(), expect * sizeof(double));
-              }
-              scan_chunk<Integer>(from, chunk, st);
-            });
-            // The pages of the whole record's values, mapped here rather than before the scan, so
-            // that the other half is parsed meanwhile.
-            prefault_values();
+                scan_chunk<Integer>(from, chunk, st);
+              });
+              // The pages of the whole record's values, mapped here rather than before the scan,
+              // so that the other part is parsed meanwhile.
+              prefault_values();
+            }
           }
         }
       }

@@ -19,8 +19,9 @@ class TextBuffer {
   static constexpr std::size_t kPadding = 16;
   TextBuffer() = default;
   /// Buffer of `size` bytes plus room for the sentinel newline; contents uninitialised. Its pages
-  /// are mapped in one call (prefault) unless map_pages is false.
-  explicit TextBuffer(std::size_t capacity, bool map_pages = true);
+  /// are mapped in one call (prefault) unless map_pages is false. `spare` bytes more are allocated
+  /// and never touched (see load_source).
+  explicit TextBuffer(std::size_t capacity, bool map_pages = true, std::size_t spare = 0);
   [[nodiscard]] char* data() noexcept { return data_.get(); }
   [[nodiscard]] const char* data() const noexcept { return data_.get(); }
   [[nodiscard]] std::size_t size() const noexcept { return size_; }

@@ -32,8 +32,8 @@ void prefault(void* data, std::size_t bytes) noexcept {
 #endif
 }
 
-TextBuffer::TextBuffer(std::size_t capacity, bool map_pages)
-    : data_(std::make_unique_for_overwrite<char[]>(capacity + 1 + kPadding)), capacity_(capacity) {
+TextBuffer::TextBuffer(std::size_t capacity, bool map_pages, std::size_t spare)
+    : data_(std::make_unique_for_overwrite<char[]>(capacity + 1 + kPadding + spare)), capacity_(capacity) {
   if (map_pages) prefault(data_.get(), capacity);
   std::memset(data_.get() + capacity + 1, 0, kPadding);
 }
@@ -209,7 +209,12 @@ TextBuffer load_source(const std::string& path, unsigned threads) {
     constexpr std::size_t kHalvesBytes = std::size_t{4} << 20;
     const auto size = static_cast<std::size_t>(st.st_size);
     if (S_ISREG(st.st_mode) && threads > 1 && size > kHalvesBytes) {
-      raw = TextBuffer(size + 1, false);
+      // Twice the file's size is allocated and only its first half used: once the text is freed,
+      // the int32 view of the counts (4 bytes per line, at most 2 per byte of a pulse file) fits
+      // in the freed block and reuses the pages the text mapped instead of mapping fresh ones
+      // (the heap keeps blocks below M_MMAP_THRESHOLD mapped, src/main.cpp). The untouched half
+      // costs address space only. Performance only: nothing depends on where the view lives.
+      raw = TextBuffer(size + 1, false, size);
       if (!read_halves(fd.get(), size, raw, name) && ::lseek(fd.get(), 0, SEEK_SET) < 0)
         fail_errno(name, "cannot seek", errno);
     } else {

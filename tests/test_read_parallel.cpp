@@ -74,6 +74,27 @@ TEST(ReadParallel, PulseFileSameAsSerial) {
   EXPECT_EQ(parallel.line_of_sample(1199999), 1200000u + 3 + 4);
 }
 
+// The second part's values are written into the values array right after the most the first part
+// can hold (one value per line); lines without a value in the first part (here 20 000 comments and
+// blank lines spread over it) leave a gap the merge closes by moving them down: the same record as
+// the serial read, and the same as when the gap is filled with values.
+TEST(ReadParallel, LinesWithoutValuesInTheFirstPart) {
+  std::mt19937_64 rng(7);
+  std::uniform_int_distribution<int> pulse(-9, 9);
+  std::string text = "pulses\n";
+  const std::size_t n = 1000000;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i < n / 2 && i % 50 == 25) text += (i % 100 == 25) ? "# note\n" : "\n";
+    text += fmt::format("{}\n", pulse(rng));
+  }
+  ASSERT_GT(text.size(), std::size_t{2} << 20);
+  const Recording serial = read_recording_text(text, "gaps.csv", with_threads(1));
+  const Recording parallel = read_recording_text(text, "gaps.csv", with_threads(2));
+  EXPECT_EQ(serial.samples, n);
+  expect_same(serial, parallel);
+  EXPECT_EQ(parallel.line_of_sample(n - 1), n + 1 + 10000);
+}
+
 // A file of more than 4 MB is loaded in two halves, each on its own thread: the same bytes,
 // including a file that does not end with a newline and one whose size is not a multiple of a page.
 TEST(ReadParallel, FileLoadedInHalvesSameAsText) {
