@@ -494,9 +494,10 @@ PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_pref
     pass(0, c.size(), lo, hi);
   }
   const bool small = lo > -kLimit && hi < kLimit;
-  const std::int64_t top = std::max(-lo, hi);
-  p.small29 = top < (std::int64_t{1} << 29);
-  p.small24 = top < (std::int64_t{1} << 24);
+  // lo ≤ 0 ≤ hi (the first offset is 0); |lo| in unsigned arithmetic, exact even for lo = −2^63.
+  const std::uint64_t top = std::max(std::uint64_t{0} - static_cast<std::uint64_t>(lo), static_cast<std::uint64_t>(hi));
+  p.small29 = top < (std::uint64_t{1} << 29);
+  p.small24 = top < (std::uint64_t{1} << 24);
   if (!small) {
     p.rel32.clear();
     p.rel32.shrink_to_fit();
