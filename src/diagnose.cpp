@@ -196,8 +196,8 @@ struct Stretch {
   MidTauReference ref;              ///< mid-τ AV reference of its base model's ensemble
   MidTauReference clean_ref;        ///< the same of its records without their own candidate
   std::size_t runs = 0;
-  // For the extended model's own pilot calibration (all set, or none: no pilot).
-  const SimulationSettings* settings = nullptr;  ///< simulation settings of the stretch
+  // For the extended model's pilot calibration, like the base's (all set, or none: no pilot).
+  const SimulationSettings* settings = nullptr;  ///< settings (and seed) of the base model's pilot ensemble
   const std::vector<std::int64_t>* octave_m = nullptr;
   const DiagnoseOptions* opt = nullptr;
   std::size_t pilot_runs = 0;
@@ -221,9 +221,6 @@ double mean_rate_of(const NoiseModel& det, double T) {
   return a / T;
 }
 
-/// Estimate the named effects on a stretch and build the extended model: deterministic terms by
-/// least squares on their statistic, removed before the re-fit of the five terms and before the
-/// mid-τ shape fit of a stochastic term, whose Q/N/B/K corrections also enter the model.
 /// Add a fit-scale correction to a coefficient (°/√h, °/h, …), the corrected square kept ≥ 0.
 void correct(double& coef, Term t, double dc) {
   coef = coefficient_from_c(t, std::max(0.0, c_from_coefficient(t, coef) + dc));
@@ -254,9 +251,16 @@ std::array<double, 4> pilot_corrections(const NoiseModel& m, const SimulationSet
   return calibration_corrections(decimated_avar(dec, grid), ref, c_of(m), dec.duration() / 6.0);
 }
 
+NoiseModel calibrated(const NoiseModel& m0, const SimulationSettings& settings, std::size_t runs,
+                      const std::vector<std::int64_t>& octave_m, const Decimated& dec,
+                      const std::vector<std::size_t>& grid, const DiagnoseOptions& opt);
+
+/// Estimate the named effects on a stretch and build the extended model: deterministic terms by
+/// least squares on their statistic, removed before the five-term fit and pilot calibration of
+/// the rest (as for the base) and before the mid-τ shape fit of a stochastic term, whose Q/N/B/K
+/// corrections also enter the model.
 Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std::string>& effects, double f_hint,
                  const AnalysisOptions& aopt) {
-  (void)aopt;
   Extension x;
   NoiseModel det;
   std::optional<OutputLowpassEstimate> lowpass;
@@ -328,17 +332,40 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
     correct(x.model.bias_instability_deg_per_h, Term::B, dc[2]);
     correct(x.model.rrw_deg_per_h_per_sqrt_h, Term::K, dc[3]);
   }
-  if (self_pilot) {
-    // The extended model calibrated against its own pilot ensemble, the named terms included:
-    // the corrections of N², B² (K held, τ ≤ T/6, as for the base) that bring the pilot's mean
-    // mid-τ AV onto the data's. The re-fit above compares records without their candidates;
-    // what the named terms themselves add to the AV is only seen here, so the base B, which
-    // already covered the data's long-τ AV, gives back what the terms now explain.
-    SimulationSettings sp = *s.settings;
-    sp.seed += 2000;
-    const auto dc = pilot_corrections(x.model, sp, s.pilot_runs, *s.octave_m, s.dec, s.ref.grid, *s.opt, false);
-    correct(x.model.arw_deg_per_sqrt_h, Term::N, dc[1]);
-    correct(x.model.bias_instability_deg_per_h, Term::B, dc[2]);
+  if (deterministic && !lowpass && s.rec && (self_pilot || !det.sinusoids.empty())) {
+    // The extended model is built like the base, on the data without the named terms: the
+    // five-term fit of the record without them (and without its mean-shape candidate when no step
+    // or transient is named), then N and B calibrated by a pilot ensemble against the mid-τ AV of
+    // those data, the pilot records without their own candidates (like with like), with the
+    // base's pilot seeds (common random numbers: where the named terms are the base's candidate,
+    // the two models differ by the terms only, not by the pilot's sampling noise). A sinusoid is
+    // not part of the base's candidate, so the base took it into N, B and the fit's Q: beyond its
+    // AV peak (τ ≈ 1/(2f)) a line's AV falls as 1/τ², the shape of white angle noise, and the fit
+    // from 20 s on takes it into Q; simulated as extra white angle noise under a counting read-out
+    // that multiplies σ at τ0 (a misfit of 250–500 at the high-EDF short τ for lines of
+    // 0.01–0.03 Hz, for both models, when the extended model kept the base's Q).
+    NoiseModel rm = det;
+    if (det.bias_steps.empty() && det.warmups.empty()) {
+      const NoiseModel c = own_candidates(s.dec);
+      rm.bias_steps = c.bias_steps;
+      rm.warmups = c.warmups;
+    }
+    const Recording clean = with_series(*s.rec, cleaned(s.rec->phase, rm, 0.0));
+    NoiseModel m0 = base_model(analyze_for_base(clean, aopt), s.rec->phase);
+    m0.bias_deg_per_h = base.bias_deg_per_h;
+    Decimated dclean = s.dec;
+    subtract_deterministic(dclean, rm);
+    x.model.white_angle_arcsec = m0.white_angle_arcsec;
+    x.model.readout = m0.readout;
+    if (self_pilot) {
+      const NoiseModel m = calibrated(m0, *s.settings, s.pilot_runs, *s.octave_m, dclean, s.ref.grid, *s.opt);
+      x.model.arw_deg_per_sqrt_h = m.arw_deg_per_sqrt_h;
+      x.model.bias_instability_deg_per_h = m.bias_instability_deg_per_h;
+      x.model.rrw_deg_per_h_per_sqrt_h = m.rrw_deg_per_h_per_sqrt_h;
+      x.model.ramp_deg_per_h2 = m.ramp_deg_per_h2;
+    }
+    // (With a stochastic term N, B, K come from its joint fit below; the white angle noise is
+    // still the fit's without the line.)
   }
   for (const auto& e : effects) {
     if (!is_mid_tau(e)) continue;
@@ -643,6 +670,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   // 3–4. Extended model: parameters, re-fit, re-simulation.
   const double f_hint = d_sin.named ? sin.f_hz : 0.0;
   SimulationSettings ext_pilot = r.settings;
+  ext_pilot.seed = opt.seed + 1000;  // the base's pilot seed
   full.settings = &ext_pilot;
   full.octave_m = &octave_m;
   full.opt = &opt;
@@ -708,22 +736,51 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     const auto hgrid = mid_tau_grid(st.dec);
     const NoiseModel b_fit =
         robust_base(fit_rec, a_fit, aopt, st.dec, sh, r.holdout_runs, om, hgrid, opt).model;
+    const SimulationSettings sh_pilot = sh;
     sh.seed += 50;
     const double dt = (static_cast<double>(pa) - static_cast<double>(fa)) * x.tau0_s;
-    const auto b_runs = run_ensemble(b_fit, sh, r.holdout_runs, om, hgrid, false, opt, !effects.empty());
-    hb += band_misfit(make_band(a_pred.points, b_runs, opt.band_level), r.holdout_runs);
-    if (effects.empty()) {
-      he += band_misfit(make_band(a_pred.points, b_runs, opt.band_level), r.holdout_runs);
+    const bool mean_terms = std::any_of(effects.begin(), effects.end(), [](const std::string& e) {
+      return e == "sinusoid" || e == "bias_step" || e == "warmup_transient";
+    });
+    const auto b_runs = run_ensemble(b_fit, sh, r.holdout_runs, om, hgrid, mean_terms, opt, !effects.empty());
+    const double hb_dir = band_misfit(make_band(a_pred.points, b_runs, opt.band_level), r.holdout_runs);
+    hb += hb_dir;
+    // A deterministic term is carried into the fitting half's extended model only when the half
+    // itself shows it: its detector fires against the half's own base ensemble. A step or
+    // transient that lies in the predicted half cannot be estimated from the fitting half; a
+    // re-estimate there would be the half's largest rate excursion, a spurious term.
+    std::vector<std::string> half_effects;
+    for (const auto& e : effects) {
+      double stat = 0;
+      std::vector<double> ens;
+      if (e == "sinusoid") {
+        stat = sinusoid_detect(without_mean_shape(st.dec), 0.0, false).statistic;
+        for (const auto& br : b_runs) ens.push_back(br.sin_stat);
+      } else if (e == "bias_step") {
+        stat = step_detect(st.dec).statistic;
+        for (const auto& br : b_runs) ens.push_back(br.step_stat);
+      } else if (e == "warmup_transient") {
+        stat = warmup_detect(st.dec).statistic;
+        for (const auto& br : b_runs) ens.push_back(br.warm_stat);
+      } else {
+        half_effects.push_back(e);
+        continue;
+      }
+      if (stat > gumbel_threshold(ens, opt.alpha)) half_effects.push_back(e);
+    }
+    if (half_effects.empty()) {
+      // Nothing named shows in the fitting half: the extended model of the half is its base.
+      he += hb_dir;
       continue;
     }
     st.ref = make_reference(hgrid, st.dec.tau_d, b_runs);
     st.clean_ref = clean_reference(hgrid, st.dec.tau_d, b_runs);
     st.runs = r.holdout_runs;
-    st.settings = &sh;
+    st.settings = &sh_pilot;
     st.octave_m = &om;
     st.opt = &opt;
     st.pilot_runs = r.holdout_runs;
-    const Extension e = extend(st, b_fit, effects, f_hint, aopt);
+    const Extension e = extend(st, b_fit, half_effects, f_hint, aopt);
     const auto e_runs = run_ensemble(shifted(e.model, dt), sh, r.holdout_runs, om, hgrid, false, opt, false);
     he += band_misfit(make_band(a_pred.points, e_runs, opt.band_level), r.holdout_runs);
   }

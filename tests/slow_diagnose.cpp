@@ -150,9 +150,10 @@ void expect_rates(const Tally& t) {
 
 // Ranges and tolerances are those of docs/diagnosis.md.
 // Measured (seeds 1000…, 10 cases, 20 runs): named and within tolerance 10/10; gain in sample
-// 8/10 (misfits 0.11 -> 0.13 and 0.31 -> 0.82), out of sample 9/10 (0.52 -> 1.03); three lines at
-// 0.011-0.025 Hz leave misfits of 250-500 for both models. The every-case gain criterion is not
-// met: disabled, not weakened.
+// 8/10 (misfits 0.31 -> 0.59 and 0.112 -> 0.113: records the base already fits, well under 1 per
+// point), out of sample 9/10 (0.52 -> 0.63). The three lines at 0.011-0.025 Hz whose misfits were
+// 250-500 for both models (the base fit's Q had taken the line) now give 256 -> 0.12,
+// 351 -> 0.12, 512 -> 2.18. The every-case gain criterion is not met: disabled, not weakened.
 TEST(DiagnoseAcceptance, DISABLED_Sinusoid) {
   const auto t = run_effect(
       "sinusoid", cases(10), 1000,
@@ -169,9 +170,12 @@ TEST(DiagnoseAcceptance, DISABLED_Sinusoid) {
 }
 
 // Measured (seeds 2000…, 10 cases, 20 runs, |δ| 0.025–0.08 °/h): named and within tolerance
-// 10/10; gain in sample 10/10, out of sample 8/10 (holdout misfits 4.41 -> 4.67, 3.55 -> 4.82: a
-// step carries no AV into the other half). Detection and in-sample gain met, the every-case
-// out-of-sample gain not: disabled, not weakened. Below the range (RWCALC_DIAGNOSE_RANGE=0.01,0.02): named 3/10.
+// 10/10; gain in sample 10/10, out of sample 8/10: one tie (holdout 4.41 = 4.41, a 0.02 °/h step
+// 350 s before the middle that neither half's detector sees, so both half models are the bases)
+// and one loss (2.86 -> 3.18: the half model predicts the right rate level, -0.032 against the
+// base's -0.017 °/h, and still loses at the counting read-out's 5-20 s points). Detection and
+// in-sample gain met, the every-case out-of-sample gain not: disabled, not weakened. Below the
+// range (RWCALC_DIAGNOSE_RANGE=0.01,0.02): named 3/10.
 TEST(DiagnoseAcceptance, DISABLED_BiasStep) {
   const auto t = run_effect(
       "bias_step", cases(10), 2000,
@@ -188,9 +192,11 @@ TEST(DiagnoseAcceptance, DISABLED_BiasStep) {
 }
 
 // Measured (seeds 3000…, 10 cases, 20 runs, A 0.1–0.4 °/h, τw 180–1800 s): named 10/10,
-// within tolerance 9/10 (one A +31 % with τw +33 % at τw ≈ 1700 s), gain in sample 10/10, out of
-// sample 8/10 (holdout misfits 3.22 -> 4.76, 1.22 -> 1.66). Detection met (90 %), the out-of-sample gain criterion not: disabled, not weakened.
-TEST(DiagnoseAcceptance, DISABLED_WarmupTransient) {
+// within tolerance 9/10 (one A +31 % with τw +33 % at τw ≈ 1700 s), gain in sample 10/10
+// (misfits 0.81 -> 0.35 … 95.2 -> 0.09), out of sample 10/10 (1.22 -> 0.88 … 56.1 -> 24.4; the
+// narrowest 43.82 -> 43.82, lower by 0.0025: a 0.3 °/h, 16-min transient after which the
+// first-half base fit has a ramp R of 0.05 °/h², and the second half does not show the transient).
+TEST(DiagnoseAcceptance, WarmupTransient) {
   const auto t = run_effect(
       "warmup_transient", cases(10), 3000,
       [r = size_range(0.1, 0.4)](std::mt19937_64& g, NoiseModel& m) {
