@@ -28,10 +28,10 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kPulseFitTauMin = 20.0;  ///< s, start of the base fit for pulse data
 constexpr double kGmMinPeakRatio = 0.6;  ///< bump AV at its peak / base AV there, to name a Gauss–Markov term
-constexpr double kGmMinExcess = 2.0;
+constexpr double kGmMinExcess = 2.0;      ///< ensemble SDs a Gauss–Markov bump must raise the mid-τ AV by
 /// Gauss–Markov statistic: the deviance drop (2 ln of the likelihood ratio) M1 must reach at least.
 const double kGmMinLogLr = 2.0 * std::log(100.0);
-constexpr double kModelEdf = 1000.0;      ///< model floor of the EDF in the deviance (as band_misfit)      ///< ensemble SDs a Gauss–Markov bump must raise the mid-τ AV by
+constexpr double kModelEdf = 1000.0;      ///< model floor of the EDF in the deviance (as band_misfit)
 
 double term_value(const FitResult& f, Term t) {
   const auto& c = f[t];
@@ -237,18 +237,17 @@ NoiseModel with_bump(const NoiseModel& base, const ShapeEstimate& est) {
   return m;
 }
 
-/// The Gauss–Markov detector on a mid-τ AV `v` (the data without its mean-shape candidate): the
+/// The Gauss–Markov detector on a mid-τ AV `mid_meas` (the data without its mean-shape candidate): the
 /// bump fit against the base ensemble (`ref`, its records `base_runs`) proposes M1 = base plus the
 /// bump, which is simulated; the statistic is the drop of the mid-τ Gamma deviance from the base
 /// ensemble (`clean_ref`, records without their candidate) to M1's, and the threshold the largest
 /// drop of a base record (scored alike) and at least 2 ln 100. docs/diagnosis.md, "Naming a
 /// Gauss–Markov term".
-DetectorResult gauss_markov_test(const std::vector<double>& v, const MidTauReference& ref,
+DetectorResult gauss_markov_test(const std::vector<double>& mid_meas, const MidTauReference& ref,
                                  const MidTauReference& clean_ref, const std::vector<RunStats>& base_runs,
                                  const NoiseModel& base, const SimulationSettings& settings, std::size_t runs,
                                  const std::vector<std::int64_t>& octave_m, const std::vector<std::size_t>& grid,
                                  double tau_d, const DiagnoseOptions& opt) {
-  const auto& mid_meas = v;
   const auto gm = shape_detect(mid_meas, ref, c_of(base));
   DetectorResult d_gm;
   d_gm.effect = "gauss_markov";
