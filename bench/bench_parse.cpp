@@ -1,7 +1,10 @@
 // Reading: parse the text of a 2-h 400 Hz GL-2D pulse file already in memory (the floor of
-// `rwcalc analyze` is reading and parsing ~6 MB), and the cumulative sums it ends with.
+// `rwcalc analyze` is reading and parsing ~6 MB), the same read from a file, and the cumulative
+// sums it ends with.
 #include <benchmark/benchmark.h>
 
+#include <filesystem>
+#include <fstream>
 #include <numeric>
 
 #include "bench_inputs.hpp"
@@ -24,6 +27,38 @@ void BM_ParsePulseFile2h(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * 2'880'000);
 }
 BENCHMARK(BM_ParsePulseFile2h)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The same text read from a file (page cache): loading the bytes (argument 2: in two halves on two
+// threads), then parsing as above. What `rwcalc analyze` does before its analysis.
+class PulseFileOnDisk {
+ public:
+  PulseFileOnDisk() : path_(std::filesystem::temp_directory_path() / "rwcalc_bench_gl2d_p50C.csv") {
+    std::ofstream(path_, std::ios::binary) << bench::gl2d_text();
+  }
+  ~PulseFileOnDisk() {
+    std::error_code ec;
+    std::filesystem::remove(path_, ec);
+  }
+  PulseFileOnDisk(const PulseFileOnDisk&) = delete;
+  PulseFileOnDisk& operator=(const PulseFileOnDisk&) = delete;
+  [[nodiscard]] std::string path() const { return path_.string(); }
+
+ private:
+  std::filesystem::path path_;
+};
+
+void BM_ReadPulseFile2h(benchmark::State& state) {
+  static const PulseFileOnDisk file;
+  ReadOptions o;
+  o.threads = static_cast<unsigned>(state.range(0));
+  for (auto _ : state) {
+    auto rec = read_recording(file.path(), o);
+    benchmark::DoNotOptimize(rec.phase.counts.data());
+  }
+  state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(bench::gl2d_text().size()));
+  state.SetItemsProcessed(state.iterations() * 2'880'000);
+}
+BENCHMARK(BM_ReadPulseFile2h)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // Cumulative sum of int64 increments into counts (wrap-around arithmetic, as PhaseSeries keeps them).
 void BM_CumulativeSum2h(benchmark::State& state) {

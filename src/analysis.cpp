@@ -7,6 +7,7 @@
 #include <cctype>
 #include <cmath>
 #include <numbers>
+#include <thread>
 
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
@@ -140,14 +141,19 @@ std::string_view to_string(OutlierAction a) {
 namespace {
 
 // Detect outliers in the recording's rates and locate them in the input.
-std::vector<Outlier> detect_outliers(const Recording& rec, const AnalysisOptions& options, OutlierReport& rep) {
-  rep.action = options.outlier_action;
-  rep.threshold = options.outlier_threshold;
+void check_outlier_threshold(const AnalysisOptions& options) {
   if (!(options.outlier_threshold > 0) || !std::isfinite(options.outlier_threshold))
     throw UsageError(fmt::format("--outlier-threshold must be a positive number, got {}", options.outlier_threshold));
+}
+
+std::vector<Outlier> detect_outliers(const Recording& rec, const AnalysisOptions& options, OutlierReport& rep,
+                                     unsigned threads) {
+  rep.action = options.outlier_action;
+  rep.threshold = options.outlier_threshold;
+  check_outlier_threshold(options);
   // The rates are computed block by block from the phase (no copy of the whole record).
   OutlierScale scale;
-  std::vector<Outlier> found = scan_outliers(rec.phase, options.outlier_threshold, scale, options.allan.threads);
+  std::vector<Outlier> found = scan_outliers(rec.phase, options.outlier_threshold, scale, threads);
   rep.scale_deg_per_h = scale.scale;
   rep.count = found.size();
   // Rate sample i comes from data sample i (pulses, rate) or i+1 (counter, angle: the later reading).
@@ -172,10 +178,29 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   OutlierReport outliers;
   Recording rec_storage;
   const Recording* recp = &read;
-  if (read.phase.points() >= 3) {
+  // Outliers that are only reported (the default) change nothing the Allan stage computes: then
+  // the scan runs on a thread of its own beside the Allan stage (joined before the result is
+  // assembled), filling the gaps the Allan stage leaves on the cores between its parallel phases.
+  const unsigned budget = options.allan.threads ? options.allan.threads
+                                                : std::max(1u, std::thread::hardware_concurrency());
+  const bool beside = options.outlier_action == OutlierAction::Keep && budget > 1 && read.phase.points() >= 3 &&
+                      read.phase.kind == PhaseKind::Gyro;
+  std::jthread scan_thread;
+  std::exception_ptr scan_error;
+  if (beside) {
+    check_outlier_threshold(options);
+    scan_thread = std::jthread([&] {
+      try {
+        detail::ScopedTimer t("analyze: outlier scan (beside)");
+        (void)detect_outliers(read, options, outliers, 1);
+      } catch (...) {
+        scan_error = std::current_exception();
+      }
+    });
+  } else if (read.phase.points() >= 3) {
     const std::vector<Outlier> found = [&] {
       detail::ScopedTimer t("analyze: outlier scan");
-      return detect_outliers(read, options, outliers);
+      return detect_outliers(read, options, outliers, options.allan.threads);
     }();
     if (options.outlier_action != OutlierAction::Keep && !found.empty()) {
       rec_storage.source = read.source;
@@ -191,7 +216,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   }
   const Recording& rec = *recp;
   AnalysisResult r;
-  r.outliers = std::move(outliers);
+  if (!beside) r.outliers = std::move(outliers);
   r.source = rec.source;
   r.samples = rec.samples;
   r.rate_hz = rec.rate_hz;
@@ -311,6 +336,11 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
       break;
   }
   r.verdict = decide(b_in, from_fit(Term::N), rho, options.verdict);
+  if (beside) {
+    scan_thread.join();
+    if (scan_error) std::rethrow_exception(scan_error);
+    r.outliers = std::move(outliers);
+  }
   return r;
 }
 

@@ -18,8 +18,9 @@ class TextBuffer {
  public:
   static constexpr std::size_t kPadding = 16;
   TextBuffer() = default;
-  /// Buffer of `size` bytes plus room for the sentinel newline; contents uninitialised.
-  explicit TextBuffer(std::size_t capacity);
+  /// Buffer of `size` bytes plus room for the sentinel newline; contents uninitialised. Its pages
+  /// are mapped in one call (prefault) unless map_pages is false.
+  explicit TextBuffer(std::size_t capacity, bool map_pages = true);
   [[nodiscard]] char* data() noexcept { return data_.get(); }
   [[nodiscard]] const char* data() const noexcept { return data_.get(); }
   [[nodiscard]] std::size_t size() const noexcept { return size_; }
@@ -42,7 +43,9 @@ std::string display_name(const std::string& path);
 
 /// Read a whole file (or stdin for "-") into memory, inflating gzip data. Throws InputError
 /// (line 0) for a missing, unreadable or non-regular path and for corrupt or truncated gzip.
-TextBuffer load_source(const std::string& path);
+/// With threads > 1 a regular file of more than a few MB is read in two halves side by side (each
+/// thread maps the pages of its half and copies it).
+TextBuffer load_source(const std::string& path, unsigned threads = 1);
 
 /// Copy in-memory text, inflating it when it starts with the gzip magic bytes.
 TextBuffer load_text(std::string_view text, const std::string& name);

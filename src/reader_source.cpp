@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <cstring>
 #include <limits>
+#include <thread>
 
 #include "reader_detail.hpp"
 #include "rwcalc/error.hpp"
@@ -31,9 +32,9 @@ void prefault(void* data, std::size_t bytes) noexcept {
 #endif
 }
 
-TextBuffer::TextBuffer(std::size_t capacity)
+TextBuffer::TextBuffer(std::size_t capacity, bool map_pages)
     : data_(std::make_unique_for_overwrite<char[]>(capacity + 1 + kPadding)), capacity_(capacity) {
-  prefault(data_.get(), capacity);
+  if (map_pages) prefault(data_.get(), capacity);
   std::memset(data_.get() + capacity + 1, 0, kPadding);
 }
 
@@ -95,6 +96,44 @@ void read_all(int fd, TextBuffer& buf, const std::string& name) {
   }
 }
 
+// Read exactly `count` bytes at `offset` into dst (its pages mapped first). False when the file
+// ended early; err holds errno when the read failed.
+bool pread_exact(int fd, char* dst, std::size_t count, off_t offset, int& err) noexcept {
+  prefault(dst, count);
+  while (count > 0) {
+    const ssize_t n = ::pread(fd, dst, count, offset);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      err = errno;
+      return false;
+    }
+    if (n == 0) return false;
+    dst += n;
+    count -= static_cast<std::size_t>(n);
+    offset += n;
+  }
+  return true;
+}
+
+// A regular file of `size` bytes in two halves, the second on another thread. False (the buffer
+// then holds nothing) when the file turned out shorter than its size.
+bool read_halves(int fd, std::size_t size, TextBuffer& buf, const std::string& name) {
+  const std::size_t half = (size / 2) & ~std::size_t{4095};
+  int err1 = 0, err2 = 0;
+  bool ok2 = false;
+  {
+    std::jthread other([&] { ok2 = pread_exact(fd, buf.data() + half, size - half, static_cast<off_t>(half), err2); });
+    const bool ok1 = pread_exact(fd, buf.data(), half, 0, err1);
+    other.join();
+    if (err1 || err2) fail_errno(name, "cannot read", err1 ? err1 : err2);
+    if (!ok1 || !ok2) return false;
+  }
+  buf.set_size(size);
+  // The file may have grown meanwhile: read on from its known size to the end, as read_all does.
+  if (::lseek(fd, static_cast<off_t>(size), SEEK_SET) < 0) fail_errno(name, "cannot seek", errno);
+  return true;
+}
+
 }  // namespace
 
 TextBuffer inflate_gzip(std::string_view bytes, const std::string& name) {
@@ -152,7 +191,7 @@ TextBuffer load_text(std::string_view text, const std::string& name) {
   return buf;
 }
 
-TextBuffer load_source(const std::string& path) {
+TextBuffer load_source(const std::string& path, unsigned threads) {
   const std::string name = display_name(path);
   TextBuffer raw;
   if (path == "-") {
@@ -167,7 +206,15 @@ TextBuffer load_source(const std::string& path) {
     if (S_ISDIR(st.st_mode)) throw InputError(name, 0, "is a directory, not a recording");
     // Regular files: one read of the known size; pipes and devices grow as they go.
     // One spare byte lets the final read(2) see end-of-file without growing the buffer.
-    raw.reserve(S_ISREG(st.st_mode) ? static_cast<std::size_t>(st.st_size) + 1 : std::size_t{1} << 20);
+    constexpr std::size_t kHalvesBytes = std::size_t{4} << 20;
+    const auto size = static_cast<std::size_t>(st.st_size);
+    if (S_ISREG(st.st_mode) && threads > 1 && size > kHalvesBytes) {
+      raw = TextBuffer(size + 1, false);
+      if (!read_halves(fd.get(), size, raw, name) && ::lseek(fd.get(), 0, SEEK_SET) < 0)
+        fail_errno(name, "cannot seek", errno);
+    } else {
+      raw.reserve(S_ISREG(st.st_mode) ? size + 1 : std::size_t{1} << 20);
+    }
     read_all(fd.get(), raw, name);
   }
   if (is_gzip(raw.view())) return inflate_gzip(raw.view(), name);

@@ -1,6 +1,7 @@
-// The plain-line path for one-column pulse files: single digits and 8-byte word scans of up to 7
-// digits, with the cumulative counts summed while parsing. It must give exactly what the per-line
-// paths give (values, runs of lines, errors and their line numbers) on any mixture of lines.
+// The plain-line path for one-column pulse files: line ends found 64 bytes at a time, single digits
+// and 8-byte word scans of up to 7 digits, with the cumulative counts summed while parsing. It must
+// give exactly what the per-line paths give (values, runs of lines, errors and their line numbers)
+// on any mixture of lines.
 #include <cstdint>
 #include <random>
 #include <string>
@@ -138,6 +139,32 @@ TEST(ReadIntLines, SameAsThePerLinePathsAndKnownSums) {
       EXPECT_EQ(r.phase.counts, want) << "threads " << t;
       EXPECT_EQ(r.line_runs, ref.line_runs) << "threads " << t;
     }
+  }
+}
+
+// The plain-line path finds line ends 64 bytes at a time: lines longer than a window, lines cut
+// by a window's end, and lines it must leave to the per-line paths at every offset in a window.
+TEST(ReadIntLines, LinesAcrossAndLongerThanTheWindows) {
+  std::mt19937_64 rng(29);
+  std::string text = "pulses\n";
+  std::vector<std::int64_t> want{0};
+  std::uint64_t acc = 0;
+  for (std::size_t i = 0; i < 300000; ++i) {
+    const auto r = rng() % 97;
+    if (r == 0) text += "# " + std::string(60 + rng() % 140, 'x') + "\n";  // one or more windows long
+    if (r == 1) text += "\n";
+    std::int64_t v = static_cast<std::int64_t>(rng() % 2001) - 1000;
+    if (r == 2) v = 99999999;  // 8 digits: not the plain form
+    if (r == 3) text += " ";   // a leading blank: not the plain form
+    text += fmt::format("{}", v);
+    text += r == 4 ? "\r\n" : "\n";
+    want.push_back(static_cast<std::int64_t>(acc += static_cast<std::uint64_t>(v)));
+  }
+  for (const unsigned t : {1u, 2u}) {
+    const Recording r = read_recording_text(text, "windows.csv", with_threads(t));
+    EXPECT_EQ(r.phase.counts, want) << "threads " << t;
+    const Recording slow = read_recording_text(indented(text), "slow.csv", with_threads(t));
+    EXPECT_EQ(r.line_runs, slow.line_runs) << "threads " << t;
   }
 }
 

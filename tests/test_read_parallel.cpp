@@ -11,6 +11,7 @@
 
 #include "rwcalc/error.hpp"
 #include "rwcalc/reader.hpp"
+#include "test_support.hpp"
 
 namespace {
 
@@ -71,6 +72,23 @@ TEST(ReadParallel, PulseFileSameAsSerial) {
   expect_same(serial, parallel);
   // The line of the last sample: 3 header lines, 4 extra lines.
   EXPECT_EQ(parallel.line_of_sample(1199999), 1200000u + 3 + 4);
+}
+
+// A file of more than 4 MB is loaded in two halves, each on its own thread: the same bytes,
+// including a file that does not end with a newline and one whose size is not a multiple of a page.
+TEST(ReadParallel, FileLoadedInHalvesSameAsText) {
+  const rwcalc::test::TempDir dir;
+  std::string text = pulse_text(2500000, 3);
+  ASSERT_GT(text.size(), std::size_t{4} << 20);
+  for (const std::string& t : {text, text.substr(0, text.size() - 1), text + "7\n12"}) {
+    const auto path = dir.write("long.csv", t).string();
+    const Recording from_text = read_recording_text(t, path, with_threads(1));
+    for (const unsigned threads : {1u, 2u}) {
+      const Recording from_file = rwcalc::read_recording(path, with_threads(threads));
+      expect_same(from_text, from_file);
+      EXPECT_EQ(from_file.samples, from_text.samples);
+    }
+  }
 }
 
 TEST(ReadParallel, TimeAndTemperatureColumnsSameAsSerial) {
