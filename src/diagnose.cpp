@@ -30,6 +30,9 @@ constexpr double kPulseFitTauMin = 20.0;  ///< s, start of the base fit for puls
 constexpr double kGmMinPeakRatio = 0.6;  ///< bump AV at its peak / base AV there, to name a Gauss–Markov term
 constexpr double kGmMinExcess = 2.0;      ///< ensemble SDs a Gauss–Markov bump must raise the mid-τ AV by
 constexpr double kStepMinSide = 60.0;     ///< s of a half on each side of a known step to estimate its size there
+/// Gauss–Markov statistic: the deviance drop (2 ln of the likelihood ratio) M1 must reach at least.
+const double kGmMinLogLr = 2.0 * std::log(100.0);
+constexpr double kModelEdf = 1000.0;      ///< model floor of the EDF in the deviance (as band_misfit)
 
 double term_value(const FitResult& f, Term t) {
   const auto& c = f[t];
@@ -173,6 +176,19 @@ MidTauReference clean_reference(const std::vector<std::size_t>& grid, double tau
   return make_reference(grid, tau_d, runs);
 }
 
+/// Gamma deviance of a mid-τ AV against an ensemble reference: Σ ν(r − 1 − ln r), r = v/E v, with
+/// the EDF ν = 2(E v)²/Var v of the ensemble and a 1000-EDF model floor (as band_misfit).
+double mid_deviance(const std::vector<double>& v, const MidTauReference& ref) {
+  double d = 0;
+  for (std::size_t i = 0; i < v.size() && i < ref.mean.size(); ++i) {
+    if (!(v[i] > 0) || !(ref.mean[i] > 0) || !(ref.var[i] > 0)) continue;
+    const double nu = 1.0 / (ref.var[i] / (2.0 * ref.mean[i] * ref.mean[i]) + 1.0 / kModelEdf);
+    const double q = v[i] / ref.mean[i];
+    d += nu * (q - 1.0 - std::log(q));
+  }
+  return d;
+}
+
 /// Everything needed to estimate named effects on one stretch of data.
 struct Stretch {
   const Recording* rec = nullptr;   ///< the stretch as a recording
@@ -236,6 +252,68 @@ StepEstimate step_at(const Decimated& d, double ts) {
 /// Add a fit-scale correction to a coefficient (°/√h, °/h, …), the corrected square kept ≥ 0.
 void correct(double& coef, Term t, double dc) {
   coef = coefficient_from_c(t, std::max(0.0, c_from_coefficient(t, coef) + dc));
+}
+
+/// A model plus a fitted Gauss–Markov bump, with the fit's corrections of B² and K² and the white
+/// rate noise it leaves beside the bump.
+NoiseModel with_bump(const NoiseModel& base, const ShapeEstimate& est) {
+  NoiseModel m = base;
+  correct(m.bias_instability_deg_per_h, Term::B, est.dc[2]);
+  correct(m.rrw_deg_per_h_per_sqrt_h, Term::K, est.dc[3]);
+  m.arw_deg_per_sqrt_h = coefficient_from_c(Term::N, est.white_rest);
+  m.gauss_markov.push_back({std::sqrt(std::max(est.scale, 0.0)), std::max(est.time, 1e-3)});
+  return m;
+}
+
+/// The Gauss–Markov detector on a mid-τ AV `mid_meas` (the data without its mean-shape candidate): the
+/// bump fit against the base ensemble (`ref`, its records `base_runs`) proposes M1 = base plus the
+/// bump, which is simulated; the statistic is the drop of the mid-τ Gamma deviance from the base
+/// ensemble (`clean_ref`, records without their candidate) to M1's, and the threshold the largest
+/// drop of a base record (scored alike) and at least 2 ln 100. docs/diagnosis.md, "Naming a
+/// Gauss–Markov term".
+DetectorResult gauss_markov_test(const std::vector<double>& mid_meas, const MidTauReference& ref,
+                                 const MidTauReference& clean_ref, const std::vector<RunStats>& base_runs,
+                                 const NoiseModel& base, const SimulationSettings& settings, std::size_t runs,
+                                 const std::vector<std::int64_t>& octave_m, const std::vector<std::size_t>& grid,
+                                 double tau_d, const DiagnoseOptions& opt) {
+  const auto gm = shape_detect(mid_meas, ref, c_of(base));
+  DetectorResult d_gm;
+  d_gm.effect = "gauss_markov";
+  d_gm.threshold = kGmMinLogLr;
+  if (!(gm.scale > 0)) {
+    d_gm.note = "no bump improves the fit of the mid-τ Allan variance";
+  } else if (gm.excess < kGmMinExcess && gm.white_rest < 2.0 * gm.white_rest_sigma) {
+    // A Gauss–Markov rate adds variance around its peak, or keeps white rate noise beside it
+    // when the base fit has taken the bump into B. A fit that only lowers the mid-τ AV by trading
+    // the white noise for a bump (a deficit, e.g. after a sinusoid absorbed into the base N and B
+    // was removed) is not one. (A low-pass of the sensed rate before counting is a Gauss–Markov
+    // rate, Tc = τf and 2σ²Tc = N², and is named as one.)
+    d_gm.note = fmt::format("the fitted shape raises the mid-τ Allan variance by at most {:.2g} ensemble standard "
+                            "deviations and leaves no white rate noise ({:.3g} ± {:.2g} (°/h)²·s): a deficit, not a "
+                            "Gauss–Markov bump",
+                            gm.excess, gm.white_rest, gm.white_rest_sigma);
+  } else if (gm.peak_ratio < kGmMinPeakRatio) {
+    // A bump far below the local AV is a re-arrangement of the flicker or white noise (a flicker
+    // floor is a sum of Gauss–Markov terms): tested only when it carries a sizeable share there.
+    d_gm.note = fmt::format("the bump's Allan variance at its peak is {:.2g} of the base model's there (at least {:g} "
+                            "needed): not told apart from the flicker and white noise",
+                            gm.peak_ratio, kGmMinPeakRatio);
+  } else {
+    const NoiseModel m1 = with_bump(base, gm);
+    const auto m1_runs = run_ensemble(m1, settings, runs, octave_m, grid, false, opt, true);
+    const auto m1_ref = clean_reference(grid, tau_d, m1_runs);
+    d_gm.statistic = mid_deviance(mid_meas, clean_ref) - mid_deviance(mid_meas, m1_ref);
+    std::vector<double> e_gm;
+    for (const auto& br : base_runs) {
+      const auto loo = leave_one_out(clean_ref, br.mid_var_clean, runs);
+      e_gm.push_back(mid_deviance(br.mid_var_clean, loo) - mid_deviance(br.mid_var_clean, m1_ref));
+    }
+    d_gm.ensemble_max = *std::max_element(e_gm.begin(), e_gm.end());
+    d_gm.ensemble_median = quantile(e_gm, 0.5);
+    d_gm.threshold = std::max(kGmMinLogLr, d_gm.ensemble_max);
+    d_gm.fired = d_gm.named = d_gm.statistic > d_gm.threshold;
+  }
+  return d_gm;
 }
 
 /// The corrections of N², B² (K held, τ ≤ T/6) that bring the mean mid-τ AV of a pilot ensemble
@@ -584,35 +662,17 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   Decimated dclean = full.dec;
   subtract_deterministic(dclean, det);
   const auto mid_meas = decimated_avar(dclean, grid);
-  const auto c_base = c_of(r.base);
-  const auto gm = shape_detect(mid_meas, full.ref, c_base);
-  std::vector<double> e_gm;
-  for (const auto& br : base_runs) {
-    const auto loo = leave_one_out(full.ref, br.mid_var, opt.runs);
-    // Each record without its own mean-shape candidate, as the measurement.
-    e_gm.push_back(shape_detect(br.mid_var_clean.empty() ? br.mid_var : br.mid_var_clean, loo, c_base).statistic);
-  }
-  DetectorResult d_gm = calibrate("gauss_markov", gm.statistic, e_gm);
-  // A Gauss–Markov rate adds variance around its peak, or keeps white rate noise beside it when
-  // the base fit has taken the bump into B. A fit that only lowers the mid-τ AV by trading the
-  // white noise for a bump (a deficit, e.g. after a sinusoid absorbed into the base N and B was
-  // removed) is not one. (A low-pass of the sensed rate before counting is a
-  // Gauss–Markov rate, Tc = τf and 2σ²Tc = N², and is named as one.)
-  if (d_gm.fired && gm.excess < kGmMinExcess && gm.white_rest < 2.0 * gm.white_rest_sigma) {
-    d_gm.named = false;
-    d_gm.note = fmt::format("the fitted shape raises the mid-τ Allan variance by at most {:.2g} ensemble standard "
-                            "deviations and leaves no white rate noise ({:.3g} ± {:.2g} (°/h)²·s): a deficit, not a "
-                            "Gauss–Markov bump",
-                            gm.excess, gm.white_rest, gm.white_rest_sigma);
-  }
-  // A bump far below the local AV is a re-arrangement of the flicker or white noise (a flicker
-  // floor is a sum of Gauss–Markov terms): named only when it carries a sizeable share there.
-  if (d_gm.named && gm.peak_ratio < kGmMinPeakRatio) {
-    d_gm.named = false;
-    d_gm.note = fmt::format("the bump's Allan variance at its peak is {:.2g} of the base model's there (at least {:g} "
-                            "needed): not told apart from the flicker and white noise",
-                            gm.peak_ratio, kGmMinPeakRatio);
-  }
+  // Gauss–Markov. The five-term base fit takes a bump into a large flicker floor (B several times
+  // the true one), and such a flicker realises bumps of that size by itself: the χ² drop of the
+  // bump fit alone has no power against it. So the bump fit (Q, N, B, K corrections plus σ²·g(τ;
+  // Tc), on the mid-τ AV of the data without its candidate) only proposes the alternative M1 =
+  // corrected base plus the bump; M1 is simulated (same seeds), and the statistic is the drop of
+  // the mid-τ Gamma deviance from the base ensemble to M1's — twice the log likelihood ratio of
+  // the data under the two simulated models. It is computed alike on every base record (against
+  // the base ensemble without it, and M1's), and M1 must win by more than every one of them and
+  // by a likelihood ratio of at least 100.
+  const DetectorResult d_gm = gauss_markov_test(mid_meas, full.ref, full.clean_ref, base_runs, r.base, r.settings,
+                                                 opt.runs, octave_m, grid, full.dec.tau_d, opt);
   if (d_gm.named) effects.push_back("gauss_markov");
 
   // Output-chain low-pass: only floating (sub-pulse) data can have passed through one; whole
@@ -756,6 +816,16 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
       } else if (e == "warmup_transient") {
         stat = warmup_detect(st.dec).statistic;
         for (const auto& br : b_runs) ens.push_back(br.warm_stat);
+      } else if (e == "gauss_markov") {
+        // The same for a Gauss–Markov term: its test on the half's mid-τ AV (without the half's
+        // own candidate) against the half's base ensemble and the bump model fitted there.
+        Decimated dh = st.dec;
+        subtract_deterministic(dh, own_candidates(st.dec));
+        const auto d = gauss_markov_test(decimated_avar(dh, hgrid), make_reference(hgrid, st.dec.tau_d, b_runs),
+                                         clean_reference(hgrid, st.dec.tau_d, b_runs), b_runs, b_fit, sh,
+                                         r.holdout_runs, om, hgrid, st.dec.tau_d, opt);
+        if (d.named) half_effects.push_back(e);
+        continue;
       } else {
         half_effects.push_back(e);
         continue;
