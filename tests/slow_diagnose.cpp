@@ -25,7 +25,13 @@ namespace {
 using namespace rwcalc;
 using nlohmann::json;
 
-constexpr std::size_t kRuns = 20;
+/// Ensemble runs per diagnosis: 20 (the command's default is 50), overridable as RWCALC_DIAGNOSE_RUNS=K to
+/// measure how the rates depend on the ensemble size.
+std::size_t ensemble_runs() {
+  if (const char* s = std::getenv("RWCALC_DIAGNOSE_RUNS"))
+    if (const int k = std::atoi(s); k >= 10) return static_cast<std::size_t>(k);
+  return 20;
+}
 
 std::size_t cases(std::size_t dflt) {
   if (const char* s = std::getenv("RWCALC_DIAGNOSE_CASES")) return static_cast<std::size_t>(std::atoi(s));
@@ -63,7 +69,7 @@ DiagnoseResult run_case(const NoiseModel& m, std::uint64_t seed) {
   rec.rate_hz = 400;
   rec.samples = rec.phase.points() - 1;
   DiagnoseOptions o;
-  o.runs = kRuns;
+  o.runs = ensemble_runs();
   o.seed = seed * 7919 + 3;
   return diagnose(rec, o);
 }
