@@ -147,13 +147,13 @@ void check_outlier_threshold(const AnalysisOptions& options) {
 }
 
 std::vector<Outlier> detect_outliers(const Recording& rec, const AnalysisOptions& options, OutlierReport& rep,
-                                     unsigned threads, OutlierScanHelp* help = nullptr) {
+                                     unsigned threads) {
   rep.action = options.outlier_action;
   rep.threshold = options.outlier_threshold;
   check_outlier_threshold(options);
   // The rates are computed block by block from the phase (no copy of the whole record).
   OutlierScale scale;
-  std::vector<Outlier> found = scan_outliers(rec.phase, options.outlier_threshold, scale, threads, help);
+  std::vector<Outlier> found = scan_outliers(rec.phase, options.outlier_threshold, scale, threads);
   rep.scale_deg_per_h = scale.scale;
   rep.count = found.size();
   // Rate sample i comes from data sample i (pulses, rate) or i+1 (counter, angle: the later reading).
@@ -181,20 +181,18 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   // Outliers that are only reported (the default) change nothing the Allan stage or the fit
   // computes: then the scan runs on a thread of its own, started once the Allan stage is done,
   // beside the fit, the cross-checks and the verdict (joined before the result is assembled),
-  // filling the core the fit's covariance leaves; once the verdict is in, this thread takes the
-  // chunks of the scan's pass that are left (scan_help), so the scan's tail runs on both cores.
+  // filling the core the fit's covariance leaves.
   const unsigned budget = options.allan.threads ? options.allan.threads
                                                 : std::max(1u, std::thread::hardware_concurrency());
   const bool beside = options.outlier_action == OutlierAction::Keep && budget > 1 && read.phase.points() >= 3 &&
                       read.phase.kind == PhaseKind::Gyro;
-  OutlierScanHelp scan_help;  // declared before the thread: outlives it
   std::jthread scan_thread;
   std::exception_ptr scan_error;
   auto start_scan = [&] {
     scan_thread = std::jthread([&] {
       try {
         detail::ScopedTimer t("analyze: outlier scan (beside)", true);  // this thread's CPU only
-        (void)detect_outliers(read, options, outliers, 1, &scan_help);
+        (void)detect_outliers(read, options, outliers, 1);
       } catch (...) {
         scan_error = std::current_exception();
       }
@@ -346,8 +344,6 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   }
   r.verdict = decide(b_in, from_fit(Term::N), rho, options.verdict);
   if (beside) {
-    detail::ScopedTimer t("analyze: scan help + join");
-    scan_help.help();
     scan_thread.join();
     if (scan_error) std::rethrow_exception(scan_error);
     r.outliers = std::move(outliers);

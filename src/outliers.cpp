@@ -217,8 +217,7 @@ bool screen_block(const double* w, std::size_t len, double limit) {
 // With `flagged`, the same pass also screens every interior block against a provisional limit
 // `pre` and lists the blocks (their first index) where some |residual| exceeds it.
 template <class Src>
-OutlierScale scale_of(const Src& src, unsigned threads, double pre = 0, std::vector<std::size_t>* flagged = nullptr,
-                      OutlierScanHelp* help = nullptr) {
+OutlierScale scale_of(const Src& src, unsigned threads, double pre = 0, std::vector<std::size_t>* flagged = nullptr) {
   OutlierScale s;
   const std::size_t n = src.n;
   if (n < kMinSamples) return s;
@@ -257,27 +256,7 @@ OutlierScale scale_of(const Src& src, unsigned threads, double pre = 0, std::vec
   // values: the same whatever the split).
   constexpr std::size_t kParallelFrom = std::size_t{1} << 20;
   if (threads == 0) threads = std::thread::hardware_concurrency();
-  if (help && end > 3) {
-    // Chunks of kChunkBlocks blocks, taken by this thread and any helper; their results are
-    // merged in chunk order, which is the order of the one-thread loop.
-    constexpr std::size_t kChunkBlocks = 64;
-    constexpr std::size_t span = kChunkBlocks * kBlock;
-    struct Part {
-      double res = std::numeric_limits<double>::infinity();
-      std::vector<double> a;
-      std::vector<std::size_t> hits;
-    };
-    std::vector<Part> parts((end - 3 + span - 1) / span);
-    help->run(parts.size(), [&](std::size_t c) {
-      const std::size_t from = 3 + c * span;
-      blocks(from, std::min(end, from + span), parts[c].res, parts[c].a, parts[c].hits);
-    });
-    for (const Part& p : parts) {
-      res = std::min(res, p.res);
-      a.insert(a.end(), p.a.begin(), p.a.end());
-      hits1.insert(hits1.end(), p.hits.begin(), p.hits.end());
-    }
-  } else if (end > 3 && end - 3 >= kParallelFrom && threads > 1) {
+  if (end > 3 && end - 3 >= kParallelFrom && threads > 1) {
     const std::size_t mid = 3 + ((end - 3) / 2 / kBlock) * kBlock;
     double res2 = std::numeric_limits<double>::infinity();
     std::vector<double> a2;
@@ -404,55 +383,7 @@ std::vector<Outlier> find_outliers(const PhaseSeries& phase, double threshold, c
   return outliers_of(PhaseRates{phase, rate_count(phase)}, threshold, s, threads);
 }
 
-void OutlierScanHelp::work() {
-  for (std::size_t c = next_++; c < count_; c = next_++) (*task_)(c);
-}
-
-void OutlierScanHelp::help() {
-  {
-    std::lock_guard lock(m_);
-    if (!open_) return;
-    ++active_;
-  }
-  std::exception_ptr error;
-  try {
-    work();
-  } catch (...) {
-    error = std::current_exception();
-  }
-  std::lock_guard lock(m_);
-  if (error && !error_) error_ = error;
-  --active_;
-  cv_.notify_all();
-}
-
-void OutlierScanHelp::run(std::size_t count, const std::function<void(std::size_t)>& task) {
-  {
-    std::lock_guard lock(m_);
-    task_ = &task;
-    count_ = count;
-    next_.store(0);
-    error_ = nullptr;
-    open_ = true;
-  }
-  std::exception_ptr error;
-  try {
-    work();
-  } catch (...) {
-    error = std::current_exception();
-    next_.store(count);  // the helpers take no further chunk
-  }
-  std::unique_lock lock(m_);
-  open_ = false;  // no new helper; wait for those still in a chunk
-  cv_.wait(lock, [this] { return active_ == 0; });
-  task_ = nullptr;
-  if (!error) error = error_;
-  error_ = nullptr;
-  if (error) std::rethrow_exception(error);
-}
-
-std::vector<Outlier> scan_outliers(const PhaseSeries& phase, double threshold, OutlierScale& scale, unsigned threads,
-                                   OutlierScanHelp* help) {
+std::vector<Outlier> scan_outliers(const PhaseSeries& phase, double threshold, OutlierScale& scale, unsigned threads) {
   const PhaseRates src{phase, rate_count(phase)};
   // Exact counts: the limit is at least threshold × one count's rate step (the resolution of
   // integer data), so one pass can compute the scale and screen every block against (just under)
@@ -461,11 +392,11 @@ std::vector<Outlier> scan_outliers(const PhaseSeries& phase, double threshold, O
   // resolution, sets the scale), the ordinary screen runs instead: the result is the same.
   const double pre = threshold * (phase.arcsec_per_count / phase.tau0_s) * (1.0 - 1.0 / 1048576.0);
   if (!phase.exact() || src.n < kMinSamples || !(pre > 0) || !std::isfinite(pre)) {
-    scale = scale_of(src, threads, 0, nullptr, help);
+    scale = scale_of(src, threads);
     return outliers_of(src, threshold, scale, threads);
   }
   std::vector<std::size_t> flagged;
-  scale = scale_of(src, threads, pre, &flagged, help);
+  scale = scale_of(src, threads, pre, &flagged);
   const std::size_t blocks = (src.n - 6 + kBlock - 1) / kBlock;
   if (threshold * scale.scale >= pre && flagged.size() <= blocks / 16)
     return outliers_of(src, threshold, scale, threads, &flagged);

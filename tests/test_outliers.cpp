@@ -1,12 +1,10 @@
 // Outlier detection: no false alarms on clean noise (white, drifting, quantised), every planted
 // spike found, the known glitches of real IMU records found, and the remove/replace helpers.
 #include <algorithm>
-#include <atomic>
 #include <iterator>
 #include <cmath>
 #include <random>
 #include <set>
-#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -323,54 +321,6 @@ TEST(Outliers, OnePassScanEqualsScaleThenScreen) {
         EXPECT_EQ(o1[k].index, o2[k].index);
         EXPECT_EQ(o1[k].value, o2[k].value);
         EXPECT_EQ(o1[k].robust_z, o2[k].robust_z);
-      }
-    }
-  }
-}
-
-// A scan whose pass is shared with a helper thread (what analyze does beside the fit) gives the
-// one-thread result bit for bit, whichever chunks the helper takes; help() with no scan under way
-// returns at once.
-TEST(Outliers, ScanSharedWithHelperSameAsAlone) {
-  std::mt19937_64 rng(47);
-  for (double mean : {0.05, 2.5, 400.0}) {
-    std::poisson_distribution<int> pulses(mean);
-    rwcalc::PhaseSeries ph;
-    ph.tau0_s = 0.0025;
-    ph.arcsec_per_count = 0.92;
-    ph.counts.assign(1, 5);
-    const std::size_t n = 700000 + 321;  // 11 chunks of 64 blocks, the last one short
-    for (std::size_t i = 0; i < n; ++i) {
-      std::int64_t c = pulses(rng);
-      if (i % 40009 == 7 || i == 3 || i == n - 3) c += 30 + static_cast<std::int64_t>(mean) * 4;
-      ph.counts.push_back(ph.counts.back() + c);
-    }
-    rwcalc::OutlierScale s1;
-    const auto o1 = rwcalc::scan_outliers(ph, 8.0, s1, 1);
-    ASSERT_FALSE(o1.empty()) << mean;
-    for (int round = 0; round < 3; ++round) {
-      rwcalc::OutlierScanHelp help;
-      help.help();  // nothing under way: returns
-      std::atomic<bool> done{false};
-      rwcalc::OutlierScale s2;
-      std::vector<rwcalc::Outlier> o2;
-      {
-        std::jthread scan([&] {
-          o2 = rwcalc::scan_outliers(ph, 8.0, s2, 1, &help);
-          done = true;
-        });
-        while (!done) {
-          help.help();
-        }
-      }
-      EXPECT_EQ(s2.scale, s1.scale) << mean;
-      EXPECT_EQ(s2.mad_sigma, s1.mad_sigma) << mean;
-      EXPECT_EQ(s2.resolution, s1.resolution) << mean;
-      ASSERT_EQ(o2.size(), o1.size()) << mean;
-      for (std::size_t k = 0; k < o1.size(); ++k) {
-        EXPECT_EQ(o2[k].index, o1[k].index);
-        EXPECT_EQ(o2[k].value, o1[k].value);
-        EXPECT_EQ(o2[k].robust_z, o1[k].robust_z);
       }
     }
   }

@@ -13,12 +13,7 @@
 /// slow drift and bias instability cancel in the neighbour median. Runs of up to two adjacent bad
 /// samples are found without false alarms beside them (the median tolerates two bad neighbours
 /// of six); longer bursts are found in part.
-#include <atomic>
-#include <condition_variable>
 #include <cstddef>
-#include <exception>
-#include <functional>
-#include <mutex>
 #include <vector>
 
 #include "rwcalc/reader.hpp"
@@ -64,37 +59,10 @@ std::vector<Outlier> find_outliers(const std::vector<double>& rates, double thre
 std::vector<Outlier> find_outliers(const PhaseSeries& phase, double threshold, const OutlierScale& scale,
                                    unsigned threads = 0);
 
-/// Lets other threads take part in a scan_outliers call that runs on one thread (analyze runs
-/// the scan beside the fit; the thread of the fit helps once it is done). The scan's pass over
-/// the record is cut into chunks of 64 blocks of 1024 rates that whichever thread is free takes;
-/// the chunks' results are merged in their order, so the result does not depend on who took
-/// which. help() takes chunks until none is left and returns once its last chunk is done (at
-/// once when no shared pass is under way). One scan at a time per object.
-class OutlierScanHelp {
- public:
-  void help();
-  /// Runs task(0) … task(count − 1), on this thread and on any thread in help(); returns when
-  /// all are done (rethrowing the first exception a task threw).
-  void run(std::size_t count, const std::function<void(std::size_t)>& task);
-
- private:
-  void work();
-  std::mutex m_;
-  std::condition_variable cv_;
-  const std::function<void(std::size_t)>* task_ = nullptr;
-  std::size_t count_ = 0;
-  std::atomic<std::size_t> next_{0};
-  bool open_ = false;
-  unsigned active_ = 0;
-  std::exception_ptr error_;
-};
-
 /// outlier_scale(phase, threads) and find_outliers(phase, threshold, scale, threads) in one call,
 /// with the same results; on exact counts usually in one pass over the record instead of two.
-/// With `help`, the pass is shared with the threads that call help->help() meanwhile (and
-/// `threads` does not split it further).
 std::vector<Outlier> scan_outliers(const PhaseSeries& phase, double threshold, OutlierScale& scale,
-                                   unsigned threads = 0, OutlierScanHelp* help = nullptr);
+                                   unsigned threads = 0);
 
 /// Same, on a recording's rates, with the input line of each outlier filled in.
 std::vector<Outlier> find_outliers(const Recording& recording,
