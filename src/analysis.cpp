@@ -191,7 +191,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   auto start_scan = [&] {
     scan_thread = std::jthread([&] {
       try {
-        detail::ScopedTimer t("analyze: outlier scan (beside)");
+        detail::ScopedTimer t("analyze: outlier scan (beside)", true);  // this thread's CPU only
         (void)detect_outliers(read, options, outliers, 1);
       } catch (...) {
         scan_error = std::current_exception();

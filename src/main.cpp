@@ -12,5 +12,10 @@ int main(int argc, char** argv) {
   // are mapped and unmapped as before. Performance only: results do not depend on it.
   (void)mallopt(M_MMAP_THRESHOLD, 64 << 20);
   (void)mallopt(M_TRIM_THRESHOLD, 128 << 20);
+  // One arena for all threads. A thread's own arena is built of 64-MB heaps that glibc unmaps as
+  // soon as one is wholly free, whatever M_TRIM_THRESHOLD says: the buffers of batch's second
+  // worker, and the outlier scan's beside the fit, were mapped and zeroed afresh every time. The
+  // threads allocate a few large blocks each, not many small ones, so the shared lock costs nothing.
+  (void)mallopt(M_ARENA_MAX, 1);
   return rwcalc::cli::run(argc, argv, std::cout, std::cerr);
 }

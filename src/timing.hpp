@@ -29,17 +29,20 @@ inline std::int64_t cpu_ns(bool thread = false) {
 
 class ScopedTimer {
  public:
-  explicit ScopedTimer(const char* name) : name_(name), on_(timing_enabled()) {
+  /// With `thread_cpu`, the CPU time is the calling thread's only (for a stage that runs beside
+  /// others: the process's CPU time would count theirs as well).
+  explicit ScopedTimer(const char* name, bool thread_cpu = false)
+      : name_(name), on_(timing_enabled()), thread_(thread_cpu) {
     if (on_) {
       start_ = std::chrono::steady_clock::now();
-      cpu_ = cpu_ns();
+      cpu_ = cpu_ns(thread_);
     }
   }
   ~ScopedTimer() {
     if (!on_) return;
     const std::chrono::duration<double, std::milli> d = std::chrono::steady_clock::now() - start_;
     std::fprintf(stderr, "timing: %-28s %8.2f ms wall %8.2f ms cpu\n", name_, d.count(),
-                 static_cast<double>(cpu_ns() - cpu_) * 1e-6);
+                 static_cast<double>(cpu_ns(thread_) - cpu_) * 1e-6);
   }
   ScopedTimer(const ScopedTimer&) = delete;
   ScopedTimer& operator=(const ScopedTimer&) = delete;
@@ -47,6 +50,7 @@ class ScopedTimer {
  private:
   const char* name_;
   bool on_;
+  bool thread_ = false;
   std::chrono::steady_clock::time_point start_;
   std::int64_t cpu_ = 0;
 };
