@@ -6,15 +6,10 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <cstdlib>
 #include <exception>
 #include <fstream>
-#include <functional>
 #include <mutex>
-#include <string_view>
 #include <thread>
-
-#include <sched.h>
 
 #include "rwcalc/error.hpp"
 
@@ -27,19 +22,6 @@ using nlohmann::json;
 std::optional<int> opt_int(const json& j) {
   if (j.is_null()) return std::nullopt;
   return j.get<int>();
-}
-
-/// Whether this thread runs under a time-slicing scheduling class (threads inherit it).
-bool time_sliced() {
-  const int policy = sched_getscheduler(0);
-  return policy == SCHED_OTHER || policy == SCHED_BATCH || policy == SCHED_IDLE;
-}
-
-/// RWCALC_BATCH_TAIL=spread keeps the last files on the idle workers' threads even under the
-/// normal scheduler (for comparing the two schedules on the same binary).
-bool tail_override_off() {
-  const char* e = std::getenv("RWCALC_BATCH_TAIL");
-  return e && std::string_view(e) == "spread";
 }
 
 json opt_json(const std::optional<int>& c) { return c ? json(*c) : json(nullptr); }
@@ -169,33 +151,19 @@ std::vector<json> analyze_files(const std::vector<std::string>& files, const Rea
   if (jobs == 0) jobs = std::max(1u, std::thread::hardware_concurrency());
   // `jobs` threads in all. Files go to min(jobs, files) workers; while at least `jobs` files are
   // left (the one being picked included) every worker is busy, so each run reads and analyses on
-  // its own thread alone (no oversubscribed cores, and --jobs 1 is one thread).
-  //
-  // The files that do not fill a last round of `jobs` (files % jobs of them) would leave cores
-  // idle at the end. Under a time-slicing scheduler (SCHED_OTHER, the normal one) the last round
-  // and that remainder run together instead, one thread per file (jobs + files % jobs threads,
-  // started by the worker that picks the first file of that tail): the scheduler shares the cores
-  // between them, so both stay busy to the end and every run finishes at about the same time.
-  // Under a real-time class (SCHED_FIFO, e.g. `chrt -f`), which does not time-slice, the extra
-  // threads would only wait, so the last runs, picked when fewer files than workers are left,
-  // share out the threads of the workers that have nothing left to do instead (the read, the
-  // outlier screen and the τ loop then run on several).
+  // its own thread alone (no oversubscribed cores, and --jobs 1 is one thread). The last runs,
+  // picked when fewer files than workers are left, share out the threads of the workers that
+  // have nothing left to do (the read, the outlier screen and the τ loop then run on several).
   const unsigned total = jobs;
   jobs = std::min<unsigned>(jobs, static_cast<unsigned>(files.size()));
-  const std::size_t rem = files.size() > total ? files.size() % total : 0;
-  const bool tail_together = rem > 0 && time_sliced() && !tail_override_off();
-  const std::size_t tail_start = tail_together ? files.size() - (total + rem) : files.size();
   std::vector<json> out(files.size());
   std::vector<std::exception_ptr> errors(files.size());
   std::atomic<std::size_t> next{0};
-  std::vector<std::thread> extra;  // started by the one worker that picks `tail_start`
-  std::function<void()> worker = [&] {
+  auto worker = [&] {
     for (std::size_t i = next++; i < files.size(); i = next++) {
       try {
-        if (i == tail_start)
-          for (std::size_t t = 0; t < rem; ++t) extra.emplace_back(worker);
         const std::size_t left = files.size() - i;
-        const unsigned per_run = tail_together || left >= total ? 1u : std::max(1u, total / static_cast<unsigned>(left));
+        const unsigned per_run = left >= total ? 1u : std::max(1u, total / static_cast<unsigned>(left));
         ReadOptions ro = read;
         ro.threads = per_run;
         AnalysisOptions opt = options;
@@ -211,7 +179,6 @@ std::vector<json> analyze_files(const std::vector<std::string>& files, const Rea
   for (unsigned t = 1; t < jobs; ++t) pool.emplace_back(worker);
   worker();
   for (auto& t : pool) t.join();
-  for (auto& t : extra) t.join();  // `extra` is complete: its creator has joined above
   for (std::size_t i = 0; i < files.size(); ++i) {
     if (!errors[i]) continue;
     try {

@@ -198,8 +198,8 @@ TEST_F(BatchCli, JsonLinesMergeToTheSameTablesAndTheToleranceGivesClass2) {
 }
 
 TEST_F(BatchCli, ThreadCountDoesNotChangeTheResult) {
-  // --jobs 2 and 3 leave one and two files beyond the last full round (run together with it under
-  // the normal scheduler), --jobs 4 one file; every schedule gives the same bytes in input order.
+  // --jobs 2, 3 and 4 leave one, two and one file for the end, which then run on the threads of the
+  // idle workers; every schedule gives the same bytes in input order.
   auto args = [&](const char* jobs) {
     std::vector<std::string> a{"batch"};
     for (const auto& f : files()) a.push_back(f);
@@ -216,7 +216,7 @@ TEST_F(BatchCli, ThreadCountDoesNotChangeTheResult) {
 }
 
 TEST_F(BatchCli, AnInputErrorInTheLastFilesNamesItsFile) {
-  // Three files on two jobs: all three run together, the bad one on the thread started for the tail.
+  // Three files on two jobs: the bad one is the last, read on the threads of both workers.
   test::TempDir dir;
   const auto bad = dir.write("broken_p10C.csv", "# rate_hz: 400\npulses\n1\n2\nthree\n4\n");
   const auto r = run_cli({"batch", gl2d("gl2d_0C.csv.gz"), gl2d("gl2d_p25C.csv.gz"), bad.string(), "--jobs", "2"});
