@@ -601,14 +601,14 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   const auto grid = mid_tau_grid(full.dec);
   const std::size_t pilot_runs = std::max<std::size_t>(10, opt.runs / 2);
   NoiseModel candidate;
-  Coefficient b_fit;
+  Coefficient b_of_fit;  // B of the five-term fit without the candidate
   {
     SimulationSettings sp = r.settings;
     sp.seed = opt.seed + 1000;
     const RobustBase rb = robust_base(rec, r.analysis, aopt, full.dec, sp, pilot_runs, octave_m, grid, opt);
     r.base = rb.model;
     candidate = rb.candidate;
-    b_fit = rb.b_fit;
+    b_of_fit = rb.b_fit;
   }
   timer.lap("pilot calibration");
 
@@ -650,9 +650,9 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   // flicker wander looks like a step or a transient. Their thresholds are then also taken under B
   // at the fit's upper confidence bound (same seeds), and the larger kept: the false-alarm level
   // then holds over the range of B the record allows.
-  if (b_fit.enabled && !b_fit.resolved && b_fit.high > r.base.bias_instability_deg_per_h) {
+  if (b_of_fit.enabled && !b_of_fit.resolved && b_of_fit.high > r.base.bias_instability_deg_per_h) {
     NoiseModel hi = r.base;
-    hi.bias_instability_deg_per_h = b_fit.high;
+    hi.bias_instability_deg_per_h = b_of_fit.high;
     const auto hi_runs = run_ensemble(hi, r.settings, opt.runs, octave_m, grid, true, opt);
     std::vector<double> h_step, h_warm;
     for (const auto& br : hi_runs) {
@@ -812,6 +812,12 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     const auto b_runs = run_ensemble(b_fit, sh, r.holdout_runs, om, hgrid, mean_terms, opt, !effects.empty());
     const double hb_dir = band_misfit(make_band(a_pred.points, b_runs, opt.band_level), r.holdout_runs);
     hb += hb_dir;
+    // The half's mid-τ references from its base ensemble: for the Gauss–Markov test on the half and
+    // for its extended model.
+    if (!effects.empty()) {
+      st.ref = make_reference(hgrid, st.dec.tau_d, b_runs);
+      st.clean_ref = clean_reference(hgrid, st.dec.tau_d, b_runs);
+    }
     // A deterministic term is carried into the fitting half's extended model only when the half
     // itself shows it: its detector fires against the half's own base ensemble. A step or
     // transient that lies in the predicted half cannot be estimated from the fitting half; a
@@ -845,8 +851,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
         // own candidate) against the half's base ensemble and the bump model fitted there.
         Decimated dh = st.dec;
         subtract_deterministic(dh, own_candidates(st.dec));
-        const auto d = gauss_markov_test(decimated_avar(dh, hgrid), make_reference(hgrid, st.dec.tau_d, b_runs),
-                                         clean_reference(hgrid, st.dec.tau_d, b_runs), b_runs, b_fit, sh,
+        const auto d = gauss_markov_test(decimated_avar(dh, hgrid), st.ref, st.clean_ref, b_runs, b_fit, sh,
                                          r.holdout_runs, om, hgrid, st.dec.tau_d, opt);
         if (d.named) half_effects.push_back(e);
         continue;
@@ -861,8 +866,6 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
       he += hb_dir;
       continue;
     }
-    st.ref = make_reference(hgrid, st.dec.tau_d, b_runs);
-    st.clean_ref = clean_reference(hgrid, st.dec.tau_d, b_runs);
     st.runs = r.holdout_runs;
     st.settings = &sh_pilot;
     st.octave_m = &om;
