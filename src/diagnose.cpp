@@ -16,6 +16,7 @@
 #include "rwcalc/diagnose_detectors.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/fit.hpp"
+#include "rwcalc/units.hpp"
 #include "timing.hpp"
 
 namespace rwcalc {
@@ -465,6 +466,76 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
   return x;
 }
 
+/// The model's mean rate over [0, T], °/h.
+double model_mean_rate(const NoiseModel& m, double T) {
+  return m.earth_rate_deg_per_h + m.bias_deg_per_h + mean_rate_of(m, T) +
+         m.ramp_deg_per_h2 * T / units::seconds_per_hour / 2.0;
+}
+
+/// Variance of the records' mean rates in an ensemble, (°/h)².
+double mean_rate_variance(const std::vector<RunStats>& runs) {
+  if (runs.size() < 2) return 0.0;
+  double s = 0, s2 = 0;
+  for (const auto& r : runs) s += r.mean_rate;
+  const double mu = s / static_cast<double>(runs.size());
+  for (const auto& r : runs) s2 += (r.mean_rate - mu) * (r.mean_rate - mu);
+  return s2 / static_cast<double>(runs.size() - 1);
+}
+
+/// Sum of a band's deviance terms and their number (band_misfit is their mean).
+std::pair<double, std::size_t> band_deviance(const std::vector<BandPoint>& band, std::size_t runs) {
+  std::size_t n = 0;
+  for (const auto& b : band) n += (b.mean_var > 0 && b.dev > 0 && b.edf > 0) ? 1 : 0;
+  return {band_misfit(band, runs) * static_cast<double>(n), n};
+}
+
+/// The extended model's last step: N and B re-fitted to the whole band of the data it was built
+/// on (refit_to_band), the re-fitted model simulated again with the same seeds and kept, with its
+/// band, when that band fits better.
+void refit_whole_band(NoiseModel& m, std::vector<BandPoint>& band, const std::vector<AllanPoint>& measured,
+                      const SimulationSettings& settings, std::size_t runs, const std::vector<std::int64_t>& octave_m,
+                      const std::vector<std::size_t>& grid, const DiagnoseOptions& opt);
+
+/// The model with its constant rate set so that its mean rate over [0, T] is `mean_rate` (°/h):
+/// under a counting read-out the fine structure of the short-τ AV (the beat of the pulse rate
+/// against the sampling) depends on the rate, so a simulated record must have the data's.
+NoiseModel with_mean_rate(NoiseModel m, double T, double mean_rate) {
+  m.bias_deg_per_h += mean_rate - model_mean_rate(m, T);
+  return m;
+}
+
+/// N, B, K of a model in the fit scale (band_refit's order).
+std::array<double, 3> nbk_of(const NoiseModel& m) {
+  return {c_from_coefficient(Term::N, m.arw_deg_per_sqrt_h), c_from_coefficient(Term::B, m.bias_instability_deg_per_h),
+          c_from_coefficient(Term::K, m.rrw_deg_per_h_per_sqrt_h)};
+}
+
+/// The model with N and B re-fitted to a band of its own ensemble (band_refit), K held as in the
+/// pilot calibration (over one record the trade between B and K is loose, and the longest τ with
+/// a few EDF would otherwise bring in a K no fit found); false when unchanged.
+bool refit_to_band(NoiseModel& m, const std::vector<BandPoint>& band, std::size_t runs) {
+  const auto c = nbk_of(m);
+  const auto dc = band_refit(band, runs, c, {true, true, false});
+  if (dc[0] == 0 && dc[1] == 0 && dc[2] == 0) return false;
+  m.arw_deg_per_sqrt_h = coefficient_from_c(Term::N, c[0] + dc[0]);
+  m.bias_instability_deg_per_h = coefficient_from_c(Term::B, c[1] + dc[1]);
+  m.rrw_deg_per_h_per_sqrt_h = coefficient_from_c(Term::K, c[2] + dc[2]);
+  return true;
+}
+
+void refit_whole_band(NoiseModel& m, std::vector<BandPoint>& band, const std::vector<AllanPoint>& measured,
+                      const SimulationSettings& settings, std::size_t runs, const std::vector<std::int64_t>& octave_m,
+                      const std::vector<std::size_t>& grid, const DiagnoseOptions& opt) {
+  NoiseModel refit = m;
+  if (!refit_to_band(refit, band, runs)) return;
+  const auto rr = run_ensemble(refit, settings, runs, octave_m, grid, false, opt, false);
+  auto b2 = make_band(measured, rr, opt.band_level);
+  if (band_misfit(b2, runs) < band_misfit(band, runs)) {
+    m = refit;
+    band = std::move(b2);
+  }
+}
+
 /// Shift a model's time origin by dt (the model then describes the record from t = dt on).
 NoiseModel shifted(NoiseModel m, double dt) {
   for (auto& s : m.sinusoids) s.phase_rad = std::fmod(s.phase_rad + 2 * kPi * s.f_hz * dt, 2 * kPi);
@@ -772,6 +843,9 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     // bands differ by the model change, not by sampling noise.
     const auto ext_runs = run_ensemble(r.extended, r.settings, opt.runs, octave_m, grid, false, opt, false);
     r.extended_band = make_band(r.analysis.allan.points, ext_runs, opt.band_level);
+    // Re-fit of N, B, K to the whole band (the extension was calibrated at mid τ only), kept when
+    // its re-simulation (same seeds) fits the band better.
+    refit_whole_band(r.extended, r.extended_band, r.analysis.allan.points, r.settings, opt.runs, octave_m, grid, opt);
   }
   timer.lap("extended model");
 
@@ -809,15 +883,38 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     const bool mean_terms = std::any_of(effects.begin(), effects.end(), [](const std::string& e) {
       return e == "sinusoid" || e == "bias_step" || e == "warmup_transient";
     });
-    const auto b_runs = run_ensemble(b_fit, sh, r.holdout_runs, om, hgrid, mean_terms, opt, !effects.empty());
-    const double hb_dir = band_misfit(make_band(a_pred.points, b_runs, opt.band_level), r.holdout_runs);
+    // Both models are simulated over the predicted half at its measured mean rate: under a
+    // counting read-out the rate sets the fine structure of the short-τ AV (the beat of the pulse
+    // rate against the sampling), which also moves with the rate's wander inside a half and would
+    // otherwise score the level twice and erratically. The level each model predicts is scored
+    // once, explicitly: one more deviance term beside the band's, the measured mean rate against
+    // the model's (its constant rate and its named terms over the window; a ramp, of unknown
+    // sign, predicts no change) with the ensemble's spread of half means — −2 ln L of a normal,
+    // relative to the base's spread. A step or transient in the fitting half predicts the level
+    // after it; the base predicts the fitting half's mean.
+    const double pred_T = pred_rec.phase.duration_s();
+    const double pred_mean = pred_rec.phase.diff(pred_rec.phase.points() - 1, 0) / pred_T;
+    const auto b_pred =
+        run_ensemble(with_mean_rate(b_fit, pred_T, pred_mean), sh, r.holdout_runs, om, hgrid, false, opt, false);
+    const double v_base = std::max(mean_rate_variance(b_pred), 1e-30);
+    auto prediction_misfit = [&](const std::vector<RunStats>& runs, const NoiseModel& m) {
+      const auto [s, k] = band_deviance(make_band(a_pred.points, runs, opt.band_level), r.holdout_runs);
+      const double v = std::max(mean_rate_variance(runs), 1e-30);
+      const double level = model_mean_rate(m, pred_T) - m.ramp_deg_per_h2 * pred_T / units::seconds_per_hour / 2.0;
+      const double d = pred_mean - level;
+      return (s + d * d / v + std::log(v / v_base)) / static_cast<double>(k + 1);
+    };
+    const double hb_dir = prediction_misfit(b_pred, b_fit);
     hb += hb_dir;
-    // The half's mid-τ references from its base ensemble: for the Gauss–Markov test on the half and
-    // for its extended model.
-    if (!effects.empty()) {
-      st.ref = make_reference(hgrid, st.dec.tau_d, b_runs);
-      st.clean_ref = clean_reference(hgrid, st.dec.tau_d, b_runs);
+    if (effects.empty()) {
+      he += hb_dir;
+      continue;
     }
+    // The half's base ensemble at the half's own level: the half's detectors and its mid-τ
+    // references (for the Gauss–Markov test on the half and for its extended model).
+    const auto b_runs = run_ensemble(b_fit, sh, r.holdout_runs, om, hgrid, mean_terms, opt, true);
+    st.ref = make_reference(hgrid, st.dec.tau_d, b_runs);
+    st.clean_ref = clean_reference(hgrid, st.dec.tau_d, b_runs);
     // A deterministic term is carried into the fitting half's extended model only when the half
     // itself shows it: its detector fires against the half's own base ensemble. A step or
     // transient that lies in the predicted half cannot be estimated from the fitting half; a
@@ -873,8 +970,18 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     st.pilot_runs = r.holdout_runs;
     st.step_time_s = step_time;
     const Extension e = extend(st, b_fit, half_effects, f_hint, aopt);
-    const auto e_runs = run_ensemble(shifted(e.model, dt), sh, r.holdout_runs, om, hgrid, false, opt, false);
-    he += band_misfit(make_band(a_pred.points, e_runs, opt.band_level), r.holdout_runs);
+    NoiseModel em = e.model;
+    {
+      // Its last step as in sample: N and B re-fitted to the fitting half's whole band.
+      const auto om_fit = octave_of(a_fit.allan);
+      auto fit_band = make_band(a_fit.allan.points, run_ensemble(em, sh, r.holdout_runs, om_fit, hgrid, false, opt, false),
+                          opt.band_level);
+      refit_whole_band(em, fit_band, a_fit.allan.points, sh, r.holdout_runs, om_fit, hgrid, opt);
+    }
+    const NoiseModel e_pred = shifted(em, dt);
+    const auto e_runs =
+        run_ensemble(with_mean_rate(e_pred, pred_T, pred_mean), sh, r.holdout_runs, om, hgrid, false, opt, false);
+    he += prediction_misfit(e_runs, e_pred);
   }
   timer.lap("out-of-sample check");
   r.gain.holdout_misfit_base = hb / 2;

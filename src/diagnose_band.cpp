@@ -2,10 +2,14 @@
 // statistics), the band of σ per τ, and the measured-versus-ensemble misfit and coverage.
 #include <algorithm>
 #include <cmath>
+#include <limits>
+
+#include <Eigen/Dense>
 
 #include "allan_kernels.hpp"
 #include "rwcalc/diagnose_detectors.hpp"
 #include "rwcalc/allan.hpp"
+#include "rwcalc/fit.hpp"
 
 namespace rwcalc {
 
@@ -40,6 +44,7 @@ std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSett
           for (std::size_t i = 0; i < octave_m.size(); ++i)
             st.octave_var[i] = allan_variance(s, octave_m[i], Estimator::Overlapping);
         }
+        st.mean_rate = s.diff(s.points() - 1, 0) / s.duration_s();
         const Decimated d = decimate(s);
         st.mid_var = decimated_avar(d, mid_grid);
         if (with_detectors || clean_mid) {
@@ -124,6 +129,88 @@ MidTauReference make_reference(const std::vector<std::size_t>& grid, double tau_
     }
   }
   return ref;
+}
+
+std::array<double, 3> band_refit(const std::vector<BandPoint>& band, std::size_t runs, const std::array<double, 3>& c,
+                                 const std::array<bool, 3>& held_free) {
+  constexpr std::array<Term, 3> terms{Term::N, Term::B, Term::K};
+  struct Point {
+    double d, mu, nu;
+    std::array<double, 3> g;
+  };
+  std::vector<Point> pts;
+  const double K = static_cast<double>(std::max<std::size_t>(runs, 1));
+  for (const auto& b : band) {
+    if (!(b.mean_var > 0) || !(b.dev > 0) || !(b.edf > 0)) continue;
+    Point p{b.dev * b.dev, b.mean_var, 1.0 / (1.0 / b.edf + 1.0 / (K * b.edf) + 1.0 / 1000.0), {}};
+    for (std::size_t j = 0; j < 3; ++j) p.g[j] = term_basis(terms[j], b.tau_s);
+    pts.push_back(p);
+  }
+  std::array<double, 3> x{0, 0, 0};
+  if (pts.size() < 4) return x;
+  auto deviance = [&](const std::array<double, 3>& y) {
+    double s = 0;
+    for (const auto& p : pts) {
+      double m = p.mu;
+      for (std::size_t j = 0; j < 3; ++j) m += p.g[j] * y[j];
+      if (!(m > 0)) return std::numeric_limits<double>::infinity();
+      const double r = p.d / m;
+      s += p.nu * (r - 1.0 - std::log(r));
+    }
+    return s;
+  };
+  const double d0 = deviance(x);
+  double dx = d0;
+  for (int it = 0; it < 40; ++it) {
+    // Fisher scoring: weights ν/m², residuals d − m; a term at its bound c + Δc = 0 stays there
+    // while the deviance's slope pushes it down.
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    for (const auto& p : pts) {
+      double m = p.mu;
+      for (std::size_t j = 0; j < 3; ++j) m += p.g[j] * x[j];
+      const double w = p.nu / (m * m);
+      const Eigen::Vector3d g(p.g[0], p.g[1], p.g[2]);
+      A += w * g * g.transpose();
+      rhs += w * (p.d - m) * g;
+    }
+    std::array<bool, 3> free{};
+    for (std::size_t j = 0; j < 3; ++j)
+      free[j] = held_free[j] && (c[j] + x[j] > 1e-12 * (c[j] + 1e-30) || rhs(static_cast<Eigen::Index>(j)) > 0);
+    Eigen::Vector3d step = Eigen::Vector3d::Zero();
+    {
+      std::vector<Eigen::Index> idx;
+      for (std::size_t j = 0; j < 3; ++j)
+        if (free[j]) idx.push_back(static_cast<Eigen::Index>(j));
+      if (idx.empty()) break;
+      const auto n = static_cast<Eigen::Index>(idx.size());
+      Eigen::MatrixXd a(n, n);
+      Eigen::VectorXd b(n);
+      Eigen::VectorXd sc(n);
+      for (Eigen::Index i = 0; i < n; ++i) sc(i) = A(idx[i], idx[i]) > 0 ? 1.0 / std::sqrt(A(idx[i], idx[i])) : 0.0;
+      for (Eigen::Index i = 0; i < n; ++i) {
+        b(i) = rhs(idx[i]) * sc(i);
+        for (Eigen::Index k = 0; k < n; ++k) a(i, k) = A(idx[i], idx[k]) * sc(i) * sc(k);
+      }
+      const Eigen::VectorXd s = a.completeOrthogonalDecomposition().solve(b);
+      for (Eigen::Index i = 0; i < n; ++i) step(idx[i]) = s(i) * sc(i);
+    }
+    bool improved = false;
+    for (double t = 1.0; t > 1e-4; t *= 0.5) {
+      std::array<double, 3> y = x;
+      for (std::size_t j = 0; j < 3; ++j) y[j] = std::max(x[j] + t * step(static_cast<Eigen::Index>(j)), -c[j]);
+      const double dy = deviance(y);
+      if (dy < dx) {
+        improved = dx - dy > 1e-10 * (1.0 + dx);
+        x = y;
+        dx = dy;
+        break;
+      }
+    }
+    if (!improved) break;
+  }
+  if (!(dx < d0)) return {0, 0, 0};
+  return x;
 }
 
 }  // namespace diag

@@ -10,6 +10,7 @@
 #include "rwcalc/diagnose.hpp"
 #include "rwcalc/diagnose_detectors.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/fit.hpp"
 #include "rwcalc/simulate.hpp"
 
 #include <nlohmann/json.hpp>
@@ -227,6 +228,56 @@ TEST(DiagnoseBlocks, MisfitAndCoverage) {
   const double r = 1.69;
   const double nu = 1.0 / (1.0 / 100 + 1.0 / 5000 + 1.0 / 1000);
   EXPECT_NEAR(band_misfit(band, 50), nu * (r - 1 - std::log(r)) / 4, 1e-9);
+}
+
+// The band re-fit finds the N², B², K² changes that carry an ensemble mean onto measured values
+// made from it with known changes, respects c + Δc ≥ 0, and leaves a fitting band alone.
+TEST(DiagnoseBlocks, BandRefitRecoversKnownCoefficientChanges) {
+  const std::array<double, 3> c{c_from_coefficient(Term::N, 0.001), c_from_coefficient(Term::B, 0.005),
+                                c_from_coefficient(Term::K, 0.002)};
+  const std::array<Term, 3> terms{Term::N, Term::B, Term::K};
+  auto model = [&](double tau, const std::array<double, 3>& cc) {
+    double v = 3e-4 / (tau * tau);  // a read-out term the re-fit does not touch
+    for (std::size_t j = 0; j < 3; ++j) v += cc[j] * term_basis(terms[j], tau);
+    return v;
+  };
+  const std::array<double, 3> truth{c[0] * 0.44, c[1] * 1.7, -c[2]};  // N up 20 %, B up 30 %, K to 0
+  std::vector<BandPoint> band;
+  for (double tau = 0.5; tau < 3000; tau *= 2) {
+    BandPoint b;
+    b.tau_s = tau;
+    b.mean_var = model(tau, c);
+    std::array<double, 3> ct{};
+    for (std::size_t j = 0; j < 3; ++j) ct[j] = c[j] + truth[j];
+    b.dev = std::sqrt(model(tau, ct));
+    b.edf = 1e4;
+    band.push_back(b);
+  }
+  const auto dc = band_refit(band, 50, c);
+  EXPECT_NEAR(dc[0], truth[0], 0.01 * c[0]);
+  EXPECT_NEAR(dc[1], truth[1], 0.01 * c[1]);
+  EXPECT_NEAR(dc[2], truth[2], 1e-3 * c[2]);
+  EXPECT_GE(c[2] + dc[2], 0.0);
+
+  // K asked to go below zero: held at its bound, N and B still found.
+  for (auto& b : band) {
+    std::array<double, 3> ct{c[0] + truth[0], c[1] + truth[1], 0.0};
+    b.dev = std::sqrt(std::max(1e-30, model(b.tau_s, ct) - 0.5 * c[2] * term_basis(Term::K, b.tau_s)));
+  }
+  const auto dk = band_refit(band, 50, c);
+  EXPECT_NEAR(dk[2], -c[2], 1e-12 * c[2]);
+  EXPECT_GT(dk[0], 0.0);
+
+  // K held: only N and B move.
+  const auto dh = band_refit(band, 50, c, {true, true, false});
+  EXPECT_EQ(dh[2], 0.0);
+  EXPECT_GT(dh[0], 0.0);
+
+  for (auto& b : band) b.dev = std::sqrt(b.mean_var);
+  const auto d0 = band_refit(band, 50, c);
+  EXPECT_EQ(d0[0], 0.0);
+  EXPECT_EQ(d0[1], 0.0);
+  EXPECT_EQ(d0[2], 0.0);
 }
 
 }  // namespace

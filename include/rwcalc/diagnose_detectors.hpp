@@ -168,6 +168,7 @@ struct RunStats {
   /// better of the best step and the best warm-up) is removed, as it is from the measurement.
   std::vector<double> mid_var_clean;
   double sin_stat = 0, step_stat = 0, warm_stat = 0;
+  double mean_rate = 0;  ///< the record's mean rate, °/h
 };
 
 /// Simulate `runs` records of `model` and collect their statistics; with `clean_mid` (or
@@ -180,5 +181,13 @@ std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSett
 std::vector<BandPoint> make_band(const std::vector<AllanPoint>& measured, const std::vector<RunStats>& runs,
                                  double level);
 MidTauReference make_reference(const std::vector<std::size_t>& grid, double tau_d, const std::vector<RunStats>& runs);
+
+/// Re-fit of a simulated model's N, B and K to the whole band: the changes of their fit-scale c
+/// (order N, B, K; term_basis) that minimise the band's Gamma deviance (band_misfit's ν) when the
+/// ensemble mean σ² moves by Σ Δc·basis(τ), with every c + Δc ≥ 0 (Fisher scoring with a bounded
+/// active set and a halving line search); the terms not in `free` are held. All zero when no
+/// change lowers the deviance.
+std::array<double, 3> band_refit(const std::vector<BandPoint>& band, std::size_t runs, const std::array<double, 3>& c,
+                                 const std::array<bool, 3>& free = {true, true, true});
 
 }  // namespace rwcalc::diag
