@@ -25,6 +25,7 @@
 #include <fmt/format.h>
 
 #include "reader_detail.hpp"
+#include "reader_simd.hpp"
 #include "timing.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/units.hpp"
@@ -194,6 +195,13 @@ class Reader {
     [[nodiscard]] std::int64_t* end() const noexcept { return p + n; }
     std::int64_t& operator[](std::size_t i) const noexcept { return p[i]; }
   };
+  // Count the k values written past the end (within the reserved room) as appended. For the vector,
+  // insert() from that room onto itself moves nothing (memmove of a range onto itself).
+  static void grow_in_place(std::vector<std::int64_t>& v, std::size_t k) {
+    const std::int64_t* t = v.data() + v.size();
+    v.insert(v.end(), t, t + k);
+  }
+  static void grow_in_place(IntSink& v, std::size_t k) noexcept { v.n += k; }
   struct Chunk {
     IntSink ints;
     // Pulses: ints[0, summed) are already the running sums of the chunk's counts (from 0), acc the
@@ -786,11 +794,30 @@ inline const char* Reader::int_lines(const char* p, const char* limit, Vec& out,
     }
   };
 #if defined(__SSE2__)
-  // Windows of 64 bytes: the line ends come from one compare per 16 bytes, so where a line starts
-  // does not wait for the previous line's bytes to be read and tested (the scalar loop below is a
-  // chain of dependent loads, one per line); each line is then taken by scan_int_line as there,
-  // and must end at the newline found. Any other outcome leaves that line to the scalar loop.
+  // Windows of 64 bytes. Runs of windows made only of one-digit lines ("0", "1", "-1": nearly every
+  // line of a pulse file) go to detail::digit_windows, which takes a window's lines together and
+  // writes their values (or running sums) straight into the room reserved past out's end; then
+  // they are appended in place (a move of nothing). The first window it does not take comes here.
+  // After a window it refused at once, the next kDigitBackoff windows skip it (files of longer
+  // counts do not pay a classification per window for nothing).
+  constexpr int kDigitBackoff = 8;
+  int skip = 0;
   while (limit - p >= 64) {
+    if (skip == 0) {
+      std::size_t n = 0;
+      std::int64_t* tail = out.data() + out.size();
+      const char* q = detail::digit_windows<Sum>(p, limit, tail, n, a, m);
+      if (n > 0) grow_in_place(out, n);
+      if (q == p) skip = kDigitBackoff;
+      p = q;
+      if (limit - p < 64) break;
+    } else {
+      --skip;
+    }
+    // The line ends come from one compare per 16 bytes, so where a line starts does not wait for
+    // the previous line's bytes to be read and tested (the scalar loop below is a chain of
+    // dependent loads, one per line); each line is then taken by scan_int_line as there, and must
+    // end at the newline found. Any other outcome leaves that line to the scalar loop.
     std::uint64_t nl = 0;
     const __m128i lf = _mm_set1_epi8('\n');
     for (int k = 0; k < 4; ++k) {
