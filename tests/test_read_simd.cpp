@@ -287,7 +287,7 @@ TEST(ReadSimd, ErrorsNameTheSameFileAndLine) {
   // and late; the same error with every kernel and the vectorised path off.
   const std::size_t n = 1200000;
   for (const char* bad : {"1x\n", "--1\n", "-\n", "1,5\n"})
-    for (const std::size_t at : {std::size_t{40}, n * 11 / 20 - 3, n * 11 / 20 + 40, n - 7}) {
+    for (const std::size_t at : {std::size_t{40}, n / 2 - 3, n / 2 + 40, n * 11 / 20, n - 7}) {
       std::string t = "pulses\n";
       t.reserve(3 * n);
       std::mt19937_64 rng(at);
