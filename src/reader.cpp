@@ -8,6 +8,7 @@
 #include "rwcalc/reader.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <array>
 #include <charconv>
 #include <cmath>
@@ -211,10 +212,44 @@ class Reader {
     std::vector<double> reals, times, temps;
     const char* stop = nullptr;  // where the chunk's fast path stopped
   };
+  // The second part's thread, once its part is parsed, offsets the first half of its running sums
+  // by the first part's total while this thread offsets the second half (a pass over ~10 MB on the
+  // 2-h file, ~0.8 ms on one thread). Phases: 0 parsing, 1 parsed (waiting), 2 offset d[0, n) by
+  // base, 3 nothing more to do (also set when the thread is asked to stop).
+  struct MergeHelp {
+    std::atomic<int> phase{0};
+    std::uint64_t base = 0;
+    std::int64_t* d = nullptr;
+    std::size_t n = 0;
+    void parsed_then_help(const std::stop_token& st) {  // on the second part's thread
+      phase.store(1, std::memory_order_release);
+      phase.notify_all();
+      const std::stop_callback on_stop(st, [this] { dismiss(); });
+      int v = 1;
+      while ((v = phase.load(std::memory_order_acquire)) == 1) phase.wait(1, std::memory_order_acquire);
+      if (v == 2)
+        for (std::size_t i = 0; i < n; ++i) d[i] = static_cast<std::int64_t>(base + static_cast<std::uint64_t>(d[i]));
+    }
+    void wait_parsed() {
+      while (phase.load(std::memory_order_acquire) == 0) phase.wait(0, std::memory_order_acquire);
+    }
+    void give(std::uint64_t b, std::int64_t* at, std::size_t count) {
+      base = b;
+      d = at;
+      n = count;
+      phase.store(2, std::memory_order_release);
+      phase.notify_all();
+    }
+    void dismiss() {
+      int one = 1;
+      phase.compare_exchange_strong(one, 3, std::memory_order_acq_rel);
+      phase.notify_all();
+    }
+  };
   template <bool Integer>
   void scan_chunk(const char* from, Chunk& out, std::stop_token stop) const;
   template <bool Integer>
-  void merge_chunk(Chunk& c);
+  void merge_chunk(Chunk& c, MergeHelp& help, std::jthread& worker);
   template <bool Integer>
   void scan(const char* p);
 
@@ -933,7 +968,17 @@ void Reader::scan_chunk(const char* from, Chunk& out, std::stop_token stop) cons
 }
 
 template <bool Integer>
-void Reader::merge_chunk(Chunk& c) {
+void Reader::merge_chunk(Chunk& c, MergeHelp& help, std::jthread& worker) {
+  // Until `finish` the other thread may still be running: it reads nothing of the chunk and writes
+  // only the values given to it.
+  const auto finish = [&] {
+    help.dismiss();
+    if (worker.joinable()) worker.join();
+  };
+  const struct Finish {
+    const decltype(finish)& f;
+    ~Finish() { f(); }
+  } at_exit{finish};
   const std::size_t k = Integer ? c.ints.size() : c.reals.size();
   if (k == 0) return;
   if (new_run_) {
@@ -950,13 +995,17 @@ void Reader::merge_chunk(Chunk& c) {
         // gap (an overlapping move), or has nothing to move.
         const std::uint64_t base = acc_;
         std::int64_t* d = c.ints.data();
-        for (std::size_t i = 0; i < c.summed; ++i)
+        const std::size_t half = c.summed / 2;
+        help.give(base, d, half);  // the other thread offsets the first half
+        for (std::size_t i = half; i < c.summed; ++i)
           d[i] = static_cast<std::int64_t>(base + static_cast<std::uint64_t>(d[i]));
+        finish();
         ints_.insert(ints_.end(), d, d + c.summed);
         acc_ = base + c.acc;
         mag_ += c.mag;
         summed_ = ints_.size();
       } else {
+        finish();
         // Back to the counts as read (exact modulo 2^64); build_phase sums them and names the line
         // where Σ|c| passes the limit.
         for (std::size_t i = c.summed; i-- > 1;)
@@ -985,6 +1034,7 @@ void Reader::scan(const char* p) {
   bool split_pending = may_split();
   const char* limit = end_;
   Chunk chunk;
+  MergeHelp help;  // before the thread, which may still use it when an exception unwinds this frame
   std::jthread worker;
   for (;;) {
     while (p < limit) {
@@ -1009,9 +1059,10 @@ void Reader::scan(const char* p) {
               if (bad) throw std::logic_error("reader: byte check and line count disagree");
               chunk.ints.p = ints_.data() + at;
               const std::size_t room = ints_.capacity() - at;
-              worker = std::jthread([this, &chunk, room, from = limit](std::stop_token st) {
+              worker = std::jthread([this, &chunk, &help, room, from = limit](std::stop_token st) {
                 detail::prefault(chunk.ints.p, room * sizeof(std::int64_t));
                 scan_chunk<Integer>(from, chunk, st);
+                help.parsed_then_help(st);
               });
               detail::prefault(ints_.data() + ints_.size(), (at - ints_.size()) * sizeof(std::int64_t));
             } else {
@@ -1048,12 +1099,18 @@ void Reader::scan(const char* p) {
     if (!worker.joinable()) break;
     {
       detail::ScopedTimer tj("read: join");
-      worker.join();  // p == limit: the first half is done
+      // p == limit: the first part is done. Integers: wait until the other part is parsed (its
+      // thread then waits to help with the merge); else for the thread's end.
+      if constexpr (Integer)
+        help.wait_parsed();
+      else
+        worker.join();
     }
     detail::ScopedTimer tm("read: merge");
-    merge_chunk<Integer>(chunk);
+    merge_chunk<Integer>(chunk, help, worker);  // the thread has ended when it returns
     p = chunk.stop;
     chunk = Chunk{};
+    help.phase.store(0, std::memory_order_relaxed);
     limit = end_;
   }
   if (samples_ > 0 && runs_.empty()) runs_.emplace_back(0, first_data_line_);
