@@ -151,6 +151,12 @@ class Reader {
   }
 
   std::size_t check_bytes(const char* text);  // returns the number of '\n'
+  // Line ends in [marks_from_, x) for x in the checked text: the count at the last mark before x,
+  // plus the rest counted (less than kMarkBytes).
+  static constexpr std::ptrdiff_t kMarkBytes = 256 * 240;  // a whole number of count_lines_checked blocks
+  const char* marks_from_ = nullptr;
+  std::vector<std::size_t> line_marks_;
+  [[nodiscard]] std::size_t lines_before(const char* x) const;
   LineKind careful_line(std::string_view line);
   void metadata_line(std::string_view body);
   void detect_delimiter(std::string_view line);
@@ -362,8 +368,17 @@ std::size_t Reader::check_bytes(const char* text) {
   // Binary data: NUL and other control bytes (tab, LF and CR excepted). Checked, and the lines
   // counted, in one pass (count_lines_checked); the block that trips is searched again for the
   // first bad byte.
+  // The count is kept at every kMarkBytes (lines_before()), so that the split of a long text
+  // needs no second count of its first part.
   const char* bad = nullptr;
-  const std::size_t lines = count_lines_checked(text, end_, bad);
+  std::size_t lines = 0;
+  marks_from_ = text;
+  line_marks_.clear();
+  line_marks_.reserve(static_cast<std::size_t>(end_ - text) / kMarkBytes + 1);
+  for (const char* b = text; b < end_ && !bad; b += kMarkBytes) {
+    line_marks_.push_back(lines);
+    lines += count_lines_checked(b, end_ - b > kMarkBytes ? b + kMarkBytes : end_, bad);
+  }
   if (!bad) return lines;
   for (const char* q = bad; q < end_; ++q) {
     const auto c = static_cast<unsigned char>(*q);
@@ -377,6 +392,13 @@ std::size_t Reader::check_bytes(const char* text) {
     }
   }
   return lines;  // not reached: the block that tripped holds a bad byte
+}
+
+std::size_t Reader::lines_before(const char* x) const {
+  const auto i = static_cast<std::size_t>((x - marks_from_) / kMarkBytes);
+  const char* b = marks_from_ + static_cast<std::ptrdiff_t>(i) * kMarkBytes;
+  const char* bad = nullptr;  // every byte has passed check_bytes()
+  return line_marks_[i] + count_lines_checked(b, x, bad);
 }
 
 // ---- careful path ------------------------------------------------------------------------------
@@ -1053,10 +1075,7 @@ void Reader::scan(const char* p) {
               // The first part adds at most one value per line before `limit`: the second part's
               // values go right after that (ints_ holds one slot per line of the text, so both
               // fit and it is never reallocated). Each thread maps the pages it will write.
-              // (check_bytes() has passed every byte, so the count does not stop early.)
-              const char* bad = nullptr;
-              const std::size_t at = ints_.size() + count_lines_checked(p, limit, bad);
-              if (bad) throw std::logic_error("reader: byte check and line count disagree");
+              const std::size_t at = ints_.size() + (lines_before(limit) - lines_before(p));
               chunk.ints.p = ints_.data() + at;
               const std::size_t room = ints_.capacity() - at;
               worker = std::jthread([this, &chunk, &help, room, from = limit](std::stop_token st) {
