@@ -178,7 +178,7 @@ class Reader {
   // second on another thread, from the first line start after kSplitNum/kSplitDen of the rest.
   static constexpr std::ptrdiff_t kParallelBytes = std::ptrdiff_t{1} << 20;
   // Where the text is split: the other thread takes the part after kSplitNum/kSplitDen of it.
-  static constexpr std::ptrdiff_t kSplitNum = 1, kSplitDen = 2;
+  static constexpr std::ptrdiff_t kSplitNum = 11, kSplitDen = 20;
   [[nodiscard]] bool may_split() const {
     const unsigned threads = opt_.threads ? opt_.threads : std::thread::hardware_concurrency();
     return threads > 1 && end_ - begin_ > kParallelBytes;
@@ -215,6 +215,9 @@ class Reader {
     // last of them and mag the sum of the |counts|; the rest are counts as read.
     std::size_t summed = 0;
     std::uint64_t acc = 0, mag = 0;
+    // The running sums start from pred (acc's first value): the first part's total as predicted by
+    // digit_sum when its lines are all plain, else 0; the merge adds what the true total differs.
+    std::uint64_t pred = 0;
     std::vector<double> reals, times, temps;
     const char* stop = nullptr;  // where the chunk's fast path stopped
   };
@@ -1011,19 +1014,22 @@ void Reader::merge_chunk(Chunk& c, MergeHelp& help, std::jthread& worker) {
     auto from = c.ints.begin();
     if (c.summed > 0) {
       if (sum_pending() && c.mag <= kSumLimit - mag_) {
-        // The chunk's running sums, offset by the sum so far where they are (a vectorised add):
-        // C_k without a second pass. They sit in ints_'s reserved room at its end, or after it
-        // when the first part held lines without a value; insert() then moves them down over that
-        // gap (an overlapping move), or has nothing to move.
-        const std::uint64_t base = acc_;
+        // The chunk's running sums, offset where they are by what the sum so far differs from the
+        // one they started from (nothing when it was predicted; else a vectorised add, half of it
+        // on the other thread): C_k without a second pass. They sit in ints_'s reserved room at
+        // its end, or after it when the first part held lines without a value; insert() then
+        // moves them down over that gap (an overlapping move), or has nothing to move.
+        const std::uint64_t offset = acc_ - c.pred;
         std::int64_t* d = c.ints.data();
-        const std::size_t half = c.summed / 2;
-        help.give(base, d, half);  // the other thread offsets the first half
-        for (std::size_t i = half; i < c.summed; ++i)
-          d[i] = static_cast<std::int64_t>(base + static_cast<std::uint64_t>(d[i]));
+        if (offset != 0) {
+          const std::size_t half = c.summed / 2;
+          help.give(offset, d, half);  // the other thread offsets the first half
+          for (std::size_t i = half; i < c.summed; ++i)
+            d[i] = static_cast<std::int64_t>(offset + static_cast<std::uint64_t>(d[i]));
+        }
         finish();
         ints_.insert(ints_.end(), d, d + c.summed);
-        acc_ = base + c.acc;
+        acc_ = c.acc + offset;
         mag_ += c.mag;
         summed_ = ints_.size();
       } else {
@@ -1033,6 +1039,7 @@ void Reader::merge_chunk(Chunk& c, MergeHelp& help, std::jthread& worker) {
         for (std::size_t i = c.summed; i-- > 1;)
           c.ints[i] = static_cast<std::int64_t>(static_cast<std::uint64_t>(c.ints[i]) -
                                                 static_cast<std::uint64_t>(c.ints[i - 1]));
+        c.ints[0] = static_cast<std::int64_t>(static_cast<std::uint64_t>(c.ints[0]) - c.pred);
         ints_.insert(ints_.end(), c.ints.begin(), c.ints.begin() + static_cast<std::ptrdiff_t>(c.summed));
       }
       from += static_cast<std::ptrdiff_t>(c.summed);
@@ -1078,7 +1085,15 @@ void Reader::scan(const char* p) {
               const std::size_t at = ints_.size() + (lines_before(limit) - lines_before(p));
               chunk.ints.p = ints_.data() + at;
               const std::size_t room = ints_.capacity() - at;
-              worker = std::jthread([this, &chunk, &help, room, from = limit](std::stop_token st) {
+              // The total the first part will end with, when its lines are all plain and
+              // everything before is summed: then the other part's running sums start from it,
+              // and the merge has nothing to add to them (the same values either way: the merge
+              // adds the difference, modulo 2^64).
+              const bool base_known = sum_pending();
+              worker = std::jthread([this, &chunk, &help, room, first = p, from = limit, base = acc_,
+                                     base_known](std::stop_token st) {
+                std::uint64_t first_sum = 0;
+                if (base_known && detail::digit_sum(first, from, first_sum)) chunk.acc = chunk.pred = base + first_sum;
                 detail::prefault(chunk.ints.p, room * sizeof(std::int64_t));
                 scan_chunk<Integer>(from, chunk, st);
                 help.parsed_then_help(st);

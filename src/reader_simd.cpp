@@ -6,6 +6,8 @@
 // for the previous one's bytes).
 #include "reader_simd.hpp"
 
+#include "reader_detail.hpp"
+
 #include <atomic>
 #include <bit>
 
@@ -121,6 +123,24 @@ const char* windows_portable(const char* p, const char* limit, std::int64_t* out
   return p;
 }
 
+// Sum of the counts of the windows of one-digit lines from p (as windows_portable, nothing written).
+const char* sum_portable(const char* p, const char* limit, std::uint64_t& sum) noexcept {
+  std::uint64_t a = sum;
+  while (limit - p >= 64) {
+    Window w;
+    if (!plain_window(classify_sse2(p), w)) break;
+    for (std::uint64_t e = w.value; e != 0; e &= e - 1) {
+      const auto i = static_cast<unsigned>(std::countr_zero(e));
+      const auto d = static_cast<std::uint64_t>(static_cast<unsigned char>(p[i]) - '0');
+      const std::uint64_t s = 0 - ((w.neg >> i) & 1U);
+      a += (d ^ s) - s;
+    }
+    p += w.used;
+  }
+  sum = a;
+  return p;
+}
+
 #if defined(__x86_64__)
 // GCC 12 warns about the deliberately undefined upper lanes inside its own AVX-512 headers
 // (_mm512_undefined_epi32 in the casts and conversions): nothing here reads them.
@@ -204,6 +224,34 @@ RWCALC_VBMI2 const char* windows_avx512(const char* p, const char* limit, std::i
   }
   return p;
 }
+// Sum of the counts of the windows of one-digit lines from p: the digits after a minus and the
+// others summed apart by vpsadbw (eight 64-bit partial sums each), nothing written.
+RWCALC_VBMI2 const char* sum_avx512(const char* p, const char* limit, std::uint64_t& sum) noexcept {
+  const __m512i lf = _mm512_set1_epi8('\n');
+  const __m512i mn = _mm512_set1_epi8('-');
+  const __m512i crv = _mm512_set1_epi8('\r');
+  const __m512i zero_char = _mm512_set1_epi8('0');
+  const __m512i ten = _mm512_set1_epi8(10);
+  const __m512i zero = _mm512_setzero_si512();
+  __m512i pos = zero, neg = zero;
+  while (limit - p >= 64) {
+    const __m512i b = _mm512_loadu_si512(p);
+    const __m512i d = _mm512_sub_epi8(b, zero_char);
+    Classes c;
+    c.nl = _mm512_cmpeq_epi8_mask(b, lf);
+    c.minus = _mm512_cmpeq_epi8_mask(b, mn);
+    c.cr = _mm512_cmpeq_epi8_mask(b, crv);
+    c.digit = _mm512_cmplt_epu8_mask(d, ten);
+    Window w;
+    if (!plain_window(c, w)) break;
+    pos = _mm512_add_epi64(pos, _mm512_sad_epu8(_mm512_maskz_mov_epi8(w.value & ~w.neg, d), zero));
+    neg = _mm512_add_epi64(neg, _mm512_sad_epu8(_mm512_maskz_mov_epi8(w.neg, d), zero));
+    p += w.used;
+  }
+  sum += static_cast<std::uint64_t>(_mm512_reduce_add_epi64(pos)) -
+         static_cast<std::uint64_t>(_mm512_reduce_add_epi64(neg));
+  return p;
+}
 #undef RWCALC_VBMI2
 #pragma GCC diagnostic pop
 
@@ -258,6 +306,28 @@ const char* digit_windows(const char* p, const char* limit, std::int64_t* out, s
       n = 0;
       return p;
   }
+}
+
+bool digit_sum(const char* p, const char* limit, std::uint64_t& sum) noexcept {
+  std::uint64_t a = 0;
+  const DigitKernel k = digit_kernel();
+  while (p < limit) {
+#if defined(__x86_64__)
+    if (k == DigitKernel::Avx512) p = sum_avx512(p, limit, a);
+#endif
+    if (k == DigitKernel::Portable) p = sum_portable(p, limit, a);
+    // A window of other lines, or the last bytes: one line at a time up to the next window.
+    const char* stop = limit - p > 64 ? p + 64 : limit;
+    while (p < stop) {
+      std::int64_t v = 0;
+      const char* next = scan_int_line(p, v);
+      if (!next) return false;
+      a += static_cast<std::uint64_t>(v);
+      p = next;
+    }
+  }
+  sum = a;
+  return p == limit;
 }
 
 template const char* digit_windows<true>(const char*, const char*, std::int64_t*, std::size_t&, std::uint64_t&,

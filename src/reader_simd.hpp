@@ -36,6 +36,12 @@ template <bool Sum>
 const char* digit_windows(const char* p, const char* limit, std::int64_t* out, std::size_t& n,
                           std::uint64_t& acc, std::uint64_t& mag) noexcept;
 
+/// The sum (modulo 2^64) of the counts of the lines in [p, limit), where limit is a line start,
+/// when every one of them is a plain integer line ("[-]d…d" of 1 to 7 digits, then LF or CRLF:
+/// what scan_int_line takes); false at the first line that is not (sum is then meaningless).
+/// Windows of one-digit lines are summed without writing anything, by the kernel in use.
+bool digit_sum(const char* p, const char* limit, std::uint64_t& sum) noexcept;
+
 extern template const char* digit_windows<true>(const char*, const char*, std::int64_t*, std::size_t&,
                                                 std::uint64_t&, std::uint64_t&) noexcept;
 extern template const char* digit_windows<false>(const char*, const char*, std::int64_t*, std::size_t&,

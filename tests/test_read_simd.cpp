@@ -218,6 +218,49 @@ TEST(ReadSimd, LargestAndExtremeSums) {
     }
 }
 
+// digit_sum: the sum of the counts of a range of lines when every line in it is plain (what
+// scan_int_line takes: up to 7 digits, LF or CRLF), else false; the same with every kernel.
+TEST(ReadSimd, DigitSumOfARangeOfLines) {
+  for (const int rare : {0, 1, 5, 50}) {
+    std::string t = mixed_lines(6000, 300U + static_cast<unsigned>(rare), rare);
+    const std::string text = padded(t);
+    std::vector<std::size_t> starts{0};
+    for (std::size_t i = 0; i < t.size(); ++i)
+      if (text[i] == '\n') starts.push_back(i + 1);
+    std::mt19937_64 rng(static_cast<unsigned>(rare));
+    for (int trial = 0; trial < 300; ++trial) {
+      std::size_t a = starts[rng() % starts.size()], b = starts[rng() % starts.size()];
+      if (trial % 50 == 0) {  // the whole text
+        a = 0;
+        b = t.size();
+      }
+      if (a > b) std::swap(a, b);
+      // The reference: line by line.
+      bool plain = true;
+      std::uint64_t want = 0;
+      for (std::size_t q = a; q < b && plain;) {
+        std::int64_t v = 0;
+        const char* next = detail::scan_int_line(text.data() + q, v);
+        plain = next != nullptr;
+        if (plain) {
+          want += static_cast<std::uint64_t>(v);
+          q = static_cast<std::size_t>(next - text.data());
+        }
+      }
+      for (const DigitKernel k : {DigitKernel::Avx512, DigitKernel::Portable, DigitKernel::Off}) {
+        if (!detail::digit_kernel_available(k)) continue;
+        const KernelScope scope(k);
+        std::uint64_t got = 12345;
+        const bool ok = detail::digit_sum(text.data() + a, text.data() + b, got);
+        ASSERT_EQ(ok, plain) << kernel_name(k) << " [" << a << ", " << b << ") rare " << rare;
+        if (plain) {
+          ASSERT_EQ(got, want) << kernel_name(k) << " [" << a << ", " << b << ") rare " << rare;
+        }
+      }
+    }
+  }
+}
+
 ReadOptions with_threads(unsigned t) {
   ReadOptions o;
   o.threads = t;
