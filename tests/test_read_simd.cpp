@@ -269,11 +269,13 @@ ReadOptions with_threads(unsigned t) {
 
 // A pulse file of mostly one-digit lines with the reader's other line kinds (comments, blank lines,
 // multi-digit and CRLF lines, "+3", indented values) spread through both parts of the text.
-std::string pulse_file(std::size_t n, unsigned seed) {
+// Lines before `plain_until` are all one-digit (the second part's sums then start from the first
+// part's total, summed beforehand).
+std::string pulse_file(std::size_t n, unsigned seed, std::size_t plain_until = 0) {
   std::mt19937_64 rng(seed);
   std::string t = "# rate_hz: 400\npulses\n";
   for (std::size_t i = 0; i < n; ++i) {
-    const auto r = rng() % 3000;
+    const auto r = i < plain_until ? 3000 : rng() % 3000;
     if (r == 0) t += "# note\n";
     if (r == 1) t += "\n";
     const int v = static_cast<int>(rng() % 7) - 3;
@@ -290,8 +292,12 @@ std::string pulse_file(std::size_t n, unsigned seed) {
 }
 
 TEST(ReadSimd, ReaderSameRecordWithEveryKernel) {
-  for (const std::size_t n : {std::size_t{3000}, std::size_t{1200000}}) {  // serial; two parts
-    const std::string text = pulse_file(n, 17);
+  // Serial; two parts with other lines in both; a first part of one-digit lines only, the other
+  // lines in the second; one-digit lines only.
+  const std::size_t big = 1200000;
+  for (const auto& [n, plain_until] : {std::pair{std::size_t{3000}, std::size_t{0}}, std::pair{big, std::size_t{0}},
+                                       std::pair{big, big * 3 / 5}, std::pair{big, big}}) {
+    const std::string text = pulse_file(n, 17, plain_until);
     Recording ref;
     {
       const KernelScope off(DigitKernel::Off);
