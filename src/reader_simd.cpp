@@ -144,9 +144,11 @@ const char* sum_portable(const char* p, const char* limit, std::uint64_t& sum) n
 #if defined(__x86_64__)
 // GCC 12 warns about the deliberately undefined upper lanes inside its own AVX-512 headers
 // (_mm512_undefined_epi32 in the casts and conversions): nothing here reads them.
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #define RWCALC_VBMI2 __attribute__((target("avx512f,avx512bw,avx512vbmi2,popcnt,bmi2")))
 
 // AVX-512 kernel: masks from four compares of the whole window; the values (digit − '0', negated
@@ -253,7 +255,9 @@ RWCALC_VBMI2 const char* sum_avx512(const char* p, const char* limit, std::uint6
   return p;
 }
 #undef RWCALC_VBMI2
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 
 bool has_avx512_kernel() noexcept {
   static const bool yes = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
