@@ -211,8 +211,8 @@ class Reader {
   static void grow_in_place(IntSink& v, std::size_t k) noexcept { v.n += k; }
   struct Chunk {
     IntSink ints;
-    // Pulses: ints[0, summed) are already the running sums of the chunk's counts (from 0), acc the
-    // last of them and mag the sum of the |counts|; the rest are counts as read.
+    // Pulses: ints[0, summed) are already the running sums of the chunk's counts (from pred), acc
+    // the last of them and mag the sum of the |counts|; the rest are counts as read.
     std::size_t summed = 0;
     std::uint64_t acc = 0, mag = 0;
     // The running sums start from pred (acc's first value): the first part's total as predicted by
@@ -221,10 +221,11 @@ class Reader {
     std::vector<double> reals, times, temps;
     const char* stop = nullptr;  // where the chunk's fast path stopped
   };
-  // The second part's thread, once its part is parsed, offsets the first half of its running sums
-  // by the first part's total while this thread offsets the second half (a pass over ~10 MB on the
-  // 2-h file, ~0.8 ms on one thread). Phases: 0 parsing, 1 parsed (waiting), 2 offset d[0, n) by
-  // base, 3 nothing more to do (also set when the thread is asked to stop).
+  // When the merge has to offset the second part's running sums (the first part's total was not
+  // predicted), that part's thread, once its part is parsed, offsets the first half of them while
+  // this thread offsets the second half (a pass over ~10 MB on the 2-h file, ~0.8 ms on one
+  // thread). Phases: 0 parsing, 1 parsed (waiting), 2 offset d[0, n) by base, 3 nothing more to
+  // do (also set when the thread is asked to stop).
   struct MergeHelp {
     std::atomic<int> phase{0};
     std::uint64_t base = 0;
