@@ -38,6 +38,7 @@ namespace {
 using detail::is_digit;
 using detail::scan_double_fast;
 using detail::scan_int_fast;
+using detail::count_lines_checked;
 using detail::TextBuffer;
 
 enum class Delim { Comma, Semicolon, Tab, Blanks };
@@ -138,7 +139,11 @@ std::vector<std::string_view> value_names(InputMode m) {
 class Reader {
  public:
   Reader(const TextBuffer& buf, std::string name, const ReadOptions& options)
-      : name_(std::move(name)), opt_(options), begin_(buf.data()), end_(buf.data() + buf.size()) {}
+      : loaded_lines_(&buf.segment_lines),
+        name_(std::move(name)),
+        opt_(options),
+        begin_(buf.data()),
+        end_(buf.data() + buf.size()) {}
 
   Recording run(bool store_times);
 
@@ -151,11 +156,12 @@ class Reader {
   }
 
   std::size_t check_bytes(const char* text);  // returns the number of '\n'
-  // Line ends in [marks_from_, x) for x in the checked text: the count at the last mark before x,
-  // plus the rest counted (less than kMarkBytes).
-  static constexpr std::ptrdiff_t kMarkBytes = 256 * 240;  // a whole number of count_lines_checked blocks
+  // Line ends in [marks_from_, x) for x in the checked text: the count at the last mark before x
+  // (one every kMarkBytes from the buffer's start), plus the rest counted (less than kMarkBytes).
+  static constexpr auto kMarkBytes = static_cast<std::ptrdiff_t>(TextBuffer::kSegment);
   const char* marks_from_ = nullptr;
   std::vector<std::size_t> line_marks_;
+  const std::vector<std::size_t>* loaded_lines_;  // TextBuffer::segment_lines
   [[nodiscard]] std::size_t lines_before(const char* x) const;
   LineKind careful_line(std::string_view line);
   void metadata_line(std::string_view body);
@@ -341,45 +347,26 @@ class Reader {
 
 // ---- bytes ---------------------------------------------------------------------------------------
 
-// Lines ('\n') in [b, end) and whether a control byte other than tab, LF, CR (or DEL) occurs: in
-// blocks of 240 bytes (a multiple of the vector width, below 256 so that an 8-bit line counter
-// cannot overflow within a block), branch-free inside a block so the compiler vectorises it; an
-// AVX2 clone is chosen at run time where the processor has it. Stops after the first block that
-// trips, setting `bad` to its start (else nullptr).
-__attribute__((target_clones("avx2", "default"))) std::size_t count_lines_checked(const char* b, const char* end,
-                                                                                 const char*& bad) {
-  constexpr std::size_t kBlock = 240;
-  std::size_t lines = 0;
-  bad = nullptr;
-  for (; b < end; b += kBlock) {
-    const char* e = end - b > static_cast<std::ptrdiff_t>(kBlock) ? b + kBlock : end;
-    unsigned char trip = 0, nl = 0;
-    for (const char* q = b; q < e; ++q) {
-      const auto c = static_cast<unsigned char>(*q);
-      nl = static_cast<unsigned char>(nl + (c == '\n'));
-      trip |= static_cast<unsigned char>(((c < 0x20) & (c != '\t') & (c != '\n') & (c != '\r')) | (c == 0x7f));
-    }
-    lines += nl;
-    if (trip) {
-      bad = b;
-      return lines;
-    }
-  }
-  return lines;
-}
-
 std::size_t Reader::check_bytes(const char* text) {
   // Binary data: NUL and other control bytes (tab, LF and CR excepted). Checked, and the lines
   // counted, in one pass (count_lines_checked); the block that trips is searched again for the
   // first bad byte.
   // The count is kept at every kMarkBytes (lines_before()), so that the split of a long text
   // needs no second count of its first part.
+  // The segments checked and counted while the file was loaded (from the buffer's start; a
+  // byte-order mark before `text` holds no line end and no control byte) are taken as counted.
   const char* bad = nullptr;
   std::size_t lines = 0;
-  marks_from_ = text;
+  marks_from_ = begin_;
   line_marks_.clear();
-  line_marks_.reserve(static_cast<std::size_t>(end_ - text) / kMarkBytes + 1);
-  for (const char* b = text; b < end_ && !bad; b += kMarkBytes) {
+  line_marks_.reserve(static_cast<std::size_t>(end_ - begin_) / kMarkBytes + 1);
+  const char* b = begin_;
+  for (const std::size_t n : *loaded_lines_) {
+    line_marks_.push_back(lines);
+    lines += n;
+    b += kMarkBytes;
+  }
+  for (; b < end_ && !bad; b += kMarkBytes) {
     line_marks_.push_back(lines);
     lines += count_lines_checked(b, end_ - b > kMarkBytes ? b + kMarkBytes : end_, bad);
   }
@@ -1420,8 +1407,10 @@ void validate(const ReadOptions& o) {
 
 Recording read_buffer(TextBuffer& buf, const std::string& source, const ReadOptions& options) {
   // Classic Mac line ends (CR only, no LF before the sentinel): read CR as the line end.
-  if (buf.size() > 1 && !std::memchr(buf.data(), '\n', buf.size() - 1) && std::memchr(buf.data(), '\r', buf.size()))
+  if (buf.size() > 1 && !std::memchr(buf.data(), '\n', buf.size() - 1) && std::memchr(buf.data(), '\r', buf.size())) {
     std::replace(buf.data(), buf.data() + buf.size(), '\r', '\n');
+    buf.segment_lines.clear();  // counted before the line ends changed
+  }
   Recording rec;
   try {
     rec = Reader(buf, detail::display_name(source), options).run(false);
