@@ -303,7 +303,8 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
     p.dev = std::sqrt(p.var);
     const std::int64_t t1 = timing ? detail::cpu_ns(true) : 0;
     p.alpha = options.noise_id ? detail::identify_noise(x, p.m, est, options.noise_id_domain,
-                                                        prepared.rel32.empty() ? nullptr : prepared.rel32.data())
+                                                        prepared.rel32.empty() ? nullptr : prepared.rel32.data(),
+                                                        prepared.small24)
                                : options.alpha;
     if (timing) {
       const std::int64_t t2 = detail::cpu_ns(true);

@@ -129,117 +129,187 @@ int acf_exponent(const P& phase, std::size_t count, int base) {
   }
 }
 
-#if defined(__x86_64__) || defined(__i386__)
-// p(from) … p(from + n − 1) as doubles into w (stride 1: eight conversions per instruction).
-__attribute__((target("avx2"))) void load_decimated(const std::int32_t* rel32, std::size_t stride, std::size_t from,
-                                                    std::size_t n, double* w) {
-  std::size_t t = 0;
-  if (stride == 1) {
-    for (; t + 4 <= n; t += 4)
-      _mm256_storeu_pd(w + t, _mm256_cvtepi32_pd(_mm_loadu_si128(reinterpret_cast<const __m128i*>(rel32 + from + t))));
-  }
-  for (; t < n; ++t) w[t] = static_cast<double>(rel32[(from + t) * stride]);
-}
+// ---- Exact integer lag-1 sums on the int32 view ----------------------------------------------
+//
+// On the int32 view of exact counts the level-L differences z are integers, so Σz, Σz² and
+// Σz_k·z_{k+1} are taken exactly (int64 lanes, flushed into 128-bit totals) in any order, and r1 is
+// formed once from them: only its final conversion rounds. The result therefore does not depend
+// on the order of the sums (vector lanes, chunks, tails, AVX2 or not), and differs from the
+// floating two-pass sum of lag1_autocorrelation() by that sum's rounding only.
 
-// z_L(k) … z_L(k + 3), the level-L difference of the decimated phase at w[o] … (integers: exact).
-template <int L>
-__attribute__((target("avx2"), always_inline)) inline __m256d zvec(const double* w, std::size_t o) {
-  if constexpr (L == 0)
-    return _mm256_loadu_pd(w + o);
-  else
-    return _mm256_sub_pd(zvec<L - 1>(w, o + 1), zvec<L - 1>(w, o));
-}
+__extension__ typedef __int128 i128;
 
-// Running lag-1 sums of one difference level in the scalar code's four lanes.
-struct Lag1Sums {
-  __m256d num, den, mean;
+/// Exact sums over z_0 … z_{len−1} of one difference level.
+struct ExactLag1 {
+  i128 s1 = 0;   // Σ z_k
+  i128 s2 = 0;   // Σ z_k²
+  i128 lag = 0;  // Σ z_k·z_{k+1}, k < len − 1
 };
 
-template <int L>
-__attribute__((target("avx2"), always_inline)) inline void lag1_step(const double* w, Lag1Sums& s) {
-  const __m256d a = _mm256_sub_pd(zvec<L>(w, 0), s.mean);
-  const __m256d b = _mm256_sub_pd(zvec<L>(w, 1), s.mean);
-  s.den = _mm256_add_pd(s.den, _mm256_mul_pd(a, a));
-  s.num = _mm256_add_pd(s.num, _mm256_mul_pd(a, b));
+/// The view has fewer points than this: every total below stays inside 128 bits even for
+/// |z| < 2^34 (level 3 of any int32 offset); longer records take the floating sums.
+constexpr std::size_t kExactMaxPoints = std::size_t{1} << 28;
+
+/// z_L(k) of p as an integer (|p| < 2^31: no overflow for L ≤ 3).
+template <class P>
+inline std::int64_t idiff(const P& p, int level, std::size_t k) {
+  switch (level) {
+    case 0: return p(k);
+    case 1: return p(k + 1) - p(k);
+    case 2: return p(k + 2) - 2 * p(k + 1) + p(k);
+    default: return p(k + 3) - 3 * p(k + 2) + 3 * p(k + 1) - p(k);
+  }
 }
 
-// lag1_autocorrelation<L> (and, with Pair, lag1_autocorrelation<L + 1> in the same pass over the
-// data) on the int32 view, four z values per instruction. Lane j takes the terms k ≡ j (mod 4) in
-// the order the scalar loop's lanes do, the differences of integers are exact in double whatever
-// the order, and products and sums are separate roundings (no fused multiply-add), so each r1 is
-// the scalar one bit for bit. p(k) = rel32[k·stride].
+/// r1 = Σ(z_k − z̄)(z_{k+1} − z̄) / Σ(z_k − z̄)² from the exact sums, with z̄ = S1/n:
+/// n·num = U − S1²/n, U = n·Slag − S1² + S1·(z_0 + z_{n−1});  n·den = n·S2 − S1²
+/// (integers but for the fraction of S1²/n, which is added last).
+double r1_from_exact(const ExactLag1& s, std::size_t len, std::int64_t z_first, std::int64_t z_last) {
+  const auto n = static_cast<i128>(len);
+  const i128 s1sq = s.s1 * s.s1;
+  const i128 den = n * s.s2 - s1sq;
+  if (den <= 0) return 0.0;
+  const i128 u = n * s.lag - s1sq + s.s1 * (static_cast<i128>(z_first) + z_last);
+  const i128 q = s1sq / n;
+  const i128 rem = s1sq % n;
+  const long double num =
+      static_cast<long double>(u - q) - static_cast<long double>(rem) / static_cast<long double>(len);
+  return static_cast<double>(num / static_cast<long double>(den));
+}
+
+/// Adds the terms k ∈ [from, len) of level `level` to s (lag terms for k + 1 < len).
+void exact_terms(const std::int32_t* rel32, std::size_t stride, int level, std::size_t from, std::size_t len,
+                 ExactLag1& s) {
+  auto p = [rel32, stride](std::size_t k) { return static_cast<std::int64_t>(rel32[k * stride]); };
+  for (std::size_t k = from; k < len; ++k) {
+    const std::int64_t z = idiff(p, level, k);
+    s.s1 += z;
+    s.s2 += static_cast<i128>(z) * z;
+    if (k + 1 < len) s.lag += static_cast<i128>(z) * idiff(p, level, k + 1);
+  }
+}
+
+double r1_exact_finish(const std::int32_t* rel32, std::size_t stride, int level, std::size_t len,
+                       const ExactLag1& s) {
+  auto p = [rel32, stride](std::size_t k) { return static_cast<std::int64_t>(rel32[k * stride]); };
+  return r1_from_exact(s, len, idiff(p, level, 0), idiff(p, level, len - 1));
+}
+
+/// r1 of level `level` with the exact sums, one term at a time (the portable path).
+double lag1_exact_scalar(const std::int32_t* rel32, std::size_t stride, std::size_t count, int level) {
+  if (count <= static_cast<std::size_t>(level) + 1) return 0.0;
+  const std::size_t len = count - static_cast<std::size_t>(level);
+  ExactLag1 s;
+  exact_terms(rel32, stride, level, 0, len, s);
+  return r1_exact_finish(rel32, stride, level, len, s);
+}
+
+#if defined(__x86_64__) || defined(__i386__)
+// z_L(k) … z_L(k + 3) of the int32 values at w[o] … as int64 lanes.
+template <int L>
+__attribute__((target("avx2"), always_inline)) inline __m256i izvec(const std::int32_t* w, std::size_t o) {
+  if constexpr (L == 0)
+    return _mm256_cvtepi32_epi64(_mm_loadu_si128(reinterpret_cast<const __m128i*>(w + o)));
+  else
+    return _mm256_sub_epi64(izvec<L - 1>(w, o + 1), izvec<L - 1>(w, o));
+}
+
+struct ExactLanes {
+  __m256i s1, s2, lag;
+};
+
+// One vector step: terms k … k + 3 (z_{k+4} read for the last lag product). _mm256_mul_epi32
+// multiplies the low 32 bits of each lane as signed: exact while |z| < 2^31.
+template <int L>
+__attribute__((target("avx2"), always_inline)) inline void exact_step(const std::int32_t* w, ExactLanes& a) {
+  const __m256i z = izvec<L>(w, 0);
+  const __m256i zn = izvec<L>(w, 1);
+  a.s1 = _mm256_add_epi64(a.s1, z);
+  a.s2 = _mm256_add_epi64(a.s2, _mm256_mul_epi32(z, z));
+  a.lag = _mm256_add_epi64(a.lag, _mm256_mul_epi32(z, zn));
+}
+
+__attribute__((target("avx2"))) inline void exact_flush(const ExactLanes& a, ExactLag1& s) {
+  alignas(32) std::int64_t l[3][4];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(l[0]), a.s1);
+  _mm256_store_si256(reinterpret_cast<__m256i*>(l[1]), a.s2);
+  _mm256_store_si256(reinterpret_cast<__m256i*>(l[2]), a.lag);
+  for (int j = 0; j < 4; ++j) {
+    s.s1 += l[0][j];
+    s.s2 += l[1][j];
+    s.lag += l[2][j];
+  }
+}
+
+// r1 of level L (and, with Pair, of level L + 1 in the same pass) with the exact sums, four
+// int64 lanes per instruction. Requires every |p| < 2^24 (PreparedCounts::small24): then
+// |z| < 2^27 for L ≤ 3, each product < 2^54, and a chunk of 256 steps per lane stays below 2^63.
 template <int L, bool Pair>
-__attribute__((target("avx2"))) void lag1_rel32_avx2(const std::int32_t* rel32, std::size_t stride, std::size_t count,
-                                                     double r[2]) {
-  auto p = [rel32, stride](std::size_t k) { return static_cast<double>(rel32[k * stride]); };
+__attribute__((target("avx2"))) void lag1_exact_avx2(const std::int32_t* rel32, std::size_t stride,
+                                                     std::size_t count, double r[2]) {
   constexpr int kLevels = Pair ? 2 : 1;
   r[0] = r[1] = 0.0;
-  // The decimated phase goes through a small buffer, a chunk at a time (each value converted once).
-  constexpr std::size_t kChunk = 2048;  // a multiple of 4: the lanes keep k ≡ j (mod 4)
-  constexpr std::size_t kExtra = static_cast<std::size_t>(L) + 6;
-  alignas(32) double buf[kChunk + kExtra + 3];
-  double mean[2] = {0, 0};
+  if (count <= static_cast<std::size_t>(L) + 1) return;  // r1 = 0: no pair of points at level L
+  if (Pair && count <= static_cast<std::size_t>(L) + 2) {  // none at level L + 1 (r[1] = 0)
+    r[0] = lag1_exact_scalar(rel32, stride, count, L);
+    return;
+  }
   std::size_t len[2] = {0, 0};
-  for (int q = 0; q < kLevels; ++q) {
-    const int lev = L + q;
-    if (count <= static_cast<std::size_t>(lev) + 1) return;  // as the scalar code: r1 = 0 (Pair: never here)
-    len[q] = count - static_cast<std::size_t>(lev);
-  }
-  if constexpr (L == 0) {
-    __m256d lane = _mm256_setzero_pd();
-    std::size_t i = 0;
-    while (i + 4 <= len[0]) {
-      const std::size_t stop = std::min(i + kChunk, len[0]) & ~std::size_t{3};
-      load_decimated(rel32, stride, i, stop - i, buf);
-      for (std::size_t t = 0; i < stop; i += 4, t += 4) lane = _mm256_add_pd(lane, _mm256_loadu_pd(buf + t));
-    }
-    alignas(32) double l[4];
-    _mm256_store_pd(l, lane);
-    for (; i < len[0]; ++i) l[0] += p(i);
-    mean[0] = (l[0] + l[1] + l[2] + l[3]) / static_cast<double>(len[0]);
-  } else {
-    mean[0] = (difference(p, L - 1, len[0]) - difference(p, L - 1, 0)) / static_cast<double>(len[0]);
-  }
-  if constexpr (Pair) mean[1] = (difference(p, L, len[1]) - difference(p, L, 0)) / static_cast<double>(len[1]);
-  Lag1Sums s0{_mm256_setzero_pd(), _mm256_setzero_pd(), _mm256_set1_pd(mean[0])};
-  Lag1Sums s1{_mm256_setzero_pd(), _mm256_setzero_pd(), _mm256_set1_pd(mean[1])};
-  // Vector iterations i (multiples of 4) with i + 4 < len[q]; with Pair, both levels while the
-  // shorter one lasts, then at most one more for level L alone.
+  for (int q = 0; q < kLevels; ++q) len[q] = count - static_cast<std::size_t>(L + q);
+  const std::size_t vlen = len[kLevels - 1];  // both levels have terms k < vlen
+  constexpr std::size_t kChunk = 1024;        // 256 steps: one flush per chunk
+  alignas(32) std::int32_t buf[kChunk + L + 8];
+  ExactLag1 s[2];
   std::size_t i = 0;
-  const std::size_t both = Pair ? len[1] : len[0];
-  while (i + 4 < len[0]) {
-    const std::size_t i0 = i;
-    load_decimated(rel32, stride, i0, std::min(kChunk + kExtra, count - i0), buf);
-    for (; i + 4 < both && i < i0 + kChunk; i += 4) {
-      lag1_step<L>(buf + (i - i0), s0);
-      if constexpr (Pair) lag1_step<L + 1>(buf + (i - i0), s1);
+  while (i + 4 < vlen) {
+    const std::int32_t* w = rel32 + i;
+    if (stride != 1) {  // the decimated phase into the buffer (each value read once)
+      const std::size_t n = std::min(kChunk + L + 6, count - i);
+      for (std::size_t t = 0; t < n; ++t) buf[t] = rel32[(i + t) * stride];
+      w = buf;
     }
-    if (i + 4 < both) continue;  // the chunk ended, the loop did not
-    for (; i + 4 < len[0] && i < i0 + kChunk; i += 4) lag1_step<L>(buf + (i - i0), s0);
-    if (i + 4 < len[0]) continue;
-    break;
+    ExactLanes a0{_mm256_setzero_si256(), _mm256_setzero_si256(), _mm256_setzero_si256()};
+    ExactLanes a1 = a0;
+    std::size_t t = 0;
+    for (; t < kChunk && i + t + 4 < vlen; t += 4) {
+      exact_step<L>(w + t, a0);
+      if constexpr (Pair) exact_step<L + 1>(w + t, a1);
+    }
+    exact_flush(a0, s[0]);
+    if constexpr (Pair) exact_flush(a1, s[1]);
+    i += t;
   }
-  const std::size_t i_end[2] = {i, Pair ? std::min(i, len[1] > 4 ? ((len[1] - 5) / 4 + 1) * 4 : 0) : 0};
   for (int q = 0; q < kLevels; ++q) {
-    const Lag1Sums& sq = q == 0 ? s0 : s1;
-    alignas(32) double nu[4], de[4];
-    _mm256_store_pd(nu, sq.num);
-    _mm256_store_pd(de, sq.den);
-    const int lev = L + q;
-    for (std::size_t k = i_end[q]; k < len[q]; ++k) {
-      const double a = difference(p, lev, k) - mean[q];
-      de[0] += a * a;
-      if (k + 1 < len[q]) nu[0] += a * (difference(p, lev, k + 1) - mean[q]);
-    }
-    const double n_sum = nu[0] + nu[1] + nu[2] + nu[3];
-    const double d_sum = de[0] + de[1] + de[2] + de[3];
-    r[q] = d_sum > 0 ? n_sum / d_sum : 0.0;
+    exact_terms(rel32, stride, L + q, i, len[q], s[q]);
+    r[q] = r1_exact_finish(rel32, stride, L + q, len[q], s[q]);
   }
 }
 
-/// acf_exponent() on the int32 view with the AVX2 sums (same result bit for bit). A level that
-/// may be followed by the next has both computed in one pass over the data.
-int acf_exponent_rel32_avx2(const std::int32_t* rel32, std::size_t stride, std::size_t count, int base) {
+// r1 of `level` (and of level + 1 into r[1] when pair) on the view, exact sums in AVX2.
+void lag1_exact_avx2_at(const std::int32_t* rel32, std::size_t stride, std::size_t count, int level, bool pair,
+                        double r[2]) {
+  switch (level * 2 + (pair ? 1 : 0)) {
+    case 0: lag1_exact_avx2<0, false>(rel32, stride, count, r); break;
+    case 1: lag1_exact_avx2<0, true>(rel32, stride, count, r); break;
+    case 2: lag1_exact_avx2<1, false>(rel32, stride, count, r); break;
+    case 3: lag1_exact_avx2<1, true>(rel32, stride, count, r); break;
+    case 4: lag1_exact_avx2<2, false>(rel32, stride, count, r); break;
+    case 5: lag1_exact_avx2<2, true>(rel32, stride, count, r); break;
+    default: lag1_exact_avx2<3, false>(rel32, stride, count, r); break;
+  }
+}
+#endif
+
+/// The ACF method (see acf_exponent) on the int32 view with the exact sums; with AVX2 and
+/// small24, a level that may be followed by the next has both computed in one pass.
+int acf_exponent_exact(const std::int32_t* rel32, std::size_t stride, std::size_t count, int base, bool small24) {
+#if defined(__x86_64__) || defined(__i386__)
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  const bool vector = avx2 && small24;
+#else
+  const bool vector = false;
+  (void)small24;
+#endif
   double next = 0;  // r1 of level base + d, when computed with the previous level
   bool have_next = false;
   for (int d = 0;; ++d) {
@@ -248,37 +318,29 @@ int acf_exponent_rel32_avx2(const std::int32_t* rel32, std::size_t stride, std::
     if (have_next) {
       r1 = next;
       have_next = false;
-    } else {
+    } else if (vector) {
+#if defined(__x86_64__) || defined(__i386__)
       double r[2];
       const bool pair = d < kMaxDifferences && level < 3 && count > static_cast<std::size_t>(level) + 16;
-      switch (level * 2 + (pair ? 1 : 0)) {
-        case 0: lag1_rel32_avx2<0, false>(rel32, stride, count, r); break;
-        case 1: lag1_rel32_avx2<0, true>(rel32, stride, count, r); break;
-        case 2: lag1_rel32_avx2<1, false>(rel32, stride, count, r); break;
-        case 3: lag1_rel32_avx2<1, true>(rel32, stride, count, r); break;
-        case 4: lag1_rel32_avx2<2, false>(rel32, stride, count, r); break;
-        case 5: lag1_rel32_avx2<2, true>(rel32, stride, count, r); break;
-        default: lag1_rel32_avx2<3, false>(rel32, stride, count, r); break;
-      }
+      lag1_exact_avx2_at(rel32, stride, count, level, pair, r);
       r1 = r[0];
       next = r[1];
       have_next = pair;
+#endif
+    } else {
+      r1 = lag1_exact_scalar(rel32, stride, count, level);
     }
     const double delta = r1 / (1.0 + r1);
     if (delta < 0.25 || d >= kMaxDifferences) return -static_cast<int>(std::lround(2.0 * delta)) - 2 * d;
   }
 }
-#endif
 
 /// The ACF method on the phase decimated by m, read in place (no copy): p(k) = x_{k·m} − x_0 as
-/// decimated_phase() forms it, bit for bit.
-int acf_exponent_at(const PhaseSeries& x, std::int64_t m, std::size_t count, int base, const std::int32_t* rel32) {
+/// decimated_phase() forms it; on the int32 view with the exact integer sums.
+int acf_exponent_at(const PhaseSeries& x, std::int64_t m, std::size_t count, int base, const std::int32_t* rel32,
+                    bool small24) {
   const auto um = static_cast<std::size_t>(m);
-#if defined(__x86_64__) || defined(__i386__)
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  if (rel32 && avx2)
-    return acf_exponent_rel32_avx2(rel32, um, count, base);
-#endif
+  if (rel32 && x.points() < kExactMaxPoints) return acf_exponent_exact(rel32, um, count, base, small24);
   if (rel32) {
     if (um == 1) return acf_exponent([rel32](std::size_t k) { return static_cast<double>(rel32[k]); }, count, base);
     return acf_exponent([rel32, um](std::size_t k) { return static_cast<double>(rel32[k * um]); }, count, base);
@@ -447,21 +509,36 @@ double binomial(int n, int k) {
 }  // namespace
 
 int identify_noise(const PhaseSeries& x, std::int64_t m, Estimator est, NoiseIdDomain domain) {
-  return detail::identify_noise(x, m, est, domain, nullptr);
+  return detail::identify_noise(x, m, est, domain, nullptr, false);
 }
 
 namespace detail {
 
 int identify_noise(const PhaseSeries& x, std::int64_t m, Estimator est, NoiseIdDomain domain,
-                   const std::int32_t* rel32) {
+                   const std::int32_t* rel32, bool small24) {
   if (m < 1 || x.points() < 3 || static_cast<std::size_t>(m) > x.points() - 1) return 0;
   // Points at τ: phase samples for phase data, averaged frequencies (one fewer) for frequency data.
   const std::size_t phase_points = (x.points() - 1) / static_cast<std::size_t>(m) + 1;
   if (domain == NoiseIdDomain::Phase && phase_points >= kMinAcfPoints)
-    return std::clamp(acf_exponent_at(x, m, phase_points, 0, rel32) + 2, -2, 2);
+    return std::clamp(acf_exponent_at(x, m, phase_points, 0, rel32, small24) + 2, -2, 2);
   if (domain == NoiseIdDomain::Frequency && phase_points - 1 >= kMinAcfPoints)
-    return std::clamp(acf_exponent_at(x, m, phase_points, 1, rel32), -2, 2);
+    return std::clamp(acf_exponent_at(x, m, phase_points, 1, rel32, small24), -2, 2);
   return noise_id_b1(x, m, est);
+}
+
+void lag1_exact(const std::int32_t* rel32, std::size_t stride, std::size_t count, int level, bool vector, bool pair,
+                double r[2]) {
+  pair = pair && level < 3;
+#if defined(__x86_64__) || defined(__i386__)
+  if (vector && __builtin_cpu_supports("avx2")) {
+    lag1_exact_avx2_at(rel32, stride, count, level, pair, r);
+    if (!pair) r[1] = 0.0;
+    return;
+  }
+#endif
+  (void)vector;
+  r[0] = lag1_exact_scalar(rel32, stride, count, level);
+  r[1] = pair ? lag1_exact_scalar(rel32, stride, count, level + 1) : 0.0;
 }
 
 }  // namespace detail

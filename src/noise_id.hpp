@@ -1,5 +1,6 @@
 #pragma once
 // Noise identification reading the prepared int32 view of exact counts in place (internal).
+#include <cstddef>
 #include <cstdint>
 
 #include "rwcalc/allan.hpp"
@@ -8,8 +9,19 @@
 namespace rwcalc::detail {
 
 /// identify_noise() with, for exact counts, the offsets C_k − C_0 as int32 (PreparedCounts::rel32;
-/// nullptr to read the counts themselves). Same result bit for bit; no allocation on the ACF path.
+/// nullptr to read the counts themselves); small24: every |C_k − C_0| < 2^24 (PreparedCounts::small24).
+/// On the view, the lag-1 autocorrelations come from exact integer sums (AVX2 when small24), so
+/// they differ from the floating sums on the counts by those sums' rounding only. No allocation on
+/// the ACF path.
 int identify_noise(const PhaseSeries& x, std::int64_t m, Estimator est, NoiseIdDomain domain,
-                   const std::int32_t* rel32);
+                   const std::int32_t* rel32, bool small24);
+
+/// The lag-1 autocorrelation r1 of the level-th difference (0 … 3) of p(k) = rel32[k·stride],
+/// k < count, from exact integer sums, into r[0]; with pair (level < 3), also that of level + 1 into r[1]
+/// (else r[1] = 0).
+/// vector: the AVX2 kernel where the CPU has it (requires every |p| < 2^24), else one term at a
+/// time. Both give the same bits.
+void lag1_exact(const std::int32_t* rel32, std::size_t stride, std::size_t count, int level, bool vector, bool pair,
+                double r[2]);
 
 }  // namespace rwcalc::detail
