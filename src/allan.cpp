@@ -279,6 +279,15 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
     if (!ok) swept.clear();
   }
 
+  // The first two lag-1 levels of the noise identification at every small m, in one pass over the
+  // int32 view shared by all of them (the per-τ passes each streamed the whole view).
+  std::vector<double> lag1_start;
+  if (options.noise_id && !prepared.rel32.empty()) {
+    detail::ScopedTimer t("allan: noise id start pass");
+    lag1_start = detail::lag1_start_pass(x, ms.data(), ms.size(), options.noise_id_domain, prepared.rel32.data(),
+                                         prepared.small24, threads);
+  }
+
   const bool timing = detail::timing_enabled();
   std::atomic<std::int64_t> ns_sums{0}, ns_noise{0};
   auto work = [&](std::size_t i) {
@@ -304,7 +313,10 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
     const std::int64_t t1 = timing ? detail::cpu_ns(true) : 0;
     p.alpha = options.noise_id ? detail::identify_noise(x, p.m, est, options.noise_id_domain,
                                                         prepared.rel32.empty() ? nullptr : prepared.rel32.data(),
-                                                        prepared.small24)
+                                                        prepared.small24,
+                                                        !lag1_start.empty() && !std::isnan(lag1_start[2 * i])
+                                                            ? &lag1_start[2 * i]
+                                                            : nullptr)
                                : options.alpha;
     if (timing) {
       const std::int64_t t2 = detail::cpu_ns(true);

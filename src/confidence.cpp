@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <thread>
 #include <vector>
 
 #if defined(__x86_64__) || defined(__i386__)
@@ -150,6 +151,9 @@ struct ExactLag1 {
 /// |z| < 2^34 (level 3 of any int32 offset); longer records take the floating sums.
 constexpr std::size_t kExactMaxPoints = std::size_t{1} << 28;
 
+/// The cluster sizes up to this one take their first two levels from the start pass.
+constexpr std::int64_t kStartPassMaxM = 256;
+
 /// z_L(k) of p as an integer (|p| < 2^31: no overflow for L ≤ 3).
 template <class P>
 inline std::int64_t idiff(const P& p, int level, std::size_t k) {
@@ -241,48 +245,79 @@ __attribute__((target("avx2"))) inline void exact_flush(const ExactLanes& a, Exa
   }
 }
 
-// r1 of level L (and, with Pair, of level L + 1 in the same pass) with the exact sums, four
-// int64 lanes per instruction. Requires every |p| < 2^24 (PreparedCounts::small24): then
+// Vector steps of the exact sums of level L (and, with Pair, of level L + 1) at the positions
+// i ∈ {from, from + 4, …} below `to`, each adding the terms k = i … i + 3 to s; requires
+// to ≤ vlen − 4 (vlen: the points of the highest level summed), so that every z_{k+1} exists.
+// Four int64 lanes per instruction. Requires every |p| < 2^24 (PreparedCounts::small24): then
 // |z| < 2^27 for L ≤ 3, each product < 2^54, and a chunk of 256 steps per lane stays below 2^63.
+// Returns the first position not taken.
+template <int L, bool Pair>
+__attribute__((target("avx2"))) std::size_t lag1_exact_steps_avx2(const std::int32_t* rel32, std::size_t stride,
+                                                                  std::size_t count, std::size_t from,
+                                                                  std::size_t to, ExactLag1 s[2]) {
+  constexpr std::size_t kChunk = 1024;  // 256 steps: one flush per chunk
+  alignas(32) std::int32_t buf[kChunk + L + 8];
+  std::size_t i = from;
+  while (i < to) {
+    const std::int32_t* w = rel32 + i;
+    if (stride != 1) {  // the decimated phase into the buffer (each value read once), eight per gather
+      const std::size_t n = std::min(kChunk + L + 6, count - i);
+      const std::int32_t* base = rel32 + i * stride;
+      const __m256i step = _mm256_set1_epi32(static_cast<std::int32_t>(8 * stride));
+      __m256i idx = _mm256_mullo_epi32(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7),
+                                       _mm256_set1_epi32(static_cast<std::int32_t>(stride)));
+      std::size_t t = 0;
+      if (stride < (std::size_t{1} << 20))  // the int32 indices (t·stride, t < 1040) do not overflow
+        for (; t + 8 <= n; t += 8, idx = _mm256_add_epi32(idx, step))
+          _mm256_store_si256(reinterpret_cast<__m256i*>(buf + t), _mm256_i32gather_epi32(base, idx, 4));
+      for (; t < n; ++t) buf[t] = base[t * stride];
+      w = buf;
+    }
+    ExactLanes a0{_mm256_setzero_si256(), _mm256_setzero_si256(), _mm256_setzero_si256()};
+    ExactLanes a1 = a0;
+    const std::size_t i0 = i;
+    for (; i < to && i < i0 + kChunk; i += 4) {
+      exact_step<L>(w + (i - i0), a0);
+      if constexpr (Pair) exact_step<L + 1>(w + (i - i0), a1);
+    }
+    exact_flush(a0, s[0]);
+    if constexpr (Pair) exact_flush(a1, s[1]);
+  }
+  return i;
+}
+
+// Points of level L and the end of its vector steps (0: none), for `count` phase points.
+template <int L, bool Pair>
+std::size_t vector_end(std::size_t count) {
+  const std::size_t vlen = count - static_cast<std::size_t>(L + (Pair ? 1 : 0));
+  return vlen > 4 ? vlen - 4 : 0;
+}
+
+// The scalar tail from `covered` and r1 of each level.
+template <int L, bool Pair>
+void lag1_exact_tail(const std::int32_t* rel32, std::size_t stride, std::size_t count, std::size_t covered,
+                     ExactLag1 s[2], double r[2]) {
+  for (int q = 0; q < (Pair ? 2 : 1); ++q) {
+    const std::size_t len = count - static_cast<std::size_t>(L + q);
+    exact_terms(rel32, stride, L + q, covered, len, s[q]);
+    r[q] = r1_exact_finish(rel32, stride, L + q, len, s[q]);
+  }
+}
+
+// r1 of level L (and, with Pair, of level L + 1 in the same pass over the data) with the exact
+// sums in AVX2.
 template <int L, bool Pair>
 __attribute__((target("avx2"))) void lag1_exact_avx2(const std::int32_t* rel32, std::size_t stride,
                                                      std::size_t count, double r[2]) {
-  constexpr int kLevels = Pair ? 2 : 1;
   r[0] = r[1] = 0.0;
   if (count <= static_cast<std::size_t>(L) + 1) return;  // r1 = 0: no pair of points at level L
   if (Pair && count <= static_cast<std::size_t>(L) + 2) {  // none at level L + 1 (r[1] = 0)
     r[0] = lag1_exact_scalar(rel32, stride, count, L);
     return;
   }
-  std::size_t len[2] = {0, 0};
-  for (int q = 0; q < kLevels; ++q) len[q] = count - static_cast<std::size_t>(L + q);
-  const std::size_t vlen = len[kLevels - 1];  // both levels have terms k < vlen
-  constexpr std::size_t kChunk = 1024;        // 256 steps: one flush per chunk
-  alignas(32) std::int32_t buf[kChunk + L + 8];
   ExactLag1 s[2];
-  std::size_t i = 0;
-  while (i + 4 < vlen) {
-    const std::int32_t* w = rel32 + i;
-    if (stride != 1) {  // the decimated phase into the buffer (each value read once)
-      const std::size_t n = std::min(kChunk + L + 6, count - i);
-      for (std::size_t t = 0; t < n; ++t) buf[t] = rel32[(i + t) * stride];
-      w = buf;
-    }
-    ExactLanes a0{_mm256_setzero_si256(), _mm256_setzero_si256(), _mm256_setzero_si256()};
-    ExactLanes a1 = a0;
-    std::size_t t = 0;
-    for (; t < kChunk && i + t + 4 < vlen; t += 4) {
-      exact_step<L>(w + t, a0);
-      if constexpr (Pair) exact_step<L + 1>(w + t, a1);
-    }
-    exact_flush(a0, s[0]);
-    if constexpr (Pair) exact_flush(a1, s[1]);
-    i += t;
-  }
-  for (int q = 0; q < kLevels; ++q) {
-    exact_terms(rel32, stride, L + q, i, len[q], s[q]);
-    r[q] = r1_exact_finish(rel32, stride, L + q, len[q], s[q]);
-  }
+  const std::size_t covered = lag1_exact_steps_avx2<L, Pair>(rel32, stride, count, 0, vector_end<L, Pair>(count), s);
+  lag1_exact_tail<L, Pair>(rel32, stride, count, covered, s, r);
 }
 
 // r1 of `level` (and of level + 1 into r[1] when pair) on the view, exact sums in AVX2.
@@ -298,11 +333,64 @@ void lag1_exact_avx2_at(const std::int32_t* rel32, std::size_t stride, std::size
     default: lag1_exact_avx2<3, false>(rel32, stride, count, r); break;
   }
 }
+
+// The start pass (detail::lag1_start_pass) of one thread: the vector steps of every stride j at
+// positions [lo[j], hi[j]), walking the view in blocks so that all strides read a block while it
+// is in the core's cache.
+template <int L>
+__attribute__((target("avx2"))) void lag1_start_part(const std::int32_t* rel32, std::size_t b_lo, std::size_t b_hi,
+                                                     const std::vector<std::size_t>& stride,
+                                                     const std::vector<std::size_t>& count,
+                                                     const std::vector<std::size_t>& lo,
+                                                     const std::vector<std::size_t>& hi, ExactLag1* s) {
+  constexpr std::size_t kBlock = 16384;  // 64 KB of the view
+  std::vector<std::size_t> pos = lo;
+  for (std::size_t b0 = b_lo; b0 < b_hi; b0 += kBlock) {
+    const std::size_t b1 = std::min(b_hi, b0 + kBlock);
+    for (std::size_t j = 0; j < stride.size(); ++j) {
+      const std::size_t kb = std::min(hi[j], (b1 + stride[j] - 1) / stride[j]);
+      if (pos[j] < kb) pos[j] = lag1_exact_steps_avx2<L, true>(rel32, stride[j], count[j], pos[j], kb, s + 2 * j);
+    }
+  }
+}
+
+template <int L>
+void lag1_start_pass_impl(const std::int32_t* rel32, std::size_t points, const std::vector<std::size_t>& stride,
+                          const std::vector<std::size_t>& count, unsigned threads, std::vector<double>& r) {
+  const std::size_t n = stride.size();
+  std::vector<std::size_t> vend(n), split(n), zero(n, 0);
+  const std::size_t mid = threads > 1 ? points / 2 : points;
+  for (std::size_t j = 0; j < n; ++j) {
+    vend[j] = vector_end<L, true>(count[j]);
+    // Thread 0 takes the steps below split (a multiple of 4, so both threads keep the positions
+    // 0, 4, 8, …), thread 1 the rest: the sums are exact, so the split changes no bit.
+    split[j] = std::min(vend[j], ((mid + stride[j] - 1) / stride[j]) & ~std::size_t{3});
+  }
+  std::vector<ExactLag1> s0(2 * n), s1(2 * n);
+  {
+    std::jthread second;
+    if (threads > 1)
+      second = std::jthread([&] { lag1_start_part<L>(rel32, mid, points, stride, count, split, vend, s1.data()); });
+    lag1_start_part<L>(rel32, 0, mid, stride, count, zero, threads > 1 ? split : vend, s0.data());
+  }
+  r.assign(2 * n, 0.0);
+  for (std::size_t j = 0; j < n; ++j) {
+    ExactLag1 s[2];
+    for (int q = 0; q < 2; ++q) {
+      s[q].s1 = s0[2 * j + q].s1 + s1[2 * j + q].s1;
+      s[q].s2 = s0[2 * j + q].s2 + s1[2 * j + q].s2;
+      s[q].lag = s0[2 * j + q].lag + s1[2 * j + q].lag;
+    }
+    const std::size_t covered = (vend[j] + 3) & ~std::size_t{3};  // the terms of the steps 0, 4, …
+    lag1_exact_tail<L, true>(rel32, stride[j], count[j], covered, s, &r[2 * j]);
+  }
+}
 #endif
 
 /// The ACF method (see acf_exponent) on the int32 view with the exact sums; with AVX2 and
 /// small24, a level that may be followed by the next has both computed in one pass.
-int acf_exponent_exact(const std::int32_t* rel32, std::size_t stride, std::size_t count, int base, bool small24) {
+int acf_exponent_exact(const std::int32_t* rel32, std::size_t stride, std::size_t count, int base, bool small24,
+                       const double* start) {
 #if defined(__x86_64__) || defined(__i386__)
   static const bool avx2 = __builtin_cpu_supports("avx2");
   const bool vector = avx2 && small24;
@@ -315,7 +403,9 @@ int acf_exponent_exact(const std::int32_t* rel32, std::size_t stride, std::size_
   for (int d = 0;; ++d) {
     const int level = base + d;
     double r1 = 0;
-    if (have_next) {
+    if (start && d < 2) {  // levels base and base + 1 from the start pass
+      r1 = start[d];
+    } else if (have_next) {
       r1 = next;
       have_next = false;
     } else if (vector) {
@@ -338,9 +428,9 @@ int acf_exponent_exact(const std::int32_t* rel32, std::size_t stride, std::size_
 /// The ACF method on the phase decimated by m, read in place (no copy): p(k) = x_{k·m} − x_0 as
 /// decimated_phase() forms it; on the int32 view with the exact integer sums.
 int acf_exponent_at(const PhaseSeries& x, std::int64_t m, std::size_t count, int base, const std::int32_t* rel32,
-                    bool small24) {
+                    bool small24, const double* start) {
   const auto um = static_cast<std::size_t>(m);
-  if (rel32 && x.points() < kExactMaxPoints) return acf_exponent_exact(rel32, um, count, base, small24);
+  if (rel32 && x.points() < kExactMaxPoints) return acf_exponent_exact(rel32, um, count, base, small24, start);
   if (rel32) {
     if (um == 1) return acf_exponent([rel32](std::size_t k) { return static_cast<double>(rel32[k]); }, count, base);
     return acf_exponent([rel32, um](std::size_t k) { return static_cast<double>(rel32[k * um]); }, count, base);
@@ -509,21 +599,55 @@ double binomial(int n, int k) {
 }  // namespace
 
 int identify_noise(const PhaseSeries& x, std::int64_t m, Estimator est, NoiseIdDomain domain) {
-  return detail::identify_noise(x, m, est, domain, nullptr, false);
+  return detail::identify_noise(x, m, est, domain, nullptr, false, nullptr);
 }
 
 namespace detail {
 
 int identify_noise(const PhaseSeries& x, std::int64_t m, Estimator est, NoiseIdDomain domain,
-                   const std::int32_t* rel32, bool small24) {
+                   const std::int32_t* rel32, bool small24, const double* start) {
   if (m < 1 || x.points() < 3 || static_cast<std::size_t>(m) > x.points() - 1) return 0;
   // Points at τ: phase samples for phase data, averaged frequencies (one fewer) for frequency data.
   const std::size_t phase_points = (x.points() - 1) / static_cast<std::size_t>(m) + 1;
   if (domain == NoiseIdDomain::Phase && phase_points >= kMinAcfPoints)
-    return std::clamp(acf_exponent_at(x, m, phase_points, 0, rel32, small24) + 2, -2, 2);
+    return std::clamp(acf_exponent_at(x, m, phase_points, 0, rel32, small24, start) + 2, -2, 2);
   if (domain == NoiseIdDomain::Frequency && phase_points - 1 >= kMinAcfPoints)
-    return std::clamp(acf_exponent_at(x, m, phase_points, 1, rel32, small24), -2, 2);
+    return std::clamp(acf_exponent_at(x, m, phase_points, 1, rel32, small24, start), -2, 2);
   return noise_id_b1(x, m, est);
+}
+
+std::vector<double> lag1_start_pass(const PhaseSeries& x, const std::int64_t* ms, std::size_t n_ms,
+                                    NoiseIdDomain domain, const std::int32_t* rel32, bool small24, unsigned threads) {
+  std::vector<double> out;
+#if defined(__x86_64__) || defined(__i386__)
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  const std::size_t points = x.points();
+  if (!avx2 || !rel32 || !small24 || points < 3 || points >= kExactMaxPoints) return out;
+  const int base = domain == NoiseIdDomain::Phase ? 0 : 1;
+  std::vector<std::size_t> stride, count, index;
+  for (std::size_t j = 0; j < n_ms; ++j) {
+    if (ms[j] < 1 || ms[j] > kStartPassMaxM || static_cast<std::size_t>(ms[j]) > points - 1) continue;
+    const std::size_t phase_points = (points - 1) / static_cast<std::size_t>(ms[j]) + 1;
+    if (phase_points - static_cast<std::size_t>(base) < kMinAcfPoints) continue;  // B1 at this m
+    stride.push_back(static_cast<std::size_t>(ms[j]));
+    count.push_back(phase_points);
+    index.push_back(j);
+  }
+  if (stride.empty()) return out;
+  std::vector<double> r;
+  if (base == 0)
+    lag1_start_pass_impl<0>(rel32, points, stride, count, threads, r);
+  else
+    lag1_start_pass_impl<1>(rel32, points, stride, count, threads, r);
+  out.assign(2 * n_ms, std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t i = 0; i < index.size(); ++i) {
+    out[2 * index[i]] = r[2 * i];
+    out[2 * index[i] + 1] = r[2 * i + 1];
+  }
+#else
+  (void)x, (void)ms, (void)n_ms, (void)domain, (void)rel32, (void)small24, (void)threads;
+#endif
+  return out;
 }
 
 void lag1_exact(const std::int32_t* rel32, std::size_t stride, std::size_t count, int level, bool vector, bool pair,

@@ -86,7 +86,9 @@ TEST(NoiseIdExact, Lag1MatchesLongDoubleReferenceAndVectorEqualsScalar) {
                   << "n " << n << " kind " << kind << " range " << range << " stride " << stride << " level " << level;
               if (pair) {
                 EXPECT_EQ(rv[1], rs[1]) << "n " << n << " kind " << kind << " level " << level + 1;
-                if (level < 3) EXPECT_NEAR(rv[1], reference_r1(v, stride, count, level + 1), kTol);
+                if (level < 3) {
+                  EXPECT_NEAR(rv[1], reference_r1(v, stride, count, level + 1), kTol);
+                }
               }
               ++compared;
             }
@@ -127,6 +129,49 @@ TEST(NoiseIdExact, Lag1DegenerateCases) {
     rwcalc::detail::lag1_exact(ramp.data(), 1, ramp.size(), 0, vector, false, r);  // a line: r1 near 1
     EXPECT_NEAR(r[0], reference_r1(ramp, 1, ramp.size(), 0), kTol);
   }
+}
+
+}  // namespace
+
+namespace {
+
+// The start pass computes the first two levels of every small m in one pass over the view, split
+// over threads: its r1 must be those of lag1_exact at each m, bit for bit (exact sums), for both
+// domains, on one and two threads, at lengths that leave every tail size.
+TEST(NoiseIdExact, StartPassEqualsPerTauSums) {
+  std::uint64_t seed = 300;
+  int compared = 0;
+  for (std::size_t n : {std::size_t{1001}, std::size_t{65539}, std::size_t{300007}}) {
+    for (int kind = 0; kind < 5; ++kind) {
+      const auto v = record(n, kind, 1.0e6, ++seed);
+      rwcalc::PhaseSeries x;
+      x.counts.reserve(n);
+      for (std::int32_t c : v) x.counts.push_back(c);  // C_k − C_0 = the view
+      const std::vector<std::int64_t> ms = {1, 2, 3, 4, 5, 7, 8, 16, 33, 64, 128, 256, 512, 1024};
+      for (auto domain : {rwcalc::NoiseIdDomain::Phase, rwcalc::NoiseIdDomain::Frequency}) {
+        const int base = domain == rwcalc::NoiseIdDomain::Phase ? 0 : 1;
+        for (unsigned threads : {1u, 2u}) {
+          const auto start = rwcalc::detail::lag1_start_pass(x, ms.data(), ms.size(), domain, v.data(), true, threads);
+          if (start.empty()) GTEST_SKIP() << "no AVX2 on this processor";
+          ASSERT_EQ(start.size(), 2 * ms.size());
+          for (std::size_t j = 0; j < ms.size(); ++j) {
+            const auto m = static_cast<std::size_t>(ms[j]);
+            const std::size_t count = (n - 1) / m + 1;
+            if (m > 256 || count - static_cast<std::size_t>(base) < 30) {
+              EXPECT_TRUE(std::isnan(start[2 * j])) << "m " << m;
+              continue;
+            }
+            double r[2];
+            rwcalc::detail::lag1_exact(v.data(), m, count, base, false, true, r);
+            EXPECT_EQ(start[2 * j], r[0]) << "n " << n << " kind " << kind << " m " << m << " threads " << threads;
+            EXPECT_EQ(start[2 * j + 1], r[1]) << "n " << n << " kind " << kind << " m " << m << " threads " << threads;
+            ++compared;
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GT(compared, 300);
 }
 
 }  // namespace
