@@ -124,11 +124,12 @@ TEST(NoiseId, ConstantDataFallBackToWhiteFm) {
 
 namespace {
 
-// compute_allan identifies the noise of exact counts on their int32 view with vector sums (two
-// difference levels per pass); identify_noise reads the counts with the plain scalar loop. Both
-// must give the same α at every τ, for phase and frequency domains, on records whose lag-1
-// autocorrelations fall on every side of the thresholds (white, random-walk and integrated
-// random-walk phase, mixtures), at odd lengths (vector tails of every size).
+// compute_allan identifies the noise of exact counts on their int32 view from exact integer lag-1
+// sums (the first two levels of small m in one shared pass); identify_noise reads the counts with
+// the plain floating loop. The r1 differ by that loop's rounding only (tests/test_noise_id_exact.cpp
+// bounds it), so both must give the same α at every τ, for phase and frequency domains, on records
+// whose lag-1 autocorrelations fall on every side of the thresholds (white, random-walk and
+// integrated random-walk phase, mixtures), at odd lengths (vector tails of every size).
 TEST(NoiseIdentification, VectorPathEqualsScalarPathOnCounts) {
   std::mt19937_64 rng(77);
   std::normal_distribution<double> g(0.0, 1.0);
