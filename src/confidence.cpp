@@ -8,6 +8,7 @@
 #include <array>
 #include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <numbers>
 #include <thread>
@@ -130,6 +131,150 @@ int acf_exponent(const P& phase, std::size_t count, int base) {
   }
 }
 
+// ---- Floating lag-1 sums on the int32 view (offsets of 2^24 or more) -------------------------
+
+#if defined(__x86_64__) || defined(__i386__)
+// p(from) … p(from + n − 1) as doubles into w (stride 1: eight conversions per instruction).
+__attribute__((target("avx2"))) void load_decimated(const std::int32_t* rel32, std::size_t stride, std::size_t from,
+                                                    std::size_t n, double* w) {
+  std::size_t t = 0;
+  if (stride == 1) {
+    for (; t + 4 <= n; t += 4)
+      _mm256_storeu_pd(w + t, _mm256_cvtepi32_pd(_mm_loadu_si128(reinterpret_cast<const __m128i*>(rel32 + from + t))));
+  }
+  for (; t < n; ++t) w[t] = static_cast<double>(rel32[(from + t) * stride]);
+}
+
+// z_L(k) … z_L(k + 3), the level-L difference of the decimated phase at w[o] … (integers: exact).
+template <int L>
+__attribute__((target("avx2"), always_inline)) inline __m256d zvec(const double* w, std::size_t o) {
+  if constexpr (L == 0)
+    return _mm256_loadu_pd(w + o);
+  else
+    return _mm256_sub_pd(zvec<L - 1>(w, o + 1), zvec<L - 1>(w, o));
+}
+
+// Running lag-1 sums of one difference level in the scalar code's four lanes.
+struct Lag1Sums {
+  __m256d num, den, mean;
+};
+
+template <int L>
+__attribute__((target("avx2"), always_inline)) inline void lag1_step(const double* w, Lag1Sums& s) {
+  const __m256d a = _mm256_sub_pd(zvec<L>(w, 0), s.mean);
+  const __m256d b = _mm256_sub_pd(zvec<L>(w, 1), s.mean);
+  s.den = _mm256_add_pd(s.den, _mm256_mul_pd(a, a));
+  s.num = _mm256_add_pd(s.num, _mm256_mul_pd(a, b));
+}
+
+// lag1_autocorrelation<L> (and, with Pair, lag1_autocorrelation<L + 1> in the same pass over the
+// data) on the int32 view, four z values per instruction. Lane j takes the terms k ≡ j (mod 4) in
+// the order the scalar loop's lanes do, the differences of integers are exact in double whatever
+// the order, and products and sums are separate roundings (no fused multiply-add), so each r1 is
+// the scalar one bit for bit. p(k) = rel32[k·stride].
+template <int L, bool Pair>
+__attribute__((target("avx2"))) void lag1_rel32_avx2(const std::int32_t* rel32, std::size_t stride, std::size_t count,
+                                                     double r[2]) {
+  auto p = [rel32, stride](std::size_t k) { return static_cast<double>(rel32[k * stride]); };
+  constexpr int kLevels = Pair ? 2 : 1;
+  r[0] = r[1] = 0.0;
+  // The decimated phase goes through a small buffer, a chunk at a time (each value converted once).
+  constexpr std::size_t kChunk = 2048;  // a multiple of 4: the lanes keep k ≡ j (mod 4)
+  constexpr std::size_t kExtra = static_cast<std::size_t>(L) + 6;
+  alignas(32) double buf[kChunk + kExtra + 3];
+  double mean[2] = {0, 0};
+  std::size_t len[2] = {0, 0};
+  for (int q = 0; q < kLevels; ++q) {
+    const int lev = L + q;
+    if (count <= static_cast<std::size_t>(lev) + 1) return;  // as the scalar code: r1 = 0 (Pair: never here)
+    len[q] = count - static_cast<std::size_t>(lev);
+  }
+  if constexpr (L == 0) {
+    __m256d lane = _mm256_setzero_pd();
+    std::size_t i = 0;
+    while (i + 4 <= len[0]) {
+      const std::size_t stop = std::min(i + kChunk, len[0]) & ~std::size_t{3};
+      load_decimated(rel32, stride, i, stop - i, buf);
+      for (std::size_t t = 0; i < stop; i += 4, t += 4) lane = _mm256_add_pd(lane, _mm256_loadu_pd(buf + t));
+    }
+    alignas(32) double l[4];
+    _mm256_store_pd(l, lane);
+    for (; i < len[0]; ++i) l[0] += p(i);
+    mean[0] = (l[0] + l[1] + l[2] + l[3]) / static_cast<double>(len[0]);
+  } else {
+    mean[0] = (difference(p, L - 1, len[0]) - difference(p, L - 1, 0)) / static_cast<double>(len[0]);
+  }
+  if constexpr (Pair) mean[1] = (difference(p, L, len[1]) - difference(p, L, 0)) / static_cast<double>(len[1]);
+  Lag1Sums s0{_mm256_setzero_pd(), _mm256_setzero_pd(), _mm256_set1_pd(mean[0])};
+  Lag1Sums s1{_mm256_setzero_pd(), _mm256_setzero_pd(), _mm256_set1_pd(mean[1])};
+  // Vector iterations i (multiples of 4) with i + 4 < len[q]; with Pair, both levels while the
+  // shorter one lasts, then at most one more for level L alone.
+  std::size_t i = 0;
+  const std::size_t both = Pair ? len[1] : len[0];
+  while (i + 4 < len[0]) {
+    const std::size_t i0 = i;
+    load_decimated(rel32, stride, i0, std::min(kChunk + kExtra, count - i0), buf);
+    for (; i + 4 < both && i < i0 + kChunk; i += 4) {
+      lag1_step<L>(buf + (i - i0), s0);
+      if constexpr (Pair) lag1_step<L + 1>(buf + (i - i0), s1);
+    }
+    if (i + 4 < both) continue;  // the chunk ended, the loop did not
+    for (; i + 4 < len[0] && i < i0 + kChunk; i += 4) lag1_step<L>(buf + (i - i0), s0);
+    if (i + 4 < len[0]) continue;
+    break;
+  }
+  const std::size_t i_end[2] = {i, Pair ? std::min(i, len[1] > 4 ? ((len[1] - 5) / 4 + 1) * 4 : 0) : 0};
+  for (int q = 0; q < kLevels; ++q) {
+    const Lag1Sums& sq = q == 0 ? s0 : s1;
+    alignas(32) double nu[4], de[4];
+    _mm256_store_pd(nu, sq.num);
+    _mm256_store_pd(de, sq.den);
+    const int lev = L + q;
+    for (std::size_t k = i_end[q]; k < len[q]; ++k) {
+      const double a = difference(p, lev, k) - mean[q];
+      de[0] += a * a;
+      if (k + 1 < len[q]) nu[0] += a * (difference(p, lev, k + 1) - mean[q]);
+    }
+    const double n_sum = nu[0] + nu[1] + nu[2] + nu[3];
+    const double d_sum = de[0] + de[1] + de[2] + de[3];
+    r[q] = d_sum > 0 ? n_sum / d_sum : 0.0;
+  }
+}
+
+/// acf_exponent() on the int32 view with the AVX2 floating sums (same result bit for bit), for
+/// views whose offsets reach 2^24 (the exact vector kernel needs them below). A level that
+/// may be followed by the next has both computed in one pass over the data.
+int acf_exponent_rel32_avx2(const std::int32_t* rel32, std::size_t stride, std::size_t count, int base) {
+  double next = 0;  // r1 of level base + d, when computed with the previous level
+  bool have_next = false;
+  for (int d = 0;; ++d) {
+    const int level = base + d;
+    double r1 = 0;
+    if (have_next) {
+      r1 = next;
+      have_next = false;
+    } else {
+      double r[2];
+      const bool pair = d < kMaxDifferences && level < 3 && count > static_cast<std::size_t>(level) + 16;
+      switch (level * 2 + (pair ? 1 : 0)) {
+        case 0: lag1_rel32_avx2<0, false>(rel32, stride, count, r); break;
+        case 1: lag1_rel32_avx2<0, true>(rel32, stride, count, r); break;
+        case 2: lag1_rel32_avx2<1, false>(rel32, stride, count, r); break;
+        case 3: lag1_rel32_avx2<1, true>(rel32, stride, count, r); break;
+        case 4: lag1_rel32_avx2<2, false>(rel32, stride, count, r); break;
+        case 5: lag1_rel32_avx2<2, true>(rel32, stride, count, r); break;
+        default: lag1_rel32_avx2<3, false>(rel32, stride, count, r); break;
+      }
+      r1 = r[0];
+      next = r[1];
+      have_next = pair;
+    }
+    const double delta = r1 / (1.0 + r1);
+    if (delta < 0.25 || d >= kMaxDifferences) return -static_cast<int>(std::lround(2.0 * delta)) - 2 * d;
+  }
+}
+#endif
+
 // ---- Exact integer lag-1 sums on the int32 view ----------------------------------------------
 //
 // On the int32 view of exact counts the level-L differences z are integers, so Σz, Σz² and
@@ -181,10 +326,35 @@ double r1_from_exact(const ExactLag1& s, std::size_t len, std::int64_t z_first, 
   return static_cast<double>(num / static_cast<long double>(den));
 }
 
-/// Adds the terms k ∈ [from, len) of level `level` to s (lag terms for k + 1 < len).
+/// Adds the terms k ∈ [from, len) of level `level` to s (lag terms for k + 1 < len). small: every
+/// |p| < 2^24, so |z| < 2^27 and 256 terms of each sum stay inside int64 between flushes.
 void exact_terms(const std::int32_t* rel32, std::size_t stride, int level, std::size_t from, std::size_t len,
-                 ExactLag1& s) {
+                 ExactLag1& s, bool small = false) {
   auto p = [rel32, stride](std::size_t k) { return static_cast<std::int64_t>(rel32[k * stride]); };
+  if (small) {
+    std::size_t k = from;
+    while (k + 1 < len) {
+      const std::size_t stop = std::min(len - 1, k + 256);
+      std::int64_t s1 = 0, s2 = 0, lag = 0;
+      std::int64_t z = idiff(p, level, k);
+      for (; k < stop; ++k) {
+        const std::int64_t zn = idiff(p, level, k + 1);
+        s1 += z;
+        s2 += z * z;
+        lag += z * zn;
+        z = zn;
+      }
+      s.s1 += s1;
+      s.s2 += s2;
+      s.lag += lag;
+    }
+    if (k < len) {  // the last term: no lag product
+      const std::int64_t z = idiff(p, level, k);
+      s.s1 += z;
+      s.s2 += static_cast<i128>(z) * z;
+    }
+    return;
+  }
   for (std::size_t k = from; k < len; ++k) {
     const std::int64_t z = idiff(p, level, k);
     s.s1 += z;
@@ -200,11 +370,12 @@ double r1_exact_finish(const std::int32_t* rel32, std::size_t stride, int level,
 }
 
 /// r1 of level `level` with the exact sums, one term at a time (the portable path).
-double lag1_exact_scalar(const std::int32_t* rel32, std::size_t stride, std::size_t count, int level) {
+double lag1_exact_scalar(const std::int32_t* rel32, std::size_t stride, std::size_t count, int level,
+                         bool small = false) {
   if (count <= static_cast<std::size_t>(level) + 1) return 0.0;
   const std::size_t len = count - static_cast<std::size_t>(level);
   ExactLag1 s;
-  exact_terms(rel32, stride, level, 0, len, s);
+  exact_terms(rel32, stride, level, 0, len, s, small);
   return r1_exact_finish(rel32, stride, level, len, s);
 }
 
@@ -418,7 +589,7 @@ int acf_exponent_exact(const std::int32_t* rel32, std::size_t stride, std::size_
       have_next = pair;
 #endif
     } else {
-      r1 = lag1_exact_scalar(rel32, stride, count, level);
+      r1 = lag1_exact_scalar(rel32, stride, count, level, small24);
     }
     const double delta = r1 / (1.0 + r1);
     if (delta < 0.25 || d >= kMaxDifferences) return -static_cast<int>(std::lround(2.0 * delta)) - 2 * d;
@@ -430,7 +601,11 @@ int acf_exponent_exact(const std::int32_t* rel32, std::size_t stride, std::size_
 int acf_exponent_at(const PhaseSeries& x, std::int64_t m, std::size_t count, int base, const std::int32_t* rel32,
                     bool small24, const double* start) {
   const auto um = static_cast<std::size_t>(m);
-  if (rel32 && x.points() < kExactMaxPoints) return acf_exponent_exact(rel32, um, count, base, small24, start);
+  if (rel32 && x.points() < kExactMaxPoints && small24) return acf_exponent_exact(rel32, um, count, base, true, start);
+#if defined(__x86_64__) || defined(__i386__)
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (rel32 && avx2) return acf_exponent_rel32_avx2(rel32, um, count, base);
+#endif
   if (rel32) {
     if (um == 1) return acf_exponent([rel32](std::size_t k) { return static_cast<double>(rel32[k]); }, count, base);
     return acf_exponent([rel32, um](std::size_t k) { return static_cast<double>(rel32[k * um]); }, count, base);
@@ -661,8 +836,11 @@ void lag1_exact(const std::int32_t* rel32, std::size_t stride, std::size_t count
   }
 #endif
   (void)vector;
-  r[0] = lag1_exact_scalar(rel32, stride, count, level);
-  r[1] = pair ? lag1_exact_scalar(rel32, stride, count, level + 1) : 0.0;
+  std::int64_t top = 0;  // the one-term path takes int64 sums between flushes when every |p| < 2^24
+  for (std::size_t k = 0; k < count; ++k) top = std::max<std::int64_t>(top, std::abs(std::int64_t{rel32[k * stride]}));
+  const bool small = top < (std::int64_t{1} << 24);
+  r[0] = lag1_exact_scalar(rel32, stride, count, level, small);
+  r[1] = pair ? lag1_exact_scalar(rel32, stride, count, level + 1, small) : 0.0;
 }
 
 }  // namespace detail
