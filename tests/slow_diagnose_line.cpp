@@ -75,7 +75,11 @@ std::string summary(const DiagnoseResult& r) {
 
 }  // namespace
 
-// Measured: see the commit and docs/diagnosis.md ("High-frequency line").
+// Measured (seeds 6000…, 10 cases, 20 runs): named 9/10, all 9 within tolerance (f within
+// 1e-5 Hz, amplitude within 10 %), gain in sample 9/9 (0.30 -> 0.10 … 4.98 -> 0.55), out of sample
+// 8/9 (0.46 -> 0.48 the loss). The miss is the weakest line, 30.9 °/h at 9.45 Hz (statistic 14.7
+// against a threshold of 15.6): the detection limit on 1 h of this noise is about 30 °/h (σ of the
+// amplitude ≈ 3.3 °/h).
 TEST(DiagnoseLineAcceptance, HighFrequencyLine) {
   const std::size_t n = cases(10);
   std::mt19937_64 g(6000);
@@ -112,7 +116,9 @@ TEST(DiagnoseLineAcceptance, HighFrequencyLine) {
 }
 
 // Records without a line, with and without the ADIS16405's output-chain low-pass (τf 5.5 ms):
-// no high-frequency sinusoid named (false-alarm level 1 % per record).
+// no high-frequency sinusoid named (false-alarm level 1 % per record). Measured (seeds 7000…, 10
+// cases): none in 10/10 (statistics 4.7–14.7 against thresholds 11–20.5; the low-pass named on all
+// five filtered records).
 TEST(DiagnoseLineAcceptance, NoLineNamesNone) {
   const std::size_t n = cases(10);
   std::size_t none = 0;
