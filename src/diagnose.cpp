@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <complex>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
@@ -397,6 +398,29 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
   x.model.sinusoids.insert(x.model.sinusoids.end(), broad.begin(), broad.end());
   x.model.bias_steps = det.bias_steps;
   x.model.warmups = det.warmups;
+  if (lowpass && lowpass->tf > 0) {
+    // A high-frequency line measured behind the output-chain low-pass: the model's line is the
+    // sensed one, which the simulated filter y_k = φy_{k−1} + (1 − φ)r_k then attenuates by
+    // |H| and shifts by arg H, H = (1 − φ)/(1 − φe^{−iωτ0}).
+    const double t0 = s.rec->phase.tau0_s, phi = std::exp(-t0 / lowpass->tf);
+    std::size_t j = 0;
+    for (auto& l : x.model.sinusoids) {
+      if (!(l.f_hz > kHighLineMinHz)) continue;
+      const std::complex<double> h = (1.0 - phi) / (1.0 - phi * std::polar(1.0, -2.0 * kPi * l.f_hz * t0));
+      l.amp_deg_per_h /= std::abs(h);
+      if (l.phase_rad != 0) l.phase_rad = std::remainder(l.phase_rad - std::arg(h), 2.0 * kPi);
+      for (; j < x.findings.size(); ++j)
+        if (x.findings[j].effect == "sinusoid_hf") {
+          auto& f = x.findings[j];
+          f.evidence["measured_amplitude_deg_per_h"] = f.params["amplitude_deg_per_h"];
+          f.params["amplitude_deg_per_h"] = l.amp_deg_per_h;
+          f.params["phase_rad"] = l.phase_rad;
+          f.uncertainty["amplitude_deg_per_h"] = f.uncertainty["amplitude_deg_per_h"].get<double>() / std::abs(h);
+          ++j;
+          break;
+        }
+    }
+  }
   if (!broad.empty() && !lowpass) {
     // Beyond its first Allan-variance peak (τ ≳ 1/(2f)) a line's AV averages 3A²/(8π²f²τ²): the
     // shape of white angle noise Q² = A²/(8π²f²), which the five-term fit has taken into its Q. A
