@@ -8,6 +8,7 @@
 #include "rwcalc/reader.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <array>
 #include <charconv>
 #include <cmath>
@@ -25,6 +26,7 @@
 #include <fmt/format.h>
 
 #include "reader_detail.hpp"
+#include "reader_simd.hpp"
 #include "timing.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/units.hpp"
@@ -36,6 +38,7 @@ namespace {
 using detail::is_digit;
 using detail::scan_double_fast;
 using detail::scan_int_fast;
+using detail::count_lines_checked;
 using detail::TextBuffer;
 
 enum class Delim { Comma, Semicolon, Tab, Blanks };
@@ -136,7 +139,11 @@ std::vector<std::string_view> value_names(InputMode m) {
 class Reader {
  public:
   Reader(const TextBuffer& buf, std::string name, const ReadOptions& options)
-      : name_(std::move(name)), opt_(options), begin_(buf.data()), end_(buf.data() + buf.size()) {}
+      : loaded_lines_(&buf.segment_lines),
+        name_(std::move(name)),
+        opt_(options),
+        begin_(buf.data()),
+        end_(buf.data() + buf.size()) {}
 
   Recording run(bool store_times);
 
@@ -149,6 +156,13 @@ class Reader {
   }
 
   std::size_t check_bytes(const char* text);  // returns the number of '\n'
+  // Line ends in [marks_from_, x) for x in the checked text: the count at the last mark before x
+  // (one every kMarkBytes from the buffer's start), plus the rest counted (less than kMarkBytes).
+  static constexpr auto kMarkBytes = static_cast<std::ptrdiff_t>(TextBuffer::kSegment);
+  const char* marks_from_ = nullptr;
+  std::vector<std::size_t> line_marks_;
+  const std::vector<std::size_t>* loaded_lines_;  // TextBuffer::segment_lines
+  [[nodiscard]] std::size_t lines_before(const char* x) const;
   LineKind careful_line(std::string_view line);
   void metadata_line(std::string_view body);
   void detect_delimiter(std::string_view line);
@@ -194,19 +208,64 @@ class Reader {
     [[nodiscard]] std::int64_t* end() const noexcept { return p + n; }
     std::int64_t& operator[](std::size_t i) const noexcept { return p[i]; }
   };
+  // Count the k values written past the end (within the reserved room) as appended. For the vector,
+  // insert() from that room onto itself moves nothing (memmove of a range onto itself).
+  static void grow_in_place(std::vector<std::int64_t>& v, std::size_t k) {
+    const std::int64_t* t = v.data() + v.size();
+    v.insert(v.end(), t, t + k);
+  }
+  static void grow_in_place(IntSink& v, std::size_t k) noexcept { v.n += k; }
   struct Chunk {
     IntSink ints;
-    // Pulses: ints[0, summed) are already the running sums of the chunk's counts (from 0), acc the
-    // last of them and mag the sum of the |counts|; the rest are counts as read.
+    // Pulses: ints[0, summed) are already the running sums of the chunk's counts (from pred), acc
+    // the last of them and mag the sum of the |counts|; the rest are counts as read.
     std::size_t summed = 0;
     std::uint64_t acc = 0, mag = 0;
+    // The running sums start from pred (acc's first value): the first part's total as predicted by
+    // digit_sum when its lines are all plain, else 0; the merge adds what the true total differs.
+    std::uint64_t pred = 0;
     std::vector<double> reals, times, temps;
     const char* stop = nullptr;  // where the chunk's fast path stopped
+  };
+  // When the merge has to offset the second part's running sums (the first part's total was not
+  // predicted), that part's thread, once its part is parsed, offsets the first half of them while
+  // this thread offsets the second half (a pass over ~10 MB on the 2-h file, ~0.8 ms on one
+  // thread). Phases: 0 parsing, 1 parsed (waiting), 2 offset d[0, n) by base, 3 nothing more to
+  // do (also set when the thread is asked to stop).
+  struct MergeHelp {
+    std::atomic<int> phase{0};
+    std::uint64_t base = 0;
+    std::int64_t* d = nullptr;
+    std::size_t n = 0;
+    void parsed_then_help(const std::stop_token& st) {  // on the second part's thread
+      phase.store(1, std::memory_order_release);
+      phase.notify_all();
+      const std::stop_callback on_stop(st, [this] { dismiss(); });
+      int v = 1;
+      while ((v = phase.load(std::memory_order_acquire)) == 1) phase.wait(1, std::memory_order_acquire);
+      if (v == 2)
+        for (std::size_t i = 0; i < n; ++i) d[i] = static_cast<std::int64_t>(base + static_cast<std::uint64_t>(d[i]));
+    }
+    void wait_parsed() {
+      while (phase.load(std::memory_order_acquire) == 0) phase.wait(0, std::memory_order_acquire);
+    }
+    void give(std::uint64_t b, std::int64_t* at, std::size_t count) {
+      base = b;
+      d = at;
+      n = count;
+      phase.store(2, std::memory_order_release);
+      phase.notify_all();
+    }
+    void dismiss() {
+      int one = 1;
+      phase.compare_exchange_strong(one, 3, std::memory_order_acq_rel);
+      phase.notify_all();
+    }
   };
   template <bool Integer>
   void scan_chunk(const char* from, Chunk& out, std::stop_token stop) const;
   template <bool Integer>
-  void merge_chunk(Chunk& c);
+  void merge_chunk(Chunk& c, MergeHelp& help, std::jthread& worker);
   template <bool Integer>
   void scan(const char* p);
 
@@ -288,39 +347,29 @@ class Reader {
 
 // ---- bytes ---------------------------------------------------------------------------------------
 
-// Lines ('\n') in [b, end) and whether a control byte other than tab, LF, CR (or DEL) occurs: in
-// blocks of 240 bytes (a multiple of the vector width, below 256 so that an 8-bit line counter
-// cannot overflow within a block), branch-free inside a block so the compiler vectorises it; an
-// AVX2 clone is chosen at run time where the processor has it. Stops after the first block that
-// trips, setting `bad` to its start (else nullptr).
-__attribute__((target_clones("avx2", "default"))) std::size_t count_lines_checked(const char* b, const char* end,
-                                                                                 const char*& bad) {
-  constexpr std::size_t kBlock = 240;
-  std::size_t lines = 0;
-  bad = nullptr;
-  for (; b < end; b += kBlock) {
-    const char* e = end - b > static_cast<std::ptrdiff_t>(kBlock) ? b + kBlock : end;
-    unsigned char trip = 0, nl = 0;
-    for (const char* q = b; q < e; ++q) {
-      const auto c = static_cast<unsigned char>(*q);
-      nl = static_cast<unsigned char>(nl + (c == '\n'));
-      trip |= static_cast<unsigned char>(((c < 0x20) & (c != '\t') & (c != '\n') & (c != '\r')) | (c == 0x7f));
-    }
-    lines += nl;
-    if (trip) {
-      bad = b;
-      return lines;
-    }
-  }
-  return lines;
-}
-
 std::size_t Reader::check_bytes(const char* text) {
   // Binary data: NUL and other control bytes (tab, LF and CR excepted). Checked, and the lines
   // counted, in one pass (count_lines_checked); the block that trips is searched again for the
   // first bad byte.
+  // The count is kept at every kMarkBytes (lines_before()), so that the split of a long text
+  // needs no second count of its first part.
+  // The segments checked and counted while the file was loaded (from the buffer's start; a
+  // byte-order mark before `text` holds no line end and no control byte) are taken as counted.
   const char* bad = nullptr;
-  const std::size_t lines = count_lines_checked(text, end_, bad);
+  std::size_t lines = 0;
+  marks_from_ = begin_;
+  line_marks_.clear();
+  line_marks_.reserve(static_cast<std::size_t>(end_ - begin_) / kMarkBytes + 1);
+  const char* b = begin_;
+  for (const std::size_t n : *loaded_lines_) {
+    line_marks_.push_back(lines);
+    lines += n;
+    b += kMarkBytes;
+  }
+  for (; b < end_ && !bad; b += kMarkBytes) {
+    line_marks_.push_back(lines);
+    lines += count_lines_checked(b, end_ - b > kMarkBytes ? b + kMarkBytes : end_, bad);
+  }
   if (!bad) return lines;
   for (const char* q = bad; q < end_; ++q) {
     const auto c = static_cast<unsigned char>(*q);
@@ -334,6 +383,13 @@ std::size_t Reader::check_bytes(const char* text) {
     }
   }
   return lines;  // not reached: the block that tripped holds a bad byte
+}
+
+std::size_t Reader::lines_before(const char* x) const {
+  const auto i = static_cast<std::size_t>((x - marks_from_) / kMarkBytes);
+  const char* b = marks_from_ + static_cast<std::ptrdiff_t>(i) * kMarkBytes;
+  const char* bad = nullptr;  // every byte has passed check_bytes()
+  return line_marks_[i] + count_lines_checked(b, x, bad);
 }
 
 // ---- careful path ------------------------------------------------------------------------------
@@ -786,11 +842,30 @@ inline const char* Reader::int_lines(const char* p, const char* limit, Vec& out,
     }
   };
 #if defined(__SSE2__)
-  // Windows of 64 bytes: the line ends come from one compare per 16 bytes, so where a line starts
-  // does not wait for the previous line's bytes to be read and tested (the scalar loop below is a
-  // chain of dependent loads, one per line); each line is then taken by scan_int_line as there,
-  // and must end at the newline found. Any other outcome leaves that line to the scalar loop.
+  // Windows of 64 bytes. Runs of windows made only of one-digit lines ("0", "1", "-1": nearly every
+  // line of a pulse file) go to detail::digit_windows, which takes a window's lines together and
+  // writes their values (or running sums) straight into the room reserved past out's end; then
+  // they are appended in place (a move of nothing). The first window it does not take comes here.
+  // After a window it refused at once, the next kDigitBackoff windows skip it (files of longer
+  // counts do not pay a classification per window for nothing).
+  constexpr int kDigitBackoff = 8;
+  int skip = 0;
   while (limit - p >= 64) {
+    if (skip == 0) {
+      std::size_t n = 0;
+      std::int64_t* tail = out.data() + out.size();
+      const char* q = detail::digit_windows<Sum>(p, limit, tail, n, a, m);
+      if (n > 0) grow_in_place(out, n);
+      if (q == p) skip = kDigitBackoff;
+      p = q;
+      if (limit - p < 64) break;
+    } else {
+      --skip;
+    }
+    // The line ends come from one compare per 16 bytes, so where a line starts does not wait for
+    // the previous line's bytes to be read and tested (the scalar loop below is a chain of
+    // dependent loads, one per line); each line is then taken by scan_int_line as there, and must
+    // end at the newline found. Any other outcome leaves that line to the scalar loop.
     std::uint64_t nl = 0;
     const __m128i lf = _mm_set1_epi8('\n');
     for (int k = 0; k < 4; ++k) {
@@ -906,7 +981,17 @@ void Reader::scan_chunk(const char* from, Chunk& out, std::stop_token stop) cons
 }
 
 template <bool Integer>
-void Reader::merge_chunk(Chunk& c) {
+void Reader::merge_chunk(Chunk& c, MergeHelp& help, std::jthread& worker) {
+  // Until `finish` the other thread may still be running: it reads nothing of the chunk and writes
+  // only the values given to it.
+  const auto finish = [&] {
+    help.dismiss();
+    if (worker.joinable()) worker.join();
+  };
+  const struct Finish {
+    const decltype(finish)& f;
+    ~Finish() { f(); }
+  } at_exit{finish};
   const std::size_t k = Integer ? c.ints.size() : c.reals.size();
   if (k == 0) return;
   if (new_run_) {
@@ -917,24 +1002,32 @@ void Reader::merge_chunk(Chunk& c) {
     auto from = c.ints.begin();
     if (c.summed > 0) {
       if (sum_pending() && c.mag <= kSumLimit - mag_) {
-        // The chunk's running sums, offset by the sum so far where they are (a vectorised add):
-        // C_k without a second pass. They sit in ints_'s reserved room at its end, or after it
-        // when the first part held lines without a value; insert() then moves them down over that
-        // gap (an overlapping move), or has nothing to move.
-        const std::uint64_t base = acc_;
+        // The chunk's running sums, offset where they are by what the sum so far differs from the
+        // one they started from (nothing when it was predicted; else a vectorised add, half of it
+        // on the other thread): C_k without a second pass. They sit in ints_'s reserved room at
+        // its end, or after it when the first part held lines without a value; insert() then
+        // moves them down over that gap (an overlapping move), or has nothing to move.
+        const std::uint64_t offset = acc_ - c.pred;
         std::int64_t* d = c.ints.data();
-        for (std::size_t i = 0; i < c.summed; ++i)
-          d[i] = static_cast<std::int64_t>(base + static_cast<std::uint64_t>(d[i]));
+        if (offset != 0) {
+          const std::size_t half = c.summed / 2;
+          help.give(offset, d, half);  // the other thread offsets the first half
+          for (std::size_t i = half; i < c.summed; ++i)
+            d[i] = static_cast<std::int64_t>(offset + static_cast<std::uint64_t>(d[i]));
+        }
+        finish();
         ints_.insert(ints_.end(), d, d + c.summed);
-        acc_ = base + c.acc;
+        acc_ = c.acc + offset;
         mag_ += c.mag;
         summed_ = ints_.size();
       } else {
+        finish();
         // Back to the counts as read (exact modulo 2^64); build_phase sums them and names the line
         // where Σ|c| passes the limit.
         for (std::size_t i = c.summed; i-- > 1;)
           c.ints[i] = static_cast<std::int64_t>(static_cast<std::uint64_t>(c.ints[i]) -
                                                 static_cast<std::uint64_t>(c.ints[i - 1]));
+        c.ints[0] = static_cast<std::int64_t>(static_cast<std::uint64_t>(c.ints[0]) - c.pred);
         ints_.insert(ints_.end(), c.ints.begin(), c.ints.begin() + static_cast<std::ptrdiff_t>(c.summed));
       }
       from += static_cast<std::ptrdiff_t>(c.summed);
@@ -958,16 +1051,17 @@ void Reader::scan(const char* p) {
   bool split_pending = may_split();
   const char* limit = end_;
   Chunk chunk;
+  MergeHelp help;  // before the thread, which may still use it when an exception unwinds this frame
   std::jthread worker;
   for (;;) {
     while (p < limit) {
       if (split_pending && layout_known_) {
         split_pending = false;
         if (end_ - p > kParallelBytes) {
-          // The other thread takes the last 45 %: it starts later (its thread and the mapping
-          // of its pages) and parses more slowly per byte; with halves, this thread waited
-          // ~1 ms for it on the 2-h file, with 55/45 neither waits (60/40 while the other part
-          // had a buffer of its own, whose pages took it ~2 ms more to map).
+          // The other thread takes the last 45 %: with one-digit lines taken by the vectorised
+          // path, mapping the values' pages is most of either part's time, and the other thread
+          // first sums this part's counts (Chunk::pred) so that the merge has nothing to add;
+          // 55/45 balances that on the 2-h file (halves: it waited ~0.8 ms for the other thread).
           const char* mid = p + (end_ - p) / kSplitDen * kSplitNum;
           const char* nl = static_cast<const char*>(std::memchr(mid, '\n', static_cast<std::size_t>(end_ - mid)));
           if (nl && nl + 1 < end_) {
@@ -976,15 +1070,22 @@ void Reader::scan(const char* p) {
               // The first part adds at most one value per line before `limit`: the second part's
               // values go right after that (ints_ holds one slot per line of the text, so both
               // fit and it is never reallocated). Each thread maps the pages it will write.
-              // (check_bytes() has passed every byte, so the count does not stop early.)
-              const char* bad = nullptr;
-              const std::size_t at = ints_.size() + count_lines_checked(p, limit, bad);
-              if (bad) throw std::logic_error("reader: byte check and line count disagree");
+              const std::size_t at = ints_.size() + (lines_before(limit) - lines_before(p));
               chunk.ints.p = ints_.data() + at;
               const std::size_t room = ints_.capacity() - at;
-              worker = std::jthread([this, &chunk, room, from = limit](std::stop_token st) {
+              // The total the first part will end with, when its lines are all plain and
+              // everything before is summed: then the other part's running sums start from it,
+              // and the merge has nothing to add to them (the same values either way: the merge
+              // adds the difference, modulo 2^64). Only with the AVX-512 kernel, which sums the
+              // 2-h file's first part in ~0.7 ms; the portable one takes longer than the merge.
+              const bool base_known = detail::digit_kernel() == detail::DigitKernel::Avx512 && sum_pending();
+              worker = std::jthread([this, &chunk, &help, room, first = p, from = limit, base = acc_,
+                                     base_known](std::stop_token st) {
+                std::uint64_t first_sum = 0;
+                if (base_known && detail::digit_sum(first, from, first_sum)) chunk.acc = chunk.pred = base + first_sum;
                 detail::prefault(chunk.ints.p, room * sizeof(std::int64_t));
                 scan_chunk<Integer>(from, chunk, st);
+                help.parsed_then_help(st);
               });
               detail::prefault(ints_.data() + ints_.size(), (at - ints_.size()) * sizeof(std::int64_t));
             } else {
@@ -1021,12 +1122,18 @@ void Reader::scan(const char* p) {
     if (!worker.joinable()) break;
     {
       detail::ScopedTimer tj("read: join");
-      worker.join();  // p == limit: the first half is done
+      // p == limit: the first part is done. Integers: wait until the other part is parsed (its
+      // thread then waits to help with the merge); else for the thread's end.
+      if constexpr (Integer)
+        help.wait_parsed();
+      else
+        worker.join();
     }
     detail::ScopedTimer tm("read: merge");
-    merge_chunk<Integer>(chunk);
+    merge_chunk<Integer>(chunk, help, worker);  // the thread has ended when it returns
     p = chunk.stop;
     chunk = Chunk{};
+    help.phase.store(0, std::memory_order_relaxed);
     limit = end_;
   }
   if (samples_ > 0 && runs_.empty()) runs_.emplace_back(0, first_data_line_);
@@ -1300,8 +1407,10 @@ void validate(const ReadOptions& o) {
 
 Recording read_buffer(TextBuffer& buf, const std::string& source, const ReadOptions& options) {
   // Classic Mac line ends (CR only, no LF before the sentinel): read CR as the line end.
-  if (buf.size() > 1 && !std::memchr(buf.data(), '\n', buf.size() - 1) && std::memchr(buf.data(), '\r', buf.size()))
+  if (buf.size() > 1 && !std::memchr(buf.data(), '\n', buf.size() - 1) && std::memchr(buf.data(), '\r', buf.size())) {
     std::replace(buf.data(), buf.data() + buf.size(), '\r', '\n');
+    buf.segment_lines.clear();  // counted before the line ends changed
+  }
   Recording rec;
   try {
     rec = Reader(buf, detail::display_name(source), options).run(false);

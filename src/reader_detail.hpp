@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace rwcalc::detail {
 
@@ -33,11 +34,23 @@ class TextBuffer {
   void terminate();
   [[nodiscard]] std::string_view view() const noexcept { return {data_.get(), size_}; }
 
+  /// Line ends in each whole segment of kSegment bytes from the start, when they were counted (and
+  /// the segments found free of control bytes) as the file was loaded: the first
+  /// segment_lines.size() segments; the reader counts the rest. Empty when not counted; to be
+  /// cleared by whoever changes the bytes.
+  static constexpr std::size_t kSegment = 256 * 240;
+  std::vector<std::size_t> segment_lines;
+
  private:
   std::unique_ptr<char[]> data_;
   std::size_t size_ = 0;
   std::size_t capacity_ = 0;
 };
+
+/// Lines ('\n') in [b, end) and whether a control byte other than tab, LF, CR (or DEL) occurs,
+/// vectorised (an AVX2 clone where the processor has it). Stops after the first block of 240
+/// bytes that trips, setting `bad` to its start (else nullptr).
+std::size_t count_lines_checked(const char* b, const char* end, const char*& bad);
 
 /// Name used in messages for a path ("<stdin>" for "-").
 std::string display_name(const std::string& path);

@@ -1,6 +1,7 @@
 // Reading a long text in two halves on two threads gives exactly what the serial reader gives:
 // the same samples, runs of lines, time and temperature statistics, and the same error (the
 // earliest bad line, with its right line number) wherever the bad line falls.
+#include <algorithm>
 #include <cstdint>
 #include <random>
 #include <string>
@@ -109,6 +110,50 @@ TEST(ReadParallel, FileLoadedInHalvesSameAsText) {
       expect_same(from_text, from_file);
       EXPECT_EQ(from_file.samples, from_text.samples);
     }
+  }
+}
+
+struct ReadFailure {
+  std::size_t line = 0;
+  std::string message;
+};
+
+template <class Read>
+ReadFailure read_failure(Read read) {
+  try {
+    (void)read();
+  } catch (const rwcalc::InputError& e) {
+    return {e.line(), e.message()};
+  }
+  return {};
+}
+
+// The two loading threads check and count the lines of their halves as they load them: a control
+// byte anywhere (first segment, either side of the halves' boundary, last bytes) gives the error
+// of the text read in one piece, and a byte-order mark or classic Mac line ends read the same.
+TEST(ReadParallel, FileLoadedInHalvesChecksBytesAsText) {
+  const rwcalc::test::TempDir dir;
+  const std::string text = pulse_text(2500000, 5);
+  ASSERT_GT(text.size(), std::size_t{4} << 20);
+  const std::size_t half = (text.size() / 2) & ~std::size_t{4095};
+  for (const std::size_t at : {std::size_t{100}, half - 3, half, half + 2, text.size() - 4}) {
+    std::string t = text;
+    t[at] = '\x01';
+    const auto path = dir.write("bad.csv", t).string();
+    const ReadFailure want = read_failure([&] { return read_recording_text(t, path, with_threads(1)); });
+    ASSERT_GT(want.line, 0u) << at;
+    const ReadFailure got = read_failure([&] { return rwcalc::read_recording(path, with_threads(2)); });
+    EXPECT_EQ(got.line, want.line) << at;
+    EXPECT_EQ(got.message, want.message) << at;
+  }
+  std::string mac = text;
+  std::replace(mac.begin(), mac.end(), '\n', '\r');
+  for (const std::string& t : {"\xEF\xBB\xBF" + text, mac}) {
+    const auto path = dir.write("other.csv", t).string();
+    const Recording from_text = read_recording_text(t, path, with_threads(1));
+    const Recording from_file = rwcalc::read_recording(path, with_threads(2));
+    expect_same(from_text, from_file);
+    EXPECT_EQ(from_file.samples, 2500000u);
   }
 }
 
