@@ -458,21 +458,21 @@ LineEstimate line_detect(const PhaseSeries& x, double f_min, double f_hint, bool
       best.w2 = 0.375 * static_cast<double>(n);
     }
     if (!e.coherent) {
-    double s2 = 0;
-    for (std::size_t k = a; k <= b; ++k) {
-      const double f = static_cast<double>(k) * best.df;
-      s2 += (best.P[k] - base) * scale * best.df * (f - fm) * (f - fm);
-    }
-    e.width_hz = std::sqrt(std::max(0.0, s2 / pw));
-    const double xs = kPi * fm * t0;
-    const double att = xs > 1e-9 ? std::sin(xs) / xs : 1.0;
-    const double amp_s = std::sqrt(2.0 * pw);  // amplitude of the per-sample rate
-    e.f_hz = fm;
-    e.amp = amp_s / att;
-    e.phase = 0;
-    e.amp_sigma = std::sqrt(var) / amp_s / att;
-    e.f_sigma = std::max(e.width_hz * std::sqrt(var) / pw, e.resolution_hz / std::sqrt(12.0));
-    return e;
+      double s2 = 0;
+      for (std::size_t k = a; k <= b; ++k) {
+        const double f = static_cast<double>(k) * best.df;
+        s2 += (best.P[k] - base) * scale * best.df * (f - fm) * (f - fm);
+      }
+      e.width_hz = std::sqrt(std::max(0.0, s2 / pw));
+      const double xs = kPi * fm * t0;
+      const double att = xs > 1e-9 ? std::sin(xs) / xs : 1.0;
+      const double amp_s = std::sqrt(2.0 * pw);  // amplitude of the per-sample rate
+      e.f_hz = fm;
+      e.amp = amp_s / att;
+      e.phase = 0;
+      e.amp_sigma = std::sqrt(var) / amp_s / att;
+      e.f_sigma = std::max(e.width_hz * std::sqrt(var) / pw, e.resolution_hz / std::sqrt(12.0));
+      return e;
     }
   }
   // A coherent line: least-squares sinusoid on the detrended samples (at their centres), cos/sin
