@@ -32,7 +32,11 @@ def fmt_finding(f):
         s = f"{f[k]:.{d}g}"
         if k in u: s += f" ± {u[k]:.2g}"
         return s + f" {unit}"
-    if e == "sinusoid": return f"sinusoid {v('frequency_hz','Hz')}, {v('amplitude_deg_per_h','°/h')}"
+    if e == "sinusoid":
+        ev = f.get("evidence", {})
+        s = f"sinusoid {v('frequency_hz','Hz')}, {v('amplitude_deg_per_h','°/h')}"
+        if ev.get("coherent") is False: s += f" (broadened, width {ev['width_hz']:.2g} Hz)"
+        return s
     if e == "gauss_markov": return f"Gauss–Markov σ {v('sigma_deg_per_h','°/h')}, Tc {v('correlation_time_s','s')}"
     if e == "bias_step": return f"bias step {v('size_deg_per_h','°/h')} at {v('time_s','s')}"
     if e == "warmup_transient": return f"warm-up {v('amplitude_deg_per_h','°/h')}, τw {v('time_constant_s','s')}"

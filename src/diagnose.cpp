@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <complex>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
@@ -206,6 +207,8 @@ struct Stretch {
   /// A named step's time known from the whole record, in stretch time (< 0: estimate it on the
   /// stretch). Only its size is then estimated on the stretch.
   double step_time_s = -1;
+  /// A named high-frequency line's frequency from the whole record (0: search the whole band).
+  double line_hint_hz = 0;
 };
 
 struct Extension {
@@ -343,6 +346,7 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
                  const AnalysisOptions& aopt) {
   Extension x;
   NoiseModel det;
+  std::vector<Sinusoid> broad;  // broadened high-frequency lines: in the model, not subtracted
   std::optional<OutputLowpassEstimate> lowpass;
   for (const auto& e : effects) {
     Finding f;
@@ -352,6 +356,17 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
       det.sinusoids.push_back({est.f_hz, est.amp, est.phase});
       f.params = {{"frequency_hz", est.f_hz}, {"amplitude_deg_per_h", est.amp}, {"phase_rad", est.phase}};
       f.uncertainty = {{"frequency_hz", est.f_sigma}, {"amplitude_deg_per_h", est.amp_sigma}};
+    } else if (e == "sinusoid_hf") {
+      // The high-frequency line, on the stretch's raw samples (reported as a sinusoid).
+      // A coherent line is subtracted from the data like the low-frequency one; a broadened line
+      // (power spread over a band by a wandering phase) cannot be, and enters the model only, as
+      // a sinusoid of its power at its centroid (the Allan variance sees the power, not the phase).
+      const auto est = line_detect(s.rec->phase, kHighLineMinHz, s.line_hint_hz);
+      (est.coherent ? det.sinusoids : broad).push_back({est.f_hz, est.amp, est.phase});
+      f.params = {{"frequency_hz", est.f_hz}, {"amplitude_deg_per_h", est.amp}, {"phase_rad", est.phase}};
+      f.uncertainty = {{"frequency_hz", est.f_sigma}, {"amplitude_deg_per_h", est.amp_sigma}};
+      f.evidence = {{"coherent", est.coherent}, {"resolution_hz", est.resolution_hz}};
+      if (!est.coherent) f.evidence["width_hz"] = est.width_hz;
     } else if (e == "bias_step") {
       const auto est = s.step_time_s >= 0 ? step_at(s.dec, s.step_time_s) : step_detect(s.dec);
       det.bias_steps.push_back({est.t_s, est.size});
@@ -380,8 +395,40 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
   // record, so the level before a step or under a transient must be the data's, not the mean's.
   x.model.bias_deg_per_h -= mean_rate_of(det, s.rec->phase.duration_s());
   x.model.sinusoids = det.sinusoids;
+  x.model.sinusoids.insert(x.model.sinusoids.end(), broad.begin(), broad.end());
   x.model.bias_steps = det.bias_steps;
   x.model.warmups = det.warmups;
+  if (lowpass && lowpass->tf > 0) {
+    // A high-frequency line measured behind the output-chain low-pass: the model's line is the
+    // sensed one, which the simulated filter y_k = φy_{k−1} + (1 − φ)r_k then attenuates by
+    // |H| and shifts by arg H, H = (1 − φ)/(1 − φe^{−iωτ0}).
+    const double t0 = s.rec->phase.tau0_s, phi = std::exp(-t0 / lowpass->tf);
+    std::size_t j = 0;
+    for (auto& l : x.model.sinusoids) {
+      if (!(l.f_hz > kHighLineMinHz)) continue;
+      const std::complex<double> h = (1.0 - phi) / (1.0 - phi * std::polar(1.0, -2.0 * kPi * l.f_hz * t0));
+      l.amp_deg_per_h /= std::abs(h);
+      if (l.phase_rad != 0) l.phase_rad = std::remainder(l.phase_rad - std::arg(h), 2.0 * kPi);
+      for (; j < x.findings.size(); ++j)
+        if (x.findings[j].effect == "sinusoid_hf") {
+          auto& f = x.findings[j];
+          f.evidence["measured_amplitude_deg_per_h"] = f.params["amplitude_deg_per_h"];
+          f.params["amplitude_deg_per_h"] = l.amp_deg_per_h;
+          f.params["phase_rad"] = l.phase_rad;
+          f.uncertainty["amplitude_deg_per_h"] = f.uncertainty["amplitude_deg_per_h"].get<double>() / std::abs(h);
+          ++j;
+          break;
+        }
+    }
+  }
+  if (!broad.empty() && !lowpass) {
+    // Beyond its first Allan-variance peak (τ ≳ 1/(2f)) a line's AV averages 3A²/(8π²f²τ²): the
+    // shape of white angle noise Q² = A²/(8π²f²), which the five-term fit has taken into its Q. A
+    // broadened line is not subtracted from the data, so its share is taken out of Q here.
+    double q2 = x.model.white_angle_arcsec * x.model.white_angle_arcsec;
+    for (const auto& l : broad) q2 -= l.amp_deg_per_h * l.amp_deg_per_h / (8.0 * kPi * kPi * l.f_hz * l.f_hz);
+    x.model.white_angle_arcsec = std::sqrt(std::max(0.0, q2));
+  }
   if (lowpass) {
     x.model.output_lowpass_tc_s = lowpass->tf;
     x.model.white_angle_arcsec = std::sqrt(std::max(0.0, lowpass->white_angle2));
@@ -670,6 +717,10 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   full.analysis = &r.analysis;
   full.dec = decimate(x);
   const auto grid = mid_tau_grid(full.dec);
+  // The high-frequency line search runs on floating data only: whole pulse counts (or counts
+  // given as numbers) carry the counting read-out's beat of the pulse rate against the sampling,
+  // which makes lines of its own (as the output-chain low-pass, it is skipped there).
+  const bool floating = !x.exact() && !on_lattice(x);
   const std::size_t pilot_runs = std::max<std::size_t>(10, opt.runs / 2);
   NoiseModel candidate;
   Coefficient b_of_fit;  // B of the five-term fit without the candidate
@@ -684,7 +735,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   timer.lap("pilot calibration");
 
   // 1. The base model's ensemble: band and detector calibration.
-  const auto base_runs = run_ensemble(r.base, r.settings, opt.runs, octave_m, grid, true, opt);
+  const auto base_runs = run_ensemble(r.base, r.settings, opt.runs, octave_m, grid, true, opt, true, floating);
   r.base_band = make_band(r.analysis.allan.points, base_runs, opt.band_level);
   full.ref = make_reference(grid, full.dec.tau_d, base_runs);
   full.clean_ref = clean_reference(grid, full.dec.tau_d, base_runs);
@@ -745,8 +796,17 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
       d_warm.note = "the bias step explains the block means better";
     }
   }
+  // High-frequency line: the same periodogram statistic on the raw rate samples from 0.25 Hz to
+  // the Nyquist frequency, calibrated on the base records alike.
+  DetectorResult d_line;
+  if (floating) {
+    std::vector<double> e_line;
+    for (const auto& br : base_runs) e_line.push_back(br.line_stat);
+    d_line = calibrate("sinusoid_hf", line_detect(x, kHighLineMinHz, 0.0, false).statistic, e_line);
+  }
   std::vector<std::string> effects;
   if (d_sin.named) effects.push_back("sinusoid");
+  if (d_line.named) effects.push_back("sinusoid_hf");
   if (d_step.named) effects.push_back("bias_step");
   if (d_warm.named) effects.push_back("warmup_transient");
 
@@ -754,6 +814,14 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   // without a named sinusoid.
   NoiseModel det = candidate;
   if (d_sin.named) det.sinusoids.push_back({sin.f_hz, sin.amp, sin.phase});
+  double line_f = 0;  // a coherent line's frequency (the halves search ±3 bins around it)
+  if (d_line.named) {
+    const auto line = line_detect(x);
+    if (line.coherent) {
+      line_f = line.f_hz;
+      det.sinusoids.push_back({line.f_hz, line.amp, line.phase});
+    }
+  }
   Decimated dclean = full.dec;
   subtract_deterministic(dclean, det);
   const auto mid_meas = decimated_avar(dclean, grid);
@@ -803,6 +871,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     if (d_lp.named) effects.push_back("lowpass");
   }
   r.detectors = {d_sin, d_step, d_warm, d_gm, d_lp};
+  if (floating) r.detectors.push_back(d_line);
   timer.lap("detectors");
 
   // 3–4. Extended model: parameters, re-fit, re-simulation.
@@ -818,6 +887,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   for (auto& f : ext.findings) {
     const auto& d = *std::find_if(r.detectors.begin(), r.detectors.end(),
                                   [&](const DetectorResult& dd) { return dd.effect == f.effect; });
+    const json extra = f.evidence;
     f.evidence = {{"statistic", d.statistic},
                   {"threshold", d.threshold},
                   {"ensemble_max", d.ensemble_max},
@@ -825,6 +895,13 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
                   {"false_alarm_level", opt.alpha}};
     if (f.effect == "sinusoid")
       f.evidence["detector"] = "periodogram peak of the 0.5-s block-mean rates over its local median level";
+    else if (f.effect == "sinusoid_hf") {
+      // Reported as a sinusoid; the evidence names its detector and band.
+      f.evidence["detector"] = "periodogram peak of the raw rate samples over its local median level, whole record and Welch means (detector sinusoid_hf)";
+      f.evidence["search_band_hz"] = {kHighLineMinHz, 0.5 * r.settings.rate_hz};
+      for (const auto& [k, v] : extra.items()) f.evidence[k] = v;
+      f.effect = "sinusoid";
+    }
     else if (f.effect == "bias_step")
       f.evidence["detector"] = "largest two-window change of the 10-s block-mean rates, in units of its standard error";
     else if (f.effect == "warmup_transient")
@@ -883,6 +960,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     const bool mean_terms = std::any_of(effects.begin(), effects.end(), [](const std::string& e) {
       return e == "sinusoid" || e == "bias_step" || e == "warmup_transient";
     });
+    const bool line_named = std::find(effects.begin(), effects.end(), "sinusoid_hf") != effects.end();
     // Both models are simulated over the predicted half at its measured mean rate: under a
     // counting read-out the rate sets the fine structure of the short-τ AV (the beat of the pulse
     // rate against the sampling), which also moves with the rate's wander inside a half and would
@@ -912,7 +990,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     }
     // The half's base ensemble at the half's own level: the half's detectors and its mid-τ
     // references (for the Gauss–Markov test on the half and for its extended model).
-    const auto b_runs = run_ensemble(b_fit, sh, r.holdout_runs, om, hgrid, mean_terms, opt, true);
+    const auto b_runs = run_ensemble(b_fit, sh, r.holdout_runs, om, hgrid, mean_terms, opt, true, line_named);
     st.ref = make_reference(hgrid, st.dec.tau_d, b_runs);
     st.clean_ref = clean_reference(hgrid, st.dec.tau_d, b_runs);
     // A deterministic term is carried into the fitting half's extended model only when the half
@@ -940,6 +1018,9 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
       if (e == "sinusoid") {
         stat = sinusoid_detect(without_mean_shape(st.dec), 0.0, false).statistic;
         for (const auto& br : b_runs) ens.push_back(br.sin_stat);
+      } else if (e == "sinusoid_hf") {
+        stat = line_detect(fit_rec.phase, kHighLineMinHz, 0.0, false).statistic;
+        for (const auto& br : b_runs) ens.push_back(br.line_stat);
       } else if (e == "warmup_transient") {
         stat = warmup_detect(st.dec).statistic;
         for (const auto& br : b_runs) ens.push_back(br.warm_stat);
@@ -969,6 +1050,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     st.opt = &opt;
     st.pilot_runs = r.holdout_runs;
     st.step_time_s = step_time;
+    st.line_hint_hz = line_f;
     const Extension e = extend(st, b_fit, half_effects, f_hint, aopt);
     // (No whole-band re-fit here: on the fitting half's band it lost two warm-up records out of
     // sample and changed no other count; docs/diagnosis.md.)

@@ -17,7 +17,8 @@ namespace diag {
 
 std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSettings& settings, std::size_t runs,
                                    const std::vector<std::int64_t>& octave_m, const std::vector<std::size_t>& mid_grid,
-                                   bool with_detectors, const DiagnoseOptions& options, bool clean_mid) {
+                                   bool with_detectors, const DiagnoseOptions& options, bool clean_mid,
+                                   bool high_line) {
   std::vector<RunStats> out(runs);
   EnsembleOptions eo;
   eo.path = SimulationPath::Ensemble;
@@ -45,6 +46,7 @@ std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSett
             st.octave_var[i] = allan_variance(s, octave_m[i], Estimator::Overlapping);
         }
         st.mean_rate = s.diff(s.points() - 1, 0) / s.duration_s();
+        if (high_line) st.line_stat = line_detect(s, kHighLineMinHz, 0.0, false).statistic;
         const Decimated d = decimate(s);
         st.mid_var = decimated_avar(d, mid_grid);
         if (with_detectors || clean_mid) {

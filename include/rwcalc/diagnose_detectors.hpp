@@ -46,6 +46,26 @@ struct SinusoidEstimate {
 /// Periodogram line search on 0.5-s block rates. `f_hint` > 0 restricts the search to ±3 bins.
 SinusoidEstimate sinusoid_detect(const Decimated& d, double f_hint = 0, bool estimate = true);
 
+/// Lower end of the high-frequency line search, Hz: the upper end of sinusoid_detect's.
+constexpr double kHighLineMinHz = 0.25;
+struct LineEstimate : SinusoidEstimate {
+  double resolution_hz = 0;  ///< bin width of the periodogram that showed the line
+  bool coherent = true;      ///< found at the whole record's resolution: one phase-stable line
+  double width_hz = 0;       ///< spread (standard deviation) of a broadened line's power, Hz
+};
+/// Line search on the raw rate samples of a floating series, from `f_min` to the Nyquist
+/// frequency, at several resolutions: the Hann-windowed periodogram of the whole record (zero-
+/// padded 2×) and Welch means of 16384-, 4096- and 1024-sample segments, each over its local
+/// median level (±24 bins). The statistic is the largest, over the resolutions, of −ln of the
+/// peak's tail probability less ln of the number of bins searched. A line found at the whole
+/// record's resolution is estimated by a least-squares sinusoid on the samples; a broadened one
+/// (a Welch resolution wins) by its excess power over the surrounding level (amplitude √(2·power)),
+/// its centroid and spread, phase 0. The amplitude is the continuous rate's (the sample mean
+/// attenuates it by sinc(π f τ0)); the phase is that of amp·cos(2πf t + phase), t from x(0).
+/// `f_hint` > 0: the whole record's resolution only, ±3 bins around it.
+LineEstimate line_detect(const PhaseSeries& x, double f_min = kHighLineMinHz, double f_hint = 0,
+                         bool estimate = true);
+
 struct StepEstimate {
   double statistic = 0;   ///< max local two-window |z|
   double t_s = 0, size = 0, t_sigma = 0, size_sigma = 0;
@@ -168,14 +188,17 @@ struct RunStats {
   /// better of the best step and the best warm-up) is removed, as it is from the measurement.
   std::vector<double> mid_var_clean;
   double sin_stat = 0, step_stat = 0, warm_stat = 0;
+  double line_stat = 0;  ///< line_detect on the raw samples (only when asked: floating data)
   double mean_rate = 0;  ///< the record's mean rate, °/h
 };
 
 /// Simulate `runs` records of `model` and collect their statistics; with `clean_mid` (or
-/// `with_detectors`) also the mid-τ AV of each record without its own candidate (own_candidates).
+/// `with_detectors`) also the mid-τ AV of each record without its own candidate (own_candidates);
+/// with `high_line` also line_detect's statistic of each record.
 std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSettings& settings, std::size_t runs,
                                    const std::vector<std::int64_t>& octave_m, const std::vector<std::size_t>& mid_grid,
-                                   bool with_detectors, const DiagnoseOptions& options, bool clean_mid = true);
+                                   bool with_detectors, const DiagnoseOptions& options, bool clean_mid = true,
+                                   bool high_line = false);
 
 /// The band from the ensemble's octave variances and the measured points.
 std::vector<BandPoint> make_band(const std::vector<AllanPoint>& measured, const std::vector<RunStats>& runs,
