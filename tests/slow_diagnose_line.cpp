@@ -73,17 +73,12 @@ std::string summary(const DiagnoseResult& r) {
   return s;
 }
 
-}  // namespace
+struct LineTally {
+  std::size_t n = 0, named = 0, recovered = 0, gain_in = 0, gain_out = 0;
+};
 
-// Measured (seeds 6000…, 10 cases, 20 runs): named 9/10, all 9 within tolerance (f within
-// 1e-5 Hz, amplitude within 10 %), gain in sample 9/9 (0.30 -> 0.10 … 4.98 -> 0.55). The miss is
-// the weakest line, 30.9 °/h at 9.45 Hz (statistic 14.7 against a threshold of 15.6): the detection
-// limit on 1 h of this noise is about 30 °/h (σ of the amplitude ≈ 3.3 °/h). Out of sample (logged,
-// not asserted): 5/9, the two models within 0.02 of each other (2.45 -> 2.43, 6.82 -> 6.84): the half
-// models are not re-fitted to their whole band, and the base half model has taken the line into its
-// white angle noise; with that re-fit (before it was removed for the warm-up records) 8/9, e.g.
-// 2.89 -> 0.45, 6.82 -> 2.91.
-TEST(DiagnoseLineAcceptance, HighFrequencyLine) {
+/// The drawn line cases (seeds 6000…), each diagnosed and logged.
+LineTally run_line_cases() {
   const std::size_t n = cases(10);
   std::mt19937_64 g(6000);
   std::size_t named = 0, recovered = 0, gain_in = 0, gain_out = 0;
@@ -114,8 +109,29 @@ TEST(DiagnoseLineAcceptance, HighFrequencyLine) {
   }
   std::cout << fmt::format("high-frequency line: named {}/{}, recovered {}/{}, gain in sample {}/{}, out of sample {}/{}\n",
                            named, n, recovered, n, gain_in, named, gain_out, named);
-  EXPECT_GE(static_cast<double>(recovered), 0.9 * static_cast<double>(n));
-  EXPECT_GE(static_cast<double>(gain_in), 0.9 * static_cast<double>(named));
+  return {n, named, recovered, gain_in, gain_out};
+}
+
+}  // namespace
+
+// Measured (seeds 6000…, 10 cases, 20 runs): named 9/10, all 9 within tolerance (f within
+// 1e-5 Hz, amplitude within 10 %), gain in sample 9/9 (0.30 -> 0.10 … 4.98 -> 0.55). The miss is
+// the weakest line, 30.9 °/h at 9.45 Hz (statistic 14.7 against a threshold of 15.6): the detection
+// limit on 1 h of this noise is about 30 °/h (σ of the amplitude ≈ 3.3 °/h). Out of sample (the disabled
+// test below): 5/9, the two models within 0.02 of each other (2.45 -> 2.43, 6.82 -> 6.84): the half
+// models are not re-fitted to their whole band, and the base half model has taken the line into its
+// white angle noise; with that re-fit (before it was removed for the warm-up records) 8/9, e.g.
+// 2.89 -> 0.45, 6.82 -> 2.91.
+TEST(DiagnoseLineAcceptance, HighFrequencyLine) {
+  const LineTally t = run_line_cases();
+  EXPECT_GE(static_cast<double>(t.recovered), 0.9 * static_cast<double>(t.n));
+  EXPECT_EQ(t.gain_in, t.named) << "the extended model must gain in sample on every named case";
+}
+
+// The every-case out-of-sample gain (measured 5/9, see above): not met, disabled, not weakened.
+TEST(DiagnoseLineAcceptance, DISABLED_HighFrequencyLineGainOutOfSample) {
+  const LineTally t = run_line_cases();
+  EXPECT_EQ(t.gain_out, t.named) << "the extended model must gain out of sample on every named case";
 }
 
 // Records without a line, with and without the ADIS16405's output-chain low-pass (τf 5.5 ms):
@@ -135,5 +151,5 @@ TEST(DiagnoseLineAcceptance, NoLineNamesNone) {
               << std::flush;
   }
   std::cout << fmt::format("no line: no high-frequency sinusoid in {}/{}\n", none, n);
-  EXPECT_GE(static_cast<double>(none), 0.9 * static_cast<double>(n));
+  EXPECT_GE(static_cast<double>(none), 0.95 * static_cast<double>(n));
 }
