@@ -103,6 +103,37 @@ std::vector<double> decimated_avar(const Decimated& d, const std::vector<std::si
 
 // ---- sinusoid --------------------------------------------------------------------------------
 
+namespace {
+
+/// The frequency of a line near f0: the best of f0 + i·step (|i| ≤ half_steps, 0 < f < f_max) by
+/// the explained sum of squares of fit_at(f, a, b), then `iters` golden-section steps in ±step.
+template <class Fit>
+double refine_frequency(Fit& fit_at, double f0, double step, int half_steps, int iters, double f_max) {
+  double fbest = f0, ebest = -1;
+  for (int i = -half_steps; i <= half_steps; ++i) {
+    const double f = f0 + static_cast<double>(i) * step;
+    if (f <= 0 || f >= f_max) continue;
+    double a, b;
+    const double ex = fit_at(f, a, b);
+    if (ex > ebest) {
+      ebest = ex;
+      fbest = f;
+    }
+  }
+  double lo = fbest - step, hi = fbest + step;
+  for (int it = 0; it < iters; ++it) {
+    const double m1 = lo + 0.382 * (hi - lo), m2 = lo + 0.618 * (hi - lo);
+    double a, b;
+    if (fit_at(m1, a, b) > fit_at(m2, a, b))
+      hi = m2;
+    else
+      lo = m1;
+  }
+  return 0.5 * (lo + hi);
+}
+
+}  // namespace
+
 SinusoidEstimate sinusoid_detect(const Decimated& d, double f_hint, bool estimate) {
   SinusoidEstimate e;
   const std::size_t pb = per_block_for(d, 0.5);
@@ -201,28 +232,7 @@ SinusoidEstimate sinusoid_detect(const Decimated& d, double f_hint, bool estimat
     return x.dot(r);  // explained sum of squares
   };
   const double f0 = static_cast<double>(kbest) * df;
-  double fbest = f0, ebest = -1;
-  for (int i = -30; i <= 30; ++i) {
-    const double f = f0 + static_cast<double>(i) * (1.0 / T) / 20.0;
-    if (f <= 0) continue;
-    double a, b;
-    const double ex = fit_at(f, a, b);
-    if (ex > ebest) {
-      ebest = ex;
-      fbest = f;
-    }
-  }
-  // Golden refinement in ±1/(20T).
-  double lo = fbest - 1.0 / (20.0 * T), hi = fbest + 1.0 / (20.0 * T);
-  for (int it = 0; it < 30; ++it) {
-    const double m1 = lo + 0.382 * (hi - lo), m2 = lo + 0.618 * (hi - lo);
-    double a, b;
-    if (fit_at(m1, a, b) > fit_at(m2, a, b))
-      hi = m2;
-    else
-      lo = m1;
-  }
-  fbest = 0.5 * (lo + hi);
+  const double fbest = refine_frequency(fit_at, f0, 1.0 / (20.0 * T), 30, 30, std::numeric_limits<double>::infinity());
   double a = 0, b = 0;
   fit_at(fbest, a, b);
   // Block averaging attenuates the rate amplitude by sinc(π f tb); the block mean sits at its centre.
@@ -500,27 +510,7 @@ LineEstimate line_detect(const PhaseSeries& x, double f_min, double f_hint, bool
     b = sol(1);
     return sol.dot(r);
   };
-  double fbest = f0, ebest = -1;
-  for (int i = -12; i <= 12; ++i) {
-    const double f = f0 + static_cast<double>(i) * (1.0 / T) / 16.0;
-    if (f <= 0 || f >= 0.5 / t0) continue;
-    double a, b;
-    const double ex = fit_at(f, a, b);
-    if (ex > ebest) {
-      ebest = ex;
-      fbest = f;
-    }
-  }
-  double lo = fbest - 1.0 / (16.0 * T), hi = fbest + 1.0 / (16.0 * T);
-  for (int it = 0; it < 20; ++it) {
-    const double m1 = lo + 0.382 * (hi - lo), m2 = lo + 0.618 * (hi - lo);
-    double a, b;
-    if (fit_at(m1, a, b) > fit_at(m2, a, b))
-      hi = m2;
-    else
-      lo = m1;
-  }
-  fbest = 0.5 * (lo + hi);
+  const double fbest = refine_frequency(fit_at, f0, 1.0 / (16.0 * T), 12, 20, 0.5 / t0);
   double a = 0, b = 0;
   fit_at(fbest, a, b);
   const double xs = kPi * fbest * t0;

@@ -93,12 +93,10 @@ inline Classes classify_sse2(const char* p) noexcept {
 }
 #endif
 
-// Portable kernel: the masks from SSE2 compares, the values by a loop over the digit bits.
-template <bool Sum>
-const char* windows_portable(const char* p, const char* limit, std::int64_t* out, std::size_t& count,
-                             std::uint64_t& acc, std::uint64_t& mag) noexcept {
-  std::size_t k = 0;
-  std::uint64_t a = acc, m = mag;
+// Portable kernel: the masks from SSE2 compares, the values by a loop over the digit bits; emit(u,
+// d) takes each line's count u (modulo 2^64) and its digit d, in line order.
+template <class Emit>
+const char* each_portable(const char* p, const char* limit, Emit&& emit) noexcept {
   while (limit - p >= 64) {
     Window w;
     if (!plain_window(classify_sse2(p), w)) break;
@@ -106,17 +104,27 @@ const char* windows_portable(const char* p, const char* limit, std::int64_t* out
       const auto i = static_cast<unsigned>(std::countr_zero(e));
       const auto d = static_cast<std::uint64_t>(static_cast<unsigned char>(p[i]) - '0');
       const std::uint64_t s = 0 - ((w.neg >> i) & 1U);
-      const std::uint64_t u = (d ^ s) - s;  // the count, modulo 2^64
-      if constexpr (Sum) {
-        a += u;
-        m += d;
-        out[k++] = static_cast<std::int64_t>(a);
-      } else {
-        out[k++] = static_cast<std::int64_t>(u);
-      }
+      emit((d ^ s) - s, d);
     }
     p += w.used;
   }
+  return p;
+}
+
+template <bool Sum>
+const char* windows_portable(const char* p, const char* limit, std::int64_t* out, std::size_t& count,
+                             std::uint64_t& acc, std::uint64_t& mag) noexcept {
+  std::size_t k = 0;
+  std::uint64_t a = acc, m = mag;
+  p = each_portable(p, limit, [&](std::uint64_t u, std::uint64_t d) {
+    if constexpr (Sum) {
+      a += u;
+      m += d;
+      out[k++] = static_cast<std::int64_t>(a);
+    } else {
+      out[k++] = static_cast<std::int64_t>(u);
+    }
+  });
   count = k;
   acc = a;
   mag = m;
@@ -126,17 +134,7 @@ const char* windows_portable(const char* p, const char* limit, std::int64_t* out
 // Sum of the counts of the windows of one-digit lines from p (as windows_portable, nothing written).
 const char* sum_portable(const char* p, const char* limit, std::uint64_t& sum) noexcept {
   std::uint64_t a = sum;
-  while (limit - p >= 64) {
-    Window w;
-    if (!plain_window(classify_sse2(p), w)) break;
-    for (std::uint64_t e = w.value; e != 0; e &= e - 1) {
-      const auto i = static_cast<unsigned>(std::countr_zero(e));
-      const auto d = static_cast<std::uint64_t>(static_cast<unsigned char>(p[i]) - '0');
-      const std::uint64_t s = 0 - ((w.neg >> i) & 1U);
-      a += (d ^ s) - s;
-    }
-    p += w.used;
-  }
+  p = each_portable(p, limit, [&](std::uint64_t u, std::uint64_t) { a += u; });
   sum = a;
   return p;
 }
@@ -155,14 +153,21 @@ const char* sum_portable(const char* p, const char* limit, std::uint64_t& sum) n
 // after a minus) compressed to the first bytes of a register (vpcompressb), widened to 16 bits for
 // an in-register prefix sum over the window's ≤ 32 lines (|sum| ≤ 288), widened again to 64 bits
 // and offset by the running sum, kept broadcast in a register; Σ|c| by vpsadbw on the digits.
+// The classes of the 64 bytes at p (as classify_sse2), and the bytes less '0' in d.
+RWCALC_VBMI2 inline __attribute__((always_inline)) Classes classify_avx512(const char* p, __m512i& d) noexcept {
+  const __m512i b = _mm512_loadu_si512(p);
+  d = _mm512_sub_epi8(b, _mm512_set1_epi8('0'));
+  Classes c;
+  c.nl = _mm512_cmpeq_epi8_mask(b, _mm512_set1_epi8('\n'));
+  c.minus = _mm512_cmpeq_epi8_mask(b, _mm512_set1_epi8('-'));
+  c.cr = _mm512_cmpeq_epi8_mask(b, _mm512_set1_epi8('\r'));
+  c.digit = _mm512_cmplt_epu8_mask(d, _mm512_set1_epi8(10));
+  return c;
+}
+
 template <bool Sum>
 RWCALC_VBMI2 const char* windows_avx512(const char* p, const char* limit, std::int64_t* out, std::size_t& count,
                                         std::uint64_t& acc, std::uint64_t& mag) noexcept {
-  const __m512i lf = _mm512_set1_epi8('\n');
-  const __m512i mn = _mm512_set1_epi8('-');
-  const __m512i crv = _mm512_set1_epi8('\r');
-  const __m512i zero_char = _mm512_set1_epi8('0');
-  const __m512i ten = _mm512_set1_epi8(10);
   const __m512i zero = _mm512_setzero_si512();
   // Lane i of the shift by s takes lane i − s (lanes below s are zeroed by the mask).
   const __m512i lane = _mm512_set_epi16(31, 30, 29, 28, 27, 26, 25, 24, 23, 22, 21, 20, 19, 18, 17, 16, 15, 14, 13,
@@ -172,13 +177,8 @@ RWCALC_VBMI2 const char* windows_avx512(const char* p, const char* limit, std::i
   __m512i magv = zero;
   std::size_t k = 0;
   while (limit - p >= 64) {
-    const __m512i b = _mm512_loadu_si512(p);
-    const __m512i d = _mm512_sub_epi8(b, zero_char);
-    Classes c;
-    c.nl = _mm512_cmpeq_epi8_mask(b, lf);
-    c.minus = _mm512_cmpeq_epi8_mask(b, mn);
-    c.cr = _mm512_cmpeq_epi8_mask(b, crv);
-    c.digit = _mm512_cmplt_epu8_mask(d, ten);
+    __m512i d;
+    const Classes c = classify_avx512(p, d);
     Window w;
     if (!plain_window(c, w)) break;
     const __m512i v = _mm512_mask_sub_epi8(d, w.neg, zero, d);   // the counts, as int8
@@ -229,21 +229,11 @@ RWCALC_VBMI2 const char* windows_avx512(const char* p, const char* limit, std::i
 // Sum of the counts of the windows of one-digit lines from p: the digits after a minus and the
 // others summed apart by vpsadbw (eight 64-bit partial sums each), nothing written.
 RWCALC_VBMI2 const char* sum_avx512(const char* p, const char* limit, std::uint64_t& sum) noexcept {
-  const __m512i lf = _mm512_set1_epi8('\n');
-  const __m512i mn = _mm512_set1_epi8('-');
-  const __m512i crv = _mm512_set1_epi8('\r');
-  const __m512i zero_char = _mm512_set1_epi8('0');
-  const __m512i ten = _mm512_set1_epi8(10);
   const __m512i zero = _mm512_setzero_si512();
   __m512i pos = zero, neg = zero;
   while (limit - p >= 64) {
-    const __m512i b = _mm512_loadu_si512(p);
-    const __m512i d = _mm512_sub_epi8(b, zero_char);
-    Classes c;
-    c.nl = _mm512_cmpeq_epi8_mask(b, lf);
-    c.minus = _mm512_cmpeq_epi8_mask(b, mn);
-    c.cr = _mm512_cmpeq_epi8_mask(b, crv);
-    c.digit = _mm512_cmplt_epu8_mask(d, ten);
+    __m512i d;
+    const Classes c = classify_avx512(p, d);
     Window w;
     if (!plain_window(c, w)) break;
     pos = _mm512_add_epi64(pos, _mm512_sad_epu8(_mm512_maskz_mov_epi8(w.value & ~w.neg, d), zero));
