@@ -513,10 +513,15 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
   return x;
 }
 
-/// The model's mean rate over [0, T], °/h.
+/// The level a model predicts over [0, T], °/h: its constant rate and its named terms' mean (a
+/// ramp, whose sign the AV does not give, predicts no change).
+double model_level(const NoiseModel& m, double T) {
+  return m.earth_rate_deg_per_h + m.bias_deg_per_h + mean_rate_of(m, T);
+}
+
+/// The model's mean rate over [0, T] as simulated (the ramp included), °/h.
 double model_mean_rate(const NoiseModel& m, double T) {
-  return m.earth_rate_deg_per_h + m.bias_deg_per_h + mean_rate_of(m, T) +
-         m.ramp_deg_per_h2 * T / units::seconds_per_hour / 2.0;
+  return model_level(m, T) + m.ramp_deg_per_h2 * T / units::seconds_per_hour / 2.0;
 }
 
 /// Variance of the records' mean rates in an ensemble, (°/h)².
@@ -528,20 +533,6 @@ double mean_rate_variance(const std::vector<RunStats>& runs) {
   for (const auto& r : runs) s2 += (r.mean_rate - mu) * (r.mean_rate - mu);
   return s2 / static_cast<double>(runs.size() - 1);
 }
-
-/// Sum of a band's deviance terms and their number (band_misfit is their mean).
-std::pair<double, std::size_t> band_deviance(const std::vector<BandPoint>& band, std::size_t runs) {
-  std::size_t n = 0;
-  for (const auto& b : band) n += (b.mean_var > 0 && b.dev > 0 && b.edf > 0) ? 1 : 0;
-  return {band_misfit(band, runs) * static_cast<double>(n), n};
-}
-
-/// The extended model's last step: N and B re-fitted to the whole band of the data it was built
-/// on (refit_to_band), the re-fitted model simulated again with the same seeds and kept, with its
-/// band, when that band fits better.
-void refit_whole_band(NoiseModel& m, std::vector<BandPoint>& band, const std::vector<AllanPoint>& measured,
-                      const SimulationSettings& settings, std::size_t runs, const std::vector<std::int64_t>& octave_m,
-                      const std::vector<std::size_t>& grid, const DiagnoseOptions& opt);
 
 /// The model with its constant rate set so that its mean rate over [0, T] is `mean_rate` (°/h):
 /// under a counting read-out the fine structure of the short-τ AV (the beat of the pulse rate
@@ -570,6 +561,9 @@ bool refit_to_band(NoiseModel& m, const std::vector<BandPoint>& band, std::size_
   return true;
 }
 
+/// The extended model's last step: N and B re-fitted to the whole band of the data it was built
+/// on (refit_to_band), the re-fitted model simulated again with the same seeds and kept, with its
+/// band, when that band fits better.
 void refit_whole_band(NoiseModel& m, std::vector<BandPoint>& band, const std::vector<AllanPoint>& measured,
                       const SimulationSettings& settings, std::size_t runs, const std::vector<std::int64_t>& octave_m,
                       const std::vector<std::size_t>& grid, const DiagnoseOptions& opt) {
@@ -976,11 +970,10 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
         run_ensemble(with_mean_rate(b_fit, pred_T, pred_mean), sh, r.holdout_runs, om, hgrid, false, opt, false);
     const double v_base = std::max(mean_rate_variance(b_pred), 1e-30);
     auto prediction_misfit = [&](const std::vector<RunStats>& runs, const NoiseModel& m) {
-      const auto [s, k] = band_deviance(make_band(a_pred.points, runs, opt.band_level), r.holdout_runs);
+      const auto dev = band_deviance(make_band(a_pred.points, runs, opt.band_level), r.holdout_runs);
       const double v = std::max(mean_rate_variance(runs), 1e-30);
-      const double level = model_mean_rate(m, pred_T) - m.ramp_deg_per_h2 * pred_T / units::seconds_per_hour / 2.0;
-      const double d = pred_mean - level;
-      return (s + d * d / v + std::log(v / v_base)) / static_cast<double>(k + 1);
+      const double d = pred_mean - model_level(m, pred_T);
+      return (dev.sum + d * d / v + std::log(v / v_base)) / static_cast<double>(dev.points + 1);
     };
     const double hb_dir = prediction_misfit(b_pred, b_fit);
     hb += hb_dir;

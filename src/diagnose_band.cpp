@@ -141,10 +141,9 @@ std::array<double, 3> band_refit(const std::vector<BandPoint>& band, std::size_t
     std::array<double, 3> g;
   };
   std::vector<Point> pts;
-  const double K = static_cast<double>(std::max<std::size_t>(runs, 1));
   for (const auto& b : band) {
-    if (!(b.mean_var > 0) || !(b.dev > 0) || !(b.edf > 0)) continue;
-    Point p{b.dev * b.dev, b.mean_var, 1.0 / (1.0 / b.edf + 1.0 / (K * b.edf) + 1.0 / 1000.0), {}};
+    if (!band_point_valid(b)) continue;
+    Point p{b.dev * b.dev, b.mean_var, band_nu(b.edf, runs), {}};
     for (std::size_t j = 0; j < 3; ++j) p.g[j] = term_basis(terms[j], b.tau_s);
     pts.push_back(p);
   }
@@ -215,20 +214,29 @@ std::array<double, 3> band_refit(const std::vector<BandPoint>& band, std::size_t
   return x;
 }
 
+double band_nu(double edf, std::size_t runs) {
+  const double K = static_cast<double>(std::max<std::size_t>(runs, 1));
+  return 1.0 / (1.0 / edf + 1.0 / (K * edf) + 1.0 / 1000.0);
+}
+
+bool band_point_valid(const BandPoint& b) { return b.mean_var > 0 && b.dev > 0 && b.edf > 0; }
+
+BandDeviance band_deviance(const std::vector<BandPoint>& band, std::size_t runs) {
+  BandDeviance d;
+  for (const auto& b : band) {
+    if (!band_point_valid(b)) continue;
+    const double r = b.dev * b.dev / b.mean_var;
+    d.sum += band_nu(b.edf, runs) * (r - 1.0 - std::log(r));
+    ++d.points;
+  }
+  return d;
+}
+
 }  // namespace diag
 
 double band_misfit(const std::vector<BandPoint>& band, std::size_t runs) {
-  double s = 0;
-  std::size_t n = 0;
-  const double K = static_cast<double>(std::max<std::size_t>(runs, 1));
-  for (const auto& b : band) {
-    if (!(b.mean_var > 0) || !(b.dev > 0) || !(b.edf > 0)) continue;
-    const double nu = 1.0 / (1.0 / b.edf + 1.0 / (K * b.edf) + 1.0 / 1000.0);
-    const double r = b.dev * b.dev / b.mean_var;
-    s += nu * (r - 1.0 - std::log(r));
-    ++n;
-  }
-  return n ? s / static_cast<double>(n) : 0.0;
+  const auto d = diag::band_deviance(band, runs);
+  return d.points ? d.sum / static_cast<double>(d.points) : 0.0;
 }
 
 double band_coverage(const std::vector<BandPoint>& band) {

@@ -105,6 +105,30 @@ std::vector<double> decimated_avar(const Decimated& d, const std::vector<std::si
 
 namespace {
 
+/// A periodogram's largest ratio to its local level over bins [k_lo, k_hi], the level (of a bin,
+/// by `level`) taken afresh every 4 true bins (pad padded bins each); ratio 0 when no level is
+/// positive.
+struct Peak {
+  double ratio = 0, level = 0;
+  std::size_t k = 0;
+};
+template <class Level>
+Peak peak_over_level(const std::vector<double>& P, std::size_t k_lo, std::size_t k_hi, double pad, Level& level) {
+  Peak best;
+  best.k = k_lo;
+  const std::size_t stride = std::max<std::size_t>(1, static_cast<std::size_t>(pad));
+  double lev = 0;
+  for (std::size_t k = k_lo; k <= k_hi; ++k) {
+    if ((k - k_lo) % (4 * stride) == 0) lev = level(k);
+    if (lev <= 0) continue;
+    const double r = P[k] / lev;
+    if (r > best.ratio) {
+      best = {r, lev, k};
+    }
+  }
+  return best;
+}
+
 /// The frequency of a line near f0: the best of f0 + i·step (|i| ≤ half_steps, 0 < f < f_max) by
 /// the explained sum of squares of fit_at(f, a, b), then `iters` golden-section steps in ±step.
 template <class Fit>
@@ -195,20 +219,9 @@ SinusoidEstimate sinusoid_detect(const Decimated& d, double f_hint, bool estimat
     }
     return median_of(std::move(v)) / std::log(2.0);
   };
-  double best = 0, best_level = 0;
-  std::size_t kbest = k_lo;
-  const std::size_t stride = std::max<std::size_t>(1, static_cast<std::size_t>(pad));
-  double lev = 0;
-  for (std::size_t k = k_lo; k <= k_hi; ++k) {
-    if ((k - k_lo) % (4 * stride) == 0) lev = level(k);
-    if (lev <= 0) continue;
-    const double r = P[k] / lev;
-    if (r > best) {
-      best = r;
-      kbest = k;
-      best_level = lev;
-    }
-  }
+  const Peak peak = peak_over_level(P, k_lo, k_hi, pad, level);
+  const double best = peak.ratio, best_level = peak.level;
+  const std::size_t kbest = peak.k;
   e.statistic = best;
   if (!estimate) return e;
   // Least-squares sinusoid on the (untapered, detrended) block rates around the peak.
@@ -370,19 +383,9 @@ LineEstimate line_detect(const PhaseSeries& x, double f_min, double f_hint, bool
       }
       return median_of(v) / med;
     };
-    double rbest = 0, lbest = 0, lev = 0;
-    std::size_t kbest = k_lo;
-    const std::size_t stride = std::max<std::size_t>(1, static_cast<std::size_t>(pad));
-    for (std::size_t k = k_lo; k <= k_hi; ++k) {
-      if ((k - k_lo) % (4 * stride) == 0) lev = level(k);
-      if (lev <= 0) continue;
-      const double r = P[k] / lev;
-      if (r > rbest) {
-        rbest = r;
-        kbest = k;
-        lbest = lev;
-      }
-    }
+    const Peak peak = peak_over_level(P, k_lo, k_hi, pad, level);
+    const double rbest = peak.ratio, lbest = peak.level;
+    const std::size_t kbest = peak.k;
     if (!(rbest > 0)) continue;
     // Comparable across resolutions: −ln of the peak's tail probability less ln of the number of
     // true bins searched (the expected null maximum is then about the same at every resolution).

@@ -205,6 +205,19 @@ std::vector<BandPoint> make_band(const std::vector<AllanPoint>& measured, const 
                                  double level);
 MidTauReference make_reference(const std::vector<std::size_t>& grid, double tau_d, const std::vector<RunStats>& runs);
 
+/// The weight of a band point in the misfit: the measured EDF combined with the ensemble's own
+/// sampling error (`runs` records) and a 1000-EDF model floor (band_misfit).
+double band_nu(double edf, std::size_t runs);
+/// Whether a band point enters the misfit (positive measured σ, ensemble mean σ² and EDF).
+bool band_point_valid(const BandPoint& b);
+/// The band's Gamma deviance terms ν·(r − 1 − ln r), summed, and their number (band_misfit is
+/// their mean).
+struct BandDeviance {
+  double sum = 0;
+  std::size_t points = 0;
+};
+BandDeviance band_deviance(const std::vector<BandPoint>& band, std::size_t runs);
+
 /// Re-fit of a simulated model's N, B and K to the whole band: the changes of their fit-scale c
 /// (order N, B, K; term_basis) that minimise the band's Gamma deviance (band_misfit's ν) when the
 /// ensemble mean σ² moves by Σ Δc·basis(τ), with every c + Δc ≥ 0 (Fisher scoring with a bounded
