@@ -364,6 +364,52 @@ __attribute__((target("avx2"))) std::uint64_t block_sumsq_i24_avx2(const std::in
 }
 #endif
 
+#if RWCALC_X86_DISPATCH
+// The same exact sum with AVX-512: sixteen 32-bit differences per vector, squared into eight
+// 64-bit lanes twice (vpmuldq on the even and the shifted odd lanes); 32 terms per iteration in
+// four accumulators. A lane holds at most 4096/16 = 256 squares below 2^52; the block sum stays
+// below 2^64 as above. Integer operations only: the same sum as the AVX2 kernel, bit for bit.
+// (GCC 12's AVX-512 headers trip its own uninitialised-value warnings: silenced here only.)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+__attribute__((target("avx512f"))) std::uint64_t block_sumsq_i24_avx512(const std::int32_t* __restrict a,
+                                                                         const std::int32_t* __restrict b,
+                                                                         const std::int32_t* __restrict e,
+                                                                         std::int64_t len) {
+  __m512i acc0 = _mm512_setzero_si512(), acc1 = _mm512_setzero_si512();
+  __m512i acc2 = _mm512_setzero_si512(), acc3 = _mm512_setzero_si512();
+  std::int64_t i = 0;
+  for (; i + 32 <= len; i += 32) {
+    const __m512i vb0 = _mm512_loadu_si512(b + i), vb1 = _mm512_loadu_si512(b + i + 16);
+    const __m512i d0 = _mm512_sub_epi32(_mm512_add_epi32(_mm512_loadu_si512(e + i), _mm512_loadu_si512(a + i)),
+                                        _mm512_add_epi32(vb0, vb0));
+    const __m512i d1 = _mm512_sub_epi32(
+        _mm512_add_epi32(_mm512_loadu_si512(e + i + 16), _mm512_loadu_si512(a + i + 16)), _mm512_add_epi32(vb1, vb1));
+    const __m512i h0 = _mm512_srli_epi64(d0, 32), h1 = _mm512_srli_epi64(d1, 32);
+    acc0 = _mm512_add_epi64(acc0, _mm512_mul_epi32(d0, d0));
+    acc1 = _mm512_add_epi64(acc1, _mm512_mul_epi32(h0, h0));
+    acc2 = _mm512_add_epi64(acc2, _mm512_mul_epi32(d1, d1));
+    acc3 = _mm512_add_epi64(acc3, _mm512_mul_epi32(h1, h1));
+  }
+  std::uint64_t s = static_cast<std::uint64_t>(
+      _mm512_reduce_add_epi64(_mm512_add_epi64(_mm512_add_epi64(acc0, acc1), _mm512_add_epi64(acc2, acc3))));
+  for (; i < len; ++i) {
+    const std::int64_t d = std::int64_t{e[i]} + std::int64_t{a[i]} - 2 * std::int64_t{b[i]};
+    s += static_cast<std::uint64_t>(d * d);
+  }
+  return s;
+}
+#pragma GCC diagnostic pop
+
+using SumsqI24 = std::uint64_t (*)(const std::int32_t*, const std::int32_t*, const std::int32_t*, std::int64_t);
+/// The widest of the two kernels this processor runs (AVX-512 where the OS keeps its registers).
+SumsqI24 sumsq_i24_kernel() {
+  static const SumsqI24 k = __builtin_cpu_supports("avx512f") ? block_sumsq_i24_avx512 : block_sumsq_i24_avx2;
+  return k;
+}
+#endif
+
 bool block_sumsq_i32(const std::int32_t* a, const std::int32_t* b, const std::int32_t* e, std::int64_t len,
                      double* out) {
 #if RWCALC_X86_DISPATCH
@@ -528,9 +574,10 @@ u128 second_diff_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m, 
 #if RWCALC_X86_DISPATCH
   static const bool avx2 = __builtin_cpu_supports("avx2");
   if (avx2 && c.small24) {
+    const SumsqI24 kernel = sumsq_i24_kernel();
     for (std::int64_t k0 = 0; k0 < n; k0 += kBlock24) {
       const std::int64_t len = std::min(kBlock24, n - k0);
-      total += block_sumsq_i24_avx2(r + k0, r + k0 + m, r + k0 + 2 * m, len);
+      total += kernel(r + k0, r + k0 + m, r + k0 + 2 * m, len);
     }
     return total;
   }
@@ -569,11 +616,12 @@ bool second_diff_sumsq_sweep(const PreparedCounts& c, std::size_t points, const 
     out[i] = 0;
     longest = std::max(longest, np - 2 * ms[i]);
   }
+  const SumsqI24 kernel = sumsq_i24_kernel();
   for (std::int64_t k0 = 0; k0 < longest; k0 += kBlock24) {
     for (std::size_t i = first; i < count; i += step) {
       const std::int64_t m = ms[i], n = np - 2 * m;
       if (k0 >= n) continue;
-      out[i] += block_sumsq_i24_avx2(r + k0, r + k0 + m, r + k0 + 2 * m, std::min(kBlock24, n - k0));
+      out[i] += kernel(r + k0, r + k0 + m, r + k0 + 2 * m, std::min(kBlock24, n - k0));
     }
   }
   return true;

@@ -7,6 +7,7 @@
 #include <cctype>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <thread>
 
 #include "rwcalc/confidence.hpp"
@@ -146,14 +147,11 @@ void check_outlier_threshold(const AnalysisOptions& options) {
     throw UsageError(fmt::format("--outlier-threshold must be a positive number, got {}", options.outlier_threshold));
 }
 
-std::vector<Outlier> detect_outliers(const Recording& rec, const AnalysisOptions& options, OutlierReport& rep,
-                                     unsigned threads) {
+/// The report of a finished scan (`found`, with its scale).
+void report_outliers(const Recording& rec, const AnalysisOptions& options, const OutlierScale& scale,
+                     const std::vector<Outlier>& found, OutlierReport& rep) {
   rep.action = options.outlier_action;
   rep.threshold = options.outlier_threshold;
-  check_outlier_threshold(options);
-  // The rates are computed block by block from the phase (no copy of the whole record).
-  OutlierScale scale;
-  std::vector<Outlier> found = scan_outliers(rec.phase, options.outlier_threshold, scale, threads);
   rep.scale_deg_per_h = scale.scale;
   rep.count = found.size();
   // Rate sample i comes from data sample i (pulses, rate) or i+1 (counter, angle: the later reading).
@@ -165,6 +163,15 @@ std::vector<Outlier> detect_outliers(const Recording& rec, const AnalysisOptions
   }
   if (options.outlier_action == OutlierAction::Remove) rep.removed = found.size();
   if (options.outlier_action == OutlierAction::Replace) rep.replaced = found.size();
+}
+
+std::vector<Outlier> detect_outliers(const Recording& rec, const AnalysisOptions& options, OutlierReport& rep,
+                                     unsigned threads) {
+  check_outlier_threshold(options);
+  // The rates are computed block by block from the phase (no copy of the whole record).
+  OutlierScale scale;
+  std::vector<Outlier> found = scan_outliers(rec.phase, options.outlier_threshold, scale, threads);
+  report_outliers(rec, options, scale, found, rep);
   return found;
 }
 
@@ -186,13 +193,17 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
                                                 : std::max(1u, std::thread::hardware_concurrency());
   const bool beside = options.outlier_action == OutlierAction::Keep && budget > 1 && read.phase.points() >= 3 &&
                       read.phase.kind == PhaseKind::Gyro;
+  // The scan is shared: a thread of its own takes stretches of the record from the start, and
+  // the analysis' thread joins in once the verdict is done (SharedOutlierScan).
+  std::optional<SharedOutlierScan> shared;
   std::jthread scan_thread;
   std::exception_ptr scan_error;
   auto start_scan = [&] {
+    shared.emplace(read.phase, options.outlier_threshold);
     scan_thread = std::jthread([&] {
       try {
         detail::ScopedTimer t("analyze: outlier scan (beside)", true);  // this thread's CPU only
-        (void)detect_outliers(read, options, outliers, 1);
+        shared->help();
       } catch (...) {
         scan_error = std::current_exception();
       }
@@ -284,7 +295,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   try {
     detail::ScopedTimer t("analyze: fit");
     FitOptions fopt = options.fit;
-    if (fopt.threads == 0) fopt.threads = aopt.threads;  // the analysis' thread budget
+    if (fopt.threads == 0) fopt.threads = beside ? 1u : aopt.threads;
     r.fit = fit_noise(fit_points(fitted), fopt);
   } catch (const AnalysisError& e) {
     throw AnalysisError(fmt::format("{}: {}", rec.source, e.what()));
@@ -344,8 +355,13 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   }
   r.verdict = decide(b_in, from_fit(Term::N), rho, options.verdict);
   if (beside) {
+    detail::ScopedTimer t("analyze: outlier scan (rest)", true);
+    shared->help();
     scan_thread.join();
     if (scan_error) std::rethrow_exception(scan_error);
+    OutlierScale scale;
+    const std::vector<Outlier> found = shared->finish(scale);
+    report_outliers(read, options, scale, found, outliers);
     r.outliers = std::move(outliers);
   }
   return r;

@@ -13,6 +13,7 @@
 #include <numbers>
 #include <thread>
 
+#include "fit_kernels.hpp"
 #include "rwcalc/error.hpp"
 
 namespace rwcalc {
@@ -430,7 +431,7 @@ Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix
   };
   constexpr std::array<double, 3> kw{1.0, -2.0, 1.0};
   // Row a of the upper triangle; rows go to the threads alternately (row a has j − a entries).
-  auto row = [&](Eigen::Index a) {
+  auto row = [&](Eigen::Index a, std::vector<double>& centres, std::vector<double>& weights) {
     for (Eigen::Index b = a; b < (diagonal_only ? a + 1 : j); ++b) {
       const auto& pa = pts[static_cast<std::size_t>(a)];
       const auto& pb = pts[static_cast<std::size_t>(b)];
@@ -469,10 +470,17 @@ Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix
         for (int l = 0; l < 3; ++l) knots[static_cast<std::size_t>(nk++)] = oa[static_cast<std::size_t>(k)] - ob[static_cast<std::size_t>(l)];
       std::sort(knots.begin(), knots.begin() + nk);
       const std::int64_t s0 = std::max<std::int64_t>(1, mn / 16);
+      // Each block contributes its length times the summand at its centre; the centres and
+      // weights are gathered first and γ² summed over them in one vectorised pass.
+      centres.clear();
+      weights.clear();
       auto block = [&](std::int64_t start, std::int64_t len) {
         const double hc = static_cast<double>(start) + 0.5 * static_cast<double>(len - 1);
-        const double g = gamma_c(hc);
-        return static_cast<double>(len) * count(hc) * g * g;
+        const double wc = static_cast<double>(len) * count(hc);
+        if (wc > 0) {
+          centres.push_back(hc);
+          weights.push_back(wc);
+        }
       };
       double total = 0;
       for (int q = 0; q + 1 < nk; ++q) {
@@ -482,14 +490,28 @@ Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix
         const std::int64_t mid = left + (right - left) / 2;
         for (std::int64_t h = left; h < mid;) {
           const std::int64_t len = std::min(mid - h, std::max(s0, (h - left) / 4));
-          total += block(h, len);
+          block(h, len);
           h += len;
         }
         for (std::int64_t h = right; h > mid;) {
           const std::int64_t len = std::min(h - mid, std::max(s0, (right - h) / 4));
-          total += block(h - len, len);
+          block(h - len, len);
           h -= len;
         }
+      }
+      {
+        detail::GammaPair gp;
+        gp.tau0 = tau0;
+        gp.c1 = c[1];
+        gp.c2 = c[2];
+        gp.c3 = c[3];
+        for (int k = 0; k < 3; ++k)
+          for (int l = 0; l < 3; ++l) {
+            const auto q = static_cast<std::size_t>(3 * k + l);
+            gp.d[q] = static_cast<double>(oa[static_cast<std::size_t>(k)] - ob[static_cast<std::size_t>(l)]);
+            gp.w[q] = kw[static_cast<std::size_t>(k)] * kw[static_cast<std::size_t>(l)];
+          }
+        total += detail::gamma_sq_sum(gp, centres.data(), weights.data(), centres.size());
       }
       // White angle noise: exact additions at the few lags where sample indices coincide.
       if (cq > 0) {
@@ -522,11 +544,14 @@ Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix
   if (threads == 0) threads = std::thread::hardware_concurrency();
   if (threads > 1 && !diagonal_only && j >= 8) {
     std::jthread other([&] {
-      for (Eigen::Index a = 1; a < j; a += 2) row(a);
+      std::vector<double> centres, weights;
+      for (Eigen::Index a = 1; a < j; a += 2) row(a, centres, weights);
     });
-    for (Eigen::Index a = 0; a < j; a += 2) row(a);
+    std::vector<double> centres, weights;
+    for (Eigen::Index a = 0; a < j; a += 2) row(a, centres, weights);
   } else {
-    for (Eigen::Index a = 0; a < j; ++a) row(a);
+    std::vector<double> centres, weights;
+    for (Eigen::Index a = 0; a < j; ++a) row(a, centres, weights);
   }
   return cov;
 }

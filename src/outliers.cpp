@@ -2,8 +2,11 @@
 #include "rwcalc/outliers.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <optional>
 #include <thread>
 
 #if defined(__x86_64__) || defined(__i386__)
@@ -214,82 +217,103 @@ bool screen_block(const double* w, std::size_t len, double limit) {
   return hit;
 }
 
-// With `flagged`, the same pass also screens every interior block against a provisional limit
-// `pre` and lists the blocks (their first index) where some |residual| exceeds it.
+// The scale pass in three parts, so that its interior can be split between threads in any way:
+// the first samples (constructor), interior stretches of whole blocks, each into a Part of its
+// own (`interior`, from any thread), and the last samples with the merge of the parts (`finish`,
+// the parts given in the order of their stretches). With `pre` > 0 the same pass also screens
+// every interior block against that provisional limit and lists the blocks (their first index)
+// where some |residual| exceeds it. A minimum and a set of values: the scale is the same
+// whatever the split.
 template <class Src>
-OutlierScale scale_of(const Src& src, unsigned threads, double pre = 0, std::vector<std::size_t>* flagged = nullptr) {
-  OutlierScale s;
-  const std::size_t n = src.n;
-  if (n < kMinSamples) return s;
-  double head[7], tail[7];
-  edges(src, head, tail);
-
-  // Resolution: the smallest non-zero step, over i in [1, n).
-  double res = std::numeric_limits<double>::infinity();
-  res = min_step(head, 4, res);  // steps 1..3
-  // Robust scale: 1.4826 × the median |residual| of an evenly strided subset.
-  const std::size_t stride = (n + kScaleSamples - 1) / kScaleSamples;
-  std::vector<double> a;
-  a.reserve(n / stride + 1);
-  auto add_edge = [&](std::size_t i) {
-    if (i < 3) a.push_back(std::abs(residual(head, i, 7)));
-    else a.push_back(std::abs(residual(tail, i - (n - 7), 7)));
+struct ScalePass {
+  struct Part {
+    double res = std::numeric_limits<double>::infinity();
+    std::vector<double> a;
+    std::vector<std::size_t> hits;
   };
-  for (std::size_t i = 0; i < 3 && i < n; i += stride) add_edge(i);
-  const std::size_t end = n - 3;  // interior [3, n − 3)
-  // Interior blocks [from, to): their steps i in [b+1, e+1) (the window's local [3, e − b + 4)
-  // with its previous sample) and the subset's indices among them.
-  auto blocks = [&](std::size_t from, std::size_t to, double& r, std::vector<double>& out,
-                    std::vector<std::size_t>& hits) {
+  const Src& src;
+  std::size_t n, stride, end;
+  double pre;
+  double head[7], tail[7];
+
+  ScalePass(const Src& s, double pre_limit) : src(s), n(s.n), stride(1), end(0), pre(pre_limit) {
+    if (n < kMinSamples) return;
+    edges(src, head, tail);
+    stride = (n + kScaleSamples - 1) / kScaleSamples;
+    end = n - 3;  // interior [3, n − 3)
+  }
+  /// Interior blocks [from, to): their steps i in [b+1, e+1) (the window's local [3, e − b + 4)
+  /// with its previous sample) and the subset's indices among them.
+  void interior(std::size_t from, std::size_t to, Part& p) const {
     std::vector<double> buf(kBlock + 2 * kHalo);
     std::size_t next = (from + stride - 1) / stride * stride;
+    p.a.reserve(p.a.size() + (to - from) / stride + 1);
     for (std::size_t b = from; b < to; b += kBlock) {
       const std::size_t e = std::min(to, b + kBlock);
       const double* w = src.window(b, e, buf.data());
-      r = min_step(w + kHalo, e - b + 1, r);
-      for (; next < e; next += stride) out.push_back(std::abs(interior_residual(w, next - b + kHalo)));
-      if (flagged && screen_block(w, e - b, pre)) hits.push_back(b);
+      p.res = min_step(w + kHalo, e - b + 1, p.res);
+      for (; next < e; next += stride) p.a.push_back(std::abs(interior_residual(w, next - b + kHalo)));
+      if (pre > 0 && screen_block(w, e - b, pre)) p.hits.push_back(b);
     }
-  };
-  std::vector<std::size_t> hits1, hits2;
-  // Long records: the second half of the interior on another thread (a minimum and a set of
-  // values: the same whatever the split).
-  constexpr std::size_t kParallelFrom = std::size_t{1} << 20;
-  if (threads == 0) threads = std::thread::hardware_concurrency();
-  if (end > 3 && end - 3 >= kParallelFrom && threads > 1) {
-    const std::size_t mid = 3 + ((end - 3) / 2 / kBlock) * kBlock;
-    double res2 = std::numeric_limits<double>::infinity();
-    std::vector<double> a2;
-    a2.reserve((end - mid) / stride + 1);
-    {
-      std::jthread worker([&] { blocks(mid, end, res2, a2, hits2); });
-      blocks(3, mid, res, a, hits1);
+  }
+  OutlierScale finish(const std::vector<Part*>& parts, std::vector<std::size_t>* flagged) const {
+    OutlierScale s;
+    if (n < kMinSamples) return s;
+    // Resolution: the smallest non-zero step, over i in [1, n).
+    double res = min_step(head, 4, std::numeric_limits<double>::infinity());  // steps 1..3
+    // Robust scale: 1.4826 × the median |residual| of an evenly strided subset.
+    std::vector<double> a;
+    std::size_t total = 8;
+    for (const Part* p : parts) total += p->a.size();
+    a.reserve(total);
+    auto add_edge = [&](std::size_t i) {
+      if (i < 3) a.push_back(std::abs(residual(head, i, 7)));
+      else a.push_back(std::abs(residual(tail, i - (n - 7), 7)));
+    };
+    for (std::size_t i = 0; i < 3 && i < n; i += stride) add_edge(i);
+    if (flagged) flagged->clear();
+    for (const Part* p : parts) {
+      res = std::min(res, p->res);
+      a.insert(a.end(), p->a.begin(), p->a.end());
+      if (flagged) flagged->insert(flagged->end(), p->hits.begin(), p->hits.end());
     }
-    res = std::min(res, res2);
-    a.insert(a.end(), a2.begin(), a2.end());
-  } else {
-    blocks(3, end, res, a, hits1);
-  }
-  if (flagged) {
-    *flagged = std::move(hits1);
-    flagged->insert(flagged->end(), hits2.begin(), hits2.end());
-  }
-  // Remaining steps of the tail: i in [max(4, n − 2), n) — locals of tail.
-  {
-    const std::size_t first = std::max<std::size_t>(4, n - 2);  // steps below were counted in blocks/head
-    for (std::size_t i = first; i < n; ++i) {
+    // Remaining steps of the tail: i in [max(4, n − 2), n) — locals of tail.
+    for (std::size_t i = std::max<std::size_t>(4, n - 2); i < n; ++i) {
       const double d = std::abs(tail[i - (n - 7)] - tail[i - 1 - (n - 7)]);
       res = std::min(res, d > 0 ? d : std::numeric_limits<double>::infinity());
     }
+    for (std::size_t i = std::max<std::size_t>(3, (end + stride - 1) / stride * stride); i < n; i += stride) add_edge(i);
+    s.resolution = std::isfinite(res) ? res : 0.0;
+    auto mid = a.begin() + static_cast<std::ptrdiff_t>(a.size() / 2);
+    std::nth_element(a.begin(), mid, a.end());
+    s.mad_sigma = kMadToSigma * *mid;
+    s.scale = std::max(s.mad_sigma, s.resolution);
+    return s;
   }
-  for (std::size_t i = std::max<std::size_t>(3, (end + stride - 1) / stride * stride); i < n; i += stride) add_edge(i);
-  s.resolution = std::isfinite(res) ? res : 0.0;
+};
 
-  auto mid = a.begin() + static_cast<std::ptrdiff_t>(a.size() / 2);
-  std::nth_element(a.begin(), mid, a.end());
-  s.mad_sigma = kMadToSigma * *mid;
-  s.scale = std::max(s.mad_sigma, s.resolution);
-  return s;
+// Records of at least this many samples split their passes between two threads when allowed.
+constexpr std::size_t kParallelFrom = std::size_t{1} << 20;
+
+// With `flagged`, the same pass also screens every interior block against the provisional limit
+// `pre` (see ScalePass).
+template <class Src>
+OutlierScale scale_of(const Src& src, unsigned threads, double pre = 0, std::vector<std::size_t>* flagged = nullptr) {
+  if (src.n < kMinSamples) return {};
+  const ScalePass<Src> pass(src, flagged ? pre : 0.0);
+  using Part = typename ScalePass<Src>::Part;
+  Part first, second;
+  if (threads == 0) threads = std::thread::hardware_concurrency();
+  const std::size_t end = pass.end;
+  // Long records: the second half of the interior on another thread.
+  if (end > 3 && end - 3 >= kParallelFrom && threads > 1) {
+    const std::size_t mid = 3 + ((end - 3) / 2 / kBlock) * kBlock;
+    std::jthread worker([&] { pass.interior(mid, end, second); });
+    pass.interior(3, mid, first);
+  } else {
+    pass.interior(3, end, first);
+  }
+  return pass.finish({&first, &second}, flagged);
 }
 
 // With `only`, the interior blocks outside that list (first indices, ascending) are known to hold
@@ -330,7 +354,6 @@ std::vector<Outlier> outliers_of(const Src& src, double threshold, const Outlier
   test_edge(2);
   const std::size_t end = n - 3;
   // Long records: the second half of the interior on another thread (results joined in order).
-  constexpr std::size_t kParallelFrom = std::size_t{1} << 20;
   if (threads == 0) threads = std::thread::hardware_concurrency();
   if (only) {
     std::vector<double> buf(kBlock + 2 * kHalo);
@@ -383,6 +406,28 @@ std::vector<Outlier> find_outliers(const PhaseSeries& phase, double threshold, c
   return outliers_of(PhaseRates{phase, rate_count(phase)}, threshold, s, threads);
 }
 
+namespace {
+
+/// The provisional limit of the one-pass scan of exact counts: threshold × one count's rate step
+/// (the resolution of integer data), just under it; 0 when that scan does not apply.
+double one_pass_limit(const PhaseSeries& phase, std::size_t n, double threshold) {
+  const double pre = threshold * (phase.arcsec_per_count / phase.tau0_s) * (1.0 - 1.0 / 1048576.0);
+  if (!phase.exact() || n < kMinSamples || !(pre > 0) || !std::isfinite(pre)) return 0.0;
+  return pre;
+}
+
+/// The outliers once the one-pass scale and its flagged blocks are known: only those blocks are
+/// read again, unless the bound exceeds the real limit after all or too many blocks tripped.
+std::vector<Outlier> after_one_pass(const PhaseRates& src, double threshold, const OutlierScale& scale, double pre,
+                                    const std::vector<std::size_t>& flagged, unsigned threads) {
+  const std::size_t blocks = (src.n - 6 + kBlock - 1) / kBlock;
+  if (threshold * scale.scale >= pre && flagged.size() <= blocks / 16)
+    return outliers_of(src, threshold, scale, threads, &flagged);
+  return outliers_of(src, threshold, scale, threads);
+}
+
+}  // namespace
+
 std::vector<Outlier> scan_outliers(const PhaseSeries& phase, double threshold, OutlierScale& scale, unsigned threads) {
   const PhaseRates src{phase, rate_count(phase)};
   // Exact counts: the limit is at least threshold × one count's rate step (the resolution of
@@ -390,17 +435,68 @@ std::vector<Outlier> scan_outliers(const PhaseSeries& phase, double threshold, O
   // that bound; only the blocks that trip are read again, against the real limit. If the bound
   // should exceed the real limit after all, or too many blocks trip (the spread, not the
   // resolution, sets the scale), the ordinary screen runs instead: the result is the same.
-  const double pre = threshold * (phase.arcsec_per_count / phase.tau0_s) * (1.0 - 1.0 / 1048576.0);
-  if (!phase.exact() || src.n < kMinSamples || !(pre > 0) || !std::isfinite(pre)) {
+  const double pre = one_pass_limit(phase, src.n, threshold);
+  if (!(pre > 0)) {
     scale = scale_of(src, threads);
     return outliers_of(src, threshold, scale, threads);
   }
   std::vector<std::size_t> flagged;
   scale = scale_of(src, threads, pre, &flagged);
-  const std::size_t blocks = (src.n - 6 + kBlock - 1) / kBlock;
-  if (threshold * scale.scale >= pre && flagged.size() <= blocks / 16)
-    return outliers_of(src, threshold, scale, threads, &flagged);
-  return outliers_of(src, threshold, scale, threads);
+  return after_one_pass(src, threshold, scale, pre, flagged, threads);
+}
+
+struct SharedOutlierScan::Impl {
+  static constexpr std::size_t kChunk = kBlock * 64;  ///< samples per stretch a helper takes
+  PhaseRates src;
+  double threshold;
+  double pre;
+  std::optional<ScalePass<PhaseRates>> pass;
+  std::vector<ScalePass<PhaseRates>::Part> parts;
+  std::atomic<std::size_t> next{0};
+  // Other data (not the one-pass case): the first helper runs the whole scan.
+  std::atomic<bool> claimed{false};
+  OutlierScale scale;
+  std::vector<Outlier> found;
+
+  Impl(const PhaseSeries& phase, double thr)
+      : src{phase, rate_count(phase)}, threshold(thr), pre(one_pass_limit(phase, src.n, thr)) {
+    if (!(pre > 0)) return;
+    pass.emplace(src, pre);
+    const std::size_t interior = pass->end > 3 ? pass->end - 3 : 0;
+    parts.resize((interior + kChunk - 1) / kChunk);
+  }
+};
+
+SharedOutlierScan::SharedOutlierScan(const PhaseSeries& phase, double threshold)
+    : impl_(std::make_unique<Impl>(phase, threshold)) {}
+
+SharedOutlierScan::~SharedOutlierScan() = default;
+
+void SharedOutlierScan::help() {
+  Impl& m = *impl_;
+  if (!m.pass) {
+    if (!m.claimed.exchange(true)) m.found = scan_outliers(m.src.ph, m.threshold, m.scale, 1);
+    return;
+  }
+  for (std::size_t k = m.next++; k < m.parts.size(); k = m.next++) {
+    const std::size_t from = 3 + k * Impl::kChunk;
+    m.pass->interior(from, std::min(m.pass->end, from + Impl::kChunk), m.parts[k]);
+  }
+}
+
+std::vector<Outlier> SharedOutlierScan::finish(OutlierScale& scale, unsigned threads) {
+  Impl& m = *impl_;
+  if (!m.pass) {
+    help();  // nobody took it yet: run it here
+    scale = m.scale;
+    return std::move(m.found);
+  }
+  help();  // whatever is left
+  std::vector<ScalePass<PhaseRates>::Part*> ptrs;
+  for (auto& p : m.parts) ptrs.push_back(&p);
+  std::vector<std::size_t> flagged;
+  scale = m.pass->finish(ptrs, &flagged);
+  return after_one_pass(m.src, m.threshold, scale, m.pre, flagged, threads);
 }
 
 std::vector<Outlier> find_outliers(const Recording& recording, double threshold) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 #include <set>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -324,6 +325,62 @@ TEST(Outliers, OnePassScanEqualsScaleThenScreen) {
       }
     }
   }
+}
+
+}  // namespace
+
+namespace {
+
+// SharedOutlierScan gives what scan_outliers gives, however the work is shared: finish() alone,
+// one helper thread, or a helper and the finishing thread both taking stretches — on exact counts
+// (the one-pass path, and a wide spread that falls back to the ordinary screen) and on floating
+// rates (the first helper runs the whole scan).
+TEST(Outliers, SharedScanEqualsScanOutliers) {
+  std::mt19937_64 rng(47);
+  auto expect_same = [](const rwcalc::PhaseSeries& ph, const char* what) {
+    rwcalc::OutlierScale s0;
+    const auto o0 = rwcalc::scan_outliers(ph, 8.0, s0, 1);
+    EXPECT_FALSE(o0.empty()) << what;
+    for (int helpers = 0; helpers < 3; ++helpers) {
+      rwcalc::SharedOutlierScan shared(ph, 8.0);
+      {
+        std::vector<std::jthread> pool;
+        for (int h = 0; h < helpers; ++h) pool.emplace_back([&] { shared.help(); });
+        if (helpers == 2) shared.help();
+      }
+      rwcalc::OutlierScale s1;
+      const auto o1 = shared.finish(s1);
+      EXPECT_EQ(s1.scale, s0.scale) << what << " helpers " << helpers;
+      EXPECT_EQ(s1.mad_sigma, s0.mad_sigma) << what;
+      EXPECT_EQ(s1.resolution, s0.resolution) << what;
+      ASSERT_EQ(o1.size(), o0.size()) << what << " helpers " << helpers;
+      for (std::size_t k = 0; k < o1.size(); ++k) {
+        EXPECT_EQ(o1[k].index, o0[k].index);
+        EXPECT_EQ(o1[k].value, o0[k].value);
+        EXPECT_EQ(o1[k].robust_z, o0[k].robust_z);
+      }
+    }
+  };
+  const std::size_t n = (std::size_t{1} << 20) + 70'001;  // not a whole number of stretches
+  for (double mean : {2.5, 400.0}) {
+    std::poisson_distribution<int> pulses(mean);
+    rwcalc::PhaseSeries ph;
+    ph.tau0_s = 0.0025;
+    ph.arcsec_per_count = 0.92;
+    ph.counts.assign(1, 5);
+    for (std::size_t i = 0; i < n; ++i) {
+      std::int64_t c = pulses(rng);
+      if (i % 99991 == 17 || i == 1 || i == n - 3) c += 20 + static_cast<std::int64_t>(mean) * 4;
+      ph.counts.push_back(ph.counts.back() + c);
+    }
+    expect_same(ph, mean < 10 ? "counts, one pass" : "counts, wide spread");
+  }
+  rwcalc::PhaseSeries fl;
+  fl.tau0_s = 0.01;
+  std::normal_distribution<double> g(0.0, 1.0);
+  fl.values.assign(1, 0.0);
+  for (std::size_t i = 0; i < n; ++i) fl.values.push_back(fl.values.back() + 0.01 * (g(rng) + (i % 77777 == 3 ? 40 : 0)));
+  expect_same(fl, "floating rates");
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 /// samples are found without false alarms beside them (the median tolerates two bad neighbours
 /// of six); longer bursts are found in part.
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 #include "rwcalc/reader.hpp"
@@ -63,6 +64,25 @@ std::vector<Outlier> find_outliers(const PhaseSeries& phase, double threshold, c
 /// with the same results; on exact counts usually in one pass over the record instead of two.
 std::vector<Outlier> scan_outliers(const PhaseSeries& phase, double threshold, OutlierScale& scale,
                                    unsigned threads = 0);
+
+/// scan_outliers shared between threads that join in whenever they are free: any number of
+/// threads call help(), each taking stretches of the record until none is left (on exact counts;
+/// on other data the first caller runs the whole scan), and once every help() has returned one
+/// thread calls finish(), which does what is left. The results are those of scan_outliers.
+class SharedOutlierScan {
+ public:
+  SharedOutlierScan(const PhaseSeries& phase, double threshold);
+  ~SharedOutlierScan();
+  SharedOutlierScan(const SharedOutlierScan&) = delete;
+  SharedOutlierScan& operator=(const SharedOutlierScan&) = delete;
+  void help();
+  /// `threads` for the last step (records of more than 2^20 samples use two when allowed).
+  std::vector<Outlier> finish(OutlierScale& scale, unsigned threads = 1);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 /// Same, on a recording's rates, with the input line of each outlier filled in.
 std::vector<Outlier> find_outliers(const Recording& recording,
