@@ -457,11 +457,79 @@ __attribute__((target("avx2"))) std::size_t lag1_exact_steps_avx2(const std::int
   return i;
 }
 
-// Points of level L and the end of its vector steps (0: none), for `count` phase points.
+// The same with AVX-512: eight int64 lanes, positions i ∈ {from, from + 8, …} below `to`, each
+// step adding the terms k = i … i + 7; requires to ≤ vlen − 8. A chunk gives a lane 128 steps.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+template <int L>
+__attribute__((target("avx512f"), always_inline)) inline __m512i izvec512(const std::int32_t* w, std::size_t o) {
+  if constexpr (L == 0)
+    return _mm512_cvtepi32_epi64(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(w + o)));
+  else
+    return _mm512_sub_epi64(izvec512<L - 1>(w, o + 1), izvec512<L - 1>(w, o));
+}
+
+struct ExactLanes512 {
+  __m512i s1, s2, lag;
+};
+
+template <int L>
+__attribute__((target("avx512f"), always_inline)) inline void exact_step512(const std::int32_t* w, ExactLanes512& a) {
+  const __m512i z = izvec512<L>(w, 0);
+  const __m512i zn = izvec512<L>(w, 1);
+  a.s1 = _mm512_add_epi64(a.s1, z);
+  a.s2 = _mm512_add_epi64(a.s2, _mm512_mul_epi32(z, z));
+  a.lag = _mm512_add_epi64(a.lag, _mm512_mul_epi32(z, zn));
+}
+
+__attribute__((target("avx512f"))) inline void exact_flush512(const ExactLanes512& a, ExactLag1& s) {
+  s.s1 += _mm512_reduce_add_epi64(a.s1);
+  s.s2 += _mm512_reduce_add_epi64(a.s2);
+  s.lag += _mm512_reduce_add_epi64(a.lag);
+}
+
 template <int L, bool Pair>
+__attribute__((target("avx512f"))) std::size_t lag1_exact_steps_avx512(const std::int32_t* rel32, std::size_t stride,
+                                                                       std::size_t count, std::size_t from,
+                                                                       std::size_t to, ExactLag1 s[2]) {
+  constexpr std::size_t kChunk = 1024;  // 128 steps: one flush per chunk
+  alignas(64) std::int32_t buf[kChunk + L + 16];
+  std::size_t i = from;
+  while (i < to) {
+    const std::int32_t* w = rel32 + i;
+    if (stride != 1) {  // the decimated phase into the buffer, sixteen per gather
+      const std::size_t n = std::min(kChunk + L + 10, count - i);
+      const std::int32_t* base = rel32 + i * stride;
+      const __m512i step = _mm512_set1_epi32(static_cast<std::int32_t>(16 * stride));
+      __m512i idx = _mm512_mullo_epi32(_mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15),
+                                       _mm512_set1_epi32(static_cast<std::int32_t>(stride)));
+      std::size_t t = 0;
+      if (stride < (std::size_t{1} << 20))  // the int32 indices (t·stride, t < 1050) do not overflow
+        for (; t + 16 <= n; t += 16, idx = _mm512_add_epi32(idx, step))
+          _mm512_store_si512(buf + t, _mm512_i32gather_epi32(idx, base, 4));
+      for (; t < n; ++t) buf[t] = base[t * stride];
+      w = buf;
+    }
+    ExactLanes512 a0{_mm512_setzero_si512(), _mm512_setzero_si512(), _mm512_setzero_si512()};
+    ExactLanes512 a1 = a0;
+    const std::size_t i0 = i;
+    for (; i < to && i < i0 + kChunk; i += 8) {
+      exact_step512<L>(w + (i - i0), a0);
+      if constexpr (Pair) exact_step512<L + 1>(w + (i - i0), a1);
+    }
+    exact_flush512(a0, s[0]);
+    if constexpr (Pair) exact_flush512(a1, s[1]);
+  }
+  return i;
+}
+#pragma GCC diagnostic pop
+
+// Points of level L and the end of the vector steps of width W (0: none), for `count` phase points.
+template <int L, bool Pair, std::size_t W = 4>
 std::size_t vector_end(std::size_t count) {
   const std::size_t vlen = count - static_cast<std::size_t>(L + (Pair ? 1 : 0));
-  return vlen > 4 ? vlen - 4 : 0;
+  return vlen > W ? vlen - W : 0;
 }
 
 // The scalar tail from `covered` and r1 of each level.
@@ -508,7 +576,7 @@ void lag1_exact_avx2_at(const std::int32_t* rel32, std::size_t stride, std::size
 // The start pass (detail::lag1_start_pass) of one thread: the vector steps of every stride j at
 // positions [lo[j], hi[j]), walking the view in blocks so that all strides read a block while it
 // is in the core's cache.
-template <int L>
+template <int L, std::size_t W>
 __attribute__((target("avx2"))) void lag1_start_part(const std::int32_t* rel32, std::size_t b_lo, std::size_t b_hi,
                                                      const std::vector<std::size_t>& stride,
                                                      const std::vector<std::size_t>& count,
@@ -520,29 +588,33 @@ __attribute__((target("avx2"))) void lag1_start_part(const std::int32_t* rel32, 
     const std::size_t b1 = std::min(b_hi, b0 + kBlock);
     for (std::size_t j = 0; j < stride.size(); ++j) {
       const std::size_t kb = std::min(hi[j], (b1 + stride[j] - 1) / stride[j]);
-      if (pos[j] < kb) pos[j] = lag1_exact_steps_avx2<L, true>(rel32, stride[j], count[j], pos[j], kb, s + 2 * j);
+      if (pos[j] >= kb) continue;
+      if constexpr (W == 8)
+        pos[j] = lag1_exact_steps_avx512<L, true>(rel32, stride[j], count[j], pos[j], kb, s + 2 * j);
+      else
+        pos[j] = lag1_exact_steps_avx2<L, true>(rel32, stride[j], count[j], pos[j], kb, s + 2 * j);
     }
   }
 }
 
-template <int L>
+template <int L, std::size_t W>
 void lag1_start_pass_impl(const std::int32_t* rel32, std::size_t points, const std::vector<std::size_t>& stride,
                           const std::vector<std::size_t>& count, unsigned threads, std::vector<double>& r) {
   const std::size_t n = stride.size();
   std::vector<std::size_t> vend(n), split(n), zero(n, 0);
   const std::size_t mid = threads > 1 ? points / 2 : points;
   for (std::size_t j = 0; j < n; ++j) {
-    vend[j] = vector_end<L, true>(count[j]);
-    // Thread 0 takes the steps below split (a multiple of 4, so both threads keep the positions
-    // 0, 4, 8, …), thread 1 the rest: the sums are exact, so the split changes no bit.
-    split[j] = std::min(vend[j], ((mid + stride[j] - 1) / stride[j]) & ~std::size_t{3});
+    vend[j] = vector_end<L, true, W>(count[j]);
+    // Thread 0 takes the steps below split (a multiple of W, so both threads keep the positions
+    // 0, W, 2W, …), thread 1 the rest: the sums are exact, so the split changes no bit.
+    split[j] = std::min(vend[j], ((mid + stride[j] - 1) / stride[j]) & ~(W - 1));
   }
   std::vector<ExactLag1> s0(2 * n), s1(2 * n);
   {
     std::jthread second;
     if (threads > 1)
-      second = std::jthread([&] { lag1_start_part<L>(rel32, mid, points, stride, count, split, vend, s1.data()); });
-    lag1_start_part<L>(rel32, 0, mid, stride, count, zero, threads > 1 ? split : vend, s0.data());
+      second = std::jthread([&] { lag1_start_part<L, W>(rel32, mid, points, stride, count, split, vend, s1.data()); });
+    lag1_start_part<L, W>(rel32, 0, mid, stride, count, zero, threads > 1 ? split : vend, s0.data());
   }
   r.assign(2 * n, 0.0);
   for (std::size_t j = 0; j < n; ++j) {
@@ -552,7 +624,7 @@ void lag1_start_pass_impl(const std::int32_t* rel32, std::size_t points, const s
       s[q].s2 = s0[2 * j + q].s2 + s1[2 * j + q].s2;
       s[q].lag = s0[2 * j + q].lag + s1[2 * j + q].lag;
     }
-    const std::size_t covered = (vend[j] + 3) & ~std::size_t{3};  // the terms of the steps 0, 4, …
+    const std::size_t covered = (vend[j] + W - 1) & ~(W - 1);  // the terms of the steps 0, W, …
     lag1_exact_tail<L, true>(rel32, stride[j], count[j], covered, s, &r[2 * j]);
   }
 }
@@ -810,10 +882,12 @@ std::vector<double> lag1_start_pass(const PhaseSeries& x, const std::int64_t* ms
   }
   if (stride.empty()) return out;
   std::vector<double> r;
-  if (base == 0)
-    lag1_start_pass_impl<0>(rel32, points, stride, count, threads, r);
+  // Eight lanes where the processor has AVX-512, else four: the same exact integer sums.
+  static const bool avx512 = __builtin_cpu_supports("avx512f");
+  if (avx512)
+    (base == 0 ? lag1_start_pass_impl<0, 8> : lag1_start_pass_impl<1, 8>)(rel32, points, stride, count, threads, r);
   else
-    lag1_start_pass_impl<1>(rel32, points, stride, count, threads, r);
+    (base == 0 ? lag1_start_pass_impl<0, 4> : lag1_start_pass_impl<1, 4>)(rel32, points, stride, count, threads, r);
   out.assign(2 * n_ms, std::numeric_limits<double>::quiet_NaN());
   for (std::size_t i = 0; i < index.size(); ++i) {
     out[2 * index[i]] = r[2 * i];

@@ -3,6 +3,7 @@
 
 #include <iostream>
 
+#include "reader_detail.hpp"
 #include "rwcalc/cli.hpp"
 
 int main(int argc, char** argv) {
@@ -17,5 +18,7 @@ int main(int argc, char** argv) {
   // worker, and the outlier scan's beside the fit, were mapped and zeroed afresh every time. The
   // threads allocate a few large blocks each, not many small ones, so the shared lock costs nothing.
   (void)mallopt(M_ARENA_MAX, 1);
+  // So a buffer that reuses such pages is not mapped again (detail::prefault).
+  rwcalc::detail::remember_mapped_pages(true);
   return rwcalc::cli::run(argc, argv, std::cout, std::cerr);
 }

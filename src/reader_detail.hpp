@@ -74,6 +74,12 @@ TextBuffer inflate_gzip(std::string_view bytes, const std::string& name);
 /// faults otherwise dominate reading a large recording. A hint only; failures are ignored.
 void prefault(void* data, std::size_t bytes) noexcept;
 
+/// From now on, prefault maps only the pages of the brk heap that no earlier call mapped: for a
+/// process whose heap keeps freed buffers mapped (glibc with a high M_TRIM_THRESHOLD and
+/// M_MMAP_THRESHOLD, as src/main.cpp sets them), so that the next file's buffers in `batch` do
+/// not walk pages that are already there. A hint only, like prefault itself.
+void remember_mapped_pages(bool on) noexcept;
+
 // ---- number scanners ---------------------------------------------------------------------------
 
 inline bool is_digit(char c) noexcept { return static_cast<unsigned char>(c - '0') < 10; }

@@ -10,6 +10,10 @@
 #include <cerrno>
 #include <cstring>
 #include <limits>
+#include <mutex>
+#include <utility>
+#include <vector>
+#include <atomic>
 #include <thread>
 
 #include "reader_detail.hpp"
@@ -45,19 +49,81 @@ __attribute__((target_clones("avx2", "default"))) std::size_t count_lines_checke
 }
 
 
-void prefault(void* data, std::size_t bytes) noexcept {
+namespace {
+
+// Pages of the brk heap already mapped by prefault (see remember_mapped_pages): disjoint
+// [begin, end) ranges, ascending.
+struct MappedPages {
+  std::atomic<bool> on{false};
+  std::uintptr_t heap_low = 0;
+  std::mutex mu;
+  std::vector<std::pair<std::uintptr_t, std::uintptr_t>> ranges;
+};
+MappedPages& mapped_pages() {
+  static MappedPages m;
+  return m;
+}
+
+void populate(std::uintptr_t start, std::uintptr_t end) noexcept {
 #ifdef MADV_POPULATE_WRITE
+  if (end > start) (void)::madvise(reinterpret_cast<void*>(start), end - start, MADV_POPULATE_WRITE);
+#else
+  (void)start;
+  (void)end;
+#endif
+}
+
+}  // namespace
+
+void remember_mapped_pages(bool on) noexcept {
+  MappedPages& m = mapped_pages();
+  m.heap_low = reinterpret_cast<std::uintptr_t>(::sbrk(0));
+  m.on = on;
+}
+
+void prefault(void* data, std::size_t bytes) noexcept {
   constexpr std::size_t kMin = std::size_t{1} << 20;  // small buffers: not worth a system call
   if (!data || bytes < kMin) return;
   const auto page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
   const auto a = reinterpret_cast<std::uintptr_t>(data);
   const std::uintptr_t start = (a + page - 1) & ~(page - 1);
   const std::uintptr_t end = (a + bytes) & ~(page - 1);
-  if (end > start) (void)::madvise(reinterpret_cast<void*>(start), end - start, MADV_POPULATE_WRITE);
-#else
-  (void)data;
-  (void)bytes;
-#endif
+  if (end <= start) return;
+  MappedPages& m = mapped_pages();
+  const auto brk = reinterpret_cast<std::uintptr_t>(::sbrk(0));
+  if (!m.on || start < m.heap_low || end > brk) {  // not in the heap: a fresh mapping
+    populate(start, end);
+    return;
+  }
+  // In the heap: only the pages no earlier buffer mapped (a heap that shrank forgets its top).
+  std::vector<std::pair<std::uintptr_t, std::uintptr_t>> todo;
+  try {
+    const std::lock_guard lock(m.mu);
+    auto& r = m.ranges;
+    std::erase_if(r, [brk](const auto& x) { return x.first >= brk; });
+    for (auto& x : r) x.second = std::min(x.second, brk);
+    std::uintptr_t at = start;
+    for (const auto& x : r) {
+      if (x.second <= at) continue;
+      if (x.first >= end) break;
+      if (x.first > at) todo.emplace_back(at, x.first);
+      at = std::max(at, x.second);
+      if (at >= end) break;
+    }
+    if (at < end) todo.emplace_back(at, end);
+    r.emplace_back(start, end);
+    std::sort(r.begin(), r.end());
+    std::vector<std::pair<std::uintptr_t, std::uintptr_t>> merged;
+    for (const auto& x : r) {
+      if (!merged.empty() && x.first <= merged.back().second) merged.back().second = std::max(merged.back().second, x.second);
+      else merged.push_back(x);
+    }
+    r = std::move(merged);
+  } catch (...) {  // no memory for the list: map the whole buffer
+    populate(start, end);
+    return;
+  }
+  for (const auto& [b, e] : todo) populate(b, e);
 }
 
 TextBuffer::TextBuffer(std::size_t capacity, bool map_pages, std::size_t spare)
