@@ -503,6 +503,38 @@ __attribute__((target("avx2"))) void offsets_pass_avx2(const std::int64_t* __res
 }
 #endif
 
+#if RWCALC_X86_DISPATCH
+// The same with AVX-512: eight int64 offsets per vector, min/max in 64-bit lanes, the low halves
+// narrowed by vpmovqd. Integer operations only, so the same values as the scalar pass.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+__attribute__((target("avx512f"))) void offsets_pass_avx512(const std::int64_t* __restrict in,
+                                                           std::int32_t* __restrict out, std::size_t begin,
+                                                           std::size_t end, std::uint64_t c0, std::int64_t& lo_out,
+                                                           std::int64_t& hi_out) {
+  const __m512i base = _mm512_set1_epi64(static_cast<std::int64_t>(c0));
+  __m512i lo = _mm512_setzero_si512(), hi = _mm512_setzero_si512();
+  __m512i lo2 = lo, hi2 = hi;
+  std::size_t i = begin;
+  for (; i + 16 <= end; i += 16) {
+    const __m512i a = _mm512_sub_epi64(_mm512_loadu_si512(in + i), base);
+    const __m512i b = _mm512_sub_epi64(_mm512_loadu_si512(in + i + 8), base);
+    lo = _mm512_min_epi64(lo, a);
+    hi = _mm512_max_epi64(hi, a);
+    lo2 = _mm512_min_epi64(lo2, b);
+    hi2 = _mm512_max_epi64(hi2, b);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + i), _mm512_cvtepi64_epi32(a));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + i + 8), _mm512_cvtepi64_epi32(b));
+  }
+  std::int64_t tl = 0, th = 0;
+  offsets_pass_scalar(in, out, i, end, c0, tl, th);
+  lo_out = std::min<std::int64_t>(tl, _mm512_reduce_min_epi64(_mm512_min_epi64(lo, lo2)));
+  hi_out = std::max<std::int64_t>(th, _mm512_reduce_max_epi64(_mm512_max_epi64(hi, hi2)));
+}
+#pragma GCC diagnostic pop
+#endif
+
 }  // namespace
 
 PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_prefix, unsigned threads) {
@@ -517,11 +549,13 @@ PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_pref
   prefault(p.rel32.data(), p.rel32.size() * sizeof(std::int32_t));
 #if RWCALC_X86_DISPATCH
   static const bool avx2 = __builtin_cpu_supports("avx2");
+  static const bool avx512 = __builtin_cpu_supports("avx512f");
 #else
   constexpr bool avx2 = false;
 #endif
   auto pass = [&c, c0, &p](std::size_t begin, std::size_t end, std::int64_t& lo_out, std::int64_t& hi_out) {
 #if RWCALC_X86_DISPATCH
+    if (avx512) return offsets_pass_avx512(c.data(), p.rel32.data(), begin, end, c0, lo_out, hi_out);
     if (avx2) return offsets_pass_avx2(c.data(), p.rel32.data(), begin, end, c0, lo_out, hi_out);
 #endif
     offsets_pass_scalar(c.data(), p.rel32.data(), begin, end, c0, lo_out, hi_out);

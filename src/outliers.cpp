@@ -115,12 +115,124 @@ bool have_avx2() {
 #endif
 }
 
+bool have_avx512() {
+#if defined(__x86_64__) || defined(__i386__)
+  static const bool yes = __builtin_cpu_supports("avx512f");
+  return yes;
+#else
+  return false;
+#endif
+}
+
+/// The rates of sixteen consecutive count increments lo … lo + 15, each computed as
+/// PhaseSeries::rate computes it: a window whose increments all lie in that range is filled by
+/// lookup, bit-identical to dividing (exact counts only; `ok` false otherwise).
+struct RateTable {
+  bool ok = false;
+  std::int64_t lo = 0;
+  alignas(64) double v[16] = {};
+};
+
+RateTable rate_table(const PhaseSeries& ph, std::size_t n) {
+  RateTable t;
+  if (!ph.exact() || n == 0) return t;
+  // The smallest increment among the first ones, less a margin: pulse records keep their
+  // increments in a narrow band around the mean rate.
+  std::int64_t lo = std::numeric_limits<std::int64_t>::max();
+  for (std::size_t i = 0; i < std::min<std::size_t>(n, 4096); ++i)
+    lo = std::min(lo, static_cast<std::int64_t>(static_cast<std::uint64_t>(ph.counts[i + 1]) -
+                                                 static_cast<std::uint64_t>(ph.counts[i])));
+  if (lo < -(std::int64_t{1} << 40) || lo > (std::int64_t{1} << 40)) return t;
+  t.lo = lo - 4;
+  for (int k = 0; k < 16; ++k)
+    t.v[k] = static_cast<double>(t.lo + k) * ph.arcsec_per_count / ph.tau0_s;
+  t.ok = true;
+  return t;
+}
+
+#if defined(__x86_64__) || defined(__i386__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+// Rates of exact counts by lookup in the table, eight at a time; false (the window then needs
+// the division) when an increment lies outside the table's range.
+__attribute__((target("avx512f"))) bool table_rates_avx512(const std::int64_t* c, std::size_t from, std::size_t to,
+                                                         const RateTable& t, double q, double tau0, double* out) {
+  const __m512i lo = _mm512_set1_epi64(t.lo), top = _mm512_set1_epi64(15);
+  const __m512d t0 = _mm512_load_pd(t.v), t1 = _mm512_load_pd(t.v + 8);
+  __mmask8 bad = 0;
+  std::size_t i = from;
+  for (; i + 8 <= to; i += 8) {
+    const __m512i d = _mm512_sub_epi64(_mm512_loadu_si512(c + i + 1), _mm512_loadu_si512(c + i));
+    const __m512i idx = _mm512_sub_epi64(d, lo);
+    bad |= _mm512_cmpgt_epu64_mask(idx, top);
+    _mm512_storeu_pd(out + (i - from), _mm512_permutex2var_pd(t0, idx, t1));
+  }
+  for (; i < to; ++i) {
+    const auto d = static_cast<std::int64_t>(static_cast<std::uint64_t>(c[i + 1]) - static_cast<std::uint64_t>(c[i]));
+    out[i - from] = static_cast<double>(d) * q / tau0;
+  }
+  return bad == 0;
+}
+
+__attribute__((target("avx512f"))) inline void s2_512(__m512d& a, __m512d& b) {
+  const __m512d lo = _mm512_min_pd(a, b);
+  b = _mm512_max_pd(a, b);
+  a = lo;
+}
+
+// screen_avx2 with eight samples at a time.
+__attribute__((target("avx512f"))) bool screen_avx512(const double* w, std::size_t len, double limit) {
+  const __m512d lim = _mm512_set1_pd(limit);
+  const __m512d halfv = _mm512_set1_pd(0.5);
+  __mmask8 hit = 0;
+  std::size_t k = kHalo;
+  for (; k + 8 <= kHalo + len; k += 8) {
+    __m512d a = _mm512_loadu_pd(w + k - 3), b = _mm512_loadu_pd(w + k - 2), c = _mm512_loadu_pd(w + k - 1);
+    __m512d d = _mm512_loadu_pd(w + k + 1), e = _mm512_loadu_pd(w + k + 2), f = _mm512_loadu_pd(w + k + 3);
+    s2_512(a, f); s2_512(b, d); s2_512(c, e);
+    s2_512(b, c); s2_512(d, e);
+    s2_512(a, d); s2_512(c, f);
+    s2_512(a, b); s2_512(c, d); s2_512(e, f);
+    s2_512(b, c); s2_512(d, e);
+    const __m512d r = _mm512_sub_pd(_mm512_loadu_pd(w + k), _mm512_mul_pd(halfv, _mm512_add_pd(c, d)));
+    hit |= _mm512_cmp_pd_mask(_mm512_abs_pd(r), lim, _CMP_GT_OQ);
+  }
+  bool any = hit != 0;
+  for (; k < kHalo + len; ++k) any |= std::abs(interior_residual(w, k)) > limit;
+  return any;
+}
+
+// min_step_avx2 with eight steps at a time.
+__attribute__((target("avx512f"))) double min_step_avx512(const double* w, std::size_t len, double res) {
+  const __m512d inf = _mm512_set1_pd(std::numeric_limits<double>::infinity());
+  const __m512d zero = _mm512_setzero_pd();
+  __m512d acc = _mm512_set1_pd(res);
+  std::size_t i = 1;
+  for (; i + 8 <= len; i += 8) {
+    const __m512d d = _mm512_abs_pd(_mm512_sub_pd(_mm512_loadu_pd(w + i), _mm512_loadu_pd(w + i - 1)));
+    acc = _mm512_min_pd(acc, _mm512_mask_blend_pd(_mm512_cmp_pd_mask(d, zero, _CMP_GT_OQ), inf, d));
+  }
+  res = std::min(res, _mm512_reduce_min_pd(acc));
+  for (; i < len; ++i) {
+    const double d = std::abs(w[i] - w[i - 1]);
+    res = std::min(res, d > 0 ? d : std::numeric_limits<double>::infinity());
+  }
+  return res;
+}
+#pragma GCC diagnostic pop
+#endif
+
 struct PhaseRates {
   const PhaseSeries& ph;
   std::size_t n;
+  RateTable table{};
   void fill(std::size_t from, std::size_t to, double* out) const {
     if (ph.exact()) {
 #if defined(__x86_64__) || defined(__i386__)
+      if (table.ok && have_avx512() &&
+          table_rates_avx512(ph.counts.data(), from, to, table, ph.arcsec_per_count, ph.tau0_s, out))
+        return;
       if (have_avx2() && count_rates_avx2(ph.counts.data(), from, to, ph.arcsec_per_count, ph.tau0_s, out)) return;
 #endif
       for (std::size_t i = from; i < to; ++i) out[i - from] = ph.rate(i);
@@ -134,6 +246,11 @@ struct PhaseRates {
     return buf;
   }
 };
+
+PhaseRates phase_rates(const PhaseSeries& phase) {
+  const std::size_t n = phase.points() > 0 ? phase.points() - 1 : 0;
+  return {phase, n, rate_table(phase, n)};
+}
 
 // The first and the last seven rates (the samples whose neighbours are not centred).
 template <class Src>
@@ -199,6 +316,7 @@ __attribute__((target("avx2"))) bool screen_avx2(const double* w, std::size_t le
 
 double min_step(const double* w, std::size_t len, double res) {
 #if defined(__x86_64__) || defined(__i386__)
+  if (have_avx512()) return min_step_avx512(w, len, res);
   if (have_avx2()) return min_step_avx2(w, len, res);
 #endif
   for (std::size_t i = 1; i < len; ++i) {
@@ -210,6 +328,7 @@ double min_step(const double* w, std::size_t len, double res) {
 
 bool screen_block(const double* w, std::size_t len, double limit) {
 #if defined(__x86_64__) || defined(__i386__)
+  if (have_avx512()) return screen_avx512(w, len, limit);
   if (have_avx2()) return screen_avx2(w, len, limit);
 #endif
   bool hit = false;
@@ -383,14 +502,13 @@ std::vector<Outlier> outliers_of(const Src& src, double threshold, const Outlier
   return out;
 }
 
-std::size_t rate_count(const PhaseSeries& phase) { return phase.points() > 0 ? phase.points() - 1 : 0; }
 
 }  // namespace
 
 OutlierScale outlier_scale(const std::vector<double>& rates) { return scale_of(VectorRates{rates.data(), rates.size()}, 0); }
 
 OutlierScale outlier_scale(const PhaseSeries& phase, unsigned threads) {
-  return scale_of(PhaseRates{phase, rate_count(phase)}, threads);
+  return scale_of(phase_rates(phase), threads);
 }
 
 std::vector<Outlier> find_outliers(const std::vector<double>& rates, double threshold) {
@@ -403,7 +521,7 @@ std::vector<Outlier> find_outliers(const std::vector<double>& rates, double thre
 
 std::vector<Outlier> find_outliers(const PhaseSeries& phase, double threshold, const OutlierScale& s,
                                    unsigned threads) {
-  return outliers_of(PhaseRates{phase, rate_count(phase)}, threshold, s, threads);
+  return outliers_of(phase_rates(phase), threshold, s, threads);
 }
 
 namespace {
@@ -429,7 +547,7 @@ std::vector<Outlier> after_one_pass(const PhaseRates& src, double threshold, con
 }  // namespace
 
 std::vector<Outlier> scan_outliers(const PhaseSeries& phase, double threshold, OutlierScale& scale, unsigned threads) {
-  const PhaseRates src{phase, rate_count(phase)};
+  const PhaseRates src = phase_rates(phase);
   // Exact counts: the limit is at least threshold × one count's rate step (the resolution of
   // integer data), so one pass can compute the scale and screen every block against (just under)
   // that bound; only the blocks that trip are read again, against the real limit. If the bound
@@ -459,7 +577,7 @@ struct SharedOutlierScan::Impl {
   std::vector<Outlier> found;
 
   Impl(const PhaseSeries& phase, double thr)
-      : src{phase, rate_count(phase)}, threshold(thr), pre(one_pass_limit(phase, src.n, thr)) {
+      : src(phase_rates(phase)), threshold(thr), pre(one_pass_limit(phase, src.n, thr)) {
     if (!(pre > 0)) return;
     pass.emplace(src, pre);
     const std::size_t interior = pass->end > 3 ? pass->end - 3 : 0;
