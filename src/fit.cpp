@@ -81,9 +81,13 @@ bool solve_support(const Mat5& a, const Vec5& b, unsigned s, Vec5& d, double& ob
   int n = 0;
   for (int i = 0; i < P; ++i)
     if (s & (1u << i)) ids[static_cast<std::size_t>(n++)] = i;
-  Eigen::MatrixXd as(k, k);
-  Eigen::VectorXd bs(k);
-  Eigen::VectorXd dsc(k);
+  // At most 5×5: fixed-capacity storage, no heap allocation (this runs for every support of
+  // every NNLS of every IRLS step of every profile).
+  using SmallMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, P, P>;
+  using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, P, 1>;
+  SmallMat as(k, k);
+  SmallVec bs(k);
+  SmallVec dsc(k);
   for (int r = 0; r < k; ++r) {
     const double diag = a(ids[static_cast<std::size_t>(r)], ids[static_cast<std::size_t>(r)]);
     if (!(diag > 0)) return false;
@@ -94,10 +98,10 @@ bool solve_support(const Mat5& a, const Vec5& b, unsigned s, Vec5& d, double& ob
     for (int q = 0; q < k; ++q)
       as(r, q) = a(ids[static_cast<std::size_t>(r)], ids[static_cast<std::size_t>(q)]) * dsc[r] * dsc[q];
   }
-  const Eigen::LLT<Eigen::MatrixXd> llt(as);
+  const Eigen::LLT<SmallMat> llt(as);
   if (llt.info() != Eigen::Success || llt.rcond() < 1e-13) return false;
-  const Eigen::VectorXd z = llt.solve(bs);
-  const Eigen::VectorXd cs = z.cwiseProduct(dsc);
+  const SmallVec z = llt.solve(bs);
+  const SmallVec cs = z.cwiseProduct(dsc);
   if (!cs.allFinite() || (cs.array() <= 0).any()) return false;
   obj = -bs.dot(z);
   for (int r = 0; r < k; ++r) d[ids[static_cast<std::size_t>(r)]] = cs[r];
