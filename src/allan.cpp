@@ -233,7 +233,7 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
   detail::PreparedCounts prepared;
   if (x.exact()) {
     detail::ScopedTimer t("allan: prepare counts");
-    prepared = detail::prepare_counts(x.counts, est == Estimator::Modified, threads);
+    prepared = detail::prepare_counts(x.counts, est == Estimator::Modified, threads, options.crew);
   }
 
   // Every m of a long record: the sums above kAllExactBelow come from FFT autocorrelations
@@ -262,7 +262,9 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
     detail::ScopedTimer t("allan: swept variance sums");
     swept.resize(ms.size());
     bool ok = false;
-    if (threads > 1) {
+    if (options.crew) {
+      ok = detail::second_diff_sumsq_sweep_shared(prepared, points, ms.data(), ms.size(), *options.crew, swept.data());
+    } else if (threads > 1) {
       std::vector<char> oks(threads, 0);
       {
         std::vector<std::jthread> pool;
@@ -285,7 +287,7 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
   if (options.noise_id && !prepared.rel32.empty()) {
     detail::ScopedTimer t("allan: noise id start pass");
     lag1_start = detail::lag1_start_pass(x, ms.data(), ms.size(), options.noise_id_domain, prepared.rel32.data(),
-                                         prepared.small24, threads);
+                                         prepared.small24, threads, options.crew);
   }
 
   const bool timing = detail::timing_enabled();

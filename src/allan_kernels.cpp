@@ -4,6 +4,7 @@
 #include "allan_kernels.hpp"
 
 #include "reader_detail.hpp"
+#include "rwcalc/crew.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -537,7 +538,7 @@ __attribute__((target("avx512f"))) void offsets_pass_avx512(const std::int64_t* 
 
 }  // namespace
 
-PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_prefix, unsigned threads) {
+PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_prefix, unsigned threads, Crew* crew) {
   PreparedCounts p;
   p.raw = &c;
   if (c.empty()) return p;
@@ -561,7 +562,16 @@ PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_pref
     offsets_pass_scalar(c.data(), p.rel32.data(), begin, end, c0, lo_out, hi_out);
   };
   std::int64_t lo = 0, hi = 0;
-  if (threads > 1 && c.size() >= (std::size_t{1} << 20)) {  // long records: the two halves side by side
+  if (crew && c.size() >= (std::size_t{1} << 20)) {  // stretches for whoever is free
+    constexpr std::size_t kStretch = std::size_t{1} << 18;
+    const std::size_t parts = (c.size() + kStretch - 1) / kStretch;
+    std::vector<std::int64_t> los(parts, 0), his(parts, 0);
+    crew->share(parts, [&](std::size_t k) {
+      pass(k * kStretch, std::min(c.size(), (k + 1) * kStretch), los[k], his[k]);
+    });
+    lo = *std::min_element(los.begin(), los.end());
+    hi = *std::max_element(his.begin(), his.end());
+  } else if (threads > 1 && c.size() >= (std::size_t{1} << 20)) {  // long records: the two halves side by side
     std::int64_t lo2 = 0, hi2 = 0;
     const std::size_t mid = c.size() / 2;
     {
@@ -661,6 +671,42 @@ bool second_diff_sumsq_sweep(const PreparedCounts& c, std::size_t points, const 
   return true;
 #else
   (void)c, (void)points, (void)ms, (void)count, (void)first, (void)step, (void)out;
+  return false;
+#endif
+}
+
+bool second_diff_sumsq_sweep_shared(const PreparedCounts& c, std::size_t points, const std::int64_t* ms,
+                                    std::size_t count, Crew& crew, u128* out) {
+#if RWCALC_X86_DISPATCH
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (!avx2 || !c.small24 || c.rel32.empty() || count == 0) return false;
+  const std::int32_t* r = c.rel32.data();
+  const auto np = static_cast<std::int64_t>(points);
+  std::int64_t longest = 0;
+  for (std::size_t i = 0; i < count; ++i) longest = std::max(longest, np - 2 * ms[i]);
+  constexpr std::int64_t kStretch = kBlock24 * 64;  // 256 K terms per stretch
+  const auto parts = static_cast<std::size_t>((longest + kStretch - 1) / kStretch);
+  std::vector<u128> sums(parts * count, 0);
+  const SumsqI24 kernel = sumsq_i24_kernel();
+  crew.share(parts, [&](std::size_t k) {
+    u128* part = sums.data() + k * count;
+    const std::int64_t from = static_cast<std::int64_t>(k) * kStretch, to = std::min(longest, from + kStretch);
+    for (std::int64_t k0 = from; k0 < to; k0 += kBlock24) {
+      for (std::size_t i = 0; i < count; ++i) {
+        const std::int64_t m = ms[i], n = np - 2 * m;
+        if (k0 >= n) continue;
+        part[i] += kernel(r + k0, r + k0 + m, r + k0 + 2 * m, std::min({kBlock24, n - k0, to - k0}));
+      }
+    }
+  });
+  for (std::size_t i = 0; i < count; ++i) {
+    u128 total = 0;
+    for (std::size_t k = 0; k < parts; ++k) total += sums[k * count + i];
+    out[i] = total;
+  }
+  return true;
+#else
+  (void)c, (void)points, (void)ms, (void)count, (void)crew, (void)out;
   return false;
 #endif
 }

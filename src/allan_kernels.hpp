@@ -10,6 +10,10 @@
 #include <utility>
 #include <vector>
 
+namespace rwcalc {
+class Crew;
+}
+
 namespace rwcalc::detail {
 
 __extension__ typedef unsigned __int128 u128;  // exact sums of squared int64 differences
@@ -65,7 +69,10 @@ struct PreparedCounts {
   std::vector<double> prefix_f64;       ///< Σ_{i<k} (C_i − C_0), exact integers (MVAR), when small enough
   std::vector<std::uint64_t> prefix_u64;  ///< modular prefix sums of C (MVAR) otherwise
 };
-PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_prefix, unsigned threads = 1);
+/// With a crew, the offsets pass is shared out in chunks to the calling thread and the crew's
+/// lenders (`threads` is then not used for it); the same result.
+PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_prefix, unsigned threads = 1,
+                              Crew* crew = nullptr);
 u128 second_diff_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m, std::int64_t stride);
 double modified_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m);
 
@@ -76,5 +83,11 @@ double modified_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m);
 /// with every |C_k − C_0| < 2^24 on AVX2 machines; returns false (and writes nothing) otherwise.
 bool second_diff_sumsq_sweep(const PreparedCounts& c, std::size_t points, const std::int64_t* ms,
                              std::size_t count, std::size_t first, std::size_t step, u128* out);
+
+/// The same sums for every τ of ms[0 … count) with the data cut into stretches that the calling
+/// thread and the crew's lenders take as they are free (each stretch's sums kept apart, then
+/// added: exact, so the same bits). False (nothing written) where the sweep does not apply.
+bool second_diff_sumsq_sweep_shared(const PreparedCounts& c, std::size_t points, const std::int64_t* ms,
+                                    std::size_t count, Crew& crew, u128* out);
 
 }  // namespace rwcalc::detail

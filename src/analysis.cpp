@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "rwcalc/confidence.hpp"
+#include "rwcalc/crew.hpp"
 #include "rwcalc/error.hpp"
 #include "timing.hpp"
 #include "rwcalc/units.hpp"
@@ -168,9 +169,17 @@ void report_outliers(const Recording& rec, const AnalysisOptions& options, const
 std::vector<Outlier> detect_outliers(const Recording& rec, const AnalysisOptions& options, OutlierReport& rep,
                                      unsigned threads) {
   check_outlier_threshold(options);
-  // The rates are computed block by block from the phase (no copy of the whole record).
+  // The rates are computed block by block from the phase (no copy of the whole record); with a
+  // crew, by this thread and any lender free to help.
   OutlierScale scale;
-  std::vector<Outlier> found = scan_outliers(rec.phase, options.outlier_threshold, scale, threads);
+  std::vector<Outlier> found;
+  if (Crew* crew = options.allan.crew) {
+    SharedOutlierScan shared(rec.phase, options.outlier_threshold);
+    crew->share(2, [&shared](std::size_t) { shared.help(); });
+    found = shared.finish(scale);
+  } else {
+    found = scan_outliers(rec.phase, options.outlier_threshold, scale, threads);
+  }
   report_outliers(rec, options, scale, found, rep);
   return found;
 }
@@ -191,8 +200,8 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   // filling the core the fit's covariance leaves.
   const unsigned budget = options.allan.threads ? options.allan.threads
                                                 : std::max(1u, std::thread::hardware_concurrency());
-  const bool beside = options.outlier_action == OutlierAction::Keep && budget > 1 && read.phase.points() >= 3 &&
-                      read.phase.kind == PhaseKind::Gyro;
+  const bool beside = options.outlier_action == OutlierAction::Keep && budget > 1 && !options.allan.crew &&
+                      read.phase.points() >= 3 && read.phase.kind == PhaseKind::Gyro;
   // The scan is shared: a thread of its own takes stretches of the record from the start, and
   // the analysis' thread joins in once the verdict is done (SharedOutlierScan).
   std::optional<SharedOutlierScan> shared;

@@ -1,6 +1,8 @@
 // Batch analysis over files (threads), JSON-lines merge, and the Table 1 / Table 2 layout.
 #include "rwcalc/batch.hpp"
 
+#include "rwcalc/crew.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -149,31 +151,38 @@ std::vector<json> analyze_files(const std::vector<std::string>& files, const Rea
                                 const AnalysisOptions& options, unsigned jobs) {
   if (files.empty()) throw UsageError("batch: no input files");
   if (jobs == 0) jobs = std::max(1u, std::thread::hardware_concurrency());
-  // `jobs` threads in all. Files go to min(jobs, files) workers; while at least `jobs` files are
-  // left (the one being picked included) every worker is busy, so each run reads and analyses on
-  // its own thread alone (no oversubscribed cores, and --jobs 1 is one thread). The last runs,
-  // picked when fewer files than workers are left, share out the threads of the workers that
-  // have nothing left to do (the read, the outlier screen and the τ loop then run on several).
+  // `jobs` threads in all. Files go to min(jobs, files) workers, each run read and analysed on
+  // its worker's thread (--jobs 1 is one thread). A worker with no file left lends its thread to
+  // the runs still in flight — their passes over the data (the int32 view, the Allan sums, the
+  // noise identification's first pass, the outlier scan) are shared out in stretches (crew.hpp)
+  // — until the last run ends: the last runs take up the cores as they free, and no core is given
+  // two threads while another run still holds it. A single worker (one file) has all the threads.
   const unsigned total = jobs;
   jobs = std::min<unsigned>(jobs, static_cast<unsigned>(files.size()));
   std::vector<json> out(files.size());
   std::vector<std::exception_ptr> errors(files.size());
   std::atomic<std::size_t> next{0};
+  Crew crew;
+  std::atomic<unsigned> active{jobs};
   auto worker = [&] {
     for (std::size_t i = next++; i < files.size(); i = next++) {
       try {
-        const std::size_t left = files.size() - i;
-        const unsigned per_run = left >= total ? 1u : std::max(1u, total / static_cast<unsigned>(left));
+        const unsigned threads = jobs > 1 ? 1u : total;
         ReadOptions ro = read;
-        ro.threads = per_run;
+        ro.threads = threads;
         AnalysisOptions opt = options;
-        opt.allan.threads = per_run;
+        opt.allan.threads = threads;
+        if (jobs > 1) opt.allan.crew = &crew;
         const Recording rec = read_recording(files[i], ro);
         out[i] = to_json(analyze(rec, opt));
       } catch (...) {
         errors[i] = std::current_exception();
       }
     }
+    if (--active == 0)
+      crew.close();
+    else
+      crew.lend();
   };
   std::vector<std::thread> pool;
   for (unsigned t = 1; t < jobs; ++t) pool.emplace_back(worker);

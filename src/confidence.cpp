@@ -19,6 +19,7 @@
 #endif
 
 #include "noise_id.hpp"
+#include "rwcalc/crew.hpp"
 #include "rwcalc/error.hpp"
 
 namespace rwcalc {
@@ -599,31 +600,50 @@ __attribute__((target("avx2"))) void lag1_start_part(const std::int32_t* rel32, 
 
 template <int L, std::size_t W>
 void lag1_start_pass_impl(const std::int32_t* rel32, std::size_t points, const std::vector<std::size_t>& stride,
-                          const std::vector<std::size_t>& count, unsigned threads, std::vector<double>& r) {
+                          const std::vector<std::size_t>& count, unsigned threads, Crew* crew,
+                          std::vector<double>& r) {
   const std::size_t n = stride.size();
-  std::vector<std::size_t> vend(n), split(n), zero(n, 0);
-  const std::size_t mid = threads > 1 ? points / 2 : points;
-  for (std::size_t j = 0; j < n; ++j) {
-    vend[j] = vector_end<L, true, W>(count[j]);
-    // Thread 0 takes the steps below split (a multiple of W, so both threads keep the positions
-    // 0, W, 2W, …), thread 1 the rest: the sums are exact, so the split changes no bit.
-    split[j] = std::min(vend[j], ((mid + stride[j] - 1) / stride[j]) & ~(W - 1));
-  }
-  std::vector<ExactLag1> s0(2 * n), s1(2 * n);
-  {
-    std::jthread second;
-    if (threads > 1)
-      second = std::jthread([&] { lag1_start_part<L, W>(rel32, mid, points, stride, count, split, vend, s1.data()); });
-    lag1_start_part<L, W>(rel32, 0, mid, stride, count, zero, threads > 1 ? split : vend, s0.data());
+  std::vector<std::size_t> vend(n);
+  for (std::size_t j = 0; j < n; ++j) vend[j] = vector_end<L, true, W>(count[j]);
+  // The view in parts: halves on two threads, or stretches that a crew's threads take as they
+  // are free. Part c reads the view from edge(c) and takes the steps of stride j from bound(c, j)
+  // to bound(c + 1, j) (multiples of W, so every part keeps the positions 0, W, 2W, …); the sums
+  // are exact, so the split changes no bit.
+  constexpr std::size_t kStretch = std::size_t{1} << 18;
+  const std::size_t parts = crew ? std::max<std::size_t>(1, (points + kStretch - 1) / kStretch) : threads > 1 ? 2 : 1;
+  auto edge = [&](std::size_t c) { return c >= parts ? points : crew ? c * kStretch : points / 2 * c; };
+  auto bound = [&](std::size_t c, std::size_t j) -> std::size_t {
+    if (c == 0) return 0;
+    if (c >= parts) return vend[j];
+    return std::min(vend[j], ((edge(c) + stride[j] - 1) / stride[j]) & ~(W - 1));
+  };
+  std::vector<ExactLag1> sums(parts * 2 * n);
+  auto run_part = [&](std::size_t c) {
+    std::vector<std::size_t> lo(n), hi(n);
+    for (std::size_t j = 0; j < n; ++j) {
+      lo[j] = bound(c, j);
+      hi[j] = bound(c + 1, j);
+    }
+    lag1_start_part<L, W>(rel32, edge(c), edge(c + 1), stride, count, lo, hi, sums.data() + c * 2 * n);
+  };
+  if (crew) {
+    crew->share(parts, run_part);
+  } else if (parts == 2) {
+    std::jthread second([&] { run_part(1); });
+    run_part(0);
+  } else {
+    run_part(0);
   }
   r.assign(2 * n, 0.0);
   for (std::size_t j = 0; j < n; ++j) {
     ExactLag1 s[2];
-    for (int q = 0; q < 2; ++q) {
-      s[q].s1 = s0[2 * j + q].s1 + s1[2 * j + q].s1;
-      s[q].s2 = s0[2 * j + q].s2 + s1[2 * j + q].s2;
-      s[q].lag = s0[2 * j + q].lag + s1[2 * j + q].lag;
-    }
+    for (std::size_t c = 0; c < parts; ++c)
+      for (int q = 0; q < 2; ++q) {
+        const ExactLag1& part = sums[c * 2 * n + 2 * j + static_cast<std::size_t>(q)];
+        s[q].s1 += part.s1;
+        s[q].s2 += part.s2;
+        s[q].lag += part.lag;
+      }
     const std::size_t covered = (vend[j] + W - 1) & ~(W - 1);  // the terms of the steps 0, W, …
     lag1_exact_tail<L, true>(rel32, stride[j], count[j], covered, s, &r[2 * j]);
   }
@@ -864,7 +884,8 @@ int identify_noise(const PhaseSeries& x, std::int64_t m, Estimator est, NoiseIdD
 }
 
 std::vector<double> lag1_start_pass(const PhaseSeries& x, const std::int64_t* ms, std::size_t n_ms,
-                                    NoiseIdDomain domain, const std::int32_t* rel32, bool small24, unsigned threads) {
+                                    NoiseIdDomain domain, const std::int32_t* rel32, bool small24, unsigned threads,
+                                    Crew* crew) {
   std::vector<double> out;
 #if defined(__x86_64__) || defined(__i386__)
   static const bool avx2 = __builtin_cpu_supports("avx2");
@@ -885,16 +906,18 @@ std::vector<double> lag1_start_pass(const PhaseSeries& x, const std::int64_t* ms
   // Eight lanes where the processor has AVX-512, else four: the same exact integer sums.
   static const bool avx512 = __builtin_cpu_supports("avx512f");
   if (avx512)
-    (base == 0 ? lag1_start_pass_impl<0, 8> : lag1_start_pass_impl<1, 8>)(rel32, points, stride, count, threads, r);
+    (base == 0 ? lag1_start_pass_impl<0, 8> : lag1_start_pass_impl<1, 8>)(rel32, points, stride, count, threads, crew,
+                                                                         r);
   else
-    (base == 0 ? lag1_start_pass_impl<0, 4> : lag1_start_pass_impl<1, 4>)(rel32, points, stride, count, threads, r);
+    (base == 0 ? lag1_start_pass_impl<0, 4> : lag1_start_pass_impl<1, 4>)(rel32, points, stride, count, threads, crew,
+                                                                         r);
   out.assign(2 * n_ms, std::numeric_limits<double>::quiet_NaN());
   for (std::size_t i = 0; i < index.size(); ++i) {
     out[2 * index[i]] = r[2 * i];
     out[2 * index[i] + 1] = r[2 * i + 1];
   }
 #else
-  (void)x, (void)ms, (void)n_ms, (void)domain, (void)rel32, (void)small24, (void)threads;
+  (void)x, (void)ms, (void)n_ms, (void)domain, (void)rel32, (void)small24, (void)threads, (void)crew;
 #endif
   return out;
 }

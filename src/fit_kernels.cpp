@@ -100,7 +100,7 @@ double gamma_sq_sum_scalar(const GammaPair& g, const double* h, const double* we
 }
 
 double gamma_sq_sum(const GammaPair& g, const double* h, const double* weight, std::size_t n) noexcept {
-#if RWCALC_X86_DISPATCH && !defined(__SANITIZE_ADDRESS__)
+#if RWCALC_X86_DISPATCH
   static const bool avx512 = __builtin_cpu_supports("avx512f");
   if (avx512) return gamma_sq_sum_avx512(g, h, weight, n);
 #endif

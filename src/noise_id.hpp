@@ -7,6 +7,10 @@
 #include "rwcalc/allan.hpp"
 #include "rwcalc/series.hpp"
 
+namespace rwcalc {
+class Crew;
+}
+
 namespace rwcalc::detail {
 
 /// identify_noise() with, for exact counts, the offsets C_k − C_0 as int32 (PreparedCounts::rel32;
@@ -25,8 +29,11 @@ int identify_noise(const PhaseSeries& x, std::int64_t m, Estimator est, NoiseIdD
 /// split in halves on two threads (exact sums: the split changes no bit). Returns 2·n_ms values
 /// (NaN where the pass did not compute: large m, B1 region), or nothing where the pass does not
 /// apply (no AVX2, no view, not small24).
+/// With a crew, the view is cut into stretches that the calling thread and the crew's lenders
+/// take as they are free (`threads` is then not used); the same bits.
 std::vector<double> lag1_start_pass(const PhaseSeries& x, const std::int64_t* ms, std::size_t n_ms,
-                                    NoiseIdDomain domain, const std::int32_t* rel32, bool small24, unsigned threads);
+                                    NoiseIdDomain domain, const std::int32_t* rel32, bool small24, unsigned threads,
+                                    Crew* crew = nullptr);
 
 /// The lag-1 autocorrelation r1 of the level-th difference (0 … 3) of p(k) = rel32[k·stride],
 /// k < count, from exact integer sums, into r[0]; with pair (level < 3), also that of level + 1 into r[1]

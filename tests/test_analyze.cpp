@@ -198,8 +198,9 @@ TEST_F(BatchCli, JsonLinesMergeToTheSameTablesAndTheToleranceGivesClass2) {
 }
 
 TEST_F(BatchCli, ThreadCountDoesNotChangeTheResult) {
-  // --jobs 2, 3 and 4 leave one, two and one file for the end, which then run on the threads of the
-  // idle workers; every schedule gives the same bytes in input order.
+  // --jobs 2, 3 and 4 leave one, two and one file for the end, whose passes over the data then
+  // take the threads of the idle workers as they free (crew.hpp); every schedule gives the same
+  // bytes in input order.
   auto args = [&](const char* jobs) {
     std::vector<std::string> a{"batch"};
     for (const auto& f : files()) a.push_back(f);
@@ -216,7 +217,7 @@ TEST_F(BatchCli, ThreadCountDoesNotChangeTheResult) {
 }
 
 TEST_F(BatchCli, AnInputErrorInTheLastFilesNamesItsFile) {
-  // Three files on two jobs: the bad one is the last, read on the threads of both workers.
+  // Three files on two jobs: the bad one is the last, read while the other worker lends its thread.
   test::TempDir dir;
   const auto bad = dir.write("broken_p10C.csv", "# rate_hz: 400\npulses\n1\n2\nthree\n4\n");
   const auto r = run_cli({"batch", gl2d("gl2d_0C.csv.gz"), gl2d("gl2d_p25C.csv.gz"), bad.string(), "--jobs", "2"});

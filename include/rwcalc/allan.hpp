@@ -58,6 +58,8 @@ std::vector<std::int64_t> cluster_sizes(const TauGrid& grid, Estimator est, std:
 /// phase files and for frequency files. Rate and pulse-increment input is frequency data.
 enum class NoiseIdDomain { Phase, Frequency };
 
+class Crew;
+
 struct AllanOptions {
   Estimator estimator = Estimator::Overlapping;
   TauGrid grid;
@@ -66,6 +68,10 @@ struct AllanOptions {
   int alpha = 0;              ///< noise exponent used when noise_id is false (−2 … +2)
   NoiseIdDomain noise_id_domain = NoiseIdDomain::Phase;
   unsigned threads = 0;       ///< 0: all hardware threads
+  /// Threads lent by the caller (crew.hpp): the passes over the data that can be shared out are
+  /// then cut into stretches that this thread and the crew's lenders take as they are free, and
+  /// `threads` sets only the rest. The same results.
+  Crew* crew = nullptr;
 };
 
 struct AllanPoint {

@@ -1,0 +1,82 @@
+// Threads lent to parallel loops (see crew.hpp).
+#include "rwcalc/crew.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <exception>
+
+namespace rwcalc {
+
+struct Crew::Job {
+  std::size_t chunks = 0;
+  const std::function<void(std::size_t)>* fn = nullptr;
+  std::atomic<std::size_t> next{0};
+  std::size_t users = 0;  ///< lenders inside run(), guarded by the crew's mutex
+  std::mutex error_mu;
+  std::exception_ptr error;
+};
+
+void Crew::run(Job& job) {
+  for (std::size_t c = job.next++; c < job.chunks; c = job.next++) {
+    try {
+      (*job.fn)(c);
+    } catch (...) {
+      const std::lock_guard lock(job.error_mu);
+      if (!job.error) job.error = std::current_exception();
+      job.next = job.chunks;  // start no more chunks
+    }
+  }
+}
+
+void Crew::share(std::size_t chunks, const std::function<void(std::size_t)>& fn) {
+  if (chunks == 0) return;
+  Job job;
+  job.chunks = chunks;
+  job.fn = &fn;
+  if (chunks > 1) {
+    {
+      const std::lock_guard lock(mu_);
+      jobs_.push_back(&job);
+    }
+    cv_.notify_all();
+  }
+  run(job);
+  if (chunks > 1) {
+    std::unique_lock lock(mu_);
+    std::erase(jobs_, &job);
+    // Lenders that took chunks finish them before they leave run().
+    cv_.wait(lock, [&job] { return job.users == 0; });
+  }
+  if (job.error) std::rethrow_exception(job.error);
+}
+
+void Crew::lend() {
+  std::unique_lock lock(mu_);
+  for (;;) {
+    Job* job = nullptr;
+    cv_.wait(lock, [&] {
+      if (closed_) return true;
+      const auto it = std::find_if(jobs_.begin(), jobs_.end(), [](Job* j) { return j->next < j->chunks; });
+      if (it == jobs_.end()) return false;
+      job = *it;
+      return true;
+    });
+    if (!job) return;  // closed
+    ++job->users;
+    lock.unlock();
+    run(*job);
+    lock.lock();
+    --job->users;
+    if (job->users == 0) cv_.notify_all();
+  }
+}
+
+void Crew::close() {
+  {
+    const std::lock_guard lock(mu_);
+    closed_ = true;
+  }
+  cv_.notify_all();
+}
+
+}  // namespace rwcalc
