@@ -269,6 +269,14 @@ NoiseModel with_bump(const NoiseModel& base, const ShapeEstimate& est) {
   return m;
 }
 
+/// Whether a bump fit passes the naming conditions of a Gauss–Markov term before its likelihood
+/// test: it raises the mid-τ AV by kGmMinExcess ensemble SDs somewhere or leaves white rate noise
+/// beside the bump, and its AV at its peak is at least kGmMinPeakRatio of the base model's there.
+bool plausible_bump(const ShapeEstimate& gm) {
+  return gm.scale > 0 && (gm.excess >= kGmMinExcess || gm.white_rest >= 2.0 * gm.white_rest_sigma) &&
+         gm.peak_ratio >= kGmMinPeakRatio;
+}
+
 /// The Gauss–Markov detector on a mid-τ AV `mid_meas` (the data without its mean-shape candidate): the
 /// bump fit against the base ensemble (`ref`, its records `base_runs`) proposes M1 = base plus the
 /// bump, which is simulated; the statistic is the drop of the mid-τ Gamma deviance from the base
@@ -687,7 +695,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     throw AnalysisError(fmt::format("{}: the record lasts {:.4g} s; the diagnosis needs at least 1200 s", rec.source, T));
   DiagnoseResult r;
   r.runs = opt.runs;
-  r.holdout_runs = opt.holdout_runs ? opt.holdout_runs : std::max<std::size_t>(10, opt.runs / 2);
+  r.holdout_runs = opt.holdout_runs ? opt.holdout_runs : opt.runs;
   r.seed = opt.seed;
   r.band_level = opt.band_level;
   r.alpha = opt.alpha;
@@ -969,15 +977,30 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     const auto b_pred =
         run_ensemble(with_mean_rate(b_fit, pred_T, pred_mean), sh, r.holdout_runs, om, hgrid, false, opt, false);
     const double v_base = std::max(mean_rate_variance(b_pred), 1e-30);
-    auto prediction_misfit = [&](const std::vector<RunStats>& runs, const NoiseModel& m) {
-      const auto dev = band_deviance(make_band(a_pred.points, runs, opt.band_level), r.holdout_runs);
-      const double v = std::max(mean_rate_variance(runs), 1e-30);
-      const double d = pred_mean - model_level(m, pred_T);
-      return (dev.sum + d * d / v + std::log(v / v_base)) / static_cast<double>(dev.points + 1);
+    // A prediction's deviance: the band's on the predicted half, the level's and (below) the named
+    // lines'. The explicit terms are scored against a yardstick common to both models (the base
+    // ensemble's spread of half means; the predicted half's own noise PSD at a line), so that they
+    // compare what each model predicts, while the noise models are compared through the band.
+    struct Score {
+      double sum = 0;
+      std::size_t points = 0;
+      [[nodiscard]] double per_point() const { return points ? sum / static_cast<double>(points) : 0.0; }
     };
-    const double hb_dir = prediction_misfit(b_pred, b_fit);
-    hb += hb_dir;
+    auto prediction_score = [&](const std::vector<RunStats>& runs, const NoiseModel& m) {
+      const auto bb = make_band(a_pred.points, runs, opt.band_level);
+      const auto dev = band_deviance(bb, r.holdout_runs);
+      if (std::getenv("RWCALC_OOS_BAND")) {
+        std::string o;
+        for (const auto& b : bb) o += fmt::format(" {:.3g}:{:.2f}", b.tau_s, b.dev * b.dev / b.mean_var);
+        std::fprintf(stderr, "DBG band r:%s | level d %.4f\n", o.c_str(), pred_mean - model_level(m, pred_T));
+      }
+      const double d = pred_mean - model_level(m, pred_T);
+      return Score{dev.sum + d * d / v_base, dev.points + 1};
+    };
+    Score sb = prediction_score(b_pred, b_fit);
+    const double hb_dir = sb.per_point();
     if (effects.empty()) {
+      hb += hb_dir;
       he += hb_dir;
       continue;
     }
@@ -1022,9 +1045,13 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
         // own candidate) against the half's base ensemble and the bump model fitted there.
         Decimated dh = st.dec;
         subtract_deterministic(dh, own_candidates(st.dec));
-        const auto d = gauss_markov_test(decimated_avar(dh, hgrid), st.ref, st.clean_ref, b_runs, b_fit, sh,
-                                         r.holdout_runs, om, hgrid, st.dec.tau_d, opt);
-        if (d.named) half_effects.push_back(e);
+        // The whole record has named the term (its likelihood-ratio test); the half only
+        // estimates it: the term enters when the half's shape fit proposes a bump that passes the
+        // same naming conditions as on the whole record (it raises the mid-τ AV or leaves white
+        // rate noise beside it, and stands at least kGmMinPeakRatio of the local AV at its peak).
+        // A bump the half cannot show leaves the half's extended model at its base.
+        const auto gm = shape_detect(decimated_avar(dh, hgrid), st.ref, c_of(b_fit));
+        if (plausible_bump(gm)) half_effects.push_back(e);
         continue;
       } else {
         half_effects.push_back(e);
@@ -1034,6 +1061,8 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     }
     if (half_effects.empty()) {
       // Nothing named shows in the fitting half: the extended model of the half is its base.
+      if (std::getenv("RWCALC_OOS_DEBUG")) std::fprintf(stderr, "DBG dir %d: base %.4f = ext (nothing shows)\n", dir, hb_dir);
+      hb += hb_dir;
       he += hb_dir;
       continue;
     }
@@ -1050,7 +1079,55 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     const NoiseModel e_pred = shifted(e.model, dt);
     const auto e_runs =
         run_ensemble(with_mean_rate(e_pred, pred_T, pred_mean), sh, r.holdout_runs, om, hgrid, false, opt, false);
-    he += prediction_misfit(e_runs, e_pred);
+    Score se = prediction_score(e_runs, e_pred);
+    // A named line keeps its frequency and phase into the predicted half, where the Allan variance
+    // hardly sees it (the base model has taken its power into its noise terms, and beyond its AV
+    // peak a line looks like white angle noise): what it predicts is the line itself, scored
+    // explicitly like the level. The line's two Fourier coefficients on the predicted half (least
+    // squares at the model's frequency; the 0.5-s block rates below kHighLineMinHz, the samples'
+    // rates above) are normal with the standard error of the half's local noise PSD: −2 ln L is
+    // |c − c_model|²/σ² for the extended model and |c|²/σ² for the base, which predicts no line.
+    // A broadened line (no phase) predicts no coefficients and is left to the band.
+    for (const auto& l : e_pred.sinusoids) {
+      const bool broad = std::any_of(e.findings.begin(), e.findings.end(), [&](const Finding& f) {
+        return f.evidence.contains("coherent") && !f.evidence["coherent"].get<bool>() &&
+               f.params["frequency_hz"].get<double>() == l.f_hz;
+      });
+      if (broad) continue;
+      std::vector<double> y;
+      double tb = 0;
+      if (l.f_hz < kHighLineMinHz) {
+        const Decimated dp = decimate(pred_rec.phase);
+        const auto per = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(0.5 / dp.tau_d)));
+        y = block_rates(dp, per);
+        tb = static_cast<double>(per) * dp.tau_d;
+      } else {
+        const auto& ph = pred_rec.phase;
+        tb = ph.tau0_s;
+        y.resize(ph.points() - 1);
+        for (std::size_t i = 0; i + 1 < ph.points(); ++i) y[i] = ph.diff(i + 1, i) / tb;
+      }
+      const LineCoefficients c = line_coefficients(std::move(y), tb, l.f_hz);
+      if (!(c.sigma > 0)) continue;
+      const double u = kPi * l.f_hz * tb, att = u > 1e-9 ? std::sin(u) / u : 1.0;
+      const double ap = l.amp_deg_per_h * att * std::cos(l.phase_rad), bp = -l.amp_deg_per_h * att * std::sin(l.phase_rad);
+      const double s2 = c.sigma * c.sigma;
+      sb.sum += (c.a * c.a + c.b * c.b) / s2;
+      se.sum += ((c.a - ap) * (c.a - ap) + (c.b - bp) * (c.b - bp)) / s2;
+      sb.points += 2;
+      se.points += 2;
+      if (std::getenv("RWCALC_OOS_DEBUG"))
+        std::fprintf(stderr, "DBG line f %.5g: meas a %.4g b %.4g sigma %.3g model a %.4g b %.4g\n", l.f_hz, c.a, c.b, c.sigma, ap, bp);
+    }
+    const double he_dir = se.per_point();
+    hb += sb.per_point();
+    if (std::getenv("RWCALC_OOS_DEBUG")) {
+      std::string hn; for (auto& q : half_effects) hn += q + " ";
+      std::fprintf(stderr, "DBG dir %d: base %.4f ext %.4f [%s] bN %.3g bB %.3g eN %.3g eB %.3g lvl b %.4f e %.4f meas %.4f\n", dir, sb.per_point(), he_dir, hn.c_str(),
+                   b_fit.arw_deg_per_sqrt_h, b_fit.bias_instability_deg_per_h, e_pred.arw_deg_per_sqrt_h, e_pred.bias_instability_deg_per_h,
+                   model_level(b_fit, pred_T), model_level(e_pred, pred_T), pred_mean);
+    }
+    he += he_dir;
   }
   timer.lap("out-of-sample check");
   r.gain.holdout_misfit_base = hb / 2;
