@@ -969,9 +969,11 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     // otherwise score the level twice and erratically. The level each model predicts is scored
     // once, explicitly: one more deviance term beside the band's, the measured mean rate against
     // the model's (its constant rate and its named terms over the window; a ramp, of unknown
-    // sign, predicts no change) with the ensemble's spread of half means — −2 ln L of a normal,
-    // relative to the base's spread. A step or transient in the fitting half predicts the level
-    // after it; the base predicts the fitting half's mean.
+    // sign, predicts no change) with the base ensemble's spread of half means, for both models —
+    // −2 ln L of a normal. A step or transient in the fitting half predicts the level after it;
+    // the base predicts the fitting half's mean. (With each model's own spread, a Gauss–Markov
+    // half model whose B the half leaves at 0 was scored by the narrow spread of its half means,
+    // not by its predicted level, which is the base's.)
     const double pred_T = pred_rec.phase.duration_s();
     const double pred_mean = pred_rec.phase.diff(pred_rec.phase.points() - 1, 0) / pred_T;
     const auto b_pred =
@@ -989,11 +991,6 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     auto prediction_score = [&](const std::vector<RunStats>& runs, const NoiseModel& m) {
       const auto bb = make_band(a_pred.points, runs, opt.band_level);
       const auto dev = band_deviance(bb, r.holdout_runs);
-      if (std::getenv("RWCALC_OOS_BAND")) {
-        std::string o;
-        for (const auto& b : bb) o += fmt::format(" {:.3g}:{:.2f}", b.tau_s, b.dev * b.dev / b.mean_var);
-        std::fprintf(stderr, "DBG band r:%s | level d %.4f\n", o.c_str(), pred_mean - model_level(m, pred_T));
-      }
       const double d = pred_mean - model_level(m, pred_T);
       return Score{dev.sum + d * d / v_base, dev.points + 1};
     };
@@ -1041,15 +1038,16 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
         stat = warmup_detect(st.dec).statistic;
         for (const auto& br : b_runs) ens.push_back(br.warm_stat);
       } else if (e == "gauss_markov") {
-        // The same for a Gauss–Markov term: its test on the half's mid-τ AV (without the half's
-        // own candidate) against the half's base ensemble and the bump model fitted there.
+        // A Gauss–Markov term: the structure is the whole record's (its likelihood-ratio test
+        // named it), the parameters the half's. The term enters when the bump fit on the half's
+        // mid-τ AV (without the half's own candidate, against the half's base ensemble) passes the
+        // naming conditions of the whole record before its test (it raises the mid-τ AV or leaves
+        // white rate noise beside the bump, and stands at least kGmMinPeakRatio of the local AV at
+        // its peak); a bump the half does not show leaves the half's extended model at its base.
+        // (The half's own likelihood-ratio test, one hour of data against its base ensemble's
+        // largest drop, named the bump in neither half of one record and only in one of another.)
         Decimated dh = st.dec;
         subtract_deterministic(dh, own_candidates(st.dec));
-        // The whole record has named the term (its likelihood-ratio test); the half only
-        // estimates it: the term enters when the half's shape fit proposes a bump that passes the
-        // same naming conditions as on the whole record (it raises the mid-τ AV or leaves white
-        // rate noise beside it, and stands at least kGmMinPeakRatio of the local AV at its peak).
-        // A bump the half cannot show leaves the half's extended model at its base.
         const auto gm = shape_detect(decimated_avar(dh, hgrid), st.ref, c_of(b_fit));
         if (plausible_bump(gm)) half_effects.push_back(e);
         continue;
@@ -1061,7 +1059,6 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     }
     if (half_effects.empty()) {
       // Nothing named shows in the fitting half: the extended model of the half is its base.
-      if (std::getenv("RWCALC_OOS_DEBUG")) std::fprintf(stderr, "DBG dir %d: base %.4f = ext (nothing shows)\n", dir, hb_dir);
       hb += hb_dir;
       he += hb_dir;
       continue;
@@ -1116,17 +1113,9 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
       se.sum += ((c.a - ap) * (c.a - ap) + (c.b - bp) * (c.b - bp)) / s2;
       sb.points += 2;
       se.points += 2;
-      if (std::getenv("RWCALC_OOS_DEBUG"))
-        std::fprintf(stderr, "DBG line f %.5g: meas a %.4g b %.4g sigma %.3g model a %.4g b %.4g\n", l.f_hz, c.a, c.b, c.sigma, ap, bp);
     }
     const double he_dir = se.per_point();
     hb += sb.per_point();
-    if (std::getenv("RWCALC_OOS_DEBUG")) {
-      std::string hn; for (auto& q : half_effects) hn += q + " ";
-      std::fprintf(stderr, "DBG dir %d: base %.4f ext %.4f [%s] bN %.3g bB %.3g eN %.3g eB %.3g lvl b %.4f e %.4f meas %.4f\n", dir, sb.per_point(), he_dir, hn.c_str(),
-                   b_fit.arw_deg_per_sqrt_h, b_fit.bias_instability_deg_per_h, e_pred.arw_deg_per_sqrt_h, e_pred.bias_instability_deg_per_h,
-                   model_level(b_fit, pred_T), model_level(e_pred, pred_T), pred_mean);
-    }
     he += he_dir;
   }
   timer.lap("out-of-sample check");
