@@ -1107,7 +1107,15 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
       const LineCoefficients c = line_coefficients(std::move(y), tb, l.f_hz);
       if (!(c.sigma > 0)) continue;
       const double u = kPi * l.f_hz * tb, att = u > 1e-9 ? std::sin(u) / u : 1.0;
-      const double ap = l.amp_deg_per_h * att * std::cos(l.phase_rad), bp = -l.amp_deg_per_h * att * std::sin(l.phase_rad);
+      // The model's line is the sensed one: behind a named output-chain low-pass the predicted
+      // half shows it through the simulated filter, H = (1 − φ)/(1 − φe^{−iωτ0}).
+      std::complex<double> hf = 1.0;
+      if (e_pred.output_lowpass_tc_s > 0) {
+        const double t0 = pred_rec.phase.tau0_s, phi = std::exp(-t0 / e_pred.output_lowpass_tc_s);
+        hf = (1.0 - phi) / (1.0 - phi * std::polar(1.0, -2.0 * kPi * l.f_hz * t0));
+      }
+      const double am = l.amp_deg_per_h * std::abs(hf) * att, ph = l.phase_rad + std::arg(hf);
+      const double ap = am * std::cos(ph), bp = -am * std::sin(ph);
       const double s2 = c.sigma * c.sigma;
       sb.sum += (c.a * c.a + c.b * c.b) / s2;
       se.sum += ((c.a - ap) * (c.a - ap) + (c.b - bp) * (c.b - bp)) / s2;

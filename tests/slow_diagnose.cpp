@@ -163,7 +163,7 @@ void expect_rates(const Tally& t) {
 // against the true 0.001 and 0.005, and the data lie high at 82-164 s where the base's N, which
 // took the line, happens to fit). The every-case gain criterion is not met out of sample:
 // disabled, not weakened.
-TEST(DiagnoseAcceptance, DISABLED_Sinusoid) {
+TEST(DiagnoseAcceptance, Sinusoid) {
   const auto t = run_effect(
       "sinusoid", cases(10), 1000,
       [](std::mt19937_64& g, NoiseModel& m) {
