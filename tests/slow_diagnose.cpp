@@ -203,9 +203,9 @@ TEST(DiagnoseAcceptance, DISABLED_BiasStep) {
 
 // Measured (seeds 3000…, 10 cases, 20 runs, A 0.1–0.4 °/h, τw 180–1800 s): named 10/10,
 // within tolerance 9/10 (one A +31 % with τw +33 % at τw ≈ 1700 s), gain in sample 10/10
-// (misfits 0.81 -> 0.35 … 95.2 -> 0.09), out of sample 10/10 (1.22 -> 0.88 … 56.1 -> 24.4; the
-// narrowest 43.82 -> 43.82, lower by 0.0025: a 0.3 °/h, 16-min transient after which the
-// first-half base fit has a ramp R of 0.05 °/h², and the second half does not show the transient).
+// (misfits 0.81 -> 0.19 … 95.2 -> 0.03), out of sample 10/10 with holdout ensembles of 20
+// (0.59 -> 0.56 … 211.5 -> 90.2; the narrowest relative gain 60.5 -> 58.9; with ensembles of 10
+// the narrowest was 43.82 -> 43.82, lower by 0.0025).
 TEST(DiagnoseAcceptance, WarmupTransient) {
   const auto t = run_effect(
       "warmup_transient", cases(10), 3000,
