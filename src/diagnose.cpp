@@ -269,6 +269,14 @@ NoiseModel with_bump(const NoiseModel& base, const ShapeEstimate& est) {
   return m;
 }
 
+/// Whether a bump fit passes the naming conditions of a Gauss–Markov term before its likelihood
+/// test: it raises the mid-τ AV by kGmMinExcess ensemble SDs somewhere or leaves white rate noise
+/// beside the bump, and its AV at its peak is at least kGmMinPeakRatio of the base model's there.
+bool plausible_bump(const ShapeEstimate& gm) {
+  return gm.scale > 0 && (gm.excess >= kGmMinExcess || gm.white_rest >= 2.0 * gm.white_rest_sigma) &&
+         gm.peak_ratio >= kGmMinPeakRatio;
+}
+
 /// The Gauss–Markov detector on a mid-τ AV `mid_meas` (the data without its mean-shape candidate): the
 /// bump fit against the base ensemble (`ref`, its records `base_runs`) proposes M1 = base plus the
 /// bump, which is simulated; the statistic is the drop of the mid-τ Gamma deviance from the base
@@ -687,7 +695,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     throw AnalysisError(fmt::format("{}: the record lasts {:.4g} s; the diagnosis needs at least 1200 s", rec.source, T));
   DiagnoseResult r;
   r.runs = opt.runs;
-  r.holdout_runs = opt.holdout_runs ? opt.holdout_runs : std::max<std::size_t>(10, opt.runs / 2);
+  r.holdout_runs = opt.holdout_runs ? opt.holdout_runs : opt.runs;
   r.seed = opt.seed;
   r.band_level = opt.band_level;
   r.alpha = opt.alpha;
@@ -961,23 +969,35 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     // otherwise score the level twice and erratically. The level each model predicts is scored
     // once, explicitly: one more deviance term beside the band's, the measured mean rate against
     // the model's (its constant rate and its named terms over the window; a ramp, of unknown
-    // sign, predicts no change) with the ensemble's spread of half means — −2 ln L of a normal,
-    // relative to the base's spread. A step or transient in the fitting half predicts the level
-    // after it; the base predicts the fitting half's mean.
+    // sign, predicts no change) with the base ensemble's spread of half means, for both models —
+    // −2 ln L of a normal. A step or transient in the fitting half predicts the level after it;
+    // the base predicts the fitting half's mean. (With each model's own spread, a Gauss–Markov
+    // half model whose B the half leaves at 0 was scored by the narrow spread of its half means,
+    // not by its predicted level, which is the base's.)
     const double pred_T = pred_rec.phase.duration_s();
     const double pred_mean = pred_rec.phase.diff(pred_rec.phase.points() - 1, 0) / pred_T;
     const auto b_pred =
         run_ensemble(with_mean_rate(b_fit, pred_T, pred_mean), sh, r.holdout_runs, om, hgrid, false, opt, false);
     const double v_base = std::max(mean_rate_variance(b_pred), 1e-30);
-    auto prediction_misfit = [&](const std::vector<RunStats>& runs, const NoiseModel& m) {
-      const auto dev = band_deviance(make_band(a_pred.points, runs, opt.band_level), r.holdout_runs);
-      const double v = std::max(mean_rate_variance(runs), 1e-30);
-      const double d = pred_mean - model_level(m, pred_T);
-      return (dev.sum + d * d / v + std::log(v / v_base)) / static_cast<double>(dev.points + 1);
+    // A prediction's deviance: the band's on the predicted half, the level's and (below) the named
+    // lines'. The explicit terms are scored against a yardstick common to both models (the base
+    // ensemble's spread of half means; the predicted half's own noise PSD at a line), so that they
+    // compare what each model predicts, while the noise models are compared through the band.
+    struct Score {
+      double sum = 0;
+      std::size_t points = 0;
+      [[nodiscard]] double per_point() const { return points ? sum / static_cast<double>(points) : 0.0; }
     };
-    const double hb_dir = prediction_misfit(b_pred, b_fit);
-    hb += hb_dir;
+    auto prediction_score = [&](const std::vector<RunStats>& runs, const NoiseModel& m) {
+      const auto bb = make_band(a_pred.points, runs, opt.band_level);
+      const auto dev = band_deviance(bb, r.holdout_runs);
+      const double d = pred_mean - model_level(m, pred_T);
+      return Score{dev.sum + d * d / v_base, dev.points + 1};
+    };
+    Score sb = prediction_score(b_pred, b_fit);
+    const double hb_dir = sb.per_point();
     if (effects.empty()) {
+      hb += hb_dir;
       he += hb_dir;
       continue;
     }
@@ -1018,13 +1038,18 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
         stat = warmup_detect(st.dec).statistic;
         for (const auto& br : b_runs) ens.push_back(br.warm_stat);
       } else if (e == "gauss_markov") {
-        // The same for a Gauss–Markov term: its test on the half's mid-τ AV (without the half's
-        // own candidate) against the half's base ensemble and the bump model fitted there.
+        // A Gauss–Markov term: the structure is the whole record's (its likelihood-ratio test
+        // named it), the parameters the half's. The term enters when the bump fit on the half's
+        // mid-τ AV (without the half's own candidate, against the half's base ensemble) passes the
+        // naming conditions of the whole record before its test (it raises the mid-τ AV or leaves
+        // white rate noise beside the bump, and stands at least kGmMinPeakRatio of the local AV at
+        // its peak); a bump the half does not show leaves the half's extended model at its base.
+        // (The half's own likelihood-ratio test, one hour of data against its base ensemble's
+        // largest drop, named the bump in neither half of one record and only in one of another.)
         Decimated dh = st.dec;
         subtract_deterministic(dh, own_candidates(st.dec));
-        const auto d = gauss_markov_test(decimated_avar(dh, hgrid), st.ref, st.clean_ref, b_runs, b_fit, sh,
-                                         r.holdout_runs, om, hgrid, st.dec.tau_d, opt);
-        if (d.named) half_effects.push_back(e);
+        const auto gm = shape_detect(decimated_avar(dh, hgrid), st.ref, c_of(b_fit));
+        if (plausible_bump(gm)) half_effects.push_back(e);
         continue;
       } else {
         half_effects.push_back(e);
@@ -1034,6 +1059,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     }
     if (half_effects.empty()) {
       // Nothing named shows in the fitting half: the extended model of the half is its base.
+      hb += hb_dir;
       he += hb_dir;
       continue;
     }
@@ -1050,7 +1076,55 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     const NoiseModel e_pred = shifted(e.model, dt);
     const auto e_runs =
         run_ensemble(with_mean_rate(e_pred, pred_T, pred_mean), sh, r.holdout_runs, om, hgrid, false, opt, false);
-    he += prediction_misfit(e_runs, e_pred);
+    Score se = prediction_score(e_runs, e_pred);
+    // A named line keeps its frequency and phase into the predicted half, where the Allan variance
+    // hardly sees it (the base model has taken its power into its noise terms, and beyond its AV
+    // peak a line looks like white angle noise): what it predicts is the line itself, scored
+    // explicitly like the level. The line's two Fourier coefficients on the predicted half (least
+    // squares at the model's frequency; the 0.5-s block rates below kHighLineMinHz, the samples'
+    // rates above) are normal with the standard error of the half's local noise PSD: −2 ln L is
+    // |c − c_model|²/σ² for the extended model and |c|²/σ² for the base, which predicts no line.
+    // A broadened line (no phase) predicts no coefficients and is left to the band.
+    for (const auto& l : e_pred.sinusoids) {
+      const bool broad = std::any_of(e.findings.begin(), e.findings.end(), [&](const Finding& f) {
+        return f.evidence.contains("coherent") && !f.evidence["coherent"].get<bool>() &&
+               f.params["frequency_hz"].get<double>() == l.f_hz;
+      });
+      if (broad) continue;
+      std::vector<double> y;
+      double tb = 0;
+      if (l.f_hz < kHighLineMinHz) {
+        const Decimated dp = decimate(pred_rec.phase);
+        const auto per = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(0.5 / dp.tau_d)));
+        y = block_rates(dp, per);
+        tb = static_cast<double>(per) * dp.tau_d;
+      } else {
+        const auto& ph = pred_rec.phase;
+        tb = ph.tau0_s;
+        y.resize(ph.points() - 1);
+        for (std::size_t i = 0; i + 1 < ph.points(); ++i) y[i] = ph.diff(i + 1, i) / tb;
+      }
+      const LineCoefficients c = line_coefficients(std::move(y), tb, l.f_hz);
+      if (!(c.sigma > 0)) continue;
+      const double u = kPi * l.f_hz * tb, att = u > 1e-9 ? std::sin(u) / u : 1.0;
+      // The model's line is the sensed one: behind a named output-chain low-pass the predicted
+      // half shows it through the simulated filter, H = (1 − φ)/(1 − φe^{−iωτ0}).
+      std::complex<double> hf = 1.0;
+      if (e_pred.output_lowpass_tc_s > 0) {
+        const double t0 = pred_rec.phase.tau0_s, phi = std::exp(-t0 / e_pred.output_lowpass_tc_s);
+        hf = (1.0 - phi) / (1.0 - phi * std::polar(1.0, -2.0 * kPi * l.f_hz * t0));
+      }
+      const double am = l.amp_deg_per_h * std::abs(hf) * att, ph = l.phase_rad + std::arg(hf);
+      const double ap = am * std::cos(ph), bp = -am * std::sin(ph);
+      const double s2 = c.sigma * c.sigma;
+      sb.sum += (c.a * c.a + c.b * c.b) / s2;
+      se.sum += ((c.a - ap) * (c.a - ap) + (c.b - bp) * (c.b - bp)) / s2;
+      sb.points += 2;
+      se.points += 2;
+    }
+    const double he_dir = se.per_point();
+    hb += sb.per_point();
+    he += he_dir;
   }
   timer.lap("out-of-sample check");
   r.gain.holdout_misfit_base = hb / 2;

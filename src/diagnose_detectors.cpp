@@ -261,6 +261,70 @@ SinusoidEstimate sinusoid_detect(const Decimated& d, double f_hint, bool estimat
   return e;
 }
 
+LineCoefficients line_coefficients(std::vector<double> y, double tb, double f) {
+  LineCoefficients c;
+  const std::size_t n = y.size();
+  if (n < 64 || !(tb > 0) || !(f > 0)) return c;
+  const double T = tb * static_cast<double>(n);
+  {  // level and linear trend removed
+    double sy = 0, sty = 0, stt = 0;
+    const double m = 0.5 * static_cast<double>(n - 1);
+    for (std::size_t i = 0; i < n; ++i) {
+      const double t = static_cast<double>(i) - m;
+      sy += y[i];
+      sty += t * y[i];
+      stt += t * t;
+    }
+    const double a = sy / static_cast<double>(n), b = sty / stt;
+    for (std::size_t i = 0; i < n; ++i) y[i] -= a + b * (static_cast<double>(i) - m);
+  }
+  Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d r = Eigen::Vector2d::Zero();
+  const double w = 2.0 * kPi * f;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double t = (static_cast<double>(i) + 0.5) * tb;
+    const double cs = std::cos(w * t), sn = std::sin(w * t);
+    A(0, 0) += cs * cs;
+    A(0, 1) += cs * sn;
+    A(1, 1) += sn * sn;
+    r(0) += cs * y[i];
+    r(1) += sn * y[i];
+  }
+  A(1, 0) = A(0, 1);
+  const Eigen::Vector2d x = A.ldlt().solve(r);
+  c.a = x(0);
+  c.b = x(1);
+  // The noise PSD at f: the Hann periodogram's median over ±24 true bins (main lobe left out).
+  std::size_t nfft = 1;
+  while (nfft < 2 * n) nfft <<= 1;
+  std::vector<double> buf(nfft, 0.0);
+  double w2 = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double h = 0.5 - 0.5 * std::cos(2.0 * kPi * (static_cast<double>(i) + 0.5) / static_cast<double>(n));
+    buf[i] = h * y[i];
+    w2 += h * h;
+  }
+  Eigen::FFT<double> fft;
+  fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
+  std::vector<std::complex<double>> spec;
+  fft.fwd(spec, buf);
+  const std::size_t half = nfft / 2;
+  const double df = 1.0 / (static_cast<double>(nfft) * tb);
+  const double pad = static_cast<double>(nfft) / static_cast<double>(n);
+  const auto k = static_cast<std::size_t>(std::lround(f / df));
+  const auto W = static_cast<std::size_t>(24.0 * pad), gap = static_cast<std::size_t>(std::ceil(3.0 * pad));
+  const auto stepb = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(pad)));
+  std::vector<double> v;
+  for (std::size_t j = k > W ? k - W : 1; j <= std::min(half, k + W) && j < spec.size(); j += stepb) {
+    if (j + gap >= k && j <= k + gap) continue;
+    v.push_back(std::norm(spec[j]));
+  }
+  if (v.empty()) return c;
+  const double S = 2.0 * tb * (median_of(std::move(v)) / std::log(2.0)) / w2;  // one-sided, (°/h)²/Hz
+  c.sigma = std::sqrt(S / T);
+  return c;
+}
+
 // ---- high-frequency line on the raw samples ---------------------------------------------------
 
 namespace {

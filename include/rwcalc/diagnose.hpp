@@ -27,7 +27,7 @@ class Progress;
 struct DiagnoseOptions {
   AnalysisOptions analysis;          ///< the base fit (as `rwcalc analyze`)
   std::size_t runs = 50;             ///< ensemble size K of each simulated band
-  std::size_t holdout_runs = 0;      ///< ensemble size of the out-of-sample check (0: max(10, K/2))
+  std::size_t holdout_runs = 0;      ///< ensemble size of the out-of-sample check (0: K, as the main ensembles)
   std::uint64_t seed = 1;            ///< base seed of every ensemble
   double band_level = 0.95;          ///< central probability of the band (2.5–97.5 %)
   double alpha = 0.01;               ///< false-alarm level of each detector (five detectors: ≤ 5 %)

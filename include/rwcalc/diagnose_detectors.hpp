@@ -46,6 +46,16 @@ struct SinusoidEstimate {
 /// Periodogram line search on 0.5-s block rates. `f_hint` > 0 restricts the search to ±3 bins.
 SinusoidEstimate sinusoid_detect(const Decimated& d, double f_hint = 0, bool estimate = true);
 
+/// The least-squares coefficients of a·cos(2πft) + b·sin(2πft) on rates `y` over consecutive
+/// blocks of `tb` s (t at the block centres, from 0; level and linear trend removed), and their
+/// common standard error √(S/T) from the noise PSD S at f: the Hann periodogram's median over ±24
+/// bins, main lobe left out, as sinusoid_detect. sigma 0: too few blocks. A rate line A·cos(2πft
+/// + φ) gives a = A·s·cos φ, b = −A·s·sin φ with s = sinc(πf·tb) (block means).
+struct LineCoefficients {
+  double a = 0, b = 0, sigma = 0;
+};
+LineCoefficients line_coefficients(std::vector<double> y, double tb, double f);
+
 /// Lower end of the high-frequency line search, Hz: the upper end of sinusoid_detect's.
 constexpr double kHighLineMinHz = 0.25;
 struct LineEstimate : SinusoidEstimate {

@@ -71,7 +71,7 @@ void register_diagnose(CLI::App& app, Runner& runner) {
       opt.alpha = cmd->alpha;
       opt.threads = cmd->threads;
       const Recording rec = read_recording(cmd->file, cmd->input.options());
-      const std::size_t hold = std::max<std::size_t>(10, cmd->runs / 2);
+      const std::size_t hold = cmd->runs;  // the out-of-sample ensembles are as large as the main one
       Progress progress("simulating", static_cast<std::uint64_t>(2 * cmd->runs + 7 * hold));
       opt.progress = &progress;
       const DiagnoseResult res = diagnose(rec, opt);
