@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <functional>
 #include <numbers>
 #include <optional>
 #include <thread>
@@ -200,8 +201,13 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   // filling the core the fit's covariance leaves.
   const unsigned budget = options.allan.threads ? options.allan.threads
                                                 : std::max(1u, std::thread::hardware_concurrency());
-  const bool beside = options.outlier_action == OutlierAction::Keep && budget > 1 && !options.allan.crew &&
-                      read.phase.points() >= 3 && read.phase.kind == PhaseKind::Gyro;
+  Crew* const crew = options.allan.crew;
+  const bool keep = options.outlier_action == OutlierAction::Keep && read.phase.points() >= 3 &&
+                    read.phase.kind == PhaseKind::Gyro;
+  const bool beside = keep && budget > 1 && !crew;
+  // With a crew the same: the scan's stretches are offered to the crew's lenders after the Allan
+  // stage, and the analysis' thread takes what is left once the verdict is done.
+  const bool posted_scan = keep && crew;
   // The scan is shared: a thread of its own takes stretches of the record from the start, and
   // the analysis' thread joins in once the verdict is done (SharedOutlierScan).
   std::optional<SharedOutlierScan> shared;
@@ -218,7 +224,9 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
       }
     });
   };
-  if (beside) {
+  std::function<void(std::size_t)> scan_chunk;
+  std::optional<Crew::Posted> posted;  // after `shared` and `scan_chunk`: joined before they go
+  if (beside || posted_scan) {
     check_outlier_threshold(options);
   } else if (read.phase.points() >= 3) {
     const std::vector<Outlier> found = [&] {
@@ -239,7 +247,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   }
   const Recording& rec = *recp;
   AnalysisResult r;
-  if (!beside) r.outliers = std::move(outliers);
+  if (!beside && !posted_scan) r.outliers = std::move(outliers);
   r.source = rec.source;
   r.samples = rec.samples;
   r.rate_hz = rec.rate_hz;
@@ -284,6 +292,11 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   // that stage splits its passes over the data evenly between its threads, so a third thread
   // there leaves one of them waiting for a core while the other idles at the end of each pass.
   if (beside) start_scan();
+  if (posted_scan) {
+    shared.emplace(read.phase, options.outlier_threshold);
+    scan_chunk = [&shared](std::size_t) { shared->help(); };
+    posted.emplace(crew->post(2, scan_chunk));
+  }
   AllanResult octave_points;
   if (!octave) {
     octave_points = r.allan;
@@ -304,7 +317,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   try {
     detail::ScopedTimer t("analyze: fit");
     FitOptions fopt = options.fit;
-    if (fopt.threads == 0) fopt.threads = beside ? 1u : aopt.threads;
+    if (fopt.threads == 0) fopt.threads = beside || posted_scan ? 1u : aopt.threads;
     r.fit = fit_noise(fit_points(fitted), fopt);
   } catch (const AnalysisError& e) {
     throw AnalysisError(fmt::format("{}: {}", rec.source, e.what()));
@@ -368,6 +381,13 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
     shared->help();
     scan_thread.join();
     if (scan_error) std::rethrow_exception(scan_error);
+    OutlierScale scale;
+    const std::vector<Outlier> found = shared->finish(scale);
+    report_outliers(read, options, scale, found, outliers);
+    r.outliers = std::move(outliers);
+  } else if (posted_scan) {
+    detail::ScopedTimer t("analyze: outlier scan (rest)", true);
+    crew->join(*posted);
     OutlierScale scale;
     const std::vector<Outlier> found = shared->finish(scale);
     report_outliers(read, options, scale, found, outliers);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <exception>
+#include <memory>
 
 namespace rwcalc {
 
@@ -28,26 +29,49 @@ void Crew::run(Job& job) {
   }
 }
 
-void Crew::share(std::size_t chunks, const std::function<void(std::size_t)>& fn) {
-  if (chunks == 0) return;
-  Job job;
-  job.chunks = chunks;
-  job.fn = &fn;
+Crew::Posted::Posted(Crew* crew, std::unique_ptr<Job> job) : crew_(crew), job_(std::move(job)) {}
+Crew::Posted::Posted(Posted&&) noexcept = default;
+Crew::Posted::~Posted() {
+  if (!job_) return;
+  try {
+    crew_->join(*this);
+  } catch (...) {  // the loop's exception: whoever destroys an unjoined loop is already unwinding
+  }
+}
+
+Crew::Posted Crew::post(std::size_t chunks, const std::function<void(std::size_t)>& fn) {
+  auto job = std::make_unique<Job>();
+  job->chunks = chunks;
+  job->fn = &fn;
   if (chunks > 1) {
     {
       const std::lock_guard lock(mu_);
-      jobs_.push_back(&job);
+      jobs_.push_back(job.get());
     }
     cv_.notify_all();
   }
+  return Posted(this, std::move(job));
+}
+
+void Crew::join(Posted& posted) {
+  if (!posted.job_) return;
+  Job& job = *posted.job_;
   run(job);
-  if (chunks > 1) {
+  if (job.chunks > 1) {
     std::unique_lock lock(mu_);
     std::erase(jobs_, &job);
     // Lenders that took chunks finish them before they leave run().
     cv_.wait(lock, [&job] { return job.users == 0; });
   }
-  if (job.error) std::rethrow_exception(job.error);
+  const std::exception_ptr error = job.error;
+  posted.job_.reset();
+  if (error) std::rethrow_exception(error);
+}
+
+void Crew::share(std::size_t chunks, const std::function<void(std::size_t)>& fn) {
+  if (chunks == 0) return;
+  Posted p = post(chunks, fn);
+  join(p);
 }
 
 void Crew::lend() {
@@ -77,6 +101,20 @@ void Crew::close() {
     closed_ = true;
   }
   cv_.notify_all();
+}
+
+}  // namespace rwcalc
+
+namespace rwcalc {
+
+OwnCrew::OwnCrew(unsigned lenders) {
+  threads_.reserve(lenders);
+  for (unsigned i = 0; i < lenders; ++i) threads_.emplace_back([this] { crew_.lend(); });
+}
+
+OwnCrew::~OwnCrew() {
+  crew_.close();
+  threads_.clear();  // joins
 }
 
 }  // namespace rwcalc

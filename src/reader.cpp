@@ -1430,7 +1430,8 @@ Recording read_recording(const std::string& path, const ReadOptions& options) {
   validate(options);
   TextBuffer buf = [&] {
     detail::ScopedTimer t("read: load");
-    return detail::load_source(path, options.threads ? options.threads : std::thread::hardware_concurrency());
+    return detail::load_source(path, options.threads ? options.threads : std::thread::hardware_concurrency(),
+                               options.crew);
   }();
   return read_buffer(buf, path, options);
 }

@@ -9,6 +9,10 @@
 #include <string_view>
 #include <vector>
 
+namespace rwcalc {
+class Crew;
+}
+
 namespace rwcalc::detail {
 
 /// Bytes of a recording held in memory. Always ends with '\n' (appended when the input does not),
@@ -59,7 +63,7 @@ std::string display_name(const std::string& path);
 /// (line 0) for a missing, unreadable or non-regular path and for corrupt or truncated gzip.
 /// With threads > 1 a regular file of more than a few MB is read in two halves side by side (each
 /// thread maps the pages of its half and copies it).
-TextBuffer load_source(const std::string& path, unsigned threads = 1);
+TextBuffer load_source(const std::string& path, unsigned threads = 1, Crew* crew = nullptr);
 
 /// Copy in-memory text, inflating it when it starts with the gzip magic bytes.
 TextBuffer load_text(std::string_view text, const std::string& name);

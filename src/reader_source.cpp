@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "reader_detail.hpp"
+#include "rwcalc/crew.hpp"
 #include "rwcalc/error.hpp"
 
 namespace rwcalc::detail {
@@ -228,7 +229,7 @@ void count_segments(const char* buf, std::size_t lo, std::size_t hi, std::vector
 // A regular file of `size` bytes in two halves, the second on another thread. False (the buffer
 // then holds nothing) when the file turned out shorter than its size. Each thread checks and
 // counts the lines of its half while its bytes are in the cache (TextBuffer::segment_lines).
-bool read_halves(int fd, std::size_t size, TextBuffer& buf, const std::string& name) {
+bool read_halves(int fd, std::size_t size, TextBuffer& buf, const std::string& name, Crew* crew) {
   const std::size_t half = (size / 2) & ~std::size_t{4095};
   const std::size_t segments = size / TextBuffer::kSegment;
   std::vector<std::size_t> lines1(segments), lines2(segments);
@@ -236,13 +237,21 @@ bool read_halves(int fd, std::size_t size, TextBuffer& buf, const std::string& n
   int err1 = 0, err2 = 0;
   bool ok2 = false;
   {
-    std::jthread other([&] {
+    bool ok1 = false;
+    auto second = [&] {
       ok2 = pread_exact(fd, buf.data() + half, size - half, static_cast<off_t>(half), err2);
       if (ok2) count_segments(buf.data(), half, size, lines2, bad2);
-    });
-    const bool ok1 = pread_exact(fd, buf.data(), half, 0, err1);
-    if (ok1) count_segments(buf.data(), 0, half, lines1, bad1);
-    other.join();
+    };
+    auto first = [&] {
+      ok1 = pread_exact(fd, buf.data(), half, 0, err1);
+      if (ok1) count_segments(buf.data(), 0, half, lines1, bad1);
+    };
+    if (crew) {  // the second half to a lender (or to this thread after the first, if none is free)
+      crew->share(2, [&](std::size_t k) { k == 0 ? first() : second(); });
+    } else {
+      std::jthread other(second);
+      first();
+    }
     if (err1 || err2) fail_errno(name, "cannot read", err1 ? err1 : err2);
     if (!ok1 || !ok2) return false;
   }
@@ -314,7 +323,7 @@ TextBuffer load_text(std::string_view text, const std::string& name) {
   return buf;
 }
 
-TextBuffer load_source(const std::string& path, unsigned threads) {
+TextBuffer load_source(const std::string& path, unsigned threads, Crew* crew) {
   const std::string name = display_name(path);
   TextBuffer raw;
   if (path == "-") {
@@ -338,7 +347,7 @@ TextBuffer load_source(const std::string& path, unsigned threads) {
       // (the heap keeps blocks below M_MMAP_THRESHOLD mapped, src/main.cpp). The untouched half
       // costs address space only. Performance only: nothing depends on where the view lives.
       raw = TextBuffer(size + 1, false, size);
-      if (!read_halves(fd.get(), size, raw, name) && ::lseek(fd.get(), 0, SEEK_SET) < 0)
+      if (!read_halves(fd.get(), size, raw, name, crew) && ::lseek(fd.get(), 0, SEEK_SET) < 0)
         fail_errno(name, "cannot seek", errno);
     } else {
       raw.reserve(S_ISREG(st.st_mode) ? size + 1 : std::size_t{1} << 20);

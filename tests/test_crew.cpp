@@ -7,6 +7,8 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <functional>
+#include <string>
 #include <random>
 #include <stdexcept>
 #include <thread>
@@ -16,7 +18,9 @@
 #include "../src/noise_id.hpp"
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/crew.hpp"
+#include "rwcalc/reader.hpp"
 #include "rwcalc/simulate.hpp"
+#include "test_support.hpp"
 
 namespace {
 
@@ -88,6 +92,31 @@ TEST(Crew, CloseReleasesLendersWithNothingToDo) {
   SUCCEED();
 }
 
+
+TEST(Crew, PostedLoopsRunWhileTheCallerWorksAndJoinWaitsForThem) {
+  for (int lenders : {0, 1}) {
+    LentCrew lc(lenders);
+    std::vector<std::atomic<int>> runs(40);
+    const std::function<void(std::size_t)> fn = [&](std::size_t c) { runs[c]++; };
+    Crew::Posted p = lc.crew.post(runs.size(), fn);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));  // the caller's own work
+    lc.crew.join(p);
+    for (std::size_t c = 0; c < runs.size(); ++c) EXPECT_EQ(runs[c].load(), 1) << "lenders " << lenders;
+    // A loop left unjoined (an exception on the way) is joined by its handle's destructor.
+    std::atomic<int> late{0};
+    const std::function<void(std::size_t)> g = [&](std::size_t) { ++late; };
+    { Crew::Posted q = lc.crew.post(7, g); }
+    EXPECT_EQ(late.load(), 7);
+  }
+}
+
+TEST(Crew, OwnCrewLendsItsThreadsUntilItEnds) {
+  OwnCrew own(2);
+  std::atomic<int> runs{0};
+  own.crew().share(64, [&](std::size_t) { ++runs; });
+  EXPECT_EQ(runs.load(), 64);
+}
+
 std::vector<std::int64_t> pulse_counts(std::size_t n, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::poisson_distribution<int> pulses(1.7);
@@ -131,6 +160,28 @@ TEST(CrewPasses, TheSamePassesWithLendersAsWithout) {
         EXPECT_EQ(start2[i], start1[i]) << i;
       }
     }
+  }
+}
+
+TEST(CrewPasses, AFileLoadedInHalvesByALenderReadsTheSame) {
+  // Over 4 MB: a regular file is loaded in two halves side by side (the second by a lender here).
+  std::string text = "# rate_hz: 400\n# scale_arcsec_per_pulse: 0.92\npulses\n";
+  std::mt19937_64 rng(9);
+  std::poisson_distribution<int> pulses(1.7);
+  while (text.size() < (std::size_t{5} << 20)) text += std::to_string(pulses(rng)) + "\n";
+  test::TempDir dir;
+  const auto path = dir.write("halves_p20C.csv", text).string();
+  ReadOptions ro;
+  ro.threads = 1;
+  const Recording a = read_recording(path, ro);
+  for (int lenders : {0, 1}) {
+    LentCrew lc(lenders);
+    ro.threads = 2;
+    ro.crew = &lc.crew;
+    const Recording b = read_recording(path, ro);
+    EXPECT_EQ(a.phase.counts, b.phase.counts) << "lenders " << lenders;
+    EXPECT_EQ(a.samples, b.samples);
+    EXPECT_EQ(a.line_of_rate(a.samples / 2), b.line_of_rate(b.samples / 2));
   }
 }
 

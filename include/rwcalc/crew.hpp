@@ -11,12 +11,16 @@
 #include <condition_variable>
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <mutex>
+#include <thread>
 #include <vector>
 
 namespace rwcalc {
 
 class Crew {
+  struct Job;
+
  public:
   Crew() = default;
   Crew(const Crew&) = delete;
@@ -28,6 +32,26 @@ class Crew {
   /// yet started are then skipped).
   void share(std::size_t chunks, const std::function<void(std::size_t)>& fn);
 
+  /// The same in two steps: post() offers the chunks to the lenders at once and returns, so the
+  /// calling thread can do other work meanwhile; join() then runs the chunks nobody has taken and
+  /// waits for the others (and rethrows as share() does). `fn` must live until join() returns; a
+  /// Posted destroyed unjoined (an exception on the way) joins in its destructor, dropping the
+  /// loop's own exception.
+  class Posted {
+   public:
+    Posted(Posted&&) noexcept;
+    Posted& operator=(Posted&&) = delete;
+    ~Posted();
+
+   private:
+    friend class Crew;
+    Posted(Crew* crew, std::unique_ptr<Job> job);
+    Crew* crew_ = nullptr;
+    std::unique_ptr<Job> job_;
+  };
+  [[nodiscard]] Posted post(std::size_t chunks, const std::function<void(std::size_t)>& fn);
+  void join(Posted& posted);
+
   /// Lend the calling thread: it runs chunks of the loops under way until close().
   void lend();
 
@@ -35,12 +59,27 @@ class Crew {
   void close();
 
  private:
-  struct Job;
   void run(Job& job);
   std::mutex mu_;
   std::condition_variable cv_;
   std::vector<Job*> jobs_;
   bool closed_ = false;
+};
+
+/// A crew with threads of its own, lent to it from construction to destruction: the helper
+/// threads of one command, started once (a thread that sleeps between loops wakes on the core it
+/// ran on, where a thread started for each loop may first wait on its creator's core).
+class OwnCrew {
+ public:
+  explicit OwnCrew(unsigned lenders);
+  ~OwnCrew();
+  OwnCrew(const OwnCrew&) = delete;
+  OwnCrew& operator=(const OwnCrew&) = delete;
+  [[nodiscard]] Crew& crew() noexcept { return crew_; }
+
+ private:
+  Crew crew_;
+  std::vector<std::jthread> threads_;
 };
 
 }  // namespace rwcalc

@@ -23,6 +23,8 @@
 
 namespace rwcalc {
 
+class Crew;
+
 /// What the selected column holds.
 enum class InputMode {
   Pulses,   ///< per-sample pulse increments (integers): the GL-2D format; default
@@ -51,6 +53,9 @@ struct ReadOptions {
   /// Threads for parsing a long text (0: all hardware threads; at most two are used, on texts of
   /// more than 1 MB). The result does not depend on it.
   unsigned threads = 0;
+  /// Threads lent by the caller (crew.hpp): a regular file is then loaded in halves by this
+  /// thread and a lender rather than by a thread started for it.
+  Crew* crew = nullptr;
 };
 
 /// Where the sample rate came from (reported in outputs).

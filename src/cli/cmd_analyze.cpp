@@ -2,13 +2,17 @@
 // cross-checks, Earth rate and bias, and the class verdict, as a report or JSON.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <memory>
+#include <optional>
 #include <ostream>
+#include <thread>
 
 #include "cli/analyze_args.hpp"
 #include "cli/commands.hpp"
 #include "cli/plot_args.hpp"
 #include "rwcalc/analysis.hpp"
+#include "rwcalc/crew.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/output.hpp"
 #include "timing.hpp"
@@ -53,9 +57,19 @@ void register_analyze(CLI::App& app, Runner& runner) {
       // Figure problems (format, existing files, no gnuplot) are reported before the analysis.
       cmd->plot.check(cmd->force);
       detail::ScopedTimer total("analyze command");
+      // The analysis' helper threads, started before the read so that they have settled on the
+      // other cores by the time the Allan stage shares its passes out (crew.hpp).
+      const unsigned threads = opt.allan.threads ? opt.allan.threads : std::max(1u, std::thread::hardware_concurrency());
+      std::optional<OwnCrew> crew;
+      if (threads > 1) {
+        crew.emplace(threads - 1);
+        opt.allan.crew = &crew->crew();
+      }
       const Recording rec = [&] {
         detail::ScopedTimer t("read");
-        return read_recording(cmd->file, cmd->input.options());
+        ReadOptions ro = cmd->input.options();
+        ro.crew = opt.allan.crew;
+        return read_recording(cmd->file, ro);
       }();
       const AnalysisResult res = analyze(rec, opt);
       const std::string text = [&] {
