@@ -2,13 +2,17 @@
 // confidence bounds per τ, as text, CSV or JSON.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <iterator>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <ostream>
+#include <thread>
 
 #include "cli/commands.hpp"
 #include "rwcalc/allan.hpp"
+#include "rwcalc/crew.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/reader.hpp"
 
@@ -81,7 +85,16 @@ int run_allan(const AllanArgs& a, Io& io) {
   o.grid = TauGrid::parse(a.tau);
   o.confidence = a.confidence;
   o.threads = a.threads;
-  const ReadOptions ro = a.input.options();
+  // The helper threads, started once before the read and lent to the passes that share their
+  // work out (crew.hpp); the τ loop keeps its own threads.
+  const unsigned threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
+  std::optional<OwnCrew> crew;
+  if (threads > 1) {
+    crew.emplace(threads - 1);
+    o.crew = &crew->crew();
+  }
+  ReadOptions ro = a.input.options();
+  ro.crew = o.crew;
   const Recording rec = read_recording(a.file, ro);
   // Increment and rate samples are frequency data for the noise identification, as Stable32
   // treats a frequency file; cumulative counters and angles are phase data.
