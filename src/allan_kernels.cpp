@@ -17,12 +17,7 @@
 #else
 #define RWCALC_CLONES
 #endif
-#if defined(__x86_64__) && defined(__GNUC__)
-#define RWCALC_X86_DISPATCH 1
-#include <immintrin.h>
-#else
-#define RWCALC_X86_DISPATCH 0
-#endif
+#include "x86_dispatch.hpp"
 
 namespace rwcalc::detail {
 
@@ -371,9 +366,7 @@ __attribute__((target("avx2"))) std::uint64_t block_sumsq_i24_avx2(const std::in
 // four accumulators. A lane holds at most 4096/16 = 256 squares below 2^52; the block sum stays
 // below 2^64 as above. Integer operations only: the same sum as the AVX2 kernel, bit for bit.
 // (GCC 12's AVX-512 headers trip its own uninitialised-value warnings: silenced here only.)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+RWCALC_AVX512_WARNINGS_OFF
 __attribute__((target("avx512f"))) std::uint64_t block_sumsq_i24_avx512(const std::int32_t* __restrict a,
                                                                          const std::int32_t* __restrict b,
                                                                          const std::int32_t* __restrict e,
@@ -401,7 +394,7 @@ __attribute__((target("avx512f"))) std::uint64_t block_sumsq_i24_avx512(const st
   }
   return s;
 }
-#pragma GCC diagnostic pop
+RWCALC_AVX512_WARNINGS_ON
 
 using SumsqI24 = std::uint64_t (*)(const std::int32_t*, const std::int32_t*, const std::int32_t*, std::int64_t);
 /// The widest of the two kernels this processor runs (AVX-512 where the OS keeps its registers).
@@ -507,9 +500,7 @@ __attribute__((target("avx2"))) void offsets_pass_avx2(const std::int64_t* __res
 #if RWCALC_X86_DISPATCH
 // The same with AVX-512: eight int64 offsets per vector, min/max in 64-bit lanes, the low halves
 // narrowed by vpmovqd. Integer operations only, so the same values as the scalar pass.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+RWCALC_AVX512_WARNINGS_OFF
 __attribute__((target("avx512f"))) void offsets_pass_avx512(const std::int64_t* __restrict in,
                                                            std::int32_t* __restrict out, std::size_t begin,
                                                            std::size_t end, std::uint64_t c0, std::int64_t& lo_out,
@@ -533,7 +524,7 @@ __attribute__((target("avx512f"))) void offsets_pass_avx512(const std::int64_t* 
   lo_out = std::min<std::int64_t>(tl, _mm512_reduce_min_epi64(_mm512_min_epi64(lo, lo2)));
   hi_out = std::max<std::int64_t>(th, _mm512_reduce_max_epi64(_mm512_max_epi64(hi, hi2)));
 }
-#pragma GCC diagnostic pop
+RWCALC_AVX512_WARNINGS_ON
 #endif
 
 }  // namespace

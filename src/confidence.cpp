@@ -19,6 +19,7 @@
 #endif
 
 #include "noise_id.hpp"
+#include "x86_dispatch.hpp"
 #include "rwcalc/crew.hpp"
 #include "rwcalc/error.hpp"
 
@@ -460,9 +461,7 @@ __attribute__((target("avx2"))) std::size_t lag1_exact_steps_avx2(const std::int
 
 // The same with AVX-512: eight int64 lanes, positions i ∈ {from, from + 8, …} below `to`, each
 // step adding the terms k = i … i + 7; requires to ≤ vlen − 8. A chunk gives a lane 128 steps.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+RWCALC_AVX512_WARNINGS_OFF
 template <int L>
 __attribute__((target("avx512f"), always_inline)) inline __m512i izvec512(const std::int32_t* w, std::size_t o) {
   if constexpr (L == 0)
@@ -524,7 +523,7 @@ __attribute__((target("avx512f"))) std::size_t lag1_exact_steps_avx512(const std
   }
   return i;
 }
-#pragma GCC diagnostic pop
+RWCALC_AVX512_WARNINGS_ON
 
 // Points of level L and the end of the vector steps of width W (0: none), for `count` phase points.
 template <int L, bool Pair, std::size_t W = 4>

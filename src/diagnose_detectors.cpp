@@ -156,6 +156,64 @@ double refine_frequency(Fit& fit_at, double f0, double step, int half_steps, int
   return 0.5 * (lo + hi);
 }
 
+/// y less its mean and its least-squares linear trend over the sample index.
+void remove_trend(std::vector<double>& y) {
+  const std::size_t n = y.size();
+  double sy = 0, sty = 0, stt = 0;
+  const double m = 0.5 * static_cast<double>(n - 1);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) - m;
+    sy += y[i];
+    sty += t * y[i];
+    stt += t * t;
+  }
+  const double a = sy / static_cast<double>(n), b = sty / stt;
+  for (std::size_t i = 0; i < n; ++i) y[i] -= a + b * (static_cast<double>(i) - m);
+}
+
+/// The FFT of y under a Hann window (at the sample centres), zero-padded to the first power of two
+/// of at least 2n (`nfft`; only the first half with `half_spectrum`), and the window's Σw².
+std::vector<std::complex<double>> hann_spectrum(const std::vector<double>& y, bool half_spectrum, std::size_t& nfft,
+                                                double& w2) {
+  const std::size_t n = y.size();
+  nfft = 1;
+  while (nfft < 2 * n) nfft <<= 1;
+  std::vector<double> buf(nfft, 0.0);
+  w2 = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double h = 0.5 - 0.5 * std::cos(2.0 * kPi * (static_cast<double>(i) + 0.5) / static_cast<double>(n));
+    buf[i] = h * y[i];
+    w2 += h * h;
+  }
+  Eigen::FFT<double> fft;
+  if (half_spectrum) fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
+  std::vector<std::complex<double>> spec;
+  fft.fwd(spec, buf);
+  return spec;
+}
+
+/// Least-squares a·cos(2πft) + b·sin(2πft) through y_i at t_i = (i + ½)·tb: (a, b), and the
+/// explained sum of squares as the result.
+double sinusoid_ls(const std::vector<double>& y, double tb, double f, double& a, double& b) {
+  Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d r = Eigen::Vector2d::Zero();
+  const double w = 2.0 * kPi * f;
+  for (std::size_t i = 0; i < y.size(); ++i) {
+    const double t = (static_cast<double>(i) + 0.5) * tb;
+    const double c = std::cos(w * t), s = std::sin(w * t);
+    A(0, 0) += c * c;
+    A(0, 1) += c * s;
+    A(1, 1) += s * s;
+    r(0) += c * y[i];
+    r(1) += s * y[i];
+  }
+  A(1, 0) = A(0, 1);
+  const Eigen::Vector2d x = A.ldlt().solve(r);
+  a = x(0);
+  b = x(1);
+  return x.dot(r);
+}
+
 }  // namespace
 
 SinusoidEstimate sinusoid_detect(const Decimated& d, double f_hint, bool estimate) {
@@ -167,30 +225,10 @@ SinusoidEstimate sinusoid_detect(const Decimated& d, double f_hint, bool estimat
   const double tb = static_cast<double>(pb) * d.tau_d;
   const double T = tb * static_cast<double>(n);
   // Remove the level and the linear trend.
-  {
-    double st = 0, sy = 0, stt = 0, sty = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      const double t = static_cast<double>(i) - 0.5 * static_cast<double>(n - 1);
-      st += t;
-      sy += y[i];
-      stt += t * t;
-      sty += t * y[i];
-    }
-    const double b = sty / stt, a = sy / static_cast<double>(n);
-    for (std::size_t i = 0; i < n; ++i) y[i] -= a + b * (static_cast<double>(i) - 0.5 * static_cast<double>(n - 1));
-  }
-  std::size_t nfft = 1;
-  while (nfft < 2 * n) nfft <<= 1;
-  std::vector<double> buf(nfft, 0.0);
+  remove_trend(y);
+  std::size_t nfft = 0;
   double w2 = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double w = 0.5 - 0.5 * std::cos(2.0 * kPi * (static_cast<double>(i) + 0.5) / static_cast<double>(n));
-    buf[i] = w * y[i];
-    w2 += w * w;
-  }
-  Eigen::FFT<double> fft;
-  std::vector<std::complex<double>> spec;
-  fft.fwd(spec, buf);
+  const std::vector<std::complex<double>> spec = hann_spectrum(y, false, nfft, w2);
   const std::size_t half = nfft / 2;
   std::vector<double> P(half + 1);
   for (std::size_t k = 0; k <= half; ++k) P[k] = std::norm(spec[k]);
@@ -225,25 +263,7 @@ SinusoidEstimate sinusoid_detect(const Decimated& d, double f_hint, bool estimat
   e.statistic = best;
   if (!estimate) return e;
   // Least-squares sinusoid on the (untapered, detrended) block rates around the peak.
-  auto fit_at = [&](double f, double& a, double& b) {
-    Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
-    Eigen::Vector2d r = Eigen::Vector2d::Zero();
-    const double w = 2.0 * kPi * f;
-    for (std::size_t i = 0; i < n; ++i) {
-      const double t = (static_cast<double>(i) + 0.5) * tb;
-      const double c = std::cos(w * t), s = std::sin(w * t);
-      A(0, 0) += c * c;
-      A(0, 1) += c * s;
-      A(1, 1) += s * s;
-      r(0) += c * y[i];
-      r(1) += s * y[i];
-    }
-    A(1, 0) = A(0, 1);
-    const Eigen::Vector2d x = A.ldlt().solve(r);
-    a = x(0);
-    b = x(1);
-    return x.dot(r);  // explained sum of squares
-  };
+  auto fit_at = [&](double f, double& a, double& b) { return sinusoid_ls(y, tb, f, a, b); };
   const double f0 = static_cast<double>(kbest) * df;
   const double fbest = refine_frequency(fit_at, f0, 1.0 / (20.0 * T), 30, 30, std::numeric_limits<double>::infinity());
   double a = 0, b = 0;
@@ -266,48 +286,12 @@ LineCoefficients line_coefficients(std::vector<double> y, double tb, double f) {
   const std::size_t n = y.size();
   if (n < 64 || !(tb > 0) || !(f > 0)) return c;
   const double T = tb * static_cast<double>(n);
-  {  // level and linear trend removed
-    double sy = 0, sty = 0, stt = 0;
-    const double m = 0.5 * static_cast<double>(n - 1);
-    for (std::size_t i = 0; i < n; ++i) {
-      const double t = static_cast<double>(i) - m;
-      sy += y[i];
-      sty += t * y[i];
-      stt += t * t;
-    }
-    const double a = sy / static_cast<double>(n), b = sty / stt;
-    for (std::size_t i = 0; i < n; ++i) y[i] -= a + b * (static_cast<double>(i) - m);
-  }
-  Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d r = Eigen::Vector2d::Zero();
-  const double w = 2.0 * kPi * f;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double t = (static_cast<double>(i) + 0.5) * tb;
-    const double cs = std::cos(w * t), sn = std::sin(w * t);
-    A(0, 0) += cs * cs;
-    A(0, 1) += cs * sn;
-    A(1, 1) += sn * sn;
-    r(0) += cs * y[i];
-    r(1) += sn * y[i];
-  }
-  A(1, 0) = A(0, 1);
-  const Eigen::Vector2d x = A.ldlt().solve(r);
-  c.a = x(0);
-  c.b = x(1);
+  remove_trend(y);  // level and linear trend
+  (void)sinusoid_ls(y, tb, f, c.a, c.b);
   // The noise PSD at f: the Hann periodogram's median over ±24 true bins (main lobe left out).
-  std::size_t nfft = 1;
-  while (nfft < 2 * n) nfft <<= 1;
-  std::vector<double> buf(nfft, 0.0);
+  std::size_t nfft = 0;
   double w2 = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double h = 0.5 - 0.5 * std::cos(2.0 * kPi * (static_cast<double>(i) + 0.5) / static_cast<double>(n));
-    buf[i] = h * y[i];
-    w2 += h * h;
-  }
-  Eigen::FFT<double> fft;
-  fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
-  std::vector<std::complex<double>> spec;
-  fft.fwd(spec, buf);
+  const std::vector<std::complex<double>> spec = hann_spectrum(y, true, nfft, w2);
   const std::size_t half = nfft / 2;
   const double df = 1.0 / (static_cast<double>(nfft) * tb);
   const double pad = static_cast<double>(nfft) / static_cast<double>(n);
@@ -378,18 +362,7 @@ LineEstimate line_detect(const PhaseSeries& x, double f_min, double f_hint, bool
   // Per-sample rates (″/s = °/h), level and linear trend removed.
   std::vector<double> y(n);
   for (std::size_t i = 0; i < n; ++i) y[i] = x.diff(i + 1, i) / t0;
-  {
-    double sy = 0, sty = 0, stt = 0;
-    const double c = 0.5 * static_cast<double>(n - 1);
-    for (std::size_t i = 0; i < n; ++i) {
-      const double t = static_cast<double>(i) - c;
-      sy += y[i];
-      sty += t * y[i];
-      stt += t * t;
-    }
-    const double a = sy / static_cast<double>(n), b = sty / stt;
-    for (std::size_t i = 0; i < n; ++i) y[i] -= a + b * (static_cast<double>(i) - c);
-  }
+  remove_trend(y);
   // Resolutions: the whole record (a coherent line), and Welch means of segments of 16384, 4096
   // and 1024 samples (at least 8 segments) for a line broadened by a wandering frequency or phase.
   std::vector<std::size_t> lens{n};

@@ -5,12 +5,7 @@
 #include <cmath>
 #include <numbers>
 
-#if defined(__x86_64__) && defined(__GNUC__)
-#define RWCALC_X86_DISPATCH 1
-#include <immintrin.h>
-#else
-#define RWCALC_X86_DISPATCH 0
-#endif
+#include "x86_dispatch.hpp"
 
 namespace rwcalc::detail {
 
@@ -25,9 +20,7 @@ inline double structure(const GammaPair& g, double u) noexcept {
 }
 
 #if RWCALC_X86_DISPATCH
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+RWCALC_AVX512_WARNINGS_OFF
 #define RWCALC_AVX512 __attribute__((target("avx512f")))
 
 /// ln x for x > 0 (normal numbers), eight lanes: x = m·2^e with m in [√½, √2), ln m =
@@ -82,7 +75,7 @@ RWCALC_AVX512 double gamma_sq_sum_avx512(const GammaPair& g, const double* h, co
   return _mm512_reduce_add_pd(acc);
 }
 #undef RWCALC_AVX512
-#pragma GCC diagnostic pop
+RWCALC_AVX512_WARNINGS_ON
 #endif
 
 }  // namespace

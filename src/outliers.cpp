@@ -9,6 +9,8 @@
 #include <optional>
 #include <thread>
 
+#include "x86_dispatch.hpp"
+
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
 #endif
@@ -29,14 +31,19 @@ inline void sort2(double& a, double& b) {
   a = lo;
 }
 
-// Median of six values: an optimal 12-comparator sorting network (branch-free, vectorisable),
-// then the mean of the middle two.
+// An optimal 12-comparator sorting network for six values a … f (branch-free), with S(x, y)
+// putting the smaller of x, y in x: afterwards c and d are the middle two. The scalar median and
+// the vector screens use the same network.
+#define RWCALC_SORT6(S, a, b, c, d, e, f) \
+  S(a, f); S(b, d); S(c, e);              \
+  S(b, c); S(d, e);                       \
+  S(a, d); S(c, f);                       \
+  S(a, b); S(c, d); S(e, f);              \
+  S(b, c); S(d, e)
+
+// Median of six values: the sorting network, then the mean of the middle two.
 inline double median6(double a, double b, double c, double d, double e, double f) {
-  sort2(a, f); sort2(b, d); sort2(c, e);
-  sort2(b, c); sort2(d, e);
-  sort2(a, d); sort2(c, f);
-  sort2(a, b); sort2(c, d); sort2(e, f);
-  sort2(b, c); sort2(d, e);
+  RWCALC_SORT6(sort2, a, b, c, d, e, f);
   return 0.5 * (c + d);
 }
 
@@ -151,9 +158,7 @@ RateTable rate_table(const PhaseSeries& ph, std::size_t n) {
 }
 
 #if defined(__x86_64__) || defined(__i386__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+RWCALC_AVX512_WARNINGS_OFF
 // Rates of exact counts by lookup in the table, eight at a time; false (the window then needs
 // the division) when an increment lies outside the table's range.
 __attribute__((target("avx512f"))) bool table_rates_avx512(const std::int64_t* c, std::size_t from, std::size_t to,
@@ -190,11 +195,7 @@ __attribute__((target("avx512f"))) bool screen_avx512(const double* w, std::size
   for (; k + 8 <= kHalo + len; k += 8) {
     __m512d a = _mm512_loadu_pd(w + k - 3), b = _mm512_loadu_pd(w + k - 2), c = _mm512_loadu_pd(w + k - 1);
     __m512d d = _mm512_loadu_pd(w + k + 1), e = _mm512_loadu_pd(w + k + 2), f = _mm512_loadu_pd(w + k + 3);
-    s2_512(a, f); s2_512(b, d); s2_512(c, e);
-    s2_512(b, c); s2_512(d, e);
-    s2_512(a, d); s2_512(c, f);
-    s2_512(a, b); s2_512(c, d); s2_512(e, f);
-    s2_512(b, c); s2_512(d, e);
+    RWCALC_SORT6(s2_512, a, b, c, d, e, f);
     const __m512d r = _mm512_sub_pd(_mm512_loadu_pd(w + k), _mm512_mul_pd(halfv, _mm512_add_pd(c, d)));
     hit |= _mm512_cmp_pd_mask(_mm512_abs_pd(r), lim, _CMP_GT_OQ);
   }
@@ -220,7 +221,7 @@ __attribute__((target("avx512f"))) double min_step_avx512(const double* w, std::
   }
   return res;
 }
-#pragma GCC diagnostic pop
+RWCALC_AVX512_WARNINGS_ON
 #endif
 
 struct PhaseRates {
@@ -300,11 +301,7 @@ __attribute__((target("avx2"))) bool screen_avx2(const double* w, std::size_t le
   for (; k + 4 <= kHalo + len; k += 4) {
     __m256d a = _mm256_loadu_pd(w + k - 3), b = _mm256_loadu_pd(w + k - 2), c = _mm256_loadu_pd(w + k - 1);
     __m256d d = _mm256_loadu_pd(w + k + 1), e = _mm256_loadu_pd(w + k + 2), f = _mm256_loadu_pd(w + k + 3);
-    s2(a, f); s2(b, d); s2(c, e);
-    s2(b, c); s2(d, e);
-    s2(a, d); s2(c, f);
-    s2(a, b); s2(c, d); s2(e, f);
-    s2(b, c); s2(d, e);
+    RWCALC_SORT6(s2, a, b, c, d, e, f);
     const __m256d r = _mm256_sub_pd(_mm256_loadu_pd(w + k), _mm256_mul_pd(halfv, _mm256_add_pd(c, d)));
     hit = _mm256_or_pd(hit, _mm256_cmp_pd(_mm256_andnot_pd(sign, r), lim, _CMP_GT_OQ));
   }

@@ -186,11 +186,7 @@ TEST(CrewPasses, AFileLoadedInHalvesByALenderReadsTheSame) {
 }
 
 TEST(CrewPasses, AnAnalysisWithLendersEqualsOneWithout) {
-  NoiseModel m;
-  m.arw_deg_per_sqrt_h = 0.001;
-  m.bias_instability_deg_per_h = 0.008;
-  m.earth_rate_deg_per_h = earth_rate_at(55.75);
-  m.readout = ReadoutMode::White;
+  const NoiseModel m = test::gl2d_model();
   SimulationSettings s;
   s.duration_s = 3600;
   s.rate_hz = 400;

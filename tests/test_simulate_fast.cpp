@@ -10,19 +10,13 @@
 
 #include "rwcalc/error.hpp"
 #include "rwcalc/simulate.hpp"
+#include "test_support.hpp"
 
 namespace {
 
 using namespace rwcalc;
 
-NoiseModel gl2d_model() {
-  NoiseModel m;
-  m.arw_deg_per_sqrt_h = 0.00098;
-  m.bias_instability_deg_per_h = 0.0081;
-  m.earth_rate_deg_per_h = earth_rate_at(55.75);
-  m.readout = ReadoutMode::White;
-  return m;
-}
+using test::gl2d_model;
 
 SimulationSettings short_record(std::size_t samples = 20000) {
   SimulationSettings s;

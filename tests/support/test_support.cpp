@@ -122,4 +122,13 @@ std::filesystem::path TempDir::write(const std::string& name, const std::string&
   return p;
 }
 
+NoiseModel gl2d_model() {
+  NoiseModel m;
+  m.arw_deg_per_sqrt_h = 0.00098;
+  m.bias_instability_deg_per_h = 0.0081;
+  m.earth_rate_deg_per_h = earth_rate_at(55.75);
+  m.readout = ReadoutMode::White;
+  return m;
+}
+
 }  // namespace rwcalc::test

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "rwcalc/simulate.hpp"
+
 namespace rwcalc::test {
 
 /// Path of a file under ../shared/data (the read-only reference material).
@@ -72,5 +74,9 @@ class ScopedEnv {
   std::string name_;
   std::optional<std::string> old_;
 };
+
+/// A GL-2D-like gyro (the +50 °C run of Table 1: N 0.00098 °/√h, B 0.0081 °/h, the Moscow vertical
+/// Earth rate, white read-out) for tests that need a realistic record.
+NoiseModel gl2d_model();
 
 }  // namespace rwcalc::test
