@@ -386,8 +386,12 @@ __attribute__((target("avx512f"))) std::uint64_t block_sumsq_i24_avx512(const st
     acc2 = _mm512_add_epi64(acc2, _mm512_mul_epi32(d1, d1));
     acc3 = _mm512_add_epi64(acc3, _mm512_mul_epi32(h1, h1));
   }
-  std::uint64_t s = static_cast<std::uint64_t>(
-      _mm512_reduce_add_epi64(_mm512_add_epi64(_mm512_add_epi64(acc0, acc1), _mm512_add_epi64(acc2, acc3))));
+  // The lanes are added as unsigned (the block's sum is below 2^64, a lane's below 2^63 is not
+  // promised once the four accumulators are combined): no signed reduction.
+  alignas(64) std::uint64_t lanes[8];
+  _mm512_store_si512(lanes, _mm512_add_epi64(_mm512_add_epi64(acc0, acc1), _mm512_add_epi64(acc2, acc3)));
+  std::uint64_t s = 0;
+  for (std::uint64_t v : lanes) s += v;
   for (; i < len; ++i) {
     const std::int64_t d = std::int64_t{e[i]} + std::int64_t{a[i]} - 2 * std::int64_t{b[i]};
     s += static_cast<std::uint64_t>(d * d);

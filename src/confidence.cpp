@@ -483,10 +483,17 @@ __attribute__((target("avx512f"), always_inline)) inline void exact_step512(cons
   a.lag = _mm512_add_epi64(a.lag, _mm512_mul_epi32(z, zn));
 }
 
+// Each lane into the 128-bit totals on its own (eight lanes of up to 2^61 could pass 2^63 together).
 __attribute__((target("avx512f"))) inline void exact_flush512(const ExactLanes512& a, ExactLag1& s) {
-  s.s1 += _mm512_reduce_add_epi64(a.s1);
-  s.s2 += _mm512_reduce_add_epi64(a.s2);
-  s.lag += _mm512_reduce_add_epi64(a.lag);
+  alignas(64) std::int64_t l[3][8];
+  _mm512_store_si512(l[0], a.s1);
+  _mm512_store_si512(l[1], a.s2);
+  _mm512_store_si512(l[2], a.lag);
+  for (int j = 0; j < 8; ++j) {
+    s.s1 += l[0][j];
+    s.s2 += l[1][j];
+    s.lag += l[2][j];
+  }
 }
 
 template <int L, bool Pair>
