@@ -643,26 +643,44 @@ u128 second_diff_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m, 
   return total;
 }
 
+#if RWCALC_X86_DISPATCH
+namespace {
+
+/// Whether the sweep applies: AVX2, offsets below 2^24, an int32 view.
+bool sweep_applies(const PreparedCounts& c) {
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2 && c.small24 && !c.rel32.empty();
+}
+
+/// The sweep's work: for the terms k in [from, to), in blocks of kBlock24 taken for every τ of
+/// ms[first], ms[first + step], … while in cache, the squared second differences added to out[i].
+void sweep_terms(const PreparedCounts& c, std::int64_t np, const std::int64_t* ms, std::size_t count,
+                 std::size_t first, std::size_t step, std::int64_t from, std::int64_t to, u128* out) {
+  const std::int32_t* r = c.rel32.data();
+  const SumsqI24 kernel = sumsq_i24_kernel();
+  for (std::int64_t k0 = from; k0 < to; k0 += kBlock24) {
+    for (std::size_t i = first; i < count; i += step) {
+      const std::int64_t m = ms[i], n = np - 2 * m;
+      if (k0 >= n) continue;
+      out[i] += kernel(r + k0, r + k0 + m, r + k0 + 2 * m, std::min({kBlock24, n - k0, to - k0}));
+    }
+  }
+}
+
+}  // namespace
+#endif
+
 bool second_diff_sumsq_sweep(const PreparedCounts& c, std::size_t points, const std::int64_t* ms,
                              std::size_t count, std::size_t first, std::size_t step, u128* out) {
 #if RWCALC_X86_DISPATCH
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  if (!avx2 || !c.small24 || c.rel32.empty() || step == 0) return false;
-  const std::int32_t* r = c.rel32.data();
+  if (!sweep_applies(c) || step == 0) return false;
   const auto np = static_cast<std::int64_t>(points);
   std::int64_t longest = 0;
   for (std::size_t i = first; i < count; i += step) {
     out[i] = 0;
     longest = std::max(longest, np - 2 * ms[i]);
   }
-  const SumsqI24 kernel = sumsq_i24_kernel();
-  for (std::int64_t k0 = 0; k0 < longest; k0 += kBlock24) {
-    for (std::size_t i = first; i < count; i += step) {
-      const std::int64_t m = ms[i], n = np - 2 * m;
-      if (k0 >= n) continue;
-      out[i] += kernel(r + k0, r + k0 + m, r + k0 + 2 * m, std::min(kBlock24, n - k0));
-    }
-  }
+  sweep_terms(c, np, ms, count, first, step, 0, longest, out);
   return true;
 #else
   (void)c, (void)points, (void)ms, (void)count, (void)first, (void)step, (void)out;
@@ -673,26 +691,16 @@ bool second_diff_sumsq_sweep(const PreparedCounts& c, std::size_t points, const 
 bool second_diff_sumsq_sweep_shared(const PreparedCounts& c, std::size_t points, const std::int64_t* ms,
                                     std::size_t count, Crew& crew, u128* out) {
 #if RWCALC_X86_DISPATCH
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  if (!avx2 || !c.small24 || c.rel32.empty() || count == 0) return false;
-  const std::int32_t* r = c.rel32.data();
+  if (!sweep_applies(c) || count == 0) return false;
   const auto np = static_cast<std::int64_t>(points);
   std::int64_t longest = 0;
   for (std::size_t i = 0; i < count; ++i) longest = std::max(longest, np - 2 * ms[i]);
   constexpr std::int64_t kStretch = kBlock24 * 64;  // 256 K terms per stretch
   const auto parts = static_cast<std::size_t>((longest + kStretch - 1) / kStretch);
   std::vector<u128> sums(parts * count, 0);
-  const SumsqI24 kernel = sumsq_i24_kernel();
   crew.share(parts, [&](std::size_t k) {
-    u128* part = sums.data() + k * count;
-    const std::int64_t from = static_cast<std::int64_t>(k) * kStretch, to = std::min(longest, from + kStretch);
-    for (std::int64_t k0 = from; k0 < to; k0 += kBlock24) {
-      for (std::size_t i = 0; i < count; ++i) {
-        const std::int64_t m = ms[i], n = np - 2 * m;
-        if (k0 >= n) continue;
-        part[i] += kernel(r + k0, r + k0 + m, r + k0 + 2 * m, std::min({kBlock24, n - k0, to - k0}));
-      }
-    }
+    const std::int64_t from = static_cast<std::int64_t>(k) * kStretch;
+    sweep_terms(c, np, ms, count, 0, 1, from, std::min(longest, from + kStretch), sums.data() + k * count);
   });
   for (std::size_t i = 0; i < count; ++i) {
     u128 total = 0;

@@ -9,7 +9,6 @@
 #include <functional>
 #include <numbers>
 #include <optional>
-#include <thread>
 
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/crew.hpp"
@@ -168,13 +167,13 @@ void report_outliers(const Recording& rec, const AnalysisOptions& options, const
 }
 
 std::vector<Outlier> detect_outliers(const Recording& rec, const AnalysisOptions& options, OutlierReport& rep,
-                                     unsigned threads) {
+                                     unsigned threads, Crew* crew) {
   check_outlier_threshold(options);
   // The rates are computed block by block from the phase (no copy of the whole record); with a
   // crew, by this thread and any lender free to help.
   OutlierScale scale;
   std::vector<Outlier> found;
-  if (Crew* crew = options.allan.crew) {
+  if (crew) {
     SharedOutlierScan shared(rec.phase, options.outlier_threshold);
     crew->share(2, [&shared](std::size_t) { shared.help(); });
     found = shared.finish(scale);
@@ -195,43 +194,25 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   OutlierReport outliers;
   Recording rec_storage;
   const Recording* recp = &read;
+  // The analysis' helper threads: the caller's crew (crew.hpp), or one of its own when the thread
+  // budget allows; the passes over the data share their work out through it.
+  std::optional<OwnCrew> own;
+  Crew* crew = options.allan.crew;
+  if (!crew) crew = own.emplace(options.allan.threads).get();
   // Outliers that are only reported (the default) change nothing the Allan stage or the fit
-  // computes: then the scan runs on a thread of its own, started once the Allan stage is done,
-  // beside the fit, the cross-checks and the verdict (joined before the result is assembled),
-  // filling the core the fit's covariance leaves.
-  const unsigned budget = options.allan.threads ? options.allan.threads
-                                                : std::max(1u, std::thread::hardware_concurrency());
-  Crew* const crew = options.allan.crew;
-  const bool keep = options.outlier_action == OutlierAction::Keep && read.phase.points() >= 3 &&
-                    read.phase.kind == PhaseKind::Gyro;
-  const bool beside = keep && budget > 1 && !crew;
-  // With a crew the same: the scan's stretches are offered to the crew's lenders after the Allan
-  // stage, and the analysis' thread takes what is left once the verdict is done.
-  const bool posted_scan = keep && crew;
-  // The scan is shared: a thread of its own takes stretches of the record from the start, and
-  // the analysis' thread joins in once the verdict is done (SharedOutlierScan).
+  // computes: then the scan's stretches are offered to the crew after the Allan stage, beside the
+  // fit, the cross-checks and the verdict, and the analysis' thread takes what is left once the
+  // verdict is done (SharedOutlierScan; not beside the Allan stage, whose passes take the crew).
+  const bool posted_scan = crew && options.outlier_action == OutlierAction::Keep && read.phase.points() >= 3;
   std::optional<SharedOutlierScan> shared;
-  std::jthread scan_thread;
-  std::exception_ptr scan_error;
-  auto start_scan = [&] {
-    shared.emplace(read.phase, options.outlier_threshold);
-    scan_thread = std::jthread([&] {
-      try {
-        detail::ScopedTimer t("analyze: outlier scan (beside)", true);  // this thread's CPU only
-        shared->help();
-      } catch (...) {
-        scan_error = std::current_exception();
-      }
-    });
-  };
   std::function<void(std::size_t)> scan_chunk;
   std::optional<Crew::Posted> posted;  // after `shared` and `scan_chunk`: joined before they go
-  if (beside || posted_scan) {
+  if (posted_scan) {
     check_outlier_threshold(options);
   } else if (read.phase.points() >= 3) {
     const std::vector<Outlier> found = [&] {
       detail::ScopedTimer t("analyze: outlier scan");
-      return detect_outliers(read, options, outliers, options.allan.threads);
+      return detect_outliers(read, options, outliers, options.allan.threads, crew);
     }();
     if (options.outlier_action != OutlierAction::Keep && !found.empty()) {
       rec_storage.source = read.source;
@@ -247,7 +228,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   }
   const Recording& rec = *recp;
   AnalysisResult r;
-  if (!beside && !posted_scan) r.outliers = std::move(outliers);
+  if (!posted_scan) r.outliers = std::move(outliers);
   r.source = rec.source;
   r.samples = rec.samples;
   r.rate_hz = rec.rate_hz;
@@ -278,6 +259,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   // A finer grid (--tau) is reported in full, but the fit and the slope readout use its octave
   // points, so the coefficients and the verdict do not depend on the grid.
   AllanOptions aopt = options.allan;
+  aopt.crew = crew;
   const bool octave = aopt.grid.kind == TauGrid::Kind::Octave;
   if (!octave) {
     aopt.grid.with_octave = true;
@@ -288,10 +270,6 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
     detail::ScopedTimer t("analyze: allan");
     r.allan = compute_allan(rec.phase, aopt);
   }
-  // The scan beside the fit, the cross-checks and the verdict rather than beside the Allan stage:
-  // that stage splits its passes over the data evenly between its threads, so a third thread
-  // there leaves one of them waiting for a core while the other idles at the end of each pass.
-  if (beside) start_scan();
   if (posted_scan) {
     shared.emplace(read.phase, options.outlier_threshold);
     scan_chunk = [&shared](std::size_t) { shared->help(); };
@@ -317,7 +295,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   try {
     detail::ScopedTimer t("analyze: fit");
     FitOptions fopt = options.fit;
-    if (fopt.threads == 0) fopt.threads = beside || posted_scan ? 1u : aopt.threads;
+    if (fopt.threads == 0) fopt.threads = posted_scan ? 1u : aopt.threads;
     r.fit = fit_noise(fit_points(fitted), fopt);
   } catch (const AnalysisError& e) {
     throw AnalysisError(fmt::format("{}: {}", rec.source, e.what()));
@@ -376,16 +354,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
       break;
   }
   r.verdict = decide(b_in, from_fit(Term::N), rho, options.verdict);
-  if (beside) {
-    detail::ScopedTimer t("analyze: outlier scan (rest)", true);
-    shared->help();
-    scan_thread.join();
-    if (scan_error) std::rethrow_exception(scan_error);
-    OutlierScale scale;
-    const std::vector<Outlier> found = shared->finish(scale);
-    report_outliers(read, options, scale, found, outliers);
-    r.outliers = std::move(outliers);
-  } else if (posted_scan) {
+  if (posted_scan) {
     detail::ScopedTimer t("analyze: outlier scan (rest)", true);
     crew->join(*posted);
     OutlierScale scale;

@@ -107,9 +107,10 @@ void Crew::close() {
 
 namespace rwcalc {
 
-OwnCrew::OwnCrew(unsigned lenders) {
-  threads_.reserve(lenders);
-  for (unsigned i = 0; i < lenders; ++i) threads_.emplace_back([this] { crew_.lend(); });
+OwnCrew::OwnCrew(unsigned threads) {
+  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+  threads_.reserve(threads - 1);
+  for (unsigned i = 1; i < threads; ++i) threads_.emplace_back([this] { crew_.lend(); });
 }
 
 OwnCrew::~OwnCrew() {

@@ -7,14 +7,14 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <limits>
 #include <mutex>
+#include <thread>
 #include <utility>
 #include <vector>
-#include <atomic>
-#include <thread>
 
 #include "reader_detail.hpp"
 #include "rwcalc/crew.hpp"

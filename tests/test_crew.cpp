@@ -111,10 +111,13 @@ TEST(Crew, PostedLoopsRunWhileTheCallerWorksAndJoinWaitsForThem) {
 }
 
 TEST(Crew, OwnCrewLendsItsThreadsUntilItEnds) {
-  OwnCrew own(2);
+  OwnCrew own(3);  // two threads of its own
+  ASSERT_NE(own.get(), nullptr);
   std::atomic<int> runs{0};
-  own.crew().share(64, [&](std::size_t) { ++runs; });
+  own.get()->share(64, [&](std::size_t) { ++runs; });
   EXPECT_EQ(runs.load(), 64);
+  OwnCrew alone(1);  // the calling thread only
+  EXPECT_EQ(alone.get(), nullptr);
 }
 
 std::vector<std::int64_t> pulse_counts(std::size_t n, std::uint64_t seed) {

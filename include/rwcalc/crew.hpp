@@ -68,14 +68,16 @@ class Crew {
 
 /// A crew with threads of its own, lent to it from construction to destruction: the helper
 /// threads of one command, started once (a thread that sleeps between loops wakes on the core it
-/// ran on, where a thread started for each loop may first wait on its creator's core).
+/// ran on, where a thread started for each loop may first wait on its creator's core). For a
+/// budget of `threads` threads in all (0: the hardware's), the calling thread one of them, so
+/// `threads` − 1 of its own; get() is the crew, or null when that leaves none.
 class OwnCrew {
  public:
-  explicit OwnCrew(unsigned lenders);
+  explicit OwnCrew(unsigned threads);
   ~OwnCrew();
   OwnCrew(const OwnCrew&) = delete;
   OwnCrew& operator=(const OwnCrew&) = delete;
-  [[nodiscard]] Crew& crew() noexcept { return crew_; }
+  [[nodiscard]] Crew* get() noexcept { return threads_.empty() ? nullptr : &crew_; }
 
  private:
   Crew crew_;

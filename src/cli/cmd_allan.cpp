@@ -2,13 +2,10 @@
 // confidence bounds per τ, as text, CSV or JSON.
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <iterator>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <optional>
 #include <ostream>
-#include <thread>
 
 #include "cli/commands.hpp"
 #include "rwcalc/allan.hpp"
@@ -87,12 +84,8 @@ int run_allan(const AllanArgs& a, Io& io) {
   o.threads = a.threads;
   // The helper threads, started once before the read and lent to the passes that share their
   // work out (crew.hpp); the τ loop keeps its own threads.
-  const unsigned threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
-  std::optional<OwnCrew> crew;
-  if (threads > 1) {
-    crew.emplace(threads - 1);
-    o.crew = &crew->crew();
-  }
+  OwnCrew crew(o.threads);
+  o.crew = crew.get();
   ReadOptions ro = a.input.options();
   ro.crew = o.crew;
   const Recording rec = read_recording(a.file, ro);

@@ -2,11 +2,8 @@
 // cross-checks, Earth rate and bias, and the class verdict, as a report or JSON.
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <memory>
-#include <optional>
 #include <ostream>
-#include <thread>
 
 #include "cli/analyze_args.hpp"
 #include "cli/commands.hpp"
@@ -59,12 +56,8 @@ void register_analyze(CLI::App& app, Runner& runner) {
       detail::ScopedTimer total("analyze command");
       // The analysis' helper threads, started before the read so that they have settled on the
       // other cores by the time the Allan stage shares its passes out (crew.hpp).
-      const unsigned threads = opt.allan.threads ? opt.allan.threads : std::max(1u, std::thread::hardware_concurrency());
-      std::optional<OwnCrew> crew;
-      if (threads > 1) {
-        crew.emplace(threads - 1);
-        opt.allan.crew = &crew->crew();
-      }
+      OwnCrew crew(opt.allan.threads);
+      opt.allan.crew = crew.get();
       const Recording rec = [&] {
         detail::ScopedTimer t("read");
         ReadOptions ro = cmd->input.options();
