@@ -86,10 +86,23 @@ TEST(Crew, AChunksExceptionReachesTheCallerAndTheCrewGoesOn) {
 
 TEST(Crew, CloseReleasesLendersWithNothingToDo) {
   Crew crew;
-  std::jthread lender([&] { crew.lend(); });
+  std::atomic<bool> returned{false};
+  std::jthread lender([&] {
+    crew.lend();
+    returned = true;
+  });
   crew.close();
-  lender.join();  // returns: the test would hang otherwise
-  SUCCEED();
+  lender.join();  // (a lender that stayed would hang here)
+  EXPECT_TRUE(returned.load());
+  // Once closed, a loop runs on its calling thread alone.
+  const auto me = std::this_thread::get_id();
+  std::atomic<int> elsewhere{0}, runs{0};
+  crew.share(5, [&](std::size_t) {
+    ++runs;
+    if (std::this_thread::get_id() != me) ++elsewhere;
+  });
+  EXPECT_EQ(runs.load(), 5);
+  EXPECT_EQ(elsewhere.load(), 0);
 }
 
 
