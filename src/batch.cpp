@@ -7,13 +7,16 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <fstream>
 #include <mutex>
 #include <thread>
 
 #include "rwcalc/error.hpp"
+#include "timing.hpp"
 
 namespace rwcalc {
 
@@ -164,7 +167,13 @@ std::vector<json> analyze_files(const std::vector<std::string>& files, const Rea
   std::atomic<std::size_t> next{0};
   Crew crew;
   std::atomic<unsigned> active{jobs};
-  auto worker = [&] {
+  // With RWCALC_TIMING, one line per run: its worker, and when (ms from here) its read began and
+  // ended and its analysis ended.
+  const auto start = std::chrono::steady_clock::now();
+  auto ms_since_start = [start] {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  };
+  auto worker = [&](unsigned w) {
     for (std::size_t i = next++; i < files.size(); i = next++) {
       try {
         const unsigned threads = jobs > 1 ? 1u : total;
@@ -173,8 +182,13 @@ std::vector<json> analyze_files(const std::vector<std::string>& files, const Rea
         AnalysisOptions opt = options;
         opt.allan.threads = threads;
         if (jobs > 1) opt.allan.crew = &crew;
+        const double t0 = ms_since_start();
         const Recording rec = read_recording(files[i], ro);
+        const double t1 = ms_since_start();
         out[i] = to_json(analyze(rec, opt));
+        if (detail::timing_enabled())
+          std::fprintf(stderr, "timing: batch run %zu on worker %u: read %.2f to %.2f ms, analysed at %.2f ms\n", i, w,
+                       t0, t1, ms_since_start());
       } catch (...) {
         errors[i] = std::current_exception();
       }
@@ -185,8 +199,8 @@ std::vector<json> analyze_files(const std::vector<std::string>& files, const Rea
       crew.lend();
   };
   std::vector<std::thread> pool;
-  for (unsigned t = 1; t < jobs; ++t) pool.emplace_back(worker);
-  worker();
+  for (unsigned t = 1; t < jobs; ++t) pool.emplace_back(worker, t);
+  worker(0);
   for (auto& t : pool) t.join();
   for (std::size_t i = 0; i < files.size(); ++i) {
     if (!errors[i]) continue;

@@ -67,7 +67,14 @@ MappedPages& mapped_pages() {
 
 void populate(std::uintptr_t start, std::uintptr_t end) noexcept {
 #ifdef MADV_POPULATE_WRITE
-  if (end > start) (void)::madvise(reinterpret_cast<void*>(start), end - start, MADV_POPULATE_WRITE);
+  // In steps of 2 MB: the call holds the process's memory map for reading while it maps, and a
+  // thread that changes the map meanwhile (mmap, brk, munmap) waits for it to end, as does every
+  // thread queued behind that one; between steps the others get through. (A 40-MB buffer mapped
+  // in one call while another thread mapped its own buffer with mmap took them 18 ms for the
+  // two; in steps, 9 ms, as for one alone.)
+  constexpr std::uintptr_t kStep = std::uintptr_t{2} << 20;
+  for (std::uintptr_t a = start; a < end; a += kStep)
+    (void)::madvise(reinterpret_cast<void*>(a), std::min(kStep, end - a), MADV_POPULATE_WRITE);
 #else
   (void)start;
   (void)end;
