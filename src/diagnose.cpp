@@ -36,6 +36,15 @@ constexpr double kStepMinSide = 60.0;     ///< s of a half on each side of a kno
 const double kGmMinLogLr = 2.0 * std::log(100.0);
 constexpr double kModelEdf = 1000.0;      ///< model floor of the EDF in the deviance (as band_misfit)
 
+constexpr double kMinDuration = 1200.0;  ///< s, the shortest record the diagnosis takes (its detectors need it)
+
+/// The splits of the out-of-sample check for a record of `T` seconds: halves, and thirds when each
+/// third lasts at least kMinDuration (docs/diagnosis.md, Gain).
+std::vector<std::size_t> holdout_splits(double T) {
+  if (T >= 3.0 * kMinDuration) return {2, 3};
+  return {2};
+}
+
 double term_value(const FitResult& f, Term t) {
   const auto& c = f[t];
   return (c.enabled && c.in_model) ? c.estimate : 0.0;
@@ -691,8 +700,8 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     throw UsageError("diagnose needs gyro data (clock phase/frequency cannot be simulated as a gyro)");
   if (opt.runs < 10) throw UsageError(fmt::format("--runs must be at least 10 (got {})", opt.runs));
   const double T = rec.phase.duration_s();
-  if (T < 1200.0)
-    throw AnalysisError(fmt::format("{}: the record lasts {:.4g} s; the diagnosis needs at least 1200 s", rec.source, T));
+  if (T < kMinDuration)
+    throw AnalysisError(fmt::format("{}: the record lasts {:.4g} s; the diagnosis needs at least {:g} s", rec.source, T, kMinDuration));
   DiagnoseResult r;
   r.runs = opt.runs;
   r.holdout_runs = opt.holdout_runs ? opt.holdout_runs : opt.runs;
@@ -934,12 +943,29 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   r.gain.coverage_base = band_coverage(r.base_band);
   r.gain.coverage_extended = band_coverage(r.extended_band);
 
-  // Out of sample: fit on one half, predict the other, both ways.
-  const std::size_t h = n / 2;
+  // Out of sample: the record is cut into halves and (when each lasts kMinDuration) thirds; a fold
+  // fits on one block and predicts a neighbouring one, both ways. The score is the mean over the
+  // folds of each split, averaged over the splits: one split alone leaves the verdict to the luck
+  // of where its cut falls (a step whose level then wanders, a bump one half shows weakly).
+  struct Fold {
+    std::size_t len, fit, pred;  // block length (samples), fitting and predicted block
+    double weight;               // of the fold's per-point score in the mean
+  };
+  std::vector<Fold> folds;
+  const auto schemes = holdout_splits(static_cast<double>(n) * x.tau0_s);
+  for (const std::size_t nb : schemes) {
+    const double w = 1.0 / (static_cast<double>(schemes.size()) * 2.0 * static_cast<double>(nb - 1));
+    for (std::size_t k = 0; k < nb; ++k) {
+      if (k + 1 < nb) folds.push_back({n / nb, k, k + 1, w});
+      if (k > 0) folds.push_back({n / nb, k, k - 1, w});
+    }
+  }
   double hb = 0, he = 0;
-  for (int dir = 0; dir < 2; ++dir) {
-    const std::size_t fa = dir == 0 ? 0 : h, fb = dir == 0 ? h : 2 * h;
-    const std::size_t pa = dir == 0 ? h : 0, pb = dir == 0 ? 2 * h : h;
+  for (std::size_t dir = 0; dir < folds.size(); ++dir) {
+    const std::size_t h = folds[dir].len;
+    const double wdir = folds[dir].weight;
+    const std::size_t fa = folds[dir].fit * h, fb = fa + h;
+    const std::size_t pa = folds[dir].pred * h, pb = pa + h;
     const Recording fit_rec = with_series(rec, slice(x, fa, fb));
     const Recording pred_rec = with_series(rec, slice(x, pa, pb));
     const AnalysisResult a_fit = analyze_for_base(fit_rec, aopt);
@@ -997,8 +1023,8 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     Score sb = prediction_score(b_pred, b_fit);
     const double hb_dir = sb.per_point();
     if (effects.empty()) {
-      hb += hb_dir;
-      he += hb_dir;
+      hb += wdir * hb_dir;
+      he += wdir * hb_dir;
       continue;
     }
     // The half's base ensemble at the half's own level: the half's detectors and its mid-τ
@@ -1059,8 +1085,8 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     }
     if (half_effects.empty()) {
       // Nothing named shows in the fitting half: the extended model of the half is its base.
-      hb += hb_dir;
-      he += hb_dir;
+      hb += wdir * hb_dir;
+      he += wdir * hb_dir;
       continue;
     }
     st.runs = r.holdout_runs;
@@ -1123,12 +1149,12 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
       se.points += 2;
     }
     const double he_dir = se.per_point();
-    hb += sb.per_point();
-    he += he_dir;
+    hb += wdir * sb.per_point();
+    he += wdir * he_dir;
   }
   timer.lap("out-of-sample check");
-  r.gain.holdout_misfit_base = hb / 2;
-  r.gain.holdout_misfit_extended = he / 2;
+  r.gain.holdout_misfit_base = hb;
+  r.gain.holdout_misfit_extended = he;
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return r;
 }

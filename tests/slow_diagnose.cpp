@@ -38,6 +38,12 @@ std::size_t cases(std::size_t dflt) {
   return dflt;
 }
 
+/// RWCALC_DIAGNOSE_ONLY=i runs case i alone (the parameters drawn as in the full run); -1: all.
+int only_case() {
+  if (const char* s = std::getenv("RWCALC_DIAGNOSE_ONLY")) return std::atoi(s);
+  return -1;
+}
+
 /// The size range of the drawn effect (step size, warm-up amplitude), overridable as
 /// RWCALC_DIAGNOSE_RANGE="lo,hi" to measure the detection rate below the acceptance range.
 std::pair<double, double> size_range(double lo, double hi) {
@@ -121,6 +127,7 @@ Tally run_effect(const std::string& effect, std::size_t n, std::uint64_t seed0,
   for (std::size_t i = 0; i < n; ++i) {
     NoiseModel m = gl2d();
     const json truth = make(g, m);
+    if (only_case() >= 0 && static_cast<std::size_t>(only_case()) != i) continue;
     const auto r = run_case(m, seed0 + 101 * i);
     const json* est = finding(r, effect);
     ++t.n;
