@@ -218,6 +218,8 @@ struct Stretch {
   double step_time_s = -1;
   /// A named high-frequency line's frequency from the whole record (0: search the whole band).
   double line_hint_hz = 0;
+  /// A named Gauss–Markov term's correlation time from the whole record (0: fit it on the stretch).
+  double gm_tc_s = 0;
 };
 
 struct Extension {
@@ -513,7 +515,7 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
   }
   for (const auto& e : effects) {
     if (!is_mid_tau(e)) continue;
-    const ShapeEstimate est = shape_detect(v, s.ref, c_of(base));
+    const ShapeEstimate est = shape_detect(v, s.ref, c_of(base), s.gm_tc_s);
     correct(x.model.bias_instability_deg_per_h, Term::B, est.dc[2]);
     correct(x.model.rrw_deg_per_h_per_sqrt_h, Term::K, est.dc[3]);
     Finding f;
@@ -960,6 +962,9 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
       if (k > 0) folds.push_back({n / nb, k, k - 1, w});
     }
   }
+  // A named Gauss–Markov term keeps the whole record's correlation time in every fold (its
+  // structure); σ and N, B, K are fitted on the fitting block.
+  const double gm_tc = r.extended.gauss_markov.empty() ? 0.0 : r.extended.gauss_markov.front().tc_s;
   double hb = 0, he = 0;
   for (std::size_t dir = 0; dir < folds.size(); ++dir) {
     const std::size_t h = folds[dir].len;
@@ -1065,7 +1070,8 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
         for (const auto& br : b_runs) ens.push_back(br.warm_stat);
       } else if (e == "gauss_markov") {
         // A Gauss–Markov term: the structure is the whole record's (its likelihood-ratio test
-        // named it), the parameters the half's. The term enters when the bump fit on the half's
+        // named it, and its correlation time is kept), σ and N, B, K the half's (a bump fitted on
+        // one block with its own Tc is loose). The term enters when the bump fit on the half's
         // mid-τ AV (without the half's own candidate, against the half's base ensemble) passes the
         // naming conditions of the whole record before its test (it raises the mid-τ AV or leaves
         // white rate noise beside the bump, and stands at least kGmMinPeakRatio of the local AV at
@@ -1074,7 +1080,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
         // largest drop, named the bump in neither half of one record and only in one of another.)
         Decimated dh = st.dec;
         subtract_deterministic(dh, own_candidates(st.dec));
-        const auto gm = shape_detect(decimated_avar(dh, hgrid), st.ref, c_of(b_fit));
+        const auto gm = shape_detect(decimated_avar(dh, hgrid), st.ref, c_of(b_fit), gm_tc);
         if (plausible_bump(gm)) half_effects.push_back(e);
         continue;
       } else {
@@ -1096,6 +1102,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     st.pilot_runs = r.holdout_runs;
     st.step_time_s = step_time;
     st.line_hint_hz = line_f;
+    st.gm_tc_s = gm_tc;
     const Extension e = extend(st, b_fit, half_effects, f_hint, aopt);
     // (No whole-band re-fit here: on the fitting half's band it lost two warm-up records out of
     // sample and changed no other count; docs/diagnosis.md.)
