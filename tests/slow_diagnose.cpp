@@ -165,7 +165,7 @@ void expect_rates(const Tally& t) {
 // Measured (seeds 1000…, 10 cases, 20 runs): named and within tolerance 10/10; gain in sample
 // 10/10 with the extended model's N and B re-fitted to the whole band (before: 8/10, misfits
 // 0.31 -> 0.59 and 0.112 -> 0.113 on two records the base already fitted; now 0.31 -> 0.29 and
-// 0.112 -> 0.093); out of sample 10/10 (3.28 -> 0.97 … 425.9 -> 6.10; folds of halves and
+// 0.112 -> 0.093); out of sample 10/10 (3.28 -> 0.97 … 425.9 -> 3.12; folds of halves and
 // thirds averaged) with the line's two Fourier coefficients on the predicted block scored against
 // the local noise level (docs/diagnosis.md, Gain); through the band and level alone one record
 // the base already predicted well lost (0.52 -> 0.68, halves only).
