@@ -36,6 +36,15 @@ constexpr double kStepMinSide = 60.0;     ///< s of a half on each side of a kno
 const double kGmMinLogLr = 2.0 * std::log(100.0);
 constexpr double kModelEdf = 1000.0;      ///< model floor of the EDF in the deviance (as band_misfit)
 
+constexpr double kMinDuration = 1200.0;  ///< s, the shortest record the diagnosis takes (its detectors need it)
+
+/// The splits of the out-of-sample check for a record of `T` seconds: halves, and thirds when each
+/// third lasts at least kMinDuration (docs/diagnosis.md, Gain).
+std::vector<std::size_t> holdout_splits(double T) {
+  if (T >= 3.0 * kMinDuration) return {2, 3};
+  return {2};
+}
+
 double term_value(const FitResult& f, Term t) {
   const auto& c = f[t];
   return (c.enabled && c.in_model) ? c.estimate : 0.0;
@@ -209,6 +218,8 @@ struct Stretch {
   double step_time_s = -1;
   /// A named high-frequency line's frequency from the whole record (0: search the whole band).
   double line_hint_hz = 0;
+  /// A named Gauss–Markov term's correlation time from the whole record (0: fit it on the stretch).
+  double gm_tc_s = 0;
 };
 
 struct Extension {
@@ -504,7 +515,7 @@ Extension extend(const Stretch& s, const NoiseModel& base, const std::vector<std
   }
   for (const auto& e : effects) {
     if (!is_mid_tau(e)) continue;
-    const ShapeEstimate est = shape_detect(v, s.ref, c_of(base));
+    const ShapeEstimate est = shape_detect(v, s.ref, c_of(base), s.gm_tc_s);
     correct(x.model.bias_instability_deg_per_h, Term::B, est.dc[2]);
     correct(x.model.rrw_deg_per_h_per_sqrt_h, Term::K, est.dc[3]);
     Finding f;
@@ -691,8 +702,8 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     throw UsageError("diagnose needs gyro data (clock phase/frequency cannot be simulated as a gyro)");
   if (opt.runs < 10) throw UsageError(fmt::format("--runs must be at least 10 (got {})", opt.runs));
   const double T = rec.phase.duration_s();
-  if (T < 1200.0)
-    throw AnalysisError(fmt::format("{}: the record lasts {:.4g} s; the diagnosis needs at least 1200 s", rec.source, T));
+  if (T < kMinDuration)
+    throw AnalysisError(fmt::format("{}: the record lasts {:.4g} s; the diagnosis needs at least {:g} s", rec.source, T, kMinDuration));
   DiagnoseResult r;
   r.runs = opt.runs;
   r.holdout_runs = opt.holdout_runs ? opt.holdout_runs : opt.runs;
@@ -934,12 +945,32 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   r.gain.coverage_base = band_coverage(r.base_band);
   r.gain.coverage_extended = band_coverage(r.extended_band);
 
-  // Out of sample: fit on one half, predict the other, both ways.
-  const std::size_t h = n / 2;
+  // Out of sample: the record is cut into halves and (when each lasts kMinDuration) thirds; a fold
+  // fits on one block and predicts a neighbouring one, both ways. The score is the mean over the
+  // folds of each split, averaged over the splits: one split alone leaves the verdict to the luck
+  // of where its cut falls (a step whose level then wanders, a bump one half shows weakly).
+  struct Fold {
+    std::size_t len, fit, pred;  // block length (samples), fitting and predicted block
+    double weight;               // of the fold's per-point score in the mean
+  };
+  std::vector<Fold> folds;
+  const auto schemes = holdout_splits(static_cast<double>(n) * x.tau0_s);
+  for (const std::size_t nb : schemes) {
+    const double w = 1.0 / (static_cast<double>(schemes.size()) * 2.0 * static_cast<double>(nb - 1));
+    for (std::size_t k = 0; k < nb; ++k) {
+      if (k + 1 < nb) folds.push_back({n / nb, k, k + 1, w});
+      if (k > 0) folds.push_back({n / nb, k, k - 1, w});
+    }
+  }
+  // A named Gauss–Markov term keeps the whole record's correlation time in every fold (its
+  // structure); σ and N, B, K are fitted on the fitting block.
+  const double gm_tc = r.extended.gauss_markov.empty() ? 0.0 : r.extended.gauss_markov.front().tc_s;
   double hb = 0, he = 0;
-  for (int dir = 0; dir < 2; ++dir) {
-    const std::size_t fa = dir == 0 ? 0 : h, fb = dir == 0 ? h : 2 * h;
-    const std::size_t pa = dir == 0 ? h : 0, pb = dir == 0 ? 2 * h : h;
+  for (std::size_t dir = 0; dir < folds.size(); ++dir) {
+    const std::size_t h = folds[dir].len;
+    const double wdir = folds[dir].weight;
+    const std::size_t fa = folds[dir].fit * h, fb = fa + h;
+    const std::size_t pa = folds[dir].pred * h, pb = pa + h;
     const Recording fit_rec = with_series(rec, slice(x, fa, fb));
     const Recording pred_rec = with_series(rec, slice(x, pa, pb));
     const AnalysisResult a_fit = analyze_for_base(fit_rec, aopt);
@@ -997,8 +1028,8 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     Score sb = prediction_score(b_pred, b_fit);
     const double hb_dir = sb.per_point();
     if (effects.empty()) {
-      hb += hb_dir;
-      he += hb_dir;
+      hb += wdir * hb_dir;
+      he += wdir * hb_dir;
       continue;
     }
     // The half's base ensemble at the half's own level: the half's detectors and its mid-τ
@@ -1039,7 +1070,8 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
         for (const auto& br : b_runs) ens.push_back(br.warm_stat);
       } else if (e == "gauss_markov") {
         // A Gauss–Markov term: the structure is the whole record's (its likelihood-ratio test
-        // named it), the parameters the half's. The term enters when the bump fit on the half's
+        // named it, and its correlation time is kept), σ and N, B, K the half's (a bump fitted on
+        // one block with its own Tc is loose). The term enters when the bump fit on the half's
         // mid-τ AV (without the half's own candidate, against the half's base ensemble) passes the
         // naming conditions of the whole record before its test (it raises the mid-τ AV or leaves
         // white rate noise beside the bump, and stands at least kGmMinPeakRatio of the local AV at
@@ -1048,7 +1080,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
         // largest drop, named the bump in neither half of one record and only in one of another.)
         Decimated dh = st.dec;
         subtract_deterministic(dh, own_candidates(st.dec));
-        const auto gm = shape_detect(decimated_avar(dh, hgrid), st.ref, c_of(b_fit));
+        const auto gm = shape_detect(decimated_avar(dh, hgrid), st.ref, c_of(b_fit), gm_tc);
         if (plausible_bump(gm)) half_effects.push_back(e);
         continue;
       } else {
@@ -1059,8 +1091,8 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     }
     if (half_effects.empty()) {
       // Nothing named shows in the fitting half: the extended model of the half is its base.
-      hb += hb_dir;
-      he += hb_dir;
+      hb += wdir * hb_dir;
+      he += wdir * hb_dir;
       continue;
     }
     st.runs = r.holdout_runs;
@@ -1070,6 +1102,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     st.pilot_runs = r.holdout_runs;
     st.step_time_s = step_time;
     st.line_hint_hz = line_f;
+    st.gm_tc_s = gm_tc;
     const Extension e = extend(st, b_fit, half_effects, f_hint, aopt);
     // (No whole-band re-fit here: on the fitting half's band it lost two warm-up records out of
     // sample and changed no other count; docs/diagnosis.md.)
@@ -1123,12 +1156,12 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
       se.points += 2;
     }
     const double he_dir = se.per_point();
-    hb += sb.per_point();
-    he += he_dir;
+    hb += wdir * sb.per_point();
+    he += wdir * he_dir;
   }
   timer.lap("out-of-sample check");
-  r.gain.holdout_misfit_base = hb / 2;
-  r.gain.holdout_misfit_extended = he / 2;
+  r.gain.holdout_misfit_base = hb;
+  r.gain.holdout_misfit_extended = he;
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return r;
 }

@@ -118,7 +118,8 @@ LineTally run_line_cases() {
 // 1e-5 Hz, amplitude within 10 %), gain in sample 9/9 (0.30 -> 0.10 … 4.98 -> 0.55). The miss is
 // the weakest line, 30.9 °/h at 9.45 Hz (statistic 14.7 against a threshold of 15.6): the detection
 // limit on 1 h of this noise is about 30 °/h (σ of the amplitude ≈ 3.3 °/h). Out of sample 9/9
-// (7.86 -> 1.65 … 50.1 -> 2.86) with the line's two Fourier coefficients on the predicted half scored
+// (7.78 -> 4.29 … 44.4 -> 2.36, folds of halves and thirds averaged; with halves alone 7.86 -> 1.65
+// … 50.1 -> 2.86) with the line's two Fourier coefficients on the predicted block scored
 // against its local noise level (docs/diagnosis.md, Gain); through the band alone 5/9, the two models
 // within 0.02 of each other (2.45 -> 2.43, 6.82 -> 6.84): the line moves the AV by ≈ 0.1 % and the
 // base half model takes its share into its white angle noise.

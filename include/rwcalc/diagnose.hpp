@@ -69,7 +69,7 @@ struct Finding {
 struct Gain {
   double misfit_base = 0, misfit_extended = 0;      ///< EDF-weighted AV misfit (≈ 1 when the model fits)
   double coverage_base = 0, coverage_extended = 0;  ///< share of measured τ inside the band
-  double holdout_misfit_base = 0, holdout_misfit_extended = 0;  ///< out of sample (two halves)
+  double holdout_misfit_base = 0, holdout_misfit_extended = 0;  ///< out of sample (halves and thirds: fit on one block, predict a neighbour)
 };
 
 struct DiagnoseResult {

@@ -143,9 +143,10 @@ enum class Shape { GaussMarkov, Lowpass };
 double shape_avar(Shape s, double tau, double time);
 /// Fit `v` (measured mid-τ AV) against the reference plus Q, N, B, K corrections plus a
 /// Gauss–Markov bump; `c_base` holds the reference model's Q², N², B², K² on the fit scale: the
-/// corrected N², B², K² are kept ≥ 0 (Q² is free).
+/// corrected N², B², K² are kept ≥ 0 (Q² is free). `fixed_time` > 0: the correlation time is
+/// given (only σ² and the corrections are fitted), else searched on a grid.
 ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& ref,
-                           const std::array<double, 4>& c_base);
+                           const std::array<double, 4>& c_base, double fixed_time = 0.0);
 /// Corrections of the fit-scale Q², N², B², K² that bring the reference to `v` (weighted least
 /// squares with the ensemble's variances, corrected N², B², K² kept ≥ 0): the calibration of the
 /// base model by a pilot ensemble.
