@@ -1,6 +1,7 @@
 // Allan-variance engine: τ grids, the three estimators, and the per-τ noise id / EDF / bounds,
 // computed in parallel across τ.
 #include "rwcalc/allan.hpp"
+#include "rwcalc/thread.hpp"
 
 #include <fmt/format.h>
 
@@ -267,7 +268,7 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
     } else if (threads > 1) {
       std::vector<char> oks(threads, 0);
       {
-        std::vector<std::jthread> pool;
+        std::vector<Thread> pool;
         for (unsigned k = 1; k < threads; ++k)
           pool.emplace_back([&, k] {
             oks[k] = detail::second_diff_sumsq_sweep(prepared, points, ms.data(), ms.size(), k, threads, swept.data());
@@ -371,7 +372,7 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
         }
       }
     };
-    std::vector<std::jthread> pool;
+    std::vector<Thread> pool;
     pool.reserve(threads - 1);
     for (unsigned t = 1; t < threads; ++t) pool.emplace_back(loop);
     loop();

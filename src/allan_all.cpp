@@ -1,6 +1,7 @@
 // Overlapping AVAR sums for every cluster size at once (the `--tau all` grid) through FFT
 // autocorrelations: O(N log² N) instead of O(N²). See allan_all.hpp.
 #include "allan_all.hpp"
+#include "rwcalc/thread.hpp"
 
 #include <algorithm>
 #include <complex>
@@ -99,7 +100,7 @@ std::vector<double> all_oavar_sumsq_fft(std::vector<double> x, std::int64_t max_
   std::vector<double> xr(x.rbegin(), x.rend());
   std::vector<double> acf, head, tail;
   {
-    std::vector<std::jthread> pool;
+    std::vector<Thread> pool;
     if (threads > 1) {
       pool.emplace_back([&] { tail = head_products(xr, max_m); });
       pool.emplace_back([&] { acf = autocorrelation(x, 2 * max_m); });

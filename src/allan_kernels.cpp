@@ -5,6 +5,7 @@
 
 #include "reader_detail.hpp"
 #include "rwcalc/crew.hpp"
+#include "rwcalc/thread.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -570,7 +571,7 @@ PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_pref
     std::int64_t lo2 = 0, hi2 = 0;
     const std::size_t mid = c.size() / 2;
     {
-      std::jthread helper([&] { pass(mid, c.size(), lo2, hi2); });
+      Thread helper([&] { pass(mid, c.size(), lo2, hi2); });
       pass(0, mid, lo, hi);
     }
     lo = std::min(lo, lo2);

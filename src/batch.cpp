@@ -1,5 +1,6 @@
 // Batch analysis over files (threads), JSON-lines merge, and the Table 1 / Table 2 layout.
 #include "rwcalc/batch.hpp"
+#include "rwcalc/thread.hpp"
 
 #include "rwcalc/crew.hpp"
 
@@ -198,8 +199,8 @@ std::vector<json> analyze_files(const std::vector<std::string>& files, const Rea
     else
       crew.lend();
   };
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < jobs; ++t) pool.emplace_back(worker, t);
+  std::vector<Thread> pool;
+  for (unsigned t = 1; t < jobs; ++t) pool.emplace_back([&worker, t] { worker(t); });
   worker(0);
   for (auto& t : pool) t.join();
   for (std::size_t i = 0; i < files.size(); ++i) {

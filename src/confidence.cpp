@@ -1,6 +1,7 @@
 // Noise identification (lag-1 autocorrelation, B1 and R(n) ratios), Greenhall–Riley EDF and
 // χ² confidence bounds, following Stable32's choices so that its tables are reproduced.
 #include "rwcalc/confidence.hpp"
+#include "rwcalc/thread.hpp"
 
 #include <fmt/format.h>
 
@@ -635,7 +636,7 @@ void lag1_start_pass_impl(const std::int32_t* rel32, std::size_t points, const s
   if (crew) {
     crew->share(parts, run_part);
   } else if (parts == 2) {
-    std::jthread second([&] { run_part(1); });
+    Thread second([&] { run_part(1); });
     run_part(0);
   } else {
     run_part(0);

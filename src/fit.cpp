@@ -1,6 +1,7 @@
 // Gamma-deviance (scaled-χ² likelihood) fit of the five-term IEEE 952 model with non-negative
 // squared coefficients, profile-likelihood intervals and the classic slope-line readout.
 #include "rwcalc/fit.hpp"
+#include "rwcalc/thread.hpp"
 
 #include <fmt/format.h>
 
@@ -547,7 +548,7 @@ Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix
   };
   if (threads == 0) threads = std::thread::hardware_concurrency();
   if (threads > 1 && !diagonal_only && j >= 8) {
-    std::jthread other([&] {
+    Thread other([&] {
       std::vector<double> centres, weights;
       for (Eigen::Index a = 1; a < j; a += 2) row(a, centres, weights);
     });

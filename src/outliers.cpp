@@ -1,5 +1,6 @@
 // Outlier detection by the neighbour median, and the remove/replace helpers. See outliers.hpp.
 #include "rwcalc/outliers.hpp"
+#include "rwcalc/thread.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -424,7 +425,7 @@ OutlierScale scale_of(const Src& src, unsigned threads, double pre = 0, std::vec
   // Long records: the second half of the interior on another thread.
   if (end > 3 && end - 3 >= kParallelFrom && threads > 1) {
     const std::size_t mid = 3 + ((end - 3) / 2 / kBlock) * kBlock;
-    std::jthread worker([&] { pass.interior(mid, end, second); });
+    Thread worker([&] { pass.interior(mid, end, second); });
     pass.interior(3, mid, first);
   } else {
     pass.interior(3, end, first);
@@ -486,7 +487,7 @@ std::vector<Outlier> outliers_of(const Src& src, double threshold, const Outlier
     const std::size_t mid = 3 + ((end - 3) / 2 / kBlock) * kBlock;
     std::vector<Outlier> second;
     {
-      std::jthread worker([&] { screen(mid, end, second); });
+      Thread worker([&] { screen(mid, end, second); });
       screen(3, mid, out);
     }
     out.insert(out.end(), second.begin(), second.end());

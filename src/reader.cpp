@@ -6,6 +6,7 @@
 // the same values the fast path would give or throws an InputError that names file, line and the
 // offending text. The two paths parse numbers to identical doubles (both correctly rounded).
 #include "rwcalc/reader.hpp"
+#include "rwcalc/thread.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -265,7 +266,7 @@ class Reader {
   template <bool Integer>
   void scan_chunk(const char* from, Chunk& out, std::stop_token stop) const;
   template <bool Integer>
-  void merge_chunk(Chunk& c, MergeHelp& help, std::jthread& worker);
+  void merge_chunk(Chunk& c, MergeHelp& help, Thread& worker);
   template <bool Integer>
   void scan(const char* p);
 
@@ -981,7 +982,7 @@ void Reader::scan_chunk(const char* from, Chunk& out, std::stop_token stop) cons
 }
 
 template <bool Integer>
-void Reader::merge_chunk(Chunk& c, MergeHelp& help, std::jthread& worker) {
+void Reader::merge_chunk(Chunk& c, MergeHelp& help, Thread& worker) {
   // Until `finish` the other thread may still be running: it reads nothing of the chunk and writes
   // only the values given to it.
   const auto finish = [&] {
@@ -1052,7 +1053,7 @@ void Reader::scan(const char* p) {
   const char* limit = end_;
   Chunk chunk;
   MergeHelp help;  // before the thread, which may still use it when an exception unwinds this frame
-  std::jthread worker;
+  Thread worker;
   for (;;) {
     while (p < limit) {
       if (split_pending && layout_known_) {
@@ -1079,7 +1080,7 @@ void Reader::scan(const char* p) {
               // adds the difference, modulo 2^64). Only with the AVX-512 kernel, which sums the
               // 2-h file's first part in ~0.7 ms; the portable one takes longer than the merge.
               const bool base_known = detail::digit_kernel() == detail::DigitKernel::Avx512 && sum_pending();
-              worker = std::jthread([this, &chunk, &help, room, first = p, from = limit, base = acc_,
+              worker = Thread([this, &chunk, &help, room, first = p, from = limit, base = acc_,
                                      base_known](std::stop_token st) {
                 std::uint64_t first_sum = 0;
                 if (base_known && detail::digit_sum(first, from, first_sum)) chunk.acc = chunk.pred = base + first_sum;
@@ -1091,7 +1092,7 @@ void Reader::scan(const char* p) {
             } else {
               const auto share = static_cast<double>(end_ - limit) / static_cast<double>(end_ - begin_);
               const auto expect = static_cast<std::size_t>(share * static_cast<double>(lines_) * 1.05) + 64;
-              worker = std::jthread([this, &chunk, expect, from = limit](std::stop_token st) {
+              worker = Thread([this, &chunk, expect, from = limit](std::stop_token st) {
                 // Room for the part's values, its pages mapped in one call on this thread.
                 chunk.reals.reserve(expect);
                 detail::prefault(chunk.reals.data(), expect * sizeof(double));

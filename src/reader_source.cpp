@@ -18,6 +18,7 @@
 
 #include "reader_detail.hpp"
 #include "rwcalc/crew.hpp"
+#include "rwcalc/thread.hpp"
 #include "rwcalc/error.hpp"
 
 namespace rwcalc::detail {
@@ -256,7 +257,7 @@ bool read_halves(int fd, std::size_t size, TextBuffer& buf, const std::string& n
     if (crew) {  // the second half to a lender (or to this thread after the first, if none is free)
       crew->share(2, [&](std::size_t k) { k == 0 ? first() : second(); });
     } else {
-      std::jthread other(second);
+      Thread other(second);
       first();
     }
     if (err1 || err2) fail_errno(name, "cannot read", err1 ? err1 : err2);

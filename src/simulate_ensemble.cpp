@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "rwcalc/progress.hpp"
+#include "rwcalc/thread.hpp"
 #include "rwcalc/random.hpp"
 #include "rwcalc/simulate.hpp"
 
@@ -42,7 +43,7 @@ void simulate_ensemble(const NoiseModel& model, const SimulationSettings& settin
       next = runs;  // the other workers stop after their current run
     }
   };
-  std::vector<std::thread> pool;
+  std::vector<Thread> pool;
   pool.reserve(threads - 1);
   for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
   work();

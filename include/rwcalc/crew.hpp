@@ -9,6 +9,7 @@
 /// results are combined exactly (integer sums, minima), so the results do not depend on who ran
 /// which chunk.
 #include <condition_variable>
+#include "rwcalc/thread.hpp"
 #include <cstddef>
 #include <functional>
 #include <memory>
@@ -81,7 +82,7 @@ class OwnCrew {
 
  private:
   Crew crew_;
-  std::vector<std::jthread> threads_;
+  std::vector<Thread> threads_;
 };
 
 }  // namespace rwcalc
