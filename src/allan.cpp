@@ -1,7 +1,6 @@
 // Allan-variance engine: τ grids, the three estimators, and the per-τ noise id / EDF / bounds,
 // computed in parallel across τ.
 #include "rwcalc/allan.hpp"
-#include "rwcalc/thread.hpp"
 
 #include <fmt/format.h>
 
@@ -19,6 +18,7 @@
 #include "timing.hpp"
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/thread.hpp"
 
 namespace rwcalc {
 

@@ -1,12 +1,12 @@
 // Overlapping AVAR sums for every cluster size at once (the `--tau all` grid) through FFT
 // autocorrelations: O(N log² N) instead of O(N²). See allan_all.hpp.
 #include "allan_all.hpp"
-#include "rwcalc/thread.hpp"
 
 #include <algorithm>
 #include <complex>
-#include <thread>
 #include <unsupported/Eigen/FFT>
+
+#include "rwcalc/thread.hpp"
 
 namespace rwcalc::detail {
 

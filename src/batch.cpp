@@ -1,6 +1,5 @@
 // Batch analysis over files (threads), JSON-lines merge, and the Table 1 / Table 2 layout.
 #include "rwcalc/batch.hpp"
-#include "rwcalc/thread.hpp"
 
 #include "rwcalc/crew.hpp"
 
@@ -17,6 +16,7 @@
 #include <thread>
 
 #include "rwcalc/error.hpp"
+#include "rwcalc/thread.hpp"
 #include "timing.hpp"
 
 namespace rwcalc {

@@ -1,7 +1,6 @@
 // Noise identification (lag-1 autocorrelation, B1 and R(n) ratios), Greenhall–Riley EDF and
 // χ² confidence bounds, following Stable32's choices so that its tables are reproduced.
 #include "rwcalc/confidence.hpp"
-#include "rwcalc/thread.hpp"
 
 #include <fmt/format.h>
 
@@ -12,7 +11,6 @@
 #include <cstdlib>
 #include <limits>
 #include <numbers>
-#include <thread>
 #include <vector>
 
 #if defined(__x86_64__) || defined(__i386__)
@@ -23,6 +21,7 @@
 #include "x86_dispatch.hpp"
 #include "rwcalc/crew.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/thread.hpp"
 
 namespace rwcalc {
 

@@ -966,11 +966,11 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   // structure); σ and N, B, K are fitted on the fitting block.
   const double gm_tc = r.extended.gauss_markov.empty() ? 0.0 : r.extended.gauss_markov.front().tc_s;
   double hb = 0, he = 0;
-  for (std::size_t dir = 0; dir < folds.size(); ++dir) {
-    const std::size_t h = folds[dir].len;
-    const double wdir = folds[dir].weight;
-    const std::size_t fa = folds[dir].fit * h, fb = fa + h;
-    const std::size_t pa = folds[dir].pred * h, pb = pa + h;
+  for (std::size_t fi = 0; fi < folds.size(); ++fi) {
+    const std::size_t h = folds[fi].len;
+    const double wf = folds[fi].weight;
+    const std::size_t fa = folds[fi].fit * h, fb = fa + h;
+    const std::size_t pa = folds[fi].pred * h, pb = pa + h;
     const Recording fit_rec = with_series(rec, slice(x, fa, fb));
     const Recording pred_rec = with_series(rec, slice(x, pa, pb));
     const AnalysisResult a_fit = analyze_for_base(fit_rec, aopt);
@@ -979,7 +979,7 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     const auto om = octave_of(a_pred);
     SimulationSettings sh = r.settings;
     sh.duration_s = static_cast<double>(h) * x.tau0_s;
-    sh.seed = opt.seed + 10 + static_cast<std::uint64_t>(dir);
+    sh.seed = opt.seed + 10 + static_cast<std::uint64_t>(fi);
     Stretch st;
     st.rec = &fit_rec;
     st.analysis = &a_fit;
@@ -1026,10 +1026,10 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
       return Score{dev.sum + d * d / v_base, dev.points + 1};
     };
     Score sb = prediction_score(b_pred, b_fit);
-    const double hb_dir = sb.per_point();
+    const double hb_fold = sb.per_point();
     if (effects.empty()) {
-      hb += wdir * hb_dir;
-      he += wdir * hb_dir;
+      hb += wf * hb_fold;
+      he += wf * hb_fold;
       continue;
     }
     // The half's base ensemble at the half's own level: the half's detectors and its mid-τ
@@ -1091,8 +1091,8 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
     }
     if (half_effects.empty()) {
       // Nothing named shows in the fitting half: the extended model of the half is its base.
-      hb += wdir * hb_dir;
-      he += wdir * hb_dir;
+      hb += wf * hb_fold;
+      he += wf * hb_fold;
       continue;
     }
     st.runs = r.holdout_runs;
@@ -1155,9 +1155,9 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
       sb.points += 2;
       se.points += 2;
     }
-    const double he_dir = se.per_point();
-    hb += wdir * sb.per_point();
-    he += wdir * he_dir;
+    const double he_fold = se.per_point();
+    hb += wf * sb.per_point();
+    he += wf * he_fold;
   }
   timer.lap("out-of-sample check");
   r.gain.holdout_misfit_base = hb;

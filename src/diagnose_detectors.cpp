@@ -1003,18 +1003,15 @@ ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& 
   auto fit = [&](const std::vector<double>* shape) { return constrained_fit(p, c_base, shape); };
   const Fit null = fit(nullptr);
   // Correlation times from 3× the shortest τ (a bump peaking at the grid's first points is white
-  // rate noise there: not identifiable) to half the longest.
-  // A given correlation time (fixed_time > 0) is the grid's only point.
-  const bool given = fixed_time > 0;
-  const double lt_lo = given ? std::log(fixed_time) : std::log(3.0 * p.tau.front());
-  const double lt_hi = given ? lt_lo : std::log(p.tau.back() / 2.0);
-  const int G = given ? 0 : 48;
+  // rate noise there: not identifiable) to half the longest; a given one (fixed_time > 0) alone.
+  const double lt_lo = std::log(3.0 * p.tau.front()), lt_hi = std::log(p.tau.back() / 2.0);
+  const int G = fixed_time > 0 ? 0 : 48;
   double best_chi2 = null.chi2;
   std::vector<std::pair<double, double>> prof;
   Fit best;
   bool have = false;
   for (int g = 0; g <= G; ++g) {
-    const double T = G > 0 ? std::exp(lt_lo + (lt_hi - lt_lo) * g / G) : std::exp(lt_lo);
+    const double T = G > 0 ? std::exp(lt_lo + (lt_hi - lt_lo) * g / G) : fixed_time;
     std::vector<double> col(p.tau.size());
     double m = 0;
     for (std::size_t i = 0; i < p.tau.size(); ++i) {

@@ -1,7 +1,6 @@
 // Gamma-deviance (scaled-χ² likelihood) fit of the five-term IEEE 952 model with non-negative
 // squared coefficients, profile-likelihood intervals and the classic slope-line readout.
 #include "rwcalc/fit.hpp"
-#include "rwcalc/thread.hpp"
 
 #include <fmt/format.h>
 
@@ -16,6 +15,7 @@
 
 #include "fit_kernels.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/thread.hpp"
 
 namespace rwcalc {
 

@@ -1,6 +1,5 @@
 // Outlier detection by the neighbour median, and the remove/replace helpers. See outliers.hpp.
 #include "rwcalc/outliers.hpp"
-#include "rwcalc/thread.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -10,6 +9,7 @@
 #include <optional>
 #include <thread>
 
+#include "rwcalc/thread.hpp"
 #include "x86_dispatch.hpp"
 
 #if defined(__x86_64__) || defined(__i386__)

@@ -6,7 +6,6 @@
 // the same values the fast path would give or throws an InputError that names file, line and the
 // offending text. The two paths parse numbers to identical doubles (both correctly rounded).
 #include "rwcalc/reader.hpp"
-#include "rwcalc/thread.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -30,6 +29,7 @@
 #include "reader_simd.hpp"
 #include "timing.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/thread.hpp"
 #include "rwcalc/units.hpp"
 
 namespace rwcalc {

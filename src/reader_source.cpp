@@ -12,14 +12,13 @@
 #include <cstring>
 #include <limits>
 #include <mutex>
-#include <thread>
 #include <utility>
 #include <vector>
 
 #include "reader_detail.hpp"
 #include "rwcalc/crew.hpp"
-#include "rwcalc/thread.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/thread.hpp"
 
 namespace rwcalc::detail {
 

@@ -7,9 +7,9 @@
 #include <vector>
 
 #include "rwcalc/progress.hpp"
-#include "rwcalc/thread.hpp"
 #include "rwcalc/random.hpp"
 #include "rwcalc/simulate.hpp"
+#include "rwcalc/thread.hpp"
 
 namespace rwcalc {
 

@@ -9,13 +9,13 @@
 /// results are combined exactly (integer sums, minima), so the results do not depend on who ran
 /// which chunk.
 #include <condition_variable>
-#include "rwcalc/thread.hpp"
 #include <cstddef>
 #include <functional>
 #include <memory>
 #include <mutex>
-#include <thread>
 #include <vector>
+
+#include "rwcalc/thread.hpp"
 
 namespace rwcalc {
 
