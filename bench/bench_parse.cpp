@@ -25,7 +25,7 @@ void BM_ParsePulseFile2h(benchmark::State& state) {
   o.threads = static_cast<unsigned>(state.range(0));
   for (auto _ : state) {
     auto rec = read_recording_text(text, "gl2d.csv", o);
-    benchmark::DoNotOptimize(rec.phase.counts.data());
+    benchmark::DoNotOptimize(rec.phase.points());
   }
   state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(text.size()));
   state.SetItemsProcessed(state.iterations() * 2'880'000);
@@ -90,7 +90,7 @@ void BM_ParsePulseFile2hKernel(benchmark::State& state) {
   const auto before = detail::set_digit_kernel(kernel_arg(state.range(1)));
   for (auto _ : state) {
     auto rec = read_recording_text(text, "gl2d.csv", o);
-    benchmark::DoNotOptimize(rec.phase.counts.data());
+    benchmark::DoNotOptimize(rec.phase.points());
   }
   detail::set_digit_kernel(before);
   state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(text.size()));
@@ -126,7 +126,7 @@ void BM_ReadPulseFile2h(benchmark::State& state) {
   o.threads = static_cast<unsigned>(state.range(0));
   for (auto _ : state) {
     auto rec = read_recording(file.path(), o);
-    benchmark::DoNotOptimize(rec.phase.counts.data());
+    benchmark::DoNotOptimize(rec.phase.points());
   }
   state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(bench::gl2d_text().size()));
   state.SetItemsProcessed(state.iterations() * 2'880'000);

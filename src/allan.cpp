@@ -177,7 +177,7 @@ double variance_at(const PhaseSeries& x, std::int64_t m, Estimator est, const de
   const double q = x.arcsec_per_count;
   detail::PreparedCounts local;
   if (x.exact() && !prepared) {
-    local = detail::prepare_counts(x.counts, est == Estimator::Modified);
+    local = detail::prepare_counts(x, est == Estimator::Modified);
     prepared = &local;
   }
   switch (est) {
@@ -234,7 +234,7 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
   detail::PreparedCounts prepared;
   if (x.exact()) {
     detail::ScopedTimer t("allan: prepare counts");
-    prepared = detail::prepare_counts(x.counts, est == Estimator::Modified, threads, options.crew);
+    prepared = detail::prepare_counts(x, est == Estimator::Modified, threads, options.crew);
   }
 
   // Every m of a long record: the sums above kAllExactBelow come from FFT autocorrelations
@@ -245,9 +245,9 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
     detail::ScopedTimer t("allan: all-τ FFT sums");
     std::vector<double> phase(points);
     if (x.exact()) {
-      const auto c0 = static_cast<std::uint64_t>(x.counts[0]);
+      const auto c0 = static_cast<std::uint64_t>(x.count(0));
       for (std::size_t k = 0; k < points; ++k)
-        phase[k] = static_cast<double>(static_cast<std::int64_t>(static_cast<std::uint64_t>(x.counts[k]) - c0));
+        phase[k] = static_cast<double>(static_cast<std::int64_t>(static_cast<std::uint64_t>(x.count(k)) - c0));
     } else {
       phase = x.values;
     }
@@ -285,9 +285,9 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
   // The first two lag-1 levels of the noise identification at every small m, in one pass over the
   // int32 view shared by all of them (the per-τ passes each streamed the whole view).
   std::vector<double> lag1_start;
-  if (options.noise_id && !prepared.rel32.empty()) {
+  if (options.noise_id && prepared.view) {
     detail::ScopedTimer t("allan: noise id start pass");
-    lag1_start = detail::lag1_start_pass(x, ms.data(), ms.size(), options.noise_id_domain, prepared.rel32.data(),
+    lag1_start = detail::lag1_start_pass(x, ms.data(), ms.size(), options.noise_id_domain, prepared.view,
                                          prepared.small24, threads, options.crew);
   }
 
@@ -315,7 +315,7 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
     p.dev = std::sqrt(p.var);
     const std::int64_t t1 = timing ? detail::cpu_ns(true) : 0;
     p.alpha = options.noise_id ? detail::identify_noise(x, p.m, est, options.noise_id_domain,
-                                                        prepared.rel32.empty() ? nullptr : prepared.rel32.data(),
+                                                        prepared.view,
                                                         prepared.small24,
                                                         !lag1_start.empty() && !std::isnan(lag1_start[2 * i])
                                                             ? &lag1_start[2 * i]

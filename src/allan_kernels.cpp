@@ -536,6 +536,7 @@ RWCALC_AVX512_WARNINGS_ON
 PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_prefix, unsigned threads, Crew* crew) {
   PreparedCounts p;
   p.raw = &c;
+  p.points = c.size();
   if (c.empty()) return p;
   const auto c0 = static_cast<std::uint64_t>(c[0]);
   constexpr std::int64_t kLimit = std::int64_t{1} << 30;
@@ -586,6 +587,8 @@ PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_pref
   if (!small) {
     p.rel32.clear();
     p.rel32.shrink_to_fit();
+  } else {
+    p.view = p.rel32.data();
   }
   if (need_prefix) {
     // Prefix sums and S = (P3 − P0) − 3(P2 − P1) stay exact doubles while 8·max|C − C0|·(N+1) < 2^53.
@@ -605,9 +608,60 @@ PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_pref
   return p;
 }
 
+namespace {
+
+// Smallest and largest of n int32 values (0 included).
+RWCALC_CLONES
+void range_i32(const std::int32_t* c, std::size_t n, std::int64_t& lo_out, std::int64_t& hi_out) {
+  std::int32_t lo = 0, hi = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    lo = c[i] < lo ? c[i] : lo;
+    hi = c[i] > hi ? c[i] : hi;
+  }
+  lo_out = lo;
+  hi_out = hi;
+}
+
+}  // namespace
+
+PreparedCounts prepare_counts(const PhaseSeries& x, bool need_prefix, unsigned threads, Crew* crew) {
+  if (!x.narrow()) return prepare_counts(x.counts, need_prefix, threads, crew);
+  PreparedCounts p;
+  const std::vector<std::int32_t>& c = x.counts32;
+  p.points = c.size();
+  if (c[0] == 0) {
+    p.view = c.data();  // C_0 = 0: the offsets are the counts themselves
+  } else {  // |C_k| < 2^30 (PhaseSeries::counts32), so every C_k − C_0 fits
+    p.rel32.resize(c.size());
+    for (std::size_t i = 0; i < c.size(); ++i) p.rel32[i] = c[i] - c[0];
+    p.view = p.rel32.data();
+  }
+  std::int64_t lo = 0, hi = 0;
+  range_i32(p.view, c.size(), lo, hi);
+  const auto top = static_cast<std::uint64_t>(std::max(-lo, hi));
+  p.small29 = top < (std::uint64_t{1} << 29);
+  p.small24 = top < (std::uint64_t{1} << 24);
+  if (need_prefix) {
+    // As for 64-bit counts: exact doubles while 8·max|C − C0|·(N+1) < 2^53.
+    const double bound = 8.0 * static_cast<double>(top) * static_cast<double>(c.size() + 1);
+    if (bound < 9007199254740992.0) {
+      p.prefix_f64.resize(c.size() + 1);
+      double run = 0;
+      p.prefix_f64[0] = 0;
+      for (std::size_t i = 0; i < c.size(); ++i) {
+        run += static_cast<double>(p.view[i]);
+        p.prefix_f64[i + 1] = run;
+      }
+    } else {
+      p.prefix_u64 = count_prefix_sums(x.wide_counts());
+    }
+  }
+  return p;
+}
+
 u128 second_diff_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m, std::int64_t stride) {
-  if (c.rel32.empty()) return second_diff_sumsq_counts(c.raw->data(), n, m, stride);
-  const std::int32_t* r = c.rel32.data();
+  if (!c.view) return second_diff_sumsq_counts(c.raw->data(), n, m, stride);
+  const std::int32_t* r = c.view;
   if (stride != 1) return exact_block_i32(r, 0, n, m, stride);
   u128 total = 0;
 #if RWCALC_X86_DISPATCH
@@ -649,14 +703,14 @@ namespace {
 /// Whether the sweep applies: AVX2, offsets below 2^24, an int32 view.
 bool sweep_applies(const PreparedCounts& c) {
   static const bool avx2 = __builtin_cpu_supports("avx2");
-  return avx2 && c.small24 && !c.rel32.empty();
+  return avx2 && c.small24 && c.view;
 }
 
 /// The sweep's work: for the terms k in [from, to), in blocks of kBlock24 taken for every τ of
 /// ms[first], ms[first + step], … while in cache, the squared second differences added to out[i].
 void sweep_terms(const PreparedCounts& c, std::int64_t np, const std::int64_t* ms, std::size_t count,
                  std::size_t first, std::size_t step, std::int64_t from, std::int64_t to, u128* out) {
-  const std::int32_t* r = c.rel32.data();
+  const std::int32_t* r = c.view;
   const SumsqI24 kernel = sumsq_i24_kernel();
   for (std::int64_t k0 = from; k0 < to; k0 += kBlock24) {
     for (std::size_t i = first; i < count; i += step) {
@@ -717,7 +771,8 @@ bool second_diff_sumsq_sweep_shared(const PreparedCounts& c, std::size_t points,
 double modified_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m) {
   if (!c.prefix_f64.empty()) return modified_sumsq_f64_prefix(c.prefix_f64.data(), n, m);
   if (!c.prefix_u64.empty()) return modified_sumsq_counts(c.prefix_u64.data(), n, m);
-  const std::vector<std::uint64_t> p = count_prefix_sums(*c.raw);
+  const std::vector<std::uint64_t> p =
+      c.raw ? count_prefix_sums(*c.raw) : count_prefix_sums(std::vector<std::int64_t>(c.view, c.view + c.points));
   return modified_sumsq_counts(p.data(), n, m);
 }
 

@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include "rwcalc/series.hpp"
+
 namespace rwcalc {
 class Crew;
 }
@@ -62,8 +64,17 @@ struct UninitAllocator : std::allocator<T> {
 };
 
 struct PreparedCounts {
-  const std::vector<std::int64_t>* raw = nullptr;
-  std::vector<std::int32_t, UninitAllocator<std::int32_t>> rel32;  ///< C_k − C_0, when small enough
+  PreparedCounts() = default;
+  PreparedCounts(PreparedCounts&&) noexcept = default;
+  PreparedCounts& operator=(PreparedCounts&&) noexcept = default;
+  PreparedCounts(const PreparedCounts&) = delete;  // `view` may point into rel32
+  PreparedCounts& operator=(const PreparedCounts&) = delete;
+  const std::vector<std::int64_t>* raw = nullptr;  ///< the 64-bit counts, when the series holds them so
+  std::vector<std::int32_t, UninitAllocator<std::int32_t>> rel32;  ///< C_k − C_0 made from `raw`, when small enough
+  /// The int32 view C_k − C_0 the kernels read: rel32's data, or a narrow series' own counts32
+  /// (C_0 = 0 there); nullptr when the offsets do not fit.
+  const std::int32_t* view = nullptr;
+  std::size_t points = 0;  ///< C_0 … C_{points−1}
   bool small29 = false;                 ///< every |C_k − C_0| < 2^29: second differences fit int32
   bool small24 = false;                 ///< every |C_k − C_0| < 2^24: every |d| < 2^26, no per-block check
   std::vector<double> prefix_f64;       ///< Σ_{i<k} (C_i − C_0), exact integers (MVAR), when small enough
@@ -73,6 +84,9 @@ struct PreparedCounts {
 /// lenders (`threads` is then not used for it); the same result.
 PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_prefix, unsigned threads = 1,
                               Crew* crew = nullptr);
+/// The same for a series' exact counts: those held in 32 bits (PhaseSeries::counts32) are viewed
+/// where they are, with no copy; the range flags come from one pass over them.
+PreparedCounts prepare_counts(const PhaseSeries& x, bool need_prefix, unsigned threads = 1, Crew* crew = nullptr);
 u128 second_diff_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m, std::int64_t stride);
 double modified_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m);
 

@@ -89,8 +89,10 @@ PhaseSeries slice(const PhaseSeries& x, std::size_t a, std::size_t b) {
   s.tau0_s = x.tau0_s;
   s.kind = x.kind;
   s.arcsec_per_count = x.arcsec_per_count;
-  if (x.exact())
+  if (!x.counts.empty())
     s.counts.assign(x.counts.begin() + static_cast<std::ptrdiff_t>(a), x.counts.begin() + static_cast<std::ptrdiff_t>(b) + 1);
+  else if (x.exact())
+    s.counts.assign(x.counts32.begin() + static_cast<std::ptrdiff_t>(a), x.counts32.begin() + static_cast<std::ptrdiff_t>(b) + 1);
   else
     s.values.assign(x.values.begin() + static_cast<std::ptrdiff_t>(a), x.values.begin() + static_cast<std::ptrdiff_t>(b) + 1);
   return s;

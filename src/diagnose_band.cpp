@@ -31,7 +31,7 @@ std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSett
         st.octave_var.resize(octave_m.size());
         if (s.exact()) {
           // The counts prepared once for all cluster sizes (allan_variance would redo it per m).
-          const auto prepared = detail::prepare_counts(s.counts, false);
+          const auto prepared = detail::prepare_counts(s, false);
           const double q = s.arcsec_per_count;
           for (std::size_t i = 0; i < octave_m.size(); ++i) {
             const std::int64_t m = octave_m[i];

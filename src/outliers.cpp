@@ -112,6 +112,20 @@ __attribute__((target("avx2"))) bool count_rates_avx2(const std::int64_t* c, std
   }
   return _mm256_testz_si256(bad, bad) != 0;
 }
+
+// Rates of counts held in 32 bits, four at a time: the increment converted exactly, then
+// multiplied and divided as PhaseSeries::rate does, so the same bits.
+__attribute__((target("avx2"))) void count_rates32_avx2(const std::int32_t* c, std::size_t from, std::size_t to,
+                                                        double q, double tau0, double* out) {
+  const __m256d vq = _mm256_set1_pd(q), vt = _mm256_set1_pd(tau0);
+  std::size_t i = from;
+  for (; i + 4 <= to; i += 4) {
+    const __m128i d = _mm_sub_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(c + i + 1)),
+                                    _mm_loadu_si128(reinterpret_cast<const __m128i*>(c + i)));
+    _mm256_storeu_pd(out + (i - from), _mm256_div_pd(_mm256_mul_pd(_mm256_cvtepi32_pd(d), vq), vt));
+  }
+  for (; i < to; ++i) out[i - from] = static_cast<double>(std::int64_t{c[i + 1]} - std::int64_t{c[i]}) * q / tau0;
+}
 #endif
 
 bool have_avx2() {
@@ -148,8 +162,8 @@ RateTable rate_table(const PhaseSeries& ph, std::size_t n) {
   // increments in a narrow band around the mean rate.
   std::int64_t lo = std::numeric_limits<std::int64_t>::max();
   for (std::size_t i = 0; i < std::min<std::size_t>(n, 4096); ++i)
-    lo = std::min(lo, static_cast<std::int64_t>(static_cast<std::uint64_t>(ph.counts[i + 1]) -
-                                                 static_cast<std::uint64_t>(ph.counts[i])));
+    lo = std::min(lo, static_cast<std::int64_t>(static_cast<std::uint64_t>(ph.count(i + 1)) -
+                                                 static_cast<std::uint64_t>(ph.count(i))));
   if (lo < -(std::int64_t{1} << 40) || lo > (std::int64_t{1} << 40)) return t;
   t.lo = lo - 4;
   for (int k = 0; k < 16; ++k)
@@ -178,6 +192,25 @@ __attribute__((target("avx512f"))) bool table_rates_avx512(const std::int64_t* c
     const auto d = static_cast<std::int64_t>(static_cast<std::uint64_t>(c[i + 1]) - static_cast<std::uint64_t>(c[i]));
     out[i - from] = static_cast<double>(d) * q / tau0;
   }
+  return bad == 0;
+}
+
+// The same for counts held in 32 bits (PhaseSeries::counts32: |C| < 2^30, so every increment
+// fits in 32 bits), widened to 64-bit lanes after the subtraction.
+__attribute__((target("avx512f"))) bool table_rates32_avx512(const std::int32_t* c, std::size_t from, std::size_t to,
+                                                           const RateTable& t, double q, double tau0, double* out) {
+  const __m512i lo = _mm512_set1_epi64(t.lo), top = _mm512_set1_epi64(15);
+  const __m512d t0 = _mm512_load_pd(t.v), t1 = _mm512_load_pd(t.v + 8);
+  __mmask8 bad = 0;
+  std::size_t i = from;
+  for (; i + 8 <= to; i += 8) {
+    const __m256i d32 = _mm256_sub_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + i + 1)),
+                                         _mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + i)));
+    const __m512i idx = _mm512_sub_epi64(_mm512_cvtepi32_epi64(d32), lo);
+    bad |= _mm512_cmpgt_epu64_mask(idx, top);
+    _mm512_storeu_pd(out + (i - from), _mm512_permutex2var_pd(t0, idx, t1));
+  }
+  for (; i < to; ++i) out[i - from] = static_cast<double>(std::int64_t{c[i + 1]} - std::int64_t{c[i]}) * q / tau0;
   return bad == 0;
 }
 
@@ -230,7 +263,15 @@ struct PhaseRates {
   std::size_t n;
   RateTable table{};
   void fill(std::size_t from, std::size_t to, double* out) const {
-    if (ph.exact()) {
+    if (ph.narrow()) {
+      const std::int32_t* c = ph.counts32.data();
+#if defined(__x86_64__) || defined(__i386__)
+      if (table.ok && have_avx512() && table_rates32_avx512(c, from, to, table, ph.arcsec_per_count, ph.tau0_s, out))
+        return;
+      if (have_avx2()) return count_rates32_avx2(c, from, to, ph.arcsec_per_count, ph.tau0_s, out);
+#endif
+      for (std::size_t i = from; i < to; ++i) out[i - from] = ph.rate(i);
+    } else if (ph.exact()) {
 #if defined(__x86_64__) || defined(__i386__)
       if (table.ok && have_avx512() &&
           table_rates_avx512(ph.counts.data(), from, to, table, ph.arcsec_per_count, ph.tau0_s, out))
@@ -676,8 +717,8 @@ PhaseSeries apply_outliers(const PhaseSeries& phase, const std::vector<Outlier>&
     std::vector<double> inc(m);
     std::vector<std::int64_t> c(m);
     for (std::size_t i = 0; i < m; ++i) {
-      c[i] = static_cast<std::int64_t>(static_cast<std::uint64_t>(phase.counts[i + 1]) -
-                                       static_cast<std::uint64_t>(phase.counts[i]));
+      c[i] = static_cast<std::int64_t>(static_cast<std::uint64_t>(phase.count(i + 1)) -
+                                       static_cast<std::uint64_t>(phase.count(i)));
       inc[i] = static_cast<double>(c[i]);
     }
     if (action == OutlierAction::Replace)
@@ -686,6 +727,7 @@ PhaseSeries apply_outliers(const PhaseSeries& phase, const std::vector<Outlier>&
           const double med = local_median(inc, bad, o.index);
           if (!std::isnan(med)) c[o.index] = static_cast<std::int64_t>(std::llround(med));
         }
+    out.counts32.clear();
     out.counts.assign(1, 0);
     std::uint64_t acc = 0;
     for (std::size_t i = 0; i < m; ++i) {

@@ -55,10 +55,10 @@ std::string format_pulse_file(const Metadata& metadata, const PhaseSeries& serie
     text.resize(static_cast<std::size_t>(p - text.data()));
     return text;
   }
-  std::vector<std::int64_t> c(series.counts.size() - 1);
+  std::vector<std::int64_t> c(series.points() - 1);
   for (std::size_t k = 0; k < c.size(); ++k)
-    c[k] = static_cast<std::int64_t>(static_cast<std::uint64_t>(series.counts[k + 1]) -
-                                     static_cast<std::uint64_t>(series.counts[k]));
+    c[k] = static_cast<std::int64_t>(static_cast<std::uint64_t>(series.count(k + 1)) -
+                                     static_cast<std::uint64_t>(series.count(k)));
   return format_pulse_file(metadata, std::span<const std::int64_t>(c));
 }
 

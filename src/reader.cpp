@@ -180,6 +180,14 @@ class Reader {
   static const char* int_lines(const char* p, const char* limit, Vec& out, std::uint64_t& acc,
                                std::uint64_t& mag);
   void int_run(const char*& p, const char* limit);
+  bool int_run_narrow(const char*& p, const char* limit);
+  // The room for every line's 64-bit value and its pages, when they were deferred (run()).
+  void map_values() {
+    if (!values_unmapped_) return;
+    values_unmapped_ = false;
+    ints_.reserve(lines_ + 1);
+    prefault_values();
+  }
   bool sum_pending();
   // Texts of more than kParallelBytes are parsed in two parts once the layout is known: the
   // second on another thread, from the first line start after kSplitNum/kSplitDen of the rest.
@@ -307,6 +315,13 @@ class Reader {
   // mag_ = Σ|c_i| over them; build_phase sums the rest.
   std::size_t summed_ = 0;
   std::uint64_t acc_ = 0, mag_ = 0;
+  // Pulses held in 32 bits (int_run_narrow): C_0 … C_n when every |C_k| < 2^30, built instead of
+  // ints_ when the whole rest of a one-column file is plain lines; then narrow_done_.
+  std::vector<std::int32_t> narrow_;
+  bool narrow_tried_ = false, narrow_done_ = false;
+  // ints_'s room for every line and its pages are taken once it is known that ints_ will hold the
+  // values (pulses read on one thread, see run()).
+  bool values_unmapped_ = false;
   std::vector<double> reals_;       // angle: samples; rate: slot 0 reserved for x_0
   // The time column is checked from running statistics (first, last, smallest and largest step),
   // so a long record needs no second array; only when a step is out of tolerance is the file read
@@ -708,6 +723,7 @@ void Reader::establish_layout() {
   if (delim_ == Delim::Blanks) stop_[' '] = true;
 
   int_lines_ok_ = ncols_ == 1 && opt_.mode == InputMode::Pulses;
+  if (!int_lines_ok_) map_values();
 
   if (opt_.mode == InputMode::Counter) {
     const int b = opt_.counter_bits;
@@ -919,7 +935,55 @@ bool Reader::sum_pending() {
   return true;
 }
 
+// The first run of plain lines of a one-column pulse file, when it reaches the end of the text
+// (no second part on another thread): the values are parsed in slices of 64 KiB into a small
+// buffer (in cache) and kept as 32-bit cumulative counts, when every |C_k| < 2^30 — the 64-bit
+// array is then never written, and the record takes half the memory. Any other line, or counts
+// too large, gives up: nothing is kept and the run is read by int_run as before.
+bool Reader::int_run_narrow(const char*& p, const char* limit) {
+  narrow_tried_ = true;
+  constexpr std::uint64_t kNarrowLimit = std::uint64_t{1} << 30;
+  if (limit != end_ || !sum_pending() || mag_ >= kNarrowLimit) return false;
+  constexpr std::ptrdiff_t kSlice = std::ptrdiff_t{1} << 16;
+  std::vector<std::int32_t> out;
+  // One slot per line to come, and the counts already summed (C_0 and any careful lines).
+  out.reserve(ints_.size() + (lines_ - lines_before(p)) + 1);
+  for (const std::int64_t c : ints_) out.push_back(static_cast<std::int32_t>(c));
+  std::vector<std::int64_t> part;
+  part.reserve(static_cast<std::size_t>(kSlice / 2 + 64));  // a line has at least 2 bytes
+  std::uint64_t acc = acc_, mag = mag_;
+  const char* q = p;
+  while (q < limit) {
+    const char* slice = limit - q > kSlice ? q + kSlice : limit;
+    part.clear();
+    const char* r = int_lines<true>(q, slice, part, acc, mag);
+    if (r < slice || mag >= kNarrowLimit) return false;  // a line of another form, or too large
+    // Σ|c| < 2^30 bounds every |C_k|: the low 32 bits are the counts.
+    std::int32_t* t = out.data() + out.size();
+    for (std::size_t i = 0; i < part.size(); ++i) t[i] = static_cast<std::int32_t>(part[i]);
+    out.insert(out.end(), t, t + part.size());  // in place (see grow_in_place)
+    q = r;
+  }
+  const std::size_t k = out.size() - ints_.size();
+  if (k > 0) {
+    if (new_run_) {
+      runs_.emplace_back(samples_, line_ + 1);
+      new_run_ = false;
+    }
+    samples_ += k;
+    line_ += k;
+  }
+  acc_ = acc;
+  mag_ = mag;
+  narrow_ = std::move(out);
+  narrow_done_ = true;
+  p = q;
+  return true;
+}
+
 void Reader::int_run(const char*& p, const char* limit) {
+  if (!narrow_tried_ && int_run_narrow(p, limit)) return;
+  map_values();
   const std::size_t before = ints_.size();
   // Sum while parsing when everything before is summed and Σ|c| cannot pass the limit in this run
   // (a line has at least 2 bytes; any real record is many orders of magnitude below the bound).
@@ -1244,6 +1308,10 @@ void Reader::build_phase(Recording& rec) {
       // never matters). Every second difference stays exact while Σ|c_i| < 2^63; beyond that the
       // record is refused.
       // ints_[0, summed_) are summed already (while parsing); acc_ and mag_ carry on from there.
+      if (narrow_done_) {  // already summed, and every |C_k| < 2^30
+        ph.counts32 = std::move(narrow_);
+        break;
+      }
       std::vector<std::int64_t>& c = ints_;
       std::uint64_t acc = acc_, mag = mag_;
       for (std::size_t i = std::max<std::size_t>(summed_, 1); i < c.size(); ++i) {
@@ -1341,8 +1409,11 @@ Recording Reader::run(bool store_times) {
   // Slot 0 holds C_0 = 0 (pulses) or x_0 = 0 (rate); counter and angle samples are points already.
   // Their pages are mapped in one call: here, or, when the text may be parsed in two halves, once
   // the other half's thread has started (scan()).
+  // Pulses read on one thread may be kept in 32 bits (int_run_narrow): their 64-bit room is
+  // taken only once it is known that they are not (map_values()).
+  const bool defer = opt_.mode == InputMode::Pulses && !may_split();
   if (integer_mode()) {
-    ints_.reserve(lines + 1);
+    ints_.reserve(defer ? 64 : lines + 1);
     if (opt_.mode == InputMode::Pulses) {
       ints_.push_back(0);
       summed_ = 1;
@@ -1351,7 +1422,10 @@ Recording Reader::run(bool store_times) {
     reals_.reserve(lines + 1);
     if (opt_.mode == InputMode::Rate) reals_.push_back(0.0);
   }
-  if (!may_split()) prefault_values();
+  if (defer)
+    values_unmapped_ = true;
+  else if (!may_split())
+    prefault_values();
   if (store_times_) times_.reserve(lines);
   lt.lap("reserve");
 

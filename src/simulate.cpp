@@ -471,6 +471,7 @@ struct Simulator::Impl {
       out.values[k] = theta;
     }
     out.counts.clear();
+    out.counts32.clear();
   }
 
   // Count whole pulses. The angle is carried as whole pulses `whole` plus a fraction in [0, 1),
@@ -480,6 +481,7 @@ struct Simulator::Impl {
     out.tau0_s = tau0;
     out.arcsec_per_count = q;
     out.values.clear();
+    out.counts32.clear();
     out.counts.resize(n + 1);
     Rng readout(seed, kReadoutStream);
     Rng white(seed, kWhiteAngleStream);
@@ -528,11 +530,11 @@ PhaseSeries simulate(const NoiseModel& model, const SimulationSettings& settings
 
 std::vector<std::int64_t> pulse_increments(const PhaseSeries& series) {
   std::vector<std::int64_t> c;
-  if (series.counts.size() < 2) return c;
-  c.resize(series.counts.size() - 1);
-  for (std::size_t k = 0; k + 1 < series.counts.size(); ++k)
-    c[k] = static_cast<std::int64_t>(static_cast<std::uint64_t>(series.counts[k + 1]) -
-                                     static_cast<std::uint64_t>(series.counts[k]));
+  if (!series.exact() || series.points() < 2) return c;
+  c.resize(series.points() - 1);
+  for (std::size_t k = 0; k + 1 < series.points(); ++k)
+    c[k] = static_cast<std::int64_t>(static_cast<std::uint64_t>(series.count(k + 1)) -
+                                     static_cast<std::uint64_t>(series.count(k)));
   return c;
 }
 

@@ -132,11 +132,11 @@ TEST(ReadIntLines, SameAsThePerLinePathsAndKnownSums) {
     std::uint64_t acc = 0;
     for (const auto v : counts) want.push_back(static_cast<std::int64_t>(acc += static_cast<std::uint64_t>(v)));
     const Recording ref = read_recording_text(slow, "slow.csv", with_threads(1));
-    ASSERT_EQ(ref.phase.counts, want);
+    ASSERT_EQ(ref.phase.wide_counts(), want);
     for (const unsigned t : {1u, 2u}) {
       const Recording r = read_recording_text(text, "fast.csv", with_threads(t));
       EXPECT_EQ(r.samples, n);
-      EXPECT_EQ(r.phase.counts, want) << "threads " << t;
+      EXPECT_EQ(r.phase.wide_counts(), want) << "threads " << t;
       EXPECT_EQ(r.line_runs, ref.line_runs) << "threads " << t;
     }
   }
@@ -162,7 +162,7 @@ TEST(ReadIntLines, LinesAcrossAndLongerThanTheWindows) {
   }
   for (const unsigned t : {1u, 2u}) {
     const Recording r = read_recording_text(text, "windows.csv", with_threads(t));
-    EXPECT_EQ(r.phase.counts, want) << "threads " << t;
+    EXPECT_EQ(r.phase.wide_counts(), want) << "threads " << t;
     const Recording slow = read_recording_text(indented(text), "slow.csv", with_threads(t));
     EXPECT_EQ(r.line_runs, slow.line_runs) << "threads " << t;
   }
@@ -197,7 +197,7 @@ TEST(ReadIntLines, SumTooLargeNamesTheSameLine) {
   for (std::size_t i = 0; i < 1000; ++i) ok += fmt::format("-{}\n", i % 3);
   ok += "-999999999999999999\n";
   const Recording r = read_recording_text(ok, "ok.csv", with_threads(2));
-  EXPECT_EQ(r.phase.counts.back(), -999);
+  EXPECT_EQ(r.phase.wide_counts().back(), -999);
 }
 
 }  // namespace
