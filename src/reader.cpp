@@ -181,12 +181,13 @@ class Reader {
                                std::uint64_t& mag);
   void int_run(const char*& p, const char* limit);
   bool int_run_narrow(const char*& p, const char* limit);
-  // The room for every line's 64-bit value and its pages, when they were deferred (run()).
-  void map_values() {
+  // The room for every line's 64-bit value, and its pages unless the text is to be parsed in two
+  // parts (each thread then maps its own), when they were deferred (run()).
+  void map_values(bool pages) {
     if (!values_unmapped_) return;
     values_unmapped_ = false;
     ints_.reserve(lines_ + 1);
-    prefault_values();
+    if (pages) prefault_values();
   }
   bool sum_pending();
   // Texts of more than kParallelBytes are parsed in two parts once the layout is known: the
@@ -723,7 +724,7 @@ void Reader::establish_layout() {
   if (delim_ == Delim::Blanks) stop_[' '] = true;
 
   int_lines_ok_ = ncols_ == 1 && opt_.mode == InputMode::Pulses;
-  if (!int_lines_ok_) map_values();
+  if (!int_lines_ok_) map_values(!may_split());
 
   if (opt_.mode == InputMode::Counter) {
     const int b = opt_.counter_bits;
@@ -982,8 +983,12 @@ bool Reader::int_run_narrow(const char*& p, const char* limit) {
 }
 
 void Reader::int_run(const char*& p, const char* limit) {
-  if (!narrow_tried_ && int_run_narrow(p, limit)) return;
-  map_values();
+  if (!narrow_tried_) {
+    if (int_run_narrow(p, limit)) return;
+    // Not kept in 32 bits: a long text is now split (scan()), which maps the values' pages.
+    if (may_split() && limit == end_) return;
+  }
+  map_values(true);
   const std::size_t before = ints_.size();
   // Sum while parsing when everything before is summed and Σ|c| cannot pass the limit in this run
   // (a line has at least 2 bytes; any real record is many orders of magnitude below the bound).
@@ -1120,7 +1125,11 @@ void Reader::scan(const char* p) {
   Thread worker;
   for (;;) {
     while (p < limit) {
-      if (split_pending && layout_known_) {
+      // A one-column pulse file is first read whole on this thread, to be kept in 32 bits
+      // (int_run_narrow, faster than two parts writing 64 bits); it is split only if it is not.
+      bool narrow_first = false;
+      if constexpr (Integer) narrow_first = int_lines_ok_ && !narrow_tried_;
+      if (split_pending && layout_known_ && !narrow_first) {
         split_pending = false;
         if (end_ - p > kParallelBytes) {
           // The other thread takes the last 45 %: with one-digit lines taken by the vectorised
@@ -1132,6 +1141,7 @@ void Reader::scan(const char* p) {
           if (nl && nl + 1 < end_) {
             limit = nl + 1;
             if constexpr (Integer) {
+              map_values(false);
               // The first part adds at most one value per line before `limit`: the second part's
               // values go right after that (ints_ holds one slot per line of the text, so both
               // fit and it is never reallocated). Each thread maps the pages it will write.
@@ -1409,9 +1419,9 @@ Recording Reader::run(bool store_times) {
   // Slot 0 holds C_0 = 0 (pulses) or x_0 = 0 (rate); counter and angle samples are points already.
   // Their pages are mapped in one call: here, or, when the text may be parsed in two halves, once
   // the other half's thread has started (scan()).
-  // Pulses read on one thread may be kept in 32 bits (int_run_narrow): their 64-bit room is
-  // taken only once it is known that they are not (map_values()).
-  const bool defer = opt_.mode == InputMode::Pulses && !may_split();
+  // Pulses may be kept in 32 bits (int_run_narrow): their 64-bit room is taken only once it is
+  // known that they are not (map_values()).
+  const bool defer = opt_.mode == InputMode::Pulses;
   if (integer_mode()) {
     ints_.reserve(defer ? 64 : lines + 1);
     if (opt_.mode == InputMode::Pulses) {
