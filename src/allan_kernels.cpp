@@ -533,6 +533,30 @@ RWCALC_AVX512_WARNINGS_ON
 
 }  // namespace
 
+// The range flags of the view's offsets (largest |C_k − C_0| = top) and, for the modified
+// variance, the prefix sums: exact doubles from the view while 8·top·(N+1) < 2^53 (then the
+// prefix sums and S = (P3 − P0) − 3(P2 − P1) stay exact), else modular 64-bit sums of the counts
+// (`wide`, or the view's values widened when the series holds no 64-bit counts).
+namespace {
+void finish_prepared(PreparedCounts& p, std::uint64_t top, bool need_prefix, const std::vector<std::int64_t>* wide) {
+  p.small29 = top < (std::uint64_t{1} << 29);
+  p.small24 = top < (std::uint64_t{1} << 24);
+  if (!need_prefix) return;
+  const double bound = 8.0 * static_cast<double>(top) * static_cast<double>(p.points + 1);
+  if (p.view && bound < 9007199254740992.0) {
+    p.prefix_f64.resize(p.points + 1);
+    double run = 0;
+    p.prefix_f64[0] = 0;
+    for (std::size_t i = 0; i < p.points; ++i) {
+      run += static_cast<double>(p.view[i]);
+      p.prefix_f64[i + 1] = run;
+    }
+  } else {
+    p.prefix_u64 = count_prefix_sums(wide ? *wide : std::vector<std::int64_t>(p.view, p.view + p.points));
+  }
+}
+}  // namespace
+
 PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_prefix, unsigned threads, Crew* crew) {
   PreparedCounts p;
   p.raw = &c;
@@ -582,29 +606,13 @@ PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_pref
   const bool small = lo > -kLimit && hi < kLimit;
   // lo ≤ 0 ≤ hi (the first offset is 0); |lo| in unsigned arithmetic, exact even for lo = −2^63.
   const std::uint64_t top = std::max(std::uint64_t{0} - static_cast<std::uint64_t>(lo), static_cast<std::uint64_t>(hi));
-  p.small29 = top < (std::uint64_t{1} << 29);
-  p.small24 = top < (std::uint64_t{1} << 24);
   if (!small) {
     p.rel32.clear();
     p.rel32.shrink_to_fit();
   } else {
     p.view = p.rel32.data();
   }
-  if (need_prefix) {
-    // Prefix sums and S = (P3 − P0) − 3(P2 − P1) stay exact doubles while 8·max|C − C0|·(N+1) < 2^53.
-    const double bound = 8.0 * static_cast<double>(top) * static_cast<double>(c.size() + 1);
-    if (small && bound < 9007199254740992.0) {
-      p.prefix_f64.resize(c.size() + 1);
-      double run = 0;
-      p.prefix_f64[0] = 0;
-      for (std::size_t i = 0; i < c.size(); ++i) {
-        run += static_cast<double>(p.rel32[i]);
-        p.prefix_f64[i + 1] = run;
-      }
-    } else {
-      p.prefix_u64 = count_prefix_sums(c);
-    }
-  }
+  finish_prepared(p, top, need_prefix, &c);
   return p;
 }
 
@@ -638,24 +646,7 @@ PreparedCounts prepare_counts(const PhaseSeries& x, bool need_prefix, unsigned t
   }
   std::int64_t lo = 0, hi = 0;
   range_i32(p.view, c.size(), lo, hi);
-  const auto top = static_cast<std::uint64_t>(std::max(-lo, hi));
-  p.small29 = top < (std::uint64_t{1} << 29);
-  p.small24 = top < (std::uint64_t{1} << 24);
-  if (need_prefix) {
-    // As for 64-bit counts: exact doubles while 8·max|C − C0|·(N+1) < 2^53.
-    const double bound = 8.0 * static_cast<double>(top) * static_cast<double>(c.size() + 1);
-    if (bound < 9007199254740992.0) {
-      p.prefix_f64.resize(c.size() + 1);
-      double run = 0;
-      p.prefix_f64[0] = 0;
-      for (std::size_t i = 0; i < c.size(); ++i) {
-        run += static_cast<double>(p.view[i]);
-        p.prefix_f64[i + 1] = run;
-      }
-    } else {
-      p.prefix_u64 = count_prefix_sums(x.wide_counts());
-    }
-  }
+  finish_prepared(p, static_cast<std::uint64_t>(std::max(-lo, hi)), need_prefix, nullptr);
   return p;
 }
 

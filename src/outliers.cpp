@@ -175,15 +175,23 @@ RateTable rate_table(const PhaseSeries& ph, std::size_t n) {
 #if defined(__x86_64__) || defined(__i386__)
 RWCALC_AVX512_WARNINGS_OFF
 // Rates of exact counts by lookup in the table, eight at a time; false (the window then needs
-// the division) when an increment lies outside the table's range.
-__attribute__((target("avx512f"))) bool table_rates_avx512(const std::int64_t* c, std::size_t from, std::size_t to,
+// the division) when an increment lies outside the table's range. Counts held in 32 bits
+// (PhaseSeries::counts32: |C| < 2^30, so every increment fits in 32 bits) are subtracted in 32-bit
+// lanes and widened.
+template <class Count>
+__attribute__((target("avx512f"))) bool table_rates_avx512(const Count* c, std::size_t from, std::size_t to,
                                                          const RateTable& t, double q, double tau0, double* out) {
   const __m512i lo = _mm512_set1_epi64(t.lo), top = _mm512_set1_epi64(15);
   const __m512d t0 = _mm512_load_pd(t.v), t1 = _mm512_load_pd(t.v + 8);
   __mmask8 bad = 0;
   std::size_t i = from;
   for (; i + 8 <= to; i += 8) {
-    const __m512i d = _mm512_sub_epi64(_mm512_loadu_si512(c + i + 1), _mm512_loadu_si512(c + i));
+    __m512i d;
+    if constexpr (sizeof(Count) == 4)
+      d = _mm512_cvtepi32_epi64(_mm256_sub_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + i + 1)),
+                                                 _mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + i))));
+    else
+      d = _mm512_sub_epi64(_mm512_loadu_si512(c + i + 1), _mm512_loadu_si512(c + i));
     const __m512i idx = _mm512_sub_epi64(d, lo);
     bad |= _mm512_cmpgt_epu64_mask(idx, top);
     _mm512_storeu_pd(out + (i - from), _mm512_permutex2var_pd(t0, idx, t1));
@@ -192,25 +200,6 @@ __attribute__((target("avx512f"))) bool table_rates_avx512(const std::int64_t* c
     const auto d = static_cast<std::int64_t>(static_cast<std::uint64_t>(c[i + 1]) - static_cast<std::uint64_t>(c[i]));
     out[i - from] = static_cast<double>(d) * q / tau0;
   }
-  return bad == 0;
-}
-
-// The same for counts held in 32 bits (PhaseSeries::counts32: |C| < 2^30, so every increment
-// fits in 32 bits), widened to 64-bit lanes after the subtraction.
-__attribute__((target("avx512f"))) bool table_rates32_avx512(const std::int32_t* c, std::size_t from, std::size_t to,
-                                                           const RateTable& t, double q, double tau0, double* out) {
-  const __m512i lo = _mm512_set1_epi64(t.lo), top = _mm512_set1_epi64(15);
-  const __m512d t0 = _mm512_load_pd(t.v), t1 = _mm512_load_pd(t.v + 8);
-  __mmask8 bad = 0;
-  std::size_t i = from;
-  for (; i + 8 <= to; i += 8) {
-    const __m256i d32 = _mm256_sub_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + i + 1)),
-                                         _mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + i)));
-    const __m512i idx = _mm512_sub_epi64(_mm512_cvtepi32_epi64(d32), lo);
-    bad |= _mm512_cmpgt_epu64_mask(idx, top);
-    _mm512_storeu_pd(out + (i - from), _mm512_permutex2var_pd(t0, idx, t1));
-  }
-  for (; i < to; ++i) out[i - from] = static_cast<double>(std::int64_t{c[i + 1]} - std::int64_t{c[i]}) * q / tau0;
   return bad == 0;
 }
 
@@ -266,7 +255,7 @@ struct PhaseRates {
     if (ph.narrow()) {
       const std::int32_t* c = ph.counts32.data();
 #if defined(__x86_64__) || defined(__i386__)
-      if (table.ok && have_avx512() && table_rates32_avx512(c, from, to, table, ph.arcsec_per_count, ph.tau0_s, out))
+      if (table.ok && have_avx512() && table_rates_avx512(c, from, to, table, ph.arcsec_per_count, ph.tau0_s, out))
         return;
       if (have_avx2()) return count_rates32_avx2(c, from, to, ph.arcsec_per_count, ph.tau0_s, out);
 #endif

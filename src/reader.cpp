@@ -321,7 +321,7 @@ class Reader {
   std::vector<std::int32_t> narrow_;
   bool narrow_tried_ = false, narrow_done_ = false;
   // ints_'s room for every line and its pages are taken once it is known that ints_ will hold the
-  // values (pulses read on one thread, see run()).
+  // values (pulses, see run() and map_values()).
   bool values_unmapped_ = false;
   std::vector<double> reals_;       // angle: samples; rate: slot 0 reserved for x_0
   // The time column is checked from running statistics (first, last, smallest and largest step),
