@@ -949,6 +949,7 @@ bool Reader::int_run_narrow(const char*& p, const char* limit) {
   std::vector<std::int32_t> out;
   // One slot per line to come, and the counts already summed (C_0 and any careful lines).
   out.reserve(ints_.size() + (lines_ - lines_before(p)) + 1);
+  detail::prefault(out.data(), out.capacity() * sizeof(std::int32_t));  // its pages in a few calls
   for (const std::int64_t c : ints_) out.push_back(static_cast<std::int32_t>(c));
   std::vector<std::int64_t> part;
   part.reserve(static_cast<std::size_t>(kSlice / 2 + 64));  // a line has at least 2 bytes
