@@ -533,12 +533,17 @@ RWCALC_AVX512_WARNINGS_ON
 
 }  // namespace
 
+namespace {
+// Modular 64-bit prefix sums of the counts: of `raw`, or of the view's offsets when the series
+// holds no 64-bit counts (an offset common to all counts cancels in the modified variance).
+std::vector<std::uint64_t> wide_prefix_sums(const PreparedCounts& p) {
+  return count_prefix_sums(p.raw ? *p.raw : std::vector<std::int64_t>(p.view, p.view + p.points));
+}
+
 // The range flags of the view's offsets (largest |C_k − C_0| = top) and, for the modified
 // variance, the prefix sums: exact doubles from the view while 8·top·(N+1) < 2^53 (then the
-// prefix sums and S = (P3 − P0) − 3(P2 − P1) stay exact), else modular 64-bit sums of the counts
-// (`wide`, or the view's values widened when the series holds no 64-bit counts).
-namespace {
-void finish_prepared(PreparedCounts& p, std::uint64_t top, bool need_prefix, const std::vector<std::int64_t>* wide) {
+// prefix sums and S = (P3 − P0) − 3(P2 − P1) stay exact), else modular 64-bit sums.
+void finish_prepared(PreparedCounts& p, std::uint64_t top, bool need_prefix) {
   p.small29 = top < (std::uint64_t{1} << 29);
   p.small24 = top < (std::uint64_t{1} << 24);
   if (!need_prefix) return;
@@ -552,7 +557,7 @@ void finish_prepared(PreparedCounts& p, std::uint64_t top, bool need_prefix, con
       p.prefix_f64[i + 1] = run;
     }
   } else {
-    p.prefix_u64 = count_prefix_sums(wide ? *wide : std::vector<std::int64_t>(p.view, p.view + p.points));
+    p.prefix_u64 = wide_prefix_sums(p);
   }
 }
 }  // namespace
@@ -612,7 +617,7 @@ PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_pref
   } else {
     p.view = p.rel32.data();
   }
-  finish_prepared(p, top, need_prefix, &c);
+  finish_prepared(p, top, need_prefix);
   return p;
 }
 
@@ -646,7 +651,7 @@ PreparedCounts prepare_counts(const PhaseSeries& x, bool need_prefix, unsigned t
   }
   std::int64_t lo = 0, hi = 0;
   range_i32(p.view, c.size(), lo, hi);
-  finish_prepared(p, static_cast<std::uint64_t>(std::max(-lo, hi)), need_prefix, nullptr);
+  finish_prepared(p, static_cast<std::uint64_t>(std::max(-lo, hi)), need_prefix);
   return p;
 }
 
@@ -762,8 +767,7 @@ bool second_diff_sumsq_sweep_shared(const PreparedCounts& c, std::size_t points,
 double modified_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m) {
   if (!c.prefix_f64.empty()) return modified_sumsq_f64_prefix(c.prefix_f64.data(), n, m);
   if (!c.prefix_u64.empty()) return modified_sumsq_counts(c.prefix_u64.data(), n, m);
-  const std::vector<std::uint64_t> p =
-      c.raw ? count_prefix_sums(*c.raw) : count_prefix_sums(std::vector<std::int64_t>(c.view, c.view + c.points));
+  const std::vector<std::uint64_t> p = wide_prefix_sums(c);
   return modified_sumsq_counts(p.data(), n, m);
 }
 

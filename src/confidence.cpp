@@ -39,14 +39,10 @@ std::vector<double> decimated_phase(const PhaseSeries& x, std::int64_t m) {
   const auto um = static_cast<std::size_t>(m);
   const std::size_t count = (x.points() - 1) / um + 1;
   std::vector<double> z(count);
-  if (x.narrow()) {
-    const std::int32_t* c = x.counts32.data();
-    for (std::size_t k = 0; k < count; ++k) z[k] = static_cast<double>(std::int64_t{c[k * um]} - std::int64_t{c[0]});
-  } else if (x.exact()) {
-    const std::int64_t* c = x.counts.data();
-    const auto c0 = static_cast<std::uint64_t>(c[0]);
+  if (x.exact()) {
+    const auto c0 = static_cast<std::uint64_t>(x.count(0));
     for (std::size_t k = 0; k < count; ++k)
-      z[k] = static_cast<double>(static_cast<std::int64_t>(static_cast<std::uint64_t>(c[k * um]) - c0));
+      z[k] = static_cast<double>(static_cast<std::int64_t>(static_cast<std::uint64_t>(x.count(k * um)) - c0));
   } else {
     const double* v = x.values.data();
     for (std::size_t k = 0; k < count; ++k) z[k] = v[k * um] - v[0];
@@ -711,18 +707,11 @@ int acf_exponent_at(const PhaseSeries& x, std::int64_t m, std::size_t count, int
     if (um == 1) return acf_exponent([rel32](std::size_t k) { return static_cast<double>(rel32[k]); }, count, base);
     return acf_exponent([rel32, um](std::size_t k) { return static_cast<double>(rel32[k * um]); }, count, base);
   }
-  if (x.narrow()) {
-    const std::int32_t* c = x.counts32.data();
-    return acf_exponent(
-        [c, um](std::size_t k) { return static_cast<double>(std::int64_t{c[k * um]} - std::int64_t{c[0]}); }, count,
-        base);
-  }
   if (x.exact()) {
-    const std::int64_t* c = x.counts.data();
-    const auto c0 = static_cast<std::uint64_t>(c[0]);
+    const auto c0 = static_cast<std::uint64_t>(x.count(0));
     return acf_exponent(
-        [c, c0, um](std::size_t k) {
-          return static_cast<double>(static_cast<std::int64_t>(static_cast<std::uint64_t>(c[k * um]) - c0));
+        [&x, c0, um](std::size_t k) {
+          return static_cast<double>(static_cast<std::int64_t>(static_cast<std::uint64_t>(x.count(k * um)) - c0));
         },
         count, base);
   }

@@ -950,7 +950,7 @@ bool Reader::int_run_narrow(const char*& p, const char* limit) {
   // One slot per line to come, and the counts already summed (C_0 and any careful lines).
   out.reserve(ints_.size() + (lines_ - lines_before(p)) + 1);
   detail::prefault(out.data(), out.capacity() * sizeof(std::int32_t));  // its pages in a few calls
-  for (const std::int64_t c : ints_) out.push_back(static_cast<std::int32_t>(c));
+  out.insert(out.end(), ints_.begin(), ints_.end());  // each value's low 32 bits (below: why they suffice)
   std::vector<std::int64_t> part;
   part.reserve(static_cast<std::size_t>(kSlice / 2 + 64));  // a line has at least 2 bytes
   std::uint64_t acc = acc_, mag = mag_;
@@ -961,9 +961,7 @@ bool Reader::int_run_narrow(const char*& p, const char* limit) {
     const char* r = int_lines<true>(q, slice, part, acc, mag);
     if (r < slice || mag >= kNarrowLimit) return false;  // a line of another form, or too large
     // Σ|c| < 2^30 bounds every |C_k|: the low 32 bits are the counts.
-    std::int32_t* t = out.data() + out.size();
-    for (std::size_t i = 0; i < part.size(); ++i) t[i] = static_cast<std::int32_t>(part[i]);
-    out.insert(out.end(), t, t + part.size());  // in place (see grow_in_place)
+    out.insert(out.end(), part.begin(), part.end());
     q = r;
   }
   const std::size_t k = out.size() - ints_.size();
