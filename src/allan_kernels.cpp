@@ -650,7 +650,19 @@ PreparedCounts prepare_counts(const PhaseSeries& x, bool need_prefix, unsigned t
     p.view = p.rel32.data();
   }
   std::int64_t lo = 0, hi = 0;
-  range_i32(p.view, c.size(), lo, hi);
+  if (crew && c.size() >= (std::size_t{1} << 20)) {  // stretches for whoever is free
+    constexpr std::size_t kStretch = std::size_t{1} << 18;
+    const std::size_t parts = (c.size() + kStretch - 1) / kStretch;
+    std::vector<std::int64_t> los(parts, 0), his(parts, 0);
+    crew->share(parts, [&](std::size_t k) {
+      const std::size_t b = k * kStretch;
+      range_i32(p.view + b, std::min(c.size() - b, kStretch), los[k], his[k]);
+    });
+    lo = *std::min_element(los.begin(), los.end());
+    hi = *std::max_element(his.begin(), his.end());
+  } else {
+    range_i32(p.view, c.size(), lo, hi);
+  }
   finish_prepared(p, static_cast<std::uint64_t>(std::max(-lo, hi)), need_prefix);
   return p;
 }
@@ -745,7 +757,7 @@ bool second_diff_sumsq_sweep_shared(const PreparedCounts& c, std::size_t points,
   const auto np = static_cast<std::int64_t>(points);
   std::int64_t longest = 0;
   for (std::size_t i = 0; i < count; ++i) longest = std::max(longest, np - 2 * ms[i]);
-  constexpr std::int64_t kStretch = kBlock24 * 64;  // 256 K terms per stretch
+  constexpr std::int64_t kStretch = kBlock24 * 16;  // 64 K terms per stretch
   const auto parts = static_cast<std::size_t>((longest + kStretch - 1) / kStretch);
   std::vector<u128> sums(parts * count, 0);
   crew.share(parts, [&](std::size_t k) {

@@ -614,7 +614,7 @@ void lag1_start_pass_impl(const std::int32_t* rel32, std::size_t points, const s
   // are free. Part c reads the view from edge(c) and takes the steps of stride j from bound(c, j)
   // to bound(c + 1, j) (multiples of W, so every part keeps the positions 0, W, 2W, …); the sums
   // are exact, so the split changes no bit.
-  constexpr std::size_t kStretch = std::size_t{1} << 18;
+  constexpr std::size_t kStretch = std::size_t{1} << 16;
   const std::size_t parts = crew ? std::max<std::size_t>(1, (points + kStretch - 1) / kStretch) : threads > 1 ? 2 : 1;
   auto edge = [&](std::size_t c) { return c >= parts ? points : crew ? c * kStretch : points / 2 * c; };
   auto bound = [&](std::size_t c, std::size_t j) -> std::size_t {

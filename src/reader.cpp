@@ -111,6 +111,9 @@ bool looks_numeric(std::string_view f, bool comma_ok) {
 
 // Thrown inside the reader when the time column must be read again in full.
 struct NeedTimes {};
+// Thrown when the 32-bit read gave up after writing counts over text in the same storage
+// (TextBuffer's host): the file is loaded again into a buffer of its own.
+struct TextOverwritten {};
 
 enum class Role : unsigned char { Skip, Value, Time, Temperature };
 
@@ -139,12 +142,13 @@ std::vector<std::string_view> value_names(InputMode m) {
 
 class Reader {
  public:
-  Reader(const TextBuffer& buf, std::string name, const ReadOptions& options)
+  Reader(TextBuffer& buf, std::string name, const ReadOptions& options)
       : loaded_lines_(&buf.segment_lines),
         name_(std::move(name)),
         opt_(options),
         begin_(buf.data()),
-        end_(buf.data() + buf.size()) {}
+        end_(buf.data() + buf.size()),
+        host_(buf.host()) {}
 
   Recording run(bool store_times);
 
@@ -320,6 +324,9 @@ class Reader {
   // ints_ when the whole rest of a one-column file is plain lines; then narrow_done_.
   std::vector<std::int32_t> narrow_;
   bool narrow_tried_ = false, narrow_done_ = false;
+  // The vector in whose storage the text lies (TextBuffer::host()), or null: int_run_narrow then
+  // writes the counts there, over text already parsed.
+  std::vector<std::int32_t>* host_ = nullptr;
   // ints_'s room for every line and its pages are taken once it is known that ints_ will hold the
   // values (pulses, see run() and map_values()).
   bool values_unmapped_ = false;
@@ -946,11 +953,29 @@ bool Reader::int_run_narrow(const char*& p, const char* limit) {
   constexpr std::uint64_t kNarrowLimit = std::uint64_t{1} << 30;
   if (limit != end_ || !sum_pending() || mag_ >= kNarrowLimit) return false;
   constexpr std::ptrdiff_t kSlice = std::ptrdiff_t{1} << 16;
-  std::vector<std::int32_t> out;
   // One slot per line to come, and the counts already summed (C_0 and any careful lines).
-  out.reserve(ints_.size() + (lines_ - lines_before(p)) + 1);
-  detail::prefault(out.data(), out.capacity() * sizeof(std::int32_t));  // its pages in a few calls
+  const std::size_t slots = ints_.size() + (lines_ - lines_before(p)) + 1;
+  // In the text's own storage when it lies in a host vector that has room (TextBuffer): the
+  // counts then overwrite text already parsed, so a read that gives up after writing into the
+  // text cannot go back to it (TextOverwritten: the caller loads the file again).
+  std::vector<std::int32_t> local;
+  const bool hosted = host_ && host_->capacity() >= slots;
+  std::vector<std::int32_t>& out = hosted ? *host_ : local;
+  const char* text = begin_;  // the text's first byte in the host's storage (when hosted)
+  auto written_end = [&out] { return reinterpret_cast<const char*>(out.data() + out.size()); };
+  auto give_up = [&] {
+    if (hosted && written_end() > text) throw TextOverwritten{};
+    out.clear();
+    return false;
+  };
+  out.clear();
+  out.reserve(slots);
+  // Its pages in a few calls (in a host, the text's pages are mapped already).
+  const auto room = static_cast<std::size_t>(hosted ? std::max<std::ptrdiff_t>(text - reinterpret_cast<const char*>(out.data()), 0)
+                                                    : static_cast<std::ptrdiff_t>(out.capacity() * sizeof(std::int32_t)));
+  detail::prefault(out.data(), room);
   out.insert(out.end(), ints_.begin(), ints_.end());  // each value's low 32 bits (below: why they suffice)
+  if (hosted && written_end() > p) return give_up();
   std::vector<std::int64_t> part;
   part.reserve(static_cast<std::size_t>(kSlice / 2 + 64));  // a line has at least 2 bytes
   std::uint64_t acc = acc_, mag = mag_;
@@ -959,7 +984,10 @@ bool Reader::int_run_narrow(const char*& p, const char* limit) {
     const char* slice = limit - q > kSlice ? q + kSlice : limit;
     part.clear();
     const char* r = int_lines<true>(q, slice, part, acc, mag);
-    if (r < slice || mag >= kNarrowLimit) return false;  // a line of another form, or too large
+    if (r < slice || mag >= kNarrowLimit) return give_up();  // a line of another form, or too large
+    // Never past the first byte not yet parsed (a host sized by TextBuffer::host_capacity
+    // always has the room).
+    if (hosted && written_end() + part.size() * sizeof(std::int32_t) > r) return give_up();
     // Σ|c| < 2^30 bounds every |C_k|: the low 32 bits are the counts.
     out.insert(out.end(), part.begin(), part.end());
     q = r;
@@ -1512,12 +1540,28 @@ Recording read_buffer(TextBuffer& buf, const std::string& source, const ReadOpti
 
 Recording read_recording(const std::string& path, const ReadOptions& options) {
   validate(options);
+  const unsigned threads = options.threads ? options.threads : std::thread::hardware_concurrency();
+  // With a crew, a long regular file is loaded in halves by this thread and whichever lender is
+  // free (this thread does both when none is).
+  const unsigned load_threads = options.crew ? std::max(threads, 2u) : threads;
+  // Pulses: the text goes to the end of the storage the 32-bit counts will take (TextBuffer's
+  // host), the caller's when it lends one. A text with lines of other forms, or counts too large,
+  // is read as before; only when the 32-bit read has already written over text is the file
+  // loaded a second time (TextOverwritten).
+  std::vector<std::int32_t> fresh;
+  std::vector<std::int32_t>* host = nullptr;
+  if (options.mode == InputMode::Pulses && path != "-") host = options.reuse ? options.reuse : &fresh;
   TextBuffer buf = [&] {
     detail::ScopedTimer t("read: load");
-    return detail::load_source(path, options.threads ? options.threads : std::thread::hardware_concurrency(),
-                               options.crew);
+    return detail::load_source(path, load_threads, options.crew, host);
   }();
-  return read_buffer(buf, path, options);
+  try {
+    return read_buffer(buf, path, options);
+  } catch (const TextOverwritten&) {
+  }
+  buf = TextBuffer{};
+  TextBuffer again = detail::load_source(path, load_threads, options.crew);
+  return read_buffer(again, path, options);
 }
 
 Recording read_recording_text(std::string_view text, const std::string& name, const ReadOptions& options) {

@@ -27,8 +27,24 @@ class TextBuffer {
   /// are mapped in one call (prefault) unless map_pages is false. `spare` bytes more are allocated
   /// and never touched (see load_source).
   explicit TextBuffer(std::size_t capacity, bool map_pages = true, std::size_t spare = 0);
-  [[nodiscard]] char* data() noexcept { return data_.get(); }
-  [[nodiscard]] const char* data() const noexcept { return data_.get(); }
+  /// Buffer of `capacity` bytes (plus the sentinel and the padding) ending host_capacity(capacity)
+  /// elements into the storage of `host`, a vector whose capacity is made at least that first
+  /// (its pages are not mapped here). A pulse file's reader then writes the 32-bit cumulative counts from
+  /// the storage's start over the text it has already parsed (4 bytes per line, at most one
+  /// line per 2 bytes of text, so the writes never reach a byte not yet read): one buffer's
+  /// pages serve both, and `host` may be the storage of a previous record's counts, already
+  /// mapped. host() gives the vector to the reader.
+  TextBuffer(std::vector<std::int32_t>&& host, std::size_t capacity);
+  /// The int32 elements a host vector needs for a text of `capacity` bytes (see above).
+  static std::size_t host_capacity(std::size_t capacity) noexcept {
+    return (2 * capacity + 2 * (1 + kPadding) + 64) / sizeof(std::int32_t) + 16;
+  }
+  /// The host vector while the text still lies in its storage, else null.
+  [[nodiscard]] std::vector<std::int32_t>* host() noexcept {
+    return host_.capacity() > 0 && !own_ ? &host_ : nullptr;
+  }
+  [[nodiscard]] char* data() noexcept { return data_; }
+  [[nodiscard]] const char* data() const noexcept { return data_; }
   [[nodiscard]] std::size_t size() const noexcept { return size_; }
   [[nodiscard]] std::size_t capacity() const noexcept { return capacity_; }
   void set_size(std::size_t n) noexcept { size_ = n; }
@@ -36,7 +52,7 @@ class TextBuffer {
   void reserve(std::size_t capacity);
   /// Append the sentinel newline if the text does not already end with one.
   void terminate();
-  [[nodiscard]] std::string_view view() const noexcept { return {data_.get(), size_}; }
+  [[nodiscard]] std::string_view view() const noexcept { return {data_, size_}; }
 
   /// Line ends in each whole segment of kSegment bytes from the start, when they were counted (and
   /// the segments found free of control bytes) as the file was loaded: the first
@@ -46,7 +62,9 @@ class TextBuffer {
   std::vector<std::size_t> segment_lines;
 
  private:
-  std::unique_ptr<char[]> data_;
+  std::unique_ptr<char[]> own_;          // the bytes, when this buffer owns them
+  std::vector<std::int32_t> host_;       // else the vector whose storage holds them
+  char* data_ = nullptr;
   std::size_t size_ = 0;
   std::size_t capacity_ = 0;
 };
@@ -62,8 +80,11 @@ std::string display_name(const std::string& path);
 /// Read a whole file (or stdin for "-") into memory, inflating gzip data. Throws InputError
 /// (line 0) for a missing, unreadable or non-regular path and for corrupt or truncated gzip.
 /// With threads > 1 a regular file of more than a few MB is read in two halves side by side (each
-/// thread maps the pages of its half and copies it).
-TextBuffer load_source(const std::string& path, unsigned threads = 1, Crew* crew = nullptr);
+/// thread maps the pages of its half and copies it). With `host`, a regular file's text is held
+/// at the end of that vector's storage (TextBuffer's second constructor: for pulse files, whose
+/// counts the reader may then write over it); the vector is moved into the buffer.
+TextBuffer load_source(const std::string& path, unsigned threads = 1, Crew* crew = nullptr,
+                       std::vector<std::int32_t>* host = nullptr);
 
 /// Copy in-memory text, inflating it when it starts with the gzip magic bytes.
 TextBuffer load_text(std::string_view text, const std::string& name);

@@ -135,18 +135,35 @@ void prefault(void* data, std::size_t bytes) noexcept {
 }
 
 TextBuffer::TextBuffer(std::size_t capacity, bool map_pages, std::size_t spare)
-    : data_(std::make_unique_for_overwrite<char[]>(capacity + 1 + kPadding + spare)), capacity_(capacity) {
-  if (map_pages) prefault(data_.get(), capacity);
-  std::memset(data_.get() + capacity + 1, 0, kPadding);
+    : own_(std::make_unique_for_overwrite<char[]>(capacity + 1 + kPadding + spare)), data_(own_.get()), capacity_(capacity) {
+  if (map_pages) prefault(data_, capacity);
+  std::memset(data_ + capacity + 1, 0, kPadding);
+}
+
+TextBuffer::TextBuffer(std::vector<std::int32_t>&& host, std::size_t capacity) : host_(std::move(host)), capacity_(capacity) {
+  host_.clear();
+  const std::size_t need = host_capacity(capacity);
+  if (host_.capacity() < need) {
+    // 1/16 more than this text needs: the next files of a batch, a little longer or shorter,
+    // then find the storage large enough.
+    host_ = std::vector<std::int32_t>();
+    host_.reserve(need + need / 16);
+  }
+  // The text ends host_capacity(capacity) elements into the storage (not at the end of a larger
+  // one: the pages past it stay untouched); the counts start where the storage starts.
+  char* end = reinterpret_cast<char*>(host_.data() + need);
+  data_ = end - (capacity + 1 + kPadding);
+  std::memset(data_ + capacity + 1, 0, kPadding);
 }
 
 void TextBuffer::reserve(std::size_t capacity) {
-  if (capacity <= capacity_) return;
+  if (capacity <= capacity_ && data_) return;
   auto bigger = std::make_unique_for_overwrite<char[]>(capacity + 1 + kPadding);
   prefault(bigger.get() + size_, capacity - size_);
   std::memset(bigger.get() + capacity + 1, 0, kPadding);
-  if (size_ > 0) std::memcpy(bigger.get(), data_.get(), size_);
-  data_ = std::move(bigger);
+  if (size_ > 0) std::memcpy(bigger.get(), data_, size_);
+  own_ = std::move(bigger);
+  data_ = own_.get();
   capacity_ = capacity;
 }
 
@@ -330,7 +347,7 @@ TextBuffer load_text(std::string_view text, const std::string& name) {
   return buf;
 }
 
-TextBuffer load_source(const std::string& path, unsigned threads, Crew* crew) {
+TextBuffer load_source(const std::string& path, unsigned threads, Crew* crew, std::vector<std::int32_t>* host) {
   const std::string name = display_name(path);
   TextBuffer raw;
   if (path == "-") {
@@ -347,7 +364,16 @@ TextBuffer load_source(const std::string& path, unsigned threads, Crew* crew) {
     // One spare byte lets the final read(2) see end-of-file without growing the buffer.
     constexpr std::size_t kHalvesBytes = std::size_t{4} << 20;
     const auto size = static_cast<std::size_t>(st.st_size);
-    if (S_ISREG(st.st_mode) && threads > 1 && size > kHalvesBytes) {
+    if (S_ISREG(st.st_mode) && host) {
+      // A pulse file: the text at the end of the counts' storage (TextBuffer's host).
+      raw = TextBuffer(std::move(*host), size + 1);
+      if (threads > 1 && size > kHalvesBytes) {
+        if (!read_halves(fd.get(), size, raw, name, crew) && ::lseek(fd.get(), 0, SEEK_SET) < 0)
+          fail_errno(name, "cannot seek", errno);
+      } else {
+        prefault(raw.data(), size + 1);
+      }
+    } else if (S_ISREG(st.st_mode) && threads > 1 && size > kHalvesBytes) {
       // Twice the file's size is allocated and only its first half used: once the text is freed,
       // the int32 view of the counts (4 bytes per line, at most 2 per byte of a pulse file) fits
       // in the freed block and reuses the pages the text mapped instead of mapping fresh ones

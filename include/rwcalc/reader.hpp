@@ -56,6 +56,11 @@ struct ReadOptions {
   /// Threads lent by the caller (crew.hpp): a regular file is then loaded in halves by this
   /// thread and a lender rather than by a thread started for it.
   Crew* crew = nullptr;
+  /// Storage to reuse for a pulse file read from a regular file: a vector (typically the counts32
+  /// of a record no longer needed) whose memory, pages already mapped, takes the text and then the
+  /// new record's 32-bit counts. It is moved from. `rwcalc batch` hands each worker's last record
+  /// to its next read. The result does not depend on it.
+  std::vector<std::int32_t>* reuse = nullptr;
 };
 
 /// Where the sample rate came from (reported in outputs).
