@@ -705,10 +705,33 @@ u128 second_diff_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m, 
   return total;
 }
 
-#if RWCALC_X86_DISPATCH
 namespace {
 
-/// Whether the sweep applies: AVX2, offsets below 2^24, an int32 view.
+// Terms per stretch of the shared sweep (a multiple of both block lengths).
+constexpr std::int64_t kSweepStretch = std::int64_t{1} << 16;
+
+/// The sweep over 64-bit counts (no int32 view: offsets of 2^30 or more): for the terms k in
+/// [from, to), in the blocks of kBlock terms that second_diff_sumsq_counts takes (from 0), the
+/// sums of every τ of ms[first], ms[first + step], … added to out[i] while the block is cached.
+/// The same blocks and kernels as per τ, so the same exact sums.
+void sweep_terms64(const std::int64_t* c, std::int64_t np, const std::int64_t* ms, std::size_t count,
+                   std::size_t first, std::size_t step, std::int64_t from, std::int64_t to, u128* out) {
+  for (std::int64_t k0 = from; k0 < to; k0 += kBlock) {
+    for (std::size_t i = first; i < count; i += step) {
+      const std::int64_t m = ms[i], n = np - 2 * m;
+      if (k0 >= n) continue;
+      const std::int64_t len = std::min(kBlock, n - k0);
+      double s = 0;
+      if (block_sumsq_contiguous(c + k0, c + k0 + m, c + k0 + 2 * m, len, &s))
+        out[i] += static_cast<std::uint64_t>(s);
+      else
+        out[i] += exact_block(c, k0, len, m, 1);
+    }
+  }
+}
+
+#if RWCALC_X86_DISPATCH
+/// Whether the int32 sweep applies: AVX2, offsets below 2^24, an int32 view.
 bool sweep_applies(const PreparedCounts& c) {
   static const bool avx2 = __builtin_cpu_supports("avx2");
   return avx2 && c.small24 && c.view;
@@ -728,41 +751,56 @@ void sweep_terms(const PreparedCounts& c, std::int64_t np, const std::int64_t* m
     }
   }
 }
+#else
+bool sweep_applies(const PreparedCounts&) { return false; }
+void sweep_terms(const PreparedCounts&, std::int64_t, const std::int64_t*, std::size_t, std::size_t, std::size_t,
+                 std::int64_t, std::int64_t, u128*) {}
+#endif
+
+/// Which sweep applies: the int32 one, the 64-bit one (counts without a view), or none.
+enum class Sweep { None, View24, Wide };
+Sweep sweep_kind(const PreparedCounts& c) {
+  if (sweep_applies(c)) return Sweep::View24;
+  if (!c.view && c.raw && !c.raw->empty()) return Sweep::Wide;
+  return Sweep::None;
+}
+
+void sweep_any(Sweep kind, const PreparedCounts& c, std::int64_t np, const std::int64_t* ms, std::size_t count,
+               std::size_t first, std::size_t step, std::int64_t from, std::int64_t to, u128* out) {
+  if (kind == Sweep::View24)
+    sweep_terms(c, np, ms, count, first, step, from, to, out);
+  else
+    sweep_terms64(c.raw->data(), np, ms, count, first, step, from, to, out);
+}
 
 }  // namespace
-#endif
 
 bool second_diff_sumsq_sweep(const PreparedCounts& c, std::size_t points, const std::int64_t* ms,
                              std::size_t count, std::size_t first, std::size_t step, u128* out) {
-#if RWCALC_X86_DISPATCH
-  if (!sweep_applies(c) || step == 0) return false;
+  const Sweep kind = sweep_kind(c);
+  if (kind == Sweep::None || step == 0) return false;
   const auto np = static_cast<std::int64_t>(points);
   std::int64_t longest = 0;
   for (std::size_t i = first; i < count; i += step) {
     out[i] = 0;
     longest = std::max(longest, np - 2 * ms[i]);
   }
-  sweep_terms(c, np, ms, count, first, step, 0, longest, out);
+  sweep_any(kind, c, np, ms, count, first, step, 0, longest, out);
   return true;
-#else
-  (void)c, (void)points, (void)ms, (void)count, (void)first, (void)step, (void)out;
-  return false;
-#endif
 }
 
 bool second_diff_sumsq_sweep_shared(const PreparedCounts& c, std::size_t points, const std::int64_t* ms,
                                     std::size_t count, Crew& crew, u128* out) {
-#if RWCALC_X86_DISPATCH
-  if (!sweep_applies(c) || count == 0) return false;
+  const Sweep kind = sweep_kind(c);
+  if (kind == Sweep::None || count == 0) return false;
   const auto np = static_cast<std::int64_t>(points);
   std::int64_t longest = 0;
   for (std::size_t i = 0; i < count; ++i) longest = std::max(longest, np - 2 * ms[i]);
-  constexpr std::int64_t kStretch = kBlock24 * 16;  // 64 K terms per stretch
-  const auto parts = static_cast<std::size_t>((longest + kStretch - 1) / kStretch);
+  const auto parts = static_cast<std::size_t>(std::max<std::int64_t>(0, (longest + kSweepStretch - 1) / kSweepStretch));
   std::vector<u128> sums(parts * count, 0);
   crew.share(parts, [&](std::size_t k) {
-    const std::int64_t from = static_cast<std::int64_t>(k) * kStretch;
-    sweep_terms(c, np, ms, count, 0, 1, from, std::min(longest, from + kStretch), sums.data() + k * count);
+    const std::int64_t from = static_cast<std::int64_t>(k) * kSweepStretch;
+    sweep_any(kind, c, np, ms, count, 0, 1, from, std::min(longest, from + kSweepStretch), sums.data() + k * count);
   });
   for (std::size_t i = 0; i < count; ++i) {
     u128 total = 0;
@@ -770,10 +808,6 @@ bool second_diff_sumsq_sweep_shared(const PreparedCounts& c, std::size_t points,
     out[i] = total;
   }
   return true;
-#else
-  (void)c, (void)points, (void)ms, (void)count, (void)crew, (void)out;
-  return false;
-#endif
 }
 
 double modified_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m) {

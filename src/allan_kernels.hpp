@@ -93,8 +93,10 @@ double modified_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m);
 /// Overlapping sums Σ_{k<N−2m} (C[k+2m] − 2C[k+m] + C[k])² for the cluster sizes ms[first],
 /// ms[first + step], … (ascending), all in one sweep over the data: each block of 4096 terms is
 /// taken for every m while it is in the core's cache, instead of streaming the whole int32 view once
-/// per m. Exact, so out[i] equals second_diff_sumsq(c, N − 2m, m, 1) bit for bit. Only for counts
-/// with every |C_k − C_0| < 2^24 on AVX2 machines; returns false (and writes nothing) otherwise.
+/// per m. Exact, so out[i] equals second_diff_sumsq(c, N − 2m, m, 1) bit for bit. For an int32
+/// view with every |C_k − C_0| < 2^24 on AVX2 machines, and for 64-bit counts that have no view
+/// (offsets of 2^30 or more: the blocks of 1024 terms of second_diff_sumsq_counts); returns false
+/// (and writes nothing) for any other view.
 bool second_diff_sumsq_sweep(const PreparedCounts& c, std::size_t points, const std::int64_t* ms,
                              std::size_t count, std::size_t first, std::size_t step, u128* out);
 

@@ -22,7 +22,8 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kCorrShrink = 0.2;  ///< weight of the identity in the mid-τ correlation matrix
 
-double median_of(std::vector<double> v) {
+/// The median of v's values (the upper one of an even count); reorders v.
+double median_of(std::vector<double>& v) {
   if (v.empty()) return 0.0;
   const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
   std::nth_element(v.begin(), mid, v.end());
@@ -245,17 +246,18 @@ SinusoidEstimate sinusoid_detect(const Decimated& d, double f_hint, bool estimat
   const auto gap = static_cast<std::size_t>(std::ceil(3.0 * pad));
   // Local level: the median of the periodogram over ±24 true bins around k (one value per true
   // bin, the main lobe left out), / ln 2 (the median of an exponential variable).
+  std::vector<double> v;  // the level's scratch, reused
+  v.reserve(64);
   auto level = [&](std::size_t k) {
     const auto W = static_cast<std::size_t>(24.0 * pad);
     const auto stepb = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(pad)));
-    std::vector<double> v;
-    v.reserve(64);
+    v.clear();
     const std::size_t a = k > W ? k - W : 1, b = std::min(half, k + W);
     for (std::size_t j = a; j <= b; j += stepb) {
       if (j + gap >= k && j <= k + gap) continue;
       v.push_back(P[j]);
     }
-    return median_of(std::move(v)) / std::log(2.0);
+    return median_of(v) / std::log(2.0);
   };
   const Peak peak = peak_over_level(P, k_lo, k_hi, pad, level);
   const double best = peak.ratio, best_level = peak.level;
@@ -304,7 +306,7 @@ LineCoefficients line_coefficients(std::vector<double> y, double tb, double f) {
     v.push_back(std::norm(spec[j]));
   }
   if (v.empty()) return c;
-  const double S = 2.0 * tb * (median_of(std::move(v)) / std::log(2.0)) / w2;  // one-sided, (°/h)²/Hz
+  const double S = 2.0 * tb * (median_of(v) / std::log(2.0)) / w2;  // one-sided, (°/h)²/Hz
   c.sigma = std::sqrt(S / T);
   return c;
 }

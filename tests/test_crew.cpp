@@ -142,6 +142,28 @@ std::vector<std::int64_t> pulse_counts(std::size_t n, std::uint64_t seed) {
   return c;
 }
 
+TEST(CrewPasses, TheWideSweepWithLendersAsWithout) {
+  // Counts whose offsets pass 2^30: no int32 view, the 64-bit sweep, shared in stretches.
+  auto c = pulse_counts((std::size_t{1} << 20) + 777, 6);
+  for (std::size_t k = 0; k < c.size(); ++k) c[k] += static_cast<std::int64_t>(k) * 2000;
+  const detail::PreparedCounts p = detail::prepare_counts(c, false, 1);
+  ASSERT_EQ(p.view, nullptr);
+  std::vector<std::int64_t> ms;
+  for (std::int64_t m = 1; 2 * m < static_cast<std::int64_t>(c.size()); m *= 2) ms.push_back(m);
+  std::vector<detail::u128> swept(ms.size());
+  ASSERT_TRUE(detail::second_diff_sumsq_sweep(p, c.size(), ms.data(), ms.size(), 0, 1, swept.data()));
+  for (int lenders : {0, 1}) {
+    LentCrew lc(lenders);
+    std::vector<detail::u128> shared(ms.size());
+    ASSERT_TRUE(detail::second_diff_sumsq_sweep_shared(p, c.size(), ms.data(), ms.size(), lc.crew, shared.data()));
+    for (std::size_t i = 0; i < ms.size(); ++i) {
+      EXPECT_TRUE(shared[i] == swept[i]) << "m " << ms[i];
+      const std::int64_t n = static_cast<std::int64_t>(c.size()) - 2 * ms[i];
+      EXPECT_TRUE(swept[i] == detail::second_diff_sumsq(p, n, ms[i], 1)) << "m " << ms[i];
+    }
+  }
+}
+
 TEST(CrewPasses, TheSamePassesWithLendersAsWithout) {
   const auto c = pulse_counts((std::size_t{1} << 21) + 12345, 5);
   const detail::PreparedCounts p1 = detail::prepare_counts(c, false, 1);

@@ -1,9 +1,11 @@
 // The vector kernels against plain loops: the exact overlapping second-difference sums of counts
 // (|C_k − C_0| < 2^24: AVX-512 or AVX2 where the processor has them) for every length around the
-// vector widths, one τ at a time and in one sweep; and the γ² sum of the AV-point covariance
+// vector widths, one τ at a time and in one sweep (and of 64-bit counts without an int32 view, in
+// one sweep); and the γ² sum of the AV-point covariance
 // (AVX-512 with its own logarithm) against the same sum with std::log.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -66,6 +68,39 @@ TEST(ExactKernels, SweepEqualsOneTauAtATimeNearTheRangeLimit) {
     EXPECT_TRUE(out[i] == brute_sumsq(c, n, ms[i])) << "m " << ms[i];
     EXPECT_TRUE(second_diff_sumsq(p, n, ms[i], 1) == out[i]) << "m " << ms[i];
   }
+}
+
+// Counts whose offsets pass 2^30 have no int32 view; their sweep takes the 64-bit kernel's blocks
+// of 1024 terms for every τ at once. Steps of up to 2^19 make some blocks' second differences pass
+// 2^21 (the kernel's exact floating range), so the exact 128-bit path of those blocks is taken too.
+TEST(ExactKernels, WideSweepEqualsOneTauAtATime) {
+  const auto w = walk(200'017, 1 << 12, 8);
+  std::vector<std::int64_t> c(w.size(), w[0]);
+  for (std::size_t k = 1; k < c.size(); ++k) {
+    std::int64_t step = w[k] - w[k - 1];
+    if (k % 5003 < 40) step += std::int64_t{1} << 19;  // second differences beyond 2^21
+    if (k > 100'000) step += std::int64_t{1} << 14;    // and offsets beyond 2^30
+    c[k] = c[k - 1] + step;
+  }
+  const PreparedCounts p = prepare_counts(c, false, 1);
+  ASSERT_EQ(p.view, nullptr) << "the offsets were meant to pass 2^30";
+  std::vector<std::int64_t> ms;
+  for (std::int64_t m = 1; 2 * m < static_cast<std::int64_t>(c.size()); m = m * 2 + (m % 3 == 0)) ms.push_back(m);
+  std::vector<u128> all(ms.size()), odd(ms.size());
+  ASSERT_TRUE(second_diff_sumsq_sweep(p, c.size(), ms.data(), ms.size(), 0, 1, all.data()));
+  ASSERT_TRUE(second_diff_sumsq_sweep(p, c.size(), ms.data(), ms.size(), 1, 2, odd.data()));
+  bool beyond = false;
+  for (std::size_t i = 0; i < ms.size(); ++i) {
+    const std::int64_t n = static_cast<std::int64_t>(c.size()) - 2 * ms[i];
+    const u128 want = second_diff_sumsq(p, n, ms[i], 1);
+    EXPECT_TRUE(want == brute_sumsq(c, n, ms[i])) << "m " << ms[i];
+    EXPECT_TRUE(all[i] == want) << "m " << ms[i];
+    if (i % 2 == 1) {
+      EXPECT_TRUE(odd[i] == want) << "m " << ms[i];
+    }
+    beyond = beyond || want > (static_cast<u128>(1) << 42) * static_cast<u128>(n);
+  }
+  EXPECT_TRUE(beyond) << "no block left the exact floating range";
 }
 
 TEST(CovarianceKernel, VectorSumAgreesWithTheScalarSum) {
