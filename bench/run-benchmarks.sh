@@ -2,7 +2,9 @@
 # End-to-end benchmark of rwcalc against the targets of docs/performance.md (issue "Speed and
 # scale"): builds the `bench` preset if needed, generates the standard inputs with
 # `rwcalc simulate` (cached under the build directory), times whole processes (median of
-# --repeat runs: wall clock, and user+sys CPU time; peak RSS from /usr/bin/time -v) and prints ONE
+# --repeat runs: wall clock from bash's EPOCHREALTIME and user+sys CPU time from its `time`,
+# around the bare process; peak RSS from
+# /usr/bin/time -v) and prints ONE
 # table with every target and the measured figure beside it, plus the NumPy baseline of the same
 # estimator. On a shared machine the CPU column is the load-independent figure.
 #
@@ -77,22 +79,29 @@ fi
 calc() { awk "BEGIN { print $1 }"; }  # arithmetic without bc
 loadavg() { cut -d' ' -f1 /proc/loadavg; }
 # measure N CMD...: run CMD N times; sets med_s (median wall s), cpu_s (median user+sys CPU s),
-# rss_mb (largest peak RSS, MB), status (exit status of the last failing run, else 0).
+# rss_mb (largest peak RSS, MB), status (exit status of the last failing run, else 0). Wall and
+# CPU time are the process's own, with no wrapper process in between: the wall from bash's
+# EPOCHREALTIME around it (µs), the CPU from bash's `time` (the child's rusage, ms); peak RSS comes
+# from /usr/bin/time -v around up to three further runs (GNU time's own start would otherwise add
+# 1–2 ms to every wall time).
 measure() {
   local n="$1"; shift
-  local times=() cpus=() t0 t1 rss=0 r u sy
+  local times=() cpus=() rss=0 r t0 t1 u sy
+  local TIMEFORMAT='%3U %3S'
   status=0
   for ((i = 0; i < n; i++)); do
     t0=$EPOCHREALTIME
-    if /usr/bin/time -v -o "$tmp/time.txt" "$@" >"$tmp/out.txt" 2>"$tmp/err.txt"; then :; else status=$?; fi
+    if { time "$@" >"$tmp/out.txt" 2>"$tmp/err.txt"; } 2>"$tmp/t.txt"; then :; else status=$?; fi
     t1=$EPOCHREALTIME
+    read -r u sy <"$tmp/t.txt" || true
     times+=("$(calc "$t1 - $t0")")
-    r=$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$tmp/time.txt")
-    u=$(sed -n 's/.*User time (seconds): //p' "$tmp/time.txt")
-    sy=$(sed -n 's/.*System time (seconds): //p' "$tmp/time.txt")
     cpus+=("$(calc "${u:-0} + ${sy:-0}")")
-    ((r > rss)) && rss=$r
     ((status)) && break
+    if ((i < 3)); then
+      /usr/bin/time -v -o "$tmp/time.txt" "$@" >/dev/null 2>&1 || true
+      r=$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$tmp/time.txt")
+      ((${r:-0} > rss)) && rss=$r
+    fi
   done
   med_s=$(median "${times[@]}")
   cpu_s=$(median "${cpus[@]}")
