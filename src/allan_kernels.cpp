@@ -560,6 +560,22 @@ void finish_prepared(PreparedCounts& p, std::uint64_t top, bool need_prefix) {
     p.prefix_u64 = wide_prefix_sums(p);
   }
 }
+
+// Records of at least this many points share their range passes with a crew.
+constexpr std::size_t kSharedRangeFrom = std::size_t{1} << 20;
+
+/// pass(begin, end, lo, hi) over [0, n) in stretches of 2^18 that the calling thread and the
+/// crew's lenders take as they are free; lo and hi the smallest and largest of the stretches'.
+template <class Pass>
+void shared_range(Crew& crew, std::size_t n, Pass&& pass, std::int64_t& lo, std::int64_t& hi) {
+  constexpr std::size_t kStretch = std::size_t{1} << 18;
+  const std::size_t parts = (n + kStretch - 1) / kStretch;
+  std::vector<std::int64_t> los(parts, 0), his(parts, 0);
+  crew.share(parts, [&](std::size_t k) { pass(k * kStretch, std::min(n, (k + 1) * kStretch), los[k], his[k]); });
+  lo = *std::min_element(los.begin(), los.end());
+  hi = *std::max_element(his.begin(), his.end());
+}
+
 }  // namespace
 
 PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_prefix, unsigned threads, Crew* crew) {
@@ -587,16 +603,9 @@ PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_pref
     offsets_pass_scalar(c.data(), p.rel32.data(), begin, end, c0, lo_out, hi_out);
   };
   std::int64_t lo = 0, hi = 0;
-  if (crew && c.size() >= (std::size_t{1} << 20)) {  // stretches for whoever is free
-    constexpr std::size_t kStretch = std::size_t{1} << 18;
-    const std::size_t parts = (c.size() + kStretch - 1) / kStretch;
-    std::vector<std::int64_t> los(parts, 0), his(parts, 0);
-    crew->share(parts, [&](std::size_t k) {
-      pass(k * kStretch, std::min(c.size(), (k + 1) * kStretch), los[k], his[k]);
-    });
-    lo = *std::min_element(los.begin(), los.end());
-    hi = *std::max_element(his.begin(), his.end());
-  } else if (threads > 1 && c.size() >= (std::size_t{1} << 20)) {  // long records: the two halves side by side
+  if (crew && c.size() >= kSharedRangeFrom) {  // stretches for whoever is free
+    shared_range(*crew, c.size(), pass, lo, hi);
+  } else if (threads > 1 && c.size() >= kSharedRangeFrom) {  // long records: the two halves side by side
     std::int64_t lo2 = 0, hi2 = 0;
     const std::size_t mid = c.size() / 2;
     {
@@ -650,16 +659,11 @@ PreparedCounts prepare_counts(const PhaseSeries& x, bool need_prefix, unsigned t
     p.view = p.rel32.data();
   }
   std::int64_t lo = 0, hi = 0;
-  if (crew && c.size() >= (std::size_t{1} << 20)) {  // stretches for whoever is free
-    constexpr std::size_t kStretch = std::size_t{1} << 18;
-    const std::size_t parts = (c.size() + kStretch - 1) / kStretch;
-    std::vector<std::int64_t> los(parts, 0), his(parts, 0);
-    crew->share(parts, [&](std::size_t k) {
-      const std::size_t b = k * kStretch;
-      range_i32(p.view + b, std::min(c.size() - b, kStretch), los[k], his[k]);
-    });
-    lo = *std::min_element(los.begin(), los.end());
-    hi = *std::max_element(his.begin(), his.end());
+  if (crew && c.size() >= kSharedRangeFrom) {  // stretches for whoever is free
+    shared_range(
+        *crew, c.size(),
+        [&p](std::size_t b, std::size_t e, std::int64_t& l, std::int64_t& h) { range_i32(p.view + b, e - b, l, h); }, lo,
+        hi);
   } else {
     range_i32(p.view, c.size(), lo, hi);
   }

@@ -970,10 +970,10 @@ bool Reader::int_run_narrow(const char*& p, const char* limit) {
   };
   out.clear();
   out.reserve(slots);
-  // Its pages in a few calls (in a host, the text's pages are mapped already).
-  const auto room = static_cast<std::size_t>(hosted ? std::max<std::ptrdiff_t>(text - reinterpret_cast<const char*>(out.data()), 0)
-                                                    : static_cast<std::ptrdiff_t>(out.capacity() * sizeof(std::int32_t)));
-  detail::prefault(out.data(), room);
+  // Its pages in a few calls; in a host, those before the text (the text's are mapped already).
+  const char* storage = reinterpret_cast<const char*>(out.data());
+  detail::prefault(out.data(), hosted ? static_cast<std::size_t>(std::max(text - storage, std::ptrdiff_t{0}))
+                                      : out.capacity() * sizeof(std::int32_t));
   out.insert(out.end(), ints_.begin(), ints_.end());  // each value's low 32 bits (below: why they suffice)
   if (hosted && written_end() > p) return give_up();
   std::vector<std::int64_t> part;

@@ -364,27 +364,25 @@ TextBuffer load_source(const std::string& path, unsigned threads, Crew* crew, st
     // One spare byte lets the final read(2) see end-of-file without growing the buffer.
     constexpr std::size_t kHalvesBytes = std::size_t{4} << 20;
     const auto size = static_cast<std::size_t>(st.st_size);
-    if (S_ISREG(st.st_mode) && host) {
-      // A pulse file: the text at the end of the counts' storage (TextBuffer's host).
+    const bool regular = S_ISREG(st.st_mode);
+    const bool halves = regular && threads > 1 && size > kHalvesBytes;
+    if (regular && host) {
+      // A pulse file: the text at the end of the counts' storage (TextBuffer's host); its pages
+      // are mapped here, or by each loading thread for its half.
       raw = TextBuffer(std::move(*host), size + 1);
-      if (threads > 1 && size > kHalvesBytes) {
-        if (!read_halves(fd.get(), size, raw, name, crew) && ::lseek(fd.get(), 0, SEEK_SET) < 0)
-          fail_errno(name, "cannot seek", errno);
-      } else {
-        prefault(raw.data(), size + 1);
-      }
-    } else if (S_ISREG(st.st_mode) && threads > 1 && size > kHalvesBytes) {
+      if (!halves) prefault(raw.data(), size + 1);
+    } else if (halves) {
       // Twice the file's size is allocated and only its first half used: once the text is freed,
       // the int32 view of the counts (4 bytes per line, at most 2 per byte of a pulse file) fits
       // in the freed block and reuses the pages the text mapped instead of mapping fresh ones
       // (the heap keeps blocks below M_MMAP_THRESHOLD mapped, src/main.cpp). The untouched half
       // costs address space only. Performance only: nothing depends on where the view lives.
       raw = TextBuffer(size + 1, false, size);
-      if (!read_halves(fd.get(), size, raw, name, crew) && ::lseek(fd.get(), 0, SEEK_SET) < 0)
-        fail_errno(name, "cannot seek", errno);
     } else {
-      raw.reserve(S_ISREG(st.st_mode) ? size + 1 : std::size_t{1} << 20);
+      raw.reserve(regular ? size + 1 : std::size_t{1} << 20);
     }
+    if (halves && !read_halves(fd.get(), size, raw, name, crew) && ::lseek(fd.get(), 0, SEEK_SET) < 0)
+      fail_errno(name, "cannot seek", errno);
     read_all(fd.get(), raw, name);
   }
   if (is_gzip(raw.view())) return inflate_gzip(raw.view(), name);
