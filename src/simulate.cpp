@@ -280,8 +280,6 @@ struct Simulator::Impl {
   std::size_t flicker_hold = 1; // samples each flicker rate value is held for (D)
   double tau0 = 0.0;
   double q = 0.0;
-  std::vector<double> inc;  // angle increment of each interval, ″ (index k−1 for interval k)
-  std::vector<double> work;
   // Flicker: the Kasdin filter's spectrum, computed once per length.
   std::size_t fft_size = 0;
   Eigen::FFT<double> fft;
@@ -301,7 +299,6 @@ struct Simulator::Impl {
     }
     tau0 = settings.tau0_s();
     q = settings.scale_arcsec;
-    inc.resize(n);
     fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
     if (model.bias_instability_deg_per_h > 0) prepare_flicker();
     for (const auto& g : model.gauss_markov)
@@ -328,11 +325,11 @@ struct Simulator::Impl {
     flicker.resize(fft_size);
   }
 
-  // Flicker rate samples x_0..x_{n−1}, ″/s, added to inc as x·τ0. The white input's DFT is
-  // drawn directly (its bins are independent complex normals), which saves the forward FFT.
-  // On the Ensemble path x is the Kasdin sequence at τd = D·τ0 (Q_d = B² keeps the low-frequency
-  // PSD B²/(πf) of the exact path), held over each block of D samples.
-  void add_flicker(std::uint64_t seed) {
+  // Flicker rate samples x_0..x_{n−1}, ″/s (added to the increments as x·τ0 in `Pass`). The
+  // white input's DFT is drawn directly (its bins are independent complex normals), which saves
+  // the forward FFT. On the Ensemble path x is the Kasdin sequence at τd = D·τ0 (Q_d = B² keeps
+  // the low-frequency PSD B²/(πf) of the exact path), held over each block of D samples.
+  void make_flicker(std::uint64_t seed) {
     Rng rng(seed, kFlickerStream);
     const double b = model.bias_instability_deg_per_h;  // Q_d = B²
     const double len = static_cast<double>(fft_size);
@@ -346,26 +343,95 @@ struct Simulator::Impl {
     }
     spectrum[half] = filter_spectrum[half] * s_edge * rng.normal();
     fft.inv(flicker.data(), spectrum.data(), static_cast<Eigen::Index>(fft_size));
-    if (flicker_hold == 1) {
-      for (std::size_t k = 0; k < n; ++k) inc[k] += flicker[k] * tau0;
-      return;
-    }
-    for (std::size_t j = 0, k = 0; j < flicker_n; ++j) {
-      const double step = flicker[j] * tau0;
-      for (const std::size_t end = std::min(n, k + flicker_hold); k < end; ++k) inc[k] += step;
-    }
   }
 
-  void add_deterministic() {
+  // One realisation, generated in blocks of kBlock samples that stay in L1: each term adds its
+  // angle increments of the block (″; x[j] is the increment of interval b + j + 1) in a fixed
+  // order, with its state (random streams, integrated rates) carried from block to block, and
+  // the read-out counts the block's pulses. Every term draws from its own stream in sample order,
+  // so a record does not depend on the block length except through the rounding of the angle's
+  // running sum (quantize_block).
+  static constexpr std::size_t kBlock = 256;
+  struct Pass {
+    Rng arw, rrw, readout, white;
+    std::vector<Rng> gm;
+    std::vector<double> gm_eps;
+    double rrw_omega = 0.0;
+    double lp_y = 0.0, lp_arw_eps = 0.0;
+    Rng lp_arw;
+    double phase0 = 0.0, wa = 0.0, inv_q = 0.0;
+    std::int64_t whole = 0;
+    double frac = 0.0;
+    bool dither = false;
+    Pass(std::uint64_t seed)
+        : arw(seed, kArwStream), rrw(seed, kRrwStream), readout(seed, kReadoutStream),
+          white(seed, kWhiteAngleStream),
+          lp_arw(seed, kGaussMarkovStream0 + std::numeric_limits<std::uint32_t>::max()) {}
+  };
+
+  void run(std::uint64_t seed, PhaseSeries& out) {
+    if (model.bias_instability_deg_per_h > 0) make_flicker(seed);
+    Pass st(seed);
+    for (std::size_t i = 0; i < gm_steps.size(); ++i) {
+      st.gm.emplace_back(seed, kGaussMarkovStream0 + i);
+      st.gm_eps.push_back(st.gm.back().normal() * gm_steps[i].sigma0);  // stationary start
+    }
+    if (model.lowpass_tc_s > 0 && model.arw_deg_per_sqrt_h > 0)
+      st.lp_arw_eps = lowpass_arw.sigma0 * st.lp_arw.normal();
+    start_quantize(st, out);
+    double x[kBlock];
+    for (std::size_t b = 0; b < n; b += kBlock) {
+      const std::size_t len = std::min(kBlock, n - b);
+      deterministic_block(b, len, x);
+      if (model.rrw_deg_per_h_per_sqrt_h > 0) rrw_block(st, len, x);
+      if (model.bias_instability_deg_per_h > 0) {
+        if (flicker_hold == 1) {
+          for (std::size_t j = 0; j < len; ++j) x[j] += flicker[b + j] * tau0;
+        } else {
+          // Held values: the one at b and its hold's remaining samples, then whole holds.
+          std::size_t v = b / flicker_hold, left = flicker_hold - b % flicker_hold;
+          for (std::size_t j = 0; j < len; ++v, left = flicker_hold) {
+            const double step = flicker[v] * tau0;
+            for (const std::size_t end = std::min(len, j + left); j < end; ++j) x[j] += step;
+          }
+        }
+      }
+      for (std::size_t i = 0; i < gm_steps.size(); ++i)
+        if (model.gauss_markov[i].sigma_deg_per_h > 0) gm_block(st.gm[i], st.gm_eps[i], gm_steps[i], len, x);
+      if (model.lowpass_tc_s > 0) lowpass_block(st, b == 0, len, x);
+      if (model.arw_deg_per_sqrt_h > 0) {
+        if (model.lowpass_tc_s > 0) {
+          gm_block(st.lp_arw, st.lp_arw_eps, lowpass_arw, len, x);
+        } else {
+          const double s = units::sqrt_s_per_sqrt_h * model.arw_deg_per_sqrt_h * std::sqrt(tau0);
+          double z[kBlock];
+          st.arw.fill_normal(z, len, s);
+          for (std::size_t j = 0; j < len; ++j) x[j] += z[j];
+        }
+      }
+      quantize_block(st, b, len, x, out);
+    }
+    if (model.output_lowpass_tc_s > 0) output_lowpass(out);
+  }
+
+  // The rate terms known in closed form: constant rate and ramp, sinusoids, bias steps, warm-up
+  // transients, temperature-driven bias (each as the difference of its angle at the interval's
+  // ends where it has one).
+  void deterministic_block(std::size_t b, std::size_t len, double* x) const {
     const double omega = model.bias_deg_per_h + model.earth_rate_deg_per_h;  // ″/s
     const double r_s = model.ramp_deg_per_h2 / units::seconds_per_hour;      // ″/s²
     const double ramp_unit = 0.5 * r_s * tau0 * tau0;
-    for (std::size_t k = 0; k < n; ++k) inc[k] = omega * tau0 + ramp_unit * (2.0 * static_cast<double>(k) + 1.0);
+    const double base = omega * tau0;
+    if (ramp_unit == 0.0) {
+      std::fill_n(x, len, base);  // base + 0·(2k + 1), without the per-sample conversion
+    } else {
+      for (std::size_t j = 0; j < len; ++j) x[j] = base + ramp_unit * (2.0 * static_cast<double>(b + j) + 1.0);
+    }
     auto add_angle = [&](auto&& angle) {
-      double prev = angle(0.0);
-      for (std::size_t k = 0; k < n; ++k) {
-        const double cur = angle(static_cast<double>(k + 1) * tau0);
-        inc[k] += cur - prev;
+      double prev = angle(static_cast<double>(b) * tau0);
+      for (std::size_t j = 0; j < len; ++j) {
+        const double cur = angle(static_cast<double>(b + j + 1) * tau0);
+        x[j] += cur - prev;
         prev = cur;
       }
     };
@@ -376,15 +442,15 @@ struct Simulator::Impl {
     }
     for (const auto& st : model.bias_steps) {
       const auto first = static_cast<std::size_t>(std::max(0.0, std::floor(st.t_s / tau0)));
-      for (std::size_t k = first; k < n; ++k) {
-        const double t1 = static_cast<double>(k) * tau0, t2 = t1 + tau0;
-        inc[k] += st.size_deg_per_h * (t2 - std::max(t1, st.t_s));
+      for (std::size_t j = first > b ? first - b : 0; j < len; ++j) {
+        const double t1 = static_cast<double>(b + j) * tau0, t2 = t1 + tau0;
+        x[j] += st.size_deg_per_h * (t2 - std::max(t1, st.t_s));
       }
     }
     for (const auto& w : model.warmups) {
       const double decay = -std::expm1(-tau0 / w.tc_s);
-      for (std::size_t k = 0; k < n; ++k)
-        inc[k] += w.amp_deg_per_h * w.tc_s * std::exp(-static_cast<double>(k) * tau0 / w.tc_s) * decay;
+      for (std::size_t j = 0; j < len; ++j)
+        x[j] += w.amp_deg_per_h * w.tc_s * std::exp(-static_cast<double>(b + j) * tau0 / w.tc_s) * decay;
     }
     if (model.temperature_bias) {
       const auto& tb = *model.temperature_bias;
@@ -395,63 +461,90 @@ struct Simulator::Impl {
     }
   }
 
-  void add_rrw(std::uint64_t seed) {
+  void rrw_block(Pass& st, std::size_t len, double* x) const {
     // Exact two-state step: Ω' = Ω + w1, Δθ = Ωτ0 + w2, Cov = K²[[τ0, τ0²/2], [τ0²/2, τ0³/3]].
     const double k_s = model.rrw_deg_per_h_per_sqrt_h / units::sqrt_s_per_sqrt_h;
     const double l11 = k_s * std::sqrt(tau0);
     const double l21 = k_s * tau0 * std::sqrt(tau0) / 2.0;
     const double l22 = k_s * tau0 * std::sqrt(tau0) / std::sqrt(12.0);
-    Rng rng(seed, kRrwStream);
-    double omega = 0.0;
-    for (std::size_t k = 0; k < n; ++k) {
-      const double z1 = rng.normal(), z2 = rng.normal();
-      inc[k] += omega * tau0 + l21 * z1 + l22 * z2;
+    double omega = st.rrw_omega;
+    for (std::size_t j = 0; j < len; ++j) {
+      const double z1 = st.rrw.normal(), z2 = st.rrw.normal();
+      x[j] += omega * tau0 + l21 * z1 + l22 * z2;
       omega += l11 * z1;
     }
+    st.rrw_omega = omega;
   }
 
-  void add_gm(std::uint64_t seed, std::size_t index, const GmStep& st) {
-    Rng rng(seed, kGaussMarkovStream0 + index);
-    double eps = st.sigma0 * rng.normal();  // stationary start
-    for (std::size_t k = 0; k < n; ++k) {
+  static void gm_block(Rng& rng, double& state, const GmStep& st, std::size_t len, double* x) {
+    double eps = state;
+    for (std::size_t j = 0; j < len; ++j) {
       const double z1 = rng.normal(), z2 = rng.normal();
-      inc[k] += st.gain * eps + st.l21 * z1 + st.l22 * z2;
+      x[j] += st.gain * eps + st.l21 * z1 + st.l22 * z2;
       eps = st.phi * eps + st.l11 * z1;
     }
+    state = eps;
   }
 
   // First-order low-pass of the sensed rate, exact for a rate constant over each sample:
   // y_k = φy_{k−1} + (1−φ)r_k and ∫y = r_kτ0 − τf(y_k − y_{k−1}). Starts in steady state.
-  void lowpass_increments() {
+  void lowpass_block(Pass& st, bool first, std::size_t len, double* x) const {
     const double tf = model.lowpass_tc_s;
     const double phi = std::exp(-tau0 / tf);
-    double y = inc[0] / tau0;
-    for (std::size_t k = 0; k < n; ++k) {
-      const double r = inc[k] / tau0;
+    double y = first ? x[0] / tau0 : st.lp_y;
+    for (std::size_t j = 0; j < len; ++j) {
+      const double r = x[j] / tau0;
       const double y_new = phi * y + (1.0 - phi) * r;
-      inc[k] = r * tau0 - tf * (y_new - y);
+      x[j] = r * tau0 - tf * (y_new - y);
       y = y_new;
     }
+    st.lp_y = y;
   }
 
-  void run(std::uint64_t seed, PhaseSeries& out) {
-    add_deterministic();
-    if (model.rrw_deg_per_h_per_sqrt_h > 0) add_rrw(seed);
-    if (model.bias_instability_deg_per_h > 0) add_flicker(seed);
-    for (std::size_t i = 0; i < gm_steps.size(); ++i)
-      if (model.gauss_markov[i].sigma_deg_per_h > 0) add_gm(seed, i, gm_steps[i]);
-    if (model.lowpass_tc_s > 0) lowpass_increments();
-    if (model.arw_deg_per_sqrt_h > 0) {
-      if (model.lowpass_tc_s > 0) {
-        add_gm(seed, std::numeric_limits<std::uint32_t>::max(), lowpass_arw);
-      } else {
-        Rng rng(seed, kArwStream);
-        const double s = units::sqrt_s_per_sqrt_h * model.arw_deg_per_sqrt_h * std::sqrt(tau0);
-        for (std::size_t k = 0; k < n; ++k) inc[k] += s * rng.normal();
-      }
+  // Count whole pulses. The angle is carried as whole pulses `whole` plus a fraction in [0, 1),
+  // so its resolution does not degrade as the count grows. Within a block the angle is a running
+  // sum from the block's fraction (at most kBlock increments, so its resolution stays far below a
+  // pulse), and each sample's count is a floor of its own, off the running sum's dependency
+  // chain; the whole pulses move into `whole` at the block's end.
+  void start_quantize(Pass& st, PhaseSeries& out) const {
+    out.kind = PhaseKind::Gyro;
+    out.tau0_s = tau0;
+    out.arcsec_per_count = q;
+    out.values.clear();
+    out.counts32.clear();
+    out.counts.resize(n + 1);
+    st.dither = model.readout == ReadoutMode::White;
+    st.wa = model.white_angle_arcsec / q;
+    st.inv_q = 1.0 / q;
+    st.phase0 = st.readout.uniform();
+    // The first count: angle 0, its own read-out draw (and white angle noise).
+    const double e0 = st.wa > 0 ? st.wa * st.white.normal() : 0.0;
+    const std::int64_t c0 = floor_to_int((st.dither ? st.readout.uniform() : st.phase0) + e0);
+    out.counts[0] = 0;
+    st.whole = -c0;
+    st.frac = 0.0;
+  }
+
+  static void quantize_block(Pass& st, std::size_t b, std::size_t len, double* x, PhaseSeries& out) {
+    double acc = st.frac;
+    for (std::size_t j = 0; j < len; ++j) {
+      acc += x[j] * st.inv_q;
+      x[j] = acc;
     }
-    quantize(seed, out);
-    if (model.output_lowpass_tc_s > 0) output_lowpass(out);
+    // Read-out offsets (dither or the fixed phase) plus white angle noise, in pulses.
+    double extra[kBlock];
+    if (st.dither) {
+      for (std::size_t j = 0; j < len; ++j) extra[j] = st.readout.uniform();
+    } else {
+      std::fill_n(extra, len, st.phase0);
+    }
+    if (st.wa > 0)
+      for (std::size_t j = 0; j < len; ++j) extra[j] += st.wa * st.white.normal();
+    std::int64_t* c = out.counts.data() + b + 1;
+    for (std::size_t j = 0; j < len; ++j) c[j] = st.whole + floor_to_int(x[j] + extra[j]);
+    const std::int64_t fl = floor_to_int(acc);
+    st.whole += fl;
+    st.frac = acc - static_cast<double>(fl);
   }
 
   // First-order low-pass in the output chain: the read-out's per-sample rate
@@ -472,41 +565,6 @@ struct Simulator::Impl {
     }
     out.counts.clear();
     out.counts32.clear();
-  }
-
-  // Count whole pulses. The angle is carried as whole pulses `whole` plus a fraction in [0, 1),
-  // so its resolution does not degrade as the count grows.
-  void quantize(std::uint64_t seed, PhaseSeries& out) {
-    out.kind = PhaseKind::Gyro;
-    out.tau0_s = tau0;
-    out.arcsec_per_count = q;
-    out.values.clear();
-    out.counts32.clear();
-    out.counts.resize(n + 1);
-    Rng readout(seed, kReadoutStream);
-    Rng white(seed, kWhiteAngleStream);
-    const bool dither = model.readout == ReadoutMode::White;
-    const double wa = model.white_angle_arcsec / q;
-    const double inv_q = 1.0 / q;
-    const double phase0 = readout.uniform();
-    std::int64_t whole = 0;
-    double frac = 0.0;
-    auto count = [&](double extra) {
-      const double u = dither ? readout.uniform() : phase0;
-      const double y = frac + u + extra;  // extra: white angle noise in pulses (not accumulated)
-      return whole + floor_to_int(y);
-    };
-    const double e0 = wa > 0 ? wa * white.normal() : 0.0;
-    const std::int64_t c0 = count(e0);
-    out.counts[0] = 0;
-    for (std::size_t k = 0; k < n; ++k) {
-      frac += inc[k] * inv_q;
-      const std::int64_t fl = floor_to_int(frac);
-      whole += fl;
-      frac -= static_cast<double>(fl);
-      const double e = wa > 0 ? wa * white.normal() : 0.0;
-      out.counts[k + 1] = count(e) - c0;
-    }
   }
 };
 

@@ -96,6 +96,29 @@ TEST(EnsemblePath, RecordLengthNotAMultipleOfTheDecimation) {
   }
 }
 
+TEST(EnsemblePath, GoldenChecksumPinsTheHeldFlicker) {
+  // 1001 samples: the simulator's blocks end inside flicker holds of D = 40 samples and the record
+  // ends inside a block, so this pins the held flicker across block edges with the rest of the
+  // generator (Simulate.GoldenChecksumPinsTheGenerator pins the Exact path).
+  NoiseModel m;
+  m.arw_deg_per_sqrt_h = 0.001;
+  m.bias_instability_deg_per_h = 0.008;
+  m.earth_rate_deg_per_h = earth_rate_at(55.75);
+  m.readout = ReadoutMode::White;
+  Simulator fast(m, short_record(1001), SimulationPath::Ensemble);
+  PhaseSeries p;
+  fast.run(5, p);
+  const auto c = pulse_increments(p);
+  ASSERT_EQ(c.size(), 1001u);
+  std::uint64_t h = 1469598103934665603ULL;  // FNV-1a over the increments' bytes
+  for (const auto x : c)
+    for (int i = 0; i < 8; ++i) {
+      h ^= (static_cast<std::uint64_t>(x) >> (8 * i)) & 0xff;
+      h *= 1099511628211ULL;
+    }
+  EXPECT_EQ(h, 1007802909734560938ULL) << h;
+}
+
 TEST(SimulateEnsemble, SameRecordsWhateverTheThreadCount) {
   const auto m = gl2d_model();
   const auto s = short_record();
