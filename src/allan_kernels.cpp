@@ -671,6 +671,38 @@ PreparedCounts prepare_counts(const PhaseSeries& x, bool need_prefix, unsigned t
   return p;
 }
 
+PreparedCounts prepare_second_differences(const PhaseSeries& x) {
+  PreparedCounts p = prepare_counts(x, false);
+  if (p.view || !p.raw || p.points < 2) return p;
+  const std::vector<std::int64_t>& c = *p.raw;
+  // s = round((C_{P−1} − C_0)/(P − 1)) in 128-bit arithmetic; the offsets modulo 2^64 (their
+  // second differences are exact in that ring, and so in the int32 range checked below).
+  const i128 span = static_cast<i128>(c.back()) - static_cast<i128>(c.front());
+  const auto steps = static_cast<i128>(p.points - 1);
+  const i128 half = steps / 2;
+  const i128 s128 = span >= 0 ? (span + half) / steps : -((-span + half) / steps);
+  const auto s = static_cast<std::uint64_t>(static_cast<std::int64_t>(s128));
+  const auto c0 = static_cast<std::uint64_t>(c.front());
+  constexpr std::int64_t kLimit = std::int64_t{1} << 30;
+  std::int64_t lo = 0, hi = 0;
+  p.rel32.resize(c.size());
+  std::uint64_t line = c0;
+  for (std::size_t k = 0; k < c.size(); ++k, line += s) {
+    const auto d = static_cast<std::int64_t>(static_cast<std::uint64_t>(c[k]) - line);
+    lo = d < lo ? d : lo;
+    hi = d > hi ? d : hi;
+    p.rel32[k] = static_cast<std::int32_t>(d);
+  }
+  if (lo <= -kLimit || hi >= kLimit) {
+    p.rel32.clear();
+    p.rel32.shrink_to_fit();
+    return p;
+  }
+  p.view = p.rel32.data();
+  finish_prepared(p, static_cast<std::uint64_t>(std::max(-lo, hi)), false);
+  return p;
+}
+
 u128 second_diff_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m, std::int64_t stride) {
   if (!c.view) return second_diff_sumsq_counts(c.raw->data(), n, m, stride);
   const std::int32_t* r = c.view;

@@ -87,6 +87,13 @@ PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_pref
 /// The same for a series' exact counts: those held in 32 bits (PhaseSeries::counts32) are viewed
 /// where they are, with no copy; the range flags come from one pass over them.
 PreparedCounts prepare_counts(const PhaseSeries& x, bool need_prefix, unsigned threads = 1, Crew* crew = nullptr);
+/// Counts prepared for second-difference sums only (second_diff_sumsq and its sweep, nothing that
+/// reads the offsets themselves): as prepare_counts(x, false) when the offsets fit the int32 view;
+/// otherwise the view holds C_k − C_0 − k·s, the offsets from a line of a whole number s of
+/// pulses per sample (the rounded mean), when those fit. A line of whole pulses has second
+/// differences of exactly 0, so every sum is the counts' own; a record whose offsets are wide only
+/// because of its mean rate (a fine pulse, a fast rate) gets the narrow kernels.
+PreparedCounts prepare_second_differences(const PhaseSeries& x);
 u128 second_diff_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m, std::int64_t stride);
 double modified_sumsq(const PreparedCounts& c, std::int64_t n, std::int64_t m);
 

@@ -31,8 +31,9 @@ std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSett
         st.octave_var.resize(octave_m.size());
         if (s.exact()) {
           // The counts prepared once for all cluster sizes (allan_variance would redo it per m),
-          // and every cluster size's sum in one sweep over them where it applies (the same sums).
-          const auto prepared = detail::prepare_counts(s, false);
+          // off a line of whole pulses per sample when the offsets are wide (a floating record's
+          // fine pulse), and every cluster size's sum in one sweep over them (the same sums).
+          const auto prepared = detail::prepare_second_differences(s);
           const double q = s.arcsec_per_count;
           std::vector<detail::u128> swept(octave_m.size());
           const bool sweep =

@@ -106,25 +106,43 @@ std::vector<double> decimated_avar(const Decimated& d, const std::vector<std::si
 
 namespace {
 
-/// A periodogram's largest ratio to its local level over bins [k_lo, k_hi], the level (of a bin,
-/// by `level`) taken afresh every 4 true bins (pad padded bins each); ratio 0 when no level is
-/// positive.
+/// A periodogram's largest ratio to its local level over bins [k_lo, k_hi] (the first bin of the
+/// largest), the level taken afresh every 4 true bins (pad padded bins each) for the group of bins
+/// up to the next: the median of the values `window(k)` fills in for the group's first bin k, over
+/// `divisor`. Ratio 0 when no level is positive.
+///
+/// The median (a selection, most of the search's time) is taken only for a group that can beat
+/// the best ratio so far: its largest bin g can give g/level > best only if the median M is below
+/// g·divisor/best, i.e. if more than half the window lies below that bound — a count, branch-free.
+/// A group is skipped only when M is at least the bound times (1 + 1e-9), so that its rounded
+/// ratios cannot exceed the best: the result is the one every group's median gives.
 struct Peak {
   double ratio = 0, level = 0;
   std::size_t k = 0;
 };
-template <class Level>
-Peak peak_over_level(const std::vector<double>& P, std::size_t k_lo, std::size_t k_hi, double pad, Level& level) {
+template <class Window>
+Peak peak_over_level(const std::vector<double>& P, std::size_t k_lo, std::size_t k_hi, double pad, Window& window,
+                     double divisor) {
   Peak best;
   best.k = k_lo;
   const std::size_t stride = std::max<std::size_t>(1, static_cast<std::size_t>(pad));
-  double lev = 0;
-  for (std::size_t k = k_lo; k <= k_hi; ++k) {
-    if ((k - k_lo) % (4 * stride) == 0) lev = level(k);
+  const std::size_t group = 4 * stride;
+  for (std::size_t k0 = k_lo; k0 <= k_hi; k0 += group) {
+    const std::size_t k1 = std::min(k_hi, k0 + group - 1);
+    std::vector<double>& v = window(k0);
+    if (best.ratio > 0) {
+      double g = 0;
+      for (std::size_t k = k0; k <= k1; ++k) g = P[k] > g ? P[k] : g;
+      const double bound = g * divisor / best.ratio * (1.0 + 1e-9);
+      std::size_t below = 0;
+      for (const double x : v) below += x < bound;
+      if (below <= v.size() / 2) continue;  // the median is at least the bound
+    }
+    const double lev = median_of(v) / divisor;
     if (lev <= 0) continue;
-    const double r = P[k] / lev;
-    if (r > best.ratio) {
-      best = {r, lev, k};
+    for (std::size_t k = k0; k <= k1; ++k) {
+      const double r = P[k] / lev;
+      if (r > best.ratio) best = {r, lev, k};
     }
   }
   return best;
@@ -248,7 +266,7 @@ SinusoidEstimate sinusoid_detect(const Decimated& d, double f_hint, bool estimat
   // bin, the main lobe left out), / ln 2 (the median of an exponential variable).
   std::vector<double> v;  // the level's scratch, reused
   v.reserve(64);
-  auto level = [&](std::size_t k) {
+  auto window = [&](std::size_t k) -> std::vector<double>& {
     const auto W = static_cast<std::size_t>(24.0 * pad);
     const auto stepb = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(pad)));
     v.clear();
@@ -257,9 +275,9 @@ SinusoidEstimate sinusoid_detect(const Decimated& d, double f_hint, bool estimat
       if (j + gap >= k && j <= k + gap) continue;
       v.push_back(P[j]);
     }
-    return median_of(v) / std::log(2.0);
+    return v;
   };
-  const Peak peak = peak_over_level(P, k_lo, k_hi, pad, level);
+  const Peak peak = peak_over_level(P, k_lo, k_hi, pad, window, std::log(2.0));
   const double best = peak.ratio, best_level = peak.level;
   const std::size_t kbest = peak.k;
   e.statistic = best;
@@ -409,7 +427,7 @@ LineEstimate line_detect(const PhaseSeries& x, double f_min, double f_hint, bool
     v.reserve(64);
     // Local level: the median of one value per true bin over ±24 true bins (main lobe left out);
     // at the ends of the spectrum the window is shifted inwards so that it keeps its size.
-    auto level = [&](std::size_t k) {
+    auto window = [&](std::size_t k) -> std::vector<double>& {
       std::size_t a = k > W ? k - W : 1, b = k + W;
       if (b > half) {
         a = a > b - half ? a - (b - half) : 1;
@@ -420,9 +438,9 @@ LineEstimate line_detect(const PhaseSeries& x, double f_min, double f_hint, bool
         if (j + gap >= k && j <= k + gap) continue;
         v.push_back(P[j]);
       }
-      return median_of(v) / med;
+      return v;
     };
-    const Peak peak = peak_over_level(P, k_lo, k_hi, pad, level);
+    const Peak peak = peak_over_level(P, k_lo, k_hi, pad, window, med);
     const double rbest = peak.ratio, lbest = peak.level;
     const std::size_t kbest = peak.k;
     if (!(rbest > 0)) continue;

@@ -4,12 +4,14 @@
 // every length around the vector width, on one and two threads, for counts near each limit.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <random>
 #include <vector>
 
 #include "../src/allan_kernels.hpp"
+#include "rwcalc/series.hpp"
 
 namespace {
 
@@ -102,6 +104,70 @@ TEST(PrepareCounts, LongRecordOnTwoThreads) {
   auto wide = c;
   wide[wide.size() - 3] = wide[0] - (std::int64_t{1} << 30);  // past the limit in the second half
   check(wide, 2, "past the limit in the second half");
+}
+
+// Σ (C[k+2m] − 2C[k+m] + C[k])² over k < P − 2m, straight from the 64-bit counts.
+rwcalc::detail::u128 plain_sumsq(const std::vector<std::int64_t>& c, std::int64_t m) {
+  rwcalc::detail::u128 s = 0;
+  for (std::size_t k = 0; k + 2 * static_cast<std::size_t>(m) < c.size(); ++k) {
+    const auto d = static_cast<std::int64_t>(static_cast<std::uint64_t>(c[k + 2 * m]) -
+                                             2 * static_cast<std::uint64_t>(c[k + m]) + static_cast<std::uint64_t>(c[k]));
+    s += static_cast<rwcalc::detail::u128>(static_cast<rwcalc::detail::i128>(d) * d);
+  }
+  return s;
+}
+
+rwcalc::PhaseSeries series_of(std::vector<std::int64_t> c) {
+  rwcalc::PhaseSeries x;
+  x.kind = rwcalc::PhaseKind::Gyro;
+  x.tau0_s = 0.0025;
+  x.arcsec_per_count = 1e-4;
+  x.counts = std::move(c);
+  return x;
+}
+
+TEST(PrepareSecondDifferences, AFastRateGetsTheNarrowViewAndTheSameSums) {
+  using rwcalc::detail::prepare_second_differences;
+  // A record of a fine pulse: ~3·10^4 pulses per sample (offsets past 2^30 after 35 000 samples)
+  // and a wandering rate; its start far from 0, rising and falling.
+  const std::int64_t ms[] = {1, 2, 7, 64, 1000, 9000};
+  for (const std::int64_t rate : {std::int64_t{30011}, std::int64_t{-30011}}) {
+    std::vector<std::int64_t> c = walk(40001, std::int64_t{1} << 50, 40, 7);
+    for (std::size_t k = 0; k < c.size(); ++k) c[k] += rate * static_cast<std::int64_t>(k) + static_cast<std::int64_t>(k * k / 5000);
+    const auto x = series_of(c);
+    ASSERT_EQ(prepare_counts(x, false).view, nullptr) << "the plain offsets are too wide";
+    const auto p = prepare_second_differences(x);
+    ASSERT_NE(p.view, nullptr);
+    EXPECT_TRUE(p.small24);
+    std::vector<rwcalc::detail::u128> swept(std::size(ms));
+    const auto np = static_cast<std::int64_t>(c.size());
+    for (std::size_t i = 0; i < std::size(ms); ++i) {
+      const auto want = plain_sumsq(c, ms[i]);
+      EXPECT_TRUE(rwcalc::detail::second_diff_sumsq(p, np - 2 * ms[i], ms[i], 1) == want) << ms[i];
+      if (rwcalc::detail::second_diff_sumsq_sweep(p, c.size(), ms, std::size(ms), 0, 1, swept.data())) {
+        EXPECT_TRUE(swept[i] == want) << ms[i];
+      }
+    }
+  }
+}
+
+TEST(PrepareSecondDifferences, NarrowCountsAndAWideWanderAreLeftAsTheyAre) {
+  using rwcalc::detail::prepare_second_differences;
+  // Narrow offsets: the plain view, C_k − C_0.
+  const auto small = walk(5000, 12345, 3, 1);
+  const auto sx = series_of(small);
+  const auto p = prepare_second_differences(sx);
+  ASSERT_NE(p.view, nullptr);
+  for (std::size_t k = 0; k < small.size(); ++k) ASSERT_EQ(p.view[k], small[k] - small[0]) << k;
+  // A wander of 2^31 pulses away from the line through the ends: no view, the 64-bit sums.
+  std::vector<std::int64_t> wide = walk(5000, 0, 3, 2);
+  for (std::size_t k = 0; k < wide.size(); ++k)
+    wide[k] += static_cast<std::int64_t>(std::sin(static_cast<double>(k) * 6.283 / 5000.0) * 2147483648.0);
+  const auto wx = series_of(wide);  // the prepared counts point into it
+  const auto w = prepare_second_differences(wx);
+  EXPECT_EQ(w.view, nullptr);
+  for (const std::int64_t m : {1, 3, 1000})
+    EXPECT_TRUE(rwcalc::detail::second_diff_sumsq(w, 5000 - 2 * m, m, 1) == plain_sumsq(wide, m)) << m;
 }
 
 }  // namespace
