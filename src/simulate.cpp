@@ -286,6 +286,12 @@ struct Simulator::Impl {
   std::vector<std::complex<double>> filter_spectrum, spectrum;
   std::vector<double> flicker;
   std::vector<GmStep> gm_steps;
+  // Sinusoids: cos and sin of (j + 1)·ωτ0 for j < kBlock, one table pair per line (deterministic_block).
+  struct LineSteps {
+    std::vector<double> c, s;
+  };
+  std::vector<LineSteps> line_steps;
+  std::vector<std::vector<double>> warmup_steps;  // e^{−jτ0/Tc} for j < kBlock, per warm-up
   GmStep lowpass_arw;
 
   Impl(NoiseModel m, SimulationSettings s, SimulationPath p)
@@ -301,6 +307,21 @@ struct Simulator::Impl {
     q = settings.scale_arcsec;
     fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
     if (model.bias_instability_deg_per_h > 0) prepare_flicker();
+    for (const auto& l : model.sinusoids) {
+      LineSteps t;
+      const double w = 2.0 * kPi * l.f_hz;
+      for (std::size_t j = 0; j < kBlock; ++j) {
+        const double b = w * static_cast<double>(j + 1) * tau0;
+        t.c.push_back(std::cos(b));
+        t.s.push_back(std::sin(b));
+      }
+      line_steps.push_back(std::move(t));
+    }
+    for (const auto& w : model.warmups) {
+      std::vector<double> e(kBlock);
+      for (std::size_t j = 0; j < kBlock; ++j) e[j] = std::exp(-static_cast<double>(j) * tau0 / w.tc_s);
+      warmup_steps.push_back(std::move(e));
+    }
     for (const auto& g : model.gauss_markov)
       gm_steps.emplace_back(2.0 * g.sigma_deg_per_h * g.sigma_deg_per_h / g.tc_s, g.tc_s, tau0);
     if (model.lowpass_tc_s > 0 && model.arw_deg_per_sqrt_h > 0) {
@@ -435,10 +456,22 @@ struct Simulator::Impl {
         prev = cur;
       }
     };
-    for (const auto& s : model.sinusoids) {
-      const double a = s.amp_deg_per_h / (2.0 * kPi * s.f_hz);
-      const double w = 2.0 * kPi * s.f_hz;
-      add_angle([&](double t) { return a * std::sin(w * t + s.phase_rad); });
+    // A sinusoid's angle a·sin(ωt + φ) at the block's sample times from its phase α at the block's
+    // start: sin(α + β_j) = sin α cos β_j + cos α sin β_j with β_j = (j + 1)ωτ0 from the tables
+    // (one sincos per block instead of one sin per sample; the same angle to a few ulps).
+    for (std::size_t i = 0; i < model.sinusoids.size(); ++i) {
+      const auto& l = model.sinusoids[i];
+      const double a = l.amp_deg_per_h / (2.0 * kPi * l.f_hz);
+      const double alpha = 2.0 * kPi * l.f_hz * (static_cast<double>(b) * tau0) + l.phase_rad;
+      const double sa = a * std::sin(alpha), ca = a * std::cos(alpha);
+      const double* tc = line_steps[i].c.data();
+      const double* ts = line_steps[i].s.data();
+      double prev = sa;
+      for (std::size_t j = 0; j < len; ++j) {
+        const double cur = sa * tc[j] + ca * ts[j];
+        x[j] += cur - prev;
+        prev = cur;
+      }
     }
     for (const auto& st : model.bias_steps) {
       const auto first = static_cast<std::size_t>(std::max(0.0, std::floor(st.t_s / tau0)));
@@ -447,10 +480,15 @@ struct Simulator::Impl {
         x[j] += st.size_deg_per_h * (t2 - std::max(t1, st.t_s));
       }
     }
-    for (const auto& w : model.warmups) {
+    // A warm-up's rate A·e^{−t/Tc} integrated over each interval: A·Tc·e^{−kτ0/Tc}(1 − e^{−τ0/Tc}),
+    // e^{−kτ0/Tc} as the block start's value times e^{−jτ0/Tc} from a table (one exp per block).
+    for (std::size_t i = 0; i < model.warmups.size(); ++i) {
+      const auto& w = model.warmups[i];
       const double decay = -std::expm1(-tau0 / w.tc_s);
-      for (std::size_t j = 0; j < len; ++j)
-        x[j] += w.amp_deg_per_h * w.tc_s * std::exp(-static_cast<double>(b + j) * tau0 / w.tc_s) * decay;
+      const double start = w.amp_deg_per_h * w.tc_s * std::exp(-static_cast<double>(b) * tau0 / w.tc_s) * decay;
+      if (start == 0.0) continue;
+      const double* e = warmup_steps[i].data();
+      for (std::size_t j = 0; j < len; ++j) x[j] += start * e[j];
     }
     if (model.temperature_bias) {
       const auto& tb = *model.temperature_bias;
