@@ -15,6 +15,8 @@
 
 #include "rwcalc/diagnose_detectors.hpp"
 
+#include "fft.hpp"
+
 namespace rwcalc::diag {
 
 namespace {
@@ -342,20 +344,17 @@ std::vector<double> mean_periodogram(const std::vector<double>& y, std::size_t l
   const std::size_t n = y.size();
   len = std::min(len, n);
   const std::size_t hop = len;
-  std::vector<double> P(nfft / 2 + 1, 0.0), win(len), buf(nfft, 0.0);
+  std::vector<double> P(nfft / 2 + 1, 0.0), win(len), buf(len);
   w2 = 0;
   for (std::size_t i = 0; i < len; ++i) {
     win[i] = 0.5 - 0.5 * std::cos(2.0 * kPi * (static_cast<double>(i) + 0.5) / static_cast<double>(len));
     w2 += win[i] * win[i];
   }
-  Eigen::FFT<double> fft;
-  fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
-  std::vector<std::complex<double>> spec;
+  detail::RealPowerSpectrum spectrum(nfft);
   segs = 0;
   for (std::size_t s = 0; s + len <= n; s += hop) {
     for (std::size_t i = 0; i < len; ++i) buf[i] = win[i] * y[s + i];
-    fft.fwd(spec, buf);
-    for (std::size_t k = 0; k < P.size() && k < spec.size(); ++k) P[k] += std::norm(spec[k]);
+    spectrum.add(buf.data(), len, P.data());
     ++segs;
   }
   for (double& p : P) p /= static_cast<double>(std::max<std::size_t>(segs, 1));
