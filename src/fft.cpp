@@ -18,7 +18,7 @@ using cd = std::complex<double>;
 class Twiddles {
  public:
   Twiddles() = default;
-  explicit Twiddles(std::size_t n) : n_(n) {
+  explicit Twiddles(std::size_t n) {
     const double step = -2.0 * std::numbers::pi / static_cast<double>(n);
     lo_.resize(kL);
     for (std::size_t i = 0; i < kL; ++i) lo_[i] = std::polar(1.0, step * static_cast<double>(i));
@@ -29,7 +29,6 @@ class Twiddles {
 
  private:
   static constexpr std::size_t kL = 2048;
-  std::size_t n_ = 0;
   std::vector<cd> lo_, hi_;
 };
 

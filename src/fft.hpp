@@ -3,10 +3,8 @@
 // of the line search. Small transforms go to Eigen's kissfft as they are; a long one (the whole
 // record's, 2^23 points for a 2-h record at 400 Hz) is taken in four steps over sub-transforms that
 // stay in cache (docs/performance.md, "The line search's long transform in four steps").
-#include <complex>
 #include <cstddef>
 #include <memory>
-#include <vector>
 
 namespace rwcalc::detail {
 

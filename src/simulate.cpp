@@ -370,8 +370,8 @@ struct Simulator::Impl {
   // angle increments of the block (″; x[j] is the increment of interval b + j + 1) in a fixed
   // order, with its state (random streams, integrated rates) carried from block to block, and
   // the read-out counts the block's pulses. Every term draws from its own stream in sample order,
-  // so a record does not depend on the block length except through the rounding of the angle's
-  // running sum (quantize_block).
+  // so a record depends on the block length only through roundings far below a pulse: the angle's
+  // running sum (quantize_block) and the sinusoid and warm-up steps from the block's start.
   static constexpr std::size_t kBlock = 256;
   struct Pass {
     Rng arw, rrw, readout, white;
@@ -384,7 +384,7 @@ struct Simulator::Impl {
     std::int64_t whole = 0;
     double frac = 0.0;
     bool dither = false;
-    Pass(std::uint64_t seed)
+    explicit Pass(std::uint64_t seed)
         : arw(seed, kArwStream), rrw(seed, kRrwStream), readout(seed, kReadoutStream),
           white(seed, kWhiteAngleStream),
           lp_arw(seed, kGaussMarkovStream0 + std::numeric_limits<std::uint32_t>::max()) {}
