@@ -3,10 +3,9 @@
 # scale"): builds the `bench` preset if needed, generates the standard inputs with
 # `rwcalc simulate` (cached under the build directory), times whole processes (median of
 # --repeat runs: wall clock from bash's EPOCHREALTIME and user+sys CPU time from its `time`,
-# around the bare process; peak RSS from
-# /usr/bin/time -v) and prints ONE
-# table with every target and the measured figure beside it, plus the NumPy baseline of the same
-# estimator. On a shared machine the CPU column is the load-independent figure.
+# around the bare process; peak RSS from /usr/bin/time -v) and prints ONE table with every target
+# and the measured figure beside it, plus the NumPy baseline of the same estimator. On a shared
+# machine the CPU column is the load-independent figure.
 #
 # Usage: bench/run-benchmarks.sh [--repeat N] [--build-dir DIR] [--no-build] [--skip-24h]
 #                                [--skip-tau-all] [--kernels]
@@ -29,7 +28,7 @@ while (($#)); do
     --skip-24h) skip24=1; shift ;;
     --skip-tau-all) skipall=1; shift ;;
     --kernels) kernels=1; shift ;;
-    -h|--help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "run-benchmarks.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done

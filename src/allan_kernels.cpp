@@ -672,28 +672,36 @@ PreparedCounts prepare_counts(const PhaseSeries& x, bool need_prefix, unsigned t
 }
 
 PreparedCounts prepare_second_differences(const PhaseSeries& x) {
-  PreparedCounts p = prepare_counts(x, false);
-  if (p.view || !p.raw || p.points < 2) return p;
-  const std::vector<std::int64_t>& c = *p.raw;
-  // s = round((C_{P−1} − C_0)/(P − 1)) in 128-bit arithmetic; the offsets modulo 2^64 (their
-  // second differences are exact in that ring, and so in the int32 range checked below).
+  constexpr std::int64_t kLimit = std::int64_t{1} << 30;
+  if (x.narrow() || x.counts.size() < 2) return prepare_counts(x, false);
+  const std::vector<std::int64_t>& c = x.counts;
+  // The last offset is the span C_{P−1} − C_0: at 2^30 or more the plain view cannot be made, and
+  // its pass over the counts is not taken at all.
   const i128 span = static_cast<i128>(c.back()) - static_cast<i128>(c.front());
-  const auto steps = static_cast<i128>(p.points - 1);
+  // s = round(span/(P − 1)), the line's whole pulses per sample.
+  const auto steps = static_cast<i128>(c.size() - 1);
   const i128 half = steps / 2;
   const i128 s128 = span >= 0 ? (span + half) / steps : -((-span + half) / steps);
+  if (span > -kLimit && span < kLimit) {
+    PreparedCounts plain = prepare_counts(x, false);
+    if (plain.view || s128 == 0) return plain;  // a line of 0 pulses per sample changes nothing
+  }
+  PreparedCounts p;
+  p.raw = &c;
+  p.points = c.size();
+  // The offsets from the line modulo 2^64 (their second differences are exact in that ring, and
+  // so in the int32 range checked below).
   const auto s = static_cast<std::uint64_t>(static_cast<std::int64_t>(s128));
-  const auto c0 = static_cast<std::uint64_t>(c.front());
-  constexpr std::int64_t kLimit = std::int64_t{1} << 30;
   std::int64_t lo = 0, hi = 0;
   p.rel32.resize(c.size());
-  std::uint64_t line = c0;
+  std::uint64_t line = static_cast<std::uint64_t>(c.front());
   for (std::size_t k = 0; k < c.size(); ++k, line += s) {
     const auto d = static_cast<std::int64_t>(static_cast<std::uint64_t>(c[k]) - line);
     lo = d < lo ? d : lo;
     hi = d > hi ? d : hi;
     p.rel32[k] = static_cast<std::int32_t>(d);
   }
-  if (lo <= -kLimit || hi >= kLimit) {
+  if (lo <= -kLimit || hi >= kLimit) {  // wide even off the line: the 64-bit sums
     p.rel32.clear();
     p.rel32.shrink_to_fit();
     return p;
