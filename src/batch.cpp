@@ -14,6 +14,8 @@
 #include <fstream>
 #include <mutex>
 #include <thread>
+#include <utility>
+#include <utility>
 
 #include "rwcalc/error.hpp"
 #include "rwcalc/thread.hpp"
@@ -255,7 +257,12 @@ json summarize_runs(std::vector<json> runs, const std::string& source) {
     overall["runs"] = runs.size();
     json trends = json::object();
     for (const auto& s : series_list()) trends[s.key] = trend(runs, s);
-    return {{"runs", runs}, {"overall", overall}, {"trends", trends}};
+    // Built key by key so that the runs are moved in, not deep-copied as an initializer list would.
+    json out = json::object();
+    out["runs"] = std::move(runs);
+    out["overall"] = std::move(overall);
+    out["trends"] = std::move(trends);
+    return out;
   } catch (const json::exception& e) {
     throw InputError(source, 0, fmt::format("malformed run object: {}", e.what()));
   }

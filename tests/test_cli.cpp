@@ -19,6 +19,23 @@ TEST(Cli, HelpListsEveryCommand) {
     EXPECT_NE(r.out.find(cmd), std::string::npos) << cmd << "\n" << r.out;
 }
 
+TEST(Cli, EachCommandsHelpAndAnUnknownCommand) {
+  // A command named first is set up alone; its help is its own, and a name that is no command
+  // still gets the list of them all.
+  for (const char* cmd : {"allan", "analyze", "batch", "simulate", "diagnose", "report", "merge"}) {
+    auto r = run_cli({cmd, "--help"});
+    EXPECT_EQ(r.status, 0) << cmd;
+    EXPECT_NE(r.out.find(std::string("rwcalc ") + cmd), std::string::npos) << cmd << "\n" << r.out;
+  }
+  auto r = run_cli({"analyse", "x.csv"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("rwcalc --help"), std::string::npos) << r.err;
+  // An option before the command: every command is set up, and the option is honoured.
+  auto v = run_cli({"--version", "analyze"});
+  EXPECT_EQ(v.status, 0);
+  EXPECT_NE(v.out.find(RWCALC_VERSION), std::string::npos) << v.out;
+}
+
 TEST(Cli, NoCommandIsAUsageErrorWithStatusTwo) {
   auto r = run_exe({});
   EXPECT_EQ(r.status, 2);

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cli/commands.hpp"
@@ -21,13 +22,14 @@ struct TableFormat {
     g->add_flag("--jsonl", jsonl, "One analyze JSON object per line (input of 'rwcalc merge')");
     g->require_option(0, 1);
   }
-  [[nodiscard]] inline std::string render(const std::vector<nlohmann::json>& runs) const {
+  /// The runs are taken over (moved in): the summary holds them without a deep copy.
+  [[nodiscard]] inline std::string render(std::vector<nlohmann::json> runs) const {
     if (jsonl) {
       std::string s;
       for (const auto& r : runs) s += r.dump() + "\n";
       return s;
     }
-    const nlohmann::json summary = summarize_runs(runs);
+    const nlohmann::json summary = summarize_runs(std::move(runs));
     if (json) return summary.dump(2) + "\n";
     if (csv) return format_batch_csv(summary);
     if (markdown) return format_batch_markdown(summary);

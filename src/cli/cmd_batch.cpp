@@ -5,6 +5,7 @@
 
 #include <memory>
 #include <ostream>
+#include <utility>
 
 #include "cli/analyze_args.hpp"
 #include "cli/batch_format.hpp"
@@ -56,9 +57,9 @@ void register_batch(CLI::App& app, Runner& runner) {
         opt.temperature_c = cmd->temperature;
       }
       cmd->plot.check(cmd->force);
-      const auto runs = analyze_files(cmd->files, cmd->input.options(), opt, cmd->jobs);
+      auto runs = analyze_files(cmd->files, cmd->input.options(), opt, cmd->jobs);
       if (cmd->plot.any()) cmd->plot.draw_batch(nlohmann::json{{"runs", runs}}, cmd->force, io);
-      emit(io, cmd->format.render(runs), cmd->output, cmd->force);
+      emit(io, cmd->format.render(std::move(runs)), cmd->output, cmd->force);
       return 0;
     };
   });

@@ -1,6 +1,7 @@
 // 'rwcalc merge LINES.jsonl…': the batch tables and overall verdict from JSON lines written by
 // 'rwcalc batch --jsonl', e.g. on many machines (GNU parallel, a Slurm job array).
 #include <memory>
+#include <utility>
 
 #include "cli/batch_format.hpp"
 #include "cli/commands.hpp"
@@ -34,7 +35,7 @@ void register_merge(CLI::App& app, Runner& runner) {
         auto part = read_json_lines(f);
         for (auto& r : part) runs.push_back(std::move(r));
       }
-      emit(io, cmd->format.render(runs), cmd->output, cmd->force);
+      emit(io, cmd->format.render(std::move(runs)), cmd->output, cmd->force);
       return 0;
     };
   });
