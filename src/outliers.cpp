@@ -7,9 +7,11 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <span>
 #include <thread>
 
 #include "rwcalc/thread.hpp"
+#include "select.hpp"
 #include "x86_dispatch.hpp"
 
 #if defined(__x86_64__) || defined(__i386__)
@@ -408,11 +410,9 @@ struct ScalePass {
     if (n < kMinSamples) return s;
     // Resolution: the smallest non-zero step, over i in [1, n).
     double res = min_step(head, 4, std::numeric_limits<double>::infinity());  // steps 1..3
-    // Robust scale: 1.4826 × the median |residual| of an evenly strided subset.
+    // Robust scale: 1.4826 × the median |residual| of an evenly strided subset: the parts' values
+    // where they are, and the edges' few.
     std::vector<double> a;
-    std::size_t total = 8;
-    for (const Part* p : parts) total += p->a.size();
-    a.reserve(total);
     auto add_edge = [&](std::size_t i) {
       if (i < 3) a.push_back(std::abs(residual(head, i, 7)));
       else a.push_back(std::abs(residual(tail, i - (n - 7), 7)));
@@ -421,7 +421,6 @@ struct ScalePass {
     if (flagged) flagged->clear();
     for (const Part* p : parts) {
       res = std::min(res, p->res);
-      a.insert(a.end(), p->a.begin(), p->a.end());
       if (flagged) flagged->insert(flagged->end(), p->hits.begin(), p->hits.end());
     }
     // Remaining steps of the tail: i in [max(4, n − 2), n) — locals of tail.
@@ -431,9 +430,13 @@ struct ScalePass {
     }
     for (std::size_t i = std::max<std::size_t>(3, (end + stride - 1) / stride * stride); i < n; i += stride) add_edge(i);
     s.resolution = std::isfinite(res) ? res : 0.0;
-    auto mid = a.begin() + static_cast<std::ptrdiff_t>(a.size() / 2);
-    std::nth_element(a.begin(), mid, a.end());
-    s.mad_sigma = kMadToSigma * *mid;
+    std::vector<std::span<const double>> sets{a};
+    std::size_t total = a.size();
+    for (const Part* p : parts) {
+      sets.emplace_back(p->a);
+      total += p->a.size();
+    }
+    s.mad_sigma = kMadToSigma * detail::select_nonnegative(sets, total / 2);
     s.scale = std::max(s.mad_sigma, s.resolution);
     return s;
   }
