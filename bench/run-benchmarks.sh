@@ -9,7 +9,8 @@
 #
 # Usage: bench/run-benchmarks.sh [--repeat N] [--build-dir DIR] [--no-build] [--skip-24h]
 #                                [--skip-tau-all] [--kernels]
-#   --repeat N      runs per measurement (default 5; the median is reported)
+#   --repeat N      runs per measurement (default 5; the median is reported; the batch ratio
+#                   takes at least 21 pairs of runs)
 #   --build-dir D   build directory of the bench preset (default build-bench)
 #   --no-build      use the existing build as it is
 #   --skip-24h      skip the 24-h 1 kHz record (its text file takes ~1 min to generate once)
@@ -28,7 +29,7 @@ while (($#)); do
     --skip-24h) skip24=1; shift ;;
     --skip-tau-all) skipall=1; shift ;;
     --kernels) kernels=1; shift ;;
-    -h|--help) sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "run-benchmarks.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -82,13 +83,16 @@ loadavg() { cut -d' ' -f1 /proc/loadavg; }
 # CPU time are the process's own, with no wrapper process in between: the wall from bash's
 # EPOCHREALTIME around it (µs), the CPU from bash's `time` (the child's rusage, ms); peak RSS comes
 # from /usr/bin/time -v around up to three further runs (GNU time's own start would otherwise add
-# 1–2 ms to every wall time).
+# 1–2 ms to every wall time). Each run writes new files: the last run's are removed first, outside
+# the timed part, because a file truncated and written again is flushed to disk when it is closed
+# (ext4's auto_da_alloc), a cost of the file system that would be timed as the process's own.
 measure() {
   local n="$1"; shift
   local times=() cpus=() rss=0 r t0 t1 u sy
   local TIMEFORMAT='%3U %3S'
   status=0
   for ((i = 0; i < n; i++)); do
+    rm -f "$tmp/out.txt" "$tmp/err.txt" "$tmp/t.txt"
     t0=$EPOCHREALTIME
     if { time "$@" >"$tmp/out.txt" 2>"$tmp/err.txt"; } 2>"$tmp/t.txt"; then :; else status=$?; fi
     t1=$EPOCHREALTIME
@@ -155,9 +159,10 @@ fi
 
 if available batch; then
   # --jobs 1 and --jobs 2 alternately, so that a drift of the machine's speed during the
-  # measurement weighs on both alike; each figure the median of its --repeat runs.
-  l=$(loadavg); w1=() w2=() cp1=() cp2=() st1=0 rss2=0
-  for ((k = 0; k < repeat; k++)); do
+  # measurement weighs on both alike; each figure the median of its runs. A ratio of two medians
+  # scatters more than either: at least 21 pairs (~10 s), whatever --repeat says.
+  l=$(loadavg); w1=() w2=() cp1=() cp2=() st1=0 rss2=0 pairs=$((repeat > 21 ? repeat : 21))
+  for ((k = 0; k < pairs; k++)); do
     measure 1 "$rw" batch "${five[@]}" --json --jobs 1; w1+=("$med_s"); cp1+=("$cpu_s"); ((status)) && st1=$status
     measure 1 "$rw" batch "${five[@]}" --json --jobs 2; w2+=("$med_s"); cp2+=("$cpu_s")
     rss2=$(awk -v a="$rss_mb" -v b="$rss2" 'BEGIN { print (a > b) ? a : b }')
@@ -242,7 +247,7 @@ timed "floor: cat of the 2-h file ($(du -k "$run2h" | cut -f1) kB)" "—" "" cat
 # ---- the table --------------------------------------------------------------------------------
 echo
 echo "$("$rw" --version 2>/dev/null | head -1) — $(date -u '+%Y-%m-%d %H:%M UTC'); $(nproc) cores," \
-  "$(sed -n 's/^model name\s*: //p' /proc/cpuinfo | head -1); median of $repeat runs; load = 1-min load average"
+  "$(sed -n 's/^model name\s*: //p' /proc/cpuinfo | head -1); median of $repeat runs (the batch ratio: ${pairs:-$repeat} alternating pairs); load = 1-min load average"
 echo
 echo "| target | limit | wall (median) | CPU user+sys (median) | peak RSS | result | load |"
 echo "|---|---|---|---|---|---|---|"
