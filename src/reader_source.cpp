@@ -252,8 +252,11 @@ void count_segments(const char* buf, std::size_t lo, std::size_t hi, std::vector
 
 // A regular file of `size` bytes in two halves, the second on another thread. False (the buffer
 // then holds nothing) when the file turned out shorter than its size. Each thread checks and
-// counts the lines of its half while its bytes are in the cache (TextBuffer::segment_lines).
-bool read_halves(int fd, std::size_t size, TextBuffer& buf, const std::string& name, Crew* crew) {
+// counts the lines of its half while its bytes are in the cache (TextBuffer::segment_lines), then
+// maps the pages of its half of `front` (a hosted text's counts storage before the text, which the
+// pulse reader writes next: mapped here by two threads rather than there by one).
+bool read_halves(int fd, std::size_t size, TextBuffer& buf, const std::string& name, Crew* crew,
+                 char* front = nullptr, std::size_t front_bytes = 0) {
   const std::size_t half = (size / 2) & ~std::size_t{4095};
   const std::size_t segments = size / TextBuffer::kSegment;
   std::vector<std::size_t> lines1(segments), lines2(segments);
@@ -262,13 +265,16 @@ bool read_halves(int fd, std::size_t size, TextBuffer& buf, const std::string& n
   bool ok2 = false;
   {
     bool ok1 = false;
+    const std::size_t front_half = (front_bytes / 2) & ~std::size_t{4095};
     auto second = [&] {
       ok2 = pread_exact(fd, buf.data() + half, size - half, static_cast<off_t>(half), err2);
       if (ok2) count_segments(buf.data(), half, size, lines2, bad2);
+      if (front) prefault(front + front_half, front_bytes - front_half);
     };
     auto first = [&] {
       ok1 = pread_exact(fd, buf.data(), half, 0, err1);
       if (ok1) count_segments(buf.data(), 0, half, lines1, bad1);
+      if (front) prefault(front, front_half);
     };
     if (crew) {  // the second half to a lender (or to this thread after the first, if none is free)
       crew->share(2, [&](std::size_t k) { k == 0 ? first() : second(); });
@@ -366,11 +372,16 @@ TextBuffer load_source(const std::string& path, unsigned threads, Crew* crew, st
     const auto size = static_cast<std::size_t>(st.st_size);
     const bool regular = S_ISREG(st.st_mode);
     const bool halves = regular && threads > 1 && size > kHalvesBytes;
+    char* front = nullptr;
+    std::size_t front_bytes = 0;
     if (regular && host) {
       // A pulse file: the text at the end of the counts' storage (TextBuffer's host); its pages
-      // are mapped here, or by each loading thread for its half.
+      // are mapped here, or by each loading thread for its half, with half of the storage before
+      // it each (the reader maps what is left when it writes the counts there).
       raw = TextBuffer(std::move(*host), size + 1);
       if (!halves) prefault(raw.data(), size + 1);
+      front = reinterpret_cast<char*>(raw.host()->data());
+      front_bytes = static_cast<std::size_t>(raw.data() - front);
     } else if (halves) {
       // Twice the file's size is allocated and only its first half used: once the text is freed,
       // the int32 view of the counts (4 bytes per line, at most 2 per byte of a pulse file) fits
@@ -381,7 +392,8 @@ TextBuffer load_source(const std::string& path, unsigned threads, Crew* crew, st
     } else {
       raw.reserve(regular ? size + 1 : std::size_t{1} << 20);
     }
-    if (halves && !read_halves(fd.get(), size, raw, name, crew) && ::lseek(fd.get(), 0, SEEK_SET) < 0)
+    if (halves && !read_halves(fd.get(), size, raw, name, crew, front, front_bytes) &&
+        ::lseek(fd.get(), 0, SEEK_SET) < 0)
       fail_errno(name, "cannot seek", errno);
     read_all(fd.get(), raw, name);
   }
