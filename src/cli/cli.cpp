@@ -35,7 +35,7 @@ constexpr Command kCommands[] = {
 
 /// The commands, in the order of `rwcalc --help`. When the first argument names one, only that
 /// one is built: the parse, its help and its errors are the same, and a command does not pay for
-/// setting up the options of the other six (0.5–1.5 ms of a 25-ms analysis). Anything else (no
+/// setting up the options of the other six (0.5–1.9 ms of a 25-ms analysis). Anything else (no
 /// command, an option first, an unknown name) gets them all, so the overall help and the
 /// unknown-command message list every command.
 void build_app(CLI::App& app, Runner& runner, int argc, const char* const* argv) {
