@@ -247,7 +247,7 @@ timed "floor: cat of the 2-h file ($(du -k "$run2h" | cut -f1) kB)" "—" "" cat
 # ---- the table --------------------------------------------------------------------------------
 echo
 echo "$("$rw" --version 2>/dev/null | head -1) — $(date -u '+%Y-%m-%d %H:%M UTC'); $(nproc) cores," \
-  "$(sed -n 's/^model name\s*: //p' /proc/cpuinfo | head -1); median of $repeat runs (the batch ratio: ${pairs:-$repeat} alternating pairs); load = 1-min load average"
+  "$(sed -n 's/^model name\s*: //p' /proc/cpuinfo | head -1); median of $repeat runs${pairs:+ (the batch ratio: $pairs alternating pairs)}; load = 1-min load average"
 echo
 echo "| target | limit | wall (median) | CPU user+sys (median) | peak RSS | result | load |"
 echo "|---|---|---|---|---|---|---|"
