@@ -142,17 +142,17 @@ std::string_view to_string(OutlierAction a) {
 
 namespace {
 
-// Detect outliers in the recording's rates and locate them in the input.
-void check_outlier_threshold(const AnalysisOptions& options) {
-  if (!(options.outlier_threshold > 0) || !std::isfinite(options.outlier_threshold))
-    throw UsageError(fmt::format("--outlier-threshold must be a positive number, got {}", options.outlier_threshold));
+void check_outlier_threshold(double threshold) {
+  if (!(threshold > 0) || !std::isfinite(threshold))
+    throw UsageError(fmt::format("--outlier-threshold must be a positive number, got {}", threshold));
 }
 
-/// The report of a finished scan (`found`, with its scale).
-void report_outliers(const Recording& rec, const AnalysisOptions& options, const OutlierScale& scale,
+/// The report of a finished scan (`found`, with its scale), located in the input.
+void report_outliers(const Recording& rec, OutlierAction action, double threshold, const OutlierScale& scale,
                      const std::vector<Outlier>& found, OutlierReport& rep) {
-  rep.action = options.outlier_action;
-  rep.threshold = options.outlier_threshold;
+  rep = OutlierReport{};
+  rep.action = action;
+  rep.threshold = threshold;
   rep.scale_deg_per_h = scale.scale;
   rep.count = found.size();
   // Rate sample i comes from data sample i (pulses, rate) or i+1 (counter, angle: the later reading).
@@ -162,29 +162,49 @@ void report_outliers(const Recording& rec, const AnalysisOptions& options, const
     rep.positions.push_back({o.index, static_cast<double>(o.index + shift) * rec.phase.tau0_s,
                              rec.line_of_rate(o.index), o.value, o.robust_z});
   }
-  if (options.outlier_action == OutlierAction::Remove) rep.removed = found.size();
-  if (options.outlier_action == OutlierAction::Replace) rep.replaced = found.size();
+  if (action == OutlierAction::Remove) rep.removed = found.size();
+  if (action == OutlierAction::Replace) rep.replaced = found.size();
 }
 
-std::vector<Outlier> detect_outliers(const Recording& rec, const AnalysisOptions& options, OutlierReport& rep,
-                                     unsigned threads, Crew* crew) {
-  check_outlier_threshold(options);
-  // The rates are computed block by block from the phase (no copy of the whole record); with a
-  // crew, by this thread and any lender free to help.
-  OutlierScale scale;
-  std::vector<Outlier> found;
+/// Detect outliers in the recording's rates. The rates are computed block by block from the
+/// phase (no copy of the whole record); with a crew, by this thread and any lender free to help.
+std::vector<Outlier> detect_outliers(const Recording& rec, double threshold, OutlierScale& scale, unsigned threads,
+                                     Crew* crew) {
   if (crew) {
-    SharedOutlierScan shared(rec.phase, options.outlier_threshold);
+    SharedOutlierScan shared(rec.phase, threshold);
     crew->share(2, [&shared](std::size_t) { shared.help(); });
-    found = shared.finish(scale);
-  } else {
-    found = scan_outliers(rec.phase, options.outlier_threshold, scale, threads);
+    return shared.finish(scale);
   }
-  report_outliers(rec, options, scale, found, rep);
-  return found;
+  return scan_outliers(rec.phase, threshold, scale, threads);
 }
 
 }  // namespace
+
+const Recording& screen_outliers(const Recording& read, OutlierAction action, double threshold,
+                                 OutlierReport& report, Recording& edited, unsigned threads, Crew* crew) {
+  check_outlier_threshold(threshold);
+  report = OutlierReport{};
+  report.action = action;
+  report.threshold = threshold;
+  if (read.phase.points() < 3) return read;  // too short to screen; the caller says so
+  OutlierScale scale;
+  const std::vector<Outlier> found = detect_outliers(read, threshold, scale, threads, crew);
+  report_outliers(read, action, threshold, scale, found, report);
+  if (action == OutlierAction::Keep || found.empty()) return read;
+  edited = Recording{};
+  edited.source = read.source;
+  edited.phase = apply_outliers(read.phase, found, action);
+  edited.rate_hz = read.rate_hz;
+  edited.rate_source = read.rate_source;
+  edited.samples = read.samples - report.removed;
+  edited.metadata = read.metadata;
+  edited.temperature_c = read.temperature_c;
+  edited.column_name = read.column_name;
+  edited.time_column = read.time_column;
+  edited.mode = read.mode;
+  edited.counter_wraps = read.counter_wraps;
+  return edited;
+}
 
 AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   if (read.phase.kind != PhaseKind::Gyro)
@@ -208,23 +228,11 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   std::function<void(std::size_t)> scan_chunk;
   std::optional<Crew::Posted> posted;  // after `shared` and `scan_chunk`: joined before they go
   if (posted_scan) {
-    check_outlier_threshold(options);
-  } else if (read.phase.points() >= 3) {
-    const std::vector<Outlier> found = [&] {
-      detail::ScopedTimer t("analyze: outlier scan");
-      return detect_outliers(read, options, outliers, options.allan.threads, crew);
-    }();
-    if (options.outlier_action != OutlierAction::Keep && !found.empty()) {
-      rec_storage.source = read.source;
-      rec_storage.phase = apply_outliers(read.phase, found, options.outlier_action);
-      rec_storage.rate_hz = read.rate_hz;
-      rec_storage.samples = read.samples - outliers.removed;
-      rec_storage.metadata = read.metadata;
-      rec_storage.temperature_c = read.temperature_c;
-      rec_storage.column_name = read.column_name;
-      rec_storage.mode = read.mode;
-      recp = &rec_storage;
-    }
+    check_outlier_threshold(options.outlier_threshold);
+  } else {
+    detail::ScopedTimer t("analyze: outlier scan");
+    recp = &screen_outliers(read, options.outlier_action, options.outlier_threshold, outliers, rec_storage,
+                            options.allan.threads, crew);
   }
   const Recording& rec = *recp;
   AnalysisResult r;
@@ -359,15 +367,13 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
     crew->join(*posted);
     OutlierScale scale;
     const std::vector<Outlier> found = shared->finish(scale);
-    report_outliers(read, options, scale, found, outliers);
+    report_outliers(read, options.outlier_action, options.outlier_threshold, scale, found, outliers);
     r.outliers = std::move(outliers);
   }
   return r;
 }
 
-namespace {
-
-nlohmann::json outliers_json(const OutlierReport& o) {
+nlohmann::json to_json(const OutlierReport& o) {
   nlohmann::json pos = nlohmann::json::array();
   for (const auto& p : o.positions)
     pos.push_back({{"index", p.index}, {"time_s", p.time_s}, {"line", p.line}, {"value_deg_per_h", p.value},
@@ -382,9 +388,11 @@ nlohmann::json outliers_json(const OutlierReport& o) {
           {"positions", pos}};
 }
 
-constexpr std::size_t kReportOutliers = 20;
+namespace {
+constexpr std::size_t kReportOutliers = 20;  // rows of the readable list; the JSON has up to kMaxOutlierPositions
+}  // namespace
 
-std::string outliers_text(const OutlierReport& o) {
+std::string format_outliers(const OutlierReport& o) {
   std::string s = fmt::format(
       "Outliers (rate samples more than {:g} robust sigma from the median of their 6 neighbours; scale {} °/h)\n",
       o.threshold, num(o.scale_deg_per_h, 3));
@@ -410,8 +418,6 @@ std::string outliers_text(const OutlierReport& o) {
     s += fmt::format("  … and {} more (the first {} are listed in --json)\n", o.count - kReportOutliers, o.positions.size());
   return s + "\n";
 }
-
-}  // namespace
 
 nlohmann::json to_json(const AnalysisResult& r) {
   using nlohmann::json;
@@ -481,7 +487,7 @@ nlohmann::json to_json(const AnalysisResult& r) {
             {"K_deg_per_h_per_sqrt_h", opt_num(r.slope.K)},
             {"tau_K_s", r.slope.tau_K_s}}},
           {"methods", {{"N_direct_deg_per_sqrt_h", n_direct}, {"B_100s_deg_per_h", b100}}},
-          {"outliers", outliers_json(r.outliers)},
+          {"outliers", to_json(r.outliers)},
           {"verdict", to_json(r.verdict)},
           {"conventions",
            {{"Q", "rms white angle error, sigma^2 = 3 Q^2/tau^2 (IEEE 952); the paper's eq. (2) Q is sqrt(3) Q"},
@@ -507,7 +513,7 @@ std::string format_report(const AnalysisResult& r) {
                    r.mean_rate_deg_per_h, r.earth_rate_deg_per_h,
                    r.earth_rate_given ? std::string("given") : fmt::format("latitude {:g}°", r.latitude_deg),
                    r.bias_deg_per_h);
-  s += outliers_text(r.outliers);
+  s += format_outliers(r.outliers);
 
   s += fmt::format("Allan deviation ({}, bounds at {:g} %; * = used in the fit)\n", to_string(r.allan.estimator),
                    100.0 * r.allan.confidence);

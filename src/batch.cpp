@@ -151,6 +151,27 @@ std::string temp_cell(const json& run) {
 
 std::string class_cell(const json& v) { return v.is_null() ? std::string("none") : fmt::format("{}", v.get<int>()); }
 
+/// One run's line of the batch text's outlier section: count, action, the first input lines.
+std::string outliers_line(const json& run) {
+  const std::string source = run.at("source").get<std::string>();
+  if (!run.contains("outliers") || !run.at("outliers").is_object())
+    return fmt::format("  {}: not in the results (no outlier summary)\n", source);
+  const auto& o = run.at("outliers");
+  const auto n = o.value("count", std::size_t{0});
+  if (n == 0) return fmt::format("  {}: none found\n", source);
+  const std::string action = o.value("action", std::string("keep"));
+  std::string s = fmt::format("  {}: {} outlier(s) {}", source, n,
+                              action == "keep"     ? "kept"
+                              : action == "remove" ? "removed"
+                              : action == "replace" ? "replaced by the local median"
+                                                    : "with action " + action);
+  const auto& pos = o.at("positions");
+  for (std::size_t k = 0; k < pos.size() && k < 5; ++k)
+    s += fmt::format("{} line {} ({:g} s)", k ? "," : ": at", pos[k].at("line").get<std::size_t>(),
+                     pos[k].at("time_s").get<double>());
+  return s + (n > 5 ? ", …\n" : "\n");
+}
+
 }  // namespace
 
 std::vector<json> analyze_files(const std::vector<std::string>& files, const ReadOptions& read,
@@ -314,23 +335,9 @@ std::string format_batch_text(const json& summary) {
     s += fmt::format("  {:>6}  {:<30} {:<30} {}\n", temp_cell(r), v.value("statement_N", class_cell(v.at("class_N"))),
                      v.value("statement_B", class_cell(v.at("class_B"))), o);
   }
-  // Outliers are never passed over in silence: one line per run that had any.
-  std::string outl;
-  for (const auto& r : runs) {
-    if (!r.contains("outliers")) continue;
-    const auto& o = r.at("outliers");
-    const auto n = o.value("count", std::size_t{0});
-    if (n == 0) continue;
-    const std::string action = o.value("action", std::string("keep"));
-    outl += fmt::format("  {}: {} outlier(s) {}", r.at("source").get<std::string>(), n,
-                        action == "keep" ? "kept" : action == "remove" ? "removed" : "replaced by the local median");
-    const auto& pos = o.at("positions");
-    for (std::size_t k = 0; k < pos.size() && k < 5; ++k)
-      outl += fmt::format("{} line {} ({:g} s)", k ? "," : ": at", pos[k].at("line").get<std::size_t>(),
-                          pos[k].at("time_s").get<double>());
-    outl += n > 5 ? ", …\n" : "\n";
-  }
-  if (!outl.empty()) s += "\nOutliers (see 'rwcalc analyze' for each; --outliers keep|remove|replace)\n" + outl;
+  // Outliers are never passed over in silence: one line per run.
+  s += "\nOutliers (see 'rwcalc analyze' for each; --outliers keep|remove|replace)\n";
+  for (const auto& r : runs) s += outliers_line(r);
   s += fmt::format("\nOverall over the runs: {}", ov.at("statement").get<std::string>());
   if (ov.value("tolerance_changed", false))
     s += fmt::format("  [with the +{:g} % tolerance on B; strict: class {}]", ov.value("tolerance_pct", 0.0),
@@ -372,13 +379,19 @@ std::string format_batch_markdown(const json& summary) {
   }
   s += fmt::format("| overall | | | | | {} | {} | {} |\n", ov.at("N").at("statement").get<std::string>(),
                    ov.at("B").at("statement").get<std::string>(), ov.at("statement").get<std::string>());
+  s += "\nOutliers (--outliers keep|remove|replace):\n\n";
+  for (const auto& r : runs) {
+    std::string item = outliers_line(r);  // "  file: …" → "- file: …", a Markdown list item
+    item[0] = '-';
+    s += item;
+  }
   return s;
 }
 
 std::string format_batch_csv(const json& summary) {
   std::string s =
       "source,temperature_c,N_fit,N_fit_sigma,N_fit_resolved,N_direct,N_direct_sigma,B_fit,B_fit_sigma,B_fit_resolved,"
-      "B_100s,B_100s_sigma,class_N,class_B,class,p_class\n";
+      "B_100s,B_100s_sigma,class_N,class_B,class,p_class,outliers,outlier_action\n";
   auto val = [](const json& r, std::vector<std::string> path, const char* k) -> std::string {
     const json* e = lookup(r, path);
     if (!e) return "";
@@ -395,17 +408,20 @@ std::string format_batch_csv(const json& summary) {
   };
   for (const auto& r : summary.at("runs")) {
     const auto& v = r.at("verdict");
-    s += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4f}\n", csv_escape(r.at("source").get<std::string>()),
+    const json* o = lookup(r, {"outliers"});
+    s += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4f},{},{}\n", csv_escape(r.at("source").get<std::string>()),
                      r.at("temperature_c").is_null() ? std::string("") : fmt::format("{:g}", r.at("temperature_c").get<double>()),
                      val(r, {"fit", "N_deg_per_sqrt_h"}, "value"), val(r, {"fit", "N_deg_per_sqrt_h"}, "sigma"),
                      val(r, {"fit", "N_deg_per_sqrt_h"}, "resolved"), val(r, {"methods", "N_direct_deg_per_sqrt_h"}, "value"),
                      val(r, {"methods", "N_direct_deg_per_sqrt_h"}, "sigma"), val(r, {"fit", "B_deg_per_h"}, "value"),
                      val(r, {"fit", "B_deg_per_h"}, "sigma"), val(r, {"fit", "B_deg_per_h"}, "resolved"),
                      val(r, {"methods", "B_100s_deg_per_h"}, "value"), val(r, {"methods", "B_100s_deg_per_h"}, "sigma"),
-                     cls(v.at("class_N")), cls(v.at("class_B")), cls(v.at("class")), v.at("p_class").get<double>());
+                     cls(v.at("class_N")), cls(v.at("class_B")), cls(v.at("class")), v.at("p_class").get<double>(),
+                     o ? fmt::format("{}", o->value("count", std::size_t{0})) : std::string(),
+                     o ? csv_escape(o->value("action", std::string())) : std::string());
   }
   const auto& ov = summary.at("overall");
-  s += fmt::format("overall,,,,,,,,,,,,{},{},{},{:.4f}\n", cls(ov.at("class_N")), cls(ov.at("class_B")), cls(ov.at("class")),
+  s += fmt::format("overall,,,,,,,,,,,,{},{},{},{:.4f},,\n", cls(ov.at("class_N")), cls(ov.at("class_B")), cls(ov.at("class")),
                    ov.at("p_class").get<double>());
   return s;
 }

@@ -698,11 +698,19 @@ json clean_json(json j) {
 
 }  // namespace
 
-DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
+DiagnoseResult diagnose(const Recording& read, const DiagnoseOptions& opt) {
   const auto t_start = std::chrono::steady_clock::now();
-  if (rec.phase.kind != PhaseKind::Gyro)
+  if (read.phase.kind != PhaseKind::Gyro)
     throw UsageError("diagnose needs gyro data (clock phase/frequency cannot be simulated as a gyro)");
   if (opt.runs < 10) throw UsageError(fmt::format("--runs must be at least 10 (got {})", opt.runs));
+  // Outliers are screened once, on the record as read, and the requested action applied before
+  // anything else: the detectors, the pilot fits and the hold-out splits all see the same data,
+  // and a spike cannot pass for a bias step or inflate N. Every later analysis keeps the data it
+  // is given; the report is that of the record as read.
+  OutlierReport outliers;
+  Recording edited;
+  const Recording& rec = screen_outliers(read, opt.analysis.outlier_action, opt.analysis.outlier_threshold,
+                                         outliers, edited, opt.threads);
   const double T = rec.phase.duration_s();
   if (T < kMinDuration)
     throw AnalysisError(fmt::format("{}: the record lasts {:.4g} s; the diagnosis needs at least {:g} s", rec.source, T, kMinDuration));
@@ -716,8 +724,10 @@ DiagnoseResult diagnose(const Recording& rec, const DiagnoseOptions& opt) {
   // Pulse data: the counting read-out is simulated exactly, and its structured AV at short τ
   // would distort the five-term fit, so the base fit starts at 20 s unless a range was given.
   AnalysisOptions aopt = opt.analysis;
+  aopt.outlier_action = OutlierAction::Keep;
   if (rec.phase.exact() && aopt.fit.tau_min_s <= 0) aopt.fit.tau_min_s = kPulseFitTauMin;
   r.analysis = analyze_for_base(rec, aopt);
+  r.analysis.outliers = std::move(outliers);
   timer.lap("base fit");
   const PhaseSeries& x = rec.phase;
   const std::size_t n = x.points() - 1;
@@ -1181,6 +1191,7 @@ json to_json(const DiagnoseResult& r) {
   j["seed"] = r.seed;
   j["false_alarm_level_per_detector"] = r.alpha;
   j["simulation_path"] = "ensemble";
+  j["outliers"] = to_json(r.analysis.outliers);
   json base = model_json(r.base, r.base_band, r.band_level, r.gain.misfit_base, r.gain.coverage_base);
   // Not under "fit": model_from_analysis_json would read those coefficients instead of this model.
   base["fitted_coefficients"] = {{"Q_arcsec", r.analysis.fit[Term::Q].estimate},
@@ -1239,6 +1250,7 @@ std::string format_report(const DiagnoseResult& r) {
                    "(seed {}), band {:g} % per τ\n\n",
                    r.settings.duration_s, r.settings.rate_hz, r.settings.scale_arcsec, r.runs, r.seed,
                    r.band_level * 100);
+  s += format_outliers(r.analysis.outliers);
   const auto& m = r.base;
   s += fmt::format("Base model (five-term fit): N = {:.4g} °/√h, B = {:.4g} °/h, K = {:.4g} °/h/√h, R = {:.4g} °/h², "
                    "white angle {:.4g}″, {} read-out, Earth rate {:.4g} °/h, bias {:.4g} °/h\n",

@@ -285,6 +285,48 @@ std::string json_value_html(const json& v) {
   return esc(v.dump());
 }
 
+/// What was done with the outliers, in words (saved JSON may hold any string: escaped).
+std::string outlier_action_html(const json& outliers, std::size_t count) {
+  const std::string action = str(outliers, "action");
+  if (action == "keep") return "kept in the analysis (--outliers remove or replace leaves them out)";
+  if (action == "remove")
+    return fmt::format("{:.0f} removed before the analysis (later samples move one period earlier)",
+                       num(outliers, "removed").value_or(static_cast<double>(count)));
+  if (action == "replace")
+    return fmt::format("{:.0f} replaced by the median of their nearest good neighbours before the analysis",
+                       num(outliers, "replaced").value_or(static_cast<double>(count)));
+  return "action " + (action.empty() ? std::string(kNotAvailable) : esc(action));
+}
+
+constexpr std::size_t kReportOutlierPositions = 10;  ///< positions listed per run (the JSON has more)
+
+/// The outlier line of a run or a diagnosis: count, action and the first positions (input line,
+/// time, rate); says so when the results carry no outlier summary.
+std::string outliers_html(const json& outliers) {
+  if (!outliers.is_object()) return "<span class=\"na\">not in these results (no outlier summary)</span>";
+  const auto count_value = num(outliers, "count");
+  if (!count_value) return kNotAvailable;
+  const auto count = static_cast<std::size_t>(*count_value);
+  const std::string threshold =
+      num(outliers, "threshold_robust_z") ? fmt::format(" (threshold {:g} robust σ)", *num(outliers, "threshold_robust_z"))
+                                          : std::string();
+  if (count == 0) return "none found" + threshold;
+  std::string s = fmt::format("<b>{} found</b>{}; {}", count, threshold, outlier_action_html(outliers, count));
+  const auto& positions = at(outliers, "positions");
+  std::size_t listed = 0;
+  if (positions.is_array()) {
+    for (const auto& p : positions) {
+      if (listed == kReportOutlierPositions) break;
+      const auto line = num(p, "line"), time = num(p, "time_s"), value = num(p, "value_deg_per_h");
+      s += listed++ ? ", " : ": ";
+      s += line ? fmt::format("line {:.0f}", *line) : std::string("line ") + kNotAvailable;
+      if (time) s += fmt::format(" (t = {:g} s", *time) + (value ? fmt::format(", {:.6g} °/h)", *value) : ")");
+    }
+  }
+  if (count > listed) s += fmt::format("{}… {} more in the JSON results", listed ? ", " : ": ", count - listed);
+  return s;
+}
+
 std::string run_summary(const json& run, std::size_t index) {
   std::string s = fmt::format("<table class=\"run\" id=\"run{}-data\">\n<caption>Data and rates</caption>\n", index + 1);
   s += kv_row("file", esc(str(run, "source")));
@@ -295,6 +337,8 @@ std::string run_summary(const json& run, std::size_t index) {
   if (const auto m = num(run, "mean_rate_deg_per_h")) s += kv_row("mean rate", fmt::format("{:.5g} °/h", *m));
   if (const auto e = num(run, "earth_rate_deg_per_h")) s += kv_row("expected Earth rate", fmt::format("{:.5g} °/h", *e));
   if (const auto b = num(run, "bias_deg_per_h")) s += kv_row("bias (mean − Earth rate)", fmt::format("{:.4g} °/h", *b));
+  s += fmt::format("<tr id=\"run{}-outliers\"><th>outliers</th><td>{}</td></tr>\n", index + 1,
+                   outliers_html(at(run, "outliers")));
   s += "</table>\n";
 
   const auto& fit = at(run, "fit");
@@ -351,6 +395,8 @@ std::string number_with_unit_key(std::string_view key, const json& v) {
 
 std::string diagnosis_html(const json& d, std::size_t index, const json& run, FigureCounter& counter, bool figures) {
   std::string s = fmt::format("<h3 id=\"run{}-diagnosis\">Diagnosis: what the noise model misses</h3>\n", index + 1);
+  s += fmt::format("<p id=\"run{}-diagnosis-outliers\">Outliers of the diagnosed record: {}.</p>\n", index + 1,
+                   outliers_html(at(d, "outliers")));
   const auto& findings = at(d, "findings");
   if (!findings.is_array() || findings.empty()) {
     s += "<p>No finding: the five-term model's simulations explain the measurement.</p>\n";

@@ -52,6 +52,21 @@ struct OutlierReport {
 };
 inline constexpr std::size_t kMaxOutlierPositions = 1000;
 
+/// Outlier screening as every command that analyses a record does it (analyze, batch, report,
+/// diagnose, allan): the isolated outliers of `read` are detected and reported (count, positions
+/// with their input lines, the action taken), then the action is applied. Returns `read` itself
+/// when the data stay as read (Keep, or nothing found), else `edited`, filled with the record
+/// whose outliers were removed or replaced. Throws UsageError for a threshold that is not a
+/// positive number. `crew` (may be null) shares the scan out (crew.hpp).
+const Recording& screen_outliers(const Recording& read, OutlierAction action, double threshold,
+                                 OutlierReport& report, Recording& edited, unsigned threads = 0,
+                                 Crew* crew = nullptr);
+
+/// The outlier report as the readable reports print it ("Outliers" section) and as the JSON
+/// "outliers" object of analyze, batch, diagnose and allan.
+std::string format_outliers(const OutlierReport& report);
+nlohmann::json to_json(const OutlierReport& report);
+
 /// Parse "keep", "remove" or "replace" (UsageError otherwise).
 OutlierAction parse_outlier_action(std::string_view s);
 std::string_view to_string(OutlierAction a);

@@ -32,6 +32,20 @@ std::pair<double, double> parse_range(const std::string& spec, const char* what,
 
 }  // namespace
 
+void add_outlier_options(CLI::App& app, std::string& action, double& threshold) {
+  app.add_option("--outliers", action,
+                 "Isolated outliers are always detected and reported (sample, time, line); then: keep "
+                 "(default: analyse the data as read), remove (drop them; later samples move one period "
+                 "earlier), or replace (by the median of the nearest good neighbours; keeps every sample)")
+      ->capture_default_str()
+      ->group("Outliers");
+  app.add_option("--outlier-threshold", threshold,
+                 "Detection threshold, robust sigma of the residual from the neighbour median")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str()
+      ->group("Outliers");
+}
+
 void AnalyzeArgs::add_to(CLI::App& app) {
   app.add_option("--fit-range", fit_range, "Tau range of the fit, TMIN:TMAX in s (either may be empty; default: all)")
       ->group("Fit");
@@ -71,17 +85,7 @@ void AnalyzeArgs::add_to(CLI::App& app) {
   app.add_option("--direct-range", direct_range, "Interval lengths of the direct N method, TMIN:TMAX in s")
       ->capture_default_str()
       ->group("Cross-checks");
-  app.add_option("--outliers", outliers,
-                 "Isolated outliers are always detected and reported (sample, time, line); then: keep "
-                 "(default: analyse the data as read), remove (drop them; later samples move one period "
-                 "earlier), or replace (by the median of the nearest good neighbours; keeps every sample)")
-      ->capture_default_str()
-      ->group("Outliers");
-  app.add_option("--outlier-threshold", outlier_threshold,
-                 "Detection threshold, robust sigma of the residual from the neighbour median")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str()
-      ->group("Outliers");
+  add_outlier_options(app, outliers, outlier_threshold);
 }
 
 AnalysisOptions AnalyzeArgs::options() const {

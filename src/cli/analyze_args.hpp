@@ -9,6 +9,10 @@
 
 namespace rwcalc::cli {
 
+/// --outliers keep|remove|replace and --outlier-threshold, as every command that analyses a record
+/// takes them (the action is applied by rwcalc::screen_outliers).
+void add_outlier_options(CLI::App& app, std::string& action, double& threshold);
+
 struct AnalyzeArgs {
   std::string fit_range;            ///< "TMIN:TMAX" (s; either side may be empty)
   double min_edf = 1.0;

@@ -7,8 +7,10 @@
 #include <nlohmann/json.hpp>
 #include <ostream>
 
+#include "cli/analyze_args.hpp"
 #include "cli/commands.hpp"
 #include "rwcalc/allan.hpp"
+#include "rwcalc/analysis.hpp"
 #include "rwcalc/crew.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/reader.hpp"
@@ -26,6 +28,8 @@ struct AllanArgs {
   bool json = false;
   bool csv = false;
   unsigned threads = 0;
+  std::string outliers = "keep";
+  double outlier_threshold = kDefaultOutlierThreshold;
 };
 
 // The JSON of a result, written straight into one string: the same document as
@@ -37,7 +41,7 @@ void append_number(std::string& out, double v) {
   if (out.find_first_of(".e", at) == std::string::npos) out += ".0";
 }
 
-std::string allan_json_text(const AllanResult& r, const Recording& rec) {
+std::string allan_json_text(const AllanResult& r, const Recording& rec, const OutlierReport& outliers) {
   std::string out;
   out.reserve(256 + r.points.size() * 260);
   out += "{\n";
@@ -49,6 +53,10 @@ std::string allan_json_text(const AllanResult& r, const Recording& rec) {
                          .dump());
   out += fmt::format("  \"estimator\": {},\n", nlohmann::json(std::string(to_string(r.estimator))).dump());
   if (r.fft_from_m > 0) out += fmt::format("  \"fft_from_af\": {},\n", r.fft_from_m);
+  // The outlier object one level in, as dump(2) writes a nested object.
+  std::string outl = to_json(outliers).dump(2);
+  for (std::size_t at = outl.find('\n'); at != std::string::npos; at = outl.find('\n', at + 3)) outl.replace(at, 1, "\n  ");
+  out += "  \"outliers\": " + outl + ",\n";
   out += fmt::format("  \"phase_points\": {},\n", r.points_in);
   out += r.points.empty() ? "  \"points\": []" : "  \"points\": [";
   for (std::size_t i = 0; i < r.points.size(); ++i) {
@@ -82,24 +90,33 @@ int run_allan(const AllanArgs& a, Io& io) {
   o.grid = TauGrid::parse(a.tau);
   o.confidence = a.confidence;
   o.threads = a.threads;
+  const OutlierAction outlier_action = parse_outlier_action(a.outliers);
   // The helper threads, started once before the read and lent to the passes that share their
   // work out (crew.hpp); the τ loop keeps its own threads.
   OwnCrew crew(o.threads);
   o.crew = crew.get();
   ReadOptions ro = a.input.options();
   ro.crew = o.crew;
-  const Recording rec = read_recording(a.file, ro);
+  const Recording read = read_recording(a.file, ro);
+  // Outliers are looked for, reported and dealt with as by analyze (--outliers).
+  OutlierReport outliers;
+  Recording edited;
+  const Recording& rec =
+      screen_outliers(read, outlier_action, a.outlier_threshold, outliers, edited, o.threads, o.crew);
   // Increment and rate samples are frequency data for the noise identification, as Stable32
   // treats a frequency file; cumulative counters and angles are phase data.
   o.noise_id_domain = (rec.mode == InputMode::Pulses || rec.mode == InputMode::Rate) ? NoiseIdDomain::Frequency
                                                                                       : NoiseIdDomain::Phase;
   const AllanResult res = compute_allan(rec.phase, o);
   if (a.json) {
-    io.out << allan_json_text(res, rec);
+    io.out << allan_json_text(res, rec, outliers);
   } else if (a.csv) {
     io.out << format_allan_csv(res);
+    // The CSV holds the table only; the outliers found are said on standard error.
+    if (outliers.count > 0) io.err << "rwcalc: note: " << rec.source << ": " << format_outliers(outliers);
   } else {
     io.out << format_allan_table(res, {rec.source, rec.samples, rec.rate_hz, std::string(to_string(rec.rate_source))});
+    io.out << "\n" << format_outliers(outliers);
   }
   return 0;
 }
@@ -125,6 +142,7 @@ void register_allan(CLI::App& app, Runner& runner) {
   sub->add_option("--confidence", args->confidence, "Two-sided confidence of the bounds (0..1)")
       ->capture_default_str();
   sub->add_option("--threads", args->threads, "Worker threads across τ (0: all cores)")->capture_default_str();
+  add_outlier_options(*sub, args->outliers, args->outlier_threshold);
   auto* json = sub->add_flag("--json", args->json, "Print JSON instead of the table");
   auto* csv = sub->add_flag("--csv", args->csv, "Print CSV instead of the table");
   json->excludes(csv);
