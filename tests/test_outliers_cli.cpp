@@ -112,6 +112,9 @@ TEST_P(OutliersCli, ReportShowsTheOutliersOfRecordingsAndOfSavedResults) {
   auto r = run_exe({"report", rec_->spiked, "-o", (tmp.path() / "rec").string(), "--no-figures", "--outliers", action});
   ASSERT_EQ(r.status, 0) << r.err;
   check_html(tmp.path() / "rec");
+  EXPECT_NE(slurp(tmp.path() / "rec" / "report.html").find("<tr><th>outliers</th><td>" + action + "</td></tr>"),
+            std::string::npos)
+      << "the settings table does not name the outlier action";
   // The same from the saved analysis JSON, which carries the outlier summary.
   r = run_exe({"analyze", rec_->spiked, "--json", "--outliers", action});
   ASSERT_EQ(r.status, 0) << r.err;
@@ -119,6 +122,13 @@ TEST_P(OutliersCli, ReportShowsTheOutliersOfRecordingsAndOfSavedResults) {
   r = run_exe({"report", saved.string(), "-o", (tmp.path() / "saved").string(), "--no-figures"});
   ASSERT_EQ(r.status, 0) << r.err;
   check_html(tmp.path() / "saved");
+  // Saved results without an outlier summary (older or hand-made JSON) say so, never "none".
+  json stripped = json::parse(slurp(saved));
+  stripped.erase("outliers");
+  const auto bare = tmp.write("bare.json", stripped.dump());
+  r = run_exe({"report", bare.string(), "-o", (tmp.path() / "bare").string(), "--no-figures"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(slurp(tmp.path() / "bare" / "report.html").find("not in these results"), std::string::npos);
 }
 
 TEST_P(OutliersCli, AllanReportsAndAppliesTheAction) {

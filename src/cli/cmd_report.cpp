@@ -182,6 +182,8 @@ json settings_of(const ReportCmd& c, const std::vector<std::string>& recordings,
   s["class table"] = a.limits_file.empty() ? std::string("GOST RV 52339 (built in)") : a.limits_file;
   s["averaging block (s)"] = a.block_s;
   s["direct method t range (s)"] = a.direct_range;
+  s["outliers"] = a.outliers;
+  s["outlier threshold (robust σ)"] = a.outlier_threshold;
   if (c.temperature) s["temperature (°C)"] = *c.temperature;
   return s;
 }
