@@ -77,3 +77,20 @@ TEST(DiagnoseOutliers, SpikeIsReportedAndTheActionAppliedBeforeTheDiagnosis) {
   EXPECT_NE(r.out.find("1 found; 1 REPLACED"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find(" " + std::to_string(rec.spike_line) + " "), std::string::npos) << r.out;
 }
+
+// `rwcalc report --diagnose` shows the outliers of the diagnosed record above its diagnosis.
+TEST(DiagnoseOutliers, ReportDiagnosisSectionNamesTheOutliers) {
+  const SpikedRecord rec(1320.0);
+  rwcalc::test::TempDir tmp;
+  const auto dir = tmp.path() / "report";
+  const auto r = run_exe({"report", rec.spiked, "-o", dir.string(), "--no-figures", "--diagnose", "--diagnose-runs",
+                          "10", "--outliers", "remove"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string html = rwcalc::test::slurp(dir / "report.html");
+  const auto at = html.find("id=\"run1-diagnosis-outliers\"");
+  ASSERT_NE(at, std::string::npos) << "no outlier line in the diagnosis section";
+  const std::string line = html.substr(at, html.find("</p>", at) - at);
+  EXPECT_NE(line.find("1 found"), std::string::npos) << line;
+  EXPECT_NE(line.find("removed"), std::string::npos) << line;
+  EXPECT_NE(line.find("line " + std::to_string(rec.spike_line)), std::string::npos) << line;
+}
