@@ -93,16 +93,6 @@ std::vector<AllanRow> allan_rows(const json& allan) {
 
 // ---- script text ---------------------------------------------------------------------------
 
-/// A gnuplot single-quoted string (no escapes; a quote is doubled).
-std::string q(std::string_view s) {
-  std::string r = "'";
-  for (char c : s) {
-    if (c == '\'') r += '\'';
-    r += c;
-  }
-  return r + "'";
-}
-
 /// A number for display: 4 significant digits, no exponent when avoidable.
 std::string show(double v) { return fmt::format("{:.4g}", v); }
 
@@ -150,14 +140,14 @@ std::string loglog_preamble(const std::string& title, const std::string& ylabel,
                             double ymin, double ymax, const std::vector<std::string>& elements) {
   std::string s;
   s += "set encoding utf8\n";
-  s += fmt::format("set title {} noenhanced\n", q(title));
+  s += fmt::format("set title {} noenhanced\n", gnuplot_string(title));
   s += "set logscale xy 10\n";
   s += "set format x '10^{%L}'\nset format y '10^{%L}'\n";
   s += "set xtics nomirror\nset ytics nomirror\nset mxtics 10\nset mytics 10\n";
   s += "set grid xtics ytics mxtics mytics lw 0.6 lc rgb '#d9d9d9', lw 0.4 lc rgb '#eeeeee'\n";
   s += "set border 3 lw 1\n";
-  s += "set xlabel 'τ (s)' offset 0,0.7\n";  // clear of the key below
-  s += fmt::format("set ylabel {}\n", q(ylabel));
+  s += "set xlabel 'τ (s)' noenhanced offset 0,0.7\n";  // clear of the key below
+  s += fmt::format("set ylabel {} noenhanced\n", gnuplot_string(ylabel));
   s += fmt::format("set xrange [{:.6g}:{:.6g}]\nset yrange [{:.6g}:{:.6g}]\n", xmin, xmax, ymin, ymax);
   s += key_below(elements.size(), longest_title(elements));
   s += "set samples 250\n";
@@ -254,7 +244,7 @@ void add_class_floors(const json& analysis, std::string& vars, PlotCommand& plot
     vars += fmt::format("B_class{} = {:.6g}   # °/h, class {} limit for B\n", cls, b, cls);
     plot.add(fmt::format("sB(x, B_class{0}) w l lw 1.3 dt {1} lc rgb '#d62728' t {2}", cls,
                          kDash[i % kDash.size()],
-                         q(fmt::format("class {} limit B = {} °/h{} (floor {} °/h)", cls, show(b),
+                         gnuplot_string(fmt::format("class {} limit B = {} °/h{} (floor {} °/h)", cls, show(b),
                                        tolerance_note(analysis), show(kFloorPerB * b)))));
     ++i;
   }
@@ -348,7 +338,7 @@ Figure analysis_figure(const json& analysis, const PlotOptions& options) {
   PlotCommand plot;
   const auto conf = number_at(allan, "confidence");
   plot.add(fmt::format("$allan u 1:2:3:4 w yerrorbars pt 7 ps 0.55 lw 1.2 lc rgb '#222222' t {}",
-                       q(conf ? fmt::format("measured σ(τ), {:g} % bounds", *conf * 100) : "measured σ(τ)")));
+                       gnuplot_string(conf ? fmt::format("measured σ(τ), {:g} % bounds", *conf * 100) : "measured σ(τ)")));
 
   if (gyro && fit.is_object()) {
     vars += kTermFunctions;
@@ -363,18 +353,18 @@ Figure analysis_figure(const json& analysis, const PlotOptions& options) {
       const double v = c.value.value_or(0.0);
       if (c.resolved && v > 0) {
         term_lines.push_back(fmt::format("{}(x, {}) w l lw 1.4 lc rgb '{}' t {}", t.fn, t.var, t.colour,
-                                         q(fmt::format("{} = {} {}", t.label, show(v), t.unit))));
+                                         gnuplot_string(fmt::format("{} = {} {}", t.label, show(v), t.unit))));
       } else if (const double bound = c.high95.value_or(v); !c.resolved && bound > 0) {
         // An unresolved term is only bounded: draw the bound, dashed.
         vars += fmt::format("{}_up95 = {:.8g}   # {}, 95 % upper bound\n", t.var, bound, t.unit);
         term_lines.push_back(fmt::format("{}(x, {}_up95) w l lw 1.2 dt 3 lc rgb '{}' t {}", t.fn, t.var,
                                          t.colour,
-                                         q(fmt::format("{} < {} {} (95 %)", t.label, show(bound), t.unit))));
+                                         gnuplot_string(fmt::format("{} < {} {} (95 %)", t.label, show(bound), t.unit))));
       }
     }
     vars += model + ")\n";
     plot.add(fmt::format("model(x) w l lw 2.2 lc rgb '#000000' t {}",
-                         q(fit.contains("chi2_per_dof") && number_at(fit, "chi2_per_dof")
+                         gnuplot_string(fit.contains("chi2_per_dof") && number_at(fit, "chi2_per_dof")
                                ? fmt::format("fitted model (χ²/dof = {:.3g})", *number_at(fit, "chi2_per_dof"))
                                : std::string("fitted model"))));
     for (auto& l : term_lines) plot.add(std::move(l));
@@ -448,7 +438,7 @@ Figure batch_allan_figure(const json& runs, const PlotOptions& options) {
     }
     const auto colour = temperature_colour(child(run, "temperature_c"), i);
     plot.add(fmt::format("${} u 1:2:3:4 w yerrorlines pt {} ps 0.6 lw 1.4 lc rgb '{}' t {}", name,
-                         kPointTypes[i % kPointTypes.size()], colour, q(run_label(run, i))));
+                         kPointTypes[i % kPointTypes.size()], colour, gnuplot_string(run_label(run, i))));
   }
   if (plot.elements.empty())
     throw AnalysisError("no run of the batch has Allan deviation points (runs[].allan.points): nothing to plot");
@@ -515,7 +505,7 @@ Figure batch_direct_figure(const json& runs, const PlotOptions& options) {
     std::string label = run_label(run, i);
     if (n_val) label += fmt::format(": N {} {} °/√h", n_resolved ? "=" : "<", show(*n_val));
     plot.add(fmt::format("${} u 1:2 w p pt {} ps 0.8 lc rgb '{}' t {}", name, kPointTypes[i % kPointTypes.size()],
-                         colour, q(label)));
+                         colour, gnuplot_string(label)));
     if (slope) {
       // The angle variance of ARW grows as (60N)²·t in ″² (N in °/√h, t in s).
       vars += fmt::format("slope{0} = {1:.8g}   # ″²/s\nintercept{0} = {2:.8g}   # ″²\n", i + 1, *slope,
@@ -527,12 +517,12 @@ Figure batch_direct_figure(const json& runs, const PlotOptions& options) {
   if (plot.elements.empty()) return f;
   f.script += "set encoding utf8\n";
   f.script += fmt::format("set title {} noenhanced\n",
-                          q(options.title.empty() ? "Direct method: variance of the angle over t (Earth rate removed), with regression lines"
+                          gnuplot_string(options.title.empty() ? "Direct method: variance of the angle over t (Earth rate removed), with regression lines"
                                                   : options.title + " — direct method"));
   f.script += "set xtics nomirror\nset ytics nomirror\nset mxtics\nset mytics\n";
   f.script += "set grid xtics ytics lw 0.6 lc rgb '#d9d9d9'\nset border 3 lw 1\n";
-  f.script += "set xlabel 'interval length t (s)'\n";
-  f.script += "set ylabel 'angle variance D(t) (″²)'\n";
+  f.script += "set xlabel 'interval length t (s)' noenhanced\n";
+  f.script += "set ylabel 'angle variance D(t) (″²)' noenhanced\n";
   f.script += fmt::format("set xrange [0:{:.6g}]\nset yrange [0:{:.6g}]\n", tmax * 1.02, vmax * 1.25);
   // The variance grows with t, so the upper-left corner is empty: the key goes there.
   f.script += "set key inside left top vertical Left reverse noenhanced samplen 2.5 spacing 1.1 opaque "
@@ -611,14 +601,14 @@ Figure diagnosis_figure(const json& diagnosis, const PlotOptions& options) {
   };
   add_band("base", base);
   plot.add(fmt::format("$base u 1:3:4 w filledcurves fs transparent solid 0.30 noborder lc rgb '#1f77b4' t {}",
-                       q(band_label("base", child(diagnosis, "base_model"), base))));
+                       gnuplot_string(band_label("base", child(diagnosis, "base_model"), base))));
   if (std::all_of(base.begin(), base.end(), [](const BandRow& r) { return r.median > 0; }))
     plot.add("$base u 1:5 w l lw 1.2 dt 2 lc rgb '#1f77b4' t 'base model: simulated median'");
   if (!ext.empty()) {
     add_band("extended", ext);
     plot.add(fmt::format(
         "$extended u 1:3:4 w filledcurves fs transparent pattern 5 border lc rgb '#e6550d' lc rgb '#e6550d' t {}",
-        q(band_label("extended", child(diagnosis, "extended_model"), ext))));
+        gnuplot_string(band_label("extended", child(diagnosis, "extended_model"), ext))));
   }
   // The measurement, and the τ where it leaves the base band marked so they stand out.
   std::string outside = "$outside << EOD\n# tau_s dev (outside the base band)\n";

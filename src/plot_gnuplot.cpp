@@ -14,9 +14,11 @@
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <vector>
 
 #include "rwcalc/error.hpp"
 #include "rwcalc/plot.hpp"
+#include "rwcalc/printable.hpp"
 
 extern char** environ;
 
@@ -30,16 +32,6 @@ std::string lower(std::string_view s) {
   std::string r(s);
   std::transform(r.begin(), r.end(), r.begin(), [](unsigned char c) { return std::tolower(c); });
   return r;
-}
-
-/// A gnuplot single-quoted string literal (no escapes inside; a quote is doubled).
-std::string gp_string(std::string_view s) {
-  std::string r = "'";
-  for (char c : s) {
-    if (c == '\'') r += '\'';
-    r += c;
-  }
-  return r + "'";
 }
 
 std::string slurp(const fs::path& p) {
@@ -78,9 +70,10 @@ struct ProcessResult {
   std::string err;  ///< what the process wrote to stderr
 };
 
-/// Run `command args…` with stdin from /dev/null and stdout+stderr captured in `log`.
+/// Run `command args…` with stdin from /dev/null and stdout+stderr captured in `log`; in the
+/// directory `cwd` when it is not empty.
 ProcessResult run_process(const std::string& command, const std::vector<std::string>& args,
-                          const fs::path& log) {
+                          const fs::path& log, const fs::path& cwd = {}) {
   ProcessResult r;
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
@@ -88,13 +81,19 @@ ProcessResult run_process(const std::string& command, const std::vector<std::str
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
                                    0600);
   posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  std::vector<std::string> storage{command};
+  if (!cwd.empty()) posix_spawn_file_actions_addchdir_np(&actions, cwd.c_str());
+  // A relative command path names a file from our directory, not from `cwd`.
+  std::error_code ec;
+  const auto absolute = fs::absolute(command, ec);
+  std::vector<std::string> storage{!cwd.empty() && command.find('/') != std::string::npos && !ec
+                                       ? absolute.string()
+                                       : command};
   storage.insert(storage.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (auto& s : storage) argv.push_back(s.data());
   argv.push_back(nullptr);
   pid_t pid = 0;
-  const int rc = posix_spawnp(&pid, command.c_str(), &actions, nullptr, argv.data(), environ);
+  const int rc = posix_spawnp(&pid, storage.front().c_str(), &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   if (rc != 0) {
     r.spawn_errno = rc;
@@ -120,25 +119,40 @@ std::string missing_gnuplot_message(const std::string& command, int err) {
       command, std::strerror(err));
 }
 
-/// Keep gnuplot's message short enough for a terminal: its last few lines carry the error.
+/// gnuplot's message on one line, short enough for a terminal: its last few lines carry the
+/// error. The lines are joined with " | " (a message is one line); the caret line that points
+/// into the echoed command is dropped, since it cannot stay aligned.
 std::string tail_lines(const std::string& text, int lines) {
-  std::size_t pos = text.size();
-  while (pos > 0 && (text[pos - 1] == '\n' || text[pos - 1] == '\r')) --pos;
-  std::size_t end = pos;
-  for (int i = 0; i < lines && pos > 0; ++i) {
-    const auto nl = text.rfind('\n', pos - 1);
-    if (nl == std::string::npos) {
-      pos = 0;
-      break;
-    }
-    pos = nl;
+  std::vector<std::string> kept;
+  std::size_t end = text.size();
+  while (end > 0 && static_cast<int>(kept.size()) < lines) {
+    const auto nl = text.rfind('\n', end - 1);
+    const std::size_t begin = nl == std::string::npos ? 0 : nl + 1;
+    auto line = text.substr(begin, end - begin);
+    end = nl == std::string::npos ? 0 : nl;
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line.find_first_not_of(" \t\r^") == std::string::npos) continue;
+    line = line.substr(first, line.find_last_not_of(" \t\r") + 1 - first);
+    kept.insert(kept.begin(), std::move(line));
   }
-  auto s = text.substr(pos, end - pos);
-  while (!s.empty() && s.front() == '\n') s.erase(s.begin());
-  return s;
+  std::string joined;
+  for (const auto& l : kept) joined += (joined.empty() ? "" : " | ") + l;
+  return joined;
 }
 
 }  // namespace
+
+std::string gnuplot_string(std::string_view text) {
+  // Single quotes: gnuplot expands backslash escapes and backquoted commands inside double
+  // quotes only. Nothing can escape a line break there, so printable() spells control characters
+  // out; the one character left to handle is the quote itself.
+  std::string r = "'";
+  for (char c : printable(text)) {
+    if (c == '\'') r += '\'';
+    r += c;
+  }
+  return r + "'";
+}
 
 PlotFormat plot_format_for(std::string_view path) {
   const auto ext = lower(fs::path(std::string(path)).extension().string());
@@ -205,7 +219,7 @@ std::string full_script(const std::vector<Figure>& figures, PlotFormat format, i
                        width_px / 96.0, height / 96.0);
       break;
   }
-  s += fmt::format("set output {}\n", gp_string(output_path));
+  s += fmt::format("set output {}\n", gnuplot_string(output_path));
   const bool multi = figures.size() > 1;
   if (multi) {
     // Panels stacked top to bottom, each as tall as its figure asks (placed by origin/size).
@@ -230,16 +244,19 @@ std::string full_script(const std::vector<Figure>& figures, PlotFormat format, i
 
 std::string render_figures(const std::vector<Figure>& figures, PlotFormat format, int width_px) {
   ScratchDir dir;
-  const auto ext = format == PlotFormat::Svg ? ".svg" : format == PlotFormat::Png ? ".png" : ".pdf";
-  const fs::path out = dir.path() / (std::string("figure") + ext);
+  // gnuplot runs inside the scratch directory and names its files relative to it, so no path
+  // (the temporary directory's comes from TMPDIR) is ever written into the script.
+  const std::string out_name = std::string("figure") +
+                               (format == PlotFormat::Svg ? ".svg" : format == PlotFormat::Png ? ".png" : ".pdf");
+  const fs::path out = dir.path() / out_name;
   const fs::path script = dir.path() / "figure.gp";
   {
     std::ofstream f(script, std::ios::binary);
-    f << full_script(figures, format, width_px, out.string());
+    f << full_script(figures, format, width_px, out_name);
     if (!f) throw OutputError(fmt::format("{}: cannot write the gnuplot script", script.string()));
   }
   const auto command = gnuplot_command();
-  const auto r = run_process(command, {script.string()}, dir.path() / "gnuplot.log");
+  const auto r = run_process(command, {"figure.gp"}, dir.path() / "gnuplot.log", dir.path());
   if (!r.started) throw OutputError(missing_gnuplot_message(command, r.spawn_errno));
   if (r.status != 0) {
     // A shell wrapper reports a missing binary as 127.

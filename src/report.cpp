@@ -12,6 +12,7 @@
 #include "rwcalc/error.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/plot.hpp"
+#include "rwcalc/printable.hpp"
 
 namespace rwcalc {
 
@@ -68,7 +69,12 @@ std::string str(const json& j, std::string_view key) {
 
 // ---- HTML text -----------------------------------------------------------------------------
 
-std::string esc(std::string_view s) {
+/// Text for HTML, in element content and in quoted attribute values alike: the markup
+/// characters as entities, and (by printable()) control characters and bytes that are not UTF-8
+/// spelled out, so the page is valid UTF-8 and a name shows as what it is. Every string from
+/// outside (file names, strings of saved results, the title, settings) goes through here.
+std::string esc(std::string_view text) {
+  const auto s = printable(text);
   std::string r;
   r.reserve(s.size());
   for (char c : s) {
@@ -282,7 +288,8 @@ std::string json_value_html(const json& v) {
     for (const auto& e : v) s += (s.empty() ? "" : ", ") + json_value_html(e);
     return s;
   }
-  return esc(v.dump());
+  // (replace: a file name that is not UTF-8 must not make the dump throw)
+  return esc(v.dump(-1, ' ', false, json::error_handler_t::replace));
 }
 
 /// What was done with the outliers, in words (saved JSON may hold any string: escaped).

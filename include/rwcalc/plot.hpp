@@ -96,6 +96,13 @@ std::string render_figures(const std::vector<Figure>& figures, PlotFormat format
 std::string full_script(const std::vector<Figure>& figures, PlotFormat format, int width_px,
                         const std::string& output_path);
 
+/// `text` as a gnuplot string literal: single-quoted (gnuplot expands no escape, backquote or
+/// macro there; a quote is doubled) with every control character and invalid byte made visible
+/// by printable(), so the literal stays on its line and runs nothing. Every string that enters a
+/// generated script goes through this one function. The figures set all their texts (titles,
+/// labels, key) noenhanced, so enhanced-text markup (^ _ @ & { } \) shows as typed.
+std::string gnuplot_string(std::string_view text);
+
 /// The gnuplot command: $RWCALC_GNUPLOT when set and non-empty, else "gnuplot".
 std::string gnuplot_command();
 

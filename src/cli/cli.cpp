@@ -11,6 +11,7 @@
 
 #include "cli/commands.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/printable.hpp"
 
 namespace rwcalc::cli {
 
@@ -20,6 +21,8 @@ constexpr const char* kDescription =
     "noise coefficients with uncertainties, navigation accuracy class verdicts (GOST RV 52339),\n"
     "simulation of gyro records and diagnosis of what the noise model misses.";
 }
+
+void print_message(std::ostream& err, std::string_view text) { err << "rwcalc: " << printable(text) << "\n"; }
 
 namespace {
 
@@ -75,7 +78,7 @@ std::optional<int> parse_args(CLI::App& app, int argc, const char* const* argv, 
       if (app.get_subcommands().empty()) out << app.help();
       return 0;
     }
-    err << "rwcalc: " << e.what() << "\n";
+    print_message(err, e.what());
     if (app.get_subcommands().empty())
       err << "Run 'rwcalc --help' for the list of commands.\n";
     else
@@ -94,12 +97,12 @@ int parse_only(int argc, const char* const* argv, std::ostream& out, std::ostrea
     build_app(app, runner, argc, argv);
     if (const auto status = parse_args(app, argc, argv, out, err)) return *status;
     if (!runner) {
-      err << "rwcalc: no command given; run 'rwcalc --help'\n";
+      print_message(err, "no command given; run 'rwcalc --help'");
       return static_cast<int>(ExitCode::BadInput);
     }
     return 0;
   } catch (const Error& e) {
-    err << "rwcalc: error: " << e.what() << "\n";
+    print_message(err, fmt::format("error: {}", e.what()));
     return static_cast<int>(e.code());
   }
 }
@@ -113,18 +116,18 @@ int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err)
 
   try {
     if (!runner) {
-      err << "rwcalc: no command given; run 'rwcalc --help'\n";
+      print_message(err, "no command given; run 'rwcalc --help'");
       return static_cast<int>(ExitCode::BadInput);
     }
     return runner(io);
   } catch (const Error& e) {
-    err << "rwcalc: error: " << e.what() << "\n";
+    print_message(err, fmt::format("error: {}", e.what()));
     return static_cast<int>(e.code());
   } catch (const std::bad_alloc&) {
-    err << "rwcalc: error: out of memory\n";
+    print_message(err, "error: out of memory");
     return static_cast<int>(ExitCode::AnalysisFailed);
   } catch (const std::exception& e) {
-    err << "rwcalc: internal error: " << e.what() << "\n";
+    print_message(err, fmt::format("internal error: {}", e.what()));
     return static_cast<int>(ExitCode::AnalysisFailed);
   }
 }

@@ -241,8 +241,9 @@ int run_report(const ReportCmd& c, Io& io) {
     } catch (const InputError& e) {
       // Saved results without the verdict's class probabilities (older or hand-made JSON): the
       // report still states the worst class over the runs, without a combined probability.
-      io.err << "rwcalc: note: no combined verdict over the runs (" << e.what()
-             << "); the report states the worst class over the runs\n";
+      print_message(io.err, fmt::format("note: no combined verdict over the runs ({}); the report states the worst "
+                                        "class over the runs",
+                                        e.what()));
     }
   }
 

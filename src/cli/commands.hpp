@@ -6,6 +6,7 @@
 #include <iosfwd>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "rwcalc/reader.hpp"
 
@@ -18,6 +19,11 @@ struct Io {
 };
 
 using Runner = std::function<int(Io&)>;
+
+/// Print one message line, "rwcalc: TEXT", to `err`. TEXT goes through printable(): a newline,
+/// an escape sequence or an invalid byte in a file name (or anywhere else in the text) shows as
+/// \n, \x1b, \xff and cannot forge a line or drive the terminal. Every message goes through here.
+void print_message(std::ostream& err, std::string_view text);
 
 /// Input options shared by every command that reads a recording (allan, analyze, batch, diagnose).
 struct InputArgs {

@@ -22,9 +22,9 @@ PlotOptions plot_options(const PlotArgs& a, bool force) {
 }
 
 void tell(const PlotArgs& a, const PlotResult& r, Io& io) {
-  for (const auto& note : r.notes) io.err << "rwcalc: note: " << note << "\n";
-  if (!a.plot.empty()) io.err << fmt::format("rwcalc: figure written to {} ({} data series)\n", a.plot, r.series);
-  if (!a.script.empty()) io.err << fmt::format("rwcalc: gnuplot script written to {}\n", a.script);
+  for (const auto& note : r.notes) print_message(io.err, "note: " + note);
+  if (!a.plot.empty()) print_message(io.err, fmt::format("figure written to {} ({} data series)", a.plot, r.series));
+  if (!a.script.empty()) print_message(io.err, fmt::format("gnuplot script written to {}", a.script));
 }
 
 }  // namespace

@@ -1,0 +1,83 @@
+// Text from outside made safe to show: one escaping for messages, gnuplot strings and HTML.
+#include "rwcalc/printable.hpp"
+
+#include <fmt/format.h>
+
+#include <cstdint>
+
+namespace rwcalc {
+
+namespace {
+
+/// Length of the valid UTF-8 sequence at `s[i]` and its code point, or 0 when the bytes there
+/// are not valid UTF-8 (a stray continuation byte, a truncated or overlong sequence, a UTF-16
+/// surrogate, a code point beyond U+10FFFF).
+std::size_t utf8_sequence(std::string_view s, std::size_t i, char32_t& code) {
+  const auto lead = static_cast<unsigned char>(s[i]);
+  std::size_t n = 0;
+  char32_t min = 0;
+  if (lead < 0x80) {
+    code = lead;
+    return 1;
+  }
+  if ((lead & 0xE0) == 0xC0) {
+    n = 2, code = lead & 0x1F, min = 0x80;
+  } else if ((lead & 0xF0) == 0xE0) {
+    n = 3, code = lead & 0x0F, min = 0x800;
+  } else if ((lead & 0xF8) == 0xF0) {
+    n = 4, code = lead & 0x07, min = 0x10000;
+  } else {
+    return 0;
+  }
+  if (i + n > s.size()) return 0;
+  for (std::size_t k = 1; k < n; ++k) {
+    const auto b = static_cast<unsigned char>(s[i + k]);
+    if ((b & 0xC0) != 0x80) return 0;
+    code = (code << 6) | (b & 0x3F);
+  }
+  if (code < min || code > 0x10FFFF || (code >= 0xD800 && code <= 0xDFFF)) return 0;
+  return n;
+}
+
+/// Code points that act on a terminal or on the layout of text rather than show: the C1
+/// controls, the line and paragraph separators, and the bidirectional embeddings, overrides and
+/// isolates (which can make a name read differently from its bytes).
+bool acting_code_point(char32_t c) {
+  return (c >= 0x80 && c <= 0x9F) || c == 0x2028 || c == 0x2029 || (c >= 0x202A && c <= 0x202E) ||
+         (c >= 0x2066 && c <= 0x2069);
+}
+
+}  // namespace
+
+std::string printable(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  std::size_t i = 0;
+  while (i < text.size()) {
+    const auto byte = static_cast<unsigned char>(text[i]);
+    char32_t code = 0;
+    const std::size_t n = utf8_sequence(text, i, code);
+    if (n == 0) {
+      out += fmt::format("\\x{:02x}", byte);
+      ++i;
+      continue;
+    }
+    if (code == '\n') {
+      out += "\\n";
+    } else if (code == '\r') {
+      out += "\\r";
+    } else if (code == '\t') {
+      out += "\\t";
+    } else if (code < 0x20 || code == 0x7F) {
+      out += fmt::format("\\x{:02x}", byte);
+    } else if (acting_code_point(code)) {
+      out += fmt::format("\\u{:04x}", static_cast<std::uint32_t>(code));
+    } else {
+      out.append(text.substr(i, n));
+    }
+    i += n;
+  }
+  return out;
+}
+
+}  // namespace rwcalc
