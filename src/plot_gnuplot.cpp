@@ -10,11 +10,13 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <sstream>
 
+#include "cleanup.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/plot.hpp"
 
@@ -49,7 +51,9 @@ std::string slurp(const fs::path& p) {
   return ss.str();
 }
 
-/// A private temporary directory, removed with everything in it.
+/// A private temporary directory, removed with everything in it — also when SIGINT, SIGTERM or
+/// SIGHUP ends rwcalc while gnuplot runs (cleanup.hpp): the directory and the files this file
+/// puts there are registered for removal by the signal handler, which cannot list a directory.
 class ScratchDir {
  public:
   ScratchDir() {
@@ -58,6 +62,9 @@ class ScratchDir {
       throw OutputError(fmt::format("cannot create a temporary directory for gnuplot: {}",
                                     std::strerror(errno)));
     path_ = templ;
+    on_signal_.emplace_back(path_.string(), detail::RemoveOnSignal::Kind::Directory);
+    for (const char* name : {"log", "gnuplot.log", "figure.gp", "figure.svg", "figure.png", "figure.pdf"})
+      on_signal_.emplace_back((path_ / name).string(), detail::RemoveOnSignal::Kind::File);
   }
   ~ScratchDir() {
     std::error_code ec;
@@ -69,6 +76,7 @@ class ScratchDir {
 
  private:
   fs::path path_;
+  std::deque<detail::RemoveOnSignal> on_signal_;  ///< unregistered after the removal above
 };
 
 struct ProcessResult {
