@@ -170,11 +170,11 @@ void AtomicOutput::State::open_target() {
     if (fd < 0) throw OutputError(fmt::format("{}: cannot open for writing: {}", path, reason(errno)));
   } else {
     std::random_device rd;
-    fs::path dir = plan.target.parent_path();
-    tmp = dir / fmt::format(".{}.tmp{:08x}", plan.target.filename().string(), rd());
-    on_signal.emplace(tmp.string(), detail::RemoveOnSignal::Kind::File);
-    fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    const fs::path name = plan.target.parent_path() / fmt::format(".{}.tmp{:08x}", plan.target.filename().string(), rd());
+    on_signal.emplace(name.string(), detail::RemoveOnSignal::Kind::File);  // before it exists
+    fd = ::open(name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd < 0) throw OutputError(fmt::format("{}: cannot write: {}", path, reason(errno)));
+    tmp = name;  // ours from here on: removed unless committed
     if (plan.old) {
       // The replacement keeps the replaced file's permissions (not the set-id bits) and, where the
       // system allows it (root), its owner.
