@@ -273,13 +273,9 @@ void write_outputs(const std::vector<Figure>& figures, const PlotOptions& option
   for (const auto& f : figures) result.series += f.series;
   if (options.output.empty() && options.script.empty()) return;
   std::optional<PlotFormat> format;
-  if (!options.output.empty()) {
-    format = plot_format_for(options.output);
-    std::error_code ec;
-    // Fail before the work when the figure could not be written anyway.
-    if (!options.force && std::filesystem::exists(options.output, ec))
-      throw OutputError(fmt::format("{}: exists; use --force to overwrite it", options.output));
-  }
+  if (!options.output.empty()) format = plot_format_for(options.output);
+  // Fail before the work (and before the script is written) when the figure could not be written.
+  check_output_targets({{"--plot", options.output}, {"--plot-script", options.script}}, options.force);
   if (!options.script.empty()) {
     std::string target = options.output;
     if (target.empty()) target = std::filesystem::path(options.script).replace_extension(".svg").string();

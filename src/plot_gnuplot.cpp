@@ -10,12 +10,14 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <sstream>
 #include <vector>
 
+#include "cleanup.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/plot.hpp"
 #include "rwcalc/printable.hpp"
@@ -41,7 +43,9 @@ std::string slurp(const fs::path& p) {
   return ss.str();
 }
 
-/// A private temporary directory, removed with everything in it.
+/// A private temporary directory, removed with everything in it — also when SIGINT, SIGTERM or
+/// SIGHUP ends rwcalc while gnuplot runs (cleanup.hpp): the directory and the files this file
+/// puts there are registered for removal by the signal handler, which cannot list a directory.
 class ScratchDir {
  public:
   ScratchDir() {
@@ -50,6 +54,9 @@ class ScratchDir {
       throw OutputError(fmt::format("cannot create a temporary directory for gnuplot: {}",
                                     std::strerror(errno)));
     path_ = templ;
+    on_signal_.emplace_back(path_.string(), detail::RemoveOnSignal::Kind::Directory);
+    for (const char* name : {"log", "gnuplot.log", "figure.gp", "figure.svg", "figure.png", "figure.pdf"})
+      on_signal_.emplace_back((path_ / name).string(), detail::RemoveOnSignal::Kind::File);
   }
   ~ScratchDir() {
     std::error_code ec;
@@ -61,6 +68,7 @@ class ScratchDir {
 
  private:
   fs::path path_;
+  std::deque<detail::RemoveOnSignal> on_signal_;  ///< unregistered after the removal above
 };
 
 struct ProcessResult {

@@ -572,8 +572,6 @@ std::string write_report(const std::string& dir, const ReportInput& input, const
     throw OutputError(fmt::format("{}: cannot create the report directory: {}", dir,
                                   ec ? ec.message() : std::string("not a directory")));
   const auto path = (fs::path(dir) / "report.html").string();
-  if (!force && fs::exists(path, ec))
-    throw OutputError(fmt::format("{}: exists; use --force to overwrite it", path));
   write_file_atomic(path, report_html(input, options), force);
   return path;
 }

@@ -11,6 +11,7 @@
 
 #include "cli/commands.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/output.hpp"
 #include "rwcalc/printable.hpp"
 
 namespace rwcalc::cli {
@@ -107,7 +108,10 @@ int parse_only(int argc, const char* const* argv, std::ostream& out, std::ostrea
   }
 }
 
-int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+namespace {
+
+/// Parse and run the command; the exit status.
+int parse_and_run(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   CLI::App app{kDescription, "rwcalc"};
   Runner runner;
   build_app(app, runner, argc, argv);
@@ -130,6 +134,22 @@ int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err)
     print_message(err, fmt::format("internal error: {}", e.what()));
     return static_cast<int>(ExitCode::AnalysisFailed);
   }
+}
+
+}  // namespace
+
+int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  const int status = parse_and_run(argc, argv, out, err);
+  // The one place where every command's standard output (reports, tables, help) is flushed and
+  // checked: a full disk or a closed descriptor must not end in status 0.
+  try {
+    flush_standard_output(out);
+  } catch (const OutputError& e) {
+    if (status != 0) return status;  // the command failed first and has said why
+    err << "rwcalc: error: " << e.what() << "\n";
+    return static_cast<int>(ExitCode::OutputFailed);
+  }
+  return status;
 }
 
 }  // namespace rwcalc::cli

@@ -51,8 +51,9 @@ void register_analyze(CLI::App& app, Runner& runner) {
     runner = [cmd](Io& io) -> int {
       AnalysisOptions opt = cmd->analysis.options();
       opt.temperature_c = cmd->temperature;
-      // Figure problems (format, existing files, no gnuplot) are reported before the analysis.
-      cmd->plot.check(cmd->force);
+      // Output problems (figure format, existing files, two outputs naming one file, no gnuplot)
+      // are reported before the analysis, and before anything is written.
+      cmd->plot.check(cmd->force, {{"-o", cmd->output}});
       detail::ScopedTimer total("analyze command");
       // The analysis' helper threads, started before the read so that they have settled on the
       // other cores by the time the Allan stage shares its passes out (crew.hpp).

@@ -56,7 +56,7 @@ void register_batch(CLI::App& app, Runner& runner) {
         if (cmd->files.size() != 1) throw UsageError("--temperature applies to a single file; name the temperature in each file instead");
         opt.temperature_c = cmd->temperature;
       }
-      cmd->plot.check(cmd->force);
+      cmd->plot.check(cmd->force, {{"-o", cmd->output}});
       auto runs = analyze_files(cmd->files, cmd->input.options(), opt, cmd->jobs);
       if (cmd->plot.any()) cmd->plot.draw_batch(nlohmann::json{{"runs", runs}}, cmd->force, io);
       emit(io, cmd->format.render(std::move(runs)), cmd->output, cmd->force);

@@ -1,8 +1,5 @@
 // 'rwcalc diagnose FILE': compare the measurement with simulations of its fitted five-term model,
 // name what the model misses, extend the model and measure the gain (docs/diagnosis.md).
-#include <fmt/format.h>
-
-#include <filesystem>
 #include <memory>
 #include <ostream>
 
@@ -60,9 +57,7 @@ void register_diagnose(CLI::App& app, Runner& runner) {
   sub->callback([cmd, &runner] {
     runner = [cmd](Io& io) -> int {
       // Refuse bad figure names and existing outputs before the simulations rather than after them.
-      cmd->plot.check(cmd->force);
-      if (cmd->output != "-" && !cmd->force && std::filesystem::exists(cmd->output))
-        throw OutputError(fmt::format("{} exists; use --force to overwrite it", cmd->output));
+      cmd->plot.check(cmd->force, {{"-o", cmd->output}});
       DiagnoseOptions opt;
       opt.analysis = cmd->analysis.options();
       opt.analysis.temperature_c = cmd->temperature;

@@ -30,6 +30,7 @@ void register_merge(CLI::App& app, Runner& runner) {
   sub->add_flag("--force", cmd->force, "Overwrite an existing output file");
   sub->callback([cmd, &runner] {
     runner = [cmd](Io& io) -> int {
+      check_output_targets({{"-o", cmd->output}}, cmd->force);  // before the reading
       std::vector<nlohmann::json> runs;
       for (const auto& f : cmd->files) {
         auto part = read_json_lines(f);

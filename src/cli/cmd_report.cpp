@@ -23,6 +23,7 @@
 #include "rwcalc/diagnose.hpp"
 #include "rwcalc/reader.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/output.hpp"
 #include "rwcalc/plot.hpp"
 #include "rwcalc/report.hpp"
 
@@ -212,10 +213,10 @@ int run_report(const ReportCmd& c, Io& io) {
     throw UsageError("--diagnose needs recordings; saved diagnoses are given as 'rwcalc diagnose --json' files");
   const ReadOptions read = c.input.options();
   if (c.diagnose && c.diagnose_runs < 10) throw UsageError("--diagnose-runs: at least 10 simulated records are needed");
-  // Fail before the analysis: an existing report without --force, no gnuplot for the figures.
-  const auto target = (fs::path(c.dir) / "report.html").string();
+  // Fail before the analysis: a report.html that cannot be written (existing without --force, a
+  // directory…; a missing DIR is created later), no gnuplot for the figures.
   std::error_code ec;
-  if (!c.force && fs::exists(target, ec)) throw OutputError(fmt::format("{}: exists; use --force to overwrite it", target));
+  if (fs::is_directory(c.dir, ec)) check_output_targets({{"-o", (fs::path(c.dir) / "report.html").string()}}, c.force);
   if (!c.no_figures) require_gnuplot();
 
   Saved saved;

@@ -216,18 +216,14 @@ int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
   if (a.runs < 1) throw UsageError(fmt::format("--runs must be >= 1, got {}", a.runs));
   if (a.output == "-" && a.runs > 1) throw UsageError("--runs > 1 needs a file name for -o");
 
-  // Refuse before writing anything when any target exists (no half-written set of runs).
-  if (!a.force) {
-    for (int r = 1; r <= a.runs; ++r) {
-      for (const std::string& base : {a.output, a.truth}) {
-        if (base.empty() || base == "-") continue;
-        const std::string p = a.runs > 1 ? numbered(base, r, a.runs) : base;
-        std::error_code ec;
-        if (std::filesystem::exists(p, ec))
-          throw OutputError(fmt::format("{}: exists; use --force to overwrite it (nothing was written)", p));
-      }
-    }
+  // Refuse before writing anything when any target exists or two name the same file (no
+  // half-written set of runs, no truth written over its record).
+  std::vector<OutputTarget> targets;
+  for (int r = 1; r <= a.runs; ++r) {
+    targets.push_back({"-o", a.runs > 1 ? numbered(a.output, r, a.runs) : a.output});
+    if (!a.truth.empty()) targets.push_back({"--truth", a.runs > 1 ? numbered(a.truth, r, a.runs) : a.truth});
   }
+  check_output_targets(targets, a.force);
   Simulator sim(m, s);
   PhaseSeries series;
   for (int r = 1; r <= a.runs; ++r) {

@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <ostream>
 
@@ -38,15 +37,12 @@ void PlotArgs::add_to(CLI::App& app, const std::string& what) {
       ->group("Figures");
 }
 
-void PlotArgs::check(bool force) const {
+void PlotArgs::check(bool force, const std::vector<OutputTarget>& others) const {
   if (!plot.empty()) plot_format_for(plot);  // UsageError for an unknown extension
-  if (!plot.empty() && !script.empty() &&
-      std::filesystem::absolute(plot).lexically_normal() == std::filesystem::absolute(script).lexically_normal())
-    throw UsageError(fmt::format("--plot and --plot-script name the same file '{}'", plot));
-  std::error_code ec;
-  for (const auto* path : {&plot, &script})
-    if (!path->empty() && !force && std::filesystem::exists(*path, ec))
-      throw OutputError(fmt::format("{}: exists; use --force to overwrite it", *path));
+  std::vector<OutputTarget> all = others;
+  all.push_back({"--plot", plot});
+  all.push_back({"--plot-script", script});
+  check_output_targets(all, force);
   if (!plot.empty()) require_gnuplot();
 }
 

@@ -5,8 +5,10 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json_fwd.hpp>
 #include <string>
+#include <vector>
 
 #include "cli/commands.hpp"
+#include "rwcalc/output.hpp"
 
 namespace rwcalc::cli {
 
@@ -17,9 +19,11 @@ struct PlotArgs {
   /// Adds --plot and --plot-script; `what` describes the figure in the help text.
   void add_to(CLI::App& app, const std::string& what);
   [[nodiscard]] bool any() const { return !plot.empty() || !script.empty(); }
-  /// Fails before the work: UsageError for an unknown extension, OutputError for an existing
-  /// file without `force` or (for --plot) when gnuplot cannot be run.
-  void check(bool force) const;
+  /// Fails before the work: UsageError for an unknown extension or when two outputs of the
+  /// command (--plot, --plot-script and the command's `others`, e.g. -o) name the same file,
+  /// OutputError for a file that cannot be written (existing without `force`…) or (for --plot)
+  /// when gnuplot cannot be run.
+  void check(bool force, const std::vector<OutputTarget>& others) const;
   /// Draw the figure of a `rwcalc analyze --json` object; notes and the files written go to io.err.
   void draw_analysis(const nlohmann::json& analysis, bool force, Io& io) const;
   /// Draw Figs. 1 and 2 of a batch ({"runs": [...]}).

@@ -80,21 +80,31 @@ std::string shell_quote(const std::string& s) {
   return q + "'";
 }
 
-}  // namespace
-
-CliResult run_exe(const std::vector<std::string>& args, const std::string& stdin_text) {
+CliResult run_exe_as(const std::vector<std::string>& args, const std::string& stdin_text,
+                     const std::optional<std::string>& stdout_redirection) {
   TempDir tmp;
   auto in_path = tmp.write("stdin.txt", stdin_text);
   std::string cmd = shell_quote(RWCALC_EXE);
   for (const auto& a : args) cmd += " " + shell_quote(a);
-  cmd += " <" + shell_quote(in_path.string()) + " >" + shell_quote((tmp.path() / "out").string()) +
-         " 2>" + shell_quote((tmp.path() / "err").string());
+  cmd += " <" + shell_quote(in_path.string()) + " " +
+         stdout_redirection.value_or(">" + shell_quote((tmp.path() / "out").string())) + " 2>" +
+         shell_quote((tmp.path() / "err").string());
   const int rc = std::system(cmd.c_str());
   CliResult r;
   r.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : 128 + WTERMSIG(rc);
   r.out = slurp(tmp.path() / "out");
   r.err = slurp(tmp.path() / "err");
   return r;
+}
+
+}  // namespace
+
+CliResult run_exe(const std::vector<std::string>& args, const std::string& stdin_text) {
+  return run_exe_as(args, stdin_text, std::nullopt);
+}
+
+CliResult run_exe_stdout(const std::vector<std::string>& args, const std::string& redirection) {
+  return run_exe_as(args, {}, redirection);
 }
 
 TempDir::TempDir() {

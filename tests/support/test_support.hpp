@@ -37,6 +37,10 @@ CliResult run_cli(const std::vector<std::string>& args);
 /// Run the built executable as a separate process (argv[0] = rwcalc), optionally feeding stdin.
 CliResult run_exe(const std::vector<std::string>& args, const std::string& stdin_text = {});
 
+/// Run the built executable with standard output redirected by the shell as `redirection` says,
+/// e.g. ">/dev/full" or ">&-" (closed); `out` is then empty.
+CliResult run_exe_stdout(const std::vector<std::string>& args, const std::string& redirection);
+
 /// A fresh temporary directory removed when the object goes out of scope.
 class TempDir {
  public:
