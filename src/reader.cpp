@@ -115,7 +115,8 @@ struct NeedTimes {};
 // (TextBuffer's host): the file is loaded again into a buffer of its own.
 struct TextOverwritten {};
 
-enum class Role : unsigned char { Skip, Value, Time, Temperature };
+// Time2: a second time column, which must agree with the first (Reader::check_time_columns_agree).
+enum class Role : unsigned char { Skip, Value, Time, Time2, Temperature };
 
 // What the careful path made of a line.
 enum class LineKind { Blank, Comment, Header, Data };
@@ -123,11 +124,22 @@ enum class LineKind { Blank, Comment, Header, Data };
 struct Sample {
   std::int64_t integer = 0;  // pulses, or a counter reading's bit pattern
   double real = 0.0;         // angle / rate sample
-  double time = 0.0;
+  double time = 0.0;   // in the time column's own unit (TimeName)
+  double time2 = 0.0;  // the second time column's
   double temperature = 0.0;
 };
 
-const char* const kTimeNames[] = {"time_s", "time", "t", "t_s", "timestamp", "time_sec"};
+// Names of a time column, with the unit each one is in.
+struct TimeName {
+  std::string_view name;
+  std::string_view unit;
+  double per_second;  // units per second
+};
+constexpr TimeName kTimeNames[] = {
+    {"time_s", "s", 1},       {"time", "s", 1},    {"t", "s", 1},        {"t_s", "s", 1},
+    {"timestamp", "s", 1},    {"time_sec", "s", 1}, {"time_ms", "ms", 1e3}, {"t_ms", "ms", 1e3},
+    {"time_us", "us", 1e6},   {"t_us", "us", 1e6},  {"time_ns", "ns", 1e9}, {"t_ns", "ns", 1e9}};
+constexpr TimeName kSeconds = kTimeNames[0];
 const char* const kTemperatureNames[] = {"temperature_c", "temperature", "temp_c", "temp", "t_c"};
 
 std::vector<std::string_view> value_names(InputMode m) {
@@ -138,6 +150,25 @@ std::vector<std::string_view> value_names(InputMode m) {
     case InputMode::Rate: return {"rate", "gyro", "frequency", "freq"};
   }
   return {};
+}
+
+// The time column name a header field is, or null.
+const TimeName* time_name(std::string_view field) {
+  for (const TimeName& t : kTimeNames)
+    if (iequals(field, t.name)) return &t;
+  return nullptr;
+}
+
+bool any_named(std::string_view field, const auto& names) {
+  return std::any_of(std::begin(names), std::end(names), [&](std::string_view n) { return iequals(field, n); });
+}
+
+// The header's columns for which `matches` holds, in column order.
+std::vector<std::size_t> columns_where(const std::vector<std::string>& header, const auto& matches) {
+  std::vector<std::size_t> out;
+  for (std::size_t c = 0; c < header.size(); ++c)
+    if (matches(header[c])) out.push_back(c);
+  return out;
 }
 
 class Reader {
@@ -174,6 +205,8 @@ class Reader {
   void split(std::string_view line);
   void check_foreign_delimiters(std::string_view line) const;
   void establish_layout();
+  void choose_header_columns(bool value_given);
+  [[nodiscard]] std::string column_list(const std::vector<std::size_t>& cols) const;
   void parse_field(std::string_view field, Role role, Sample& s) const;
   void push(const Sample& s);
   template <bool Integer>
@@ -238,7 +271,7 @@ class Reader {
     // The running sums start from pred (acc's first value): the first part's total as predicted by
     // digit_sum when its lines are all plain, else 0; the merge adds what the true total differs.
     std::uint64_t pred = 0;
-    std::vector<double> reals, times, temps;
+    std::vector<double> reals, times, times2, temps;
     const char* stop = nullptr;  // where the chunk's fast path stopped
   };
   // When the merge has to offset the second part's running sums (the first part's total was not
@@ -285,6 +318,8 @@ class Reader {
 
   std::size_t line_of_sample(std::size_t k) const;
   void finish_rate();
+  void check_unread_keys() const;
+  void check_time_columns_agree() const;
   void check_time_column();
   void build_phase(Recording& rec);
 
@@ -306,6 +341,9 @@ class Reader {
   std::vector<Role> roles_;
   std::size_t value_col_ = 0;
   std::optional<std::size_t> time_col_, temp_col_;
+  std::optional<std::size_t> time2_col_;  // a second time column, checked against the first
+  const TimeName* time_unit_ = &kSeconds;
+  const TimeName* time2_unit_ = &kSeconds;
   std::array<bool, 256> stop_{};  // bytes that end an unselected field in the fast path
   bool int_lines_ok_ = false;     // one column of pulses: int_lines() may take the data lines
   std::int64_t counter_lo_ = 0, counter_max_ = 0;  // accepted reading range
@@ -342,6 +380,7 @@ class Reader {
   double min_dt_ = std::numeric_limits<double>::infinity(), max_dt_ = -std::numeric_limits<double>::infinity();
   std::size_t n_times_ = 0;
   void track_time(double t) {
+    t /= time_unit_->per_second;
     if (store_times_) times_.push_back(t);
     if (n_times_ == 0) {
       t_first_ = t;
@@ -354,6 +393,19 @@ class Reader {
     t_prev_ = t;
     ++n_times_;
   }
+  // Two time columns: where they differ most (after track_time for the same sample).
+  double time_gap_max_ = 0;
+  std::size_t time_gap_sample_ = 0;
+  double time_gap_t_ = 0, time_gap_t2_ = 0;  // the two stamps there, each in its own unit
+  void track_time_pair(double t, double t2) {
+    const double d = std::abs(t / time_unit_->per_second - t2 / time2_unit_->per_second);
+    if (!(d <= time_gap_max_)) {
+      time_gap_max_ = d;
+      time_gap_sample_ = n_times_ - 1;
+      time_gap_t_ = t;
+      time_gap_t2_ = t2;
+    }
+  }
   long double temp_sum_ = 0;
   std::size_t temp_n_ = 0;
   std::size_t samples_ = 0;
@@ -365,6 +417,8 @@ class Reader {
   std::map<std::string, std::string> metadata_;
   std::optional<double> meta_rate_, meta_scale_, meta_temp_;
   std::size_t meta_rate_line_ = 0;
+  // The first key rwcalc does not read that looks like a sample rate / a pulse weight, and its line.
+  std::optional<std::pair<std::string, std::size_t>> unread_rate_key_, unread_scale_key_;
   double rate_hz_ = units::gl2d_rate_hz;
   RateSource rate_source_ = RateSource::Default;
 };
@@ -418,8 +472,30 @@ std::size_t Reader::lines_before(const char* x) const {
 
 // ---- careful path ------------------------------------------------------------------------------
 
+// A metadata key as the reader compares it: without regard to case, '-' read as '_' ("Rate-Hz" is
+// rate_hz).
+std::string canonical_key(std::string_view key) {
+  std::string k(key);
+  for (char& c : k) c = c == '-' ? '_' : (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c;
+  return k;
+}
+
+// Keys rwcalc does not read but that look like a sample rate or a pulse weight: with them in the
+// file, falling back to 400 Hz or 0.92″ would be a silent choice (Reader::check_unread_keys).
+bool looks_like_rate_key(const std::string& k) {
+  const auto has = [&](std::string_view w) { return k.find(w) != std::string::npos; };
+  return k == "rate" || k == "fs" || k == "freq" || k == "frequency" || k == "odr" || k == "data_rate" ||
+         k == "output_rate" || has("hz") || (has("sampl") && (has("rate") || has("freq")));
+}
+bool looks_like_scale_key(const std::string& k) {
+  return k.find("scale") != std::string::npos || k.find("arcsec") != std::string::npos ||
+         k.find("per_pulse") != std::string::npos;
+}
+
 void Reader::metadata_line(std::string_view body) {
-  // "# key: value" with key = letter/underscore then letters, digits, '_', '.', '-'.
+  // "# key: value" or "# key = value", with key = letter/underscore then letters, digits, '_',
+  // '.', '-'. The known keys are matched without regard to case and with '-' for '_', and kept
+  // under their own spelling; other keys are kept as written.
   body = trim(body);
   std::size_t k = 0;
   auto key_char = [](char c, bool first) {
@@ -430,8 +506,11 @@ void Reader::metadata_line(std::string_view body) {
   if (k == 0) return;
   std::size_t c = k;
   while (c < body.size() && (body[c] == ' ' || body[c] == '\t')) ++c;
-  if (c >= body.size() || body[c] != ':') return;
-  const std::string key(body.substr(0, k));
+  if (c >= body.size() || (body[c] != ':' && body[c] != '=')) return;
+  const std::string canonical = canonical_key(body.substr(0, k));
+  const bool known = canonical == "rate_hz" || canonical == "scale_arcsec_per_pulse" ||
+                     canonical == "temperature_c" || canonical == "serial";
+  const std::string key = known ? canonical : std::string(body.substr(0, k));
   const std::string value(trim(body.substr(c + 1)));
 
   auto number = [&](bool positive) {
@@ -460,6 +539,10 @@ void Reader::metadata_line(std::string_view body) {
     set_known(meta_scale_, true);
   } else if (key == "temperature_c") {
     set_known(meta_temp_, false);
+  } else if (!known && looks_like_rate_key(canonical) && !unread_rate_key_) {
+    unread_rate_key_ = {key, line_};
+  } else if (!known && looks_like_scale_key(canonical) && !unread_scale_key_) {
+    unread_scale_key_ = {key, line_};
   }
   auto [it, inserted] = metadata_.try_emplace(key, value);
   if (!inserted && it->second != value) it->second += "; " + value;  // nothing is dropped
@@ -528,14 +611,15 @@ void Reader::split(std::string_view line) {
 }
 
 void Reader::parse_field(std::string_view f, Role role, Sample& s) const {
-  const std::string col_label =
-      role == Role::Value ? fmt::format("column {}", value_col_ + 1)
-      : role == Role::Time ? fmt::format("time column {}", *time_col_ + 1)
-                           : fmt::format("temperature column {}", *temp_col_ + 1);
-  const std::string col = header_.empty() ? col_label
-                          : role == Role::Value ? "column '" + header_[value_col_] + "'"
-                          : role == Role::Time  ? "time column '" + header_[*time_col_] + "'"
-                                                : "temperature column '" + header_[*temp_col_] + "'";
+  const std::size_t index = role == Role::Value ? value_col_
+                            : role == Role::Time  ? *time_col_
+                            : role == Role::Time2 ? *time2_col_
+                                                  : *temp_col_;
+  const std::string_view kind = role == Role::Value ? "column"
+                                : role == Role::Temperature ? "temperature column"
+                                                            : "time column";
+  const std::string col = header_.empty() ? fmt::format("{} {}", kind, index + 1)
+                                          : fmt::format("{} '{}'", kind, header_[index]);
   if (f.empty()) fail(line_, fmt::format("empty field in {}", col));
   std::string_view t = f;
   if (t.size() > 1 && t.front() == '+' && t[1] != '-' && t[1] != '+') t.remove_prefix(1);
@@ -583,7 +667,7 @@ void Reader::parse_field(std::string_view f, Role role, Sample& s) const {
   if (r.ec == std::errc::result_out_of_range)
     fail(line_, fmt::format("number out of range in {}: {}", col, quoted(f)));
   if (!std::isfinite(v)) fail(line_, fmt::format("non-finite value in {}: {}", col, quoted(f)));
-  (role == Role::Value ? s.real : role == Role::Time ? s.time : s.temperature) = v;
+  (role == Role::Value ? s.real : role == Role::Time ? s.time : role == Role::Time2 ? s.time2 : s.temperature) = v;
 }
 
 LineKind Reader::careful_line(std::string_view line) {
@@ -649,23 +733,10 @@ void Reader::establish_layout() {
   layout_known_ = true;
   first_data_line_ = line_;
   const std::size_t where = header_line_ ? header_line_ : line_;
-  auto find_name = [&](auto&& names, std::optional<std::size_t> exclude) -> std::optional<std::size_t> {
-    for (std::string_view want : names)
-      for (std::size_t c = 0; c < header_.size(); ++c)
-        if (c != exclude && iequals(header_[c], want)) return c;
-    return std::nullopt;
-  };
   auto list_columns = [&] {
-    std::string s;
-    for (std::size_t c = 0; c < ncols_; ++c) {
-      if (c) s += ", ";
-      s += header_.empty() ? std::to_string(c + 1) : quoted(header_[c]);
-      if (s.size() > 200) {
-        s += ", ...";
-        break;
-      }
-    }
-    return s;
+    std::vector<std::size_t> all(ncols_);
+    for (std::size_t c = 0; c < ncols_; ++c) all[c] = c;
+    return column_list(all);
   };
 
   const std::string& want = opt_.column;
@@ -681,10 +752,15 @@ void Reader::establish_layout() {
       fail(where, fmt::format("--column '{}' names a column but the file has no header row; give a "
                               "1-based index instead",
                               want));
-    } else if (auto c = find_name(std::array{std::string_view(want)}, std::nullopt)) {
-      value_col_ = *c;
     } else {
-      fail(header_line_, fmt::format("no column named '{}'; the columns are {}", want, list_columns()));
+      const auto named = columns_where(header_, [&](std::string_view h) { return iequals(h, want); });
+      if (named.empty())
+        fail(header_line_, fmt::format("no column named '{}'; the columns are {}", want, list_columns()));
+      if (named.size() > 1)
+        fail(header_line_, fmt::format("{} columns are named '{}' (columns {}); choose one by its index with "
+                                       "--column",
+                                       named.size(), want, column_list(named)));
+      value_col_ = named.front();
     }
   }
   if (header_.empty()) {
@@ -697,30 +773,12 @@ void Reader::establish_layout() {
     if ((ncols_ == 2 || ncols_ == 3) && value_col_ == 1) time_col_ = 0;
     if (ncols_ == 3 && value_col_ == 1) temp_col_ = 2;
   } else {
-    time_col_ = find_name(kTimeNames, std::nullopt);
-    if (time_col_ && want.empty() && ncols_ == 1) time_col_.reset();
-    if (want.empty()) {
-      auto c = find_name(value_names(opt_.mode), time_col_);
-      if (!c) {
-        temp_col_ = find_name(kTemperatureNames, time_col_);
-        std::vector<std::size_t> rest;
-        for (std::size_t k = 0; k < ncols_; ++k)
-          if (k != time_col_ && k != temp_col_) rest.push_back(k);
-        if (rest.size() != 1)
-          fail(header_line_, fmt::format("cannot tell which column holds the {} samples; choose one with "
-                                         "--column (the columns are {})",
-                                         to_string(opt_.mode), list_columns()));
-        c = rest.front();
-      }
-      value_col_ = *c;
-    }
-    if (time_col_ == value_col_) time_col_.reset();
-    temp_col_.reset();
-    if (auto tc = find_name(kTemperatureNames, time_col_); tc && tc != value_col_) temp_col_ = tc;
+    choose_header_columns(!want.empty());
   }
   roles_.assign(ncols_, Role::Skip);
   roles_[value_col_] = Role::Value;
   if (time_col_) roles_[*time_col_] = Role::Time;
+  if (time2_col_) roles_[*time2_col_] = Role::Time2;
   if (temp_col_) roles_[*temp_col_] = Role::Temperature;
 
   // Bytes that end an unselected field in the fast path: its delimiter, the line end, and the
@@ -740,6 +798,65 @@ void Reader::establish_layout() {
   }
 }
 
+// The columns of a header row: the samples (unless --column chose them), the time column(s) and the
+// temperature column. Two columns that could both be the one wanted are an error, never a choice.
+void Reader::choose_header_columns(bool value_given) {
+  std::vector<std::size_t> times = columns_where(header_, [](std::string_view h) { return time_name(h) != nullptr; });
+  std::vector<std::size_t> temps = columns_where(header_, [](std::string_view h) { return any_named(h, kTemperatureNames); });
+  if (!value_given && ncols_ == 1) times.clear();  // a lone column named "time" holds the samples
+  if (value_given) {
+    std::erase(times, value_col_);
+    std::erase(temps, value_col_);
+  } else {
+    const auto names = value_names(opt_.mode);
+    const auto named = columns_where(header_, [&](std::string_view h) { return any_named(h, names); });
+    if (named.size() > 1)
+      fail(header_line_, fmt::format("columns {} could each hold the {} samples; choose one with --column",
+                                     column_list(named), to_string(opt_.mode)));
+    std::vector<std::size_t> rest;
+    for (std::size_t k = 0; k < ncols_; ++k)
+      if (std::count(times.begin(), times.end(), k) + std::count(temps.begin(), temps.end(), k) == 0) rest.push_back(k);
+    if (named.empty() && rest.size() != 1) {
+      std::vector<std::size_t> all(ncols_);
+      for (std::size_t c = 0; c < ncols_; ++c) all[c] = c;
+      fail(header_line_, fmt::format("cannot tell which column holds the {} samples; choose one with "
+                                     "--column (the columns are {})",
+                                     to_string(opt_.mode), column_list(all)));
+    }
+    value_col_ = named.empty() ? rest.front() : named.front();
+  }
+  if (times.size() > 2)
+    fail(header_line_, fmt::format("{} time columns ({}); rwcalc reads one, or two that agree: remove the others",
+                                   times.size(), column_list(times)));
+  if (temps.size() > 1)
+    fail(header_line_, fmt::format("{} temperature columns ({}); rwcalc reports one temperature: remove or "
+                                   "rename the others",
+                                   temps.size(), column_list(temps)));
+  if (!times.empty()) {
+    time_col_ = times[0];
+    time_unit_ = time_name(header_[times[0]]);
+  }
+  if (times.size() == 2) {
+    time2_col_ = times[1];
+    time2_unit_ = time_name(header_[times[1]]);
+  }
+  if (!temps.empty()) temp_col_ = temps[0];
+}
+
+// "'a' (1), 'b' (2)" for header columns, "1, 2" without a header; cut after ~200 characters.
+std::string Reader::column_list(const std::vector<std::size_t>& cols) const {
+  std::string s;
+  for (const std::size_t c : cols) {
+    if (!s.empty()) s += ", ";
+    if (s.size() > 200) {
+      s += "...";
+      break;
+    }
+    s += header_.empty() ? std::to_string(c + 1) : fmt::format("{} ({})", quoted(header_[c]), c + 1);
+  }
+  return s;
+}
+
 void Reader::push(const Sample& s) {
   if (new_run_) {
     runs_.emplace_back(samples_, line_);
@@ -750,6 +867,7 @@ void Reader::push(const Sample& s) {
   else
     reals_.push_back(s.real);
   if (time_col_) track_time(s.time);
+  if (time2_col_) track_time_pair(s.time, s.time2);
   if (temp_col_) {
     temp_sum_ += s.temperature;
     ++temp_n_;
@@ -787,8 +905,9 @@ inline __attribute__((always_inline)) const char* Reader::parse_fast(const char*
         }
         break;
       case Role::Time:
+      case Role::Time2:
       case Role::Temperature: {
-        double& v = roles_[c] == Role::Time ? s.time : s.temperature;
+        double& v = roles_[c] == Role::Time ? s.time : roles_[c] == Role::Time2 ? s.time2 : s.temperature;
         const char* e = scan_double_fast(q, v, comma_ok);
         if (!e) {
           const auto r = std::from_chars(q, end_, v);
@@ -832,6 +951,7 @@ bool Reader::fast_line(const char*& p) {
   else
     reals_.push_back(s.real);
   if (time_col_) track_time(s.time);
+  if (time2_col_) track_time_pair(s.time, s.time2);
   if (temp_col_) {
     temp_sum_ += s.temperature;
     ++temp_n_;
@@ -1071,6 +1191,7 @@ void Reader::scan_chunk(const char* from, Chunk& out, std::stop_token stop) cons
     else
       out.reals.push_back(s.real);
     if (time_col_) out.times.push_back(s.time);
+    if (time2_col_) out.times2.push_back(s.time2);
     if (temp_col_) out.temps.push_back(s.temperature);
     p = next;
   }
@@ -1133,7 +1254,10 @@ void Reader::merge_chunk(Chunk& c, MergeHelp& help, Thread& worker) {
   } else
     reals_.insert(reals_.end(), c.reals.begin(), c.reals.end());
   if (time_col_)
-    for (double t : c.times) track_time(t);
+    for (std::size_t i = 0; i < c.times.size(); ++i) {
+      track_time(c.times[i]);
+      if (time2_col_) track_time_pair(c.times[i], c.times2[i]);
+    }
   if (temp_col_)
     for (double t : c.temps) temp_sum_ += t;
   if (temp_col_) temp_n_ += k;
@@ -1281,6 +1405,34 @@ void Reader::finish_rate() {
     rate_hz_ = rate;
     rate_source_ = RateSource::TimeColumn;
   }
+}
+
+// A key that looks like a sample rate (or a pulse weight) but is not the one rwcalc reads, when
+// nothing else gives the rate (or the weight): using 400 Hz (0.92″) then would be a silent choice.
+void Reader::check_unread_keys() const {
+  if (rate_source_ == RateSource::Default && unread_rate_key_)
+    fail(unread_rate_key_->second,
+         fmt::format("metadata '{}' looks like the sample rate, but rwcalc reads the rate from rate_hz, a time "
+                     "column or --rate, and would otherwise use {:g} Hz; write '# rate_hz: VALUE' or give --rate",
+                     unread_rate_key_->first, units::gl2d_rate_hz));
+  if (integer_mode() && !opt_.scale_arcsec && !meta_scale_ && unread_scale_key_)
+    fail(unread_scale_key_->second,
+         fmt::format("metadata '{}' looks like the pulse weight, but rwcalc reads it from scale_arcsec_per_pulse "
+                     "or --scale, and would otherwise use {:g} arcsec; write '# scale_arcsec_per_pulse: VALUE' or "
+                     "give --scale",
+                     unread_scale_key_->first, units::gl2d_arcsec_per_pulse));
+}
+
+// Two time columns are used only when they agree, every line, within the time tolerance.
+void Reader::check_time_columns_agree() const {
+  if (!time2_col_) return;
+  const double period = 1.0 / rate_hz_;
+  if (time_gap_max_ <= opt_.time_tolerance * period) return;
+  fail(line_of_sample(time_gap_sample_),
+       fmt::format("the time columns '{}' and '{}' disagree: {} {} and {} {} differ by {:g} s here (their largest "
+                   "difference), more than the time tolerance ({} of the {:g}-s period); remove one of them",
+                   header_[*time_col_], header_[*time2_col_], time_gap_t_, time_unit_->unit, time_gap_t2_,
+                   time2_unit_->unit, time_gap_max_, opt_.time_tolerance, period));
 }
 
 void Reader::check_time_column() {
@@ -1483,6 +1635,8 @@ Recording Reader::run(bool store_times) {
 
   lt.lap("scan");
   finish_rate();
+  check_unread_keys();
+  check_time_columns_agree();
   check_time_column();
 
   Recording rec;

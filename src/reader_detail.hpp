@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace rwcalc {
@@ -69,6 +70,36 @@ class TextBuffer {
   std::size_t capacity_ = 0;
 };
 
+/// The longest line the reader takes, in bytes (its line end not counted). A recording's lines are
+/// short; a longer one is refused as soon as it has arrived this far, so that a stream without
+/// line ends cannot fill the memory.
+constexpr std::size_t kMaxLineBytes = std::size_t{1} << 20;
+
+/// Checks text as it arrives, before the next chunk is read or inflated: binary data (a control
+/// byte other than tab, LF and CR, or DEL) and lines longer than kMaxLineBytes are refused at once
+/// with an InputError naming the file, the line and (for binary data) the column. The line ends of
+/// each whole TextBuffer::kSegment it checks go to the buffer's segment_lines, so that the reader
+/// does not count them again.
+class ArrivalCheck {
+ public:
+  explicit ArrivalCheck(std::string name) : name_(std::move(name)) {}
+  /// Check buf's bytes from where the last call stopped up to buf.size(). Segments the loader has
+  /// already checked and counted (buf.segment_lines) are only checked for line length.
+  void advance(TextBuffer& buf);
+
+ private:
+  void check_piece(const char* text, std::size_t from, std::size_t to);
+  void check_line_lengths(const char* text, std::size_t from, std::size_t to);
+  [[noreturn]] void fail_binary(const char* text, const char* at) const;
+  [[noreturn]] void fail_long_line(const char* text, std::size_t from) const;
+
+  std::string name_;
+  std::size_t checked_ = 0;         // bytes checked so far
+  std::size_t lines_ = 0;           // line ends ('\n') in them
+  std::size_t segment_count_ = 0;   // line ends in the checked part of the current segment
+  std::size_t line_bytes_ = 0;      // bytes of the last line so far (no line end yet)
+};
+
 /// Lines ('\n') in [b, end) and whether a control byte other than tab, LF, CR (or DEL) occurs,
 /// vectorised (an AVX2 clone where the processor has it). Stops after the first block of 240
 /// bytes that trips, setting `bad` to its start (else nullptr).
@@ -77,8 +108,10 @@ std::size_t count_lines_checked(const char* b, const char* end, const char*& bad
 /// Name used in messages for a path ("<stdin>" for "-").
 std::string display_name(const std::string& path);
 
-/// Read a whole file (or stdin for "-") into memory, inflating gzip data. Throws InputError
-/// (line 0) for a missing, unreadable or non-regular path and for corrupt or truncated gzip.
+/// Read a whole file (or stdin for "-") into memory, inflating gzip data, and check the text as it
+/// arrives (ArrivalCheck). Throws InputError (line 0) for a missing or unreadable path or a
+/// directory and for corrupt or truncated gzip. Standard input, pipes and devices are read in
+/// chunks of at most kStreamChunk, each checked (gzip: inflated and checked) before the next.
 /// With threads > 1 a regular file of more than a few MB is read in two halves side by side (each
 /// thread maps the pages of its half and copies it). With `host`, a regular file's text is held
 /// at the end of that vector's storage (TextBuffer's second constructor: for pulse files, whose
@@ -86,13 +119,17 @@ std::string display_name(const std::string& path);
 TextBuffer load_source(const std::string& path, unsigned threads = 1, Crew* crew = nullptr,
                        std::vector<std::int32_t>* host = nullptr);
 
-/// Copy in-memory text, inflating it when it starts with the gzip magic bytes.
+/// Bytes read at a time from a stream (standard input, a pipe, a device).
+constexpr std::size_t kStreamChunk = std::size_t{1} << 16;
+
+/// Copy in-memory text, inflating it when it starts with the gzip magic bytes; checked as a file is.
 TextBuffer load_text(std::string_view text, const std::string& name);
 
 /// True when the bytes start with the gzip magic 1f 8b.
 bool is_gzip(std::string_view bytes) noexcept;
 
-/// Inflate a complete gzip stream (one or more members). Throws InputError naming `name`.
+/// Inflate a complete gzip stream (one or more members), checking the text as it comes out
+/// (ArrivalCheck). Throws InputError naming `name`.
 TextBuffer inflate_gzip(std::string_view bytes, const std::string& name);
 
 /// Ask the kernel to map the pages of a fresh buffer in one call (where supported): first-touch page

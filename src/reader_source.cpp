@@ -1,5 +1,7 @@
-// Getting the bytes of a recording into memory: regular files with read(2), standard input, and
-// gzip data inflated with zlib into a growing buffer. One allocation per file, no iostreams.
+// Getting the bytes of a recording into memory: regular files with read(2); standard input, pipes
+// and devices in chunks; gzip data inflated with zlib into a growing buffer. Text is checked as it
+// arrives (ArrivalCheck), so that binary data or an endless line is refused before more is read.
+// No iostreams.
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <sys/mman.h>
@@ -14,6 +16,8 @@
 #include <mutex>
 #include <utility>
 #include <vector>
+
+#include <fmt/format.h>
 
 #include "reader_detail.hpp"
 #include "rwcalc/crew.hpp"
@@ -49,6 +53,109 @@ __attribute__((target_clones("avx2", "default"))) std::size_t count_lines_checke
   return lines;
 }
 
+
+namespace {
+
+bool is_control(unsigned char c) noexcept { return (c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7f; }
+
+// The first line end (LF or CR) in [b, e), or null. CR counts too: a file with classic Mac line
+// ends has no LF at all.
+const char* first_line_end(const char* b, const char* e) noexcept {
+  const auto* lf = static_cast<const char*>(std::memchr(b, '\n', static_cast<std::size_t>(e - b)));
+  const auto* cr = static_cast<const char*>(std::memchr(b, '\r', static_cast<std::size_t>((lf ? lf : e) - b)));
+  return cr ? cr : lf;
+}
+
+// The last line end (LF or CR) in [b, e), or null.
+const char* last_line_end(const char* b, const char* e) noexcept {
+  const auto* lf = static_cast<const char*>(::memrchr(b, '\n', static_cast<std::size_t>(e - b)));
+  const char* after = lf ? lf + 1 : b;
+  const auto* cr = static_cast<const char*>(::memrchr(after, '\r', static_cast<std::size_t>(e - after)));
+  return cr ? cr : lf;
+}
+
+// Line number of the line holding text[at], as the reader numbers lines: by LF, or by CR in a text
+// that has no LF before it (classic Mac line ends). Error paths only: it counts from the start.
+std::size_t line_at(const char* text, const char* at) noexcept {
+  const auto lf = static_cast<std::size_t>(std::count(text, at, '\n'));
+  return 1 + (lf > 0 ? lf : static_cast<std::size_t>(std::count(text, at, '\r')));
+}
+
+}  // namespace
+
+void ArrivalCheck::advance(TextBuffer& buf) {
+  constexpr std::size_t kSeg = TextBuffer::kSegment;
+  const char* text = buf.data();
+  const std::size_t size = buf.size();
+  // Whole segments the loader has checked and counted already (read_halves).
+  while (checked_ % kSeg == 0 && checked_ / kSeg < buf.segment_lines.size() && checked_ + kSeg <= size) {
+    check_line_lengths(text, checked_, checked_ + kSeg);
+    lines_ += buf.segment_lines[checked_ / kSeg];
+    checked_ += kSeg;
+  }
+  // The rest piece by piece, never across a segment's end, so that each whole segment's count is
+  // known when its last byte has been checked.
+  while (checked_ < size) {
+    const std::size_t to = std::min(size, (checked_ / kSeg + 1) * kSeg);
+    check_piece(text, checked_, to);
+    checked_ = to;
+    if (to % kSeg == 0 && buf.segment_lines.size() == to / kSeg - 1) {
+      buf.segment_lines.push_back(segment_count_);
+      segment_count_ = 0;
+    }
+  }
+}
+
+void ArrivalCheck::check_piece(const char* text, std::size_t from, std::size_t to) {
+  const char* bad = nullptr;
+  const std::size_t lines = count_lines_checked(text + from, text + to, bad);
+  if (bad) {
+    // The block that tripped holds a control byte: the first one, after the lines before it.
+    while (!is_control(static_cast<unsigned char>(*bad))) ++bad;
+    check_line_lengths(text, from, static_cast<std::size_t>(bad - text));
+    fail_binary(text, bad);
+  }
+  check_line_lengths(text, from, to);
+  lines_ += lines;
+  segment_count_ += lines;
+}
+
+// [from, to) is at most one segment, far shorter than kMaxLineBytes: only the line that began
+// before it and the one that runs on past it can be too long.
+void ArrivalCheck::check_line_lengths(const char* text, std::size_t from, std::size_t to) {
+  const char* b = text + from;
+  const char* e = text + to;
+  const char* first = first_line_end(b, e);
+  if (!first) {
+    line_bytes_ += to - from;
+    if (line_bytes_ > kMaxLineBytes) fail_long_line(text, from);
+    return;
+  }
+  if (line_bytes_ + static_cast<std::size_t>(first - b) > kMaxLineBytes) fail_long_line(text, from);
+  line_bytes_ = static_cast<std::size_t>(e - (last_line_end(first, e) + 1));
+}
+
+void ArrivalCheck::fail_binary(const char* text, const char* at) const {
+  const char* start = at;
+  const char end = std::memchr(text, '\n', static_cast<std::size_t>(at - text)) ? '\n' : '\r';
+  while (start > text && start[-1] != end) --start;
+  // A UTF-8 byte-order mark before the first line is not one of its columns.
+  if (start == text && at - text >= 3 && static_cast<unsigned char>(text[0]) == 0xEF &&
+      static_cast<unsigned char>(text[1]) == 0xBB && static_cast<unsigned char>(text[2]) == 0xBF)
+    start += 3;
+  throw InputError(name_, line_at(text, at),
+                   fmt::format("binary data (byte 0x{:02x} at column {}): this is not a text recording; a "
+                               "compressed file other than gzip?",
+                               static_cast<unsigned char>(*at), at - start + 1));
+}
+
+void ArrivalCheck::fail_long_line(const char* text, std::size_t from) const {
+  // The long line began before text[from] (or at it), and has no line end before text[from].
+  throw InputError(name_, line_at(text, text + from),
+                   fmt::format("line too long: more than {} bytes (1 MiB) without a line end; this is not a "
+                               "text recording",
+                               kMaxLineBytes));
+}
 
 namespace {
 
@@ -298,50 +405,96 @@ bool read_halves(int fd, std::size_t size, TextBuffer& buf, const std::string& n
 
 }  // namespace
 
-TextBuffer inflate_gzip(std::string_view bytes, const std::string& name) {
-  z_stream zs{};
-  // 16 + MAX_WBITS: gzip wrapper only (the caller checked the magic bytes).
-  if (inflateInit2(&zs, 16 + MAX_WBITS) != Z_OK) throw InputError(name, 0, "cannot initialise zlib");
-  struct Guard {
-    z_stream* z;
-    ~Guard() { inflateEnd(z); }
-  } guard{&zs};
+namespace {
 
-  // zlib counts in uInt; feed input and output in chunks so files over 4 GiB work too.
-  constexpr std::size_t kChunk = std::size_t{1} << 30;
-  const auto* in_begin = reinterpret_cast<const Bytef*>(bytes.data());
-  zs.next_in = const_cast<Bytef*>(in_begin);
-  zs.avail_in = 0;
-  auto consumed = [&] { return static_cast<std::size_t>(zs.next_in - in_begin); };
+// Inflates gzip data fed in pieces (one or more members, as `cat a.gz b.gz` makes) into a growing
+// text, checking the text after each inflate call (ArrivalCheck), before more is inflated: a
+// small file that inflates to gigabytes of binary data or of one line is refused at its first
+// megabyte. Throws InputError naming the file for corrupt or truncated data.
+class GzipInflater {
+ public:
+  GzipInflater(const std::string& name, std::size_t capacity) : name_(name), out_(capacity), check_(name) {
+    // 16 + MAX_WBITS: gzip wrapper only (the caller checked the magic bytes).
+    if (inflateInit2(&zs_, 16 + MAX_WBITS) != Z_OK) throw InputError(name, 0, "cannot initialise zlib");
+  }
+  ~GzipInflater() { inflateEnd(&zs_); }
+  GzipInflater(const GzipInflater&) = delete;
+  GzipInflater& operator=(const GzipInflater&) = delete;
 
-  TextBuffer out(std::max<std::size_t>(bytes.size() * 4, 1 << 16));
+  void feed(std::string_view bytes);
+  TextBuffer finish();
+
+ private:
+  void check_next_member();
+
+  // zlib counts in uInt: input in pieces of at most kInPiece; output in steps of at most kOutStep,
+  // each checked before the next.
+  static constexpr std::size_t kInPiece = std::size_t{1} << 30;
+  static constexpr std::size_t kOutStep = std::size_t{1} << 20;
+  std::string name_;
+  z_stream zs_{};
+  TextBuffer out_;
+  ArrivalCheck check_;
+  bool in_member_ = true;     // between a member's first byte and its end
+  std::size_t magic_seen_ = 0;  // bytes of the next member's magic seen since a member ended
+};
+
+void GzipInflater::feed(std::string_view bytes) {
+  zs_.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(bytes.data()));
+  zs_.avail_in = 0;
+  std::size_t left = bytes.size();
   for (;;) {
-    if (zs.avail_in == 0) zs.avail_in = static_cast<uInt>(std::min(kChunk, bytes.size() - consumed()));
-    if (out.size() == out.capacity()) out.reserve(out.capacity() * 2);
-    zs.next_out = reinterpret_cast<Bytef*>(out.data() + out.size());
-    zs.avail_out = static_cast<uInt>(std::min(kChunk, out.capacity() - out.size()));
-    const std::size_t room = zs.avail_out;
-    const int rc = inflate(&zs, Z_NO_FLUSH);
-    out.set_size(out.size() + (room - zs.avail_out));
-    if (rc == Z_OK) continue;
+    if (zs_.avail_in == 0) {
+      if (left == 0) return;
+      const std::size_t piece = std::min(kInPiece, left);
+      zs_.avail_in = static_cast<uInt>(piece);
+      left -= piece;
+    }
+    if (!in_member_) check_next_member();
+    if (out_.size() == out_.capacity()) out_.reserve(out_.capacity() * 2);
+    zs_.next_out = reinterpret_cast<Bytef*>(out_.data() + out_.size());
+    zs_.avail_out = static_cast<uInt>(std::min(kOutStep, out_.capacity() - out_.size()));
+    const std::size_t room = zs_.avail_out;
+    const int rc = inflate(&zs_, Z_NO_FLUSH);
+    out_.set_size(out_.size() + (room - zs_.avail_out));
+    check_.advance(out_);
     if (rc == Z_STREAM_END) {
-      const std::size_t pos = consumed();
-      if (pos == bytes.size()) break;
-      // Concatenated gzip members (as `cat a.gz b.gz` makes) are one stream, as gzip reads them.
-      if (!is_gzip(bytes.substr(pos)))
-        throw InputError(name, 0, "unexpected bytes after the end of the gzip data");
-      inflateReset(&zs);
+      inflateReset(&zs_);
+      in_member_ = false;
+      magic_seen_ = 0;
       continue;
     }
-    if (rc == Z_BUF_ERROR && zs.avail_in == 0 && consumed() == bytes.size())
-      throw InputError(name, 0,
-                       "truncated gzip data: the compressed stream ends before its end marker (" +
-                           std::to_string(out.size()) + " bytes decompressed); the file is incomplete");
-    if (rc == Z_BUF_ERROR) continue;  // needs more output room or input: the loop provides both
-    throw InputError(name, 0, std::string("corrupt gzip data: ") + (zs.msg ? zs.msg : "inflate failed"));
+    // Z_BUF_ERROR: no progress without more input or more room; the loop provides both.
+    if (rc == Z_OK || rc == Z_BUF_ERROR) continue;
+    throw InputError(name_, 0, std::string("corrupt gzip data: ") + (zs_.msg ? zs_.msg : "inflate failed"));
   }
-  out.terminate();
-  return out;
+}
+
+// After a member's end only another member may follow: its magic bytes, which may arrive split
+// between two pieces.
+void GzipInflater::check_next_member() {
+  static constexpr unsigned char kMagic[2] = {0x1f, 0x8b};
+  for (uInt i = 0; magic_seen_ < 2 && i < zs_.avail_in; ++i, ++magic_seen_)
+    if (zs_.next_in[i] != kMagic[magic_seen_])
+      throw InputError(name_, 0, "unexpected bytes after the end of the gzip data");
+  if (magic_seen_ == 2) in_member_ = true;
+}
+
+TextBuffer GzipInflater::finish() {
+  if (in_member_ || magic_seen_ > 0)
+    throw InputError(name_, 0,
+                     "truncated gzip data: the compressed stream ends before its end marker (" +
+                         std::to_string(out_.size()) + " bytes decompressed); the file is incomplete");
+  out_.terminate();
+  return std::move(out_);
+}
+
+}  // namespace
+
+TextBuffer inflate_gzip(std::string_view bytes, const std::string& name) {
+  GzipInflater z(name, std::max<std::size_t>(bytes.size() * 4, 1 << 16));
+  z.feed(bytes);
+  return z.finish();
 }
 
 TextBuffer load_text(std::string_view text, const std::string& name) {
@@ -349,32 +502,72 @@ TextBuffer load_text(std::string_view text, const std::string& name) {
   TextBuffer buf(text.size());
   if (!text.empty()) std::memcpy(buf.data(), text.data(), text.size());
   buf.set_size(text.size());
+  ArrivalCheck(name).advance(buf);
   buf.terminate();
   return buf;
 }
 
+namespace {
+
+// One read(2) of at most kStreamChunk bytes appended to buf (grown as needed): the byte count,
+// 0 at the end of the stream.
+std::size_t read_chunk(int fd, TextBuffer& buf, const std::string& name) {
+  if (buf.capacity() - buf.size() < kStreamChunk) buf.reserve(std::max(buf.capacity() * 2, buf.size() + kStreamChunk));
+  for (;;) {
+    const ssize_t n = ::read(fd, buf.data() + buf.size(), kStreamChunk);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) fail_errno(name, "cannot read", errno);
+    buf.set_size(buf.size() + static_cast<std::size_t>(n));
+    return static_cast<std::size_t>(n);
+  }
+}
+
+// Standard input, a pipe or a device (/dev/zero never ends): read chunk by chunk, each checked
+// (gzip: inflated and checked) before the next is read, so that memory follows the text that
+// passed the checks, never the length of the stream.
+TextBuffer read_stream(int fd, const std::string& name) {
+  TextBuffer text;
+  // The first two bytes tell gzip from text.
+  while (text.size() < 2 && read_chunk(fd, text, name) > 0) {
+  }
+  if (is_gzip(text.view())) {
+    GzipInflater z(name, std::size_t{1} << 20);
+    TextBuffer in = std::move(text);
+    do {
+      z.feed(in.view());
+      in.set_size(0);
+    } while (read_chunk(fd, in, name) > 0);
+    return z.finish();
+  }
+  ArrivalCheck check(name);
+  do check.advance(text);
+  while (read_chunk(fd, text, name) > 0);
+  text.terminate();
+  return text;
+}
+
+}  // namespace
+
 TextBuffer load_source(const std::string& path, unsigned threads, Crew* crew, std::vector<std::int32_t>* host) {
   const std::string name = display_name(path);
   TextBuffer raw;
-  if (path == "-") {
-    raw.reserve(1 << 20);
-    read_all(STDIN_FILENO, raw, name);
-  } else {
+  if (path == "-") return read_stream(STDIN_FILENO, name);
+  {  // a named file
     if (path.empty()) throw InputError("(empty path)", 0, "no input file given");
     FileDescriptor fd(::open(path.c_str(), O_RDONLY | O_CLOEXEC));
     if (fd.get() < 0) fail_errno(name, "cannot open", errno);
     struct stat st {};
     if (::fstat(fd.get(), &st) != 0) fail_errno(name, "cannot stat", errno);
     if (S_ISDIR(st.st_mode)) throw InputError(name, 0, "is a directory, not a recording");
-    // Regular files: one read of the known size; pipes and devices grow as they go.
+    if (!S_ISREG(st.st_mode)) return read_stream(fd.get(), name);
+    // A regular file: one read of the known size.
     // One spare byte lets the final read(2) see end-of-file without growing the buffer.
     constexpr std::size_t kHalvesBytes = std::size_t{4} << 20;
     const auto size = static_cast<std::size_t>(st.st_size);
-    const bool regular = S_ISREG(st.st_mode);
-    const bool halves = regular && threads > 1 && size > kHalvesBytes;
+    const bool halves = threads > 1 && size > kHalvesBytes;
     char* front = nullptr;
     std::size_t front_bytes = 0;
-    if (regular && host) {
+    if (host) {
       // A pulse file: the text at the end of the counts' storage (TextBuffer's host); its pages
       // are mapped here, or by each loading thread for its half, with half of the storage before
       // it each (the reader maps what is left when it writes the counts there).
@@ -390,7 +583,7 @@ TextBuffer load_source(const std::string& path, unsigned threads, Crew* crew, st
       // costs address space only. Performance only: nothing depends on where the view lives.
       raw = TextBuffer(size + 1, false, size);
     } else {
-      raw.reserve(regular ? size + 1 : std::size_t{1} << 20);
+      raw.reserve(size + 1);
     }
     if (halves && !read_halves(fd.get(), size, raw, name, crew, front, front_bytes) &&
         ::lseek(fd.get(), 0, SEEK_SET) < 0)
@@ -398,6 +591,8 @@ TextBuffer load_source(const std::string& path, unsigned threads, Crew* crew, st
     read_all(fd.get(), raw, name);
   }
   if (is_gzip(raw.view())) return inflate_gzip(raw.view(), name);
+  // A regular file is read whole (its size is known and bounds the memory), then checked.
+  ArrivalCheck(name).advance(raw);
   raw.terminate();
   return raw;
 }

@@ -50,7 +50,7 @@ PhaseSeries widened(const PhaseSeries& x) {
 
 TEST(NarrowCounts, OneThreadReadOfAPulseFileKeepsThirtyTwoBits) {
   std::vector<std::int64_t> sums;
-  const std::string text = "# scale: 0.92\npulses\n" + pulse_text(5000, 1, sums);
+  const std::string text = "# scale_arcsec_per_pulse: 0.92\npulses\n" + pulse_text(5000, 1, sums);
   const Recording r = read_recording_text(text, "p.csv", one_thread());
   ASSERT_TRUE(r.phase.narrow());
   EXPECT_TRUE(r.phase.counts.empty());

@@ -2,8 +2,9 @@
 /// @file reader.hpp
 /// Reading gyro and clock recordings into a PhaseSeries without losing or bending a sample.
 ///
-/// Text, one sample per line. Accepted: `#` comment lines; metadata lines `# key: value`
-/// (rate_hz, scale_arcsec_per_pulse, temperature_c, serial, and any other key, kept verbatim);
+/// Text, one sample per line. Accepted: `#` comment lines; metadata lines `# key: value` or
+/// `# key = value` (rate_hz, scale_arcsec_per_pulse, temperature_c, serial in any case, and any
+/// other key, kept verbatim);
 /// an optional header row naming the columns; delimiters comma, semicolon, tab or blanks
 /// (detected from the header or the first data line); a decimal comma where the delimiter is not
 /// a comma; CRLF line ends; a UTF-8 BOM; gzip (by content, whatever the name); "-" for standard
@@ -41,7 +42,7 @@ struct ReadOptions {
   InputMode mode = InputMode::Pulses;
   /// Column holding the samples: a header name, or a 1-based index as text ("2"). Empty: the
   /// column named "pulses" (or counter/angle/phase/rate/gyro by mode), else the only non-time
-  /// column, else an error asking for --column.
+  /// column, else an error asking for --column (also when two columns have such names).
   std::string column;
   std::optional<double> rate_hz;       ///< --rate, Hz; overrides metadata; checked against a time column
   std::optional<double> scale_arcsec;  ///< --scale: pulse weight, ″ per pulse; overrides metadata
@@ -72,10 +73,12 @@ struct Recording {
   double rate_hz = 400.0;  ///< sample rate, Hz (phase.tau0_s = 1/rate_hz)
   RateSource rate_source = RateSource::Default;
   std::size_t samples = 0;  ///< data lines read (samples of the selected column)
-  std::map<std::string, std::string> metadata;  ///< every `# key: value` line
+  /// every `# key: value` (or `key = value`) line; the known keys under their lower-case names
+  std::map<std::string, std::string> metadata;
   std::optional<double> temperature_c;  ///< mean of a temperature_c column, else metadata, °C
   std::string column_name;              ///< the column that was read (header name or "column N")
-  std::optional<std::string> time_column;  ///< the time column that was checked, if any
+  /// the time column that was checked, if any (the first of two, which were found to agree)
+  std::optional<std::string> time_column;
   InputMode mode = InputMode::Pulses;
   /// Counter input: how many times the counter wrapped (a backwards step counts as a wrap).
   std::size_t counter_wraps = 0;

@@ -28,7 +28,9 @@ std::vector<BadInputCase> load_bad_input_manifest() {
 }
 
 std::optional<std::string> stage_bad_input(const BadInputCase& c, const TempDir& tmp) {
-  constexpr std::size_t kHuge = 5u << 20;  // a 5 MB line
+  // A line of a megabyte, just within the reader's limit (1 MiB: 1048576 bytes), and one byte past it.
+  constexpr std::size_t kHuge = 1'048'000;
+  constexpr std::size_t kOverlong = 1'048'577;
   if (c.file == "@missing") return (tmp.path() / "no-such-recording.csv").string();
   if (c.file == "@directory") return tmp.path().string();
   if (c.file == "@unreadable") {
@@ -44,6 +46,14 @@ std::optional<std::string> stage_bad_input(const BadInputCase& c, const TempDir&
   if (c.file == "@huge_text_line")
     return tmp.write("text.csv", "pulses\n1\n" + std::string(kHuge, 'x') + "\n2\n").string();
   if (c.file == "@huge_header_line") return tmp.write("header.csv", std::string(kHuge, 'h') + "\n").string();
+  if (c.file == "@overlong_digit_line")
+    return tmp.write("long-digits.csv", "pulses\n1\n" + std::string(kOverlong, '7') + "\n2\n").string();
+  if (c.file == "@overlong_comment_line")
+    return tmp.write("long-comment.csv", "# " + std::string(kOverlong, 'c') + "\npulses\n1\n2\n").string();
+  if (c.file == "@overlong_crlf_line")
+    return tmp.write("long-crlf.csv", "pulses\r\n1\r\n2\r\n" + std::string(kOverlong, 'x') + "\r\n").string();
+  if (c.file == "@overlong_cr_line")
+    return tmp.write("long-cr.csv", "pulses\r1\r" + std::string(kOverlong, '5') + "\r2\r").string();
   return source_path("tests/bad_input/" + c.file).string();
 }
 

@@ -1,0 +1,145 @@
+// Hostile input and memory: a gzip bomb of NUL bytes, /dev/zero, /dev/urandom, an endless line from a
+// pipe. Each is refused at its first bad chunk with the file, the line and what is wrong, and the
+// process stays small: the command line runs under an address-space limit (ulimit -v) that the
+// whole decompressed text would exceed, and under `timeout` so that a regression cannot hang the
+// suite. Under AddressSanitizer (which reserves terabytes of address space) the limit is left out
+// and only the messages are checked.
+#include <sys/wait.h>
+#include <zlib.h>
+
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "rwcalc/error.hpp"
+#include "rwcalc/reader.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+
+// Address space allowed to the command line: far below the text these inputs decompress to.
+constexpr long kLimitKiB = 512L * 1024;
+
+std::string quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+// Run `FEED | rwcalc ARGS` (or rwcalc ARGS alone) under the limit and a 20-s timeout. The commands
+// run with --threads 2, so that the threads' stacks and heaps do not depend on the machine's cores.
+rwcalc::test::CliResult run_limited(const std::string& feed, const std::vector<std::string>& args) {
+  const rwcalc::test::TempDir tmp;
+  std::string cmd;
+  if (!kSanitized) cmd += "ulimit -v " + std::to_string(kLimitKiB) + "; ";
+  if (!feed.empty()) cmd += feed + " | ";
+  cmd += "timeout 20 ";
+  cmd += quote(RWCALC_EXE);
+  for (const auto& a : args) cmd.append(" ").append(quote(a));
+  cmd.append(" >").append(quote((tmp.path() / "out").string()));
+  cmd.append(" 2>").append(quote((tmp.path() / "err").string()));
+  const int rc = std::system(cmd.c_str());  // sh -c
+  rwcalc::test::CliResult r;
+  r.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : 128 + WTERMSIG(rc);
+  r.out = rwcalc::test::slurp(tmp.path() / "out");
+  r.err = rwcalc::test::slurp(tmp.path() / "err");
+  return r;
+}
+
+// gzip members of `unit` repeated `copies` times (concatenated members are one stream): a small
+// file that inflates to copies × unit.size() bytes.
+std::string gzip_repeated(const std::string& unit, std::size_t copies) {
+  z_stream z{};
+  if (deflateInit2(&z, 9, Z_DEFLATED, 15 + 16, 9, Z_DEFAULT_STRATEGY) != Z_OK) std::abort();
+  std::string member(deflateBound(&z, unit.size()) + 32, '\0');
+  z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(unit.data()));
+  z.avail_in = static_cast<uInt>(unit.size());
+  z.next_out = reinterpret_cast<Bytef*>(member.data());
+  z.avail_out = static_cast<uInt>(member.size());
+  if (deflate(&z, Z_FINISH) != Z_STREAM_END) std::abort();
+  member.resize(z.total_out);
+  deflateEnd(&z);
+  std::string out;
+  out.reserve(member.size() * copies);
+  for (std::size_t i = 0; i < copies; ++i) out += member;
+  return out;
+}
+
+// A ~1 MB gzip file of NUL bytes that inflates to ~2 GB.
+std::string zeros_bomb() { return gzip_repeated(std::string(std::size_t{2} << 20, '\0'), 1000); }
+
+TEST(HostileInput, GzipOfNulBytesIsRefusedAtLineOneWithLittleMemory) {
+  const rwcalc::test::TempDir tmp;
+  const std::string bomb = zeros_bomb();
+  ASSERT_LT(bomb.size(), std::size_t{3} << 20);
+  const auto path = tmp.write("zeros.csv.gz", bomb).string();
+  const auto r = run_limited("", {"allan", "--threads", "2", path});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err.rfind("rwcalc: error: " + path + ":1: binary data (byte 0x00 at column 1)", 0), 0u) << r.err;
+  // The same through a pipe (standard input: read and inflated chunk by chunk).
+  const auto piped = run_limited("cat " + quote(path), {"allan", "--threads", "2", "-"});
+  EXPECT_EQ(piped.status, 2) << piped.err;
+  EXPECT_EQ(piped.err.rfind("rwcalc: error: <stdin>:1: binary data (byte 0x00 at column 1)", 0), 0u) << piped.err;
+}
+
+TEST(HostileInput, GzipOfNulBytesAfterGoodLinesNamesTheirLine) {
+  // Good lines first, then the NUL bytes in a later member: the line and column of the first one.
+  const std::string head = "pulses\n1\n2\n3";
+  const std::string text = gzip_repeated(head, 1) + gzip_repeated(std::string(std::size_t{1} << 20, '\0'), 200);
+  try {
+    (void)rwcalc::read_recording_text(text, "mem.gz");
+    FAIL() << "accepted";
+  } catch (const rwcalc::InputError& e) {
+    EXPECT_EQ(e.line(), 4u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("binary data (byte 0x00 at column 2)"), std::string::npos) << e.what();
+  }
+}
+
+TEST(HostileInput, DevZeroAndDevUrandomEndQuicklyWithBinaryData) {
+  for (const std::string dev : {"/dev/zero", "/dev/urandom"}) {
+    const auto r = run_limited("", {"allan", "--threads", "2", dev});
+    EXPECT_EQ(r.status, 2) << dev << ": " << r.err;
+    EXPECT_EQ(r.err.rfind("rwcalc: error: " + dev + ":", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find("binary data (byte 0x"), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty());
+  }
+  const auto piped = run_limited("cat /dev/zero", {"allan", "--threads", "2", "-"});
+  EXPECT_EQ(piped.status, 2) << piped.err;
+  EXPECT_EQ(piped.err.rfind("rwcalc: error: <stdin>:1: binary data (byte 0x00 at column 1)", 0), 0u) << piped.err;
+}
+
+TEST(HostileInput, AnEndlessLineIsRefusedAsSoonAsItPassesTheLimit) {
+  // A pipe that never sends a line end, and a gzip file of one 2-GB line.
+  const auto piped = run_limited("{ printf 'pulses\\n1\\n'; tr '\\000' 7 </dev/zero; }", {"allan", "--threads", "2", "-"});
+  EXPECT_EQ(piped.status, 2) << piped.err;
+  EXPECT_EQ(piped.err.rfind("rwcalc: error: <stdin>:3: line too long", 0), 0u) << piped.err;
+  const rwcalc::test::TempDir tmp;
+  const auto path = tmp.write("line.csv.gz", gzip_repeated(std::string(std::size_t{2} << 20, '7'), 1000)).string();
+  const auto r = run_limited("", {"allan", "--threads", "2", path});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err.rfind("rwcalc: error: " + path + ":1: line too long", 0), 0u) << r.err;
+}
+
+TEST(HostileInput, AGoodRecordFromAPipeIsReadWhole) {
+  // Many chunks of a pipe, plain and gzip: every sample arrives (the checks drop nothing).
+  std::string text = "# rate_hz: 100\npulses\n";
+  for (int i = 0; i < 200000; ++i) text += std::to_string(i % 3) + "\n";
+  const rwcalc::test::TempDir tmp;
+  const auto plain = tmp.write("p.txt", text).string();
+  const auto gz = tmp.write("p.txt.gz", gzip_repeated(text, 1)).string();
+  for (const auto& path : {plain, gz}) {
+    const auto r = run_limited("cat " + quote(path), {"allan", "--threads", "2", "-"});
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("200000"), std::string::npos) << r.out.substr(0, 400);
+  }
+}
+
+}  // namespace
