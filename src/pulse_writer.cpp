@@ -34,12 +34,13 @@ std::string header_text(const Metadata& metadata, const char* column) {
 // Where the next line goes, for the messages about a value that cannot be written.
 struct LinePosition {
   std::string_view file;
-  std::size_t line = 0;    // the last line written
-  std::size_t sample = 0;  // its sample index k
+  std::size_t line = 0;         // the last line written
+  std::size_t next_sample = 0;  // the sample index k of the next line
 };
 
 [[noreturn]] void throw_unwritable(const LinePosition& at, const std::string& cause) {
-  throw UsageError(fmt::format("{}: line {} (sample {}): {}; the file was not written", at.file, at.line, at.sample, cause));
+  throw UsageError(
+      fmt::format("{}: line {} (sample {}): {}; the file was not written", at.file, at.line, at.next_sample, cause));
 }
 
 // One line per count: the increment C_k − C_{k−1} (`previous` is C_{k−1}; updated). An increment
@@ -51,7 +52,6 @@ void append_increments(std::string& text, std::span<const std::int64_t> counts, 
   char* const end = text.data() + text.size();
   for (const std::int64_t c : counts) {
     ++at.line;
-    ++at.sample;
     std::int64_t d = 0;
     if (__builtin_sub_overflow(c, previous, &d)) {
       text.resize(head);
@@ -60,6 +60,7 @@ void append_increments(std::string& text, std::span<const std::int64_t> counts, 
     p = std::to_chars(p, end, d).ptr;
     *p++ = '\n';
     previous = c;
+    ++at.next_sample;
   }
   text.resize(static_cast<std::size_t>(p - text.data()));
 }
@@ -69,11 +70,11 @@ void append_angles(std::string& text, std::span<const double> angles, LinePositi
   char line[400];  // the widest finite double in fixed notation with 6 decimals is 317 characters
   for (const double v : angles) {
     ++at.line;
-    ++at.sample;
     if (!std::isfinite(v)) throw_unwritable(at, fmt::format("the angle is {}, not a number of arcsec", v));
     char* p = std::to_chars(line, line + sizeof line - 1, v, std::chars_format::fixed, 6).ptr;
     *p++ = '\n';
     text.append(line, p);
+    ++at.next_sample;
   }
 }
 
@@ -104,9 +105,9 @@ std::string format_pulse_file(const Metadata& metadata, const PhaseSeries& serie
   // angle in ″ under the header `angle`, from x_0.
   if (!exact && series.values.empty()) throw AnalysisError("the series to write is empty");
   std::string text = header_text(metadata, exact ? "pulses" : "angle");
-  LinePosition at{"the pulse file", static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')), 0};
+  // The first line is x_0 in the angle column, the increment of sample 1 in the pulses column.
+  LinePosition at{"the pulse file", static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')), exact ? 1u : 0u};
   if (!exact) {
-    --at.sample;  // the first line is x_0
     append_angles(text, series.values, at);
     return text;
   }
@@ -128,7 +129,6 @@ PulseFileWriter::PulseFileWriter(const std::string& path, const Metadata& metada
     // The angle column starts at θ_0 = 0, as format_pulse_file writes a floating series.
     LinePosition at{path_, line_, 0};
     const double zero = 0.0;
-    --at.sample;
     append_angles(text_, std::span<const double>(&zero, 1), at);
     line_ = at.line;
   }
@@ -136,19 +136,19 @@ PulseFileWriter::PulseFileWriter(const std::string& path, const Metadata& metada
 
 void PulseFileWriter::add_counts(std::span<const std::int64_t> counts) {
   if (column_ != Column::Pulses) throw AnalysisError(fmt::format("{}: pulse counts given for an angle file", path_));
-  LinePosition at{path_, line_, sample_};
+  LinePosition at{path_, line_, sample_ + 1};
   append_increments(text_, counts, previous_, at);
   line_ = at.line;
-  sample_ = at.sample;
+  sample_ = at.next_sample - 1;
   flush_when_full();
 }
 
 void PulseFileWriter::add_angles(std::span<const double> angles) {
   if (column_ != Column::Angle) throw AnalysisError(fmt::format("{}: angles given for a pulse file", path_));
-  LinePosition at{path_, line_, sample_};
+  LinePosition at{path_, line_, sample_ + 1};
   append_angles(text_, angles, at);
   line_ = at.line;
-  sample_ = at.sample;
+  sample_ = at.next_sample - 1;
   flush_when_full();
 }
 
