@@ -621,9 +621,9 @@ struct Simulator::Impl {
     st.frac = 0.0;
   }
 
-  // Every count must stay within ±kMaxSimulatedPulses (the angle in pulses, and within a block
-  // its part from the block's start, converted to an integer only when they are): a NaN or an
-  // infinite angle fails the test too.
+  // Every count must stay within ±kMaxSimulatedPulses. The angle since the block's start (x), with
+  // its read-out offset, and the whole angle are tested before any of them is converted to an
+  // integer (a conversion out of range would give a wrapped count); NaN and infinity fail too.
   static bool countable(double pulses) noexcept { return std::abs(pulses) < kMaxSimulatedPulses; }
 
   [[noreturn]] static void throw_uncountable(std::size_t k, double pulses, double tau0, double q) {
