@@ -1,7 +1,10 @@
 #include "rwcalc/pulse_writer.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 
 #include "rwcalc/error.hpp"
@@ -9,7 +12,12 @@
 
 namespace rwcalc {
 
-std::string format_pulse_file(const Metadata& metadata, std::span<const std::int64_t> pulses) {
+namespace {
+
+// Text is handed to the output in pieces of about this size.
+constexpr std::size_t kFlushBytes = std::size_t{1} << 20;
+
+std::string header_text(const Metadata& metadata, const char* column) {
   std::string text;
   for (const auto& [key, value] : metadata) {
     text += "# ";
@@ -18,7 +26,62 @@ std::string format_pulse_file(const Metadata& metadata, std::span<const std::int
     text += value;
     text += '\n';
   }
-  text += "pulses\n";
+  text += column;
+  text += '\n';
+  return text;
+}
+
+// Where the next line goes, for the messages about a value that cannot be written.
+struct LinePosition {
+  std::string_view file;
+  std::size_t line = 0;         // the last line written
+  std::size_t next_sample = 0;  // the sample index k of the next line
+};
+
+[[noreturn]] void throw_unwritable(const LinePosition& at, const std::string& cause) {
+  throw UsageError(
+      fmt::format("{}: line {} (sample {}): {}; the file was not written", at.file, at.line, at.next_sample, cause));
+}
+
+// One line per count: the increment C_k − C_{k−1} (`previous` is C_{k−1}; updated). An increment
+// beyond 64 bits would be written wrapped, i.e. as a wrong number: refused.
+void append_increments(std::string& text, std::span<const std::int64_t> counts, std::int64_t& previous, LinePosition& at) {
+  const std::size_t head = text.size();
+  text.resize(head + counts.size() * 21);  // 19 digits, a sign and the newline
+  char* p = text.data() + head;
+  char* const end = text.data() + text.size();
+  for (const std::int64_t c : counts) {
+    ++at.line;
+    std::int64_t d = 0;
+    if (__builtin_sub_overflow(c, previous, &d)) {
+      text.resize(head);
+      throw_unwritable(at, fmt::format("the pulse count goes from {} to {}, an increment beyond 64 bits", previous, c));
+    }
+    p = std::to_chars(p, end, d).ptr;
+    *p++ = '\n';
+    previous = c;
+    ++at.next_sample;
+  }
+  text.resize(static_cast<std::size_t>(p - text.data()));
+}
+
+// One line per angle, ″ with 6 decimals. A NaN or an infinity is no angle: refused.
+void append_angles(std::string& text, std::span<const double> angles, LinePosition& at) {
+  char line[400];  // the widest finite double in fixed notation with 6 decimals is 317 characters
+  for (const double v : angles) {
+    ++at.line;
+    if (!std::isfinite(v)) throw_unwritable(at, fmt::format("the angle is {}, not a number of arcsec", v));
+    char* p = std::to_chars(line, line + sizeof line - 1, v, std::chars_format::fixed, 6).ptr;
+    *p++ = '\n';
+    text.append(line, p);
+    ++at.next_sample;
+  }
+}
+
+}  // namespace
+
+std::string format_pulse_file(const Metadata& metadata, std::span<const std::int64_t> pulses) {
+  std::string text = header_text(metadata, "pulses");
   const std::size_t head = text.size();
   // Room for the widest value (digits and sign) plus the newline on every line.
   std::int64_t widest = 0;
@@ -37,33 +100,68 @@ std::string format_pulse_file(const Metadata& metadata, std::span<const std::int
 }
 
 std::string format_pulse_file(const Metadata& metadata, const PhaseSeries& series) {
-  if (!series.exact()) {
-    // A floating series (an output-chain filter gives sub-pulse resolution): the cumulative
-    // angle in ″ under the header `angle`, 6 decimals.
-    if (series.values.empty()) throw AnalysisError("the series to write is empty");
-    std::string text;
-    for (const auto& [key, value] : metadata) text += "# " + key + ": " + value + '\n';
-    text += "angle\n";
-    const std::size_t head = text.size();
-    text.resize(head + series.values.size() * 32);
-    char* p = text.data() + head;
-    char* const end = text.data() + text.size();
-    for (const double v : series.values) {
-      p = std::to_chars(p, end, v, std::chars_format::fixed, 6).ptr;
-      *p++ = '\n';
-    }
-    text.resize(static_cast<std::size_t>(p - text.data()));
+  const bool exact = series.exact();
+  // A floating series (an output-chain filter gives sub-pulse resolution): the cumulative
+  // angle in ″ under the header `angle`, from x_0.
+  if (!exact && series.values.empty()) throw AnalysisError("the series to write is empty");
+  std::string text = header_text(metadata, exact ? "pulses" : "angle");
+  // The first line is x_0 in the angle column, the increment of sample 1 in the pulses column.
+  LinePosition at{"the pulse file", static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')), exact ? 1u : 0u};
+  if (!exact) {
+    append_angles(text, series.values, at);
     return text;
   }
-  std::vector<std::int64_t> c(series.points() - 1);
-  for (std::size_t k = 0; k < c.size(); ++k)
-    c[k] = static_cast<std::int64_t>(static_cast<std::uint64_t>(series.count(k + 1)) -
-                                     static_cast<std::uint64_t>(series.count(k)));
-  return format_pulse_file(metadata, std::span<const std::int64_t>(c));
+  const std::vector<std::int64_t> counts = series.wide_counts();
+  std::int64_t previous = counts.front();
+  append_increments(text, std::span<const std::int64_t>(counts).subspan(1), previous, at);
+  return text;
 }
 
 void write_pulse_file(const std::string& path, const Metadata& metadata, const PhaseSeries& series, bool force) {
   write_file_atomic(path, format_pulse_file(metadata, series), force);
+}
+
+PulseFileWriter::PulseFileWriter(const std::string& path, const Metadata& metadata, Column column, bool force)
+    : path_(path), out_(path, force), column_(column),
+      text_(header_text(metadata, column == Column::Pulses ? "pulses" : "angle")) {
+  line_ = static_cast<std::size_t>(std::count(text_.begin(), text_.end(), '\n'));
+  if (column_ == Column::Angle) {
+    // The angle column starts at θ_0 = 0, as format_pulse_file writes a floating series.
+    LinePosition at{path_, line_, 0};
+    const double zero = 0.0;
+    append_angles(text_, std::span<const double>(&zero, 1), at);
+    line_ = at.line;
+  }
+}
+
+void PulseFileWriter::add_counts(std::span<const std::int64_t> counts) {
+  if (column_ != Column::Pulses) throw AnalysisError(fmt::format("{}: pulse counts given for an angle file", path_));
+  LinePosition at{path_, line_, sample_ + 1};
+  append_increments(text_, counts, previous_, at);
+  line_ = at.line;
+  sample_ = at.next_sample - 1;
+  flush_when_full();
+}
+
+void PulseFileWriter::add_angles(std::span<const double> angles) {
+  if (column_ != Column::Angle) throw AnalysisError(fmt::format("{}: angles given for a pulse file", path_));
+  LinePosition at{path_, line_, sample_ + 1};
+  append_angles(text_, angles, at);
+  line_ = at.line;
+  sample_ = at.next_sample - 1;
+  flush_when_full();
+}
+
+void PulseFileWriter::flush_when_full() {
+  if (text_.size() < kFlushBytes) return;
+  out_.write(text_);
+  text_.clear();
+}
+
+void PulseFileWriter::commit() {
+  out_.write(text_);
+  text_.clear();
+  out_.commit();
 }
 
 }  // namespace rwcalc

@@ -130,6 +130,33 @@ double temperature_angle(const TemperatureBias& tb, double t, double t_nominal, 
   return c * p.amp_c * (1.0 - std::cos(w * t)) / w;
 }
 
+// First-order low-pass in the output chain (NoiseModel::output_lowpass_tc_s), applied to counts
+// C_1, C_2, … in order: θ_k = θ_{k−1} + y_k·τ0 with y_k = φy_{k−1} + (1 − φ)r_k,
+// r_k = (C_k − C_{k−1})·q/τ0 and φ = e^{−τ0/Tf}, from y_0 = the record's mean rate C_n·q/(n·τ0).
+class OutputChainFilter {
+ public:
+  OutputChainFilter(double tf_s, double tau0_s, double q, std::int64_t last_count, std::size_t n)
+      : phi_(std::exp(-tau0_s / tf_s)), tau0_(tau0_s), q_(q),
+        y_(static_cast<double>(last_count) * q / (static_cast<double>(n) * tau0_s)) {}
+
+  // The angles θ of the next `len` counts (they follow the previous call's).
+  void apply(const std::int64_t* counts, std::size_t len, double* angles) {
+    for (std::size_t j = 0; j < len; ++j) {
+      const auto d = static_cast<std::int64_t>(static_cast<std::uint64_t>(counts[j]) - static_cast<std::uint64_t>(prev_));
+      const double r = static_cast<double>(d) * q_ / tau0_;
+      y_ = phi_ * y_ + (1.0 - phi_) * r;
+      theta_ += y_ * tau0_;
+      angles[j] = theta_;
+      prev_ = counts[j];
+    }
+  }
+
+ private:
+  double phi_, tau0_, q_, y_;
+  double theta_ = 0.0;
+  std::int64_t prev_ = 0;
+};
+
 }  // namespace
 
 std::size_t SimulationSettings::samples() const {
@@ -391,6 +418,41 @@ struct Simulator::Impl {
   };
 
   void run(std::uint64_t seed, PhaseSeries& out) {
+    out.kind = PhaseKind::Gyro;
+    out.tau0_s = tau0;
+    out.arcsec_per_count = q;
+    out.values.clear();
+    out.counts32.clear();
+    out.counts.resize(n + 1);
+    out.counts[0] = 0;
+    generate(seed, [&](std::size_t first, const std::int64_t* c, std::size_t len) {
+      std::copy_n(c, len, out.counts.data() + first);
+    });
+    if (model.output_lowpass_tc_s > 0) output_lowpass(out);
+  }
+
+  void stream(std::uint64_t seed, const std::function<void(const RecordBlock&)>& sink) {
+    if (!(model.output_lowpass_tc_s > 0)) {
+      generate(seed, [&](std::size_t first, const std::int64_t* c, std::size_t len) {
+        sink(RecordBlock{first, {c, len}, {}});
+      });
+      return;
+    }
+    // The output-chain filter starts at the record's mean rate C_n·q/(n·τ0): a first pass finds
+    // C_n, the second (the same draws) filters and hands out the angles.
+    std::int64_t last = 0;
+    generate(seed, [&](std::size_t, const std::int64_t* c, std::size_t len) { last = c[len - 1]; });
+    OutputChainFilter filter(model.output_lowpass_tc_s, tau0, q, last, n);
+    double angles[kBlock];
+    generate(seed, [&](std::size_t first, const std::int64_t* c, std::size_t len) {
+      filter.apply(c, len, angles);
+      sink(RecordBlock{first, {}, {angles, len}});
+    });
+  }
+
+  // Generate one realisation and hand its counts C_k to `sink(first, counts, len)` block by block.
+  template <class Sink>
+  void generate(std::uint64_t seed, Sink&& sink) {
     if (model.bias_instability_deg_per_h > 0) make_flicker(seed);
     Pass st(seed);
     for (std::size_t i = 0; i < gm_steps.size(); ++i) {
@@ -399,8 +461,9 @@ struct Simulator::Impl {
     }
     if (model.lowpass_tc_s > 0 && model.arw_deg_per_sqrt_h > 0)
       st.lp_arw_eps = lowpass_arw.sigma0 * st.lp_arw.normal();
-    start_quantize(st, out);
+    start_quantize(st);
     double x[kBlock];
+    std::int64_t counts[kBlock];
     for (std::size_t b = 0; b < n; b += kBlock) {
       const std::size_t len = std::min(kBlock, n - b);
       deterministic_block(b, len, x);
@@ -430,9 +493,9 @@ struct Simulator::Impl {
           for (std::size_t j = 0; j < len; ++j) x[j] += z[j];
         }
       }
-      quantize_block(st, b, len, x, out);
+      quantize_block(st, b, len, x, counts);
+      sink(b + 1, counts, len);
     }
-    if (model.output_lowpass_tc_s > 0) output_lowpass(out);
   }
 
   // The rate terms known in closed form: constant rate and ramp, sinusoids, bias steps, warm-up
@@ -544,26 +607,34 @@ struct Simulator::Impl {
   // sum from the block's fraction (at most kBlock increments, so its resolution stays far below a
   // pulse), and each sample's count is a floor of its own, off the running sum's dependency
   // chain; the whole pulses move into `whole` at the block's end.
-  void start_quantize(Pass& st, PhaseSeries& out) const {
-    out.kind = PhaseKind::Gyro;
-    out.tau0_s = tau0;
-    out.arcsec_per_count = q;
-    out.values.clear();
-    out.counts32.clear();
-    out.counts.resize(n + 1);
+  void start_quantize(Pass& st) const {
     st.dither = model.readout == ReadoutMode::White;
     st.wa = model.white_angle_arcsec / q;
     st.inv_q = 1.0 / q;
     st.phase0 = st.readout.uniform();
     // The first count: angle 0, its own read-out draw (and white angle noise).
     const double e0 = st.wa > 0 ? st.wa * st.white.normal() : 0.0;
-    const std::int64_t c0 = floor_to_int((st.dither ? st.readout.uniform() : st.phase0) + e0);
-    out.counts[0] = 0;
+    const double a0 = (st.dither ? st.readout.uniform() : st.phase0) + e0;
+    if (!countable(a0)) throw_uncountable(0, a0, tau0, q);
+    const std::int64_t c0 = floor_to_int(a0);
     st.whole = -c0;
     st.frac = 0.0;
   }
 
-  static void quantize_block(Pass& st, std::size_t b, std::size_t len, double* x, PhaseSeries& out) {
+  // Every count must stay within ±kMaxSimulatedPulses. The angle since the block's start (x), with
+  // its read-out offset, and the whole angle are tested before any of them is converted to an
+  // integer (a conversion out of range would give a wrapped count); NaN and infinity fail too.
+  static bool countable(double pulses) noexcept { return std::abs(pulses) < kMaxSimulatedPulses; }
+
+  [[noreturn]] static void throw_uncountable(std::size_t k, double pulses, double tau0, double q) {
+    const std::string what = std::isfinite(pulses) ? fmt::format("is {:.6g} pulses", pulses) : "is not finite";
+    throw UsageError(fmt::format(
+        "the simulated angle at sample {} (t = {:.6g} s) {}, beyond the +-{:.6g} pulses a record can count, so the "
+        "record cannot be written; the model's terms (deg/h, arcsec) are too large for the pulse weight q = {:.6g} arcsec",
+        k, static_cast<double>(k) * tau0, what, kMaxSimulatedPulses, q));
+  }
+
+  void quantize_block(Pass& st, std::size_t b, std::size_t len, double* x, std::int64_t* c) const {
     double acc = st.frac;
     for (std::size_t j = 0; j < len; ++j) {
       acc += x[j] * st.inv_q;
@@ -578,7 +649,15 @@ struct Simulator::Impl {
     }
     if (st.wa > 0)
       for (std::size_t j = 0; j < len; ++j) extra[j] += st.wa * st.white.normal();
-    std::int64_t* c = out.counts.data() + b + 1;
+    const double whole = static_cast<double>(st.whole);
+    bool in_range = true;
+    for (std::size_t j = 0; j < len; ++j)
+      in_range &= countable(x[j]) & countable(x[j] + extra[j]) & countable(whole + x[j] + extra[j]);
+    if (!in_range) {
+      for (std::size_t j = 0; j < len; ++j)
+        if (!countable(x[j]) || !countable(x[j] + extra[j]) || !countable(whole + x[j] + extra[j]))
+          throw_uncountable(b + j + 1, whole + x[j] + extra[j], tau0, q);
+    }
     for (std::size_t j = 0; j < len; ++j) c[j] = st.whole + floor_to_int(x[j] + extra[j]);
     const std::int64_t fl = floor_to_int(acc);
     st.whole += fl;
@@ -590,17 +669,10 @@ struct Simulator::Impl {
   // record is θ_k = θ_{k−1} + y_k·τ0 (″, floating). The filter starts in steady state at the
   // record's mean rate.
   void output_lowpass(PhaseSeries& out) const {
-    const double phi = std::exp(-tau0 / model.output_lowpass_tc_s);
+    OutputChainFilter filter(model.output_lowpass_tc_s, tau0, q, out.counts[n], n);
     out.values.resize(n + 1);
-    double y = out.diff(n, 0) / (static_cast<double>(n) * tau0);
-    double theta = 0.0;
     out.values[0] = 0.0;
-    for (std::size_t k = 1; k <= n; ++k) {
-      const double r = out.diff(k, k - 1) / tau0;
-      y = phi * y + (1.0 - phi) * r;
-      theta += y * tau0;
-      out.values[k] = theta;
-    }
+    filter.apply(out.counts.data() + 1, n, out.values.data() + 1);
     out.counts.clear();
     out.counts32.clear();
   }
@@ -613,6 +685,9 @@ Simulator::Simulator(Simulator&&) noexcept = default;
 Simulator& Simulator::operator=(Simulator&&) noexcept = default;
 
 void Simulator::run(std::uint64_t seed, PhaseSeries& out) { impl_->run(seed, out); }
+void Simulator::stream(std::uint64_t seed, const std::function<void(const RecordBlock&)>& sink) {
+  impl_->stream(seed, sink);
+}
 const NoiseModel& Simulator::model() const noexcept { return impl_->model; }
 const SimulationSettings& Simulator::settings() const noexcept { return impl_->settings; }
 SimulationPath Simulator::path() const noexcept { return impl_->path; }

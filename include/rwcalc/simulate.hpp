@@ -21,6 +21,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -169,6 +170,20 @@ enum class SimulationPath {
 /// Throws UsageError.
 PhaseSeries simulate(const NoiseModel& model, const SimulationSettings& settings);
 
+/// A piece of a record handed out as it is generated (Simulator::stream): samples
+/// first … first + size − 1 (first ≥ 1; C_0 = 0 is not handed out). An exact record fills
+/// `counts` (C_k); one with an output-chain low-pass fills `angles` (θ_k, ″) instead.
+struct RecordBlock {
+  std::size_t first = 1;
+  std::span<const std::int64_t> counts;
+  std::span<const double> angles;
+};
+
+/// Bound on |C_k| (pulses) of a simulated record: 2^61, so that every count and every increment
+/// C_k − C_{k−1} fits in 64 bits with room to spare. A model whose angle goes beyond it (e.g. a
+/// bias of 1e300 °/h) is refused with a UsageError naming the sample, never written as wrapped counts.
+inline constexpr double kMaxSimulatedPulses = 2305843009213693952.0;
+
 /// Fast repeated simulation of one model at one length: FFT plans, the flicker filter
 /// spectrum and all buffers are made once and reused by every run.
 class Simulator {
@@ -181,7 +196,14 @@ class Simulator {
   Simulator& operator=(Simulator&&) noexcept;
 
   /// One realisation with `seed` (settings.seed is ignored); `out` is resized and overwritten.
+  /// Throws UsageError when the angle leaves the range of a pulse count (kMaxSimulatedPulses).
   void run(std::uint64_t seed, PhaseSeries& out);
+
+  /// The same realisation as run(seed, …), handed to `sink` block by block (at most 256
+  /// samples each, in order) as it is generated, so that memory does not grow with the record
+  /// (except the flicker term's FFT, which spans the record). With an output-chain low-pass the
+  /// record is generated twice: the filter starts at the record's mean rate, known only at its end.
+  void stream(std::uint64_t seed, const std::function<void(const RecordBlock&)>& sink);
 
   [[nodiscard]] const NoiseModel& model() const noexcept;
   [[nodiscard]] const SimulationSettings& settings() const noexcept;

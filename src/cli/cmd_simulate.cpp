@@ -134,6 +134,21 @@ nlohmann::json read_json_file(const std::string& path) {
   }
 }
 
+// Generate one record and write it block by block as it is generated, so that memory does not
+// grow with its length; the file appears only when it is complete (PulseFileWriter).
+void write_record(Simulator& sim, const SimulationSettings& sr, const std::string& path, bool force) {
+  const bool angle = sim.model().output_lowpass_tc_s > 0;
+  PulseFileWriter out(path, metadata_of(sim.model(), sr),
+                      angle ? PulseFileWriter::Column::Angle : PulseFileWriter::Column::Pulses, force);
+  sim.stream(sr.seed, [&](const RecordBlock& block) {
+    if (angle)
+      out.add_angles(block.angles);
+    else
+      out.add_counts(block.counts);
+  });
+  out.commit();
+}
+
 int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
   auto given = [&](const char* name) { return sub.count(name) > 0; };
   SimulationSettings s;
@@ -225,13 +240,11 @@ int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
   }
   check_output_targets(targets, a.force);
   Simulator sim(m, s);
-  PhaseSeries series;
   for (int r = 1; r <= a.runs; ++r) {
     SimulationSettings sr = s;
     sr.seed = s.seed + static_cast<std::uint64_t>(r - 1);
     const std::string path = a.runs > 1 ? numbered(a.output, r, a.runs) : a.output;
-    sim.run(sr.seed, series);
-    write_pulse_file(path, metadata_of(m, sr), series, a.force);
+    write_record(sim, sr, path, a.force);
     if (!a.truth.empty()) {
       nlohmann::json t;
       t["model"] = m;
