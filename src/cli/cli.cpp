@@ -146,7 +146,7 @@ int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err)
     flush_standard_output(out);
   } catch (const OutputError& e) {
     if (status != 0) return status;  // the command failed first and has said why
-    err << "rwcalc: error: " << e.what() << "\n";
+    print_message(err, fmt::format("error: {}", e.what()));
     return static_cast<int>(ExitCode::OutputFailed);
   }
   return status;
