@@ -144,8 +144,24 @@ namespace {
 
 // Detect outliers in the recording's rates and locate them in the input.
 void check_outlier_threshold(const AnalysisOptions& options) {
-  if (!(options.outlier_threshold > 0) || !std::isfinite(options.outlier_threshold))
-    throw UsageError(fmt::format("--outlier-threshold must be a positive number, got {}", options.outlier_threshold));
+  if (!(options.outlier_threshold >= kMinOutlierThreshold) || !std::isfinite(options.outlier_threshold))
+    throw UsageError(fmt::format("--outlier-threshold must be a finite number >= {:g} robust sigma (below it the "
+                                 "noise's own tails are flagged), got {}",
+                                 kMinOutlierThreshold, options.outlier_threshold));
+}
+
+/// Refuse to remove or replace more than kMaxOutlierShare of the rate samples (outliers.hpp).
+void check_outlier_share(const Recording& rec, const AnalysisOptions& options, std::size_t found) {
+  const std::size_t rates = rec.phase.points() - 1;
+  if (options.outlier_action == OutlierAction::Keep || found <= kMaxOutlierShare * static_cast<double>(rates))
+    return;
+  throw UsageError(fmt::format(
+      "{}: --outliers {} would change {} of {} rate samples ({:.3g} %, more than {:g} %) at --outlier-threshold "
+      "{:g}: so many are not isolated outliers but the noise itself, a burst or a step; nothing was analysed. "
+      "Raise --outlier-threshold (default {:g}) or use --outliers keep to see where they are",
+      rec.source, options.outlier_action == OutlierAction::Remove ? "remove" : "replace", found, rates,
+      100.0 * static_cast<double>(found) / static_cast<double>(rates), 100.0 * kMaxOutlierShare,
+      options.outlier_threshold, kDefaultOutlierThreshold));
 }
 
 /// The report of a finished scan (`found`, with its scale).
@@ -180,6 +196,7 @@ std::vector<Outlier> detect_outliers(const Recording& rec, const AnalysisOptions
   } else {
     found = scan_outliers(rec.phase, options.outlier_threshold, scale, threads);
   }
+  check_outlier_share(rec, options, found.size());
   report_outliers(rec, options, scale, found, rep);
   return found;
 }
