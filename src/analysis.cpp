@@ -143,8 +143,24 @@ std::string_view to_string(OutlierAction a) {
 namespace {
 
 void check_outlier_threshold(double threshold) {
-  if (!(threshold > 0) || !std::isfinite(threshold))
-    throw UsageError(fmt::format("--outlier-threshold must be a positive number, got {}", threshold));
+  if (!(threshold >= kMinOutlierThreshold) || !std::isfinite(threshold))
+    throw UsageError(fmt::format("--outlier-threshold must be a finite number >= {:g} robust sigma (below it the "
+                                 "noise's own tails are flagged), got {}",
+                                 kMinOutlierThreshold, threshold));
+}
+
+/// Refuse to remove or replace more than kMaxOutlierShare of the rate samples (outliers.hpp).
+void check_outlier_share(const Recording& rec, OutlierAction action, double threshold, std::size_t found) {
+  const std::size_t rates = rec.phase.points() - 1;
+  if (action == OutlierAction::Keep || static_cast<double>(found) <= kMaxOutlierShare * static_cast<double>(rates))
+    return;
+  throw UsageError(fmt::format(
+      "{}: --outliers {} would change {} of {} rate samples ({:.3g} %, more than {:g} %) at --outlier-threshold "
+      "{:g}: so many are not isolated outliers but the noise itself, a burst or a step; nothing was analysed. "
+      "Raise --outlier-threshold (default {:g}) or use --outliers keep to see where they are",
+      rec.source, action == OutlierAction::Remove ? "remove" : "replace", found, rates,
+      100.0 * static_cast<double>(found) / static_cast<double>(rates), 100.0 * kMaxOutlierShare,
+      threshold, kDefaultOutlierThreshold));
 }
 
 /// The report of a finished scan (`found`, with its scale), located in the input.
@@ -189,6 +205,7 @@ const Recording& screen_outliers(const Recording& read, OutlierAction action, do
   if (read.phase.points() < 3) return read;  // too short to screen; the caller says so
   OutlierScale scale;
   const std::vector<Outlier> found = detect_outliers(read, threshold, scale, threads, crew);
+  check_outlier_share(read, action, threshold, found.size());
   report_outliers(read, action, threshold, scale, found, report);
   if (action == OutlierAction::Keep || found.empty()) return read;
   edited = Recording{};

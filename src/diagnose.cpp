@@ -89,6 +89,7 @@ PhaseSeries slice(const PhaseSeries& x, std::size_t a, std::size_t b) {
   s.tau0_s = x.tau0_s;
   s.kind = x.kind;
   s.arcsec_per_count = x.arcsec_per_count;
+  s.rate_offset = x.rate_offset;
   if (!x.counts.empty())
     s.counts.assign(x.counts.begin() + static_cast<std::ptrdiff_t>(a), x.counts.begin() + static_cast<std::ptrdiff_t>(b) + 1);
   else if (x.exact())

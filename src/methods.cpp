@@ -92,7 +92,8 @@ DirectNResult direct_n(const PhaseSeries& x, const MethodOptions& o) {
   std::vector<std::size_t> ms;
   for (int i = 0; i < o.direct_points; ++i) {
     const double t = t_min * std::pow(t_max / t_min, o.direct_points > 1 ? double(i) / (o.direct_points - 1) : 0.0);
-    const auto m = static_cast<std::size_t>(std::max(1.0, std::round(t / x.tau0_s)));
+    // t ≤ t_max ≤ the record's length / 50: m fits the sample count.
+    const auto m = static_cast<std::size_t>(std::max(1.0, std::round(std::min(t / x.tau0_s, static_cast<double>(n)))));
     if (ms.empty() || m != ms.back()) ms.push_back(m);
   }
   r.points = direct_points(x, 0, n, ms);
@@ -152,7 +153,14 @@ DirectNResult direct_n(const PhaseSeries& x, const MethodOptions& o) {
 BlockSpreadResult block_spread(const PhaseSeries& x, double block_s) {
   BlockSpreadResult r;
   const std::size_t n = x.points() > 0 ? x.points() - 1 : 0;
-  const auto m = static_cast<std::size_t>(std::max(1.0, std::round(block_s / x.tau0_s)));
+  // Samples per block, compared as a double before the conversion: a block longer than the
+  // record (or NaN) has no whole block, and its count would not fit an integer.
+  const double per_block = std::max(1.0, std::round(block_s / x.tau0_s));
+  if (!(per_block <= static_cast<double>(n))) {
+    r.block_s = std::isfinite(block_s) ? block_s : 0.0;
+    return r;
+  }
+  const auto m = static_cast<std::size_t>(per_block);
   r.block_s = static_cast<double>(m) * x.tau0_s;
   const std::size_t k = n / m;
   r.blocks = k;

@@ -272,7 +272,7 @@ struct PhaseRates {
       for (std::size_t i = from; i < to; ++i) out[i - from] = ph.rate(i);
     } else {
       const double* x = ph.values.data();
-      for (std::size_t i = from; i < to; ++i) out[i - from] = (x[i + 1] - x[i]) / ph.tau0_s;
+      for (std::size_t i = from; i < to; ++i) out[i - from] = (x[i + 1] - x[i]) / ph.tau0_s + ph.rate_offset;
     }
   }
   const double* window(std::size_t b, std::size_t e, double* buf) const {

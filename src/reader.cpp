@@ -29,6 +29,7 @@
 #include "reader_simd.hpp"
 #include "timing.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/limits.hpp"
 #include "rwcalc/thread.hpp"
 #include "rwcalc/units.hpp"
 
@@ -322,6 +323,7 @@ class Reader {
   void check_time_columns_agree() const;
   void check_time_column();
   void build_phase(Recording& rec);
+  void check_data_magnitude(const PhaseSeries& ph, const char* what) const;
 
   std::string name_;
   const ReadOptions& opt_;
@@ -532,13 +534,22 @@ void Reader::metadata_line(std::string_view body) {
                               quoted(metadata_[key]), quoted(value)));
     slot = x;
   };
+  // The usable ranges of rwcalc/limits.hpp, as for the options that override these keys.
+  auto within = [&](double x, double lo, double hi, const char* unit) {
+    if (!(x >= lo && x <= hi))
+      fail(line_, fmt::format("metadata {}: {} {} is outside the usable range {:g}..{:g} {}", key, quoted(value), unit,
+                              lo, hi, unit));
+  };
   if (key == "rate_hz") {
     set_known(meta_rate_, true);
+    within(*meta_rate_, kMinRateHz, kMaxRateHz, "Hz");
     meta_rate_line_ = line_;
   } else if (key == "scale_arcsec_per_pulse") {
     set_known(meta_scale_, true);
+    within(*meta_scale_, kMinScaleArcsec, kMaxScaleArcsec, "arcsec");
   } else if (key == "temperature_c") {
     set_known(meta_temp_, false);
+    within(*meta_temp_, kMinTemperatureC, kMaxTemperatureC, "deg C");
   } else if (!known && looks_like_rate_key(canonical) && !unread_rate_key_) {
     unread_rate_key_ = {key, line_};
   } else if (!known && looks_like_scale_key(canonical) && !unread_scale_key_) {
@@ -1404,6 +1415,10 @@ void Reader::finish_rate() {
     if (rate >= 1 && std::abs(rate - std::round(rate)) <= 1e-6 * rate) rate = std::round(rate);
     rate_hz_ = rate;
     rate_source_ = RateSource::TimeColumn;
+    if (!(rate >= kMinRateHz && rate <= kMaxRateHz))
+      fail(first_data_line_, fmt::format("the time column's step of {:g} s gives a sample rate of {:g} Hz, outside the "
+                                         "usable range {:g}..{:g} Hz",
+                                         period, rate, kMinRateHz, kMaxRateHz));
   }
 }
 
@@ -1478,6 +1493,24 @@ void Reader::check_time_column() {
     }
   }
   fail(0, "the time column does not step by the sample period");  // not reached: a step tripped above
+}
+
+/// The mean of the rate samples x[1…] (x[0] is the phase's origin), rounded to a double.
+double mean_rate_sample(const std::vector<double>& x) {
+  long double sum = 0;
+  for (std::size_t i = 1; i < x.size(); ++i) sum += x[i];
+  return x.size() > 1 ? static_cast<double>(sum / static_cast<long double>(x.size() - 1)) : 0.0;
+}
+
+/// Floating data whose phase steps are all below kMinDataStep (limits.hpp) but not all zero:
+/// the Allan variance would square them to zero and call the record noiseless.
+void Reader::check_data_magnitude(const PhaseSeries& ph, const char* what) const {
+  double largest = 0;
+  for (std::size_t i = 1; i < ph.values.size(); ++i) largest = std::max(largest, std::abs(ph.values[i] - ph.values[i - 1]));
+  if (largest > 0 && largest < kMinDataStep)
+    fail(0, fmt::format("the {} data are too small to analyse: the largest step between samples is {:g} {}, below "
+                        "{:g}, where the squares in the Allan variance underflow; give the data in a larger unit",
+                        what, largest, ph.kind == PhaseKind::Clock ? "s" : "arcsec", kMinDataStep));
 }
 
 void Reader::build_phase(Recording& rec) {
@@ -1555,6 +1588,7 @@ void Reader::build_phase(Recording& rec) {
                                               "variance of the record would overflow",
                                               quoted(fmt::format("{:g}", reals_[i] / f)), kMaxPhase));
       ph.values = std::move(reals_);
+      check_data_magnitude(ph, "angle");
       break;
     }
     case InputMode::Rate: {
@@ -1564,21 +1598,27 @@ void Reader::build_phase(Recording& rec) {
         case RateUnit::DegPerSecond: f = units::arcsec_per_deg; break;
         case RateUnit::RadPerSecond: f = units::arcsec_per_rad; break;
       }
-      // SP 1065 phase from frequency: x_0 = 0, x_j = τ0·Σ_{i<j} y_i, accumulated in long double.
+      // SP 1065 phase from frequency: x_0 = 0, x_j = τ0·Σ_{i<j} (y_i − ȳ), accumulated in long
+      // double. The mean rate ȳ goes into rate_offset (series.hpp): a phase that kept it would
+      // grow to ȳ·T and round its noise away once the offset is many orders above the noise.
       std::vector<double>& x = reals_;
       const long double k = static_cast<long double>(ph.tau0_s) * f;
+      const double mean = mean_rate_sample(x);
       long double acc = 0;
       for (std::size_t i = 1; i < x.size(); ++i) {
         const double y = x[i];
-        acc += static_cast<long double>(y) * k;
+        acc += (static_cast<long double>(y) - mean) * k;
         x[i] = static_cast<double>(acc);
-        if (!(std::abs(acc) <= kMaxPhase)) [[unlikely]]
+        const long double whole = acc + static_cast<long double>(mean) * k * static_cast<long double>(i);
+        if (!(std::abs(whole) <= kMaxPhase)) [[unlikely]]
           fail(line_of_sample(i - 1),
                fmt::format("rate out of range: the accumulated phase reaches {:g} arcsec (beyond ±{:g}, where the "
                            "Allan variance would overflow) at this sample, {}",
-                           static_cast<double>(acc), kMaxPhase, quoted(fmt::format("{:g}", y))));
+                           static_cast<double>(whole), kMaxPhase, quoted(fmt::format("{:g}", y))));
       }
       ph.values = std::move(x);
+      ph.rate_offset = mean * f;
+      check_data_magnitude(ph, "rate");
       break;
     }
   }

@@ -275,9 +275,11 @@ TEST(Reader, RateInputIsIntegratedToPhaseAsSp1065) {
   for (double v : y) text += fmt::format("{}\n", v);
   const auto c = read_recording_text(text, "nbs14.txt", {.mode = InputMode::Rate, .rate_hz = 1.0, .rate_unit = RateUnit::Unitless});
   ASSERT_EQ(c.phase.values.size(), y.size() + 1);
+  // The mean rate is kept apart (PhaseSeries::rate_offset); the phase adds it back.
   double x = 0;
-  EXPECT_EQ(c.phase.values[0], 0.0);
-  for (std::size_t i = 0; i < y.size(); ++i) EXPECT_EQ(c.phase.values[i + 1], x += y[i]);
+  EXPECT_EQ(c.phase.at(0), 0.0);
+  for (std::size_t i = 0; i < y.size(); ++i) EXPECT_NEAR(c.phase.at(i + 1), x += y[i], 1e-9 * x);
+  EXPECT_NEAR(c.phase.rate_offset, 7100.0 / 9.0, 1e-9);
   EXPECT_EQ(c.phase.kind, PhaseKind::Clock);
   // Gyro units: deg/s and rad/s become ″/s (= °/h).
   const auto ds = read_recording_text("0.5\n-0.25\n", "g", {.mode = InputMode::Rate, .rate_unit = RateUnit::DegPerSecond});

@@ -39,6 +39,18 @@ struct OutlierScale {
 /// Detection threshold used when none is given (robust z).
 inline constexpr double kDefaultOutlierThreshold = 8.0;
 
+/// Lowest detection threshold accepted, robust z. Below 3 the test flags the tails of ordinary
+/// Gaussian noise (beyond 3σ: 0.27 % of the samples, beyond 1σ: 32 %), not isolated glitches.
+inline constexpr double kMinOutlierThreshold = 3.0;
+
+/// Largest share of the rate samples that `--outliers remove|replace` may change. Isolated
+/// outliers are rare by nature: Gaussian noise exceeds even the lowest threshold (3σ) on 0.27 %
+/// of its samples, and glitches of a loose connector are far rarer still. When more than 1 % of
+/// the samples are flagged they are the noise's own tail, a burst or a step, not isolated
+/// glitches, and removing or replacing them would change the very noise the Allan variance
+/// measures; the analysis refuses instead of rewriting the record.
+inline constexpr double kMaxOutlierShare = 0.01;
+
 /// The robust scale of a rate record (see the file comment). Needs at least 7 samples (else 0).
 OutlierScale outlier_scale(const std::vector<double>& rates);
 

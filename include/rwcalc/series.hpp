@@ -33,6 +33,11 @@ struct PhaseSeries {
   double arcsec_per_count = 0.92;  ///< pulse weight q, ″ per count
   /// Floating phase x_0..x_M in phase units, used when both count vectors are empty.
   std::vector<double> values;
+  /// A constant rate (phase units per second) taken out of `values`: the phase is
+  /// values[i] + rate_offset·i·τ0. Rate input keeps its mean rate here, so that a large offset
+  /// (a bias 10^12 times the noise) does not swamp the phase's 53 bits; second differences (the
+  /// Allan variances) do not see it, diff(), at() and rate() add it back.
+  double rate_offset = 0.0;
 
   [[nodiscard]] bool exact() const noexcept { return !counts.empty() || !counts32.empty(); }
   /// True when the exact counts are held in `counts32`.
@@ -52,7 +57,8 @@ struct PhaseSeries {
   }
   /// Phase at index i in phase units.
   [[nodiscard]] double at(std::size_t i) const noexcept {
-    return exact() ? static_cast<double>(count(i)) * arcsec_per_count : values[i];
+    return exact() ? static_cast<double>(count(i)) * arcsec_per_count
+                   : values[i] + rate_offset * static_cast<double>(i) * tau0_s;
   }
   /// Phase difference x_j − x_i in phase units, exact for counts.
   [[nodiscard]] double diff(std::size_t j, std::size_t i) const noexcept {
@@ -63,7 +69,7 @@ struct PhaseSeries {
     }
     if (!counts32.empty())
       return static_cast<double>(std::int64_t{counts32[j]} - std::int64_t{counts32[i]}) * arcsec_per_count;
-    return values[j] - values[i];
+    return values[j] - values[i] + rate_offset * (static_cast<double>(j) - static_cast<double>(i)) * tau0_s;
   }
   /// Record length T = (points − 1)·τ0, s.
   [[nodiscard]] double duration_s() const noexcept {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "cli/numeric_options.hpp"
 #include "rwcalc/error.hpp"
 
 namespace rwcalc::cli {
@@ -41,7 +42,7 @@ void add_outlier_options(CLI::App& app, std::string& action, double& threshold) 
       ->group("Outliers");
   app.add_option("--outlier-threshold", threshold,
                  "Detection threshold, robust sigma of the residual from the neighbour median")
-      ->check(CLI::PositiveNumber)
+      ->check(real_in(kMinOutlierThreshold, 1e6, "robust sigma"))
       ->capture_default_str()
       ->group("Outliers");
 }
@@ -50,7 +51,7 @@ void AnalyzeArgs::add_to(CLI::App& app) {
   app.add_option("--fit-range", fit_range, "Tau range of the fit, TMIN:TMAX in s (either may be empty; default: all)")
       ->group("Fit");
   app.add_option("--min-edf", min_edf, "Leave out AV points with fewer equivalent degrees of freedom")
-      ->check(CLI::PositiveNumber)
+      ->check(real_in(0.0, 1e12, "", Ends::OpenLow))
       ->capture_default_str()
       ->group("Fit");
   app.add_option("--terms", terms, "Terms to fit, a subset of QNBKR")->capture_default_str()->group("Fit");
@@ -64,22 +65,23 @@ void AnalyzeArgs::add_to(CLI::App& app) {
       ->capture_default_str()
       ->group("Fit");
   app.add_option("--latitude", latitude_deg, "Latitude for the vertical Earth rate, degrees")
-      ->check(CLI::Range(-90.0, 90.0))
+      ->check(real_in(-90.0, 90.0, "deg"))
       ->capture_default_str()
       ->group("Earth rate");
   app.add_option("--earth-rate", earth_rate, "Expected sensed Earth rate, deg/h (overrides --latitude)")
+      ->check(real_in(-kMaxRateDegPerH, kMaxRateDegPerH, "deg/h"))
       ->group("Earth rate");
   app.add_option("--b-estimate", b_estimate, "B estimate the verdict uses: fit, sigma-min or avg100")
       ->capture_default_str()
       ->group("Verdict");
   app.add_option("--tolerance", tolerance_pct,
                  "Accept a B up to PCT % above a class limit (the paper's heading-gyro rule, e.g. 50)")
-      ->check(CLI::Range(0.0, 1000.0))
+      ->check(real_in(0.0, 1000.0, "%"))
       ->capture_default_str()
       ->group("Verdict");
   app.add_option("--limits", limits_file, "Class table as JSON (default: GOST RV 52339)")->group("Verdict");
   app.add_option("--block", block_s, "Block length of the averaging cross-check, s")
-      ->check(CLI::PositiveNumber)
+      ->check(real_in(0.0, 1e9, "s", Ends::OpenLow))
       ->capture_default_str()
       ->group("Cross-checks");
   app.add_option("--direct-range", direct_range, "Interval lengths of the direct N method, TMIN:TMAX in s")

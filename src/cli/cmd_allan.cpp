@@ -2,6 +2,7 @@
 // confidence bounds per τ, as text, CSV or JSON.
 #include <fmt/format.h>
 
+#include <cmath>
 #include <iterator>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -9,6 +10,7 @@
 
 #include "cli/analyze_args.hpp"
 #include "cli/commands.hpp"
+#include "cli/numeric_options.hpp"
 #include "rwcalc/allan.hpp"
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/crew.hpp"
@@ -84,6 +86,25 @@ std::string allan_json_text(const AllanResult& r, const Recording& rec, const Ou
   return out;
 }
 
+/// No output holds a non-finite number (JSON has none, and "inf" is no result): a value that
+/// overflowed is an error that names it.
+void require_finite(const AllanResult& r, const Recording& rec) {
+  auto check = [&](const char* what, double v, double tau) {
+    if (!std::isfinite(v))
+      throw AnalysisError(fmt::format("{}: the {} at tau = {:g} s is {} (the record's numbers overflow a double); "
+                                      "nothing was printed",
+                                      rec.source, what, tau, v));
+  };
+  check("sample period tau0", r.tau0_s, r.tau0_s);
+  for (const AllanPoint& p : r.points) {
+    check("tau", p.tau_s, p.tau_s);
+    check("deviation", p.dev, p.tau_s);
+    check("lower bound", p.dev_low, p.tau_s);
+    check("upper bound", p.dev_high, p.tau_s);
+    check("EDF", p.edf, p.tau_s);
+  }
+}
+
 int run_allan(const AllanArgs& a, Io& io) {
   AllanOptions o;
   o.estimator = parse_estimator(a.estimator);
@@ -108,12 +129,13 @@ int run_allan(const AllanArgs& a, Io& io) {
   o.noise_id_domain = (rec.mode == InputMode::Pulses || rec.mode == InputMode::Rate) ? NoiseIdDomain::Frequency
                                                                                       : NoiseIdDomain::Phase;
   const AllanResult res = compute_allan(rec.phase, o);
+  require_finite(res, rec);
   if (a.json) {
     io.out << allan_json_text(res, rec, outliers);
   } else if (a.csv) {
     io.out << format_allan_csv(res);
     // The CSV holds the table only; the outliers found are said on standard error.
-    if (outliers.count > 0) io.err << "rwcalc: note: " << rec.source << ": " << format_outliers(outliers);
+    if (outliers.count > 0) print_message(io.err, fmt::format("note: {}: {}", rec.source, format_outliers(outliers)));
   } else {
     io.out << format_allan_table(res, {rec.source, rec.samples, rec.rate_hz, std::string(to_string(rec.rate_source))});
     io.out << "\n" << format_outliers(outliers);
@@ -140,8 +162,11 @@ void register_allan(CLI::App& app, Runner& runner) {
                   "seconds such as 0.01,1,10 (each a whole number of samples)")
       ->capture_default_str();
   sub->add_option("--confidence", args->confidence, "Two-sided confidence of the bounds (0..1)")
+      ->check(real_in(0.0, 1.0, "", Ends::Open))
       ->capture_default_str();
-  sub->add_option("--threads", args->threads, "Worker threads across τ (0: all cores)")->capture_default_str();
+  sub->add_option("--threads", args->threads, "Worker threads across τ (0: all cores)")
+      ->check(whole_in(0, kMaxThreads))
+      ->capture_default_str();
   add_outlier_options(*sub, args->outliers, args->outlier_threshold);
   auto* json = sub->add_flag("--json", args->json, "Print JSON instead of the table");
   auto* csv = sub->add_flag("--csv", args->csv, "Print CSV instead of the table");

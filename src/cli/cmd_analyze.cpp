@@ -7,6 +7,7 @@
 
 #include "cli/analyze_args.hpp"
 #include "cli/commands.hpp"
+#include "cli/numeric_options.hpp"
 #include "cli/plot_args.hpp"
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/crew.hpp"
@@ -40,7 +41,8 @@ void register_analyze(CLI::App& app, Runner& runner) {
   sub->add_option("FILE", cmd->file, "Recording to analyse ('-' for standard input)")->required();
   cmd->input.add_to(*sub);
   cmd->analysis.add_to(*sub);
-  sub->add_option("--temperature", cmd->temperature, "Temperature of the run, °C (overrides the file)");
+  sub->add_option("--temperature", cmd->temperature, "Temperature of the run, °C (overrides the file)")
+      ->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"));
   sub->add_flag("--json", cmd->json, "Print the JSON object instead of the report");
   sub->add_option("-o,--output", cmd->output, "Write to FILE instead of standard output")->capture_default_str();
   sub->add_flag("--force", cmd->force, "Overwrite existing output, figure and script files");
@@ -68,8 +70,9 @@ void register_analyze(CLI::App& app, Runner& runner) {
       const AnalysisResult res = analyze(rec, opt);
       const std::string text = [&] {
         detail::ScopedTimer t("format");
-        if (!cmd->json && !cmd->plot.any()) return format_report(res);
         const nlohmann::json j = to_json(res);
+        require_finite(j, rec.source);
+        if (!cmd->json && !cmd->plot.any()) return format_report(res);
         cmd->plot.draw_analysis(j, cmd->force, io);
         return cmd->json ? j.dump(2) + "\n" : format_report(res);
       }();

@@ -10,6 +10,7 @@
 #include "cli/analyze_args.hpp"
 #include "cli/batch_format.hpp"
 #include "cli/commands.hpp"
+#include "cli/numeric_options.hpp"
 #include "cli/plot_args.hpp"
 #include "rwcalc/batch.hpp"
 #include "rwcalc/error.hpp"
@@ -41,9 +42,11 @@ void register_batch(CLI::App& app, Runner& runner) {
   sub->add_option("FILES", cmd->files, "Recordings")->required();
   cmd->input.add_to(*sub);
   cmd->analysis.add_to(*sub);
-  sub->add_option("--temperature", cmd->temperature, "Temperature, °C (only with a single file)");
+  sub->add_option("--temperature", cmd->temperature, "Temperature, °C (only with a single file)")
+      ->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"));
   cmd->format.add_to(*sub);
-  sub->add_option("-j,--jobs", cmd->jobs, "Files analysed in parallel (default: hardware threads)");
+  sub->add_option("-j,--jobs", cmd->jobs, "Files analysed in parallel (default: hardware threads)")
+      ->check(whole_in(0, kMaxThreads));
   sub->add_option("-o,--output", cmd->output, "Write to FILE instead of standard output")->capture_default_str();
   sub->add_flag("--force", cmd->force, "Overwrite existing output, figure and script files");
   cmd->plot.add_to(*sub,
@@ -58,6 +61,7 @@ void register_batch(CLI::App& app, Runner& runner) {
       }
       cmd->plot.check(cmd->force, {{"-o", cmd->output}});
       auto runs = analyze_files(cmd->files, cmd->input.options(), opt, cmd->jobs);
+      for (const auto& run : runs) require_finite(run, run.value("source", std::string("batch")));
       if (cmd->plot.any()) cmd->plot.draw_batch(nlohmann::json{{"runs", runs}}, cmd->force, io);
       emit(io, cmd->format.render(std::move(runs)), cmd->output, cmd->force);
       return 0;

@@ -5,6 +5,7 @@
 
 #include "cli/analyze_args.hpp"
 #include "cli/commands.hpp"
+#include "cli/numeric_options.hpp"
 #include "cli/plot_args.hpp"
 #include "rwcalc/diagnose.hpp"
 #include "rwcalc/error.hpp"
@@ -41,16 +42,19 @@ void register_diagnose(CLI::App& app, Runner& runner) {
   sub->add_option("FILE", cmd->file, "Recording to diagnose ('-' for standard input)")->required();
   cmd->input.add_to(*sub);
   cmd->analysis.add_to(*sub);
-  sub->add_option("--temperature", cmd->temperature, "Temperature of the run, °C (overrides the file)");
+  sub->add_option("--temperature", cmd->temperature, "Temperature of the run, °C (overrides the file)")
+      ->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"));
   sub->add_flag("--json", cmd->json, "Print the JSON object instead of the report");
   sub->add_option("--runs", cmd->runs, "Simulated records per ensemble (at least 10)")
-      ->check(CLI::Range(10, 100000))
+      ->check(whole_in(10, 100000))
       ->capture_default_str();
-  sub->add_option("--seed", cmd->seed, "Base seed of the simulations")->capture_default_str();
+  sub->add_option("--seed", cmd->seed, "Base seed of the simulations")
+      ->check(whole_in(0, UINT64_MAX))
+      ->capture_default_str();
   sub->add_option("--false-alarm", cmd->alpha, "False-alarm probability of each of the five detectors")
-      ->check(CLI::Range(1e-6, 0.2))
+      ->check(real_in(1e-6, 0.2, ""))
       ->capture_default_str();
-  sub->add_option("--threads", cmd->threads, "Simulation threads (default: hardware threads)");
+  sub->add_option("--threads", cmd->threads, "Simulation threads (default: hardware threads)")->check(whole_in(0, kMaxThreads));
   sub->add_option("-o,--output", cmd->output, "Write to FILE instead of standard output")->capture_default_str();
   sub->add_flag("--force", cmd->force, "Overwrite existing output, figure and script files");
   cmd->plot.add_to(*sub, "the measured Allan deviation against the simulated bands of the base and the extended model");

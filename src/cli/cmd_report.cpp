@@ -19,6 +19,7 @@
 
 #include "cli/analyze_args.hpp"
 #include "cli/commands.hpp"
+#include "cli/numeric_options.hpp"
 #include "rwcalc/batch.hpp"
 #include "rwcalc/diagnose.hpp"
 #include "rwcalc/reader.hpp"
@@ -274,13 +275,18 @@ void register_report(CLI::App& app, Runner& runner) {
   sub->add_option("-o,--output", cmd->dir, "Directory for report.html (created when missing); required");
   cmd->input.add_to(*sub);
   cmd->analysis.add_to(*sub);
-  sub->add_option("--temperature", cmd->temperature, "Temperature, °C (only with a single recording)");
-  sub->add_option("-j,--jobs", cmd->jobs, "Recordings analysed in parallel (default: hardware threads)");
+  sub->add_option("--temperature", cmd->temperature, "Temperature, °C (only with a single recording)")
+      ->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"));
+  sub->add_option("-j,--jobs", cmd->jobs, "Recordings analysed in parallel (default: hardware threads)")
+      ->check(whole_in(0, kMaxThreads));
   sub->add_option("--title", cmd->title, "Title of the report");
   sub->add_flag("--diagnose", cmd->diagnose, "Also diagnose each recording (what the noise model misses)");
   sub->add_option("--diagnose-runs", cmd->diagnose_runs, "Simulated records per diagnosis ensemble")
+      ->check(whole_in(10, 100000))
       ->capture_default_str();
-  sub->add_option("--diagnose-seed", cmd->diagnose_seed, "Seed of the diagnosis ensembles")->capture_default_str();
+  sub->add_option("--diagnose-seed", cmd->diagnose_seed, "Seed of the diagnosis ensembles")
+      ->check(whole_in(0, UINT64_MAX))
+      ->capture_default_str();
   sub->add_flag("--no-figures", cmd->no_figures, "Tables only (needs no gnuplot)");
   sub->add_flag("--force", cmd->force, "Replace an existing report.html");
   sub->callback([cmd, &runner] {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "cli/numeric_options.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/pulse_writer.hpp"
@@ -149,6 +150,49 @@ void write_record(Simulator& sim, const SimulationSettings& sr, const std::strin
   out.commit();
 }
 
+// Most pulses a record may count: the count is an int64 and the quantizer's floor is exact below
+// 2^62; 2^60 leaves room for the random excursions the bound below does not cover.
+constexpr double kMaxPulses = 1152921504606846976.0;  // 2^60
+// Most samples a record may have (2^40: about 30 days at 400 kHz).
+constexpr double kMaxSamples = 1099511627776.0;
+
+// A generous bound of |angle| over the record, arcsec: every rate term at its largest for the
+// whole duration, random terms at ten standard deviations.
+double angle_bound_arcsec(const NoiseModel& m, const SimulationSettings& s) {
+  const double T = s.duration_s;
+  double rate = std::abs(m.bias_deg_per_h) + std::abs(m.earth_rate_deg_per_h) + std::abs(m.ramp_deg_per_h2) * T / 3600.0 +
+                10.0 * m.bias_instability_deg_per_h;
+  for (const auto& x : m.sinusoids) rate += std::abs(x.amp_deg_per_h);
+  for (const auto& x : m.gauss_markov) rate += 10.0 * x.sigma_deg_per_h;
+  for (const auto& x : m.bias_steps) rate += std::abs(x.size_deg_per_h);
+  for (const auto& x : m.warmups) rate += std::abs(x.amp_deg_per_h);
+  if (m.temperature_bias) {
+    const auto& p = m.temperature_bias->profile;
+    const double swing = std::abs(p.start_c) + std::abs(p.end_c) + std::abs(p.amp_c) + std::abs(s.temperature_c.value_or(0.0));
+    rate += std::abs(m.temperature_bias->coefficient_deg_per_h_per_c) * swing;
+  }
+  const double arw = 10.0 * m.arw_deg_per_sqrt_h * units::sqrt_s_per_sqrt_h * std::sqrt(T);
+  const double rrw = 10.0 * m.rrw_deg_per_h_per_sqrt_h / units::sqrt_s_per_sqrt_h * T * std::sqrt(T);
+  return rate * T + arw + rrw + 10.0 * m.white_angle_arcsec;
+}
+
+// Refuse a record whose angle the pulse counts cannot carry, before anything is written.
+void check_record_range(const NoiseModel& m, const SimulationSettings& s) {
+  if (!(s.duration_s * s.rate_hz <= kMaxSamples))
+    throw UsageError(fmt::format("--duration {:g} s at --rate {:g} Hz gives {:g} samples, more than the {:g} a record may have",
+                                 s.duration_s, s.rate_hz, s.duration_s * s.rate_hz, kMaxSamples));
+  for (const auto& x : m.bias_steps)
+    if (x.t_s > s.duration_s)
+      throw UsageError(fmt::format("--bias-step: the time {:g} s is beyond the record's end ({:g} s)", x.t_s, s.duration_s));
+  const double angle = angle_bound_arcsec(m, s);
+  if (!(angle / s.scale_arcsec <= kMaxPulses))
+    throw UsageError(fmt::format(
+        "the record's angle may reach {:g} arcsec (rate terms over {:g} s, random terms at ten sigma), {:g} pulses of "
+        "{:g} arcsec: beyond the {:g} (2^60) pulses a record can count. Lower --bias, --arw, --ramp or the other "
+        "terms, shorten --duration or raise --scale",
+        angle, s.duration_s, angle / s.scale_arcsec, s.scale_arcsec, kMaxPulses));
+}
+
 int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
   auto given = [&](const char* name) { return sub.count(name) > 0; };
   SimulationSettings s;
@@ -188,7 +232,8 @@ int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
     m.output_lowpass_tc_s = nonneg("--output-lowpass", a.output_lowpass);
   for (const auto& t : a.sinusoids) {
     const auto v = fields("--sinusoid", t, 2, 3, "F_HZ:AMP_DEG_PER_H[:PHASE_RAD]");
-    if (v[0] <= 0) throw UsageError(fmt::format("--sinusoid: the frequency must be > 0 Hz in '{}'", t));
+    if (v[0] <= 0 || v[0] > kMaxRateHz)
+      throw UsageError(fmt::format("--sinusoid: the frequency must be in (0, {:g}] Hz in '{}'", kMaxRateHz, t));
     m.sinusoids.push_back({v[0], v[1], v.size() > 2 ? v[2] : 0.0});
   }
   for (const auto& t : a.gauss_markov) {
@@ -216,10 +261,13 @@ int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
     const std::string rest = colon == std::string::npos ? "" : a.temp_profile.substr(colon + 1);
     if (kind == "ramp") {
       const auto v = fields("--temp-profile", rest, 2, 2, "ramp:START_C:END_C");
+      for (const double c : v)
+        if (c < kMinTemperatureC || c > kMaxTemperatureC)
+          throw UsageError(fmt::format("--temp-profile: {:g} deg C is outside {:g}..{:g} deg C", c, kMinTemperatureC, kMaxTemperatureC));
       tb.profile = {TemperatureProfile::Kind::Ramp, v[0], v[1], 0.0, 0.0};
     } else if (kind == "cycle") {
       const auto v = fields("--temp-profile", rest, 2, 2, "cycle:AMP_C:PERIOD_S");
-      if (v[1] <= 0) throw UsageError("--temp-profile: the cycle period must be > 0 s");
+      if (!(v[1] >= 1.0 / kMaxRateHz)) throw UsageError(fmt::format("--temp-profile: the cycle period must be >= {:g} s", 1.0 / kMaxRateHz));
       tb.profile = {TemperatureProfile::Kind::Cycle, 0.0, 0.0, v[0], v[1]};
     } else {
       throw UsageError(fmt::format("--temp-profile: '{}' is neither ramp:START_C:END_C nor cycle:AMP_C:PERIOD_S", a.temp_profile));
@@ -229,6 +277,7 @@ int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
     throw UsageError("--temp-profile needs --temp-bias COEF_DEG_PER_H_PER_C");
   }
   if (a.runs < 1) throw UsageError(fmt::format("--runs must be >= 1, got {}", a.runs));
+  check_record_range(m, s);
   if (a.output == "-" && a.runs > 1) throw UsageError("--runs > 1 needs a file name for -o");
 
   // Refuse before writing anything when any target exists or two name the same file (no
@@ -273,25 +322,27 @@ void register_simulate(CLI::App& app, Runner& runner) {
   sub->add_option("-o,--output", a.output, "Output pulse file (FILE.csv or FILE.csv.gz; - for stdout)")->required();
   sub->add_option("--truth", a.truth, "Also write the ground truth (model JSON, seed, settings) to this file");
   sub->add_option("--from", a.from, "Take the model from 'rwcalc analyze --json' or 'rwcalc diagnose --json' output");
-  sub->add_option("--duration", a.duration_s, "Record length, s")->capture_default_str()->group("Record");
-  sub->add_option("--rate", a.rate_hz, "Sample rate, Hz")->capture_default_str()->group("Record");
-  sub->add_option("--scale", a.scale_arcsec, "Pulse weight q, arcsec per pulse")->capture_default_str()->group("Record");
-  sub->add_option("--seed", a.seed, "Seed of the random streams (same seed, same file)")->capture_default_str()->group("Record");
-  sub->add_option("--temperature", a.temperature_c, "Nominal temperature written as metadata, deg C")->group("Record");
+  sub->add_option("--duration", a.duration_s, "Record length, s")->check(real_in(0.0, 1e9, "s", Ends::OpenLow))->capture_default_str()->group("Record");
+  sub->add_option("--rate", a.rate_hz, "Sample rate, Hz")->check(real_in(kMinRateHz, kMaxRateHz, "Hz"))->capture_default_str()->group("Record");
+  sub->add_option("--scale", a.scale_arcsec, "Pulse weight q, arcsec per pulse")->check(real_in(kMinScaleArcsec, kMaxScaleArcsec, "arcsec"))->capture_default_str()->group("Record");
+  sub->add_option("--seed", a.seed, "Seed of the random streams (same seed, same file)")->check(whole_in(0, UINT64_MAX))->capture_default_str()->group("Record");
+  sub->add_option("--temperature", a.temperature_c, "Nominal temperature written as metadata, deg C")
+      ->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"))->group("Record");
   sub->add_flag("--force", a.force, "Overwrite existing files")->group("Record");
-  sub->add_option("--runs", a.runs, "Write K realisations FILE_001… with seeds seed, seed+1, …")->capture_default_str()->group("Record");
-  sub->add_option("--arw", a.arw, "Angle random walk N, deg/sqrt(h)")->group("Noise terms");
-  sub->add_option("--bias-instability", a.bi, "Bias instability B (flicker rate noise), deg/h")->group("Noise terms");
-  sub->add_option("--rrw", a.rrw, "Rate random walk K, deg/h/sqrt(h)")->group("Noise terms");
-  sub->add_option("--ramp", a.ramp, "Rate ramp R, deg/h^2")->group("Noise terms");
-  sub->add_option("--bias", a.bias, "Constant bias, deg/h")->group("Noise terms");
+  sub->add_option("--runs", a.runs, "Write K realisations FILE_001… with seeds seed, seed+1, …")->check(whole_in(1, 100000))->capture_default_str()->group("Record");
+  sub->add_option("--arw", a.arw, "Angle random walk N, deg/sqrt(h)")->check(real_in(0.0, kMaxRateDegPerH, "deg/sqrt(h)"))->group("Noise terms");
+  sub->add_option("--bias-instability", a.bi, "Bias instability B (flicker rate noise), deg/h")->check(real_in(0.0, kMaxRateDegPerH, "deg/h"))->group("Noise terms");
+  sub->add_option("--rrw", a.rrw, "Rate random walk K, deg/h/sqrt(h)")->check(real_in(0.0, kMaxRateDegPerH, "deg/h/sqrt(h)"))->group("Noise terms");
+  sub->add_option("--ramp", a.ramp, "Rate ramp R, deg/h^2")->check(real_in(-kMaxRateDegPerH, kMaxRateDegPerH, "deg/h^2"))->group("Noise terms");
+  sub->add_option("--bias", a.bias, "Constant bias, deg/h")->check(real_in(-kMaxRateDegPerH, kMaxRateDegPerH, "deg/h"))->group("Noise terms");
   sub->add_option("--latitude", a.latitude, "Latitude for the vertical Earth rate 15.041*sin(lat) deg/h, deg")
-      ->capture_default_str()->group("Noise terms");
+      ->check(real_in(-90.0, 90.0, "deg"))->capture_default_str()->group("Noise terms");
   sub->add_flag("--no-earth-rate", a.no_earth_rate, "Do not add the Earth rate")->group("Noise terms");
   sub->add_flag("--white-readout", a.white_readout,
                 "Dither-like read-out: a fresh uniform phase per sample makes count errors white (Q = q/sqrt(6)); "
                 "default: counting with sawtooth errors")->group("Noise terms");
-  sub->add_option("--white-angle", a.white_angle, "Extra white angle noise before counting, rms arcsec")->group("Noise terms");
+  sub->add_option("--white-angle", a.white_angle, "Extra white angle noise before counting, rms arcsec")
+      ->check(real_in(0.0, 1e12, "arcsec"))->group("Noise terms");
   sub->add_option("--sinusoid", a.sinusoids, "Sinusoidal rate F_HZ:AMP_DEG_PER_H[:PHASE_RAD] (Hz, deg/h, rad); repeatable")
       ->group("Extended terms");
   sub->add_option("--gauss-markov", a.gauss_markov, "Gauss-Markov rate SIGMA_DEG_PER_H:TC_S (deg/h, s); repeatable")
@@ -301,13 +352,13 @@ void register_simulate(CLI::App& app, Runner& runner) {
   sub->add_option("--warmup", a.warmups, "Warm-up transient AMP_DEG_PER_H:TC_S, rate amp*exp(-t/tc) (deg/h, s); repeatable")
       ->group("Extended terms");
   sub->add_option("--lowpass", a.lowpass, "First-order low-pass of the sensed rate inside the sensor, time constant s")
-      ->group("Extended terms");
+      ->check(real_in(0.0, 1e9, "s"))->group("Extended terms");
   sub->add_option("--output-lowpass", a.output_lowpass,
                   "First-order low-pass of the counted rate in the output chain, time constant s; the file then holds "
                   "the filtered angle in arcsec (column 'angle', read with --input angle)")
-      ->group("Extended terms");
+      ->check(real_in(0.0, 1e9, "s"))->group("Extended terms");
   sub->add_option("--temp-bias", a.temp_bias, "Temperature-driven bias coefficient, deg/h per deg C (needs --temp-profile)")
-      ->group("Extended terms");
+      ->check(real_in(-kMaxRateDegPerH, kMaxRateDegPerH, "deg/h per deg C"))->group("Extended terms");
   sub->add_option("--temp-profile", a.temp_profile,
                   "Temperature during the record: ramp:START_C:END_C (linear) or cycle:AMP_C:PERIOD_S (about --temperature); "
                   "bias = coef*(T(t) - T_nominal), T_nominal = --temperature (ramp: else START_C; cycle: else 0)")

@@ -1,6 +1,7 @@
 #include <fmt/format.h>
 
 #include "cli/commands.hpp"
+#include "cli/numeric_options.hpp"
 #include "rwcalc/error.hpp"
 
 namespace rwcalc::cli {
@@ -14,13 +15,13 @@ void InputArgs::add_to(CLI::App& app) {
       ->group("Input");
   app.add_option("--column", column, "Column to read: a header name or a 1-based index")->group("Input");
   app.add_option("--rate", rate_hz, "Sample rate, Hz (default: metadata, time column, or 400)")
-      ->check(CLI::PositiveNumber)
+      ->check(real_in(kMinRateHz, kMaxRateHz, "Hz"))
       ->group("Input");
   app.add_option("--scale", scale_arcsec, "Pulse weight, arcsec per pulse (default: metadata or 0.92)")
-      ->check(CLI::PositiveNumber)
+      ->check(real_in(kMinScaleArcsec, kMaxScaleArcsec, "arcsec"))
       ->group("Input");
   app.add_option("--counter-bits", counter_bits, "Width of a wrapping counter, bits (counter input)")
-      ->check(CLI::Range(1, 64))
+      ->check(whole_in(1, 64))
       ->capture_default_str()
       ->group("Input");
   app.add_option("--angle-unit", angle_unit, "Unit of angle input: arcsec, deg, rad, or s (clock phase)")
@@ -32,7 +33,7 @@ void InputArgs::add_to(CLI::App& app) {
       ->group("Input");
   app.add_option("--time-tolerance", time_tolerance,
                  "Allowed deviation of a time-column step from the sample period, fraction of it")
-      ->check(CLI::Range(0.0, 0.5))
+      ->check(real_in(0.0, 0.5, ""))
       ->capture_default_str()
       ->group("Input");
 }
