@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "json_input.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/pulse_writer.hpp"
@@ -122,17 +123,9 @@ Metadata metadata_of(const NoiseModel& m, const SimulationSettings& s) {
   return md;
 }
 
-nlohmann::json read_json_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, 0, "cannot open the file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  try {
-    return nlohmann::json::parse(ss.str());
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path, 0, fmt::format("not valid JSON: {}", e.what()));
-  }
-}
+/// The model or analysis JSON of --from: parsed with the line of each value, so that invalid JSON,
+/// a number beyond a double (1e400) or runaway nesting is refused naming the file and the line.
+nlohmann::json read_json_file(const std::string& path) { return json_input::Document::load(path).take(); }
 
 int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
   auto given = [&](const char* name) { return sub.count(name) > 0; };
@@ -244,7 +237,7 @@ int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
       t["pulse_file"] = std::filesystem::path(path).filename().string();
       t["quantization_q_arcsec"] = readout_q_arcsec(m.readout, sr.scale_arcsec);
       const std::string tpath = a.runs > 1 ? numbered(a.truth, r, a.runs) : a.truth;
-      write_file_atomic(tpath, t.dump(2) + "\n", a.force);
+      write_file_atomic(tpath, t.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n", a.force);
     }
     if (path != "-")
       io.out << fmt::format("wrote {} ({} samples, {} s at {} Hz, seed {})\n", path, sr.samples(), sr.duration_s, sr.rate_hz, sr.seed);
