@@ -29,6 +29,13 @@ class Document {
   /// number). Throws InputError on invalid JSON, a number out of the range of a double (1e400),
   /// or nesting deeper than kMaxDepth.
   Document(std::string_view text, std::string file, std::size_t first_line = 1);
+  /// A value built in code (no lines: errors name `file` and the key path).
+  static Document of_value(nlohmann::json value, std::string file) {
+    Document d;
+    d.file_ = std::move(file);
+    d.root_ = std::move(value);
+    return d;
+  }
   /// Reads and parses a whole file.
   static Document load(const std::string& path);
 
@@ -40,6 +47,7 @@ class Document {
   [[nodiscard]] nlohmann::json take() { return std::move(root_); }
 
  private:
+  Document() = default;
   std::string file_;
   nlohmann::json root_;
   std::unordered_map<std::string, std::size_t> lines_;

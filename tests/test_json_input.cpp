@@ -260,7 +260,7 @@ TEST_F(JsonInput, MergeErrorsNameTheFileAndLineOfTheRun) {
   auto lines = read_lines(lines_);
   lines[1]["verdict"]["B"]["limits"][0] = 0.004;
   const auto a = dir_->write("a.jsonl", lines[0].dump() + "\n").string();
-  const auto b = dir_->write("b.jsonl", "\n" + lines[1].dump() + "\n").string();
+  const auto b = dir_->write("b.jsonl", std::string(1, '\n').append(lines[1].dump()).append("\n")).string();
   expect_input_error(run_exe({"merge", a, b}), b, 2,
                      {"another class table (\"verdict.B.limits\")", fmt::format("{}:1", a)});
 }
@@ -333,11 +333,42 @@ TEST_F(JsonInput, ClassTableValuesAreCheckedNamingFileLineAndKey) {
 
 // ---- simulate --from ------------------------------------------------------------------------------
 
-TEST_F(JsonInput, SimulateFromRefusesOutOfRangeNumbersNamingTheLine) {
-  std::size_t line = 0;
-  const auto file = dir_->write("model.json", with_value(read_json(analysis_), "/rate_hz", "1e400", line)).string();
-  expect_input_error(run_exe({"simulate", "--from", file, "-o", (dir_->path() / "sim.csv").string()}), file, line,
-                     {"\"rate_hz\": the number 1e400"});
+TEST_F(JsonInput, SimulateFromChecksEveryValueNamingTheLine) {
+  struct Case {
+    const char* pointer;
+    const char* text;
+    const char* what;
+  };
+  const auto sim = (dir_->path() / "sim.csv").string();
+  // An analysis: its settings and fitted coefficients.
+  for (const auto& c : std::vector<Case>{
+           {"/rate_hz", "1e400", "\"rate_hz\": the number 1e400"},
+           {"/rate_hz", "\"fast\"", "\"rate_hz\" must be a number, got string"},  // was silently ignored
+           {"/duration_s", "-5", "\"duration_s\" must be a positive number"},
+           {"/temperature_c", "1e300", "\"temperature_c\" must be a temperature"},
+           {"/fit/N_deg_per_sqrt_h/value", "[]", "\"fit.N_deg_per_sqrt_h.value\" must be a number, got array"},
+           {"/fit", "\"none\"", "\"fit\" must be an object, got string"},
+       }) {
+    std::size_t line = 0;
+    const auto file = dir_->write("model.json", with_value(read_json(analysis_), c.pointer, c.text, line)).string();
+    SCOPED_TRACE(std::string(c.pointer) + " = " + c.text);
+    expect_input_error(run_exe({"simulate", "--from", file, "-o", sim, "--force"}), file, line, {c.what});
+  }
+  // A model object.
+  const json model = {{"arw_deg_per_sqrt_h", 0.001}, {"readout", "white"},
+                      {"sinusoids", {{{"frequency_hz", 0.01}, {"amplitude_deg_per_h", 0.1}}}}};
+  for (const auto& c : std::vector<Case>{
+           {"/readout", "5", "\"readout\" must be a string, got 5"},
+           {"/readout", "\"loud\"", "\"readout\" must be \"counting\" or \"white\""},
+           {"/sinusoids/0/frequency_hz", "\"a\"", "\"sinusoids[0].frequency_hz\" must be a number"},
+           {"/sinusoids", "{}", "\"sinusoids\" must be an array, got object"},
+           {"/terms", "[{\"effect\": 3}]", "\"terms[0].effect\" must be a string"},
+       }) {
+    std::size_t line = 0;
+    const auto file = dir_->write("model.json", with_value(model, c.pointer, c.text, line)).string();
+    SCOPED_TRACE(std::string(c.pointer) + " = " + c.text);
+    expect_input_error(run_exe({"simulate", "--from", file, "-o", sim, "--force"}), file, line, {c.what});
+  }
 }
 
 // ---- a file name that is not UTF-8 ---------------------------------------------------------------

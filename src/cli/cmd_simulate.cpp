@@ -12,7 +12,6 @@
 #include <vector>
 
 #include "cli/commands.hpp"
-#include "json_input.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/pulse_writer.hpp"
@@ -123,17 +122,13 @@ Metadata metadata_of(const NoiseModel& m, const SimulationSettings& s) {
   return md;
 }
 
-/// The model or analysis JSON of --from: parsed with the line of each value, so that invalid JSON,
-/// a number beyond a double (1e400) or runaway nesting is refused naming the file and the line.
-nlohmann::json read_json_file(const std::string& path) { return json_input::Document::load(path).take(); }
-
 int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
   auto given = [&](const char* name) { return sub.count(name) > 0; };
   SimulationSettings s;
   NoiseModel m;
   if (!a.from.empty()) {
     s.scale_arcsec = a.scale_arcsec;
-    m = model_from_analysis_json(read_json_file(a.from), a.from, s);
+    m = model_from_analysis_file(a.from, s);
   }
   if (a.from.empty() || given("--duration")) s.duration_s = a.duration_s;
   if (a.from.empty() || given("--rate")) s.rate_hz = a.rate_hz;
