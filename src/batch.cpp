@@ -289,27 +289,6 @@ json summarize_runs(std::vector<json> runs, const std::string& source) {
   }
 }
 
-std::vector<json> read_json_lines(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, 0, "cannot open the file");
-  std::vector<json> out;
-  std::string line;
-  std::size_t no = 0;
-  while (std::getline(in, line)) {
-    ++no;
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    try {
-      out.push_back(json::parse(line));
-    } catch (const json::parse_error& e) {
-      throw InputError(path, no, fmt::format("not a JSON line: {}", e.what()));
-    }
-    if (!out.back().is_object() || !out.back().contains("verdict"))
-      throw InputError(path, no, "not an analyze object (no \"verdict\"); write it with `rwcalc batch --jsonl`");
-  }
-  if (out.empty()) throw InputError(path, 0, "no JSON lines");
-  return out;
-}
-
 std::string format_batch_text(const json& summary) {
   const auto& runs = summary.at("runs");
   const auto& ov = summary.at("overall");

@@ -2,8 +2,10 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <optional>
 #include <nlohmann/json.hpp>
 
+#include "json_input.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/simulate.hpp"
 
@@ -11,21 +13,21 @@ namespace rwcalc {
 
 namespace {
 
+using json_input::Value;
 using nlohmann::json;
 
-double num(const json& j, const char* key, double fallback = 0.0) {
-  if (!j.contains(key) || j.at(key).is_null()) return fallback;
-  if (!j.at(key).is_number()) throw UsageError(fmt::format("model JSON: '{}' must be a number", key));
-  return j.at(key).get<double>();
+/// A number of a model (absent or null: `fallback`); any other type is an input error.
+double num(const Value& object, const char* key, double fallback = 0.0) {
+  const auto v = object.find(key);
+  return v ? v->number() : fallback;
 }
 
 // Value of a fitted coefficient object {"value": …} (or a bare number); 0 when absent or null.
-double fitted(const json& fit, const char* key) {
-  if (!fit.contains(key) || fit.at(key).is_null()) return 0.0;
-  const json& v = fit.at(key);
-  if (v.is_number()) return v.get<double>();
-  if (v.is_object()) return num(v, "value");
-  throw UsageError(fmt::format("analysis JSON: fit.{} must be an object with a value", key));
+double fitted(const Value& fit, const char* key) {
+  const auto v = fit.find(key);
+  if (!v) return 0.0;
+  if (v->json().is_object()) return num(*v, "value");
+  return v->number();
 }
 
 json profile_json(const TemperatureProfile& p) {
@@ -64,10 +66,10 @@ void to_json(json& j, const NoiseModel& m) {
     j["temperature_bias"] = nullptr;
 }
 
-void add_finding(const json& f, NoiseModel& m) {
-  if (!f.is_object() || !f.contains("effect") || !f.at("effect").is_string())
-    throw UsageError("model JSON: a term needs an \"effect\" name");
-  const auto effect = f.at("effect").get<std::string>();
+namespace {
+
+void add_term(const Value& f, NoiseModel& m) {
+  const auto effect = f.object().at("effect").string();
   if (effect == "sinusoid") {
     m.sinusoids.push_back({num(f, "frequency_hz"), num(f, "amplitude_deg_per_h"), num(f, "phase_rad")});
   } else if (effect == "gauss_markov") {
@@ -81,12 +83,12 @@ void add_finding(const json& f, NoiseModel& m) {
     // rate before counting is a Gauss–Markov rate and is named gauss_markov).
     m.output_lowpass_tc_s = num(f, "time_constant_s");
   } else {
-    throw UsageError(fmt::format("model JSON: unknown effect '{}'", effect));
+    f.at("effect").fail(fmt::format("names an unknown effect '{}'", effect));
   }
 }
 
-void from_json(const json& j, NoiseModel& m) {
-  if (!j.is_object()) throw UsageError("model JSON: expected an object");
+void model_from(const Value& j, NoiseModel& m) {
+  j.object();
   m = NoiseModel{};
   m.arw_deg_per_sqrt_h = num(j, "arw_deg_per_sqrt_h");
   m.bias_instability_deg_per_h = num(j, "bias_instability_deg_per_h");
@@ -97,34 +99,34 @@ void from_json(const json& j, NoiseModel& m) {
   m.white_angle_arcsec = num(j, "white_angle_arcsec");
   m.lowpass_tc_s = num(j, "lowpass_tc_s");
   m.output_lowpass_tc_s = num(j, "output_lowpass_tc_s");
-  if (j.contains("readout") && !j.at("readout").is_null()) {
-    const auto r = j.at("readout").get<std::string>();
+  if (const auto readout = j.find("readout")) {
+    const auto r = readout->string();
     if (r == "white")
       m.readout = ReadoutMode::White;
     else if (r == "counting")
       m.readout = ReadoutMode::Counting;
     else
-      throw UsageError(fmt::format("model JSON: readout must be \"counting\" or \"white\", got \"{}\"", r));
+      readout->fail(fmt::format("must be \"counting\" or \"white\", got \"{}\"", r));
   }
   auto each = [&](const char* key, auto&& fn) {
-    if (!j.contains(key) || j.at(key).is_null()) return;
-    if (!j.at(key).is_array()) throw UsageError(fmt::format("model JSON: '{}' must be an array", key));
-    for (const auto& x : j.at(key)) fn(x);
+    if (const auto list = j.find(key))
+      for (const auto& x : list->elements()) fn(x.object());
   };
-  each("sinusoids", [&](const json& x) {
+  each("sinusoids", [&](const Value& x) {
     m.sinusoids.push_back({num(x, "frequency_hz"), num(x, "amplitude_deg_per_h"), num(x, "phase_rad")});
   });
-  each("gauss_markov", [&](const json& x) { m.gauss_markov.push_back({num(x, "sigma_deg_per_h"), num(x, "correlation_time_s")}); });
-  each("bias_steps", [&](const json& x) { m.bias_steps.push_back({num(x, "time_s"), num(x, "size_deg_per_h")}); });
-  each("warmups", [&](const json& x) { m.warmups.push_back({num(x, "amplitude_deg_per_h"), num(x, "time_constant_s")}); });
-  each("terms", [&](const json& x) { add_finding(x, m); });
-  if (j.contains("temperature_bias") && !j.at("temperature_bias").is_null()) {
-    const json& t = j.at("temperature_bias");
+  each("gauss_markov", [&](const Value& x) { m.gauss_markov.push_back({num(x, "sigma_deg_per_h"), num(x, "correlation_time_s")}); });
+  each("bias_steps", [&](const Value& x) { m.bias_steps.push_back({num(x, "time_s"), num(x, "size_deg_per_h")}); });
+  each("warmups", [&](const Value& x) { m.warmups.push_back({num(x, "amplitude_deg_per_h"), num(x, "time_constant_s")}); });
+  each("terms", [&](const Value& x) { add_term(x, m); });
+  if (const auto tbias = j.find("temperature_bias")) {
+    const Value& t = tbias->object();
     TemperatureBias tb;
     tb.coefficient_deg_per_h_per_c = num(t, "coefficient_deg_per_h_per_c");
-    if (t.contains("profile")) {
-      const json& p = t.at("profile");
-      const auto kind = p.value("kind", std::string("ramp"));
+    if (const auto profile = t.find("profile")) {
+      const Value& p = profile->object();
+      const auto kind_value = p.find("kind");
+      const auto kind = kind_value ? kind_value->string() : std::string("ramp");
       if (kind == "ramp") {
         tb.profile.kind = TemperatureProfile::Kind::Ramp;
         tb.profile.start_c = num(p, "start_c");
@@ -134,10 +136,31 @@ void from_json(const json& j, NoiseModel& m) {
         tb.profile.amp_c = num(p, "amplitude_c");
         tb.profile.period_s = num(p, "period_s");
       } else {
-        throw UsageError(fmt::format("model JSON: temperature profile kind must be ramp or cycle, got \"{}\"", kind));
+        kind_value->fail(fmt::format("must be \"ramp\" or \"cycle\", got \"{}\"", kind));
       }
     }
     m.temperature_bias = tb;
+  }
+}
+
+}  // namespace
+
+// The nlohmann hooks read models built in code: a wrong value there is a usage error.
+void add_finding(const json& f, NoiseModel& m) {
+  try {
+    const auto doc = json_input::Document::of_value(f, "model JSON");
+    add_term(doc.root(), m);
+  } catch (const InputError& e) {
+    throw UsageError(e.what());
+  }
+}
+
+void from_json(const json& j, NoiseModel& m) {
+  try {
+    const auto doc = json_input::Document::of_value(j, "model JSON");
+    model_from(doc.root(), m);
+  } catch (const InputError& e) {
+    throw UsageError(e.what());
   }
 }
 
@@ -150,57 +173,64 @@ void to_json(json& j, const SimulationSettings& s) {
   j["temperature_c"] = s.temperature_c ? json(*s.temperature_c) : json(nullptr);
 }
 
-NoiseModel model_from_analysis_json(const json& j, const std::string& name, SimulationSettings& settings) {
-  try {
-    if (!j.is_object()) throw UsageError("expected a JSON object");
-    const json* root = &j;
-    // Diagnose output: take its extended model (else the base model).
-    if (j.contains("extended_model") && j.at("extended_model").is_object())
-      root = &j.at("extended_model");
-    else if (j.contains("base_model") && j.at("base_model").is_object())
-      root = &j.at("base_model");
+namespace {
 
-    auto take = [&](const char* key, auto&& fn) {
-      for (const json* src : {root, &j})
-        if (src->contains(key) && src->at(key).is_number()) {
-          fn(src->at(key).get<double>());
-          return;
-        }
-    };
-    take("rate_hz", [&](double v) { settings.rate_hz = v; });
-    take("duration_s", [&](double v) { settings.duration_s = v; });
-    take("temperature_c", [&](double v) { settings.temperature_c = v; });
-    take("scale_arcsec_per_pulse", [&](double v) { settings.scale_arcsec = v; });
-    NoiseModel m;
-    if (root->contains("fit")) {
-      const json& fit = root->at("fit");
-      m.arw_deg_per_sqrt_h = fitted(fit, "N_deg_per_sqrt_h");
-      m.bias_instability_deg_per_h = fitted(fit, "B_deg_per_h");
-      m.rrw_deg_per_h_per_sqrt_h = fitted(fit, "K_deg_per_h_per_sqrt_h");
-      m.ramp_deg_per_h2 = fitted(fit, "R_deg_per_h2");
-      // The fitted Q is white angle noise: a white read-out contributes q/√6 of it, the rest
-      // is added as extra white angle noise before counting.
-      m.readout = ReadoutMode::White;
-      const double q_fit = fitted(fit, "Q_arcsec");
-      const double q_read = readout_q_arcsec(ReadoutMode::White, settings.scale_arcsec);
-      if (q_fit > q_read) m.white_angle_arcsec = std::sqrt(q_fit * q_fit - q_read * q_read);
-      const double earth = num(*root, "earth_rate_deg_per_h", num(j, "earth_rate_deg_per_h"));
-      const double mean = num(*root, "mean_rate_deg_per_h", num(j, "mean_rate_deg_per_h", earth));
-      m.earth_rate_deg_per_h = earth;
-      m.bias_deg_per_h = mean - earth;
-    } else {
-      from_json(*root, m);
-    }
+NoiseModel model_from_analysis(const Value& j, SimulationSettings& settings) {
+  j.object();
+  // Diagnose output: take its extended model (else the base model).
+  auto model = [&](const char* key) -> std::optional<Value> {
+    const auto v = j.find(key);
+    return v && v->json().is_object() ? v : std::nullopt;
+  };
+  const Value root = model("extended_model").value_or(model("base_model").value_or(j));
+  const bool nested = &root.json() != &j.json();
+  // The record's settings, from the model or else the top level.
+  auto setting = [&](const char* key) {
+    auto v = root.find(key);
+    return v || !nested ? v : j.find(key);
+  };
+  if (const auto v = setting("rate_hz")) settings.rate_hz = v->positive();
+  if (const auto v = setting("duration_s")) settings.duration_s = v->positive();
+  if (const auto v = setting("temperature_c"))
+    settings.temperature_c = v->number_in(-273.15, 1000, "a temperature in °C in [-273.15, 1000]");
+  if (const auto v = setting("scale_arcsec_per_pulse")) settings.scale_arcsec = v->positive();
+  NoiseModel m;
+  if (const auto fit = root.find("fit")) {
+    fit->object();
+    m.arw_deg_per_sqrt_h = fitted(*fit, "N_deg_per_sqrt_h");
+    m.bias_instability_deg_per_h = fitted(*fit, "B_deg_per_h");
+    m.rrw_deg_per_h_per_sqrt_h = fitted(*fit, "K_deg_per_h_per_sqrt_h");
+    m.ramp_deg_per_h2 = fitted(*fit, "R_deg_per_h2");
+    // The fitted Q is white angle noise: a white read-out contributes q/√6 of it, the rest
+    // is added as extra white angle noise before counting.
+    m.readout = ReadoutMode::White;
+    const double q_fit = fitted(*fit, "Q_arcsec");
+    const double q_read = readout_q_arcsec(ReadoutMode::White, settings.scale_arcsec);
+    if (q_fit > q_read) m.white_angle_arcsec = std::sqrt(q_fit * q_fit - q_read * q_read);
+    const double earth = num(root, "earth_rate_deg_per_h", num(j, "earth_rate_deg_per_h"));
+    const double mean = num(root, "mean_rate_deg_per_h", num(j, "mean_rate_deg_per_h", earth));
+    m.earth_rate_deg_per_h = earth;
+    m.bias_deg_per_h = mean - earth;
     // Extra terms: a model object's own "terms", and diagnose findings.
-    if (root != &j && root->contains("terms") && root->contains("fit")) {
-      for (const auto& t : root->at("terms")) add_finding(t, m);
-    }
-    return m;
-  } catch (const UsageError& e) {
-    throw InputError(name, 0, e.what());
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(name, 0, e.what());
+    if (nested)
+      if (const auto terms = root.find("terms"))
+        for (const auto& t : terms->elements()) add_term(t, m);
+  } else {
+    model_from(root, m);
   }
+  return m;
+}
+
+}  // namespace
+
+NoiseModel model_from_analysis_json(const json& j, const std::string& name, SimulationSettings& settings) {
+  const auto doc = json_input::Document::of_value(j, name);
+  return model_from_analysis(doc.root(), settings);
+}
+
+NoiseModel model_from_analysis_file(const std::string& path, SimulationSettings& settings) {
+  const auto doc = json_input::Document::load(path);
+  return model_from_analysis(doc.root(), settings);
 }
 
 }  // namespace rwcalc

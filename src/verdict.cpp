@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "json_input.hpp"
 #include "rwcalc/error.hpp"
 
 namespace rwcalc {
@@ -111,33 +112,40 @@ ClassTable ClassTable::gost() {
           {{1, 0.90, 0.005, 0.0010}, {2, 1.85, 0.008, 0.0015}, {3, 3.70, 0.015, 0.0030}}};
 }
 
-ClassTable ClassTable::from_json(const nlohmann::json& j, const std::string& source) {
+namespace {
+
+ClassLimit class_limit(const json_input::Value& c) {
+  c.object();
+  ClassLimit l;
+  l.cls = static_cast<int>(c.at("class").integer(0, 1000000));
+  if (const auto p = c.find("position_error_km_h")) l.position_error_km_h = p->non_negative();
+  l.B_deg_per_h = c.at("B_deg_per_h").positive();
+  l.N_deg_per_sqrt_h = c.at("N_deg_per_sqrt_h").positive();
+  return l;
+}
+
+}  // namespace
+
+ClassTable ClassTable::parse(std::string_view text, const std::string& source) {
+  const json_input::Document doc(text, source);
+  const auto root = doc.root();
+  root.object();
   ClassTable t;
-  try {
-    t.name = j.value("name", source);
-    const auto& arr = j.at("classes");
-    if (!arr.is_array() || arr.empty()) throw InputError(source, 0, "\"classes\" must be a non-empty array");
-    for (const auto& c : arr) {
-      ClassLimit l;
-      l.cls = c.at("class").get<int>();
-      l.position_error_km_h = c.value("position_error_km_h", 0.0);
-      l.B_deg_per_h = c.at("B_deg_per_h").get<double>();
-      l.N_deg_per_sqrt_h = c.at("N_deg_per_sqrt_h").get<double>();
-      if (!(l.B_deg_per_h > 0) || !(l.N_deg_per_sqrt_h > 0) || !std::isfinite(l.B_deg_per_h) ||
-          !std::isfinite(l.N_deg_per_sqrt_h))
-        throw InputError(source, 0, fmt::format("class {}: limits must be positive numbers", l.cls));
-      if (!t.classes.empty()) {
-        const auto& p = t.classes.back();
-        if (l.cls <= p.cls || l.B_deg_per_h < p.B_deg_per_h || l.N_deg_per_sqrt_h < p.N_deg_per_sqrt_h)
-          throw InputError(source, 0,
-                           fmt::format("class {}: classes must be listed best first, with ascending "
-                                       "numbers and non-decreasing limits",
-                                       l.cls));
-      }
-      t.classes.push_back(l);
+  t.name = source;
+  if (const auto name = root.find("name")) t.name = name->string();
+  const auto list = root.at("classes");
+  const auto classes = list.elements();
+  if (classes.empty()) list.fail("must list at least one class");
+  for (const auto& c : classes) {
+    const ClassLimit l = class_limit(c);
+    if (!t.classes.empty()) {
+      const auto& p = t.classes.back();
+      if (l.cls <= p.cls || l.B_deg_per_h < p.B_deg_per_h || l.N_deg_per_sqrt_h < p.N_deg_per_sqrt_h)
+        c.fail(fmt::format("(class {}): classes must be listed best first, with ascending numbers and "
+                           "non-decreasing limits",
+                           l.cls));
     }
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(source, 0, fmt::format("not a class table: {}", e.what()));
+    t.classes.push_back(l);
   }
   return t;
 }
@@ -147,13 +155,7 @@ ClassTable ClassTable::load(const std::string& path) {
   if (!in) throw InputError(path, 0, "cannot open the class-limits file");
   std::stringstream ss;
   ss << in.rdbuf();
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(ss.str());
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path, 0, fmt::format("invalid JSON: {}", e.what()));
-  }
-  return from_json(j, path);
+  return parse(ss.str(), path);
 }
 
 std::string_view to_string(BEstimate b) {

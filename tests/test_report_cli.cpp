@@ -309,7 +309,7 @@ TEST(ReportCli, BadSavedResultsNameTheFileAndLine) {
   const auto other = dir.write("other.json", "{\"hello\": 1}");
   r = run_cli({"report", other.string(), "-o", out.string(), "--no-figures"});
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find(other.string() + ": not an rwcalc result"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(other.string() + ":1: not an rwcalc result"), std::string::npos) << r.err;
   const auto diag_only = dir.write("d.json", fixture_diagnosis().dump());
   r = run_cli({"report", diag_only.string(), "-o", out.string(), "--no-figures"});
   EXPECT_EQ(r.status, 2);

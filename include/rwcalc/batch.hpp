@@ -27,9 +27,6 @@ std::vector<nlohmann::json> analyze_files(const std::vector<std::string>& files,
 /// analyze keys.
 nlohmann::json summarize_runs(std::vector<nlohmann::json> runs, const std::string& source = "batch");
 
-/// Read JSON lines (one analyze object per non-blank line). Throws InputError naming file and line.
-std::vector<nlohmann::json> read_json_lines(const std::string& path);
-
 /// Tables for people (text), Markdown, CSV (one row per run, then the overall row).
 std::string format_batch_text(const nlohmann::json& summary);
 std::string format_batch_markdown(const nlohmann::json& summary);

@@ -263,5 +263,8 @@ void add_finding(const nlohmann::json& finding, NoiseModel& model);
 /// temperature of `settings` from it when present. `name` labels errors (InputError).
 NoiseModel model_from_analysis_json(const nlohmann::json& j, const std::string& name,
                                     SimulationSettings& settings);
+/// The same from a JSON file (`simulate --from`): every value is checked (numbers finite, rate,
+/// duration and pulse weight positive, …); an error names the file, the line and the key path.
+NoiseModel model_from_analysis_file(const std::string& path, SimulationSettings& settings);
 
 }  // namespace rwcalc

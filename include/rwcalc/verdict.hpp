@@ -33,9 +33,11 @@ struct ClassTable {
 
   /// The built-in GOST RV 52339 table.
   static ClassTable gost();
-  /// From JSON: {"name": "...", "classes": [{"class": 1, "position_error_km_h": 0.9,
-  /// "B_deg_per_h": 0.005, "N_deg_per_sqrt_h": 0.001}, …]}. Throws InputError naming `source`.
-  static ClassTable from_json(const nlohmann::json& j, const std::string& source);
+  /// From JSON text: {"name": "...", "classes": [{"class": 1, "position_error_km_h": 0.9,
+  /// "B_deg_per_h": 0.005, "N_deg_per_sqrt_h": 0.001}, …]}: integer class numbers ascending,
+  /// positive finite limits non-decreasing. Throws InputError naming `source`, the line and the
+  /// key path of the first value that is wrong.
+  static ClassTable parse(std::string_view text, const std::string& source);
   /// Read a JSON file (see from_json). Throws InputError.
   static ClassTable load(const std::string& path);
 };

@@ -12,6 +12,9 @@
 
 namespace rwcalc::cli {
 
+/// A file name that is not UTF-8 is written with U+FFFD for its invalid bytes, not refused.
+inline constexpr auto kInvalidUtf8 = nlohmann::json::error_handler_t::replace;
+
 struct TableFormat {
   bool json = false, csv = false, markdown = false, jsonl = false;
   inline void add_to(CLI::App& app) {
@@ -26,11 +29,11 @@ struct TableFormat {
   [[nodiscard]] inline std::string render(std::vector<nlohmann::json> runs) const {
     if (jsonl) {
       std::string s;
-      for (const auto& r : runs) s += r.dump() + "\n";
+      for (const auto& r : runs) s += r.dump(-1, ' ', false, kInvalidUtf8) + "\n";
       return s;
     }
     const nlohmann::json summary = summarize_runs(std::move(runs));
-    if (json) return summary.dump(2) + "\n";
+    if (json) return summary.dump(2, ' ', false, kInvalidUtf8) + "\n";
     if (csv) return format_batch_csv(summary);
     if (markdown) return format_batch_markdown(summary);
     return format_batch_text(summary);

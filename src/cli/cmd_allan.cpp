@@ -80,7 +80,7 @@ std::string allan_json_text(const AllanResult& r, const Recording& rec, const Ou
   out += ",\n  \"rate_hz\": ";
   append_number(out, rec.rate_hz);
   out += fmt::format(",\n  \"samples\": {},\n  \"source\": {},\n  \"tau0_s\": ", rec.samples,
-                     nlohmann::json(rec.source).dump());
+                     nlohmann::json(rec.source).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
   append_number(out, r.tau0_s);
   out += fmt::format(",\n  \"unit\": {}\n}}\n", nlohmann::json(r.unit).dump());
   return out;

@@ -74,7 +74,8 @@ void register_analyze(CLI::App& app, Runner& runner) {
         require_finite(j, rec.source);
         if (!cmd->json && !cmd->plot.any()) return format_report(res);
         cmd->plot.draw_analysis(j, cmd->force, io);
-        return cmd->json ? j.dump(2) + "\n" : format_report(res);
+        // A file name that is not UTF-8 is written with U+FFFD for its invalid bytes, not refused.
+        return cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n" : format_report(res);
       }();
       if (cmd->output == "-")
         io.out << text;

@@ -76,7 +76,9 @@ void register_diagnose(CLI::App& app, Runner& runner) {
       const DiagnoseResult res = diagnose(rec, opt);
       progress.finish();
       const nlohmann::json j = to_json(res);
-      const std::string text = cmd->json ? j.dump(2) + "\n" : format_report(res);
+      // A file name that is not UTF-8 is written with U+FFFD for its invalid bytes, not refused.
+      const std::string text =
+          cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n" : format_report(res);
       if (cmd->output == "-")
         io.out << text;
       else

@@ -5,6 +5,7 @@
 
 #include "cli/batch_format.hpp"
 #include "cli/commands.hpp"
+#include "rwcalc/saved_results.hpp"
 
 namespace rwcalc::cli {
 
@@ -15,6 +16,7 @@ struct MergeCmd {
   TableFormat format;
   std::string output = "-";
   bool force = false;
+  bool dedupe = false;
 };
 
 }  // namespace
@@ -28,15 +30,16 @@ void register_merge(CLI::App& app, Runner& runner) {
   cmd->format.add_to(*sub);
   sub->add_option("-o,--output", cmd->output, "Write to FILE instead of standard output")->capture_default_str();
   sub->add_flag("--force", cmd->force, "Overwrite an existing output file");
+  sub->add_flag("--dedupe", cmd->dedupe,
+                "Keep one of repeated identical lines of a run (a re-queued job); lines of the same run "
+                "(same \"source\") that differ are refused all the same");
   sub->callback([cmd, &runner] {
     runner = [cmd](Io& io) -> int {
       check_output_targets({{"-o", cmd->output}}, cmd->force);  // before the reading
-      std::vector<nlohmann::json> runs;
-      for (const auto& f : cmd->files) {
-        auto part = read_json_lines(f);
-        for (auto& r : part) runs.push_back(std::move(r));
-      }
-      emit(io, cmd->format.render(std::move(runs)), cmd->output, cmd->force);
+      std::vector<SavedRun> lines;
+      for (const auto& f : cmd->files)
+        for (auto& r : load_json_lines(f, RunKeys::Combined)) lines.push_back(std::move(r));
+      emit(io, cmd->format.render(merge_runs(std::move(lines), cmd->dedupe)), cmd->output, cmd->force);
       return 0;
     };
   });

@@ -27,6 +27,7 @@
 #include "rwcalc/output.hpp"
 #include "rwcalc/plot.hpp"
 #include "rwcalc/report.hpp"
+#include "rwcalc/saved_results.hpp"
 
 namespace rwcalc::cli {
 
@@ -76,56 +77,6 @@ bool is_json_path(const std::string& path) {
   return ext == ".json" || ext == ".jsonl";
 }
 
-/// Line (1-based) of byte offset `pos` in `text`.
-std::size_t line_of(const std::string& text, std::size_t pos) {
-  pos = std::min(pos, text.size());
-  return 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(pos), '\n'));
-}
-
-/// What the saved results hold.
-struct Saved {
-  std::vector<json> analyses;
-  std::vector<std::pair<std::string, json>> diagnoses;  ///< file, object
-  std::vector<json> overalls;                           ///< batch verdicts, one per batch file
-};
-
-void load_saved(const std::string& path, Saved& saved) {
-  if (lower(fs::path(path).extension().string()) == ".jsonl") {
-    for (auto& a : read_json_lines(path)) saved.analyses.push_back(std::move(a));
-    return;
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, 0, "cannot open the file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  const std::string text = ss.str();
-  json j;
-  try {
-    j = json::parse(text);
-  } catch (const json::parse_error& e) {
-    throw InputError(path, line_of(text, e.byte > 0 ? e.byte - 1 : 0), fmt::format("not valid JSON: {}", e.what()));
-  }
-  if (!j.is_object())
-    throw InputError(path, 1, "expected a JSON object from 'rwcalc analyze --json', 'batch --json' or 'diagnose --json'");
-  if (j.contains("runs")) {
-    if (!j["runs"].is_array() || j["runs"].empty()) throw InputError(path, 0, "\"runs\" is not a non-empty array");
-    for (const auto& r : j["runs"]) {
-      if (!r.is_object() || !r.contains("verdict") || !r.contains("allan"))
-        throw InputError(path, 0, "an element of \"runs\" is not an analyze object (no \"allan\" or \"verdict\")");
-      saved.analyses.push_back(r);
-    }
-    if (j.contains("overall") && j["overall"].is_object()) saved.overalls.push_back(j["overall"]);
-  } else if (j.contains("allan") && j.contains("verdict")) {
-    saved.analyses.push_back(std::move(j));
-  } else if (j.contains("band") || j.contains("base_model")) {
-    saved.diagnoses.emplace_back(path, std::move(j));
-  } else {
-    throw InputError(path, 0,
-                     "not an rwcalc result: expected the JSON of 'rwcalc analyze --json' (\"allan\", \"verdict\"), "
-                     "'batch --json' (\"runs\") or 'diagnose --json' (\"band\")");
-  }
-}
-
 std::string file_name(const json& j) {
   const auto& s = j.contains("source") && j["source"].is_string() ? j["source"].get_ref<const std::string&>()
                                                                    : std::string();
@@ -134,8 +85,9 @@ std::string file_name(const json& j) {
 
 /// Attach each saved diagnosis to the analysis with the same source (by file name), or to the
 /// only run.
-void attach_saved_diagnoses(const Saved& saved, const std::vector<json>& analyses, std::vector<json>& diagnoses) {
-  for (const auto& [path, d] : saved.diagnoses) {
+void attach_saved_diagnoses(const SavedResults& saved, const std::vector<json>& analyses,
+                            std::vector<json>& diagnoses) {
+  for (const auto& [d, path, line] : saved.diagnoses) {
     std::optional<std::size_t> target;
     const auto name = file_name(d);
     for (std::size_t i = 0; i < analyses.size() && !name.empty(); ++i)
@@ -220,14 +172,14 @@ int run_report(const ReportCmd& c, Io& io) {
   if (fs::is_directory(c.dir, ec)) check_output_targets({{"-o", (fs::path(c.dir) / "report.html").string()}}, c.force);
   if (!c.no_figures) require_gnuplot();
 
-  Saved saved;
-  for (const auto& f : saved_files) load_saved(f, saved);
+  SavedResults saved;
+  for (const auto& f : saved_files) load_saved_result(f, saved);
   std::vector<json> diagnoses;
   if (c.diagnose) diagnoses = diagnose_recordings(recordings, read, opt, c.diagnose_runs, c.diagnose_seed);
   ReportInput in;
   if (!recordings.empty()) in.analyses = analyze_files(recordings, read, opt, c.jobs);
   diagnoses.resize(in.analyses.size());
-  for (auto& a : saved.analyses) in.analyses.push_back(std::move(a));
+  for (auto& a : saved.analyses) in.analyses.push_back(std::move(a.run));
   if (in.analyses.empty())
     throw UsageError("report: no run to report; give recordings or saved analyses (the diagnoses need their runs)");
   diagnoses.resize(in.analyses.size());

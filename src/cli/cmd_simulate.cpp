@@ -123,18 +123,6 @@ Metadata metadata_of(const NoiseModel& m, const SimulationSettings& s) {
   return md;
 }
 
-nlohmann::json read_json_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, 0, "cannot open the file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  try {
-    return nlohmann::json::parse(ss.str());
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path, 0, fmt::format("not valid JSON: {}", e.what()));
-  }
-}
-
 // Generate one record and write it block by block as it is generated, so that memory does not
 // grow with its length; the file appears only when it is complete (PulseFileWriter).
 void write_record(Simulator& sim, const SimulationSettings& sr, const std::string& path, bool force) {
@@ -199,7 +187,7 @@ int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
   NoiseModel m;
   if (!a.from.empty()) {
     s.scale_arcsec = a.scale_arcsec;
-    m = model_from_analysis_json(read_json_file(a.from), a.from, s);
+    m = model_from_analysis_file(a.from, s);
   }
   if (a.from.empty() || given("--duration")) s.duration_s = a.duration_s;
   if (a.from.empty() || given("--rate")) s.rate_hz = a.rate_hz;
@@ -302,7 +290,7 @@ int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
       t["pulse_file"] = std::filesystem::path(path).filename().string();
       t["quantization_q_arcsec"] = readout_q_arcsec(m.readout, sr.scale_arcsec);
       const std::string tpath = a.runs > 1 ? numbered(a.truth, r, a.runs) : a.truth;
-      write_file_atomic(tpath, t.dump(2) + "\n", a.force);
+      write_file_atomic(tpath, t.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n", a.force);
     }
     if (path != "-")
       io.out << fmt::format("wrote {} ({} samples, {} s at {} Hz, seed {})\n", path, sr.samples(), sr.duration_s, sr.rate_hz, sr.seed);

@@ -1,0 +1,109 @@
+#pragma once
+// Reading JSON that rwcalc is given (saved results, JSON lines, class tables, models): every value
+// is read through a typed accessor that checks its type and domain and, when it is wrong, throws an
+// InputError naming the file, the line of the value and its key path, e.g.
+//   report.json:12: "fit.N_deg_per_sqrt_h.value" must be a number, got string
+// JSON from another machine is untrusted: raw nlohmann get<>() on it would turn a wrong type into
+// an internal error, and 1e400 into an infinity that flows into the verdict.
+#include <cstddef>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+namespace rwcalc::json_input {
+
+/// Deepest nesting accepted: rwcalc's own results nest at most 6 levels; a deeper document is
+/// refused before anything (copying, printing) walks it recursively.
+inline constexpr std::size_t kMaxDepth = 64;
+
+class Value;
+
+/// A parsed JSON text with the line of each value (by key path), for error messages.
+class Document {
+ public:
+  /// Parses `text`, whose first byte is on line `first_line` of `file` (JSON lines: the line's
+  /// number). Throws InputError on invalid JSON, a number out of the range of a double (1e400),
+  /// or nesting deeper than kMaxDepth.
+  Document(std::string_view text, std::string file, std::size_t first_line = 1);
+  /// A value built in code (no lines: errors name `file` and the key path).
+  static Document of_value(nlohmann::json value, std::string file) {
+    Document d;
+    d.file_ = std::move(file);
+    d.root_ = std::move(value);
+    return d;
+  }
+  /// Reads and parses a whole file.
+  static Document load(const std::string& path);
+
+  [[nodiscard]] Value root() const;
+  [[nodiscard]] const std::string& file() const { return file_; }
+  /// Line of the value at `path`, else of its nearest ancestor that is in the document.
+  [[nodiscard]] std::size_t line_of(std::string path) const;
+  /// The parsed value, moved out (the Document's accessors must not be used afterwards).
+  [[nodiscard]] nlohmann::json take() { return std::move(root_); }
+
+ private:
+  Document() = default;
+  std::string file_;
+  nlohmann::json root_;
+  std::unordered_map<std::string, std::size_t> lines_;
+};
+
+/// One value of a Document with its key path ("" for the root, "fit.B_deg_per_h.value",
+/// "runs[2].source").
+class Value {
+ public:
+  Value(const Document& doc, const nlohmann::json& value, std::string path)
+      : doc_(&doc), value_(&value), path_(std::move(path)) {}
+
+  [[nodiscard]] const nlohmann::json& json() const { return *value_; }
+  [[nodiscard]] const std::string& path() const { return path_; }
+  [[nodiscard]] std::size_t line() const { return doc_->line_of(path_); }
+  [[nodiscard]] bool is_null() const { return value_->is_null(); }
+
+  /// The member `key` of this object (this must be an object; the member must be present).
+  [[nodiscard]] Value at(std::string_view key) const;
+  /// The member `key` when present and not null (this must be an object).
+  [[nodiscard]] std::optional<Value> find(std::string_view key) const;
+  /// The elements of this array (this must be an array).
+  [[nodiscard]] std::vector<Value> elements() const;
+  /// This must be an object.
+  const Value& object() const;
+
+  /// A finite number.
+  [[nodiscard]] double number() const;
+  /// A finite number in [lo, hi]; `domain` names the range in the message ("a probability in [0, 1]").
+  [[nodiscard]] double number_in(double lo, double hi, std::string_view domain) const;
+  /// A finite number > 0.
+  [[nodiscard]] double positive() const;
+  /// A finite number >= 0.
+  [[nodiscard]] double non_negative() const;
+  /// A probability, in [0, 1].
+  [[nodiscard]] double probability() const { return number_in(0, 1, "a probability in [0, 1]"); }
+  /// An integer (no fraction, e.g. not 2.7) in [lo, hi].
+  [[nodiscard]] std::int64_t integer(std::int64_t lo, std::int64_t hi) const;
+  /// A string.
+  [[nodiscard]] std::string string() const;
+  /// true or false.
+  [[nodiscard]] bool boolean() const;
+
+  /// Throws InputError(file, line of this value, "\"PATH\" WHAT").
+  [[noreturn]] void fail(std::string_view what) const;
+
+ private:
+  [[noreturn]] void wrong_type(std::string_view expected) const;
+  [[nodiscard]] std::string child_path(std::string_view key) const;
+
+  const Document* doc_;
+  const nlohmann::json* value_;
+  std::string path_;
+};
+
+/// JSON type name for messages ("number", "string", "object", …).
+std::string_view type_name(const nlohmann::json& j);
+
+}  // namespace rwcalc::json_input

@@ -1,0 +1,469 @@
+// Reading back rwcalc's own JSON results, every value checked against its domain.
+#include "rwcalc/saved_results.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <unordered_map>
+
+#include "json_input.hpp"
+#include "rwcalc/error.hpp"
+
+namespace rwcalc {
+
+namespace {
+
+using json_input::Document;
+using json_input::Value;
+using nlohmann::json;
+
+/// Class numbers rwcalc accepts in a class table (and so in a verdict).
+constexpr std::int64_t kMaxClassNumber = 1000000;
+/// Counts (samples, blocks, lines…) fit in 2^53, where a double still holds every integer.
+constexpr std::int64_t kMaxCount = std::int64_t{1} << 53;
+
+/// Keys a verdict, estimate or run must have for `merge`; for `report` only those present are
+/// checked.
+class Checker {
+ public:
+  explicit Checker(RunKeys keys) : combined_(keys == RunKeys::Combined) {}
+
+  /// The member `key`: required when combining, else optional (absent or null: nothing to check).
+  [[nodiscard]] std::optional<Value> member(const Value& object, std::string_view key) const {
+    if (combined_) {
+      const Value v = object.at(key);
+      return v.is_null() ? std::nullopt : std::optional<Value>(v);
+    }
+    return object.find(key);
+  }
+
+  void run(const Value& r) const;
+
+ private:
+  void estimate(const Value& e) const;
+  void fit(const Value& f) const;
+  void methods(const Value& m) const;
+  void allan(const Value& a) const;
+  void outliers(const Value& o) const;
+  void verdict(const Value& v) const;
+  void parameter_verdict(const Value& p, std::optional<std::size_t> classes) const;
+
+  bool combined_;
+};
+
+void optional_number(const Value& object, std::string_view key) {
+  if (const auto v = object.find(key)) (void)v->number();
+}
+void optional_non_negative(const Value& object, std::string_view key) {
+  if (const auto v = object.find(key)) (void)v->non_negative();
+}
+void optional_string(const Value& object, std::string_view key) {
+  if (const auto v = object.find(key)) (void)v->string();
+}
+void optional_boolean(const Value& object, std::string_view key) {
+  if (const auto v = object.find(key)) (void)v->boolean();
+}
+void optional_count(const Value& object, std::string_view key) {
+  if (const auto v = object.find(key)) (void)v->integer(0, kMaxCount);
+}
+
+/// A temperature in °C: finite, not below absolute zero.
+void temperature(const Value& t) { (void)t.number_in(-273.15, 1000, "a temperature in °C in [-273.15, 1000]"); }
+
+/// A class number, or null for "outside every class"; when given, one of `classes`.
+void class_number(const std::optional<Value>& c, const std::vector<std::int64_t>& classes) {
+  if (!c) return;
+  const auto n = c->integer(0, kMaxClassNumber);
+  if (!classes.empty() && std::find(classes.begin(), classes.end(), n) == classes.end())
+    c->fail(fmt::format("is class {}, which is not among the verdict's \"classes\"", n));
+}
+
+/// An array of `size` values, each checked by `each`.
+template <class Each>
+void array_of(const Value& a, std::size_t size, std::string_view what, Each&& each) {
+  const auto e = a.elements();
+  if (e.size() != size) a.fail(fmt::format("must hold {} {} (one per {}), got {}", size, size == 1 ? "value" : "values", what, e.size()));
+  for (const auto& x : e) each(x);
+}
+
+/// A coefficient or cross-check estimate {value, sigma, low95, high95, resolved, …}.
+void Checker::estimate(const Value& e) const {
+  e.object();
+  for (const char* key : {"value", "sigma"})
+    if (const auto v = member(e, key)) (void)v->non_negative();
+  if (const auto v = member(e, "resolved")) (void)v->boolean();
+  if (combined_) (void)e.at("high95");
+  for (const char* key : {"low95", "high95"}) optional_non_negative(e, key);
+  optional_number(e, "estimate");
+  optional_boolean(e, "in_model");
+  optional_boolean(e, "fitted");
+}
+
+void Checker::fit(const Value& f) const {
+  f.object();
+  for (const char* key : {"Q_arcsec", "N_deg_per_sqrt_h", "B_deg_per_h", "K_deg_per_h_per_sqrt_h", "R_deg_per_h2"})
+    if (const auto c = f.find(key)) estimate(*c);
+  for (const char* key : {"chi2_per_dof", "chi2", "tau_min_s", "tau_max_s"}) optional_non_negative(f, key);
+  if (const auto p = f.find("p_value")) (void)p->probability();
+  optional_count(f, "points");
+}
+
+void Checker::methods(const Value& m) const {
+  m.object();
+  for (const char* key : {"N_direct_deg_per_sqrt_h", "B_100s_deg_per_h"}) {
+    const auto e = m.find(key);
+    if (!e) continue;
+    estimate(*e);
+    if (const auto curve = e->find("curve"))
+      for (const auto& p : curve->elements()) {
+        p.object();
+        (void)p.at("t_s").positive();
+        optional_count(p, "intervals");
+        optional_non_negative(p, "var_arcsec2");
+      }
+    for (const char* k : {"t_min_s", "t_max_s", "block_s"}) optional_non_negative(*e, k);
+    optional_count(*e, "blocks");
+  }
+}
+
+void Checker::allan(const Value& a) const {
+  a.object();
+  optional_string(a, "unit");
+  optional_string(a, "estimator");
+  if (const auto points = a.find("points"))
+    for (const auto& p : points->elements()) {
+      p.object();
+      (void)p.at("tau_s").positive();
+      (void)p.at("dev").non_negative();
+      for (const char* key : {"dev_low", "dev_high", "var", "edf"}) optional_non_negative(p, key);
+      optional_count(p, "m");
+      optional_count(p, "n");
+    }
+}
+
+void Checker::outliers(const Value& o) const {
+  o.object();
+  std::int64_t count = 0;
+  if (const auto c = o.find("count")) count = c->integer(0, kMaxCount);
+  if (combined_ && count > 0) (void)o.at("positions");  // the tables list where the outliers are
+  if (const auto action = o.find("action")) {
+    const auto s = action->string();
+    if (s != "keep" && s != "remove" && s != "replace")
+      action->fail(fmt::format("must be \"keep\", \"remove\" or \"replace\", got \"{}\"", s));
+  }
+  if (const auto positions = o.find("positions"))
+    for (const auto& p : positions->elements()) {
+      p.object();
+      (void)p.at("line").integer(1, kMaxCount);
+      (void)p.at("time_s").number();
+      optional_count(p, "index");
+    }
+}
+
+/// The verdict of one parameter (B or N); its arrays hold one value per class when `classes` is
+/// known (the verdict's "classes" is given).
+void Checker::parameter_verdict(const Value& p, std::optional<std::size_t> classes) const {
+  p.object();
+  auto each = [&](const char* key, std::size_t extra, const char* per, auto&& check) {
+    if (const auto v = key == std::string_view("p_meets") ? member(p, key) : p.find(key)) {
+      if (classes)
+        array_of(*v, *classes + extra, per, check);
+      else
+        for (const auto& x : v->elements()) check(x);
+    }
+  };
+  each("p_meets", 0, "class", [](const Value& x) { (void)x.probability(); });
+  each("p_is", 1, "class and 'outside'", [](const Value& x) { (void)x.probability(); });
+  each("limits", 0, "class", [](const Value& x) { (void)x.positive(); });
+  each("margin_pct", 0, "class", [](const Value& x) { (void)x.number(); });
+  if (const auto v = p.find("p_class")) (void)v->probability();
+  optional_non_negative(p, "value");
+  optional_boolean(p, "resolved");
+  optional_string(p, "unit");
+}
+
+void Checker::verdict(const Value& v) const {
+  v.object();
+  std::vector<std::int64_t> classes;
+  if (const auto c = combined_ ? std::optional<Value>(v.at("classes")) : v.find("classes")) {
+    const auto list = c->elements();
+    if (list.empty()) c->fail("must list at least one class");
+    for (const auto& x : list) {
+      classes.push_back(x.integer(0, kMaxClassNumber));
+      if (classes.size() > 1 && classes.back() <= classes[classes.size() - 2])
+        x.fail("must be greater than the class before it (classes are listed best first)");
+    }
+  }
+  // Without "classes" nothing can be sized against it: such a verdict (hand-made) is shown as is.
+  for (const char* key : {"class", "class_B", "class_N", "class_strict"}) {
+    // A class key present with null is "outside every class": member() must still see the key.
+    if (combined_) (void)v.at(key);
+    class_number(v.find(key), classes);
+  }
+  if (const auto p = member(v, "p_class")) (void)p->probability();
+  for (const char* key : {"p_class_B", "p_class_N"})
+    if (const auto p = v.find(key)) (void)p->probability();
+  optional_boolean(v, "decisive");
+  if (const auto t = v.find("tolerance_pct")) (void)t->number_in(0, 1000, "a percentage in [0, 1000]");
+  for (const char* key : {"statement", "statement_B", "statement_N", "b_estimate", "table"}) optional_string(v, key);
+  optional_boolean(v, "tolerance_changed");
+  if (const auto r = v.find("rho_BN")) (void)r->number_in(-1, 1, "a correlation in [-1, 1]");
+  // Without "classes" (a hand-made verdict) the arrays cannot be sized against it.
+  const auto n = classes.empty() ? std::nullopt : std::optional<std::size_t>(classes.size());
+  auto probabilities = [&](const Value& a, std::size_t extra, const char* per) {
+    if (n)
+      array_of(a, *n + extra, per, [](const Value& x) { (void)x.probability(); });
+    else
+      for (const auto& x : a.elements()) (void)x.probability();
+  };
+  if (const auto p = member(v, "p_meets")) probabilities(*p, 0, "class");
+  if (const auto p = v.find("p_is")) probabilities(*p, 1, "class and 'outside'");
+  for (const char* key : {"B", "N"}) {
+    if (const auto p = member(v, key)) {
+      parameter_verdict(*p, n);
+      if (combined_) {
+        (void)p->at("class");
+        (void)p->at("class_strict");
+      }
+      class_number(p->find("class"), classes);
+      class_number(p->find("class_strict"), classes);
+    }
+  }
+}
+
+void Checker::run(const Value& r) const {
+  r.object();
+  if (const auto s = member(r, "source")) (void)s->string();
+  if (combined_) (void)r.at("temperature_c");  // null: temperature unknown
+  if (const auto t = r.find("temperature_c")) temperature(*t);
+  optional_string(r, "temperature_source");
+  optional_count(r, "samples");
+  if (const auto rate = r.find("rate_hz")) (void)rate->positive();
+  optional_non_negative(r, "duration_s");
+  for (const char* key : {"mean_rate_deg_per_h", "earth_rate_deg_per_h", "bias_deg_per_h"}) optional_number(r, key);
+  if (const auto l = r.find("latitude_deg")) (void)l->number_in(-90, 90, "a latitude in [-90, 90]");
+  if (const auto a = r.find("allan")) allan(*a);
+  if (const auto f = member(r, "fit")) fit(*f);
+  if (const auto m = member(r, "methods")) methods(*m);
+  if (const auto o = r.find("outliers")) outliers(*o);
+  verdict(r.at("verdict"));
+  if (const auto c = r.find("conventions")) c->object();
+}
+
+/// The object of `diagnose --json`, as far as the report reads it.
+void check_diagnosis(const Value& d) {
+  d.object();
+  optional_string(d, "source");
+  if (const auto t = d.find("temperature_c")) temperature(*t);
+  optional_count(d, "runs");
+  optional_count(d, "samples");
+  for (const char* key : {"rate_hz", "duration_s", "scale_arcsec_per_pulse"})
+    if (const auto v = d.find(key)) (void)v->positive();
+  if (const auto findings = d.find("findings"))
+    for (const auto& f : findings->elements()) {
+      f.object();
+      (void)f.at("effect").string();
+      for (const auto& [k, v] : f.json().items())
+        if (!v.is_number() && !v.is_string() && !v.is_boolean() && !v.is_null() && !v.is_object() && !v.is_array())
+          f.at(k).fail("must be a number, a string, true/false, an object or an array");
+    }
+  if (const auto gain = d.find("gain")) {
+    gain->object();
+    for (const auto& [k, v] : gain->json().items())
+      if (!v.is_null()) (void)gain->at(k).number();
+  }
+  auto band = [](const Value& b) {
+    for (const auto& p : b.elements()) {
+      p.object();
+      (void)p.at("tau_s").positive();
+      for (const char* key : {"band_low", "band_high", "dev", "median"}) optional_non_negative(p, key);
+    }
+  };
+  for (const char* model : {"base_model", "extended_model"})
+    if (const auto m = d.find(model)) {
+      m->object();
+      if (const auto b = m->find("band")) band(*b);
+      if (const auto level = m->find("band_level")) (void)level->probability();
+    }
+  for (const char* key : {"band", "band_extended"})
+    if (const auto b = d.find(key)) band(*b);
+}
+
+/// The overall verdict of `batch --json`, as far as the report reads it.
+void check_overall(const Value& o) {
+  o.object();
+  std::vector<std::int64_t> classes;
+  if (const auto c = o.find("classes"))
+    for (const auto& x : c->elements()) classes.push_back(x.integer(0, kMaxClassNumber));
+  for (const char* key : {"class", "class_B", "class_N", "class_strict"}) class_number(o.find(key), classes);
+  optional_string(o, "statement");
+  for (const char* key : {"B", "N"})
+    if (const auto p = o.find(key)) {
+      p->object();
+      optional_string(*p, "statement");
+      class_number(p->find("class"), classes);
+    }
+  optional_count(o, "runs");
+  if (const auto p = o.find("p_class")) (void)p->probability();
+}
+
+bool has(const json& j, const char* key) { return j.contains(key); }
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, 0, "cannot open the file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw InputError(path, 0, "cannot read the file");
+  return ss.str();
+}
+
+}  // namespace
+
+void parse_saved_result(std::string_view text, const std::string& file, SavedResults& into) {
+  Document doc(text, file);
+  const Value root = doc.root();
+  if (!root.json().is_object())
+    root.fail(fmt::format("must be a JSON object from 'rwcalc analyze --json', 'batch --json' or 'diagnose --json', "
+                          "got {}",
+                          json_input::type_name(root.json())));
+  const json& j = root.json();
+  const Checker shown(RunKeys::Shown);
+  // A batch has an array of runs; a diagnosis also has "runs", the size of its ensemble.
+  if (has(j, "runs") && j.at("runs").is_array()) {
+    const auto runs = root.at("runs").elements();
+    if (runs.empty()) root.at("runs").fail("must hold at least one run");
+    for (const auto& r : runs) shown.run(r);
+    std::optional<json> overall;
+    if (const auto o = root.find("overall")) {
+      check_overall(*o);
+      overall = o->json();
+    }
+    std::vector<std::size_t> lines;
+    for (const auto& r : runs) lines.push_back(r.line());
+    json all = doc.take();
+    for (std::size_t i = 0; i < lines.size(); ++i) into.analyses.push_back({std::move(all["runs"][i]), file, lines[i]});
+    if (overall) into.overalls.push_back(std::move(*overall));
+  } else if (has(j, "allan") || has(j, "verdict")) {
+    shown.run(root);
+    (void)root.at("allan");
+    into.analyses.push_back({doc.take(), file, 1});
+  } else if (has(j, "band") || has(j, "base_model") || has(j, "findings")) {
+    check_diagnosis(root);
+    into.diagnoses.push_back({doc.take(), file, 1});
+  } else {
+    throw InputError(file, 1,
+                     "not an rwcalc result: expected the JSON of 'rwcalc analyze --json' (\"allan\", \"verdict\"), "
+                     "'batch --json' (\"runs\") or 'diagnose --json' (\"base_model\", \"findings\")");
+  }
+}
+
+std::vector<SavedRun> parse_json_lines(std::string_view text, const std::string& file, RunKeys keys) {
+  const Checker checker(keys);
+  std::vector<SavedRun> out;
+  std::size_t no = 0;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    const auto end = std::min(text.find('\n', start), text.size());
+    const std::string_view line = text.substr(start, end - start);
+    start = end + 1;
+    ++no;
+    if (line.find_first_not_of(" \t\r") == std::string_view::npos) continue;
+    Document doc(line, file, no);
+    const Value root = doc.root();
+    if (!root.json().is_object())
+      throw InputError(file, no,
+                       fmt::format("not an analyze object but {}; write the lines with `rwcalc batch --jsonl`",
+                                   json_input::type_name(root.json())));
+    if (!root.json().contains("verdict"))
+      throw InputError(file, no, "not an analyze object (no \"verdict\"); write the lines with `rwcalc batch --jsonl`");
+    checker.run(root);
+    out.push_back({doc.take(), file, no});
+  }
+  if (out.empty()) throw InputError(file, 0, "no JSON lines");
+  return out;
+}
+
+void load_saved_result(const std::string& path, SavedResults& into) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (ext == ".jsonl") {
+    for (auto& r : load_json_lines(path, RunKeys::Shown)) into.analyses.push_back(std::move(r));
+    return;
+  }
+  parse_saved_result(read_file(path), path, into);
+}
+
+namespace {
+
+std::string place(const SavedRun& r) { return fmt::format("{}:{}", r.file, r.line); }
+const std::string& source_of(const SavedRun& r) { return r.run.at("source").get_ref<const std::string&>(); }
+
+/// The runs without repeats (see merge_runs), as indices into `runs`.
+std::vector<std::size_t> distinct_runs(const std::vector<SavedRun>& runs, bool dedupe) {
+  std::vector<std::size_t> kept;
+  std::unordered_map<std::string, std::size_t> by_source;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const auto& r = runs[i];
+    const auto [it, fresh] = by_source.emplace(source_of(r), i);
+    if (fresh) {
+      kept.push_back(i);
+      continue;
+    }
+    const auto& first = runs[it->second];
+    if (!dedupe)
+      throw InputError(r.file, r.line,
+                       fmt::format("run '{}' is already given at {}: each run is counted once (--dedupe drops a "
+                                   "repeated identical line)",
+                                   source_of(r), place(first)));
+    if (r.run != first.run)
+      throw InputError(r.file, r.line,
+                       fmt::format("run '{}' is also given at {}, with different results: merge cannot tell which "
+                                   "one holds",
+                                   source_of(r), place(first)));
+  }
+  return kept;
+}
+
+/// Every run must have been judged against the first run's class table.
+void require_one_class_table(const std::vector<SavedRun>& runs, const std::vector<std::size_t>& kept) {
+  static const std::array<std::pair<const char*, const char*>, 3> kTable{
+      {{"/classes", "verdict.classes"}, {"/B/limits", "verdict.B.limits"}, {"/N/limits", "verdict.N.limits"}}};
+  const auto& first = runs[kept.front()];
+  for (const auto i : kept) {
+    const auto& v = runs[i].run.at("verdict");
+    for (const auto& [pointer, name] : kTable) {
+      const json::json_pointer ptr(pointer);
+      const auto& v0 = first.run.at("verdict");
+      const bool in0 = v0.contains(ptr), in = v.contains(ptr);
+      if (in0 == in && (!in || v0.at(ptr) == v.at(ptr))) continue;
+      throw InputError(runs[i].file, runs[i].line,
+                       fmt::format("run '{}' was judged against another class table (\"{}\") than run '{}' at {}",
+                                   source_of(runs[i]), name, source_of(first), place(first)));
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<nlohmann::json> merge_runs(std::vector<SavedRun> runs, bool dedupe) {
+  if (runs.empty()) throw UsageError("merge: no runs");
+  const auto kept = distinct_runs(runs, dedupe);
+  require_one_class_table(runs, kept);
+  std::vector<nlohmann::json> out;
+  out.reserve(kept.size());
+  for (const auto i : kept) out.push_back(std::move(runs[i].run));
+  return out;
+}
+
+std::vector<SavedRun> load_json_lines(const std::string& path, RunKeys keys) {
+  return parse_json_lines(read_file(path), path, keys);
+}
+
+}  // namespace rwcalc
