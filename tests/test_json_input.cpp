@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "rwcalc/printable.hpp"
 #include "test_support.hpp"
 
 namespace fs = std::filesystem;
@@ -104,8 +105,9 @@ void expect_input_error(const CliResult& r, const std::string& file, std::size_t
                         const std::vector<std::string>& fragments) {
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find(fmt::format("{}:{}: ", file, line)), std::string::npos) << "expected " << file << ":" << line
-                                                                               << " in: " << r.err;
+  // Messages spell out control characters and invalid bytes (printable.hpp), file names included.
+  EXPECT_NE(r.err.find(fmt::format("{}:{}: ", rwcalc::printable(file), line)), std::string::npos)
+      << "expected " << rwcalc::printable(file) << ":" << line << " in: " << r.err;
   for (const auto& f : fragments) EXPECT_NE(r.err.find(f), std::string::npos) << "expected '" << f << "' in: " << r.err;
 }
 

@@ -144,27 +144,40 @@ constexpr double kMaxPulses = 1152921504606846976.0;  // 2^60
 // Most samples a record may have (2^40: about 30 days at 400 kHz).
 constexpr double kMaxSamples = 1099511627776.0;
 
-// A generous bound of |angle| over the record, arcsec: every rate term at its largest for the
-// whole duration, random terms at ten standard deviations.
-double angle_bound_arcsec(const NoiseModel& m, const SimulationSettings& s) {
+// One term's share of the bound on |angle|, arcsec, named by the option that sets it.
+struct AngleTerm {
+  const char* option;
+  double arcsec;
+};
+
+// A generous bound of |angle| over the record, term by term: every rate term at its largest for
+// the whole duration, random terms at ten standard deviations.
+std::vector<AngleTerm> angle_bound_terms(const NoiseModel& m, const SimulationSettings& s) {
   const double T = s.duration_s;
-  double rate = std::abs(m.bias_deg_per_h) + std::abs(m.earth_rate_deg_per_h) + std::abs(m.ramp_deg_per_h2) * T / 3600.0 +
-                10.0 * m.bias_instability_deg_per_h;
-  for (const auto& x : m.sinusoids) rate += std::abs(x.amp_deg_per_h);
-  for (const auto& x : m.gauss_markov) rate += 10.0 * x.sigma_deg_per_h;
-  for (const auto& x : m.bias_steps) rate += std::abs(x.size_deg_per_h);
-  for (const auto& x : m.warmups) rate += std::abs(x.amp_deg_per_h);
+  const double h = 1.0;  // deg/h -> arcsec/s (3600 arcsec per 3600 s)
+  std::vector<AngleTerm> t{
+      {"--bias", std::abs(m.bias_deg_per_h) * h * T},
+      {"--latitude", std::abs(m.earth_rate_deg_per_h) * h * T},
+      {"--ramp", std::abs(m.ramp_deg_per_h2) * T / 3600.0 * h * T},
+      {"--bias-instability", 10.0 * m.bias_instability_deg_per_h * h * T},
+      {"--arw", 10.0 * m.arw_deg_per_sqrt_h * units::sqrt_s_per_sqrt_h * std::sqrt(T)},  // deg/sqrt(h) = 60 arcsec/sqrt(s)
+      {"--rrw", 10.0 * m.rrw_deg_per_h_per_sqrt_h / units::sqrt_s_per_sqrt_h * T * std::sqrt(T)},
+      {"--white-angle", 10.0 * m.white_angle_arcsec}};
+  auto add = [&](const char* option, double deg_per_h) { t.push_back({option, deg_per_h * h * T}); };
+  for (const auto& x : m.sinusoids) add("--sinusoid", std::abs(x.amp_deg_per_h));
+  for (const auto& x : m.gauss_markov) add("--gauss-markov", 10.0 * x.sigma_deg_per_h);
+  for (const auto& x : m.bias_steps) add("--bias-step", std::abs(x.size_deg_per_h));
+  for (const auto& x : m.warmups) add("--warmup", std::abs(x.amp_deg_per_h));
   if (m.temperature_bias) {
     const auto& p = m.temperature_bias->profile;
     const double swing = std::abs(p.start_c) + std::abs(p.end_c) + std::abs(p.amp_c) + std::abs(s.temperature_c.value_or(0.0));
-    rate += std::abs(m.temperature_bias->coefficient_deg_per_h_per_c) * swing;
+    add("--temp-bias", std::abs(m.temperature_bias->coefficient_deg_per_h_per_c) * swing);
   }
-  const double arw = 10.0 * m.arw_deg_per_sqrt_h * units::sqrt_s_per_sqrt_h * std::sqrt(T);
-  const double rrw = 10.0 * m.rrw_deg_per_h_per_sqrt_h / units::sqrt_s_per_sqrt_h * T * std::sqrt(T);
-  return rate * T + arw + rrw + 10.0 * m.white_angle_arcsec;
+  return t;
 }
 
-// Refuse a record whose angle the pulse counts cannot carry, before anything is written.
+// Refuse a record whose angle the pulse counts cannot carry, before anything is written; the
+// message names the option whose term is largest.
 void check_record_range(const NoiseModel& m, const SimulationSettings& s) {
   if (!(s.duration_s * s.rate_hz <= kMaxSamples))
     throw UsageError(fmt::format("--duration {:g} s at --rate {:g} Hz gives {:g} samples, more than the {:g} a record may have",
@@ -172,13 +185,17 @@ void check_record_range(const NoiseModel& m, const SimulationSettings& s) {
   for (const auto& x : m.bias_steps)
     if (x.t_s > s.duration_s)
       throw UsageError(fmt::format("--bias-step: the time {:g} s is beyond the record's end ({:g} s)", x.t_s, s.duration_s));
-  const double angle = angle_bound_arcsec(m, s);
-  if (!(angle / s.scale_arcsec <= kMaxPulses))
-    throw UsageError(fmt::format(
-        "the record's angle may reach {:g} arcsec (rate terms over {:g} s, random terms at ten sigma), {:g} pulses of "
-        "{:g} arcsec: beyond the {:g} (2^60) pulses a record can count. Lower --bias, --arw, --ramp or the other "
-        "terms, shorten --duration or raise --scale",
-        angle, s.duration_s, angle / s.scale_arcsec, s.scale_arcsec, kMaxPulses));
+  const std::vector<AngleTerm> terms = angle_bound_terms(m, s);
+  double angle = 0;
+  for (const auto& t : terms) angle += t.arcsec;
+  if (angle / s.scale_arcsec <= kMaxPulses) return;
+  const auto largest = std::max_element(terms.begin(), terms.end(),
+                                        [](const AngleTerm& a, const AngleTerm& b) { return a.arcsec < b.arcsec; });
+  throw UsageError(fmt::format(
+      "{}: the record's angle may reach {:g} arcsec over {:g} s (rate terms at their largest, random terms at ten "
+      "sigma), {:g} pulses of {:g} arcsec: beyond the {:g} (2^60) pulses a record can count. Lower {}, shorten "
+      "--duration or raise --scale",
+      largest->option, angle, s.duration_s, angle / s.scale_arcsec, s.scale_arcsec, kMaxPulses, largest->option));
 }
 
 int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
