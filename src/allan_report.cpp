@@ -1,6 +1,7 @@
 // Text and CSV renderings of an Allan-variance result (the JSON form is to_json in allan.cpp).
 #include <fmt/format.h>
 
+#include "rwcalc/printable.hpp"
 #include "rwcalc/allan.hpp"
 
 namespace rwcalc {
@@ -10,7 +11,7 @@ std::string unit_label(const AllanResult& r) { return r.unit == "deg/h" ? "°/h"
 std::string format_allan_table(const AllanResult& r, const AllanReportInfo& info) {
   const std::string u = unit_label(r);
   std::string out;
-  out += fmt::format("# rwcalc allan: {}\n", info.source.empty() ? "-" : info.source);
+  out += fmt::format("# rwcalc allan: {}\n", info.source.empty() ? "-" : printable(info.source));
   out += fmt::format("# estimator: {} deviation ({})\n", long_name(r.estimator), to_string(r.estimator));
   out += fmt::format("# confidence: {:g} (two-sided chi-square bounds, Greenhall-Riley EDF, lag-1 ACF noise id)\n",
                      r.confidence);

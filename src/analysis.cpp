@@ -1,4 +1,5 @@
 // The analyze pipeline and its outputs (JSON and the readable report).
+#include "rwcalc/printable.hpp"
 #include "rwcalc/analysis.hpp"
 
 #include <fmt/format.h>
@@ -518,7 +519,7 @@ nlohmann::json to_json(const AnalysisResult& r) {
 
 std::string format_report(const AnalysisResult& r) {
   std::string s;
-  s += fmt::format("rwcalc analyze: {}\n\n", r.source);
+  s += fmt::format("rwcalc analyze: {}\n\n", printable(r.source));
   s += "Data\n";
   s += fmt::format("  {} samples at {:g} Hz (tau0 = {:g} ms), {:.1f} s ({:.2f} h), column '{}'", r.samples, r.rate_hz,
                    1000.0 / r.rate_hz, r.duration_s, r.duration_s / 3600.0, r.column);

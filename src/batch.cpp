@@ -1,4 +1,5 @@
 // Batch analysis over files (threads), JSON-lines merge, and the Table 1 / Table 2 layout.
+#include "rwcalc/printable.hpp"
 #include "rwcalc/batch.hpp"
 
 #include "rwcalc/crew.hpp"
@@ -153,7 +154,7 @@ std::string class_cell(const json& v) { return v.is_null() ? std::string("none")
 
 /// One run's line of the batch text's outlier section: count, action, the first input lines.
 std::string outliers_line(const json& run) {
-  const std::string source = run.at("source").get<std::string>();
+  const std::string source = printable(run.at("source").get<std::string>());
   if (!run.contains("outliers") || !run.at("outliers").is_object())
     return fmt::format("  {}: not in the results (no outlier summary)\n", source);
   const auto& o = run.at("outliers");
@@ -304,7 +305,7 @@ std::string format_batch_text(const json& summary) {
   for (const auto& r : runs)
     s += fmt::format("  {:>6}  {:<22} {:<22} {:<22} {:<22} {}\n", temp_cell(r), cell(r, {"fit", "N_deg_per_sqrt_h"}),
                      cell(r, {"methods", "N_direct_deg_per_sqrt_h"}), cell(r, {"fit", "B_deg_per_h"}),
-                     cell(r, {"methods", "B_100s_deg_per_h"}), r.at("source").get<std::string>());
+                     cell(r, {"methods", "B_100s_deg_per_h"}), printable(r.at("source").get<std::string>()));
   s += "\nTable 2: class per parameter (probability of the stated class)\n";
   s += fmt::format("  {:>6}  {:<30} {:<30} {}\n", "T, °C", "by N", "by B", "overall");
   for (const auto& r : runs) {

@@ -1,5 +1,6 @@
 // The diagnosis pipeline: base fit → ensemble band and detector calibration → findings →
 // extended model → its band and the gain, in and out of sample; JSON and the readable report.
+#include "rwcalc/printable.hpp"
 #include "rwcalc/diagnose.hpp"
 
 #include <fmt/format.h>
@@ -1246,7 +1247,7 @@ std::string unit_of(const std::string& key) {
 
 std::string format_report(const DiagnoseResult& r) {
   std::string s;
-  s += fmt::format("Diagnosis of {}\n", r.analysis.source);
+  s += fmt::format("Diagnosis of {}\n", printable(r.analysis.source));
   s += fmt::format("  record: {:.0f} s at {:g} Hz, pulse weight {:g}″; ensemble of {} simulated records per model "
                    "(seed {}), band {:g} % per τ\n\n",
                    r.settings.duration_s, r.settings.rate_hz, r.settings.scale_arcsec, r.runs, r.seed,

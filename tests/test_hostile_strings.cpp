@@ -457,3 +457,27 @@ TEST(HostileMessages, AFileNameCannotForgeALineOrColourTheTerminal) {
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 2) << r.err;
   EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << r.err;
 }
+
+// ---- reports on standard output ------------------------------------------------------------------
+
+/// The human-readable text of every command that names its input shows a hostile name spelled
+/// out: no control character but the line ends, valid UTF-8, so no forged line or terminal escape.
+TEST_F(HostileNames, TextReportsSpellOutTheNames) {
+  const std::string name = "nl\nrwcalc analyze: forged\x1b[2J\r\xff.csv";
+  const auto file = recording_named(name);
+  const auto expect_plain = [](const rwcalc::test::CliResult& r, const std::string& what) {
+    EXPECT_EQ(r.status, 0) << what << ": " << r.err;
+    for (char c : r.out)
+      if (c != '\n') EXPECT_FALSE(static_cast<unsigned char>(c) < 0x20 || c == '\x7f') << what << ": raw control character";
+    EXPECT_TRUE(valid_utf8(r.out)) << what;
+    EXPECT_NE(r.out.find("nl\\nrwcalc analyze: forged\\x1b[2J\\r\\xff.csv"), std::string::npos) << what << ": " << r.out;
+  };
+  expect_plain(run_exe({"analyze", file}), "analyze");
+  expect_plain(run_exe({"allan", file}), "allan");
+  expect_plain(run_exe({"batch", file}), "batch");
+  const auto sim = (work_.path() / ("sim\n\x1b[2J.csv")).string();
+  const auto r = run_exe({"simulate", "--duration", "60", "-o", sim});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out.find('\x1b'), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("sim\\n\\x1b[2J.csv"), std::string::npos) << r.out;
+}

@@ -20,6 +20,7 @@
 #include "cli/analyze_args.hpp"
 #include "cli/commands.hpp"
 #include "cli/numeric_options.hpp"
+#include "rwcalc/printable.hpp"
 #include "rwcalc/batch.hpp"
 #include "rwcalc/diagnose.hpp"
 #include "rwcalc/reader.hpp"
@@ -207,7 +208,7 @@ int run_report(const ReportCmd& c, Io& io) {
   ro.figures = !c.no_figures;
   ro.generated = utc_now();
   const auto path = write_report(c.dir, in, ro, c.force);
-  io.out << fmt::format("report written to {} ({} run(s){})\n", path, in.analyses.size(),
+  io.out << fmt::format("report written to {} ({} run(s){})\n", printable(path), in.analyses.size(),
                         c.no_figures ? ", no figures" : "");
   return 0;
 }

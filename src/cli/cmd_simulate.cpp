@@ -13,6 +13,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/numeric_options.hpp"
+#include "rwcalc/printable.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/pulse_writer.hpp"
@@ -310,7 +311,7 @@ int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
       write_file_atomic(tpath, t.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n", a.force);
     }
     if (path != "-")
-      io.out << fmt::format("wrote {} ({} samples, {} s at {} Hz, seed {})\n", path, sr.samples(), sr.duration_s, sr.rate_hz, sr.seed);
+      io.out << fmt::format("wrote {} ({} samples, {} s at {} Hz, seed {})\n", printable(path), sr.samples(), sr.duration_s, sr.rate_hz, sr.seed);
   }
   return 0;
 }
