@@ -20,6 +20,7 @@
 namespace {
 
 namespace fs = std::filesystem;
+using rwcalc::test::gunzip;
 using rwcalc::test::slurp;
 using rwcalc::test::TempDir;
 
@@ -27,16 +28,6 @@ std::set<std::string> listing(const fs::path& dir) {
   std::set<std::string> names;
   for (const auto& e : fs::directory_iterator(dir)) names.insert(e.path().filename().string());
   return names;
-}
-
-std::string gunzip(const fs::path& path) {
-  gzFile g = gzopen(path.c_str(), "rb");
-  std::string out;
-  if (g == nullptr) return out;
-  char buf[65536];
-  for (int n; (n = gzread(g, buf, sizeof buf)) > 0;) out.append(buf, static_cast<std::size_t>(n));
-  gzclose(g);
-  return out;
 }
 
 TEST(AtomicOutput, PiecesAppearOnlyAtCommitAndWhole) {

@@ -32,6 +32,7 @@
 namespace {
 
 namespace fs = std::filesystem;
+using rwcalc::test::gunzip;
 using rwcalc::test::concat;
 using rwcalc::test::run_cli;
 using rwcalc::test::TempDir;
@@ -371,16 +372,6 @@ TEST(CommandOutputs, ForceKeepsThePermissionsOfTheReplacedOutput) {
 }
 
 // ---- .gz outputs read back whole ---------------------------------------------------------------
-
-std::string gunzip(const fs::path& path) {
-  gzFile g = gzopen(path.c_str(), "rb");
-  std::string out;
-  if (g == nullptr) return out;
-  char buf[65536];
-  for (int n; (n = gzread(g, buf, sizeof buf)) > 0;) out.append(buf, static_cast<std::size_t>(n));
-  gzclose(g);
-  return out;
-}
 
 TEST(WriteFileAtomic, GzipTargetsReadBackWholeNewAndReplaced) {
   TempDir tmp;

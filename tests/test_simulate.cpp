@@ -20,6 +20,7 @@
 namespace {
 
 using namespace rwcalc;
+using rwcalc::test::gunzip;
 using rwcalc::test::run_cli;
 using rwcalc::test::TempDir;
 constexpr double kPi = std::numbers::pi;
@@ -29,16 +30,6 @@ std::string slurp(const std::filesystem::path& p) {
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
-}
-
-std::string gunzip(const std::filesystem::path& p) {
-  gzFile g = gzopen(p.c_str(), "rb");
-  std::string out;
-  char buf[1 << 16];
-  int n = 0;
-  while ((n = gzread(g, buf, sizeof buf)) > 0) out.append(buf, static_cast<std::size_t>(n));
-  gzclose(g);
-  return out;
 }
 
 // A record with (almost) no quantization and no noise: the rate series shows the deterministic terms.

@@ -13,27 +13,11 @@
 
 namespace {
 
+using rwcalc::test::gunzip;
 using rwcalc::test::run_cli;
+using rwcalc::test::slurp;
 using rwcalc::test::source_path;
 using rwcalc::test::TempDir;
-
-std::string gunzip(const std::filesystem::path& p) {
-  gzFile g = gzopen(p.c_str(), "rb");
-  std::string out;
-  if (!g) return out;
-  char buf[1 << 16];
-  int n = 0;
-  while ((n = gzread(g, buf, sizeof buf)) > 0) out.append(buf, static_cast<std::size_t>(n));
-  gzclose(g);
-  return out;
-}
-
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 std::string num(const nlohmann::json& v) { return fmt::format("{}", v.get<double>()); }
 

@@ -1,5 +1,7 @@
 #include "test_support.hpp"
 
+#include <zlib.h>
+
 #include <fmt/format.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -28,6 +30,16 @@ std::string slurp(const std::filesystem::path& path) {
   std::ostringstream ss;
   ss << in.rdbuf();
   return ss.str();
+}
+
+std::string gunzip(const std::filesystem::path& path) {
+  gzFile g = gzopen(path.c_str(), "rb");
+  std::string out;
+  if (g == nullptr) return out;
+  char buf[65536];
+  for (int n; (n = gzread(g, buf, sizeof buf)) > 0;) out.append(buf, static_cast<std::size_t>(n));
+  gzclose(g);
+  return out;
 }
 
 std::vector<std::string> gl2d_runs() {

@@ -59,6 +59,9 @@ class TempDir {
 /// The whole content of a file (empty when it cannot be read).
 std::string slurp(const std::filesystem::path& path);
 
+/// The decompressed content of a gzip file (empty when it cannot be opened).
+std::string gunzip(const std::filesystem::path& path);
+
 /// The five shipped GL-2D runs (data/gl2d/), in temperature order −50 … +50 °C.
 std::vector<std::string> gl2d_runs();
 
