@@ -467,8 +467,10 @@ TEST_F(HostileNames, TextReportsSpellOutTheNames) {
   const auto file = recording_named(name);
   const auto expect_plain = [](const rwcalc::test::CliResult& r, const std::string& what) {
     EXPECT_EQ(r.status, 0) << what << ": " << r.err;
-    for (char c : r.out)
-      if (c != '\n') EXPECT_FALSE(static_cast<unsigned char>(c) < 0x20 || c == '\x7f') << what << ": raw control character";
+    for (char c : r.out) {
+      if (c == '\n') continue;
+      EXPECT_FALSE(static_cast<unsigned char>(c) < 0x20 || c == '\x7f') << what << ": raw control character";
+    }
     EXPECT_TRUE(valid_utf8(r.out)) << what;
     EXPECT_NE(r.out.find("nl\\nrwcalc analyze: forged\\x1b[2J\\r\\xff.csv"), std::string::npos) << what << ": " << r.out;
   };

@@ -278,7 +278,10 @@ TEST(Reader, RateInputIsIntegratedToPhaseAsSp1065) {
   // The mean rate is kept apart (PhaseSeries::rate_offset); the phase adds it back.
   double x = 0;
   EXPECT_EQ(c.phase.at(0), 0.0);
-  for (std::size_t i = 0; i < y.size(); ++i) EXPECT_NEAR(c.phase.at(i + 1), x += y[i], 1e-9 * x);
+  for (std::size_t i = 0; i < y.size(); ++i) {
+    x += y[i];
+    EXPECT_NEAR(c.phase.at(i + 1), x, 1e-9 * x);
+  }
   EXPECT_NEAR(c.phase.rate_offset, 7100.0 / 9.0, 1e-9);
   EXPECT_EQ(c.phase.kind, PhaseKind::Clock);
   // Gyro units: deg/s and rad/s become ″/s (= °/h).
