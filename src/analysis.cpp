@@ -224,6 +224,83 @@ const Recording& screen_outliers(const Recording& read, OutlierAction action, do
   return edited;
 }
 
+namespace {
+
+/// What the result says of its record: source, size, column, pulse weight and temperature (from the
+/// option, the metadata or a column, or the file name, in that order).
+void describe_record(const Recording& rec, const AnalysisOptions& options, AnalysisResult& r) {
+  r.source = rec.source;
+  r.samples = rec.samples;
+  r.rate_hz = rec.rate_hz;
+  r.duration_s = rec.phase.duration_s();
+  r.column = rec.column_name;
+  r.arcsec_per_count = rec.phase.exact() ? rec.phase.arcsec_per_count : 0.0;
+  if (options.temperature_c) {
+    r.temperature_c = options.temperature_c;
+    r.temperature_source = "option";
+  } else if (rec.temperature_c) {
+    r.temperature_c = rec.temperature_c;
+    r.temperature_source = rec.metadata.count("temperature_c") ? "metadata" : "column";
+  } else if (auto t = temperature_from_name(rec.source)) {
+    r.temperature_c = t;
+    r.temperature_source = "file name";
+  }
+}
+
+/// The octave points of a finer grid's result, on which the fit and the slope readout work. As on
+/// the octave grid itself, the longest τ carries the previous τ's α (Stable32), and its EDF and
+/// bounds follow from that α.
+AllanResult octave_points_of(const AllanResult& all, const AllanOptions& aopt) {
+  AllanResult octave_points = all;
+  std::erase_if(octave_points.points, [](const AllanPoint& p) { return (p.m & (p.m - 1)) != 0; });
+  auto& op = octave_points.points;
+  if (aopt.noise_id && op.size() > 1 && op.back().alpha != op[op.size() - 2].alpha) {
+    AllanPoint& last = op.back();
+    last.alpha = op[op.size() - 2].alpha;
+    last.edf = edf_for(aopt.estimator, last.alpha, last.m, octave_points.points_in);
+    const DevInterval ci = chi2_interval(last.var, last.edf, aopt.confidence);
+    last.dev_low = ci.low;
+    last.dev_high = ci.high;
+  }
+  return octave_points;
+}
+
+/// The class verdict from the fit's N and the B estimate the options choose.
+Verdict verdict_of(const AnalysisResult& r, const AnalysisOptions& options) {
+  const FitResult& fit = r.fit;
+  auto from_fit = [&fit](Term t) {
+    EstimateInput e;
+    const auto& c = fit[t];
+    e.value = c.value;
+    e.low = c.low;
+    e.high = c.high;
+    e.resolved = c.resolved;
+    e.cdf = [&fit, t](double x) { return fit.cdf(t, x); };
+    return e;
+  };
+  EstimateInput b_in;
+  double rho = 0;
+  switch (options.verdict.b_estimate) {
+    case BEstimate::Fit:
+      b_in = from_fit(Term::B);
+      rho = fit.log_correlation(Term::B, Term::N);
+      break;
+    case BEstimate::SigmaMin:
+      if (!r.slope.B) throw AnalysisError(fmt::format("{}: no Allan deviation minimum to read B from", r.source));
+      b_in = lognormal_estimate(*r.slope.B, r.slope_B_sigma);
+      break;
+    case BEstimate::Avg100:
+      if (!r.avg100.spread.valid)
+        throw AnalysisError(fmt::format("{}: the record is shorter than three {:g}-s blocks; use --b-estimate fit",
+                                        r.source, options.methods.block_s));
+      b_in = lognormal_estimate(r.avg100.spread.value, r.avg100.spread.sigma);
+      break;
+  }
+  return decide(b_in, from_fit(Term::N), rho, options.verdict);
+}
+
+}  // namespace
+
 AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   if (read.phase.kind != PhaseKind::Gyro)
     throw UsageError(fmt::format("{}: analyze needs gyro data (pulses, counter, angle in arcsec/deg/rad, or rate in "
@@ -255,22 +332,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   const Recording& rec = *recp;
   AnalysisResult r;
   if (!posted_scan) r.outliers = std::move(outliers);
-  r.source = rec.source;
-  r.samples = rec.samples;
-  r.rate_hz = rec.rate_hz;
-  r.duration_s = rec.phase.duration_s();
-  r.column = rec.column_name;
-  r.arcsec_per_count = rec.phase.exact() ? rec.phase.arcsec_per_count : 0.0;
-  if (options.temperature_c) {
-    r.temperature_c = options.temperature_c;
-    r.temperature_source = "option";
-  } else if (rec.temperature_c) {
-    r.temperature_c = rec.temperature_c;
-    r.temperature_source = rec.metadata.count("temperature_c") ? "metadata" : "column";
-  } else if (auto t = temperature_from_name(rec.source)) {
-    r.temperature_c = t;
-    r.temperature_source = "file name";
-  }
+  describe_record(rec, options, r);
   const std::size_t pts = rec.phase.points();
   if (pts < 3) throw AnalysisError(fmt::format("{}: the record holds {} sample(s); far too short to analyse", rec.source, rec.samples));
 
@@ -301,22 +363,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
     scan_chunk = [&shared](std::size_t) { shared->help(); };
     posted.emplace(crew->post(2, scan_chunk));
   }
-  AllanResult octave_points;
-  if (!octave) {
-    octave_points = r.allan;
-    std::erase_if(octave_points.points, [](const AllanPoint& p) { return (p.m & (p.m - 1)) != 0; });
-    // As on the octave grid itself: the longest τ carries the previous τ's α (Stable32), and its
-    // EDF and bounds follow from that α.
-    auto& op = octave_points.points;
-    if (aopt.noise_id && op.size() > 1 && op.back().alpha != op[op.size() - 2].alpha) {
-      AllanPoint& last = op.back();
-      last.alpha = op[op.size() - 2].alpha;
-      last.edf = edf_for(aopt.estimator, last.alpha, last.m, octave_points.points_in);
-      const DevInterval ci = chi2_interval(last.var, last.edf, aopt.confidence);
-      last.dev_low = ci.low;
-      last.dev_high = ci.high;
-    }
-  }
+  const AllanResult octave_points = octave ? AllanResult{} : octave_points_of(r.allan, aopt);
   const AllanResult& fitted = octave ? r.allan : octave_points;
   try {
     detail::ScopedTimer t("analyze: fit");
@@ -349,37 +396,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
                                                   r.avg100.expected_sigma);
   }
 
-  // Verdict.
-  const FitResult& fit = r.fit;
-  auto from_fit = [&fit](Term t) {
-    EstimateInput e;
-    const auto& c = fit[t];
-    e.value = c.value;
-    e.low = c.low;
-    e.high = c.high;
-    e.resolved = c.resolved;
-    e.cdf = [&fit, t](double x) { return fit.cdf(t, x); };
-    return e;
-  };
-  EstimateInput b_in;
-  double rho = 0;
-  switch (options.verdict.b_estimate) {
-    case BEstimate::Fit:
-      b_in = from_fit(Term::B);
-      rho = fit.log_correlation(Term::B, Term::N);
-      break;
-    case BEstimate::SigmaMin:
-      if (!r.slope.B) throw AnalysisError(fmt::format("{}: no Allan deviation minimum to read B from", rec.source));
-      b_in = lognormal_estimate(*r.slope.B, r.slope_B_sigma);
-      break;
-    case BEstimate::Avg100:
-      if (!r.avg100.spread.valid)
-        throw AnalysisError(fmt::format("{}: the record is shorter than three {:g}-s blocks; use --b-estimate fit",
-                                        rec.source, options.methods.block_s));
-      b_in = lognormal_estimate(r.avg100.spread.value, r.avg100.spread.sigma);
-      break;
-  }
-  r.verdict = decide(b_in, from_fit(Term::N), rho, options.verdict);
+  r.verdict = verdict_of(r, options);
   if (posted_scan) {
     detail::ScopedTimer t("analyze: outlier scan (rest)", true);
     crew->join(*posted);
