@@ -1,8 +1,8 @@
 // Text and CSV renderings of an Allan-variance result (the JSON form is to_json in allan.cpp).
 #include <fmt/format.h>
 
-#include "rwcalc/printable.hpp"
 #include "rwcalc/allan.hpp"
+#include "rwcalc/printable.hpp"
 
 namespace rwcalc {
 

@@ -1,5 +1,4 @@
 // The analyze pipeline and its outputs (JSON and the readable report).
-#include "rwcalc/printable.hpp"
 #include "rwcalc/analysis.hpp"
 
 #include <fmt/format.h>
@@ -14,8 +13,9 @@
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/crew.hpp"
 #include "rwcalc/error.hpp"
-#include "timing.hpp"
+#include "rwcalc/printable.hpp"
 #include "rwcalc/units.hpp"
+#include "timing.hpp"
 
 namespace rwcalc {
 

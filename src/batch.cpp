@@ -1,5 +1,4 @@
 // Batch analysis over files (threads), JSON-lines merge, and the Table 1 / Table 2 layout.
-#include "rwcalc/printable.hpp"
 #include "rwcalc/batch.hpp"
 
 #include "rwcalc/crew.hpp"
@@ -19,6 +18,7 @@
 #include <utility>
 
 #include "rwcalc/error.hpp"
+#include "rwcalc/printable.hpp"
 #include "rwcalc/thread.hpp"
 #include "timing.hpp"
 

@@ -1,6 +1,5 @@
 // The diagnosis pipeline: base fit → ensemble band and detector calibration → findings →
 // extended model → its band and the gain, in and out of sample; JSON and the readable report.
-#include "rwcalc/printable.hpp"
 #include "rwcalc/diagnose.hpp"
 
 #include <fmt/format.h>
@@ -18,6 +17,7 @@
 #include "rwcalc/diagnose_detectors.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/fit.hpp"
+#include "rwcalc/printable.hpp"
 #include "rwcalc/units.hpp"
 #include "timing.hpp"
 
