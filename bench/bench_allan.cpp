@@ -3,7 +3,7 @@
 // MVAR, noise identification and EDF, and the int32 view of the counts they read.
 #include <benchmark/benchmark.h>
 
-#include "../src/allan_kernels.hpp"
+#include "allan/allan_kernels.hpp"
 #include "bench_inputs.hpp"
 #include "rwcalc/allan.hpp"
 #include "rwcalc/confidence.hpp"

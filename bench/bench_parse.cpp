@@ -9,8 +9,8 @@
 #include <numeric>
 #include <vector>
 
-#include "../src/reader_detail.hpp"
-#include "../src/reader_simd.hpp"
+#include "io/reader_detail.hpp"
+#include "io/reader_simd.hpp"
 #include "bench_inputs.hpp"
 #include "rwcalc/reader.hpp"
 

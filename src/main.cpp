@@ -5,7 +5,7 @@
 
 #include <iostream>
 
-#include "reader_detail.hpp"
+#include "io/reader_detail.hpp"
 #include "rwcalc/cli.hpp"
 #include "rwcalc/output.hpp"
 

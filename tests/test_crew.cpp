@@ -14,8 +14,8 @@
 #include <thread>
 #include <vector>
 
-#include "../src/allan_kernels.hpp"
-#include "../src/noise_id.hpp"
+#include "allan/allan_kernels.hpp"
+#include "allan/noise_id.hpp"
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/crew.hpp"
 #include "rwcalc/reader.hpp"

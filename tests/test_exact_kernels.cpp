@@ -11,8 +11,8 @@
 #include <random>
 #include <vector>
 
-#include "../src/allan_kernels.hpp"
-#include "../src/fit_kernels.hpp"
+#include "allan/allan_kernels.hpp"
+#include "model/fit_kernels.hpp"
 
 namespace {
 

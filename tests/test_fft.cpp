@@ -11,7 +11,7 @@
 #include <unsupported/Eigen/FFT>
 #include <vector>
 
-#include "../src/fft.hpp"
+#include "allan/fft.hpp"
 
 namespace {
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "../src/allan_kernels.hpp"
+#include "allan/allan_kernels.hpp"
 #include "rwcalc/allan.hpp"
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/error.hpp"

@@ -10,7 +10,7 @@
 #include <random>
 #include <vector>
 
-#include "../src/noise_id.hpp"
+#include "allan/noise_id.hpp"
 
 namespace {
 

@@ -12,7 +12,7 @@
 
 #include <gtest/gtest.h>
 
-#include "../src/output_detail.hpp"
+#include "core/output_detail.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/output.hpp"
 #include "test_support.hpp"

@@ -10,7 +10,7 @@
 #include <random>
 #include <vector>
 
-#include "../src/allan_kernels.hpp"
+#include "allan/allan_kernels.hpp"
 #include "rwcalc/series.hpp"
 
 namespace {

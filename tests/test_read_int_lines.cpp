@@ -10,7 +10,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include "../src/reader_detail.hpp"
+#include "io/reader_detail.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/reader.hpp"
 

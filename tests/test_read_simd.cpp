@@ -10,8 +10,8 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include "../src/reader_detail.hpp"
-#include "../src/reader_simd.hpp"
+#include "io/reader_detail.hpp"
+#include "io/reader_simd.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/reader.hpp"
 

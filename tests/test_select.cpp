@@ -10,7 +10,7 @@
 #include <span>
 #include <vector>
 
-#include "../src/select.hpp"
+#include "io/select.hpp"
 
 namespace {
 

@@ -13,7 +13,7 @@
 #include "rwcalc/crew.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/output.hpp"
-#include "timing.hpp"
+#include "core/timing.hpp"
 
 namespace rwcalc::cli {
 

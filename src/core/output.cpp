@@ -17,8 +17,8 @@
 #include <optional>
 #include <random>
 
-#include "cleanup.hpp"
-#include "output_detail.hpp"
+#include "core/cleanup.hpp"
+#include "core/output_detail.hpp"
 #include "rwcalc/error.hpp"
 
 namespace rwcalc {

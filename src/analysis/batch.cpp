@@ -20,7 +20,7 @@
 #include "rwcalc/error.hpp"
 #include "rwcalc/printable.hpp"
 #include "rwcalc/thread.hpp"
-#include "timing.hpp"
+#include "core/timing.hpp"
 
 namespace rwcalc {
 

@@ -13,7 +13,7 @@
 #include <numbers>
 #include <thread>
 
-#include "fit_kernels.hpp"
+#include "model/fit_kernels.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/thread.hpp"
 

@@ -12,7 +12,7 @@
 #include <sstream>
 #include <unordered_map>
 
-#include "json_input.hpp"
+#include "core/json_input.hpp"
 #include "rwcalc/error.hpp"
 
 namespace rwcalc {

@@ -5,7 +5,7 @@
 #include <optional>
 #include <nlohmann/json.hpp>
 
-#include "json_input.hpp"
+#include "core/json_input.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/simulate.hpp"
 

@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "json_input.hpp"
+#include "core/json_input.hpp"
 #include "rwcalc/error.hpp"
 
 namespace rwcalc {

@@ -11,8 +11,8 @@
 #include <thread>
 
 #include "rwcalc/thread.hpp"
-#include "select.hpp"
-#include "x86_dispatch.hpp"
+#include "io/select.hpp"
+#include "allan/x86_dispatch.hpp"
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>

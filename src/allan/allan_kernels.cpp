@@ -1,9 +1,9 @@
 // Hot loops of the Allan-variance estimators. Written as plain loops over contiguous arrays with
 // several independent accumulators so that the compiler vectorises them; built for AVX2 and for
 // the baseline ISA, the better one chosen at load time (function multiversioning).
-#include "allan_kernels.hpp"
+#include "allan/allan_kernels.hpp"
 
-#include "reader_detail.hpp"
+#include "io/reader_detail.hpp"
 #include "rwcalc/crew.hpp"
 #include "rwcalc/thread.hpp"
 
@@ -17,7 +17,7 @@
 #else
 #define RWCALC_CLONES
 #endif
-#include "x86_dispatch.hpp"
+#include "allan/x86_dispatch.hpp"
 
 namespace rwcalc::detail {
 

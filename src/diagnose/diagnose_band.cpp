@@ -6,7 +6,7 @@
 
 #include <Eigen/Dense>
 
-#include "allan_kernels.hpp"
+#include "allan/allan_kernels.hpp"
 #include "rwcalc/diagnose_detectors.hpp"
 #include "rwcalc/allan.hpp"
 #include "rwcalc/fit.hpp"

@@ -4,9 +4,9 @@
 // with the running sums formed in vector registers where the processor has AVX-512 VBMI2, else by
 // a loop over the set bits of the digit mask (the line starts come from the masks, so no line waits
 // for the previous one's bytes).
-#include "reader_simd.hpp"
+#include "io/reader_simd.hpp"
 
-#include "reader_detail.hpp"
+#include "io/reader_detail.hpp"
 
 #include <atomic>
 #include <bit>

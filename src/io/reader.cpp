@@ -25,9 +25,9 @@
 
 #include <fmt/format.h>
 
-#include "reader_detail.hpp"
-#include "reader_simd.hpp"
-#include "timing.hpp"
+#include "io/reader_detail.hpp"
+#include "io/reader_simd.hpp"
+#include "core/timing.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/limits.hpp"
 #include "rwcalc/thread.hpp"

@@ -17,7 +17,7 @@
 #include <sstream>
 #include <vector>
 
-#include "cleanup.hpp"
+#include "core/cleanup.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/plot.hpp"
 #include "rwcalc/printable.hpp"

@@ -15,7 +15,7 @@
 #include "rwcalc/error.hpp"
 #include "rwcalc/printable.hpp"
 #include "rwcalc/units.hpp"
-#include "timing.hpp"
+#include "core/timing.hpp"
 
 namespace rwcalc {
 

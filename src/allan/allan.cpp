@@ -12,10 +12,10 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
-#include "allan_all.hpp"
-#include "allan_kernels.hpp"
-#include "noise_id.hpp"
-#include "timing.hpp"
+#include "allan/allan_all.hpp"
+#include "allan/allan_kernels.hpp"
+#include "allan/noise_id.hpp"
+#include "core/timing.hpp"
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/thread.hpp"

@@ -17,8 +17,8 @@
 #include <immintrin.h>
 #endif
 
-#include "noise_id.hpp"
-#include "x86_dispatch.hpp"
+#include "allan/noise_id.hpp"
+#include "allan/x86_dispatch.hpp"
 #include "rwcalc/crew.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/thread.hpp"

@@ -15,7 +15,7 @@
 
 #include "rwcalc/diagnose_detectors.hpp"
 
-#include "fft.hpp"
+#include "allan/fft.hpp"
 
 namespace rwcalc::diag {
 

@@ -19,7 +19,7 @@
 
 #include <fmt/format.h>
 
-#include "reader_detail.hpp"
+#include "io/reader_detail.hpp"
 #include "rwcalc/crew.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/thread.hpp"

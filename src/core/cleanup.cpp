@@ -1,4 +1,4 @@
-#include "cleanup.hpp"
+#include "core/cleanup.hpp"
 
 #include <limits.h>
 #include <signal.h>

@@ -19,7 +19,7 @@
 #include "rwcalc/fit.hpp"
 #include "rwcalc/printable.hpp"
 #include "rwcalc/units.hpp"
-#include "timing.hpp"
+#include "core/timing.hpp"
 
 namespace rwcalc {
 

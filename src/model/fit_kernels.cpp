@@ -1,11 +1,11 @@
 // Hot loop of the AV-point covariance: γ(h)² summed over blocks of lags, eight blocks per AVX-512
 // vector with a vector natural logarithm, or one at a time with std::log.
-#include "fit_kernels.hpp"
+#include "model/fit_kernels.hpp"
 
 #include <cmath>
 #include <numbers>
 
-#include "x86_dispatch.hpp"
+#include "allan/x86_dispatch.hpp"
 
 namespace rwcalc::detail {
 
