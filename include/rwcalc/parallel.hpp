@@ -1,0 +1,21 @@
+#pragma once
+/// @file parallel.hpp
+/// The one place where rwcalc starts threads. Every parallel loop of the library is a
+/// parallel_for over independent items whose results are kept per item and combined in item
+/// order afterwards, so a result never depends on the number of threads or on who ran what.
+#include <cstddef>
+#include <functional>
+
+namespace rwcalc {
+
+/// fn(i) for every i in [0, n), each exactly once, on up to worker_count() threads (the calling
+/// thread is one of them); returns when all have run. The first exception thrown is rethrown here
+/// (items not yet started are then skipped). A parallel_for inside another one runs its items on
+/// the calling thread: the outer loop already has the cores busy.
+void parallel_for(std::size_t n, const std::function<void(std::size_t)>& fn);
+
+/// Threads a parallel_for may use: RWCALC_THREADS from the environment when set to a whole number
+/// from 1 to 4096 (tests use it to show that results do not depend on it), else the hardware's.
+unsigned worker_count();
+
+}  // namespace rwcalc
