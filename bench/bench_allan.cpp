@@ -1,7 +1,10 @@
 // Allan-variance kernels on the 2-h 400 Hz GL-2D record (2.88 M samples, exact counts):
-// one overlapping AVAR per cluster size, whole grids (octave, dense) on one and on all threads,
-// MVAR, noise identification and EDF, and the int32 view of the counts they read.
+// one overlapping AVAR per cluster size, the sweep of the dense grid's sums, whole grids (octave,
+// dense) on one and on two threads, MVAR, noise identification and EDF.
 #include <benchmark/benchmark.h>
+
+#include <cstdlib>
+#include <string>
 
 #include "allan/allan_kernels.hpp"
 #include "bench_inputs.hpp"
@@ -12,6 +15,9 @@ namespace {
 
 using namespace rwcalc;
 
+// Threads of the parallel loops (parallel.hpp reads RWCALC_THREADS at every loop).
+void use_threads(std::int64_t n) { setenv("RWCALC_THREADS", std::to_string(n).c_str(), 1); }
+
 // One OAVAR sum at cluster size m = range(0): cost is ~N whatever m.
 void BM_OavarOneTau(benchmark::State& state) {
   const auto& x = bench::gl2d_series();
@@ -21,19 +27,15 @@ void BM_OavarOneTau(benchmark::State& state) {
 }
 BENCHMARK(BM_OavarOneTau)->Arg(1)->Arg(64)->Arg(4096)->Arg(262144)->Unit(benchmark::kMillisecond);
 
-// The int32 view of the counts (offsets C_k − C_0 and their range; AVX2 where available) on
-// range(0) threads. Each iteration allocates the view afresh, as analyze does: the heap reuses the
-// previous iteration's pages, so this is the pass itself without the cost of fresh pages.
-void BM_PrepareCounts(benchmark::State& state) {
+// The overlapping sums of every τ of the dense grid in one blocked sweep on range(0) threads.
+void BM_OavarSweep(benchmark::State& state) {
   const auto& x = bench::gl2d_series();
-  const auto threads = static_cast<unsigned>(state.range(0));
-  for (auto _ : state) {
-    const auto p = detail::prepare_counts(x.counts, false, threads);
-    benchmark::DoNotOptimize(p.rel32.data());
-  }
-  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(x.points()));
+  use_threads(state.range(0));
+  const std::vector<std::int64_t> ms = cluster_sizes(TauGrid::parse("dense"), Estimator::Overlapping, x.points(), x.tau0_s);
+  for (auto _ : state) benchmark::DoNotOptimize(detail::second_diff_sumsq_sweep(x.counts.data(), x.points(), ms).data());
+  state.counters["taus"] = static_cast<double>(ms.size());
 }
-BENCHMARK(BM_PrepareCounts)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_OavarSweep)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_MvarOneTau(benchmark::State& state) {
   const auto& x = bench::gl2d_series();
@@ -45,8 +47,8 @@ BENCHMARK(BM_MvarOneTau)->Arg(1)->Arg(4096)->Unit(benchmark::kMillisecond);
 // A whole grid: AVAR, noise id, EDF and bounds for every τ. range(0): threads; range(1): 0 octave, 1 dense.
 void BM_ComputeAllanGrid(benchmark::State& state) {
   const auto& x = bench::gl2d_series();
+  use_threads(state.range(0));
   AllanOptions o;
-  o.threads = static_cast<unsigned>(state.range(0));
   o.grid = TauGrid::parse(state.range(1) ? "dense" : "octave");
   o.noise_id_domain = NoiseIdDomain::Frequency;
   std::size_t taus = 0;

@@ -3,6 +3,9 @@
 // and profile intervals) and the point covariance alone, on one and on two threads.
 #include <benchmark/benchmark.h>
 
+#include <cstdlib>
+#include <string>
+
 #include "bench_inputs.hpp"
 #include "rwcalc/allan.hpp"
 #include "rwcalc/fit.hpp"
@@ -11,19 +14,20 @@ namespace {
 
 using namespace rwcalc;
 
+// Threads of the parallel loops (parallel.hpp reads RWCALC_THREADS at every loop).
+void use_threads(std::int64_t n) { setenv("RWCALC_THREADS", std::to_string(n).c_str(), 1); }
+
 const std::vector<FitPoint>& octave_points() {
   static const std::vector<FitPoint> pts = [] {
-    AllanOptions o;
-    o.threads = 1;
-    return fit_points(compute_allan(bench::gl2d_series(), o));
+    return fit_points(compute_allan(bench::gl2d_series(), AllanOptions{}));
   }();
   return pts;
 }
 
 void BM_FitNoise(benchmark::State& state) {
   const auto& pts = octave_points();
-  FitOptions o;
-  o.threads = static_cast<unsigned>(state.range(0));
+  use_threads(state.range(0));
+  const FitOptions o;
   for (auto _ : state) {
     const FitResult r = fit_noise(pts, o);
     benchmark::DoNotOptimize(r.c.data());
@@ -36,9 +40,9 @@ BENCHMARK(BM_FitNoise)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTi
 void BM_AvCovariance(benchmark::State& state) {
   const auto& pts = octave_points();
   static const FitResult fit = fit_noise(pts, FitOptions{});
-  const auto threads = static_cast<unsigned>(state.range(0));
+  use_threads(state.range(0));
   for (auto _ : state) {
-    const Eigen::MatrixXd s = av_covariance(pts, fit.c, false, threads);
+    const Eigen::MatrixXd s = av_covariance(pts, fit.c);
     benchmark::DoNotOptimize(s.data());
   }
 }

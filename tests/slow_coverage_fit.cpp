@@ -57,7 +57,6 @@ Outcome run_one(std::uint64_t seed, double duration, double rate, double scale, 
   rec.rate_hz = rate;
   rec.samples = rec.phase.points() - 1;
   AnalysisOptions o;
-  o.allan.threads = 1;
   const AnalysisResult r = analyze(rec, o);
   Outcome out{};
   out.n_true = n;

@@ -10,6 +10,7 @@
 
 #include "rwcalc/allan.hpp"
 #include "rwcalc/error.hpp"
+#include "test_support.hpp"
 
 namespace rwcalc {
 namespace {
@@ -127,10 +128,9 @@ double exact_oavar(const PhaseSeries& x, std::int64_t m) {
 }
 
 TEST(AllanCounts, EveryCountRangeGivesTheExactSum) {
-  // Ranges on either side of each kernel's limit (|C − C0| < 2^24: unchecked int32 lanes; < 2^29:
-  // checked int32 lanes; < 2^30: int32 offsets in double; beyond: int64), each record long enough for
-  // several blocks. The extreme one alternates ±(2^24 − 1), so every |d| is 4·(2^24 − 1) and a
-  // block's sum comes within a factor 1.0000002 of 2^64.
+  // Count ranges from small to beyond 2^30, each record long enough for several blocks; the
+  // extreme one alternates ±(2^24 − 1), so every |d| is 4·(2^24 − 1), beyond the blocks' 64-bit
+  // fast path.
   const std::int64_t v24 = (std::int64_t{1} << 24) - 1;
   std::vector<PhaseSeries> records;
   {
@@ -155,16 +155,15 @@ TEST(AllanCounts, EveryCountRangeGivesTheExactSum) {
       SCOPED_TRACE("record " + std::to_string(r) + " m " + std::to_string(m));
       EXPECT_EQ(allan_variance(records[r], m, Estimator::Overlapping), exact_oavar(records[r], m));
     }
-    // A whole grid at once (one sweep over the data per thread when the range allows it).
-    for (unsigned threads : {1u, 2u, 3u}) {
+    // A whole grid at once (one sweep over the data), on one to three threads.
+    for (const char* threads : {"1", "2", "3"}) {
+      const rwcalc::test::ScopedEnv env("RWCALC_THREADS", threads);
       AllanOptions o;
       o.grid = TauGrid::parse("dense:7");
-      o.threads = threads;
       const AllanResult a = compute_allan(records[r], o);
       ASSERT_GT(a.points.size(), 20u);
       for (const AllanPoint& p : a.points) {
-        SCOPED_TRACE("record " + std::to_string(r) + " grid m " + std::to_string(p.m) + " threads " +
-                     std::to_string(threads));
+        SCOPED_TRACE("record " + std::to_string(r) + " grid m " + std::to_string(p.m) + " threads " + threads);
         EXPECT_EQ(p.var, exact_oavar(records[r], p.m));
         EXPECT_EQ(p.n, static_cast<std::int64_t>(records[r].points()) - 2 * p.m);
       }
@@ -191,16 +190,37 @@ TEST(AllanCounts, WhiteAngleNoiseHasTheExpectedLevel) {
 
 TEST(AllanEngine, ThreadCountDoesNotChangeTheResult) {
   const PhaseSeries c = counts_from(random_increments(50000, 5, 5), 7);
-  AllanOptions o;
-  o.grid = TauGrid::parse("dense:10");
-  o.threads = 1;
-  const AllanResult one = compute_allan(c, o);
-  o.threads = 2;
-  const AllanResult two = compute_allan(c, o);
-  ASSERT_EQ(one.points.size(), two.points.size());
-  for (std::size_t i = 0; i < one.points.size(); ++i) {
-    EXPECT_EQ(one.points[i].var, two.points[i].var);
-    EXPECT_EQ(one.points[i].edf, two.points[i].edf);
+  PhaseSeries v;  // the same record as floating phase
+  v.tau0_s = c.tau0_s;
+  for (std::int64_t k : c.counts) v.values.push_back(static_cast<double>(k) * c.arcsec_per_count);
+  for (const PhaseSeries* x : {&c, static_cast<const PhaseSeries*>(&v)}) {
+    for (const char* grid : {"dense:10", "all"}) {
+      for (auto est : {Estimator::Overlapping, Estimator::NonOverlapping, Estimator::Modified}) {
+        AllanOptions o;
+        o.grid = TauGrid::parse(grid);
+        o.estimator = est;
+        if (est == Estimator::Modified && o.grid.kind == TauGrid::Kind::All) o.grid.max_m = 300;
+        AllanResult one, two;
+        {
+          const rwcalc::test::ScopedEnv env("RWCALC_THREADS", "1");
+          one = compute_allan(*x, o);
+        }
+        {
+          const rwcalc::test::ScopedEnv env("RWCALC_THREADS", "2");
+          two = compute_allan(*x, o);
+        }
+        ASSERT_EQ(one.points.size(), two.points.size());
+        EXPECT_EQ(one.fft_from_m, two.fft_from_m);
+        for (std::size_t i = 0; i < one.points.size(); ++i) {
+          SCOPED_TRACE(std::string(grid) + " m " + std::to_string(one.points[i].m));
+          EXPECT_EQ(one.points[i].var, two.points[i].var);
+          EXPECT_EQ(one.points[i].alpha, two.points[i].alpha);
+          EXPECT_EQ(one.points[i].edf, two.points[i].edf);
+          EXPECT_EQ(one.points[i].dev_low, two.points[i].dev_low);
+          EXPECT_EQ(one.points[i].dev_high, two.points[i].dev_high);
+        }
+      }
+    }
   }
 }
 

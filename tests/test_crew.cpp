@@ -1,7 +1,7 @@
 // Crew: every chunk of a shared loop runs exactly once, on the calling thread and on lenders that
 // are free now or later; a chunk's exception reaches the caller; lenders leave on close(). And the
-// passes that take a crew (the int32 view, the one-sweep Allan sums, the noise identification's
-// first pass, the outlier scan, a whole analysis) give the same bits with lenders as without.
+// passes that take a crew (the reader's halves) give the same bits with lenders as without, and a
+// whole analysis the same on one thread as on two.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -14,8 +14,6 @@
 #include <thread>
 #include <vector>
 
-#include "allan/allan_kernels.hpp"
-#include "allan/noise_id.hpp"
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/crew.hpp"
 #include "rwcalc/reader.hpp"
@@ -133,74 +131,6 @@ TEST(Crew, OwnCrewLendsItsThreadsUntilItEnds) {
   EXPECT_EQ(alone.get(), nullptr);
 }
 
-std::vector<std::int64_t> pulse_counts(std::size_t n, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::poisson_distribution<int> pulses(1.7);
-  std::vector<std::int64_t> c(n);
-  std::int64_t x = -5000;
-  for (auto& v : c) v = x += pulses(rng);
-  return c;
-}
-
-TEST(CrewPasses, TheWideSweepWithLendersAsWithout) {
-  // Counts whose offsets pass 2^30: no int32 view, the 64-bit sweep, shared in stretches.
-  auto c = pulse_counts((std::size_t{1} << 20) + 777, 6);
-  for (std::size_t k = 0; k < c.size(); ++k) c[k] += static_cast<std::int64_t>(k) * 2000;
-  const detail::PreparedCounts p = detail::prepare_counts(c, false, 1);
-  ASSERT_EQ(p.view, nullptr);
-  std::vector<std::int64_t> ms;
-  for (std::int64_t m = 1; 2 * m < static_cast<std::int64_t>(c.size()); m *= 2) ms.push_back(m);
-  std::vector<detail::u128> swept(ms.size());
-  ASSERT_TRUE(detail::second_diff_sumsq_sweep(p, c.size(), ms.data(), ms.size(), 0, 1, swept.data()));
-  for (int lenders : {0, 1}) {
-    LentCrew lc(lenders);
-    std::vector<detail::u128> shared(ms.size());
-    ASSERT_TRUE(detail::second_diff_sumsq_sweep_shared(p, c.size(), ms.data(), ms.size(), lc.crew, shared.data()));
-    for (std::size_t i = 0; i < ms.size(); ++i) {
-      EXPECT_TRUE(shared[i] == swept[i]) << "m " << ms[i];
-      const std::int64_t n = static_cast<std::int64_t>(c.size()) - 2 * ms[i];
-      EXPECT_TRUE(swept[i] == detail::second_diff_sumsq(p, n, ms[i], 1)) << "m " << ms[i];
-    }
-  }
-}
-
-TEST(CrewPasses, TheSamePassesWithLendersAsWithout) {
-  const auto c = pulse_counts((std::size_t{1} << 21) + 12345, 5);
-  const detail::PreparedCounts p1 = detail::prepare_counts(c, false, 1);
-  std::vector<std::int64_t> ms;
-  for (std::int64_t m = 1; 2 * m < static_cast<std::int64_t>(c.size()); m *= 2) ms.push_back(m);
-  std::vector<detail::u128> swept(ms.size());
-  const bool swept_ok = detail::second_diff_sumsq_sweep(p1, c.size(), ms.data(), ms.size(), 0, 1, swept.data());
-  PhaseSeries x;
-  x.counts = c;
-  const auto start1 = detail::lag1_start_pass(x, ms.data(), ms.size(), NoiseIdDomain::Frequency, p1.rel32.data(),
-                                              p1.small24, 1);
-  for (int lenders : {0, 1}) {
-    LentCrew lc(lenders);
-    const detail::PreparedCounts p2 = detail::prepare_counts(c, false, 1, &lc.crew);
-    EXPECT_EQ(p2.small24, p1.small24);
-    EXPECT_EQ(p2.small29, p1.small29);
-    ASSERT_EQ(p2.rel32.size(), p1.rel32.size());
-    EXPECT_TRUE(std::equal(p1.rel32.begin(), p1.rel32.end(), p2.rel32.begin()));
-    std::vector<detail::u128> shared(ms.size());
-    EXPECT_EQ(detail::second_diff_sumsq_sweep_shared(p2, c.size(), ms.data(), ms.size(), lc.crew, shared.data()),
-              swept_ok);
-    if (swept_ok) {
-      for (std::size_t i = 0; i < ms.size(); ++i) EXPECT_TRUE(shared[i] == swept[i]) << "m " << ms[i];
-    }
-    const auto start2 = detail::lag1_start_pass(x, ms.data(), ms.size(), NoiseIdDomain::Frequency, p2.rel32.data(),
-                                                p2.small24, 1, &lc.crew);
-    ASSERT_EQ(start2.size(), start1.size());
-    for (std::size_t i = 0; i < start1.size(); ++i) {
-      if (std::isnan(start1[i])) {
-        EXPECT_TRUE(std::isnan(start2[i])) << i;
-      } else {
-        EXPECT_EQ(start2[i], start1[i]) << i;
-      }
-    }
-  }
-}
-
 TEST(CrewPasses, AFileLoadedInHalvesByALenderReadsTheSame) {
   // Over 4 MB: a regular file is loaded in two halves side by side (the second by a lender here).
   std::string text = "# rate_hz: 400\n# scale_arcsec_per_pulse: 0.92\npulses\n";
@@ -223,7 +153,7 @@ TEST(CrewPasses, AFileLoadedInHalvesByALenderReadsTheSame) {
   }
 }
 
-TEST(CrewPasses, AnAnalysisWithLendersEqualsOneWithout) {
+TEST(CrewPasses, AnAnalysisOnOneThreadEqualsOneOnTwo) {
   const NoiseModel m = test::gl2d_model();
   SimulationSettings s;
   s.duration_s = 3600;
@@ -236,11 +166,15 @@ TEST(CrewPasses, AnAnalysisWithLendersEqualsOneWithout) {
   for (std::size_t i = 123457; i < rec.phase.counts.size(); ++i) rec.phase.counts[i] += 90;
   rec.samples = rec.phase.points() - 1;
   AnalysisOptions o;
-  o.allan.threads = 1;
-  const nlohmann::json a = to_json(analyze(rec, o));
-  LentCrew lc(1);
-  o.allan.crew = &lc.crew;
-  const nlohmann::json b = to_json(analyze(rec, o));
+  nlohmann::json a, b;
+  {
+    const test::ScopedEnv env("RWCALC_THREADS", "1");
+    a = to_json(analyze(rec, o));
+  }
+  {
+    const test::ScopedEnv env("RWCALC_THREADS", "2");
+    b = to_json(analyze(rec, o));
+  }
   EXPECT_EQ(a.dump(), b.dump());
   EXPECT_GE(b.at("outliers").at("count").get<int>(), 1);
 }

@@ -7,7 +7,6 @@
 #include <string>
 #include <vector>
 
-#include "allan/allan_kernels.hpp"
 #include "rwcalc/allan.hpp"
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/error.hpp"
@@ -133,27 +132,6 @@ TEST(NarrowCounts, AnyOtherLineFallsBackWithTheSameRecordAndLines) {
   }
 }
 
-TEST(NarrowCounts, PreparedViewIsTheCountsThemselvesWithTheSameFlags) {
-  std::vector<std::int64_t> sums;
-  (void)pulse_text(20000, 5, sums);
-  PhaseSeries x;
-  x.counts32.assign(sums.begin(), sums.end());
-  const auto n = detail::prepare_counts(x, true);
-  const auto w = detail::prepare_counts(sums, true);
-  ASSERT_NE(n.view, nullptr);
-  EXPECT_EQ(n.view, x.counts32.data());  // no copy
-  EXPECT_TRUE(n.rel32.empty());
-  EXPECT_EQ(n.small24, w.small24);
-  EXPECT_EQ(n.small29, w.small29);
-  EXPECT_EQ(n.prefix_f64, w.prefix_f64);
-  // C_0 ≠ 0: the offsets are formed (|C| < 2^30, so they fit).
-  PhaseSeries y;
-  for (const auto c : sums) y.counts32.push_back(static_cast<std::int32_t>(c + 1000000));
-  const auto m = detail::prepare_counts(y, false);
-  ASSERT_NE(m.view, nullptr);
-  for (std::size_t i = 0; i < sums.size(); ++i) ASSERT_EQ(m.view[i], sums[i]) << i;
-}
-
 TEST(NarrowCounts, EveryEstimatorAndTheWholeAnalysisGiveTheSameBits) {
   SimulationSettings s;
   s.duration_s = 1800;
@@ -175,10 +153,10 @@ TEST(NarrowCounts, EveryEstimatorAndTheWholeAnalysisGiveTheSameBits) {
       EXPECT_EQ(allan_variance(narrow.phase, m, e), allan_variance(rec.phase, m, e)) << "m " << m;
 
   AnalysisOptions o;
-  o.allan.threads = 1;
-  EXPECT_EQ(to_json(analyze(narrow, o)).dump(), to_json(analyze(rec, o)).dump());
-  o.allan.threads = 2;
-  EXPECT_EQ(to_json(analyze(narrow, o)).dump(), to_json(analyze(rec, o)).dump());
+  for (const char* threads : {"1", "2"}) {
+    const test::ScopedEnv env("RWCALC_THREADS", threads);
+    EXPECT_EQ(to_json(analyze(narrow, o)).dump(), to_json(analyze(rec, o)).dump());
+  }
 
   const auto out = find_outliers(narrow);
   ASSERT_FALSE(out.empty());

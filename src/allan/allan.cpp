@@ -5,20 +5,15 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <atomic>
 #include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <nlohmann/json.hpp>
-#include <thread>
 
 #include "allan/allan_all.hpp"
 #include "allan/allan_kernels.hpp"
-#include "allan/noise_id.hpp"
-#include "core/timing.hpp"
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
-#include "rwcalc/thread.hpp"
+#include "rwcalc/parallel.hpp"
 
 namespace rwcalc {
 
@@ -46,11 +41,6 @@ double parse_number(std::string_view s, std::string_view spec) {
 // their sums from the FFT path (allan_all.hpp); smaller ones, and every other grid, stay exact.
 constexpr std::int64_t kAllExactBelow = 1024;
 constexpr std::size_t kAllFftMinPoints = std::size_t{1} << 15;
-
-// The sums for one τ with exact data: the pulse weight and τ enter only here.
-double finish_counts(detail::u128 sumsq, double q, double tau, double denom) {
-  return static_cast<double>(sumsq) * (q * q) / (2.0 * tau * tau * denom);
-}
 
 }  // namespace
 
@@ -166,57 +156,126 @@ std::vector<std::int64_t> cluster_sizes(const TauGrid& grid, Estimator est, std:
 
 namespace {
 
-// Variance of one τ; `prepared` holds the counts in their fast exact form (see PreparedCounts).
-double variance_at(const PhaseSeries& x, std::int64_t m, Estimator est, const detail::PreparedCounts* prepared,
+/// The counts of an exact record as int64 (the series' own, or a copy when it holds them in
+/// another form) and, for the modified variance, their modular prefix sums.
+struct CountData {
+  std::vector<std::int64_t> copy;
+  const std::int64_t* c = nullptr;
+  std::vector<std::uint64_t> prefix;
+
+  CountData(const PhaseSeries& x, Estimator est) {
+    if (!x.exact()) return;
+    if (!x.counts.empty()) {
+      c = x.counts.data();
+    } else {
+      copy.resize(x.points());
+      for (std::size_t k = 0; k < copy.size(); ++k) copy[k] = x.count(k);
+      c = copy.data();
+    }
+    if (est == Estimator::Modified) prefix = detail::count_prefix_sums(c, x.points());
+  }
+};
+
+/// σ² from a sum of n squared second differences; `scale` brings the sum to phase units squared
+/// (q² for counts: the pulse weight enters only here).
+double avar_from_sum(double sumsq, double scale, double tau, std::int64_t n) {
+  return sumsq * scale / (2.0 * tau * tau * static_cast<double>(n));
+}
+
+double sum_scale(const PhaseSeries& x) { return x.exact() ? x.arcsec_per_count * x.arcsec_per_count : 1.0; }
+
+// Variance of one τ.
+double variance_at(const PhaseSeries& x, const CountData& data, std::int64_t m, Estimator est,
                    std::int64_t* terms_out) {
-  const std::size_t points = x.points();
-  const std::int64_t n = term_count(est, m, points);
+  const std::int64_t n = term_count(est, m, x.points());
   if (terms_out) *terms_out = n;
   if (n < 1) return 0.0;
   const double tau = static_cast<double>(m) * x.tau0_s;
-  const double q = x.arcsec_per_count;
-  detail::PreparedCounts local;
-  if (x.exact() && !prepared) {
-    local = detail::prepare_counts(x, est == Estimator::Modified);
-    prepared = &local;
+  if (est == Estimator::Modified) {
+    const double md = static_cast<double>(m);
+    const double sumsq = x.exact() ? detail::modified_sumsq(data.prefix.data(), n, m) * sum_scale(x)
+                                   : detail::modified_sumsq(x.values.data(), n, m);
+    return sumsq / (2.0 * md * md * tau * tau * static_cast<double>(n));
   }
-  switch (est) {
-    case Estimator::Overlapping:
-    case Estimator::NonOverlapping: {
-      const std::int64_t stride = est == Estimator::Overlapping ? 1 : m;
-      if (x.exact())
-        return finish_counts(detail::second_diff_sumsq(*prepared, n, m, stride), q, tau, static_cast<double>(n));
-      return detail::second_diff_sumsq_values(x.values.data(), n, m, stride) /
-             (2.0 * tau * tau * static_cast<double>(n));
-    }
-    case Estimator::Modified: {
-      const double md = static_cast<double>(m);
-      const double sumsq = x.exact() ? detail::modified_sumsq(*prepared, n, m) * (q * q)
-                                     : detail::modified_sumsq_values(x.values.data(), n, m);
-      return sumsq / (2.0 * md * md * tau * tau * static_cast<double>(n));
-    }
-  }
-  return 0.0;
+  const std::int64_t stride = est == Estimator::Overlapping ? 1 : m;
+  const double sumsq = x.exact() ? static_cast<double>(detail::second_diff_sumsq(data.c, n, m, stride))
+                                 : detail::second_diff_sumsq(x.values.data(), n, m, stride);
+  return avar_from_sum(sumsq, sum_scale(x), tau, n);
 }
 
-}  // namespace
-
-double allan_variance(const PhaseSeries& x, std::int64_t m, Estimator est, std::int64_t* terms) {
-  return variance_at(x, m, est, nullptr, terms);
+/// Overlapping sums of every m ≥ kAllExactBelow through FFT autocorrelations (allan_all.hpp),
+/// O(N log² N) instead of O(N²), for the `all` grid of a long record; empty otherwise.
+std::vector<double> all_grid_fft_sums(const PhaseSeries& x, const CountData& data, const TauGrid& grid,
+                                      Estimator est, std::int64_t max_m) {
+  const std::size_t points = x.points();
+  if (grid.kind != TauGrid::Kind::All || est != Estimator::Overlapping || max_m < kAllExactBelow ||
+      points < kAllFftMinPoints)
+    return {};
+  std::vector<double> phase(points);
+  if (x.exact()) {
+    const auto c0 = static_cast<std::uint64_t>(data.c[0]);
+    for (std::size_t k = 0; k < points; ++k)
+      phase[k] = static_cast<double>(static_cast<std::int64_t>(static_cast<std::uint64_t>(data.c[k]) - c0));
+  } else {
+    phase = x.values;
+  }
+  return detail::all_oavar_sumsq_fft(std::move(phase), max_m);
 }
 
-AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
+/// σ² of every τ of ms: from the FFT sums where `all` takes them (analyze's fitted octave points
+/// stay exact), from one blocked sweep for the other overlapping sums of counts, else per τ.
+std::vector<double> grid_variances(const PhaseSeries& x, const CountData& data, const std::vector<std::int64_t>& ms,
+                                   const TauGrid& grid, Estimator est, std::int64_t& fft_from_m) {
+  const std::vector<double> fft_sums = all_grid_fft_sums(x, data, grid, est, ms.back());
+  if (!fft_sums.empty()) fft_from_m = kAllExactBelow;
+  auto from_fft = [&](std::int64_t m) {
+    const bool octave_kept = grid.with_octave && (m & (m - 1)) == 0;
+    return !fft_sums.empty() && m >= kAllExactBelow && !octave_kept;
+  };
+  std::vector<std::int64_t> swept_ms;
+  if (x.exact() && est == Estimator::Overlapping)
+    for (std::int64_t m : ms)
+      if (!from_fft(m)) swept_ms.push_back(m);
+  const std::vector<detail::u128> swept = detail::second_diff_sumsq_sweep(data.c, x.points(), swept_ms);
+  std::vector<double> var(ms.size(), 0.0);
+  std::size_t next_swept = 0;
+  std::vector<std::size_t> per_tau;  // the τ left to compute one by one
+  for (std::size_t i = 0; i < ms.size(); ++i) {
+    const std::int64_t m = ms[i], n = term_count(est, m, x.points());
+    const double tau = static_cast<double>(m) * x.tau0_s;
+    if (from_fft(m))
+      var[i] = n > 0 ? avar_from_sum(fft_sums[static_cast<std::size_t>(m)], sum_scale(x), tau, n) : 0.0;
+    else if (!swept_ms.empty())
+      var[i] = n > 0 ? avar_from_sum(static_cast<double>(swept[next_swept++]), sum_scale(x), tau, n) : 0.0;
+    else
+      per_tau.push_back(i);
+  }
+  parallel_for(per_tau.size(), [&](std::size_t j) { var[per_tau[j]] = variance_at(x, data, ms[per_tau[j]], est, nullptr); });
+  return var;
+}
+
+void check_options(const PhaseSeries& x, const AllanOptions& options) {
   if (!(options.confidence > 0 && options.confidence < 1))
     throw UsageError(fmt::format("--confidence must lie strictly between 0 and 1, got {}", options.confidence));
   if (!(x.tau0_s > 0) || !std::isfinite(x.tau0_s))
     throw UsageError(fmt::format("sample period must be positive, got {} s", x.tau0_s));
   if (!options.noise_id && (options.alpha < -2 || options.alpha > 2))
     throw UsageError(fmt::format("noise exponent alpha must lie in -2..2, got {}", options.alpha));
+  if (max_cluster_size(options.estimator, x.points()) < 1)
+    throw AnalysisError(fmt::format("the record has {} phase point(s); the {} variance needs at least {}",
+                                    x.points(), long_name(options.estimator), 3));
+}
+
+}  // namespace
+
+double allan_variance(const PhaseSeries& x, std::int64_t m, Estimator est, std::int64_t* terms) {
+  return variance_at(x, CountData(x, est), m, est, terms);
+}
+
+AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
+  check_options(x, options);
   const Estimator est = options.estimator;
   const std::size_t points = x.points();
-  if (max_cluster_size(est, points) < 1)
-    throw AnalysisError(fmt::format("the record has {} phase point(s); the {} variance needs at least {}",
-                                    points, long_name(est), 3));
   const std::vector<std::int64_t> ms = cluster_sizes(options.grid, est, points, x.tau0_s);
   if (ms.empty()) throw AnalysisError("no cluster size of the τ grid fits this record");
 
@@ -227,163 +286,27 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
   result.points_in = points;
   result.confidence = options.confidence;
   result.points.resize(ms.size());
-
-  unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
-  threads = static_cast<unsigned>(std::min<std::size_t>(threads, ms.size()));
-
-  detail::PreparedCounts prepared;
-  if (x.exact()) {
-    detail::ScopedTimer t("allan: prepare counts");
-    prepared = detail::prepare_counts(x, est == Estimator::Modified, threads, options.crew);
-  }
-
-  // Every m of a long record: the sums above kAllExactBelow come from FFT autocorrelations
-  // (allan_all.hpp), O(N log² N) instead of O(N²); below it the exact kernel as everywhere else.
-  std::vector<double> fft_sums;
-  if (options.grid.kind == TauGrid::Kind::All && est == Estimator::Overlapping && ms.back() >= kAllExactBelow &&
-      points >= kAllFftMinPoints) {
-    detail::ScopedTimer t("allan: all-τ FFT sums");
-    std::vector<double> phase(points);
-    if (x.exact()) {
-      const auto c0 = static_cast<std::uint64_t>(x.count(0));
-      for (std::size_t k = 0; k < points; ++k)
-        phase[k] = static_cast<double>(static_cast<std::int64_t>(static_cast<std::uint64_t>(x.count(k)) - c0));
-    } else {
-      phase = x.values;
-    }
-    fft_sums = detail::all_oavar_sumsq_fft(std::move(phase), ms.back(), threads);
-    result.fft_from_m = kAllExactBelow;
-  }
-  const double q = x.arcsec_per_count;
-
-  // Overlapping sums of every τ of a grid in one sweep over the data per thread (the threads take
-  // every threads-th τ), when the counts allow the sweep kernel; exact, so the same bits as per τ.
-  std::vector<detail::u128> swept;
-  if (x.exact() && est == Estimator::Overlapping && options.grid.kind != TauGrid::Kind::All) {
-    detail::ScopedTimer t("allan: swept variance sums");
-    swept.resize(ms.size());
-    bool ok = false;
-    if (options.crew) {
-      ok = detail::second_diff_sumsq_sweep_shared(prepared, points, ms.data(), ms.size(), *options.crew, swept.data());
-    } else if (threads > 1) {
-      std::vector<char> oks(threads, 0);
-      {
-        std::vector<Thread> pool;
-        for (unsigned k = 1; k < threads; ++k)
-          pool.emplace_back([&, k] {
-            oks[k] = detail::second_diff_sumsq_sweep(prepared, points, ms.data(), ms.size(), k, threads, swept.data());
-          });
-        oks[0] = detail::second_diff_sumsq_sweep(prepared, points, ms.data(), ms.size(), 0, threads, swept.data());
-      }
-      ok = std::all_of(oks.begin(), oks.end(), [](char v) { return v != 0; });
-    } else {
-      ok = detail::second_diff_sumsq_sweep(prepared, points, ms.data(), ms.size(), 0, 1, swept.data());
-    }
-    if (!ok) swept.clear();
-  }
-
-  // The first two lag-1 levels of the noise identification at every small m, in one pass over the
-  // int32 view shared by all of them (the per-τ passes each streamed the whole view).
-  std::vector<double> lag1_start;
-  if (options.noise_id && prepared.view) {
-    detail::ScopedTimer t("allan: noise id start pass");
-    lag1_start = detail::lag1_start_pass(x, ms.data(), ms.size(), options.noise_id_domain, prepared.view,
-                                         prepared.small24, threads, options.crew);
-  }
-
-  const bool timing = detail::timing_enabled();
-  std::atomic<std::int64_t> ns_sums{0}, ns_noise{0};
-  auto work = [&](std::size_t i) {
+  const std::vector<double> var = grid_variances(x, CountData(x, est), ms, options.grid, est, result.fft_from_m);
+  parallel_for(ms.size(), [&](std::size_t i) {
     AllanPoint& p = result.points[i];
     p.m = ms[i];
     p.tau_s = static_cast<double>(p.m) * x.tau0_s;
-    const std::int64_t t0 = timing ? detail::cpu_ns(true) : 0;
-    // (analyze's fitted octave points stay exact on the `all` grid too.)
-    const bool octave_kept = options.grid.with_octave && (p.m & (p.m - 1)) == 0;
-    if (!fft_sums.empty() && p.m >= kAllExactBelow && !octave_kept) {
-      p.n = term_count(est, p.m, points);
-      const double scale = x.exact() ? q * q : 1.0;
-      p.var = p.n > 0 ? fft_sums[static_cast<std::size_t>(p.m)] * scale /
-                            (2.0 * p.tau_s * p.tau_s * static_cast<double>(p.n))
-                      : 0.0;
-    } else if (!swept.empty()) {
-      p.n = term_count(est, p.m, points);
-      p.var = p.n > 0 ? finish_counts(swept[i], q, p.tau_s, static_cast<double>(p.n)) : 0.0;
-    } else {
-      p.var = variance_at(x, p.m, est, x.exact() ? &prepared : nullptr, &p.n);
-    }
+    p.n = term_count(est, p.m, points);
+    p.var = var[i];
     p.dev = std::sqrt(p.var);
-    const std::int64_t t1 = timing ? detail::cpu_ns(true) : 0;
-    p.alpha = options.noise_id ? detail::identify_noise(x, p.m, est, options.noise_id_domain,
-                                                        prepared.view,
-                                                        prepared.small24,
-                                                        !lag1_start.empty() && !std::isnan(lag1_start[2 * i])
-                                                            ? &lag1_start[2 * i]
-                                                            : nullptr)
-                               : options.alpha;
-    if (timing) {
-      const std::int64_t t2 = detail::cpu_ns(true);
-      ns_sums += t1 - t0;
-      ns_noise += t2 - t1;
-    }
-  };
-  struct Report {
-    const bool& on;
-    std::atomic<std::int64_t>& sums;
-    std::atomic<std::int64_t>& noise;
-    std::size_t taus;
-    ~Report() {
-      if (on)
-        std::fprintf(stderr, "timing: allan: %zu variance sums %8.2f ms cpu; noise id %8.2f ms cpu\n", taus,
-                     static_cast<double>(sums.load()) * 1e-6, static_cast<double>(noise.load()) * 1e-6);
-    }
-  } report{timing, ns_sums, ns_noise, ms.size()};
+    p.alpha = options.noise_id ? identify_noise(x, p.m, est, options.noise_id_domain) : options.alpha;
+  });
   // EDF and bounds once every α is known: Stable32 does not identify the noise at the longest τ of
   // a run (too few points) but carries the previous τ's α over.
-  auto finish = [&](AllanPoint& p) {
+  if (options.noise_id && result.points.size() > 1)
+    result.points.back().alpha = result.points[result.points.size() - 2].alpha;
+  parallel_for(ms.size(), [&](std::size_t i) {
+    AllanPoint& p = result.points[i];
     p.edf = edf_for(est, p.alpha, p.m, points);
     const DevInterval ci = chi2_interval(p.var, p.edf, options.confidence);
     p.dev_low = ci.low;
     p.dev_high = ci.high;
-  };
-  if (threads <= 1) {
-    for (std::size_t i = 0; i < ms.size(); ++i) work(i);
-    if (options.noise_id && result.points.size() > 1)
-      result.points.back().alpha = result.points[result.points.size() - 2].alpha;
-    for (AllanPoint& p : result.points) finish(p);
-    return result;
-  }
-  // Indices handed out dynamically, in chunks so that grids of a million τ (`all`) do not contend
-  // on the counter; the result does not depend on which thread did what.
-  auto parallel = [&](auto&& fn) {
-    const std::size_t count = ms.size();
-    const std::size_t chunk = std::clamp<std::size_t>(count / (64 * threads), 1, 256);
-    std::atomic<std::size_t> next{0};
-    std::exception_ptr failure;
-    std::atomic<bool> failed{false};
-    auto loop = [&] {
-      for (std::size_t i0; (i0 = next.fetch_add(chunk)) < count;) {
-        if (failed.load()) return;
-        try {
-          for (std::size_t i = i0; i < std::min(count, i0 + chunk); ++i) fn(i);
-        } catch (...) {
-          if (!failed.exchange(true)) failure = std::current_exception();
-          return;
-        }
-      }
-    };
-    std::vector<Thread> pool;
-    pool.reserve(threads - 1);
-    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(loop);
-    loop();
-    pool.clear();  // joins
-    if (failure) std::rethrow_exception(failure);
-  };
-  // Largest m first would not help: cost per τ is ~N for every m.
-  parallel(work);
-  if (options.noise_id && result.points.size() > 1)
-    result.points.back().alpha = result.points[result.points.size() - 2].alpha;
-  parallel([&](std::size_t i) { finish(result.points[i]); });
+  });
   return result;
 }
 

@@ -6,7 +6,7 @@
 #include <complex>
 #include <unsupported/Eigen/FFT>
 
-#include "rwcalc/thread.hpp"
+#include "rwcalc/parallel.hpp"
 
 namespace rwcalc::detail {
 
@@ -86,7 +86,7 @@ std::vector<double> head_products(const std::vector<double>& x, std::size_t max_
 
 }  // namespace
 
-std::vector<double> all_oavar_sumsq_fft(std::vector<double> x, std::int64_t max_m_in, unsigned threads) {
+std::vector<double> all_oavar_sumsq_fft(std::vector<double> x, std::int64_t max_m_in) {
   const std::size_t p = x.size();
   const auto max_m = static_cast<std::size_t>(std::max<std::int64_t>(max_m_in, 0));
   std::vector<double> sums(max_m + 1, 0.0);
@@ -99,17 +99,11 @@ std::vector<double> all_oavar_sumsq_fft(std::vector<double> x, std::int64_t max_
 
   std::vector<double> xr(x.rbegin(), x.rend());
   std::vector<double> acf, head, tail;
-  {
-    std::vector<Thread> pool;
-    if (threads > 1) {
-      pool.emplace_back([&] { tail = head_products(xr, max_m); });
-      pool.emplace_back([&] { acf = autocorrelation(x, 2 * max_m); });
-    } else {
-      tail = head_products(xr, max_m);
-      acf = autocorrelation(x, 2 * max_m);
-    }
-    head = head_products(x, max_m);
-  }
+  parallel_for(3, [&](std::size_t pass) {  // three independent FFT passes
+    if (pass == 0) head = head_products(x, max_m);
+    if (pass == 1) tail = head_products(xr, max_m);
+    if (pass == 2) acf = autocorrelation(x, 2 * max_m);
+  });
   xr.clear();
   xr.shrink_to_fit();
   // Prefix sums of x² in long double.

@@ -15,7 +15,7 @@
 namespace rwcalc::detail {
 
 /// S(m) for m = 0 … max_m (S(0) = 0 and S(m) = 0 where m leaves no term) from the phase x_0 … x_{P−1}
-/// in any units. `threads` > 1 runs the three FFT passes side by side.
-std::vector<double> all_oavar_sumsq_fft(std::vector<double> x, std::int64_t max_m, unsigned threads);
+/// in any units.
+std::vector<double> all_oavar_sumsq_fft(std::vector<double> x, std::int64_t max_m);
 
 }  // namespace rwcalc::detail

@@ -312,8 +312,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   // The analysis' helper threads: the caller's crew (crew.hpp), or one of its own when the thread
   // budget allows; the passes over the data share their work out through it.
   std::optional<OwnCrew> own;
-  Crew* crew = options.allan.crew;
-  if (!crew) crew = own.emplace(options.allan.threads).get();
+  Crew* crew = own.emplace(0u).get();
   // Outliers that are only reported (the default) change nothing the Allan stage or the fit
   // computes: then the scan's stretches are offered to the crew after the Allan stage, beside the
   // fit, the cross-checks and the verdict, and the analysis' thread takes what is left once the
@@ -327,7 +326,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   } else {
     detail::ScopedTimer t("analyze: outlier scan");
     recp = &screen_outliers(read, options.outlier_action, options.outlier_threshold, outliers, rec_storage,
-                            options.allan.threads, crew);
+                            0u, crew);
   }
   const Recording& rec = *recp;
   AnalysisResult r;
@@ -347,7 +346,6 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   // A finer grid (--tau) is reported in full, but the fit and the slope readout use its octave
   // points, so the coefficients and the verdict do not depend on the grid.
   AllanOptions aopt = options.allan;
-  aopt.crew = crew;
   const bool octave = aopt.grid.kind == TauGrid::Kind::Octave;
   if (!octave) {
     aopt.grid.with_octave = true;
@@ -368,7 +366,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   try {
     detail::ScopedTimer t("analyze: fit");
     FitOptions fopt = options.fit;
-    if (fopt.threads == 0) fopt.threads = posted_scan ? 1u : aopt.threads;
+    if (fopt.threads == 0) fopt.threads = posted_scan ? 1u : 0u;
     r.fit = fit_noise(fit_points(fitted), fopt);
   } catch (const AnalysisError& e) {
     throw AnalysisError(fmt::format("{}: {}", rec.source, e.what()));

@@ -210,8 +210,6 @@ std::vector<json> analyze_files(const std::vector<std::string>& files, const Rea
         ro.reuse = &spare;
         if (jobs > 1) ro.crew = &crew;  // a long file loaded in halves when a lender is free
         AnalysisOptions opt = options;
-        opt.allan.threads = threads;
-        if (jobs > 1) opt.allan.crew = &crew;
         const double t0 = ms_since_start();
         Recording rec = read_recording(files[i], ro);
         const double t1 = ms_since_start();

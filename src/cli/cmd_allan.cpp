@@ -13,7 +13,6 @@
 #include "cli/numeric_options.hpp"
 #include "rwcalc/allan.hpp"
 #include "rwcalc/analysis.hpp"
-#include "rwcalc/crew.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/reader.hpp"
 
@@ -29,7 +28,6 @@ struct AllanArgs {
   double confidence = 0.683;
   bool json = false;
   bool csv = false;
-  unsigned threads = 0;
   std::string outliers = "keep";
   double outlier_threshold = kDefaultOutlierThreshold;
 };
@@ -110,20 +108,12 @@ int run_allan(const AllanArgs& a, Io& io) {
   o.estimator = parse_estimator(a.estimator);
   o.grid = TauGrid::parse(a.tau);
   o.confidence = a.confidence;
-  o.threads = a.threads;
   const OutlierAction outlier_action = parse_outlier_action(a.outliers);
-  // The helper threads, started once before the read and lent to the passes that share their
-  // work out (crew.hpp); the τ loop keeps its own threads.
-  OwnCrew crew(o.threads);
-  o.crew = crew.get();
-  ReadOptions ro = a.input.options();
-  ro.crew = o.crew;
-  const Recording read = read_recording(a.file, ro);
+  const Recording read = read_recording(a.file, a.input.options());
   // Outliers are looked for, reported and dealt with as by analyze (--outliers).
   OutlierReport outliers;
   Recording edited;
-  const Recording& rec =
-      screen_outliers(read, outlier_action, a.outlier_threshold, outliers, edited, o.threads, o.crew);
+  const Recording& rec = screen_outliers(read, outlier_action, a.outlier_threshold, outliers, edited);
   // Increment and rate samples are frequency data for the noise identification, as Stable32
   // treats a frequency file; cumulative counters and angles are phase data.
   o.noise_id_domain = (rec.mode == InputMode::Pulses || rec.mode == InputMode::Rate) ? NoiseIdDomain::Frequency
@@ -163,9 +153,6 @@ void register_allan(CLI::App& app, Runner& runner) {
       ->capture_default_str();
   sub->add_option("--confidence", args->confidence, "Two-sided confidence of the bounds (0..1)")
       ->check(real_in(0.0, 1.0, "", Ends::Open))
-      ->capture_default_str();
-  sub->add_option("--threads", args->threads, "Worker threads across τ (0: all cores)")
-      ->check(whole_in(0, kMaxThreads))
       ->capture_default_str();
   add_outlier_options(*sub, args->outliers, args->outlier_threshold);
   auto* json = sub->add_flag("--json", args->json, "Print JSON instead of the table");

@@ -57,14 +57,9 @@ void register_analyze(CLI::App& app, Runner& runner) {
       // are reported before the analysis, and before anything is written.
       cmd->plot.check(cmd->force, {{"-o", cmd->output}});
       detail::ScopedTimer total("analyze command");
-      // The analysis' helper threads, started before the read so that they have settled on the
-      // other cores by the time the Allan stage shares its passes out (crew.hpp).
-      OwnCrew crew(opt.allan.threads);
-      opt.allan.crew = crew.get();
       const Recording rec = [&] {
         detail::ScopedTimer t("read");
         ReadOptions ro = cmd->input.options();
-        ro.crew = opt.allan.crew;
         return read_recording(cmd->file, ro);
       }();
       const AnalysisResult res = analyze(rec, opt);

@@ -30,20 +30,15 @@ std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSett
         RunStats& st = out[r];
         st.octave_var.resize(octave_m.size());
         if (s.exact()) {
-          // The counts prepared once for all cluster sizes (allan_variance would redo it per m),
-          // off a line of whole pulses per sample when the offsets are wide (a floating record's
-          // fine pulse), and every cluster size's sum in one sweep over them (the same sums).
-          const auto prepared = detail::prepare_second_differences(s);
+          // Every cluster size's sum in one sweep over the counts (the same sums as per m).
           const double q = s.arcsec_per_count;
-          std::vector<detail::u128> swept(octave_m.size());
-          const bool sweep =
-              detail::second_diff_sumsq_sweep(prepared, s.points(), octave_m.data(), octave_m.size(), 0, 1, swept.data());
+          const std::vector<detail::u128> swept = detail::second_diff_sumsq_sweep(s.counts.data(), s.points(), octave_m);
           for (std::size_t i = 0; i < octave_m.size(); ++i) {
             const std::int64_t m = octave_m[i];
             const std::int64_t n = term_count(Estimator::Overlapping, m, s.points());
             if (n < 1) continue;
             const double tau = static_cast<double>(m) * s.tau0_s;
-            const auto sum = static_cast<double>(sweep ? swept[i] : detail::second_diff_sumsq(prepared, n, m, 1));
+            const auto sum = static_cast<double>(swept[i]);
             st.octave_var[i] = sum * q * q / (2.0 * tau * tau * static_cast<double>(n));
           }
         } else {

@@ -1,0 +1,285 @@
+// Noise identification as Stable32 does it: the lag-1 autocorrelation of the decimated phase or
+// frequency, the B1 ratio where too few points remain, and R(n) for the modified variance.
+#include "allan/noise_id.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <vector>
+
+#include "rwcalc/confidence.hpp"
+
+namespace rwcalc {
+
+namespace {
+
+__extension__ typedef unsigned __int128 u128;
+__extension__ typedef __int128 i128;
+
+
+// Stable32 uses the lag-1 autocorrelation when at least this many points remain at τ.
+constexpr std::size_t kMinAcfPoints = 30;
+constexpr int kMaxDifferences = 2;  // d_max for Allan-type (two-sample) variances
+
+/// Decimated phase p_k = x_{k·m} − x_0, k = 0 … ⌊(N−1)/m⌋, in arbitrary units (the ACF and the
+/// B1 ratio do not depend on scale); offset-free and exact for counts.
+std::vector<double> decimated_phase(const PhaseSeries& x, std::int64_t m) {
+  const auto um = static_cast<std::size_t>(m);
+  const std::size_t count = (x.points() - 1) / um + 1;
+  std::vector<double> z(count);
+  if (x.exact()) {
+    const auto c0 = static_cast<std::uint64_t>(x.count(0));
+    for (std::size_t k = 0; k < count; ++k)
+      z[k] = static_cast<double>(static_cast<std::int64_t>(static_cast<std::uint64_t>(x.count(k * um)) - c0));
+  } else {
+    const double* v = x.values.data();
+    for (std::size_t k = 0; k < count; ++k) z[k] = v[k * um] - v[0];
+  }
+  return z;
+}
+
+/// Averaged frequencies ȳ_k ∝ p_{k+1} − p_k (k < ⌊(N−1)/m⌋), same arbitrary units.
+std::vector<double> averaged_frequency(const PhaseSeries& x, std::int64_t m) {
+  std::vector<double> y = decimated_phase(x, m);
+  for (std::size_t i = 0; i + 1 < y.size(); ++i) y[i] = y[i + 1] - y[i];
+  y.pop_back();
+  return y;
+}
+
+/// Value i of the level-th difference of p (level 0: p itself); p(i) gives the decimated phase.
+template <class P>
+inline __attribute__((always_inline)) double difference(const P& p, int level, std::size_t i) {
+  switch (level) {
+    case 0: return p(i);
+    case 1: return p(i + 1) - p(i);
+    case 2: return (p(i + 2) - p(i + 1)) - (p(i + 1) - p(i));
+    default: return ((p(i + 3) - p(i + 2)) - (p(i + 2) - p(i + 1))) - ((p(i + 2) - p(i + 1)) - (p(i + 1) - p(i)));
+  }
+}
+
+/// Lag-1 autocorrelation r1 = Σ(z_i − z̄)(z_{i+1} − z̄) / Σ(z_i − z̄)² (Riley & Greenhall eq. 2) of
+/// the Level-th difference z of the `count` decimated phase points p(0) … p(count − 1) from
+/// floating sums, without forming z or p: the mean of a difference follows from its end points,
+/// and the sums run in four lanes (whose order fixes the rounding).
+template <int Level, class P>
+double lag1_autocorrelation(const P& p, std::size_t count) {
+  if (count <= static_cast<std::size_t>(Level) + 1) return 0.0;
+  const std::size_t len = count - static_cast<std::size_t>(Level);  // points of z
+  double mean = 0;
+  if constexpr (Level == 0) {
+    double lane[4] = {};
+    std::size_t i = 0;
+    for (; i + 4 <= len; i += 4)
+      for (int j = 0; j < 4; ++j) lane[j] += p(i + static_cast<std::size_t>(j));
+    for (; i < len; ++i) lane[0] += p(i);
+    mean = (lane[0] + lane[1] + lane[2] + lane[3]) / static_cast<double>(len);
+  } else {
+    mean = (difference(p, Level - 1, len) - difference(p, Level - 1, 0)) / static_cast<double>(len);
+  }
+  double num[4] = {}, den[4] = {};
+  std::size_t i = 0;
+  // Pairs (z_i, z_{i+1}) for i < len − 1; den over all i < len.
+  for (; i + 4 < len; i += 4) {
+    for (int j = 0; j < 4; ++j) {
+      const auto k = i + static_cast<std::size_t>(j);
+      const double a = difference(p, Level, k) - mean;
+      const double b = difference(p, Level, k + 1) - mean;
+      den[j] += a * a;
+      num[j] += a * b;
+    }
+  }
+  for (; i < len; ++i) {
+    const double a = difference(p, Level, i) - mean;
+    den[0] += a * a;
+    if (i + 1 < len) num[0] += a * (difference(p, Level, i + 1) - mean);
+  }
+  const double n_sum = num[0] + num[1] + num[2] + num[3];
+  const double d_sum = den[0] + den[1] + den[2] + den[3];
+  return d_sum > 0 ? n_sum / d_sum : 0.0;
+}
+
+template <class P>
+double lag1_floating(const P& p, std::size_t count, int level) {
+  switch (level) {
+    case 0: return lag1_autocorrelation<0>(p, count);
+    case 1: return lag1_autocorrelation<1>(p, count);
+    case 2: return lag1_autocorrelation<2>(p, count);
+    default: return lag1_autocorrelation<3>(p, count);
+  }
+}
+
+// ---- Exact integer lag-1 sums of counts ------------------------------------------------------
+//
+// The level-L differences z of counts are integers, so Σz, Σz² and Σz_k·z_{k+1} are taken exactly
+// and r1 is formed once from them: only its final conversion rounds, whatever the order of the sums.
+
+/// Exact sums over z_0 … z_{len−1} of one difference level.
+struct ExactLag1 {
+  i128 s1 = 0;   // Σ z_k
+  i128 s2 = 0;   // Σ z_k²
+  i128 lag = 0;  // Σ z_k·z_{k+1}, k < len − 1
+};
+
+/// The sums stay inside 128 bits while every |z| < 2^34 and there are fewer than 2^28 points.
+constexpr std::uint64_t kZLimit = std::uint64_t{1} << 34;
+constexpr std::size_t kExactMaxPoints = std::size_t{1} << 28;
+
+/// z_L(k) of p (modular offsets of the counts) modulo 2^64: exact while |z| < 2^63.
+template <class P>
+std::int64_t idiff(const P& p, int level, std::size_t k) {
+  switch (level) {
+    case 0: return static_cast<std::int64_t>(p(k));
+    case 1: return static_cast<std::int64_t>(p(k + 1) - p(k));
+    case 2: return static_cast<std::int64_t>(p(k + 2) - 2 * p(k + 1) + p(k));
+    default: return static_cast<std::int64_t>(p(k + 3) - 3 * p(k + 2) + 3 * p(k + 1) - p(k));
+  }
+}
+
+/// r1 = Σ(z_k − z̄)(z_{k+1} − z̄) / Σ(z_k − z̄)² from the exact sums, with z̄ = S1/n:
+/// n·num = U − S1²/n, U = n·Slag − S1² + S1·(z_0 + z_{n−1});  n·den = n·S2 − S1²
+/// (integers but for the fraction of S1²/n, which is added last).
+double r1_from_exact(const ExactLag1& s, std::size_t len, std::int64_t z_first, std::int64_t z_last) {
+  const auto n = static_cast<i128>(len);
+  const i128 s1sq = s.s1 * s.s1;
+  const i128 den = n * s.s2 - s1sq;
+  if (den <= 0) return 0.0;
+  const i128 u = n * s.lag - s1sq + s.s1 * (static_cast<i128>(z_first) + z_last);
+  const i128 q = s1sq / n;
+  const i128 rem = s1sq % n;
+  const long double num =
+      static_cast<long double>(u - q) - static_cast<long double>(rem) / static_cast<long double>(len);
+  return static_cast<double>(num / static_cast<long double>(den));
+}
+
+/// r1 of the level-th difference of p(0) … p(count − 1) from exact sums; nothing when they could
+/// leave 128 bits (the sums run modulo 2^128 and are used only when every |z| < kZLimit).
+template <class P>
+std::optional<double> lag1_exact(const P& p, std::size_t count, int level) {
+  if (count <= static_cast<std::size_t>(level) + 1) return 0.0;
+  if (count >= kExactMaxPoints) return std::nullopt;
+  const std::size_t len = count - static_cast<std::size_t>(level);
+  u128 s1 = 0, s2 = 0, lag = 0;
+  std::uint64_t range = 0;
+  std::int64_t z = idiff(p, level, 0);
+  for (std::size_t k = 0;; ++k) {
+    range |= static_cast<std::uint64_t>(z) + kZLimit;  // below 2^35 iff −2^34 ≤ z < 2^34
+    s1 += static_cast<u128>(static_cast<i128>(z));
+    s2 += static_cast<u128>(static_cast<i128>(z) * z);
+    if (k + 1 == len) break;
+    const std::int64_t zn = idiff(p, level, k + 1);
+    lag += static_cast<u128>(static_cast<i128>(z) * zn);
+    z = zn;
+  }
+  if (range >= 2 * kZLimit) return std::nullopt;
+  const ExactLag1 s{static_cast<i128>(s1), static_cast<i128>(s2), static_cast<i128>(lag)};
+  return r1_from_exact(s, len, idiff(p, level, 0), z);
+}
+
+/// Lag-1 ACF method on the phase decimated by m, starting at difference level `base` (0: phase
+/// data, 1: frequency data): difference until δ = r1/(1 + r1) < 0.25 or d = d_max;
+/// p = −round(2δ) − 2d. Returns p, the exponent of the analysed series' own spectrum.
+int acf_exponent(const PhaseSeries& x, std::int64_t m, std::size_t count, int base) {
+  for (int d = 0;; ++d) {
+    const double r1 = detail::lag1_autocorrelation(x, m, count, base + d);
+    const double delta = r1 / (1.0 + r1);
+    if (delta < 0.25 || d >= kMaxDifferences) return -static_cast<int>(std::lround(2.0 * delta)) - 2 * d;
+  }
+}
+
+/// Expected B1 = (standard variance)/(Allan variance) for N averages and phase exponent μ
+/// (Howe, Beard, Greenhall & Riley, PTTI 2000, Table 3). μ = 2 … −2 ↔ α = −3 … +1/+2.
+double b1_expected(double n, int mu) {
+  switch (mu) {
+    case 2: return n * (n + 1.0) / 6.0;
+    case 1: return n / 2.0;
+    case 0: return n * std::log(n) / (2.0 * (n - 1.0) * std::numbers::ln2);
+    case -1: return 1.0;
+    case -2: return (n * n - 1.0) / (1.5 * n * (n - 1.0));
+    default: return n * (1.0 - std::pow(n, mu)) / (2.0 * (n - 1.0) * (1.0 - std::pow(2.0, mu)));
+  }
+}
+
+/// μ from a measured B1: the largest μ whose boundary with μ − 1 the ratio exceeds. Boundaries are
+/// geometric means of neighbouring expectations, except the arithmetic mean between μ = 2 and 1.
+int b1_mu(double measured, double n) {
+  for (int mu = 2; mu > -2; --mu) {
+    const double hi = b1_expected(n, mu), lo = b1_expected(n, mu - 1);
+    const double boundary = mu == 2 ? 0.5 * (hi + lo) : std::sqrt(hi * lo);
+    if (measured > boundary) return mu;
+  }
+  return -2;
+}
+
+double sample_variance(const std::vector<double>& y) {
+  double mean = 0;
+  for (double v : y) mean += v;
+  mean /= static_cast<double>(y.size());
+  double s = 0;
+  for (double v : y) s += (v - mean) * (v - mean);
+  return s / static_cast<double>(y.size() - 1);
+}
+
+double nonoverlapping_avar(const std::vector<double>& y) {
+  double s = 0;
+  for (std::size_t i = 0; i + 1 < y.size(); ++i) s += (y[i + 1] - y[i]) * (y[i + 1] - y[i]);
+  return 0.5 * s / static_cast<double>(y.size() - 1);
+}
+
+// The expectations are taken for N = the estimator's number of terms at this τ (not the number of
+// averages): that is what reproduces every α of Stable32's tables in the B1 region.
+int noise_id_b1(const PhaseSeries& x, std::int64_t m, Estimator est) {
+  const std::vector<double> y = averaged_frequency(x, m);
+  if (y.size() < 2) return 0;
+  const double avar = nonoverlapping_avar(y);
+  if (!(avar > 0)) return 0;
+  const double b1 = sample_variance(y) / avar;
+  const int mu = b1_mu(b1, static_cast<double>(term_count(est, m, x.points())));
+  if (mu == -2) {
+    // μ = −2 covers white and flicker PM; Stable32 reports flicker PM (α = 1) unless R(n) can
+    // tell them apart, which it uses for the modified variance only.
+    if (est != Estimator::Modified) return 1;
+    // R(n) = MVAR/AVAR tells white (1/m) from flicker PM (NIST TN 1337 Table 2, f_h = 1/(2τ0)).
+    // y is in phase units per cluster: bring AVAR to deviation units before the ratio.
+    const double unit = (x.exact() ? x.arcsec_per_count : 1.0) / (static_cast<double>(m) * x.tau0_s);
+    const double mvar = allan_variance(x, m, Estimator::Modified);
+    const double rn = mvar / (avar * unit * unit);
+    const double md = static_cast<double>(m);
+    const double r_flicker = 3.37 / (1.04 + 3.0 * std::log(std::numbers::pi * md));
+    const double r_white = 1.0 / md;
+    return rn > std::sqrt(r_flicker * r_white) ? 1 : 2;
+  }
+  return std::clamp(-mu - 1, -2, 2);  // μ = 1, 0, −1 ↔ α = −2, −1, 0 (μ = 2: α = −3, clamped)
+}
+
+}  // namespace
+
+namespace detail {
+
+double lag1_autocorrelation(const PhaseSeries& x, std::int64_t m, std::size_t count, int level) {
+  const auto um = static_cast<std::size_t>(m);
+  if (x.exact()) {
+    const auto c0 = static_cast<std::uint64_t>(x.count(0));
+    auto p = [&x, c0, um](std::size_t k) { return static_cast<std::uint64_t>(x.count(k * um)) - c0; };
+    if (const std::optional<double> r1 = lag1_exact(p, count, level)) return *r1;
+    return lag1_floating([&p](std::size_t k) { return static_cast<double>(static_cast<std::int64_t>(p(k))); }, count,
+                         level);
+  }
+  const double* v = x.values.data();
+  return lag1_floating([v, um](std::size_t k) { return v[k * um] - v[0]; }, count, level);
+}
+
+}  // namespace detail
+
+int identify_noise(const PhaseSeries& x, std::int64_t m, Estimator est, NoiseIdDomain domain) {
+  if (m < 1 || x.points() < 3 || static_cast<std::size_t>(m) > x.points() - 1) return 0;
+  // Points at τ: phase samples for phase data, averaged frequencies (one fewer) for frequency data.
+  const std::size_t phase_points = (x.points() - 1) / static_cast<std::size_t>(m) + 1;
+  if (domain == NoiseIdDomain::Phase && phase_points >= kMinAcfPoints)
+    return std::clamp(acf_exponent(x, m, phase_points, 0) + 2, -2, 2);
+  if (domain == NoiseIdDomain::Frequency && phase_points - 1 >= kMinAcfPoints)
+    return std::clamp(acf_exponent(x, m, phase_points, 1), -2, 2);
+  return noise_id_b1(x, m, est);
+}
+
+}  // namespace rwcalc
