@@ -14,19 +14,13 @@
 ///   R  °/h²       rate ramp
 /// Allan variances enter in (°/h)² at τ in seconds.
 ///
-/// Method: the squared coefficients c ≥ 0 maximise the likelihood of the AV points under the
-/// scaled-χ² law ν·σ̂²/σ² ~ χ²_ν, i.e. minimise the Gamma deviance
-///   D = Σ ν_j [σ̂²_j/σ²_j − 1 − ln(σ̂²_j/σ²_j)],
-/// by iteratively reweighted non-negative least squares (weights ν/σ⁴ from the model, never from
-/// the data). Neighbouring overlapping-AV points are correlated while the deviance treats them as
-/// independent. So, for the overlapping estimator, the covariance matrix of the AV points is
-/// computed from the fitted model itself (Gaussian fourth moments of the second differences, via
-/// the generalized structure function of each term; noise-models §4.4 extended to pairs of τ), its
-/// diagonal gives model-based EDFs for a second fit, and a sandwich covariance gives each term's
-/// variance inflation φ_i over the independent-points information, times a small-EDF factor
-/// 1 + a/ν_i (ν_i the term's own effective EDF). A model-error floor is estimated from the
-/// residuals. Intervals are profile-likelihood intervals of the deviance scaled by φ_i, never negative; a term whose lower bound is 0 is
-/// reported as an upper bound.
+/// Method (docs/analysis.md): the squared coefficients c ≥ 0 minimise the Gamma deviance
+///   D = Σ ν_j [σ̂²_j/σ²_j − 1 − ln(σ̂²_j/σ²_j)]
+/// of the scaled-χ² law ν·σ̂²/σ² ~ χ²_ν, by iteratively reweighted non-negative least squares.
+/// For the overlapping estimator the covariance of the AV points is computed from the fitted model
+/// (model-based EDFs, and a sandwich inflation φ_i of each term's variance times 1 + a/ν_i); a
+/// model-error floor comes from the residuals. Intervals are profile-likelihood intervals of the
+/// deviance scaled by φ_i, never negative; a term whose lower bound is 0 is an upper bound.
 #include <Eigen/Dense>
 #include <array>
 #include <cstddef>
@@ -74,13 +68,9 @@ struct FitOptions {
   double tau_max_s = std::numeric_limits<double>::infinity();   ///< fit range, s (inclusive)
   /// Points with fewer EDF are left out of the fit (they are still listed in the AV table).
   double min_edf = 1.0;
-  /// Model-error floor: each point's EDF enters as 1/(1/ν + 1/edf_cap), i.e. a relative model
-  /// uncertainty of √(2/edf_cap) on σ². 0 (default): estimated from the residuals of the fit
-  /// (Paule–Mandel: the smallest floor that brings Σ r²/(2/ν + 2/edf_cap) down to the residual
-  /// degrees of freedom, r the relative residuals; none when the residuals are within their
-  /// sampling scatter; at most the floor of edf_cap = 10⁴, 1.4 % on σ²), so that data following
-  /// the model keep their full weight while points with 10⁵ EDF at short τ do not force the fit
-  /// through real model defects.
+  /// Model-error floor: each point's EDF enters as 1/(1/ν + 1/edf_cap), a relative model
+  /// uncertainty of √(2/edf_cap) on σ². 0 (default): estimated from the fit's residuals
+  /// (Paule–Mandel; none when they are within their sampling scatter, at most edf_cap = 10⁴).
   double edf_cap = 0;
   /// Which terms are fitted (false: held at 0 and reported as not fitted).
   std::array<bool, kTermCount> enabled{true, true, true, true, true};
@@ -89,23 +79,16 @@ struct FitOptions {
   /// Constant variance inflation on top of the model-based one (1: none).
   double dispersion = 1.0;
   /// Small-EDF inflation a: each term's profile deviance is scaled by 1 + a/ν_i on top of its
-  /// sandwich inflation, ν_i = 2ĉ²/Var(ĉ) being the term's own effective EDF (1 + a for a term at
-  /// 0). The profile deviance of a term estimated from a few EDF (B from the long-τ points) has
-  /// heavier tails than χ²₁; well-determined terms (N from 10³+ EDF) are not affected. Calibrated
-  /// by simulation (tests/slow_coverage_fit.cpp, docs/analysis.md).
+  /// sandwich inflation, ν_i = 2ĉ²/Var(ĉ) the term's own effective EDF (a few-EDF term such as B
+  /// has heavier tails than χ²₁). Calibrated by simulation (tests/slow_coverage_fit.cpp).
   double edf_inflation = 3.0;
-  /// Use the model-based covariance of the AV points (EDFs and sandwich inflation) when the
-  /// points carry cluster sizes and term counts.
+  /// Use the model-based covariance of the AV points when they carry cluster sizes and terms.
   bool model_covariance = true;
-  /// Term selection: a term marked droppable whose removal raises the scaled deviance by less
-  /// than the χ²₁ quantile at `confidence` is left out of the model used for the other terms'
-  /// intervals (backward elimination in the order R, K, Q); it is reported as the upper bound of
-  /// the full model. N and B, the verdict's parameters, are never dropped.
+  /// Term selection: a droppable term whose removal raises the scaled deviance by less than the χ²₁
+  /// quantile is left out of the model (backward elimination R, K, Q) and reported as the full
+  /// model's upper bound. N and B, the verdict's parameters, are never dropped.
   bool select_terms = true;
   std::array<bool, kTermCount> droppable{true, false, false, true, true};
-  /// Threads for the point covariance (0: all hardware threads; at most two are used). The
-  /// result does not depend on it.
-  unsigned threads = 0;
 };
 
 /// One fitted coefficient in its IEEE unit (see term_unit).
@@ -131,8 +114,8 @@ struct FitResult {
   double p_value = 1;          ///< P(χ²_dof ≥ chi2)
   double corr_NQ = 0;          ///< correlation of the N² and Q² estimates
   double corr_NB = 0;          ///< correlation of the N² and B² estimates
-  /// Variance inflation of each term's estimate caused by the correlation of the AV points
-  /// (sandwich / independent-points information, ≥ 1), times options.dispersion·(1 + edf_inflation/ν_i).
+  /// Variance inflation of each term: sandwich / independent-points information, times
+  /// options.dispersion·(1 + edf_inflation/ν_i).
   std::array<double, kTermCount> phi{1, 1, 1, 1, 1};
   bool model_covariance = false;  ///< the model-based AV covariance was used
   int iterations = 0;
@@ -143,24 +126,19 @@ struct FitResult {
   [[nodiscard]] const Coefficient& operator[](Term t) const { return coef[static_cast<int>(t)]; }
   /// Model σ² at τ (s), (°/h)².
   [[nodiscard]] double model_var(double tau_s) const;
-  /// Confidence distribution of a coefficient: the probability that its true value is ≤ `value`
-  /// (IEEE unit), from the signed root of the scaled profile deviance, Φ(sign·√(ΔD/φ)).
-  /// Consistent with the intervals: cdf(low) = (1−conf)/2 and cdf(high) = (1+conf)/2.
+  /// Confidence distribution of a coefficient: P(true value ≤ `value`, IEEE unit) = Φ(sign·√(ΔD/φ))
+  /// from the scaled profile deviance; cdf(low) = (1−conf)/2 and cdf(high) = (1+conf)/2.
   [[nodiscard]] double cdf(Term t, double value) const;
   /// Correlation of the log-estimates of two terms (0 when either is not active).
   [[nodiscard]] double log_correlation(Term a, Term b) const;
 };
 
 /// Covariance matrix, (°/h)⁴, of overlapping-AV estimates at the given points (each needs m and
-/// terms) for Gaussian noise following the model with fit-scale squared coefficients c (the ramp,
-/// being deterministic, adds none). All pairs of τ are covered (lags summed on a mesh graded
-/// towards the kinks of the lag covariance).
-Eigen::MatrixXd av_covariance(std::span<const FitPoint> points, const Eigen::Matrix<double, kTermCount, 1>& c);
-/// Same; with `diagonal_only` only the variances (the off-diagonal entries stay 0: j of the
-/// j(j+1)/2 entries). The rows are computed on up to `threads` threads (0: all hardware threads,
-/// at most two); every entry is the same whatever the thread count.
+/// terms) for Gaussian noise following the model with fit-scale squared coefficients c (the ramp
+/// adds none); lags are summed on a mesh graded towards the kinks of the lag covariance. With
+/// `diagonal_only` only the variances (the off-diagonal entries stay 0).
 Eigen::MatrixXd av_covariance(std::span<const FitPoint> points, const Eigen::Matrix<double, kTermCount, 1>& c,
-                              bool diagonal_only, unsigned threads = 1);
+                              bool diagonal_only = false);
 
 /// The points of an Allan result usable for a fit (σ² > 0 is checked by fit_noise); cluster sizes
 /// and term counts are filled for the overlapping estimator only.
@@ -170,10 +148,9 @@ std::vector<FitPoint> fit_points(const AllanResult& allan);
 /// range, when a point is not a positive finite variance, or when the fit does not converge.
 FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options = {});
 
-/// The classic slope-line readout (IEEE 952 Annex C; MATLAB allanvar example): N from the −½
-/// line through the AV point whose local log-slope is closest to −½, read at τ = 1 h; B = σ_min/0.6643;
-/// K from the +½ line read at τ = 3 h. Each is empty when no part of the curve has the slope
-/// (within ±0.25).
+/// The classic slope-line readout (IEEE 952 Annex C): N from the −½ line through the AV point whose
+/// local log-slope is closest to −½, read at τ = 1 h; B = σ_min/0.6643; K from the +½ line read at
+/// τ = 3 h. Each is empty when no part of the curve has the slope within ±0.25.
 struct SlopeReadout {
   std::optional<double> N;  ///< °/√h
   double tau_N_s = 0;       ///< τ of the point the −½ line goes through, s

@@ -366,7 +366,6 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   try {
     detail::ScopedTimer t("analyze: fit");
     FitOptions fopt = options.fit;
-    if (fopt.threads == 0) fopt.threads = posted_scan ? 1u : 0u;
     r.fit = fit_noise(fit_points(fitted), fopt);
   } catch (const AnalysisError& e) {
     throw AnalysisError(fmt::format("{}: {}", rec.source, e.what()));

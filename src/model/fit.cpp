@@ -11,11 +11,11 @@
 #include <boost/math/special_functions/digamma.hpp>
 #include <cmath>
 #include <numbers>
-#include <thread>
+#include <tuple>
+#include <utility>
 
-#include "model/fit_kernels.hpp"
 #include "rwcalc/error.hpp"
-#include "rwcalc/thread.hpp"
+#include "rwcalc/parallel.hpp"
 
 namespace rwcalc {
 
@@ -245,6 +245,386 @@ struct Profiler {
   }
 };
 
+/// Upper confidence root of term i on the scale t = √d, given a finished fit.
+double upper_root(const Profiler& prof, int i, double t_hat, double step, double thr) {
+  auto g = [&](double t) { return std::sqrt(prof.delta(i, t * t)) - std::sqrt(thr); };
+  if (!(step > 0)) step = std::max(t_hat, 1.0);
+  double t_hi = t_hat + step;
+  double g_hi = g(t_hi);
+  for (int k = 0; k < 200 && !(g_hi > 0); ++k) {
+    t_hi = t_hat + (t_hi - t_hat) * 2.0;
+    g_hi = g(t_hi);
+  }
+  if (!(g_hi > 0)) return kInf;
+  return find_root(g, t_hat, -std::sqrt(thr), t_hi, g_hi);
+}
+
+/// Fisher-scale step of term i for bracketing its upper bound: √(z·sd(d_i)) at d_i = 0.
+double fisher_step(const Problem& pr, const Eigen::VectorXd& mu, int i, double z, double dispersion) {
+  const Eigen::VectorXd wf = pr.nu.array() / (2.0 * mu.array().square());
+  const Eigen::MatrixXd info = pr.g.transpose() * (pr.g.array().colwise() * wf.array()).matrix();
+  return info(i, i) > 0 ? std::sqrt(z * std::sqrt(dispersion / info(i, i))) : 0.0;
+}
+
+/// Covariance of the fit-scale estimates: sandwich I⁻¹ (GᵀWΣWG) I⁻¹ over the terms in `set`, and
+/// each term's inflation: the ratio to the independent-points I⁻¹ times the dispersion and the
+/// small-EDF factor 1 + a/ν_i, ν_i the term's own effective EDF 2ĉ²/Var(ĉ) (at most 1 + a: a term
+/// at the boundary). Σ is the covariance of the AV points (empty: independent with variance 2μ²/ν,
+/// where the sandwich equals I⁻¹).
+struct Sandwich {
+  Eigen::MatrixXd cov;        // over `set`, scaled parameters
+  std::vector<double> phi;    // per member of `set`
+  std::vector<double> extra;  // the part of phi beyond the sandwich ratio (small-EDF factor)
+};
+
+Sandwich sandwich(const Problem& pr, const Vec5& d, const std::vector<int>& set, const Eigen::MatrixXd& sigma_y,
+                  const FitOptions& options) {
+  Sandwich sw;
+  const auto k = static_cast<Eigen::Index>(set.size());
+  if (k == 0) return sw;
+  const Eigen::VectorXd mu = pr.g * d;
+  Eigen::MatrixXd g(pr.g.rows(), k);
+  for (Eigen::Index q = 0; q < k; ++q) g.col(q) = pr.g.col(set[static_cast<std::size_t>(q)]);
+  const Eigen::VectorXd w = pr.nu.array() / (2.0 * mu.array().square());
+  const Eigen::MatrixXd gw = g.array().colwise() * w.array();
+  const Eigen::MatrixXd info = g.transpose() * gw;
+  const Eigen::MatrixXd inv = info.inverse();
+  if (sigma_y.size() == 0) {
+    sw.cov = inv;
+  } else {
+    const Eigen::MatrixXd meat = gw.transpose() * sigma_y * gw;
+    sw.cov = inv * meat * inv;
+  }
+  for (Eigen::Index q = 0; q < k; ++q) {
+    const double r = inv(q, q) > 0 ? sw.cov(q, q) / inv(q, q) : 1.0;
+    const double v = sw.cov(q, q);
+    const int i = set[static_cast<std::size_t>(q)];
+    const double nu = v > 0 ? 2.0 * d[i] * d[i] / v : 0.0;
+    const double f = options.dispersion * (1.0 + options.edf_inflation / std::max(nu, 1.0));
+    sw.phi.push_back((std::isfinite(r) && r > 0 ? r : 1.0) * f);
+    sw.extra.push_back(f);
+  }
+  return sw;
+}
+
+/// "No floor": the EDF cap used when the residuals call for none.
+constexpr double kNoFloor = 1e12;
+/// The largest estimated floor: a relative uncertainty of √(2/10⁴) = 1.4 % on σ² (the data then
+/// depart from the five-term model far more than any floor can describe; χ²/dof says so).
+constexpr double kMinCap = 1e4;
+
+/// The model-error floor as an EDF cap 2/s²: s² ≥ 0 solves Σ r²/(2/ν + s²) = J − p for the
+/// relative residuals r = (σ̂² − μ)/μ (Paule–Mandel), none when the residuals are already within
+/// their sampling scatter, at most kMinCap's. The points' correlation is ignored here (positively
+/// correlated points scatter less about a fit than independent ones, so this errs towards no floor).
+double model_error_cap(const Problem& pr, const Eigen::VectorXd& mu, int p) {
+  const auto j = pr.y.size();
+  const double target = static_cast<double>(std::max<Eigen::Index>(1, j - p));
+  auto x2 = [&](double s2) {
+    double x = 0;
+    for (Eigen::Index r = 0; r < j; ++r) {
+      const double q = (pr.y[r] - mu[r]) / mu[r];
+      x += q * q / (2.0 / pr.nu[r] + s2);
+    }
+    return x;
+  };
+  if (!(x2(0.0) > target)) return kNoFloor;
+  double lo = 0, hi = 1e-6;
+  while (x2(hi) > target && hi < 1e6) hi *= 4;
+  for (int it = 0; it < 100; ++it) {
+    const double m = 0.5 * (lo + hi);
+    (x2(m) > target ? lo : hi) = m;
+  }
+  return std::clamp(2.0 / hi, kMinCap, kNoFloor);
+}
+
+/// Σ_y: the model covariance of the points plus the model-error floor 2μ²/edf_cap on the diagonal.
+Eigen::MatrixXd point_covariance(std::span<const FitPoint> pts, const Vec5& c, const Eigen::VectorXd& mu,
+                                 double edf_cap) {
+  Eigen::MatrixXd s = av_covariance(pts, c);
+  if (edf_cap > 0)
+    for (Eigen::Index r = 0; r < s.rows(); ++r) s(r, r) += 2.0 * mu[r] * mu[r] / edf_cap;
+  return s;
+}
+
+constexpr std::array<double, 3> kTap{1.0, -2.0, 1.0};  // weights of a second difference's taps
+
+/// Two overlapping-AV points: cluster sizes and numbers of terms.
+struct PointPair {
+  std::int64_t ma, mb;
+  double na, nb;
+  /// The lag k·ma − l·mb at which tap k of a's second differences meets tap l of b's.
+  [[nodiscard]] std::int64_t kink(int k, int l) const { return k * ma - l * mb; }
+  /// Pairs (z^a_i, z^b_{i+h}) of terms at lag h.
+  [[nodiscard]] double count(double h) const { return std::max(0.0, std::min(na, nb - h) - std::max(0.0, -h)); }
+};
+
+/// Generalized structure function of the continuous terms, ″², at lag u samples (S(0) = 0):
+/// S(u) = c1·t − (c2/π)·t²·ln t − c3·t³/6, t = u·τ0.
+struct Structure {
+  double tau0, c1, c2, c3;
+  [[nodiscard]] double operator()(double u) const {
+    if (u <= 0) return 0.0;
+    const double t = u * tau0;
+    return t * (c1 - t * (c2 / std::numbers::pi * std::log(t) + c3 * t / 6.0));
+  }
+};
+
+/// Cov(z^a_i, z^b_{i+h}) of the continuous terms: −½ Σ a_k b_l S(|o_k − h − p_l|).
+double gamma_continuous(const PointPair& pp, const Structure& s, double h) {
+  double g = 0;
+  for (int k = 0; k < 3; ++k)
+    for (int l = 0; l < 3; ++l)
+      g += kTap[static_cast<std::size_t>(k)] * kTap[static_cast<std::size_t>(l)] *
+           s(std::abs(static_cast<double>(pp.kink(k, l)) - h));
+  return -0.5 * g;
+}
+
+/// Σ_h count(h)·γ(h)² over the integer lags. γ is smooth between its kinks (where a structure
+/// function's argument crosses 0) and varies there on the scale of the smaller cluster, farther
+/// away on the scale of the distance to the nearest kink. So each stretch between kinks is summed
+/// with blocks that are single lags (or m/16) next to a kink and grow geometrically towards the
+/// middle of the stretch; each block contributes its length times the summand at its centre.
+double graded_gamma_sq_sum(const PointPair& pp, const Structure& s) {
+  const std::int64_t mx = std::max(pp.ma, pp.mb);
+  std::array<std::int64_t, 11> knots{-(2 * pp.mb + 4 * mx), 2 * pp.ma + 4 * mx + 1};
+  for (int q = 0; q < 9; ++q) knots[static_cast<std::size_t>(2 + q)] = pp.kink(q / 3, q % 3);
+  std::sort(knots.begin(), knots.end());
+  const std::int64_t s0 = std::max<std::int64_t>(1, std::min(pp.ma, pp.mb) / 16);
+  double total = 0;
+  auto block = [&](std::int64_t start, std::int64_t len) {
+    const double hc = static_cast<double>(start) + 0.5 * static_cast<double>(len - 1);
+    const double wc = static_cast<double>(len) * pp.count(hc);
+    if (wc > 0) {
+      const double g = gamma_continuous(pp, s, hc);
+      total += wc * g * g;
+    }
+  };
+  for (std::size_t q = 0; q + 1 < knots.size(); ++q) {
+    const std::int64_t left = knots[q], right = knots[q + 1];
+    const std::int64_t mid = left + (right - left) / 2;  // lags left … right − 1, graded to both ends
+    for (std::int64_t h = left, len = 0; h < mid; h += len) {
+      len = std::min(mid - h, std::max(s0, (h - left) / 4));
+      block(h, len);
+    }
+    for (std::int64_t h = right, len = 0; h > mid; h -= len) {
+      len = std::min(h - mid, std::max(s0, (right - h) / 4));
+      block(h - len, len);
+    }
+  }
+  return total;
+}
+
+/// White angle noise (Q², coefficient cq): exact additions to `total` at the few lags where sample
+/// indices coincide (each distinct kink once); the graded sum already holds (about) γ_c² there, so
+/// the cross and Q² terms.
+void add_white_angle_terms(const PointPair& pp, const Structure& s, double cq, double& total) {
+  for (int q = 0; q < 9; ++q) {
+    const std::int64_t h = pp.kink(q / 3, q % 3);
+    double gq = 0;
+    bool seen = false;
+    for (int r = 0; r < 9; ++r)
+      if (pp.kink(r / 3, r % 3) == h) {
+        seen = seen || r < q;
+        gq += kTap[static_cast<std::size_t>(r / 3)] * kTap[static_cast<std::size_t>(r % 3)];
+      }
+    if (seen) continue;
+    gq *= cq;
+    const auto hd = static_cast<double>(h);
+    const double gc = gamma_continuous(pp, s, hd);
+    total += pp.count(hd) * (2.0 * gc * gq + gq * gq);
+  }
+}
+
+/// Cov(σ̂²_a, σ̂²_b) of two overlapping-AV points.
+double point_pair_covariance(const FitPoint& a, const FitPoint& b, const Structure& s, double cq) {
+  if (a.m <= 0 || b.m <= 0 || a.terms <= 0 || b.terms <= 0) return 0.0;
+  const PointPair pp{a.m, b.m, static_cast<double>(a.terms), static_cast<double>(b.terms)};
+  double total = graded_gamma_sq_sum(pp, s);
+  if (cq > 0) add_white_angle_terms(pp, s, cq, total);
+  return 2.0 * total / (4.0 * a.tau_s * a.tau_s * b.tau_s * b.tau_s * pp.na * pp.nb);
+}
+
+/// One fitted problem: its design and the IRLS optimum.
+struct Stage {
+  Problem pr;
+  IrlsResult fit;
+  [[nodiscard]] Vec5 coefficients() const { return fit.d.cwiseProduct(pr.scale); }
+  [[nodiscard]] Eigen::VectorXd model() const { return pr.g * fit.d; }
+};
+
+void require_converged(const IrlsResult& r) {
+  if (!std::isfinite(r.dev) || !r.d.allFinite()) throw AnalysisError("the noise-model fit did not converge");
+}
+
+/// The points in the fit range with enough EDF, τ ascending; throws when too few remain.
+std::vector<FitPoint> points_in_range(std::span<const FitPoint> points, const FitOptions& options) {
+  if (!(options.dispersion > 0) || !(options.confidence > 0 && options.confidence < 1) ||
+      !(options.edf_cap >= 0) || !(options.edf_inflation >= 0))
+    throw UsageError("fit options: dispersion and EDF cap must be positive, confidence in (0, 1)");
+  int n_enabled = 0;
+  for (bool e : options.enabled) n_enabled += e ? 1 : 0;
+  if (n_enabled == 0) throw UsageError("fit: no term enabled");
+  std::vector<FitPoint> used;
+  for (const auto& p : points) {
+    if (!(p.tau_s >= options.tau_min_s && p.tau_s <= options.tau_max_s)) continue;
+    if (!(p.edf >= options.min_edf)) continue;
+    if (!std::isfinite(p.var) || !(p.var > 0))
+      throw AnalysisError(fmt::format(
+          "the Allan variance at tau = {:g} s is {:g}: the record holds no noise there (constant "
+          "or perfectly regular data); no noise model can be fitted",
+          p.tau_s, p.var));
+    used.push_back(p);
+  }
+  std::sort(used.begin(), used.end(), [](const auto& a, const auto& b) { return a.tau_s < b.tau_s; });
+  const int j = static_cast<int>(used.size());
+  if (j < n_enabled + 1)
+    throw AnalysisError(fmt::format(
+        "only {} Allan-variance point(s) with at least {:g} degrees of freedom lie in the fit range "
+        "{:g}..{:g} s; a fit of {} terms needs at least {} (use a longer record or a wider "
+        "--fit-range)",
+        j, options.min_edf, options.tau_min_s, options.tau_max_s, n_enabled, n_enabled + 1));
+  return used;
+}
+
+/// Stages 1 and 2: the full model (all enabled terms) with the estimator's own EDFs; with the model
+/// covariance, the points' EDFs from the model (written into `used`) and the full model again;
+/// then the model-error floor (opt.edf_cap, estimated from the residuals unless fixed).
+Stage fit_full_model(std::vector<FitPoint>& used, const FitOptions& options, bool use_cov, FitOptions& opt) {
+  opt = options;
+  Stage full{make_problem(used, options), {}};
+  full.fit = irls(full.pr, full.pr.enabled_mask, Vec5::Zero(), true);
+  require_converged(full.fit);
+  if (use_cov) {
+    const Vec5 c0 = full.coefficients();
+    const Eigen::VectorXd mu0 = full.model();
+    const Eigen::MatrixXd cov0 = av_covariance(used, c0, true);  // only its diagonal is used
+    for (std::size_t r = 0; r < used.size(); ++r) {
+      const double v = cov0(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(r));
+      if (v > 0 && std::isfinite(v)) used[r].edf = 2.0 * mu0[static_cast<Eigen::Index>(r)] * mu0[static_cast<Eigen::Index>(r)] / v;
+    }
+    full.pr = make_problem(used, opt);
+    full.fit = irls(full.pr, full.pr.enabled_mask, c0.cwiseQuotient(full.pr.scale), false);
+    require_converged(full.fit);
+  }
+  if (!(options.edf_cap > 0)) {
+    opt.edf_cap = model_error_cap(full.pr, full.model(), std::popcount(full.pr.enabled_mask));
+    if (opt.edf_cap < kNoFloor) {
+      const Vec5 c_prev = full.coefficients();
+      full.pr = make_problem(used, opt);
+      full.fit = irls(full.pr, full.pr.enabled_mask, c_prev.cwiseQuotient(full.pr.scale), false);
+      require_converged(full.fit);
+    }
+  }
+  return full;
+}
+
+/// Stage 3, term selection: a droppable term whose removal raises the scaled deviance by less
+/// than the χ²₁ quantile is left out of the model (`dropped`); it is reported as an upper bound
+/// from the full model. Returns the selected model's options and fit.
+std::pair<FitOptions, IrlsResult> select_terms(const std::vector<FitPoint>& used, const FitOptions& opt,
+                                               const IrlsResult& full, const std::array<double, P>& phi_full,
+                                               double chi2_1, std::array<bool, P>& dropped) {
+  FitOptions final_opt = opt;
+  IrlsResult best = full;
+  for (int i : {idx(Term::R), idx(Term::K), idx(Term::Q)}) {
+    const auto ui = static_cast<std::size_t>(i);
+    if (!final_opt.enabled[ui] || !opt.droppable[ui]) continue;
+    FitOptions trial = final_opt;
+    trial.enabled[ui] = false;
+    const Problem tp = make_problem(used, trial);
+    Vec5 start = best.d;  // column scales do not depend on the enabled terms
+    start[i] = 0;
+    const IrlsResult r = irls(tp, tp.enabled_mask, start, false);
+    if (std::isfinite(r.dev) && (r.dev - best.dev) / phi_full[ui] < chi2_1) {
+      final_opt = trial;
+      best = r;
+      dropped[ui] = true;
+    }
+  }
+  return {final_opt, best};
+}
+
+/// Goodness of fit of the selected model (points taken as independent with their EDFs; see docs).
+void goodness_of_fit(const Stage& st, FitResult& res) {
+  int active = 0;
+  for (int i = 0; i < P; ++i) active += st.fit.d[i] > 0 ? 1 : 0;
+  res.dof = static_cast<int>(st.pr.y.size()) - active;
+  const Eigen::VectorXd mu = st.model();
+  double chi2 = 0;
+  for (Eigen::Index r = 0; r < st.pr.y.size(); ++r) {
+    const double q = st.pr.y[r] / mu[r];
+    chi2 += st.pr.nu[r] * (q - 1.0 - std::log(q)) / bartlett(st.pr.nu[r]);
+  }
+  res.chi2 = chi2;
+  res.chi2_per_dof = res.dof > 0 ? chi2 / res.dof : 0.0;
+  const boost::math::chi_squared_distribution<double> dist(std::max(res.dof, 1));
+  res.p_value = res.dof > 0 ? boost::math::cdf(boost::math::complement(dist, chi2)) : 1.0;
+}
+
+/// Covariance of the active terms (sandwich) and each term's inflation; a term at the boundary of
+/// the selected model takes it from the model with the term added, a dropped one from the full model.
+void term_covariance(const Stage& st, const Eigen::MatrixXd& sigma_y, const FitOptions& options,
+                     const std::array<double, P>& phi_full, const std::array<bool, P>& dropped, FitResult& res) {
+  std::vector<int> act;
+  for (int i = 0; i < P; ++i)
+    if (st.fit.d[i] > 0) act.push_back(i);
+  res.cov_c.setZero();
+  const Sandwich sw = sandwich(st.pr, st.fit.d, act, sigma_y, options);
+  for (std::size_t r = 0; r < act.size(); ++r) {
+    res.phi[static_cast<std::size_t>(act[r])] = sw.phi[r];
+    for (std::size_t q = 0; q < act.size(); ++q)
+      res.cov_c(act[r], act[q]) = sw.cov(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(q)) *
+                                  std::sqrt(sw.extra[r] * sw.extra[q]) * st.pr.scale[act[r]] * st.pr.scale[act[q]];
+  }
+  for (int i = 0; i < P; ++i) {
+    const auto ui = static_cast<std::size_t>(i);
+    if (st.fit.d[i] > 0 || !res.options.enabled[ui]) {
+      if (dropped[ui]) res.phi[ui] = phi_full[ui];
+      continue;
+    }
+    std::vector<int> set = act;
+    set.push_back(i);
+    res.phi[ui] = sandwich(st.pr, st.fit.d, set, sigma_y, options).phi.back();
+  }
+}
+
+/// Stage 4, one term's profile-likelihood interval on the coefficient scale t = √d: an upper bound
+/// from the full model's profile for a dropped term, else the interval of the selected model.
+Coefficient coefficient_interval(int i, const Stage& sel, const Stage& full, bool dropped, const FitResult& res,
+                                 double z, double chi2_1) {
+  const auto ui = static_cast<std::size_t>(i);
+  Coefficient co;
+  co.in_model = res.options.enabled[ui];
+  const double phi = res.phi[ui];
+  const double thr = phi * chi2_1;
+  const Stage& st = dropped ? full : sel;
+  const Profiler prof{st.pr, st.fit.d, st.fit.dev};
+  const double kf = kCoefScale[ui] * std::sqrt(st.pr.scale[i]);  // coefficient = kf·t
+  const double t_hat = std::sqrt(st.fit.d[i]);
+  co.estimate = kf * t_hat;
+  double t_low = 0;
+  if (!dropped && t_hat > 0) {
+    auto g = [&](double t) { return std::sqrt(prof.delta(i, t * t)) - std::sqrt(thr); };
+    const double g0 = g(0.0);
+    if (g0 > 0) {
+      t_low = find_root(g, 0.0, g0, t_hat, -std::sqrt(thr));
+      co.resolved = true;
+    }
+  }
+  double step = fisher_step(st.pr, st.model(), i, z, phi);
+  if (dropped)
+    step = std::max(step, t_hat);
+  else if (t_hat > 0 && res.cov_c(i, i) > 0)
+    step = std::max(step, z * std::sqrt(res.cov_c(i, i)) / st.pr.scale[i] / (2.0 * t_hat));
+  co.low = co.resolved ? kf * t_low : 0.0;
+  co.high = kf * upper_root(prof, i, t_hat, step, thr);
+  co.value = co.resolved ? co.estimate : co.high;
+  // Delta method for a resolved term: coefficient = k√c → sd = k·sd(c)/(2√c).
+  co.sigma = co.resolved ? kCoefScale[ui] * std::sqrt(res.cov_c(i, i)) / (2.0 * std::sqrt(res.c[i])) : co.high / (2.0 * z);
+  return co;
+}
+
 }  // namespace
 
 std::string_view term_name(Term t) {
@@ -312,480 +692,71 @@ double FitResult::cdf(Term t, double value) const {
   return normal_cdf(v >= d_hat[i] ? r : -r);
 }
 
-namespace {
-
-/// Upper confidence root of term i on the scale t = √d, given a finished fit.
-double upper_root(const Profiler& prof, int i, double t_hat, double step, double thr) {
-  auto g = [&](double t) { return std::sqrt(prof.delta(i, t * t)) - std::sqrt(thr); };
-  if (!(step > 0)) step = std::max(t_hat, 1.0);
-  double t_hi = t_hat + step;
-  double g_hi = g(t_hi);
-  for (int k = 0; k < 200 && !(g_hi > 0); ++k) {
-    t_hi = t_hat + (t_hi - t_hat) * 2.0;
-    g_hi = g(t_hi);
-  }
-  if (!(g_hi > 0)) return kInf;
-  return find_root(g, t_hat, -std::sqrt(thr), t_hi, g_hi);
-}
-
-/// Fisher-scale step of term i for bracketing its upper bound: √(z·sd(d_i)) at d_i = 0.
-double fisher_step(const Eigen::MatrixXd& info, int i, double z, double dispersion) {
-  return info(i, i) > 0 ? std::sqrt(z * std::sqrt(dispersion / info(i, i))) : 0.0;
-}
-
-Eigen::MatrixXd fisher_info(const Problem& pr, const Eigen::VectorXd& mu) {
-  const Eigen::VectorXd wf = pr.nu.array() / (2.0 * mu.array().square());
-  return pr.g.transpose() * (pr.g.array().colwise() * wf.array()).matrix();
-}
-
-}  // namespace
-
-namespace {
-
-/// Covariance of the fit-scale estimates: sandwich I⁻¹ (GᵀWΣWG) I⁻¹ over the terms in `set`, and
-/// each term's inflation over the independent-points I⁻¹. Σ is the covariance of the AV points
-/// (empty: independent with variance 2μ²/ν, where the sandwich equals I⁻¹).
-struct Sandwich {
-  Eigen::MatrixXd cov;      // over `set`, scaled parameters
-  std::vector<double> phi;  // per member of `set`
-  std::vector<double> extra;  // the part of phi beyond the sandwich ratio (small-EDF factor)
-};
-
-Sandwich sandwich(const Problem& pr, const Eigen::VectorXd& mu, const std::vector<int>& set,
-                  const Eigen::MatrixXd& sigma_y) {
-  Sandwich sw;
-  const auto k = static_cast<Eigen::Index>(set.size());
-  if (k == 0) return sw;
-  Eigen::MatrixXd g(pr.g.rows(), k);
-  for (Eigen::Index q = 0; q < k; ++q) g.col(q) = pr.g.col(set[static_cast<std::size_t>(q)]);
-  const Eigen::VectorXd w = pr.nu.array() / (2.0 * mu.array().square());
-  const Eigen::MatrixXd gw = g.array().colwise() * w.array();
-  const Eigen::MatrixXd info = g.transpose() * gw;
-  const Eigen::MatrixXd inv = info.inverse();
-  if (sigma_y.size() == 0) {
-    sw.cov = inv;
-  } else {
-    const Eigen::MatrixXd meat = gw.transpose() * sigma_y * gw;
-    sw.cov = inv * meat * inv;
-  }
-  for (Eigen::Index q = 0; q < k; ++q) {
-    const double r = inv(q, q) > 0 ? sw.cov(q, q) / inv(q, q) : 1.0;
-    sw.phi.push_back(std::isfinite(r) && r > 0 ? r : 1.0);
-  }
-  return sw;
-}
-
-/// "No floor": the EDF cap used when the residuals call for none.
-constexpr double kNoFloor = 1e12;
-/// The largest estimated floor: a relative uncertainty of √(2/10⁴) = 1.4 % on σ² (the data then
-/// depart from the five-term model far more than any floor can describe; χ²/dof says so).
-constexpr double kMinCap = 1e4;
-
-/// The model-error floor as an EDF cap 2/s²: s² ≥ 0 solves Σ r²/(2/ν + s²) = J − p for the
-/// relative residuals r = (σ̂² − μ)/μ (Paule–Mandel), none when the residuals are already within
-/// their sampling scatter, at most kMinCap's. The points' correlation is ignored here (positively
-/// correlated points scatter less about a fit than independent ones, so this errs towards no floor).
-double model_error_cap(const Problem& pr, const Eigen::VectorXd& mu, int p) {
-  const auto j = pr.y.size();
-  const double target = static_cast<double>(std::max<Eigen::Index>(1, j - p));
-  auto x2 = [&](double s2) {
-    double x = 0;
-    for (Eigen::Index r = 0; r < j; ++r) {
-      const double q = (pr.y[r] - mu[r]) / mu[r];
-      x += q * q / (2.0 / pr.nu[r] + s2);
-    }
-    return x;
-  };
-  if (!(x2(0.0) > target)) return kNoFloor;
-  double lo = 0, hi = 1e-6;
-  while (x2(hi) > target && hi < 1e6) hi *= 4;
-  for (int it = 0; it < 100; ++it) {
-    const double m = 0.5 * (lo + hi);
-    (x2(m) > target ? lo : hi) = m;
-  }
-  return std::clamp(2.0 / hi, kMinCap, kNoFloor);
-}
-
-/// Σ_y: the model covariance of the points plus the model-error floor 2μ²/edf_cap on the diagonal.
-Eigen::MatrixXd point_covariance(std::span<const FitPoint> pts, const Vec5& c, const Eigen::VectorXd& mu,
-                                 double edf_cap, unsigned threads) {
-  Eigen::MatrixXd s = av_covariance(pts, c, false, threads);
-  if (edf_cap > 0)
-    for (Eigen::Index r = 0; r < s.rows(); ++r) s(r, r) += 2.0 * mu[r] * mu[r] / edf_cap;
-  return s;
-}
-
-}  // namespace
-
-Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix<double, kTermCount, 1>& c) {
-  return av_covariance(pts, c, false, 1);
-}
-
 Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix<double, kTermCount, 1>& c,
-                              bool diagonal_only, unsigned threads) {
+                              bool diagonal_only) {
   const auto j = static_cast<Eigen::Index>(pts.size());
   Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(j, j);
   if (j == 0) return cov;
-  const double tau0 = pts[0].tau_s / static_cast<double>(pts[0].m);
-  const double cq = c[0];
-  // Generalized structure function of the continuous terms, ″², at lag u samples.
-  auto s_cont = [&](double u) {
-    if (u <= 0) return 0.0;
-    const double t = u * tau0;
-    return c[1] * t - c[2] / std::numbers::pi * t * t * std::log(t) - c[3] * t * t * t / 6.0;
-  };
-  constexpr std::array<double, 3> kw{1.0, -2.0, 1.0};
-  // Row a of the upper triangle; rows go to the threads alternately (row a has j − a entries).
-  auto row = [&](Eigen::Index a, std::vector<double>& centres, std::vector<double>& weights) {
-    for (Eigen::Index b = a; b < (diagonal_only ? a + 1 : j); ++b) {
-      const auto& pa = pts[static_cast<std::size_t>(a)];
-      const auto& pb = pts[static_cast<std::size_t>(b)];
-      const std::int64_t ma = pa.m, mb = pb.m, na = pa.terms, nb = pb.terms;
-      if (ma <= 0 || mb <= 0 || na <= 0 || nb <= 0) continue;
-      const std::int64_t mn = std::min(ma, mb), mx = std::max(ma, mb);
-      const std::array<std::int64_t, 3> oa{0, ma, 2 * ma}, ob{0, mb, 2 * mb};
-      // Cov(z^a_i, z^b_{i+h}) = −½ Σ a_k b_l S(o_k − h − p_l), continuous part.
-      auto gamma_c = [&](double h) {
-        double g = 0;
-        for (int k = 0; k < 3; ++k)
-          for (int l = 0; l < 3; ++l)
-            g += kw[static_cast<std::size_t>(k)] * kw[static_cast<std::size_t>(l)] *
-                 s_cont(std::abs(static_cast<double>(oa[static_cast<std::size_t>(k)]) - h -
-                                 static_cast<double>(ob[static_cast<std::size_t>(l)])));
-        return -0.5 * g;
-      };
-      auto count = [&](double h) {
-        const double hi = std::min(static_cast<double>(na), static_cast<double>(nb) - h);
-        const double lo = std::max(0.0, -h);
-        return std::max(0.0, hi - lo);
-      };
-      // Σ_h count(h)·γ(h)² over the integer lags. γ is smooth between its kinks h = o_k − p_l
-      // (where a structure-function argument crosses 0) and varies there on the scale of the
-      // smaller cluster, farther away on the scale of the distance to the nearest kink. So each
-      // stretch between kinks is summed with blocks that are single lags (or mn/16) next to a
-      // kink and grow geometrically towards the middle of the stretch; each block contributes
-      // its length times the summand at its centre. Pairs of any τ ratio are covered (the
-      // correlation of white-angle-dominated points decays slowly with the ratio).
-      const std::int64_t lo = -(2 * mb + 4 * mx), hi = 2 * ma + 4 * mx + 1;
-      std::array<std::int64_t, 11> knots{};
-      int nk = 0;
-      knots[static_cast<std::size_t>(nk++)] = lo;
-      knots[static_cast<std::size_t>(nk++)] = hi;
-      for (int k = 0; k < 3; ++k)
-        for (int l = 0; l < 3; ++l) knots[static_cast<std::size_t>(nk++)] = oa[static_cast<std::size_t>(k)] - ob[static_cast<std::size_t>(l)];
-      std::sort(knots.begin(), knots.begin() + nk);
-      const std::int64_t s0 = std::max<std::int64_t>(1, mn / 16);
-      // Each block contributes its length times the summand at its centre; the centres and
-      // weights are gathered first and γ² summed over them in one vectorised pass.
-      centres.clear();
-      weights.clear();
-      auto block = [&](std::int64_t start, std::int64_t len) {
-        const double hc = static_cast<double>(start) + 0.5 * static_cast<double>(len - 1);
-        const double wc = static_cast<double>(len) * count(hc);
-        if (wc > 0) {
-          centres.push_back(hc);
-          weights.push_back(wc);
-        }
-      };
-      double total = 0;
-      for (int q = 0; q + 1 < nk; ++q) {
-        const std::int64_t left = knots[static_cast<std::size_t>(q)], right = knots[static_cast<std::size_t>(q + 1)];
-        if (right <= left) continue;
-        // Lags left .. right−1, graded towards both ends.
-        const std::int64_t mid = left + (right - left) / 2;
-        for (std::int64_t h = left; h < mid;) {
-          const std::int64_t len = std::min(mid - h, std::max(s0, (h - left) / 4));
-          block(h, len);
-          h += len;
-        }
-        for (std::int64_t h = right; h > mid;) {
-          const std::int64_t len = std::min(h - mid, std::max(s0, (right - h) / 4));
-          block(h - len, len);
-          h -= len;
-        }
-      }
-      {
-        detail::GammaPair gp;
-        gp.tau0 = tau0;
-        gp.c1 = c[1];
-        gp.c2 = c[2];
-        gp.c3 = c[3];
-        for (int k = 0; k < 3; ++k)
-          for (int l = 0; l < 3; ++l) {
-            const auto q = static_cast<std::size_t>(3 * k + l);
-            gp.d[q] = static_cast<double>(oa[static_cast<std::size_t>(k)] - ob[static_cast<std::size_t>(l)]);
-            gp.w[q] = kw[static_cast<std::size_t>(k)] * kw[static_cast<std::size_t>(l)];
-          }
-        total += detail::gamma_sq_sum(gp, centres.data(), weights.data(), centres.size());
-      }
-      // White angle noise: exact additions at the few lags where sample indices coincide.
-      if (cq > 0) {
-        std::array<std::int64_t, 9> lags{};
-        int nl = 0;
-        for (int k = 0; k < 3; ++k)
-          for (int l = 0; l < 3; ++l) {
-            const std::int64_t h = oa[static_cast<std::size_t>(k)] - ob[static_cast<std::size_t>(l)];
-            if (std::find(lags.begin(), lags.begin() + nl, h) == lags.begin() + nl) lags[static_cast<std::size_t>(nl++)] = h;
-          }
-        for (int q = 0; q < nl; ++q) {
-          const std::int64_t h = lags[static_cast<std::size_t>(q)];
-          double gq = 0;
-          for (int k = 0; k < 3; ++k)
-            for (int l = 0; l < 3; ++l)
-              if (oa[static_cast<std::size_t>(k)] == h + ob[static_cast<std::size_t>(l)])
-                gq += kw[static_cast<std::size_t>(k)] * kw[static_cast<std::size_t>(l)];
-          gq *= cq;
-          const double hd = static_cast<double>(h);
-          const double gc = gamma_c(hd);
-          // The grid already holds (about) gc²; add the cross term and the Q² term.
-          total += count(hd) * (2.0 * gc * gq + gq * gq);
-        }
-      }
-      const double ta = pa.tau_s, tb = pb.tau_s;
-      const double v = 2.0 * total / (4.0 * ta * ta * tb * tb * static_cast<double>(na) * static_cast<double>(nb));
-      cov(a, b) = cov(b, a) = v;
+  const Structure s{pts[0].tau_s / static_cast<double>(pts[0].m), c[1], c[2], c[3]};
+  // Row a of the upper triangle and its mirror: rows write disjoint entries.
+  parallel_for(static_cast<std::size_t>(j), [&](std::size_t a) {
+    const std::size_t end = diagonal_only ? a + 1 : pts.size();
+    for (std::size_t b = a; b < end; ++b) {
+      const double v = point_pair_covariance(pts[a], pts[b], s, c[0]);
+      cov(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) = v;
+      cov(static_cast<Eigen::Index>(b), static_cast<Eigen::Index>(a)) = v;
     }
-  };
-  if (threads == 0) threads = std::thread::hardware_concurrency();
-  if (threads > 1 && !diagonal_only && j >= 8) {
-    Thread other([&] {
-      std::vector<double> centres, weights;
-      for (Eigen::Index a = 1; a < j; a += 2) row(a, centres, weights);
-    });
-    std::vector<double> centres, weights;
-    for (Eigen::Index a = 0; a < j; a += 2) row(a, centres, weights);
-  } else {
-    std::vector<double> centres, weights;
-    for (Eigen::Index a = 0; a < j; ++a) row(a, centres, weights);
-  }
+  });
   return cov;
 }
 
 FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options) {
-  if (!(options.dispersion > 0) || !(options.confidence > 0 && options.confidence < 1) ||
-      !(options.edf_cap >= 0) || !(options.edf_inflation >= 0))
-    throw UsageError("fit options: dispersion and EDF cap must be positive, confidence in (0, 1)");
   FitResult res;
-  int n_enabled = 0;
-  for (bool e : options.enabled) n_enabled += e ? 1 : 0;
-  if (n_enabled == 0) throw UsageError("fit: no term enabled");
-
-  for (const auto& p : points) {
-    if (!(p.tau_s >= options.tau_min_s && p.tau_s <= options.tau_max_s)) continue;
-    if (!(p.edf >= options.min_edf)) continue;
-    if (!std::isfinite(p.var) || !(p.var > 0))
-      throw AnalysisError(fmt::format(
-          "the Allan variance at tau = {:g} s is {:g}: the record holds no noise there (constant "
-          "or perfectly regular data); no noise model can be fitted",
-          p.tau_s, p.var));
-    res.used.push_back(p);
-  }
-  std::sort(res.used.begin(), res.used.end(), [](const auto& a, const auto& b) { return a.tau_s < b.tau_s; });
-  const int j = static_cast<int>(res.used.size());
-  if (j < n_enabled + 1)
-    throw AnalysisError(fmt::format(
-        "only {} Allan-variance point(s) with at least {:g} degrees of freedom lie in the fit range "
-        "{:g}..{:g} s; a fit of {} terms needs at least {} (use a longer record or a wider "
-        "--fit-range)",
-        j, options.min_edf, options.tau_min_s, options.tau_max_s, n_enabled, n_enabled + 1));
-
+  res.used = points_in_range(points, options);
   const double z = normal_quantile(0.5 + options.confidence / 2.0);
   const double chi2_1 = chi2_quantile(options.confidence, 1.0);
-  const bool use_cov = options.model_covariance &&
-                       std::all_of(res.used.begin(), res.used.end(), [](const FitPoint& p) { return p.m > 0 && p.terms > 0; });
-  res.model_covariance = use_cov;
-
-  // 1. The full model (all enabled terms) with the estimator's own EDFs.
-  Problem full_pr = make_problem(res.used, options);
-  IrlsResult full = irls(full_pr, full_pr.enabled_mask, Vec5::Zero(), true);
-  if (!std::isfinite(full.dev) || !full.d.allFinite()) throw AnalysisError("the noise-model fit did not converge");
-  FitOptions opt = options;  // edf_cap: the one in force (estimated when options.edf_cap is 0)
-
-  // 2. Model-based EDFs and point covariance, then the full model again.
+  auto has_terms = [](const FitPoint& p) { return p.m > 0 && p.terms > 0; };
+  res.model_covariance = options.model_covariance && std::all_of(res.used.begin(), res.used.end(), has_terms);
+  FitOptions opt;  // edf_cap: the one in force (estimated when options.edf_cap is 0)
+  const Stage full = fit_full_model(res.used, options, res.model_covariance, opt);
   Eigen::MatrixXd sigma_y;
-  if (use_cov) {
-    Vec5 c0;
-    for (int i = 0; i < P; ++i) c0[i] = full.d[i] * full_pr.scale[i];
-    const Eigen::VectorXd mu0 = full_pr.g * full.d;
-    const Eigen::MatrixXd cov0 = av_covariance(res.used, c0, true, 1);  // only its diagonal is used
-    for (int r = 0; r < j; ++r) {
-      const double v = cov0(r, r);
-      if (v > 0 && std::isfinite(v)) res.used[static_cast<std::size_t>(r)].edf = 2.0 * mu0[r] * mu0[r] / v;
-    }
-    full_pr = make_problem(res.used, opt);
-    Vec5 d1;
-    for (int i = 0; i < P; ++i) d1[i] = c0[i] / full_pr.scale[i];
-    full = irls(full_pr, full_pr.enabled_mask, d1, false);
-    if (!std::isfinite(full.dev) || !full.d.allFinite()) throw AnalysisError("the noise-model fit did not converge");
-  }
-  // Model-error floor: estimated from the residuals unless fixed by the options.
-  if (!(options.edf_cap > 0)) {
-    opt.edf_cap = model_error_cap(full_pr, full_pr.g * full.d, std::popcount(full_pr.enabled_mask));
-    if (opt.edf_cap < kNoFloor) {
-      const Vec5 c_prev = full.d.cwiseProduct(full_pr.scale);
-      full_pr = make_problem(res.used, opt);
-      full = irls(full_pr, full_pr.enabled_mask, c_prev.cwiseQuotient(full_pr.scale), false);
-      if (!std::isfinite(full.dev) || !full.d.allFinite()) throw AnalysisError("the noise-model fit did not converge");
-    }
-  }
-  if (use_cov) {
-    Vec5 c1;
-    for (int i = 0; i < P; ++i) c1[i] = full.d[i] * full_pr.scale[i];
-    sigma_y = point_covariance(res.used, c1, full_pr.g * full.d, opt.edf_cap, options.threads);
-  }
-  auto phis = [&](const Problem& pr, const IrlsResult& fit, const std::vector<int>& set) {
-    Sandwich sw = sandwich(pr, pr.g * fit.d, set, sigma_y);
-    // Each term's inflation: the sandwich ratio times the small-EDF factor 1 + a/ν_i, ν_i the
-    // term's own effective EDF 2ĉ²/Var(ĉ) (at most 1 + a: a term at the boundary).
-    for (std::size_t q = 0; q < set.size(); ++q) {
-      const int i = set[q];
-      const double v = sw.cov(static_cast<Eigen::Index>(q), static_cast<Eigen::Index>(q));
-      const double nu = v > 0 ? 2.0 * fit.d[i] * fit.d[i] / v : 0.0;
-      const double f = options.dispersion * (1.0 + options.edf_inflation / std::max(nu, 1.0));
-      sw.phi[q] *= f;
-      sw.extra.push_back(f);
-    }
-    return sw;
-  };
+  if (res.model_covariance) sigma_y = point_covariance(res.used, full.coefficients(), full.model(), opt.edf_cap);
 
   // Inflation of every enabled term in the full model (at the boundary too).
   std::vector<int> full_set;
   for (int i = 0; i < P; ++i)
     if (options.enabled[static_cast<std::size_t>(i)]) full_set.push_back(i);
-  const Sandwich sw_full = phis(full_pr, full, full_set);
+  const Sandwich sw_full = sandwich(full.pr, full.fit.d, full_set, sigma_y, options);
   std::array<double, P> phi_full{1, 1, 1, 1, 1};
-  for (std::size_t q = 0; q < full_set.size(); ++q)
-    phi_full[static_cast<std::size_t>(full_set[q])] = sw_full.phi[q];
+  for (std::size_t q = 0; q < full_set.size(); ++q) phi_full[static_cast<std::size_t>(full_set[q])] = sw_full.phi[q];
 
-  // 3. Term selection: a droppable term whose removal raises the scaled deviance by less than the
-  //    χ²₁ quantile is left out of the model; it is reported as an upper bound from the full model.
-  FitOptions final_opt = opt;
-  IrlsResult best = full;
   std::array<bool, P> dropped{};
-  if (options.select_terms) {
-    for (int i : {idx(Term::R), idx(Term::K), idx(Term::Q)}) {
-      if (!final_opt.enabled[static_cast<std::size_t>(i)] || !options.droppable[static_cast<std::size_t>(i)]) continue;
-      FitOptions trial = final_opt;
-      trial.enabled[static_cast<std::size_t>(i)] = false;
-      const Problem tp = make_problem(res.used, trial);
-      Vec5 start = best.d;  // column scales do not depend on the enabled terms
-      start[i] = 0;
-      const IrlsResult r = irls(tp, tp.enabled_mask, start, false);
-      if (std::isfinite(r.dev) && (r.dev - best.dev) / phi_full[static_cast<std::size_t>(i)] < chi2_1) {
-        final_opt = trial;
-        best = r;
-        dropped[static_cast<std::size_t>(i)] = true;
-      }
-    }
-  }
-  res.options = final_opt;
-
-  const Problem pr = make_problem(res.used, final_opt);
-  best = irls(pr, pr.enabled_mask, best.d, false);
-  if (!std::isfinite(best.dev) || !best.d.allFinite()) throw AnalysisError("the noise-model fit did not converge");
-  res.iterations = best.iterations + full.iterations;
-  res.deviance = best.dev;
-  for (int i = 0; i < P; ++i) res.c[i] = best.d[i] * pr.scale[i];
-  const Eigen::VectorXd mu = pr.g * best.d;
+  IrlsResult best = full.fit;
+  res.options = opt;
+  if (options.select_terms) std::tie(res.options, best) = select_terms(res.used, opt, full.fit, phi_full, chi2_1, dropped);
+  Stage sel{make_problem(res.used, res.options), {}};
+  sel.fit = irls(sel.pr, sel.pr.enabled_mask, best.d, false);
+  require_converged(sel.fit);
+  res.iterations = sel.fit.iterations + full.fit.iterations;
+  res.deviance = sel.fit.dev;
+  res.c = sel.coefficients();
+  const Eigen::VectorXd mu = sel.model();
   res.model.assign(mu.data(), mu.data() + mu.size());
-
-  // Goodness of fit (points taken as independent with their EDFs; see docs).
-  int active = 0;
-  for (int i = 0; i < P; ++i) active += best.d[i] > 0 ? 1 : 0;
-  res.dof = j - active;
-  double chi2 = 0;
-  for (int r = 0; r < j; ++r) {
-    const double q = pr.y[r] / mu[r];
-    chi2 += pr.nu[r] * (q - 1.0 - std::log(q)) / bartlett(pr.nu[r]);
-  }
-  res.chi2 = chi2;
-  res.chi2_per_dof = res.dof > 0 ? chi2 / res.dof : 0.0;
-  res.p_value = res.dof > 0
-                    ? boost::math::cdf(boost::math::complement(
-                          boost::math::chi_squared_distribution<double>(res.dof), chi2))
-                    : 1.0;
-
-  // Covariance of the active terms (sandwich) and each term's inflation.
-  std::vector<int> act;
-  for (int i = 0; i < P; ++i)
-    if (best.d[i] > 0) act.push_back(i);
-  res.cov_c.setZero();
-  const Sandwich sw = phis(pr, best, act);
-  for (std::size_t r = 0; r < act.size(); ++r) {
-    res.phi[static_cast<std::size_t>(act[r])] = sw.phi[r];
-    for (std::size_t q = 0; q < act.size(); ++q)
-      res.cov_c(act[r], act[q]) = sw.cov(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(q)) *
-                                  std::sqrt(sw.extra[r] * sw.extra[q]) * pr.scale[act[r]] * pr.scale[act[q]];
-  }
-  // Terms at the boundary in the selected model: inflation from the model with the term added.
-  for (int i = 0; i < P; ++i) {
-    if (best.d[i] > 0 || !final_opt.enabled[static_cast<std::size_t>(i)]) {
-      if (dropped[static_cast<std::size_t>(i)]) res.phi[static_cast<std::size_t>(i)] = phi_full[static_cast<std::size_t>(i)];
-      continue;
-    }
-    std::vector<int> set = act;
-    set.push_back(i);
-    const Sandwich s1 = phis(pr, best, set);
-    res.phi[static_cast<std::size_t>(i)] = s1.phi.back();
-  }
+  goodness_of_fit(sel, res);
+  term_covariance(sel, sigma_y, options, phi_full, dropped, res);
   res.corr_NQ = res.log_correlation(Term::N, Term::Q);
   res.corr_NB = res.log_correlation(Term::N, Term::B);
-
-  // 4. Profile-likelihood intervals on the coefficient scale t = √d.
-  const Profiler prof{pr, best.d, best.dev};
-  const Eigen::MatrixXd info_all = fisher_info(pr, mu);
-  const Eigen::MatrixXd info_full = fisher_info(full_pr, full_pr.g * full.d);
-  const Profiler prof_full{full_pr, full.d, full.dev};
   for (int i = 0; i < P; ++i) {
-    auto& co = res.coef[static_cast<std::size_t>(i)];
-    const Term term = kAllTerms[static_cast<std::size_t>(i)];
-    co.enabled = options.enabled[static_cast<std::size_t>(i)];
-    co.in_model = final_opt.enabled[static_cast<std::size_t>(i)];
-    if (!co.enabled) continue;
-    const double phi = res.phi[static_cast<std::size_t>(i)];
-    const double thr = phi * chi2_1;
-    if (dropped[static_cast<std::size_t>(i)]) {
-      // Upper bound from the full model's profile.
-      const double kf = kCoefScale[static_cast<std::size_t>(i)] * std::sqrt(full_pr.scale[i]);
-      const double t_hat = std::sqrt(full.d[i]);
-      const double t_up = upper_root(prof_full, i, t_hat, std::max(fisher_step(info_full, i, z, phi), t_hat), thr);
-      co.resolved = false;
-      co.estimate = kf * t_hat;
-      co.low = 0;
-      co.high = kf * t_up;
-      co.value = co.high;
-      co.sigma = co.high / (2.0 * z);
-    } else {
-      const double kf = kCoefScale[static_cast<std::size_t>(i)] * std::sqrt(pr.scale[i]);  // coefficient = kf·t
-      const double t_hat = std::sqrt(best.d[i]);
-      auto g = [&](double t) { return std::sqrt(prof.delta(i, t * t)) - std::sqrt(thr); };
-      double t_low = 0;
-      co.resolved = false;
-      if (t_hat > 0) {
-        const double g0 = g(0.0);
-        if (g0 > 0) {
-          t_low = find_root(g, 0.0, g0, t_hat, -std::sqrt(thr));
-          co.resolved = true;
-        }
-      }
-      double step = fisher_step(info_all, i, z, phi);
-      if (t_hat > 0 && res.cov_c(i, i) > 0)
-        step = std::max(step, z * std::sqrt(res.cov_c(i, i)) / pr.scale[i] / (2.0 * t_hat));
-      const double t_up = upper_root(prof, i, t_hat, step, thr);
-      co.estimate = kf * t_hat;
-      co.low = co.resolved ? kf * t_low : 0.0;
-      co.high = kf * t_up;
-      if (co.resolved) {
-        co.value = co.estimate;
-        // Delta method: coefficient = k√c → sd = k·sd(c)/(2√c).
-        co.sigma = kCoefScale[static_cast<std::size_t>(i)] * std::sqrt(res.cov_c(i, i)) / (2.0 * std::sqrt(res.c[i]));
-      } else {
-        co.value = co.high;
-        co.sigma = co.high / (2.0 * z);
-      }
+    const auto ui = static_cast<std::size_t>(i);
+    auto& co = res.coef[ui];
+    if (!options.enabled[ui]) {
+      co.enabled = false;
+      co.in_model = res.options.enabled[ui];
+      continue;
     }
+    co = coefficient_interval(i, sel, full, dropped[ui], res, z, chi2_1);
     if (!std::isfinite(co.value) || !std::isfinite(co.sigma) || !std::isfinite(co.low) || !std::isfinite(co.high))
-      throw AnalysisError(fmt::format("the data do not bound the {} coefficient", term_name(term)));
+      throw AnalysisError(fmt::format("the data do not bound the {} coefficient", term_name(kAllTerms[ui])));
   }
   return res;
 }
