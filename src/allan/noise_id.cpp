@@ -17,7 +17,6 @@ namespace {
 __extension__ typedef unsigned __int128 u128;
 __extension__ typedef __int128 i128;
 
-
 // Stable32 uses the lag-1 autocorrelation when at least this many points remain at τ.
 constexpr std::size_t kMinAcfPoints = 30;
 constexpr int kMaxDifferences = 2;  // d_max for Allan-type (two-sample) variances
@@ -49,7 +48,7 @@ std::vector<double> averaged_frequency(const PhaseSeries& x, std::int64_t m) {
 
 /// Value i of the level-th difference of p (level 0: p itself); p(i) gives the decimated phase.
 template <class P>
-inline __attribute__((always_inline)) double difference(const P& p, int level, std::size_t i) {
+inline double difference(const P& p, int level, std::size_t i) {
   switch (level) {
     case 0: return p(i);
     case 1: return p(i + 1) - p(i);
@@ -63,7 +62,7 @@ inline __attribute__((always_inline)) double difference(const P& p, int level, s
 /// floating sums, without forming z or p: the mean of a difference follows from its end points,
 /// and the sums run in four lanes (whose order fixes the rounding).
 template <int Level, class P>
-double lag1_autocorrelation(const P& p, std::size_t count) {
+double lag1_floating(const P& p, std::size_t count) {
   if (count <= static_cast<std::size_t>(Level) + 1) return 0.0;
   const std::size_t len = count - static_cast<std::size_t>(Level);  // points of z
   double mean = 0;
@@ -102,10 +101,10 @@ double lag1_autocorrelation(const P& p, std::size_t count) {
 template <class P>
 double lag1_floating(const P& p, std::size_t count, int level) {
   switch (level) {
-    case 0: return lag1_autocorrelation<0>(p, count);
-    case 1: return lag1_autocorrelation<1>(p, count);
-    case 2: return lag1_autocorrelation<2>(p, count);
-    default: return lag1_autocorrelation<3>(p, count);
+    case 0: return lag1_floating<0>(p, count);
+    case 1: return lag1_floating<1>(p, count);
+    case 2: return lag1_floating<2>(p, count);
+    default: return lag1_floating<3>(p, count);
   }
 }
 
