@@ -1,7 +1,7 @@
 // Crew: every chunk of a shared loop runs exactly once, on the calling thread and on lenders that
 // are free now or later; a chunk's exception reaches the caller; lenders leave on close(). And the
 // passes that take a crew (the int32 view, the one-sweep Allan sums, the noise identification's
-// first pass, the outlier scan, a whole analysis) give the same bits with lenders as without.
+// first pass, the file load) give the same bits with lenders as without.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -16,7 +16,6 @@
 
 #include "allan/allan_kernels.hpp"
 #include "allan/noise_id.hpp"
-#include "rwcalc/analysis.hpp"
 #include "rwcalc/crew.hpp"
 #include "rwcalc/reader.hpp"
 #include "rwcalc/simulate.hpp"
@@ -221,28 +220,6 @@ TEST(CrewPasses, AFileLoadedInHalvesByALenderReadsTheSame) {
     EXPECT_EQ(a.samples, b.samples);
     EXPECT_EQ(a.line_of_rate(a.samples / 2), b.line_of_rate(b.samples / 2));
   }
-}
-
-TEST(CrewPasses, AnAnalysisWithLendersEqualsOneWithout) {
-  const NoiseModel m = test::gl2d_model();
-  SimulationSettings s;
-  s.duration_s = 3600;
-  s.rate_hz = 400;
-  Recording rec;
-  rec.source = "sim";
-  rec.rate_hz = 400;
-  Simulator(m, s, SimulationPath::Ensemble).run(77, rec.phase);
-  rec.phase.counts[123456] += 90;  // an outlier for the scan to find
-  for (std::size_t i = 123457; i < rec.phase.counts.size(); ++i) rec.phase.counts[i] += 90;
-  rec.samples = rec.phase.points() - 1;
-  AnalysisOptions o;
-  o.allan.threads = 1;
-  const nlohmann::json a = to_json(analyze(rec, o));
-  LentCrew lc(1);
-  o.allan.crew = &lc.crew;
-  const nlohmann::json b = to_json(analyze(rec, o));
-  EXPECT_EQ(a.dump(), b.dump());
-  EXPECT_GE(b.at("outliers").at("count").get<int>(), 1);
 }
 
 }  // namespace

@@ -57,10 +57,9 @@ inline constexpr std::size_t kMaxOutlierPositions = 1000;
 /// with their input lines, the action taken), then the action is applied. Returns `read` itself
 /// when the data stay as read (Keep, or nothing found), else `edited`, filled with the record
 /// whose outliers were removed or replaced. Throws UsageError for a threshold that is not a
-/// positive number. `crew` (may be null) shares the scan out (crew.hpp).
+/// positive number.
 const Recording& screen_outliers(const Recording& read, OutlierAction action, double threshold,
-                                 OutlierReport& report, Recording& edited, unsigned threads = 0,
-                                 Crew* crew = nullptr);
+                                 OutlierReport& report, Recording& edited);
 
 /// The outlier report as the readable reports print it ("Outliers" section) and as the JSON
 /// "outliers" object of analyze, batch, diagnose and allan.

@@ -6,16 +6,13 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <functional>
 #include <numbers>
 #include <optional>
 
 #include "rwcalc/confidence.hpp"
-#include "rwcalc/crew.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/printable.hpp"
 #include "rwcalc/units.hpp"
-#include "core/timing.hpp"
 
 namespace rwcalc {
 
@@ -183,29 +180,17 @@ void report_outliers(const Recording& rec, OutlierAction action, double threshol
   if (action == OutlierAction::Replace) rep.replaced = found.size();
 }
 
-/// Detect outliers in the recording's rates. The rates are computed block by block from the
-/// phase (no copy of the whole record); with a crew, by this thread and any lender free to help.
-std::vector<Outlier> detect_outliers(const Recording& rec, double threshold, OutlierScale& scale, unsigned threads,
-                                     Crew* crew) {
-  if (crew) {
-    SharedOutlierScan shared(rec.phase, threshold);
-    crew->share(2, [&shared](std::size_t) { shared.help(); });
-    return shared.finish(scale);
-  }
-  return scan_outliers(rec.phase, threshold, scale, threads);
-}
-
 }  // namespace
 
 const Recording& screen_outliers(const Recording& read, OutlierAction action, double threshold,
-                                 OutlierReport& report, Recording& edited, unsigned threads, Crew* crew) {
+                                 OutlierReport& report, Recording& edited) {
   check_outlier_threshold(threshold);
   report = OutlierReport{};
   report.action = action;
   report.threshold = threshold;
   if (read.phase.points() < 3) return read;  // too short to screen; the caller says so
-  OutlierScale scale;
-  const std::vector<Outlier> found = detect_outliers(read, threshold, scale, threads, crew);
+  const OutlierScale scale = outlier_scale(read.phase);
+  const std::vector<Outlier> found = find_outliers(read.phase, threshold, scale);
   check_outlier_share(read, action, threshold, found.size());
   report_outliers(read, action, threshold, scale, found, report);
   if (action == OutlierAction::Keep || found.empty()) return read;
@@ -301,90 +286,46 @@ Verdict verdict_of(const AnalysisResult& r, const AnalysisOptions& options) {
 
 }  // namespace
 
-AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
-  if (read.phase.kind != PhaseKind::Gyro)
-    throw UsageError(fmt::format("{}: analyze needs gyro data (pulses, counter, angle in arcsec/deg/rad, or rate in "
-                                 "deg/h, deg/s, rad/s); this input is clock data",
-                                 read.source));
-  OutlierReport outliers;
-  Recording rec_storage;
-  const Recording* recp = &read;
-  // The analysis' helper threads: the caller's crew (crew.hpp), or one of its own when the thread
-  // budget allows; the passes over the data share their work out through it.
-  std::optional<OwnCrew> own;
-  Crew* crew = options.allan.crew;
-  if (!crew) crew = own.emplace(options.allan.threads).get();
-  // Outliers that are only reported (the default) change nothing the Allan stage or the fit
-  // computes: then the scan's stretches are offered to the crew after the Allan stage, beside the
-  // fit, the cross-checks and the verdict, and the analysis' thread takes what is left once the
-  // verdict is done (SharedOutlierScan; not beside the Allan stage, whose passes take the crew).
-  const bool posted_scan = crew && options.outlier_action == OutlierAction::Keep && read.phase.points() >= 3;
-  std::optional<SharedOutlierScan> shared;
-  std::function<void(std::size_t)> scan_chunk;
-  std::optional<Crew::Posted> posted;  // after `shared` and `scan_chunk`: joined before they go
-  if (posted_scan) {
-    check_outlier_threshold(options.outlier_threshold);
-  } else {
-    detail::ScopedTimer t("analyze: outlier scan");
-    recp = &screen_outliers(read, options.outlier_action, options.outlier_threshold, outliers, rec_storage,
-                            options.allan.threads, crew);
-  }
-  const Recording& rec = *recp;
-  AnalysisResult r;
-  if (!posted_scan) r.outliers = std::move(outliers);
-  describe_record(rec, options, r);
-  const std::size_t pts = rec.phase.points();
-  if (pts < 3) throw AnalysisError(fmt::format("{}: the record holds {} sample(s); far too short to analyse", rec.source, rec.samples));
+namespace {
 
-  // Earth rate and bias.
-  r.mean_rate_deg_per_h = rec.phase.diff(pts - 1, 0) / r.duration_s;
+/// Mean rate, expected Earth rate and the bias between them.
+void earth_rate_and_bias(const Recording& rec, const AnalysisOptions& options, AnalysisResult& r) {
+  r.mean_rate_deg_per_h = rec.phase.diff(rec.phase.points() - 1, 0) / r.duration_s;
   r.earth_rate_given = options.earth_rate_deg_per_h.has_value();
   r.latitude_deg = r.earth_rate_given ? 0.0 : options.latitude_deg;
   r.earth_rate_deg_per_h = r.earth_rate_given ? *options.earth_rate_deg_per_h : vertical_earth_rate(options.latitude_deg);
   r.bias_deg_per_h = r.mean_rate_deg_per_h - r.earth_rate_deg_per_h;
+}
 
-  // Allan variance, fit, classic readout.
-  // A finer grid (--tau) is reported in full, but the fit and the slope readout use its octave
-  // points, so the coefficients and the verdict do not depend on the grid.
+/// Allan variance, fit and classic readout. A finer grid (--tau) is reported in full, but the fit
+/// and the slope readout use its octave points, so the coefficients and the verdict do not depend
+/// on the grid.
+void allan_and_fit(const Recording& rec, const AnalysisOptions& options, AnalysisResult& r) {
   AllanOptions aopt = options.allan;
-  aopt.crew = crew;
   const bool octave = aopt.grid.kind == TauGrid::Kind::Octave;
   if (!octave) {
     aopt.grid.with_octave = true;
-    if (aopt.grid.kind == TauGrid::Kind::Dense && aopt.grid.max_m == 0)
-      aopt.grid.max_m = std::max<std::int64_t>(1, static_cast<std::int64_t>(pts / 10));  // dense to N/10
+    if (aopt.grid.kind == TauGrid::Kind::Dense && aopt.grid.max_m == 0)  // dense to N/10
+      aopt.grid.max_m = std::max<std::int64_t>(1, static_cast<std::int64_t>(rec.phase.points() / 10));
   }
-  {
-    detail::ScopedTimer t("analyze: allan");
-    r.allan = compute_allan(rec.phase, aopt);
-  }
-  if (posted_scan) {
-    shared.emplace(read.phase, options.outlier_threshold);
-    scan_chunk = [&shared](std::size_t) { shared->help(); };
-    posted.emplace(crew->post(2, scan_chunk));
-  }
+  r.allan = compute_allan(rec.phase, aopt);
   const AllanResult octave_points = octave ? AllanResult{} : octave_points_of(r.allan, aopt);
   const AllanResult& fitted = octave ? r.allan : octave_points;
   try {
-    detail::ScopedTimer t("analyze: fit");
-    FitOptions fopt = options.fit;
-    if (fopt.threads == 0) fopt.threads = posted_scan ? 1u : aopt.threads;
-    r.fit = fit_noise(fit_points(fitted), fopt);
+    r.fit = fit_noise(fit_points(fitted), options.fit);
   } catch (const AnalysisError& e) {
     throw AnalysisError(fmt::format("{}: {}", rec.source, e.what()));
   }
   r.slope = slope_readout(fitted);
   for (const auto& p : fitted.points)
     if (p.tau_s == r.slope.tau_min_s && p.edf > 0 && r.slope.B) r.slope_B_sigma = *r.slope.B / std::sqrt(2.0 * p.edf);
+}
 
-  // Cross-checks.
-  {
-    detail::ScopedTimer t("analyze: cross-checks");
-    r.direct = direct_n(rec.phase, options.methods);
-    r.avg100 = block_spread(rec.phase, options.methods.block_s);
-    attach_expectation(r.avg100, r.fit);
-  }
-  detail::ScopedTimer verdict_timer("analyze: verdict");
+/// The paper's methods (direct N, spread of 100-s means) and their discrepancies from the fit.
+void cross_checks(const Recording& rec, const AnalysisOptions& options, AnalysisResult& r) {
+  r.direct = direct_n(rec.phase, options.methods);
+  r.avg100 = block_spread(rec.phase, options.methods.block_s);
+  attach_expectation(r.avg100, r.fit);
   const auto& fn = r.fit[Term::N];
   const auto& fb = r.fit[Term::B];
   if (r.direct.N.valid)
@@ -395,16 +336,26 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
       r.B_100s_vs_model_sigma = discrepancy_sigma(r.avg100.spread.value, r.avg100.spread.sigma, r.avg100.expected,
                                                   r.avg100.expected_sigma);
   }
+}
 
+}  // namespace
+
+AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
+  if (read.phase.kind != PhaseKind::Gyro)
+    throw UsageError(fmt::format("{}: analyze needs gyro data (pulses, counter, angle in arcsec/deg/rad, or rate in "
+                                 "deg/h, deg/s, rad/s); this input is clock data",
+                                 read.source));
+  AnalysisResult r;
+  Recording edited;
+  const Recording& rec =
+      screen_outliers(read, options.outlier_action, options.outlier_threshold, r.outliers, edited);
+  describe_record(rec, options, r);
+  if (rec.phase.points() < 3)
+    throw AnalysisError(fmt::format("{}: the record holds {} sample(s); far too short to analyse", rec.source, rec.samples));
+  earth_rate_and_bias(rec, options, r);
+  allan_and_fit(rec, options, r);
+  cross_checks(rec, options, r);
   r.verdict = verdict_of(r, options);
-  if (posted_scan) {
-    detail::ScopedTimer t("analyze: outlier scan (rest)", true);
-    crew->join(*posted);
-    OutlierScale scale;
-    const std::vector<Outlier> found = shared->finish(scale);
-    report_outliers(read, options.outlier_action, options.outlier_threshold, scale, found, outliers);
-    r.outliers = std::move(outliers);
-  }
   return r;
 }
 

@@ -123,7 +123,7 @@ int run_allan(const AllanArgs& a, Io& io) {
   OutlierReport outliers;
   Recording edited;
   const Recording& rec =
-      screen_outliers(read, outlier_action, a.outlier_threshold, outliers, edited, o.threads, o.crew);
+      screen_outliers(read, outlier_action, a.outlier_threshold, outliers, edited);
   // Increment and rate samples are frequency data for the noise identification, as Stable32
   // treats a frequency file; cumulative counters and angles are phase data.
   o.noise_id_domain = (rec.mode == InputMode::Pulses || rec.mode == InputMode::Rate) ? NoiseIdDomain::Frequency
