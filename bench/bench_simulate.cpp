@@ -5,7 +5,7 @@
 #include <atomic>
 
 #include "bench_inputs.hpp"
-#include "rwcalc/simulate.hpp"
+#include "rwcalc/ensemble.hpp"
 
 namespace {
 

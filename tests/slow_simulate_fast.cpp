@@ -14,7 +14,7 @@
 #include <numbers>
 #include <vector>
 
-#include "rwcalc/simulate.hpp"
+#include "rwcalc/ensemble.hpp"
 
 namespace {
 
@@ -37,15 +37,13 @@ struct MeanAv {
   std::vector<double> mean, se;
 };
 
-// Mean and standard error of the AV over `runs` realisations of the Ensemble path (2 threads).
+// Mean and standard error of the AV over `runs` realisations of the Ensemble path.
 MeanAv ensemble_mean(const NoiseModel& model, const SimulationSettings& s, const std::vector<std::size_t>& ms,
                      std::size_t runs) {
   std::vector<std::vector<double>> av(runs, std::vector<double>(ms.size()));
-  EnsembleOptions opt;
-  opt.threads = 2;
   simulate_ensemble(model, s, runs, [&](std::size_t r, const PhaseSeries& p) {
     for (std::size_t i = 0; i < ms.size(); ++i) av[r][i] = oavar(p, ms[i]);
-  }, opt);
+  });
   MeanAv out{std::vector<double>(ms.size()), std::vector<double>(ms.size())};
   for (std::size_t i = 0; i < ms.size(); ++i) {
     double s1 = 0, s2 = 0;

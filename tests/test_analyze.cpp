@@ -7,6 +7,7 @@
 
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/batch.hpp"
+#include "rwcalc/simulate.hpp"
 #include "test_support.hpp"
 
 namespace rwcalc {
@@ -20,6 +21,27 @@ std::string gl2d(const std::string& name) { return test::source_path("data/gl2d/
 json truth(const std::string& run) {
   std::ifstream in(gl2d(run + ".truth.json"));
   return json::parse(in);
+}
+
+// The passes of an analysis (Allan sums, fit, outlier scan) give the same bits whatever the number
+// of threads: a simulated hour with an outlier, analysed with RWCALC_THREADS=1 and =2.
+TEST(Analyze, ThreadCountDoesNotChangeTheResult) {
+  SimulationSettings s;
+  s.duration_s = 3600;
+  s.rate_hz = 400;
+  Recording rec;
+  rec.source = "sim";
+  rec.rate_hz = 400;
+  Simulator(test::gl2d_model(), s, SimulationPath::Ensemble).run(77, rec.phase);
+  for (std::size_t i = 123456; i < rec.phase.counts.size(); ++i) rec.phase.counts[i] += 90;  // one outlier
+  rec.samples = rec.phase.points() - 1;
+  auto analysed = [&](const char* threads) {
+    const test::ScopedEnv env("RWCALC_THREADS", threads);
+    return to_json(analyze(rec, {})).dump();
+  };
+  const std::string one = analysed("1");
+  EXPECT_EQ(one, analysed("2"));
+  EXPECT_GE(json::parse(one).at("outliers").at("count").get<int>(), 1);
 }
 
 TEST(TemperatureFromName, Patterns) {
@@ -185,10 +207,10 @@ TEST_F(BatchCli, JsonLinesMergeToTheSameTablesAndTheToleranceGivesClass2) {
   EXPECT_TRUE(s["overall"]["tolerance_changed"].get<bool>());
   EXPECT_NE(s["overall"]["statement"].get<std::string>().find("class 2"), std::string::npos);
 
-  // The same analysis through 'batch' directly (one job) prints the same table as 'merge'.
+  // The same analysis through 'batch' directly prints the same table as 'merge'.
   std::vector<std::string> direct{"batch"};
   for (const auto& f : files()) direct.push_back(f);
-  direct.insert(direct.end(), {"--tolerance", "50", "--jobs", "1", "--markdown"});
+  direct.insert(direct.end(), {"--tolerance", "50", "--markdown"});
   const auto d = run_cli(direct);
   ASSERT_EQ(d.status, 0) << d.err;
   const auto md = run_cli({"merge", (dir.path() / "runs.jsonl").string(), "--markdown"});
@@ -198,29 +220,30 @@ TEST_F(BatchCli, JsonLinesMergeToTheSameTablesAndTheToleranceGivesClass2) {
 }
 
 TEST_F(BatchCli, ThreadCountDoesNotChangeTheResult) {
-  // --jobs 2, 3 and 4 leave one, two and one file for the end, whose passes over the data then
-  // take the threads of the idle workers as they free (crew.hpp); every schedule gives the same
-  // bytes in input order.
-  auto args = [&](const char* jobs) {
-    std::vector<std::string> a{"batch"};
-    for (const auto& f : files()) a.push_back(f);
-    a.insert(a.end(), {"--json", "--jobs", jobs});
-    return a;
+  // One thread runs the files one after the other; two, three and four run several at once and
+  // finish them in another order: every schedule gives the same bytes, in input order.
+  std::vector<std::string> args{"batch"};
+  for (const auto& f : files()) args.push_back(f);
+  args.push_back("--json");
+  auto run_with = [&](const char* threads) {
+    const test::ScopedEnv env("RWCALC_THREADS", threads);
+    return run_cli(args);
   };
-  const auto r1 = run_cli(args("1"));
+  const auto r1 = run_with("1");
   ASSERT_EQ(r1.status, 0) << r1.err;
-  for (const char* jobs : {"2", "3", "4"}) {
-    const auto r = run_cli(args(jobs));
-    ASSERT_EQ(r.status, 0) << "--jobs " << jobs << ": " << r.err;
-    EXPECT_EQ(r1.out, r.out) << "--jobs " << jobs;
+  for (const char* threads : {"2", "3", "4"}) {
+    const auto r = run_with(threads);
+    ASSERT_EQ(r.status, 0) << "RWCALC_THREADS=" << threads << ": " << r.err;
+    EXPECT_EQ(r1.out, r.out) << "RWCALC_THREADS=" << threads;
   }
 }
 
 TEST_F(BatchCli, AnInputErrorInTheLastFilesNamesItsFile) {
-  // Three files on two jobs: the bad one is the last, read while the other worker lends its thread.
+  // Three files on two threads: the bad one is the last, read while the others are analysed.
   test::TempDir dir;
   const auto bad = dir.write("broken_p10C.csv", "# rate_hz: 400\npulses\n1\n2\nthree\n4\n");
-  const auto r = run_cli({"batch", gl2d("gl2d_0C.csv.gz"), gl2d("gl2d_p25C.csv.gz"), bad.string(), "--jobs", "2"});
+  const test::ScopedEnv env("RWCALC_THREADS", "2");
+  const auto r = run_cli({"batch", gl2d("gl2d_0C.csv.gz"), gl2d("gl2d_p25C.csv.gz"), bad.string()});
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("broken_p10C.csv:5"), std::string::npos) << r.err;
 }

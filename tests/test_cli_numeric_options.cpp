@@ -74,7 +74,7 @@ TEST(NumericOptions, TheCommandLineHasNumericOptions) {
   std::set<std::string> names;
   for (const auto& o : numeric_options()) names.insert(o.command + " " + o.name);
   for (const char* expected : {"analyze --block", "analyze --rate", "analyze --earth-rate", "allan --confidence",
-                               "simulate --bias", "simulate --seed", "diagnose --seed", "batch --jobs",
+                               "simulate --bias", "simulate --seed", "diagnose --seed", "batch --temperature",
                                "report --diagnose-runs", "analyze --temperature"})
     EXPECT_TRUE(names.count(expected)) << expected;
 }

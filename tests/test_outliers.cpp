@@ -5,7 +5,6 @@
 #include <cmath>
 #include <random>
 #include <set>
-#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -200,15 +199,15 @@ TEST(Outliers, XsensContaminatedRecordGrossErrorsAreFound) {
 
 namespace {
 
-// A long record (the interior is screened on two threads): every planted spike is found once, in
-// index order, including those beside the split and at the ends.
+// A long record (screened in stretches of 2^16 samples, several at once): every planted spike is
+// found once, in index order, including those beside a stretch's ends and at the record's ends.
 TEST(Outliers, LongRecordFindsEverySpikeOnceInOrder) {
   const std::size_t n = (std::size_t{3} << 20) + 17;
   std::mt19937_64 rng(7);
   std::normal_distribution<double> g(0.0, 1.0);
   std::vector<double> y(n);
   for (auto& v : y) v = g(rng);
-  const std::size_t mid = 3 + ((n - 6) / 2 / 1024) * 1024;
+  const std::size_t mid = std::size_t{24} << 16;  // a stretch boundary
   std::vector<std::size_t> planted = {0, 5, 1000, n / 3, mid - 2, mid - 1, mid, mid + 3, n - 4, n - 1};
   ASSERT_TRUE(std::is_sorted(planted.begin(), planted.end()));
   for (std::size_t k = 0; k < planted.size(); ++k) y[planted[k]] += (k % 2 ? -1.0 : 1.0) * 40.0;
@@ -225,15 +224,16 @@ TEST(Outliers, LongRecordFindsEverySpikeOnceInOrder) {
 
 namespace {
 
-// The scan of a phase series (rates computed block by block) is the scan of its rates as a vector,
-// bit for bit: scale, indices, values and z, on exact counts and on a floating phase, on 1 and 2 threads.
+// The scan of a phase series (rates computed stretch by stretch) is the scan of its rates as a
+// vector, bit for bit: scale, indices, values and z, on exact counts and on a floating phase, with
+// RWCALC_THREADS=1 and =2.
 TEST(Outliers, PhaseSeriesScanEqualsVectorScan) {
   std::mt19937_64 rng(21);
   std::poisson_distribution<int> pulses(2.5);
   rwcalc::PhaseSeries counts;
   counts.tau0_s = 0.0025;
   counts.arcsec_per_count = 0.92;
-  const std::size_t n = (std::size_t{1} << 20) + 4321;  // long enough for the two-thread screen
+  const std::size_t n = (std::size_t{1} << 20) + 4321;  // many stretches
   counts.counts.assign(1, 1000000007);                  // an offset: differences are what count
   for (std::size_t i = 0; i < n; ++i) {
     std::int64_t c = pulses(rng);
@@ -252,14 +252,15 @@ TEST(Outliers, PhaseSeriesScanEqualsVectorScan) {
     std::vector<double> rates(ph->points() - 1);
     for (std::size_t i = 0; i < rates.size(); ++i) rates[i] = ph->rate(i);
     const auto sv = rwcalc::outlier_scale(rates);
-    const auto sp = rwcalc::outlier_scale(*ph);
-    EXPECT_EQ(sv.scale, sp.scale);
-    EXPECT_EQ(sv.mad_sigma, sp.mad_sigma);
-    EXPECT_EQ(sv.resolution, sp.resolution);
     const auto ov = find_outliers(rates, 8.0, sv);
     EXPECT_FALSE(ov.empty());
-    for (unsigned threads : {1u, 2u}) {
-      const auto op = find_outliers(*ph, 8.0, sp, threads);
+    for (const char* threads : {"1", "2"}) {
+      const rwcalc::test::ScopedEnv env("RWCALC_THREADS", threads);
+      const auto sp = rwcalc::outlier_scale(*ph);
+      EXPECT_EQ(sv.scale, sp.scale);
+      EXPECT_EQ(sv.mad_sigma, sp.mad_sigma);
+      EXPECT_EQ(sv.resolution, sp.resolution);
+      const auto op = find_outliers(*ph, 8.0, sp);
       ASSERT_EQ(ov.size(), op.size()) << "threads " << threads;
       for (std::size_t k = 0; k < ov.size(); ++k) {
         EXPECT_EQ(ov[k].index, op[k].index);
@@ -289,98 +290,3 @@ TEST(Outliers, PhaseSeriesScanEqualsVectorScanOnShortRecords) {
 
 }  // namespace
 
-namespace {
-
-// scan_outliers (scale and screen in one pass on exact counts) gives what the two calls give:
-// pulse counts whose scale is the resolution (the one-pass path), counts with a wide spread (the
-// spread sets the scale: the ordinary screen), with glitches in both, on 1 and 2 threads.
-TEST(Outliers, OnePassScanEqualsScaleThenScreen) {
-  std::mt19937_64 rng(31);
-  for (double mean : {0.05, 2.5, 400.0}) {
-    std::poisson_distribution<int> pulses(mean);
-    rwcalc::PhaseSeries ph;
-    ph.tau0_s = 0.0025;
-    ph.arcsec_per_count = 0.92;
-    ph.counts.assign(1, -77);
-    const std::size_t n = (std::size_t{1} << 20) + 999;
-    for (std::size_t i = 0; i < n; ++i) {
-      std::int64_t c = pulses(rng);
-      if (i % 65537 == 5 || i == 2 || i == n - 2) c += 20 + static_cast<std::int64_t>(mean) * 4;
-      ph.counts.push_back(ph.counts.back() + c);
-    }
-    for (unsigned threads : {1u, 2u}) {
-      const auto s2 = rwcalc::outlier_scale(ph, threads);
-      const auto o2 = find_outliers(ph, 8.0, s2, threads);
-      rwcalc::OutlierScale s1;
-      const auto o1 = rwcalc::scan_outliers(ph, 8.0, s1, threads);
-      EXPECT_EQ(s1.scale, s2.scale) << mean;
-      EXPECT_EQ(s1.mad_sigma, s2.mad_sigma) << mean;
-      EXPECT_EQ(s1.resolution, s2.resolution) << mean;
-      EXPECT_FALSE(o2.empty()) << mean;
-      ASSERT_EQ(o1.size(), o2.size()) << mean;
-      for (std::size_t k = 0; k < o1.size(); ++k) {
-        EXPECT_EQ(o1[k].index, o2[k].index);
-        EXPECT_EQ(o1[k].value, o2[k].value);
-        EXPECT_EQ(o1[k].robust_z, o2[k].robust_z);
-      }
-    }
-  }
-}
-
-}  // namespace
-
-namespace {
-
-// SharedOutlierScan gives what scan_outliers gives, however the work is shared: finish() alone,
-// one helper thread, or a helper and the finishing thread both taking stretches — on exact counts
-// (the one-pass path, and a wide spread that falls back to the ordinary screen) and on floating
-// rates (the first helper runs the whole scan).
-TEST(Outliers, SharedScanEqualsScanOutliers) {
-  std::mt19937_64 rng(47);
-  auto expect_same = [](const rwcalc::PhaseSeries& ph, const char* what) {
-    rwcalc::OutlierScale s0;
-    const auto o0 = rwcalc::scan_outliers(ph, 8.0, s0, 1);
-    EXPECT_FALSE(o0.empty()) << what;
-    for (int helpers = 0; helpers < 3; ++helpers) {
-      rwcalc::SharedOutlierScan shared(ph, 8.0);
-      {
-        std::vector<std::jthread> pool;
-        for (int h = 0; h < helpers; ++h) pool.emplace_back([&] { shared.help(); });
-        if (helpers == 2) shared.help();
-      }
-      rwcalc::OutlierScale s1;
-      const auto o1 = shared.finish(s1);
-      EXPECT_EQ(s1.scale, s0.scale) << what << " helpers " << helpers;
-      EXPECT_EQ(s1.mad_sigma, s0.mad_sigma) << what;
-      EXPECT_EQ(s1.resolution, s0.resolution) << what;
-      ASSERT_EQ(o1.size(), o0.size()) << what << " helpers " << helpers;
-      for (std::size_t k = 0; k < o1.size(); ++k) {
-        EXPECT_EQ(o1[k].index, o0[k].index);
-        EXPECT_EQ(o1[k].value, o0[k].value);
-        EXPECT_EQ(o1[k].robust_z, o0[k].robust_z);
-      }
-    }
-  };
-  const std::size_t n = (std::size_t{1} << 20) + 70'001;  // not a whole number of stretches
-  for (double mean : {2.5, 400.0}) {
-    std::poisson_distribution<int> pulses(mean);
-    rwcalc::PhaseSeries ph;
-    ph.tau0_s = 0.0025;
-    ph.arcsec_per_count = 0.92;
-    ph.counts.assign(1, 5);
-    for (std::size_t i = 0; i < n; ++i) {
-      std::int64_t c = pulses(rng);
-      if (i % 99991 == 17 || i == 1 || i == n - 3) c += 20 + static_cast<std::int64_t>(mean) * 4;
-      ph.counts.push_back(ph.counts.back() + c);
-    }
-    expect_same(ph, mean < 10 ? "counts, one pass" : "counts, wide spread");
-  }
-  rwcalc::PhaseSeries fl;
-  fl.tau0_s = 0.01;
-  std::normal_distribution<double> g(0.0, 1.0);
-  fl.values.assign(1, 0.0);
-  for (std::size_t i = 0; i < n; ++i) fl.values.push_back(fl.values.back() + 0.01 * (g(rng) + (i % 77777 == 3 ? 40 : 0)));
-  expect_same(fl, "floating rates");
-}
-
-}  // namespace

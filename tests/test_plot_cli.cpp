@@ -153,7 +153,7 @@ TEST(BatchPlot, FiveTemperaturesOverlaidAndTheDirectMethodPanel) {
   const auto svg_path = dir.path() / "batch.svg";
   const auto json_path = dir.path() / "batch.json";
   const auto r = run_cli(concat({"batch"}, concat(gl2d_runs(), {"--json", "-o", json_path.string(), "--plot",
-                                                         svg_path.string(), "-j", "2"})));
+                                                         svg_path.string()})));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.err.find("note:"), std::string::npos) << "Fig. 2 must not be left out: " << r.err;
   const json b = json::parse(slurp(json_path));

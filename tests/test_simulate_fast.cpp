@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "rwcalc/error.hpp"
-#include "rwcalc/simulate.hpp"
+#include "rwcalc/ensemble.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -73,7 +73,6 @@ TEST(EnsemblePath, ChangesOnlyTheFlickerTerm) {
   auto m = gl2d_model();
   m.bias_instability_deg_per_h = 0;  // without flicker both paths draw the same numbers
   Simulator exact(m, short_record()), fast(m, short_record(), SimulationPath::Ensemble);
-  EXPECT_EQ(fast.path(), SimulationPath::Ensemble);
   PhaseSeries a, b;
   exact.run(11, a);
   fast.run(11, b);
@@ -122,14 +121,13 @@ TEST(EnsemblePath, GoldenChecksumPinsTheHeldFlicker) {
 TEST(SimulateEnsemble, SameRecordsWhateverTheThreadCount) {
   const auto m = gl2d_model();
   const auto s = short_record();
-  auto collect = [&](unsigned threads) {
+  auto collect = [&](const char* threads) {
+    const test::ScopedEnv env("RWCALC_THREADS", threads);
     std::vector<std::vector<std::int64_t>> out(7);
-    EnsembleOptions opt;
-    opt.threads = threads;
-    simulate_ensemble(m, s, out.size(), [&](std::size_t r, const PhaseSeries& p) { out[r] = p.counts; }, opt);
+    simulate_ensemble(m, s, out.size(), [&](std::size_t r, const PhaseSeries& p) { out[r] = p.counts; });
     return out;
   };
-  const auto one = collect(1), two = collect(2), four = collect(4);
+  const auto one = collect("1"), two = collect("2"), four = collect("4");
   EXPECT_EQ(one, two);
   EXPECT_EQ(one, four);
   for (std::size_t r = 1; r < one.size(); ++r) EXPECT_NE(one[r], one[0]) << r;
@@ -142,21 +140,23 @@ TEST(SimulateEnsemble, SameRecordsWhateverTheThreadCount) {
 
 TEST(SimulateEnsemble, ErrorsPropagateAndInvalidModelsAreRejectedUpFront) {
   const auto s = short_record();
-  // One worker: the runs are consumed in order, so the failure at run 2 stops the ensemble there.
-  EnsembleOptions one;
-  one.threads = 1;
-  int calls = 0;
-  EXPECT_THROW(simulate_ensemble(gl2d_model(), s, 20, [&](std::size_t r, const PhaseSeries&) {
-    ++calls;
-    if (r == 2) throw std::runtime_error("consumer failed");
-  }, one), std::runtime_error);
-  EXPECT_EQ(calls, 3);
-  // Two workers: the consumer's exception reaches the caller, whichever thread raised it.
-  EnsembleOptions two;
-  two.threads = 2;
-  EXPECT_THROW(simulate_ensemble(gl2d_model(), s, 20, [&](std::size_t r, const PhaseSeries&) {
-    if (r == 2) throw std::runtime_error("consumer failed");
-  }, two), std::runtime_error);
+  {
+    // One thread: the runs are consumed in order, so the failure at run 2 stops the ensemble there.
+    const test::ScopedEnv env("RWCALC_THREADS", "1");
+    int calls = 0;
+    EXPECT_THROW(simulate_ensemble(gl2d_model(), s, 20, [&](std::size_t r, const PhaseSeries&) {
+      ++calls;
+      if (r == 2) throw std::runtime_error("consumer failed");
+    }), std::runtime_error);
+    EXPECT_EQ(calls, 3);
+  }
+  {
+    // Two threads: the consumer's exception reaches the caller, whichever thread raised it.
+    const test::ScopedEnv env("RWCALC_THREADS", "2");
+    EXPECT_THROW(simulate_ensemble(gl2d_model(), s, 20, [&](std::size_t r, const PhaseSeries&) {
+      if (r == 2) throw std::runtime_error("consumer failed");
+    }), std::runtime_error);
+  }
   auto bad = gl2d_model();
   bad.arw_deg_per_sqrt_h = -1;
   EXPECT_THROW(simulate_ensemble(bad, s, 3, [](std::size_t, const PhaseSeries&) {}), UsageError);

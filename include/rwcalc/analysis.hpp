@@ -11,7 +11,7 @@
 #include "rwcalc/allan.hpp"
 #include "rwcalc/fit.hpp"
 #include "rwcalc/methods.hpp"
-#include "rwcalc/outliers.hpp"
+#include "rwcalc/outlier_screen.hpp"
 #include "rwcalc/reader.hpp"
 #include "rwcalc/verdict.hpp"
 
@@ -30,46 +30,6 @@ struct AnalysisOptions {
   OutlierAction outlier_action = OutlierAction::Keep;
   double outlier_threshold = kDefaultOutlierThreshold;  ///< robust z (see outliers.hpp)
 };
-
-/// One detected outlier, located in the input.
-struct OutlierPosition {
-  std::size_t index = 0;  ///< rate sample index (0-based; see Recording::rates)
-  double time_s = 0;      ///< time of its data line from the first sample, s (index of that line × τ0)
-  std::size_t line = 0;   ///< 1-based input line
-  double value = 0;       ///< the rate sample, °/h
-  double robust_z = 0;    ///< residual from the neighbour median over the robust scale
-};
-
-/// What outlier detection found and what was done about it.
-struct OutlierReport {
-  OutlierAction action = OutlierAction::Keep;
-  double threshold = kDefaultOutlierThreshold;
-  double scale_deg_per_h = 0;  ///< robust scale of the neighbour-median residuals, °/h
-  std::size_t count = 0;       ///< outliers found
-  std::size_t removed = 0;     ///< rate samples dropped (Remove)
-  std::size_t replaced = 0;    ///< rate samples replaced by their local median (Replace)
-  std::vector<OutlierPosition> positions;  ///< the first kMaxOutlierPositions, in input order
-};
-inline constexpr std::size_t kMaxOutlierPositions = 1000;
-
-/// Outlier screening as every command that analyses a record does it (analyze, batch, report,
-/// diagnose, allan): the isolated outliers of `read` are detected and reported (count, positions
-/// with their input lines, the action taken), then the action is applied. Returns `read` itself
-/// when the data stay as read (Keep, or nothing found), else `edited`, filled with the record
-/// whose outliers were removed or replaced. Throws UsageError for a threshold that is not a
-/// positive number. `crew` (may be null) shares the scan out (crew.hpp).
-const Recording& screen_outliers(const Recording& read, OutlierAction action, double threshold,
-                                 OutlierReport& report, Recording& edited, unsigned threads = 0,
-                                 Crew* crew = nullptr);
-
-/// The outlier report as the readable reports print it ("Outliers" section) and as the JSON
-/// "outliers" object of analyze, batch, diagnose and allan.
-std::string format_outliers(const OutlierReport& report);
-nlohmann::json to_json(const OutlierReport& report);
-
-/// Parse "keep", "remove" or "replace" (UsageError otherwise).
-OutlierAction parse_outlier_action(std::string_view s);
-std::string_view to_string(OutlierAction a);
 
 struct AnalysisResult {
   std::string source;

@@ -16,11 +16,11 @@
 
 namespace rwcalc {
 
-/// Analyse `files` with up to `jobs` threads (0: hardware threads). Each file's temperature comes
-/// from its column/metadata, else its name. Returns the analyze JSON objects in file order.
-/// On failure throws the error of the first failing file (in file order), naming it.
+/// Analyse `files`, several at once (parallel.hpp). Each file's temperature comes from its
+/// column/metadata, else its name. Returns the analyze JSON objects in file order. On failure
+/// throws the error of the first failing file (in file order), naming it.
 std::vector<nlohmann::json> analyze_files(const std::vector<std::string>& files, const ReadOptions& read,
-                                          const AnalysisOptions& options, unsigned jobs);
+                                          const AnalysisOptions& options);
 
 /// {"runs": [...sorted by temperature...], "overall": {class_B, class_N, class, p_class,
 /// statement, …}, "trends": {...}}. Throws InputError (naming `source`) on objects without the

@@ -14,7 +14,6 @@
 /// samples are found without false alarms beside them (the median tolerates two bad neighbours
 /// of six); longer bursts are found in part.
 #include <cstddef>
-#include <memory>
 #include <vector>
 
 #include "rwcalc/reader.hpp"
@@ -55,9 +54,8 @@ inline constexpr double kMaxOutlierShare = 0.01;
 OutlierScale outlier_scale(const std::vector<double>& rates);
 
 /// The same scale for the rates of a phase series (the rates Recording::rates() gives), computed
-/// block by block without a copy of the whole record: bit-identical to outlier_scale(rates).
-/// `threads`: 0 = all hardware threads; records of more than 2^20 samples use two when allowed.
-OutlierScale outlier_scale(const PhaseSeries& phase, unsigned threads = 0);
+/// stretch by stretch without a copy of the whole record: bit-identical to outlier_scale(rates).
+OutlierScale outlier_scale(const PhaseSeries& phase);
 
 /// Isolated outliers of `rates`, sorted by index; `line` is 0. Fewer than 7 samples: none.
 std::vector<Outlier> find_outliers(const std::vector<double>& rates,
@@ -66,35 +64,9 @@ std::vector<Outlier> find_outliers(const std::vector<double>& rates,
 /// Same, with the robust scale already computed by outlier_scale(rates).
 std::vector<Outlier> find_outliers(const std::vector<double>& rates, double threshold, const OutlierScale& scale);
 
-/// Same, on the rates of a phase series, computed block by block (no copy of the record); the
+/// Same, on the rates of a phase series, computed stretch by stretch (no copy of the record); the
 /// result is identical to find_outliers(rates, threshold, scale) on the rates as a vector.
-/// `threads`: 0 = all hardware threads; records of more than 2^20 samples use two when allowed.
-std::vector<Outlier> find_outliers(const PhaseSeries& phase, double threshold, const OutlierScale& scale,
-                                   unsigned threads = 0);
-
-/// outlier_scale(phase, threads) and find_outliers(phase, threshold, scale, threads) in one call,
-/// with the same results; on exact counts usually in one pass over the record instead of two.
-std::vector<Outlier> scan_outliers(const PhaseSeries& phase, double threshold, OutlierScale& scale,
-                                   unsigned threads = 0);
-
-/// scan_outliers shared between threads that join in whenever they are free: any number of
-/// threads call help(), each taking stretches of the record until none is left (on exact counts;
-/// on other data the first caller runs the whole scan), and once every help() has returned one
-/// thread calls finish(), which does what is left. The results are those of scan_outliers.
-class SharedOutlierScan {
- public:
-  SharedOutlierScan(const PhaseSeries& phase, double threshold);
-  ~SharedOutlierScan();
-  SharedOutlierScan(const SharedOutlierScan&) = delete;
-  SharedOutlierScan& operator=(const SharedOutlierScan&) = delete;
-  void help();
-  /// `threads` for the last step (records of more than 2^20 samples use two when allowed).
-  std::vector<Outlier> finish(OutlierScale& scale, unsigned threads = 1);
-
- private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
-};
+std::vector<Outlier> find_outliers(const PhaseSeries& phase, double threshold, const OutlierScale& scale);
 
 /// Same, on a recording's rates, with the input line of each outlier filled in.
 std::vector<Outlier> find_outliers(const Recording& recording,

@@ -6,16 +6,13 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <functional>
 #include <numbers>
 #include <optional>
 
 #include "rwcalc/confidence.hpp"
-#include "rwcalc/crew.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/printable.hpp"
 #include "rwcalc/units.hpp"
-#include "core/timing.hpp"
 
 namespace rwcalc {
 
@@ -85,21 +82,17 @@ std::optional<double> temperature_from_name(std::string_view path) {
     if (j >= name.size() || name[j] != 'C') continue;
     if (j + 1 < name.size() && alnum(name[j + 1])) continue;
     double sign = 1.0;
-    std::size_t before = i;  // index of the first character of the token
     if (i > 0) {
       const char s = name[i - 1];
       if (s == 'm' || s == 'p') {
         sign = s == 'm' ? -1.0 : 1.0;
-        before = i - 1;
-        if (before > 0 && alnum(name[before - 1])) continue;  // "…xm50C" is not a temperature
+        if (i > 1 && alnum(name[i - 2])) continue;  // "…xm50C" is not a temperature
       } else if (s == '-' || s == '+') {
         sign = s == '-' ? -1.0 : 1.0;
-        before = i - 1;
       } else if (alnum(s)) {
         continue;
       }
     }
-    (void)before;
     return sign * std::stod(std::string(name.substr(i, j - i)));
   }
   return std::nullopt;
@@ -123,105 +116,6 @@ nlohmann::json allan_json(const AllanResult& a) {
           {"points_in", a.points_in},
           {"confidence", a.confidence},
           {"points", pts}};
-}
-
-OutlierAction parse_outlier_action(std::string_view s) {
-  if (s == "keep") return OutlierAction::Keep;
-  if (s == "remove") return OutlierAction::Remove;
-  if (s == "replace") return OutlierAction::Replace;
-  throw UsageError(fmt::format("--outliers: '{}' is not one of keep, remove, replace", s));
-}
-
-std::string_view to_string(OutlierAction a) {
-  switch (a) {
-    case OutlierAction::Keep: return "keep";
-    case OutlierAction::Remove: return "remove";
-    case OutlierAction::Replace: return "replace";
-  }
-  return "?";
-}
-
-namespace {
-
-void check_outlier_threshold(double threshold) {
-  if (!(threshold >= kMinOutlierThreshold) || !std::isfinite(threshold))
-    throw UsageError(fmt::format("--outlier-threshold must be a finite number >= {:g} robust sigma (below it the "
-                                 "noise's own tails are flagged), got {}",
-                                 kMinOutlierThreshold, threshold));
-}
-
-/// Refuse to remove or replace more than kMaxOutlierShare of the rate samples (outliers.hpp).
-void check_outlier_share(const Recording& rec, OutlierAction action, double threshold, std::size_t found) {
-  const std::size_t rates = rec.phase.points() - 1;
-  if (action == OutlierAction::Keep || static_cast<double>(found) <= kMaxOutlierShare * static_cast<double>(rates))
-    return;
-  throw UsageError(fmt::format(
-      "{}: --outliers {} would change {} of {} rate samples ({:.3g} %, more than {:g} %) at --outlier-threshold "
-      "{:g}: so many are not isolated outliers but the noise itself, a burst or a step; nothing was analysed. "
-      "Raise --outlier-threshold (default {:g}) or use --outliers keep to see where they are",
-      rec.source, action == OutlierAction::Remove ? "remove" : "replace", found, rates,
-      100.0 * static_cast<double>(found) / static_cast<double>(rates), 100.0 * kMaxOutlierShare,
-      threshold, kDefaultOutlierThreshold));
-}
-
-/// The report of a finished scan (`found`, with its scale), located in the input.
-void report_outliers(const Recording& rec, OutlierAction action, double threshold, const OutlierScale& scale,
-                     const std::vector<Outlier>& found, OutlierReport& rep) {
-  rep = OutlierReport{};
-  rep.action = action;
-  rep.threshold = threshold;
-  rep.scale_deg_per_h = scale.scale;
-  rep.count = found.size();
-  // Rate sample i comes from data sample i (pulses, rate) or i+1 (counter, angle: the later reading).
-  const std::size_t shift = rec.samples > rec.phase.points() - 1 ? 1 : 0;
-  for (std::size_t k = 0; k < found.size() && k < kMaxOutlierPositions; ++k) {
-    const auto& o = found[k];
-    rep.positions.push_back({o.index, static_cast<double>(o.index + shift) * rec.phase.tau0_s,
-                             rec.line_of_rate(o.index), o.value, o.robust_z});
-  }
-  if (action == OutlierAction::Remove) rep.removed = found.size();
-  if (action == OutlierAction::Replace) rep.replaced = found.size();
-}
-
-/// Detect outliers in the recording's rates. The rates are computed block by block from the
-/// phase (no copy of the whole record); with a crew, by this thread and any lender free to help.
-std::vector<Outlier> detect_outliers(const Recording& rec, double threshold, OutlierScale& scale, unsigned threads,
-                                     Crew* crew) {
-  if (crew) {
-    SharedOutlierScan shared(rec.phase, threshold);
-    crew->share(2, [&shared](std::size_t) { shared.help(); });
-    return shared.finish(scale);
-  }
-  return scan_outliers(rec.phase, threshold, scale, threads);
-}
-
-}  // namespace
-
-const Recording& screen_outliers(const Recording& read, OutlierAction action, double threshold,
-                                 OutlierReport& report, Recording& edited, unsigned threads, Crew* crew) {
-  check_outlier_threshold(threshold);
-  report = OutlierReport{};
-  report.action = action;
-  report.threshold = threshold;
-  if (read.phase.points() < 3) return read;  // too short to screen; the caller says so
-  OutlierScale scale;
-  const std::vector<Outlier> found = detect_outliers(read, threshold, scale, threads, crew);
-  check_outlier_share(read, action, threshold, found.size());
-  report_outliers(read, action, threshold, scale, found, report);
-  if (action == OutlierAction::Keep || found.empty()) return read;
-  edited = Recording{};
-  edited.source = read.source;
-  edited.phase = apply_outliers(read.phase, found, action);
-  edited.rate_hz = read.rate_hz;
-  edited.rate_source = read.rate_source;
-  edited.samples = read.samples - report.removed;
-  edited.metadata = read.metadata;
-  edited.temperature_c = read.temperature_c;
-  edited.column_name = read.column_name;
-  edited.time_column = read.time_column;
-  edited.mode = read.mode;
-  edited.counter_wraps = read.counter_wraps;
-  return edited;
 }
 
 namespace {
@@ -301,87 +195,46 @@ Verdict verdict_of(const AnalysisResult& r, const AnalysisOptions& options) {
 
 }  // namespace
 
-AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
-  if (read.phase.kind != PhaseKind::Gyro)
-    throw UsageError(fmt::format("{}: analyze needs gyro data (pulses, counter, angle in arcsec/deg/rad, or rate in "
-                                 "deg/h, deg/s, rad/s); this input is clock data",
-                                 read.source));
-  OutlierReport outliers;
-  Recording rec_storage;
-  const Recording* recp = &read;
-  // The analysis' helper threads: the caller's crew (crew.hpp), or one of its own when the thread
-  // budget allows; the passes over the data share their work out through it.
-  std::optional<OwnCrew> own;
-  Crew* crew = own.emplace(0u).get();
-  // Outliers that are only reported (the default) change nothing the Allan stage or the fit
-  // computes: then the scan's stretches are offered to the crew after the Allan stage, beside the
-  // fit, the cross-checks and the verdict, and the analysis' thread takes what is left once the
-  // verdict is done (SharedOutlierScan; not beside the Allan stage, whose passes take the crew).
-  const bool posted_scan = crew && options.outlier_action == OutlierAction::Keep && read.phase.points() >= 3;
-  std::optional<SharedOutlierScan> shared;
-  std::function<void(std::size_t)> scan_chunk;
-  std::optional<Crew::Posted> posted;  // after `shared` and `scan_chunk`: joined before they go
-  if (posted_scan) {
-    check_outlier_threshold(options.outlier_threshold);
-  } else {
-    detail::ScopedTimer t("analyze: outlier scan");
-    recp = &screen_outliers(read, options.outlier_action, options.outlier_threshold, outliers, rec_storage,
-                            0u, crew);
-  }
-  const Recording& rec = *recp;
-  AnalysisResult r;
-  if (!posted_scan) r.outliers = std::move(outliers);
-  describe_record(rec, options, r);
-  const std::size_t pts = rec.phase.points();
-  if (pts < 3) throw AnalysisError(fmt::format("{}: the record holds {} sample(s); far too short to analyse", rec.source, rec.samples));
+namespace {
 
-  // Earth rate and bias.
-  r.mean_rate_deg_per_h = rec.phase.diff(pts - 1, 0) / r.duration_s;
+/// Mean rate, expected Earth rate and the bias between them.
+void earth_rate_and_bias(const Recording& rec, const AnalysisOptions& options, AnalysisResult& r) {
+  r.mean_rate_deg_per_h = rec.phase.diff(rec.phase.points() - 1, 0) / r.duration_s;
   r.earth_rate_given = options.earth_rate_deg_per_h.has_value();
   r.latitude_deg = r.earth_rate_given ? 0.0 : options.latitude_deg;
   r.earth_rate_deg_per_h = r.earth_rate_given ? *options.earth_rate_deg_per_h : vertical_earth_rate(options.latitude_deg);
   r.bias_deg_per_h = r.mean_rate_deg_per_h - r.earth_rate_deg_per_h;
+}
 
-  // Allan variance, fit, classic readout.
-  // A finer grid (--tau) is reported in full, but the fit and the slope readout use its octave
-  // points, so the coefficients and the verdict do not depend on the grid.
+/// Allan variance, fit and classic readout. A finer grid (--tau) is reported in full, but the fit
+/// and the slope readout use its octave points, so the coefficients and the verdict do not depend
+/// on the grid.
+void allan_and_fit(const Recording& rec, const AnalysisOptions& options, AnalysisResult& r) {
   AllanOptions aopt = options.allan;
   const bool octave = aopt.grid.kind == TauGrid::Kind::Octave;
   if (!octave) {
     aopt.grid.with_octave = true;
-    if (aopt.grid.kind == TauGrid::Kind::Dense && aopt.grid.max_m == 0)
-      aopt.grid.max_m = std::max<std::int64_t>(1, static_cast<std::int64_t>(pts / 10));  // dense to N/10
+    if (aopt.grid.kind == TauGrid::Kind::Dense && aopt.grid.max_m == 0)  // dense to N/10
+      aopt.grid.max_m = std::max<std::int64_t>(1, static_cast<std::int64_t>(rec.phase.points() / 10));
   }
-  {
-    detail::ScopedTimer t("analyze: allan");
-    r.allan = compute_allan(rec.phase, aopt);
-  }
-  if (posted_scan) {
-    shared.emplace(read.phase, options.outlier_threshold);
-    scan_chunk = [&shared](std::size_t) { shared->help(); };
-    posted.emplace(crew->post(2, scan_chunk));
-  }
+  r.allan = compute_allan(rec.phase, aopt);
   const AllanResult octave_points = octave ? AllanResult{} : octave_points_of(r.allan, aopt);
   const AllanResult& fitted = octave ? r.allan : octave_points;
   try {
-    detail::ScopedTimer t("analyze: fit");
-    FitOptions fopt = options.fit;
-    r.fit = fit_noise(fit_points(fitted), fopt);
+    r.fit = fit_noise(fit_points(fitted), options.fit);
   } catch (const AnalysisError& e) {
     throw AnalysisError(fmt::format("{}: {}", rec.source, e.what()));
   }
   r.slope = slope_readout(fitted);
   for (const auto& p : fitted.points)
     if (p.tau_s == r.slope.tau_min_s && p.edf > 0 && r.slope.B) r.slope_B_sigma = *r.slope.B / std::sqrt(2.0 * p.edf);
+}
 
-  // Cross-checks.
-  {
-    detail::ScopedTimer t("analyze: cross-checks");
-    r.direct = direct_n(rec.phase, options.methods);
-    r.avg100 = block_spread(rec.phase, options.methods.block_s);
-    attach_expectation(r.avg100, r.fit);
-  }
-  detail::ScopedTimer verdict_timer("analyze: verdict");
+/// The paper's methods (direct N, spread of 100-s means) and their discrepancies from the fit.
+void cross_checks(const Recording& rec, const AnalysisOptions& options, AnalysisResult& r) {
+  r.direct = direct_n(rec.phase, options.methods);
+  r.avg100 = block_spread(rec.phase, options.methods.block_s);
+  attach_expectation(r.avg100, r.fit);
   const auto& fn = r.fit[Term::N];
   const auto& fb = r.fit[Term::B];
   if (r.direct.N.valid)
@@ -392,63 +245,27 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
       r.B_100s_vs_model_sigma = discrepancy_sigma(r.avg100.spread.value, r.avg100.spread.sigma, r.avg100.expected,
                                                   r.avg100.expected_sigma);
   }
-
-  r.verdict = verdict_of(r, options);
-  if (posted_scan) {
-    detail::ScopedTimer t("analyze: outlier scan (rest)", true);
-    crew->join(*posted);
-    OutlierScale scale;
-    const std::vector<Outlier> found = shared->finish(scale);
-    report_outliers(read, options.outlier_action, options.outlier_threshold, scale, found, outliers);
-    r.outliers = std::move(outliers);
-  }
-  return r;
 }
 
-nlohmann::json to_json(const OutlierReport& o) {
-  nlohmann::json pos = nlohmann::json::array();
-  for (const auto& p : o.positions)
-    pos.push_back({{"index", p.index}, {"time_s", p.time_s}, {"line", p.line}, {"value_deg_per_h", p.value},
-                   {"robust_z", p.robust_z}});
-  return {{"action", std::string(to_string(o.action))},
-          {"threshold_robust_z", o.threshold},
-          {"scale_deg_per_h", o.scale_deg_per_h},
-          {"count", o.count},
-          {"removed", o.removed},
-          {"replaced", o.replaced},
-          {"positions_listed", o.positions.size()},
-          {"positions", pos}};
-}
-
-namespace {
-constexpr std::size_t kReportOutliers = 20;  // rows of the readable list; the JSON has up to kMaxOutlierPositions
 }  // namespace
 
-std::string format_outliers(const OutlierReport& o) {
-  std::string s = fmt::format(
-      "Outliers (rate samples more than {:g} robust sigma from the median of their 6 neighbours; scale {} °/h)\n",
-      o.threshold, num(o.scale_deg_per_h, 3));
-  if (o.count == 0) return s + "  none found\n\n";
-  switch (o.action) {
-    case OutlierAction::Keep:
-      s += fmt::format("  {} found; KEPT in the analysis below (--outliers remove or replace to leave them out)\n", o.count);
-      break;
-    case OutlierAction::Remove:
-      s += fmt::format("  {} found; {} REMOVED: the samples after each one move one period earlier (a splice)\n", o.count,
-                       o.removed);
-      break;
-    case OutlierAction::Replace:
-      s += fmt::format("  {} found; {} REPLACED by the median of their four nearest good neighbours\n", o.count, o.replaced);
-      break;
-  }
-  s += fmt::format("  {:>10} {:>12} {:>10} {:>14} {:>9}\n", "sample", "time (s)", "line", "rate (°/h)", "z");
-  for (std::size_t k = 0; k < o.positions.size() && k < kReportOutliers; ++k) {
-    const auto& p = o.positions[k];
-    s += fmt::format("  {:>10} {:>12.6g} {:>10} {:>14.6g} {:>+9.1f}\n", p.index, p.time_s, p.line, p.value, p.robust_z);
-  }
-  if (o.count > kReportOutliers)
-    s += fmt::format("  … and {} more (the first {} are listed in --json)\n", o.count - kReportOutliers, o.positions.size());
-  return s + "\n";
+AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
+  if (read.phase.kind != PhaseKind::Gyro)
+    throw UsageError(fmt::format("{}: analyze needs gyro data (pulses, counter, angle in arcsec/deg/rad, or rate in "
+                                 "deg/h, deg/s, rad/s); this input is clock data",
+                                 read.source));
+  AnalysisResult r;
+  Recording edited;
+  const Recording& rec =
+      screen_outliers(read, options.outlier_action, options.outlier_threshold, r.outliers, edited);
+  describe_record(rec, options, r);
+  if (rec.phase.points() < 3)
+    throw AnalysisError(fmt::format("{}: the record holds {} sample(s); far too short to analyse", rec.source, rec.samples));
+  earth_rate_and_bias(rec, options, r);
+  allan_and_fit(rec, options, r);
+  cross_checks(rec, options, r);
+  r.verdict = verdict_of(r, options);
+  return r;
 }
 
 nlohmann::json to_json(const AnalysisResult& r) {

@@ -1,26 +1,16 @@
-// Batch analysis over files (threads), JSON-lines merge, and the Table 1 / Table 2 layout.
+// Batch analysis over files (in parallel), JSON-lines merge, and the Table 1 / Table 2 layout.
 #include "rwcalc/batch.hpp"
-
-#include "rwcalc/crew.hpp"
 
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <atomic>
-#include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <exception>
-#include <fstream>
-#include <mutex>
-#include <thread>
-#include <utility>
 #include <utility>
 
 #include "rwcalc/error.hpp"
+#include "rwcalc/parallel.hpp"
 #include "rwcalc/printable.hpp"
-#include "rwcalc/thread.hpp"
-#include "core/timing.hpp"
 
 namespace rwcalc {
 
@@ -176,61 +166,19 @@ std::string outliers_line(const json& run) {
 }  // namespace
 
 std::vector<json> analyze_files(const std::vector<std::string>& files, const ReadOptions& read,
-                                const AnalysisOptions& options, unsigned jobs) {
+                                const AnalysisOptions& options) {
   if (files.empty()) throw UsageError("batch: no input files");
-  if (jobs == 0) jobs = std::max(1u, std::thread::hardware_concurrency());
-  // `jobs` threads in all. Files go to min(jobs, files) workers, each run read and analysed on
-  // its worker's thread (--jobs 1 is one thread). A worker with no file left lends its thread to
-  // the runs still in flight — their passes over the data (the int32 view, the Allan sums, the
-  // noise identification's first pass, the outlier scan) are shared out in stretches (crew.hpp)
-  // — until the last run ends: the last runs take up the cores as they free, and no core is given
-  // two threads while another run still holds it. A single worker (one file) has all the threads.
-  const unsigned total = jobs;
-  jobs = std::min<unsigned>(jobs, static_cast<unsigned>(files.size()));
+  // Files are independent: each is read and analysed on its own (the loops inside an analysis
+  // then run serially, parallel_for being nested). Results and errors are kept per file.
   std::vector<json> out(files.size());
   std::vector<std::exception_ptr> errors(files.size());
-  std::atomic<std::size_t> next{0};
-  Crew crew;
-  std::atomic<unsigned> active{jobs};
-  // With RWCALC_TIMING, one line per run: its worker, and when (ms from here) its read began and
-  // ended and its analysis ended.
-  const auto start = std::chrono::steady_clock::now();
-  auto ms_since_start = [start] {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  };
-  auto worker = [&](unsigned w) {
-    // Each worker's last record lends its counts' storage, pages mapped, to its next read
-    // (ReadOptions::reuse).
-    std::vector<std::int32_t> spare;
-    for (std::size_t i = next++; i < files.size(); i = next++) {
-      try {
-        const unsigned threads = jobs > 1 ? 1u : total;
-        ReadOptions ro = read;
-        ro.threads = threads;
-        ro.reuse = &spare;
-        if (jobs > 1) ro.crew = &crew;  // a long file loaded in halves when a lender is free
-        AnalysisOptions opt = options;
-        const double t0 = ms_since_start();
-        Recording rec = read_recording(files[i], ro);
-        const double t1 = ms_since_start();
-        out[i] = to_json(analyze(rec, opt));
-        spare = std::move(rec.phase.counts32);
-        if (detail::timing_enabled())
-          std::fprintf(stderr, "timing: batch run %zu on worker %u: read %.2f to %.2f ms, analysed at %.2f ms\n", i, w,
-                       t0, t1, ms_since_start());
-      } catch (...) {
-        errors[i] = std::current_exception();
-      }
+  parallel_for(files.size(), [&](std::size_t i) {
+    try {
+      out[i] = to_json(analyze(read_recording(files[i], read), options));
+    } catch (...) {
+      errors[i] = std::current_exception();
     }
-    if (--active == 0)
-      crew.close();
-    else
-      crew.lend();
-  };
-  std::vector<Thread> pool;
-  for (unsigned t = 1; t < jobs; ++t) pool.emplace_back([&worker, t] { worker(t); });
-  worker(0);
-  for (auto& t : pool) t.join();
+  });
   for (std::size_t i = 0; i < files.size(); ++i) {
     if (!errors[i]) continue;
     try {

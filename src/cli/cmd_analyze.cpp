@@ -10,10 +10,8 @@
 #include "cli/numeric_options.hpp"
 #include "cli/plot_args.hpp"
 #include "rwcalc/analysis.hpp"
-#include "rwcalc/crew.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/output.hpp"
-#include "core/timing.hpp"
 
 namespace rwcalc::cli {
 
@@ -56,15 +54,9 @@ void register_analyze(CLI::App& app, Runner& runner) {
       // Output problems (figure format, existing files, two outputs naming one file, no gnuplot)
       // are reported before the analysis, and before anything is written.
       cmd->plot.check(cmd->force, {{"-o", cmd->output}});
-      detail::ScopedTimer total("analyze command");
-      const Recording rec = [&] {
-        detail::ScopedTimer t("read");
-        ReadOptions ro = cmd->input.options();
-        return read_recording(cmd->file, ro);
-      }();
+      const Recording rec = read_recording(cmd->file, cmd->input.options());
       const AnalysisResult res = analyze(rec, opt);
       const std::string text = [&] {
-        detail::ScopedTimer t("format");
         const nlohmann::json j = to_json(res);
         require_finite(j, rec.source);
         if (!cmd->json && !cmd->plot.any()) return format_report(res);

@@ -26,7 +26,6 @@ struct BatchCmd {
   AnalyzeArgs analysis;
   std::optional<double> temperature;
   TableFormat format;
-  unsigned jobs = 0;
   std::string output = "-";
   bool force = false;
   PlotArgs plot;
@@ -45,8 +44,6 @@ void register_batch(CLI::App& app, Runner& runner) {
   sub->add_option("--temperature", cmd->temperature, "Temperature, °C (only with a single file)")
       ->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"));
   cmd->format.add_to(*sub);
-  sub->add_option("-j,--jobs", cmd->jobs, "Files analysed in parallel (default: hardware threads)")
-      ->check(whole_in(0, kMaxThreads));
   sub->add_option("-o,--output", cmd->output, "Write to FILE instead of standard output")->capture_default_str();
   sub->add_flag("--force", cmd->force, "Overwrite existing output, figure and script files");
   cmd->plot.add_to(*sub,
@@ -60,7 +57,7 @@ void register_batch(CLI::App& app, Runner& runner) {
         opt.temperature_c = cmd->temperature;
       }
       cmd->plot.check(cmd->force, {{"-o", cmd->output}});
-      auto runs = analyze_files(cmd->files, cmd->input.options(), opt, cmd->jobs);
+      auto runs = analyze_files(cmd->files, cmd->input.options(), opt);
       for (const auto& run : runs) require_finite(run, run.value("source", std::string("batch")));
       if (cmd->plot.any()) cmd->plot.draw_batch(nlohmann::json{{"runs", runs}}, cmd->force, io);
       emit(io, cmd->format.render(std::move(runs)), cmd->output, cmd->force);

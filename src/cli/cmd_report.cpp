@@ -178,7 +178,7 @@ int run_report(const ReportCmd& c, Io& io) {
   std::vector<json> diagnoses;
   if (c.diagnose) diagnoses = diagnose_recordings(recordings, read, opt, c.diagnose_runs, c.diagnose_seed);
   ReportInput in;
-  if (!recordings.empty()) in.analyses = analyze_files(recordings, read, opt, c.jobs);
+  if (!recordings.empty()) in.analyses = analyze_files(recordings, read, opt);
   diagnoses.resize(in.analyses.size());
   for (auto& a : saved.analyses) in.analyses.push_back(std::move(a.run));
   if (in.analyses.empty())

@@ -712,7 +712,7 @@ DiagnoseResult diagnose(const Recording& read, const DiagnoseOptions& opt) {
   OutlierReport outliers;
   Recording edited;
   const Recording& rec = screen_outliers(read, opt.analysis.outlier_action, opt.analysis.outlier_threshold,
-                                         outliers, edited, opt.threads);
+                                         outliers, edited);
   const double T = rec.phase.duration_s();
   if (T < kMinDuration)
     throw AnalysisError(fmt::format("{}: the record lasts {:.4g} s; the diagnosis needs at least {:g} s", rec.source, T, kMinDuration));

@@ -8,6 +8,7 @@
 
 #include "allan/allan_kernels.hpp"
 #include "rwcalc/diagnose_detectors.hpp"
+#include "rwcalc/ensemble.hpp"
 #include "rwcalc/allan.hpp"
 #include "rwcalc/fit.hpp"
 
@@ -22,7 +23,6 @@ std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSett
   std::vector<RunStats> out(runs);
   EnsembleOptions eo;
   eo.path = SimulationPath::Ensemble;
-  eo.threads = options.threads;
   eo.progress = options.progress;
   simulate_ensemble(
       model, settings, runs,

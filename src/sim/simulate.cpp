@@ -47,29 +47,7 @@ double gm_angle_var_factor(double x) {
   return x - 2.0 * (-std::expm1(-x)) + 0.5 * (-std::expm1(-2.0 * x));
 }
 
-// 1 − (3 − 4e^{−x} + e^{−2x})/(2x) without cancellation (x > 0).
-double gm_avar_factor(double x) {
-  if (x < 0.5) {
-    double sum = 0.0, term = x;  // x^n/n! for n = 1
-    double p2 = 2.0;             // 2^n
-    for (int n = 2; n < 40; ++n) {
-      term *= x / n;
-      p2 *= 2.0;
-      if (n < 3) continue;
-      sum += -((n % 2) ? -1.0 : 1.0) * (p2 - 4.0) * term / (2.0 * x);
-      if (std::abs(term * p2) < 1e-18 * std::abs(sum) * x) break;
-    }
-    return sum;
-  }
-  return 1.0 - (3.0 - 4.0 * std::exp(-x) + std::exp(-2.0 * x)) / (2.0 * x);
-}
-
-// floor(x) as an integer, bit-identical to std::floor for |x| < 2^62. Without SSE4.1 the
-// compiler turns std::floor into a library call; this is a truncation and a compare.
-inline std::int64_t floor_to_int(double x) noexcept {
-  const auto t = static_cast<std::int64_t>(x);
-  return static_cast<double>(t) > x ? t - 1 : t;
-}
+inline std::int64_t floor_to_int(double x) noexcept { return static_cast<std::int64_t>(std::floor(x)); }
 
 // Smallest 2^a·3^b·5^c ≥ n that is even (kissfft handles radices 2, 3, 5 efficiently).
 std::size_t good_fft_size(std::size_t n) {
@@ -82,16 +60,6 @@ std::size_t good_fft_size(std::size_t n) {
       best = std::min(best, s);
     }
   return best;
-}
-
-void check_finite_nonneg(double v, const char* what) {
-  if (!std::isfinite(v) || v < 0.0) throw UsageError(fmt::format("{} must be a finite value >= 0, got {}", what, v));
-}
-void check_finite(double v, const char* what) {
-  if (!std::isfinite(v)) throw UsageError(fmt::format("{} must be finite, got {}", what, v));
-}
-void check_positive(double v, const char* what) {
-  if (!std::isfinite(v) || v <= 0.0) throw UsageError(fmt::format("{} must be a finite value > 0, got {}", what, v));
 }
 
 // Exact discretisation (Van Loan, closed form) of dε = −ε/Tc dt + w dt, dθ = ε dt with w white of
@@ -130,9 +98,9 @@ double temperature_angle(const TemperatureBias& tb, double t, double t_nominal, 
   return c * p.amp_c * (1.0 - std::cos(w * t)) / w;
 }
 
-// First-order low-pass in the output chain (NoiseModel::output_lowpass_tc_s), applied to counts
-// C_1, C_2, … in order: θ_k = θ_{k−1} + y_k·τ0 with y_k = φy_{k−1} + (1 − φ)r_k,
-// r_k = (C_k − C_{k−1})·q/τ0 and φ = e^{−τ0/Tf}, from y_0 = the record's mean rate C_n·q/(n·τ0).
+// First-order low-pass in the output chain (NoiseModel::output_lowpass_tc_s) over counts C_1, C_2, …:
+// θ_k = θ_{k−1} + y_k·τ0, y_k = φy_{k−1} + (1 − φ)r_k, r_k = (C_k − C_{k−1})·q/τ0, φ = e^{−τ0/Tf},
+// starting in steady state at the record's mean rate y_0 = C_n·q/(n·τ0).
 class OutputChainFilter {
  public:
   OutputChainFilter(double tf_s, double tau0_s, double q, std::int64_t last_count, std::size_t n)
@@ -158,87 +126,6 @@ class OutputChainFilter {
 };
 
 }  // namespace
-
-std::size_t SimulationSettings::samples() const {
-  const double n = std::round(duration_s * rate_hz);
-  return n > 0 && std::isfinite(n) ? static_cast<std::size_t>(n) : 0;
-}
-
-double earth_rate_at(double latitude_deg) {
-  return units::earth_rate_deg_per_h * std::sin(latitude_deg * kPi / 180.0);
-}
-
-double readout_q_arcsec(ReadoutMode mode, double scale_arcsec) {
-  return mode == ReadoutMode::White ? scale_arcsec / std::sqrt(6.0) : scale_arcsec / std::sqrt(12.0);
-}
-
-void validate(const NoiseModel& m, const SimulationSettings& s) {
-  check_positive(s.duration_s, "duration_s");
-  check_positive(s.rate_hz, "rate_hz");
-  check_positive(s.scale_arcsec, "scale_arcsec");
-  if (s.samples() < 2) throw UsageError(fmt::format("the record must hold at least 2 samples (duration {} s at {} Hz)", s.duration_s, s.rate_hz));
-  if (s.samples() > (std::size_t{1} << 31)) throw UsageError("the record is too long (more than 2^31 samples)");
-  if (s.temperature_c) check_finite(*s.temperature_c, "temperature_c");
-  check_finite_nonneg(m.arw_deg_per_sqrt_h, "arw_deg_per_sqrt_h");
-  check_finite_nonneg(m.bias_instability_deg_per_h, "bias_instability_deg_per_h");
-  check_finite_nonneg(m.rrw_deg_per_h_per_sqrt_h, "rrw_deg_per_h_per_sqrt_h");
-  check_finite(m.ramp_deg_per_h2, "ramp_deg_per_h2");
-  check_finite(m.bias_deg_per_h, "bias_deg_per_h");
-  check_finite(m.earth_rate_deg_per_h, "earth_rate_deg_per_h");
-  check_finite_nonneg(m.white_angle_arcsec, "white_angle_arcsec");
-  check_finite_nonneg(m.lowpass_tc_s, "lowpass_tc_s");
-  check_finite_nonneg(m.output_lowpass_tc_s, "output_lowpass_tc_s");
-  for (const auto& x : m.sinusoids) {
-    check_positive(x.f_hz, "sinusoid frequency_hz");
-    check_finite(x.amp_deg_per_h, "sinusoid amplitude_deg_per_h");
-    check_finite(x.phase_rad, "sinusoid phase_rad");
-  }
-  for (const auto& x : m.gauss_markov) {
-    check_finite_nonneg(x.sigma_deg_per_h, "gauss_markov sigma_deg_per_h");
-    check_positive(x.tc_s, "gauss_markov correlation_time_s");
-  }
-  for (const auto& x : m.bias_steps) {
-    check_finite_nonneg(x.t_s, "bias_step time_s");
-    check_finite(x.size_deg_per_h, "bias_step size_deg_per_h");
-  }
-  for (const auto& x : m.warmups) {
-    check_finite(x.amp_deg_per_h, "warmup amplitude_deg_per_h");
-    check_positive(x.tc_s, "warmup time_constant_s");
-  }
-  if (m.temperature_bias) {
-    const auto& tb = *m.temperature_bias;
-    check_finite(tb.coefficient_deg_per_h_per_c, "temperature_bias coefficient_deg_per_h_per_c");
-    check_finite(tb.profile.start_c, "temperature profile start_c");
-    check_finite(tb.profile.end_c, "temperature profile end_c");
-    check_finite(tb.profile.amp_c, "temperature profile amp_c");
-    if (tb.profile.kind == TemperatureProfile::Kind::Cycle) check_positive(tb.profile.period_s, "temperature profile period_s");
-  }
-}
-
-double flicker_avar(double b, std::size_t m) {
-  // AV(m) = (2B²/(π m²)) ∫_0^{π/2} sin⁴(mu)/sin³(u) du: the discrete Kasdin spectrum
-  // B²τ0/(2 sin πfτ0) through the Allan transfer function of m-sample means.
-  const double floor = 2.0 * b * b * std::numbers::ln2 / kPi;
-  if (m > (std::size_t{1} << 16)) return floor;
-  static constexpr double kX[8] = {-0.9602898564975363, -0.7966664774136267, -0.5255324099163290, -0.1834346424956498,
-                                   0.1834346424956498,  0.5255324099163290,  0.7966664774136267,  0.9602898564975363};
-  static constexpr double kW[8] = {0.1012285362903763, 0.2223810344533745, 0.3137066378926775, 0.3626837833783620,
-                                   0.3626837833783620, 0.3137066378926775, 0.2223810344533745, 0.1012285362903763};
-  const double md = static_cast<double>(m);
-  const std::size_t panels = 8 * m;
-  const double h = (kPi / 2.0) / static_cast<double>(panels);
-  double sum = 0.0;
-  for (std::size_t p = 0; p < panels; ++p) {
-    const double mid = (static_cast<double>(p) + 0.5) * h;
-    for (int i = 0; i < 8; ++i) {
-      const double u = mid + 0.5 * h * kX[i];
-      const double s = std::sin(md * u);
-      const double su = std::sin(u);
-      sum += kW[i] * (s * s * s * s) / (su * su * su);
-    }
-  }
-  return 2.0 * b * b / (kPi * md * md) * sum * 0.5 * h;
-}
 
 std::size_t flicker_decimation(double rate_hz) {
   if (!(rate_hz >= 20.0) || !std::isfinite(rate_hz)) return 1;
@@ -273,31 +160,6 @@ double fast_flicker_avar(double b, std::size_t m, std::size_t decimation) {
   return (4.0 * b * b / kPi) * total / static_cast<double>(d) / (2.0 * md * md);
 }
 
-double theoretical_avar(const NoiseModel& model, double tau0, double q, std::size_t m) {
-  const double tau = static_cast<double>(m) * tau0;
-  const double n_s = units::sqrt_s_per_sqrt_h * model.arw_deg_per_sqrt_h;     // ″/√s
-  const double k_s = model.rrw_deg_per_h_per_sqrt_h / units::sqrt_s_per_sqrt_h;  // ″/s/√s
-  const double r_s = model.ramp_deg_per_h2 / units::seconds_per_hour;        // ″/s²
-  double av = n_s * n_s / tau + k_s * k_s * tau / 3.0 + r_s * r_s * tau * tau / 2.0;
-  if (model.bias_instability_deg_per_h > 0) av += flicker_avar(model.bias_instability_deg_per_h, m);
-  for (const auto& s : model.sinusoids) {
-    const double x = kPi * s.f_hz * tau;
-    const double v = std::sin(x) * std::sin(x) / x;
-    av += s.amp_deg_per_h * s.amp_deg_per_h * v * v;
-  }
-  for (const auto& g : model.gauss_markov) {
-    const double qc2 = 2.0 * g.sigma_deg_per_h * g.sigma_deg_per_h / g.tc_s;
-    const double x = tau / g.tc_s;
-    av += qc2 * g.tc_s * gm_avar_factor(x) / x;
-  }
-  double white_angle2 = model.white_angle_arcsec * model.white_angle_arcsec;
-  if (model.readout == ReadoutMode::White) white_angle2 += q * q / 6.0;
-  av += 3.0 * white_angle2 / (tau * tau);
-  return av;
-}
-
-// ---------------------------------------------------------------------------------------------
-
 struct Simulator::Impl {
   NoiseModel model;
   SimulationSettings settings;
@@ -313,7 +175,7 @@ struct Simulator::Impl {
   std::vector<std::complex<double>> filter_spectrum, spectrum;
   std::vector<double> flicker;
   std::vector<GmStep> gm_steps;
-  // Sinusoids: cos and sin of (j + 1)·ωτ0 for j < kBlock, one table pair per line (deterministic_block).
+  // Sinusoids: cos and sin of (j + 1)·ωτ0 for j < kBlock, per line (deterministic_block).
   struct LineSteps {
     std::vector<double> c, s;
   };
@@ -373,10 +235,9 @@ struct Simulator::Impl {
     flicker.resize(fft_size);
   }
 
-  // Flicker rate samples x_0..x_{n−1}, ″/s (added to the increments as x·τ0 in `Pass`). The
-  // white input's DFT is drawn directly (its bins are independent complex normals), which saves
-  // the forward FFT. On the Ensemble path x is the Kasdin sequence at τd = D·τ0 (Q_d = B² keeps
-  // the low-frequency PSD B²/(πf) of the exact path), held over each block of D samples.
+  // Flicker rate samples, ″/s, by filtering white noise whose DFT is drawn directly (independent
+  // complex normal bins). On the Ensemble path the Kasdin sequence is at τd = D·τ0 (Q_d = B² keeps
+  // the low-frequency PSD B²/(πf)), each value held over D samples.
   void make_flicker(std::uint64_t seed) {
     Rng rng(seed, kFlickerStream);
     const double b = model.bias_instability_deg_per_h;  // Q_d = B²
@@ -393,12 +254,9 @@ struct Simulator::Impl {
     fft.inv(flicker.data(), spectrum.data(), static_cast<Eigen::Index>(fft_size));
   }
 
-  // One realisation, generated in blocks of kBlock samples that stay in L1: each term adds its
-  // angle increments of the block (″; x[j] is the increment of interval b + j + 1) in a fixed
-  // order, with its state (random streams, integrated rates) carried from block to block, and
-  // the read-out counts the block's pulses. Every term draws from its own stream in sample order,
-  // so a record depends on the block length only through roundings far below a pulse: the angle's
-  // running sum (quantize_block) and the sinusoid and warm-up steps from the block's start.
+  // A realisation is generated in blocks of kBlock samples: each term adds its angle increments
+  // (″; x[j] is that of interval b + j + 1) in a fixed order, its state carried from block to
+  // block, and the read-out counts the block's pulses. Every term draws from its own stream.
   static constexpr std::size_t kBlock = 256;
   struct Pass {
     Rng arw, rrw, readout, white;
@@ -422,13 +280,17 @@ struct Simulator::Impl {
     out.tau0_s = tau0;
     out.arcsec_per_count = q;
     out.values.clear();
-    out.counts32.clear();
     out.counts.resize(n + 1);
     out.counts[0] = 0;
     generate(seed, [&](std::size_t first, const std::int64_t* c, std::size_t len) {
       std::copy_n(c, len, out.counts.data() + first);
     });
-    if (model.output_lowpass_tc_s > 0) output_lowpass(out);
+    if (!(model.output_lowpass_tc_s > 0)) return;
+    OutputChainFilter filter(model.output_lowpass_tc_s, tau0, q, out.counts[n], n);
+    out.values.resize(n + 1);
+    out.values[0] = 0.0;
+    filter.apply(out.counts.data() + 1, n, out.values.data() + 1);
+    out.counts.clear();
   }
 
   void stream(std::uint64_t seed, const std::function<void(const RecordBlock&)>& sink) {
@@ -438,8 +300,7 @@ struct Simulator::Impl {
       });
       return;
     }
-    // The output-chain filter starts at the record's mean rate C_n·q/(n·τ0): a first pass finds
-    // C_n, the second (the same draws) filters and hands out the angles.
+    // The filter starts at the mean rate: a first pass finds C_n, the second filters.
     std::int64_t last = 0;
     generate(seed, [&](std::size_t, const std::int64_t* c, std::size_t len) { last = c[len - 1]; });
     OutputChainFilter filter(model.output_lowpass_tc_s, tau0, q, last, n);
@@ -468,18 +329,7 @@ struct Simulator::Impl {
       const std::size_t len = std::min(kBlock, n - b);
       deterministic_block(b, len, x);
       if (model.rrw_deg_per_h_per_sqrt_h > 0) rrw_block(st, len, x);
-      if (model.bias_instability_deg_per_h > 0) {
-        if (flicker_hold == 1) {
-          for (std::size_t j = 0; j < len; ++j) x[j] += flicker[b + j] * tau0;
-        } else {
-          // Held values: the one at b and its hold's remaining samples, then whole holds.
-          std::size_t v = b / flicker_hold, left = flicker_hold - b % flicker_hold;
-          for (std::size_t j = 0; j < len; ++v, left = flicker_hold) {
-            const double step = flicker[v] * tau0;
-            for (const std::size_t end = std::min(len, j + left); j < end; ++j) x[j] += step;
-          }
-        }
-      }
+      if (model.bias_instability_deg_per_h > 0) flicker_block(b, len, x);
       for (std::size_t i = 0; i < gm_steps.size(); ++i)
         if (model.gauss_markov[i].sigma_deg_per_h > 0) gm_block(st.gm[i], st.gm_eps[i], gm_steps[i], len, x);
       if (model.lowpass_tc_s > 0) lowpass_block(st, b == 0, len, x);
@@ -498,30 +348,26 @@ struct Simulator::Impl {
     }
   }
 
-  // The rate terms known in closed form: constant rate and ramp, sinusoids, bias steps, warm-up
-  // transients, temperature-driven bias (each as the difference of its angle at the interval's
-  // ends where it has one).
+  // Flicker values held over flicker_hold samples each: the one at b for the rest of its hold,
+  // then whole holds.
+  void flicker_block(std::size_t b, std::size_t len, double* x) const {
+    std::size_t v = b / flicker_hold, left = flicker_hold - b % flicker_hold;
+    for (std::size_t j = 0; j < len; ++v, left = flicker_hold) {
+      const double step = flicker[v] * tau0;
+      for (const std::size_t end = std::min(len, j + left); j < end; ++j) x[j] += step;
+    }
+  }
+
+  // The rate terms known in closed form, each as the difference of its angle at the interval's
+  // ends where it has one.
   void deterministic_block(std::size_t b, std::size_t len, double* x) const {
     const double omega = model.bias_deg_per_h + model.earth_rate_deg_per_h;  // ″/s
     const double r_s = model.ramp_deg_per_h2 / units::seconds_per_hour;      // ″/s²
     const double ramp_unit = 0.5 * r_s * tau0 * tau0;
     const double base = omega * tau0;
-    if (ramp_unit == 0.0) {
-      std::fill_n(x, len, base);  // base + 0·(2k + 1), without the per-sample conversion
-    } else {
-      for (std::size_t j = 0; j < len; ++j) x[j] = base + ramp_unit * (2.0 * static_cast<double>(b + j) + 1.0);
-    }
-    auto add_angle = [&](auto&& angle) {
-      double prev = angle(static_cast<double>(b) * tau0);
-      for (std::size_t j = 0; j < len; ++j) {
-        const double cur = angle(static_cast<double>(b + j + 1) * tau0);
-        x[j] += cur - prev;
-        prev = cur;
-      }
-    };
-    // A sinusoid's angle a·sin(ωt + φ) at the block's sample times from its phase α at the block's
-    // start: sin(α + β_j) = sin α cos β_j + cos α sin β_j with β_j = (j + 1)ωτ0 from the tables
-    // (one sincos per block instead of one sin per sample; the same angle to a few ulps).
+    for (std::size_t j = 0; j < len; ++j) x[j] = base + ramp_unit * (2.0 * static_cast<double>(b + j) + 1.0);
+    // A sinusoid's angle a·sin(ωt + φ) from its phase α at the block's start:
+    // sin(α + β_j) = sin α cos β_j + cos α sin β_j, β_j = (j + 1)ωτ0 from the tables.
     for (std::size_t i = 0; i < model.sinusoids.size(); ++i) {
       const auto& l = model.sinusoids[i];
       const double a = l.amp_deg_per_h / (2.0 * kPi * l.f_hz);
@@ -543,8 +389,8 @@ struct Simulator::Impl {
         x[j] += st.size_deg_per_h * (t2 - std::max(t1, st.t_s));
       }
     }
-    // A warm-up's rate A·e^{−t/Tc} integrated over each interval: A·Tc·e^{−kτ0/Tc}(1 − e^{−τ0/Tc}),
-    // e^{−kτ0/Tc} as the block start's value times e^{−jτ0/Tc} from a table (one exp per block).
+    // A warm-up's rate A·e^{−t/Tc} over interval k: A·Tc·e^{−kτ0/Tc}(1 − e^{−τ0/Tc}), e^{−kτ0/Tc} as
+    // the block start's value times e^{−jτ0/Tc} from the table.
     for (std::size_t i = 0; i < model.warmups.size(); ++i) {
       const auto& w = model.warmups[i];
       const double decay = -std::expm1(-tau0 / w.tc_s);
@@ -558,7 +404,12 @@ struct Simulator::Impl {
       const double nominal = settings.temperature_c.value_or(
           tb.profile.kind == TemperatureProfile::Kind::Ramp ? tb.profile.start_c : 0.0);
       const double record = static_cast<double>(n) * tau0;
-      add_angle([&](double t) { return temperature_angle(tb, t, nominal, record); });
+      double prev = temperature_angle(tb, static_cast<double>(b) * tau0, nominal, record);
+      for (std::size_t j = 0; j < len; ++j) {
+        const double cur = temperature_angle(tb, static_cast<double>(b + j + 1) * tau0, nominal, record);
+        x[j] += cur - prev;
+        prev = cur;
+      }
     }
   }
 
@@ -603,10 +454,8 @@ struct Simulator::Impl {
   }
 
   // Count whole pulses. The angle is carried as whole pulses `whole` plus a fraction in [0, 1),
-  // so its resolution does not degrade as the count grows. Within a block the angle is a running
-  // sum from the block's fraction (at most kBlock increments, so its resolution stays far below a
-  // pulse), and each sample's count is a floor of its own, off the running sum's dependency
-  // chain; the whole pulses move into `whole` at the block's end.
+  // so its resolution does not degrade as the count grows; within a block it is a running sum from
+  // the block's fraction.
   void start_quantize(Pass& st) const {
     st.dither = model.readout == ReadoutMode::White;
     st.wa = model.white_angle_arcsec / q;
@@ -621,9 +470,8 @@ struct Simulator::Impl {
     st.frac = 0.0;
   }
 
-  // Every count must stay within ±kMaxSimulatedPulses. The angle since the block's start (x), with
-  // its read-out offset, and the whole angle are tested before any of them is converted to an
-  // integer (a conversion out of range would give a wrapped count); NaN and infinity fail too.
+  // Every count must stay within ±kMaxSimulatedPulses, tested before it is converted to an integer
+  // (out of range, the conversion would wrap); NaN and infinity fail too.
   static bool countable(double pulses) noexcept { return std::abs(pulses) < kMaxSimulatedPulses; }
 
   [[noreturn]] static void throw_uncountable(std::size_t k, double pulses, double tau0, double q) {
@@ -650,31 +498,13 @@ struct Simulator::Impl {
     if (st.wa > 0)
       for (std::size_t j = 0; j < len; ++j) extra[j] += st.wa * st.white.normal();
     const double whole = static_cast<double>(st.whole);
-    bool in_range = true;
     for (std::size_t j = 0; j < len; ++j)
-      in_range &= countable(x[j]) & countable(x[j] + extra[j]) & countable(whole + x[j] + extra[j]);
-    if (!in_range) {
-      for (std::size_t j = 0; j < len; ++j)
-        if (!countable(x[j]) || !countable(x[j] + extra[j]) || !countable(whole + x[j] + extra[j]))
-          throw_uncountable(b + j + 1, whole + x[j] + extra[j], tau0, q);
-    }
+      if (!countable(x[j]) || !countable(x[j] + extra[j]) || !countable(whole + x[j] + extra[j]))
+        throw_uncountable(b + j + 1, whole + x[j] + extra[j], tau0, q);
     for (std::size_t j = 0; j < len; ++j) c[j] = st.whole + floor_to_int(x[j] + extra[j]);
     const std::int64_t fl = floor_to_int(acc);
     st.whole += fl;
     st.frac = acc - static_cast<double>(fl);
-  }
-
-  // First-order low-pass in the output chain: the read-out's per-sample rate
-  // r_k = (C_k − C_{k−1})·q/τ0 goes through y_k = φy_{k−1} + (1 − φ)r_k, φ = e^{−τ0/Tf}, and the
-  // record is θ_k = θ_{k−1} + y_k·τ0 (″, floating). The filter starts in steady state at the
-  // record's mean rate.
-  void output_lowpass(PhaseSeries& out) const {
-    OutputChainFilter filter(model.output_lowpass_tc_s, tau0, q, out.counts[n], n);
-    out.values.resize(n + 1);
-    out.values[0] = 0.0;
-    filter.apply(out.counts.data() + 1, n, out.values.data() + 1);
-    out.counts.clear();
-    out.counts32.clear();
   }
 };
 
@@ -689,8 +519,6 @@ void Simulator::stream(std::uint64_t seed, const std::function<void(const Record
   impl_->stream(seed, sink);
 }
 const NoiseModel& Simulator::model() const noexcept { return impl_->model; }
-const SimulationSettings& Simulator::settings() const noexcept { return impl_->settings; }
-SimulationPath Simulator::path() const noexcept { return impl_->path; }
 
 PhaseSeries simulate(const NoiseModel& model, const SimulationSettings& settings) {
   Simulator sim(model, settings);

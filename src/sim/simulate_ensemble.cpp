@@ -1,15 +1,14 @@
-// Multi-threaded ensembles of simulated records (simulate.hpp): one Simulator per worker.
-#include <algorithm>
-#include <atomic>
-#include <exception>
+// Ensembles of simulated records (ensemble.hpp): the records run side by side, each Simulator
+// reused for the next record once its record is consumed.
+#include "rwcalc/ensemble.hpp"
+
+#include <memory>
 #include <mutex>
-#include <thread>
 #include <vector>
 
+#include "rwcalc/parallel.hpp"
 #include "rwcalc/progress.hpp"
 #include "rwcalc/random.hpp"
-#include "rwcalc/simulate.hpp"
-#include "rwcalc/thread.hpp"
 
 namespace rwcalc {
 
@@ -22,33 +21,32 @@ void simulate_ensemble(const NoiseModel& model, const SimulationSettings& settin
                        const std::function<void(std::size_t, const PhaseSeries&)>& consume,
                        const EnsembleOptions& options) {
   if (runs == 0) return;
-  validate(model, settings);  // throw on the calling thread, before any worker starts
-  unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
-  threads = static_cast<unsigned>(std::min<std::size_t>(threads, runs));
-  std::atomic<std::size_t> next{0};
-  std::exception_ptr error;
-  std::mutex error_mu;
-  auto work = [&] {
-    try {
-      Simulator sim(model, settings, options.path);
-      PhaseSeries series;
-      for (std::size_t r = next++; r < runs; r = next++) {
-        sim.run(ensemble_seed(settings.seed, r), series);
-        consume(r, series);
-        if (options.progress) options.progress->advance();
-      }
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(error_mu);
-      if (!error) error = std::current_exception();
-      next = runs;  // the other workers stop after their current run
-    }
+  validate(model, settings);  // throw on the calling thread, before any record starts
+  // A Simulator (its FFT plan and flicker filter) and a record's storage are made once per
+  // thread, not per record: a record borrows a free pair and gives it back when consumed. A
+  // record depends only on its seed, so which pair it borrows changes nothing.
+  struct Slot {
+    Simulator sim;
+    PhaseSeries series;
   };
-  std::vector<Thread> pool;
-  pool.reserve(threads - 1);
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
+  std::mutex mutex;
+  std::vector<std::unique_ptr<Slot>> free;
+  parallel_for(runs, [&](std::size_t r) {
+    std::unique_ptr<Slot> slot;
+    {
+      const std::lock_guard lock(mutex);
+      if (!free.empty()) {
+        slot = std::move(free.back());
+        free.pop_back();
+      }
+    }
+    if (!slot) slot = std::make_unique<Slot>(Slot{Simulator(model, settings, options.path), {}});
+    slot->sim.run(ensemble_seed(settings.seed, r), slot->series);
+    consume(r, slot->series);
+    if (options.progress) options.progress->advance();
+    const std::lock_guard lock(mutex);
+    free.push_back(std::move(slot));
+  });
 }
 
 }  // namespace rwcalc

@@ -1,13 +1,15 @@
-// JSON form of the simulator's noise model, shared by simulate, analyze and diagnose.
+// JSON form of the simulator's noise model (noise_model.hpp), shared by simulate, analyze and diagnose.
 #include <fmt/format.h>
 
 #include <cmath>
 #include <optional>
+#include <string>
+#include <utility>
 #include <nlohmann/json.hpp>
 
 #include "core/json_input.hpp"
 #include "rwcalc/error.hpp"
-#include "rwcalc/simulate.hpp"
+#include "rwcalc/noise_model.hpp"
 
 namespace rwcalc {
 
@@ -68,8 +70,8 @@ void to_json(json& j, const NoiseModel& m) {
 
 namespace {
 
-void add_term(const Value& f, NoiseModel& m) {
-  const auto effect = f.object().at("effect").string();
+// One term of the model, `effect` naming its kind as diagnose's findings do.
+void add_effect(const std::string& effect, const Value& f, NoiseModel& m) {
   if (effect == "sinusoid") {
     m.sinusoids.push_back({num(f, "frequency_hz"), num(f, "amplitude_deg_per_h"), num(f, "phase_rad")});
   } else if (effect == "gauss_markov") {
@@ -86,6 +88,8 @@ void add_term(const Value& f, NoiseModel& m) {
     f.at("effect").fail(fmt::format("names an unknown effect '{}'", effect));
   }
 }
+
+void add_term(const Value& f, NoiseModel& m) { add_effect(f.object().at("effect").string(), f, m); }
 
 void model_from(const Value& j, NoiseModel& m) {
   j.object();
@@ -108,17 +112,12 @@ void model_from(const Value& j, NoiseModel& m) {
     else
       readout->fail(fmt::format("must be \"counting\" or \"white\", got \"{}\"", r));
   }
-  auto each = [&](const char* key, auto&& fn) {
+  for (const auto& [key, effect] : {std::pair{"sinusoids", "sinusoid"}, {"gauss_markov", "gauss_markov"},
+                                     {"bias_steps", "bias_step"}, {"warmups", "warmup"}})
     if (const auto list = j.find(key))
-      for (const auto& x : list->elements()) fn(x.object());
-  };
-  each("sinusoids", [&](const Value& x) {
-    m.sinusoids.push_back({num(x, "frequency_hz"), num(x, "amplitude_deg_per_h"), num(x, "phase_rad")});
-  });
-  each("gauss_markov", [&](const Value& x) { m.gauss_markov.push_back({num(x, "sigma_deg_per_h"), num(x, "correlation_time_s")}); });
-  each("bias_steps", [&](const Value& x) { m.bias_steps.push_back({num(x, "time_s"), num(x, "size_deg_per_h")}); });
-  each("warmups", [&](const Value& x) { m.warmups.push_back({num(x, "amplitude_deg_per_h"), num(x, "time_constant_s")}); });
-  each("terms", [&](const Value& x) { add_term(x, m); });
+      for (const auto& x : list->elements()) add_effect(effect, x.object(), m);
+  if (const auto terms = j.find("terms"))
+    for (const auto& x : terms->elements()) add_term(x, m);
   if (const auto tbias = j.find("temperature_bias")) {
     const Value& t = tbias->object();
     TemperatureBias tb;

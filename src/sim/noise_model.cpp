@@ -1,0 +1,151 @@
+// The noise model's own facts: its checks and the Allan variance its terms have in theory.
+#include "rwcalc/noise_model.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "rwcalc/error.hpp"
+#include "rwcalc/units.hpp"
+
+namespace rwcalc {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// 1 − (3 − 4e^{−x} + e^{−2x})/(2x) without cancellation (x > 0).
+double gm_avar_factor(double x) {
+  if (x < 0.5) {
+    double sum = 0.0, term = x;  // x^n/n! for n = 1
+    double p2 = 2.0;             // 2^n
+    for (int n = 2; n < 40; ++n) {
+      term *= x / n;
+      p2 *= 2.0;
+      if (n < 3) continue;
+      sum += -((n % 2) ? -1.0 : 1.0) * (p2 - 4.0) * term / (2.0 * x);
+      if (std::abs(term * p2) < 1e-18 * std::abs(sum) * x) break;
+    }
+    return sum;
+  }
+  return 1.0 - (3.0 - 4.0 * std::exp(-x) + std::exp(-2.0 * x)) / (2.0 * x);
+}
+
+void check_finite_nonneg(double v, const char* what) {
+  if (!std::isfinite(v) || v < 0.0) throw UsageError(fmt::format("{} must be a finite value >= 0, got {}", what, v));
+}
+void check_finite(double v, const char* what) {
+  if (!std::isfinite(v)) throw UsageError(fmt::format("{} must be finite, got {}", what, v));
+}
+void check_positive(double v, const char* what) {
+  if (!std::isfinite(v) || v <= 0.0) throw UsageError(fmt::format("{} must be a finite value > 0, got {}", what, v));
+}
+
+}  // namespace
+
+std::size_t SimulationSettings::samples() const {
+  const double n = std::round(duration_s * rate_hz);
+  return n > 0 && std::isfinite(n) ? static_cast<std::size_t>(n) : 0;
+}
+
+double earth_rate_at(double latitude_deg) {
+  return units::earth_rate_deg_per_h * std::sin(latitude_deg * kPi / 180.0);
+}
+
+double readout_q_arcsec(ReadoutMode mode, double scale_arcsec) {
+  return mode == ReadoutMode::White ? scale_arcsec / std::sqrt(6.0) : scale_arcsec / std::sqrt(12.0);
+}
+
+void validate(const NoiseModel& m, const SimulationSettings& s) {
+  check_positive(s.duration_s, "duration_s");
+  check_positive(s.rate_hz, "rate_hz");
+  check_positive(s.scale_arcsec, "scale_arcsec");
+  if (s.samples() < 2) throw UsageError(fmt::format("the record must hold at least 2 samples (duration {} s at {} Hz)", s.duration_s, s.rate_hz));
+  if (s.samples() > (std::size_t{1} << 31)) throw UsageError("the record is too long (more than 2^31 samples)");
+  if (s.temperature_c) check_finite(*s.temperature_c, "temperature_c");
+  check_finite_nonneg(m.arw_deg_per_sqrt_h, "arw_deg_per_sqrt_h");
+  check_finite_nonneg(m.bias_instability_deg_per_h, "bias_instability_deg_per_h");
+  check_finite_nonneg(m.rrw_deg_per_h_per_sqrt_h, "rrw_deg_per_h_per_sqrt_h");
+  check_finite(m.ramp_deg_per_h2, "ramp_deg_per_h2");
+  check_finite(m.bias_deg_per_h, "bias_deg_per_h");
+  check_finite(m.earth_rate_deg_per_h, "earth_rate_deg_per_h");
+  check_finite_nonneg(m.white_angle_arcsec, "white_angle_arcsec");
+  check_finite_nonneg(m.lowpass_tc_s, "lowpass_tc_s");
+  check_finite_nonneg(m.output_lowpass_tc_s, "output_lowpass_tc_s");
+  for (const auto& x : m.sinusoids) {
+    check_positive(x.f_hz, "sinusoid frequency_hz");
+    check_finite(x.amp_deg_per_h, "sinusoid amplitude_deg_per_h");
+    check_finite(x.phase_rad, "sinusoid phase_rad");
+  }
+  for (const auto& x : m.gauss_markov) {
+    check_finite_nonneg(x.sigma_deg_per_h, "gauss_markov sigma_deg_per_h");
+    check_positive(x.tc_s, "gauss_markov correlation_time_s");
+  }
+  for (const auto& x : m.bias_steps) {
+    check_finite_nonneg(x.t_s, "bias_step time_s");
+    check_finite(x.size_deg_per_h, "bias_step size_deg_per_h");
+  }
+  for (const auto& x : m.warmups) {
+    check_finite(x.amp_deg_per_h, "warmup amplitude_deg_per_h");
+    check_positive(x.tc_s, "warmup time_constant_s");
+  }
+  if (m.temperature_bias) {
+    const auto& tb = *m.temperature_bias;
+    check_finite(tb.coefficient_deg_per_h_per_c, "temperature_bias coefficient_deg_per_h_per_c");
+    check_finite(tb.profile.start_c, "temperature profile start_c");
+    check_finite(tb.profile.end_c, "temperature profile end_c");
+    check_finite(tb.profile.amp_c, "temperature profile amp_c");
+    if (tb.profile.kind == TemperatureProfile::Kind::Cycle) check_positive(tb.profile.period_s, "temperature profile period_s");
+  }
+}
+
+double flicker_avar(double b, std::size_t m) {
+  // AV(m) = (2B²/(π m²)) ∫_0^{π/2} sin⁴(mu)/sin³(u) du: the discrete Kasdin spectrum
+  // B²τ0/(2 sin πfτ0) through the Allan transfer function of m-sample means.
+  const double floor = 2.0 * b * b * std::numbers::ln2 / kPi;
+  if (m > (std::size_t{1} << 16)) return floor;
+  static constexpr double kX[8] = {-0.9602898564975363, -0.7966664774136267, -0.5255324099163290, -0.1834346424956498,
+                                   0.1834346424956498,  0.5255324099163290,  0.7966664774136267,  0.9602898564975363};
+  static constexpr double kW[8] = {0.1012285362903763, 0.2223810344533745, 0.3137066378926775, 0.3626837833783620,
+                                   0.3626837833783620, 0.3137066378926775, 0.2223810344533745, 0.1012285362903763};
+  const double md = static_cast<double>(m);
+  const std::size_t panels = 8 * m;
+  const double h = (kPi / 2.0) / static_cast<double>(panels);
+  double sum = 0.0;
+  for (std::size_t p = 0; p < panels; ++p) {
+    const double mid = (static_cast<double>(p) + 0.5) * h;
+    for (int i = 0; i < 8; ++i) {
+      const double u = mid + 0.5 * h * kX[i];
+      const double s = std::sin(md * u);
+      const double su = std::sin(u);
+      sum += kW[i] * (s * s * s * s) / (su * su * su);
+    }
+  }
+  return 2.0 * b * b / (kPi * md * md) * sum * 0.5 * h;
+}
+
+double theoretical_avar(const NoiseModel& model, double tau0, double q, std::size_t m) {
+  const double tau = static_cast<double>(m) * tau0;
+  const double n_s = units::sqrt_s_per_sqrt_h * model.arw_deg_per_sqrt_h;     // ″/√s
+  const double k_s = model.rrw_deg_per_h_per_sqrt_h / units::sqrt_s_per_sqrt_h;  // ″/s/√s
+  const double r_s = model.ramp_deg_per_h2 / units::seconds_per_hour;        // ″/s²
+  double av = n_s * n_s / tau + k_s * k_s * tau / 3.0 + r_s * r_s * tau * tau / 2.0;
+  if (model.bias_instability_deg_per_h > 0) av += flicker_avar(model.bias_instability_deg_per_h, m);
+  for (const auto& s : model.sinusoids) {
+    const double x = kPi * s.f_hz * tau;
+    const double v = std::sin(x) * std::sin(x) / x;
+    av += s.amp_deg_per_h * s.amp_deg_per_h * v * v;
+  }
+  for (const auto& g : model.gauss_markov) {
+    const double qc2 = 2.0 * g.sigma_deg_per_h * g.sigma_deg_per_h / g.tc_s;
+    const double x = tau / g.tc_s;
+    av += qc2 * g.tc_s * gm_avar_factor(x) / x;
+  }
+  double white_angle2 = model.white_angle_arcsec * model.white_angle_arcsec;
+  if (model.readout == ReadoutMode::White) white_angle2 += q * q / 6.0;
+  av += 3.0 * white_angle2 / (tau * tau);
+  return av;
+}
+
+}  // namespace rwcalc
