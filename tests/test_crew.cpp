@@ -201,28 +201,6 @@ TEST(CrewPasses, TheSamePassesWithLendersAsWithout) {
   }
 }
 
-TEST(CrewPasses, AFileLoadedInHalvesByALenderReadsTheSame) {
-  // Over 4 MB: a regular file is loaded in two halves side by side (the second by a lender here).
-  std::string text = "# rate_hz: 400\n# scale_arcsec_per_pulse: 0.92\npulses\n";
-  std::mt19937_64 rng(9);
-  std::poisson_distribution<int> pulses(1.7);
-  while (text.size() < (std::size_t{5} << 20)) text += std::to_string(pulses(rng)) + "\n";
-  test::TempDir dir;
-  const auto path = dir.write("halves_p20C.csv", text).string();
-  ReadOptions ro;
-  ro.threads = 1;
-  const Recording a = read_recording(path, ro);
-  for (int lenders : {0, 1}) {
-    LentCrew lc(lenders);
-    ro.threads = 2;
-    ro.crew = &lc.crew;
-    const Recording b = read_recording(path, ro);
-    EXPECT_EQ(a.phase.wide_counts(), b.phase.wide_counts()) << "lenders " << lenders;
-    EXPECT_EQ(a.samples, b.samples);
-    EXPECT_EQ(a.line_of_rate(a.samples / 2), b.line_of_rate(b.samples / 2));
-  }
-}
-
 TEST(CrewPasses, AnAnalysisWithLendersEqualsOneWithout) {
   const NoiseModel m = test::gl2d_model();
   SimulationSettings s;

@@ -2,12 +2,14 @@
 // pipe. Each is refused at its first bad chunk with the file, the line and what is wrong, and the
 // process stays small: the command line runs under an address-space limit (ulimit -v) that the
 // whole decompressed text would exceed, and under `timeout` so that a regression cannot hang the
-// suite. Under AddressSanitizer (which reserves terabytes of address space) the limit is left out
-// and only the messages are checked.
+// suite. A good record of long lines is read within a limit below the size of its text: memory
+// follows the samples kept, not the text. Under AddressSanitizer (which reserves terabytes of
+// address space) the limit is left out and only the messages are checked.
 #include <sys/wait.h>
 #include <zlib.h>
 
 #include <cstdlib>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -35,13 +37,15 @@ std::string quote(const std::string& s) {
 }
 
 // Run `FEED | rwcalc ARGS` (or rwcalc ARGS alone) under the limit and a 20-s timeout. The commands
-// run with --threads 2, so that the threads' stacks and heaps do not depend on the machine's cores.
-rwcalc::test::CliResult run_limited(const std::string& feed, const std::vector<std::string>& args) {
+// run with RWCALC_THREADS=2, so that the threads' stacks and heaps do not depend on the machine's
+// cores.
+rwcalc::test::CliResult run_limited(const std::string& feed, const std::vector<std::string>& args,
+                                    long limit_kib = kLimitKiB) {
   const rwcalc::test::TempDir tmp;
   std::string cmd;
-  if (!kSanitized) cmd += "ulimit -v " + std::to_string(kLimitKiB) + "; ";
+  if (!kSanitized) cmd += "ulimit -v " + std::to_string(limit_kib) + "; ";
   if (!feed.empty()) cmd += feed + " | ";
-  cmd += "timeout 20 ";
+  cmd += "RWCALC_THREADS=2 timeout 20 ";
   cmd += quote(RWCALC_EXE);
   for (const auto& a : args) cmd.append(" ").append(quote(a));
   cmd.append(" >").append(quote((tmp.path() / "out").string()));
@@ -81,11 +85,11 @@ TEST(HostileInput, GzipOfNulBytesIsRefusedAtLineOneWithLittleMemory) {
   const std::string bomb = zeros_bomb();
   ASSERT_LT(bomb.size(), std::size_t{3} << 20);
   const auto path = tmp.write("zeros.csv.gz", bomb).string();
-  const auto r = run_limited("", {"allan", "--threads", "2", path});
+  const auto r = run_limited("", {"allan", path});
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_EQ(r.err.rfind("rwcalc: error: " + path + ":1: binary data (byte 0x00 at column 1)", 0), 0u) << r.err;
   // The same through a pipe (standard input: read and inflated chunk by chunk).
-  const auto piped = run_limited("cat " + quote(path), {"allan", "--threads", "2", "-"});
+  const auto piped = run_limited("cat " + quote(path), {"allan", "-"});
   EXPECT_EQ(piped.status, 2) << piped.err;
   EXPECT_EQ(piped.err.rfind("rwcalc: error: <stdin>:1: binary data (byte 0x00 at column 1)", 0), 0u) << piped.err;
 }
@@ -105,25 +109,25 @@ TEST(HostileInput, GzipOfNulBytesAfterGoodLinesNamesTheirLine) {
 
 TEST(HostileInput, DevZeroAndDevUrandomEndQuicklyWithBinaryData) {
   for (const std::string dev : {"/dev/zero", "/dev/urandom"}) {
-    const auto r = run_limited("", {"allan", "--threads", "2", dev});
+    const auto r = run_limited("", {"allan", dev});
     EXPECT_EQ(r.status, 2) << dev << ": " << r.err;
     EXPECT_EQ(r.err.rfind("rwcalc: error: " + dev + ":", 0), 0u) << r.err;
     EXPECT_NE(r.err.find("binary data (byte 0x"), std::string::npos) << r.err;
     EXPECT_TRUE(r.out.empty());
   }
-  const auto piped = run_limited("cat /dev/zero", {"allan", "--threads", "2", "-"});
+  const auto piped = run_limited("cat /dev/zero", {"allan", "-"});
   EXPECT_EQ(piped.status, 2) << piped.err;
   EXPECT_EQ(piped.err.rfind("rwcalc: error: <stdin>:1: binary data (byte 0x00 at column 1)", 0), 0u) << piped.err;
 }
 
 TEST(HostileInput, AnEndlessLineIsRefusedAsSoonAsItPassesTheLimit) {
   // A pipe that never sends a line end, and a gzip file of one 2-GB line.
-  const auto piped = run_limited("{ printf 'pulses\\n1\\n'; tr '\\000' 7 </dev/zero; }", {"allan", "--threads", "2", "-"});
+  const auto piped = run_limited("{ printf 'pulses\\n1\\n'; tr '\\000' 7 </dev/zero; }", {"allan", "-"});
   EXPECT_EQ(piped.status, 2) << piped.err;
   EXPECT_EQ(piped.err.rfind("rwcalc: error: <stdin>:3: line too long", 0), 0u) << piped.err;
   const rwcalc::test::TempDir tmp;
   const auto path = tmp.write("line.csv.gz", gzip_repeated(std::string(std::size_t{2} << 20, '7'), 1000)).string();
-  const auto r = run_limited("", {"allan", "--threads", "2", path});
+  const auto r = run_limited("", {"allan", path});
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_EQ(r.err.rfind("rwcalc: error: " + path + ":1: line too long", 0), 0u) << r.err;
 }
@@ -136,10 +140,33 @@ TEST(HostileInput, AGoodRecordFromAPipeIsReadWhole) {
   const auto plain = tmp.write("p.txt", text).string();
   const auto gz = tmp.write("p.txt.gz", gzip_repeated(text, 1)).string();
   for (const auto& path : {plain, gz}) {
-    const auto r = run_limited("cat " + quote(path), {"allan", "--threads", "2", "-"});
+    const auto r = run_limited("cat " + quote(path), {"allan", "-"});
     EXPECT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("200000"), std::string::npos) << r.out.substr(0, 400);
   }
+}
+
+TEST(HostileInput, MemoryFollowsTheSamplesNotTheText) {
+  // 200 MB of text, 200 000 samples: each line a pulse count and a note of 1000 characters. Read
+  // under an address-space limit of 128 MiB, below the size of the text.
+  if (kSanitized) GTEST_SKIP() << "sanitizers reserve address space: no limit to test against";
+  const rwcalc::test::TempDir tmp;
+  const auto path = (tmp.path() / "long_lines.csv").string();
+  {
+    std::ofstream out(path, std::ios::binary);
+    out << "# rate_hz: 400\npulses,note\n";
+    const std::string note(1000, 'n');
+    std::string block;
+    for (int i = 0; i < 200000; ++i) {
+      block += std::to_string(i % 3) + "," + note + "\n";
+      if (block.size() > (std::size_t{1} << 22)) out << block, block.clear();
+    }
+    out << block;
+  }
+  ASSERT_GT(std::filesystem::file_size(path), std::size_t{180} << 20);  // 191 MiB
+  const auto r = run_limited("", {"allan", path}, 128L * 1024);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("200000"), std::string::npos) << r.out.substr(0, 400);
 }
 
 }  // namespace

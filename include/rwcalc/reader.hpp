@@ -24,8 +24,6 @@
 
 namespace rwcalc {
 
-class Crew;
-
 /// What the selected column holds.
 enum class InputMode {
   Pulses,   ///< per-sample pulse increments (integers): the GL-2D format; default
@@ -51,17 +49,6 @@ struct ReadOptions {
   RateUnit rate_unit = RateUnit::DegPerHour;
   /// Allowed deviation of a time-column step from 1/rate, as a fraction of the period.
   double time_tolerance = 0.01;
-  /// Threads for parsing a long text (0: all hardware threads; at most two are used, on texts of
-  /// more than 1 MB). The result does not depend on it.
-  unsigned threads = 0;
-  /// Threads lent by the caller (crew.hpp): a regular file is then loaded in halves by this
-  /// thread and a lender rather than by a thread started for it.
-  Crew* crew = nullptr;
-  /// Storage to reuse for a pulse file read from a regular file: a vector (typically the counts32
-  /// of a record no longer needed) whose memory, pages already mapped, takes the text and then the
-  /// new record's 32-bit counts. It is moved from. `rwcalc batch` hands each worker's last record
-  /// to its next read. The result does not depend on it.
-  std::vector<std::int32_t>* reuse = nullptr;
 };
 
 /// Where the sample rate came from (reported in outputs).

@@ -3,7 +3,6 @@
 // the baseline ISA, the better one chosen at load time (function multiversioning).
 #include "allan/allan_kernels.hpp"
 
-#include "io/reader_detail.hpp"
 #include "rwcalc/crew.hpp"
 #include "rwcalc/thread.hpp"
 
@@ -588,7 +587,6 @@ PreparedCounts prepare_counts(const std::vector<std::int64_t>& c, bool need_pref
   // One branch-free (vectorisable) pass: offsets, their range, and the int32 copy; the copy is
   // dropped if the range turns out too wide.
   p.rel32.resize(c.size());  // uninitialised: the pages are mapped in one call, then written once
-  prefault(p.rel32.data(), p.rel32.size() * sizeof(std::int32_t));
 #if RWCALC_X86_DISPATCH
   static const bool avx2 = __builtin_cpu_supports("avx2");
   static const bool avx512 = __builtin_cpu_supports("avx512f");

@@ -199,24 +199,16 @@ std::vector<json> analyze_files(const std::vector<std::string>& files, const Rea
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   };
   auto worker = [&](unsigned w) {
-    // Each worker's last record lends its counts' storage, pages mapped, to its next read
-    // (ReadOptions::reuse).
-    std::vector<std::int32_t> spare;
     for (std::size_t i = next++; i < files.size(); i = next++) {
       try {
         const unsigned threads = jobs > 1 ? 1u : total;
-        ReadOptions ro = read;
-        ro.threads = threads;
-        ro.reuse = &spare;
-        if (jobs > 1) ro.crew = &crew;  // a long file loaded in halves when a lender is free
         AnalysisOptions opt = options;
         opt.allan.threads = threads;
         if (jobs > 1) opt.allan.crew = &crew;
         const double t0 = ms_since_start();
-        Recording rec = read_recording(files[i], ro);
+        const Recording rec = read_recording(files[i], read);
         const double t1 = ms_since_start();
         out[i] = to_json(analyze(rec, opt));
-        spare = std::move(rec.phase.counts32);
         if (detail::timing_enabled())
           std::fprintf(stderr, "timing: batch run %zu on worker %u: read %.2f to %.2f ms, analysed at %.2f ms\n", i, w,
                        t0, t1, ms_since_start());

@@ -116,9 +116,7 @@ int run_allan(const AllanArgs& a, Io& io) {
   // work out (crew.hpp); the τ loop keeps its own threads.
   OwnCrew crew(o.threads);
   o.crew = crew.get();
-  ReadOptions ro = a.input.options();
-  ro.crew = o.crew;
-  const Recording read = read_recording(a.file, ro);
+  const Recording read = read_recording(a.file, a.input.options());
   // Outliers are looked for, reported and dealt with as by analyze (--outliers).
   OutlierReport outliers;
   Recording edited;

@@ -63,9 +63,7 @@ void register_analyze(CLI::App& app, Runner& runner) {
       opt.allan.crew = crew.get();
       const Recording rec = [&] {
         detail::ScopedTimer t("read");
-        ReadOptions ro = cmd->input.options();
-        ro.crew = opt.allan.crew;
-        return read_recording(cmd->file, ro);
+        return read_recording(cmd->file, cmd->input.options());
       }();
       const AnalysisResult res = analyze(rec, opt);
       const std::string text = [&] {
