@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <numeric>
 
 #include <fmt/format.h>
 
@@ -23,15 +24,11 @@ constexpr TimeName kTimeNames[] = {
     {"time_us", "us", 1e6},   {"t_us", "us", 1e6},  {"time_ns", "ns", 1e9}, {"t_ns", "ns", 1e9}};
 constexpr std::string_view kTemperatureNames[] = {"temperature_c", "temperature", "temp_c", "temp", "t_c"};
 
-std::vector<std::string_view> value_names(InputMode m) {
-  switch (m) {
-    case InputMode::Pulses: return {"pulses", "pulse", "counts", "count"};
-    case InputMode::Counter: return {"counter", "count", "counts", "pulses"};
-    case InputMode::Angle: return {"angle", "phase"};
-    case InputMode::Rate: return {"rate", "gyro", "frequency", "freq"};
-  }
-  return {};
-}
+// The names of a column that holds the samples, by InputMode.
+const std::vector<std::string_view> kValueNames[] = {{"pulses", "pulse", "counts", "count"},
+                                                      {"counter", "count", "counts", "pulses"},
+                                                      {"angle", "phase"},
+                                                      {"rate", "gyro", "frequency", "freq"}};
 
 const TimeName* time_name(std::string_view field) {
   for (const TimeName& t : kTimeNames)
@@ -52,7 +49,7 @@ std::vector<std::size_t> columns_where(const std::vector<std::string>& header, c
 
 std::vector<std::size_t> all_columns(std::size_t n) {
   std::vector<std::size_t> all(n);
-  for (std::size_t c = 0; c < n; ++c) all[c] = c;
+  std::iota(all.begin(), all.end(), std::size_t{0});
   return all;
 }
 
@@ -80,16 +77,11 @@ bool looks_like_scale_key(const std::string& k) {
 std::string quoted(std::string_view s) {
   std::string out = "'";
   const std::size_t n = std::min(s.size(), kQuoteLimit);
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto c = static_cast<unsigned char>(s[i]);
-    if (c < 0x20 || c == 0x7f)
-      out += fmt::format("\\x{:02x}", c);
-    else
-      out += static_cast<char>(c);
+  for (const char ch : s.substr(0, n)) {
+    const auto c = static_cast<unsigned char>(ch);
+    out += c < 0x20 || c == 0x7f ? fmt::format("\\x{:02x}", c) : std::string(1, ch);
   }
-  if (s.size() > n) out += fmt::format("...' ({} characters)", s.size());
-  else out += "'";
-  return out;
+  return out + (s.size() > n ? fmt::format("...' ({} characters)", s.size()) : "'");
 }
 
 std::string_view trim(std::string_view s, bool tabs) {
@@ -119,11 +111,10 @@ std::string_view normalise_decimal(std::string_view f, bool comma_ok, std::strin
 bool looks_numeric(std::string_view f, bool comma_ok) {
   std::string scratch;
   f = normalise_decimal(f, comma_ok, scratch);
-  if (!f.empty() && f.front() == '+') f.remove_prefix(1);
-  if (f.empty()) return false;
+  if (f.starts_with('+')) f.remove_prefix(1);
   double v = 0;
   const auto r = std::from_chars(f.data(), f.data() + f.size(), v);
-  return r.ptr == f.data() + f.size() && r.ec != std::errc::invalid_argument;
+  return !f.empty() && r.ptr == f.data() + f.size() && r.ec != std::errc::invalid_argument;
 }
 
 void Metadata::read(std::string_view body, std::size_t line, const std::string& file) {
@@ -150,11 +141,10 @@ void Metadata::read(std::string_view body, std::size_t line, const std::string& 
   auto set_known = [&](std::optional<double>& slot, bool positive, double lo, double hi, const char* unit) {
     std::string scratch;
     std::string_view v = normalise_decimal(value, true, scratch);
-    if (!v.empty() && v.front() == '+') v.remove_prefix(1);
+    if (v.starts_with('+')) v.remove_prefix(1);
     double x = 0;
     const auto r = std::from_chars(v.data(), v.data() + v.size(), x);
-    if (v.empty() || r.ec != std::errc() || r.ptr != v.data() + v.size() || !std::isfinite(x) ||
-        (positive && !(x > 0)))
+    if (v.empty() || r.ec != std::errc() || r.ptr != v.data() + v.size() || !std::isfinite(x) || (positive && !(x > 0)))
       throw InputError(file, line, fmt::format("metadata {}: {} is not a {}number", key, quoted(value),
                                                positive ? "positive " : ""));
     if (slot && *slot != x)
@@ -182,13 +172,8 @@ void Metadata::read(std::string_view body, std::size_t line, const std::string& 
 }
 
 std::string_view delim_name(Delim d) {
-  switch (d) {
-    case Delim::Comma: return "comma";
-    case Delim::Semicolon: return "semicolon";
-    case Delim::Tab: return "tab";
-    case Delim::Blanks: return "blanks";
-  }
-  return "?";
+  constexpr std::string_view kNames[] = {"comma", "semicolon", "tab", "blanks"};
+  return kNames[static_cast<int>(d)];
 }
 
 Delim Layout::detect_delimiter(std::string_view line) {
@@ -214,10 +199,7 @@ void Layout::choose(const ReadOptions& o, std::size_t where, const std::string& 
         throw InputError(file, where, fmt::format("{} columns and no header row: choose the column with --column", ncols));
       value_col = ncols == 1 ? 0 : 1;
     }
-    if ((ncols == 2 || ncols == 3) && value_col == 1) {
-      time_col = 0;
-      time_unit = &kTimeNames[0];
-    }
+    if ((ncols == 2 || ncols == 3) && value_col == 1) time_col = 0, time_unit = &kTimeNames[0];
     if (ncols == 3 && value_col == 1) temp_col = 2;
   } else {
     choose_by_name(o, !o.column.empty(), file);
@@ -265,7 +247,7 @@ void Layout::choose_by_name(const ReadOptions& o, bool value_given, const std::s
     std::erase(times, value_col);
     std::erase(temps, value_col);
   } else {
-    const auto names = value_names(o.mode);
+    const auto& names = kValueNames[static_cast<int>(o.mode)];
     const auto named = columns_where(header, [&](std::string_view h) { return any_named(h, names); });
     if (named.size() > 1)
       throw InputError(file, header_line, fmt::format("columns {} could each hold the {} samples; choose one with --column",
@@ -286,9 +268,8 @@ void Layout::choose_by_name(const ReadOptions& o, bool value_given, const std::s
                                  times.size(), column_list(times)));
   if (temps.size() > 1)
     throw InputError(file, header_line,
-                     fmt::format("{} temperature columns ({}); rwcalc reports one temperature: remove or rename the "
-                                 "others",
-                                 temps.size(), column_list(temps)));
+                     fmt::format("{} temperature columns ({}); rwcalc reports one temperature: remove or rename "
+                                 "the others", temps.size(), column_list(temps)));
   if (!times.empty()) time_col = times[0], time_unit = time_name(header[times[0]]);
   if (times.size() == 2) time2_col = times[1], time2_unit = time_name(header[times[1]]);
   if (!temps.empty()) temp_col = temps[0];
@@ -308,10 +289,7 @@ std::string Layout::column_list(const std::vector<std::size_t>& cols) const {
 }
 
 std::string Layout::describe(Role role) const {
-  const std::size_t index = role == Role::Value ? value_col
-                            : role == Role::Time  ? *time_col
-                            : role == Role::Time2 ? *time2_col
-                                                  : *temp_col;
+  const auto index = static_cast<std::size_t>(std::find(roles.begin(), roles.end(), role) - roles.begin());
   const std::string_view kind = role == Role::Value         ? "column"
                                 : role == Role::Temperature ? "temperature column"
                                                             : "time column";

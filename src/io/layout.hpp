@@ -13,9 +13,7 @@
 
 namespace rwcalc::detail {
 
-// ---- text helpers shared by the reader's modules -----------------------------------------------
-
-/// The offending text for a message: at most ~40 characters, non-printable bytes escaped.
+/// Text helpers of the reader. The offending text for a message: at most ~40 characters, non-printable bytes escaped.
 std::string quoted(std::string_view s);
 std::string_view trim(std::string_view s, bool tabs = true);
 bool iequals(std::string_view a, std::string_view b);
@@ -24,8 +22,6 @@ bool iequals(std::string_view a, std::string_view b);
 std::string_view normalise_decimal(std::string_view f, bool comma_ok, std::string& scratch);
 /// Does the field read as a number (even one out of range, or NaN/Inf)? Decides header rows.
 bool looks_numeric(std::string_view f, bool comma_ok);
-
-// ---- metadata ----------------------------------------------------------------------------------
 
 /// Every `# key: value` (or `# key = value`) line. rate_hz, scale_arcsec_per_pulse, temperature_c
 /// and serial are matched in any case and with '-' for '_', and kept under those names.
@@ -39,8 +35,6 @@ struct Metadata {
   /// Take the text after '#' of comment line `line`; a comment that is no `key: value` is ignored.
   void read(std::string_view body, std::size_t line, const std::string& file);
 };
-
-// ---- columns -----------------------------------------------------------------------------------
 
 enum class Delim { Comma, Semicolon, Tab, Blanks };
 /// What a column is read for. Time2: a second time column, which must agree with the first.

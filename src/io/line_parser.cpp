@@ -1,7 +1,6 @@
-// Each line is split at the delimiter and its selected fields read with std::from_chars: exact
-// int64 for pulse and counter input, correctly rounded doubles otherwise. A data line of the known
-// layout is taken as soon as its fields read; anything else is looked at step by step, in the
-// order that decides which error a bad line gets.
+// Each line is split at the delimiter and its selected fields read with std::from_chars (exact int64
+// for pulses and counters, correctly rounded doubles otherwise). A data line of the known layout is
+// taken as soon as its fields read; any other is looked at in the order that decides its error.
 #include "io/line_parser.hpp"
 
 #include <algorithm>
@@ -17,6 +16,13 @@ namespace rwcalc::detail {
 
 namespace {
 
+// Does all of t read as a T?
+template <class T>
+bool reads_whole(std::string_view t, T& v) {
+  const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+  return r.ec == std::errc() && r.ptr == t.data() + t.size();
+}
+
 std::string_view unquote(std::string_view f) {
   if (f.size() >= 2 && f.front() == '"' && f.back() == '"') f = f.substr(1, f.size() - 2);
   return trim(f);
@@ -24,7 +30,11 @@ std::string_view unquote(std::string_view f) {
 
 }  // namespace
 
-LineParser::LineParser(std::string file, const ReadOptions& options) : file_(std::move(file)), opt_(options) {}
+LineParser::LineParser(std::string file, const ReadOptions& options) : file_(std::move(file)), opt_(options) {
+  const int b = options.counter_bits;  // the readings a counter of b bits can give
+  counter_lo_ = b >= 64 ? std::numeric_limits<std::int64_t>::min() : -(std::int64_t{1} << (b - 1));
+  counter_max_ = b >= 63 ? std::numeric_limits<std::int64_t>::max() : (std::int64_t{1} << b) - 1;
+}
 
 void LineParser::fail(const std::string& message) const { throw InputError(file_, line_, message); }
 
@@ -51,9 +61,11 @@ LineKind LineParser::parse(std::string_view text, std::size_t line, Sample& s) {
   split(t);
   if (layout_known_ && fields_.size() == layout_.ncols && read_fields(s, false)) return LineKind::Data;
   if (header_row(t)) return LineKind::Header;
-  if (!layout_known_) {
+  if (!layout_known_) {  // the first data line fixes the columns
     layout_.ncols = layout_.header.empty() ? fields_.size() : layout_.header.size();
-    establish_layout();
+    layout_known_ = true;
+    first_data_line_ = line;
+    layout_.choose(opt_, layout_.header_line ? layout_.header_line : line, file_);
   }
   if (fields_.size() != layout_.ncols)
     fail(fmt::format("wrong number of columns: expected {} ({}-separated, as line {} has), found {}: {}",
@@ -123,17 +135,6 @@ bool LineParser::header_row(std::string_view t) {
   return true;
 }
 
-void LineParser::establish_layout() {
-  layout_known_ = true;
-  first_data_line_ = line_;
-  layout_.choose(opt_, layout_.header_line ? layout_.header_line : line_, file_);
-  if (opt_.mode == InputMode::Counter) {
-    const int b = opt_.counter_bits;
-    counter_lo_ = b >= 64 ? std::numeric_limits<std::int64_t>::min() : -(std::int64_t{1} << (b - 1));
-    counter_max_ = b >= 63 ? std::numeric_limits<std::int64_t>::max() : (std::int64_t{1} << b) - 1;
-  }
-}
-
 // The selected fields, in column order: false at the first that does not read (with `report`,
 // its InputError instead).
 bool LineParser::read_fields(Sample& s, bool report) {
@@ -169,31 +170,20 @@ bool LineParser::read_field(std::string_view f, Role role, Sample& s, bool repor
 // as the same residue modulo 2^64).
 bool LineParser::read_integer(std::string_view f, std::string_view t, Sample& s, bool report) {
   const bool counter = opt_.mode == InputMode::Counter;
-  std::int64_t v = 0;
-  auto r = std::from_chars(t.data(), t.data() + t.size(), v);
-  if (r.ec == std::errc() && r.ptr == t.data() + t.size()) {
-    if (!counter || (v >= counter_lo_ && v <= counter_max_)) {
-      s.integer = v;
-      return true;
-    }
-    if (report)
-      fail(fmt::format("counter reading {} does not fit a {}-bit counter", quoted(f), opt_.counter_bits));
+  std::uint64_t u = 0;
+  if (reads_whole(t, s.integer)) {
+    if (!counter || (s.integer >= counter_lo_ && s.integer <= counter_max_)) return true;
+    if (report) fail(fmt::format("counter reading {} does not fit a {}-bit counter", quoted(f), opt_.counter_bits));
     return false;
   }
-  if (counter && opt_.counter_bits == 64 && t.front() != '-') {
-    std::uint64_t u = 0;
-    r = std::from_chars(t.data(), t.data() + t.size(), u);
-    if (r.ec == std::errc() && r.ptr == t.data() + t.size()) {
-      s.integer = static_cast<std::int64_t>(u);
-      return true;
-    }
+  if (counter && opt_.counter_bits == 64 && t.front() != '-' && reads_whole(t, u)) {
+    s.integer = static_cast<std::int64_t>(u);
+    return true;
   }
   if (!report) return false;
   const std::string col = layout_.describe(Role::Value);
   double d = 0;
-  const std::string_view n = normalise_decimal(t, layout_.delim != Delim::Comma, scratch_);
-  const auto rd = std::from_chars(n.data(), n.data() + n.size(), d);
-  if (rd.ptr == n.data() + n.size() && rd.ec == std::errc() && !std::isfinite(d))
+  if (reads_whole(normalise_decimal(t, layout_.delim != Delim::Comma, scratch_), d) && !std::isfinite(d))
     fail(fmt::format("non-finite value in {}: {}", col, quoted(f)));
   const bool neg = t.front() == '-';
   if (t.size() > static_cast<std::size_t>(neg) &&

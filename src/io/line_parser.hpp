@@ -42,7 +42,6 @@ class LineParser {
   void split(std::string_view line);
   void check_foreign_delimiters(std::string_view line) const;
   bool header_row(std::string_view line);
-  void establish_layout();
   bool read_fields(Sample& s, bool report);
   bool read_field(std::string_view f, Role role, Sample& s, bool report);
   bool read_integer(std::string_view f, std::string_view t, Sample& s, bool report);

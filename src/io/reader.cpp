@@ -20,7 +20,6 @@ namespace rwcalc {
 
 namespace {
 
-using detail::LineKind;
 using detail::quoted;
 using detail::Sample;
 
@@ -30,7 +29,7 @@ using detail::Sample;
 struct TimeTrack {
   struct Step {
     std::size_t sample;
-    double before, after;
+    double before, after;  // the stamps of samples `sample` − 1 and `sample`
   };
   static constexpr std::size_t kHead = 102;
   std::vector<double> head;
@@ -48,17 +47,46 @@ struct TimeTrack {
     ++n;
   }
   [[nodiscard]] Step first_outside(double lo, double hi) const {
-    Step bad{n, 0, 0};
-    for (const Step& s : lows)
-      if (!(s.after - s.before >= lo)) {
-        bad = s;
-        break;
-      }
-    for (const Step& s : highs)
-      if (s.sample < bad.sample && !(s.after - s.before <= hi)) return s;
-    return bad;
+    const auto low = std::find_if(lows.begin(), lows.end(), [&](const Step& s) { return !(s.after - s.before >= lo); });
+    const auto high = std::find_if(highs.begin(), highs.end(), [&](const Step& s) { return !(s.after - s.before <= hi); });
+    if (low == lows.end()) return *high;
+    return high != highs.end() && high->sample < low->sample ? *high : *low;
   }
 };
+
+template <class E>
+using NameTable = std::pair<E, std::string_view>[4];
+constexpr NameTable<InputMode> kModes{{InputMode::Pulses, "pulses"}, {InputMode::Counter, "counter"},
+                                      {InputMode::Angle, "angle"}, {InputMode::Rate, "rate"}};
+constexpr NameTable<AngleUnit> kAngleUnits{{AngleUnit::Arcsec, "arcsec"}, {AngleUnit::Deg, "deg"},
+                                           {AngleUnit::Rad, "rad"}, {AngleUnit::Second, "s"}};
+constexpr NameTable<RateUnit> kRateUnits{{RateUnit::DegPerHour, "deg/h"}, {RateUnit::DegPerSecond, "deg/s"},
+                                         {RateUnit::RadPerSecond, "rad/s"}, {RateUnit::Unitless, "1"}};
+constexpr NameTable<RateSource> kRateSources{{RateSource::Option, "option"}, {RateSource::Metadata, "metadata"},
+                                             {RateSource::TimeColumn, "time column"}, {RateSource::Default, "default"}};
+
+template <class E>
+E parse_name(const NameTable<E>& table, std::string_view s, std::string_view option) {
+  for (const auto& [value, name] : table)
+    if (name == s) return value;
+  throw UsageError(fmt::format("unknown {} '{}': expected {}, {}, {} or {}", option, s, table[0].second,
+                               table[1].second, table[2].second, table[3].second));
+}
+
+template <class E>
+std::string_view name_of(const NameTable<E>& table, E e) {
+  for (const auto& [value, name] : table)
+    if (value == e) return name;
+  return "?";
+}
+
+using Runs = std::vector<std::pair<std::size_t, std::size_t>>;
+
+// The line of sample k in runs of consecutive data lines (Recording::line_runs); 0 if before them.
+std::size_t line_in_runs(const Runs& runs, std::size_t k) {
+  auto it = std::upper_bound(runs.begin(), runs.end(), k, [](std::size_t v, const auto& run) { return v < run.first; });
+  return it == runs.begin() ? 0 : std::prev(it)->second + (k - std::prev(it)->first);
+}
 
 class Reader {
  public:
@@ -66,27 +94,39 @@ class Reader {
     if (o.mode == InputMode::Pulses) ints_.push_back(0);  // C_0
     if (o.mode == InputMode::Rate) reals_.push_back(0.0);  // x_0
   }
-  void read(detail::TextSource& src);
+  void read(detail::TextSource& src) {
+    std::string buf;
+    for (bool more = true; more;) {
+      more = src.read(buf);
+      buf.erase(0, take_lines(buf, !more));
+    }
+    if (!buf.empty()) line(buf);  // the last line, without a line end
+  }
   Recording finish();
 
  private:
   [[noreturn]] void fail(std::size_t line, const std::string& message) const {
     throw InputError(parser_.file(), line, message);
   }
-  [[nodiscard]] bool integer_mode() const {
-    return opt_.mode == InputMode::Pulses || opt_.mode == InputMode::Counter;
-  }
+  [[nodiscard]] bool integer_mode() const { return opt_.mode == InputMode::Pulses || opt_.mode == InputMode::Counter; }
+  [[nodiscard]] std::size_t line_of_sample(std::size_t k) const { return line_in_runs(runs_, k); }
   std::size_t take_lines(std::string& buf, bool at_end);
   bool decide_line_end(std::string_view s, bool at_end);
   std::size_t mac_limit(std::string& buf, std::size_t from, bool at_end) const;
-  void line(std::string_view text);
+  void line(std::string_view text) {
+    Sample s;
+    if (parser_.parse(text, ++line_, s) == detail::LineKind::Data)
+      push(s);
+    else
+      new_run_ = true;
+  }
   void push(const Sample& s);
-  [[nodiscard]] std::size_t line_of_sample(std::size_t k) const;
   void finish_rate();
   void check_unread_keys() const;
   void check_time_columns_agree() const;
   void check_time_column() const;
-  void build_phase(Recording& rec);
+  void build_counts(PhaseSeries& ph, std::size_t& wraps);
+  void build_values(PhaseSeries& ph);
   void check_data_magnitude(const PhaseSeries& ph, const char* what) const;
 
   detail::LineParser parser_;
@@ -95,10 +135,9 @@ class Reader {
   bool started_ = false;
   char eol_ = 0;  // the line end: LF, or CR for classic Mac text (no LF but maybe a last one); 0 undecided
   std::size_t first_cr_column_ = 0;  // Mac text: where the first CR is on line 1
-  std::size_t line_ = 0;
-  std::size_t samples_ = 0;
+  std::size_t line_ = 0, samples_ = 0;
   bool new_run_ = true;
-  std::vector<std::pair<std::size_t, std::size_t>> runs_;
+  Runs runs_;
   std::vector<std::int64_t> ints_;  // pulses (after C_0) or counter readings
   std::vector<double> reals_;       // angle samples, or rate samples after x_0
   TimeTrack times_;
@@ -110,15 +149,6 @@ class Reader {
   double rate_hz_ = units::gl2d_rate_hz;
   RateSource rate_source_ = RateSource::Default;
 };
-
-void Reader::read(detail::TextSource& src) {
-  std::string buf;
-  for (bool more = true; more;) {
-    more = src.read(buf);
-    buf.erase(0, take_lines(buf, !more));
-  }
-  if (!buf.empty()) line(buf);  // the last line, without a line end
-}
 
 // Take the complete lines of buf; returns the bytes taken.
 std::size_t Reader::take_lines(std::string& buf, bool at_end) {
@@ -159,21 +189,8 @@ bool Reader::decide_line_end(std::string_view s, bool at_end) {
 std::size_t Reader::mac_limit(std::string& buf, std::size_t from, bool at_end) const {
   const auto lf = buf.find('\n', from);
   if (lf == std::string::npos) return buf.size();
-  if (lf + 1 == buf.size() && !at_end) return lf;  // told by what follows
-  if (lf + 1 == buf.size()) {
-    buf[lf] = '\r';
-    return buf.size();
-  }
+  if (lf + 1 == buf.size()) return at_end ? (buf[lf] = '\r', buf.size()) : lf;  // else told by what follows
   fail(1, fmt::format("stray carriage return (CR) at column {} inside the line", first_cr_column_));
-}
-
-void Reader::line(std::string_view text) {
-  ++line_;
-  Sample s;
-  if (parser_.parse(text, line_, s) == LineKind::Data)
-    push(s);
-  else
-    new_run_ = true;
 }
 
 void Reader::push(const Sample& s) {
@@ -181,27 +198,14 @@ void Reader::push(const Sample& s) {
     runs_.emplace_back(samples_, line_);
     new_run_ = false;
   }
-  if (integer_mode())
-    ints_.push_back(s.integer);
-  else
-    reals_.push_back(s.real);
+  integer_mode() ? ints_.push_back(s.integer) : reals_.push_back(s.real);
   if (layout_.time_col) times_.add(s.time / layout_.time_unit->per_second);
   if (layout_.time2_col) {
     const double d = std::abs(s.time / layout_.time_unit->per_second - s.time2 / layout_.time2_unit->per_second);
     if (!(d <= gap_max_)) gap_max_ = d, gap_sample_ = samples_, gap_t_ = s.time, gap_t2_ = s.time2;
   }
-  if (layout_.temp_col) {
-    temp_sum_ += s.temperature;
-    ++temp_n_;
-  }
+  if (layout_.temp_col) temp_sum_ += s.temperature, ++temp_n_;
   ++samples_;
-}
-
-std::size_t Reader::line_of_sample(std::size_t k) const {
-  auto it = std::upper_bound(runs_.begin(), runs_.end(), k, [](std::size_t v, const auto& run) { return v < run.first; });
-  if (it == runs_.begin()) return 0;
-  --it;
-  return it->second + (k - it->first);
 }
 
 void Reader::finish_rate() {
@@ -279,13 +283,12 @@ void Reader::check_time_column() const {
   if (rate_source_ == RateSource::Option || rate_source_ == RateSource::Metadata) {
     const double est = (times_.last - times_.first) / static_cast<double>(times_.n - 1);
     const std::string tcol = layout_.header.empty() ? "column 1" : "'" + layout_.header[*layout_.time_col] + "'";
-    const std::string from = rate_source_ == RateSource::Option
-                                 ? std::string("--rate")
-                                 : fmt::format("metadata at line {}", parser_.metadata().rate_line);
     if (std::abs(est - period) > tol)
       fail(line, fmt::format("the sample rate {} Hz (from {}) is inconsistent with the time column {}, which steps "
                              "by {} s (~{:.6g} Hz), e.g. {} s at line {} then {} s",
-                             rate_hz_, from, tcol, est, 1.0 / est, t0, prev, t1));
+                             rate_hz_, rate_source_ == RateSource::Option ? "--rate" : fmt::format(
+                                 "metadata at line {}", parser_.metadata().rate_line),
+                             tcol, est, 1.0 / est, t0, prev, t1));
   }
   if (dt == 0) fail(line, fmt::format("repeated time stamp {} s (also at line {}); no resampling is done", t1, prev));
   if (dt < 0) fail(line, fmt::format("time goes backwards: {} s at line {}, then {} s", t0, prev, t1));
@@ -305,107 +308,89 @@ void Reader::check_data_magnitude(const PhaseSeries& ph, const char* what) const
                         what, largest, ph.kind == PhaseKind::Clock ? "s" : "arcsec", kMinDataStep));
 }
 
-
-void Reader::build_phase(Recording& rec) {
-  PhaseSeries& ph = rec.phase;
-  ph.tau0_s = 1.0 / rate_hz_;
-  const bool clock = (opt_.mode == InputMode::Angle && opt_.angle_unit == AngleUnit::Second) ||
-                     (opt_.mode == InputMode::Rate && opt_.rate_unit == RateUnit::Unitless);
-  ph.kind = clock ? PhaseKind::Clock : PhaseKind::Gyro;
+// C_0 = 0, C_k = Σ c_i modulo 2^64 for pulses (PhaseSeries differences are modular, so an offset
+// never matters); every second difference stays exact while Σ|c_i| < 2^63, beyond it is refused.
+// A counter is unwrapped: each step is (R_k − R_{k−1}) mod 2^B, so a backwards step is a wrap.
+void Reader::build_counts(PhaseSeries& ph, std::size_t& wraps) {
   constexpr auto kLimit = static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
+  std::vector<std::int64_t>& c = ints_;
+  std::uint64_t acc = 0, total = 0;
+  if (opt_.mode == InputMode::Pulses) {
+    for (std::size_t i = 1; i < c.size(); ++i) {
+      const auto v = static_cast<std::uint64_t>(c[i]);
+      acc += v;
+      total += c[i] < 0 ? (~v + 1) : v;
+      c[i] = static_cast<std::int64_t>(acc);
+      if (total > kLimit) [[unlikely]]
+        fail(line_of_sample(i - 1), "pulse counts too large to be summed exactly: the sum of |counts| exceeds 2^63-1 here");
+    }
+  } else {
+    const int b = opt_.counter_bits;
+    const std::uint64_t mask = b >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << b) - 1;
+    std::uint64_t prev = static_cast<std::uint64_t>(c[0]) & mask;
+    c[0] = 0;
+    for (std::size_t i = 1; i < c.size(); ++i) {
+      const std::uint64_t r = static_cast<std::uint64_t>(c[i]) & mask;
+      const std::uint64_t step = (r - prev) & mask;
+      wraps += r < prev;
+      prev = r;
+      c[i] = static_cast<std::int64_t>(acc += step);
+      if (step > kLimit - total) [[unlikely]]
+        fail(line_of_sample(i), fmt::format("the unwrapped counter advances by more than 2^63-1 counts here (a "
+                                            "backwards step counts as a wrap of the {}-bit counter)",
+                                            b));
+      total += step;
+    }
+  }
+  ph.counts = std::move(c);
+}
+
+// Angle samples in arcsec (or s); rate samples integrated to phase as in SP 1065.
+void Reader::build_values(PhaseSeries& ph) {
   // Floating phase beyond this (arcsec, or s for clocks) would overflow the squares of second
   // differences (|Δ²x| ≤ 4·max|x|) in the Allan variance; no instrument comes near it.
   constexpr double kMaxPhase = 1e150;
-  std::vector<std::int64_t>& c = ints_;
   std::vector<double>& x = reals_;
-  switch (opt_.mode) {
-    case InputMode::Pulses: {
-      // C_0 = 0, C_k = Σ c_i modulo 2^64 (PhaseSeries differences are modular, so an offset never
-      // matters). Every second difference stays exact while Σ|c_i| < 2^63; beyond, it is refused.
-      std::uint64_t acc = 0, mag = 0;
-      for (std::size_t i = 1; i < c.size(); ++i) {
-        const auto v = static_cast<std::uint64_t>(c[i]);
-        acc += v;
-        mag += c[i] < 0 ? (~v + 1) : v;
-        c[i] = static_cast<std::int64_t>(acc);
-        if (mag > kLimit) [[unlikely]]
-          fail(line_of_sample(i - 1), "pulse counts too large to be summed exactly: the sum of |counts| exceeds 2^63-1 here");
-      }
-      ph.counts = std::move(c);
-      break;
+  const bool angle = opt_.mode == InputMode::Angle;
+  const double f = angle ? (opt_.angle_unit == AngleUnit::Deg   ? units::arcsec_per_deg
+                            : opt_.angle_unit == AngleUnit::Rad ? units::arcsec_per_rad
+                                                                : 1.0)
+                         : (opt_.rate_unit == RateUnit::DegPerSecond   ? units::arcsec_per_deg
+                            : opt_.rate_unit == RateUnit::RadPerSecond ? units::arcsec_per_rad
+                                                                       : 1.0);  // rate: to ″/s = °/h
+  for (std::size_t i = 0; angle && i < x.size(); ++i)
+    if (!(std::abs(x[i] *= f) <= kMaxPhase)) [[unlikely]]
+      fail(line_of_sample(i), fmt::format("angle out of range: {} is beyond ±{:g} arcsec, where the Allan "
+                                          "variance of the record would overflow",
+                                          quoted(fmt::format("{:g}", x[i] / f)), kMaxPhase));
+  if (!angle) {
+    // x_0 = 0, x_j = τ0·Σ_{i<j} (y_i − ȳ), accumulated in long double. The mean rate ȳ goes into
+    // rate_offset (series.hpp): a phase that kept it would grow to ȳ·T and round its noise away
+    // once the offset is many orders above the noise.
+    const long double k = static_cast<long double>(ph.tau0_s) * f;
+    long double sum = 0, acc = 0;
+    for (std::size_t i = 1; i < x.size(); ++i) sum += x[i];
+    const double mean = x.size() > 1 ? static_cast<double>(sum / static_cast<long double>(x.size() - 1)) : 0.0;
+    for (std::size_t i = 1; i < x.size(); ++i) {
+      const double y = x[i];
+      acc += (static_cast<long double>(y) - mean) * k;
+      x[i] = static_cast<double>(acc);
+      const long double whole = acc + static_cast<long double>(mean) * k * static_cast<long double>(i);
+      if (!(std::abs(whole) <= kMaxPhase)) [[unlikely]]
+        fail(line_of_sample(i - 1),
+             fmt::format("rate out of range: the accumulated phase reaches {:g} arcsec (beyond ±{:g}, where the "
+                         "Allan variance would overflow) at this sample, {}",
+                         static_cast<double>(whole), kMaxPhase, quoted(fmt::format("{:g}", y))));
     }
-    case InputMode::Counter: {
-      // Unwrap: each step is (R_k − R_{k−1}) mod 2^B in [0, 2^B), so a backwards step counts as a wrap.
-      const int b = opt_.counter_bits;
-      const std::uint64_t mask = b >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << b) - 1;
-      std::uint64_t prev = static_cast<std::uint64_t>(c[0]) & mask, acc = 0, total = 0;
-      c[0] = 0;
-      for (std::size_t i = 1; i < c.size(); ++i) {
-        const std::uint64_t r = static_cast<std::uint64_t>(c[i]) & mask;
-        const std::uint64_t step = (r - prev) & mask;
-        rec.counter_wraps += r < prev;
-        prev = r;
-        acc += step;
-        c[i] = static_cast<std::int64_t>(acc);
-        if (step > kLimit - total) [[unlikely]]
-          fail(line_of_sample(i), fmt::format("the unwrapped counter advances by more than 2^63-1 counts here (a "
-                                              "backwards step counts as a wrap of the {}-bit counter)",
-                                              b));
-        total += step;
-      }
-      ph.counts = std::move(c);
-      break;
-    }
-    case InputMode::Angle: {
-      const double f = opt_.angle_unit == AngleUnit::Deg   ? units::arcsec_per_deg
-                       : opt_.angle_unit == AngleUnit::Rad ? units::arcsec_per_rad
-                                                           : 1.0;
-      if (f != 1.0)
-        for (double& v : x) v *= f;
-      for (std::size_t i = 0; i < x.size(); ++i)
-        if (!(std::abs(x[i]) <= kMaxPhase)) [[unlikely]]
-          fail(line_of_sample(i), fmt::format("angle out of range: {} is beyond ±{:g} arcsec, where the Allan "
-                                              "variance of the record would overflow",
-                                              quoted(fmt::format("{:g}", x[i] / f)), kMaxPhase));
-      ph.values = std::move(x);
-      check_data_magnitude(ph, "angle");
-      break;
-    }
-    case InputMode::Rate: {
-      const double f = opt_.rate_unit == RateUnit::DegPerSecond   ? units::arcsec_per_deg
-                       : opt_.rate_unit == RateUnit::RadPerSecond ? units::arcsec_per_rad
-                                                                  : 1.0;  // to ″/s (= °/h) for gyro data
-      // SP 1065 phase from frequency: x_0 = 0, x_j = τ0·Σ_{i<j} (y_i − ȳ), accumulated in long
-      // double. The mean rate ȳ goes into rate_offset (series.hpp): a phase that kept it would
-      // grow to ȳ·T and round its noise away once the offset is many orders above the noise.
-      const long double k = static_cast<long double>(ph.tau0_s) * f;
-      long double sum = 0;
-      for (std::size_t i = 1; i < x.size(); ++i) sum += x[i];
-      const double mean = x.size() > 1 ? static_cast<double>(sum / static_cast<long double>(x.size() - 1)) : 0.0;
-      long double acc = 0;
-      for (std::size_t i = 1; i < x.size(); ++i) {
-        const double y = x[i];
-        acc += (static_cast<long double>(y) - mean) * k;
-        x[i] = static_cast<double>(acc);
-        const long double whole = acc + static_cast<long double>(mean) * k * static_cast<long double>(i);
-        if (!(std::abs(whole) <= kMaxPhase)) [[unlikely]]
-          fail(line_of_sample(i - 1),
-               fmt::format("rate out of range: the accumulated phase reaches {:g} arcsec (beyond ±{:g}, where the "
-                           "Allan variance would overflow) at this sample, {}",
-                           static_cast<double>(whole), kMaxPhase, quoted(fmt::format("{:g}", y))));
-      }
-      ph.values = std::move(x);
-      ph.rate_offset = mean * f;
-      check_data_magnitude(ph, "rate");
-      break;
-    }
+    ph.rate_offset = mean * f;
   }
+  ph.values = std::move(x);
+  check_data_magnitude(ph, angle ? "angle" : "rate");
 }
 
 Recording Reader::finish() {
-  const std::size_t header_line = layout_.header_line;
   if (samples_ == 0) {
-    if (header_line) fail(header_line, "no samples: the file has a header row but no data lines");
+    if (layout_.header_line) fail(layout_.header_line, "no samples: the file has a header row but no data lines");
     fail(0, parser_.content_lines() == 0 ? "empty file: no samples"
                                          : "no samples: the file holds only comments and blank lines");
   }
@@ -417,7 +402,15 @@ Recording Reader::finish() {
 
   Recording rec;
   rec.samples = samples_;
-  build_phase(rec);
+  PhaseSeries& ph = rec.phase;
+  ph.tau0_s = 1.0 / rate_hz_;
+  const bool clock = (opt_.mode == InputMode::Angle && opt_.angle_unit == AngleUnit::Second) ||
+                     (opt_.mode == InputMode::Rate && opt_.rate_unit == RateUnit::Unitless);
+  ph.kind = clock ? PhaseKind::Clock : PhaseKind::Gyro;
+  if (integer_mode())
+    build_counts(ph, rec.counter_wraps);
+  else
+    build_values(ph);
   detail::Metadata& meta = parser_.metadata();
   rec.phase.arcsec_per_count = opt_.scale_arcsec ? *opt_.scale_arcsec
                                : meta.scale_arcsec ? *meta.scale_arcsec
@@ -425,10 +418,8 @@ Recording Reader::finish() {
   rec.rate_hz = rate_hz_;
   rec.rate_source = rate_source_;
   rec.metadata = std::move(meta.all);
-  if (temp_n_ > 0)
-    rec.temperature_c = static_cast<double>(temp_sum_ / static_cast<long double>(temp_n_));
-  else
-    rec.temperature_c = meta.temperature_c;
+  rec.temperature_c =
+      temp_n_ > 0 ? std::optional(static_cast<double>(temp_sum_ / static_cast<long double>(temp_n_))) : meta.temperature_c;
   const auto& h = layout_.header;
   rec.column_name = h.empty() ? fmt::format("column {}", layout_.value_col + 1) : h[layout_.value_col];
   if (layout_.time_col) rec.time_column = h.empty() ? std::string("column 1") : h[*layout_.time_col];
@@ -448,7 +439,7 @@ void validate(const ReadOptions& o) {
     throw UsageError(fmt::format("--time-tolerance must be in [0, 1), got {}", o.time_tolerance));
 }
 
-Recording read_source(detail::TextSource& src, const std::string& source, const ReadOptions& options) {
+Recording read_source(detail::TextSource&& src, const std::string& source, const ReadOptions& options) {
   Reader reader(src.name(), options);
   reader.read(src);
   Recording rec = reader.finish();
@@ -460,14 +451,12 @@ Recording read_source(detail::TextSource& src, const std::string& source, const 
 
 Recording read_recording(const std::string& path, const ReadOptions& options) {
   validate(options);
-  detail::TextSource src(path);
-  return read_source(src, path, options);
+  return read_source(detail::TextSource(path), path, options);
 }
 
 Recording read_recording_text(std::string_view text, const std::string& name, const ReadOptions& options) {
   validate(options);
-  detail::TextSource src(text, detail::display_name(name));
-  return read_source(src, name, options);
+  return read_source(detail::TextSource(text, detail::display_name(name)), name, options);
 }
 
 std::vector<double> Recording::rates() const {
@@ -477,81 +466,19 @@ std::vector<double> Recording::rates() const {
   return r;
 }
 
-std::size_t Recording::line_of_sample(std::size_t k) const noexcept {
-  if (k >= samples) return 0;
-  auto it = std::upper_bound(line_runs.begin(), line_runs.end(), k,
-                             [](std::size_t v, const auto& run) { return v < run.first; });
-  if (it == line_runs.begin()) return 0;
-  --it;
-  return it->second + (k - it->first);
-}
+std::size_t Recording::line_of_sample(std::size_t k) const noexcept { return k < samples ? line_in_runs(line_runs, k) : 0; }
 
 std::size_t Recording::line_of_rate(std::size_t i) const noexcept {
   const bool readings = mode == InputMode::Counter || mode == InputMode::Angle;
   return line_of_sample(readings ? i + 1 : i);
 }
-InputMode parse_input_mode(std::string_view s) {
-  if (s == "pulses") return InputMode::Pulses;
-  if (s == "counter") return InputMode::Counter;
-  if (s == "angle") return InputMode::Angle;
-  if (s == "rate") return InputMode::Rate;
-  throw UsageError(fmt::format("unknown --input '{}': expected pulses, counter, angle or rate", s));
-}
 
-AngleUnit parse_angle_unit(std::string_view s) {
-  if (s == "arcsec") return AngleUnit::Arcsec;
-  if (s == "deg") return AngleUnit::Deg;
-  if (s == "rad") return AngleUnit::Rad;
-  if (s == "s") return AngleUnit::Second;
-  throw UsageError(fmt::format("unknown --angle-unit '{}': expected arcsec, deg, rad or s", s));
-}
-
-RateUnit parse_rate_unit(std::string_view s) {
-  if (s == "deg/h") return RateUnit::DegPerHour;
-  if (s == "deg/s") return RateUnit::DegPerSecond;
-  if (s == "rad/s") return RateUnit::RadPerSecond;
-  if (s == "1") return RateUnit::Unitless;
-  throw UsageError(fmt::format("unknown --rate-unit '{}': expected deg/h, deg/s, rad/s or 1", s));
-}
-
-std::string_view to_string(InputMode m) {
-  switch (m) {
-    case InputMode::Pulses: return "pulses";
-    case InputMode::Counter: return "counter";
-    case InputMode::Angle: return "angle";
-    case InputMode::Rate: return "rate";
-  }
-  return "?";
-}
-
-std::string_view to_string(RateSource s) {
-  switch (s) {
-    case RateSource::Option: return "option";
-    case RateSource::Metadata: return "metadata";
-    case RateSource::TimeColumn: return "time column";
-    case RateSource::Default: return "default";
-  }
-  return "?";
-}
-
-std::string_view to_string(AngleUnit u) {
-  switch (u) {
-    case AngleUnit::Arcsec: return "arcsec";
-    case AngleUnit::Deg: return "deg";
-    case AngleUnit::Rad: return "rad";
-    case AngleUnit::Second: return "s";
-  }
-  return "?";
-}
-
-std::string_view to_string(RateUnit u) {
-  switch (u) {
-    case RateUnit::DegPerHour: return "deg/h";
-    case RateUnit::DegPerSecond: return "deg/s";
-    case RateUnit::RadPerSecond: return "rad/s";
-    case RateUnit::Unitless: return "1";
-  }
-  return "?";
-}
+InputMode parse_input_mode(std::string_view s) { return parse_name(kModes, s, "--input"); }
+AngleUnit parse_angle_unit(std::string_view s) { return parse_name(kAngleUnits, s, "--angle-unit"); }
+RateUnit parse_rate_unit(std::string_view s) { return parse_name(kRateUnits, s, "--rate-unit"); }
+std::string_view to_string(InputMode m) { return name_of(kModes, m); }
+std::string_view to_string(RateSource s) { return name_of(kRateSources, s); }
+std::string_view to_string(AngleUnit u) { return name_of(kAngleUnits, u); }
+std::string_view to_string(RateUnit u) { return name_of(kRateUnits, u); }
 
 }  // namespace rwcalc
