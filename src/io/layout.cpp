@@ -84,13 +84,6 @@ std::string quoted(std::string_view s) {
   return out + (s.size() > n ? fmt::format("...' ({} characters)", s.size()) : "'");
 }
 
-std::string_view trim(std::string_view s, bool tabs) {
-  auto blank = [tabs](char c) { return c == ' ' || (tabs && c == '\t'); };
-  while (!s.empty() && blank(s.front())) s.remove_prefix(1);
-  while (!s.empty() && blank(s.back())) s.remove_suffix(1);
-  return s;
-}
-
 bool iequals(std::string_view a, std::string_view b) {
   return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
            return (x | 0x20) == (y | 0x20) && ((x >= 'A' && x <= 'Z') || (x >= 'a' && x <= 'z') || x == y);

@@ -15,7 +15,12 @@ namespace rwcalc::detail {
 
 /// Text helpers of the reader. The offending text for a message: at most ~40 characters, non-printable bytes escaped.
 std::string quoted(std::string_view s);
-std::string_view trim(std::string_view s, bool tabs = true);
+inline std::string_view trim(std::string_view s, bool tabs = true) {
+  auto blank = [tabs](char c) { return c == ' ' || (tabs && c == '\t'); };
+  while (!s.empty() && blank(s.front())) s.remove_prefix(1);
+  while (!s.empty() && blank(s.back())) s.remove_suffix(1);
+  return s;
+}
 bool iequals(std::string_view a, std::string_view b);
 /// A field with its decimal comma turned into a point, when that reading applies: exactly one
 /// comma, no point, and the delimiter is not a comma (comma_ok).
