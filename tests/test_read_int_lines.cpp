@@ -1,71 +1,23 @@
-// The plain-line path for one-column pulse files: line ends found 64 bytes at a time, single digits
-// and 8-byte word scans of up to 7 digits, with the cumulative counts summed while parsing. It must
-// give exactly what the per-line paths give (values, runs of lines, errors and their line numbers)
-// on any mixture of lines.
+// Pulse files of many lines that mix plain counts with every other accepted spelling (comments,
+// blank lines, CRLF, blanks around the value, '+', leading zeros, up to 18 digits): the exact
+// cumulative counts, the runs of lines that map samples to line numbers, and the line named
+// when the sum of |counts| passes 2^63 - 1.
 #include <cstdint>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include "io/reader_detail.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/reader.hpp"
 
 namespace {
 
 using rwcalc::read_recording_text;
-using rwcalc::ReadOptions;
 using rwcalc::Recording;
-namespace detail = rwcalc::detail;
-
-// The line followed by zero padding, as TextBuffer provides it.
-std::string padded(const std::string& line) { return line + std::string(16, '\0'); }
-
-// What the plain-line scanners must do with `line`: its value when it is "[-]d{1,7}" then LF or
-// CRLF, else nothing (nullptr), decided here independently of the scanners.
-void check_line(const std::string& line) {
-  const std::string buf = padded(line);
-  std::size_t i = line[0] == '-' ? 1 : 0;
-  std::size_t digits = 0;
-  while (i + digits < line.size() && detail::is_digit(line[i + digits])) ++digits;
-  const std::string rest = line.substr(i + digits);
-  const bool plain = digits >= 1 && digits <= 7 && (rest == "\n" || rest == "\r\n");
-  std::int64_t a = -12345, b = -12345;
-  const char* ea = detail::scan_int_line(buf.data(), a);
-  const char* eb = detail::scan_int_line_swar(buf.data(), b);
-  if (!plain) {
-    EXPECT_EQ(ea, nullptr) << line;
-    EXPECT_EQ(eb, nullptr) << line;
-    return;
-  }
-  std::int64_t want = 0;
-  ASSERT_NE(detail::scan_int_fast(buf.data(), want), nullptr) << line;
-  ASSERT_EQ(ea, buf.data() + line.size()) << line;
-  ASSERT_EQ(eb, buf.data() + line.size()) << line;
-  EXPECT_EQ(a, want) << line;
-  EXPECT_EQ(b, want) << line;
-}
-
-TEST(ReadIntLines, ScannersAgreeWithTheCarefulIntegerScan) {
-  for (int v = -20000; v <= 20000; ++v) {
-    check_line(fmt::format("{}\n", v));
-    if (v % 7 == 0) check_line(fmt::format("{}\r\n", v));
-  }
-  std::mt19937_64 rng(11);
-  for (int k = 0; k < 200000; ++k) {
-    const int digits = 1 + static_cast<int>(rng() % 9);  // 8 and 9 digits: not plain
-    std::string s = (rng() & 1) ? "-" : "";
-    for (int d = 0; d < digits; ++d) s += static_cast<char>('0' + rng() % 10);  // leading zeros too
-    check_line(s + ((rng() & 3) == 0 ? "\r\n" : "\n"));
-  }
-  for (const char* odd : {"+1\n", " 1\n", "1 \n", "1\t\n", "-\n", "\n", "\r\n", "--1\n", "-+1\n", "1x\n",
-                          "1.5\n", "1,5\n", "1e3\n", "1\r", "1\rx\n", "12345678\n", "-12345678\n",
-                          "9999999\n", "-9999999\r\n", "0000000\n", "-0\n", "#1\n", "1;2\n"})
-    check_line(odd);
-}
 
 // A one-column pulse file of n data lines mixing the plain form with lines the per-line paths
 // take: comments, blank lines, CRLF, leading blanks, '+', 8 to 18 digits, negative counts.
@@ -103,74 +55,66 @@ std::string mixed_text(std::size_t n, unsigned seed, std::vector<std::int64_t>& 
   return t;
 }
 
-// The same samples with a blank before every value: no line takes the plain-line path.
-std::string indented(const std::string& text) {
-  std::string out;
-  std::size_t pos = 0;
+// Where each run of data lines starts, (sample index, line number), found here line by line:
+// a run starts at a data line after the start of the file, a comment, a blank line or the header.
+std::vector<std::pair<std::size_t, std::size_t>> expected_runs(const std::string& text) {
+  std::vector<std::pair<std::size_t, std::size_t>> runs;
+  std::size_t line = 0, samples = 0, pos = 0;
+  bool after_gap = true;
   while (pos < text.size()) {
     const std::size_t e = text.find('\n', pos);
-    const std::string line = text.substr(pos, e - pos + 1);
-    const bool data = !line.empty() && line[0] != '#' && line != "\n" && line != "pulses\n";
-    out += data ? " " + line : line;
+    std::string l = text.substr(pos, e - pos);
     pos = e + 1;
+    ++line;
+    if (!l.empty() && l.back() == '\r') l.pop_back();
+    const bool data = l.find_first_not_of(' ') != std::string::npos && l[0] != '#' && l != "pulses";
+    if (data && after_gap) runs.emplace_back(samples, line);
+    after_gap = !data;
+    samples += data;
   }
-  return out;
+  return runs;
 }
 
-ReadOptions with_threads(unsigned t) {
-  ReadOptions o;
-  o.threads = t;
-  return o;
-}
-
-TEST(ReadIntLines, SameAsThePerLinePathsAndKnownSums) {
-  for (const std::size_t n : {std::size_t{5000}, std::size_t{900000}}) {  // one half, and two threads
+TEST(ReadIntLines, KnownSumsAndRunsOfLines) {
+  for (const std::size_t n : {std::size_t{5000}, std::size_t{900000}}) {
     std::vector<std::int64_t> counts;
     const std::string text = mixed_text(n, 5, counts);
-    const std::string slow = indented(text);
     std::vector<std::int64_t> want{0};
     std::uint64_t acc = 0;
     for (const auto v : counts) want.push_back(static_cast<std::int64_t>(acc += static_cast<std::uint64_t>(v)));
-    const Recording ref = read_recording_text(slow, "slow.csv", with_threads(1));
-    ASSERT_EQ(ref.phase.wide_counts(), want);
-    for (const unsigned t : {1u, 2u}) {
-      const Recording r = read_recording_text(text, "fast.csv", with_threads(t));
-      EXPECT_EQ(r.samples, n);
-      EXPECT_EQ(r.phase.wide_counts(), want) << "threads " << t;
-      EXPECT_EQ(r.line_runs, ref.line_runs) << "threads " << t;
-    }
+    const Recording r = read_recording_text(text, "mixed.csv");
+    EXPECT_EQ(r.samples, n);
+    EXPECT_EQ(r.phase.counts, want);
+    EXPECT_EQ(r.line_runs, expected_runs(text));
   }
 }
 
-// The plain-line path finds line ends 64 bytes at a time: lines longer than a window, lines cut
-// by a window's end, and lines it must leave to the per-line paths at every offset in a window.
-TEST(ReadIntLines, LinesAcrossAndLongerThanTheWindows) {
+// Long comment lines, blank lines, 8-digit counts, leading blanks and CRLF at random among short
+// counts, in a text read in many pieces: lines cut by a piece's end are read whole.
+TEST(ReadIntLines, LinesOfEveryFormAcrossPieces) {
   std::mt19937_64 rng(29);
   std::string text = "pulses\n";
   std::vector<std::int64_t> want{0};
   std::uint64_t acc = 0;
   for (std::size_t i = 0; i < 300000; ++i) {
     const auto r = rng() % 97;
-    if (r == 0) text += "# " + std::string(60 + rng() % 140, 'x') + "\n";  // one or more windows long
+    if (r == 0) text += "# " + std::string(60 + rng() % 140, 'x') + "\n";
     if (r == 1) text += "\n";
     std::int64_t v = static_cast<std::int64_t>(rng() % 2001) - 1000;
-    if (r == 2) v = 99999999;  // 8 digits: not the plain form
-    if (r == 3) text += " ";   // a leading blank: not the plain form
+    if (r == 2) v = 99999999;
+    if (r == 3) text += " ";
     text += fmt::format("{}", v);
     text += r == 4 ? "\r\n" : "\n";
     want.push_back(static_cast<std::int64_t>(acc += static_cast<std::uint64_t>(v)));
   }
-  for (const unsigned t : {1u, 2u}) {
-    const Recording r = read_recording_text(text, "windows.csv", with_threads(t));
-    EXPECT_EQ(r.phase.wide_counts(), want) << "threads " << t;
-    const Recording slow = read_recording_text(indented(text), "slow.csv", with_threads(t));
-    EXPECT_EQ(r.line_runs, slow.line_runs) << "threads " << t;
-  }
+  const Recording r = read_recording_text(text, "pieces.csv");
+  EXPECT_EQ(r.phase.counts, want);
+  EXPECT_EQ(r.line_runs, expected_runs(text));
 }
 
-std::size_t error_line(const std::string& text, unsigned threads) {
+std::size_t error_line(const std::string& text) {
   try {
-    (void)read_recording_text(text, "big.csv", with_threads(threads));
+    (void)read_recording_text(text, "big.csv");
   } catch (const rwcalc::InputError& e) {
     return e.line();
   }
@@ -179,7 +123,7 @@ std::size_t error_line(const std::string& text, unsigned threads) {
 
 TEST(ReadIntLines, SumTooLargeNamesTheSameLine) {
   // Ten counts of ~1e18 pass Σ|c| = 2^63 − 1 at the tenth; placed early, in the middle, or near
-  // the end of a long file (the other thread's half), among plain lines.
+  // the end of a long file.
   const std::size_t n = 800000;
   for (const std::size_t at : {std::size_t{100}, n / 2 - 5, n - 50}) {
     std::string t = "pulses\n";
@@ -189,14 +133,13 @@ TEST(ReadIntLines, SumTooLargeNamesTheSameLine) {
       t += big ? "999999999999999999\n" : fmt::format("{}\n", i % 5);
       if (big) want = i + 2;
     }
-    EXPECT_EQ(error_line(t, 1), want) << at;
-    EXPECT_EQ(error_line(t, 2), want) << at;
+    EXPECT_EQ(error_line(t), want) << at;
   }
   // Plain counts between two 18-digit ones that cancel: no error, exact sums.
   std::string ok = "pulses\n999999999999999999\n";
   for (std::size_t i = 0; i < 1000; ++i) ok += fmt::format("-{}\n", i % 3);
   ok += "-999999999999999999\n";
-  const Recording r = read_recording_text(ok, "ok.csv", with_threads(2));
+  const Recording r = read_recording_text(ok, "ok.csv");
   EXPECT_EQ(r.phase.wide_counts().back(), -999);
 }
 

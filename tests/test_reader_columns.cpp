@@ -117,15 +117,13 @@ TEST(ReaderTimeColumns, TwoTimeColumnsAreUsedOnlyWhenTheyAgree) {
   EXPECT_EQ(line, 4u);
 }
 
-TEST(ReaderTimeColumns, TwoTimeColumnsAreComparedInALongTextReadInTwoParts) {
-  // More than 1 MB: the second part is parsed on another thread (Reader::scan_chunk).
+TEST(ReaderTimeColumns, TwoTimeColumnsAreComparedOverALongText) {
+  // More than 2 MB, read in many pieces: the disagreement near the end is found and named.
   std::string text = "time_s,pulses,time_us\n";
   const int n = 120000;
   for (int k = 0; k < n; ++k) text += fmt::format("{:.4f},{},{}\n", k * 0.0025, k % 2, k == n - 10 ? k * 2500 + 100 : k * 2500);
   ASSERT_GT(text.size(), std::size_t{2} << 20);
-  ReadOptions o;
-  o.threads = 2;
-  const auto [msg, line] = error_of(text, o);
+  const auto [msg, line] = error_of(text, ReadOptions{});
   EXPECT_NE(msg.find("the time columns 'time_s' and 'time_us' disagree"), std::string::npos) << msg;
   EXPECT_EQ(line, static_cast<std::size_t>(n - 10 + 2));
 }

@@ -2,12 +2,14 @@
 // pipe. Each is refused at its first bad chunk with the file, the line and what is wrong, and the
 // process stays small: the command line runs under an address-space limit (ulimit -v) that the
 // whole decompressed text would exceed, and under `timeout` so that a regression cannot hang the
-// suite. Under AddressSanitizer (which reserves terabytes of address space) the limit is left out
-// and only the messages are checked.
+// suite. A good record of long lines is read within a limit below the size of its text: memory
+// follows the samples kept, not the text. Under AddressSanitizer (which reserves terabytes of
+// address space) the limit is left out and only the messages are checked.
 #include <sys/wait.h>
 #include <zlib.h>
 
 #include <cstdlib>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -35,11 +37,13 @@ std::string quote(const std::string& s) {
 }
 
 // Run `FEED | rwcalc ARGS` (or rwcalc ARGS alone) under the limit and a 20-s timeout. The commands
-// run with --threads 2, so that the threads' stacks and heaps do not depend on the machine's cores.
-rwcalc::test::CliResult run_limited(const std::string& feed, const std::vector<std::string>& args) {
+// run with RWCALC_THREADS=2, so that the threads' stacks and heaps do not depend on the machine's
+// cores.
+rwcalc::test::CliResult run_limited(const std::string& feed, const std::vector<std::string>& args,
+                                    long limit_kib = kLimitKiB) {
   const rwcalc::test::TempDir tmp;
   std::string cmd;
-  if (!kSanitized) cmd += "ulimit -v " + std::to_string(kLimitKiB) + "; ";
+  if (!kSanitized) cmd += "ulimit -v " + std::to_string(limit_kib) + "; ";
   if (!feed.empty()) cmd += feed + " | ";
   cmd += "RWCALC_THREADS=2 timeout 20 ";  // two worker threads' stacks under the address-space limit
   cmd += quote(RWCALC_EXE);
@@ -140,6 +144,29 @@ TEST(HostileInput, AGoodRecordFromAPipeIsReadWhole) {
     EXPECT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("200000"), std::string::npos) << r.out.substr(0, 400);
   }
+}
+
+TEST(HostileInput, MemoryFollowsTheSamplesNotTheText) {
+  // 200 MB of text, 200 000 samples: each line a pulse count and a note of 1000 characters. Read
+  // under an address-space limit of 128 MiB, below the size of the text.
+  if (kSanitized) GTEST_SKIP() << "sanitizers reserve address space: no limit to test against";
+  const rwcalc::test::TempDir tmp;
+  const auto path = (tmp.path() / "long_lines.csv").string();
+  {
+    std::ofstream out(path, std::ios::binary);
+    out << "# rate_hz: 400\npulses,note\n";
+    const std::string note(1000, 'n');
+    std::string block;
+    for (int i = 0; i < 200000; ++i) {
+      block += std::to_string(i % 3) + "," + note + "\n";
+      if (block.size() > (std::size_t{1} << 22)) out << block, block.clear();
+    }
+    out << block;
+  }
+  ASSERT_GT(std::filesystem::file_size(path), std::size_t{180} << 20);  // 191 MiB
+  const auto r = run_limited("", {"allan", path}, 128L * 1024);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("200000"), std::string::npos) << r.out.substr(0, 400);
 }
 
 }  // namespace

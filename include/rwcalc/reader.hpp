@@ -2,15 +2,13 @@
 /// @file reader.hpp
 /// Reading gyro and clock recordings into a PhaseSeries without losing or bending a sample.
 ///
-/// Text, one sample per line. Accepted: `#` comment lines; metadata lines `# key: value` or
-/// `# key = value` (rate_hz, scale_arcsec_per_pulse, temperature_c, serial in any case, and any
-/// other key, kept verbatim);
-/// an optional header row naming the columns; delimiters comma, semicolon, tab or blanks
-/// (detected from the header or the first data line); a decimal comma where the delimiter is not
-/// a comma; CRLF line ends; a UTF-8 BOM; gzip (by content, whatever the name); "-" for standard
-/// input. Blank lines are skipped (they carry no sample). Any other malformed line is an
-/// InputError naming the file and the line; nothing is skipped silently. docs/input-formats.md
-/// is the user-facing description.
+/// Text, one sample per line, read as a stream (memory follows the samples, not the text).
+/// Accepted: `#` comment lines; metadata lines `# key: value` or `# key = value` (rate_hz,
+/// scale_arcsec_per_pulse, temperature_c, serial in any case; any other key kept verbatim); an
+/// optional header row; delimiters comma, semicolon, tab or blanks (detected from the header or
+/// the first data line); a decimal comma where the delimiter is not a comma; CRLF or CR line ends;
+/// a UTF-8 BOM; gzip (by content); "-" for standard input. Blank lines carry no sample. Any other
+/// malformed line is an InputError naming the file and the line. See docs/input-formats.md.
 #include <cstddef>
 #include <cstdint>
 #include <map>
@@ -23,8 +21,6 @@
 #include "rwcalc/series.hpp"
 
 namespace rwcalc {
-
-class Crew;
 
 /// What the selected column holds.
 enum class InputMode {
@@ -49,19 +45,7 @@ struct ReadOptions {
   int counter_bits = 32;               ///< wrap width of Counter mode (1..64)
   AngleUnit angle_unit = AngleUnit::Arcsec;
   RateUnit rate_unit = RateUnit::DegPerHour;
-  /// Allowed deviation of a time-column step from 1/rate, as a fraction of the period.
-  double time_tolerance = 0.01;
-  /// Threads for parsing a long text (0: all hardware threads; at most two are used, on texts of
-  /// more than 1 MB). The result does not depend on it.
-  unsigned threads = 0;
-  /// Threads lent by the caller (crew.hpp): a regular file is then loaded in halves by this
-  /// thread and a lender rather than by a thread started for it.
-  Crew* crew = nullptr;
-  /// Storage to reuse for a pulse file read from a regular file: a vector (typically the counts32
-  /// of a record no longer needed) whose memory, pages already mapped, takes the text and then the
-  /// new record's 32-bit counts. It is moved from. `rwcalc batch` hands each worker's last record
-  /// to its next read. The result does not depend on it.
-  std::vector<std::int32_t>* reuse = nullptr;
+  double time_tolerance = 0.01;  ///< allowed deviation of a time-column step, fraction of 1/rate
 };
 
 /// Where the sample rate came from (reported in outputs).
@@ -99,7 +83,7 @@ struct Recording {
 /// Read a file (or "-" for stdin). Throws InputError (file, line, message) on any malformed input.
 Recording read_recording(const std::string& path, const ReadOptions& options = {});
 
-/// Read from text already in memory (used by tests, fuzzers and stdin); `name` labels errors.
+/// Read from text already in memory (used by tests and fuzzers); `name` labels errors.
 /// The text may be gzip-compressed (detected by its magic bytes).
 Recording read_recording_text(std::string_view text, const std::string& name,
                               const ReadOptions& options = {});

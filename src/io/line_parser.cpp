@@ -1,0 +1,197 @@
+// Each line is split at the delimiter and its selected fields read with std::from_chars (exact int64
+// for pulses and counters, correctly rounded doubles otherwise). A data line of the known layout is
+// taken as soon as its fields read; any other is looked at in the order that decides its error.
+#include "io/line_parser.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "rwcalc/error.hpp"
+
+namespace rwcalc::detail {
+
+namespace {
+
+// Does all of t read as a T?
+template <class T>
+bool reads_whole(std::string_view t, T& v) {
+  const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+  return r.ec == std::errc() && r.ptr == t.data() + t.size();
+}
+
+std::string_view unquote(std::string_view f) {
+  if (f.size() >= 2 && f.front() == '"' && f.back() == '"') f = f.substr(1, f.size() - 2);
+  return trim(f);
+}
+
+}  // namespace
+
+LineParser::LineParser(std::string file, const ReadOptions& options) : file_(std::move(file)), opt_(options) {
+  const int b = options.counter_bits;  // the readings a counter of b bits can give
+  counter_lo_ = b >= 64 ? std::numeric_limits<std::int64_t>::min() : -(std::int64_t{1} << (b - 1));
+  counter_max_ = b >= 63 ? std::numeric_limits<std::int64_t>::max() : (std::int64_t{1} << b) - 1;
+}
+
+void LineParser::fail(const std::string& message) const { throw InputError(file_, line_, message); }
+
+LineKind LineParser::parse(std::string_view text, std::size_t line, Sample& s) {
+  line_ = line;
+  if (!text.empty() && text.back() == '\r') text.remove_suffix(1);
+  // One pass over the line for the bytes that need a look: CR, semicolon, tab.
+  bool special = false;
+  for (const char c : text) special |= c == '\r' || c == ';' || c == '\t';
+  if (const auto cr = special ? text.find('\r') : std::string_view::npos; cr != std::string_view::npos)
+    fail(fmt::format("stray carriage return (CR) at column {} inside the line", cr + 1));
+  const std::string_view t = trim(text);
+  if (t.empty()) return LineKind::Blank;
+  ++content_lines_;
+  if (t.front() == '#') {
+    meta_.read(t.substr(1), line, file_);
+    return LineKind::Comment;
+  }
+  if (!layout_known_ && layout_.header.empty()) {
+    layout_.delim = Layout::detect_delimiter(t);
+    layout_.layout_line = line;
+  }
+  if (special) check_foreign_delimiters(t);
+  split(t);
+  if (layout_known_ && fields_.size() == layout_.ncols && read_fields(s, false)) return LineKind::Data;
+  if (header_row(t)) return LineKind::Header;
+  if (!layout_known_) {  // the first data line fixes the columns
+    layout_.ncols = layout_.header.empty() ? fields_.size() : layout_.header.size();
+    layout_known_ = true;
+    first_data_line_ = line;
+    layout_.choose(opt_, layout_.header_line ? layout_.header_line : line, file_);
+  }
+  if (fields_.size() != layout_.ncols)
+    fail(fmt::format("wrong number of columns: expected {} ({}-separated, as line {} has), found {}: {}",
+                     layout_.ncols, delim_name(layout_.delim),
+                     layout_.header_line ? layout_.header_line : first_data_line_, fields_.size(), quoted(t)));
+  read_fields(s, true);
+  return LineKind::Data;
+}
+
+void LineParser::check_foreign_delimiters(std::string_view line) const {
+  const std::string_view foreign = layout_.delim == Delim::Comma       ? ";\t"
+                                   : layout_.delim == Delim::Semicolon ? "\t"
+                                                                       : ";";
+  const auto at = line.find_first_of(foreign);
+  if (at == std::string_view::npos) return;
+  fail(fmt::format("mixed delimiters: the file is {}-separated (from line {}) but this line has a {} at column {}: {}",
+                   delim_name(layout_.delim), layout_.layout_line, line[at] == '\t' ? "tab" : "semicolon", at + 1,
+                   quoted(line)));
+}
+
+void LineParser::split(std::string_view line) {
+  fields_.clear();
+  if (layout_.delim == Delim::Blanks) {
+    std::size_t i = 0;
+    while (i < line.size()) {
+      while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+      if (i >= line.size()) break;
+      const std::size_t s = i;
+      while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
+      fields_.push_back(line.substr(s, i - s));
+    }
+    return;
+  }
+  const char d = layout_.delim == Delim::Comma ? ',' : layout_.delim == Delim::Semicolon ? ';' : '\t';
+  for (std::size_t start = 0;;) {
+    const auto e = line.find(d, start);
+    fields_.push_back(trim(line.substr(start, e == std::string_view::npos ? e : e - start), false));
+    if (e == std::string_view::npos) break;
+    start = e + 1;
+  }
+}
+
+// An all-text line is the header row before the data. Inside the data it is a second header row
+// when it repeats the header or has several fields; a lone word in a one-column file is just text
+// in a numeric column.
+bool LineParser::header_row(std::string_view t) {
+  const bool comma_ok = layout_.delim != Delim::Comma;
+  const bool any_numeric =
+      std::any_of(fields_.begin(), fields_.end(), [&](std::string_view f) { return looks_numeric(f, comma_ok); });
+  const bool any_text = std::any_of(fields_.begin(), fields_.end(), [](std::string_view f) { return !f.empty(); });
+  auto repeats_header = [&] {
+    const auto& h = layout_.header;
+    if (h.empty() || fields_.size() != h.size()) return false;
+    for (std::size_t c = 0; c < fields_.size(); ++c)
+      if (!iequals(unquote(fields_[c]), h[c])) return false;
+    return true;
+  };
+  if (any_numeric || !any_text || (layout_known_ && fields_.size() < 2 && !repeats_header())) return false;
+  if (layout_known_)
+    fail(fmt::format("a second header row inside the data: {} (the first is at line {}); were two files joined?",
+                     quoted(t), layout_.header_line ? layout_.header_line : first_data_line_));
+  if (!layout_.header.empty())
+    fail(fmt::format("a second header row {} (the first is at line {}); only one is allowed", quoted(t),
+                     layout_.header_line));
+  for (const auto f : fields_) layout_.header.emplace_back(unquote(f));
+  layout_.header_line = line_;
+  return true;
+}
+
+// The selected fields, in column order: false at the first that does not read (with `report`,
+// its InputError instead).
+bool LineParser::read_fields(Sample& s, bool report) {
+  for (std::size_t c = 0; c < layout_.ncols; ++c)
+    if (layout_.roles[c] != Role::Skip && !read_field(fields_[c], layout_.roles[c], s, report)) return false;
+  return true;
+}
+
+bool LineParser::read_field(std::string_view f, Role role, Sample& s, bool report) {
+  if (f.empty()) {
+    if (report) fail(fmt::format("empty field in {}", layout_.describe(role)));
+    return false;
+  }
+  std::string_view t = f;
+  if (t.size() > 1 && t.front() == '+' && t[1] != '-' && t[1] != '+') t.remove_prefix(1);
+  if (role == Role::Value && integer_mode()) return read_integer(f, t, s, report);
+  const std::string_view n = normalise_decimal(t, layout_.delim != Delim::Comma, scratch_);
+  double v = 0;
+  const auto r = std::from_chars(n.data(), n.data() + n.size(), v);
+  if (r.ptr == n.data() + n.size() && r.ec == std::errc() && std::isfinite(v)) {
+    (role == Role::Value ? s.real : role == Role::Time ? s.time : role == Role::Time2 ? s.time2 : s.temperature) = v;
+    return true;
+  }
+  if (!report) return false;
+  const std::string col = layout_.describe(role);
+  if (r.ptr != n.data() + n.size() || r.ec == std::errc::invalid_argument)
+    fail(fmt::format("not a number in {}: {}", col, quoted(f)));
+  if (r.ec == std::errc::result_out_of_range) fail(fmt::format("number out of range in {}: {}", col, quoted(f)));
+  fail(fmt::format("non-finite value in {}: {}", col, quoted(f)));
+}
+
+// A pulse count or counter reading: exact, as an int64 (a 64-bit counter's reading above 2^63-1
+// as the same residue modulo 2^64).
+bool LineParser::read_integer(std::string_view f, std::string_view t, Sample& s, bool report) {
+  const bool counter = opt_.mode == InputMode::Counter;
+  std::uint64_t u = 0;
+  if (reads_whole(t, s.integer)) {
+    if (!counter || (s.integer >= counter_lo_ && s.integer <= counter_max_)) return true;
+    if (report) fail(fmt::format("counter reading {} does not fit a {}-bit counter", quoted(f), opt_.counter_bits));
+    return false;
+  }
+  if (counter && opt_.counter_bits == 64 && t.front() != '-' && reads_whole(t, u)) {
+    s.integer = static_cast<std::int64_t>(u);
+    return true;
+  }
+  if (!report) return false;
+  const std::string col = layout_.describe(Role::Value);
+  double d = 0;
+  if (reads_whole(normalise_decimal(t, layout_.delim != Delim::Comma, scratch_), d) && !std::isfinite(d))
+    fail(fmt::format("non-finite value in {}: {}", col, quoted(f)));
+  const bool neg = t.front() == '-';
+  if (t.size() > static_cast<std::size_t>(neg) &&
+      std::all_of(t.begin() + neg, t.end(), [](char c) { return c >= '0' && c <= '9'; }))
+    fail(fmt::format("number out of range of a 64-bit integer in {}: {}", col, quoted(f)));
+  if (looks_numeric(f, layout_.delim != Delim::Comma))
+    fail(fmt::format("{} counts must be integers: {} in {}", counter ? "counter" : "pulse", quoted(f), col));
+  fail(fmt::format("not a number in {}: {}", col, quoted(f)));
+}
+
+}  // namespace rwcalc::detail

@@ -1,0 +1,65 @@
+#pragma once
+// The one parser of a recording's lines: each line is blank, a comment (maybe metadata), the
+// header row, or a data line, whose selected columns it reads into a Sample.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "io/layout.hpp"
+#include "rwcalc/reader.hpp"
+
+namespace rwcalc::detail {
+
+enum class LineKind { Blank, Comment, Header, Data };
+
+/// The selected columns of a data line.
+struct Sample {
+  std::int64_t integer = 0;  ///< pulses, or a counter reading's bit pattern
+  double real = 0.0;         ///< angle / rate sample
+  double time = 0.0;         ///< in the time column's own unit
+  double time2 = 0.0;        ///< the second time column's
+  double temperature = 0.0;
+};
+
+class LineParser {
+ public:
+  LineParser(std::string file, const ReadOptions& options);
+
+  /// Read line number `line` (without its LF). Throws InputError naming the file and the line.
+  LineKind parse(std::string_view text, std::size_t line, Sample& s);
+
+  [[nodiscard]] const Layout& layout() const noexcept { return layout_; }
+  [[nodiscard]] Metadata& metadata() noexcept { return meta_; }
+  [[nodiscard]] const Metadata& metadata() const noexcept { return meta_; }
+  [[nodiscard]] std::size_t first_data_line() const noexcept { return first_data_line_; }
+  [[nodiscard]] std::size_t content_lines() const noexcept { return content_lines_; }
+  [[nodiscard]] const std::string& file() const noexcept { return file_; }
+
+ private:
+  [[noreturn]] void fail(const std::string& message) const;
+  void split(std::string_view line);
+  void check_foreign_delimiters(std::string_view line) const;
+  bool header_row(std::string_view line);
+  bool read_fields(Sample& s, bool report);
+  bool read_field(std::string_view f, Role role, Sample& s, bool report);
+  bool read_integer(std::string_view f, std::string_view t, Sample& s, bool report);
+  [[nodiscard]] bool integer_mode() const noexcept {
+    return opt_.mode == InputMode::Pulses || opt_.mode == InputMode::Counter;
+  }
+
+  std::string file_;
+  const ReadOptions& opt_;
+  std::size_t line_ = 0;
+  std::size_t content_lines_ = 0;  // lines that are not blank
+  std::size_t first_data_line_ = 0;
+  bool layout_known_ = false;
+  Layout layout_;
+  Metadata meta_;
+  std::int64_t counter_lo_ = 0, counter_max_ = 0;  // the readings a counter can give
+  std::vector<std::string_view> fields_;
+  std::string scratch_;
+};
+
+}  // namespace rwcalc::detail

@@ -1,0 +1,75 @@
+#pragma once
+// The bytes of a recording as checked text, piece by piece: a file, standard input, a pipe, a
+// device or text in memory, gzip-compressed or not (told by content). Nothing holds the whole text.
+#include <zlib.h>
+
+#include <cstddef>
+#include <string>
+#include <string_view>
+
+namespace rwcalc::detail {
+
+/// The longest line taken, in bytes without its line end: a stream without line ends is refused
+/// as soon as it passes this, so it cannot fill the memory.
+constexpr std::size_t kMaxLineBytes = std::size_t{1} << 20;
+/// Bytes handed out at a time; far below kMaxLineBytes.
+constexpr std::size_t kPieceBytes = std::size_t{1} << 18;
+
+/// Name used in messages for a path ("<stdin>" for "-").
+std::string display_name(const std::string& path);
+
+/// Checks text as it arrives: binary data (a control byte other than tab, LF and CR, or DEL) and
+/// lines longer than kMaxLineBytes are an InputError naming the line (and the column of the byte).
+/// Lines are numbered by LF, or by CR while no LF has come (classic Mac line ends).
+class TextCheck {
+ public:
+  explicit TextCheck(std::string name) : name_(std::move(name)) {}
+  void check(std::string_view piece);  ///< a piece of at most kPieceBytes
+
+ private:
+  [[nodiscard]] std::size_t line() const noexcept { return 1 + (lf_ > 0 ? lf_ : cr_); }
+
+  std::string name_;
+  std::size_t offset_ = 0, lf_ = 0, cr_ = 0;  // bytes checked, LF and CR among them
+  std::size_t after_lf_ = 0, after_cr_ = 0;   // where the last LF, the last CR ends
+  bool bom_ = false;                          // the text starts with a UTF-8 byte-order mark
+};
+
+/// A recording's text. Throws InputError (line 0) for a path that cannot be opened or read, a
+/// directory, and corrupt or truncated gzip data, and TextCheck's errors.
+class TextSource {
+ public:
+  explicit TextSource(const std::string& path);          ///< a file, or standard input for "-"
+  TextSource(std::string_view bytes, std::string name);  ///< bytes in memory, which must outlive it
+  ~TextSource();
+  TextSource(const TextSource&) = delete;
+  TextSource& operator=(const TextSource&) = delete;
+
+  /// Append the next piece of checked text to `out`; false once the input has ended.
+  bool read(std::string& out);
+  [[nodiscard]] const std::string& name() const noexcept { return name_; }
+
+ private:
+  struct Descriptor {
+    int fd = -1;
+    bool own = false;
+    ~Descriptor();
+  };
+  std::size_t read_raw(char* to, std::size_t max);
+  bool start(std::string& out);
+  bool refill();
+  bool inflate_piece(std::string& out);
+
+  std::string name_;
+  Descriptor in_;
+  std::string_view memory_;  // the bytes not yet read, when there is no descriptor
+  bool started_ = false, gzip_ = false;
+  std::string raw_;  // compressed bytes, or the first bytes before gzip is told from text
+  z_stream zs_{};
+  bool in_member_ = true;       // between a gzip member's first byte and its end
+  std::size_t magic_seen_ = 0;  // bytes of the next member's magic seen since a member ended
+  std::size_t inflated_ = 0;
+  TextCheck check_;
+};
+
+}  // namespace rwcalc::detail
