@@ -1,5 +1,6 @@
 #pragma once
-// Output formats shared by 'rwcalc batch' and 'rwcalc merge' (same tables from the same objects).
+// Output shared by the commands: the table formats of 'rwcalc batch' and 'rwcalc merge' (same
+// tables from the same objects), and where a command's text goes (emit).
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 #include <string>

@@ -6,6 +6,7 @@
 #include <ostream>
 
 #include "cli/analyze_args.hpp"
+#include "cli/batch_format.hpp"
 #include "cli/commands.hpp"
 #include "cli/numeric_options.hpp"
 #include "cli/plot_args.hpp"
@@ -13,7 +14,6 @@
 #include "rwcalc/crew.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/output.hpp"
-#include "core/timing.hpp"
 
 namespace rwcalc::cli {
 
@@ -56,20 +56,17 @@ void register_analyze(CLI::App& app, Runner& runner) {
       // Output problems (figure format, existing files, two outputs naming one file, no gnuplot)
       // are reported before the analysis, and before anything is written.
       cmd->plot.check(cmd->force, {{"-o", cmd->output}});
-      detail::ScopedTimer total("analyze command");
       // The analysis' helper threads, started before the read so that they have settled on the
       // other cores by the time the Allan stage shares its passes out (crew.hpp).
       OwnCrew crew(opt.allan.threads);
       opt.allan.crew = crew.get();
       const Recording rec = [&] {
-        detail::ScopedTimer t("read");
         ReadOptions ro = cmd->input.options();
         ro.crew = opt.allan.crew;
         return read_recording(cmd->file, ro);
       }();
       const AnalysisResult res = analyze(rec, opt);
       const std::string text = [&] {
-        detail::ScopedTimer t("format");
         const nlohmann::json j = to_json(res);
         require_finite(j, rec.source);
         if (!cmd->json && !cmd->plot.any()) return format_report(res);
@@ -77,10 +74,7 @@ void register_analyze(CLI::App& app, Runner& runner) {
         // A file name that is not UTF-8 is written with U+FFFD for its invalid bytes, not refused.
         return cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n" : format_report(res);
       }();
-      if (cmd->output == "-")
-        io.out << text;
-      else
-        write_file_atomic(cmd->output, text, cmd->force);
+      emit(io, text, cmd->output, cmd->force);
       return 0;
     };
   });

@@ -1,8 +1,6 @@
-// 'rwcalc report FILES… -o DIR': one self-contained HTML test report (DIR/report.html) with the
-// run summaries, the seed paper's Tables 1 and 2, the verdict, the figures, the settings and the
-// version. FILES are recordings (analysed here, in parallel) and/or saved results: the JSON of
-// 'rwcalc analyze --json', 'rwcalc batch --json' or 'rwcalc diagnose --json', or the JSON lines
-// of 'rwcalc batch --jsonl'.
+// 'rwcalc report FILES… -o DIR': one self-contained HTML test report (DIR/report.html). FILES are
+// recordings (analysed here) and/or saved results of 'analyze', 'batch' or 'diagnose --json', or
+// the JSON lines of 'batch --jsonl'.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -44,7 +42,6 @@ struct ReportCmd {
   std::optional<double> temperature;
   std::string dir;
   std::string title;
-  unsigned jobs = 0;
   bool diagnose = false;
   std::size_t diagnose_runs = 50;
   std::uint64_t diagnose_seed = 1;
@@ -68,20 +65,15 @@ std::vector<json> diagnose_recordings(const std::vector<std::string>& recordings
   return out;
 }
 
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
-  return s;
-}
-
 bool is_json_path(const std::string& path) {
-  const auto ext = lower(fs::path(path).extension().string());
+  auto ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   return ext == ".json" || ext == ".jsonl";
 }
 
 std::string file_name(const json& j) {
-  const auto& s = j.contains("source") && j["source"].is_string() ? j["source"].get_ref<const std::string&>()
-                                                                   : std::string();
-  return fs::path(s).filename().string();
+  const auto it = j.find("source");
+  return it != j.end() && it->is_string() ? fs::path(it->get<std::string>()).filename().string() : std::string();
 }
 
 /// Attach each saved diagnosis to the analysis with the same source (by file name), or to the
@@ -178,7 +170,7 @@ int run_report(const ReportCmd& c, Io& io) {
   std::vector<json> diagnoses;
   if (c.diagnose) diagnoses = diagnose_recordings(recordings, read, opt, c.diagnose_runs, c.diagnose_seed);
   ReportInput in;
-  if (!recordings.empty()) in.analyses = analyze_files(recordings, read, opt, c.jobs);
+  if (!recordings.empty()) in.analyses = analyze_files(recordings, read, opt, 0);
   diagnoses.resize(in.analyses.size());
   for (auto& a : saved.analyses) in.analyses.push_back(std::move(a.run));
   if (in.analyses.empty())
@@ -230,8 +222,6 @@ void register_report(CLI::App& app, Runner& runner) {
   cmd->analysis.add_to(*sub);
   sub->add_option("--temperature", cmd->temperature, "Temperature, °C (only with a single recording)")
       ->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"));
-  sub->add_option("-j,--jobs", cmd->jobs, "Recordings analysed in parallel (default: hardware threads)")
-      ->check(whole_in(0, kMaxThreads));
   sub->add_option("--title", cmd->title, "Title of the report");
   sub->add_flag("--diagnose", cmd->diagnose, "Also diagnose each recording (what the noise model misses)");
   sub->add_option("--diagnose-runs", cmd->diagnose_runs, "Simulated records per diagnosis ensemble")

@@ -117,10 +117,6 @@ std::string format_pulse_file(const Metadata& metadata, const PhaseSeries& serie
   return text;
 }
 
-void write_pulse_file(const std::string& path, const Metadata& metadata, const PhaseSeries& series, bool force) {
-  write_file_atomic(path, format_pulse_file(metadata, series), force);
-}
-
 PulseFileWriter::PulseFileWriter(const std::string& path, const Metadata& metadata, Column column, bool force)
     : path_(path), out_(path, force), column_(column),
       text_(header_text(metadata, column == Column::Pulses ? "pulses" : "angle")) {
