@@ -41,11 +41,9 @@ void register_analyze(CLI::App& app, Runner& runner) {
   sub->add_option("FILE", cmd->file, "Recording to analyse ('-' for standard input)")->required();
   cmd->input.add_to(*sub);
   cmd->analysis.add_to(*sub);
-  sub->add_option("--temperature", cmd->temperature, "Temperature of the run, °C (overrides the file)")
-      ->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"));
+  add_temperature_option(*sub, cmd->temperature, "Temperature of the run, °C (overrides the file)");
   sub->add_flag("--json", cmd->json, "Print the JSON object instead of the report");
-  sub->add_option("-o,--output", cmd->output, "Write to FILE instead of standard output")->capture_default_str();
-  sub->add_flag("--force", cmd->force, "Overwrite existing output, figure and script files");
+  add_output_options(*sub, cmd->output, cmd->force);
   cmd->plot.add_to(*sub,
                    "the Allan deviation with its confidence bars, the fitted model, each term's line and the "
                    "class limits for B");

@@ -88,6 +88,9 @@ class Value {
   std::string path_;
 };
 
+/// The whole file; InputError when it cannot be opened or read.
+std::string read_file(const std::string& path);
+
 /// JSON type name for messages ("number", "string", "object", …).
 std::string_view type_name(const nlohmann::json& j);
 

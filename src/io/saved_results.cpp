@@ -7,9 +7,7 @@
 #include <array>
 #include <cctype>
 #include <filesystem>
-#include <fstream>
 #include <optional>
-#include <sstream>
 #include <unordered_map>
 
 #include "core/json_input.hpp"
@@ -20,6 +18,7 @@ namespace rwcalc {
 namespace {
 
 using json_input::Document;
+using json_input::read_file;
 using json_input::Value;
 using nlohmann::json;
 
@@ -297,15 +296,6 @@ void check_overall(const Value& o) {
 }
 
 bool has(const json& j, const char* key) { return j.contains(key); }
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, 0, "cannot open the file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw InputError(path, 0, "cannot read the file");
-  return ss.str();
-}
 
 }  // namespace
 
