@@ -63,7 +63,7 @@ class ReportOfGl2d : public ::testing::Test {
     if (!rwcalc::gnuplot_available()) return;
     dir_ = std::make_unique<TempDir>();
     report_ = run_cli(concat({"report"}, concat(gl2d_all(), {"-o", (dir_->path() / "out").string(), "--tolerance", "50",
-                                                       "-j", "2", "--title", "GL-2D <temperature> test"})));
+                                                       "--title", "GL-2D <temperature> test"})));
     batch_ = run_cli(concat({"batch"}, concat(gl2d_all(), {"--json", "--tolerance", "50", "-o",
                                                      (dir_->path() / "batch.json").string()})));
   }

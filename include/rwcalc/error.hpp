@@ -1,13 +1,8 @@
 #pragma once
 /// @file error.hpp
-/// Error types of rwcalc and the process exit status each one maps to.
-///
-/// The library throws; the command-line layer catches at one place (cli::run) and turns the
-/// exception into a message on stderr and an exit status. Exit statuses:
-///   0  success
-///   1  the analysis cannot be done on valid input (too short a record, too few τ for a fit, …)
-///   2  bad input or bad usage (unreadable file, malformed line, invalid option value)
-///   3  an output could not be written (exists without --force, directory missing, disk full)
+/// Error types and the exit status each maps to. The library throws; cli::run catches at one
+/// place and prints the message. Exit statuses: 0 success; 1 the analysis cannot be done on valid
+/// input; 2 bad input or usage; 3 an output could not be written.
 #include <cstddef>
 #include <stdexcept>
 #include <string>
@@ -16,7 +11,6 @@ namespace rwcalc {
 
 enum class ExitCode : int { Ok = 0, AnalysisFailed = 1, BadInput = 2, OutputFailed = 3 };
 
-/// Base of all rwcalc errors.
 class Error : public std::runtime_error {
  public:
   explicit Error(const std::string& what, ExitCode code) : std::runtime_error(what), code_(code) {}
@@ -26,8 +20,7 @@ class Error : public std::runtime_error {
   ExitCode code_;
 };
 
-/// Bad input data: names the file, the line (1-based, 0 when no line applies) and what was wrong.
-/// what() reads "FILE:LINE: MESSAGE" (or "FILE: MESSAGE").
+/// Bad input data: what() reads "FILE:LINE: MESSAGE" (or "FILE: MESSAGE" when line is 0).
 class InputError : public Error {
  public:
   InputError(std::string file, std::size_t line, std::string message);
@@ -53,7 +46,7 @@ class AnalysisError : public Error {
   explicit AnalysisError(const std::string& what) : Error(what, ExitCode::AnalysisFailed) {}
 };
 
-/// An output file could not be written (exit 3).
+/// An output could not be written (exit 3).
 class OutputError : public Error {
  public:
   explicit OutputError(const std::string& what) : Error(what, ExitCode::OutputFailed) {}

@@ -1,21 +1,13 @@
 #pragma once
 /// @file output.hpp
-/// Files written by rwcalc appear whole or not at all: content goes to a temporary file in the
-/// target's directory, is flushed and synced, renamed over the target, and the directory is
-/// synced. An existing target is replaced only with `force`; the new file keeps the replaced
-/// file's permissions (and, when permitted, its owner). A ".gz" target is gzip-compressed.
-///
-/// What the target is decides how it is written:
-/// - "-": standard output.
-/// - a character device or a FIFO (/dev/null, /dev/stdout, a named pipe): written straight into,
-///   without a temporary file and without `force` (nothing is replaced);
-/// - a symbolic link: followed; its final target is written by the rules here (a regular file is
-///   replaced by a rename in the target's directory, so the link stays a link). The link counts
-///   as an existing file, dangling or not: it needs `force`, and a dangling link's target is
-///   then created;
-/// - a directory, block device, socket: refused.
-#include <memory>
+/// Files written by rwcalc appear whole or not at all: a temporary file in the target's
+/// directory is written, synced, renamed over the target, and the directory synced. An existing
+/// target is replaced only with `force` and keeps its permissions (and, when permitted, owner);
+/// a ".gz" target is gzip-compressed. "-" is standard output; a character device or FIFO is
+/// written straight into; a symbolic link is followed (it counts as existing, dangling or not);
+/// a directory, block device or socket is refused.
 #include <cstddef>
+#include <memory>
 #include <ostream>
 #include <streambuf>
 #include <string>
@@ -24,16 +16,9 @@
 
 namespace rwcalc {
 
-/// One output being written, in pieces: the streaming form of write_file_atomic.
-///
-///     AtomicOutput out(path, force);   // checks the target, opens the temporary file
-///     out.write(chunk); …              // as many pieces as needed
-///     out.commit();                    // flush, sync, rename into place, sync the directory
-///
-/// Without commit() (an exception, an early return) the destructor removes the temporary file
-/// and the target stays as it was. A device, FIFO or standard output receives the pieces as
-/// they come (there is nothing to take back). Every failure throws OutputError naming the
-/// path and the reason.
+/// One output written in pieces: write() as often as needed, then commit(). Without commit()
+/// the destructor removes the temporary file and the target stays as it was. Every failure
+/// throws OutputError naming the path and the reason.
 class AtomicOutput {
  public:
   AtomicOutput(const std::string& path, bool force);
@@ -50,28 +35,25 @@ class AtomicOutput {
   std::unique_ptr<State> state_;
 };
 
-/// Write `content` to `path` atomically. "-" writes to standard output. Throws OutputError.
+/// Write `content` to `path` atomically. Throws OutputError.
 void write_file_atomic(const std::string& path, std::string_view content, bool force);
 
-/// One output of a command: the option that names it (for messages) and its path.
+/// One output of a command: the option that names it (for messages) and its path (empty: none).
 struct OutputTarget {
-  std::string option;  ///< e.g. "-o", "--plot", "--truth"
-  std::string path;    ///< empty: not asked for
+  std::string option;
+  std::string path;
 };
 
-/// Check all outputs of one command before any is written, so that a refused one leaves nothing
-/// written: no two name the same file (also as different spellings or through symbolic links;
-/// two "-" both mean standard output) — UsageError; each can be written as the rules above say
-/// (existing without `force`, a directory, a missing directory…) — OutputError.
+/// Checks all outputs of a command before any is written: no two name the same file (also
+/// through other spellings or links) — UsageError; each can be written — OutputError.
 void check_output_targets(const std::vector<OutputTarget>& targets, bool force);
 
-/// Flush `out` (standard output) and throw OutputError naming standard output when a write to
-/// it failed (a full device, a closed descriptor): output that did not arrive is never a success.
+/// Flush standard output; OutputError when a write to it failed (output that did not arrive is
+/// never a success).
 void flush_standard_output(std::ostream& out);
 
-/// The stream buffer main() puts under std::cout: it writes to a file descriptor and keeps the
-/// reason of the first failed write, so that flush_standard_output can say why (a stream only
-/// knows that something failed).
+/// The stream buffer main() puts under std::cout: it writes to a descriptor and keeps the reason
+/// of the first failed write, so that flush_standard_output can say why.
 class DescriptorBuffer : public std::streambuf {
  public:
   explicit DescriptorBuffer(int fd) : fd_(fd) { setp(buffer_, buffer_ + sizeof buffer_); }

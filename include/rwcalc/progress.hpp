@@ -1,14 +1,8 @@
 #pragma once
 /// @file progress.hpp
-/// Progress of long work (ensembles, `allan --tau all`, large batches) on stderr.
-///
-/// Shown only when stderr is a terminal (rwcalc::stderr_is_terminal()), so pipes, files, CI logs
-/// and tests stay clean; the line is redrawn in place (carriage return) at most ~8 times a
-/// second and erased when the work ends. advance() is thread-safe and costs one atomic add
-/// when nothing is redrawn. Typical use, one line per place:
-///
-///     rwcalc::Progress progress("diagnose: ensemble", runs);   // before the loop
-///     progress.advance();                                       // once per finished item
+/// Progress of long work on stderr, shown only when stderr is a terminal (pipes, logs and tests
+/// stay clean): one line redrawn in place at most ~8 times a second and erased at the end.
+/// advance() is thread-safe and costs one atomic add when nothing is redrawn.
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -20,24 +14,22 @@ namespace rwcalc {
 
 class Progress {
  public:
-  /// A reporter for `total` items labelled `label`; shown when stderr is a terminal.
   Progress(std::string label, std::uint64_t total);
-  /// Explicit sink (nullptr: show nothing); used by tests and by callers that decide themselves.
+  /// Explicit sink (nullptr: show nothing).
   Progress(std::string label, std::uint64_t total, std::FILE* sink);
   ~Progress();  ///< calls finish()
   Progress(const Progress&) = delete;
   Progress& operator=(const Progress&) = delete;
 
-  /// Count `n` more finished items (any thread).
   void advance(std::uint64_t n = 1) noexcept;
-  /// Erase the progress line (idempotent). Later advance() calls draw nothing.
+  /// Erase the line (idempotent); later advance() calls draw nothing.
   void finish() noexcept;
 
   [[nodiscard]] bool enabled() const noexcept { return sink_ != nullptr; }
   [[nodiscard]] std::uint64_t done() const noexcept { return done_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t total() const noexcept { return total_; }
 
-  /// The text of one progress line: "label: 12/50 (24%), 3.1 s, ~9.8 s left".
+  /// "label: 12/50 (24%), 3.1 s, ~9.8 s left".
   [[nodiscard]] static std::string format_line(const std::string& label, std::uint64_t done,
                                                std::uint64_t total, double elapsed_s);
 

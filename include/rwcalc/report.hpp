@@ -1,51 +1,37 @@
 #pragma once
 /// @file report.hpp
-/// A test report a lab can file: one self-contained HTML page (figures inline, no external
-/// resources) with the run summaries, the seed paper's Tables 1 and 2 (per temperature: N by the
-/// Allan variance and by the direct method, B by the Allan variance and by 100-s averaging; the
-/// class each of them gives), the verdict with its probability, the diagnosis when there is one,
-/// the settings and the rwcalc version. It prints to PDF (print style sheet: no page breaks inside
-/// tables or figures).
-///
-/// The generator takes the JSON objects of `rwcalc analyze --json` and `rwcalc diagnose --json`
-/// (keys listed in docs/plots-and-reports.md), so it renders whatever produced them.
+/// A test report a lab can file: one self-contained HTML page (figures inline) with the run
+/// summaries, the seed paper's Tables 1 and 2, the verdict with its probability, the diagnoses,
+/// the settings and the version. It prints to PDF. It renders the JSON of `analyze --json` and
+/// `diagnose --json` (keys in docs/plots-and-reports.md).
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 namespace rwcalc {
 
-/// What goes into a report.
 struct ReportInput {
-  /// One `rwcalc analyze --json` object per run (any order; the tables sort by temperature).
-  std::vector<nlohmann::json> analyses;
-  /// Empty, or one `rwcalc diagnose --json` object per analysis (null where none was made).
-  std::vector<nlohmann::json> diagnoses;
-  /// Optional overall verdict of a batch ({"class_B", "class_N", "class", …}); when null the
-  /// report states the worst class over the runs.
-  nlohmann::json overall;
+  std::vector<nlohmann::json> analyses;   ///< one analyze object per run, any order
+  std::vector<nlohmann::json> diagnoses;  ///< empty, or one per analysis (null where none)
+  nlohmann::json overall;                 ///< a batch's overall verdict; null: the worst class
 };
 
 struct ReportOptions {
   std::string title = "Gyro noise test report";
-  /// Settings shown in the report (option name → value), e.g. the command line's options.
-  nlohmann::json settings = nlohmann::json::object();
-  /// Embed figures (needs gnuplot); false writes the tables only, saying that figures were left out.
-  bool figures = true;
-  /// Text of the "generated" line (e.g. a UTC time stamp); empty leaves it out.
-  std::string generated;
+  nlohmann::json settings = nlohmann::json::object();  ///< option name → value, shown as is
+  bool figures = true;                                 ///< embed figures (needs gnuplot)
+  std::string generated;                               ///< time stamp; empty: left out
 };
 
-/// The HTML page. Throws AnalysisError when there is no analysis, OutputError when a figure
-/// cannot be drawn (gnuplot missing or failing).
+/// The HTML page. Throws AnalysisError without analyses, OutputError when a figure fails.
 std::string report_html(const ReportInput& input, const ReportOptions& options);
 
-/// Write `report_html` to DIR/report.html (DIR is created when missing) atomically; returns the
-/// path written. An existing report is replaced only with `force` (OutputError otherwise).
+/// Writes report_html to DIR/report.html (DIR created when missing) atomically; an existing
+/// report is replaced only with `force`. Returns the path.
 std::string write_report(const std::string& dir, const ReportInput& input, const ReportOptions& options,
                          bool force);
 
-/// Standard base64 (RFC 4648, with padding) of bytes, for inline figures.
+/// Standard base64 (RFC 4648, padded), for inline figures.
 std::string base64_encode(std::string_view bytes);
 
 }  // namespace rwcalc

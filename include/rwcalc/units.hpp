@@ -1,15 +1,11 @@
 #pragma once
 /// @file units.hpp
-/// Unit conventions and exact conversion factors used throughout rwcalc.
+/// Unit conventions and exact conversion factors.
 ///
-/// Gyro data are carried as an angle in arcseconds (″) sampled every τ0 seconds, so that an Allan
-/// deviation comes out in ″/s, which is exactly °/h (1″ = 1/3600°, 1 s = 1/3600 h).
-/// Noise coefficients are reported in the IEEE 952 units:
-///   Q  ″ (rms white angle error; σ² = 3Q²/τ²)
-///   N  °/√h   (σ² = N²/τ)          60·N [°/h·√s] = σ at τ = 1 s
-///   B  °/h    (σ² = (2 ln2/π)·B²)
-///   K  °/h/√h (σ² = K²τ/3)
-///   R  °/h²   (σ² = R²τ²/2)
+/// Gyro data are carried as an angle in arcseconds (″) sampled every τ0 seconds, so an Allan
+/// deviation comes out in ″/s, which is exactly °/h. Noise coefficients are in IEEE 952 units:
+///   Q ″ (σ² = 3Q²/τ²), N °/√h (σ² = N²/τ), B °/h (σ² = (2 ln2/π)·B²), K °/h/√h (σ² = K²τ/3),
+///   R °/h² (σ² = R²τ²/2).
 #include <numbers>
 
 namespace rwcalc::units {
@@ -17,7 +13,6 @@ namespace rwcalc::units {
 inline constexpr double arcsec_per_deg = 3600.0;
 inline constexpr double seconds_per_hour = 3600.0;
 inline constexpr double arcsec_per_rad = 180.0 * 3600.0 / std::numbers::pi;
-/// °/h per ″/s (exactly one).
 inline constexpr double deg_per_h_per_arcsec_per_s = 1.0;
 /// Earth's sidereal rotation rate, °/h (7.2921150e-5 rad/s).
 inline constexpr double earth_rate_deg_per_h = 7.2921150e-5 * arcsec_per_rad;
@@ -25,8 +20,19 @@ inline constexpr double earth_rate_deg_per_h = 7.2921150e-5 * arcsec_per_rad;
 inline constexpr double gl2d_rate_hz = 400.0;
 inline constexpr double gl2d_arcsec_per_pulse = 0.92;
 inline constexpr double moscow_latitude_deg = 55.75;
-
-/// N in °/√h from a white-rate AV level σ²·τ given in (°/h)²·s: N = sqrt(σ²τ)/60.
+/// N in °/√h from a white-rate AV level σ²·τ in (°/h)²·s: N = sqrt(σ²τ)/60.
 inline constexpr double sqrt_s_per_sqrt_h = 60.0;
+
+/// Unit labels as reports and figures show them: one place, so that another sensor's units can
+/// replace them.
+namespace label {
+inline constexpr const char* rate = "°/h";        ///< rate, Allan deviation, B
+inline constexpr const char* arw = "°/√h";        ///< N
+inline constexpr const char* rrw = "°/h/√h";      ///< K
+inline constexpr const char* ramp = "°/h²";       ///< R
+inline constexpr const char* angle = "″";         ///< angle, Q
+inline constexpr const char* angle2 = "″²";       ///< angle variance
+inline constexpr const char* celsius = "°C";
+}  // namespace label
 
 }  // namespace rwcalc::units

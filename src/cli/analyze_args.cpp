@@ -47,6 +47,10 @@ void add_outlier_options(CLI::App& app, std::string& action, double& threshold) 
       ->group("Outliers");
 }
 
+CLI::Option* add_temperature_option(CLI::App& app, std::optional<double>& temperature, const std::string& help) {
+  return app.add_option("--temperature", temperature, help)->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"));
+}
+
 void AnalyzeArgs::add_to(CLI::App& app) {
   app.add_option("--fit-range", fit_range, "Tau range of the fit, TMIN:TMAX in s (either may be empty; default: all)")
       ->group("Fit");

@@ -13,6 +13,9 @@ namespace rwcalc::cli {
 /// takes them (the action is applied by rwcalc::screen_outliers).
 void add_outlier_options(CLI::App& app, std::string& action, double& threshold);
 
+/// --temperature C, checked against the usable range; `help` says what it applies to.
+CLI::Option* add_temperature_option(CLI::App& app, std::optional<double>& temperature, const std::string& help);
+
 struct AnalyzeArgs {
   std::string fit_range;            ///< "TMIN:TMAX" (s; either side may be empty)
   double min_edf = 1.0;

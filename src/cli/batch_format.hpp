@@ -1,5 +1,6 @@
 #pragma once
-// Output formats shared by 'rwcalc batch' and 'rwcalc merge' (same tables from the same objects).
+// Output shared by the commands: the table formats of 'rwcalc batch' and 'rwcalc merge' (same
+// tables from the same objects), and where a command's text goes (emit).
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -40,13 +41,19 @@ struct TableFormat {
   }
 };
 
+/// -o,--output FILE (default "-": standard output) and --force.
+inline void add_output_options(CLI::App& app, std::string& output, bool& force,
+                               const char* force_help = "Overwrite existing output, figure and script files") {
+  app.add_option("-o,--output", output, "Write to FILE instead of standard output")->capture_default_str();
+  app.add_flag("--force", force, force_help);
+}
 
+/// The command's text to standard output ("-") or to the file, atomically.
 inline void emit(Io& io, const std::string& text, const std::string& output, bool force) {
   if (output == "-")
     io.out << text;
   else
     write_file_atomic(output, text, force);
 }
-
 
 }  // namespace rwcalc::cli

@@ -6,6 +6,7 @@
 #include <ostream>
 
 #include "cli/analyze_args.hpp"
+#include "cli/batch_format.hpp"
 #include "cli/commands.hpp"
 #include "cli/numeric_options.hpp"
 #include "cli/plot_args.hpp"
@@ -39,11 +40,9 @@ void register_analyze(CLI::App& app, Runner& runner) {
   sub->add_option("FILE", cmd->file, "Recording to analyse ('-' for standard input)")->required();
   cmd->input.add_to(*sub);
   cmd->analysis.add_to(*sub);
-  sub->add_option("--temperature", cmd->temperature, "Temperature of the run, °C (overrides the file)")
-      ->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"));
+  add_temperature_option(*sub, cmd->temperature, "Temperature of the run, °C (overrides the file)");
   sub->add_flag("--json", cmd->json, "Print the JSON object instead of the report");
-  sub->add_option("-o,--output", cmd->output, "Write to FILE instead of standard output")->capture_default_str();
-  sub->add_flag("--force", cmd->force, "Overwrite existing output, figure and script files");
+  add_output_options(*sub, cmd->output, cmd->force);
   cmd->plot.add_to(*sub,
                    "the Allan deviation with its confidence bars, the fitted model, each term's line and the "
                    "class limits for B");
@@ -64,10 +63,7 @@ void register_analyze(CLI::App& app, Runner& runner) {
         // A file name that is not UTF-8 is written with U+FFFD for its invalid bytes, not refused.
         return cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n" : format_report(res);
       }();
-      if (cmd->output == "-")
-        io.out << text;
-      else
-        write_file_atomic(cmd->output, text, cmd->force);
+      emit(io, text, cmd->output, cmd->force);
       return 0;
     };
   });

@@ -41,11 +41,9 @@ void register_batch(CLI::App& app, Runner& runner) {
   sub->add_option("FILES", cmd->files, "Recordings")->required();
   cmd->input.add_to(*sub);
   cmd->analysis.add_to(*sub);
-  sub->add_option("--temperature", cmd->temperature, "Temperature, °C (only with a single file)")
-      ->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"));
+  add_temperature_option(*sub, cmd->temperature, "Temperature, °C (only with a single file)");
   cmd->format.add_to(*sub);
-  sub->add_option("-o,--output", cmd->output, "Write to FILE instead of standard output")->capture_default_str();
-  sub->add_flag("--force", cmd->force, "Overwrite existing output, figure and script files");
+  add_output_options(*sub, cmd->output, cmd->force);
   cmd->plot.add_to(*sub,
                    "the paper's Fig. 1 (the Allan deviations of all runs overlaid) above Fig. 2 (the direct "
                    "method's angle variance against t with its regression line per run)");

@@ -28,8 +28,7 @@ void register_merge(CLI::App& app, Runner& runner) {
                                  "'rwcalc batch --jsonl' (runs analysed on many machines)");
   sub->add_option("LINES", cmd->files, "JSON-lines files")->required();
   cmd->format.add_to(*sub);
-  sub->add_option("-o,--output", cmd->output, "Write to FILE instead of standard output")->capture_default_str();
-  sub->add_flag("--force", cmd->force, "Overwrite an existing output file");
+  add_output_options(*sub, cmd->output, cmd->force, "Overwrite an existing output file");
   sub->add_flag("--dedupe", cmd->dedupe,
                 "Keep one of repeated identical lines of a run (a re-queued job); lines of the same run "
                 "(same \"source\") that differ are refused all the same");

@@ -1,8 +1,6 @@
-// 'rwcalc report FILES… -o DIR': one self-contained HTML test report (DIR/report.html) with the
-// run summaries, the seed paper's Tables 1 and 2, the verdict, the figures, the settings and the
-// version. FILES are recordings (analysed here, in parallel) and/or saved results: the JSON of
-// 'rwcalc analyze --json', 'rwcalc batch --json' or 'rwcalc diagnose --json', or the JSON lines
-// of 'rwcalc batch --jsonl'.
+// 'rwcalc report FILES… -o DIR': one self-contained HTML test report (DIR/report.html). FILES are
+// recordings (analysed here) and/or saved results of 'analyze', 'batch' or 'diagnose --json', or
+// the JSON lines of 'batch --jsonl'.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -44,7 +42,6 @@ struct ReportCmd {
   std::optional<double> temperature;
   std::string dir;
   std::string title;
-  unsigned jobs = 0;
   bool diagnose = false;
   std::size_t diagnose_runs = 50;
   std::uint64_t diagnose_seed = 1;
@@ -68,20 +65,15 @@ std::vector<json> diagnose_recordings(const std::vector<std::string>& recordings
   return out;
 }
 
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
-  return s;
-}
-
 bool is_json_path(const std::string& path) {
-  const auto ext = lower(fs::path(path).extension().string());
+  auto ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   return ext == ".json" || ext == ".jsonl";
 }
 
 std::string file_name(const json& j) {
-  const auto& s = j.contains("source") && j["source"].is_string() ? j["source"].get_ref<const std::string&>()
-                                                                   : std::string();
-  return fs::path(s).filename().string();
+  const auto it = j.find("source");
+  return it != j.end() && it->is_string() ? fs::path(it->get<std::string>()).filename().string() : std::string();
 }
 
 /// Attach each saved diagnosis to the analysis with the same source (by file name), or to the
@@ -152,34 +144,16 @@ std::string utc_now() {
   return buf;
 }
 
-int run_report(const ReportCmd& c, Io& io) {
-  if (c.dir.empty())
-    throw UsageError("report: -o DIR is required (the directory that receives report.html; created when missing)");
-  std::vector<std::string> recordings, saved_files;
-  for (const auto& f : c.files) (is_json_path(f) ? saved_files : recordings).push_back(f);
-  AnalysisOptions opt = c.analysis.options();
-  if (c.temperature) {
-    if (recordings.size() != 1)
-      throw UsageError("--temperature applies to a single recording; name the temperature in each file instead");
-    opt.temperature_c = c.temperature;
-  }
-  if (c.diagnose && recordings.empty())
-    throw UsageError("--diagnose needs recordings; saved diagnoses are given as 'rwcalc diagnose --json' files");
-  const ReadOptions read = c.input.options();
-  if (c.diagnose && c.diagnose_runs < 10) throw UsageError("--diagnose-runs: at least 10 simulated records are needed");
-  // Fail before the analysis: a report.html that cannot be written (existing without --force, a
-  // directory…; a missing DIR is created later), no gnuplot for the figures.
-  std::error_code ec;
-  if (fs::is_directory(c.dir, ec)) check_output_targets({{"-o", (fs::path(c.dir) / "report.html").string()}}, c.force);
-  if (!c.no_figures) require_gnuplot();
-
+/// The runs (recordings analysed here, then the saved ones), their diagnoses and the overall verdict.
+ReportInput report_input(const ReportCmd& c, const std::vector<std::string>& recordings,
+                         const std::vector<std::string>& saved_files, const ReadOptions& read,
+                         const AnalysisOptions& opt, Io& io) {
   SavedResults saved;
   for (const auto& f : saved_files) load_saved_result(f, saved);
   std::vector<json> diagnoses;
   if (c.diagnose) diagnoses = diagnose_recordings(recordings, read, opt, c.diagnose_runs, c.diagnose_seed);
   ReportInput in;
   if (!recordings.empty()) in.analyses = analyze_files(recordings, read, opt);
-  diagnoses.resize(in.analyses.size());
   for (auto& a : saved.analyses) in.analyses.push_back(std::move(a.run));
   if (in.analyses.empty())
     throw UsageError("report: no run to report; give recordings or saved analyses (the diagnoses need their runs)");
@@ -201,6 +175,31 @@ int run_report(const ReportCmd& c, Io& io) {
                                         e.what()));
     }
   }
+  return in;
+}
+
+int run_report(const ReportCmd& c, Io& io) {
+  if (c.dir.empty())
+    throw UsageError("report: -o DIR is required (the directory that receives report.html; created when missing)");
+  std::vector<std::string> recordings, saved_files;
+  for (const auto& f : c.files) (is_json_path(f) ? saved_files : recordings).push_back(f);
+  AnalysisOptions opt = c.analysis.options();
+  if (c.temperature) {
+    if (recordings.size() != 1)
+      throw UsageError("--temperature applies to a single recording; name the temperature in each file instead");
+    opt.temperature_c = c.temperature;
+  }
+  if (c.diagnose && recordings.empty())
+    throw UsageError("--diagnose needs recordings; saved diagnoses are given as 'rwcalc diagnose --json' files");
+  const ReadOptions read = c.input.options();
+  if (c.diagnose && c.diagnose_runs < 10) throw UsageError("--diagnose-runs: at least 10 simulated records are needed");
+  // Fail before the analysis: a report.html that cannot be written (existing without --force, a
+  // directory…; a missing DIR is created later), no gnuplot for the figures.
+  std::error_code ec;
+  if (fs::is_directory(c.dir, ec)) check_output_targets({{"-o", (fs::path(c.dir) / "report.html").string()}}, c.force);
+  if (!c.no_figures) require_gnuplot();
+
+  const ReportInput in = report_input(c, recordings, saved_files, read, opt, io);
 
   ReportOptions ro;
   if (!c.title.empty()) ro.title = c.title;
@@ -228,10 +227,7 @@ void register_report(CLI::App& app, Runner& runner) {
   sub->add_option("-o,--output", cmd->dir, "Directory for report.html (created when missing); required");
   cmd->input.add_to(*sub);
   cmd->analysis.add_to(*sub);
-  sub->add_option("--temperature", cmd->temperature, "Temperature, °C (only with a single recording)")
-      ->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"));
-  sub->add_option("-j,--jobs", cmd->jobs, "Recordings analysed in parallel (default: hardware threads)")
-      ->check(whole_in(0, kMaxThreads));
+  add_temperature_option(*sub, cmd->temperature, "Temperature, °C (only with a single recording)");
   sub->add_option("--title", cmd->title, "Title of the report");
   sub->add_flag("--diagnose", cmd->diagnose, "Also diagnose each recording (what the noise model misses)");
   sub->add_option("--diagnose-runs", cmd->diagnose_runs, "Simulated records per diagnosis ensemble")

@@ -1,13 +1,13 @@
 // 'rwcalc simulate': write simulated gyro pulse records (docs/simulation.md).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -47,27 +47,23 @@ struct SimulateArgs {
   std::string temp_profile;
 };
 
-// Split "a:b[:c]" into numbers; `min_n`..`max_n` fields. Errors name the option.
+// "a:b[:c]" as numbers, `min_n`..`max_n` of them; errors name the option and the form.
 std::vector<double> fields(const std::string& option, const std::string& text, std::size_t min_n, std::size_t max_n,
                            const char* form) {
   std::vector<double> v;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t colon = text.find(':', start);
-    const std::string part = text.substr(start, colon == std::string::npos ? std::string::npos : colon - start);
+  for (std::size_t start = 0;;) {
+    const std::size_t colon = std::min(text.find(':', start), text.size());
     double x = 0.0;
-    const auto* b = part.data();
-    const auto* e = part.data() + part.size();
-    auto [ptr, ec] = std::from_chars(b, e, x);
-    if (part.empty() || ec != std::errc() || ptr != e || !std::isfinite(x))
-      throw UsageError(fmt::format("{}: '{}' is not of the form {}", option, text, form));
+    const auto [ptr, ec] = std::from_chars(text.data() + start, text.data() + colon, x);
+    if (colon == start || ec != std::errc() || ptr != text.data() + colon || !std::isfinite(x)) break;
     v.push_back(x);
-    if (colon == std::string::npos) break;
+    if (colon == text.size()) {
+      if (v.size() >= min_n && v.size() <= max_n) return v;
+      break;
+    }
     start = colon + 1;
   }
-  if (v.size() < min_n || v.size() > max_n)
-    throw UsageError(fmt::format("{}: '{}' is not of the form {}", option, text, form));
-  return v;
+  throw UsageError(fmt::format("{}: '{}' is not of the form {}", option, text, form));
 }
 
 // FILE with _001 inserted before the extension (everything from the first dot of the name).
@@ -199,43 +195,45 @@ void check_record_range(const NoiseModel& m, const SimulationSettings& s) {
       largest->option, angle, s.duration_s, angle / s.scale_arcsec, s.scale_arcsec, kMaxPulses, largest->option));
 }
 
-int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
-  auto given = [&](const char* name) { return sub.count(name) > 0; };
-  SimulationSettings s;
-  NoiseModel m;
-  if (!a.from.empty()) {
-    s.scale_arcsec = a.scale_arcsec;
-    m = model_from_analysis_file(a.from, s);
-  }
-  if (a.from.empty() || given("--duration")) s.duration_s = a.duration_s;
-  if (a.from.empty() || given("--rate")) s.rate_hz = a.rate_hz;
-  if (a.from.empty() || given("--scale")) s.scale_arcsec = a.scale_arcsec;
+using Take = std::function<bool(const char*)>;
+
+/// The record's settings from the options taken (`s` holds those of --from, if any).
+void apply_settings(const SimulateArgs& a, const Take& take, SimulationSettings& s) {
+  if (take("--duration")) s.duration_s = a.duration_s;
+  if (take("--rate")) s.rate_hz = a.rate_hz;
+  if (take("--scale")) s.scale_arcsec = a.scale_arcsec;
   if (a.temperature_c) s.temperature_c = a.temperature_c;
   s.seed = a.seed;
   if (!std::isfinite(s.duration_s) || s.duration_s <= 0) throw UsageError(fmt::format("--duration must be > 0 s, got {}", s.duration_s));
   if (!std::isfinite(s.rate_hz) || s.rate_hz <= 0) throw UsageError(fmt::format("--rate must be > 0 Hz, got {}", s.rate_hz));
   if (!std::isfinite(s.scale_arcsec) || s.scale_arcsec <= 0) throw UsageError(fmt::format("--scale must be > 0 arcsec, got {}", s.scale_arcsec));
   if (s.samples() < 2) throw UsageError(fmt::format("--duration {} s at --rate {} Hz gives fewer than 2 samples", s.duration_s, s.rate_hz));
+}
 
-  auto nonneg = [](const char* opt, double v) {
-    if (!std::isfinite(v) || v < 0) throw UsageError(fmt::format("{} must be >= 0, got {}", opt, v));
-    return v;
-  };
-  if (a.from.empty() || given("--arw")) m.arw_deg_per_sqrt_h = nonneg("--arw", a.arw);
-  if (a.from.empty() || given("--bias-instability")) m.bias_instability_deg_per_h = nonneg("--bias-instability", a.bi);
-  if (a.from.empty() || given("--rrw")) m.rrw_deg_per_h_per_sqrt_h = nonneg("--rrw", a.rrw);
-  if (a.from.empty() || given("--ramp")) m.ramp_deg_per_h2 = a.ramp;
-  if (a.from.empty() || given("--bias")) m.bias_deg_per_h = a.bias;
-  if (a.from.empty() || given("--latitude") || given("--no-earth-rate")) {
-    if (!std::isfinite(a.latitude) || std::abs(a.latitude) > 90.0)
-      throw UsageError(fmt::format("--latitude must be within -90..90 deg, got {}", a.latitude));
-    m.earth_rate_deg_per_h = a.no_earth_rate ? 0.0 : earth_rate_at(a.latitude);
+TemperatureBias temperature_bias(double coefficient, const std::string& profile) {
+  TemperatureBias tb;
+  tb.coefficient_deg_per_h_per_c = coefficient;
+  const auto colon = profile.find(':');
+  const std::string kind = profile.substr(0, colon);
+  const std::string rest = colon == std::string::npos ? "" : profile.substr(colon + 1);
+  if (kind == "ramp") {
+    const auto v = fields("--temp-profile", rest, 2, 2, "ramp:START_C:END_C");
+    for (const double c : v)
+      if (c < kMinTemperatureC || c > kMaxTemperatureC)
+        throw UsageError(fmt::format("--temp-profile: {:g} deg C is outside {:g}..{:g} deg C", c, kMinTemperatureC, kMaxTemperatureC));
+    tb.profile = {TemperatureProfile::Kind::Ramp, v[0], v[1], 0.0, 0.0};
+  } else if (kind == "cycle") {
+    const auto v = fields("--temp-profile", rest, 2, 2, "cycle:AMP_C:PERIOD_S");
+    if (!(v[1] >= 1.0 / kMaxRateHz)) throw UsageError(fmt::format("--temp-profile: the cycle period must be >= {:g} s", 1.0 / kMaxRateHz));
+    tb.profile = {TemperatureProfile::Kind::Cycle, 0.0, 0.0, v[0], v[1]};
+  } else {
+    throw UsageError(fmt::format("--temp-profile: '{}' is neither ramp:START_C:END_C nor cycle:AMP_C:PERIOD_S", profile));
   }
-  if (a.white_readout) m.readout = ReadoutMode::White;
-  if (a.from.empty() || given("--white-angle")) m.white_angle_arcsec = nonneg("--white-angle", a.white_angle);
-  if (a.from.empty() || given("--lowpass")) m.lowpass_tc_s = nonneg("--lowpass", a.lowpass);
-  if (a.from.empty() || given("--output-lowpass"))
-    m.output_lowpass_tc_s = nonneg("--output-lowpass", a.output_lowpass);
+  return tb;
+}
+
+/// The extended terms (repeatable options) added to `m`.
+void add_extended_terms(const SimulateArgs& a, NoiseModel& m) {
   for (const auto& t : a.sinusoids) {
     const auto v = fields("--sinusoid", t, 2, 3, "F_HZ:AMP_DEG_PER_H[:PHASE_RAD]");
     if (v[0] <= 0 || v[0] > kMaxRateHz)
@@ -260,56 +258,77 @@ int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
   if (a.temp_bias) {
     if (!std::isfinite(*a.temp_bias)) throw UsageError("--temp-bias must be finite");
     if (a.temp_profile.empty()) throw UsageError("--temp-bias needs --temp-profile ramp:START_C:END_C or cycle:AMP_C:PERIOD_S");
-    TemperatureBias tb;
-    tb.coefficient_deg_per_h_per_c = *a.temp_bias;
-    const auto colon = a.temp_profile.find(':');
-    const std::string kind = a.temp_profile.substr(0, colon);
-    const std::string rest = colon == std::string::npos ? "" : a.temp_profile.substr(colon + 1);
-    if (kind == "ramp") {
-      const auto v = fields("--temp-profile", rest, 2, 2, "ramp:START_C:END_C");
-      for (const double c : v)
-        if (c < kMinTemperatureC || c > kMaxTemperatureC)
-          throw UsageError(fmt::format("--temp-profile: {:g} deg C is outside {:g}..{:g} deg C", c, kMinTemperatureC, kMaxTemperatureC));
-      tb.profile = {TemperatureProfile::Kind::Ramp, v[0], v[1], 0.0, 0.0};
-    } else if (kind == "cycle") {
-      const auto v = fields("--temp-profile", rest, 2, 2, "cycle:AMP_C:PERIOD_S");
-      if (!(v[1] >= 1.0 / kMaxRateHz)) throw UsageError(fmt::format("--temp-profile: the cycle period must be >= {:g} s", 1.0 / kMaxRateHz));
-      tb.profile = {TemperatureProfile::Kind::Cycle, 0.0, 0.0, v[0], v[1]};
-    } else {
-      throw UsageError(fmt::format("--temp-profile: '{}' is neither ramp:START_C:END_C nor cycle:AMP_C:PERIOD_S", a.temp_profile));
-    }
-    m.temperature_bias = tb;
+    m.temperature_bias = temperature_bias(*a.temp_bias, a.temp_profile);
   } else if (!a.temp_profile.empty()) {
     throw UsageError("--temp-profile needs --temp-bias COEF_DEG_PER_H_PER_C");
   }
+}
+
+/// The noise model from the options taken (`m` holds that of --from, if any).
+void apply_model(const SimulateArgs& a, const Take& take, NoiseModel& m) {
+  auto nonneg = [](const char* opt, double v) {
+    if (!std::isfinite(v) || v < 0) throw UsageError(fmt::format("{} must be >= 0, got {}", opt, v));
+    return v;
+  };
+  if (take("--arw")) m.arw_deg_per_sqrt_h = nonneg("--arw", a.arw);
+  if (take("--bias-instability")) m.bias_instability_deg_per_h = nonneg("--bias-instability", a.bi);
+  if (take("--rrw")) m.rrw_deg_per_h_per_sqrt_h = nonneg("--rrw", a.rrw);
+  if (take("--ramp")) m.ramp_deg_per_h2 = a.ramp;
+  if (take("--bias")) m.bias_deg_per_h = a.bias;
+  if (take("--latitude") || take("--no-earth-rate")) {
+    if (!std::isfinite(a.latitude) || std::abs(a.latitude) > 90.0)
+      throw UsageError(fmt::format("--latitude must be within -90..90 deg, got {}", a.latitude));
+    m.earth_rate_deg_per_h = a.no_earth_rate ? 0.0 : earth_rate_at(a.latitude);
+  }
+  if (a.white_readout) m.readout = ReadoutMode::White;
+  if (take("--white-angle")) m.white_angle_arcsec = nonneg("--white-angle", a.white_angle);
+  if (take("--lowpass")) m.lowpass_tc_s = nonneg("--lowpass", a.lowpass);
+  if (take("--output-lowpass")) m.output_lowpass_tc_s = nonneg("--output-lowpass", a.output_lowpass);
+  add_extended_terms(a, m);
+}
+
+void write_truth(const std::string& path, const NoiseModel& m, const SimulationSettings& sr, const std::string& record,
+                 bool force) {
+  nlohmann::json t;
+  t["model"] = m;
+  t["settings"] = sr;
+  t["seed"] = sr.seed;
+  t["pulse_file"] = std::filesystem::path(record).filename().string();
+  t["quantization_q_arcsec"] = readout_q_arcsec(m.readout, sr.scale_arcsec);
+  write_file_atomic(path, t.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n", force);
+}
+
+int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
+  // Without --from every option counts (its default included); with it, only those given.
+  const Take take = [&](const char* name) { return a.from.empty() || sub.count(name) > 0; };
+  SimulationSettings s;
+  NoiseModel m;
+  if (!a.from.empty()) {
+    s.scale_arcsec = a.scale_arcsec;
+    m = model_from_analysis_file(a.from, s);
+  }
+  apply_settings(a, take, s);
+  apply_model(a, take, m);
   if (a.runs < 1) throw UsageError(fmt::format("--runs must be >= 1, got {}", a.runs));
   check_record_range(m, s);
   if (a.output == "-" && a.runs > 1) throw UsageError("--runs > 1 needs a file name for -o");
 
+  auto path_of = [&](const std::string& p, int r) { return a.runs > 1 ? numbered(p, r, a.runs) : p; };
   // Refuse before writing anything when any target exists or two name the same file (no
   // half-written set of runs, no truth written over its record).
   std::vector<OutputTarget> targets;
   for (int r = 1; r <= a.runs; ++r) {
-    targets.push_back({"-o", a.runs > 1 ? numbered(a.output, r, a.runs) : a.output});
-    if (!a.truth.empty()) targets.push_back({"--truth", a.runs > 1 ? numbered(a.truth, r, a.runs) : a.truth});
+    targets.push_back({"-o", path_of(a.output, r)});
+    if (!a.truth.empty()) targets.push_back({"--truth", path_of(a.truth, r)});
   }
   check_output_targets(targets, a.force);
   Simulator sim(m, s);
   for (int r = 1; r <= a.runs; ++r) {
     SimulationSettings sr = s;
     sr.seed = s.seed + static_cast<std::uint64_t>(r - 1);
-    const std::string path = a.runs > 1 ? numbered(a.output, r, a.runs) : a.output;
+    const std::string path = path_of(a.output, r);
     write_record(sim, sr, path, a.force);
-    if (!a.truth.empty()) {
-      nlohmann::json t;
-      t["model"] = m;
-      t["settings"] = sr;
-      t["seed"] = sr.seed;
-      t["pulse_file"] = std::filesystem::path(path).filename().string();
-      t["quantization_q_arcsec"] = readout_q_arcsec(m.readout, sr.scale_arcsec);
-      const std::string tpath = a.runs > 1 ? numbered(a.truth, r, a.runs) : a.truth;
-      write_file_atomic(tpath, t.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n", a.force);
-    }
+    if (!a.truth.empty()) write_truth(path_of(a.truth, r), m, sr, path, a.force);
     if (path != "-")
       io.out << fmt::format("wrote {} ({} samples, {} s at {} Hz, seed {})\n", printable(path), sr.samples(), sr.duration_s, sr.rate_hz, sr.seed);
   }

@@ -1,10 +1,8 @@
 #pragma once
-// Files and directories that must not outlive an interrupted rwcalc: the temporary file of an
-// output being written, gnuplot's scratch directory. When SIGINT, SIGTERM or SIGHUP ends the
-// process, a signal handler removes every path still registered (async-signal-safe calls only:
-// unlink, rmdir), then re-raises the signal with its default action, so the exit status stays
-// 128 + signal. A signal that is ignored or handled elsewhere when the first path is registered
-// is left as it is.
+// Files and directories that must not outlive an interrupted rwcalc (an output's temporary file,
+// gnuplot's scratch directory). On SIGINT, SIGTERM or SIGHUP a handler removes every path still
+// registered (unlink, rmdir: async-signal-safe), then re-raises the signal with its default
+// action, so the exit status stays 128 + signal. A signal ignored or handled elsewhere is left so.
 #include <string>
 
 namespace rwcalc::detail {
@@ -12,11 +10,9 @@ namespace rwcalc::detail {
 class RemoveOnSignal {
  public:
   enum class Kind { File, Directory };  ///< files are removed before directories
-  /// Registers `path`. Best effort: a path longer than PATH_MAX, or more than the fixed number of
-  /// paths at once (128), is not registered.
+  /// Best effort: a path beyond PATH_MAX, or beyond 128 paths at once, is not registered.
   RemoveOnSignal(const std::string& path, Kind kind);
-  /// Unregisters; removing the path in the normal course is the owner's business.
-  ~RemoveOnSignal();
+  ~RemoveOnSignal();  ///< unregisters; removing the path in the normal course is the owner's job
   RemoveOnSignal(const RemoveOnSignal&) = delete;
   RemoveOnSignal& operator=(const RemoveOnSignal&) = delete;
 

@@ -194,13 +194,16 @@ Document::Document(std::string_view text, std::string file, std::size_t first_li
   json::sax_parse(begin, end, &handler);
 }
 
-Document Document::load(const std::string& path) {
+std::string read_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, 0, "cannot open the file");
   std::ostringstream ss;
   ss << in.rdbuf();
-  return Document(ss.str(), path);
+  if (in.bad()) throw InputError(path, 0, "cannot read the file");
+  return ss.str();
 }
+
+Document Document::load(const std::string& path) { return Document(read_file(path), path); }
 
 Value Document::root() const { return Value(*this, root_, ""); }
 

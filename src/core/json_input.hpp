@@ -1,10 +1,8 @@
 #pragma once
-// Reading JSON that rwcalc is given (saved results, JSON lines, class tables, models): every value
-// is read through a typed accessor that checks its type and domain and, when it is wrong, throws an
-// InputError naming the file, the line of the value and its key path, e.g.
+// Reading JSON that rwcalc is given (saved results, class tables, models). JSON from another
+// machine is untrusted: every value is read through a typed accessor that checks its type and
+// domain and otherwise throws an InputError naming the file, the value's line and key path, e.g.
 //   report.json:12: "fit.N_deg_per_sqrt_h.value" must be a number, got string
-// JSON from another machine is untrusted: raw nlohmann get<>() on it would turn a wrong type into
-// an internal error, and 1e400 into an infinity that flows into the verdict.
 #include <cstddef>
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -16,8 +14,8 @@
 
 namespace rwcalc::json_input {
 
-/// Deepest nesting accepted: rwcalc's own results nest at most 6 levels; a deeper document is
-/// refused before anything (copying, printing) walks it recursively.
+/// Deepest nesting accepted (rwcalc's results nest 6 levels): refused before anything walks it
+/// recursively.
 inline constexpr std::size_t kMaxDepth = 64;
 
 class Value;
@@ -25,25 +23,23 @@ class Value;
 /// A parsed JSON text with the line of each value (by key path), for error messages.
 class Document {
  public:
-  /// Parses `text`, whose first byte is on line `first_line` of `file` (JSON lines: the line's
-  /// number). Throws InputError on invalid JSON, a number out of the range of a double (1e400),
-  /// or nesting deeper than kMaxDepth.
+  /// `text` starts on line `first_line` of `file`. Throws InputError on invalid JSON, a number
+  /// beyond a double (1e400), a key given twice, or nesting deeper than kMaxDepth.
   Document(std::string_view text, std::string file, std::size_t first_line = 1);
-  /// A value built in code (no lines: errors name `file` and the key path).
+  /// A value built in code (errors name `file` and the key path, no line).
   static Document of_value(nlohmann::json value, std::string file) {
     Document d;
     d.file_ = std::move(file);
     d.root_ = std::move(value);
     return d;
   }
-  /// Reads and parses a whole file.
   static Document load(const std::string& path);
 
   [[nodiscard]] Value root() const;
   [[nodiscard]] const std::string& file() const { return file_; }
-  /// Line of the value at `path`, else of its nearest ancestor that is in the document.
+  /// Line of the value at `path`, else of its nearest ancestor in the document.
   [[nodiscard]] std::size_t line_of(std::string path) const;
-  /// The parsed value, moved out (the Document's accessors must not be used afterwards).
+  /// The parsed value, moved out (the accessors must not be used afterwards).
   [[nodiscard]] nlohmann::json take() { return std::move(root_); }
 
  private:
@@ -53,8 +49,7 @@ class Document {
   std::unordered_map<std::string, std::size_t> lines_;
 };
 
-/// One value of a Document with its key path ("" for the root, "fit.B_deg_per_h.value",
-/// "runs[2].source").
+/// One value of a Document with its key path ("" for the root, "runs[2].fit.B_deg_per_h").
 class Value {
  public:
   Value(const Document& doc, const nlohmann::json& value, std::string path)
@@ -65,30 +60,20 @@ class Value {
   [[nodiscard]] std::size_t line() const { return doc_->line_of(path_); }
   [[nodiscard]] bool is_null() const { return value_->is_null(); }
 
-  /// The member `key` of this object (this must be an object; the member must be present).
-  [[nodiscard]] Value at(std::string_view key) const;
-  /// The member `key` when present and not null (this must be an object).
-  [[nodiscard]] std::optional<Value> find(std::string_view key) const;
-  /// The elements of this array (this must be an array).
-  [[nodiscard]] std::vector<Value> elements() const;
-  /// This must be an object.
-  const Value& object() const;
+  [[nodiscard]] Value at(std::string_view key) const;                   ///< must be present
+  [[nodiscard]] std::optional<Value> find(std::string_view key) const;  ///< absent or null: none
+  [[nodiscard]] std::vector<Value> elements() const;                    ///< must be an array
+  const Value& object() const;                                          ///< must be an object
 
-  /// A finite number.
-  [[nodiscard]] double number() const;
-  /// A finite number in [lo, hi]; `domain` names the range in the message ("a probability in [0, 1]").
+  [[nodiscard]] double number() const;  ///< finite
+  /// Finite, in [lo, hi]; `domain` names the range in the message ("a probability in [0, 1]").
   [[nodiscard]] double number_in(double lo, double hi, std::string_view domain) const;
-  /// A finite number > 0.
   [[nodiscard]] double positive() const;
-  /// A finite number >= 0.
   [[nodiscard]] double non_negative() const;
-  /// A probability, in [0, 1].
   [[nodiscard]] double probability() const { return number_in(0, 1, "a probability in [0, 1]"); }
-  /// An integer (no fraction, e.g. not 2.7) in [lo, hi].
+  /// No fraction (2.0 is fine, 2.7 is not), in [lo, hi].
   [[nodiscard]] std::int64_t integer(std::int64_t lo, std::int64_t hi) const;
-  /// A string.
   [[nodiscard]] std::string string() const;
-  /// true or false.
   [[nodiscard]] bool boolean() const;
 
   /// Throws InputError(file, line of this value, "\"PATH\" WHAT").
@@ -102,6 +87,9 @@ class Value {
   const nlohmann::json* value_;
   std::string path_;
 };
+
+/// The whole file; InputError when it cannot be opened or read.
+std::string read_file(const std::string& path);
 
 /// JSON type name for messages ("number", "string", "object", …).
 std::string_view type_name(const nlohmann::json& j);

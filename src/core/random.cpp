@@ -28,14 +28,15 @@ const Ziggurat& zig() {
   return z;
 }
 
-}  // namespace
-
+/// SplitMix64 finaliser (Steele, Lea & Flood 2014): a bijective 64-bit mix.
 std::uint64_t splitmix64_mix(std::uint64_t z) noexcept {
   z += 0x9e3779b97f4a7c15ULL;
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
   return z ^ (z >> 31);
 }
+
+}  // namespace
 
 std::uint64_t derive_seed(std::uint64_t seed, std::uint64_t stream) noexcept {
   return splitmix64_mix(splitmix64_mix(seed) ^ splitmix64_mix(stream + 0x5851f42d4c957f2dULL));
@@ -85,10 +86,6 @@ double Rng::normal_slow(double u, int i) noexcept {
 
 void Rng::fill_normal(double* out, std::size_t n, double sigma) noexcept {
   for (std::size_t i = 0; i < n; ++i) out[i] = sigma * normal();
-}
-
-void Rng::fill_uniform(double* out, std::size_t n) noexcept {
-  for (std::size_t i = 0; i < n; ++i) out[i] = uniform();
 }
 
 }  // namespace rwcalc

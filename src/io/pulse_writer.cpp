@@ -19,16 +19,8 @@ constexpr std::size_t kFlushBytes = std::size_t{1} << 20;
 
 std::string header_text(const Metadata& metadata, const char* column) {
   std::string text;
-  for (const auto& [key, value] : metadata) {
-    text += "# ";
-    text += key;
-    text += ": ";
-    text += value;
-    text += '\n';
-  }
-  text += column;
-  text += '\n';
-  return text;
+  for (const auto& [key, value] : metadata) text += "# " + key + ": " + value + "\n";
+  return text + column + "\n";
 }
 
 // Where the next line goes, for the messages about a value that cannot be written.
@@ -83,12 +75,7 @@ void append_angles(std::string& text, std::span<const double> angles, LinePositi
 std::string format_pulse_file(const Metadata& metadata, std::span<const std::int64_t> pulses) {
   std::string text = header_text(metadata, "pulses");
   const std::size_t head = text.size();
-  // Room for the widest value (digits and sign) plus the newline on every line.
-  std::int64_t widest = 0;
-  for (const std::int64_t c : pulses) widest = std::max(widest, c < 0 ? (c == INT64_MIN ? INT64_MAX : -c) : c);
-  std::size_t width = 3;  // sign, one digit, newline
-  for (std::int64_t w = widest; w >= 10; w /= 10) ++width;
-  text.resize(head + pulses.size() * width);
+  text.resize(head + pulses.size() * 21);  // 19 digits, a sign and the newline
   char* p = text.data() + head;
   char* const end = text.data() + text.size();
   for (const std::int64_t c : pulses) {
@@ -115,10 +102,6 @@ std::string format_pulse_file(const Metadata& metadata, const PhaseSeries& serie
   std::int64_t previous = counts.front();
   append_increments(text, std::span<const std::int64_t>(counts).subspan(1), previous, at);
   return text;
-}
-
-void write_pulse_file(const std::string& path, const Metadata& metadata, const PhaseSeries& series, bool force) {
-  write_file_atomic(path, format_pulse_file(metadata, series), force);
 }
 
 PulseFileWriter::PulseFileWriter(const std::string& path, const Metadata& metadata, Column column, bool force)

@@ -7,9 +7,7 @@
 #include <array>
 #include <cctype>
 #include <filesystem>
-#include <fstream>
 #include <optional>
-#include <sstream>
 #include <unordered_map>
 
 #include "core/json_input.hpp"
@@ -20,6 +18,7 @@ namespace rwcalc {
 namespace {
 
 using json_input::Document;
+using json_input::read_file;
 using json_input::Value;
 using nlohmann::json;
 
@@ -57,21 +56,17 @@ class Checker {
   bool combined_;
 };
 
-void optional_number(const Value& object, std::string_view key) {
-  if (const auto v = object.find(key)) (void)v->number();
+/// The member `key` when present and not null, checked by `check` (a Value accessor).
+template <class Check>
+void optional(const Value& object, std::string_view key, Check check) {
+  if (const auto v = object.find(key)) (void)check(*v);
 }
-void optional_non_negative(const Value& object, std::string_view key) {
-  if (const auto v = object.find(key)) (void)v->non_negative();
-}
-void optional_string(const Value& object, std::string_view key) {
-  if (const auto v = object.find(key)) (void)v->string();
-}
-void optional_boolean(const Value& object, std::string_view key) {
-  if (const auto v = object.find(key)) (void)v->boolean();
-}
-void optional_count(const Value& object, std::string_view key) {
-  if (const auto v = object.find(key)) (void)v->integer(0, kMaxCount);
-}
+constexpr auto as_number = [](const Value& v) { return v.number(); };
+constexpr auto as_non_negative = [](const Value& v) { return v.non_negative(); };
+constexpr auto as_string = [](const Value& v) { return v.string(); };
+constexpr auto as_boolean = [](const Value& v) { return v.boolean(); };
+constexpr auto as_probability = [](const Value& v) { return v.probability(); };
+constexpr auto as_count = [](const Value& v) { return v.integer(0, kMaxCount); };
 
 /// A temperature in °C: finite, not below absolute zero.
 void temperature(const Value& t) { (void)t.number_in(-273.15, 1000, "a temperature in °C in [-273.15, 1000]"); }
@@ -84,12 +79,13 @@ void class_number(const std::optional<Value>& c, const std::vector<std::int64_t>
     c->fail(fmt::format("is class {}, which is not among the verdict's \"classes\"", n));
 }
 
-/// An array of `size` values, each checked by `each`.
+/// Each element of the array `a` checked by `each`; `size`, when known, is how many it must hold.
 template <class Each>
-void array_of(const Value& a, std::size_t size, std::string_view what, Each&& each) {
+void array_of(const Value& a, std::optional<std::size_t> size, std::string_view what, Each each) {
   const auto e = a.elements();
-  if (e.size() != size) a.fail(fmt::format("must hold {} {} (one per {}), got {}", size, size == 1 ? "value" : "values", what, e.size()));
-  for (const auto& x : e) each(x);
+  if (size && e.size() != *size)
+    a.fail(fmt::format("must hold {} {} (one per {}), got {}", *size, *size == 1 ? "value" : "values", what, e.size()));
+  for (const auto& x : e) (void)each(x);
 }
 
 /// A coefficient or cross-check estimate {value, sigma, low95, high95, resolved, …}.
@@ -99,19 +95,19 @@ void Checker::estimate(const Value& e) const {
     if (const auto v = member(e, key)) (void)v->non_negative();
   if (const auto v = member(e, "resolved")) (void)v->boolean();
   if (combined_) (void)e.at("high95");
-  for (const char* key : {"low95", "high95"}) optional_non_negative(e, key);
-  optional_number(e, "estimate");
-  optional_boolean(e, "in_model");
-  optional_boolean(e, "fitted");
+  for (const char* key : {"low95", "high95"}) optional(e, key, as_non_negative);
+  optional(e, "estimate", as_number);
+  optional(e, "in_model", as_boolean);
+  optional(e, "fitted", as_boolean);
 }
 
 void Checker::fit(const Value& f) const {
   f.object();
   for (const char* key : {"Q_arcsec", "N_deg_per_sqrt_h", "B_deg_per_h", "K_deg_per_h_per_sqrt_h", "R_deg_per_h2"})
     if (const auto c = f.find(key)) estimate(*c);
-  for (const char* key : {"chi2_per_dof", "chi2", "tau_min_s", "tau_max_s"}) optional_non_negative(f, key);
-  if (const auto p = f.find("p_value")) (void)p->probability();
-  optional_count(f, "points");
+  for (const char* key : {"chi2_per_dof", "chi2", "tau_min_s", "tau_max_s"}) optional(f, key, as_non_negative);
+  optional(f, "p_value", as_probability);
+  optional(f, "points", as_count);
 }
 
 void Checker::methods(const Value& m) const {
@@ -124,26 +120,26 @@ void Checker::methods(const Value& m) const {
       for (const auto& p : curve->elements()) {
         p.object();
         (void)p.at("t_s").positive();
-        optional_count(p, "intervals");
-        optional_non_negative(p, "var_arcsec2");
+        optional(p, "intervals", as_count);
+        optional(p, "var_arcsec2", as_non_negative);
       }
-    for (const char* k : {"t_min_s", "t_max_s", "block_s"}) optional_non_negative(*e, k);
-    optional_count(*e, "blocks");
+    for (const char* k : {"t_min_s", "t_max_s", "block_s"}) optional(*e, k, as_non_negative);
+    optional(*e, "blocks", as_count);
   }
 }
 
 void Checker::allan(const Value& a) const {
   a.object();
-  optional_string(a, "unit");
-  optional_string(a, "estimator");
+  optional(a, "unit", as_string);
+  optional(a, "estimator", as_string);
   if (const auto points = a.find("points"))
     for (const auto& p : points->elements()) {
       p.object();
       (void)p.at("tau_s").positive();
       (void)p.at("dev").non_negative();
-      for (const char* key : {"dev_low", "dev_high", "var", "edf"}) optional_non_negative(p, key);
-      optional_count(p, "m");
-      optional_count(p, "n");
+      for (const char* key : {"dev_low", "dev_high", "var", "edf"}) optional(p, key, as_non_negative);
+      optional(p, "m", as_count);
+      optional(p, "n", as_count);
     }
 }
 
@@ -162,7 +158,7 @@ void Checker::outliers(const Value& o) const {
       p.object();
       (void)p.at("line").integer(1, kMaxCount);
       (void)p.at("time_s").number();
-      optional_count(p, "index");
+      optional(p, "index", as_count);
     }
 }
 
@@ -170,22 +166,15 @@ void Checker::outliers(const Value& o) const {
 /// known (the verdict's "classes" is given).
 void Checker::parameter_verdict(const Value& p, std::optional<std::size_t> classes) const {
   p.object();
-  auto each = [&](const char* key, std::size_t extra, const char* per, auto&& check) {
-    if (const auto v = key == std::string_view("p_meets") ? member(p, key) : p.find(key)) {
-      if (classes)
-        array_of(*v, *classes + extra, per, check);
-      else
-        for (const auto& x : v->elements()) check(x);
-    }
-  };
-  each("p_meets", 0, "class", [](const Value& x) { (void)x.probability(); });
-  each("p_is", 1, "class and 'outside'", [](const Value& x) { (void)x.probability(); });
-  each("limits", 0, "class", [](const Value& x) { (void)x.positive(); });
-  each("margin_pct", 0, "class", [](const Value& x) { (void)x.number(); });
-  if (const auto v = p.find("p_class")) (void)v->probability();
-  optional_non_negative(p, "value");
-  optional_boolean(p, "resolved");
-  optional_string(p, "unit");
+  const auto plus = [&](std::size_t extra) { return classes ? std::optional(*classes + extra) : std::nullopt; };
+  if (const auto v = member(p, "p_meets")) array_of(*v, plus(0), "class", as_probability);
+  if (const auto v = p.find("p_is")) array_of(*v, plus(1), "class and 'outside'", as_probability);
+  if (const auto v = p.find("limits")) array_of(*v, plus(0), "class", [](const Value& x) { return x.positive(); });
+  if (const auto v = p.find("margin_pct")) array_of(*v, plus(0), "class", as_number);
+  optional(p, "p_class", as_probability);
+  optional(p, "value", as_non_negative);
+  optional(p, "resolved", as_boolean);
+  optional(p, "unit", as_string);
 }
 
 void Checker::verdict(const Value& v) const {
@@ -207,23 +196,16 @@ void Checker::verdict(const Value& v) const {
     class_number(v.find(key), classes);
   }
   if (const auto p = member(v, "p_class")) (void)p->probability();
-  for (const char* key : {"p_class_B", "p_class_N"})
-    if (const auto p = v.find(key)) (void)p->probability();
-  optional_boolean(v, "decisive");
+  for (const char* key : {"p_class_B", "p_class_N"}) optional(v, key, as_probability);
+  optional(v, "decisive", as_boolean);
   if (const auto t = v.find("tolerance_pct")) (void)t->number_in(0, 1000, "a percentage in [0, 1000]");
-  for (const char* key : {"statement", "statement_B", "statement_N", "b_estimate", "table"}) optional_string(v, key);
-  optional_boolean(v, "tolerance_changed");
+  for (const char* key : {"statement", "statement_B", "statement_N", "b_estimate", "table"}) optional(v, key, as_string);
+  optional(v, "tolerance_changed", as_boolean);
   if (const auto r = v.find("rho_BN")) (void)r->number_in(-1, 1, "a correlation in [-1, 1]");
   // Without "classes" (a hand-made verdict) the arrays cannot be sized against it.
   const auto n = classes.empty() ? std::nullopt : std::optional<std::size_t>(classes.size());
-  auto probabilities = [&](const Value& a, std::size_t extra, const char* per) {
-    if (n)
-      array_of(a, *n + extra, per, [](const Value& x) { (void)x.probability(); });
-    else
-      for (const auto& x : a.elements()) (void)x.probability();
-  };
-  if (const auto p = member(v, "p_meets")) probabilities(*p, 0, "class");
-  if (const auto p = v.find("p_is")) probabilities(*p, 1, "class and 'outside'");
+  if (const auto p = member(v, "p_meets")) array_of(*p, n, "class", as_probability);
+  if (const auto p = v.find("p_is")) array_of(*p, n ? std::optional(*n + 1) : std::nullopt, "class and 'outside'", as_probability);
   for (const char* key : {"B", "N"}) {
     if (const auto p = member(v, key)) {
       parameter_verdict(*p, n);
@@ -242,11 +224,11 @@ void Checker::run(const Value& r) const {
   if (const auto s = member(r, "source")) (void)s->string();
   if (combined_) (void)r.at("temperature_c");  // null: temperature unknown
   if (const auto t = r.find("temperature_c")) temperature(*t);
-  optional_string(r, "temperature_source");
-  optional_count(r, "samples");
-  if (const auto rate = r.find("rate_hz")) (void)rate->positive();
-  optional_non_negative(r, "duration_s");
-  for (const char* key : {"mean_rate_deg_per_h", "earth_rate_deg_per_h", "bias_deg_per_h"}) optional_number(r, key);
+  optional(r, "temperature_source", as_string);
+  optional(r, "samples", as_count);
+  optional(r, "rate_hz", [](const Value& v) { return v.positive(); });
+  optional(r, "duration_s", as_non_negative);
+  for (const char* key : {"mean_rate_deg_per_h", "earth_rate_deg_per_h", "bias_deg_per_h"}) optional(r, key, as_number);
   if (const auto l = r.find("latitude_deg")) (void)l->number_in(-90, 90, "a latitude in [-90, 90]");
   if (const auto a = r.find("allan")) allan(*a);
   if (const auto f = member(r, "fit")) fit(*f);
@@ -259,10 +241,10 @@ void Checker::run(const Value& r) const {
 /// The object of `diagnose --json`, as far as the report reads it.
 void check_diagnosis(const Value& d) {
   d.object();
-  optional_string(d, "source");
+  optional(d, "source", as_string);
   if (const auto t = d.find("temperature_c")) temperature(*t);
-  optional_count(d, "runs");
-  optional_count(d, "samples");
+  optional(d, "runs", as_count);
+  optional(d, "samples", as_count);
   for (const char* key : {"rate_hz", "duration_s", "scale_arcsec_per_pulse"})
     if (const auto v = d.find(key)) (void)v->positive();
   if (const auto findings = d.find("findings"))
@@ -282,7 +264,7 @@ void check_diagnosis(const Value& d) {
     for (const auto& p : b.elements()) {
       p.object();
       (void)p.at("tau_s").positive();
-      for (const char* key : {"band_low", "band_high", "dev", "median"}) optional_non_negative(p, key);
+      for (const char* key : {"band_low", "band_high", "dev", "median"}) optional(p, key, as_non_negative);
     }
   };
   for (const char* model : {"base_model", "extended_model"})
@@ -302,27 +284,18 @@ void check_overall(const Value& o) {
   if (const auto c = o.find("classes"))
     for (const auto& x : c->elements()) classes.push_back(x.integer(0, kMaxClassNumber));
   for (const char* key : {"class", "class_B", "class_N", "class_strict"}) class_number(o.find(key), classes);
-  optional_string(o, "statement");
+  optional(o, "statement", as_string);
   for (const char* key : {"B", "N"})
     if (const auto p = o.find(key)) {
       p->object();
-      optional_string(*p, "statement");
+      optional(*p, "statement", as_string);
       class_number(p->find("class"), classes);
     }
-  optional_count(o, "runs");
-  if (const auto p = o.find("p_class")) (void)p->probability();
+  optional(o, "runs", as_count);
+  optional(o, "p_class", as_probability);
 }
 
 bool has(const json& j, const char* key) { return j.contains(key); }
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, 0, "cannot open the file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw InputError(path, 0, "cannot read the file");
-  return ss.str();
-}
 
 }  // namespace
 

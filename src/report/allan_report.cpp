@@ -3,10 +3,11 @@
 
 #include "rwcalc/allan.hpp"
 #include "rwcalc/printable.hpp"
+#include "rwcalc/units.hpp"
 
 namespace rwcalc {
 
-std::string unit_label(const AllanResult& r) { return r.unit == "deg/h" ? "°/h" : "input units/s"; }
+std::string unit_label(const AllanResult& r) { return r.unit == "deg/h" ? units::label::rate : "input units/s"; }
 
 std::string format_allan_table(const AllanResult& r, const AllanReportInfo& info) {
   const std::string u = unit_label(r);
@@ -16,7 +17,8 @@ std::string format_allan_table(const AllanResult& r, const AllanReportInfo& info
   out += fmt::format("# confidence: {:g} (two-sided chi-square bounds, Greenhall-Riley EDF, lag-1 ACF noise id)\n",
                      r.confidence);
   if (r.unit == "deg/h")
-    out += "# units: deviations in °/h (convention 1″/s = 1 °/h exactly); τ in s\n";
+    out += fmt::format("# units: deviations in {0} (convention 1{1}/s = 1 {0} exactly); τ in s\n", units::label::rate,
+                       units::label::angle);
   else
     out += "# units: deviations in input units per second (dimensionless for phase in s); τ in s\n";
   out += fmt::format("# samples: {}   phase points: {}   τ0: {:g} s", info.samples, r.points_in, r.tau0_s);

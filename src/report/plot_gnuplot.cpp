@@ -30,12 +30,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string lower(std::string_view s) {
-  std::string r(s);
-  std::transform(r.begin(), r.end(), r.begin(), [](unsigned char c) { return std::tolower(c); });
-  return r;
-}
-
 std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   std::ostringstream ss;
@@ -43,9 +37,8 @@ std::string slurp(const fs::path& p) {
   return ss.str();
 }
 
-/// A private temporary directory, removed with everything in it — also when SIGINT, SIGTERM or
-/// SIGHUP ends rwcalc while gnuplot runs (cleanup.hpp): the directory and the files this file
-/// puts there are registered for removal by the signal handler, which cannot list a directory.
+/// A private temporary directory, removed with everything in it, also when a signal ends rwcalc
+/// while gnuplot runs: the signal handler cannot list a directory, so each file is registered.
 class ScratchDir {
  public:
   ScratchDir() {
@@ -120,16 +113,17 @@ ProcessResult run_process(const std::string& command, const std::vector<std::str
   return r;
 }
 
-std::string missing_gnuplot_message(const std::string& command, int err) {
-  return fmt::format(
+/// Throws when gnuplot could not be started (a shell wrapper reports a missing binary as 127).
+void require_started(const ProcessResult& r, const std::string& command) {
+  if (r.started && r.status != 127) return;
+  throw OutputError(fmt::format(
       "cannot run gnuplot ('{}': {}): plots need gnuplot; install it (Debian: apt-get install "
       "gnuplot-nox) or name the binary in the environment variable RWCALC_GNUPLOT",
-      command, std::strerror(err));
+      command, std::strerror(r.started ? ENOENT : r.spawn_errno)));
 }
 
-/// gnuplot's message on one line, short enough for a terminal: its last few lines carry the
-/// error. The lines are joined with " | " (a message is one line); the caret line that points
-/// into the echoed command is dropped, since it cannot stay aligned.
+/// The last `lines` lines of gnuplot's message (they carry the error) joined by " | ", without the
+/// caret line that points into the echoed command (it cannot stay aligned).
 std::string tail_lines(const std::string& text, int lines) {
   std::vector<std::string> kept;
   std::size_t end = text.size();
@@ -151,9 +145,6 @@ std::string tail_lines(const std::string& text, int lines) {
 }  // namespace
 
 std::string gnuplot_string(std::string_view text) {
-  // Single quotes: gnuplot expands backslash escapes and backquoted commands inside double
-  // quotes only. Nothing can escape a line break there, so printable() spells control characters
-  // out; the one character left to handle is the quote itself.
   std::string r = "'";
   for (char c : printable(text)) {
     if (c == '\'') r += '\'';
@@ -163,7 +154,8 @@ std::string gnuplot_string(std::string_view text) {
 }
 
 PlotFormat plot_format_for(std::string_view path) {
-  const auto ext = lower(fs::path(std::string(path)).extension().string());
+  auto ext = fs::path(std::string(path)).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   if (ext == ".svg") return PlotFormat::Svg;
   if (ext == ".png") return PlotFormat::Png;
   if (ext == ".pdf") return PlotFormat::Pdf;
@@ -178,17 +170,19 @@ std::string gnuplot_command() {
 }
 
 bool gnuplot_available() {
-  ScratchDir dir;
-  const auto r = run_process(gnuplot_command(), {"--version"}, dir.path() / "log");
-  return r.started && r.status == 0;
+  try {
+    require_gnuplot();
+    return true;
+  } catch (const OutputError&) {
+    return false;
+  }
 }
 
 void require_gnuplot() {
   ScratchDir dir;
   const auto command = gnuplot_command();
   const auto r = run_process(command, {"--version"}, dir.path() / "log");
-  if (!r.started) throw OutputError(missing_gnuplot_message(command, r.spawn_errno));
-  if (r.status == 127) throw OutputError(missing_gnuplot_message(command, ENOENT));
+  require_started(r, command);
   if (r.status != 0)
     throw OutputError(fmt::format("gnuplot ('{}') does not run: '{} --version' failed with status {}: {}", command,
                                   command, r.status, tail_lines(r.err, 4)));
@@ -229,10 +223,7 @@ std::string full_script(const std::vector<Figure>& figures, PlotFormat format, i
   }
   s += fmt::format("set output {}\n", gnuplot_string(output_path));
   const bool multi = figures.size() > 1;
-  if (multi) {
-    // Panels stacked top to bottom, each as tall as its figure asks (placed by origin/size).
-    s += "set multiplot\n";
-  }
+  if (multi) s += "set multiplot\n";  // panels top to bottom, each as tall as its figure asks
   double top = 1.0;
   for (std::size_t i = 0; i < figures.size(); ++i) {
     const auto& f = figures[i];
@@ -265,13 +256,9 @@ std::string render_figures(const std::vector<Figure>& figures, PlotFormat format
   }
   const auto command = gnuplot_command();
   const auto r = run_process(command, {"figure.gp"}, dir.path() / "gnuplot.log", dir.path());
-  if (!r.started) throw OutputError(missing_gnuplot_message(command, r.spawn_errno));
-  if (r.status != 0) {
-    // A shell wrapper reports a missing binary as 127.
-    if (r.status == 127) throw OutputError(missing_gnuplot_message(command, ENOENT));
-    throw OutputError(fmt::format("gnuplot ('{}') failed with status {}: {}", command, r.status,
-                                  tail_lines(r.err, 4)));
-  }
+  require_started(r, command);
+  if (r.status != 0)
+    throw OutputError(fmt::format("gnuplot ('{}') failed with status {}: {}", command, r.status, tail_lines(r.err, 4)));
   std::error_code ec;
   if (!fs::exists(out, ec) || fs::file_size(out, ec) == 0)
     throw OutputError(fmt::format("gnuplot ('{}') produced no figure: {}", command, tail_lines(r.err, 4)));
