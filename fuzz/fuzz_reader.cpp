@@ -97,7 +97,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   check(rec.line_of_sample(0) >= 1, "first sample has no line");
 
   rwcalc::AllanOptions ao;
-  ao.threads = 1;
   try {
     const rwcalc::AllanResult a = rwcalc::compute_allan(rec.phase, ao);
     for (const auto& p : a.points) {
