@@ -8,7 +8,7 @@
 #include <random>
 
 #include "rwcalc/diagnose.hpp"
-#include "rwcalc/diagnose_detectors.hpp"
+#include "diagnose/detector.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/fit.hpp"
 #include "rwcalc/simulate.hpp"
@@ -191,7 +191,7 @@ TEST(DiagnoseBlocks, LowpassDetectorSkipsPulseCountsGivenAsNumbers) {
   o.runs = 10;
   const auto r = diagnose(rec, o);
   ASSERT_EQ(r.detectors.size(), 5u);
-  EXPECT_EQ(r.detectors[4].effect, "lowpass");
+  EXPECT_EQ(r.detectors[4].effect, Effect::Lowpass);
   EXPECT_FALSE(r.detectors[4].fired);
   EXPECT_NE(r.detectors[4].note.find("multiples"), std::string::npos) << r.detectors[4].note;
 }

@@ -1,0 +1,253 @@
+// The base model of a record and the helpers of the extended one.
+#include "diagnose/models.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "rwcalc/error.hpp"
+#include "rwcalc/units.hpp"
+
+namespace rwcalc::diag {
+
+namespace {
+
+double term_value(const FitResult& f, Term t) {
+  const auto& c = f[t];
+  return (c.enabled && c.in_model) ? c.estimate : 0.0;
+}
+
+}  // namespace
+
+NoiseModel base_model(const AnalysisResult& a, const PhaseSeries& x) {
+  NoiseModel m;
+  m.arw_deg_per_sqrt_h = term_value(a.fit, Term::N);
+  m.bias_instability_deg_per_h = term_value(a.fit, Term::B);
+  m.rrw_deg_per_h_per_sqrt_h = term_value(a.fit, Term::K);
+  m.ramp_deg_per_h2 = term_value(a.fit, Term::R);
+  m.earth_rate_deg_per_h = a.earth_rate_deg_per_h;
+  m.bias_deg_per_h = a.mean_rate_deg_per_h - a.earth_rate_deg_per_h;
+  const double q_fit = term_value(a.fit, Term::Q);
+  if (x.exact()) {
+    // Pulse data: which read-out? A dithered (white) read-out gives σ(τ0) ≈ √(1/2)·q/τ0 = 0.71·q/τ0;
+    // plain counting of a rate of a few pulses per sample or less gives far less (0.18·q/τ0 at
+    // 13.5 pulses/s and 400 Hz). The boundary 0.45·q/τ0 separates them.
+    const double q = x.arcsec_per_count;
+    const bool white = !a.allan.points.empty() && a.allan.points.front().m == 1 &&
+                       a.allan.points.front().dev * x.tau0_s / q > 0.45;
+    m.readout = white ? ReadoutMode::White : ReadoutMode::Counting;
+    // Extra white angle noise only when the fitted Q clearly exceeds the read-out's own level.
+    const double q_read = readout_q_arcsec(m.readout, q);
+    if (q_fit > 1.2 * q_read) m.white_angle_arcsec = std::sqrt(q_fit * q_fit - q_read * q_read);
+  } else {
+    m.readout = ReadoutMode::White;
+    m.white_angle_arcsec = q_fit;
+  }
+  return m;
+}
+
+double sim_scale(const PhaseSeries& x, const AnalysisResult& a) {
+  if (x.exact()) return x.arcsec_per_count;
+  return std::max(1e-6, 1e-3 * term_value(a.fit, Term::Q));
+}
+
+AnalysisResult analyze_for_base(const Recording& rec, const AnalysisOptions& aopt) {
+  try {
+    return analyze(rec, aopt);
+  } catch (const AnalysisError&) {
+    if (!(aopt.fit.tau_min_s > 0)) throw;
+    AnalysisOptions wider = aopt;
+    wider.fit.tau_min_s = aopt.fit.tau_min_s > 1.0 ? 1.0 : 0.0;
+    return analyze_for_base(rec, wider);
+  }
+}
+
+PhaseSeries slice(const PhaseSeries& x, std::size_t a, std::size_t b) {
+  PhaseSeries s;
+  s.tau0_s = x.tau0_s;
+  s.kind = x.kind;
+  s.arcsec_per_count = x.arcsec_per_count;
+  s.rate_offset = x.rate_offset;
+  const auto first = static_cast<std::ptrdiff_t>(a), last = static_cast<std::ptrdiff_t>(b) + 1;
+  if (!x.counts.empty())
+    s.counts.assign(x.counts.begin() + first, x.counts.begin() + last);
+  else
+    s.values.assign(x.values.begin() + first, x.values.begin() + last);
+  return s;
+}
+
+Recording with_series(const Recording& rec, PhaseSeries s) {
+  Recording r;
+  r.source = rec.source;
+  r.rate_hz = rec.rate_hz;
+  r.rate_source = rec.rate_source;
+  r.samples = s.points() - 1;
+  r.temperature_c = rec.temperature_c;
+  r.column_name = rec.column_name;
+  r.mode = s.exact() ? rec.mode : InputMode::Angle;
+  r.phase = std::move(s);
+  return r;
+}
+
+bool on_lattice(const PhaseSeries& x) {
+  const std::size_t n = std::min<std::size_t>(x.points() - 1, 100000);
+  if (n < 2) return false;
+  double step = 0, sum = 0, sum2 = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double d = x.diff(i + 1, i);
+    sum += d;
+    sum2 += d * d;
+    if (std::abs(d) > 1e-9 && (step == 0 || std::abs(d) < step)) step = std::abs(d);
+  }
+  if (!(step > 0)) return false;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double r = std::abs(x.diff(i + 1, i)) / step;
+    if (std::abs(r - std::round(r)) > 1e-3) return false;
+  }
+  const double mean = sum / double(n);
+  const double sd = std::sqrt(std::max(0.0, sum2 / double(n) - mean * mean));
+  return step >= 0.5 * sd;
+}
+
+std::vector<std::int64_t> octave_of(const AllanResult& a) {
+  std::vector<std::int64_t> m;
+  for (const auto& p : a.points) m.push_back(p.m);
+  return m;
+}
+
+std::array<double, 4> c_of(const NoiseModel& m) {
+  return {-std::numeric_limits<double>::infinity(), c_from_coefficient(Term::N, m.arw_deg_per_sqrt_h),
+          c_from_coefficient(Term::B, m.bias_instability_deg_per_h),
+          c_from_coefficient(Term::K, m.rrw_deg_per_h_per_sqrt_h)};
+}
+
+void correct(double& coef, Term t, double dc) {
+  coef = coefficient_from_c(t, std::max(0.0, c_from_coefficient(t, coef) + dc));
+}
+
+double mean_rate_of(const NoiseModel& det, double T) {
+  if (!(T > 0)) return 0.0;
+  double a = 0;  // angle added over [0, T], (°/h)·s
+  for (const auto& x : det.sinusoids) {
+    const double w = 2.0 * kPi * x.f_hz;
+    if (w > 0) a += x.amp_deg_per_h / w * (std::sin(w * T + x.phase_rad) - std::sin(x.phase_rad));
+  }
+  for (const auto& x : det.bias_steps) a += x.size_deg_per_h * std::max(0.0, T - std::max(0.0, x.t_s));
+  for (const auto& x : det.warmups) a += x.amp_deg_per_h * x.tc_s * -std::expm1(-T / x.tc_s);
+  return a / T;
+}
+
+double model_level(const NoiseModel& m, double T) {
+  return m.earth_rate_deg_per_h + m.bias_deg_per_h + mean_rate_of(m, T);
+}
+
+NoiseModel with_mean_rate(NoiseModel m, double T, double mean_rate) {
+  m.bias_deg_per_h += mean_rate - (model_level(m, T) + m.ramp_deg_per_h2 * T / units::seconds_per_hour / 2.0);
+  return m;
+}
+
+NoiseModel shifted(NoiseModel m, double dt) {
+  for (auto& s : m.sinusoids) s.phase_rad = std::fmod(s.phase_rad + 2 * kPi * s.f_hz * dt, 2 * kPi);
+  std::vector<BiasStep> steps;
+  for (const auto& st : m.bias_steps) {
+    if (st.t_s - dt > 0)
+      steps.push_back({st.t_s - dt, st.size_deg_per_h});
+    else
+      m.bias_deg_per_h += st.size_deg_per_h;  // before the window: part of its constant rate
+    // (A step after the window cannot be known: the rate stays the level before it.)
+  }
+  m.bias_steps = steps;
+  std::vector<Warmup> w;
+  if (dt >= 0)
+    for (const auto& x : m.warmups) w.push_back({x.amp_deg_per_h * std::exp(-dt / x.tc_s), x.tc_s});
+  m.warmups = w;  // a transient is not extrapolated backwards in time
+  return m;
+}
+
+double mean_rate_variance(const std::vector<RunStats>& runs) {
+  if (runs.size() < 2) return 0.0;
+  double s = 0, s2 = 0;
+  for (const auto& r : runs) s += r.mean_rate;
+  const double mu = s / static_cast<double>(runs.size());
+  for (const auto& r : runs) s2 += (r.mean_rate - mu) * (r.mean_rate - mu);
+  return s2 / static_cast<double>(runs.size() - 1);
+}
+
+/// The series with the deterministic terms of `det` removed: floating phase.
+PhaseSeries cleaned(const PhaseSeries& x, const NoiseModel& det) {
+  PhaseSeries s;
+  s.tau0_s = x.tau0_s;
+  s.kind = x.kind;
+  s.arcsec_per_count = x.arcsec_per_count;
+  s.values.resize(x.points());
+  const double a0 = deterministic_angle(det, 0.0);
+  for (std::size_t i = 0; i < x.points(); ++i)
+    s.values[i] = x.diff(i, 0) - (deterministic_angle(det, static_cast<double>(i) * x.tau0_s) - a0);
+  return s;
+}
+
+namespace {
+
+/// N, B, K of a model in the fit scale (band_refit's order).
+std::array<double, 3> nbk_of(const NoiseModel& m) {
+  return {c_from_coefficient(Term::N, m.arw_deg_per_sqrt_h), c_from_coefficient(Term::B, m.bias_instability_deg_per_h),
+          c_from_coefficient(Term::K, m.rrw_deg_per_h_per_sqrt_h)};
+}
+
+}  // namespace
+
+/// K stays at the fit's value: over 1 s … T/6 of one record the trade between B and K is too
+/// loose, and a B pulled low makes a quiet model beside which the record's own wander looks like
+/// a step.
+NoiseModel calibrated(const NoiseModel& m0, const SimulationSettings& settings, std::size_t runs,
+                      const EnsemblePlan& plan, const Decimated& dec, Progress* progress) {
+  const EnsemblePlan pilot_plan{plan.octave_m, plan.grid, true, {}};
+  const auto pilot = run_ensemble(m0, settings, runs, pilot_plan, progress);
+  const auto ref = make_reference(plan.grid, dec.tau_d, pilot, true);
+  const auto dc = calibration_corrections(decimated_avar(dec, plan.grid), ref, c_of(m0), dec.duration() / 6.0);
+  NoiseModel m = m0;
+  correct(m.arw_deg_per_sqrt_h, Term::N, dc[1]);
+  correct(m.bias_instability_deg_per_h, Term::B, dc[2]);
+  correct(m.rrw_deg_per_h_per_sqrt_h, Term::K, dc[3]);
+  return m;
+}
+
+/// A step or a transient left in would be taken up into K, R or B, and the ensemble's wander
+/// would then hide it: the fit is of the data without the candidate.
+RobustBase robust_base(const Recording& rec, const AnalysisResult& original, const AnalysisOptions& aopt,
+                       const Decimated& dec, const SimulationSettings& pilot, std::size_t pilot_runs,
+                       const EnsemblePlan& plan, Progress* progress) {
+  RobustBase b;
+  b.candidate = own_candidates(dec);
+  const Recording clean = with_series(rec, cleaned(rec.phase, b.candidate));
+  const AnalysisResult a = analyze_for_base(clean, aopt);
+  NoiseModel m0 = base_model(a, rec.phase);
+  m0.bias_deg_per_h = original.mean_rate_deg_per_h - original.earth_rate_deg_per_h;
+  b.b_fit = a.fit[Term::B];
+  Decimated dclean = dec;
+  subtract_deterministic(dclean, b.candidate);
+  b.model = calibrated(m0, pilot, pilot_runs, plan, dclean, progress);
+  return b;
+}
+
+/// K is held as in the pilot calibration: over one record the trade between B and K is loose,
+/// and the longest τ with a few EDF would otherwise bring in a K no fit found.
+void refit_whole_band(NoiseModel& m, std::vector<BandPoint>& band, const std::vector<AllanPoint>& measured,
+                      const SimulationSettings& settings, std::size_t runs, const EnsemblePlan& plan,
+                      const DiagnoseOptions& opt) {
+  const auto c = nbk_of(m);
+  const auto dc = band_refit(band, runs, c, {true, true, false});
+  if (dc[0] == 0 && dc[1] == 0 && dc[2] == 0) return;
+  NoiseModel refit = m;
+  refit.arw_deg_per_sqrt_h = coefficient_from_c(Term::N, c[0] + dc[0]);
+  refit.bias_instability_deg_per_h = coefficient_from_c(Term::B, c[1] + dc[1]);
+  refit.rrw_deg_per_h_per_sqrt_h = coefficient_from_c(Term::K, c[2] + dc[2]);
+  const auto rr = run_ensemble(refit, settings, runs, {plan.octave_m, plan.grid, false, {}}, opt.progress);
+  auto b2 = make_band(measured, rr, opt.band_level);
+  if (band_misfit(b2, runs) < band_misfit(band, runs)) {
+    m = refit;
+    band = std::move(b2);
+  }
+}
+
+}  // namespace rwcalc::diag
