@@ -32,11 +32,8 @@ struct ShapeEstimate {
   /// The bump's AV at its peak (τ = 1.89·Tc) over the reference's mean AV there.
   double peak_ratio = 0;
 };
-enum class Shape { GaussMarkov, Lowpass };
-/// AV of a unit-variance Gauss–Markov process (Shape::GaussMarkov, time = Tc) or minus the AV
-/// removed from a unit white rate (°/h·√s)² by a first-order low-pass (Shape::Lowpass, time = τf).
-/// A low-passed white rate is a Gauss–Markov process: white(τ) + lowpass(τ) = GM(τ)/(2τf).
-double shape_avar(Shape s, double tau, double time);
+/// AV of a unit-variance Gauss–Markov process of correlation time tc.
+double gauss_markov_avar(double tau, double tc);
 /// Fit `v` (measured mid-τ AV) against the reference plus Q, N, B, K corrections plus a
 /// Gauss–Markov bump; `c_base` holds the reference model's Q², N², B², K² on the fit scale: the
 /// corrected N², B², K² are kept ≥ 0 (Q² is free). `fixed_time` > 0: the correlation time is
@@ -51,7 +48,7 @@ std::array<double, 4> power_law_corrections(const std::vector<double>& v, const 
 /// reference model's value.
 std::array<double, 4> calibration_corrections(const std::vector<double>& v, const MidTauReference& ref,
                                               const std::array<double, 4>& c_base, double tau_max);
-/// `v` being one ensemble member, the reference without it.
+/// `v` being one ensemble member, the reference's mean and variance without it.
 MidTauReference leave_one_out(const MidTauReference& ref, const std::vector<double>& v, std::size_t runs);
 /// Gamma deviance of a mid-τ AV against a reference: Σ ν(r − 1 − ln r), r = v/E v, with the EDF
 /// ν = 2(E v)²/Var v of the ensemble and a 1000-EDF model floor (as band_misfit).

@@ -125,17 +125,7 @@ void correct(double& coef, Term t, double dc) {
   coef = coefficient_from_c(t, std::max(0.0, c_from_coefficient(t, coef) + dc));
 }
 
-double mean_rate_of(const NoiseModel& det, double T) {
-  if (!(T > 0)) return 0.0;
-  double a = 0;  // angle added over [0, T], (°/h)·s
-  for (const auto& x : det.sinusoids) {
-    const double w = 2.0 * kPi * x.f_hz;
-    if (w > 0) a += x.amp_deg_per_h / w * (std::sin(w * T + x.phase_rad) - std::sin(x.phase_rad));
-  }
-  for (const auto& x : det.bias_steps) a += x.size_deg_per_h * std::max(0.0, T - std::max(0.0, x.t_s));
-  for (const auto& x : det.warmups) a += x.amp_deg_per_h * x.tc_s * -std::expm1(-T / x.tc_s);
-  return a / T;
-}
+double mean_rate_of(const NoiseModel& det, double T) { return T > 0 ? deterministic_angle(det, T) / T : 0.0; }
 
 double model_level(const NoiseModel& m, double T) {
   return m.earth_rate_deg_per_h + m.bias_deg_per_h + mean_rate_of(m, T);

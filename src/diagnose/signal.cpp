@@ -32,14 +32,12 @@ std::size_t decimation(double rate_hz) {
   return static_cast<std::size_t>(std::floor(rate_hz / 10.0));
 }
 
-Decimated decimate(const PhaseSeries& x, std::size_t first, std::size_t last) {
+Decimated decimate(const PhaseSeries& x) {
   Decimated d;
-  if (last == 0 || last >= x.points()) last = x.points() - 1;
   const std::size_t D = decimation(1.0 / x.tau0_s);
   d.tau_d = static_cast<double>(D) * x.tau0_s;
-  const std::size_t n = (last - first) / D;
-  d.theta.resize(n + 1);
-  for (std::size_t j = 0; j <= n; ++j) d.theta[j] = x.diff(first + j * D, first);
+  d.theta.resize((x.points() - 1) / D + 1);
+  for (std::size_t j = 0; j < d.theta.size(); ++j) d.theta[j] = x.diff(j * D, 0);
   return d;
 }
 

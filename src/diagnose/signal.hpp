@@ -25,7 +25,7 @@ struct Decimated {
 
 /// Decimation factor for a sample rate (rate/D ≈ 10 Hz; 1 below 20 Hz).
 std::size_t decimation(double rate_hz);
-Decimated decimate(const PhaseSeries& x, std::size_t first = 0, std::size_t last = 0);
+Decimated decimate(const PhaseSeries& x);
 /// Mean rates over blocks of `per_block` decimated periods, °/h.
 std::vector<double> block_rates(const Decimated& d, std::size_t per_block);
 /// Decimated periods in a block of about `seconds`.
