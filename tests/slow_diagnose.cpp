@@ -92,7 +92,10 @@ const json* finding(const DiagnoseResult& r, const std::string& effect) {
 
 std::string names(const DiagnoseResult& r) {
   std::string s;
-  for (const auto& f : r.findings) s += (s.empty() ? "" : ",") + std::string(finding_name(f.effect));
+  for (const auto& f : r.findings) {
+    if (!s.empty()) s += ',';
+    s += finding_name(f.effect);
+  }
   return s.empty() ? "none" : s;
 }
 

@@ -68,7 +68,7 @@ const Finding* line_finding(const DiagnoseResult& r) {
 
 std::string summary(const DiagnoseResult& r) {
   std::string s;
-  for (const auto& f : r.findings) s += " " + std::string(finding_name(f.effect)) + f.params.dump();
+  for (const auto& f : r.findings) s += fmt::format(" {}{}", finding_name(f.effect), f.params.dump());
   for (const auto& d : r.detectors) s += fmt::format(" {}:{:.3g}/{:.3g}", detector_name(d.effect), d.statistic, d.threshold);
   return s;
 }

@@ -1,12 +1,62 @@
 // The sinusoid detector: a periodogram line search on the 0.5-s block-mean rates of the record
 // without its own mean-shape candidate (a step left in spreads over the low frequencies), and
 // the least-squares sinusoid at the peak.
+#include <unsupported/Eigen/FFT>
+
 #include <cmath>
+#include <complex>
 #include <limits>
 
 #include "diagnose/detector.hpp"
 
 namespace rwcalc::diag {
+
+namespace {
+
+/// FFT of y under a Hann window, zero-padded to the first power of two ≥ 2n (`nfft`; the first
+/// half only with `half_spectrum`); `w2` = Σw².
+std::vector<std::complex<double>> hann_spectrum(const std::vector<double>& y, bool half_spectrum, std::size_t& nfft,
+                                                double& w2) {
+  const std::size_t n = y.size();
+  nfft = 1;
+  while (nfft < 2 * n) nfft <<= 1;
+  std::vector<double> buf(nfft, 0.0);
+  w2 = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double h = 0.5 - 0.5 * std::cos(2.0 * kPi * (static_cast<double>(i) + 0.5) / static_cast<double>(n));
+    buf[i] = h * y[i];
+    w2 += h * h;
+  }
+  Eigen::FFT<double> fft;
+  if (half_spectrum) fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
+  std::vector<std::complex<double>> spec;
+  fft.fwd(spec, buf);
+  return spec;
+}
+
+/// Least-squares a·cos(2πft) + b·sin(2πft) through y_i at t_i = (i + ½)·tb; returns the explained
+/// sum of squares.
+double sinusoid_ls(const std::vector<double>& y, double tb, double f, double& a, double& b) {
+  Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d r = Eigen::Vector2d::Zero();
+  const double w = 2.0 * kPi * f;
+  for (std::size_t i = 0; i < y.size(); ++i) {
+    const double t = (static_cast<double>(i) + 0.5) * tb;
+    const double c = std::cos(w * t), s = std::sin(w * t);
+    A(0, 0) += c * c;
+    A(0, 1) += c * s;
+    A(1, 1) += s * s;
+    r(0) += c * y[i];
+    r(1) += s * y[i];
+  }
+  A(1, 0) = A(0, 1);
+  const Eigen::Vector2d x = A.ldlt().solve(r);
+  a = x(0);
+  b = x(1);
+  return x.dot(r);
+}
+
+}  // namespace
 
 SinusoidEstimate sinusoid_detect(const Decimated& d, double f_hint, bool estimate) {
   SinusoidEstimate e;

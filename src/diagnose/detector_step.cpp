@@ -90,6 +90,11 @@ StepEstimate step_detect(const Decimated& d) {
   return e;
 }
 
+
+namespace {
+
+/// A bias step at a known time `ts`: its size from the mean rates over up to 30 min each side,
+/// σ from the 1-s block means' white level.
 StepEstimate step_at(const Decimated& d, double ts) {
   StepEstimate e;
   e.t_s = ts;
@@ -111,8 +116,6 @@ StepEstimate step_at(const Decimated& d, double ts) {
   e.size_sigma = sig1 * std::sqrt(1.0 / wa + 1.0 / wb);
   return e;
 }
-
-namespace {
 
 class StepDetector final : public RecordDetector {
  public:

@@ -40,6 +40,15 @@ std::vector<double> octave_avar(const PhaseSeries& s, const std::vector<std::int
   return v;
 }
 
+/// The weight of a band point in the misfit: the measured EDF combined with the ensemble's own
+/// sampling error (`runs` records) and a 1000-EDF model floor.
+double band_nu(double edf, std::size_t runs) {
+  const double K = static_cast<double>(std::max<std::size_t>(runs, 1));
+  return 1.0 / (1.0 / edf + 1.0 / (K * edf) + 1.0 / 1000.0);
+}
+
+bool band_point_valid(const BandPoint& b) { return b.mean_var > 0 && b.dev > 0 && b.edf > 0; }
+
 }  // namespace
 
 std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSettings& settings, std::size_t runs,
@@ -219,13 +228,6 @@ std::array<double, 3> band_refit(const std::vector<BandPoint>& band, std::size_t
   if (!(dx < d0)) return {0, 0, 0};
   return x;
 }
-
-double band_nu(double edf, std::size_t runs) {
-  const double K = static_cast<double>(std::max<std::size_t>(runs, 1));
-  return 1.0 / (1.0 / edf + 1.0 / (K * edf) + 1.0 / 1000.0);
-}
-
-bool band_point_valid(const BandPoint& b) { return b.mean_var > 0 && b.dev > 0 && b.edf > 0; }
 
 BandDeviance band_deviance(const std::vector<BandPoint>& band, std::size_t runs) {
   BandDeviance d;

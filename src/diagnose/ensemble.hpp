@@ -48,11 +48,6 @@ std::vector<BandPoint> make_band(const std::vector<AllanPoint>& measured, const 
 MidTauReference make_reference(const std::vector<std::size_t>& grid, double tau_d, const std::vector<RunStats>& runs,
                                bool clean = false);
 
-/// The weight of a band point in the misfit: the measured EDF combined with the ensemble's own
-/// sampling error (`runs` records) and a 1000-EDF model floor.
-double band_nu(double edf, std::size_t runs);
-/// Whether a band point enters the misfit (positive measured σ, ensemble mean σ² and EDF).
-bool band_point_valid(const BandPoint& b);
 /// The band's Gamma deviance terms ν·(r − 1 − ln r), summed, and their number.
 struct BandDeviance {
   double sum = 0;

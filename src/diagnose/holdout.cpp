@@ -9,6 +9,7 @@
 #include <complex>
 
 #include "diagnose/models.hpp"
+#include "rwcalc/units.hpp"
 
 namespace rwcalc::diag {
 
@@ -33,6 +34,46 @@ std::vector<Fold> holdout_folds(std::size_t n, double tau0) {
     }
   }
   return folds;
+}
+
+/// The level a model predicts over [0, T], °/h: its constant rate and its named terms' mean (a
+/// ramp, whose sign the AV does not give, predicts no change).
+double model_level(const NoiseModel& m, double T) {
+  return m.earth_rate_deg_per_h + m.bias_deg_per_h + mean_rate_of(m, T);
+}
+
+/// The model with its mean rate over [0, T] (the ramp included) set to `mean_rate`.
+NoiseModel with_mean_rate(NoiseModel m, double T, double mean_rate) {
+  m.bias_deg_per_h += mean_rate - (model_level(m, T) + m.ramp_deg_per_h2 * T / units::seconds_per_hour / 2.0);
+  return m;
+}
+
+/// The model from t = dt on: steps before it join the constant rate, transients decay.
+NoiseModel shifted(NoiseModel m, double dt) {
+  for (auto& s : m.sinusoids) s.phase_rad = std::fmod(s.phase_rad + 2 * kPi * s.f_hz * dt, 2 * kPi);
+  std::vector<BiasStep> steps;
+  for (const auto& st : m.bias_steps) {
+    if (st.t_s - dt > 0)
+      steps.push_back({st.t_s - dt, st.size_deg_per_h});
+    else
+      m.bias_deg_per_h += st.size_deg_per_h;  // before the window: part of its constant rate
+    // (A step after the window cannot be known: the rate stays the level before it.)
+  }
+  m.bias_steps = steps;
+  std::vector<Warmup> w;
+  if (dt >= 0)
+    for (const auto& x : m.warmups) w.push_back({x.amp_deg_per_h * std::exp(-dt / x.tc_s), x.tc_s});
+  m.warmups = w;  // a transient is not extrapolated backwards in time
+  return m;
+}
+
+double mean_rate_variance(const std::vector<RunStats>& runs) {
+  if (runs.size() < 2) return 0.0;
+  double s = 0, s2 = 0;
+  for (const auto& r : runs) s += r.mean_rate;
+  const double mu = s / static_cast<double>(runs.size());
+  for (const auto& r : runs) s2 += (r.mean_rate - mu) * (r.mean_rate - mu);
+  return s2 / static_cast<double>(runs.size() - 1);
 }
 
 struct Score {

@@ -6,7 +6,6 @@
 #include <limits>
 
 #include "rwcalc/error.hpp"
-#include "rwcalc/units.hpp"
 
 namespace rwcalc::diag {
 
@@ -126,42 +125,6 @@ void correct(double& coef, Term t, double dc) {
 }
 
 double mean_rate_of(const NoiseModel& det, double T) { return T > 0 ? deterministic_angle(det, T) / T : 0.0; }
-
-double model_level(const NoiseModel& m, double T) {
-  return m.earth_rate_deg_per_h + m.bias_deg_per_h + mean_rate_of(m, T);
-}
-
-NoiseModel with_mean_rate(NoiseModel m, double T, double mean_rate) {
-  m.bias_deg_per_h += mean_rate - (model_level(m, T) + m.ramp_deg_per_h2 * T / units::seconds_per_hour / 2.0);
-  return m;
-}
-
-NoiseModel shifted(NoiseModel m, double dt) {
-  for (auto& s : m.sinusoids) s.phase_rad = std::fmod(s.phase_rad + 2 * kPi * s.f_hz * dt, 2 * kPi);
-  std::vector<BiasStep> steps;
-  for (const auto& st : m.bias_steps) {
-    if (st.t_s - dt > 0)
-      steps.push_back({st.t_s - dt, st.size_deg_per_h});
-    else
-      m.bias_deg_per_h += st.size_deg_per_h;  // before the window: part of its constant rate
-    // (A step after the window cannot be known: the rate stays the level before it.)
-  }
-  m.bias_steps = steps;
-  std::vector<Warmup> w;
-  if (dt >= 0)
-    for (const auto& x : m.warmups) w.push_back({x.amp_deg_per_h * std::exp(-dt / x.tc_s), x.tc_s});
-  m.warmups = w;  // a transient is not extrapolated backwards in time
-  return m;
-}
-
-double mean_rate_variance(const std::vector<RunStats>& runs) {
-  if (runs.size() < 2) return 0.0;
-  double s = 0, s2 = 0;
-  for (const auto& r : runs) s += r.mean_rate;
-  const double mu = s / static_cast<double>(runs.size());
-  for (const auto& r : runs) s2 += (r.mean_rate - mu) * (r.mean_rate - mu);
-  return s2 / static_cast<double>(runs.size() - 1);
-}
 
 /// The series with the deterministic terms of `det` removed: floating phase.
 PhaseSeries cleaned(const PhaseSeries& x, const NoiseModel& det) {

@@ -39,14 +39,6 @@ void correct(double& coef, Term t, double dc);
 
 /// The mean over [0, T] of the rate added by a model's deterministic terms, °/h.
 double mean_rate_of(const NoiseModel& det, double T);
-/// The level a model predicts over [0, T], °/h: its constant rate and its named terms' mean (a
-/// ramp, whose sign the AV does not give, predicts no change).
-double model_level(const NoiseModel& m, double T);
-/// The model with its constant rate set so that its mean rate over [0, T] (the ramp included) is
-/// `mean_rate`: under a counting read-out the short-τ AV's fine structure depends on the rate.
-NoiseModel with_mean_rate(NoiseModel m, double T, double mean_rate);
-/// Shift a model's time origin by dt (the model then describes the record from t = dt on).
-NoiseModel shifted(NoiseModel m, double dt);
 
 /// Calibrate N and B of a five-term model by a pilot ensemble of `runs` records: the corrections
 /// (K held) that bring the pilot's mean mid-τ AV onto that of `dec`, from 1 s to T/6, data and
@@ -74,8 +66,5 @@ Extension extend(const Stretch& s, const std::vector<const Detector*>& named);
 void refit_whole_band(NoiseModel& m, std::vector<BandPoint>& band, const std::vector<AllanPoint>& measured,
                       const SimulationSettings& settings, std::size_t runs, const EnsemblePlan& plan,
                       const DiagnoseOptions& opt);
-
-/// Variance of the records' mean rates in an ensemble, (°/h)².
-double mean_rate_variance(const std::vector<RunStats>& runs);
 
 }  // namespace rwcalc::diag

@@ -2,8 +2,6 @@
 // spectral helpers, and the ensemble quantiles.
 #include "diagnose/signal.hpp"
 
-#include <unsupported/Eigen/FFT>
-
 #include <cmath>
 #include <limits>
 
@@ -96,44 +94,7 @@ void remove_trend(std::vector<double>& y) {
   for (std::size_t i = 0; i < n; ++i) y[i] -= a + b * (static_cast<double>(i) - m);
 }
 
-std::vector<std::complex<double>> hann_spectrum(const std::vector<double>& y, bool half_spectrum, std::size_t& nfft,
-                                                double& w2) {
-  const std::size_t n = y.size();
-  nfft = 1;
-  while (nfft < 2 * n) nfft <<= 1;
-  std::vector<double> buf(nfft, 0.0);
-  w2 = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double h = 0.5 - 0.5 * std::cos(2.0 * kPi * (static_cast<double>(i) + 0.5) / static_cast<double>(n));
-    buf[i] = h * y[i];
-    w2 += h * h;
-  }
-  Eigen::FFT<double> fft;
-  if (half_spectrum) fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
-  std::vector<std::complex<double>> spec;
-  fft.fwd(spec, buf);
-  return spec;
-}
 
-double sinusoid_ls(const std::vector<double>& y, double tb, double f, double& a, double& b) {
-  Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d r = Eigen::Vector2d::Zero();
-  const double w = 2.0 * kPi * f;
-  for (std::size_t i = 0; i < y.size(); ++i) {
-    const double t = (static_cast<double>(i) + 0.5) * tb;
-    const double c = std::cos(w * t), s = std::sin(w * t);
-    A(0, 0) += c * c;
-    A(0, 1) += c * s;
-    A(1, 1) += s * s;
-    r(0) += c * y[i];
-    r(1) += s * y[i];
-  }
-  A(1, 0) = A(0, 1);
-  const Eigen::Vector2d x = A.ldlt().solve(r);
-  a = x(0);
-  b = x(1);
-  return x.dot(r);
-}
 
 double ls_rss(const std::vector<double>& y, const std::vector<std::vector<double>>& extra, Eigen::VectorXd* coef,
               Eigen::MatrixXd* inv) {

@@ -1,8 +1,7 @@
 #pragma once
 /// @file signal.hpp
-/// What the detectors read: the angle decimated to about 10 Hz, its block-mean rates and mid-τ
-/// Allan variance, the deterministic terms of a model, least-squares and spectral helpers, and
-/// the ensemble quantiles that calibrate the thresholds (docs/diagnosis.md).
+/// What the detectors read: the angle decimated to about 10 Hz, its block rates and mid-τ AV, a
+/// model's deterministic terms, least-squares and spectral helpers, ensemble quantiles.
 #include <Eigen/Dense>
 #include <algorithm>
 #include <complex>
@@ -22,49 +21,33 @@ struct Decimated {
   std::vector<double> theta;  ///< θ_0 = 0 … θ_L
   [[nodiscard]] double duration() const { return theta.size() > 1 ? tau_d * double(theta.size() - 1) : 0.0; }
 };
-
-/// Decimation factor for a sample rate (rate/D ≈ 10 Hz; 1 below 20 Hz).
-std::size_t decimation(double rate_hz);
+std::size_t decimation(double rate_hz);  ///< D: rate/D ≈ 10 Hz; 1 below 20 Hz
 Decimated decimate(const PhaseSeries& x);
-/// Mean rates over blocks of `per_block` decimated periods, °/h.
+/// Mean rates over blocks of `per_block` decimated periods (about `seconds`: per_block_for), °/h.
 std::vector<double> block_rates(const Decimated& d, std::size_t per_block);
-/// Decimated periods in a block of about `seconds`.
 std::size_t per_block_for(const Decimated& d, double seconds);
-/// Dense τ grid of the mid-τ detectors (cluster sizes in decimated periods, 10 per decade).
+/// The mid-τ grid: 10 cluster sizes per decade from 1 s to T/3, and the AV there, (°/h)².
 std::vector<std::size_t> mid_tau_grid(const Decimated& d);
-/// Overlapping AV of the decimated angle at those cluster sizes, (°/h)².
 std::vector<double> decimated_avar(const Decimated& d, const std::vector<std::size_t>& grid);
 
-/// Angle (″) at time t of the deterministic terms of a model (sinusoids, steps, warm-ups),
-/// relative to t = 0.
+/// Angle (″) at time t of a model's deterministic terms (sinusoids, steps, warm-ups), from t = 0;
+/// subtract_deterministic removes them from a decimated angle whose θ_0 is at t0.
 double deterministic_angle(const NoiseModel& m, double t);
-/// Subtract the deterministic terms of `m` from the decimated angle (t0: time of θ_0).
 void subtract_deterministic(Decimated& d, const NoiseModel& m, double t0 = 0);
 
 /// (1 − α) quantile of a maximum-type statistic from ensemble values (Gumbel fit by moments),
 /// never below the largest ensemble value.
 double gumbel_threshold(const std::vector<double>& values, double alpha);
 double quantile(std::vector<double> v, double p);
-/// The median of v's values (the upper one of an even count); reorders v.
-double median_of(std::vector<double>& v);
-/// White-noise σ of a series from its first differences (rms / √2): block means of pulse
-/// counts are quantized, and most differences can be 0, so not the median absolute difference.
+double median_of(std::vector<double>& v);  ///< the upper median; reorders v
+/// White-noise σ from first differences (rms/√2; block means of counts make most differences 0,
+/// so not their median).
 double diff_sigma(const std::vector<double>& y);
 
-/// y less its mean and its least-squares linear trend over the sample index.
-void remove_trend(std::vector<double>& y);
-/// The FFT of y under a Hann window (at the sample centres), zero-padded to the first power of two
-/// of at least 2n (`nfft`; only the first half with `half_spectrum`), and the window's Σw².
-std::vector<std::complex<double>> hann_spectrum(const std::vector<double>& y, bool half_spectrum, std::size_t& nfft,
-                                                double& w2);
-/// Least-squares a·cos(2πft) + b·sin(2πft) through y_i at t_i = (i + ½)·tb: (a, b), and the
-/// explained sum of squares as the result.
-double sinusoid_ls(const std::vector<double>& y, double tb, double f, double& a, double& b);
-/// RSS of y ~ level + trend + Σ extra columns by least squares; the coefficients and (XᵀX)⁻¹ on
-/// request.
+void remove_trend(std::vector<double>& y);  ///< less mean and least-squares line
+/// RSS of y ~ level + trend + extra columns; coefficients and (XᵀX)⁻¹ on request.
 double ls_rss(const std::vector<double>& y, const std::vector<std::vector<double>>& extra,
               Eigen::VectorXd* coef = nullptr, Eigen::MatrixXd* inv = nullptr);
-
 /// Weighted least squares of y on columns: χ², coefficients and (XᵀWX)⁺.
 struct WlsOut {
   double chi2 = 0;
@@ -73,11 +56,10 @@ struct WlsOut {
 };
 WlsOut wls(const std::vector<double>& y, const std::vector<double>& w, const std::vector<std::vector<double>>& cols);
 
-/// A periodogram's largest ratio to its local level over bins [k_lo, k_hi], the level taken
-/// afresh every 4 true bins (`pad` padded bins each) for the group of bins up to the next: the
-/// median of the values `window(k)` fills in for the group's first bin k, over `divisor`.
-/// A group whose median cannot be below the bound that beats the best ratio so far (a count of
-/// the window's values under it) is skipped: its ratios cannot win, so the result is the same.
+/// A periodogram's largest ratio to its local level over bins [k_lo, k_hi]: the level of each
+/// group of 4 true bins (`pad` padded bins each) is the median of `window(first bin)` over
+/// `divisor`. A group whose median cannot be below the bound that beats the best ratio so far (a
+/// count of the window's values under it) is skipped: its ratios cannot win.
 struct Peak {
   double ratio = 0, level = 0;
   std::size_t k = 0;
@@ -110,8 +92,8 @@ Peak peak_over_level(const std::vector<double>& P, std::size_t k_lo, std::size_t
   return best;
 }
 
-/// The frequency of a line near f0: the best of f0 + i·step (|i| ≤ half_steps, 0 < f < f_max) by
-/// the explained sum of squares of fit_at(f, a, b), then `iters` golden-section steps in ±step.
+/// A line's frequency near f0: the best of f0 + i·step (|i| ≤ half_steps, 0 < f < f_max) by the
+/// explained sum of squares of fit_at(f, a, b), then `iters` golden-section steps in ±step.
 template <class Fit>
 double refine_frequency(Fit& fit_at, double f0, double step, int half_steps, int iters, double f_max) {
   double fbest = f0, ebest = -1;
