@@ -67,11 +67,12 @@ PhaseSeries slice(const PhaseSeries& x, std::size_t a, std::size_t b) {
   s.kind = x.kind;
   s.arcsec_per_count = x.arcsec_per_count;
   s.rate_offset = x.rate_offset;
-  const auto first = static_cast<std::ptrdiff_t>(a), last = static_cast<std::ptrdiff_t>(b) + 1;
-  if (!x.counts.empty())
-    s.counts.assign(x.counts.begin() + first, x.counts.begin() + last);
-  else
-    s.values.assign(x.values.begin() + first, x.values.begin() + last);
+  if (x.exact()) {  // the exact counts, as 64-bit integers
+    s.counts.resize(b - a + 1);
+    for (std::size_t i = a; i <= b; ++i) s.counts[i - a] = x.count(i);
+  } else {
+    s.values.assign(x.values.begin() + static_cast<std::ptrdiff_t>(a), x.values.begin() + static_cast<std::ptrdiff_t>(b) + 1);
+  }
   return s;
 }
 
