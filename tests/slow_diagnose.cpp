@@ -83,7 +83,7 @@ DiagnoseResult run_case(const NoiseModel& m, std::uint64_t seed) {
 const json* finding(const DiagnoseResult& r, const std::string& effect) {
   static thread_local json j;
   for (const auto& f : r.findings)
-    if (f.effect == effect) {
+    if (finding_name(f.effect) == effect) {
       j = f.params;
       return &j;
     }
@@ -92,7 +92,10 @@ const json* finding(const DiagnoseResult& r, const std::string& effect) {
 
 std::string names(const DiagnoseResult& r) {
   std::string s;
-  for (const auto& f : r.findings) s += (s.empty() ? "" : ",") + f.effect;
+  for (const auto& f : r.findings) {
+    if (!s.empty()) s += ',';
+    s += finding_name(f.effect);
+  }
   return s.empty() ? "none" : s;
 }
 
@@ -103,7 +106,7 @@ std::string evidence(const DiagnoseResult& r) {
   if (!r.findings.empty())
     s += fmt::format(" ext N {:.3g} B {:.3g} K {:.3g};", r.extended.arw_deg_per_sqrt_h,
                      r.extended.bias_instability_deg_per_h, r.extended.rrw_deg_per_h_per_sqrt_h);
-  for (const auto& d : r.detectors) s += fmt::format(" {}:{:.3g}/{:.3g}", d.effect.substr(0, 4), d.statistic, d.threshold);
+  for (const auto& d : r.detectors) s += fmt::format(" {}:{:.3g}/{:.3g}", detector_name(d.effect).substr(0, 4), d.statistic, d.threshold);
   return s;
 }
 

@@ -62,14 +62,14 @@ DiagnoseResult run_case(const NoiseModel& m, std::uint64_t seed) {
 /// The high-frequency sinusoid finding (searched from 0.25 Hz on), if any.
 const Finding* line_finding(const DiagnoseResult& r) {
   for (const auto& f : r.findings)
-    if (f.effect == "sinusoid" && f.params["frequency_hz"].get<double>() > 0.25) return &f;
+    if (f.effect == Effect::Line) return &f;
   return nullptr;
 }
 
 std::string summary(const DiagnoseResult& r) {
   std::string s;
-  for (const auto& f : r.findings) s += " " + f.effect + f.params.dump();
-  for (const auto& d : r.detectors) s += fmt::format(" {}:{:.3g}/{:.3g}", d.effect, d.statistic, d.threshold);
+  for (const auto& f : r.findings) s += fmt::format(" {}{}", finding_name(f.effect), f.params.dump());
+  for (const auto& d : r.detectors) s += fmt::format(" {}:{:.3g}/{:.3g}", detector_name(d.effect), d.statistic, d.threshold);
   return s;
 }
 

@@ -75,6 +75,22 @@ TEST_F(DiagnoseCli, JsonHasTheDocumentedKeysAndFindsTheSinusoid) {
   EXPECT_GE(j["gain"]["coverage_extended"].get<double>(), j["gain"]["coverage_base"].get<double>());
 }
 
+TEST_F(DiagnoseCli, ResultDoesNotDependOnTheThreadCount) {
+  auto diagnosis = [](const char* threads) {
+    const rwcalc::test::ScopedEnv env("RWCALC_THREADS", threads);
+    const auto d = rwcalc::test::run_exe({"diagnose", record_, "--json", "--runs", "12", "--seed", "5"});
+    EXPECT_EQ(d.status, 0) << d.err;
+    json j = json::parse(d.out);
+    j.erase("seconds");
+    return j;
+  };
+  const json one = diagnosis("1");
+  EXPECT_EQ(one, diagnosis("2"));
+  json same = *json_;
+  same.erase("seconds");
+  EXPECT_EQ(one, same);
+}
+
 TEST_F(DiagnoseCli, ReportCarriesUnitsAndTheFinding) {
   const auto r = run_cli({"diagnose", record_, "--runs", "10"});
   ASSERT_EQ(r.status, 0) << r.err;

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "rwcalc/diagnose.hpp"
-#include "rwcalc/diagnose_detectors.hpp"
+#include "diagnose/detector.hpp"
 #include "rwcalc/simulate.hpp"
 
 namespace {
@@ -165,8 +165,8 @@ TEST(DiagnoseLine, DiagnoseNamesTheLineBehindTheOutputLowpass) {
   bool lowpass = false;
   const Finding* line = nullptr;
   for (const auto& f : r.findings) {
-    lowpass = lowpass || f.effect == "lowpass";
-    if (f.effect == "sinusoid" && f.params["frequency_hz"].get<double>() > kHighLineMinHz) line = &f;
+    lowpass = lowpass || f.effect == Effect::Lowpass;
+    if (f.effect == Effect::Line) line = &f;
   }
   ASSERT_TRUE(lowpass);
   ASSERT_NE(line, nullptr);
@@ -179,7 +179,7 @@ TEST(DiagnoseLine, DiagnoseNamesTheLineBehindTheOutputLowpass) {
   EXPECT_LT(r.gain.misfit_extended, r.gain.misfit_base);
   // The detector is listed on floating data.
   EXPECT_TRUE(std::any_of(r.detectors.begin(), r.detectors.end(),
-                          [](const DetectorResult& d) { return d.effect == "sinusoid_hf" && d.named; }));
+                          [](const DetectorResult& d) { return d.effect == Effect::Line && d.named; }));
 }
 
 }  // namespace

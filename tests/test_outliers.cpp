@@ -121,16 +121,16 @@ TEST(Outliers, ApplyToExactPulseCountsKeepsThemExact) {
   EXPECT_DOUBLE_EQ(out[0].value, 90 * 0.92 / 0.0025);
 
   const auto kept = rwcalc::apply_outliers(rec.phase, out, OutlierAction::Keep);
-  EXPECT_EQ(kept.wide_counts(), rec.phase.wide_counts());
+  EXPECT_EQ(kept.counts, rec.phase.counts);
   const auto replaced = rwcalc::apply_outliers(rec.phase, out, OutlierAction::Replace);
-  ASSERT_EQ(replaced.wide_counts().size(), rec.phase.wide_counts().size());
+  ASSERT_EQ(replaced.counts.size(), rec.phase.counts.size());
   // Neighbours 48, 49, 51, 52 hold 3, 2, 3, 2 pulses: median 2.5, rounded half away from zero.
-  EXPECT_EQ(replaced.wide_counts()[51] - replaced.wide_counts()[50], 3);
-  EXPECT_EQ(replaced.wide_counts().back(), rec.phase.wide_counts().back() - 90 + 3);
+  EXPECT_EQ(replaced.counts[51] - replaced.counts[50], 3);
+  EXPECT_EQ(replaced.counts.back(), rec.phase.counts.back() - 90 + 3);
   const auto removed = rwcalc::apply_outliers(rec.phase, out, OutlierAction::Remove);
-  EXPECT_EQ(removed.wide_counts().size(), rec.phase.wide_counts().size() - 1);
-  EXPECT_EQ(removed.wide_counts().back(), rec.phase.wide_counts().back() - 90);
-  EXPECT_TRUE(find_outliers(replaced.wide_counts().empty() ? std::vector<double>{} : [&] {
+  EXPECT_EQ(removed.counts.size(), rec.phase.counts.size() - 1);
+  EXPECT_EQ(removed.counts.back(), rec.phase.counts.back() - 90);
+  EXPECT_TRUE(find_outliers(replaced.counts.empty() ? std::vector<double>{} : [&] {
                 std::vector<double> r;
                 for (std::size_t i = 0; i + 1 < replaced.points(); ++i) r.push_back(replaced.rate(i));
                 return r;

@@ -57,7 +57,7 @@ const std::vector<std::int64_t> kPulses{3, -1, 0, 2, 7, 1};
 // The same six pulses in every layout must give the same exact counts.
 void expect_pulses(const Recording& r) {
   EXPECT_EQ(r.samples, kPulses.size());
-  EXPECT_EQ(r.phase.wide_counts(), cumulative(kPulses));
+  EXPECT_EQ(r.phase.counts, cumulative(kPulses));
   EXPECT_TRUE(r.phase.values.empty());
   EXPECT_EQ(r.phase.kind, PhaseKind::Gyro);
 }
@@ -225,30 +225,30 @@ TEST(Reader, NumberSpellingsGiveIdenticalValues) {
 TEST(Reader, CounterModeUnwrapsAndCountsWraps) {
   // 8-bit counter: 250 → 254 → 3 (wrap: +5) → 10 → 9 (backwards: taken as a wrap, +255).
   const auto r = read_recording_text("250\n254\n3\n10\n9\n", "c.txt", {.mode = InputMode::Counter, .counter_bits = 8});
-  EXPECT_EQ(r.phase.wide_counts(), (std::vector<std::int64_t>{0, 4, 9, 16, 271}));
+  EXPECT_EQ(r.phase.counts, (std::vector<std::int64_t>{0, 4, 9, 16, 271}));
   EXPECT_EQ(r.counter_wraps, 2u);
   EXPECT_EQ(r.samples, 5u);
   EXPECT_EQ(r.line_of_rate(0), 2u);  // increment 0 ends at the second reading
   // 64-bit counter printed unsigned across the wrap point.
   const auto w = read_recording_text("18446744073709551614\n18446744073709551615\n0\n2\n", "c64.txt",
                                      {.mode = InputMode::Counter, .counter_bits = 64});
-  EXPECT_EQ(w.phase.wide_counts(), (std::vector<std::int64_t>{0, 1, 2, 4}));
+  EXPECT_EQ(w.phase.counts, (std::vector<std::int64_t>{0, 1, 2, 4}));
   // Signed readings of a 16-bit counter are the same residues.
   const auto s = read_recording_text("-2\n-1\n0\n1\n", "c16.txt", {.mode = InputMode::Counter, .counter_bits = 16});
-  EXPECT_EQ(s.phase.wide_counts(), (std::vector<std::int64_t>{0, 1, 2, 3}));
+  EXPECT_EQ(s.phase.counts, (std::vector<std::int64_t>{0, 1, 2, 3}));
 }
 
 TEST(Reader, PulsesNearTwoToTheSixtyTwoStayExact) {
   const std::int64_t big = std::int64_t{1} << 62;
   const auto r = read_recording_text(fmt::format("{}\n3\n-1\n0\n2\n7\n1\n", big), "big.txt");
-  ASSERT_EQ(r.phase.wide_counts().size(), 8u);
-  EXPECT_EQ(r.phase.wide_counts()[1], big);
+  ASSERT_EQ(r.phase.counts.size(), 8u);
+  EXPECT_EQ(r.phase.counts[1], big);
   for (std::size_t i = 0; i < kPulses.size(); ++i)
     EXPECT_EQ(r.phase.diff(i + 2, i + 1), static_cast<double>(kPulses[i]) * 0.92);
   // Up to Σ|c| = 2^63 − 1 is accepted; one more count is refused (second differences could wrap).
   const std::int64_t max = std::numeric_limits<std::int64_t>::max();
   const auto m = read_recording_text(fmt::format("{}\n-1\n", max - 1), "max.txt");
-  EXPECT_EQ(m.phase.wide_counts().back(), max - 2);
+  EXPECT_EQ(m.phase.counts.back(), max - 2);
   EXPECT_THROW((void)read_recording_text(fmt::format("{}\n-2\n", max - 1), "over.txt"), rwcalc::InputError);
 }
 
@@ -343,14 +343,14 @@ TEST(Reader, LargeRecordThroughTheFastPathMatchesTheCarefulPath) {
   }
   const auto a = read_recording_text(fast, "fast.csv");
   ASSERT_NO_THROW((void)read_recording_text(fast, "fast.csv"));
-  EXPECT_EQ(a.phase.wide_counts(), cumulative(c));
+  EXPECT_EQ(a.phase.counts, cumulative(c));
   EXPECT_DOUBLE_EQ(a.rate_hz, 400.0);
   // Tabs after a comma are mixed delimiters; spaces are fine.
   EXPECT_THROW((void)read_recording_text(careful, "careful.csv"), rwcalc::InputError);
   std::string spaced = careful;
   for (char& ch : spaced)
     if (ch == '\t') ch = ' ';
-  EXPECT_EQ(read_recording_text(spaced, "careful.csv").phase.wide_counts(), a.phase.wide_counts());
+  EXPECT_EQ(read_recording_text(spaced, "careful.csv").phase.counts, a.phase.counts);
 }
 
 TEST(Reader, ParseNamesAndUsageErrors) {

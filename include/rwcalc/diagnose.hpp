@@ -4,17 +4,17 @@
 /// which effect causes it, the extended model and its gain (docs/diagnosis.md).
 ///
 /// Steps: (1) fit the five-term model (analysis.hpp) and simulate an ensemble of records from it
-/// with the data's length, rate, pulse weight and read-out (SimulationPath::Ensemble); (2) compare
-/// the measured Allan deviation with the ensemble's band per τ, and run one dedicated detector per
-/// effect whose statistic is computed identically on the measurement and on every ensemble record,
-/// so that the detection threshold is the ensemble's (1 − α) quantile (Gumbel tail); (3) estimate
-/// the parameters of each detected effect by least squares on the statistic that carries it;
-/// (4) add them to the model, re-fit, re-simulate, and measure the gain in- and out-of-sample.
+/// with the data's length, rate, pulse weight and read-out; (2) compare the measured Allan
+/// deviation with the ensemble's band per τ, and run one detector per effect whose statistic is
+/// computed alike on the measurement and on every ensemble record, so that the threshold is the
+/// ensemble's (1 − α) quantile; (3) estimate each detected effect by least squares on the
+/// statistic that carries it; (4) add them to the model, re-simulate, and measure the gain in and
+/// out of sample.
 #include <cstddef>
 #include <cstdint>
 #include <nlohmann/json.hpp>
-#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "rwcalc/analysis.hpp"
@@ -27,13 +27,20 @@ class Progress;
 struct DiagnoseOptions {
   AnalysisOptions analysis;          ///< the base fit (as `rwcalc analyze`)
   std::size_t runs = 50;             ///< ensemble size K of each simulated band
-  std::size_t holdout_runs = 0;      ///< ensemble size of the out-of-sample check (0: K, as the main ensembles)
+  std::size_t holdout_runs = 0;      ///< ensemble size of the out-of-sample check (0: K)
   std::uint64_t seed = 1;            ///< base seed of every ensemble
   double band_level = 0.95;          ///< central probability of the band (2.5–97.5 %)
-  double alpha = 0.01;               ///< false-alarm level of each detector (five detectors: ≤ 5 %)
-  unsigned threads = 0;              ///< simulation threads (0: all)
+  double alpha = 0.01;               ///< false-alarm level of each detector
   Progress* progress = nullptr;      ///< advanced once per simulated record (may be null)
 };
+
+/// The effects the diagnosis can name, in the order they are named and estimated.
+enum class Effect { Sinusoid, Line, BiasStep, Warmup, GaussMarkov, Lowpass };
+inline constexpr std::size_t kEffectCount = 6;
+/// The detector's name in the output ("sinusoid", "sinusoid_hf", "bias_step", …).
+std::string_view detector_name(Effect e);
+/// The finding's name in the output: the detector's, except "sinusoid" for a high-frequency line.
+std::string_view finding_name(Effect e);
 
 /// One τ of a band: the measured deviation against the ensemble's quantiles.
 struct BandPoint {
@@ -48,19 +55,20 @@ struct BandPoint {
 
 /// One detector's verdict: its statistic on the measurement against the ensemble calibration.
 struct DetectorResult {
-  std::string effect;
+  Effect effect = Effect::Sinusoid;
   double statistic = 0;      ///< on the measurement
   double threshold = 0;      ///< the ensemble's (1 − α) quantile (never below the ensemble maximum)
   double ensemble_max = 0;
   double ensemble_median = 0;
   bool fired = false;        ///< statistic > threshold
   bool named = false;        ///< kept as a finding (a competing explanation may win)
-  std::string note;          ///< why it was not named although it fired
+  std::string note;          ///< why it was not named although it fired, or not tested
 };
 
-/// A named effect: parameters (the JSON keys add_finding reads), 1σ uncertainties and evidence.
+/// A named effect: parameters (JSON keys as simulate's model reads them), 1σ uncertainties and
+/// evidence.
 struct Finding {
-  std::string effect;
+  Effect effect = Effect::Sinusoid;
   nlohmann::json params;       ///< e.g. {"frequency_hz": …, "amplitude_deg_per_h": …}
   nlohmann::json uncertainty;  ///< same keys, standard errors
   nlohmann::json evidence;     ///< statistic, threshold, where it shows
@@ -69,7 +77,7 @@ struct Finding {
 struct Gain {
   double misfit_base = 0, misfit_extended = 0;      ///< EDF-weighted AV misfit (≈ 1 when the model fits)
   double coverage_base = 0, coverage_extended = 0;  ///< share of measured τ inside the band
-  double holdout_misfit_base = 0, holdout_misfit_extended = 0;  ///< out of sample (halves and thirds: fit on one block, predict a neighbour)
+  double holdout_misfit_base = 0, holdout_misfit_extended = 0;  ///< out of sample (fit on one block, predict a neighbour)
 };
 
 struct DiagnoseResult {

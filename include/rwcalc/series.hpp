@@ -26,12 +26,8 @@ struct PhaseSeries {
   /// Exact cumulative pulse counts C_0..C_M (C_0 = 0). Used when not empty. Differences are
   /// computed with wrap-around (modular) int64 arithmetic, so any offset gives identical results.
   std::vector<std::int64_t> counts;
-  /// The same exact counts held in 32 bits, used when `counts` is empty: C_0 = 0 and every
-  /// |C_k| < 2^30. The reader stores pulse records whose counts fit so (half the memory, and the
-  /// Allan kernels read them as they are); count(i) reads either form.
-  std::vector<std::int32_t> counts32;
   double arcsec_per_count = 0.92;  ///< pulse weight q, ″ per count
-  /// Floating phase x_0..x_M in phase units, used when both count vectors are empty.
+  /// Floating phase x_0..x_M in phase units, used when `counts` is empty.
   std::vector<double> values;
   /// A constant rate (phase units per second) taken out of `values`: the phase is
   /// values[i] + rate_offset·i·τ0. Rate input keeps its mean rate here, so that a large offset
@@ -39,22 +35,11 @@ struct PhaseSeries {
   /// Allan variances) do not see it, diff(), at() and rate() add it back.
   double rate_offset = 0.0;
 
-  [[nodiscard]] bool exact() const noexcept { return !counts.empty() || !counts32.empty(); }
-  /// True when the exact counts are held in `counts32`.
-  [[nodiscard]] bool narrow() const noexcept { return counts.empty() && !counts32.empty(); }
+  [[nodiscard]] bool exact() const noexcept { return !counts.empty(); }
   /// Number of phase points (samples + 1 for increment or rate data).
-  [[nodiscard]] std::size_t points() const noexcept {
-    return !counts.empty() ? counts.size() : !counts32.empty() ? counts32.size() : values.size();
-  }
-  /// Exact count C_i (exact() only), from whichever vector holds the counts.
-  [[nodiscard]] std::int64_t count(std::size_t i) const noexcept {
-    return counts.empty() ? std::int64_t{counts32[i]} : counts[i];
-  }
-  /// The exact counts as 64-bit integers: `counts`, or a copy of `counts32`.
-  [[nodiscard]] std::vector<std::int64_t> wide_counts() const {
-    if (!counts.empty()) return counts;
-    return std::vector<std::int64_t>(counts32.begin(), counts32.end());
-  }
+  [[nodiscard]] std::size_t points() const noexcept { return exact() ? counts.size() : values.size(); }
+  /// Exact count C_i (exact() only).
+  [[nodiscard]] std::int64_t count(std::size_t i) const noexcept { return counts[i]; }
   /// Phase at index i in phase units.
   [[nodiscard]] double at(std::size_t i) const noexcept {
     return exact() ? static_cast<double>(count(i)) * arcsec_per_count
@@ -67,8 +52,6 @@ struct PhaseSeries {
                                                static_cast<std::uint64_t>(counts[i]));
       return static_cast<double>(d) * arcsec_per_count;
     }
-    if (!counts32.empty())
-      return static_cast<double>(std::int64_t{counts32[j]} - std::int64_t{counts32[i]}) * arcsec_per_count;
     return values[j] - values[i] + rate_offset * (static_cast<double>(j) - static_cast<double>(i)) * tau0_s;
   }
   /// Record length T = (points − 1)·τ0, s.

@@ -25,7 +25,6 @@ struct DiagnoseCmd {
   std::size_t runs = 50;
   std::uint64_t seed = 1;
   double alpha = 0.01;
-  unsigned threads = 0;
   std::string output = "-";
   PlotArgs plot;
   bool force = false;
@@ -54,7 +53,6 @@ void register_diagnose(CLI::App& app, Runner& runner) {
   sub->add_option("--false-alarm", cmd->alpha, "False-alarm probability of each of the five detectors")
       ->check(real_in(1e-6, 0.2, ""))
       ->capture_default_str();
-  sub->add_option("--threads", cmd->threads, "Simulation threads (default: hardware threads)")->check(whole_in(0, kMaxThreads));
   sub->add_option("-o,--output", cmd->output, "Write to FILE instead of standard output")->capture_default_str();
   sub->add_flag("--force", cmd->force, "Overwrite existing output, figure and script files");
   cmd->plot.add_to(*sub, "the measured Allan deviation against the simulated bands of the base and the extended model");
@@ -68,7 +66,6 @@ void register_diagnose(CLI::App& app, Runner& runner) {
       opt.runs = cmd->runs;
       opt.seed = cmd->seed;
       opt.alpha = cmd->alpha;
-      opt.threads = cmd->threads;
       const Recording rec = read_recording(cmd->file, cmd->input.options());
       const std::size_t hold = cmd->runs;  // the out-of-sample ensembles are as large as the main one
       Progress progress("simulating", static_cast<std::uint64_t>(2 * cmd->runs + 7 * hold));

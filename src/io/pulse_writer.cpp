@@ -98,7 +98,7 @@ std::string format_pulse_file(const Metadata& metadata, const PhaseSeries& serie
     append_angles(text, series.values, at);
     return text;
   }
-  const std::vector<std::int64_t> counts = series.wide_counts();
+  const std::vector<std::int64_t>& counts = series.counts;
   std::int64_t previous = counts.front();
   append_increments(text, std::span<const std::int64_t>(counts).subspan(1), previous, at);
   return text;

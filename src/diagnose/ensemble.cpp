@@ -1,66 +1,76 @@
-// The simulated ensemble of a model: per-record statistics (octave AV, mid-τ AV, detector
-// statistics), the band of σ per τ, and the measured-versus-ensemble misfit and coverage.
+// The simulated ensemble of a model: per-record statistics, the band of σ per τ, the mid-τ
+// reference, and the measured-versus-ensemble deviance.
+#include "diagnose/ensemble.hpp"
+
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include <Eigen/Dense>
-
 #include "allan/allan_kernels.hpp"
-#include "rwcalc/diagnose_detectors.hpp"
-#include "rwcalc/ensemble.hpp"
+#include "diagnose/detector.hpp"
 #include "rwcalc/allan.hpp"
+#include "rwcalc/ensemble.hpp"
 #include "rwcalc/fit.hpp"
 
-namespace rwcalc {
+namespace rwcalc::diag {
 
-namespace diag {
+namespace {
+
+/// Overlapping AV of a simulated record at the octave cluster sizes; pulse counts by their exact
+/// integer sums, every cluster size in one sweep over the counts.
+std::vector<double> octave_avar(const PhaseSeries& s, const std::vector<std::int64_t>& octave_m) {
+  std::vector<double> v(octave_m.size(), 0.0);
+  if (!s.exact()) {
+    for (std::size_t i = 0; i < octave_m.size(); ++i) v[i] = allan_variance(s, octave_m[i], Estimator::Overlapping);
+    return v;
+  }
+  // Every cluster size's sum in one sweep over the counts (the same sums as per m).
+  const std::vector<detail::u128> swept = detail::second_diff_sumsq_sweep(s.counts.data(), s.points(), octave_m);
+  const double q = s.arcsec_per_count;
+  for (std::size_t i = 0; i < octave_m.size(); ++i) {
+    const std::int64_t m = octave_m[i];
+    const std::int64_t n = term_count(Estimator::Overlapping, m, s.points());
+    if (n < 1) continue;
+    const double tau = static_cast<double>(m) * s.tau0_s;
+    v[i] = static_cast<double>(swept[i]) * q * q / (2.0 * tau * tau * static_cast<double>(n));
+  }
+  return v;
+}
+
+/// The weight of a band point in the misfit: the measured EDF combined with the ensemble's own
+/// sampling error (`runs` records) and a 1000-EDF model floor.
+double band_nu(double edf, std::size_t runs) {
+  const double K = static_cast<double>(std::max<std::size_t>(runs, 1));
+  return 1.0 / (1.0 / edf + 1.0 / (K * edf) + 1.0 / 1000.0);
+}
+
+bool band_point_valid(const BandPoint& b) { return b.mean_var > 0 && b.dev > 0 && b.edf > 0; }
+
+}  // namespace
 
 std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSettings& settings, std::size_t runs,
-                                   const std::vector<std::int64_t>& octave_m, const std::vector<std::size_t>& mid_grid,
-                                   bool with_detectors, const DiagnoseOptions& options, bool clean_mid,
-                                   bool high_line) {
+                                   const EnsemblePlan& plan, Progress* progress) {
   std::vector<RunStats> out(runs);
   EnsembleOptions eo;
   eo.path = SimulationPath::Ensemble;
-  eo.progress = options.progress;
+  eo.progress = progress;
+  const bool clean = plan.clean_mid || !plan.scored.empty();
   simulate_ensemble(
       model, settings, runs,
       [&](std::size_t r, const PhaseSeries& s) {
         RunStats& st = out[r];
-        st.octave_var.resize(octave_m.size());
-        if (s.exact()) {
-          // Every cluster size's sum in one sweep over the counts (the same sums as per m).
-          const double q = s.arcsec_per_count;
-          const std::vector<detail::u128> swept = detail::second_diff_sumsq_sweep(s.counts.data(), s.points(), octave_m);
-          for (std::size_t i = 0; i < octave_m.size(); ++i) {
-            const std::int64_t m = octave_m[i];
-            const std::int64_t n = term_count(Estimator::Overlapping, m, s.points());
-            if (n < 1) continue;
-            const double tau = static_cast<double>(m) * s.tau0_s;
-            const auto sum = static_cast<double>(swept[i]);
-            st.octave_var[i] = sum * q * q / (2.0 * tau * tau * static_cast<double>(n));
-          }
-        } else {
-          for (std::size_t i = 0; i < octave_m.size(); ++i)
-            st.octave_var[i] = allan_variance(s, octave_m[i], Estimator::Overlapping);
-        }
+        st.octave_var = octave_avar(s, plan.octave_m);
         st.mean_rate = s.diff(s.points() - 1, 0) / s.duration_s();
-        if (high_line) st.line_stat = line_detect(s, kHighLineMinHz, 0.0, false).statistic;
         const Decimated d = decimate(s);
-        st.mid_var = decimated_avar(d, mid_grid);
-        if (with_detectors || clean_mid) {
-          // The record without its own mean-shape candidate, as the measurement: the sinusoid
-          // statistic, the pilot calibration and the mid-τ shape statistic read it.
-          Decimated dc = d;
-          subtract_deterministic(dc, own_candidates(d));
-          st.mid_var_clean = decimated_avar(dc, mid_grid);
-          if (with_detectors) {
-            st.sin_stat = sinusoid_detect(dc, 0.0, false).statistic;
-            st.step_stat = step_detect(d).statistic;
-            st.warm_stat = warmup_detect(d).statistic;
-          }
-        }
+        st.mid_var = decimated_avar(d, plan.grid);
+        if (!clean) return;
+        const Decimated dc = without_own_candidates(d);
+        st.mid_var_clean = decimated_avar(dc, plan.grid);
+        const RecordView view{s, d, dc, st.octave_var};
+        for (const RecordDetector* det : plan.scored)
+          st.stat[static_cast<std::size_t>(det->effect())] = det->statistic(view);
       },
       eo);
   return out;
@@ -91,16 +101,20 @@ std::vector<BandPoint> make_band(const std::vector<AllanPoint>& measured, const 
   return band;
 }
 
-MidTauReference make_reference(const std::vector<std::size_t>& grid, double tau_d, const std::vector<RunStats>& runs) {
+MidTauReference make_reference(const std::vector<std::size_t>& grid, double tau_d, const std::vector<RunStats>& runs,
+                               bool clean) {
+  const auto var_of = [clean](const RunStats& r) -> const std::vector<double>& {
+    return clean ? r.mid_var_clean : r.mid_var;
+  };
   MidTauReference ref;
   ref.grid = grid;
   for (std::size_t i = 0; i < grid.size(); ++i) {
     double m = 0, m2 = 0;
     std::size_t k = 0;
     for (const auto& r : runs) {
-      if (i >= r.mid_var.size() || !(r.mid_var[i] > 0)) continue;
-      m += r.mid_var[i];
-      m2 += r.mid_var[i] * r.mid_var[i];
+      if (i >= var_of(r).size() || !(var_of(r)[i] > 0)) continue;
+      m += var_of(r)[i];
+      m2 += var_of(r)[i] * var_of(r)[i];
       ++k;
     }
     ref.tau.push_back(static_cast<double>(grid[i]) * tau_d);
@@ -122,8 +136,8 @@ MidTauReference make_reference(const std::vector<std::size_t>& grid, double tau_
         double c = 0;
         std::size_t k = 0;
         for (const auto& r : runs) {
-          if (i >= r.mid_var.size() || j >= r.mid_var.size() || !(r.mid_var[i] > 0) || !(r.mid_var[j] > 0)) continue;
-          c += (r.mid_var[i] - ref.mean[i]) * (r.mid_var[j] - ref.mean[j]);
+          if (i >= var_of(r).size() || j >= var_of(r).size() || !(var_of(r)[i] > 0) || !(var_of(r)[j] > 0)) continue;
+          c += (var_of(r)[i] - ref.mean[i]) * (var_of(r)[j] - ref.mean[j]);
           ++k;
         }
         ref.cov[i * g + j] = ref.cov[j * g + i] = k > 2 ? c / double(k - 1) : 0.0;
@@ -214,13 +228,6 @@ std::array<double, 3> band_refit(const std::vector<BandPoint>& band, std::size_t
   return x;
 }
 
-double band_nu(double edf, std::size_t runs) {
-  const double K = static_cast<double>(std::max<std::size_t>(runs, 1));
-  return 1.0 / (1.0 / edf + 1.0 / (K * edf) + 1.0 / 1000.0);
-}
-
-bool band_point_valid(const BandPoint& b) { return b.mean_var > 0 && b.dev > 0 && b.edf > 0; }
-
 BandDeviance band_deviance(const std::vector<BandPoint>& band, std::size_t runs) {
   BandDeviance d;
   for (const auto& b : band) {
@@ -232,7 +239,9 @@ BandDeviance band_deviance(const std::vector<BandPoint>& band, std::size_t runs)
   return d;
 }
 
-}  // namespace diag
+}  // namespace rwcalc::diag
+
+namespace rwcalc {
 
 double band_misfit(const std::vector<BandPoint>& band, std::size_t runs) {
   const auto d = diag::band_deviance(band, runs);

@@ -1,0 +1,112 @@
+// The warm-up detector: the drop of the residual sum of squares of the 10-s block rates when an
+// exponential transient joins level and trend; and a record's own mean-shape candidate, the
+// better of the best step and the best transient.
+#include <cmath>
+#include <limits>
+
+#include "diagnose/detector.hpp"
+
+namespace rwcalc::diag {
+
+WarmupEstimate warmup_detect(const Decimated& d) {
+  WarmupEstimate e;
+  const std::size_t pb = per_block_for(d, 10.0);
+  const std::vector<double> y = block_rates(d, pb);
+  const std::size_t n = y.size();
+  if (n < 40) return e;
+  const double tb = static_cast<double>(pb) * d.tau_d;
+  const double T = tb * static_cast<double>(n);
+  const double sig = std::max(diff_sigma(y), 1e-12);
+  const double rss0 = ls_rss(y, {});
+  auto column = [&](double tc) {
+    std::vector<double> c(n);
+    const double f = tc / tb * -std::expm1(-tb / tc);  // block mean of exp(−t/tc) over [0, tb]
+    for (std::size_t i = 0; i < n; ++i) c[i] = std::exp(-static_cast<double>(i) * tb / tc) * f;
+    return c;
+  };
+  auto rss_at = [&](double tc) { return ls_rss(y, {column(tc)}); };
+  const double lt_lo = std::log(2.0 * tb), lt_hi = std::log(T / 3.0);
+  const int G = 40;
+  double best = std::numeric_limits<double>::infinity(), lbest = lt_lo;
+  std::vector<std::pair<double, double>> prof;
+  for (int g = 0; g <= G; ++g) {
+    const double lt = lt_lo + (lt_hi - lt_lo) * g / G;
+    const double r = rss_at(std::exp(lt));
+    prof.emplace_back(lt, r);
+    if (r < best) {
+      best = r;
+      lbest = lt;
+    }
+  }
+  const double step = (lt_hi - lt_lo) / G;
+  double lo = lbest - step, hi = lbest + step;
+  for (int it = 0; it < 25; ++it) {
+    const double m1 = lo + 0.382 * (hi - lo), m2 = lo + 0.618 * (hi - lo);
+    if (rss_at(std::exp(m1)) < rss_at(std::exp(m2)))
+      hi = m2;
+    else
+      lo = m1;
+  }
+  lbest = 0.5 * (lo + hi);
+  Eigen::VectorXd coef;
+  Eigen::MatrixXd inv;
+  e.tc = std::exp(lbest);
+  e.rss = ls_rss(y, {column(e.tc)}, &coef, &inv);
+  e.amp = coef(2);
+  e.amp_sigma = sig * std::sqrt(inv(2, 2));
+  // F-type statistic: the residual variance, not the white level, normalises the drop, so that
+  // wander the base fit took up into K or R does not hide the transient.
+  e.statistic = std::max(0.0, (rss0 - e.rss) / (e.rss / static_cast<double>(n - 4)));
+  // Time-constant range: Δ RSS/σ̂² ≤ 1 on a fine profile around the optimum.
+  double tl = e.tc, th = e.tc;
+  for (int g = -40; g <= 40; ++g) {
+    const double lt = lbest + g * 0.025;
+    if (lt < lt_lo - 1 || lt > lt_hi + 1) continue;
+    if ((rss_at(std::exp(lt)) - e.rss) / (sig * sig) <= 1.0) {
+      tl = std::min(tl, std::exp(lt));
+      th = std::max(th, std::exp(lt));
+    }
+  }
+  e.tc_sigma = std::max(0.5 * (th - tl), 0.0);
+  return e;
+}
+
+NoiseModel own_candidates(const Decimated& d) {
+  NoiseModel c;
+  const auto st = step_detect(d);
+  const auto w = warmup_detect(d);
+  if (st.rss <= w.rss)
+    c.bias_steps.push_back({st.t_s, st.size});
+  else
+    c.warmups.push_back({w.amp, w.tc});
+  return c;
+}
+
+Decimated without_own_candidates(const Decimated& d) {
+  Decimated c = d;
+  subtract_deterministic(c, own_candidates(d));
+  return c;
+}
+
+namespace {
+
+class WarmupDetector final : public RecordDetector {
+ public:
+  [[nodiscard]] Effect effect() const override { return Effect::Warmup; }
+  [[nodiscard]] bool mean_shape() const override { return true; }
+  [[nodiscard]] double statistic(const RecordView& r) const override { return warmup_detect(r.dec).statistic; }
+  void estimate(const Stretch& s, Extension& x) const override {
+    const auto est = warmup_detect(s.dec);
+    x.det.warmups.push_back({est.amp, est.tc});
+    x.findings.push_back({Effect::Warmup,
+                          {{"amplitude_deg_per_h", est.amp}, {"time_constant_s", est.tc}},
+                          {{"amplitude_deg_per_h", est.amp_sigma}, {"time_constant_s", est.tc_sigma}},
+                          {}});
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<RecordDetector> warmup_detector() { return std::make_unique<WarmupDetector>(); }
+
+}  // namespace rwcalc::diag

@@ -1,0 +1,223 @@
+// The out-of-sample check: the record is cut into halves and (when each lasts kMinDuration)
+// thirds; a fold fits both models on one block and scores their prediction of a neighbouring
+// block, both ways. The score is the mean over the folds of each split, averaged over the
+// splits: one split alone leaves the verdict to the luck of where its cut falls.
+#include "diagnose/holdout.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+
+#include "diagnose/models.hpp"
+#include "rwcalc/units.hpp"
+
+namespace rwcalc::diag {
+
+namespace {
+
+constexpr double kStepMinSide = 60.0;  ///< s of a block on each side of a known step to estimate its size
+
+struct Fold {
+  std::size_t len, fit, pred;  ///< block length (samples), fitting and predicted block
+  double weight;               ///< of the fold's per-point score in the mean
+};
+
+std::vector<Fold> holdout_folds(std::size_t n, double tau0) {
+  const std::vector<std::size_t> splits =
+      static_cast<double>(n) * tau0 >= 3.0 * kMinDuration ? std::vector<std::size_t>{2, 3} : std::vector<std::size_t>{2};
+  std::vector<Fold> folds;
+  for (const std::size_t nb : splits) {
+    const double w = 1.0 / (static_cast<double>(splits.size()) * 2.0 * static_cast<double>(nb - 1));
+    for (std::size_t k = 0; k < nb; ++k) {
+      if (k + 1 < nb) folds.push_back({n / nb, k, k + 1, w});
+      if (k > 0) folds.push_back({n / nb, k, k - 1, w});
+    }
+  }
+  return folds;
+}
+
+/// The level a model predicts over [0, T], °/h: its constant rate and its named terms' mean (a
+/// ramp, whose sign the AV does not give, predicts no change).
+double model_level(const NoiseModel& m, double T) {
+  return m.earth_rate_deg_per_h + m.bias_deg_per_h + mean_rate_of(m, T);
+}
+
+/// The model with its mean rate over [0, T] (the ramp included) set to `mean_rate`.
+NoiseModel with_mean_rate(NoiseModel m, double T, double mean_rate) {
+  m.bias_deg_per_h += mean_rate - (model_level(m, T) + m.ramp_deg_per_h2 * T / units::seconds_per_hour / 2.0);
+  return m;
+}
+
+/// The model from t = dt on: steps before it join the constant rate, transients decay.
+NoiseModel shifted(NoiseModel m, double dt) {
+  for (auto& s : m.sinusoids) s.phase_rad = std::fmod(s.phase_rad + 2 * kPi * s.f_hz * dt, 2 * kPi);
+  std::vector<BiasStep> steps;
+  for (const auto& st : m.bias_steps) {
+    if (st.t_s - dt > 0)
+      steps.push_back({st.t_s - dt, st.size_deg_per_h});
+    else
+      m.bias_deg_per_h += st.size_deg_per_h;  // before the window: part of its constant rate
+    // (A step after the window cannot be known: the rate stays the level before it.)
+  }
+  m.bias_steps = steps;
+  std::vector<Warmup> w;
+  if (dt >= 0)
+    for (const auto& x : m.warmups) w.push_back({x.amp_deg_per_h * std::exp(-dt / x.tc_s), x.tc_s});
+  m.warmups = w;  // a transient is not extrapolated backwards in time
+  return m;
+}
+
+double mean_rate_variance(const std::vector<RunStats>& runs) {
+  if (runs.size() < 2) return 0.0;
+  double s = 0, s2 = 0;
+  for (const auto& r : runs) s += r.mean_rate;
+  const double mu = s / static_cast<double>(runs.size());
+  for (const auto& r : runs) s2 += (r.mean_rate - mu) * (r.mean_rate - mu);
+  return s2 / static_cast<double>(runs.size() - 1);
+}
+
+struct Score {
+  double sum = 0;
+  std::size_t points = 0;
+  [[nodiscard]] double per_point() const { return points ? sum / static_cast<double>(points) : 0.0; }
+};
+
+/// A named line keeps its frequency and phase into the predicted block, where the Allan variance
+/// hardly sees it: what it predicts is the line itself, scored explicitly like the level. The
+/// line's two Fourier coefficients on the predicted block (least squares at the model's
+/// frequency; the 0.5-s block rates below kHighLineMinHz, the samples' rates above) are normal
+/// with the standard error of the block's local noise PSD: −2 ln L is |c − c_model|²/σ² for the
+/// extended model and |c|²/σ² for the base, which predicts no line. A broadened line (no phase)
+/// is left to the band.
+void score_lines(const PhaseSeries& pred, const NoiseModel& e_pred, const std::vector<Sinusoid>& broad, Score& sb,
+                 Score& se) {
+  for (const auto& l : e_pred.sinusoids) {
+    if (std::any_of(broad.begin(), broad.end(), [&](const Sinusoid& b) { return b.f_hz == l.f_hz; })) continue;
+    std::vector<double> y;
+    double tb = 0;
+    if (l.f_hz < kHighLineMinHz) {
+      const Decimated dp = decimate(pred);
+      const auto per = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(0.5 / dp.tau_d)));
+      y = block_rates(dp, per);
+      tb = static_cast<double>(per) * dp.tau_d;
+    } else {
+      tb = pred.tau0_s;
+      y.resize(pred.points() - 1);
+      for (std::size_t i = 0; i + 1 < pred.points(); ++i) y[i] = pred.diff(i + 1, i) / tb;
+    }
+    const LineCoefficients c = line_coefficients(std::move(y), tb, l.f_hz);
+    if (!(c.sigma > 0)) continue;
+    const double u = kPi * l.f_hz * tb, att = u > 1e-9 ? std::sin(u) / u : 1.0;
+    // Behind a named output-chain low-pass the block shows the sensed line through the filter.
+    std::complex<double> hf = 1.0;
+    if (e_pred.output_lowpass_tc_s > 0) {
+      const double t0 = pred.tau0_s, phi = std::exp(-t0 / e_pred.output_lowpass_tc_s);
+      hf = (1.0 - phi) / (1.0 - phi * std::polar(1.0, -2.0 * kPi * l.f_hz * t0));
+    }
+    const double am = l.amp_deg_per_h * std::abs(hf) * att, ph = l.phase_rad + std::arg(hf);
+    const double ap = am * std::cos(ph), bp = -am * std::sin(ph);
+    const double s2 = c.sigma * c.sigma;
+    sb.sum += (c.a * c.a + c.b * c.b) / s2;
+    se.sum += ((c.a - ap) * (c.a - ap) + (c.b - bp) * (c.b - bp)) / s2;
+    sb.points += 2;
+    se.points += 2;
+  }
+}
+
+/// The fitting block as a stretch with its base model, pilot settings and hints.
+Stretch fitting_stretch(const Stretch& full, const DiagnoseResult& r, const Named& named, const Recording& fit_rec,
+                        const AnalysisResult& a_fit, const SimulationSettings& pilot, double t_fit) {
+  Stretch st;
+  st.rec = &fit_rec;
+  st.analysis = &a_fit;
+  st.aopt = full.aopt;
+  st.opt = full.opt;
+  st.dec = decimate(fit_rec.phase);
+  st.pilot = pilot;
+  st.pilot_runs = r.holdout_runs;
+  st.sin_hint_hz = named.sin_hint_hz;
+  st.line_hint_hz = named.line_hint_hz;
+  // A named Gauss–Markov term keeps the whole record's correlation time (its structure).
+  st.gm_tc_s = r.extended.gauss_markov.empty() ? 0.0 : r.extended.gauss_markov.front().tc_s;
+  // A step whose time lies inside the fitting block, with data on each side, keeps that time.
+  if (!r.extended.bias_steps.empty()) {
+    const double t_local = r.extended.bias_steps.front().t_s - t_fit;
+    if (t_local >= kStepMinSide && t_local <= fit_rec.phase.duration_s() - kStepMinSide) st.step_time_s = t_local;
+  }
+  return st;
+}
+
+/// One fold's per-point scores of the base and the extended model. Both models are simulated
+/// over the predicted block at its measured mean rate: under a counting read-out the rate sets
+/// the fine structure of the short-τ AV, which would otherwise score the level twice and
+/// erratically. The level each model predicts (its constant rate and named terms over the block)
+/// is scored once, explicitly, against a yardstick common to both models (the base ensemble's
+/// spread of block means), as are the named lines; the noise models are compared by the band.
+std::pair<double, double> score_fold(const Stretch& full, const DiagnoseResult& r, const Named& named,
+                                     const Fold& f, std::size_t index) {
+  const PhaseSeries& x = full.rec->phase;
+  const DiagnoseOptions& opt = *full.opt;
+  const std::size_t h = f.len, fa = f.fit * h, pa = f.pred * h;
+  const Recording fit_rec = with_series(*full.rec, slice(x, fa, fa + h));
+  const Recording pred_rec = with_series(*full.rec, slice(x, pa, pa + h));
+  const AnalysisResult a_fit = analyze_for_base(fit_rec, *full.aopt);
+  const AllanResult a_pred = compute_allan(pred_rec.phase, opt.analysis.allan);
+  SimulationSettings sh = r.settings;
+  sh.duration_s = static_cast<double>(h) * x.tau0_s;
+  sh.seed = opt.seed + 10 + static_cast<std::uint64_t>(index);
+  Stretch st = fitting_stretch(full, r, named, fit_rec, a_fit, sh, static_cast<double>(fa) * x.tau0_s);
+  st.octave_m = octave_of(a_pred);
+  EnsemblePlan plan{st.octave_m, mid_tau_grid(st.dec), true, {}};
+  st.base = robust_base(fit_rec, a_fit, *full.aopt, st.dec, sh, r.holdout_runs, plan, opt.progress).model;
+  sh.seed += 50;
+  const double pred_T = pred_rec.phase.duration_s();
+  const double pred_mean = pred_rec.phase.diff(pred_rec.phase.points() - 1, 0) / pred_T;
+  const EnsemblePlan pred_plan{plan.octave_m, plan.grid, false, {}};
+  const auto b_pred =
+      run_ensemble(with_mean_rate(st.base, pred_T, pred_mean), sh, r.holdout_runs, pred_plan, opt.progress);
+  const double v_base = std::max(mean_rate_variance(b_pred), 1e-30);
+  auto prediction_score = [&](const std::vector<RunStats>& runs, const NoiseModel& m) {
+    const auto dev = band_deviance(make_band(a_pred.points, runs, opt.band_level), r.holdout_runs);
+    const double d = pred_mean - model_level(m, pred_T);
+    return Score{dev.sum + d * d / v_base, dev.points + 1};
+  };
+  Score sb = prediction_score(b_pred, st.base);
+  if (named.detectors.empty()) return {sb.per_point(), sb.per_point()};
+  // The block's base ensemble at the block's own level: its detectors' thresholds and its mid-τ
+  // references. An effect enters the block's extended model only when the block shows it.
+  for (const Detector* d : named.detectors)
+    if (const auto* rd = dynamic_cast<const RecordDetector*>(d); rd && rd->block_statistic()) plan.scored.push_back(rd);
+  const auto b_runs = run_ensemble(st.base, sh, r.holdout_runs, plan, opt.progress);
+  st.ref = make_reference(plan.grid, st.dec.tau_d, b_runs);
+  st.clean_ref = make_reference(plan.grid, st.dec.tau_d, b_runs, true);
+  st.clean = without_own_candidates(st.dec);
+  const std::vector<double> no_octave;
+  const Trial trial{{fit_rec.phase, st.dec, st.clean, no_octave}, b_runs, st, sh, nullptr};
+  std::vector<const Detector*> shown;
+  for (const Detector* d : named.detectors)
+    if (d->shows_in(trial)) shown.push_back(d);
+  if (shown.empty()) return {sb.per_point(), sb.per_point()};
+  const Extension e = extend(st, shown);
+  const NoiseModel e_pred = shifted(e.model, (static_cast<double>(pa) - static_cast<double>(fa)) * x.tau0_s);
+  const auto e_runs =
+      run_ensemble(with_mean_rate(e_pred, pred_T, pred_mean), sh, r.holdout_runs, pred_plan, opt.progress);
+  Score se = prediction_score(e_runs, e_pred);
+  score_lines(pred_rec.phase, e_pred, e.broad, sb, se);
+  return {sb.per_point(), se.per_point()};
+}
+
+}  // namespace
+
+HoldoutScores out_of_sample(const Stretch& full, const DiagnoseResult& r, const Named& named) {
+  const PhaseSeries& x = full.rec->phase;
+  const auto folds = holdout_folds(x.points() - 1, x.tau0_s);
+  HoldoutScores s;
+  for (std::size_t i = 0; i < folds.size(); ++i) {
+    const auto [b, e] = score_fold(full, r, named, folds[i], i);
+    s.base += folds[i].weight * b;
+    s.extended += folds[i].weight * e;
+  }
+  return s;
+}
+
+}  // namespace rwcalc::diag

@@ -1,0 +1,179 @@
+// The results of the diagnosis as JSON (`rwcalc diagnose --json`, docs/diagnosis.md) and as the
+// readable report.
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "rwcalc/diagnose.hpp"
+#include "rwcalc/fit.hpp"
+#include "rwcalc/printable.hpp"
+
+namespace rwcalc {
+
+using nlohmann::json;
+
+namespace {
+
+json band_json(const std::vector<BandPoint>& band) {
+  json a = json::array();
+  for (const auto& b : band)
+    a.push_back({{"tau_s", b.tau_s}, {"dev", b.dev}, {"band_low", b.low}, {"band_high", b.high}, {"median", b.median},
+                 {"edf", b.edf}});
+  return a;
+}
+
+/// A simulated model with its band and how well the measurement sits in it.
+json model_json(const NoiseModel& model, const std::vector<BandPoint>& band, double level, double misfit,
+                double coverage) {
+  json m;
+  to_json(m, model);
+  m["band"] = band_json(band);
+  m["band_level"] = level;
+  m["misfit"] = misfit;
+  m["coverage"] = coverage;
+  return m;
+}
+
+double finite_or(double v, double d = 0.0) { return std::isfinite(v) ? v : d; }
+
+json clean_json(json j) {
+  if (j.is_number_float()) return finite_or(j.get<double>());
+  if (j.is_object() || j.is_array())
+    for (auto& v : j) v = clean_json(v);
+  return j;
+}
+
+std::string unit_of(const std::string& key) {
+  if (key.ends_with("_hz")) return "Hz";
+  if (key.ends_with("_deg_per_h")) return "°/h";
+  if (key.ends_with("_s")) return "s";
+  if (key.ends_with("_rad")) return "rad";
+  return "";
+}
+
+}  // namespace
+
+json to_json(const DiagnoseResult& r) {
+  json j;
+  j["source"] = r.analysis.source;
+  j["samples"] = r.analysis.samples;
+  j["rate_hz"] = r.settings.rate_hz;
+  j["duration_s"] = r.settings.duration_s;
+  j["scale_arcsec_per_pulse"] = r.settings.scale_arcsec;
+  j["temperature_c"] = r.analysis.temperature_c ? json(*r.analysis.temperature_c) : json(nullptr);
+  j["runs"] = r.runs;
+  j["holdout_runs"] = r.holdout_runs;
+  j["seed"] = r.seed;
+  j["false_alarm_level_per_detector"] = r.alpha;
+  j["simulation_path"] = "ensemble";
+  j["outliers"] = to_json(r.analysis.outliers);
+  json base = model_json(r.base, r.base_band, r.band_level, r.gain.misfit_base, r.gain.coverage_base);
+  // Not under "fit": model_from_analysis_json would read those coefficients instead of this model.
+  base["fitted_coefficients"] = {{"Q_arcsec", r.analysis.fit[Term::Q].estimate},
+                                 {"N_deg_per_sqrt_h", r.analysis.fit[Term::N].estimate},
+                                 {"B_deg_per_h", r.analysis.fit[Term::B].estimate},
+                                 {"K_deg_per_h_per_sqrt_h", r.analysis.fit[Term::K].estimate},
+                                 {"R_deg_per_h2", r.analysis.fit[Term::R].estimate},
+                                 {"chi2_per_dof", r.analysis.fit.chi2_per_dof}};
+  j["base_model"] = base;
+  json det = json::array();
+  for (const auto& d : r.detectors) {
+    json o = {{"effect", std::string(detector_name(d.effect))},         {"statistic", d.statistic},   {"threshold", d.threshold},
+              {"ensemble_max", d.ensemble_max}, {"ensemble_median", d.ensemble_median}, {"fired", d.fired},
+              {"named", d.named}};
+    if (!d.note.empty()) o["note"] = d.note;
+    det.push_back(o);
+  }
+  j["detectors"] = det;
+  json fnd = json::array();
+  for (const auto& f : r.findings) {
+    json o = {{"effect", std::string(finding_name(f.effect))}};
+    for (const auto& [k, v] : f.params.items()) o[k] = v;
+    o["uncertainty"] = f.uncertainty;
+    o["evidence"] = f.evidence;
+    fnd.push_back(o);
+  }
+  j["findings"] = fnd;
+  j["extended_model"] =
+      model_json(r.extended, r.extended_band, r.band_level, r.gain.misfit_extended, r.gain.coverage_extended);
+  j["gain"] = {{"misfit_base", r.gain.misfit_base},
+               {"misfit_extended", r.gain.misfit_extended},
+               {"coverage_base", r.gain.coverage_base},
+               {"coverage_extended", r.gain.coverage_extended},
+               {"holdout_misfit_base", r.gain.holdout_misfit_base},
+               {"holdout_misfit_extended", r.gain.holdout_misfit_extended}};
+  j["seconds"] = r.seconds;
+  return clean_json(j);
+}
+
+std::string format_report(const DiagnoseResult& r) {
+  std::string s;
+  s += fmt::format("Diagnosis of {}\n", printable(r.analysis.source));
+  s += fmt::format("  record: {:.0f} s at {:g} Hz, pulse weight {:g}″; ensemble of {} simulated records per model "
+                   "(seed {}), band {:g} % per τ\n\n",
+                   r.settings.duration_s, r.settings.rate_hz, r.settings.scale_arcsec, r.runs, r.seed,
+                   r.band_level * 100);
+  s += format_outliers(r.analysis.outliers);
+  const auto& m = r.base;
+  s += fmt::format("Base model (five-term fit): N = {:.4g} °/√h, B = {:.4g} °/h, K = {:.4g} °/h/√h, R = {:.4g} °/h², "
+                   "white angle {:.4g}″, {} read-out, Earth rate {:.4g} °/h, bias {:.4g} °/h\n",
+                   m.arw_deg_per_sqrt_h, m.bias_instability_deg_per_h, m.rrw_deg_per_h_per_sqrt_h, m.ramp_deg_per_h2,
+                   m.white_angle_arcsec, m.readout == ReadoutMode::Counting ? "counting" : "white",
+                   m.earth_rate_deg_per_h, m.bias_deg_per_h);
+  std::size_t outside = 0;
+  std::string rows;
+  for (const auto& b : r.base_band) {
+    if (b.dev >= b.low && b.dev <= b.high) continue;
+    ++outside;
+    if (b.dev > b.high)
+      rows += fmt::format("    τ = {:>9.4g} s: σ = {:.4g} °/h, {:.1f} % above the band's upper edge {:.4g} °/h\n",
+                          b.tau_s, b.dev, 100 * (b.dev / b.high - 1), b.high);
+    else
+      rows += fmt::format("    τ = {:>9.4g} s: σ = {:.4g} °/h, {:.1f} % below the band's lower edge {:.4g} °/h\n",
+                          b.tau_s, b.dev, 100 * (1 - b.dev / b.low), b.low);
+  }
+  s += fmt::format("  measured Allan deviation inside the base band at {} of {} τ\n", r.base_band.size() - outside,
+                   r.base_band.size());
+  s += rows;
+  s += "\nDetectors (statistic on the measurement against the ensemble-calibrated threshold, "
+       + fmt::format("false-alarm level {:g} % each):\n", r.alpha * 100);
+  for (const auto& d : r.detectors)
+    s += fmt::format("  {:<17} statistic {:>9.3f} (dimensionless), threshold {:>8.3f}, ensemble max {:>8.3f}: {}{}\n",
+                     detector_name(d.effect), d.statistic, d.threshold, d.ensemble_max,
+                     d.named ? "FOUND" : (d.fired ? "fired, not named" : "not found"),
+                     d.note.empty() ? "" : " (" + d.note + ")");
+  s += "\nFindings:\n";
+  if (r.findings.empty()) s += "  none: the base model's simulations explain the measurement\n";
+  for (const auto& f : r.findings) {
+    s += fmt::format("  {}:", finding_name(f.effect));
+    for (const auto& [k, v] : f.params.items()) {
+      if (!v.is_number()) continue;
+      const double u = f.uncertainty.contains(k) ? f.uncertainty[k].get<double>() : -1;
+      const std::string unit = unit_of(k);
+      if (u >= 0)
+        s += fmt::format(" {} = {:.4g} ± {:.2g} {}", k, v.get<double>(), u, unit);
+      else
+        s += fmt::format(" {} = {:.4g} {}", k, v.get<double>(), unit);
+      s += ";";
+    }
+    s.pop_back();
+    s += "\n";
+  }
+  const auto& e = r.extended;
+  s += fmt::format("\nExtended model: N = {:.4g} °/√h, B = {:.4g} °/h, K = {:.4g} °/h/√h, R = {:.4g} °/h², "
+                   "{} extra term(s)\n",
+                   e.arw_deg_per_sqrt_h, e.bias_instability_deg_per_h, e.rrw_deg_per_h_per_sqrt_h, e.ramp_deg_per_h2,
+                   r.findings.size());
+  s += "\nGain (misfit: mean EDF-weighted Gamma deviance per τ, about 1 (dimensionless) when the model fits):\n";
+  s += fmt::format("  {:<44} {:>10} {:>10}\n", "", "base", "extended");
+  s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", "Allan-variance misfit (dimensionless)", r.gain.misfit_base,
+                   r.gain.misfit_extended);
+  s += fmt::format("  {:<44} {:>9.1f}% {:>9.1f}%\n", "measured τ inside the simulated band", 100 * r.gain.coverage_base,
+                   100 * r.gain.coverage_extended);
+  s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", "out-of-sample misfit (dimensionless)",
+                   r.gain.holdout_misfit_base, r.gain.holdout_misfit_extended);
+  s += fmt::format("\n  ({:.1f} s)\n", r.seconds);
+  return s;
+}
+
+}  // namespace rwcalc
