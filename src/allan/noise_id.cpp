@@ -124,17 +124,6 @@ struct ExactLag1 {
 constexpr std::uint64_t kZLimit = std::uint64_t{1} << 34;
 constexpr std::size_t kExactMaxPoints = std::size_t{1} << 28;
 
-/// z_L(k) of p (modular offsets of the counts) modulo 2^64: exact while |z| < 2^63.
-template <class P>
-std::int64_t idiff(const P& p, int level, std::size_t k) {
-  switch (level) {
-    case 0: return static_cast<std::int64_t>(p(k));
-    case 1: return static_cast<std::int64_t>(p(k + 1) - p(k));
-    case 2: return static_cast<std::int64_t>(p(k + 2) - 2 * p(k + 1) + p(k));
-    default: return static_cast<std::int64_t>(p(k + 3) - 3 * p(k + 2) + 3 * p(k + 1) - p(k));
-  }
-}
-
 /// r1 = Σ(z_k − z̄)(z_{k+1} − z̄) / Σ(z_k − z̄)² from the exact sums, with z̄ = S1/n:
 /// n·num = U − S1²/n, U = n·Slag − S1² + S1·(z_0 + z_{n−1});  n·den = n·S2 − S1²
 /// (integers but for the fraction of S1²/n, which is added last).
@@ -151,28 +140,54 @@ double r1_from_exact(const ExactLag1& s, std::size_t len, std::int64_t z_first, 
   return static_cast<double>(num / static_cast<long double>(den));
 }
 
-/// r1 of the level-th difference of p(0) … p(count − 1) from exact sums; nothing when they could
-/// leave 128 bits (the sums run modulo 2^128 and are used only when every |z| < kZLimit).
+/// Terms per block: while every |z| ≤ 2^26 a block's Σz² and Σz·z' stay below 2^62, so it is summed
+/// in 64 bits and flushed into the 128-bit totals; a block with a larger z is summed in 128 bits.
+constexpr std::size_t kBlock = 1024;
+
+template <class Acc, class Wide>
+void add_block(const std::int64_t* z, std::size_t n, std::size_t pairs, u128 (&s)[3]) {
+  Acc a = 0, b = 0, c = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    a += static_cast<Acc>(static_cast<Wide>(z[i]));
+    b += static_cast<Acc>(static_cast<Wide>(z[i]) * z[i]);
+  }
+  for (std::size_t i = 0; i < pairs; ++i) c += static_cast<Acc>(static_cast<Wide>(z[i]) * z[i + 1]);
+  s[0] += static_cast<u128>(static_cast<i128>(a));
+  s[1] += static_cast<u128>(static_cast<i128>(b));
+  s[2] += static_cast<u128>(static_cast<i128>(c));
+}
+
+/// r1 of the level-th difference z of p(0) … p(count − 1) from exact sums; nothing when they could
+/// leave 128 bits (the sums run modulo 2^128 and are used only when every |z| < kZLimit). The
+/// differences of a block are taken in place, modulo 2^64: exact while |z| < 2^63.
 template <class P>
 std::optional<double> lag1_exact(const P& p, std::size_t count, int level) {
   if (count <= static_cast<std::size_t>(level) + 1) return 0.0;
   if (count >= kExactMaxPoints) return std::nullopt;
-  const std::size_t len = count - static_cast<std::size_t>(level);
-  u128 s1 = 0, s2 = 0, lag = 0;
-  std::uint64_t range = 0;
-  std::int64_t z = idiff(p, level, 0);
-  for (std::size_t k = 0;; ++k) {
-    range |= static_cast<std::uint64_t>(z) + kZLimit;  // below 2^35 iff −2^34 ≤ z < 2^34
-    s1 += static_cast<u128>(static_cast<i128>(z));
-    s2 += static_cast<u128>(static_cast<i128>(z) * z);
-    if (k + 1 == len) break;
-    const std::int64_t zn = idiff(p, level, k + 1);
-    lag += static_cast<u128>(static_cast<i128>(z) * zn);
-    z = zn;
+  const auto lv = static_cast<std::size_t>(level);
+  const std::size_t len = count - lv;
+  u128 s[3] = {};
+  std::int64_t z[kBlock + 4], z_first = 0, z_last = 0;
+  for (std::size_t k0 = 0; k0 < len; k0 += kBlock) {
+    const std::size_t n = std::min(kBlock, len - k0), pairs = k0 + n < len ? n : n - 1;
+    for (std::size_t i = 0; i < pairs + 1 + lv; ++i) z[i] = static_cast<std::int64_t>(p(k0 + i));
+    for (std::size_t d = 0; d < lv; ++d)
+      for (std::size_t i = 0; i < pairs + lv - d; ++i)
+        z[i] = static_cast<std::int64_t>(static_cast<std::uint64_t>(z[i + 1]) - static_cast<std::uint64_t>(z[i]));
+    std::uint64_t small = 0, range = 0;  // below 2^27 (2^35) iff every −2^26 ≤ z < 2^26 (2^34)
+    for (std::size_t i = 0; i < n; ++i) small |= static_cast<std::uint64_t>(z[i]) + (kZLimit >> 8);
+    if (small < (kZLimit >> 7)) {
+      add_block<std::int64_t, std::int64_t>(z, n, pairs, s);
+    } else {
+      for (std::size_t i = 0; i < n; ++i) range |= static_cast<std::uint64_t>(z[i]) + kZLimit;
+      if (range >= 2 * kZLimit) return std::nullopt;
+      add_block<u128, i128>(z, n, pairs, s);
+    }
+    if (k0 == 0) z_first = z[0];
+    z_last = z[n - 1];
   }
-  if (range >= 2 * kZLimit) return std::nullopt;
-  const ExactLag1 s{static_cast<i128>(s1), static_cast<i128>(s2), static_cast<i128>(lag)};
-  return r1_from_exact(s, len, idiff(p, level, 0), z);
+  const ExactLag1 e{static_cast<i128>(s[0]), static_cast<i128>(s[1]), static_cast<i128>(s[2])};
+  return r1_from_exact(e, len, z_first, z_last);
 }
 
 /// Lag-1 ACF method on the phase decimated by m, starting at difference level `base` (0: phase

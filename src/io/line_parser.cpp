@@ -40,6 +40,10 @@ void LineParser::fail(const std::string& message) const { throw InputError(file_
 
 LineKind LineParser::parse(std::string_view text, std::size_t line, Sample& s) {
   line_ = line;
+  if (plain_integer(text, s)) {
+    ++content_lines_;
+    return LineKind::Data;
+  }
   if (!text.empty() && text.back() == '\r') text.remove_suffix(1);
   // One pass over the line for the bytes that need a look: CR, semicolon, tab.
   bool special = false;
@@ -73,6 +77,22 @@ LineKind LineParser::parse(std::string_view text, std::size_t line, Sample& s) {
                      layout_.header_line ? layout_.header_line : first_data_line_, fields_.size(), quoted(t)));
   read_fields(s, true);
   return LineKind::Data;
+}
+
+// The common data line, read without splitting: one integer column and the line just an optional
+// minus and up to 18 digits (no overflow). Anything else goes the general way, which reports.
+bool LineParser::plain_integer(std::string_view t, Sample& s) const {
+  if (!layout_known_ || layout_.ncols != 1 || layout_.roles[0] != Role::Value || !integer_mode()) return false;
+  const bool neg = !t.empty() && t.front() == '-';
+  if (t.size() == static_cast<std::size_t>(neg) || t.size() > 18 + static_cast<std::size_t>(neg)) return false;
+  std::int64_t v = 0;
+  for (std::size_t i = neg; i < t.size(); ++i) {
+    const auto d = static_cast<unsigned char>(t[i] - '0');
+    if (d > 9) return false;
+    v = v * 10 + d;
+  }
+  s.integer = neg ? -v : v;
+  return opt_.mode != InputMode::Counter || (s.integer >= counter_lo_ && s.integer <= counter_max_);
 }
 
 void LineParser::check_foreign_delimiters(std::string_view line) const {

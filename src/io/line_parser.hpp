@@ -44,6 +44,7 @@ class LineParser {
   bool header_row(std::string_view line);
   bool read_fields(Sample& s, bool report);
   bool read_field(std::string_view f, Role role, Sample& s, bool report);
+  bool plain_integer(std::string_view t, Sample& s) const;
   bool read_integer(std::string_view f, std::string_view t, Sample& s, bool report);
   [[nodiscard]] bool integer_mode() const noexcept {
     return opt_.mode == InputMode::Pulses || opt_.mode == InputMode::Counter;

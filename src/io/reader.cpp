@@ -96,9 +96,13 @@ class Reader {
   }
   void read(detail::TextSource& src) {
     std::string buf;
-    for (bool more = true; more;) {
+    for (bool more = true, first = true; more;) {
       more = src.read(buf);
-      buf.erase(0, take_lines(buf, !more));
+      const std::size_t taken = take_lines(buf, !more);
+      const auto lines = static_cast<double>(line_);
+      if (first && line_ > 0) reserve(static_cast<double>(src.size_estimate()) / static_cast<double>(taken) * lines);
+      first = first && line_ == 0;
+      buf.erase(0, taken);
     }
     if (!buf.empty()) line(buf);  // the last line, without a line end
   }
@@ -121,6 +125,12 @@ class Reader {
       new_run_ = true;
   }
   void push(const Sample& s);
+  // Room for the samples the text likely holds, judged from its first lines, so that a long record
+  // is not copied as it grows (capped: only an estimate).
+  void reserve(double lines) {
+    const auto n = static_cast<std::size_t>(std::min(lines * 1.05 + 2, 0x1p26));
+    integer_mode() ? ints_.reserve(n) : reals_.reserve(n);
+  }
   void finish_rate();
   void check_unread_keys() const;
   void check_time_columns_agree() const;

@@ -98,10 +98,11 @@ TextSource::TextSource(const std::string& path) : name_(display_name(path)), che
   struct stat st {};
   if (::fstat(in_.fd, &st) != 0) fail_errno(name_, "cannot stat", errno);
   if (S_ISDIR(st.st_mode)) throw InputError(name_, 0, "is a directory, not a recording");
+  if (S_ISREG(st.st_mode)) bytes_ = static_cast<std::size_t>(st.st_size);
 }
 
 TextSource::TextSource(std::string_view bytes, std::string name)
-    : name_(std::move(name)), memory_(bytes), check_(name_) {}
+    : name_(std::move(name)), memory_(bytes), bytes_(bytes.size()), check_(name_) {}
 
 TextSource::Descriptor::~Descriptor() {
   if (own) ::close(fd);

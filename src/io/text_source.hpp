@@ -48,6 +48,14 @@ class TextSource {
   /// Append the next piece of checked text to `out`; false once the input has ended.
   bool read(std::string& out);
   [[nodiscard]] const std::string& name() const noexcept { return name_; }
+  /// The text's likely length in bytes: the input's size, for gzip times the ratio inflated so far;
+  /// 0 when unknown (a pipe). An estimate only.
+  [[nodiscard]] std::size_t size_estimate() const noexcept {
+    if (!gzip_) return bytes_;
+    return zs_.total_in ? static_cast<std::size_t>(static_cast<double>(bytes_) / static_cast<double>(zs_.total_in) *
+                                                   static_cast<double>(zs_.total_out))
+                        : 0;
+  }
 
  private:
   struct Descriptor {
@@ -63,6 +71,7 @@ class TextSource {
   std::string name_;
   Descriptor in_;
   std::string_view memory_;  // the bytes not yet read, when there is no descriptor
+  std::size_t bytes_ = 0;    // the input's size, if known
   bool started_ = false, gzip_ = false;
   std::string raw_;  // compressed bytes, or the first bytes before gzip is told from text
   z_stream zs_{};
