@@ -18,8 +18,6 @@ namespace rwcalc {
 
 namespace {
 
-constexpr double kZ95 = 1.959963984540054;
-
 nlohmann::json coef_json(const Coefficient& c) {
   return {{"value", c.value},       {"sigma", c.sigma},       {"low95", c.low},
           {"high95", c.high},       {"resolved", c.resolved}, {"estimate", c.estimate},
@@ -192,10 +190,6 @@ Verdict verdict_of(const AnalysisResult& r, const AnalysisOptions& options) {
   }
   return decide(b_in, from_fit(Term::N), rho, options.verdict);
 }
-
-}  // namespace
-
-namespace {
 
 /// Mean rate, expected Earth rate and the bias between them.
 void earth_rate_and_bias(const Recording& rec, const AnalysisOptions& options, AnalysisResult& r) {
