@@ -1,8 +1,6 @@
 #pragma once
 /// @file analysis.hpp
-/// The whole `rwcalc analyze` pipeline: a Recording → Allan variance (octave τ) → five-term fit
-/// with uncertainties → the paper's cross-checks → Earth rate and bias → class verdict, with its
-/// JSON form and the readable report.
+/// The `rwcalc analyze` pipeline (Allan variance, fit, cross-checks, bias, verdict) and its outputs.
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -25,9 +23,7 @@ struct AnalysisOptions {
   double latitude_deg = 55.75;                 ///< for the vertical Earth rate Ω_E·sin(lat)
   std::optional<double> earth_rate_deg_per_h;  ///< overrides the latitude
   std::optional<double> temperature_c;         ///< overrides the recording's temperature
-  /// Isolated outliers are always looked for and reported; this says what is done with them
-  /// before the analysis. Keep is the default: the data are analysed as read.
-  OutlierAction outlier_action = OutlierAction::Keep;
+  OutlierAction outlier_action = OutlierAction::Keep;  ///< outliers are always reported
   double outlier_threshold = kDefaultOutlierThreshold;  ///< robust z (see outliers.hpp)
 };
 
@@ -58,8 +54,7 @@ struct AnalysisResult {
   Verdict verdict;
 };
 
-/// Run the pipeline. Throws UsageError for clock data, AnalysisError when the record is too short
-/// or holds no noise.
+/// Throws UsageError for clock data, AnalysisError for a record too short or without noise.
 AnalysisResult analyze(const Recording& rec, const AnalysisOptions& options = {});
 
 /// The JSON object of `rwcalc analyze --json` (keys in docs/analysis.md).

@@ -1,12 +1,7 @@
 #pragma once
 /// @file batch.hpp
-/// Many runs at once: analyse files in parallel, or merge the JSON lines of runs analysed
-/// elsewhere, into the seed paper's layout (Table 1: N by AV, N direct, B by AV, B by 100-s
-/// averaging per temperature; Table 2: class per parameter) with the overall verdict over the
-/// temperature range and the trend of each coefficient with temperature.
-///
-/// Both paths build the table from the analyze JSON objects (to_json(AnalysisResult)), so
-/// `rwcalc batch` and `rwcalc merge` of its `--jsonl` lines print the same table.
+/// Many runs at once (analysed here or merged from JSON lines) in the seed paper's Table 1/Table 2
+/// layout, with the overall verdict and trends with temperature; built from analyze JSON objects.
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -16,9 +11,7 @@
 
 namespace rwcalc {
 
-/// Analyse `files`, several at once (parallel.hpp). Each file's temperature comes from its
-/// column/metadata, else its name. Returns the analyze JSON objects in file order. On failure
-/// throws the error of the first failing file (in file order), naming it.
+/// The analyze JSON objects of `files` in file order; throws the first failing file's error.
 std::vector<nlohmann::json> analyze_files(const std::vector<std::string>& files, const ReadOptions& read,
                                           const AnalysisOptions& options);
 

@@ -1,11 +1,7 @@
 #pragma once
 /// @file methods.hpp
-/// The seed paper's cross-checks of the AV results, with uncertainties (docs/analysis.md):
-///  - N by the direct method: the variance of the angle over non-overlapping intervals of length
-///    t (mean removed) against t, by a weighted regression s²(t) = a + N²·t; its standard error
-///    from the spread over contiguous segments (Student t);
-///  - the spread of 100-s mean rates, with its expectation under the fitted AV model (the spread
-///    measures the whole noise at 100 s, not B alone); χ² with (blocks − 1) degrees of freedom.
+/// The seed paper's cross-checks of the AV results, with uncertainties (docs/analysis.md): N by
+/// the direct method (angle variance against interval) and the spread of 100-s mean rates.
 #include <cstddef>
 #include <vector>
 

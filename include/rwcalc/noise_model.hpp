@@ -1,13 +1,7 @@
 #pragma once
 /// @file noise_model.hpp
-/// What a simulated gyro senses and how it is read out: the noise terms (noise-models.md §3), the
-/// record's length and sampling, their checks, the Allan variance the terms have in theory, and
-/// the model's JSON form. Rates are in °/h (= ″/s), angles in arcseconds (″), times in seconds.
-///
-/// Read-out modes (docs/simulation.md): Counting takes C_k = floor(θ_k/q + u) with one random
-/// phase u for the record, so the count error is a deterministic sawtooth whose Allan variance is
-/// structured (§2.1). White draws u afresh for every sample, as a mechanical dither does: the count
-/// error is white with mean variance q²/6 (σ²(τ) = 3Q²/τ², Q = q/√6) for any non-zero rate.
+/// What a simulated gyro senses and how it is read out (docs/simulation.md), its theoretical
+/// Allan variance and its JSON form. Rates in °/h (= ″/s), angles in ″, times in s.
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -83,12 +77,9 @@ struct NoiseModel {
   std::vector<GaussMarkov> gauss_markov;
   std::vector<BiasStep> bias_steps;
   std::vector<Warmup> warmups;
-  /// Time constant of a first-order low-pass of the sensed rate inside the sensor, before the
-  /// pulses are counted, s (0: none). Its Allan variance is that of a Gauss–Markov rate.
-  double lowpass_tc_s = 0.0;
-  /// Time constant of a first-order low-pass in the output chain, s (0: none): the read-out's
-  /// per-sample rate is filtered (a decimation or dither-stripping filter) and the record is its
-  /// integral, a floating angle (PhaseSeries::values); a `lowpass` finding of diagnose names it.
+  double lowpass_tc_s = 0.0;  ///< low-pass of the sensed rate before counting, s (0: none)
+  /// Low-pass of the read-out's rate in the output chain, s (0: none): the record becomes a
+  /// floating angle (diagnose's `lowpass` finding).
   double output_lowpass_tc_s = 0.0;
   std::optional<TemperatureBias> temperature_bias;
 };
@@ -107,35 +98,22 @@ struct SimulationSettings {
 /// Vertical component of Earth's rotation at a latitude: Ω_E·sin(lat), °/h.
 [[nodiscard]] double earth_rate_at(double latitude_deg);
 
-/// Throw UsageError if a model or settings value is invalid (negative σ, zero time constant,
-/// non-finite values, a record shorter than 2 samples, …).
+/// Throws UsageError for an invalid value (negative σ, zero time constant, non-finite, < 2 samples).
 void validate(const NoiseModel& model, const SimulationSettings& settings);
 
-/// Quantization Q of the read-out (rms white angle error), ″: q/√6 for the white read-out; for
-/// counting, q/√12, the nominal level of the (structured, not white) sawtooth.
+/// Quantization Q of the read-out, ″: q/√6 (white), q/√12 (counting: the sawtooth's level).
 [[nodiscard]] double readout_q_arcsec(ReadoutMode mode, double scale_arcsec);
 
-/// Theoretical Allan variance (°/h)² at τ = m·τ0 of the random and periodic terms of `model`
-/// as simulated: ARW, flicker (exact discrete value, including the small-m overshoot), RRW, ramp,
-/// sinusoids, Gauss–Markov, extra white angle noise and the white read-out's quantization.
-/// Steps, warm-ups, temperature bias, low-pass and the counting read-out are not included.
+/// Theoretical Allan variance (°/h)² at τ = m·τ0 of the random and periodic terms as simulated
+/// (not steps, warm-ups, temperature bias, low-pass or the counting read-out).
 [[nodiscard]] double theoretical_avar(const NoiseModel& model, double tau0_s, double scale_arcsec,
                                       std::size_t m);
 
 /// Exact AV of the discrete (Kasdin) flicker with Q_d = B² at cluster size m, (°/h)².
 [[nodiscard]] double flicker_avar(double b_deg_per_h, std::size_t m);
 
-// JSON form of the model (the "extended_model" of diagnose uses the same form):
-// {"arw_deg_per_sqrt_h", "bias_instability_deg_per_h", "rrw_deg_per_h_per_sqrt_h",
-//  "ramp_deg_per_h2", "bias_deg_per_h", "earth_rate_deg_per_h", "readout": "counting"|"white",
-//  "white_angle_arcsec", "lowpass_tc_s", "output_lowpass_tc_s",
-//  "sinusoids": [{"frequency_hz", "amplitude_deg_per_h", "phase_rad"}],
-//  "gauss_markov": [{"sigma_deg_per_h", "correlation_time_s"}],
-//  "bias_steps": [{"time_s", "size_deg_per_h"}],
-//  "warmups": [{"amplitude_deg_per_h", "time_constant_s"}],
-//  "temperature_bias": {"coefficient_deg_per_h_per_c", "profile": {"kind": "ramp"|"cycle", …}}}
-// Missing keys mean zero/absent. from_json also accepts a "terms" array of findings in the
-// diagnose form ({"effect": "sinusoid", "frequency_hz", "amplitude_deg_per_h", …}).
+// JSON form of the model (docs/simulation.md; also diagnose's "extended_model"); missing keys
+// mean zero. from_json also accepts a "terms" array of findings in the diagnose form.
 void to_json(nlohmann::json& j, const NoiseModel& model);
 void from_json(const nlohmann::json& j, NoiseModel& model);
 void to_json(nlohmann::json& j, const SimulationSettings& settings);
@@ -144,13 +122,11 @@ void to_json(nlohmann::json& j, const SimulationSettings& settings);
 /// "warmup_transient"|"lowpass", parameters…}) to a model. Throws UsageError on an unknown effect.
 void add_finding(const nlohmann::json& finding, NoiseModel& model);
 
-/// Build a model from `rwcalc analyze --json` output (fit.*.value, mean_rate_deg_per_h…) or from
-/// diagnose JSON (its "extended_model", else "base_model"), and fill in rate, duration and
-/// temperature of `settings` from it when present. `name` labels errors (InputError).
+/// A model from `analyze --json` or diagnose JSON ("extended_model", else "base_model"); fills
+/// rate, duration and temperature of `settings` when present. Errors: InputError naming `name`.
 NoiseModel model_from_analysis_json(const nlohmann::json& j, const std::string& name,
                                     SimulationSettings& settings);
-/// The same from a JSON file (`simulate --from`): every value is checked (numbers finite, rate,
-/// duration and pulse weight positive, …); an error names the file, the line and the key path.
+/// The same from a JSON file (`simulate --from`), every value checked.
 NoiseModel model_from_analysis_file(const std::string& path, SimulationSettings& settings);
 
 }  // namespace rwcalc

@@ -1,8 +1,7 @@
 #pragma once
 /// @file outlier_screen.hpp
-/// Outlier screening as every command that analyses a record does it (analyze, batch, report,
-/// diagnose, allan): detection (outliers.hpp), the report of what was found and where in the
-/// input, and the action the user chose (--outliers keep|remove|replace).
+/// Outlier screening as every command that analyses a record does it: detection, report of
+/// where in the input, and the action chosen (--outliers keep|remove|replace).
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
@@ -34,16 +33,12 @@ struct OutlierReport {
 };
 inline constexpr std::size_t kMaxOutlierPositions = 1000;
 
-/// The isolated outliers of `read` detected and reported (count, positions with their input
-/// lines, the action taken), then the action applied. Returns `read` itself
-/// when the data stay as read (Keep, or nothing found), else `edited`, filled with the record
-/// whose outliers were removed or replaced. Throws UsageError for a threshold that is not a
-/// positive number.
+/// Detects and reports the outliers of `read`, then applies the action: returns `read` when the
+/// data stay as read, else `edited`. Throws UsageError for a threshold that is not positive.
 const Recording& screen_outliers(const Recording& read, OutlierAction action, double threshold,
                                  OutlierReport& report, Recording& edited);
 
-/// The outlier report as the readable reports print it ("Outliers" section) and as the JSON
-/// "outliers" object of analyze, batch, diagnose and allan.
+/// The "Outliers" section of the readable reports, and the JSON "outliers" object.
 std::string format_outliers(const OutlierReport& report);
 nlohmann::json to_json(const OutlierReport& report);
 

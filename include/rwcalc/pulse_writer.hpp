@@ -1,8 +1,7 @@
 #pragma once
 /// @file pulse_writer.hpp
-/// GL-2D pulse files: `# key: value` metadata lines, the header `pulses`, then one pulse count
-/// per line (the increments C_k − C_{k−1}); or the header `angle` and the cumulative angle in ″
-/// (read back with `--input angle`). rwcalc's reader takes them by default.
+/// GL-2D pulse files: `# key: value` metadata, the header `pulses` and one increment per line, or
+/// the header `angle` and the cumulative angle in ″.
 #include <cstdint>
 #include <span>
 #include <string>
@@ -24,10 +23,8 @@ using Metadata = std::vector<std::pair<std::string, std::string>>;
 /// Throws UsageError for a value that cannot be written (see PulseFileWriter).
 [[nodiscard]] std::string format_pulse_file(const Metadata& metadata, const PhaseSeries& series);
 
-/// Writes a pulse file while its record is generated, so memory does not grow with the record:
-/// the text is handed to an AtomicOutput about once per MiB and commit() puts the file in place.
-/// A value that cannot be written as it is (an increment beyond 64 bits, a non-finite angle)
-/// throws UsageError naming the file, the line and the sample; the file is then not written.
+/// Writes a pulse file while its record is generated (memory does not grow with the record). A
+/// value that cannot be written (increment beyond 64 bits, non-finite angle) throws UsageError.
 class PulseFileWriter {
  public:
   enum class Column { Pulses, Angle };

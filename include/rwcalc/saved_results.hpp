@@ -1,9 +1,7 @@
 #pragma once
 /// @file saved_results.hpp
-/// Reading back rwcalc's JSON (`analyze`, `batch`, `diagnose --json`, the lines of `batch
-/// --jsonl`) as input of `report` and `merge`. Such files travel between machines, so every value
-/// read is checked against its type and domain; a violation is an InputError naming the file,
-/// the line and the key path. Keys rwcalc does not read are left alone.
+/// Reading back rwcalc's JSON (`analyze`, `batch`, `diagnose --json`, `batch --jsonl`) for
+/// `report` and `merge`: every value read is checked (InputError naming file, line and key path).
 #include <cstddef>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -25,8 +23,7 @@ struct SavedResults {
   std::vector<nlohmann::json> overalls;  ///< the verdicts of `batch --json` files
 };
 
-/// The report shows what it finds (hand-made or older results may lack the class
-/// probabilities); merge combines the verdicts, so every key the combination reads must be there.
+/// Shown: only keys present are checked (report); Combined: the keys merge reads are required.
 enum class RunKeys { Shown, Combined };
 
 /// One saved result (an analyze, batch or diagnose object) named `file`.
@@ -40,10 +37,8 @@ void load_saved_result(const std::string& path, SavedResults& into);
 
 std::vector<SavedRun> load_json_lines(const std::string& path, RunKeys keys);
 
-/// The runs that `merge` combines, in input order. Two lines with the same "source" are the same
-/// run, and counting it twice would count its probabilities twice: refused, naming both places;
-/// with `dedupe` a line equal to an earlier one is dropped (a re-queued job). Runs judged
-/// against different class tables are refused too.
+/// The runs `merge` combines, in input order. A repeated "source" is refused (with `dedupe`, a
+/// line equal to an earlier one is dropped), as are runs judged against other class tables.
 std::vector<nlohmann::json> merge_runs(std::vector<SavedRun> runs, bool dedupe);
 
 }  // namespace rwcalc

@@ -1,13 +1,7 @@
 #pragma once
 /// @file series.hpp
-/// The phase series every estimator works on: the cumulative angle (gyro) or phase (clock),
-/// sampled every τ0.
-///
-/// Gyro pulse data keep their exact integer cumulative counts C_0 = 0, C_1 … C_M; the angle is
-/// θ_k = q·C_k with q the pulse weight in arcseconds, applied only at the last step. All other
-/// inputs are converted once into a floating phase in "phase units": arcseconds for gyro data
-/// (so deviations come out in ″/s = °/h), seconds or the input's own unit for clock data
-/// (deviations dimensionless, "input units per second").
+/// The phase series every estimator works on: the cumulative angle (gyro, ″) or phase (clock),
+/// sampled every τ0; pulse data keep exact integer counts, the pulse weight applied last.
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -29,10 +23,7 @@ struct PhaseSeries {
   double arcsec_per_count = 0.92;  ///< pulse weight q, ″ per count
   /// Floating phase x_0..x_M in phase units, used when `counts` is empty.
   std::vector<double> values;
-  /// A constant rate (phase units per second) taken out of `values`: the phase is
-  /// values[i] + rate_offset·i·τ0. Rate input keeps its mean rate here, so that a large offset
-  /// (a bias 10^12 times the noise) does not swamp the phase's 53 bits; second differences (the
-  /// Allan variances) do not see it, diff(), at() and rate() add it back.
+  /// Phase = values[i] + rate_offset·i·τ0: a large mean rate kept out of the 53 bits of `values`.
   double rate_offset = 0.0;
 
   [[nodiscard]] bool exact() const noexcept { return !counts.empty(); }

@@ -1,9 +1,7 @@
 #pragma once
 /// @file verdict.hpp
-/// Navigation accuracy class of a gyro from its bias instability B and angle random walk N, with
-/// the probability, from each estimate's uncertainty, that the true value meets each class.
-/// A run's class by a parameter is the best class whose limit the estimate meets; the overall
-/// class is the worse of the two; beyond the last class there is none (null in JSON).
+/// Accuracy class of a gyro from B and N (the best class whose limits the estimates meet; null
+/// beyond the last), with the probability that the true values meet each class.
 #include <functional>
 #include <nlohmann/json_fwd.hpp>
 #include <optional>

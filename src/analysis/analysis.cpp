@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <numbers>
@@ -17,8 +18,6 @@
 namespace rwcalc {
 
 namespace {
-
-constexpr double kZ95 = 1.959963984540054;
 
 nlohmann::json coef_json(const Coefficient& c) {
   return {{"value", c.value},       {"sigma", c.sigma},       {"low95", c.low},
@@ -192,10 +191,6 @@ Verdict verdict_of(const AnalysisResult& r, const AnalysisOptions& options) {
   }
   return decide(b_in, from_fit(Term::N), rho, options.verdict);
 }
-
-}  // namespace
-
-namespace {
 
 /// Mean rate, expected Earth rate and the bias between them.
 void earth_rate_and_bias(const Recording& rec, const AnalysisOptions& options, AnalysisResult& r) {
@@ -378,11 +373,8 @@ std::string format_report(const AnalysisResult& r) {
   const auto& f = r.fit;
   s += fmt::format("Noise coefficients (Gamma-deviance fit of {} octave points, tau {:g}..{:g} s; 95 % profile intervals)\n",
                    f.used.size(), f.used.front().tau_s, f.used.back().tau_s);
-  s += coef_line(f[Term::Q], "Q", "arcsec");
-  s += coef_line(f[Term::N], "N", "°/√h");
-  s += coef_line(f[Term::B], "B", "°/h");
-  s += coef_line(f[Term::K], "K", "°/h/√h");
-  s += coef_line(f[Term::R], "R", "°/h²");
+  for (const Term t : kAllTerms)
+    s += coef_line(f[t], term_name(t), std::array{"arcsec", "°/√h", "°/h", "°/h/√h", "°/h²"}[static_cast<std::size_t>(t)]);
   s += fmt::format("  chi2/dof = {:.2f} (dof {}, p = {:.3g}); corr(N,Q) = {:+.2f}, corr(N,B) = {:+.2f}\n", f.chi2_per_dof,
                    f.dof, f.p_value, f.corr_NQ, f.corr_NB);
   s += fmt::format("  (variance inflation for correlated AV points and few EDF: N x{:.2f}, B x{:.2f})\n\n",

@@ -281,8 +281,7 @@ std::string format_batch_text(const json& summary) {
     if (!t.at("worst").is_null()) {
       const auto& w = t.at("worst");
       s += fmt::format(" worst {}{:.3g} {} at {} °C", w.at("resolved").get<bool>() ? "" : "< ", w.at("value").get<double>(),
-                       t.at("unit").get<std::string>(),
-                       w.at("temperature_c").is_null() ? std::string("?") : fmt::format("{:+g}", w.at("temperature_c").get<double>()));
+                       t.at("unit").get<std::string>(), temp_cell(w));
     }
     s += "\n";
   }
@@ -335,14 +334,13 @@ std::string format_batch_csv(const json& summary) {
   for (const auto& r : summary.at("runs")) {
     const auto& v = r.at("verdict");
     const json* o = lookup(r, {"outliers"});
-    s += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4f},{},{}\n", csv_escape(r.at("source").get<std::string>()),
+    std::string values;  // value, sigma (and resolved, for the fit) of each series
+    for (const auto& se : series_list())
+      for (const char* k : {"value", "sigma", "resolved"})
+        if (std::string_view(k) != "resolved" || se.path[0] == "fit") values += val(r, se.path, k) + ",";
+    s += fmt::format("{},{},{}{},{},{},{:.4f},{},{}\n", csv_escape(r.at("source").get<std::string>()),
                      r.at("temperature_c").is_null() ? std::string("") : fmt::format("{:g}", r.at("temperature_c").get<double>()),
-                     val(r, {"fit", "N_deg_per_sqrt_h"}, "value"), val(r, {"fit", "N_deg_per_sqrt_h"}, "sigma"),
-                     val(r, {"fit", "N_deg_per_sqrt_h"}, "resolved"), val(r, {"methods", "N_direct_deg_per_sqrt_h"}, "value"),
-                     val(r, {"methods", "N_direct_deg_per_sqrt_h"}, "sigma"), val(r, {"fit", "B_deg_per_h"}, "value"),
-                     val(r, {"fit", "B_deg_per_h"}, "sigma"), val(r, {"fit", "B_deg_per_h"}, "resolved"),
-                     val(r, {"methods", "B_100s_deg_per_h"}, "value"), val(r, {"methods", "B_100s_deg_per_h"}, "sigma"),
-                     cls(v.at("class_N")), cls(v.at("class_B")), cls(v.at("class")), v.at("p_class").get<double>(),
+                     values, cls(v.at("class_N")), cls(v.at("class_B")), cls(v.at("class")), v.at("p_class").get<double>(),
                      o ? fmt::format("{}", o->value("count", std::size_t{0})) : std::string(),
                      o ? csv_escape(o->value("action", std::string())) : std::string());
   }

@@ -48,12 +48,9 @@ void check_outlier_share(const Recording& rec, OutlierAction action, double thre
       threshold, kDefaultOutlierThreshold));
 }
 
-/// The report of a finished scan (`found`, with its scale), located in the input.
-void report_outliers(const Recording& rec, OutlierAction action, double threshold, const OutlierScale& scale,
+/// The rest of the report (action and threshold are set) of a finished scan, located in the input.
+void report_outliers(const Recording& rec, OutlierAction action, const OutlierScale& scale,
                      const std::vector<Outlier>& found, OutlierReport& rep) {
-  rep = OutlierReport{};
-  rep.action = action;
-  rep.threshold = threshold;
   rep.scale_deg_per_h = scale.scale;
   rep.count = found.size();
   // Rate sample i comes from data sample i (pulses, rate) or i+1 (counter, angle: the later reading).
@@ -79,7 +76,7 @@ const Recording& screen_outliers(const Recording& read, OutlierAction action, do
   const OutlierScale scale = outlier_scale(read.phase);
   const std::vector<Outlier> found = find_outliers(read.phase, threshold, scale);
   check_outlier_share(read, action, threshold, found.size());
-  report_outliers(read, action, threshold, scale, found, report);
+  report_outliers(read, action, scale, found, report);
   if (action == OutlierAction::Keep || found.empty()) return read;
   edited = Recording{};
   edited.source = read.source;

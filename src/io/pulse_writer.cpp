@@ -35,26 +35,25 @@ struct LinePosition {
       fmt::format("{}: line {} (sample {}): {}; the file was not written", at.file, at.line, at.next_sample, cause));
 }
 
+void append_line(std::string& text, std::int64_t v) {
+  char line[24];
+  char* p = std::to_chars(line, line + sizeof line - 1, v).ptr;
+  *p++ = '\n';
+  text.append(line, p);
+}
+
 // One line per count: the increment C_k − C_{k−1} (`previous` is C_{k−1}; updated). An increment
 // beyond 64 bits would be written wrapped, i.e. as a wrong number: refused.
 void append_increments(std::string& text, std::span<const std::int64_t> counts, std::int64_t& previous, LinePosition& at) {
-  const std::size_t head = text.size();
-  text.resize(head + counts.size() * 21);  // 19 digits, a sign and the newline
-  char* p = text.data() + head;
-  char* const end = text.data() + text.size();
   for (const std::int64_t c : counts) {
     ++at.line;
     std::int64_t d = 0;
-    if (__builtin_sub_overflow(c, previous, &d)) {
-      text.resize(head);
+    if (__builtin_sub_overflow(c, previous, &d))
       throw_unwritable(at, fmt::format("the pulse count goes from {} to {}, an increment beyond 64 bits", previous, c));
-    }
-    p = std::to_chars(p, end, d).ptr;
-    *p++ = '\n';
+    append_line(text, d);
     previous = c;
     ++at.next_sample;
   }
-  text.resize(static_cast<std::size_t>(p - text.data()));
 }
 
 // One line per angle, ″ with 6 decimals. A NaN or an infinity is no angle: refused.
@@ -74,15 +73,7 @@ void append_angles(std::string& text, std::span<const double> angles, LinePositi
 
 std::string format_pulse_file(const Metadata& metadata, std::span<const std::int64_t> pulses) {
   std::string text = header_text(metadata, "pulses");
-  const std::size_t head = text.size();
-  text.resize(head + pulses.size() * 21);  // 19 digits, a sign and the newline
-  char* p = text.data() + head;
-  char* const end = text.data() + text.size();
-  for (const std::int64_t c : pulses) {
-    p = std::to_chars(p, end, c).ptr;
-    *p++ = '\n';
-  }
-  text.resize(static_cast<std::size_t>(p - text.data()));
+  for (const std::int64_t c : pulses) append_line(text, c);
   return text;
 }
 

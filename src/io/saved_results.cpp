@@ -189,7 +189,6 @@ void Checker::verdict(const Value& v) const {
         x.fail("must be greater than the class before it (classes are listed best first)");
     }
   }
-  // Without "classes" nothing can be sized against it: such a verdict (hand-made) is shown as is.
   for (const char* key : {"class", "class_B", "class_N", "class_strict"}) {
     // A class key present with null is "outside every class": member() must still see the key.
     if (combined_) (void)v.at(key);
@@ -209,12 +208,9 @@ void Checker::verdict(const Value& v) const {
   for (const char* key : {"B", "N"}) {
     if (const auto p = member(v, key)) {
       parameter_verdict(*p, n);
-      if (combined_) {
-        (void)p->at("class");
-        (void)p->at("class_strict");
-      }
-      class_number(p->find("class"), classes);
-      class_number(p->find("class_strict"), classes);
+      for (const char* k : {"class", "class_strict"})
+        if (combined_) (void)p->at(k);
+      for (const char* k : {"class", "class_strict"}) class_number(p->find(k), classes);
     }
   }
 }

@@ -82,8 +82,6 @@ bool solve_support(const Mat5& a, const Vec5& b, unsigned s, Vec5& d, double& ob
   int n = 0;
   for (int i = 0; i < P; ++i)
     if (s & (1u << i)) ids[static_cast<std::size_t>(n++)] = i;
-  // At most 5×5: fixed-capacity storage, no heap allocation (this runs for every support of
-  // every NNLS of every IRLS step of every profile).
   using SmallMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, P, P>;
   using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, P, 1>;
   SmallMat as(k, k);
@@ -195,13 +193,6 @@ double bartlett(double nu) {
   return -nu * (boost::math::digamma(nu / 2.0) - std::log(nu / 2.0));
 }
 
-double normal_quantile(double p) {
-  return boost::math::quantile(boost::math::normal_distribution<double>(), p);
-}
-double normal_cdf(double x) { return boost::math::cdf(boost::math::normal_distribution<double>(), x); }
-double chi2_quantile(double p, double dof) {
-  return boost::math::quantile(boost::math::chi_squared_distribution<double>(dof), p);
-}
 
 /// Illinois false position for f(a)·f(b) < 0; returns the root to a relative tolerance.
 template <class F>
@@ -266,11 +257,8 @@ double fisher_step(const Problem& pr, const Eigen::VectorXd& mu, int i, double z
   return info(i, i) > 0 ? std::sqrt(z * std::sqrt(dispersion / info(i, i))) : 0.0;
 }
 
-/// Covariance of the fit-scale estimates: sandwich I⁻¹ (GᵀWΣWG) I⁻¹ over the terms in `set`, and
-/// each term's inflation: the ratio to the independent-points I⁻¹ times the dispersion and the
-/// small-EDF factor 1 + a/ν_i, ν_i the term's own effective EDF 2ĉ²/Var(ĉ) (at most 1 + a: a term
-/// at the boundary). Σ is the covariance of the AV points (empty: independent with variance 2μ²/ν,
-/// where the sandwich equals I⁻¹).
+/// Sandwich covariance I⁻¹(GᵀWΣWG)I⁻¹ over the terms in `set` (Σ empty: I⁻¹), and each term's
+/// inflation: the ratio to I⁻¹ times dispersion·(1 + a/ν_i), ν_i = 2ĉ²/Var(ĉ).
 struct Sandwich {
   Eigen::MatrixXd cov;        // over `set`, scaled parameters
   std::vector<double> phi;    // per member of `set`
@@ -314,9 +302,7 @@ constexpr double kNoFloor = 1e12;
 constexpr double kMinCap = 1e4;
 
 /// The model-error floor as an EDF cap 2/s²: s² ≥ 0 solves Σ r²/(2/ν + s²) = J − p for the
-/// relative residuals r = (σ̂² − μ)/μ (Paule–Mandel), none when the residuals are already within
-/// their sampling scatter, at most kMinCap's. The points' correlation is ignored here (positively
-/// correlated points scatter less about a fit than independent ones, so this errs towards no floor).
+/// relative residuals r = (σ̂² − μ)/μ (Paule–Mandel); none when they are within their scatter.
 double model_error_cap(const Problem& pr, const Eigen::VectorXd& mu, int p) {
   const auto j = pr.y.size();
   const double target = static_cast<double>(std::max<Eigen::Index>(1, j - p));
@@ -380,11 +366,8 @@ double gamma_continuous(const PointPair& pp, const Structure& s, double h) {
   return -0.5 * g;
 }
 
-/// Σ_h count(h)·γ(h)² over the integer lags. γ is smooth between its kinks (where a structure
-/// function's argument crosses 0) and varies there on the scale of the smaller cluster, farther
-/// away on the scale of the distance to the nearest kink. So each stretch between kinks is summed
-/// with blocks that are single lags (or m/16) next to a kink and grow geometrically towards the
-/// middle of the stretch; each block contributes its length times the summand at its centre.
+/// Σ_h count(h)·γ(h)² over the integer lags: γ is smooth between its kinks, so each stretch is
+/// summed in blocks (length × summand at the centre) that grow geometrically away from the kinks.
 double graded_gamma_sq_sum(const PointPair& pp, const Structure& s) {
   const std::int64_t mx = std::max(pp.ma, pp.mb);
   std::array<std::int64_t, 11> knots{-(2 * pp.mb + 4 * mx), 2 * pp.ma + 4 * mx + 1};
@@ -487,9 +470,8 @@ std::vector<FitPoint> points_in_range(std::span<const FitPoint> points, const Fi
   return used;
 }
 
-/// Stages 1 and 2: the full model (all enabled terms) with the estimator's own EDFs; with the model
-/// covariance, the points' EDFs from the model (written into `used`) and the full model again;
-/// then the model-error floor (opt.edf_cap, estimated from the residuals unless fixed).
+/// The full model with the estimator's EDFs; with the model covariance, again with the model's
+/// EDFs (written into `used`); then again with the model-error floor (opt.edf_cap).
 Stage fit_full_model(std::vector<FitPoint>& used, const FitOptions& options, bool use_cov, FitOptions& opt) {
   opt = options;
   Stage full{make_problem(used, options), {}};
@@ -519,9 +501,7 @@ Stage fit_full_model(std::vector<FitPoint>& used, const FitOptions& options, boo
   return full;
 }
 
-/// Stage 3, term selection: a droppable term whose removal raises the scaled deviance by less
-/// than the χ²₁ quantile is left out of the model (`dropped`); it is reported as an upper bound
-/// from the full model. Returns the selected model's options and fit.
+/// Term selection (FitOptions::select_terms); returns the selected model's options and fit.
 std::pair<FitOptions, IrlsResult> select_terms(const std::vector<FitPoint>& used, const FitOptions& opt,
                                                const IrlsResult& full, const std::array<double, P>& phi_full,
                                                double chi2_1, std::array<bool, P>& dropped) {
@@ -589,8 +569,7 @@ void term_covariance(const Stage& st, const Eigen::MatrixXd& sigma_y, const FitO
   }
 }
 
-/// Stage 4, one term's profile-likelihood interval on the coefficient scale t = √d: an upper bound
-/// from the full model's profile for a dropped term, else the interval of the selected model.
+/// One term's profile-likelihood interval on t = √d (a dropped term: the full model's upper bound).
 Coefficient coefficient_interval(int i, const Stage& sel, const Stage& full, bool dropped, const FitResult& res,
                                  double z, double chi2_1) {
   const auto ui = static_cast<std::size_t>(i);
@@ -689,7 +668,7 @@ double FitResult::cdf(Term t, double value) const {
   const double v = c_from_coefficient(t, value) / pr.scale[i];
   const double dd = prof.delta(i, v);
   const double r = std::sqrt(dd / phi[static_cast<std::size_t>(i)]);
-  return normal_cdf(v >= d_hat[i] ? r : -r);
+  return boost::math::cdf(boost::math::normal_distribution<double>(), v >= d_hat[i] ? r : -r);
 }
 
 Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix<double, kTermCount, 1>& c,
@@ -713,8 +692,8 @@ Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix
 FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options) {
   FitResult res;
   res.used = points_in_range(points, options);
-  const double z = normal_quantile(0.5 + options.confidence / 2.0);
-  const double chi2_1 = chi2_quantile(options.confidence, 1.0);
+  const double z = boost::math::quantile(boost::math::normal_distribution<double>(), 0.5 + options.confidence / 2.0);
+  const double chi2_1 = boost::math::quantile(boost::math::chi_squared_distribution<double>(1.0), options.confidence);
   auto has_terms = [](const FitPoint& p) { return p.m > 0 && p.terms > 0; };
   res.model_covariance = options.model_covariance && std::all_of(res.used.begin(), res.used.end(), has_terms);
   FitOptions opt;  // edf_cap: the one in force (estimated when options.edf_cap is 0)

@@ -18,6 +18,16 @@ struct LineFit {
   bool ok = false;
 };
 
+/// Sample variance (divisor n − 1) of `v`, n ≥ 2.
+double sample_variance(const std::vector<double>& v) {
+  double mean = 0;
+  for (double x : v) mean += x;
+  mean /= static_cast<double>(v.size());
+  double ss = 0;
+  for (double x : v) ss += (x - mean) * (x - mean);
+  return ss / static_cast<double>(v.size() - 1);
+}
+
 /// Weighted regression s²(t) = a + b t with model-based weights (n − 1)/(a + b t)², iterated.
 LineFit fit_line(const std::vector<DirectPoint>& pts) {
   LineFit f;
@@ -56,16 +66,10 @@ std::vector<DirectPoint> direct_points(const PhaseSeries& x, std::size_t begin, 
   for (std::size_t m : ms) {
     const std::size_t k = len / m;
     if (k < 10) continue;
-    // Mean removal: the mean increment over the k intervals (Earth rate + bias), then the variance.
-    double mean = 0;
-    for (std::size_t j = 0; j < k; ++j) mean += x.diff(begin + (j + 1) * m, begin + j * m);
-    mean /= static_cast<double>(k);
-    double ss = 0;
-    for (std::size_t j = 0; j < k; ++j) {
-      const double d = x.diff(begin + (j + 1) * m, begin + j * m) - mean;
-      ss += d * d;
-    }
-    pts.push_back({static_cast<double>(m) * x.tau0_s, k, ss / static_cast<double>(k - 1)});
+    // The variance about the mean increment (Earth rate + bias).
+    std::vector<double> d(k);
+    for (std::size_t j = 0; j < k; ++j) d[j] = x.diff(begin + (j + 1) * m, begin + j * m);
+    pts.push_back({static_cast<double>(m) * x.tau0_s, k, sample_variance(d)});
   }
   return pts;
 }
@@ -117,13 +121,7 @@ DirectNResult direct_n(const PhaseSeries& x, const MethodOptions& o) {
   }
   r.segments_used = static_cast<int>(slopes.size());
   if (slopes.size() < 3) return r;
-  double mean = 0;
-  for (double s : slopes) mean += s;
-  mean /= static_cast<double>(slopes.size());
-  double var = 0;
-  for (double s : slopes) var += (s - mean) * (s - mean);
-  var /= static_cast<double>(slopes.size() - 1);
-  const double se_b = std::sqrt(var / static_cast<double>(slopes.size()));
+  const double se_b = std::sqrt(sample_variance(slopes) / static_cast<double>(slopes.size()));
   const double tq = boost::math::quantile(
       boost::math::students_t_distribution<double>(static_cast<double>(slopes.size() - 1)), 0.975);
 
@@ -166,18 +164,10 @@ BlockSpreadResult block_spread(const PhaseSeries& x, double block_s) {
   r.blocks = k;
   if (k < 3) return r;
   std::vector<double> y(k);
-  double mean = 0;
-  for (std::size_t j = 0; j < k; ++j) {
-    y[j] = x.diff((j + 1) * m, j * m) / r.block_s;
-    mean += y[j];
-  }
-  mean /= static_cast<double>(k);
-  double ss = 0;
-  for (double v : y) ss += (v - mean) * (v - mean);
-  const double var = ss / static_cast<double>(k - 1);
+  for (std::size_t j = 0; j < k; ++j) y[j] = x.diff((j + 1) * m, j * m) / r.block_s;
   auto& e = r.spread;
   e.valid = true;
-  e.value = std::sqrt(var);
+  e.value = std::sqrt(sample_variance(y));
   e.sigma = e.value / std::sqrt(2.0 * static_cast<double>(k - 1));
   lognormal_bounds(e);
   return r;

@@ -73,26 +73,6 @@ ParameterVerdict decide_one(const std::string& name, const std::string& unit, co
   return p;
 }
 
-std::string statement_of(const std::vector<double>& p_is, const std::optional<int>& cls, const std::vector<int>& classes,
-                         double decisive) {
-  const std::size_t n = classes.size();
-  const std::size_t s = cls ? static_cast<std::size_t>(std::find(classes.begin(), classes.end(), *cls) - classes.begin()) : n;
-  auto label = [&](std::size_t k) { return k < n ? fmt::format("{}", classes[k]) : std::string("outside"); };
-  if (p_is[s] >= decisive || n == 0) {
-    if (s == n) return fmt::format("outside class {} (P={:.2f})", classes.empty() ? 0 : classes.back(), p_is[s]);
-    return fmt::format("class {} (P={:.2f})", label(s), p_is[s]);
-  }
-  // Runner-up: the more probable neighbour.
-  std::size_t r = s;
-  if (s > 0) r = s - 1;
-  if (s + 1 <= n && (r == s || p_is[s + 1] > p_is[r])) r = s + 1;
-  const std::size_t a = std::min(s, r);
-  const std::size_t b = std::max(s, r);
-  if (b == n)
-    return fmt::format("class {} or outside class {} (P={:.2f}/{:.2f})", label(a), classes.back(), p_is[a], p_is[b]);
-  return fmt::format("class {} or {} (P={:.2f}/{:.2f})", label(a), label(b), p_is[a], p_is[b]);
-}
-
 nlohmann::json opt_class(const std::optional<int>& c) { return c ? nlohmann::json(*c) : nlohmann::json(nullptr); }
 
 nlohmann::json param_json(const ParameterVerdict& p) {
@@ -249,7 +229,22 @@ Verdict decide(const EstimateInput& B, const EstimateInput& N, double rho_BN, co
 std::string describe_class(const std::vector<double>& p_is, const std::optional<int>& cls,
                            const std::vector<int>& classes, double decisive) {
   if (p_is.size() != classes.size() + 1) throw UsageError("class probabilities do not match the class table");
-  return statement_of(p_is, cls, classes, decisive);
+  const std::size_t n = classes.size();
+  const std::size_t s = cls ? static_cast<std::size_t>(std::find(classes.begin(), classes.end(), *cls) - classes.begin()) : n;
+  auto label = [&](std::size_t k) { return k < n ? fmt::format("{}", classes[k]) : std::string("outside"); };
+  if (p_is[s] >= decisive || n == 0) {
+    if (s == n) return fmt::format("outside class {} (P={:.2f})", classes.empty() ? 0 : classes.back(), p_is[s]);
+    return fmt::format("class {} (P={:.2f})", label(s), p_is[s]);
+  }
+  // Runner-up: the more probable neighbour.
+  std::size_t r = s;
+  if (s > 0) r = s - 1;
+  if (s + 1 <= n && (r == s || p_is[s + 1] > p_is[r])) r = s + 1;
+  const std::size_t a = std::min(s, r);
+  const std::size_t b = std::max(s, r);
+  if (b == n)
+    return fmt::format("class {} or outside class {} (P={:.2f}/{:.2f})", label(a), classes.back(), p_is[a], p_is[b]);
+  return fmt::format("class {} or {} (P={:.2f}/{:.2f})", label(a), label(b), p_is[a], p_is[b]);
 }
 
 std::string Verdict::statement() const { return describe_class(p_is, cls, class_numbers, decisive_threshold); }

@@ -32,6 +32,18 @@ double fitted(const Value& fit, const char* key) {
   return v->number();
 }
 
+/// The model's scalar terms and their JSON keys, in the order they are read.
+constexpr std::pair<const char*, double NoiseModel::*> kScalars[] = {
+    {"arw_deg_per_sqrt_h", &NoiseModel::arw_deg_per_sqrt_h},
+    {"bias_instability_deg_per_h", &NoiseModel::bias_instability_deg_per_h},
+    {"rrw_deg_per_h_per_sqrt_h", &NoiseModel::rrw_deg_per_h_per_sqrt_h},
+    {"ramp_deg_per_h2", &NoiseModel::ramp_deg_per_h2},
+    {"bias_deg_per_h", &NoiseModel::bias_deg_per_h},
+    {"earth_rate_deg_per_h", &NoiseModel::earth_rate_deg_per_h},
+    {"white_angle_arcsec", &NoiseModel::white_angle_arcsec},
+    {"lowpass_tc_s", &NoiseModel::lowpass_tc_s},
+    {"output_lowpass_tc_s", &NoiseModel::output_lowpass_tc_s}};
+
 json profile_json(const TemperatureProfile& p) {
   if (p.kind == TemperatureProfile::Kind::Ramp) return {{"kind", "ramp"}, {"start_c", p.start_c}, {"end_c", p.end_c}};
   return {{"kind", "cycle"}, {"amplitude_c", p.amp_c}, {"period_s", p.period_s}};
@@ -40,16 +52,8 @@ json profile_json(const TemperatureProfile& p) {
 }  // namespace
 
 void to_json(json& j, const NoiseModel& m) {
-  j = json{{"arw_deg_per_sqrt_h", m.arw_deg_per_sqrt_h},
-           {"bias_instability_deg_per_h", m.bias_instability_deg_per_h},
-           {"rrw_deg_per_h_per_sqrt_h", m.rrw_deg_per_h_per_sqrt_h},
-           {"ramp_deg_per_h2", m.ramp_deg_per_h2},
-           {"bias_deg_per_h", m.bias_deg_per_h},
-           {"earth_rate_deg_per_h", m.earth_rate_deg_per_h},
-           {"readout", m.readout == ReadoutMode::White ? "white" : "counting"},
-           {"white_angle_arcsec", m.white_angle_arcsec},
-           {"lowpass_tc_s", m.lowpass_tc_s},
-           {"output_lowpass_tc_s", m.output_lowpass_tc_s}};
+  j = json{{"readout", m.readout == ReadoutMode::White ? "white" : "counting"}};
+  for (const auto& [key, member] : kScalars) j[key] = m.*member;
   json s = json::array(), g = json::array(), st = json::array(), w = json::array();
   for (const auto& x : m.sinusoids)
     s.push_back({{"frequency_hz", x.f_hz}, {"amplitude_deg_per_h", x.amp_deg_per_h}, {"phase_rad", x.phase_rad}});
@@ -94,15 +98,7 @@ void add_term(const Value& f, NoiseModel& m) { add_effect(f.object().at("effect"
 void model_from(const Value& j, NoiseModel& m) {
   j.object();
   m = NoiseModel{};
-  m.arw_deg_per_sqrt_h = num(j, "arw_deg_per_sqrt_h");
-  m.bias_instability_deg_per_h = num(j, "bias_instability_deg_per_h");
-  m.rrw_deg_per_h_per_sqrt_h = num(j, "rrw_deg_per_h_per_sqrt_h");
-  m.ramp_deg_per_h2 = num(j, "ramp_deg_per_h2");
-  m.bias_deg_per_h = num(j, "bias_deg_per_h");
-  m.earth_rate_deg_per_h = num(j, "earth_rate_deg_per_h");
-  m.white_angle_arcsec = num(j, "white_angle_arcsec");
-  m.lowpass_tc_s = num(j, "lowpass_tc_s");
-  m.output_lowpass_tc_s = num(j, "output_lowpass_tc_s");
+  for (const auto& [key, member] : kScalars) m.*member = num(j, key);
   if (const auto readout = j.find("readout")) {
     const auto r = readout->string();
     if (r == "white")

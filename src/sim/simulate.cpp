@@ -222,9 +222,8 @@ struct Simulator::Impl {
   }
 
   void prepare_flicker() {
-    // Circular convolution of length L ≥ 2n with a filter of L − n + 1 ≥ n + 1 taps gives, on
-    // the first n outputs, the linear convolution of the filter with an i.i.d. sequence that
-    // starts L − n samples before the record: no wrap-around, filter longer than the record.
+    // Circular convolution of length L ≥ 2n, filter of L − n + 1 taps: no wrap-around on the
+    // first n outputs.
     fft_size = good_fft_size(2 * flicker_n);
     const std::size_t taps = fft_size - flicker_n + 1;
     std::vector<double> h(fft_size, 0.0);
@@ -453,9 +452,7 @@ struct Simulator::Impl {
     st.lp_y = y;
   }
 
-  // Count whole pulses. The angle is carried as whole pulses `whole` plus a fraction in [0, 1),
-  // so its resolution does not degrade as the count grows; within a block it is a running sum from
-  // the block's fraction.
+  // The angle is carried as whole pulses plus a fraction in [0, 1): no loss as the count grows.
   void start_quantize(Pass& st) const {
     st.dither = model.readout == ReadoutMode::White;
     st.wa = model.white_angle_arcsec / q;
@@ -470,8 +467,7 @@ struct Simulator::Impl {
     st.frac = 0.0;
   }
 
-  // Every count must stay within ±kMaxSimulatedPulses, tested before it is converted to an integer
-  // (out of range, the conversion would wrap); NaN and infinity fail too.
+  // Tested before the conversion to an integer (out of range it would wrap); NaN fails too.
   static bool countable(double pulses) noexcept { return std::abs(pulses) < kMaxSimulatedPulses; }
 
   [[noreturn]] static void throw_uncountable(std::size_t k, double pulses, double tau0, double q) {
