@@ -21,8 +21,7 @@ Progress::Progress(std::string label, std::uint64_t total, std::FILE* sink)
 
 Progress::~Progress() { finish(); }
 
-std::string Progress::format_line(const std::string& label, std::uint64_t done, std::uint64_t total,
-                                  double elapsed_s) {
+std::string Progress::format_line(const std::string& label, std::uint64_t done, std::uint64_t total, double elapsed_s) {
   std::string line = fmt::format("{}: {}/{}", label, done, total);
   if (total > 0) line += fmt::format(" ({}%)", done * 100 / total);
   line += fmt::format(", {:.1f} s", elapsed_s);

@@ -44,8 +44,7 @@ class ScratchDir {
   ScratchDir() {
     std::string templ = (fs::temp_directory_path() / "rwcalc-plot-XXXXXX").string();
     if (mkdtemp(templ.data()) == nullptr)
-      throw OutputError(fmt::format("cannot create a temporary directory for gnuplot: {}",
-                                    std::strerror(errno)));
+      throw OutputError(fmt::format("cannot create a temporary directory for gnuplot: {}", std::strerror(errno)));
     path_ = templ;
     on_signal_.emplace_back(path_.string(), detail::RemoveOnSignal::Kind::Directory);
     for (const char* name : {"log", "gnuplot.log", "figure.gp", "figure.svg", "figure.png", "figure.pdf"})
@@ -79,8 +78,7 @@ ProcessResult run_process(const std::string& command, const std::vector<std::str
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
-                                   0600);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
   posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
   if (!cwd.empty()) posix_spawn_file_actions_addchdir_np(&actions, cwd.c_str());
   // A relative command path names a file from our directory, not from `cwd`.
