@@ -100,12 +100,10 @@ ProcessResult run_process(const std::string& command, const std::vector<std::str
   }
   r.started = true;
   int wstatus = 0;
-  while (waitpid(pid, &wstatus, 0) < 0) {
-    if (errno != EINTR) {
-      r.status = -1;
-      return r;
-    }
+  pid_t waited = 0;
+  while ((waited = waitpid(pid, &wstatus, 0)) < 0 && errno == EINTR) {
   }
+  if (waited < 0) return r;  // status -1
   r.status = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : 128 + WTERMSIG(wstatus);
   r.err = slurp(log);
   return r;
@@ -163,8 +161,7 @@ PlotFormat plot_format_for(std::string_view path) {
 
 std::string gnuplot_command() {
   const char* env = std::getenv("RWCALC_GNUPLOT");
-  if (env != nullptr && *env != '\0') return env;
-  return "gnuplot";
+  return env != nullptr && *env != '\0' ? env : "gnuplot";
 }
 
 bool gnuplot_available() {
