@@ -34,10 +34,6 @@ void set_sync_observer(SyncObserver observer) { g_sync_observer.store(observer);
 
 namespace {
 
-bool ends_with(std::string_view s, std::string_view suffix) {
-  return s.size() >= suffix.size() && s.substr(s.size() - suffix.size()) == suffix;
-}
-
 std::string reason(int err) { return std::strerror(err); }
 
 /// How the content reaches its target.
@@ -184,7 +180,7 @@ void AtomicOutput::State::open_target() {
         throw OutputError(fmt::format("{}: cannot keep the permissions of the replaced file: {}", path, reason(errno)));
     }
   }
-  if (ends_with(path, ".gz")) {
+  if (path.ends_with(".gz")) {
     // zlib takes over one descriptor and closes it; the other stays open to sync the finished file.
     const int own = ::dup(fd);
     if (own < 0 || (gz = gzdopen(own, "wb6")) == nullptr) {
