@@ -276,20 +276,15 @@ void AtomicOutput::write(std::string_view chunk) {
 void AtomicOutput::commit() {
   State& s = *state_;
   if (s.committed) return;
-  if (s.plan.sink == Sink::Stdout) {
-    s.committed = true;
-    flush_standard_output(std::cout);
-    return;
-  }
-  s.finish_writing();
+  if (s.plan.sink != Sink::Stdout) s.finish_writing();
   if (s.plan.sink == Sink::Replace) {
     s.move_into_place();
     s.tmp.clear();  // renamed: nothing to remove any more
     s.on_signal.reset();
-    s.committed = true;
-    sync_directory(s.plan.target, s.path);
   }
   s.committed = true;
+  if (s.plan.sink == Sink::Stdout) flush_standard_output(std::cout);
+  if (s.plan.sink == Sink::Replace) sync_directory(s.plan.target, s.path);
 }
 
 const std::string& AtomicOutput::path() const { return state_->path; }
