@@ -28,8 +28,7 @@ std::string report_html(const ReportInput& input, const ReportOptions& options);
 
 /// Writes report_html to DIR/report.html (DIR created when missing) atomically; an existing
 /// report is replaced only with `force`. Returns the path.
-std::string write_report(const std::string& dir, const ReportInput& input, const ReportOptions& options,
-                         bool force);
+std::string write_report(const std::string& dir, const ReportInput& input, const ReportOptions& options, bool force);
 
 /// Standard base64 (RFC 4648, padded), for inline figures.
 std::string base64_encode(std::string_view bytes);

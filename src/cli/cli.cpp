@@ -50,8 +50,7 @@ void build_app(CLI::App& app, Runner& runner, int argc, const char* const* argv)
 
 /// Parse argv into `app`. Returns the exit status to stop with (help, version, a parse error),
 /// or nothing when a command should run.
-std::optional<int> parse_args(CLI::App& app, int argc, const char* const* argv, std::ostream& out,
-                              std::ostream& err) {
+std::optional<int> parse_args(CLI::App& app, int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   try {
     std::vector<std::string> args;
     for (int i = argc - 1; i > 0; --i) args.emplace_back(argv[i]);

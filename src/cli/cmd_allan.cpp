@@ -152,8 +152,7 @@ void register_allan(CLI::App& app, Runner& runner) {
                   "seconds such as 0.01,1,10 (each a whole number of samples)")
       ->capture_default_str();
   sub->add_option("--confidence", args->confidence, "Two-sided confidence of the bounds (0..1)")
-      ->check(real_in(0.0, 1.0, "", Ends::Open))
-      ->capture_default_str();
+      ->check(real_in(0.0, 1.0, "", Ends::Open))->capture_default_str();
   add_outlier_options(*sub, args->outliers, args->outlier_threshold);
   auto* json = sub->add_flag("--json", args->json, "Print JSON instead of the table");
   auto* csv = sub->add_flag("--csv", args->csv, "Print CSV instead of the table");

@@ -8,12 +8,10 @@
 #include <chrono>
 #include <ctime>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <ostream>
-#include <sstream>
 
 #include "cli/analyze_args.hpp"
 #include "cli/commands.hpp"
@@ -231,11 +229,9 @@ void register_report(CLI::App& app, Runner& runner) {
   sub->add_option("--title", cmd->title, "Title of the report");
   sub->add_flag("--diagnose", cmd->diagnose, "Also diagnose each recording (what the noise model misses)");
   sub->add_option("--diagnose-runs", cmd->diagnose_runs, "Simulated records per diagnosis ensemble")
-      ->check(whole_in(10, 100000))
-      ->capture_default_str();
+      ->check(whole_in(10, 100000))->capture_default_str();
   sub->add_option("--diagnose-seed", cmd->diagnose_seed, "Seed of the diagnosis ensembles")
-      ->check(whole_in(0, UINT64_MAX))
-      ->capture_default_str();
+      ->check(whole_in(0, UINT64_MAX))->capture_default_str();
   sub->add_flag("--no-figures", cmd->no_figures, "Tables only (needs no gnuplot)");
   sub->add_flag("--force", cmd->force, "Replace an existing report.html");
   sub->callback([cmd, &runner] {

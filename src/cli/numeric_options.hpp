@@ -16,9 +16,6 @@ namespace rwcalc::cli {
 /// Name every numeric check carries (the tests look for it on every numeric option).
 inline constexpr const char* kNumberCheck = "NUMBER_CHECK";
 
-/// Most threads or parallel jobs an option may ask for.
-inline constexpr std::uint64_t kMaxThreads = 4096;
-
 /// Whether an end of a range is included.
 enum class Ends { Closed, OpenLow, OpenHigh, Open };
 

@@ -12,15 +12,15 @@ namespace rwcalc::cli {
 
 namespace {
 
-PlotOptions plot_options(const PlotArgs& a, bool force) {
+/// The figure of `j` drawn by `plot`, when asked for; notes and the files written go to io.err.
+void draw(const PlotArgs& a, PlotResult (*plot)(const nlohmann::json&, const PlotOptions&), const nlohmann::json& j,
+          bool force, Io& io) {
+  if (!a.any()) return;
   PlotOptions o;
   o.output = a.plot;
   o.script = a.script;
   o.force = force;
-  return o;
-}
-
-void tell(const PlotArgs& a, const PlotResult& r, Io& io) {
+  const PlotResult r = plot(j, o);
   for (const auto& note : r.notes) print_message(io.err, "note: " + note);
   if (!a.plot.empty()) print_message(io.err, fmt::format("figure written to {} ({} data series)", a.plot, r.series));
   if (!a.script.empty()) print_message(io.err, fmt::format("gnuplot script written to {}", a.script));
@@ -47,18 +47,15 @@ void PlotArgs::check(bool force, const std::vector<OutputTarget>& others) const 
 }
 
 void PlotArgs::draw_analysis(const nlohmann::json& analysis, bool force, Io& io) const {
-  if (!any()) return;
-  tell(*this, plot_analysis(analysis, plot_options(*this, force)), io);
+  draw(*this, plot_analysis, analysis, force, io);
 }
 
 void PlotArgs::draw_batch(const nlohmann::json& batch, bool force, Io& io) const {
-  if (!any()) return;
-  tell(*this, plot_batch(batch, plot_options(*this, force)), io);
+  draw(*this, plot_batch, batch, force, io);
 }
 
 void PlotArgs::draw_diagnosis(const nlohmann::json& diagnosis, bool force, Io& io) const {
-  if (!any()) return;
-  tell(*this, plot_diagnosis(diagnosis, plot_options(*this, force)), io);
+  draw(*this, plot_diagnosis, diagnosis, force, io);
 }
 
 }  // namespace rwcalc::cli

@@ -88,11 +88,7 @@ class LocatingHandler {
   }
   bool string(json::string_t& s) { return value() && dom_.string(s); }
   bool binary(json::binary_t& b) { return value() && dom_.binary(b); }
-  bool start_object(std::size_t n) {
-    value();
-    push(false);
-    return dom_.start_object(n);
-  }
+  bool start_object(std::size_t n) { return value() && push(false) && dom_.start_object(n); }
   bool key(json::string_t& k) {
     frames_.back().key = k;
     // nlohmann keeps the last of two equal keys: a second "p_meets" would silently replace the first.
@@ -100,19 +96,9 @@ class LocatingHandler {
       throw InputError(file_, current_line(), fmt::format("{} is given twice in one object", where(path_of_next())));
     return dom_.key(k);
   }
-  bool end_object() {
-    frames_.pop_back();
-    return dom_.end_object();
-  }
-  bool start_array(std::size_t n) {
-    value();
-    push(true);
-    return dom_.start_array(n);
-  }
-  bool end_array() {
-    frames_.pop_back();
-    return dom_.end_array();
-  }
+  bool end_object() { return pop() && dom_.end_object(); }
+  bool start_array(std::size_t n) { return value() && push(true) && dom_.start_array(n); }
+  bool end_array() { return pop() && dom_.end_array(); }
   bool parse_error(std::size_t position, const std::string& token, const nlohmann::detail::exception& e) {
     const std::size_t line = line_at(position > 0 ? position - 1 : 0);
     // nlohmann refuses a number beyond a double (1e400) as out_of_range 406.
@@ -137,10 +123,16 @@ class LocatingHandler {
     if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
     return true;
   }
-  void push(bool array) {
+  /// Enters an object or array (always true).
+  bool push(bool array) {
     if (frames_.size() >= kMaxDepth)
       throw InputError(file_, current_line(), fmt::format("nested deeper than {} levels", kMaxDepth));
     frames_.push_back({array, last_path_, {}, 0});
+    return true;
+  }
+  bool pop() {
+    frames_.pop_back();
+    return true;
   }
   std::string path_of_next() const {
     if (frames_.empty()) return {};

@@ -34,10 +34,6 @@ void set_sync_observer(SyncObserver observer) { g_sync_observer.store(observer);
 
 namespace {
 
-bool ends_with(std::string_view s, std::string_view suffix) {
-  return s.size() >= suffix.size() && s.substr(s.size() - suffix.size()) == suffix;
-}
-
 std::string reason(int err) { return std::strerror(err); }
 
 /// How the content reaches its target.
@@ -184,7 +180,7 @@ void AtomicOutput::State::open_target() {
         throw OutputError(fmt::format("{}: cannot keep the permissions of the replaced file: {}", path, reason(errno)));
     }
   }
-  if (ends_with(path, ".gz")) {
+  if (path.ends_with(".gz")) {
     // zlib takes over one descriptor and closes it; the other stays open to sync the finished file.
     const int own = ::dup(fd);
     if (own < 0 || (gz = gzdopen(own, "wb6")) == nullptr) {
@@ -280,20 +276,15 @@ void AtomicOutput::write(std::string_view chunk) {
 void AtomicOutput::commit() {
   State& s = *state_;
   if (s.committed) return;
-  if (s.plan.sink == Sink::Stdout) {
-    s.committed = true;
-    flush_standard_output(std::cout);
-    return;
-  }
-  s.finish_writing();
+  if (s.plan.sink != Sink::Stdout) s.finish_writing();
   if (s.plan.sink == Sink::Replace) {
     s.move_into_place();
     s.tmp.clear();  // renamed: nothing to remove any more
     s.on_signal.reset();
-    s.committed = true;
-    sync_directory(s.plan.target, s.path);
   }
   s.committed = true;
+  if (s.plan.sink == Sink::Stdout) flush_standard_output(std::cout);
+  if (s.plan.sink == Sink::Replace) sync_directory(s.plan.target, s.path);
 }
 
 const std::string& AtomicOutput::path() const { return state_->path; }

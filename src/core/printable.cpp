@@ -20,15 +20,14 @@ std::size_t utf8_sequence(std::string_view s, std::size_t i, char32_t& code) {
     code = lead;
     return 1;
   }
-  if ((lead & 0xE0) == 0xC0) {
+  if ((lead & 0xE0) == 0xC0)
     n = 2, code = lead & 0x1F, min = 0x80;
-  } else if ((lead & 0xF0) == 0xE0) {
+  else if ((lead & 0xF0) == 0xE0)
     n = 3, code = lead & 0x0F, min = 0x800;
-  } else if ((lead & 0xF8) == 0xF0) {
+  else if ((lead & 0xF8) == 0xF0)
     n = 4, code = lead & 0x07, min = 0x10000;
-  } else {
+  else
     return 0;
-  }
   if (i + n > s.size()) return 0;
   for (std::size_t k = 1; k < n; ++k) {
     const auto b = static_cast<unsigned char>(s[i + k]);
@@ -52,30 +51,18 @@ bool acting_code_point(char32_t c) {
 std::string printable(std::string_view text) {
   std::string out;
   out.reserve(text.size());
-  std::size_t i = 0;
-  while (i < text.size()) {
-    const auto byte = static_cast<unsigned char>(text[i]);
+  for (std::size_t i = 0; i < text.size();) {
     char32_t code = 0;
     const std::size_t n = utf8_sequence(text, i, code);
-    if (n == 0) {
-      out += fmt::format("\\x{:02x}", byte);
-      ++i;
-      continue;
-    }
-    if (code == '\n') {
-      out += "\\n";
-    } else if (code == '\r') {
-      out += "\\r";
-    } else if (code == '\t') {
-      out += "\\t";
-    } else if (code < 0x20 || code == 0x7F) {
-      out += fmt::format("\\x{:02x}", byte);
-    } else if (acting_code_point(code)) {
+    if (n == 0 || code == 0x7F || (code < 0x20 && code != '\n' && code != '\r' && code != '\t'))
+      out += fmt::format("\\x{:02x}", static_cast<unsigned char>(text[i]));  // invalid byte or C0 control
+    else if (code < 0x20)
+      out += code == '\n' ? "\\n" : code == '\r' ? "\\r" : "\\t";
+    else if (acting_code_point(code))
       out += fmt::format("\\u{:04x}", static_cast<std::uint32_t>(code));
-    } else {
+    else
       out.append(text.substr(i, n));
-    }
-    i += n;
+    i += n == 0 ? 1 : n;
   }
   return out;
 }

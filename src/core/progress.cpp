@@ -21,8 +21,7 @@ Progress::Progress(std::string label, std::uint64_t total, std::FILE* sink)
 
 Progress::~Progress() { finish(); }
 
-std::string Progress::format_line(const std::string& label, std::uint64_t done, std::uint64_t total,
-                                  double elapsed_s) {
+std::string Progress::format_line(const std::string& label, std::uint64_t done, std::uint64_t total, double elapsed_s) {
   std::string line = fmt::format("{}: {}/{}", label, done, total);
   if (total > 0) line += fmt::format(" ({}%)", done * 100 / total);
   line += fmt::format(", {:.1f} s", elapsed_s);
@@ -52,8 +51,7 @@ void Progress::draw(std::uint64_t done) noexcept {
     const std::size_t w = line.size();
     if (w < width_) line.append(width_ - w, ' ');  // wipe the tail of a longer previous line
     width_ = w;
-    std::fputc('\r', sink_);
-    std::fputs(line.c_str(), sink_);
+    std::fprintf(sink_, "\r%s", line.c_str());
     std::fflush(sink_);
     drawn_ = true;
   } catch (...) {
@@ -67,9 +65,7 @@ void Progress::finish() noexcept {
     if (finished_) return;
     finished_ = true;
     if (sink_ && drawn_) {
-      std::fputc('\r', sink_);
-      std::fputs(std::string(width_, ' ').c_str(), sink_);
-      std::fputc('\r', sink_);
+      std::fprintf(sink_, "\r%s\r", std::string(width_, ' ').c_str());
       std::fflush(sink_);
     }
   } catch (...) {

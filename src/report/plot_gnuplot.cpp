@@ -13,7 +13,6 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
-#include <random>
 #include <sstream>
 #include <vector>
 
@@ -44,8 +43,7 @@ class ScratchDir {
   ScratchDir() {
     std::string templ = (fs::temp_directory_path() / "rwcalc-plot-XXXXXX").string();
     if (mkdtemp(templ.data()) == nullptr)
-      throw OutputError(fmt::format("cannot create a temporary directory for gnuplot: {}",
-                                    std::strerror(errno)));
+      throw OutputError(fmt::format("cannot create a temporary directory for gnuplot: {}", std::strerror(errno)));
     path_ = templ;
     on_signal_.emplace_back(path_.string(), detail::RemoveOnSignal::Kind::Directory);
     for (const char* name : {"log", "gnuplot.log", "figure.gp", "figure.svg", "figure.png", "figure.pdf"})
@@ -79,8 +77,7 @@ ProcessResult run_process(const std::string& command, const std::vector<std::str
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
-                                   0600);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
   posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
   if (!cwd.empty()) posix_spawn_file_actions_addchdir_np(&actions, cwd.c_str());
   // A relative command path names a file from our directory, not from `cwd`.
@@ -102,12 +99,10 @@ ProcessResult run_process(const std::string& command, const std::vector<std::str
   }
   r.started = true;
   int wstatus = 0;
-  while (waitpid(pid, &wstatus, 0) < 0) {
-    if (errno != EINTR) {
-      r.status = -1;
-      return r;
-    }
+  pid_t waited = 0;
+  while ((waited = waitpid(pid, &wstatus, 0)) < 0 && errno == EINTR) {
   }
+  if (waited < 0) return r;  // status -1
   r.status = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : 128 + WTERMSIG(wstatus);
   r.err = slurp(log);
   return r;
@@ -165,8 +160,7 @@ PlotFormat plot_format_for(std::string_view path) {
 
 std::string gnuplot_command() {
   const char* env = std::getenv("RWCALC_GNUPLOT");
-  if (env != nullptr && *env != '\0') return env;
-  return "gnuplot";
+  return env != nullptr && *env != '\0' ? env : "gnuplot";
 }
 
 bool gnuplot_available() {

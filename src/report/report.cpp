@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cmath>
 #include <filesystem>
 #include <optional>
 
@@ -494,8 +493,7 @@ std::string report_html(const ReportInput& input, const ReportOptions& options) 
   return h + "</body>\n</html>\n";
 }
 
-std::string write_report(const std::string& dir, const ReportInput& input, const ReportOptions& options,
-                         bool force) {
+std::string write_report(const std::string& dir, const ReportInput& input, const ReportOptions& options, bool force) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec || !std::filesystem::is_directory(dir))
