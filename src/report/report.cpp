@@ -310,13 +310,13 @@ std::string fit_table(const json& fit, std::size_t index) {
                               "σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)B² + K²τ/3 + R²τ²/2</caption>\n"
                               "<tr><th>term</th><th>value ± standard error [95 %]</th><th>unit</th></tr>\n",
                               index + 1);
-  static constexpr std::array<std::array<const char*, 3>, 5> kTerms{
+  static constexpr std::array<std::array<const char*, 3>, 5> kCoefficientRows{
       {{"Q_arcsec", "Q quantization", lbl::angle},
        {"N_deg_per_sqrt_h", "N angle random walk", lbl::arw},
        {"B_deg_per_h", "B bias instability", lbl::rate},
        {"K_deg_per_h_per_sqrt_h", "K rate random walk", lbl::rrw},
        {"R_deg_per_h2", "R rate ramp", lbl::ramp}}};
-  for (const auto& [key, name, unit] : kTerms)
+  for (const auto& [key, name, unit] : kCoefficientRows)
     s += fmt::format("<tr><td>{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n", name, coef_cell(at(fit, key)), unit);
   if (const auto c = num(fit, "chi2_per_dof")) {
     std::string gof = fmt::format("χ²/dof = {:.3g}", *c);

@@ -13,7 +13,6 @@ namespace rwcalc {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 
 // 1 − (3 − 4e^{−x} + e^{−2x})/(2x) without cancellation (x > 0).
 double gm_avar_factor(double x) {
@@ -50,7 +49,7 @@ std::size_t SimulationSettings::samples() const {
 }
 
 double earth_rate_at(double latitude_deg) {
-  return units::earth_rate_deg_per_h * std::sin(latitude_deg * kPi / 180.0);
+  return units::earth_rate_deg_per_h * std::sin(latitude_deg * std::numbers::pi / 180.0);
 }
 
 double readout_q_arcsec(ReadoutMode mode, double scale_arcsec) {
@@ -103,7 +102,7 @@ void validate(const NoiseModel& m, const SimulationSettings& s) {
 double flicker_avar(double b, std::size_t m) {
   // AV(m) = (2B²/(π m²)) ∫_0^{π/2} sin⁴(mu)/sin³(u) du: the discrete Kasdin spectrum
   // B²τ0/(2 sin πfτ0) through the Allan transfer function of m-sample means.
-  const double floor = 2.0 * b * b * std::numbers::ln2 / kPi;
+  const double floor = 2.0 * b * b * std::numbers::ln2 / std::numbers::pi;
   if (m > (std::size_t{1} << 16)) return floor;
   static constexpr double kX[8] = {-0.9602898564975363, -0.7966664774136267, -0.5255324099163290, -0.1834346424956498,
                                    0.1834346424956498,  0.5255324099163290,  0.7966664774136267,  0.9602898564975363};
@@ -111,7 +110,7 @@ double flicker_avar(double b, std::size_t m) {
                                    0.3626837833783620, 0.3137066378926775, 0.2223810344533745, 0.1012285362903763};
   const double md = static_cast<double>(m);
   const std::size_t panels = 8 * m;
-  const double h = (kPi / 2.0) / static_cast<double>(panels);
+  const double h = (std::numbers::pi / 2.0) / static_cast<double>(panels);
   double sum = 0.0;
   for (std::size_t p = 0; p < panels; ++p) {
     const double mid = (static_cast<double>(p) + 0.5) * h;
@@ -122,7 +121,7 @@ double flicker_avar(double b, std::size_t m) {
       sum += kW[i] * (s * s * s * s) / (su * su * su);
     }
   }
-  return 2.0 * b * b / (kPi * md * md) * sum * 0.5 * h;
+  return 2.0 * b * b / (std::numbers::pi * md * md) * sum * 0.5 * h;
 }
 
 double theoretical_avar(const NoiseModel& model, double tau0, double q, std::size_t m) {
@@ -133,7 +132,7 @@ double theoretical_avar(const NoiseModel& model, double tau0, double q, std::siz
   double av = n_s * n_s / tau + k_s * k_s * tau / 3.0 + r_s * r_s * tau * tau / 2.0;
   if (model.bias_instability_deg_per_h > 0) av += flicker_avar(model.bias_instability_deg_per_h, m);
   for (const auto& s : model.sinusoids) {
-    const double x = kPi * s.f_hz * tau;
+    const double x = std::numbers::pi * s.f_hz * tau;
     const double v = std::sin(x) * std::sin(x) / x;
     av += s.amp_deg_per_h * s.amp_deg_per_h * v * v;
   }

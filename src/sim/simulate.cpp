@@ -18,8 +18,6 @@ namespace rwcalc {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
 // Random stream numbers: one per term, so terms never share draws.
 enum Stream : std::uint64_t {
   kArwStream = 1,
@@ -94,7 +92,7 @@ double temperature_angle(const TemperatureBias& tb, double t, double t_nominal, 
     const double slope = record_s > 0 ? (p.end_c - p.start_c) / record_s : 0.0;
     return c * ((p.start_c - t_nominal) * t + slope * t * t / 2.0);
   }
-  const double w = 2.0 * kPi / p.period_s;
+  const double w = 2.0 * std::numbers::pi / p.period_s;
   return c * p.amp_c * (1.0 - std::cos(w * t)) / w;
 }
 
@@ -157,7 +155,7 @@ double fast_flicker_avar(double b, std::size_t m, std::size_t decimation) {
     total += -sum;  // −½·2·Σ_{i<j}
   }
   const double md = static_cast<double>(m);
-  return (4.0 * b * b / kPi) * total / static_cast<double>(d) / (2.0 * md * md);
+  return (4.0 * b * b / std::numbers::pi) * total / static_cast<double>(d) / (2.0 * md * md);
 }
 
 struct Simulator::Impl {
@@ -198,7 +196,7 @@ struct Simulator::Impl {
     if (model.bias_instability_deg_per_h > 0) prepare_flicker();
     for (const auto& l : model.sinusoids) {
       LineSteps t;
-      const double w = 2.0 * kPi * l.f_hz;
+      const double w = 2.0 * std::numbers::pi * l.f_hz;
       for (std::size_t j = 0; j < kBlock; ++j) {
         const double b = w * static_cast<double>(j + 1) * tau0;
         t.c.push_back(std::cos(b));
@@ -369,8 +367,8 @@ struct Simulator::Impl {
     // sin(α + β_j) = sin α cos β_j + cos α sin β_j, β_j = (j + 1)ωτ0 from the tables.
     for (std::size_t i = 0; i < model.sinusoids.size(); ++i) {
       const auto& l = model.sinusoids[i];
-      const double a = l.amp_deg_per_h / (2.0 * kPi * l.f_hz);
-      const double alpha = 2.0 * kPi * l.f_hz * (static_cast<double>(b) * tau0) + l.phase_rad;
+      const double a = l.amp_deg_per_h / (2.0 * std::numbers::pi * l.f_hz);
+      const double alpha = 2.0 * std::numbers::pi * l.f_hz * (static_cast<double>(b) * tau0) + l.phase_rad;
       const double sa = a * std::sin(alpha), ca = a * std::cos(alpha);
       const double* tc = line_steps[i].c.data();
       const double* ts = line_steps[i].s.data();
