@@ -1,6 +1,6 @@
 // Fits of the mid-τ Allan variance against an ensemble reference: Q, N, B, K corrections under
 // ≥ 0 constraints, the Gauss–Markov bump beside them, and the reference without one run.
-#include "diagnose/mid_tau.hpp"
+#include "diagnose/ensemble.hpp"
 
 #include <Eigen/Dense>
 
@@ -13,7 +13,8 @@ namespace rwcalc::diag {
 
 namespace {
 
-constexpr double kCorrShrink = 0.2;  ///< weight of the identity in the mid-τ correlation matrix
+/// Weight of the identity in the mid-τ correlation matrix: the runs are fewer than the grid points.
+constexpr double kCorrShrink = 0.2;
 constexpr double kModelEdf = 1000.0;  ///< model floor of the EDF in the deviance (as band_misfit)
 
 /// The measured-minus-reference mid-τ AV, its weights (1/ensemble variance) and the Q, N, B, K
@@ -48,9 +49,8 @@ MidTauProblem mid_tau_problem(const std::vector<double>& v, const MidTauReferenc
   return p;
 }
 
-/// The problem decorrelated with the reference's correlation matrix: with C = D^½ R D^½ (D the
-/// variances) = L·Lᵀ, y and every column are replaced by L⁻¹y, L⁻¹x and the weights by 1, so that
-/// least squares minimise the generalised χ². Without a correlation matrix: unchanged.
+/// The problem decorrelated (C = L·Lᵀ; y, x → L⁻¹y, L⁻¹x, weights 1) so that least squares
+/// minimise the generalised χ². Without a correlation matrix: unchanged.
 struct Whitener {
   Eigen::MatrixXd L;
   bool on = false;
@@ -67,14 +67,12 @@ Whitener whiten(MidTauProblem& p, const MidTauReference& ref) {
   const std::size_t g = ref.grid.size();
   const std::size_t n = p.y.size();
   if (ref.cov.size() != g * g || n < 2) return wh;
-  // Correlations shrunk toward the identity: the runs are fewer than the grid points.
-  const double shrink = kCorrShrink;
   Eigen::MatrixXd C(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
   for (std::size_t a = 0; a < n; ++a)
     for (std::size_t b = 0; b < n; ++b) {
       const std::size_t ia = p.index[a], ib = p.index[b];
       const double d = std::sqrt(ref.var[ia] * ref.var[ib]);
-      double rho = a == b ? 1.0 : (d > 0 ? std::clamp(ref.cov[ia * g + ib] / d, -1.0, 1.0) * (1.0 - shrink) : 0.0);
+      double rho = a == b ? 1.0 : (d > 0 ? std::clamp(ref.cov[ia * g + ib] / d, -1.0, 1.0) * (1.0 - kCorrShrink) : 0.0);
       C(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) = rho / std::sqrt(p.w[a] * p.w[b]);
     }
   Eigen::LLT<Eigen::MatrixXd> llt(C);
@@ -87,10 +85,8 @@ Whitener whiten(MidTauProblem& p, const MidTauReference& ref) {
   return wh;
 }
 
-/// Weighted least squares of the mid-τ problem with the corrections of N², B², K² constrained so
-/// that the corrected coefficients c_base + Δc stay ≥ 0 (active set: a correction that would make
-/// its coefficient negative is held at −c_base and the rest re-fitted). `shape` (optional) is a
-/// further, unconstrained column. Q² is free (the read-out is simulated, not fitted).
+/// Weighted least squares with c_base + Δc ≥ 0 for N², B², K² (active set: the most negative is
+/// held at −c_base and the rest re-fitted); `shape`: a further, free column. Q² is free.
 struct ConstrainedFit {
   double chi2 = 0;
   std::array<double, 4> dc{0, 0, 0, 0};
@@ -157,22 +153,13 @@ double gauss_markov_avar(double tau, double tc) {
 }
 
 std::array<double, 4> power_law_corrections(const std::vector<double>& v, const MidTauReference& ref,
-                                            const std::array<double, 4>& c_base) {
-  std::array<double, 4> dc{0, 0, 0, 0};
-  const MidTauProblem p = mid_tau_problem(v, ref);
-  if (p.y.size() < 6) return dc;
-  return constrained_fit(p, c_base, nullptr).dc;
-}
-
-std::array<double, 4> calibration_corrections(const std::vector<double>& v, const MidTauReference& ref,
-                                              const std::array<double, 4>& c_base, double tau_max) {
-  std::array<double, 4> dc{0, 0, 0, 0};
+                                            const std::array<double, 4>& c_base, double tau_max, bool hold_k) {
   std::vector<double> w = v;
   for (std::size_t i = 0; i < w.size() && i < ref.tau.size(); ++i)
     if (ref.tau[i] > tau_max) w[i] = 0.0;  // left out of the problem
   const MidTauProblem p = mid_tau_problem(w, ref);
-  if (p.y.size() < 6) return dc;
-  return constrained_fit(p, c_base, nullptr, {true, true, true, false}).dc;
+  if (p.y.size() < 6) return {0, 0, 0, 0};
+  return constrained_fit(p, c_base, nullptr, {true, true, true, !hold_k}).dc;
 }
 
 ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& ref,
