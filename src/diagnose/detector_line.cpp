@@ -95,6 +95,17 @@ Resolution search(const std::vector<double>& y, std::size_t len, double t0, doub
   return r;
 }
 
+/// P at k ± d, d = inner, inner + step, … ≤ outer, within P[2 …].
+std::vector<double> ring_values(const std::vector<double>& P, std::size_t k, std::size_t inner, std::size_t outer,
+                                std::size_t step) {
+  std::vector<double> v;
+  for (std::size_t d = inner; d <= outer; d += step) {
+    if (k > d + 1) v.push_back(P[k - d]);
+    if (k + d < P.size()) v.push_back(P[k + d]);
+  }
+  return v;
+}
+
 /// A line that won at a Welch resolution: its power is the excess over the level 48–96 true bins
 /// away, summed over the contiguous bins above it; frequency and width from its centroid and
 /// spread, phase 0. A strong coherent line can win there too: when the whole record's highest bin
@@ -104,12 +115,8 @@ bool broad_line(LineEstimate& e, Resolution& best, const std::vector<double>& fu
                 double t0, double& f0) {
   const auto inner = static_cast<std::size_t>(48 * best.pad), outer = static_cast<std::size_t>(96 * best.pad);
   const std::size_t half = best.P.size() - 1;
-  std::vector<double> ring;
   const auto stepb = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(best.pad)));
-  for (std::size_t d = inner; d <= outer; d += stepb) {
-    if (best.k > d + 1) ring.push_back(best.P[best.k - d]);
-    if (best.k + d <= half) ring.push_back(best.P[best.k + d]);
-  }
+  std::vector<double> ring = ring_values(best.P, best.k, inner, outer, stepb);
   const double med = boost::math::gamma_p_inv(best.K, 0.5) / best.K;
   const double base = ring.empty() ? best.level : median_of(ring) / med;
   std::size_t a = best.k, b = best.k;
@@ -138,11 +145,7 @@ bool broad_line(LineEstimate& e, Resolution& best, const std::vector<double>& fu
     e.coherent = true;
     e.resolution_hz = 1.0 / (t0 * static_cast<double>(n));
     f0 = static_cast<double>(kk) * full_df;
-    std::vector<double> lv;  // the noise level at the line, ±48 … ±96 true bins
-    for (std::size_t d = 96; d <= 192; d += 2) {
-      if (kk > d + 1) lv.push_back(full_P[kk - d]);
-      if (kk + d < full_P.size()) lv.push_back(full_P[kk + d]);
-    }
+    std::vector<double> lv = ring_values(full_P, kk, 96, 192, 2);  // the level at ±48 … ±96 true bins
     best.level = median_of(lv) / std::log(2.0);
     best.w2 = 0.375 * static_cast<double>(n);
     return false;

@@ -204,14 +204,9 @@ class LowpassDetector final : public RecordDetector {
   [[nodiscard]] bool shows_in(const Trial&) const override { return true; }
   /// The filter and the white angle noise before it from the short-τ octave AV; N, B, K stay.
   void estimate(const Stretch& s, Extension& x) const override {
-    std::vector<std::int64_t> m;
-    std::vector<double> v, edf;
-    for (const auto& p : s.analysis->allan.points) {
-      m.push_back(p.m);
-      v.push_back(p.var);
-      edf.push_back(p.edf);
-    }
-    const auto est = output_lowpass_detect(m, v, edf, s.analysis->allan.tau0_s, s.rec->phase.duration_s());
+    std::vector<double> v;
+    for (const auto& p : s.analysis->allan.points) v.push_back(p.var);
+    const auto est = LowpassDetector(*s.analysis, s.rec->phase.duration_s(), "").fit(v);
     x.findings.push_back({Effect::Lowpass,
                           {{"time_constant_s", est.tf}},
                           {{"time_constant_s", 0.5 * (est.tf_high - est.tf_low)}},

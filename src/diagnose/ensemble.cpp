@@ -115,14 +115,9 @@ MidTauReference make_reference(const std::vector<std::size_t>& grid, double tau_
       ++k;
     }
     ref.tau.push_back(static_cast<double>(grid[i]) * tau_d);
-    if (k < 3) {
-      ref.mean.push_back(0);
-      ref.var.push_back(0);
-      continue;
-    }
-    const double mean = m / double(k);
+    const double mean = k < 3 ? 0.0 : m / double(k);  // fewer than 3 runs: no reference
     ref.mean.push_back(mean);
-    ref.var.push_back(std::max((m2 - double(k) * mean * mean) / double(k - 1), 0.0));
+    ref.var.push_back(k < 3 ? 0.0 : std::max((m2 - double(k) * mean * mean) / double(k - 1), 0.0));
   }
   const std::size_t g = grid.size();
   if (runs.size() >= 5) {
@@ -185,27 +180,22 @@ std::array<double, 3> band_refit(const std::vector<BandPoint>& band, std::size_t
       A += w * g * g.transpose();
       rhs += w * (p.d - m) * g;
     }
-    std::array<bool, 3> free{};
+    std::vector<Eigen::Index> idx;  // the free terms
     for (std::size_t j = 0; j < 3; ++j)
-      free[j] = held_free[j] && (c[j] + x[j] > 1e-12 * (c[j] + 1e-30) || rhs(static_cast<Eigen::Index>(j)) > 0);
-    Eigen::Vector3d step = Eigen::Vector3d::Zero();
-    {
-      std::vector<Eigen::Index> idx;
-      for (std::size_t j = 0; j < 3; ++j)
-        if (free[j]) idx.push_back(static_cast<Eigen::Index>(j));
-      if (idx.empty()) break;
-      const auto n = static_cast<Eigen::Index>(idx.size());
-      Eigen::MatrixXd a(n, n);
-      Eigen::VectorXd b(n);
-      Eigen::VectorXd sc(n);
-      for (Eigen::Index i = 0; i < n; ++i) sc(i) = A(idx[i], idx[i]) > 0 ? 1.0 / std::sqrt(A(idx[i], idx[i])) : 0.0;
-      for (Eigen::Index i = 0; i < n; ++i) {
-        b(i) = rhs(idx[i]) * sc(i);
-        for (Eigen::Index k = 0; k < n; ++k) a(i, k) = A(idx[i], idx[k]) * sc(i) * sc(k);
-      }
-      const Eigen::VectorXd s = a.completeOrthogonalDecomposition().solve(b);
-      for (Eigen::Index i = 0; i < n; ++i) step(idx[i]) = s(i) * sc(i);
+      if (held_free[j] && (c[j] + x[j] > 1e-12 * (c[j] + 1e-30) || rhs(static_cast<Eigen::Index>(j)) > 0))
+        idx.push_back(static_cast<Eigen::Index>(j));
+    if (idx.empty()) break;
+    const auto n = static_cast<Eigen::Index>(idx.size());
+    Eigen::MatrixXd a(n, n);
+    Eigen::VectorXd b(n), sc(n);
+    for (Eigen::Index i = 0; i < n; ++i) sc(i) = A(idx[i], idx[i]) > 0 ? 1.0 / std::sqrt(A(idx[i], idx[i])) : 0.0;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      b(i) = rhs(idx[i]) * sc(i);
+      for (Eigen::Index k = 0; k < n; ++k) a(i, k) = A(idx[i], idx[k]) * sc(i) * sc(k);
     }
+    const Eigen::VectorXd sol = a.completeOrthogonalDecomposition().solve(b);
+    Eigen::Vector3d step = Eigen::Vector3d::Zero();
+    for (Eigen::Index i = 0; i < n; ++i) step(idx[i]) = sol(i) * sc(i);
     bool improved = false;
     for (double t = 1.0; t > 1e-4; t *= 0.5) {
       std::array<double, 3> y = x;

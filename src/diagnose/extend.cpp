@@ -56,18 +56,22 @@ NoiseModel with_named_terms(const Stretch& s, Extension& x) {
   return m;
 }
 
-/// The mid-τ AV of the stretch without the named deterministic terms, and without its own
-/// candidates of the kinds not named (as the base ensemble's records are taken).
-std::vector<double> mid_var_without(const Stretch& s, const NoiseModel& det) {
-  NoiseModel det_mid = det;
-  const NoiseModel c = own_candidates(s.dec);
+/// The named deterministic terms, and the stretch's own candidate when no mean shape is named
+/// (as the base ensemble's records are taken).
+NoiseModel with_candidate(const Stretch& s, const NoiseModel& det) {
+  NoiseModel m = det;
   if (det.bias_steps.empty() && det.warmups.empty()) {
-    det_mid.bias_steps = c.bias_steps;
-    det_mid.warmups = c.warmups;
+    const NoiseModel c = own_candidates(s.dec);
+    m.bias_steps = c.bias_steps;
+    m.warmups = c.warmups;
   }
-  if (det.sinusoids.empty()) det_mid.sinusoids = c.sinusoids;
+  return m;
+}
+
+/// The mid-τ AV of the stretch without the named terms (and its candidate).
+std::vector<double> mid_var_without(const Stretch& s, const NoiseModel& det) {
   Decimated dm = s.dec;
-  subtract_deterministic(dm, det_mid);
+  subtract_deterministic(dm, with_candidate(s, det));
   return decimated_avar(dm, s.ref.grid);
 }
 
@@ -76,12 +80,7 @@ std::vector<double> mid_var_without(const Stretch& s, const NoiseModel& det) {
 /// calibrated with the base's pilot seeds, so that the models differ by the terms only. The base
 /// took a sinusoid into Q: the white angle noise is the fit's without it.
 void refit_without_named(const Stretch& s, Extension& x, bool pilot) {
-  NoiseModel rm = x.det;
-  if (x.det.bias_steps.empty() && x.det.warmups.empty()) {
-    const NoiseModel c = own_candidates(s.dec);
-    rm.bias_steps = c.bias_steps;
-    rm.warmups = c.warmups;
-  }
+  const NoiseModel rm = with_candidate(s, x.det);
   const Recording clean = with_series(*s.rec, cleaned(s.rec->phase, rm));
   NoiseModel m0 = base_model(analyze_for_base(clean, *s.aopt), s.rec->phase);
   m0.bias_deg_per_h = s.base.bias_deg_per_h;
