@@ -206,6 +206,26 @@ void coherent_line(LineEstimate& e, const std::vector<double>& y, double t0, dou
   e.f_sigma = e.amp > 0 ? std::sqrt(6.0 * S / (e.amp * att * e.amp * att * T * T * T)) / (2.0 * kPi) : 0.0;
 }
 
+class LineDetector final : public RecordDetector {
+ public:
+  [[nodiscard]] Effect effect() const override { return Effect::Line; }
+  [[nodiscard]] double statistic(const RecordView& r) const override {
+    return line_detect(r.series, kHighLineMinHz, 0.0, false).statistic;
+  }
+  /// A broadened line cannot be subtracted from the data: it enters the model only, as a sinusoid
+  /// of its power at its centroid (the Allan variance sees the power, not the phase).
+  void estimate(const Stretch& s, Extension& x) const override {
+    const auto est = line_detect(s.rec->phase, kHighLineMinHz, s.line_hint_hz);
+    (est.coherent ? x.det.sinusoids : x.broad).push_back({est.f_hz, est.amp, est.phase});
+    Finding f{Effect::Line,
+              {{"frequency_hz", est.f_hz}, {"amplitude_deg_per_h", est.amp}, {"phase_rad", est.phase}},
+              {{"frequency_hz", est.f_sigma}, {"amplitude_deg_per_h", est.amp_sigma}},
+              {{"coherent", est.coherent}, {"resolution_hz", est.resolution_hz}}};
+    if (!est.coherent) f.evidence["width_hz"] = est.width_hz;
+    x.findings.push_back(std::move(f));
+  }
+};
+
 }  // namespace
 
 LineEstimate line_detect(const PhaseSeries& x, double f_min, double f_hint, bool estimate) {
@@ -243,30 +263,6 @@ LineEstimate line_detect(const PhaseSeries& x, double f_min, double f_hint, bool
   coherent_line(e, y, t0, f0, best.level, best.w2);
   return e;
 }
-
-namespace {
-
-class LineDetector final : public RecordDetector {
- public:
-  [[nodiscard]] Effect effect() const override { return Effect::Line; }
-  [[nodiscard]] double statistic(const RecordView& r) const override {
-    return line_detect(r.series, kHighLineMinHz, 0.0, false).statistic;
-  }
-  /// A broadened line cannot be subtracted from the data: it enters the model only, as a sinusoid
-  /// of its power at its centroid (the Allan variance sees the power, not the phase).
-  void estimate(const Stretch& s, Extension& x) const override {
-    const auto est = line_detect(s.rec->phase, kHighLineMinHz, s.line_hint_hz);
-    (est.coherent ? x.det.sinusoids : x.broad).push_back({est.f_hz, est.amp, est.phase});
-    Finding f{Effect::Line,
-              {{"frequency_hz", est.f_hz}, {"amplitude_deg_per_h", est.amp}, {"phase_rad", est.phase}},
-              {{"frequency_hz", est.f_sigma}, {"amplitude_deg_per_h", est.amp_sigma}},
-              {{"coherent", est.coherent}, {"resolution_hz", est.resolution_hz}}};
-    if (!est.coherent) f.evidence["width_hz"] = est.width_hz;
-    x.findings.push_back(std::move(f));
-  }
-};
-
-}  // namespace
 
 std::unique_ptr<RecordDetector> line_detector() { return std::make_unique<LineDetector>(); }
 

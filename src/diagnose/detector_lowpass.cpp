@@ -67,6 +67,64 @@ NnFit nn_fit3(const std::vector<double>& y, const std::vector<double>& w, const 
   return best;
 }
 
+class LowpassDetector final : public RecordDetector {
+ public:
+  LowpassDetector(const AnalysisResult& a, double duration_s, std::string skip)
+      : tau0_(a.allan.tau0_s), duration_(duration_s), skip_(std::move(skip)) {
+    for (const auto& p : a.allan.points) {
+      m_.push_back(p.m);
+      edf_.push_back(p.edf);
+    }
+  }
+  [[nodiscard]] Effect effect() const override { return Effect::Lowpass; }
+  [[nodiscard]] double statistic(const RecordView& r) const override {
+    return skip_.empty() ? fit(r.octave_var).statistic : 0.0;
+  }
+  /// The base records have no filter and often a statistic of 0: the threshold is at least the
+  /// χ²(1) (1 − α) quantile, scaled by the best fit's χ² per degree of freedom.
+  [[nodiscard]] DetectorResult test(const Trial& t) const override {
+    DetectorResult d;
+    d.effect = Effect::Lowpass;
+    if (!skip_.empty()) {
+      d.note = skip_;
+      return d;
+    }
+    const double alpha = t.stretch.opt->alpha;
+    const auto lp = fit(t.data.octave_var);
+    d = calibrate(lp.statistic, t.runs, alpha);
+    const double dof = std::max(1.0, lp.points - 4.0);
+    const double floor =
+        boost::math::quantile(boost::math::chi_squared(1.0), 1.0 - alpha) * std::max(1.0, lp.chi2 / dof);
+    if (d.threshold < floor) {
+      d.threshold = floor;
+      d.fired = d.named = lp.statistic > floor;
+    }
+    return d;
+  }
+  [[nodiscard]] bool block_statistic() const override { return false; }
+  [[nodiscard]] bool shows_in(const Trial&) const override { return true; }
+  /// The filter and the white angle noise before it from the short-τ octave AV; N, B, K stay.
+  void estimate(const Stretch& s, Extension& x) const override {
+    std::vector<double> v;
+    for (const auto& p : s.analysis->allan.points) v.push_back(p.var);
+    const auto est = LowpassDetector(*s.analysis, s.rec->phase.duration_s(), "").fit(v);
+    x.findings.push_back({Effect::Lowpass,
+                          {{"time_constant_s", est.tf}},
+                          {{"time_constant_s", 0.5 * (est.tf_high - est.tf_low)}},
+                          {}});
+    x.lowpass = est;
+  }
+
+ private:
+  [[nodiscard]] OutputLowpassEstimate fit(const std::vector<double>& octave_var) const {
+    return output_lowpass_detect(m_, octave_var, edf_, tau0_, duration_);
+  }
+  double tau0_, duration_;
+  std::string skip_;
+  std::vector<std::int64_t> m_;
+  std::vector<double> edf_;
+};
+
 }  // namespace
 
 OutputLowpassEstimate output_lowpass_detect(const std::vector<std::int64_t>& m, const std::vector<double>& v,
@@ -163,68 +221,6 @@ OutputLowpassEstimate output_lowpass_detect(const std::vector<std::int64_t>& m, 
   }
   return e;
 }
-
-namespace {
-
-class LowpassDetector final : public RecordDetector {
- public:
-  LowpassDetector(const AnalysisResult& a, double duration_s, std::string skip)
-      : tau0_(a.allan.tau0_s), duration_(duration_s), skip_(std::move(skip)) {
-    for (const auto& p : a.allan.points) {
-      m_.push_back(p.m);
-      edf_.push_back(p.edf);
-    }
-  }
-  [[nodiscard]] Effect effect() const override { return Effect::Lowpass; }
-  [[nodiscard]] double statistic(const RecordView& r) const override {
-    return skip_.empty() ? fit(r.octave_var).statistic : 0.0;
-  }
-  /// The base records have no filter and often a statistic of 0: the threshold is at least the
-  /// χ²(1) (1 − α) quantile, scaled by the best fit's χ² per degree of freedom.
-  [[nodiscard]] DetectorResult test(const Trial& t) const override {
-    DetectorResult d;
-    d.effect = Effect::Lowpass;
-    if (!skip_.empty()) {
-      d.note = skip_;
-      return d;
-    }
-    const double alpha = t.stretch.opt->alpha;
-    const auto lp = fit(t.data.octave_var);
-    d = calibrate(lp.statistic, t.runs, alpha);
-    const double dof = std::max(1.0, lp.points - 4.0);
-    const double floor =
-        boost::math::quantile(boost::math::chi_squared(1.0), 1.0 - alpha) * std::max(1.0, lp.chi2 / dof);
-    if (d.threshold < floor) {
-      d.threshold = floor;
-      d.fired = d.named = lp.statistic > floor;
-    }
-    return d;
-  }
-  [[nodiscard]] bool block_statistic() const override { return false; }
-  [[nodiscard]] bool shows_in(const Trial&) const override { return true; }
-  /// The filter and the white angle noise before it from the short-τ octave AV; N, B, K stay.
-  void estimate(const Stretch& s, Extension& x) const override {
-    std::vector<double> v;
-    for (const auto& p : s.analysis->allan.points) v.push_back(p.var);
-    const auto est = LowpassDetector(*s.analysis, s.rec->phase.duration_s(), "").fit(v);
-    x.findings.push_back({Effect::Lowpass,
-                          {{"time_constant_s", est.tf}},
-                          {{"time_constant_s", 0.5 * (est.tf_high - est.tf_low)}},
-                          {}});
-    x.lowpass = est;
-  }
-
- private:
-  [[nodiscard]] OutputLowpassEstimate fit(const std::vector<double>& octave_var) const {
-    return output_lowpass_detect(m_, octave_var, edf_, tau0_, duration_);
-  }
-  double tau0_, duration_;
-  std::string skip_;
-  std::vector<std::int64_t> m_;
-  std::vector<double> edf_;
-};
-
-}  // namespace
 
 std::unique_ptr<RecordDetector> lowpass_detector(const AnalysisResult& analysis, double duration_s, std::string skip) {
   return std::make_unique<LowpassDetector>(analysis, duration_s, std::move(skip));

@@ -57,6 +57,22 @@ double sinusoid_ls(const std::vector<double>& y, double tb, double f, double& a,
   return x.dot(r);
 }
 
+class SinusoidDetector final : public RecordDetector {
+ public:
+  [[nodiscard]] Effect effect() const override { return Effect::Sinusoid; }
+  [[nodiscard]] double statistic(const RecordView& r) const override {
+    return sinusoid_detect(r.clean, 0.0, false).statistic;
+  }
+  void estimate(const Stretch& s, Extension& x) const override {
+    const auto est = sinusoid_detect(s.clean, s.sin_hint_hz);
+    x.det.sinusoids.push_back({est.f_hz, est.amp, est.phase});
+    x.findings.push_back({Effect::Sinusoid,
+                          {{"frequency_hz", est.f_hz}, {"amplitude_deg_per_h", est.amp}, {"phase_rad", est.phase}},
+                          {{"frequency_hz", est.f_sigma}, {"amplitude_deg_per_h", est.amp_sigma}},
+                          {}});
+  }
+};
+
 }  // namespace
 
 SinusoidEstimate sinusoid_detect(const Decimated& d, double f_hint, bool estimate) {
@@ -128,26 +144,6 @@ LineCoefficients line_coefficients(std::vector<double> y, double tb, double f) {
   c.sigma = std::sqrt(S / T);
   return c;
 }
-
-namespace {
-
-class SinusoidDetector final : public RecordDetector {
- public:
-  [[nodiscard]] Effect effect() const override { return Effect::Sinusoid; }
-  [[nodiscard]] double statistic(const RecordView& r) const override {
-    return sinusoid_detect(r.clean, 0.0, false).statistic;
-  }
-  void estimate(const Stretch& s, Extension& x) const override {
-    const auto est = sinusoid_detect(s.clean, s.sin_hint_hz);
-    x.det.sinusoids.push_back({est.f_hz, est.amp, est.phase});
-    x.findings.push_back({Effect::Sinusoid,
-                          {{"frequency_hz", est.f_hz}, {"amplitude_deg_per_h", est.amp}, {"phase_rad", est.phase}},
-                          {{"frequency_hz", est.f_sigma}, {"amplitude_deg_per_h", est.amp_sigma}},
-                          {}});
-  }
-};
-
-}  // namespace
 
 std::unique_ptr<RecordDetector> sinusoid_detector() { return std::make_unique<SinusoidDetector>(); }
 

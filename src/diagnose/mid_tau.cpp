@@ -169,7 +169,6 @@ ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& 
   if (p0.y.size() < 8) return e;
   MidTauProblem p = p0;
   const Whitener wh = whiten(p, ref);
-  const double c_n_base = c_base[1];
   using Fit = ConstrainedFit;
   auto fit = [&](const std::vector<double>* shape) { return constrained_fit(p, c_base, shape); };
   const Fit null = fit(nullptr);
@@ -221,7 +220,7 @@ ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& 
     const double m = ref.mean[p0.index[k]];
     e.peak_ratio = m > 0 ? e.scale * gauss_markov_avar(tp, e.time) / m : 0.0;
   }
-  e.white_rest = std::max(0.0, c_n_base + best.dc[1]);
+  e.white_rest = std::max(0.0, c_base[1] + best.dc[1]);
   e.white_rest_sigma = std::sqrt(std::max(0.0, best.dn_var));
   e.time_low = e.time_high = e.time;
   for (const auto& [T, c] : prof)
