@@ -1,6 +1,5 @@
-// The high-frequency line detector: a line search on the raw rate samples of floating data, from
-// 0.25 Hz to the Nyquist frequency, at the whole record's resolution (a coherent line) and at
-// Welch resolutions (a line broadened by a wandering phase).
+// The high-frequency line detector: a line search on the rate samples of floating data from 0.25 Hz
+// to Nyquist, for a coherent line and (at Welch resolutions) one broadened by a wandering phase.
 #include <boost/math/special_functions/gamma.hpp>
 
 #include <cmath>
@@ -54,8 +53,7 @@ struct Resolution {
   std::vector<double> P;
 };
 
-/// The score, −ln of the peak's tail probability less ln of the true bins searched, has about the
-/// same null maximum at every resolution.
+/// The score (−ln tail probability less ln of the bins searched) has one null maximum at all resolutions.
 Resolution search(const std::vector<double>& y, std::size_t len, double t0, double f_min, double f_hint) {
   const std::size_t n = y.size();
   const double T = t0 * static_cast<double>(n);
@@ -166,8 +164,7 @@ bool broad_line(LineEstimate& e, Resolution& best, const std::vector<double>& fu
   return true;
 }
 
-/// A coherent line: least-squares sinusoid on the detrended samples, cos/sin by rotation re-seeded
-/// every 4096 samples; σ from the noise level at the line.
+/// A coherent line: least-squares sinusoid on the detrended samples; σ from the level at the line.
 void coherent_line(LineEstimate& e, const std::vector<double>& y, double t0, double f0, double level, double w2) {
   const std::size_t n = y.size();
   const double T = t0 * static_cast<double>(n);

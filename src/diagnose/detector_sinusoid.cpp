@@ -1,6 +1,5 @@
-// The sinusoid detector: a periodogram line search on the 0.5-s block-mean rates of the record
-// without its own mean-shape candidate (a step left in spreads over the low frequencies), and
-// the least-squares sinusoid at the peak.
+// The sinusoid detector: a periodogram line search on the 0.5-s block rates of the record without
+// its mean-shape candidate (a step left in spreads over the low frequencies); a least-squares fit.
 #include <unsupported/Eigen/FFT>
 
 #include <cmath>
@@ -35,8 +34,7 @@ std::vector<double> hann_periodogram(const std::vector<double>& y, bool half_spe
   return P;
 }
 
-/// Least-squares a·cos(2πft) + b·sin(2πft) through y_i at t_i = (i + ½)·tb; returns the explained
-/// sum of squares.
+/// Least-squares a·cos(2πft) + b·sin(2πft) through y_i at (i + ½)·tb; the explained sum of squares.
 double sinusoid_ls(const std::vector<double>& y, double tb, double f, double& a, double& b) {
   Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
   Eigen::Vector2d r = Eigen::Vector2d::Zero();

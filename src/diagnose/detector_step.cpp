@@ -17,8 +17,7 @@ StepEstimate step_detect(const Decimated& d) {
   const double sig = std::max(diff_sigma(y), 1e-12);
   std::vector<double> cs(n + 1, 0.0);
   for (std::size_t i = 0; i < n; ++i) cs[i + 1] = cs[i] + y[i];
-  // Likelihood ratio of one change of the mean at block k against none (white noise of the
-  // level σ̂ seen in the block-to-block differences): n/(k(n−k))·(S_k − k·ȳ)²/σ̂², maximised over k.
+  // Likelihood ratio of one change of the mean at block k (white noise σ̂): n/(k(n−k))·(S_k − k·ȳ)²/σ̂².
   double best = 0;
   std::size_t ibest = n / 2;
   const double ybar = cs[n] / static_cast<double>(n);
@@ -92,8 +91,7 @@ StepEstimate step_detect(const Decimated& d) {
 
 namespace {
 
-/// A bias step at a known time `ts`: its size from the mean rates over up to 30 min each side,
-/// σ from the 1-s block means' white level.
+/// A bias step at a known time: its size from the mean rates over up to 30 min each side.
 StepEstimate step_at(const Decimated& d, double ts) {
   StepEstimate e;
   e.t_s = ts;

@@ -26,8 +26,7 @@ struct Context {
   EnsemblePlan plan;                 ///< octave sizes and mid-τ grid of the record
   Stretch full;                      ///< the whole record as a stretch
   std::vector<double> octave_var;    ///< measured octave AV
-  NoiseModel candidate;              ///< the record's own mean-shape candidate
-  Coefficient b_fit;                 ///< B of the five-term fit without it
+  RobustBase rb;                     ///< base model, own candidate, B of the fit without it
   std::vector<std::unique_ptr<Detector>> detectors;
   [[nodiscard]] RecordView view() const { return {rec.phase, full.dec, full.clean, octave_var}; }
 };
@@ -74,12 +73,10 @@ void fit_base(Context& c, DiagnoseResult& r, OutlierReport outliers) {
   s.pilot.seed = c.opt.seed + 1000;
   s.pilot_runs = std::max<std::size_t>(10, c.opt.runs / 2);
   c.plan = {s.octave_m, mid_tau_grid(s.dec), true, {}};
-  const RobustBase rb = robust_base(c.rec, r.analysis, c.aopt, s.dec, s.pilot, s.pilot_runs, c.plan, c.opt.progress);
-  r.base = s.base = rb.model;
-  c.candidate = rb.candidate;
-  c.b_fit = rb.b_fit;
+  c.rb = robust_base(c.rec, r.analysis, c.aopt, s.dec, s.pilot, s.pilot_runs, c.plan, c.opt.progress);
+  r.base = s.base = c.rb.model;
   s.clean = s.dec;
-  subtract_deterministic(s.clean, c.candidate);
+  subtract_deterministic(s.clean, c.rb.candidate);
   c.detectors = make_detectors(r.analysis, x, !x.exact() && on_lattice(x));
 }
 
@@ -107,9 +104,10 @@ std::vector<RunStats> base_ensemble(Context& c, DiagnoseResult& r) {
 /// such a quiet model the record's flicker wander looks like a step or a transient: the
 /// mean-shape thresholds are also taken under B at its upper bound (same seeds), the larger kept.
 void recalibrate_under_high_b(const Context& c, const DiagnoseResult& r, std::vector<DetectorResult>& results) {
-  if (!(c.b_fit.enabled && !c.b_fit.resolved && c.b_fit.high > r.base.bias_instability_deg_per_h)) return;
+  const Coefficient& b = c.rb.b_fit;
+  if (!(b.enabled && !b.resolved && b.high > r.base.bias_instability_deg_per_h)) return;
   NoiseModel hi = r.base;
-  hi.bias_instability_deg_per_h = c.b_fit.high;
+  hi.bias_instability_deg_per_h = b.high;
   EnsemblePlan plan = c.plan;
   plan.scored = record_detectors(c, true);
   const auto hi_runs = run_ensemble(hi, r.settings, c.opt.runs, plan, c.opt.progress);
@@ -121,8 +119,7 @@ void recalibrate_under_high_b(const Context& c, const DiagnoseResult& r, std::ve
       }
 }
 
-/// A step and a transient that both fire are one change of the mean: the record's own candidate
-/// is named.
+/// A step and a transient that both fire are one change of the mean: the candidate is named.
 void one_mean_shape(const NoiseModel& candidate, std::vector<DetectorResult>& results) {
   auto of = [&](Effect e) { return std::find_if(results.begin(), results.end(), [e](auto& d) { return d.effect == e; }); };
   const auto step = of(Effect::BiasStep), warm = of(Effect::Warmup);
@@ -150,9 +147,9 @@ Named test_detectors(Context& c, const std::vector<RunStats>& runs, DiagnoseResu
     if (!c.detectors[i]->mid_tau()) res[i] = c.detectors[i]->test(trial);
   }
   recalibrate_under_high_b(c, r, res);
-  one_mean_shape(c.candidate, res);
+  one_mean_shape(c.rb.candidate, res);
   Named named;
-  NoiseModel det = c.candidate;
+  NoiseModel det = c.rb.candidate;
   if (is_named(res, Effect::Sinusoid)) {
     const auto sin = sinusoid_detect(c.full.clean);
     det.sinusoids.push_back({sin.f_hz, sin.amp, sin.phase});
@@ -222,7 +219,7 @@ DiagnoseResult diagnose(const Recording& read, const DiagnoseOptions& opt) {
   const auto t_start = std::chrono::steady_clock::now();
   OutlierReport outliers;
   Recording edited;
-  Context c{screened(read, opt, outliers, edited), opt, {}, {}, {}, {}, {}, {}, {}};
+  Context c{screened(read, opt, outliers, edited), opt, {}, {}, {}, {}, {}, {}};
   DiagnoseResult r;
   r.runs = opt.runs;
   r.holdout_runs = opt.holdout_runs ? opt.holdout_runs : opt.runs;

@@ -99,8 +99,7 @@ void refit_without_named(const Stretch& s, Extension& x, bool pilot) {
 
 }  // namespace
 
-/// Deterministic terms are estimated first and removed before the re-fit of the rest; an effect
-/// of the mid-τ AV (a Gauss–Markov term) is fitted last, jointly with its N, B, K corrections.
+/// Deterministic terms are estimated and removed first; a mid-τ effect is fitted last, with N, B, K.
 Extension extend(const Stretch& s, const std::vector<const Detector*>& named) {
   Extension x;
   bool stochastic = false;
@@ -115,8 +114,7 @@ Extension extend(const Stretch& s, const std::vector<const Detector*>& named) {
   const bool deterministic = !x.det.sinusoids.empty() || !x.det.bias_steps.empty() || !x.det.warmups.empty();
   const bool self_pilot = !stochastic && deterministic && s.pilot_runs > 0;
   if (!stochastic && !x.findings.empty() && !self_pilot) {
-    // Like the base calibration: the data without their candidate (or named terms) against the
-    // ensemble's records without their own candidate.
+    // Like the base calibration: data and ensemble records without their candidates.
     correct_nbk(x.model, power_law_corrections(x.mid_var, s.clean_ref, c_of(s.base)));
   }
   if (deterministic && !x.lowpass && (self_pilot || !x.det.sinusoids.empty())) refit_without_named(s, x, self_pilot);

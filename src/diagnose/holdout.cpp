@@ -35,8 +35,7 @@ std::vector<Fold> holdout_folds(std::size_t n, double tau0) {
   return folds;
 }
 
-/// The level a model predicts over [0, T], °/h: its constant rate and its named terms' mean (a
-/// ramp, whose sign the AV does not give, predicts no change).
+/// The level a model predicts over [0, T], °/h (a ramp, whose sign the AV does not give, none).
 double model_level(const NoiseModel& m, double T) {
   return m.earth_rate_deg_per_h + m.bias_deg_per_h + mean_rate_of(m, T);
 }

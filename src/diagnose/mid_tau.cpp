@@ -1,5 +1,5 @@
-// Fits of the mid-τ Allan variance against an ensemble reference: Q, N, B, K corrections under
-// ≥ 0 constraints, the Gauss–Markov bump beside them, and the reference without one run.
+// Fits of the mid-τ Allan variance against an ensemble reference: Q, N, B, K corrections kept
+// ≥ 0, the Gauss–Markov bump beside them, and the reference without one run.
 #include "diagnose/ensemble.hpp"
 
 #include <Eigen/Dense>
@@ -17,8 +17,7 @@ namespace {
 constexpr double kCorrShrink = 0.2;
 constexpr double kModelEdf = 1000.0;  ///< model floor of the EDF in the deviance (as band_misfit)
 
-/// The measured-minus-reference mid-τ AV, its weights (1/ensemble variance) and the Q, N, B, K
-/// basis columns (normalised; `colscale` holds the factors).
+/// Measured-minus-reference mid-τ AV, weights 1/variance, normalised Q, N, B, K basis columns.
 struct MidTauProblem {
   std::vector<double> y, w, tau;
   std::vector<std::size_t> index;  ///< grid index of each point
@@ -172,8 +171,8 @@ ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& 
   using Fit = ConstrainedFit;
   auto fit = [&](const std::vector<double>* shape) { return constrained_fit(p, c_base, shape); };
   const Fit null = fit(nullptr);
-  // Correlation times from 3× the shortest τ (a bump peaking at the grid's first points is white
-  // rate noise there: not identifiable) to half the longest; a given one (fixed_time > 0) alone.
+  // Correlation times from 3× the shortest τ (a bump peaking earlier is white rate noise there) to
+  // half the longest, or fixed_time alone.
   const double lt_lo = std::log(3.0 * p.tau.front()), lt_hi = std::log(p.tau.back() / 2.0);
   const int G = fixed_time > 0 ? 0 : 48;
   double best_chi2 = null.chi2;

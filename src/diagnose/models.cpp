@@ -157,8 +157,7 @@ NoiseModel calibrated(const NoiseModel& m0, const SimulationSettings& settings, 
   return m;
 }
 
-/// A step or a transient left in would be taken up into K, R or B, and the ensemble's wander
-/// would then hide it: the fit is of the data without the candidate.
+/// A step or transient left in would go into K, R or B, and the ensemble's wander would hide it.
 RobustBase robust_base(const Recording& rec, const AnalysisResult& original, const AnalysisOptions& aopt,
                        const Decimated& dec, const SimulationSettings& pilot, std::size_t pilot_runs,
                        const EnsemblePlan& plan, Progress* progress) {
