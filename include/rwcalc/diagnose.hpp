@@ -1,15 +1,9 @@
 #pragma once
 /// @file diagnose.hpp
-/// `rwcalc diagnose`: where the fitted five-term model's simulations depart from the measurement,
-/// which effect causes it, the extended model and its gain (docs/diagnosis.md).
-///
-/// Steps: (1) fit the five-term model (analysis.hpp) and simulate an ensemble of records from it
-/// with the data's length, rate, pulse weight and read-out; (2) compare the measured Allan
-/// deviation with the ensemble's band per τ, and run one detector per effect whose statistic is
-/// computed alike on the measurement and on every ensemble record, so that the threshold is the
-/// ensemble's (1 − α) quantile; (3) estimate each detected effect by least squares on the
-/// statistic that carries it; (4) add them to the model, re-simulate, and measure the gain in and
-/// out of sample.
+/// `rwcalc diagnose`: fit the five-term model, simulate an ensemble of records from it, compare
+/// the measurement with the ensemble (the band of σ per τ, one detector per effect calibrated on
+/// the ensemble), estimate the detected effects, and measure the extended model's gain in and out
+/// of sample (docs/diagnosis.md).
 #include <cstddef>
 #include <cstdint>
 #include <nlohmann/json.hpp>

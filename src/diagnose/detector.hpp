@@ -1,31 +1,93 @@
 #pragma once
 /// @file detector.hpp
-/// The detector interface of the diagnosis: each effect has one detector (one file each,
-/// detector_*.cpp) that tests the measurement against the base model's ensemble, tells whether a
-/// block of the out-of-sample check shows the effect, and estimates it on a stretch of data.
+/// The detectors of the diagnosis (one file each, detector_*.cpp): their statistics and estimates
+/// (docs/diagnosis.md), and the interface through which the pipeline tests and estimates effects.
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "diagnose/ensemble.hpp"
-#include "diagnose/estimators.hpp"
-#include "diagnose/mid_tau.hpp"
 #include "diagnose/signal.hpp"
 #include "rwcalc/diagnose.hpp"
 
 namespace rwcalc::diag {
 
-/// One stretch of data (the whole record or the fitting block of a fold) with what the
-/// estimates on it read: its base model and that model's ensemble references.
+struct SinusoidEstimate {
+  double statistic = 0;  ///< max over f of periodogram / local level
+  double f_hz = 0, amp = 0, phase = 0;
+  double f_sigma = 0, amp_sigma = 0;
+};
+/// Periodogram line search on 0.5-s block rates. `f_hint` > 0 restricts the search to ±3 bins.
+SinusoidEstimate sinusoid_detect(const Decimated& d, double f_hint = 0, bool estimate = true);
+
+/// Least-squares a·cos(2πft) + b·sin(2πft) on block rates `y` (`tb` s each) and its standard
+/// error (0: too few blocks). A line A·cos(2πft + φ) gives a = A·s·cos φ, b = −A·s·sin φ,
+/// s = sinc(πf·tb).
+struct LineCoefficients {
+  double a = 0, b = 0, sigma = 0;
+};
+LineCoefficients line_coefficients(std::vector<double> y, double tb, double f);
+
+/// Lower end of the high-frequency line search, Hz: the upper end of sinusoid_detect's.
+constexpr double kHighLineMinHz = 0.25;
+struct LineEstimate : SinusoidEstimate {
+  double resolution_hz = 0;  ///< bin width of the periodogram that showed the line
+  bool coherent = true;      ///< found at the whole record's resolution: one phase-stable line
+  double width_hz = 0;       ///< spread (standard deviation) of a broadened line's power, Hz
+};
+/// Line search on the rate samples of a floating series from `f_min` to Nyquist, at the whole
+/// record's and at Welch resolutions. `f_hint` > 0: the whole record's resolution, ±3 bins.
+LineEstimate line_detect(const PhaseSeries& x, double f_min = kHighLineMinHz, double f_hint = 0,
+                         bool estimate = true);
+
+struct StepEstimate {
+  double statistic = 0;  ///< max likelihood ratio of one change of the mean
+  double t_s = 0, size = 0, t_sigma = 0, size_sigma = 0;
+  double rss = 0;  ///< RSS of level + trend + step on 10-s block means, (°/h)²
+};
+StepEstimate step_detect(const Decimated& d);
+
+struct WarmupEstimate {
+  double statistic = 0;  ///< RSS drop on 10-s block means when an exponential joins
+  double amp = 0, tc = 0, amp_sigma = 0, tc_sigma = 0;
+  double rss = 0;
+};
+WarmupEstimate warmup_detect(const Decimated& d);
+
+/// A record's own mean-shape candidate: its best step or warm-up, whichever has the lower RSS.
+/// The measurement and every simulated record alike are compared without it.
+NoiseModel own_candidates(const Decimated& d);
+Decimated without_own_candidates(const Decimated& d);
+
+/// Overlapping AV at cluster size m of unit white angle noise and of a unit white rate after a
+/// first-order output-chain low-pass of time constant tf (0: none).
+double output_lowpass_angle_avar(std::size_t m, double tau0, double tf);
+double output_lowpass_rate_avar(std::size_t m, double tau0, double tf);
+
+struct OutputLowpassEstimate {
+  double statistic = 0;                    ///< χ² drop of the short-τ octave AV with the filter
+  double tf = 0, tf_low = 0, tf_high = 0;  ///< time constant, s, and its Δχ² range
+  double white_angle2 = 0;                 ///< white angle variance before the filter, ″²
+  double white_rate = 0;                   ///< white rate N² before the filter, (°/h)²·s
+  double points = 0;                       ///< octave points used
+  double chi2 = 0;                         ///< χ² of the best fit (with the filter)
+};
+/// Fit the octave AV `v` (τ ≤ min(20 s, T/100)) by white angle and rate noise and a floor
+/// through a low-pass, against the same without it.
+OutputLowpassEstimate output_lowpass_detect(const std::vector<std::int64_t>& m, const std::vector<double>& v,
+                                            const std::vector<double>& edf, double tau0, double duration);
+
+/// One stretch of data (the whole record or a fold's fitting block) with its base model and
+/// that model's ensemble references.
 struct Stretch {
   const Recording* rec = nullptr;
   const AnalysisResult* analysis = nullptr;
   const AnalysisOptions* aopt = nullptr;  ///< the five-term fit's options
   const DiagnoseOptions* opt = nullptr;
-  NoiseModel base;                  ///< its base model
-  Decimated dec;                    ///< its decimated angle
-  Decimated clean;                  ///< the same without its own mean-shape candidate
+  NoiseModel base;
+  Decimated dec;
+  Decimated clean;                  ///< dec without its own mean-shape candidate
   MidTauReference ref;              ///< mid-τ AV reference of the base model's ensemble
   MidTauReference clean_ref;        ///< the same of its records without their own candidate
   std::vector<std::int64_t> octave_m;
@@ -43,25 +105,25 @@ struct Extension {
   NoiseModel det;                   ///< deterministic terms subtracted from the data
   std::vector<Sinusoid> broad;      ///< broadened lines: in the model, not subtracted
   std::optional<OutputLowpassEstimate> lowpass;
-  std::vector<double> mid_var;      ///< mid-τ AV of the data without the named terms (mid-τ fits)
+  std::vector<double> mid_var;      ///< mid-τ AV of the data without the named terms
   NoiseModel model;                 ///< extended model (time origin: the stretch start)
-  std::vector<Finding> findings;    ///< parameters only (the evidence is added by the caller)
+  std::vector<Finding> findings;    ///< parameters only (the caller adds the evidence)
 };
 
 /// One record as a detector's statistic reads it: the measurement or a simulated record.
 struct RecordView {
   const PhaseSeries& series;
-  const Decimated& dec;                   ///< decimated angle
-  const Decimated& clean;                 ///< the same without its own mean-shape candidate
+  const Decimated& dec;
+  const Decimated& clean;                 ///< dec without its own mean-shape candidate
   const std::vector<double>& octave_var;  ///< overlapping AV at the octave cluster sizes
 };
 
 /// A record under test and its base model's ensemble.
 struct Trial {
   RecordView data;
-  const std::vector<RunStats>& runs;       ///< the base model's ensemble
-  const Stretch& stretch;                  ///< the data as a stretch (base model, references)
-  const SimulationSettings& settings;      ///< of the base ensemble (alternatives reuse its seeds)
+  const std::vector<RunStats>& runs;
+  const Stretch& stretch;
+  const SimulationSettings& settings;  ///< of the base ensemble (alternatives reuse its seeds)
   const std::vector<double>* mid_var = nullptr;  ///< mid-τ AV without candidate and named lines
 };
 
@@ -71,38 +133,33 @@ class Detector {
   [[nodiscard]] virtual Effect effect() const = 0;
   /// The verdict on the measurement against its base ensemble.
   [[nodiscard]] virtual DetectorResult test(const Trial& t) const = 0;
-  /// Whether the fitting block of a fold (`t`, with its own base ensemble) shows the effect, so
-  /// that the effect enters the block's extended model.
+  /// Whether a fold's fitting block (with its own base ensemble) shows the effect.
   [[nodiscard]] virtual bool shows_in(const Trial& t) const { return test(t).fired; }
   /// Whether the effect is fitted on the mid-τ AV jointly with N, B, K (after the re-fit).
   [[nodiscard]] virtual bool mid_tau() const { return false; }
-  /// Whether the effect changes the mean rate (a step or a transient: one change of the mean).
+  /// Whether the effect changes the mean rate (a step or a transient).
   [[nodiscard]] virtual bool mean_shape() const { return false; }
   /// Estimate the effect on a stretch and add it (terms and finding) to the extension.
   virtual void estimate(const Stretch& s, Extension& x) const = 0;
 };
 
 /// A detector whose statistic is a function of one record, computed alike on the measurement and
-/// on every record of an ensemble (RunStats::stat); the threshold is the ensemble's Gumbel
-/// (1 − α) quantile.
+/// on every ensemble record; the threshold is the ensemble's Gumbel (1 − α) quantile.
 class RecordDetector : public Detector {
  public:
   [[nodiscard]] virtual double statistic(const RecordView& r) const = 0;
   /// Whether shows_in reads the statistic on a block's own ensemble (which then scores it).
   [[nodiscard]] virtual bool block_statistic() const { return true; }
   [[nodiscard]] DetectorResult test(const Trial& t) const override;
-  /// The verdict of a statistic against ensemble values (Gumbel (1 − α) quantile).
   [[nodiscard]] DetectorResult calibrate(double statistic, const std::vector<RunStats>& runs, double alpha) const;
 };
 
 /// What a detector's statistic is, as the evidence of a finding says.
 std::string_view detector_description(Effect e);
 
-/// The detectors of a record, in the order of the report: sinusoid, bias step, warm-up,
-/// Gauss–Markov, low-pass, and the high-frequency line. `analysis` is the record's (the low-pass
-/// statistic reads its octave EDF); `lattice`: floating samples on a pulse lattice (on_lattice).
-/// Pulse counts, whole or as numbers, get neither the line nor the low-pass: the counting
-/// read-out's beat of the pulse rate against the sampling makes lines and short-τ structure.
+/// The detectors of a record in the order of the report. Pulse counts, whole or as numbers
+/// (`lattice`), get neither the line nor the low-pass: the counting read-out's beat of the pulse
+/// rate against the sampling makes lines and short-τ structure.
 std::vector<std::unique_ptr<Detector>> make_detectors(const AnalysisResult& analysis, const PhaseSeries& x,
                                                       bool lattice);
 std::unique_ptr<RecordDetector> sinusoid_detector();

@@ -1,11 +1,8 @@
-// The Gauss–Markov detector. The five-term base fit takes a bump into a large flicker floor, and
-// such a flicker realises bumps of that size by itself: the χ² drop of the bump fit alone has no
-// power against it. So the bump fit (Q, N, B, K corrections plus σ²·g(τ; Tc) on the mid-τ AV of
-// the data without its candidate) only proposes the alternative M1 = corrected base plus the
-// bump; M1 is simulated (same seeds), and the statistic is the drop of the mid-τ Gamma deviance
-// from the base ensemble to M1's. It is computed alike on every base record (against the base
-// ensemble without it, and M1's), and M1 must win by more than every one of them and by a
-// likelihood ratio of at least 100 (docs/diagnosis.md, "Naming a Gauss–Markov term").
+// The Gauss–Markov detector. The base fit takes a bump into a large flicker floor, which realises
+// such bumps by itself, so the bump fit on the mid-τ AV only proposes the alternative M1 (base
+// plus bump), simulated with the same seeds; the statistic is the drop of the mid-τ Gamma deviance
+// from the base ensemble to M1's, which must beat every base record's drop and a likelihood ratio
+// of 100 (docs/diagnosis.md, "Naming a Gauss–Markov term").
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -22,8 +19,7 @@ constexpr double kGmMinExcess = 2.0;     ///< ensemble SDs the bump must raise t
 /// The deviance drop (2 ln of the likelihood ratio) M1 must reach at least.
 const double kGmMinLogLr = 2.0 * std::log(100.0);
 
-/// A model plus a fitted bump, with the fit's corrections of B² and K² and the white rate noise
-/// it leaves beside the bump.
+/// A model plus a fitted bump, its B² and K² corrections and the white rate noise left beside it.
 NoiseModel with_bump(const NoiseModel& base, const ShapeEstimate& est) {
   NoiseModel m = base;
   correct(m.bias_instability_deg_per_h, Term::B, est.dc[2]);
@@ -33,10 +29,8 @@ NoiseModel with_bump(const NoiseModel& base, const ShapeEstimate& est) {
   return m;
 }
 
-/// Why a bump fit cannot be a Gauss–Markov term (empty: it can). A Gauss–Markov rate adds
-/// variance around its peak, or keeps white rate noise beside it when the base fit has taken the
-/// bump into B; a fit that only lowers the mid-τ AV by trading the white noise for a bump is a
-/// deficit. A bump far below the local AV is a re-arrangement of the flicker or white noise.
+/// Why a bump fit cannot be a Gauss–Markov term (empty: it can): a fit that only trades the white
+/// noise for a bump is a deficit; a bump far below the local AV re-arranges flicker or white noise.
 std::string implausible(const ShapeEstimate& gm) {
   if (!(gm.scale > 0)) return "no bump improves the fit of the mid-τ Allan variance";
   if (gm.excess < kGmMinExcess && gm.white_rest < 2.0 * gm.white_rest_sigma)
@@ -82,9 +76,8 @@ class GaussMarkovDetector final : public Detector {
     return d;
   }
 
-  /// A block shows the term when the bump fit on its mid-τ AV, with the whole record's
-  /// correlation time, passes the naming conditions above (a block's own likelihood-ratio test,
-  /// one hour of data against its base ensemble's largest drop, has too little power).
+  /// A block shows the term when its bump fit with the whole record's correlation time passes the
+  /// naming conditions (a block's own likelihood-ratio test has too little power).
   [[nodiscard]] bool shows_in(const Trial& t) const override {
     const Stretch& s = t.stretch;
     return implausible(shape_detect(decimated_avar(t.data.clean, s.ref.grid), s.ref, c_of(s.base), s.gm_tc_s))
@@ -93,11 +86,8 @@ class GaussMarkovDetector final : public Detector {
 
   void estimate(const Stretch& s, Extension& x) const override {
     const ShapeEstimate est = shape_detect(x.mid_var, s.ref, c_of(s.base), s.gm_tc_s);
-    correct(x.model.bias_instability_deg_per_h, Term::B, est.dc[2]);
-    correct(x.model.rrw_deg_per_h_per_sqrt_h, Term::K, est.dc[3]);
-    x.model.arw_deg_per_sqrt_h = coefficient_from_c(Term::N, est.white_rest);
-    const double sigma = std::sqrt(std::max(est.scale, 0.0));
-    x.model.gauss_markov.push_back({sigma, std::max(est.time, 1e-3)});
+    x.model = with_bump(x.model, est);
+    const double sigma = x.model.gauss_markov.back().sigma_deg_per_h;
     x.findings.push_back({Effect::GaussMarkov,
                           {{"sigma_deg_per_h", sigma}, {"correlation_time_s", est.time}},
                           {{"sigma_deg_per_h", sigma > 0 ? est.scale_sigma / (2 * sigma) : 0.0},

@@ -1,6 +1,5 @@
-// The high-frequency line detector: a line search on the raw rate samples of floating data, from
-// 0.25 Hz to the Nyquist frequency, at the whole record's resolution (a coherent line) and at
-// Welch resolutions (a line broadened by a wandering phase).
+// The high-frequency line detector: a line search on the rate samples of floating data from 0.25 Hz
+// to Nyquist, for a coherent line and (at Welch resolutions) one broadened by a wandering phase.
 #include <boost/math/special_functions/gamma.hpp>
 
 #include <cmath>
@@ -14,10 +13,9 @@ namespace rwcalc::diag {
 
 namespace {
 
-/// Mean periodogram of consecutive Hann-windowed segments of `len` samples (one of the whole
-/// series when len ≥ y.size()), each zero-padded to `nfft`; P[0 … nfft/2]. The segments do not
-/// overlap: a coherent line then gains no more from the mean of K segments than from the whole
-/// record's periodogram, and K·P/level is Gamma(K) under the null.
+/// Mean periodogram P[0 … nfft/2] of consecutive Hann-windowed segments of `len` samples. They do
+/// not overlap: a coherent line then gains no more from the mean than from the whole record's
+/// periodogram, and K·P/level is Gamma(K) under the null.
 std::vector<double> mean_periodogram(const std::vector<double>& y, std::size_t len, std::size_t nfft, std::size_t& segs,
                                      double& w2) {
   const std::size_t n = y.size();
@@ -40,8 +38,7 @@ std::vector<double> mean_periodogram(const std::vector<double>& y, std::size_t l
   return P;
 }
 
-/// −ln of the upper tail of a mean of K unit exponential variables at r (K·r ~ Gamma(K)), with the
-/// leading asymptotic term where the tail underflows.
+/// −ln of the upper tail of a mean of K unit exponentials at r, asymptotic where it underflows.
 double neg_log_tail(double K, double r) {
   const double x = K * r;
   const double q = boost::math::gamma_q(K, x);
@@ -49,15 +46,14 @@ double neg_log_tail(double K, double r) {
   return x - (K - 1.0) * std::log(x) + std::lgamma(K);
 }
 
-/// The best peak of the periodogram at one resolution (the mean over segments of `len` samples).
+/// The best peak of the periodogram at one resolution (segments of `len` samples).
 struct Resolution {
   double score = -std::numeric_limits<double>::infinity(), ratio = 0, level = 0, K = 1, w2 = 0, df = 0, pad = 2;
   std::size_t k = 0, len = 0;
   std::vector<double> P;
 };
 
-/// The score is comparable across resolutions: −ln of the peak's tail probability less ln of the
-/// number of true bins searched (the expected null maximum is then about the same at every one).
+/// The score (−ln tail probability less ln of the bins searched) has one null maximum at all resolutions.
 Resolution search(const std::vector<double>& y, std::size_t len, double t0, double f_min, double f_hint) {
   const std::size_t n = y.size();
   const double T = t0 * static_cast<double>(n);
@@ -82,22 +78,9 @@ Resolution search(const std::vector<double>& y, std::size_t len, double t0, doub
   r.P = mean_periodogram(y, len, nfft, segs, r.w2);
   r.K = static_cast<double>(segs);
   const double med = r.K == 1 ? std::log(2.0) : boost::math::gamma_p_inv(r.K, 0.5) / r.K;  // of a mean of K exponentials
-  const auto gap = static_cast<std::size_t>(std::ceil(3.0 * r.pad));
-  const auto W = static_cast<std::size_t>(24.0 * r.pad);
-  const auto stepb = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(r.pad)));
   std::vector<double> v;
-  v.reserve(64);
-  // Local level: the median of one value per true bin over ±24 true bins (main lobe left out);
-  // at the ends of the spectrum the window is shifted inwards so that it keeps its size.
   auto window = [&](std::size_t k) -> std::vector<double>& {
-    std::size_t a = k > W ? k - W : 1, b = k + W;
-    if (b > half) {
-      a = a > b - half ? a - (b - half) : 1;
-      b = half;
-    }
-    v.clear();
-    for (std::size_t j = a; j <= b; j += stepb)
-      if (j + gap < k || j > k + gap) v.push_back(r.P[j]);
+    level_window(r.P, k, r.pad, true, v);  // at the spectrum's end shifted inwards, keeping its size
     return v;
   };
   const Peak peak = peak_over_level(r.P, k_lo, k_hi, r.pad, window, med);
@@ -110,23 +93,28 @@ Resolution search(const std::vector<double>& y, std::size_t len, double t0, doub
   return r;
 }
 
-/// A line that won at a Welch resolution: its power is the periodogram's excess over the level
-/// around the band (the median of the bins 48–96 true bins away), summed over the contiguous bins
-/// above that level; frequency and width from the excess's centroid and spread, phase 0. A strong
-/// phase-stable line can win there too (its sidelobes raise every level alike, and the mean of K
-/// segments counts it K times): it is coherent when the whole record's highest bin in the band
-/// holds at least half the excess power (a Hann peak of height P carries 2P/(Σw)²); then f0 and
-/// the level come from the whole record's periodogram and false is returned.
+/// P at k ± d, d = inner, inner + step, … ≤ outer, within P[2 …].
+std::vector<double> ring_values(const std::vector<double>& P, std::size_t k, std::size_t inner, std::size_t outer,
+                                std::size_t step) {
+  std::vector<double> v;
+  for (std::size_t d = inner; d <= outer; d += step) {
+    if (k > d + 1) v.push_back(P[k - d]);
+    if (k + d < P.size()) v.push_back(P[k + d]);
+  }
+  return v;
+}
+
+/// A line that won at a Welch resolution: its power is the excess over the level 48–96 true bins
+/// away, summed over the contiguous bins above it; frequency and width from its centroid and
+/// spread, phase 0. A strong coherent line can win there too: when the whole record's highest bin
+/// in the band holds half the excess power (a Hann peak P carries 2P/(Σw)²), f0 and the level
+/// come from the whole record and false is returned.
 bool broad_line(LineEstimate& e, Resolution& best, const std::vector<double>& full_P, double full_df, std::size_t n,
                 double t0, double& f0) {
   const auto inner = static_cast<std::size_t>(48 * best.pad), outer = static_cast<std::size_t>(96 * best.pad);
   const std::size_t half = best.P.size() - 1;
-  std::vector<double> ring;
   const auto stepb = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(best.pad)));
-  for (std::size_t d = inner; d <= outer; d += stepb) {
-    if (best.k > d + 1) ring.push_back(best.P[best.k - d]);
-    if (best.k + d <= half) ring.push_back(best.P[best.k + d]);
-  }
+  std::vector<double> ring = ring_values(best.P, best.k, inner, outer, stepb);
   const double med = boost::math::gamma_p_inv(best.K, 0.5) / best.K;
   const double base = ring.empty() ? best.level : median_of(ring) / med;
   std::size_t a = best.k, b = best.k;
@@ -155,11 +143,7 @@ bool broad_line(LineEstimate& e, Resolution& best, const std::vector<double>& fu
     e.coherent = true;
     e.resolution_hz = 1.0 / (t0 * static_cast<double>(n));
     f0 = static_cast<double>(kk) * full_df;
-    std::vector<double> lv;  // the noise level at the line, ±48 … ±96 true bins
-    for (std::size_t d = 96; d <= 192; d += 2) {
-      if (kk > d + 1) lv.push_back(full_P[kk - d]);
-      if (kk + d < full_P.size()) lv.push_back(full_P[kk + d]);
-    }
+    std::vector<double> lv = ring_values(full_P, kk, 96, 192, 2);  // the level at ±48 … ±96 true bins
     best.level = median_of(lv) / std::log(2.0);
     best.w2 = 0.375 * static_cast<double>(n);
     return false;
@@ -170,8 +154,7 @@ bool broad_line(LineEstimate& e, Resolution& best, const std::vector<double>& fu
     s2 += (best.P[k] - base) * scale * best.df * (f - fm) * (f - fm);
   }
   e.width_hz = std::sqrt(std::max(0.0, s2 / pw));
-  const double xs = kPi * fm * t0;
-  const double att = xs > 1e-9 ? std::sin(xs) / xs : 1.0;
+  const double att = block_attenuation(fm, t0);
   const double amp_s = std::sqrt(2.0 * pw);  // amplitude of the per-sample rate
   e.f_hz = fm;
   e.amp = amp_s / att;
@@ -181,8 +164,7 @@ bool broad_line(LineEstimate& e, Resolution& best, const std::vector<double>& fu
   return true;
 }
 
-/// A coherent line: least-squares sinusoid on the detrended samples (at their centres), cos/sin
-/// by rotation re-seeded every 4096 samples; σ from the noise level at the line.
+/// A coherent line: least-squares sinusoid on the detrended samples; σ from the level at the line.
 void coherent_line(LineEstimate& e, const std::vector<double>& y, double t0, double f0, double level, double w2) {
   const std::size_t n = y.size();
   const double T = t0 * static_cast<double>(n);
@@ -212,8 +194,7 @@ void coherent_line(LineEstimate& e, const std::vector<double>& y, double t0, dou
   const double fbest = refine_frequency(fit_at, f0, 1.0 / (16.0 * T), 12, 20, 0.5 / t0);
   double a = 0, b = 0;
   fit_at(fbest, a, b);
-  const double xs = kPi * fbest * t0;
-  const double att = xs > 1e-9 ? std::sin(xs) / xs : 1.0;
+  const double att = block_attenuation(fbest, t0);
   e.f_hz = fbest;
   e.amp = std::hypot(a, b) / att;
   e.phase = std::atan2(-b, a);
@@ -221,6 +202,26 @@ void coherent_line(LineEstimate& e, const std::vector<double>& y, double t0, dou
   e.amp_sigma = std::sqrt(S / T) / att;
   e.f_sigma = e.amp > 0 ? std::sqrt(6.0 * S / (e.amp * att * e.amp * att * T * T * T)) / (2.0 * kPi) : 0.0;
 }
+
+class LineDetector final : public RecordDetector {
+ public:
+  [[nodiscard]] Effect effect() const override { return Effect::Line; }
+  [[nodiscard]] double statistic(const RecordView& r) const override {
+    return line_detect(r.series, kHighLineMinHz, 0.0, false).statistic;
+  }
+  /// A broadened line cannot be subtracted from the data: it enters the model only, as a sinusoid
+  /// of its power at its centroid (the Allan variance sees the power, not the phase).
+  void estimate(const Stretch& s, Extension& x) const override {
+    const auto est = line_detect(s.rec->phase, kHighLineMinHz, s.line_hint_hz);
+    (est.coherent ? x.det.sinusoids : x.broad).push_back({est.f_hz, est.amp, est.phase});
+    Finding f{Effect::Line,
+              {{"frequency_hz", est.f_hz}, {"amplitude_deg_per_h", est.amp}, {"phase_rad", est.phase}},
+              {{"frequency_hz", est.f_sigma}, {"amplitude_deg_per_h", est.amp_sigma}},
+              {{"coherent", est.coherent}, {"resolution_hz", est.resolution_hz}}};
+    if (!est.coherent) f.evidence["width_hz"] = est.width_hz;
+    x.findings.push_back(std::move(f));
+  }
+};
 
 }  // namespace
 
@@ -232,8 +233,7 @@ LineEstimate line_detect(const PhaseSeries& x, double f_min, double f_hint, bool
   std::vector<double> y(n);  // per-sample rates (″/s = °/h), level and linear trend removed
   for (std::size_t i = 0; i < n; ++i) y[i] = x.diff(i + 1, i) / t0;
   remove_trend(y);
-  // The whole record (a coherent line), and Welch means of 16384, 4096 and 1024 samples (at least
-  // 8 segments) for a line broadened by a wandering frequency or phase.
+  // The whole record (a coherent line), and Welch means (≥ 8 segments) for a broadened one.
   std::vector<std::size_t> lens{n};
   if (f_hint <= 0)
     for (std::size_t len : {std::size_t{16384}, std::size_t{4096}, std::size_t{1024}})
@@ -260,31 +260,6 @@ LineEstimate line_detect(const PhaseSeries& x, double f_min, double f_hint, bool
   coherent_line(e, y, t0, f0, best.level, best.w2);
   return e;
 }
-
-namespace {
-
-class LineDetector final : public RecordDetector {
- public:
-  [[nodiscard]] Effect effect() const override { return Effect::Line; }
-  [[nodiscard]] double statistic(const RecordView& r) const override {
-    return line_detect(r.series, kHighLineMinHz, 0.0, false).statistic;
-  }
-  /// A coherent line is subtracted from the data like the low-frequency one; a broadened line
-  /// (power spread over a band by a wandering phase) cannot be, and enters the model only, as a
-  /// sinusoid of its power at its centroid (the Allan variance sees the power, not the phase).
-  void estimate(const Stretch& s, Extension& x) const override {
-    const auto est = line_detect(s.rec->phase, kHighLineMinHz, s.line_hint_hz);
-    (est.coherent ? x.det.sinusoids : x.broad).push_back({est.f_hz, est.amp, est.phase});
-    Finding f{Effect::Line,
-              {{"frequency_hz", est.f_hz}, {"amplitude_deg_per_h", est.amp}, {"phase_rad", est.phase}},
-              {{"frequency_hz", est.f_sigma}, {"amplitude_deg_per_h", est.amp_sigma}},
-              {{"coherent", est.coherent}, {"resolution_hz", est.resolution_hz}}};
-    if (!est.coherent) f.evidence["width_hz"] = est.width_hz;
-    x.findings.push_back(std::move(f));
-  }
-};
-
-}  // namespace
 
 std::unique_ptr<RecordDetector> line_detector() { return std::make_unique<LineDetector>(); }
 

@@ -1,6 +1,5 @@
 // The output-chain low-pass detector: the χ² drop of the short-τ octave AV when white angle and
-// white rate noise (and a floor) pass through a first-order filter. Only floating (sub-pulse)
-// data can have passed through one; pulse counts come straight from the counter.
+// rate noise (and a floor) pass through a first-order filter. Pulse counts cannot have.
 #include <boost/math/distributions/chi_squared.hpp>
 
 #include <array>
@@ -24,8 +23,7 @@ double output_lowpass_angle_avar(std::size_t m, double tau0, double tf) {
 double output_lowpass_rate_avar(std::size_t m, double tau0, double tf) {
   const double md = static_cast<double>(m);
   if (!(tf > 0)) return 1.0 / (md * tau0);
-  // Rate samples of variance 1/τ0 through the AR(1) filter: variance V, autocorrelation φ^k.
-  // AV = (Var of an m-sum − Cov of adjacent m-sums)/m².
+  // AR(1)-filtered rate samples of variance 1/τ0: AV = (Var of an m-sum − Cov of adjacent ones)/m².
   const double x = tau0 / tf;
   const double a = -std::expm1(-x);                 // 1 − φ
   const double phi = 1.0 - a;
@@ -68,6 +66,64 @@ NnFit nn_fit3(const std::vector<double>& y, const std::vector<double>& w, const 
   }
   return best;
 }
+
+class LowpassDetector final : public RecordDetector {
+ public:
+  LowpassDetector(const AnalysisResult& a, double duration_s, std::string skip)
+      : tau0_(a.allan.tau0_s), duration_(duration_s), skip_(std::move(skip)) {
+    for (const auto& p : a.allan.points) {
+      m_.push_back(p.m);
+      edf_.push_back(p.edf);
+    }
+  }
+  [[nodiscard]] Effect effect() const override { return Effect::Lowpass; }
+  [[nodiscard]] double statistic(const RecordView& r) const override {
+    return skip_.empty() ? fit(r.octave_var).statistic : 0.0;
+  }
+  /// The base records have no filter and often a statistic of 0: the threshold is at least the
+  /// χ²(1) (1 − α) quantile, scaled by the best fit's χ² per degree of freedom.
+  [[nodiscard]] DetectorResult test(const Trial& t) const override {
+    DetectorResult d;
+    d.effect = Effect::Lowpass;
+    if (!skip_.empty()) {
+      d.note = skip_;
+      return d;
+    }
+    const double alpha = t.stretch.opt->alpha;
+    const auto lp = fit(t.data.octave_var);
+    d = calibrate(lp.statistic, t.runs, alpha);
+    const double dof = std::max(1.0, lp.points - 4.0);
+    const double floor =
+        boost::math::quantile(boost::math::chi_squared(1.0), 1.0 - alpha) * std::max(1.0, lp.chi2 / dof);
+    if (d.threshold < floor) {
+      d.threshold = floor;
+      d.fired = d.named = lp.statistic > floor;
+    }
+    return d;
+  }
+  [[nodiscard]] bool block_statistic() const override { return false; }
+  [[nodiscard]] bool shows_in(const Trial&) const override { return true; }
+  /// The filter and the white angle noise before it from the short-τ octave AV; N, B, K stay.
+  void estimate(const Stretch& s, Extension& x) const override {
+    std::vector<double> v;
+    for (const auto& p : s.analysis->allan.points) v.push_back(p.var);
+    const auto est = LowpassDetector(*s.analysis, s.rec->phase.duration_s(), "").fit(v);
+    x.findings.push_back({Effect::Lowpass,
+                          {{"time_constant_s", est.tf}},
+                          {{"time_constant_s", 0.5 * (est.tf_high - est.tf_low)}},
+                          {}});
+    x.lowpass = est;
+  }
+
+ private:
+  [[nodiscard]] OutputLowpassEstimate fit(const std::vector<double>& octave_var) const {
+    return output_lowpass_detect(m_, octave_var, edf_, tau0_, duration_);
+  }
+  double tau0_, duration_;
+  std::string skip_;
+  std::vector<std::int64_t> m_;
+  std::vector<double> edf_;
+};
 
 }  // namespace
 
@@ -144,7 +200,7 @@ OutputLowpassEstimate output_lowpass_detect(const std::vector<std::int64_t>& m, 
     e.statistic = std::max(0.0, chi0 - best);
   }
   e.chi2 = best;
-  // Δχ² range, widened by the misfit per degree of freedom when the shape does not fit exactly.
+  // Δχ² range, widened by the misfit per degree of freedom.
   const double dof = std::max(1.0, e.points - 4.0);
   const double delta = std::max(1.0, best / dof);
   e.tf_low = e.tf_high = e.tf;
@@ -165,75 +221,6 @@ OutputLowpassEstimate output_lowpass_detect(const std::vector<std::int64_t>& m, 
   }
   return e;
 }
-
-namespace {
-
-class LowpassDetector final : public RecordDetector {
- public:
-  LowpassDetector(const AnalysisResult& a, double duration_s, std::string skip)
-      : tau0_(a.allan.tau0_s), duration_(duration_s), skip_(std::move(skip)) {
-    for (const auto& p : a.allan.points) {
-      m_.push_back(p.m);
-      edf_.push_back(p.edf);
-    }
-  }
-  [[nodiscard]] Effect effect() const override { return Effect::Lowpass; }
-  [[nodiscard]] double statistic(const RecordView& r) const override {
-    return skip_.empty() ? fit(r.octave_var).statistic : 0.0;
-  }
-  /// The simulated base records have no filter, and their statistic is often exactly 0: the
-  /// threshold is at least the χ²(1) (1 − α) quantile, scaled by the best fit's χ² per degree of
-  /// freedom when the measured shape is not fitted exactly.
-  [[nodiscard]] DetectorResult test(const Trial& t) const override {
-    DetectorResult d;
-    d.effect = Effect::Lowpass;
-    if (!skip_.empty()) {
-      d.note = skip_;
-      return d;
-    }
-    const double alpha = t.stretch.opt->alpha;
-    const auto lp = fit(t.data.octave_var);
-    d = calibrate(lp.statistic, t.runs, alpha);
-    const double dof = std::max(1.0, lp.points - 4.0);
-    const double floor =
-        boost::math::quantile(boost::math::chi_squared(1.0), 1.0 - alpha) * std::max(1.0, lp.chi2 / dof);
-    if (d.threshold < floor) {
-      d.threshold = floor;
-      d.fired = d.named = lp.statistic > floor;
-    }
-    return d;
-  }
-  [[nodiscard]] bool block_statistic() const override { return false; }
-  [[nodiscard]] bool shows_in(const Trial&) const override { return true; }
-  /// The filter's time constant and the white angle noise before it from the short-τ octave AV of
-  /// the stretch; N, B, K stay the mid-τ ones.
-  void estimate(const Stretch& s, Extension& x) const override {
-    std::vector<std::int64_t> m;
-    std::vector<double> v, edf;
-    for (const auto& p : s.analysis->allan.points) {
-      m.push_back(p.m);
-      v.push_back(p.var);
-      edf.push_back(p.edf);
-    }
-    const auto est = output_lowpass_detect(m, v, edf, s.analysis->allan.tau0_s, s.rec->phase.duration_s());
-    x.findings.push_back({Effect::Lowpass,
-                          {{"time_constant_s", est.tf}},
-                          {{"time_constant_s", 0.5 * (est.tf_high - est.tf_low)}},
-                          {}});
-    x.lowpass = est;
-  }
-
- private:
-  [[nodiscard]] OutputLowpassEstimate fit(const std::vector<double>& octave_var) const {
-    return output_lowpass_detect(m_, octave_var, edf_, tau0_, duration_);
-  }
-  double tau0_, duration_;
-  std::string skip_;
-  std::vector<std::int64_t> m_;
-  std::vector<double> edf_;
-};
-
-}  // namespace
 
 std::unique_ptr<RecordDetector> lowpass_detector(const AnalysisResult& analysis, double duration_s, std::string skip) {
   return std::make_unique<LowpassDetector>(analysis, duration_s, std::move(skip));

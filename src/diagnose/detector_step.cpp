@@ -17,8 +17,7 @@ StepEstimate step_detect(const Decimated& d) {
   const double sig = std::max(diff_sigma(y), 1e-12);
   std::vector<double> cs(n + 1, 0.0);
   for (std::size_t i = 0; i < n; ++i) cs[i + 1] = cs[i] + y[i];
-  // Likelihood ratio of one change of the mean at block k against none (white noise of the
-  // level σ̂ seen in the block-to-block differences): n/(k(n−k))·(S_k − k·ȳ)²/σ̂², maximised over k.
+  // Likelihood ratio of one change of the mean at block k (white noise σ̂): n/(k(n−k))·(S_k − k·ȳ)²/σ̂².
   double best = 0;
   std::size_t ibest = n / 2;
   const double ybar = cs[n] / static_cast<double>(n);
@@ -90,11 +89,9 @@ StepEstimate step_detect(const Decimated& d) {
   return e;
 }
 
-
 namespace {
 
-/// A bias step at a known time `ts`: its size from the mean rates over up to 30 min each side,
-/// σ from the 1-s block means' white level.
+/// A bias step at a known time: its size from the mean rates over up to 30 min each side.
 StepEstimate step_at(const Decimated& d, double ts) {
   StepEstimate e;
   e.t_s = ts;
@@ -109,10 +106,7 @@ StepEstimate step_at(const Decimated& d, double ts) {
   };
   const double th = theta_at(ts);
   e.size = (theta_at(ts + wb) - th) / wb - (th - theta_at(ts - wa)) / wa;
-  const auto y1 = block_rates(d, std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(1.0 / d.tau_d))));
-  double s2 = 0;
-  for (std::size_t i = 0; i + 1 < y1.size(); ++i) s2 += (y1[i + 1] - y1[i]) * (y1[i + 1] - y1[i]);
-  const double sig1 = y1.size() > 2 ? std::sqrt(s2 / static_cast<double>(y1.size() - 1) / 2.0) : 0.0;
+  const double sig1 = diff_sigma(block_rates(d, per_block_for(d, 1.0)));
   e.size_sigma = sig1 * std::sqrt(1.0 / wa + 1.0 / wb);
   return e;
 }
@@ -122,9 +116,8 @@ class StepDetector final : public RecordDetector {
   [[nodiscard]] Effect effect() const override { return Effect::BiasStep; }
   [[nodiscard]] bool mean_shape() const override { return true; }
   [[nodiscard]] double statistic(const RecordView& r) const override { return step_detect(r.dec).statistic; }
-  /// A block shows a step when the step's time, known from the whole record, lies inside it with
-  /// data on both sides: its size is estimable there even where the block's own detector, which
-  /// also searches for the time, does not fire; a step in the predicted block stays out.
+  /// A block shows a step whose time, known from the whole record, lies inside it with data on
+  /// both sides: its size is estimable there even where the block's own time search fails.
   [[nodiscard]] bool block_statistic() const override { return false; }
   [[nodiscard]] bool shows_in(const Trial& t) const override { return t.stretch.step_time_s >= 0; }
   void estimate(const Stretch& s, Extension& x) const override {

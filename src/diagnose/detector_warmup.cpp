@@ -1,6 +1,5 @@
-// The warm-up detector: the drop of the residual sum of squares of the 10-s block rates when an
-// exponential transient joins level and trend; and a record's own mean-shape candidate, the
-// better of the best step and the best transient.
+// The warm-up detector: the RSS drop of the 10-s block rates when an exponential transient joins
+// level and trend; and a record's own mean-shape candidate.
 #include <cmath>
 #include <limits>
 
@@ -28,26 +27,16 @@ WarmupEstimate warmup_detect(const Decimated& d) {
   const double lt_lo = std::log(2.0 * tb), lt_hi = std::log(T / 3.0);
   const int G = 40;
   double best = std::numeric_limits<double>::infinity(), lbest = lt_lo;
-  std::vector<std::pair<double, double>> prof;
   for (int g = 0; g <= G; ++g) {
     const double lt = lt_lo + (lt_hi - lt_lo) * g / G;
     const double r = rss_at(std::exp(lt));
-    prof.emplace_back(lt, r);
     if (r < best) {
       best = r;
       lbest = lt;
     }
   }
   const double step = (lt_hi - lt_lo) / G;
-  double lo = lbest - step, hi = lbest + step;
-  for (int it = 0; it < 25; ++it) {
-    const double m1 = lo + 0.382 * (hi - lo), m2 = lo + 0.618 * (hi - lo);
-    if (rss_at(std::exp(m1)) < rss_at(std::exp(m2)))
-      hi = m2;
-    else
-      lo = m1;
-  }
-  lbest = 0.5 * (lo + hi);
+  lbest = golden_min([&](double lt) { return rss_at(std::exp(lt)); }, lbest - step, lbest + step, 25);
   Eigen::VectorXd coef;
   Eigen::MatrixXd inv;
   e.tc = std::exp(lbest);

@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <chrono>
 
-#include "diagnose/holdout.hpp"
 #include "diagnose/models.hpp"
 #include "rwcalc/error.hpp"
 
@@ -27,15 +26,13 @@ struct Context {
   EnsemblePlan plan;                 ///< octave sizes and mid-τ grid of the record
   Stretch full;                      ///< the whole record as a stretch
   std::vector<double> octave_var;    ///< measured octave AV
-  NoiseModel candidate;              ///< the record's own mean-shape candidate
-  Coefficient b_fit;                 ///< B of the five-term fit without it
+  RobustBase rb;                     ///< base model, own candidate, B of the fit without it
   std::vector<std::unique_ptr<Detector>> detectors;
   [[nodiscard]] RecordView view() const { return {rec.phase, full.dec, full.clean, octave_var}; }
 };
 
-/// Outliers are screened once, on the record as read, and the requested action applied before
-/// anything else: the detectors, the pilot fits and the hold-out blocks all see the same data,
-/// and a spike cannot pass for a bias step or inflate N.
+/// Outliers are screened once, first: every stage sees the same data, and a spike cannot pass for
+/// a bias step or inflate N.
 const Recording& screened(const Recording& read, const DiagnoseOptions& opt, OutlierReport& outliers,
                           Recording& edited) {
   if (read.phase.kind != PhaseKind::Gyro)
@@ -50,9 +47,8 @@ const Recording& screened(const Recording& read, const DiagnoseOptions& opt, Out
   return rec;
 }
 
-/// The five-term fit of the record and its base model. Pulse data: the counting read-out is
-/// simulated exactly, and its structured AV at short τ would distort the fit, so the fit starts
-/// at 20 s unless a range was given.
+/// The five-term fit of the record and its base model. Pulse data: the counting read-out's
+/// structured short-τ AV (simulated exactly) would distort the fit, which starts at 20 s.
 void fit_base(Context& c, DiagnoseResult& r, OutlierReport outliers) {
   c.aopt = c.opt.analysis;
   c.aopt.outlier_action = OutlierAction::Keep;
@@ -77,12 +73,10 @@ void fit_base(Context& c, DiagnoseResult& r, OutlierReport outliers) {
   s.pilot.seed = c.opt.seed + 1000;
   s.pilot_runs = std::max<std::size_t>(10, c.opt.runs / 2);
   c.plan = {s.octave_m, mid_tau_grid(s.dec), true, {}};
-  const RobustBase rb = robust_base(c.rec, r.analysis, c.aopt, s.dec, s.pilot, s.pilot_runs, c.plan, c.opt.progress);
-  r.base = s.base = rb.model;
-  c.candidate = rb.candidate;
-  c.b_fit = rb.b_fit;
+  c.rb = robust_base(c.rec, r.analysis, c.aopt, s.dec, s.pilot, s.pilot_runs, c.plan, c.opt.progress);
+  r.base = s.base = c.rb.model;
   s.clean = s.dec;
-  subtract_deterministic(s.clean, c.candidate);
+  subtract_deterministic(s.clean, c.rb.candidate);
   c.detectors = make_detectors(r.analysis, x, !x.exact() && on_lattice(x));
 }
 
@@ -95,7 +89,7 @@ std::vector<const RecordDetector*> record_detectors(const Context& c, bool mean_
   return out;
 }
 
-/// The base model's ensemble: its band, the mid-τ references, every record's detector statistics.
+/// The base model's ensemble: its band, mid-τ references and every record's detector statistics.
 std::vector<RunStats> base_ensemble(Context& c, DiagnoseResult& r) {
   EnsemblePlan plan = c.plan;
   plan.scored = record_detectors(c, false);
@@ -106,15 +100,14 @@ std::vector<RunStats> base_ensemble(Context& c, DiagnoseResult& r) {
   return runs;
 }
 
-/// The null of the mean-shape detectors carries the uncertainty of B: when the five-term fit of
-/// the record without its candidate does not resolve B, the pilot's calibrated B may be far below
-/// the record's, and beside such a quiet model the record's own flicker wander looks like a step
-/// or a transient. Their thresholds are then also taken under B at the fit's upper confidence
-/// bound (same seeds), and the larger kept.
+/// When the fit does not resolve B, the calibrated B may be far below the record's, and beside
+/// such a quiet model the record's flicker wander looks like a step or a transient: the
+/// mean-shape thresholds are also taken under B at its upper bound (same seeds), the larger kept.
 void recalibrate_under_high_b(const Context& c, const DiagnoseResult& r, std::vector<DetectorResult>& results) {
-  if (!(c.b_fit.enabled && !c.b_fit.resolved && c.b_fit.high > r.base.bias_instability_deg_per_h)) return;
+  const Coefficient& b = c.rb.b_fit;
+  if (!(b.enabled && !b.resolved && b.high > r.base.bias_instability_deg_per_h)) return;
   NoiseModel hi = r.base;
-  hi.bias_instability_deg_per_h = c.b_fit.high;
+  hi.bias_instability_deg_per_h = b.high;
   EnsemblePlan plan = c.plan;
   plan.scored = record_detectors(c, true);
   const auto hi_runs = run_ensemble(hi, r.settings, c.opt.runs, plan, c.opt.progress);
@@ -126,8 +119,7 @@ void recalibrate_under_high_b(const Context& c, const DiagnoseResult& r, std::ve
       }
 }
 
-/// A step and a transient that both fire are one change of the mean: the shape that fits the
-/// block means better (the record's own candidate) is named.
+/// A step and a transient that both fire are one change of the mean: the candidate is named.
 void one_mean_shape(const NoiseModel& candidate, std::vector<DetectorResult>& results) {
   auto of = [&](Effect e) { return std::find_if(results.begin(), results.end(), [e](auto& d) { return d.effect == e; }); };
   const auto step = of(Effect::BiasStep), warm = of(Effect::Warmup);
@@ -145,9 +137,8 @@ bool is_named(const std::vector<DetectorResult>& results, Effect e) {
   return std::any_of(results.begin(), results.end(), [e](const auto& d) { return d.effect == e && d.named; });
 }
 
-/// Every detector's verdict on the measurement (r.detectors, in the registry's order) and the
-/// named effects. The mid-τ detectors read the measurement without its own candidate (as every
-/// ensemble record) and without the named lines, so they run after the others.
+/// Every detector's verdict (r.detectors) and the named effects. The mid-τ detectors read the
+/// measurement without its candidate and without the named lines, so they run last.
 Named test_detectors(Context& c, const std::vector<RunStats>& runs, DiagnoseResult& r) {
   std::vector<DetectorResult> res(c.detectors.size());
   const Trial trial{c.view(), runs, c.full, r.settings, nullptr};
@@ -156,9 +147,9 @@ Named test_detectors(Context& c, const std::vector<RunStats>& runs, DiagnoseResu
     if (!c.detectors[i]->mid_tau()) res[i] = c.detectors[i]->test(trial);
   }
   recalibrate_under_high_b(c, r, res);
-  one_mean_shape(c.candidate, res);
+  one_mean_shape(c.rb.candidate, res);
   Named named;
-  NoiseModel det = c.candidate;
+  NoiseModel det = c.rb.candidate;
   if (is_named(res, Effect::Sinusoid)) {
     const auto sin = sinusoid_detect(c.full.clean);
     det.sinusoids.push_back({sin.f_hz, sin.amp, sin.phase});
@@ -201,10 +192,9 @@ void add_evidence(Finding& f, const DiagnoseResult& r) {
   }
 }
 
-/// The extended model of the whole record, its findings and its band. Common random numbers: the
-/// extended ensemble reuses the base ensemble's seeds, so the two bands differ by the model
-/// change, not by sampling noise; N and B are then re-fitted to the whole band (the extension was
-/// calibrated at mid τ only).
+/// The extended model of the whole record, its findings and its band. Its ensemble reuses the
+/// base's seeds, so the bands differ by the model, not by sampling noise; N and B are then
+/// re-fitted to the whole band (the extension was calibrated at mid τ only).
 void extended_model(Context& c, const Named& named, DiagnoseResult& r) {
   c.full.sin_hint_hz = named.sin_hint_hz;
   Extension ext = extend(c.full, named.detectors);
@@ -229,7 +219,7 @@ DiagnoseResult diagnose(const Recording& read, const DiagnoseOptions& opt) {
   const auto t_start = std::chrono::steady_clock::now();
   OutlierReport outliers;
   Recording edited;
-  Context c{screened(read, opt, outliers, edited), opt, {}, {}, {}, {}, {}, {}, {}};
+  Context c{screened(read, opt, outliers, edited), opt, {}, {}, {}, {}, {}, {}};
   DiagnoseResult r;
   r.runs = opt.runs;
   r.holdout_runs = opt.holdout_runs ? opt.holdout_runs : opt.runs;

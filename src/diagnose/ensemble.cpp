@@ -1,5 +1,4 @@
-// The simulated ensemble of a model: per-record statistics, the band of σ per τ, the mid-τ
-// reference, and the measured-versus-ensemble deviance.
+// The simulated ensemble of a model: per-record statistics, band, mid-τ reference, deviance.
 #include "diagnose/ensemble.hpp"
 
 #include <Eigen/Dense>
@@ -18,15 +17,14 @@ namespace rwcalc::diag {
 
 namespace {
 
-/// Overlapping AV of a simulated record at the octave cluster sizes; pulse counts by their exact
-/// integer sums, every cluster size in one sweep over the counts.
+/// Overlapping AV of a simulated record at the octave cluster sizes; pulse counts by exact integer
+/// sums, every cluster size in one sweep.
 std::vector<double> octave_avar(const PhaseSeries& s, const std::vector<std::int64_t>& octave_m) {
   std::vector<double> v(octave_m.size(), 0.0);
   if (!s.exact()) {
     for (std::size_t i = 0; i < octave_m.size(); ++i) v[i] = allan_variance(s, octave_m[i], Estimator::Overlapping);
     return v;
   }
-  // Every cluster size's sum in one sweep over the counts (the same sums as per m).
   const std::vector<detail::u128> swept = detail::second_diff_sumsq_sweep(s.counts.data(), s.points(), octave_m);
   const double q = s.arcsec_per_count;
   for (std::size_t i = 0; i < octave_m.size(); ++i) {
@@ -39,8 +37,7 @@ std::vector<double> octave_avar(const PhaseSeries& s, const std::vector<std::int
   return v;
 }
 
-/// The weight of a band point in the misfit: the measured EDF combined with the ensemble's own
-/// sampling error (`runs` records) and a 1000-EDF model floor.
+/// A band point's weight: its EDF with the ensemble's sampling error and a 1000-EDF model floor.
 double band_nu(double edf, std::size_t runs) {
   const double K = static_cast<double>(std::max<std::size_t>(runs, 1));
   return 1.0 / (1.0 / edf + 1.0 / (K * edf) + 1.0 / 1000.0);
@@ -118,16 +115,10 @@ MidTauReference make_reference(const std::vector<std::size_t>& grid, double tau_
       ++k;
     }
     ref.tau.push_back(static_cast<double>(grid[i]) * tau_d);
-    if (k < 3) {
-      ref.mean.push_back(0);
-      ref.var.push_back(0);
-      continue;
-    }
-    const double mean = m / double(k);
+    const double mean = k < 3 ? 0.0 : m / double(k);  // fewer than 3 runs: no reference
     ref.mean.push_back(mean);
-    ref.var.push_back(std::max((m2 - double(k) * mean * mean) / double(k - 1), 0.0));
+    ref.var.push_back(k < 3 ? 0.0 : std::max((m2 - double(k) * mean * mean) / double(k - 1), 0.0));
   }
-  // Covariance between grid points over the runs.
   const std::size_t g = grid.size();
   if (runs.size() >= 5) {
     ref.cov.assign(g * g, 0.0);
@@ -189,27 +180,22 @@ std::array<double, 3> band_refit(const std::vector<BandPoint>& band, std::size_t
       A += w * g * g.transpose();
       rhs += w * (p.d - m) * g;
     }
-    std::array<bool, 3> free{};
+    std::vector<Eigen::Index> idx;  // the free terms
     for (std::size_t j = 0; j < 3; ++j)
-      free[j] = held_free[j] && (c[j] + x[j] > 1e-12 * (c[j] + 1e-30) || rhs(static_cast<Eigen::Index>(j)) > 0);
-    Eigen::Vector3d step = Eigen::Vector3d::Zero();
-    {
-      std::vector<Eigen::Index> idx;
-      for (std::size_t j = 0; j < 3; ++j)
-        if (free[j]) idx.push_back(static_cast<Eigen::Index>(j));
-      if (idx.empty()) break;
-      const auto n = static_cast<Eigen::Index>(idx.size());
-      Eigen::MatrixXd a(n, n);
-      Eigen::VectorXd b(n);
-      Eigen::VectorXd sc(n);
-      for (Eigen::Index i = 0; i < n; ++i) sc(i) = A(idx[i], idx[i]) > 0 ? 1.0 / std::sqrt(A(idx[i], idx[i])) : 0.0;
-      for (Eigen::Index i = 0; i < n; ++i) {
-        b(i) = rhs(idx[i]) * sc(i);
-        for (Eigen::Index k = 0; k < n; ++k) a(i, k) = A(idx[i], idx[k]) * sc(i) * sc(k);
-      }
-      const Eigen::VectorXd s = a.completeOrthogonalDecomposition().solve(b);
-      for (Eigen::Index i = 0; i < n; ++i) step(idx[i]) = s(i) * sc(i);
+      if (held_free[j] && (c[j] + x[j] > 1e-12 * (c[j] + 1e-30) || rhs(static_cast<Eigen::Index>(j)) > 0))
+        idx.push_back(static_cast<Eigen::Index>(j));
+    if (idx.empty()) break;
+    const auto n = static_cast<Eigen::Index>(idx.size());
+    Eigen::MatrixXd a(n, n);
+    Eigen::VectorXd b(n), sc(n);
+    for (Eigen::Index i = 0; i < n; ++i) sc(i) = A(idx[i], idx[i]) > 0 ? 1.0 / std::sqrt(A(idx[i], idx[i])) : 0.0;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      b(i) = rhs(idx[i]) * sc(i);
+      for (Eigen::Index k = 0; k < n; ++k) a(i, k) = A(idx[i], idx[k]) * sc(i) * sc(k);
     }
+    const Eigen::VectorXd sol = a.completeOrthogonalDecomposition().solve(b);
+    Eigen::Vector3d step = Eigen::Vector3d::Zero();
+    for (Eigen::Index i = 0; i < n; ++i) step(idx[i]) = sol(i) * sc(i);
     bool improved = false;
     for (double t = 1.0; t > 1e-4; t *= 0.5) {
       std::array<double, 3> y = x;
@@ -244,8 +230,7 @@ BandDeviance band_deviance(const std::vector<BandPoint>& band, std::size_t runs)
 namespace rwcalc {
 
 double band_misfit(const std::vector<BandPoint>& band, std::size_t runs) {
-  const auto d = diag::band_deviance(band, runs);
-  return d.points ? d.sum / static_cast<double>(d.points) : 0.0;
+  return diag::band_deviance(band, runs).per_point();
 }
 
 double band_coverage(const std::vector<BandPoint>& band) {

@@ -1,5 +1,5 @@
-// The extended model of a stretch: the named effects estimated by their detectors, added to the
-// base model, and the rest re-fitted on the data without the named terms.
+// The extended model of a stretch: the named effects added to the base model, the rest re-fitted
+// on the data without the named terms.
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -11,14 +11,12 @@ namespace rwcalc::diag {
 namespace {
 
 /// A high-frequency line measured behind the output-chain low-pass: the model's line is the
-/// sensed one, which the simulated filter y_k = φy_{k−1} + (1 − φ)r_k then attenuates by |H| and
-/// shifts by arg H, H = (1 − φ)/(1 − φe^{−iωτ0}).
+/// sensed one, which the simulated filter then attenuates by |H| and shifts by arg H.
 void unfilter_lines(NoiseModel& model, std::vector<Finding>& findings, double tau0, double tf) {
-  const double phi = std::exp(-tau0 / tf);
   std::size_t j = 0;
   for (auto& l : model.sinusoids) {
     if (!(l.f_hz > kHighLineMinHz)) continue;
-    const std::complex<double> h = (1.0 - phi) / (1.0 - phi * std::polar(1.0, -2.0 * kPi * l.f_hz * tau0));
+    const std::complex<double> h = lowpass_response(l.f_hz, tau0, tf);
     l.amp_deg_per_h /= std::abs(h);
     if (l.phase_rad != 0) l.phase_rad = std::remainder(l.phase_rad - std::arg(h), 2.0 * kPi);
     for (; j < findings.size(); ++j)
@@ -34,9 +32,8 @@ void unfilter_lines(NoiseModel& model, std::vector<Finding>& findings, double ta
   }
 }
 
-/// The base model with the named terms. They keep the stretch's mean rate: the counting
-/// read-out's fine structure at short τ depends on the rate in each part of the record, so the
-/// level before a step or under a transient must be the data's, not the mean's.
+/// The base model with the named terms, keeping the stretch's mean rate: the counting read-out's
+/// short-τ structure depends on the rate in each part of the record.
 NoiseModel with_named_terms(const Stretch& s, Extension& x) {
   NoiseModel m = s.base;
   m.bias_deg_per_h -= mean_rate_of(x.det, s.rec->phase.duration_s());
@@ -46,9 +43,8 @@ NoiseModel with_named_terms(const Stretch& s, Extension& x) {
   m.warmups = x.det.warmups;
   if (x.lowpass && x.lowpass->tf > 0) unfilter_lines(m, x.findings, s.rec->phase.tau0_s, x.lowpass->tf);
   if (!x.broad.empty() && !x.lowpass) {
-    // Beyond its first AV peak a line's AV averages 3A²/(8π²f²τ²), the shape of white angle
-    // noise, which the five-term fit took into its Q; a broadened line is not subtracted from the
-    // data, so its share is taken out of Q here.
+    // Beyond its first peak a line's AV is that of white angle noise (3A²/(8π²f²τ²)), which the
+    // fit took into Q; a broadened line is not subtracted from the data, so Q loses its share.
     double q2 = m.white_angle_arcsec * m.white_angle_arcsec;
     for (const auto& l : x.broad) q2 -= l.amp_deg_per_h * l.amp_deg_per_h / (8.0 * kPi * kPi * l.f_hz * l.f_hz);
     m.white_angle_arcsec = std::sqrt(std::max(0.0, q2));
@@ -60,35 +56,31 @@ NoiseModel with_named_terms(const Stretch& s, Extension& x) {
   return m;
 }
 
-/// The mid-τ AV of the stretch without the named deterministic terms, and without its own
-/// candidates of the kinds not named (as the base ensemble's records are taken).
-std::vector<double> mid_var_without(const Stretch& s, const NoiseModel& det) {
-  NoiseModel det_mid = det;
-  const NoiseModel c = own_candidates(s.dec);
+/// The named deterministic terms, and the stretch's own candidate when no mean shape is named
+/// (as the base ensemble's records are taken).
+NoiseModel with_candidate(const Stretch& s, const NoiseModel& det) {
+  NoiseModel m = det;
   if (det.bias_steps.empty() && det.warmups.empty()) {
-    det_mid.bias_steps = c.bias_steps;
-    det_mid.warmups = c.warmups;
+    const NoiseModel c = own_candidates(s.dec);
+    m.bias_steps = c.bias_steps;
+    m.warmups = c.warmups;
   }
-  if (det.sinusoids.empty()) det_mid.sinusoids = c.sinusoids;
+  return m;
+}
+
+/// The mid-τ AV of the stretch without the named terms (and its candidate).
+std::vector<double> mid_var_without(const Stretch& s, const NoiseModel& det) {
   Decimated dm = s.dec;
-  subtract_deterministic(dm, det_mid);
+  subtract_deterministic(dm, with_candidate(s, det));
   return decimated_avar(dm, s.ref.grid);
 }
 
-/// The extended model built like the base on the data without the named terms: the five-term fit
-/// of the record without them (and without its mean-shape candidate when no step or transient is
-/// named), then, with `pilot`, N and B calibrated by a pilot ensemble with the base's pilot seeds
-/// (common random numbers: where the named terms are the base's candidate, the two models differ
-/// by the terms only). A sinusoid is not part of the base's candidate, so the base took it into
-/// N, B and Q (beyond its AV peak a line looks like white angle noise): the white angle noise is
-/// the fit's without the line.
+/// The extended model built like the base on the data without the named terms (and without its
+/// candidate when no mean shape is named): the five-term fit, then, with `pilot`, N and B
+/// calibrated with the base's pilot seeds, so that the models differ by the terms only. The base
+/// took a sinusoid into Q: the white angle noise is the fit's without it.
 void refit_without_named(const Stretch& s, Extension& x, bool pilot) {
-  NoiseModel rm = x.det;
-  if (x.det.bias_steps.empty() && x.det.warmups.empty()) {
-    const NoiseModel c = own_candidates(s.dec);
-    rm.bias_steps = c.bias_steps;
-    rm.warmups = c.warmups;
-  }
+  const NoiseModel rm = with_candidate(s, x.det);
   const Recording clean = with_series(*s.rec, cleaned(s.rec->phase, rm));
   NoiseModel m0 = base_model(analyze_for_base(clean, *s.aopt), s.rec->phase);
   m0.bias_deg_per_h = s.base.bias_deg_per_h;
@@ -107,8 +99,7 @@ void refit_without_named(const Stretch& s, Extension& x, bool pilot) {
 
 }  // namespace
 
-/// Deterministic terms are estimated first and removed before the re-fit of the rest; an effect
-/// of the mid-τ AV (a Gauss–Markov term) is fitted last, jointly with its N, B, K corrections.
+/// Deterministic terms are estimated and removed first; a mid-τ effect is fitted last, with N, B, K.
 Extension extend(const Stretch& s, const std::vector<const Detector*>& named) {
   Extension x;
   bool stochastic = false;
@@ -123,12 +114,8 @@ Extension extend(const Stretch& s, const std::vector<const Detector*>& named) {
   const bool deterministic = !x.det.sinusoids.empty() || !x.det.bias_steps.empty() || !x.det.warmups.empty();
   const bool self_pilot = !stochastic && deterministic && s.pilot_runs > 0;
   if (!stochastic && !x.findings.empty() && !self_pilot) {
-    // Like the base calibration: the data without their candidate (or named terms) against the
-    // ensemble's records without their own candidate.
-    const auto dc = power_law_corrections(x.mid_var, s.clean_ref, c_of(s.base));
-    correct(x.model.arw_deg_per_sqrt_h, Term::N, dc[1]);
-    correct(x.model.bias_instability_deg_per_h, Term::B, dc[2]);
-    correct(x.model.rrw_deg_per_h_per_sqrt_h, Term::K, dc[3]);
+    // Like the base calibration: data and ensemble records without their candidates.
+    correct_nbk(x.model, power_law_corrections(x.mid_var, s.clean_ref, c_of(s.base)));
   }
   if (deterministic && !x.lowpass && (self_pilot || !x.det.sinusoids.empty())) refit_without_named(s, x, self_pilot);
   for (const Detector* d : named)

@@ -1,8 +1,7 @@
 // The out-of-sample check: the record is cut into halves and (when each lasts kMinDuration)
-// thirds; a fold fits both models on one block and scores their prediction of a neighbouring
-// block, both ways. The score is the mean over the folds of each split, averaged over the
-// splits: one split alone leaves the verdict to the luck of where its cut falls.
-#include "diagnose/holdout.hpp"
+// thirds; a fold fits both models on one block and scores their prediction of a neighbour. The
+// score is averaged over the splits: one alone leaves the verdict to where its cut falls.
+#include "diagnose/models.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -36,8 +35,7 @@ std::vector<Fold> holdout_folds(std::size_t n, double tau0) {
   return folds;
 }
 
-/// The level a model predicts over [0, T], °/h: its constant rate and its named terms' mean (a
-/// ramp, whose sign the AV does not give, predicts no change).
+/// The level a model predicts over [0, T], °/h (a ramp, whose sign the AV does not give, none).
 double model_level(const NoiseModel& m, double T) {
   return m.earth_rate_deg_per_h + m.bias_deg_per_h + mean_rate_of(m, T);
 }
@@ -76,28 +74,18 @@ double mean_rate_variance(const std::vector<RunStats>& runs) {
   return s2 / static_cast<double>(runs.size() - 1);
 }
 
-struct Score {
-  double sum = 0;
-  std::size_t points = 0;
-  [[nodiscard]] double per_point() const { return points ? sum / static_cast<double>(points) : 0.0; }
-};
-
-/// A named line keeps its frequency and phase into the predicted block, where the Allan variance
-/// hardly sees it: what it predicts is the line itself, scored explicitly like the level. The
-/// line's two Fourier coefficients on the predicted block (least squares at the model's
-/// frequency; the 0.5-s block rates below kHighLineMinHz, the samples' rates above) are normal
-/// with the standard error of the block's local noise PSD: −2 ln L is |c − c_model|²/σ² for the
-/// extended model and |c|²/σ² for the base, which predicts no line. A broadened line (no phase)
-/// is left to the band.
-void score_lines(const PhaseSeries& pred, const NoiseModel& e_pred, const std::vector<Sinusoid>& broad, Score& sb,
-                 Score& se) {
+/// A named line predicts its frequency and phase, which the Allan variance hardly sees: its two
+/// Fourier coefficients on the predicted block are scored, −2 ln L = |c − c_model|²/σ² (the base
+/// predicts c = 0). A broadened line (no phase) is left to the band.
+void score_lines(const PhaseSeries& pred, const NoiseModel& e_pred, const std::vector<Sinusoid>& broad,
+                 BandDeviance& sb, BandDeviance& se) {
   for (const auto& l : e_pred.sinusoids) {
     if (std::any_of(broad.begin(), broad.end(), [&](const Sinusoid& b) { return b.f_hz == l.f_hz; })) continue;
     std::vector<double> y;
     double tb = 0;
     if (l.f_hz < kHighLineMinHz) {
       const Decimated dp = decimate(pred);
-      const auto per = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(0.5 / dp.tau_d)));
+      const auto per = per_block_for(dp, 0.5);
       y = block_rates(dp, per);
       tb = static_cast<double>(per) * dp.tau_d;
     } else {
@@ -107,13 +95,10 @@ void score_lines(const PhaseSeries& pred, const NoiseModel& e_pred, const std::v
     }
     const LineCoefficients c = line_coefficients(std::move(y), tb, l.f_hz);
     if (!(c.sigma > 0)) continue;
-    const double u = kPi * l.f_hz * tb, att = u > 1e-9 ? std::sin(u) / u : 1.0;
+    const double att = block_attenuation(l.f_hz, tb);
     // Behind a named output-chain low-pass the block shows the sensed line through the filter.
-    std::complex<double> hf = 1.0;
-    if (e_pred.output_lowpass_tc_s > 0) {
-      const double t0 = pred.tau0_s, phi = std::exp(-t0 / e_pred.output_lowpass_tc_s);
-      hf = (1.0 - phi) / (1.0 - phi * std::polar(1.0, -2.0 * kPi * l.f_hz * t0));
-    }
+    const std::complex<double> hf =
+        e_pred.output_lowpass_tc_s > 0 ? lowpass_response(l.f_hz, pred.tau0_s, e_pred.output_lowpass_tc_s) : 1.0;
     const double am = l.amp_deg_per_h * std::abs(hf) * att, ph = l.phase_rad + std::arg(hf);
     const double ap = am * std::cos(ph), bp = -am * std::sin(ph);
     const double s2 = c.sigma * c.sigma;
@@ -147,12 +132,9 @@ Stretch fitting_stretch(const Stretch& full, const DiagnoseResult& r, const Name
   return st;
 }
 
-/// One fold's per-point scores of the base and the extended model. Both models are simulated
-/// over the predicted block at its measured mean rate: under a counting read-out the rate sets
-/// the fine structure of the short-τ AV, which would otherwise score the level twice and
-/// erratically. The level each model predicts (its constant rate and named terms over the block)
-/// is scored once, explicitly, against a yardstick common to both models (the base ensemble's
-/// spread of block means), as are the named lines; the noise models are compared by the band.
+/// One fold's per-point scores of the base and the extended model. Both are simulated at the
+/// predicted block's measured mean rate (under a counting read-out the rate sets the short-τ AV);
+/// the level each predicts is scored once, against the base ensemble's spread of block means.
 std::pair<double, double> score_fold(const Stretch& full, const DiagnoseResult& r, const Named& named,
                                      const Fold& f, std::size_t index) {
   const PhaseSeries& x = full.rec->phase;
@@ -179,12 +161,11 @@ std::pair<double, double> score_fold(const Stretch& full, const DiagnoseResult& 
   auto prediction_score = [&](const std::vector<RunStats>& runs, const NoiseModel& m) {
     const auto dev = band_deviance(make_band(a_pred.points, runs, opt.band_level), r.holdout_runs);
     const double d = pred_mean - model_level(m, pred_T);
-    return Score{dev.sum + d * d / v_base, dev.points + 1};
+    return BandDeviance{dev.sum + d * d / v_base, dev.points + 1};
   };
-  Score sb = prediction_score(b_pred, st.base);
+  BandDeviance sb = prediction_score(b_pred, st.base);
   if (named.detectors.empty()) return {sb.per_point(), sb.per_point()};
-  // The block's base ensemble at the block's own level: its detectors' thresholds and its mid-τ
-  // references. An effect enters the block's extended model only when the block shows it.
+  // An effect enters the block's extended model only when the block shows it.
   for (const Detector* d : named.detectors)
     if (const auto* rd = dynamic_cast<const RecordDetector*>(d); rd && rd->block_statistic()) plan.scored.push_back(rd);
   const auto b_runs = run_ensemble(st.base, sh, r.holdout_runs, plan, opt.progress);
@@ -201,7 +182,7 @@ std::pair<double, double> score_fold(const Stretch& full, const DiagnoseResult& 
   const NoiseModel e_pred = shifted(e.model, (static_cast<double>(pa) - static_cast<double>(fa)) * x.tau0_s);
   const auto e_runs =
       run_ensemble(with_mean_rate(e_pred, pred_T, pred_mean), sh, r.holdout_runs, pred_plan, opt.progress);
-  Score se = prediction_score(e_runs, e_pred);
+  BandDeviance se = prediction_score(e_runs, e_pred);
   score_lines(pred_rec.phase, e_pred, e.broad, sb, se);
   return {sb.per_point(), se.per_point()};
 }

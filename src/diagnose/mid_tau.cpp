@@ -1,6 +1,6 @@
-// Fits of the mid-τ Allan variance against an ensemble reference: Q, N, B, K corrections under
-// ≥ 0 constraints, the Gauss–Markov bump beside them, and the reference without one run.
-#include "diagnose/mid_tau.hpp"
+// Fits of the mid-τ Allan variance against an ensemble reference: Q, N, B, K corrections kept
+// ≥ 0, the Gauss–Markov bump beside them, and the reference without one run.
+#include "diagnose/ensemble.hpp"
 
 #include <Eigen/Dense>
 
@@ -13,11 +13,11 @@ namespace rwcalc::diag {
 
 namespace {
 
-constexpr double kCorrShrink = 0.2;  ///< weight of the identity in the mid-τ correlation matrix
+/// Weight of the identity in the mid-τ correlation matrix: the runs are fewer than the grid points.
+constexpr double kCorrShrink = 0.2;
 constexpr double kModelEdf = 1000.0;  ///< model floor of the EDF in the deviance (as band_misfit)
 
-/// The measured-minus-reference mid-τ AV, its weights (1/ensemble variance) and the Q, N, B, K
-/// basis columns (normalised; `colscale` holds the factors).
+/// Measured-minus-reference mid-τ AV, weights 1/variance, normalised Q, N, B, K basis columns.
 struct MidTauProblem {
   std::vector<double> y, w, tau;
   std::vector<std::size_t> index;  ///< grid index of each point
@@ -48,9 +48,8 @@ MidTauProblem mid_tau_problem(const std::vector<double>& v, const MidTauReferenc
   return p;
 }
 
-/// The problem decorrelated with the reference's correlation matrix: with C = D^½ R D^½ (D the
-/// variances) = L·Lᵀ, y and every column are replaced by L⁻¹y, L⁻¹x and the weights by 1, so that
-/// least squares minimise the generalised χ². Without a correlation matrix: unchanged.
+/// The problem decorrelated (C = L·Lᵀ; y, x → L⁻¹y, L⁻¹x, weights 1) so that least squares
+/// minimise the generalised χ². Without a correlation matrix: unchanged.
 struct Whitener {
   Eigen::MatrixXd L;
   bool on = false;
@@ -67,14 +66,12 @@ Whitener whiten(MidTauProblem& p, const MidTauReference& ref) {
   const std::size_t g = ref.grid.size();
   const std::size_t n = p.y.size();
   if (ref.cov.size() != g * g || n < 2) return wh;
-  // Correlations shrunk toward the identity: the runs are fewer than the grid points.
-  const double shrink = kCorrShrink;
   Eigen::MatrixXd C(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
   for (std::size_t a = 0; a < n; ++a)
     for (std::size_t b = 0; b < n; ++b) {
       const std::size_t ia = p.index[a], ib = p.index[b];
       const double d = std::sqrt(ref.var[ia] * ref.var[ib]);
-      double rho = a == b ? 1.0 : (d > 0 ? std::clamp(ref.cov[ia * g + ib] / d, -1.0, 1.0) * (1.0 - shrink) : 0.0);
+      double rho = a == b ? 1.0 : (d > 0 ? std::clamp(ref.cov[ia * g + ib] / d, -1.0, 1.0) * (1.0 - kCorrShrink) : 0.0);
       C(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) = rho / std::sqrt(p.w[a] * p.w[b]);
     }
   Eigen::LLT<Eigen::MatrixXd> llt(C);
@@ -87,10 +84,8 @@ Whitener whiten(MidTauProblem& p, const MidTauReference& ref) {
   return wh;
 }
 
-/// Weighted least squares of the mid-τ problem with the corrections of N², B², K² constrained so
-/// that the corrected coefficients c_base + Δc stay ≥ 0 (active set: a correction that would make
-/// its coefficient negative is held at −c_base and the rest re-fitted). `shape` (optional) is a
-/// further, unconstrained column. Q² is free (the read-out is simulated, not fitted).
+/// Weighted least squares with c_base + Δc ≥ 0 for N², B², K² (active set: the most negative is
+/// held at −c_base and the rest re-fitted); `shape`: a further, free column. Q² is free.
 struct ConstrainedFit {
   double chi2 = 0;
   std::array<double, 4> dc{0, 0, 0, 0};
@@ -157,22 +152,13 @@ double gauss_markov_avar(double tau, double tc) {
 }
 
 std::array<double, 4> power_law_corrections(const std::vector<double>& v, const MidTauReference& ref,
-                                            const std::array<double, 4>& c_base) {
-  std::array<double, 4> dc{0, 0, 0, 0};
-  const MidTauProblem p = mid_tau_problem(v, ref);
-  if (p.y.size() < 6) return dc;
-  return constrained_fit(p, c_base, nullptr).dc;
-}
-
-std::array<double, 4> calibration_corrections(const std::vector<double>& v, const MidTauReference& ref,
-                                              const std::array<double, 4>& c_base, double tau_max) {
-  std::array<double, 4> dc{0, 0, 0, 0};
+                                            const std::array<double, 4>& c_base, double tau_max, bool hold_k) {
   std::vector<double> w = v;
   for (std::size_t i = 0; i < w.size() && i < ref.tau.size(); ++i)
     if (ref.tau[i] > tau_max) w[i] = 0.0;  // left out of the problem
   const MidTauProblem p = mid_tau_problem(w, ref);
-  if (p.y.size() < 6) return dc;
-  return constrained_fit(p, c_base, nullptr, {true, true, true, false}).dc;
+  if (p.y.size() < 6) return {0, 0, 0, 0};
+  return constrained_fit(p, c_base, nullptr, {true, true, true, !hold_k}).dc;
 }
 
 ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& ref,
@@ -182,12 +168,11 @@ ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& 
   if (p0.y.size() < 8) return e;
   MidTauProblem p = p0;
   const Whitener wh = whiten(p, ref);
-  const double c_n_base = c_base[1];
   using Fit = ConstrainedFit;
   auto fit = [&](const std::vector<double>* shape) { return constrained_fit(p, c_base, shape); };
   const Fit null = fit(nullptr);
-  // Correlation times from 3× the shortest τ (a bump peaking at the grid's first points is white
-  // rate noise there: not identifiable) to half the longest; a given one (fixed_time > 0) alone.
+  // Correlation times from 3× the shortest τ (a bump peaking earlier is white rate noise there) to
+  // half the longest, or fixed_time alone.
   const double lt_lo = std::log(3.0 * p.tau.front()), lt_hi = std::log(p.tau.back() / 2.0);
   const int G = fixed_time > 0 ? 0 : 48;
   double best_chi2 = null.chi2;
@@ -234,7 +219,7 @@ ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& 
     const double m = ref.mean[p0.index[k]];
     e.peak_ratio = m > 0 ? e.scale * gauss_markov_avar(tp, e.time) / m : 0.0;
   }
-  e.white_rest = std::max(0.0, c_n_base + best.dc[1]);
+  e.white_rest = std::max(0.0, c_base[1] + best.dc[1]);
   e.white_rest_sigma = std::sqrt(std::max(0.0, best.dn_var));
   e.time_low = e.time_high = e.time;
   for (const auto& [T, c] : prof)

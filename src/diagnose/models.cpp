@@ -28,9 +28,8 @@ NoiseModel base_model(const AnalysisResult& a, const PhaseSeries& x) {
   m.bias_deg_per_h = a.mean_rate_deg_per_h - a.earth_rate_deg_per_h;
   const double q_fit = term_value(a.fit, Term::Q);
   if (x.exact()) {
-    // Pulse data: which read-out? A dithered (white) read-out gives σ(τ0) ≈ √(1/2)·q/τ0 = 0.71·q/τ0;
-    // plain counting of a rate of a few pulses per sample or less gives far less (0.18·q/τ0 at
-    // 13.5 pulses/s and 400 Hz). The boundary 0.45·q/τ0 separates them.
+    // A dithered (white) read-out gives σ(τ0) ≈ 0.71·q/τ0, plain counting of a few pulses per
+    // sample far less (0.18·q/τ0 at 13.5 pulses/s and 400 Hz): 0.45·q/τ0 separates them.
     const double q = x.arcsec_per_count;
     const bool white = !a.allan.points.empty() && a.allan.points.front().m == 1 &&
                        a.allan.points.front().dev * x.tau0_s / q > 0.45;
@@ -125,9 +124,14 @@ void correct(double& coef, Term t, double dc) {
   coef = coefficient_from_c(t, std::max(0.0, c_from_coefficient(t, coef) + dc));
 }
 
+void correct_nbk(NoiseModel& m, const std::array<double, 4>& dc) {
+  correct(m.arw_deg_per_sqrt_h, Term::N, dc[1]);
+  correct(m.bias_instability_deg_per_h, Term::B, dc[2]);
+  correct(m.rrw_deg_per_h_per_sqrt_h, Term::K, dc[3]);
+}
+
 double mean_rate_of(const NoiseModel& det, double T) { return T > 0 ? deterministic_angle(det, T) / T : 0.0; }
 
-/// The series with the deterministic terms of `det` removed: floating phase.
 PhaseSeries cleaned(const PhaseSeries& x, const NoiseModel& det) {
   PhaseSeries s;
   s.tau0_s = x.tau0_s;
@@ -140,34 +144,20 @@ PhaseSeries cleaned(const PhaseSeries& x, const NoiseModel& det) {
   return s;
 }
 
-namespace {
-
-/// N, B, K of a model in the fit scale (band_refit's order).
-std::array<double, 3> nbk_of(const NoiseModel& m) {
-  return {c_from_coefficient(Term::N, m.arw_deg_per_sqrt_h), c_from_coefficient(Term::B, m.bias_instability_deg_per_h),
-          c_from_coefficient(Term::K, m.rrw_deg_per_h_per_sqrt_h)};
-}
-
-}  // namespace
-
-/// K stays at the fit's value: over 1 s … T/6 of one record the trade between B and K is too
-/// loose, and a B pulled low makes a quiet model beside which the record's own wander looks like
-/// a step.
+/// K stays at the fit's value: over 1 s … T/6 the trade between B and K is too loose, and a B
+/// pulled low makes a quiet model beside which the record's own wander looks like a step.
 NoiseModel calibrated(const NoiseModel& m0, const SimulationSettings& settings, std::size_t runs,
                       const EnsemblePlan& plan, const Decimated& dec, Progress* progress) {
   const EnsemblePlan pilot_plan{plan.octave_m, plan.grid, true, {}};
   const auto pilot = run_ensemble(m0, settings, runs, pilot_plan, progress);
   const auto ref = make_reference(plan.grid, dec.tau_d, pilot, true);
-  const auto dc = calibration_corrections(decimated_avar(dec, plan.grid), ref, c_of(m0), dec.duration() / 6.0);
+  const auto dc = power_law_corrections(decimated_avar(dec, plan.grid), ref, c_of(m0), dec.duration() / 6.0, true);
   NoiseModel m = m0;
-  correct(m.arw_deg_per_sqrt_h, Term::N, dc[1]);
-  correct(m.bias_instability_deg_per_h, Term::B, dc[2]);
-  correct(m.rrw_deg_per_h_per_sqrt_h, Term::K, dc[3]);
+  correct_nbk(m, dc);
   return m;
 }
 
-/// A step or a transient left in would be taken up into K, R or B, and the ensemble's wander
-/// would then hide it: the fit is of the data without the candidate.
+/// A step or transient left in would go into K, R or B, and the ensemble's wander would hide it.
 RobustBase robust_base(const Recording& rec, const AnalysisResult& original, const AnalysisOptions& aopt,
                        const Decimated& dec, const SimulationSettings& pilot, std::size_t pilot_runs,
                        const EnsemblePlan& plan, Progress* progress) {
@@ -184,12 +174,13 @@ RobustBase robust_base(const Recording& rec, const AnalysisResult& original, con
   return b;
 }
 
-/// K is held as in the pilot calibration: over one record the trade between B and K is loose,
-/// and the longest τ with a few EDF would otherwise bring in a K no fit found.
+/// K is held as in the pilot calibration: the longest τ, with a few EDF, would otherwise bring in
+/// a K no fit found.
 void refit_whole_band(NoiseModel& m, std::vector<BandPoint>& band, const std::vector<AllanPoint>& measured,
                       const SimulationSettings& settings, std::size_t runs, const EnsemblePlan& plan,
                       const DiagnoseOptions& opt) {
-  const auto c = nbk_of(m);
+  const auto c4 = c_of(m);
+  const std::array<double, 3> c{c4[1], c4[2], c4[3]};
   const auto dc = band_refit(band, runs, c, {true, true, false});
   if (dc[0] == 0 && dc[1] == 0 && dc[2] == 0) return;
   NoiseModel refit = m;

@@ -14,33 +14,33 @@ using nlohmann::json;
 
 namespace {
 
-json band_json(const std::vector<BandPoint>& band) {
-  json a = json::array();
-  for (const auto& b : band)
-    a.push_back({{"tau_s", b.tau_s}, {"dev", b.dev}, {"band_low", b.low}, {"band_high", b.high}, {"median", b.median},
-                 {"edf", b.edf}});
-  return a;
-}
-
 /// A simulated model with its band and how well the measurement sits in it.
 json model_json(const NoiseModel& model, const std::vector<BandPoint>& band, double level, double misfit,
                 double coverage) {
   json m;
   to_json(m, model);
-  m["band"] = band_json(band);
+  m["band"] = json::array();
+  for (const auto& b : band)
+    m["band"].push_back({{"tau_s", b.tau_s}, {"dev", b.dev}, {"band_low", b.low}, {"band_high", b.high},
+                         {"median", b.median}, {"edf", b.edf}});
   m["band_level"] = level;
   m["misfit"] = misfit;
   m["coverage"] = coverage;
   return m;
 }
 
-double finite_or(double v, double d = 0.0) { return std::isfinite(v) ? v : d; }
-
+/// Non-finite numbers become 0 (JSON has none).
 json clean_json(json j) {
-  if (j.is_number_float()) return finite_or(j.get<double>());
+  if (j.is_number_float()) return std::isfinite(j.get<double>()) ? j.get<double>() : 0.0;
   if (j.is_object() || j.is_array())
     for (auto& v : j) v = clean_json(v);
   return j;
+}
+
+/// N, B, K and R of a model, as the report prints them.
+std::string power_laws(const NoiseModel& m) {
+  return fmt::format("N = {:.4g} °/√h, B = {:.4g} °/h, K = {:.4g} °/h/√h, R = {:.4g} °/h²", m.arw_deg_per_sqrt_h,
+                     m.bias_instability_deg_per_h, m.rrw_deg_per_h_per_sqrt_h, m.ramp_deg_per_h2);
 }
 
 std::string unit_of(const std::string& key) {
@@ -78,9 +78,9 @@ json to_json(const DiagnoseResult& r) {
   j["base_model"] = base;
   json det = json::array();
   for (const auto& d : r.detectors) {
-    json o = {{"effect", std::string(detector_name(d.effect))},         {"statistic", d.statistic},   {"threshold", d.threshold},
-              {"ensemble_max", d.ensemble_max}, {"ensemble_median", d.ensemble_median}, {"fired", d.fired},
-              {"named", d.named}};
+    json o = {{"effect", std::string(detector_name(d.effect))}, {"statistic", d.statistic},
+              {"threshold", d.threshold}, {"ensemble_max", d.ensemble_max},
+              {"ensemble_median", d.ensemble_median}, {"fired", d.fired}, {"named", d.named}};
     if (!d.note.empty()) o["note"] = d.note;
     det.push_back(o);
   }
@@ -115,22 +115,18 @@ std::string format_report(const DiagnoseResult& r) {
                    r.band_level * 100);
   s += format_outliers(r.analysis.outliers);
   const auto& m = r.base;
-  s += fmt::format("Base model (five-term fit): N = {:.4g} °/√h, B = {:.4g} °/h, K = {:.4g} °/h/√h, R = {:.4g} °/h², "
-                   "white angle {:.4g}″, {} read-out, Earth rate {:.4g} °/h, bias {:.4g} °/h\n",
-                   m.arw_deg_per_sqrt_h, m.bias_instability_deg_per_h, m.rrw_deg_per_h_per_sqrt_h, m.ramp_deg_per_h2,
-                   m.white_angle_arcsec, m.readout == ReadoutMode::Counting ? "counting" : "white",
-                   m.earth_rate_deg_per_h, m.bias_deg_per_h);
+  s += "Base model (five-term fit): " + power_laws(m) +
+       fmt::format(", white angle {:.4g}″, {} read-out, Earth rate {:.4g} °/h, bias {:.4g} °/h\n", m.white_angle_arcsec,
+                   m.readout == ReadoutMode::Counting ? "counting" : "white", m.earth_rate_deg_per_h, m.bias_deg_per_h);
   std::size_t outside = 0;
   std::string rows;
   for (const auto& b : r.base_band) {
     if (b.dev >= b.low && b.dev <= b.high) continue;
     ++outside;
-    if (b.dev > b.high)
-      rows += fmt::format("    τ = {:>9.4g} s: σ = {:.4g} °/h, {:.1f} % above the band's upper edge {:.4g} °/h\n",
-                          b.tau_s, b.dev, 100 * (b.dev / b.high - 1), b.high);
-    else
-      rows += fmt::format("    τ = {:>9.4g} s: σ = {:.4g} °/h, {:.1f} % below the band's lower edge {:.4g} °/h\n",
-                          b.tau_s, b.dev, 100 * (1 - b.dev / b.low), b.low);
+    const bool above = b.dev > b.high;
+    rows += fmt::format("    τ = {:>9.4g} s: σ = {:.4g} °/h, {:.1f} % {} the band's {} edge {:.4g} °/h\n", b.tau_s,
+                        b.dev, 100 * (above ? b.dev / b.high - 1 : 1 - b.dev / b.low), above ? "above" : "below",
+                        above ? "upper" : "lower", above ? b.high : b.low);
   }
   s += fmt::format("  measured Allan deviation inside the base band at {} of {} τ\n", r.base_band.size() - outside,
                    r.base_band.size());
@@ -149,21 +145,14 @@ std::string format_report(const DiagnoseResult& r) {
     for (const auto& [k, v] : f.params.items()) {
       if (!v.is_number()) continue;
       const double u = f.uncertainty.contains(k) ? f.uncertainty[k].get<double>() : -1;
-      const std::string unit = unit_of(k);
-      if (u >= 0)
-        s += fmt::format(" {} = {:.4g} ± {:.2g} {}", k, v.get<double>(), u, unit);
-      else
-        s += fmt::format(" {} = {:.4g} {}", k, v.get<double>(), unit);
-      s += ";";
+      s += fmt::format(" {} = {:.4g}", k, v.get<double>());
+      if (u >= 0) s += fmt::format(" ± {:.2g}", u);
+      s += fmt::format(" {};", unit_of(k));
     }
     s.pop_back();
     s += "\n";
   }
-  const auto& e = r.extended;
-  s += fmt::format("\nExtended model: N = {:.4g} °/√h, B = {:.4g} °/h, K = {:.4g} °/h/√h, R = {:.4g} °/h², "
-                   "{} extra term(s)\n",
-                   e.arw_deg_per_sqrt_h, e.bias_instability_deg_per_h, e.rrw_deg_per_h_per_sqrt_h, e.ramp_deg_per_h2,
-                   r.findings.size());
+  s += "\nExtended model: " + power_laws(r.extended) + fmt::format(", {} extra term(s)\n", r.findings.size());
   s += "\nGain (misfit: mean EDF-weighted Gamma deviance per τ, about 1 (dimensionless) when the model fits):\n";
   s += fmt::format("  {:<44} {:>10} {:>10}\n", "", "base", "extended");
   s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", "Allan-variance misfit (dimensionless)", r.gain.misfit_base,

@@ -49,7 +49,6 @@ std::vector<double> block_rates(const Decimated& d, std::size_t per_block) {
 }
 
 std::vector<std::size_t> mid_tau_grid(const Decimated& d) {
-  // 10 per decade from 1 s to a third of the record.
   std::vector<std::size_t> g;
   const double T = d.duration();
   for (int i = 0;; ++i) {
@@ -80,6 +79,20 @@ std::vector<double> decimated_avar(const Decimated& d, const std::vector<std::si
   return v;
 }
 
+void level_window(const std::vector<double>& P, std::size_t k, double pad, bool keep_size, std::vector<double>& v) {
+  const std::size_t half = P.size() - 1;
+  const auto W = static_cast<std::size_t>(24.0 * pad), gap = static_cast<std::size_t>(std::ceil(3.0 * pad));
+  const auto stepb = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(pad)));
+  std::size_t a = k > W ? k - W : 1, b = k + W;
+  if (b > half) {
+    if (keep_size) a = a > b - half ? a - (b - half) : 1;
+    b = half;
+  }
+  v.clear();
+  for (std::size_t j = a; j <= b; j += stepb)
+    if (j + gap < k || j > k + gap) v.push_back(P[j]);
+}
+
 void remove_trend(std::vector<double>& y) {
   const std::size_t n = y.size();
   double sy = 0, sty = 0, stt = 0;
@@ -93,8 +106,6 @@ void remove_trend(std::vector<double>& y) {
   const double a = sy / static_cast<double>(n), b = sty / stt;
   for (std::size_t i = 0; i < n; ++i) y[i] -= a + b * (static_cast<double>(i) - m);
 }
-
-
 
 double ls_rss(const std::vector<double>& y, const std::vector<std::vector<double>>& extra, Eigen::VectorXd* coef,
               Eigen::MatrixXd* inv) {

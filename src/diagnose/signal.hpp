@@ -4,6 +4,7 @@
 /// model's deterministic terms, least-squares and spectral helpers, ensemble quantiles.
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cmath>
 #include <complex>
 #include <cstddef>
 #include <vector>
@@ -40,8 +41,8 @@ void subtract_deterministic(Decimated& d, const NoiseModel& m, double t0 = 0);
 double gumbel_threshold(const std::vector<double>& values, double alpha);
 double quantile(std::vector<double> v, double p);
 double median_of(std::vector<double>& v);  ///< the upper median; reorders v
-/// White-noise σ from first differences (rms/√2; block means of counts make most differences 0,
-/// so not their median).
+/// White-noise σ from first differences (block means of counts make most differences 0, so not
+/// their median).
 double diff_sigma(const std::vector<double>& y);
 
 void remove_trend(std::vector<double>& y);  ///< less mean and least-squares line
@@ -56,10 +57,26 @@ struct WlsOut {
 };
 WlsOut wls(const std::vector<double>& y, const std::vector<double>& w, const std::vector<std::vector<double>>& cols);
 
+/// The attenuation sinc(πf·tb) of a line of frequency f by means over blocks of tb.
+inline double block_attenuation(double f, double tb) {
+  const double x = kPi * f * tb;
+  return x > 1e-9 ? std::sin(x) / x : 1.0;
+}
+/// The response H = (1 − φ)/(1 − φe^{−iωτ0}) at f of the output-chain low-pass y_k = φy_{k−1} +
+/// (1 − φ)r_k, φ = e^{−τ0/tf}.
+inline std::complex<double> lowpass_response(double f, double tau0, double tf) {
+  const double phi = std::exp(-tau0 / tf);
+  return (1.0 - phi) / (1.0 - phi * std::polar(1.0, -2.0 * kPi * f * tau0));
+}
+
+/// A periodogram's local level window at bin k: one value per true bin (`pad` padded bins) over
+/// ±24 true bins, the main lobe (±3) left out; within P[1 … P.size() − 1], shifted inwards at the
+/// upper end when `keep_size`.
+void level_window(const std::vector<double>& P, std::size_t k, double pad, bool keep_size, std::vector<double>& v);
+
 /// A periodogram's largest ratio to its local level over bins [k_lo, k_hi]: the level of each
-/// group of 4 true bins (`pad` padded bins each) is the median of `window(first bin)` over
-/// `divisor`. A group whose median cannot be below the bound that beats the best ratio so far (a
-/// count of the window's values under it) is skipped: its ratios cannot win.
+/// group of 4 true bins is the median of `window(first bin)` over `divisor`. A group whose median
+/// cannot be below the bound that beats the best ratio so far is skipped.
 struct Peak {
   double ratio = 0, level = 0;
   std::size_t k = 0;
@@ -92,6 +109,19 @@ Peak peak_over_level(const std::vector<double>& P, std::size_t k_lo, std::size_t
   return best;
 }
 
+/// `iters` golden-section steps towards a minimum of f in [lo, hi]; the final interval's midpoint.
+template <class F>
+double golden_min(const F& f, double lo, double hi, int iters) {
+  for (int it = 0; it < iters; ++it) {
+    const double m1 = lo + 0.382 * (hi - lo), m2 = lo + 0.618 * (hi - lo);
+    if (f(m1) < f(m2))
+      hi = m2;
+    else
+      lo = m1;
+  }
+  return 0.5 * (lo + hi);
+}
+
 /// A line's frequency near f0: the best of f0 + i·step (|i| ≤ half_steps, 0 < f < f_max) by the
 /// explained sum of squares of fit_at(f, a, b), then `iters` golden-section steps in ±step.
 template <class Fit>
@@ -107,16 +137,11 @@ double refine_frequency(Fit& fit_at, double f0, double step, int half_steps, int
       fbest = f;
     }
   }
-  double lo = fbest - step, hi = fbest + step;
-  for (int it = 0; it < iters; ++it) {
-    const double m1 = lo + 0.382 * (hi - lo), m2 = lo + 0.618 * (hi - lo);
+  const auto loss = [&](double f) {
     double a, b;
-    if (fit_at(m1, a, b) > fit_at(m2, a, b))
-      hi = m2;
-    else
-      lo = m1;
-  }
-  return 0.5 * (lo + hi);
+    return -fit_at(f, a, b);
+  };
+  return golden_min(loss, fbest - step, fbest + step, iters);
 }
 
 }  // namespace rwcalc::diag
