@@ -138,7 +138,7 @@ TEST(AnalyzeOutliers, XsensContaminatedRecordReportsCountAndPositions) {
     EXPECT_GE(i, previous);
     previous = i;
     EXPECT_EQ(p["line"], i + 4);  // two comment lines and the header
-    EXPECT_NEAR(p["time_s"].get<double>(), i / 100.0, 1e-9);
+    EXPECT_NEAR(p["time_s"].get<double>(), static_cast<double>(i) / 100.0, 1e-9);
     found_largest |= i == largest;
   }
   if (largest < o["positions"].back()["index"].get<std::size_t>()) {

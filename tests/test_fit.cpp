@@ -330,7 +330,7 @@ TEST(AvCovariance, WhiteAngleCorrelationReachesDistantOctaves) {
   const std::int64_t n = 200000;
   std::vector<FitPoint> pts;
   for (std::int64_t m : {std::int64_t{1}, std::int64_t{64}})
-    pts.push_back({static_cast<double>(m) * tau0, 3 * c[0] / std::pow(m * tau0, 2), 0, m, n});
+    pts.push_back({static_cast<double>(m) * tau0, 3 * c[0] / std::pow(static_cast<double>(m) * tau0, 2), 0, m, n});
   const Eigen::MatrixXd cov = av_covariance(pts, c);
   const double ta = pts[0].tau_s, tb = pts[1].tau_s;
   const double expect = 72.0 * c[0] * c[0] / (4 * ta * ta * tb * tb * static_cast<double>(n));

@@ -70,8 +70,8 @@ inline nlohmann::json fixture_analysis(const FixtureCoefficients& c, unsigned se
   const std::int64_t samples = 2 * 3600 * 400;
   json points = json::array();
   for (std::int64_t m = 1; 2 * m + 1 <= samples / 2; m *= 2) {
-    const double tau = m * tau0;
-    const double edf = std::max(1.0, static_cast<double>(samples) / m * 0.5);
+    const double tau = static_cast<double>(m) * tau0;
+    const double edf = std::max(1.0, static_cast<double>(samples) / static_cast<double>(m) * 0.5);
     const double dev = fixture_sigma(c, tau) * std::max(0.2, 1 + z(rng) / std::sqrt(edf));
     const double rel = 1 / std::sqrt(edf);
     points.push_back({{"m", m},
