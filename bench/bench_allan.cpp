@@ -31,8 +31,10 @@ BENCHMARK(BM_OavarOneTau)->Arg(1)->Arg(64)->Arg(4096)->Arg(262144)->Unit(benchma
 void BM_OavarSweep(benchmark::State& state) {
   const auto& x = bench::gl2d_series();
   use_threads(state.range(0));
-  const std::vector<std::int64_t> ms = cluster_sizes(TauGrid::parse("dense"), Estimator::Overlapping, x.points(), x.tau0_s);
-  for (auto _ : state) benchmark::DoNotOptimize(detail::second_diff_sumsq_sweep(x.counts.data(), x.points(), ms).data());
+  const std::vector<std::int64_t> ms =
+      cluster_sizes(TauGrid::parse("dense"), Estimator::Overlapping, x.points(), x.tau0_s);
+  for (auto _ : state)
+    benchmark::DoNotOptimize(detail::second_diff_sumsq_sweep(x.counts.data(), x.points(), ms).data());
   state.counters["taus"] = static_cast<double>(ms.size());
 }
 BENCHMARK(BM_OavarSweep)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();

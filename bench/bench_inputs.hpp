@@ -39,8 +39,9 @@ inline const PhaseSeries& gl2d_series() {
 
 /// The 2-h record as the text of a GL-2D pulse file (~6 MB).
 inline const std::string& gl2d_text() {
-  static const std::string t = format_pulse_file(
-      {{"rate_hz", "400"}, {"scale_arcsec_per_pulse", "0.92"}, {"temperature_c", "50"}}, gl2d_series());
+  static const std::string t =
+      format_pulse_file({{"rate_hz", "400"}, {"scale_arcsec_per_pulse", "0.92"}, {"temperature_c", "50"}},
+                        gl2d_series());
   return t;
 }
 

@@ -26,7 +26,8 @@ void BM_ParsePulseFile2h(benchmark::State& state) {
 }
 BENCHMARK(BM_ParsePulseFile2h)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// The same text read from a file (page cache), in pieces, parsed as above. What `rwcalc analyze` does before its analysis.
+// The same text read from a file (page cache), in pieces, parsed as above. What `rwcalc analyze` does before its
+// analysis.
 class PulseFileOnDisk {
  public:
   PulseFileOnDisk() : path_(std::filesystem::temp_directory_path() / "rwcalc_bench_gl2d_p50C.csv") {

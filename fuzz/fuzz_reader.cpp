@@ -19,8 +19,8 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <string_view>
 
@@ -68,8 +68,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   o.column = kColumns[b2 & 7];
   if (b2 & 8) o.scale_arcsec = 0.92;
   if (b0 & 0x80) {
-    static const double kRates[] = {400, 100, 1, 0.5, 1e6, 1e-3, 200, 250,
-                                    3, 10, 1000, 40, 4e5, 7, 1e9, 1e-9};
+    static const double kRates[] = {400, 100, 1, 0.5, 1e6, 1e-3, 200, 250, 3, 10, 1000, 40, 4e5, 7, 1e9, 1e-9};
     o.rate_hz = kRates[b2 >> 4];
   }
   o.time_tolerance = b3 / 512.0;
@@ -92,8 +91,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   check(rec.samples >= 2, "fewer than two samples accepted");
   check(std::isfinite(rec.rate_hz) && rec.rate_hz > 0, "sample rate not positive and finite");
   check(rec.phase.points() >= 2, "phase series too short");
-  for (std::size_t i = 0; i < rec.phase.points(); ++i)
-    check(std::isfinite(rec.phase.at(i)), "non-finite phase");
+  for (std::size_t i = 0; i < rec.phase.points(); ++i) check(std::isfinite(rec.phase.at(i)), "non-finite phase");
   check(rec.line_of_sample(0) >= 1, "first sample has no line");
 
   rwcalc::AllanOptions ao;

@@ -7,8 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
-#include <cstdlib>
 #include <cmath>
+#include <cstdlib>
 #include <mutex>
 #include <random>
 #include <thread>
@@ -22,9 +22,9 @@ namespace {
 struct Outcome {
   double n_true, b_true;
   bool n_in, b_in;
-  double p_class;   // probability of the stated overall class
-  bool class_right; // the true class equals the stated one
-  double p_b2;      // P(B ≤ class-2 limit)
+  double p_class;    // probability of the stated overall class
+  bool class_right;  // the true class equals the stated one
+  double p_b2;       // P(B ≤ class-2 limit)
   bool b2_true;
 };
 
@@ -120,14 +120,16 @@ TEST(SlowCoverage, IntervalsAndVerdictProbabilitiesOnShortRecords) {
       if (cnt < 10) continue;
       const double pm = ps / cnt, share = double(hit) / cnt;
       const double se = std::sqrt(pq) / cnt;
-      std::printf("%s: stated %.2f..%.2f: %d verdicts, mean P %.3f, share right %.3f (%+.1f MC s.e.)\n", what,
-                  edges[k], std::min(edges[k + 1], 1.0), cnt, pm, share, (share - pm) / se);
+      std::printf("%s: stated %.2f..%.2f: %d verdicts, mean P %.3f, share right %.3f (%+.1f MC s.e.)\n", what, edges[k],
+                  std::min(edges[k + 1], 1.0), cnt, pm, share, (share - pm) / se);
       EXPECT_LE(std::abs(share - pm), 2.5 * se) << what << " bin " << k;
     }
   };
-  check("overall class", [](const Outcome& o) { return o.p_class; }, [](const Outcome& o) { return o.class_right; });
-  check("P(B <= 0.008)", [](const Outcome& o) { return std::max(o.p_b2, 1 - o.p_b2); },
-        [](const Outcome& o) { return (o.p_b2 >= 0.5) == o.b2_true; });
+  check(
+      "overall class", [](const Outcome& o) { return o.p_class; }, [](const Outcome& o) { return o.class_right; });
+  check(
+      "P(B <= 0.008)", [](const Outcome& o) { return std::max(o.p_b2, 1 - o.p_b2); },
+      [](const Outcome& o) { return (o.p_b2 >= 0.5) == o.b2_true; });
 }
 
 TEST(SlowCoverage, FullLengthGl2dLikeRecord) {

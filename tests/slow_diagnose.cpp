@@ -101,12 +101,14 @@ std::string names(const DiagnoseResult& r) {
 
 /// Each detector's statistic against its threshold, for the log of a case.
 std::string evidence(const DiagnoseResult& r) {
-  std::string s = fmt::format(" base N {:.3g} B {:.3g} K {:.3g} R {:.3g};", r.base.arw_deg_per_sqrt_h,
-                              r.base.bias_instability_deg_per_h, r.base.rrw_deg_per_h_per_sqrt_h, r.base.ramp_deg_per_h2);
+  std::string s =
+      fmt::format(" base N {:.3g} B {:.3g} K {:.3g} R {:.3g};", r.base.arw_deg_per_sqrt_h,
+                  r.base.bias_instability_deg_per_h, r.base.rrw_deg_per_h_per_sqrt_h, r.base.ramp_deg_per_h2);
   if (!r.findings.empty())
     s += fmt::format(" ext N {:.3g} B {:.3g} K {:.3g};", r.extended.arw_deg_per_sqrt_h,
                      r.extended.bias_instability_deg_per_h, r.extended.rrw_deg_per_h_per_sqrt_h);
-  for (const auto& d : r.detectors) s += fmt::format(" {}:{:.3g}/{:.3g}", detector_name(d.effect).substr(0, 4), d.statistic, d.threshold);
+  for (const auto& d : r.detectors)
+    s += fmt::format(" {}:{:.3g}/{:.3g}", detector_name(d.effect).substr(0, 4), d.statistic, d.threshold);
   return s;
 }
 
@@ -144,13 +146,16 @@ Tally run_effect(const std::string& effect, std::size_t n, std::uint64_t seed0,
       t.gain_in += gin;
       t.gain_out += gout;
     }
-    std::cout << fmt::format("{} case {:2}: truth {} -> {} {} | misfit {:.2f}->{:.2f} holdout {:.2f}->{:.2f} ({:.1f} s) |{}\n",
-                             effect, i, truth.dump(), names(r), est ? est->dump() : "", r.gain.misfit_base,
-                             r.gain.misfit_extended, r.gain.holdout_misfit_base, r.gain.holdout_misfit_extended,
-                             r.seconds, evidence(r)) << std::flush;
+    std::cout << fmt::format(
+                     "{} case {:2}: truth {} -> {} {} | misfit {:.2f}->{:.2f} holdout {:.2f}->{:.2f} ({:.1f} s) |{}\n",
+                     effect, i, truth.dump(), names(r), est ? est->dump() : "", r.gain.misfit_base,
+                     r.gain.misfit_extended, r.gain.holdout_misfit_base, r.gain.holdout_misfit_extended, r.seconds,
+                     evidence(r))
+              << std::flush;
   }
-  std::cout << fmt::format("{}: named {}/{}, recovered within tolerance {}/{}, gain in sample {}/{}, out of sample {}/{}\n",
-                           effect, t.named, t.n, t.recovered, t.n, t.gain_in, t.named, t.gain_out, t.named);
+  std::cout << fmt::format(
+      "{}: named {}/{}, recovered within tolerance {}/{}, gain in sample {}/{}, out of sample {}/{}\n", effect, t.named,
+      t.n, t.recovered, t.n, t.gain_in, t.named, t.gain_out, t.named);
   return t;
 }
 
@@ -282,9 +287,7 @@ TEST(DiagnoseAcceptance, Lowpass) {
         m.output_lowpass_tc_s = log_uniform(g, r[0], r[1]);
         return json{{"time_constant_s", m.output_lowpass_tc_s}};
       },
-      [](const json& tr, const json& e) {
-        return within(e["time_constant_s"], tr["time_constant_s"], 0.25);
-      });
+      [](const json& tr, const json& e) { return within(e["time_constant_s"], tr["time_constant_s"], 0.25); });
   expect_rates(t);
 }
 

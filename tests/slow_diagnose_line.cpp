@@ -69,7 +69,8 @@ const Finding* line_finding(const DiagnoseResult& r) {
 std::string summary(const DiagnoseResult& r) {
   std::string s;
   for (const auto& f : r.findings) s += fmt::format(" {}{}", finding_name(f.effect), f.params.dump());
-  for (const auto& d : r.detectors) s += fmt::format(" {}:{:.3g}/{:.3g}", detector_name(d.effect), d.statistic, d.threshold);
+  for (const auto& d : r.detectors)
+    s += fmt::format(" {}:{:.3g}/{:.3g}", detector_name(d.effect), d.statistic, d.threshold);
   return s;
 }
 
@@ -100,15 +101,17 @@ LineTally run_line_cases() {
       gain_in += gin;
       gain_out += gout;
     }
-    std::cout << fmt::format("line case {:2}: truth {:.4f} Hz {:.1f} °/h -> {} | misfit {:.2f}->{:.2f} holdout "
-                             "{:.2f}->{:.2f} ({:.1f} s) |{}\n",
-                             i, f, a, ok ? "recovered" : (e ? "named, off" : "missed"), r.gain.misfit_base,
-                             r.gain.misfit_extended, r.gain.holdout_misfit_base, r.gain.holdout_misfit_extended,
-                             r.seconds, summary(r))
+    std::cout << fmt::format(
+                     "line case {:2}: truth {:.4f} Hz {:.1f} °/h -> {} | misfit {:.2f}->{:.2f} holdout "
+                     "{:.2f}->{:.2f} ({:.1f} s) |{}\n",
+                     i, f, a, ok ? "recovered" : (e ? "named, off" : "missed"), r.gain.misfit_base,
+                     r.gain.misfit_extended, r.gain.holdout_misfit_base, r.gain.holdout_misfit_extended, r.seconds,
+                     summary(r))
               << std::flush;
   }
-  std::cout << fmt::format("high-frequency line: named {}/{}, recovered {}/{}, gain in sample {}/{}, out of sample {}/{}\n",
-                           named, n, recovered, n, gain_in, named, gain_out, named);
+  std::cout << fmt::format(
+      "high-frequency line: named {}/{}, recovered {}/{}, gain in sample {}/{}, out of sample {}/{}\n", named, n,
+      recovered, n, gain_in, named, gain_out, named);
   return {n, named, recovered, gain_in, gain_out};
 }
 

@@ -98,7 +98,8 @@ TEST(SimulateAllan, AngleRandomWalk) {
   m.readout = ReadoutMode::White;
   const auto s = settings(1e-3);
   const auto e = run_ensemble(m, s, octaves(1, 8192));
-  expect_follows(e, [&](std::size_t k) { return theoretical_avar(m, tau0(), s.scale_arcsec, k); }, "ARW");
+  expect_follows(
+      e, [&](std::size_t k) { return theoretical_avar(m, tau0(), s.scale_arcsec, k); }, "ARW");
   // The ARW term dominates: at m = 1 the quantization is < 1e-6 of it.
   EXPECT_NEAR(e.mean[0], 9.0 / tau0(), 0.05 * 9.0 / tau0());
 }
@@ -111,7 +112,8 @@ TEST(SimulateAllan, FlickerFloorIncludingSmallLagOvershoot) {
   // The floor applies over the whole range (the Kasdin filter is longer than the record); the
   // first lags overshoot by the exact discrete values (1.4427 at m = 1 …).
   const auto e = run_ensemble(m, s, octaves(1, 8192));
-  expect_follows(e, [&](std::size_t k) { return theoretical_avar(m, tau0(), s.scale_arcsec, k); }, "flicker");
+  expect_follows(
+      e, [&](std::size_t k) { return theoretical_avar(m, tau0(), s.scale_arcsec, k); }, "flicker");
   const double floor = 2 * 0.02 * 0.02 * std::numbers::ln2 / std::numbers::pi;
   EXPECT_NEAR(e.mean[0] / floor, 1.4427, 0.03);
   EXPECT_NEAR(e.mean[6] / floor, 1.0, 0.05);  // m = 64
@@ -124,7 +126,8 @@ TEST(SimulateAllan, RateRandomWalk) {
   const auto s = settings(1e-5);
   const auto e = run_ensemble(m, s, octaves(1, 8192));
   // K²τ/3 exactly at every m: no spurious white term at small m (naive discretisation adds K²τ0²/(6τ)).
-  expect_follows(e, [&](std::size_t k) { return theoretical_avar(m, tau0(), s.scale_arcsec, k); }, "RRW");
+  expect_follows(
+      e, [&](std::size_t k) { return theoretical_avar(m, tau0(), s.scale_arcsec, k); }, "RRW");
 }
 
 TEST(SimulateAllan, RampIsExactAtEveryM) {
@@ -134,7 +137,8 @@ TEST(SimulateAllan, RampIsExactAtEveryM) {
   m.readout = ReadoutMode::White;
   const auto s = settings(1e-4);
   const auto e = run_ensemble(m, s, octaves(1, 8192));
-  expect_follows(e, [&](std::size_t k) { return theoretical_avar(m, tau0(), s.scale_arcsec, k); }, "ramp");
+  expect_follows(
+      e, [&](std::size_t k) { return theoretical_avar(m, tau0(), s.scale_arcsec, k); }, "ramp");
 }
 
 TEST(SimulateAllan, WhiteReadoutQuantizationIsWhiteAtEveryM) {
@@ -144,10 +148,13 @@ TEST(SimulateAllan, WhiteReadoutQuantizationIsWhiteAtEveryM) {
   const auto s = settings(0.92);
   const auto e = run_ensemble(m, s, octaves(1, 8192));
   // 3Q²/τ² with Q = q/√6 (q/√12 of counting error about the dithered angle plus q/√12 of dither).
-  expect_follows(e, [&](std::size_t k) {
-    const double tau = static_cast<double>(k) * tau0();
-    return 3.0 * 0.92 * 0.92 / 6.0 / (tau * tau);
-  }, "white read-out");
+  expect_follows(
+      e,
+      [&](std::size_t k) {
+        const double tau = static_cast<double>(k) * tau0();
+        return 3.0 * 0.92 * 0.92 / 6.0 / (tau * tau);
+      },
+      "white read-out");
 }
 
 TEST(SimulateAllan, CountingReadoutIsStructuredUnlessTheAngleIsRandomised) {
@@ -176,10 +183,13 @@ TEST(SimulateAllan, CountingReadoutIsStructuredUnlessTheAngleIsRandomised) {
   NoiseModel w;
   w.arw_deg_per_sqrt_h = 1.0;  // 60 ″/√s: 3″ jitter per sample
   const auto ew = run_ensemble(w, s, octaves(1, 4096));
-  expect_follows(ew, [&](std::size_t k) {
-    const double tau = static_cast<double>(k) * tau0();
-    return 3600.0 / tau + 3.0 * 0.92 * 0.92 / 12.0 / (tau * tau);
-  }, "counting with jitter");
+  expect_follows(
+      ew,
+      [&](std::size_t k) {
+        const double tau = static_cast<double>(k) * tau0();
+        return 3600.0 / tau + 3.0 * 0.92 * 0.92 / 12.0 / (tau * tau);
+      },
+      "counting with jitter");
 }
 
 TEST(SimulateAllan, SinusoidFollowsTheExactFormulaAndPeak) {
@@ -197,7 +207,8 @@ TEST(SimulateAllan, SinusoidFollowsTheExactFormulaAndPeak) {
     return true;
   };
   const auto e = run_ensemble(m, s, ms, random_phase);
-  expect_follows(e, [&](std::size_t k) { return theoretical_avar(m, tau0(), s.scale_arcsec, k); }, "sinusoid");
+  expect_follows(
+      e, [&](std::size_t k) { return theoretical_avar(m, tau0(), s.scale_arcsec, k); }, "sinusoid");
   const std::size_t ipeak = ms.size() - 2;
   EXPECT_NEAR(std::sqrt(e.mean[ipeak]), 0.7246 * 20.0, 0.005 * 20.0);
 }
@@ -211,7 +222,8 @@ TEST(SimulateAllan, GaussMarkovFollowsTheContinuousFormulaAndPeak) {
   std::vector<std::size_t> ms = octaves(1, 4096);
   ms.push_back(379);
   const auto e = run_ensemble(m, s, ms);
-  expect_follows(e, [&](std::size_t k) { return theoretical_avar(m, tau0(), s.scale_arcsec, k); }, "Gauss-Markov");
+  expect_follows(
+      e, [&](std::size_t k) { return theoretical_avar(m, tau0(), s.scale_arcsec, k); }, "Gauss-Markov");
   const double qc = sigma * std::sqrt(2.0 / tc);
   EXPECT_NEAR(std::sqrt(e.mean.back()), 0.4365 * qc * std::sqrt(tc), 0.05 * 0.4365 * qc * std::sqrt(tc));
 }
@@ -229,7 +241,8 @@ TEST(SimulateAllan, LowpassedWhiteRateIsTheGaussMarkovCurve) {
   const double n_s = 60.0 * 0.05;
   gm.gauss_markov.push_back({n_s / std::sqrt(2.0 * 0.05), 0.05});
   gm.readout = ReadoutMode::White;
-  expect_follows(e, [&](std::size_t k) { return theoretical_avar(gm, tau0(), s.scale_arcsec, k); }, "low-pass");
+  expect_follows(
+      e, [&](std::size_t k) { return theoretical_avar(gm, tau0(), s.scale_arcsec, k); }, "low-pass");
   EXPECT_LT(e.mean[0], 0.2 * n_s * n_s / tau0());
 }
 
@@ -244,7 +257,8 @@ TEST(SimulateAllan, FiveTermSumFollowsTheModel) {
   m.ramp_deg_per_h2 = 100.0;
   const auto s = settings(0.92, std::size_t{1} << 17);
   const auto e = run_ensemble(m, s, octaves(1, 16384));
-  expect_follows(e, [&](std::size_t k) { return theoretical_avar(m, tau0(), s.scale_arcsec, k); }, "five terms");
+  expect_follows(
+      e, [&](std::size_t k) { return theoretical_avar(m, tau0(), s.scale_arcsec, k); }, "five terms");
 }
 
 }  // namespace

@@ -2,10 +2,10 @@
 // the integer path, agreement with the textbook definitions, τ grids, limits and error paths.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
-#include <algorithm>
 #include <random>
 
 #include "rwcalc/allan.hpp"
@@ -124,7 +124,8 @@ double exact_oavar(const PhaseSeries& x, std::int64_t m) {
     s += static_cast<u128>(d * d);
   }
   const double tau = static_cast<double>(m) * x.tau0_s;
-  return static_cast<double>(s) * (x.arcsec_per_count * x.arcsec_per_count) / (2.0 * tau * tau * static_cast<double>(n));
+  return static_cast<double>(s) * (x.arcsec_per_count * x.arcsec_per_count) /
+         (2.0 * tau * tau * static_cast<double>(n));
 }
 
 TEST(AllanCounts, EveryCountRangeGivesTheExactSum) {

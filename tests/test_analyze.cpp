@@ -71,7 +71,8 @@ TEST(AnalyzeCli, JsonHasTheIssueKeysAndCoversTheTruth) {
   // The simulated run senses exactly the Earth rate: the bias is within the noise of a 2-h mean.
   EXPECT_NEAR(j["mean_rate_deg_per_h"].get<double>(), 12.433, 0.01);
   for (const char* k : {"Q_arcsec", "N_deg_per_sqrt_h", "B_deg_per_h", "K_deg_per_h_per_sqrt_h", "R_deg_per_h2"})
-    for (const char* f : {"value", "sigma", "low95", "high95", "resolved"}) EXPECT_TRUE(j["fit"][k].contains(f)) << k << f;
+    for (const char* f : {"value", "sigma", "low95", "high95", "resolved"})
+      EXPECT_TRUE(j["fit"][k].contains(f)) << k << f;
   EXPECT_TRUE(j["fit"].contains("chi2_per_dof"));
   EXPECT_TRUE(j["methods"]["N_direct_deg_per_sqrt_h"].contains("value"));
   EXPECT_TRUE(j["methods"]["B_100s_deg_per_h"].contains("value"));
@@ -90,7 +91,8 @@ TEST(AnalyzeCli, JsonHasTheIssueKeysAndCoversTheTruth) {
 TEST(AnalyzeCli, ReportStatesUnitsConventionsAndVerdict) {
   const auto r = run_cli({"analyze", gl2d("gl2d_m25C.csv.gz"), "--earth-rate", "12.0", "--b-estimate", "sigma-min"});
   ASSERT_EQ(r.status, 0) << r.err;
-  for (const char* s : {"°/√h", "°/h", "arcsec", "√3·Q", "Verdict", "B from sigma-min", "N direct", "expected vertical Earth rate 12.0000 °/h (given)"})
+  for (const char* s : {"°/√h", "°/h", "arcsec", "√3·Q", "Verdict", "B from sigma-min", "N direct",
+                        "expected vertical Earth rate 12.0000 °/h (given)"})
     EXPECT_NE(r.out.find(s), std::string::npos) << s;
   EXPECT_EQ(r.out.find("nan"), std::string::npos);
 }

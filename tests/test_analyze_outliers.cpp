@@ -6,11 +6,11 @@
 // largest sample must be among those reported.
 #include <gtest/gtest.h>
 
+#include <zlib.h>
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <string>
-#include <zlib.h>
 
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/reader.hpp"
@@ -84,13 +84,14 @@ TEST(AnalyzeOutliers, PlantedSpikeIsReportedAtItsSampleTimeAndLine) {
 TEST(AnalyzeOutliers, Adis16405Run4GyroXSingleSpikeFoundAtItsPosition) {
   const auto file = shared_data("real/imudata_adis16405/adis_16405_imu4.csv.gz");
   RWCALC_REQUIRE_SHARED(file);
-  const auto r = run_cli({"analyze", file.string(), "--input", "rate", "--rate-unit", "deg/s", "--column",
-                          "gyro_x_dps", "--rate", "100", "--json"});
+  const auto r = run_cli({"analyze", file.string(), "--input", "rate", "--rate-unit", "deg/s", "--column", "gyro_x_dps",
+                          "--rate", "100", "--json"});
   ASSERT_EQ(r.status, 0) << r.err;
   const json o = json::parse(r.out)["outliers"];
   // The glitch (the only sample off the 0.05 °/s LSB grid) sits inside a burst of large readings
   // (indices 404605-404615, up to 17 °/s against a 0.35 °/s spread); three more excursions of
-  // 3-4 °/s come near 117 s (flagged readings are all beyond 2 °/s). All are flagged; nothing else in the 10^6 samples is.
+  // 3-4 °/s come near 117 s (flagged readings are all beyond 2 °/s). All are flagged; nothing else in the 10^6 samples
+  // is.
   const std::size_t count = o["count"];
   std::printf("[ outliers ] ADIS16405 run 4 gyro X: %zu found\n", count);
   EXPECT_GE(count, 1u);
@@ -122,13 +123,13 @@ TEST(AnalyzeOutliers, XsensContaminatedRecordReportsCountAndPositions) {
   for (std::size_t i = 0; i < rates.size(); ++i)
     if (std::abs(rates[i]) > std::abs(rates[largest])) largest = i;
 
-  const auto r = run_cli({"analyze", file.string(), "--input", "rate", "--rate-unit", "rad/s", "--rate", "100",
-                          "--json"});
+  const auto r =
+      run_cli({"analyze", file.string(), "--input", "rate", "--rate-unit", "rad/s", "--rate", "100", "--json"});
   ASSERT_EQ(r.status, 0) << r.err;
   const json o = json::parse(r.out)["outliers"];
   const std::size_t count = o["count"];
   std::printf("[ outliers ] Xsens contaminated gyro X: %zu found\n", count);
-  EXPECT_GE(count, 100u);           // heavily contaminated (PROVENANCE: ~27 000 beyond 6 robust sd)
+  EXPECT_GE(count, 100u);               // heavily contaminated (PROVENANCE: ~27 000 beyond 6 robust sd)
   EXPECT_LT(count, rates.size() / 10);  // but not a tenth of the record
   EXPECT_EQ(o["positions"].size(), std::min<std::size_t>(count, rwcalc::kMaxOutlierPositions));
   bool found_largest = false;

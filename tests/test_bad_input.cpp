@@ -14,9 +14,9 @@
 
 #include <gtest/gtest.h>
 
+#include "bad_input_corpus.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/reader.hpp"
-#include "bad_input_corpus.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -32,15 +32,24 @@ rwcalc::ReadOptions parse_options(const std::string& text) {
   std::stringstream ss(text);
   std::string key, value;
   while (ss >> key >> value) {
-    if (key == "--input") o.mode = rwcalc::parse_input_mode(value);
-    else if (key == "--rate") o.rate_hz = std::stod(value);
-    else if (key == "--scale") o.scale_arcsec = std::stod(value);
-    else if (key == "--column") o.column = value;
-    else if (key == "--counter-bits") o.counter_bits = std::stoi(value);
-    else if (key == "--angle-unit") o.angle_unit = rwcalc::parse_angle_unit(value);
-    else if (key == "--rate-unit") o.rate_unit = rwcalc::parse_rate_unit(value);
-    else if (key == "--time-tolerance") o.time_tolerance = std::stod(value);
-    else throw std::runtime_error("MANIFEST.tsv: unknown option " + key);
+    if (key == "--input")
+      o.mode = rwcalc::parse_input_mode(value);
+    else if (key == "--rate")
+      o.rate_hz = std::stod(value);
+    else if (key == "--scale")
+      o.scale_arcsec = std::stod(value);
+    else if (key == "--column")
+      o.column = value;
+    else if (key == "--counter-bits")
+      o.counter_bits = std::stoi(value);
+    else if (key == "--angle-unit")
+      o.angle_unit = rwcalc::parse_angle_unit(value);
+    else if (key == "--rate-unit")
+      o.rate_unit = rwcalc::parse_rate_unit(value);
+    else if (key == "--time-tolerance")
+      o.time_tolerance = std::stod(value);
+    else
+      throw std::runtime_error("MANIFEST.tsv: unknown option " + key);
   }
   return o;
 }

@@ -73,9 +73,9 @@ TEST(NumericOptions, TheCommandLineHasNumericOptions) {
   // The walk below must see the options it is meant to check (a guard against an empty walk).
   std::set<std::string> names;
   for (const auto& o : numeric_options()) names.insert(o.command + " " + o.name);
-  for (const char* expected : {"analyze --block", "analyze --rate", "analyze --earth-rate", "allan --confidence",
-                               "simulate --bias", "simulate --seed", "diagnose --seed", "batch --temperature",
-                               "report --diagnose-runs", "analyze --temperature"})
+  for (const char* expected :
+       {"analyze --block", "analyze --rate", "analyze --earth-rate", "allan --confidence", "simulate --bias",
+        "simulate --seed", "diagnose --seed", "batch --temperature", "report --diagnose-runs", "analyze --temperature"})
     EXPECT_TRUE(names.count(expected)) << expected;
 }
 
@@ -95,7 +95,8 @@ TEST(NumericOptions, EveryNumericOptionHasACheck) {
 }
 
 TEST(NumericOptions, EveryNumericOptionRefusesNonFiniteAndHugeValues) {
-  const std::vector<std::string> always_bad = {"nan", "NaN", "inf", "-inf", "1e400", "-1e400", "1e300", "-1e300", "abc"};
+  const std::vector<std::string> always_bad = {"nan",    "NaN",   "inf",    "-inf", "1e400",
+                                               "-1e400", "1e300", "-1e300", "abc"};
   for (const auto& o : numeric_options()) {
     std::vector<std::string> bad = always_bad;
     if (o.type.find("INT") != std::string::npos) bad.insert(bad.end(), {"1.5", "1e3"});
@@ -156,8 +157,8 @@ TEST(NumericOptions, OptionsRefuseValuesOutsideTheirMeaning) {
 /// A 60-s pulse record from `rwcalc simulate` in `dir`.
 std::string pulse_record(const TempDir& dir) {
   const std::string path = (dir.path() / "p.csv").string();
-  const CliResult r = run_exe({"simulate", "-o", path, "--duration", "120", "--arw", "0.001",
-                               "--bias-instability", "0.01", "--white-readout"});
+  const CliResult r = run_exe(
+      {"simulate", "-o", path, "--duration", "120", "--arw", "0.001", "--bias-instability", "0.01", "--white-readout"});
   EXPECT_EQ(r.status, 0) << r.err;
   return path;
 }
@@ -193,7 +194,7 @@ TEST(NumericOptionsExe, AllanNeverPrintsNonFiniteNumbers) {
   }
   // The extreme accepted scales still give finite numbers everywhere.
   for (const auto& extra : {std::vector<std::string>{"--rate", "1e9", "--scale", "1e9"},
-                                               std::vector<std::string>{"--rate", "1e-9", "--scale", "1e-9"}}) {
+                            std::vector<std::string>{"--rate", "1e-9", "--scale", "1e-9"}}) {
     for (const char* fmt : {"--json", "--csv"}) {
       const CliResult r = run_exe(rwcalc::test::concat({"allan", p, fmt}, extra));
       EXPECT_EQ(r.status, 0) << r.err;
@@ -211,17 +212,15 @@ TEST(NumericOptionsExe, SimulateRefusesMagnitudesTheCountsCannotCarry) {
         std::vector<std::string>{"--arw", "1e9", "--duration", "1e6", "--rate", "1", "--scale", "1e-9"},
         std::vector<std::string>{"--bias", "1e6", "--scale", "1e-9", "--duration", "1e5", "--rate", "1"},
         std::vector<std::string>{"--ramp", "1e9", "--duration", "3e6", "--rate", "1"},
-        std::vector<std::string>{"--sinusoid", "1:1e300"},
-        std::vector<std::string>{"--bias-step", "1e300:1"}}) {
+        std::vector<std::string>{"--sinusoid", "1:1e300"}, std::vector<std::string>{"--bias-step", "1e300:1"}}) {
     const CliResult r = run_exe(rwcalc::test::concat({"simulate", "-o", out}, extra));
     EXPECT_EQ(r.status, 2) << extra[0] << ": " << r.err;
     EXPECT_FALSE(std::filesystem::exists(out)) << extra[0] << " wrote a record";
     std::filesystem::remove(out);
     EXPECT_TRUE(r.err.find("pulses") != std::string::npos || r.err.find(extra[0]) != std::string::npos) << r.err;
   }
-  for (const auto& extra : {std::vector<std::string>{"--bias", "1e300"},
-                                               std::vector<std::string>{"--arw", "1e300"},
-                                               std::vector<std::string>{"--scale", "1e-300"}}) {
+  for (const auto& extra : {std::vector<std::string>{"--bias", "1e300"}, std::vector<std::string>{"--arw", "1e300"},
+                            std::vector<std::string>{"--scale", "1e-300"}}) {
     const CliResult r = run_exe(rwcalc::test::concat({"simulate", "-o", out}, extra));
     EXPECT_EQ(r.status, 2) << extra[0] << ": " << r.err;
     EXPECT_NE(r.err.find(extra[0]), std::string::npos) << r.err;

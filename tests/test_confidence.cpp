@@ -42,7 +42,7 @@ TEST(Edf, AsymptotesAndTheWhitePmClosedFormAreContinuous) {
         }
     }
   EXPECT_THROW(edf_greenhall(-3, 1, 4, 100, true, false), AnalysisError);  // α + 2d ≤ 1
-  EXPECT_EQ(edf_greenhall(0, 2, 600, 1001, true, false), 0.0);              // no term left
+  EXPECT_EQ(edf_greenhall(0, 2, 600, 1001, true, false), 0.0);             // no term left
 }
 
 TEST(Chi2, IntervalBracketsTheEstimateAndNarrowsWithEdf) {
@@ -143,10 +143,10 @@ TEST(NoiseIdentification, CountsAndFloatingPhaseGiveTheSameAlpha) {
         rrw += 0.01 * g(rng);
         double v = 0;
         switch (kind) {
-          case 0: v = 3.0 * g(rng); break;                 // white phase
-          case 1: v = rw; break;                           // random-walk phase
-          case 2: v = 0.3 * rw + 2.0 * g(rng); break;      // mixture near a threshold
-          default: v = rw + 50.0 * rrw; break;             // with a random-walk frequency
+          case 0: v = 3.0 * g(rng); break;             // white phase
+          case 1: v = rw; break;                       // random-walk phase
+          case 2: v = 0.3 * rw + 2.0 * g(rng); break;  // mixture near a threshold
+          default: v = rw + 50.0 * rrw; break;         // with a random-walk frequency
         }
         x.counts.push_back(x.counts.front() + static_cast<std::int64_t>(std::llround(v * 8.0)));
       }

@@ -7,8 +7,8 @@
 #include <numbers>
 #include <random>
 
-#include "rwcalc/diagnose.hpp"
 #include "diagnose/detector.hpp"
+#include "rwcalc/diagnose.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/fit.hpp"
 #include "rwcalc/simulate.hpp"

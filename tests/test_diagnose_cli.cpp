@@ -15,8 +15,8 @@
 namespace fs = std::filesystem;
 using nlohmann::json;
 using rwcalc::test::run_cli;
-using rwcalc::test::TempDir;
 using rwcalc::test::slurp;
+using rwcalc::test::TempDir;
 
 namespace {
 
@@ -49,7 +49,8 @@ json* DiagnoseCli::json_ = nullptr;
 
 TEST_F(DiagnoseCli, JsonHasTheDocumentedKeysAndFindsTheSinusoid) {
   const json& j = *json_;
-  for (const char* k : {"base_model", "findings", "extended_model", "gain", "detectors"}) ASSERT_TRUE(j.contains(k)) << k;
+  for (const char* k : {"base_model", "findings", "extended_model", "gain", "detectors"})
+    ASSERT_TRUE(j.contains(k)) << k;
   for (const char* m : {"base_model", "extended_model"}) {
     ASSERT_TRUE(j[m]["band"].is_array());
     ASSERT_FALSE(j[m]["band"].empty());

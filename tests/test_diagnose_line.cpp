@@ -9,8 +9,8 @@
 #include <numbers>
 #include <vector>
 
-#include "rwcalc/diagnose.hpp"
 #include "diagnose/detector.hpp"
+#include "rwcalc/diagnose.hpp"
 #include "rwcalc/simulate.hpp"
 
 namespace {

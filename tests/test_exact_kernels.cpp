@@ -57,8 +57,8 @@ constexpr std::uint64_t kWrapping = std::uint64_t{std::numeric_limits<std::int64
 
 TEST(ExactKernels, SecondDifferenceSumsEqualTheBruteForceSum) {
   for (std::int64_t step : {std::int64_t{9}, std::int64_t{1} << 22, std::int64_t{1} << 40}) {
-    for (std::size_t len : {std::size_t{3}, std::size_t{4}, std::size_t{17}, std::size_t{1030}, std::size_t{2051},
-                            std::size_t{5000}}) {
+    for (std::size_t len :
+         {std::size_t{3}, std::size_t{4}, std::size_t{17}, std::size_t{1030}, std::size_t{2051}, std::size_t{5000}}) {
       const auto c = shifted(walk(len, step, len + static_cast<std::size_t>(step % 997)), kWrapping);
       const auto np = static_cast<std::int64_t>(len);
       for (std::int64_t m = 1; 2 * m < np; m = m * 2 + 1) {

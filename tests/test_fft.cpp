@@ -22,7 +22,8 @@ std::vector<double> noisy_lines(std::size_t n, std::uint64_t seed) {
   std::normal_distribution<double> z(0.0, 1.0);
   std::vector<double> x(n);
   for (std::size_t t = 0; t < n; ++t)
-    x[t] = z(g) + 40.0 * std::cos(0.0123 * static_cast<double>(t) + 0.4) + 3.0 * std::sin(2.71 * static_cast<double>(t));
+    x[t] =
+        z(g) + 40.0 * std::cos(0.0123 * static_cast<double>(t) + 0.4) + 3.0 * std::sin(2.71 * static_cast<double>(t));
   return x;
 }
 
@@ -62,7 +63,8 @@ TEST(RealPowerSpectrum, FourStepsAgreeWithKissfftAndTheDirectSum) {
     double top = 0;
     for (const double v : ref) top = std::max(top, v);
     for (std::size_t k = 0; k < p.size(); ++k) ASSERT_NEAR(p[k], ref[k], 1e-11 * top) << "bin " << k << " of " << nfft;
-    for (const std::size_t k : {std::size_t{0}, std::size_t{1}, std::size_t{513}, nfft / 4 + 3, nfft / 2 - 1, nfft / 2}) {
+    for (const std::size_t k :
+         {std::size_t{0}, std::size_t{1}, std::size_t{513}, nfft / 4 + 3, nfft / 2 - 1, nfft / 2}) {
       const long double d = direct_power(x, nfft, k);
       EXPECT_NEAR(p[k], static_cast<double>(d), 1e-10 * top) << "bin " << k;
     }

@@ -13,16 +13,15 @@ namespace rwcalc {
 namespace {
 
 struct Truth {
-  double Q = 0.2656;   // ″ (0.92″ pulses: q/√12)
-  double N = 0.0010;   // °/√h
-  double B = 0.0060;   // °/h
-  double K = 0.0005;   // °/h/√h
-  double R = 0.0;      // °/h²
+  double Q = 0.2656;  // ″ (0.92″ pulses: q/√12)
+  double N = 0.0010;  // °/√h
+  double B = 0.0060;  // °/h
+  double K = 0.0005;  // °/h/√h
+  double R = 0.0;     // °/h²
   [[nodiscard]] double var(double tau) const {
     double v = 0;
     const double vals[5] = {Q, N, B, K, R};
-    for (int i = 0; i < kTermCount; ++i)
-      v += c_from_coefficient(kAllTerms[i], vals[i]) * term_basis(kAllTerms[i], tau);
+    for (int i = 0; i < kTermCount; ++i) v += c_from_coefficient(kAllTerms[i], vals[i]) * term_basis(kAllTerms[i], tau);
     return v;
   }
   [[nodiscard]] double coef(Term t) const {
@@ -111,8 +110,8 @@ TEST(Fit, AbsentTermIsAnUpperBoundNeverZeroOrNegative) {
     SCOPED_TRACE(std::string(term_name(t)));
     EXPECT_FALSE(f[t].resolved);
     EXPECT_EQ(f[t].low, 0.0);
-    EXPECT_GT(f[t].value, 0.0);           // the upper bound is reported …
-    EXPECT_EQ(f[t].value, f[t].high);     // … as the value
+    EXPECT_GT(f[t].value, 0.0);        // the upper bound is reported …
+    EXPECT_EQ(f[t].value, f[t].high);  // … as the value
     EXPECT_NEAR(f[t].estimate, 0.0, 1e-6 * f[t].high);
     EXPECT_TRUE(std::isfinite(f[t].sigma));
   }

@@ -17,10 +17,10 @@
 namespace rwcalc::test {
 
 struct SimTruth {
-  double Q = 0.0;      // ″
-  double N = 0.0;      // °/√h
-  double B = 0.0;      // °/h
-  double rate = 12.43; // °/h
+  double Q = 0.0;       // ″
+  double N = 0.0;       // °/√h
+  double B = 0.0;       // °/h
+  double rate = 12.43;  // °/h
 };
 
 /// Box–Muller normal on mt19937_64 (reproducible across standard libraries).
@@ -33,7 +33,8 @@ class Normal {
       return spare_;
     }
     double u1 = 0;
-    do u1 = (static_cast<double>(rng_() >> 11) + 0.5) * 0x1.0p-53; while (u1 <= 0);
+    do u1 = (static_cast<double>(rng_() >> 11) + 0.5) * 0x1.0p-53;
+    while (u1 <= 0);
     const double u2 = (static_cast<double>(rng_() >> 11) + 0.5) * 0x1.0p-53;
     const double r = std::sqrt(-2.0 * std::log(u1));
     spare_ = r * std::sin(2.0 * M_PI * u2);

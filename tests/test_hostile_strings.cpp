@@ -211,11 +211,11 @@ TEST(Printable, ControlCharactersAndInvalidBytesAreEscapedTextKept) {
   EXPECT_EQ(printable(std::string("nul\0x", 5)), "nul\\x00x");
   EXPECT_EQ(printable("\x1b[31mred\x7f"), "\\x1b[31mred\\x7f");
   EXPECT_EQ(printable("bad\xff\xfe"), "bad\\xff\\xfe");
-  EXPECT_EQ(printable("cut\xc3"), "cut\\xc3");                  // truncated sequence
-  EXPECT_EQ(printable("over\xc0\xaf"), "over\\xc0\\xaf");       // overlong '/'
+  EXPECT_EQ(printable("cut\xc3"), "cut\\xc3");                    // truncated sequence
+  EXPECT_EQ(printable("over\xc0\xaf"), "over\\xc0\\xaf");         // overlong '/'
   EXPECT_EQ(printable("sur\xed\xa0\x80"), "sur\\xed\\xa0\\x80");  // a UTF-16 surrogate
-  EXPECT_EQ(printable("c1\xc2\x9b"), "c1\\u009b");              // C1 control (CSI)
-  EXPECT_EQ(printable("bidi\xe2\x80\xae"), "bidi\\u202e");      // right-to-left override
+  EXPECT_EQ(printable("c1\xc2\x9b"), "c1\\u009b");                // C1 control (CSI)
+  EXPECT_EQ(printable("bidi\xe2\x80\xae"), "bidi\\u202e");        // right-to-left override
   EXPECT_EQ(printable("quote ' \" \\ kept"), "quote ' \" \\ kept");
 }
 
@@ -225,9 +225,9 @@ TEST(GnuplotString, EveryStringBecomesOneInertSingleQuotedLiteral) {
   EXPECT_EQ(gnuplot_string("it's"), "'it''s'");
   EXPECT_EQ(gnuplot_string("a\nsystem(\"touch x\")\n#"), "'a\\nsystem(\"touch x\")\\n#'");
   EXPECT_EQ(gnuplot_string("cr\rtab\t"), "'cr\\rtab\\t'");
-  EXPECT_EQ(gnuplot_string("back\\slash"), "'back\\slash'");   // no escapes in '…': kept as typed
-  EXPECT_EQ(gnuplot_string("`touch x`"), "'`touch x`'");       // no substitution in '…'
-  EXPECT_EQ(gnuplot_string("^{x}_y@&~{}"), "'^{x}_y@&~{}'");   // shown as typed: texts are noenhanced
+  EXPECT_EQ(gnuplot_string("back\\slash"), "'back\\slash'");  // no escapes in '…': kept as typed
+  EXPECT_EQ(gnuplot_string("`touch x`"), "'`touch x`'");      // no substitution in '…'
+  EXPECT_EQ(gnuplot_string("^{x}_y@&~{}"), "'^{x}_y@&~{}'");  // shown as typed: texts are noenhanced
   EXPECT_EQ(gnuplot_string("bad\xff"), "'bad\\xff'");
   EXPECT_EQ(gnuplot_string("τ (s) °/h"), "'τ (s) °/h'");
   for (const auto& s : hostile_strings()) {
@@ -250,9 +250,9 @@ TEST(PlotScriptStrings, NoControlCharacterInsideAnyStringOfAnyFigure) {
     d["source"] = bad;
     d["findings"][0]["effect"] = nonutf8;
     rwcalc::PlotOptions o;
-    const std::vector<rwcalc::Figure> figures{
-        rwcalc::analysis_figure(a, o), rwcalc::batch_allan_figure(b["runs"], o),
-        rwcalc::batch_direct_figure(b["runs"], o), rwcalc::diagnosis_figure(d, o)};
+    const std::vector<rwcalc::Figure> figures{rwcalc::analysis_figure(a, o), rwcalc::batch_allan_figure(b["runs"], o),
+                                              rwcalc::batch_direct_figure(b["runs"], o),
+                                              rwcalc::diagnosis_figure(d, o)};
     o.title = nonutf8;
     const std::vector<rwcalc::Figure> titled{rwcalc::analysis_figure(a, o), rwcalc::batch_direct_figure(b["runs"], o),
                                              rwcalc::diagnosis_figure(d, o)};
@@ -309,8 +309,8 @@ TEST_F(HostileNames, DiagnosePlotAndScriptRunNothing) {
     SCOPED_TRACE(rwcalc::printable(name));
     const auto file = recording_named(name);
     const auto svg = work_.path() / "d.svg", gp = work_.path() / "d.gp";
-    const auto r = run_exe({"diagnose", file, "--runs", "10", "--plot", svg.string(), "--plot-script", gp.string(),
-                            "--force"});
+    const auto r =
+        run_exe({"diagnose", file, "--runs", "10", "--plot", svg.string(), "--plot-script", gp.string(), "--force"});
     EXPECT_EQ(r.status, 0) << r.err;
     EXPECT_FALSE(marker_exists()) << "diagnose --plot ran an injected command";
     expect_good_svg(svg);
@@ -472,7 +472,8 @@ TEST_F(HostileNames, TextReportsSpellOutTheNames) {
       EXPECT_FALSE(static_cast<unsigned char>(c) < 0x20 || c == '\x7f') << what << ": raw control character";
     }
     EXPECT_TRUE(valid_utf8(r.out)) << what;
-    EXPECT_NE(r.out.find("nl\\nrwcalc analyze: forged\\x1b[2J\\r\\xff.csv"), std::string::npos) << what << ": " << r.out;
+    EXPECT_NE(r.out.find("nl\\nrwcalc analyze: forged\\x1b[2J\\r\\xff.csv"), std::string::npos)
+        << what << ": " << r.out;
   };
   expect_plain(run_exe({"analyze", file}), "analyze");
   expect_plain(run_exe({"allan", file}), "allan");

@@ -167,9 +167,9 @@ TEST_F(JsonInput, ReportRefusesCraftedValuesNamingFileLineAndKey) {
   }
   // The same in a batch file: the path runs through "runs[1]".
   std::size_t line = 0;
-  const auto file = dir_->write("crafted.json", with_value(read_json(batch_), "/runs/1/fit/B_deg_per_h/value",
-                                                            "\"big\"", line))
-                        .string();
+  const auto file =
+      dir_->write("crafted.json", with_value(read_json(batch_), "/runs/1/fit/B_deg_per_h/value", "\"big\"", line))
+          .string();
   expect_input_error(report({file}), file, line, {"\"runs[1].fit.B_deg_per_h.value\" must be a number"});
 }
 
@@ -357,7 +357,8 @@ TEST_F(JsonInput, SimulateFromChecksEveryValueNamingTheLine) {
     expect_input_error(run_exe({"simulate", "--from", file, "-o", sim, "--force"}), file, line, {c.what});
   }
   // A model object.
-  const json model = {{"arw_deg_per_sqrt_h", 0.001}, {"readout", "white"},
+  const json model = {{"arw_deg_per_sqrt_h", 0.001},
+                      {"readout", "white"},
                       {"sinusoids", {{{"frequency_hz", 0.01}, {"amplitude_deg_per_h", 0.1}}}}};
   for (const auto& c : std::vector<Case>{
            {"/readout", "5", "\"readout\" must be a string, got 5"},
@@ -380,9 +381,11 @@ TEST_F(JsonInput, FileNameThatIsNotUtf8IsWrittenWithReplacementCharacters) {
   const auto name = (dir.path() / "run_\xff\xfe_p20C.csv").string();
   fs::copy_file(records_[0], name);
   const std::string replaced = "run_\xEF\xBF\xBD\xEF\xBF\xBD_p20C.csv";  // U+FFFD for each invalid byte
-  for (const auto& args : std::vector<std::vector<std::string>>{
-           {"analyze", name, "--json"}, {"batch", name, records_[1], "--json"}, {"batch", name, "--jsonl"},
-           {"allan", name, "--json"}, {"diagnose", name, "--json", "--runs", "10"}}) {
+  for (const auto& args : std::vector<std::vector<std::string>>{{"analyze", name, "--json"},
+                                                                {"batch", name, records_[1], "--json"},
+                                                                {"batch", name, "--jsonl"},
+                                                                {"allan", name, "--json"},
+                                                                {"diagnose", name, "--json", "--runs", "10"}}) {
     const auto r = run_exe(args);
     ASSERT_EQ(r.status, 0) << args[0] << ": " << r.err;
     EXPECT_NE(r.out.find(replaced), std::string::npos) << args[0];

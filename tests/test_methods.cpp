@@ -35,7 +35,8 @@ PhaseSeries quantize(const PhaseSeries& x, double q) {
   c.tau0_s = x.tau0_s;
   c.arcsec_per_count = q;
   c.counts.resize(x.values.size());
-  for (std::size_t k = 0; k < x.values.size(); ++k) c.counts[k] = static_cast<std::int64_t>(std::floor(x.values[k] / q));
+  for (std::size_t k = 0; k < x.values.size(); ++k)
+    c.counts[k] = static_cast<std::int64_t>(std::floor(x.values[k] / q));
   return c;
 }
 

@@ -22,8 +22,8 @@ double reference_r1(const std::vector<std::int64_t>& c, std::size_t stride, std:
   if (count <= static_cast<std::size_t>(level) + 1) return 0.0;
   std::vector<long double> z(count);
   for (std::size_t k = 0; k < count; ++k)
-    z[k] = static_cast<long double>(static_cast<std::int64_t>(static_cast<std::uint64_t>(c[k * stride]) -
-                                                              static_cast<std::uint64_t>(c[0])));
+    z[k] = static_cast<long double>(
+        static_cast<std::int64_t>(static_cast<std::uint64_t>(c[k * stride]) - static_cast<std::uint64_t>(c[0])));
   for (int l = 0; l < level; ++l) {
     for (std::size_t k = 0; k + 1 < z.size(); ++k) z[k] = z[k + 1] - z[k];
     z.pop_back();

@@ -1,8 +1,8 @@
 // Outlier detection: no false alarms on clean noise (white, drifting, quantised), every planted
 // spike found, the known glitches of real IMU records found, and the remove/replace helpers.
 #include <algorithm>
-#include <iterator>
 #include <cmath>
+#include <iterator>
 #include <random>
 #include <set>
 #include <vector>
@@ -75,9 +75,9 @@ TEST(Outliers, EveryPlantedSpikeFoundAndNothingElse) {
     if (planted.lower_bound(i >= 3 ? i - 3 : 0) != planted.upper_bound(i + 3)) continue;
     planted.insert(i);
   }
-  planted.insert(0);               // first sample
-  planted.insert(y.size() - 1);    // last sample
-  planted.insert(250000);          // two adjacent bad samples
+  planted.insert(0);             // first sample
+  planted.insert(y.size() - 1);  // last sample
+  planted.insert(250000);        // two adjacent bad samples
   planted.insert(250001);
   std::uniform_real_distribution<double> mag(12.0, 60.0);
   for (auto i : planted) y[i] += ((rng() & 1) ? 1 : -1) * mag(rng) * sigma;
@@ -140,7 +140,9 @@ TEST(Outliers, ApplyToExactPulseCountsKeepsThemExact) {
 TEST(Outliers, SingleSpikeOfAdis16405RunFourGyroX) {
   const auto path = rwcalc::test::shared_data("real/imudata_adis16405/adis_16405_imu4.csv.gz");
   RWCALC_REQUIRE_SHARED(path);
-  rwcalc::ReadOptions o{.mode = rwcalc::InputMode::Rate, .column = "gyro_x_dps", .rate_hz = 100.0,
+  rwcalc::ReadOptions o{.mode = rwcalc::InputMode::Rate,
+                        .column = "gyro_x_dps",
+                        .rate_hz = 100.0,
                         .rate_unit = rwcalc::RateUnit::DegPerSecond};
   const auto rec = rwcalc::read_recording(path.string(), o);
   const auto out = find_outliers(rec);
@@ -289,4 +291,3 @@ TEST(Outliers, PhaseSeriesScanEqualsVectorScanOnShortRecords) {
 }
 
 }  // namespace
-

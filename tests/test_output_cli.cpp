@@ -34,8 +34,8 @@ using rwcalc::test::TempDir;
 // A short simulated record to feed the commands (10 min at 100 Hz).
 fs::path make_record(const TempDir& tmp) {
   const auto path = tmp.path() / "rec.csv";
-  const auto r = run_cli({"simulate", "-o", path.string(), "--duration", "600", "--rate", "100", "--arw", "0.05",
-                          "--seed", "3"});
+  const auto r =
+      run_cli({"simulate", "-o", path.string(), "--duration", "600", "--rate", "100", "--arw", "0.05", "--seed", "3"});
   EXPECT_EQ(r.status, 0) << r.err;
   return path;
 }
@@ -177,8 +177,9 @@ TEST(InterruptedWrite, NoGnuplotScratchDirectoryIsLeftBehind) {
   TempDir tmp;
   const auto rec = make_record(tmp);
   // A stand-in for gnuplot that answers --version and then takes its time over the figure.
-  const auto fake = tmp.write("slow-gnuplot", "#!/bin/sh\nif [ \"$1\" = --version ]; then echo 'gnuplot 5.4'; exit 0; fi\n"
-                                              "exec sleep 60\n");
+  const auto fake = tmp.write("slow-gnuplot",
+                              "#!/bin/sh\nif [ \"$1\" = --version ]; then echo 'gnuplot 5.4'; exit 0; fi\n"
+                              "exec sleep 60\n");
   fs::permissions(fake, fs::perms::owner_all);
   for (const bool whole_group : {true, false}) {  // Ctrl-C reaches the group; kill reaches rwcalc
     const int sig = whole_group ? SIGINT : SIGTERM;

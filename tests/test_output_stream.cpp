@@ -89,7 +89,8 @@ TEST(AtomicOutput, TheFileIsSyncedBeforeTheRenameAndItsDirectoryAfter) {
     g_target = tmp.path() / "out" / name;
     g_synced.clear();
     rwcalc::write_file_atomic(g_target.string(), "content\n", false);
-    struct stat file {}, dir {};
+    struct stat file {
+    }, dir{};
     ASSERT_EQ(::stat(g_target.c_str(), &file), 0);
     ASSERT_EQ(::stat((tmp.path() / "out").c_str(), &dir), 0);
     ASSERT_EQ(g_synced.size(), 2u) << name;
@@ -120,9 +121,9 @@ TEST(CheckOutputTargets, SameFileUnderAnyNameIsAUsageError) {
   };
   for (const auto& [a, b] : same)
     EXPECT_THROW(rwcalc::check_output_targets({{"-o", a}, {"--truth", b}}, true), rwcalc::UsageError) << a << " " << b;
-  EXPECT_NO_THROW(rwcalc::check_output_targets({{"-o", (dir / "a.txt").string()}, {"--truth", (dir / "b.txt").string()},
-                                                {"--plot", ""}, {"--plot-script", "-"}},
-                                               false));
+  EXPECT_NO_THROW(rwcalc::check_output_targets(
+      {{"-o", (dir / "a.txt").string()}, {"--truth", (dir / "b.txt").string()}, {"--plot", ""}, {"--plot-script", "-"}},
+      false));
   EXPECT_THROW(rwcalc::check_output_targets({{"-o", (dir / "a.txt").string()}, {"--truth", existing.string()}}, false),
                rwcalc::OutputError);
   EXPECT_EQ(listing(dir), (std::set<std::string>{"sub", "link.txt", "dangling.txt"}));

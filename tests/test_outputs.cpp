@@ -32,11 +32,11 @@
 namespace {
 
 namespace fs = std::filesystem;
-using rwcalc::test::gunzip;
 using rwcalc::test::concat;
+using rwcalc::test::gunzip;
 using rwcalc::test::run_cli;
-using rwcalc::test::TempDir;
 using rwcalc::test::slurp;
+using rwcalc::test::TempDir;
 
 std::set<std::string> listing(const fs::path& dir) {
   std::set<std::string> names;
@@ -112,15 +112,15 @@ TEST(CommandOutputs, SimulateRefusesExistingRecordAndTruthWithoutForce) {
   // An existing truth file stops the run before the (new) record is written.
   const auto truth = tmp.write("truth.json", "{}\n");
   const auto fresh = tmp.path() / "fresh.csv";
-  r = run_cli({"simulate", "-o", fresh.string(), "--truth", truth.string(), "--duration", "60", "--rate", "100",
-               "--arw", "1"});
+  r = run_cli(
+      {"simulate", "-o", fresh.string(), "--truth", truth.string(), "--duration", "60", "--rate", "100", "--arw", "1"});
   EXPECT_EQ(r.status, 3) << r.err;
   EXPECT_FALSE(fs::exists(fresh)) << "the record was written although its truth file could not be";
   EXPECT_EQ(slurp(truth), "{}\n");
 
   // With --force both are replaced, and nothing else appears.
-  r = run_cli({"simulate", "-o", rec.string(), "--truth", truth.string(), "--duration", "60", "--rate", "100",
-               "--arw", "1", "--force"});
+  r = run_cli({"simulate", "-o", rec.string(), "--truth", truth.string(), "--duration", "60", "--rate", "100", "--arw",
+               "1", "--force"});
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_NE(slurp(rec), original);
   EXPECT_NE(slurp(truth), "{}\n");
@@ -201,7 +201,8 @@ std::optional<fs::path> make_null_device(const fs::path& dir) {
 TEST(WriteFileAtomic, WritesIntoACharacterDeviceAndLeavesItADevice) {
   TempDir tmp;
   const auto node = make_null_device(tmp.path());
-  if (!node) GTEST_SKIP() << "a character device cannot be made here (mknod needs root and a file system without nodev)";
+  if (!node)
+    GTEST_SKIP() << "a character device cannot be made here (mknod needs root and a file system without nodev)";
   for (const bool force : {false, true}) {
     rwcalc::write_file_atomic(node->string(), "discarded\n", force);
     rwcalc::write_file_atomic(node->string(), std::string(3 << 20, 'x'), force);  // larger than any buffer
@@ -412,8 +413,8 @@ TEST(CommandOutputs, TwoOutputsNamingTheSameFileAreRefusedBeforeAnyIsWritten) {
   }
   expect_refused({"simulate", "-o", a, "--truth", dotted, "--duration", "60", "--arw", "1"}, 2, dir, before,
                  "same file");
-  expect_refused({"simulate", "-o", a, "--truth", a, "--runs", "2", "--duration", "60", "--arw", "1"}, 2, dir,
-                 before, "same file");
+  expect_refused({"simulate", "-o", a, "--truth", a, "--runs", "2", "--duration", "60", "--arw", "1"}, 2, dir, before,
+                 "same file");
   expect_refused({"simulate", "-o", "-", "--truth", "-", "--duration", "60", "--arw", "1"}, 2, dir, before,
                  "same file");
 
@@ -441,10 +442,10 @@ TEST(CommandOutputs, AnExistingOutputStopsEveryOutputOfTheCommand) {
     std::vector<std::string> base{cmd, rec.string()};
     if (cmd == "diagnose") base = concat(base, {"--runs", "10"});
     // The existing file is the report; the new figure script must not be written either.
-    expect_refused(concat(base, {"-o", existing.string(), "--plot-script", (dir / "new.gp").string()}), 3, dir,
-                   before, "use --force");
-    expect_refused(concat(base, {"-o", (dir / "new.txt").string(), "--plot-script", existing.string()}), 3, dir,
-                   before, "use --force");
+    expect_refused(concat(base, {"-o", existing.string(), "--plot-script", (dir / "new.gp").string()}), 3, dir, before,
+                   "use --force");
+    expect_refused(concat(base, {"-o", (dir / "new.txt").string(), "--plot-script", existing.string()}), 3, dir, before,
+                   "use --force");
   }
   expect_refused({"simulate", "-o", (dir / "new.csv").string(), "--truth", existing.string(), "--duration", "60",
                   "--arw", "1"},

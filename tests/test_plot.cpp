@@ -20,11 +20,11 @@ using rwcalc::test::fixture_analysis;
 using rwcalc::test::fixture_batch;
 using rwcalc::test::fixture_diagnosis;
 using rwcalc::test::FixtureCoefficients;
+using rwcalc::test::ScopedEnv;
+using rwcalc::test::slurp;
 using rwcalc::test::svg_series;
 using rwcalc::test::TempDir;
 using rwcalc::test::xml_problem;
-using rwcalc::test::slurp;
-using rwcalc::test::ScopedEnv;
 
 namespace {
 
@@ -63,9 +63,8 @@ TEST(PlotScript, AnalysisFigureHasDataModelTermsAndClassFloors) {
   EXPECT_NE(f.script.find("rate random walk K < 0.0008 °/h/√h (95 %)"), std::string::npos);
   EXPECT_EQ(f.script.find("rate ramp R"), std::string::npos);
   for (const char* s : {"class 1 limit B = 0.005 °/h (floor 0.003321 °/h)", "class 2 limit B = 0.008 °/h",
-                        "class 3 limit B = 0.015 °/h", "set xlabel 'τ (s)'",
-                        "set ylabel 'Allan deviation σ(τ) (°/h)'", "set format x '10^{%L}'",
-                        "set key outside below"})
+                        "class 3 limit B = 0.015 °/h", "set xlabel 'τ (s)'", "set ylabel 'Allan deviation σ(τ) (°/h)'",
+                        "set format x '10^{%L}'", "set key outside below"})
     EXPECT_NE(f.script.find(s), std::string::npos) << s;
   // Every Allan point of the JSON is in the data block.
   const auto n_points = k_unresolved_analysis()["allan"]["points"].size();

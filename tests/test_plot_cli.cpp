@@ -8,9 +8,9 @@
 #include <stdlib.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <cstdlib>
 #include <optional>
 #include <sstream>
 
@@ -20,15 +20,15 @@
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+using rwcalc::test::concat;
+using rwcalc::test::gl2d_runs;
 using rwcalc::test::run_cli;
+using rwcalc::test::ScopedEnv;
+using rwcalc::test::slurp;
 using rwcalc::test::source_path;
 using rwcalc::test::svg_series;
 using rwcalc::test::TempDir;
 using rwcalc::test::xml_problem;
-using rwcalc::test::slurp;
-using rwcalc::test::ScopedEnv;
-using rwcalc::test::concat;
-using rwcalc::test::gl2d_runs;
 
 namespace {
 
@@ -95,8 +95,8 @@ TEST(AnalyzePlot, SvgHasTheMeasurementModelTermsAndClassLimits) {
   TempDir dir;
   const auto svg_path = dir.path() / "allan.svg";
   const auto json_path = dir.path() / "a.json";
-  const auto r = run_cli({"analyze", gl2d("gl2d_p25C.csv.gz"), "--json", "-o", json_path.string(), "--plot",
-                          svg_path.string()});
+  const auto r =
+      run_cli({"analyze", gl2d("gl2d_p25C.csv.gz"), "--json", "-o", json_path.string(), "--plot", svg_path.string()});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("figure written to " + svg_path.string()), std::string::npos) << r.err;
   const json a = json::parse(slurp(json_path));
@@ -106,9 +106,8 @@ TEST(AnalyzePlot, SvgHasTheMeasurementModelTermsAndClassLimits) {
   EXPECT_GE(n, 2u + 3u + 3u) << "Q, N and B are resolved on this run";
   EXPECT_EQ(svg_series(svg).size(), n);
   EXPECT_NE(r.err.find(fmt::format("({} data series)", n)), std::string::npos) << r.err;
-  for (const char* s : {"τ (s)", "Allan deviation σ(τ) (°/h)", "fitted model", "class 1 limit B",
-                        "angle random walk N", "bias instability B", "quantization Q", "68.3 % bounds",
-                        "gl2d_p25C.csv.gz at +25 °C"})
+  for (const char* s : {"τ (s)", "Allan deviation σ(τ) (°/h)", "fitted model", "class 1 limit B", "angle random walk N",
+                        "bias instability B", "quantization Q", "68.3 % bounds", "gl2d_p25C.csv.gz at +25 °C"})
     EXPECT_NE(svg.find(s), std::string::npos) << s;
 }
 
@@ -152,8 +151,8 @@ TEST(BatchPlot, FiveTemperaturesOverlaidAndTheDirectMethodPanel) {
   TempDir dir;
   const auto svg_path = dir.path() / "batch.svg";
   const auto json_path = dir.path() / "batch.json";
-  const auto r = run_cli(concat({"batch"}, concat(gl2d_runs(), {"--json", "-o", json_path.string(), "--plot",
-                                                         svg_path.string()})));
+  const auto r = run_cli(
+      concat({"batch"}, concat(gl2d_runs(), {"--json", "-o", json_path.string(), "--plot", svg_path.string()})));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.err.find("note:"), std::string::npos) << "Fig. 2 must not be left out: " << r.err;
   const json b = json::parse(slurp(json_path));
@@ -218,10 +217,9 @@ TEST(PlotCliErrors, ExistingFilesAreKeptWithoutForce) {
   TempDir dir;
   const auto svg = dir.write("a.svg", "old figure");
   const auto gp = dir.write("a.gp", "old script");
-  for (const auto& args :
-       {std::vector<std::string>{"analyze", gl2d("gl2d_p25C.csv.gz"), "--plot", svg.string()},
-        std::vector<std::string>{"analyze", gl2d("gl2d_p25C.csv.gz"), "--plot-script", gp.string()},
-        std::vector<std::string>{"batch", gl2d("gl2d_p25C.csv.gz"), "--plot", svg.string()}}) {
+  for (const auto& args : {std::vector<std::string>{"analyze", gl2d("gl2d_p25C.csv.gz"), "--plot", svg.string()},
+                           std::vector<std::string>{"analyze", gl2d("gl2d_p25C.csv.gz"), "--plot-script", gp.string()},
+                           std::vector<std::string>{"batch", gl2d("gl2d_p25C.csv.gz"), "--plot", svg.string()}}) {
     const auto r = run_cli(args);
     EXPECT_EQ(r.status, 3) << args[2] << args[3];
     EXPECT_NE(r.err.find("exists; use --force to overwrite it"), std::string::npos) << r.err;

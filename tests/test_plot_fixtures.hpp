@@ -22,29 +22,28 @@
 #include "rwcalc/plot.hpp"
 
 /// Skip the current test with a clear message when gnuplot cannot be run.
-#define REQUIRE_GNUPLOT()                                                                        \
-  do {                                                                                           \
-    if (!rwcalc::gnuplot_available())                                                            \
-      GTEST_SKIP() << "gnuplot not found ('" << rwcalc::gnuplot_command()                        \
-                   << "'): install gnuplot-nox to run the figure rendering tests";              \
+#define REQUIRE_GNUPLOT()                                                          \
+  do {                                                                             \
+    if (!rwcalc::gnuplot_available())                                              \
+      GTEST_SKIP() << "gnuplot not found ('" << rwcalc::gnuplot_command()          \
+                   << "'): install gnuplot-nox to run the figure rendering tests"; \
   } while (0)
 
 namespace rwcalc::test {
 
 struct FixtureCoefficients {
   double temperature_c = 25;
-  double Q = 0.2656;    // ″
-  double N = 0.0009;    // °/√h
-  double B = 0.0075;    // °/h
-  double K = 0.0004;    // °/h/√h
-  double R = 0;         // °/h²
+  double Q = 0.2656;  // ″
+  double N = 0.0009;  // °/√h
+  double B = 0.0075;  // °/h
+  double K = 0.0004;  // °/h/√h
+  double R = 0;       // °/h²
   bool K_resolved = true;
 };
 
 inline double fixture_sigma(const FixtureCoefficients& c, double tau) {
-  const double v = 3 * c.Q * c.Q / (tau * tau) + std::pow(60 * c.N, 2) / tau +
-                   2 * std::log(2.0) / M_PI * c.B * c.B + c.K * c.K * tau / (3 * 3600) +
-                   c.R * c.R * tau * tau / (2 * 3600.0 * 3600.0);
+  const double v = 3 * c.Q * c.Q / (tau * tau) + std::pow(60 * c.N, 2) / tau + 2 * std::log(2.0) / M_PI * c.B * c.B +
+                   c.K * c.K * tau / (3 * 3600) + c.R * c.R * tau * tau / (2 * 3600.0 * 3600.0);
   return std::sqrt(v);
 }
 
@@ -52,17 +51,21 @@ inline double fixture_sigma(const FixtureCoefficients& c, double tau) {
 /// upper bound (here `bound`), the model's estimate is 0.
 inline nlohmann::json fixture_coefficient(double value, double rel_sigma, bool resolved = true, double bound = 0) {
   if (!resolved)
-    return {{"value", bound}, {"sigma", bound / (2 * 1.96)}, {"low95", 0.0}, {"high95", bound},
-            {"resolved", false}, {"estimate", 0.0}, {"in_model", false}, {"fitted", true}};
+    return {{"value", bound},  {"sigma", bound / (2 * 1.96)}, {"low95", 0.0},  {"high95", bound}, {"resolved", false},
+            {"estimate", 0.0}, {"in_model", false},           {"fitted", true}};
   const double s = value * rel_sigma;
-  return {{"value", value},        {"sigma", s},         {"low95", std::max(0.0, value - 1.96 * s)},
-          {"high95", value + 1.96 * s}, {"resolved", true}, {"estimate", value},
-          {"in_model", true},      {"fitted", true}};
+  return {{"value", value},
+          {"sigma", s},
+          {"low95", std::max(0.0, value - 1.96 * s)},
+          {"high95", value + 1.96 * s},
+          {"resolved", true},
+          {"estimate", value},
+          {"in_model", true},
+          {"fitted", true}};
 }
 
 /// One `rwcalc analyze --json` object.
-inline nlohmann::json fixture_analysis(const FixtureCoefficients& c, unsigned seed = 1,
-                                       bool with_direct_curve = true) {
+inline nlohmann::json fixture_analysis(const FixtureCoefficients& c, unsigned seed = 1, bool with_direct_curve = true) {
   using nlohmann::json;
   std::mt19937 rng(seed);
   std::normal_distribution<double> z;
@@ -103,11 +106,11 @@ inline nlohmann::json fixture_analysis(const FixtureCoefficients& c, unsigned se
     return nullptr;
   };
   const json class_B = class_of(c.B, 0.005, 0.008, 0.015), class_N = class_of(c.N, 0.0010, 0.0015, 0.0030);
-  const json cls = class_B.is_null() || class_N.is_null() ? json(nullptr)
-                                                           : json(std::max(class_B.get<int>(), class_N.get<int>()));
+  const json cls =
+      class_B.is_null() || class_N.is_null() ? json(nullptr) : json(std::max(class_B.get<int>(), class_N.get<int>()));
   auto param = [](double v, const char* unit, const json& k, std::vector<double> limits) {
-    return json{{"value", v}, {"unit", unit}, {"resolved", true}, {"class", k}, {"class_strict", k},
-                {"limits", limits}, {"p_class", 0.8}};
+    return json{{"value", v},        {"unit", unit},     {"resolved", true}, {"class", k},
+                {"class_strict", k}, {"limits", limits}, {"p_class", 0.8}};
   };
   json verdict = {{"class_B", class_B},
                   {"class_N", class_N},
@@ -125,26 +128,26 @@ inline nlohmann::json fixture_analysis(const FixtureCoefficients& c, unsigned se
                   {"p_is", {0.05, 0.83, 0.1, 0.02}},
                   {"B", param(c.B, "deg/h", class_B, {0.005, 0.008, 0.015})},
                   {"N", param(c.N, "deg/sqrt(h)", class_N, {0.0010, 0.0015, 0.0030})}};
-  return {{"source", "gl2d_" + std::to_string(static_cast<int>(c.temperature_c)) + "C.csv"},
-          {"samples", samples},
-          {"rate_hz", rate},
-          {"duration_s", samples / rate},
-          {"temperature_c", c.temperature_c},
-          {"mean_rate_deg_per_h", 12.44},
-          {"earth_rate_deg_per_h", 12.43},
-          {"allan",
-           {{"estimator", "overlapping"}, {"unit", "deg/h"}, {"tau0_s", tau0}, {"confidence", 0.683},
-            {"points", points}}},
-          {"fit",
-           {{"Q_arcsec", fixture_coefficient(c.Q, 0.02)},
-            {"N_deg_per_sqrt_h", fixture_coefficient(c.N, 0.15)},
-            {"B_deg_per_h", fixture_coefficient(c.B, 0.2)},
-            {"K_deg_per_h_per_sqrt_h", c.K_resolved ? fixture_coefficient(c.K, 0.4)
-                                                    : fixture_coefficient(0, 0, false, 2 * c.K)},
-            {"R_deg_per_h2", fixture_coefficient(0, 0, false)},  // unresolved, no bound: not drawn
-            {"chi2_per_dof", 1.08}}},
-          {"methods", {{"N_direct_deg_per_sqrt_h", direct}, {"B_100s_deg_per_h", fixture_coefficient(c.B * 0.95, 0.25)}}},
-          {"verdict", verdict}};
+  return {
+      {"source", "gl2d_" + std::to_string(static_cast<int>(c.temperature_c)) + "C.csv"},
+      {"samples", samples},
+      {"rate_hz", rate},
+      {"duration_s", samples / rate},
+      {"temperature_c", c.temperature_c},
+      {"mean_rate_deg_per_h", 12.44},
+      {"earth_rate_deg_per_h", 12.43},
+      {"allan",
+       {{"estimator", "overlapping"}, {"unit", "deg/h"}, {"tau0_s", tau0}, {"confidence", 0.683}, {"points", points}}},
+      {"fit",
+       {{"Q_arcsec", fixture_coefficient(c.Q, 0.02)},
+        {"N_deg_per_sqrt_h", fixture_coefficient(c.N, 0.15)},
+        {"B_deg_per_h", fixture_coefficient(c.B, 0.2)},
+        {"K_deg_per_h_per_sqrt_h",
+         c.K_resolved ? fixture_coefficient(c.K, 0.4) : fixture_coefficient(0, 0, false, 2 * c.K)},
+        {"R_deg_per_h2", fixture_coefficient(0, 0, false)},  // unresolved, no bound: not drawn
+        {"chi2_per_dof", 1.08}}},
+      {"methods", {{"N_direct_deg_per_sqrt_h", direct}, {"B_100s_deg_per_h", fixture_coefficient(c.B * 0.95, 0.25)}}},
+      {"verdict", verdict}};
 }
 
 /// The paper's five temperatures, `rwcalc batch --json` shape.
@@ -183,20 +186,32 @@ inline nlohmann::json fixture_diagnosis(bool with_extended = true, bool nested =
     const double measured = std::sqrt(model * model + sin_var);
     const double ext = measured;  // the extended model follows the measurement
     const double w = 0.05 + 0.3 * std::sqrt(tau / 1500);
-    base_band.push_back({{"tau_s", tau}, {"dev", measured}, {"band_low", model * (1 - w)},
-                         {"band_high", model * (1 + w)}, {"median", model}});
-    ext_band.push_back({{"tau_s", tau}, {"dev", measured}, {"band_low", ext * (1 - w)},
-                        {"band_high", ext * (1 + w)}, {"median", ext}});
+    base_band.push_back({{"tau_s", tau},
+                         {"dev", measured},
+                         {"band_low", model * (1 - w)},
+                         {"band_high", model * (1 + w)},
+                         {"median", model}});
+    ext_band.push_back({{"tau_s", tau},
+                        {"dev", measured},
+                        {"band_low", ext * (1 - w)},
+                        {"band_high", ext * (1 + w)},
+                        {"median", ext}});
   }
   json d = {{"source", "gl2d_25C.csv"},
             {"units", {{"dev", "deg/h"}, {"tau", "s"}, {"band", "2.5-97.5 % quantiles of the simulated ADEV"}}},
             {"base_model", {{"misfit_per_point", 14.2}}},
-            {"findings", json::array({{{"effect", "sinusoid"}, {"frequency_hz", f0}, {"amplitude_deg_per_h", amp},
+            {"findings", json::array({{{"effect", "sinusoid"},
+                                       {"frequency_hz", f0},
+                                       {"amplitude_deg_per_h", amp},
                                        {"evidence", "PSD line 40 times the background"}}})},
             {"extended_model", {{"sinusoids", json::array({{{"frequency_hz", f0}, {"amplitude_deg_per_h", amp}}})}}},
             {"gain",
-             {{"misfit_base", 14.2}, {"misfit_extended", 1.1}, {"coverage_base", 0.55}, {"coverage_extended", 1.0},
-              {"holdout_misfit_base", 12.0}, {"holdout_misfit_extended", 1.4}}}};
+             {{"misfit_base", 14.2},
+              {"misfit_extended", 1.1},
+              {"coverage_base", 0.55},
+              {"coverage_extended", 1.0},
+              {"holdout_misfit_base", 12.0},
+              {"holdout_misfit_extended", 1.4}}}};
   if (nested) {
     d["base_model"]["band"] = base_band;
     if (with_extended) d["extended_model"]["band"] = ext_band;

@@ -52,7 +52,10 @@ TEST(Progress, SilentWithoutASinkAndCountsFromManyThreads) {
   Progress p("quiet", 8000, nullptr);
   EXPECT_FALSE(p.enabled());
   std::vector<std::thread> ts;
-  for (int t = 0; t < 4; ++t) ts.emplace_back([&] { for (int i = 0; i < 2000; ++i) p.advance(); });
+  for (int t = 0; t < 4; ++t)
+    ts.emplace_back([&] {
+      for (int i = 0; i < 2000; ++i) p.advance();
+    });
   for (auto& t : ts) t.join();
   EXPECT_EQ(p.done(), 8000u);
   EXPECT_EQ(p.total(), 8000u);
@@ -64,7 +67,10 @@ TEST(Progress, ConcurrentDrawingWritesWholeLines) {
   {
     Progress p("par", 4000, f);
     std::vector<std::thread> ts;
-    for (int t = 0; t < 4; ++t) ts.emplace_back([&] { for (int i = 0; i < 1000; ++i) p.advance(); });
+    for (int t = 0; t < 4; ++t)
+      ts.emplace_back([&] {
+        for (int i = 0; i < 1000; ++i) p.advance();
+      });
     for (auto& t : ts) t.join();
     p.finish();
     p.advance();  // after finish: nothing more is drawn

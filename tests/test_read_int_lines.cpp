@@ -146,8 +146,8 @@ TEST(ReadIntLines, SumTooLargeNamesTheSameLine) {
 TEST(ReadIntLines, PlainLineEdgesReadAsTheGeneralWay) {
   // 18 digits, 19 digits, "-0": the same counts whichever way the line is read.
   const Recording r = read_recording_text("pulses\n999999999999999999\n-0\n1000000000000000000\n-1\n", "e.csv");
-  EXPECT_EQ(r.phase.counts, (std::vector<std::int64_t>{0, 999999999999999999, 999999999999999999,
-                                                        1999999999999999999, 1999999999999999998}));
+  EXPECT_EQ(r.phase.counts, (std::vector<std::int64_t>{0, 999999999999999999, 999999999999999999, 1999999999999999999,
+                                                       1999999999999999998}));
   EXPECT_EQ(error_line("pulses\n1\n-\n"), 3u);  // a lone sign is not a number
   rwcalc::ReadOptions counter;
   counter.mode = rwcalc::InputMode::Counter;

@@ -76,9 +76,7 @@ TEST(Reader, SingleColumnPulsesWithDefaults) {
   EXPECT_DOUBLE_EQ(r.rates().at(0), 3 * 0.92 / 0.0025);
 }
 
-TEST(Reader, NoFinalNewlineAndHeaderRow) {
-  expect_pulses(read_recording_text("pulses\n3\n-1\n0\n2\n7\n1", "p.txt"));
-}
+TEST(Reader, NoFinalNewlineAndHeaderRow) { expect_pulses(read_recording_text("pulses\n3\n-1\n0\n2\n7\n1", "p.txt")); }
 
 TEST(Reader, EveryDelimiterGivesTheSameSamples) {
   for (const char* text : {"time_s,pulses\n0,3\n0.0025,-1\n0.005,0\n0.0075,2\n0.01,7\n0.0125,1\n",
@@ -100,8 +98,8 @@ TEST(Reader, RussianLocaleSpreadsheetExportWithDecimalComma) {
   expect_pulses(r);
   EXPECT_DOUBLE_EQ(r.rate_hz, 400.0);  // 1-based index given; no time column by name, so default
   // With the standard name the time column is used and checked.
-  const auto t = read_recording_text("time_s;pulses\n0,0000;3\n0,0025;-1\n0,0050;0\n0,0075;2\n0,0100;7\n0,0125;1\n",
-                                     "ru.csv");
+  const auto t =
+      read_recording_text("time_s;pulses\n0,0000;3\n0,0025;-1\n0,0050;0\n0,0075;2\n0,0100;7\n0,0125;1\n", "ru.csv");
   expect_pulses(t);
   EXPECT_EQ(t.rate_source, RateSource::TimeColumn);
   // Decimal comma in rate samples, tab- and blank-separated.
@@ -116,23 +114,25 @@ TEST(Reader, RussianLocaleSpreadsheetExportWithDecimalComma) {
 
 TEST(Reader, CrlfBomAndClassicMacLineEnds) {
   expect_pulses(read_recording_text("\xEF\xBB\xBFpulses\r\n3\r\n-1\r\n0\r\n2\r\n7\r\n1\r\n", "w.txt"));
-  expect_pulses(read_recording_text("# made on Windows\r\ntime_s,pulses\r\n0,3\r\n0.0025,-1\r\n0.005,0\r\n"
-                                    "0.0075,2\r\n0.01,7\r\n0.0125,1\r\n",
-                                    "w.txt"));
+  expect_pulses(
+      read_recording_text("# made on Windows\r\ntime_s,pulses\r\n0,3\r\n0.0025,-1\r\n0.005,0\r\n"
+                          "0.0075,2\r\n0.01,7\r\n0.0125,1\r\n",
+                          "w.txt"));
   expect_pulses(read_recording_text("pulses\r3\r-1\r0\r2\r7\r1\r", "mac.txt"));
 }
 
 TEST(Reader, TimePulsesTemperatureColumns) {
-  const auto r = read_recording_text("time_s,pulses,temperature_c\n10,3,20\n10.0025,-1,21\n10.005,0,22\n"
-                                     "10.0075,2,23\n10.01,7,24\n10.0125,1,25\n",
-                                     "t.csv");
+  const auto r = read_recording_text(
+      "time_s,pulses,temperature_c\n10,3,20\n10.0025,-1,21\n10.005,0,22\n"
+      "10.0075,2,23\n10.01,7,24\n10.0125,1,25\n",
+      "t.csv");
   expect_pulses(r);
   ASSERT_TRUE(r.temperature_c.has_value());
   EXPECT_DOUBLE_EQ(*r.temperature_c, 22.5);
   EXPECT_EQ(r.time_column, "time_s");
   // Headerless three-column layout means the same.
-  const auto h = read_recording_text("10,3,20\n10.0025,-1,21\n10.005,0,22\n10.0075,2,23\n10.01,7,24\n10.0125,1,25\n",
-                                     "t.csv");
+  const auto h =
+      read_recording_text("10,3,20\n10.0025,-1,21\n10.005,0,22\n10.0075,2,23\n10.01,7,24\n10.0125,1,25\n", "t.csv");
   expect_pulses(h);
   EXPECT_DOUBLE_EQ(*h.temperature_c, 22.5);
 }
@@ -150,7 +150,7 @@ TEST(Reader, MetadataLinesAndPrecedence) {
   EXPECT_DOUBLE_EQ(*r.temperature_c, 21.5);
   EXPECT_EQ(r.metadata.at("serial"), "0417");
   EXPECT_EQ(r.metadata.at("operator"), "Fomin; Bolotnov");  // repeated keys: nothing dropped
-  EXPECT_EQ(r.metadata.count("GL-2D bench run"), 0u);         // prose comments are not metadata
+  EXPECT_EQ(r.metadata.count("GL-2D bench run"), 0u);       // prose comments are not metadata
   const auto o = read_recording_text(text, "m.txt", {.rate_hz = 400.0, .scale_arcsec = 1.0});
   EXPECT_DOUBLE_EQ(o.rate_hz, 400.0);
   EXPECT_EQ(o.rate_source, RateSource::Option);
@@ -273,7 +273,8 @@ TEST(Reader, RateInputIsIntegratedToPhaseAsSp1065) {
   const std::vector<double> y{892, 809, 823, 798, 671, 644, 883, 903, 677};
   std::string text;
   for (double v : y) text += fmt::format("{}\n", v);
-  const auto c = read_recording_text(text, "nbs14.txt", {.mode = InputMode::Rate, .rate_hz = 1.0, .rate_unit = RateUnit::Unitless});
+  const auto c = read_recording_text(text, "nbs14.txt",
+                                     {.mode = InputMode::Rate, .rate_hz = 1.0, .rate_unit = RateUnit::Unitless});
   ASSERT_EQ(c.phase.values.size(), y.size() + 1);
   // The mean rate is kept apart (PhaseSeries::rate_offset); the phase adds it back.
   double x = 0;
@@ -285,10 +286,12 @@ TEST(Reader, RateInputIsIntegratedToPhaseAsSp1065) {
   EXPECT_NEAR(c.phase.rate_offset, 7100.0 / 9.0, 1e-9);
   EXPECT_EQ(c.phase.kind, PhaseKind::Clock);
   // Gyro units: deg/s and rad/s become ″/s (= °/h).
-  const auto ds = read_recording_text("0.5\n-0.25\n", "g", {.mode = InputMode::Rate, .rate_unit = RateUnit::DegPerSecond});
+  const auto ds =
+      read_recording_text("0.5\n-0.25\n", "g", {.mode = InputMode::Rate, .rate_unit = RateUnit::DegPerSecond});
   EXPECT_DOUBLE_EQ(ds.rates()[0], 1800.0);
   EXPECT_DOUBLE_EQ(ds.rates()[1], -900.0);
-  const auto rs = read_recording_text("1e-5\n2e-5\n", "g", {.mode = InputMode::Rate, .rate_unit = RateUnit::RadPerSecond});
+  const auto rs =
+      read_recording_text("1e-5\n2e-5\n", "g", {.mode = InputMode::Rate, .rate_unit = RateUnit::RadPerSecond});
   EXPECT_NEAR(rs.rates()[1], 2e-5 * rwcalc::units::arcsec_per_rad, 1e-9);
 }
 

@@ -30,7 +30,8 @@ std::pair<std::string, std::size_t> error_of(const std::string& text, const Read
 }
 
 TEST(ReaderMetadataKeys, RateInAnyCaseWithColonOrEqualsSign) {
-  for (const std::string line : {"# RATE_HZ: 100", "# rate_hz = 100", "# Rate-Hz=100", "#rate_hz :100", "# rate_Hz: 100,0"}) {
+  for (const std::string line :
+       {"# RATE_HZ: 100", "# rate_hz = 100", "# Rate-Hz=100", "#rate_hz :100", "# rate_Hz: 100,0"}) {
     const auto r = read_recording_text(line + "\npulses\n1\n2\n3\n", "mem.txt");
     EXPECT_EQ(r.rate_hz, 100.0) << line;
     EXPECT_EQ(r.rate_source, rwcalc::RateSource::Metadata) << line;
@@ -40,7 +41,8 @@ TEST(ReaderMetadataKeys, RateInAnyCaseWithColonOrEqualsSign) {
 }
 
 TEST(ReaderMetadataKeys, ScaleTemperatureAndSerialInOtherSpellings) {
-  const auto r = read_recording_text("# SCALE_ARCSEC_PER_PULSE = 2\n# Temperature_C: -5\n# Serial = 0417\npulses\n1\n2\n", "m");
+  const auto r =
+      read_recording_text("# SCALE_ARCSEC_PER_PULSE = 2\n# Temperature_C: -5\n# Serial = 0417\npulses\n1\n2\n", "m");
   EXPECT_EQ(r.phase.arcsec_per_count, 2.0);
   ASSERT_TRUE(r.temperature_c);
   EXPECT_EQ(*r.temperature_c, -5.0);
@@ -91,8 +93,9 @@ TEST(ReaderMetadataKeys, AKeyThatLooksLikeThePulseWeightIsRefusedOnlyWhenNothing
 }
 
 TEST(ReaderTimeColumns, EveryUnitIsReadInItsUnit) {
-  const std::vector<std::pair<std::string, double>> units{
-      {"time_s", 1}, {"Time_MS", 1e3}, {"t_ms", 1e3}, {"time_us", 1e6}, {"t_us", 1e6}, {"time_ns", 1e9}, {"t_ns", 1e9}};
+  const std::vector<std::pair<std::string, double>> units{{"time_s", 1},    {"Time_MS", 1e3}, {"t_ms", 1e3},
+                                                          {"time_us", 1e6}, {"t_us", 1e6},    {"time_ns", 1e9},
+                                                          {"t_ns", 1e9}};
   for (const auto& [name, per_s] : units) {
     std::string text = name + ",pulses\n";
     for (int k = 0; k < 50; ++k) text += fmt::format("{},{}\n", k * 0.004 * per_s, k % 3);
@@ -101,9 +104,10 @@ TEST(ReaderTimeColumns, EveryUnitIsReadInItsUnit) {
     EXPECT_EQ(r.rate_source, rwcalc::RateSource::TimeColumn) << name;
     EXPECT_EQ(r.time_column.value_or(""), name);
     // A gap is named in seconds, whatever the column's unit.
-    const auto [msg, line] =
-        error_of(name + ",pulses\n0,1\n" + fmt::format("{},1\n{},1\n{},1\n", 0.004 * per_s, 0.008 * per_s, 0.016 * per_s));
-    EXPECT_NE(msg.find("gap in the time column: 0.008 s at line 4, then 0.016 s"), std::string::npos) << name << ": " << msg;
+    const auto [msg, line] = error_of(name + ",pulses\n0,1\n" +
+                                      fmt::format("{},1\n{},1\n{},1\n", 0.004 * per_s, 0.008 * per_s, 0.016 * per_s));
+    EXPECT_NE(msg.find("gap in the time column: 0.008 s at line 4, then 0.016 s"), std::string::npos)
+        << name << ": " << msg;
     EXPECT_EQ(line, 5u) << name;
   }
 }
@@ -121,7 +125,8 @@ TEST(ReaderTimeColumns, TwoTimeColumnsAreComparedOverALongText) {
   // More than 2 MB, read in many pieces: the disagreement near the end is found and named.
   std::string text = "time_s,pulses,time_us\n";
   const int n = 120000;
-  for (int k = 0; k < n; ++k) text += fmt::format("{:.4f},{},{}\n", k * 0.0025, k % 2, k == n - 10 ? k * 2500 + 100 : k * 2500);
+  for (int k = 0; k < n; ++k)
+    text += fmt::format("{:.4f},{},{}\n", k * 0.0025, k % 2, k == n - 10 ? k * 2500 + 100 : k * 2500);
   ASSERT_GT(text.size(), std::size_t{2} << 20);
   const auto [msg, line] = error_of(text, ReadOptions{});
   EXPECT_NE(msg.find("the time columns 'time_s' and 'time_us' disagree"), std::string::npos) << msg;
@@ -129,11 +134,10 @@ TEST(ReaderTimeColumns, TwoTimeColumnsAreComparedOverALongText) {
 }
 
 TEST(ReaderColumns, TwoCandidateSampleColumnsAreAnErrorInEveryMode) {
-  const std::vector<std::pair<rwcalc::InputMode, std::string>> cases{
-      {rwcalc::InputMode::Pulses, "pulse,count"},
-      {rwcalc::InputMode::Counter, "counter,counts"},
-      {rwcalc::InputMode::Angle, "angle,phase"},
-      {rwcalc::InputMode::Rate, "gyro,rate"}};
+  const std::vector<std::pair<rwcalc::InputMode, std::string>> cases{{rwcalc::InputMode::Pulses, "pulse,count"},
+                                                                     {rwcalc::InputMode::Counter, "counter,counts"},
+                                                                     {rwcalc::InputMode::Angle, "angle,phase"},
+                                                                     {rwcalc::InputMode::Rate, "gyro,rate"}};
   for (const auto& [mode, header] : cases) {
     ReadOptions o;
     o.mode = mode;

@@ -4,8 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
-#include <nlohmann/json.hpp>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "rwcalc/error.hpp"
@@ -16,8 +16,8 @@
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-using rwcalc::test::fixture_batch;
 using rwcalc::test::base64_decode;
+using rwcalc::test::fixture_batch;
 using rwcalc::test::fixture_diagnosis;
 using rwcalc::test::inline_figures;
 using rwcalc::test::svg_series;
@@ -114,8 +114,8 @@ TEST(Report, UnresolvedAndMissingValuesAreStatedNotZero) {
   in.overall = nullptr;
   auto& run = in.analyses[0];
   run["methods"]["B_100s_deg_per_h"] = nullptr;  // too short for 100-s blocks
-  run["fit"]["N_deg_per_sqrt_h"] = {{"value", 0.0012}, {"sigma", 0.0003}, {"low95", 0.0},
-                                    {"high95", 0.0012}, {"resolved", false}};
+  run["fit"]["N_deg_per_sqrt_h"] = {
+      {"value", 0.0012}, {"sigma", 0.0003}, {"low95", 0.0}, {"high95", 0.0012}, {"resolved", false}};
   const auto html = rwcalc::report_html(in, no_figures());
   const auto row = row_of(html, "table1", "gl2d_25C.csv");
   EXPECT_NE(row.find("&lt; 0.0012 <span class=\"ci\">95 % upper bound</span>"), std::string::npos) << row;

@@ -19,18 +19,18 @@
 namespace fs = std::filesystem;
 using nlohmann::json;
 using rwcalc::test::CliResult;
+using rwcalc::test::concat;
 using rwcalc::test::fixture_analysis;
 using rwcalc::test::fixture_diagnosis;
 using rwcalc::test::FixtureCoefficients;
 using rwcalc::test::inline_figures;
 using rwcalc::test::run_cli;
+using rwcalc::test::ScopedEnv;
+using rwcalc::test::slurp;
 using rwcalc::test::source_path;
 using rwcalc::test::svg_series;
 using rwcalc::test::TempDir;
 using rwcalc::test::xml_problem;
-using rwcalc::test::slurp;
-using rwcalc::test::ScopedEnv;
-using rwcalc::test::concat;
 
 namespace {
 
@@ -63,9 +63,9 @@ class ReportOfGl2d : public ::testing::Test {
     if (!rwcalc::gnuplot_available()) return;
     dir_ = std::make_unique<TempDir>();
     report_ = run_cli(concat({"report"}, concat(gl2d_all(), {"-o", (dir_->path() / "out").string(), "--tolerance", "50",
-                                                       "--title", "GL-2D <temperature> test"})));
+                                                             "--title", "GL-2D <temperature> test"})));
     batch_ = run_cli(concat({"batch"}, concat(gl2d_all(), {"--json", "--tolerance", "50", "-o",
-                                                     (dir_->path() / "batch.json").string()})));
+                                                           (dir_->path() / "batch.json").string()})));
   }
   static void TearDownTestSuite() { dir_.reset(); }
   void SetUp() override {
@@ -93,8 +93,8 @@ TEST_F(ReportOfGl2d, IsOneWellFormedPageWithEverySection) {
   // Self-contained: nothing fetched from elsewhere.
   for (const char* ext : {"src=\"http", "href=\"http", "src=\"file", "<link ", "<script src"})
     EXPECT_EQ(html_.find(ext), std::string::npos) << ext;
-  for (const char* id : {"id=\"verdict\"", "id=\"table1\"", "id=\"table2\"", "id=\"figures\"", "id=\"runs\"",
-                         "id=\"settings-table\""})
+  for (const char* id :
+       {"id=\"verdict\"", "id=\"table1\"", "id=\"table2\"", "id=\"figures\"", "id=\"runs\"", "id=\"settings-table\""})
     EXPECT_NE(html_.find(id), std::string::npos) << id;
   // The title is escaped.
   EXPECT_NE(html_.find("GL-2D &lt;temperature&gt; test"), std::string::npos);

@@ -1,7 +1,7 @@
 // Quick tests of the simulator: RNG, reproducibility, file format, options, and that each
 // deterministic effect appears in the time series where and how it should.
-#include <gtest/gtest.h>
 #include <fmt/format.h>
+#include <gtest/gtest.h>
 #include <zlib.h>
 
 #include <cmath>
@@ -143,8 +143,9 @@ TEST(Simulate, GoldenChecksumPinsTheGenerator) {
 TEST(Simulate, CliRunsAreByteIdenticalAndFileFormatIsComplete) {
   TempDir dir;
   const auto a = dir.path() / "a.csv", b = dir.path() / "b.csv";
-  const std::vector<std::string> common = {"--duration", "5", "--seed", "9", "--arw", "0.002", "--bias-instability", "0.01",
-                                           "--sinusoid", "1:0.5", "--temperature", "25", "--white-readout"};
+  const std::vector<std::string> common = {
+      "--duration", "5",     "--seed",        "9",  "--arw",          "0.002", "--bias-instability", "0.01",
+      "--sinusoid", "1:0.5", "--temperature", "25", "--white-readout"};
   auto args = common;
   args.insert(args.begin(), {"simulate", "-o", a.string()});
   ASSERT_EQ(run_cli(args).status, 0);
@@ -153,9 +154,10 @@ TEST(Simulate, CliRunsAreByteIdenticalAndFileFormatIsComplete) {
   ASSERT_EQ(run_cli(args).status, 0);
   const std::string ta = slurp(a);
   EXPECT_EQ(ta, slurp(b));
-  for (const char* key : {"# rate_hz: 400\n", "# scale_arcsec_per_pulse: 0.92\n", "# temperature_c: 25\n", "# seed: 9\n",
-                          "# arw_deg_per_sqrt_h: 0.002\n", "# bias_instability_deg_per_h: 0.01\n", "# readout: white\n",
-                          "# sinusoid: frequency_hz=1 amplitude_deg_per_h=0.5 phase_rad=0\n", "\npulses\n"})
+  for (const char* key :
+       {"# rate_hz: 400\n", "# scale_arcsec_per_pulse: 0.92\n", "# temperature_c: 25\n", "# seed: 9\n",
+        "# arw_deg_per_sqrt_h: 0.002\n", "# bias_instability_deg_per_h: 0.01\n", "# readout: white\n",
+        "# sinusoid: frequency_hz=1 amplitude_deg_per_h=0.5 phase_rad=0\n", "\npulses\n"})
     EXPECT_NE(ta.find(key), std::string::npos) << key;
   // 2000 integer lines after the header, summing to the record's final count.
   std::istringstream in(ta.substr(ta.find("\npulses\n") + 8));
@@ -261,9 +263,7 @@ TEST(Simulate, FromAnalysisJsonTakesFitAndRecordSettings) {
   EXPECT_EQ(s.temperature_c, -25.0);
 
   // Diagnose output: the extended model with its findings.
-  nlohmann::json d = {{"base_model", j},
-                      {"extended_model", j},
-                      {"findings", nlohmann::json::array()}};
+  nlohmann::json d = {{"base_model", j}, {"extended_model", j}, {"findings", nlohmann::json::array()}};
   d["extended_model"]["terms"] = {{{"effect", "sinusoid"}, {"frequency_hz", 0.0125}, {"amplitude_deg_per_h", 0.03}},
                                   {{"effect", "bias_step"}, {"time_s", 5.0}, {"size_deg_per_h", -0.01}}};
   const NoiseModel e = model_from_analysis_json(d, "d.json", s);
@@ -424,7 +424,8 @@ TEST(Simulate, CountsStayExactOverLongRecords) {
 TEST(Simulate, TheoreticalFlickerMatchesTheSmallLagTable) {
   const double floor = 2 * 0.01 * 0.01 * std::numbers::ln2 / kPi;
   EXPECT_NEAR(flicker_avar(0.01, 1), 2 * 0.01 * 0.01 / kPi, 1e-12);
-  const std::pair<int, double> table[] = {{2, 1.1542}, {3, 1.0804}, {4, 1.0500}, {8, 1.0154}, {16, 1.0046}, {64, 1.00038}};
+  const std::pair<int, double> table[] = {{2, 1.1542}, {3, 1.0804},  {4, 1.0500},
+                                          {8, 1.0154}, {16, 1.0046}, {64, 1.00038}};
   for (auto [m, ratio] : table) EXPECT_NEAR(flicker_avar(0.01, m) / floor, ratio, 1e-4) << m;
 }
 

@@ -8,8 +8,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "rwcalc/error.hpp"
 #include "rwcalc/ensemble.hpp"
+#include "rwcalc/error.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -61,7 +61,8 @@ TEST(FastFlickerAvar, DepartureIsNegligibleInTheTotalAvOfAGl2dRecord) {
   // (Above 256·D = 10240 samples fast_flicker_avar is the exact value by construction.)
   for (std::size_t k = 1; k <= 12'000; k = k < 64 ? k + 1 : k * 3 / 2) {
     const double total = theoretical_avar(m, 0.0025, 0.92, k);
-    const double missing = flicker_avar(m.bias_instability_deg_per_h, k) - fast_flicker_avar(m.bias_instability_deg_per_h, k, d);
+    const double missing =
+        flicker_avar(m.bias_instability_deg_per_h, k) - fast_flicker_avar(m.bias_instability_deg_per_h, k, d);
     EXPECT_GE(missing, -1e-12 * total) << k;
     worst = std::max(worst, missing / total);
   }
@@ -144,18 +145,22 @@ TEST(SimulateEnsemble, ErrorsPropagateAndInvalidModelsAreRejectedUpFront) {
     // One thread: the runs are consumed in order, so the failure at run 2 stops the ensemble there.
     const test::ScopedEnv env("RWCALC_THREADS", "1");
     int calls = 0;
-    EXPECT_THROW(simulate_ensemble(gl2d_model(), s, 20, [&](std::size_t r, const PhaseSeries&) {
-      ++calls;
-      if (r == 2) throw std::runtime_error("consumer failed");
-    }), std::runtime_error);
+    EXPECT_THROW(simulate_ensemble(gl2d_model(), s, 20,
+                                   [&](std::size_t r, const PhaseSeries&) {
+                                     ++calls;
+                                     if (r == 2) throw std::runtime_error("consumer failed");
+                                   }),
+                 std::runtime_error);
     EXPECT_EQ(calls, 3);
   }
   {
     // Two threads: the consumer's exception reaches the caller, whichever thread raised it.
     const test::ScopedEnv env("RWCALC_THREADS", "2");
-    EXPECT_THROW(simulate_ensemble(gl2d_model(), s, 20, [&](std::size_t r, const PhaseSeries&) {
-      if (r == 2) throw std::runtime_error("consumer failed");
-    }), std::runtime_error);
+    EXPECT_THROW(simulate_ensemble(gl2d_model(), s, 20,
+                                   [&](std::size_t r, const PhaseSeries&) {
+                                     if (r == 2) throw std::runtime_error("consumer failed");
+                                   }),
+                 std::runtime_error);
   }
   auto bad = gl2d_model();
   bad.arw_deg_per_sqrt_h = -1;

@@ -1,7 +1,7 @@
 // The shipped data/gl2d runs are reproducible bit for bit: re-running the documented command
 // (scripts/make-gl2d-data.sh) for one 2-h run gives the shipped file's exact content.
-#include <gtest/gtest.h>
 #include <fmt/format.h>
+#include <gtest/gtest.h>
 #include <zlib.h>
 
 #include <filesystem>
@@ -31,11 +31,26 @@ TEST(Gl2dData, ShippedRunRegeneratesBitForBit) {
   // The command of scripts/make-gl2d-data.sh, written uncompressed.
   TempDir dir;
   const auto out = dir.path() / "p50C.csv";
-  const auto r = run_cli({"simulate", "-o", out.string(), "--duration", num(s.at("duration_s")), "--rate",
-                          num(s.at("rate_hz")), "--scale", num(s.at("scale_arcsec_per_pulse")), "--latitude", "55.75",
-                          "--white-readout", "--arw", num(m.at("arw_deg_per_sqrt_h")), "--bias-instability",
-                          num(m.at("bias_instability_deg_per_h")), "--temperature", num(s.at("temperature_c")),
-                          "--seed", std::to_string(truth.at("seed").get<std::uint64_t>())});
+  const auto r = run_cli({"simulate",
+                          "-o",
+                          out.string(),
+                          "--duration",
+                          num(s.at("duration_s")),
+                          "--rate",
+                          num(s.at("rate_hz")),
+                          "--scale",
+                          num(s.at("scale_arcsec_per_pulse")),
+                          "--latitude",
+                          "55.75",
+                          "--white-readout",
+                          "--arw",
+                          num(m.at("arw_deg_per_sqrt_h")),
+                          "--bias-instability",
+                          num(m.at("bias_instability_deg_per_h")),
+                          "--temperature",
+                          num(s.at("temperature_c")),
+                          "--seed",
+                          std::to_string(truth.at("seed").get<std::uint64_t>())});
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string shipped = gunzip(data_path);
   ASSERT_FALSE(shipped.empty());

@@ -189,8 +189,8 @@ TEST(SimulateStream, LongRecordIsWrittenInBoundedMemory) {
   if (kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space";
   TempDir dir;
   const fs::path out = dir.path() / "long.csv.gz";
-  const int status = run_exe_limited({"simulate", "-o", out.string(), "--duration", "7200", "--rate", "1000",
-                                      "--arw", "0.001", "--white-readout"},
+  const int status = run_exe_limited({"simulate", "-o", out.string(), "--duration", "7200", "--rate", "1000", "--arw",
+                                      "0.001", "--white-readout"},
                                      150u << 20);
   ASSERT_EQ(status, 0);
   // The file is complete: every sample has its line after the header.
@@ -232,9 +232,14 @@ TEST(SimulateStream, UncountableAngleIsAUsageErrorNamingTheSample) {
 }
 
 TEST(SimulateStream, CliRefusesAnUncountableRecordAndLeavesNoFile) {
-  const std::vector<std::vector<std::string>> cases = {
-      {"--bias", "1e300"}, {"--arw", "1e300"}, {"--scale", "1e-300"}, {"--ramp", "1e300"}, {"--white-angle", "1e300"},
-      {"--bias", "1e300", "--output-lowpass", "0.1"}, {"--bias", "1e300", "--runs", "2"}, {"--sinusoid", "1:1e300"}};
+  const std::vector<std::vector<std::string>> cases = {{"--bias", "1e300"},
+                                                       {"--arw", "1e300"},
+                                                       {"--scale", "1e-300"},
+                                                       {"--ramp", "1e300"},
+                                                       {"--white-angle", "1e300"},
+                                                       {"--bias", "1e300", "--output-lowpass", "0.1"},
+                                                       {"--bias", "1e300", "--runs", "2"},
+                                                       {"--sinusoid", "1:1e300"}};
   for (const char* name : {"x.csv", "x.csv.gz"}) {
     for (const auto& opts : cases) {
       TempDir dir;
@@ -303,7 +308,7 @@ TEST(SimulateStream, AtomicOutputAppearsWholeOrNotAtAll) {
       o.write("first ");
       EXPECT_FALSE(fs::exists(out));
       EXPECT_EQ(entries(dir.path()), before + 1);  // the temporary file
-    }  // abandoned: the temporary file goes with it
+    }                                              // abandoned: the temporary file goes with it
     EXPECT_EQ(entries(dir.path()), before);
     AtomicOutput o(out.string(), false);
     o.write("first ");

@@ -127,7 +127,8 @@ TEST(Stable32, TimeIntervalCounterNoiseFloor) {
   RWCALC_REQUIRE_SHARED(dir / "tic_phase.txt");
   const PhaseSeries x = phase_series(load_column(dir / "tic_phase.txt"));
   ASSERT_EQ(x.points(), 55688u);
-  for (const char* f : {"tic_adev.txt", "tic_oadev.txt", "tic_mdev.txt"}) check_table(std::string("TIC ") + f, x, dir / f);
+  for (const char* f : {"tic_adev.txt", "tic_oadev.txt", "tic_mdev.txt"})
+    check_table(std::string("TIC ") + f, x, dir / f);
 }
 
 PhaseSeries ocxo_series() {

@@ -18,9 +18,9 @@ EstimateInput exact(double v) { return lognormal_estimate(v, 0.0); }
 
 TEST(Verdict, ClassBoundariesOfTheGostTable) {
   const VerdictOptions o;
-  EXPECT_EQ(decide(exact(0.005), exact(0.0010), 0, o).cls, 1);          // on the limit meets it
+  EXPECT_EQ(decide(exact(0.005), exact(0.0010), 0, o).cls, 1);  // on the limit meets it
   EXPECT_EQ(decide(exact(0.0050001), exact(0.0010), 0, o).B.cls, 2);
-  EXPECT_EQ(decide(exact(0.0050001), exact(0.0010), 0, o).cls, 2);      // overall is the worse
+  EXPECT_EQ(decide(exact(0.0050001), exact(0.0010), 0, o).cls, 2);  // overall is the worse
   EXPECT_EQ(decide(exact(0.004), exact(0.0016), 0, o).N.cls, 3);
   EXPECT_EQ(decide(exact(0.004), exact(0.0016), 0, o).cls, 3);
   const Verdict out = decide(exact(0.016), exact(0.0005), 0, o);
@@ -75,8 +75,8 @@ TEST(Verdict, ProbabilitiesFromTheLogNormalSamplingDistribution) {
 
 TEST(Verdict, OverallProbabilityCombinesBothParameters) {
   const VerdictOptions o;
-  const auto b = lognormal_estimate(0.005, 0.001);  // P(B ≤ class 1) = 0.5
-  const auto n = lognormal_estimate(0.001, 0.0002); // P(N ≤ class 1) = 0.5
+  const auto b = lognormal_estimate(0.005, 0.001);   // P(B ≤ class 1) = 0.5
+  const auto n = lognormal_estimate(0.001, 0.0002);  // P(N ≤ class 1) = 0.5
   const Verdict ind = decide(b, n, 0.0, o);
   EXPECT_NEAR(ind.p_meets[0], 0.25, 1e-6);
   const Verdict pos = decide(b, n, 0.999999, o);
@@ -121,7 +121,8 @@ TEST(ClassTableFile, LoadsAndRejects) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("order.json"), std::string::npos);
   }
-  const auto neg = dir.write("neg.json", R"({"classes": [{"class": 1, "B_deg_per_h": -1, "N_deg_per_sqrt_h": 0.002}]})");
+  const auto neg =
+      dir.write("neg.json", R"({"classes": [{"class": 1, "B_deg_per_h": -1, "N_deg_per_sqrt_h": 0.002}]})");
   EXPECT_THROW(ClassTable::load(neg.string()), InputError);
 }
 

@@ -24,9 +24,9 @@ enum class Estimator { Overlapping, NonOverlapping, Modified };
 /// log-spaced cluster sizes per decade; default 20), all (every m), or a list of τ in seconds.
 struct TauGrid {
   enum class Kind { Octave, Decade, Dense, All, Explicit } kind = Kind::Octave;
-  int per_decade = 20;             ///< for Dense
-  std::vector<double> taus_s;      ///< for Explicit, s
-  std::int64_t max_m = 0;          ///< optional cap on m (0: the estimator's own limit)
+  int per_decade = 20;         ///< for Dense
+  std::vector<double> taus_s;  ///< for Explicit, s
+  std::int64_t max_m = 0;      ///< optional cap on m (0: the estimator's own limit)
   /// Also every octave cluster size (up to the estimator's limit, whatever max_m): analyze fits
   /// the octave points of a finer grid, so its coefficients do not depend on the grid.
   bool with_octave = false;
@@ -44,8 +44,7 @@ std::int64_t term_count(Estimator est, std::int64_t m, std::size_t points);
 
 /// The cluster sizes m of a grid for `points` phase points every tau0_s, increasing and distinct.
 /// Throws UsageError for an explicit τ that is not a whole number of samples or out of range.
-std::vector<std::int64_t> cluster_sizes(const TauGrid& grid, Estimator est, std::size_t points,
-                                        double tau0_s);
+std::vector<std::int64_t> cluster_sizes(const TauGrid& grid, Estimator est, std::size_t points, double tau0_s);
 
 /// The series the noise identification looks at, as Stable32's phase and frequency files (rate and
 /// pulse-increment input is frequency data).
@@ -61,22 +60,22 @@ struct AllanOptions {
 };
 
 struct AllanPoint {
-  std::int64_t m = 0;        ///< averaging factor (cluster size)
-  double tau_s = 0;          ///< τ = m·τ0, s
-  std::int64_t n = 0;        ///< number of terms in the sum
-  int alpha = 0;             ///< identified noise exponent of S_y(f) ∝ f^α (+2 … −2)
-  double edf = 0;            ///< equivalent degrees of freedom (Greenhall–Riley)
-  double var = 0;            ///< σ²(τ), deviation units squared
-  double dev = 0;            ///< σ(τ)
-  double dev_low = 0;        ///< lower confidence bound of σ
-  double dev_high = 0;       ///< upper confidence bound of σ
+  std::int64_t m = 0;   ///< averaging factor (cluster size)
+  double tau_s = 0;     ///< τ = m·τ0, s
+  std::int64_t n = 0;   ///< number of terms in the sum
+  int alpha = 0;        ///< identified noise exponent of S_y(f) ∝ f^α (+2 … −2)
+  double edf = 0;       ///< equivalent degrees of freedom (Greenhall–Riley)
+  double var = 0;       ///< σ²(τ), deviation units squared
+  double dev = 0;       ///< σ(τ)
+  double dev_low = 0;   ///< lower confidence bound of σ
+  double dev_high = 0;  ///< upper confidence bound of σ
 };
 
 struct AllanResult {
   Estimator estimator = Estimator::Overlapping;
-  std::string unit;          ///< unit of the deviations: "deg/h" or "1"
+  std::string unit;  ///< unit of the deviations: "deg/h" or "1"
   double tau0_s = 0;
-  std::size_t points_in = 0; ///< phase points of the record
+  std::size_t points_in = 0;  ///< phase points of the record
   double confidence = 0.683;
   /// 0, or the smallest m whose variance came from the FFT path of the `all` grid (floating-point).
   std::int64_t fft_from_m = 0;
@@ -95,10 +94,10 @@ nlohmann::json to_json(const AllanResult& r);
 
 /// What the report header says about the record.
 struct AllanReportInfo {
-  std::string source;        ///< file name as given
-  std::size_t samples = 0;   ///< samples read
-  double rate_hz = 0;        ///< sample rate, Hz
-  std::string rate_source;   ///< where the rate came from ("option", "metadata", …); may be empty
+  std::string source;       ///< file name as given
+  std::size_t samples = 0;  ///< samples read
+  double rate_hz = 0;       ///< sample rate, Hz
+  std::string rate_source;  ///< where the rate came from ("option", "metadata", …); may be empty
 };
 
 /// Human-readable table: a header block (source, estimator, confidence, unit convention, samples,
@@ -109,8 +108,8 @@ std::string format_allan_csv(const AllanResult& r);
 /// Unit label of the deviations for people: "°/h" for gyro data, "input units/s" otherwise.
 std::string unit_label(const AllanResult& r);
 
-std::string_view to_string(Estimator e);  ///< "oadev", "adev" or "mdev"
-std::string_view long_name(Estimator e);  ///< "overlapping Allan", "non-overlapping Allan", "modified Allan"
+std::string_view to_string(Estimator e);        ///< "oadev", "adev" or "mdev"
+std::string_view long_name(Estimator e);        ///< "overlapping Allan", "non-overlapping Allan", "modified Allan"
 Estimator parse_estimator(std::string_view s);  ///< "oadev"|"overlapping", "adev"|"nonoverlapping", "mdev"|"modified"
 
 }  // namespace rwcalc

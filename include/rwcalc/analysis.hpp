@@ -16,14 +16,14 @@
 namespace rwcalc {
 
 struct AnalysisOptions {
-  AllanOptions allan;        ///< default: overlapping AVAR on the octave grid
+  AllanOptions allan;  ///< default: overlapping AVAR on the octave grid
   FitOptions fit;
   MethodOptions methods;
   VerdictOptions verdict;
-  double latitude_deg = 55.75;                 ///< for the vertical Earth rate Ω_E·sin(lat)
-  std::optional<double> earth_rate_deg_per_h;  ///< overrides the latitude
-  std::optional<double> temperature_c;         ///< overrides the recording's temperature
-  OutlierAction outlier_action = OutlierAction::Keep;  ///< outliers are always reported
+  double latitude_deg = 55.75;                          ///< for the vertical Earth rate Ω_E·sin(lat)
+  std::optional<double> earth_rate_deg_per_h;           ///< overrides the latitude
+  std::optional<double> temperature_c;                  ///< overrides the recording's temperature
+  OutlierAction outlier_action = OutlierAction::Keep;   ///< outliers are always reported
   double outlier_threshold = kDefaultOutlierThreshold;  ///< robust z (see outliers.hpp)
 };
 
@@ -33,18 +33,18 @@ struct AnalysisResult {
   double rate_hz = 0;
   double duration_s = 0;
   std::string column;
-  double arcsec_per_count = 0;    ///< pulse weight (0 when the input was not pulses/counter)
+  double arcsec_per_count = 0;  ///< pulse weight (0 when the input was not pulses/counter)
   std::optional<double> temperature_c;
-  std::string temperature_source; ///< "option", "column or metadata", "file name", or ""
+  std::string temperature_source;  ///< "option", "column or metadata", "file name", or ""
   double mean_rate_deg_per_h = 0;
   double earth_rate_deg_per_h = 0;
-  double latitude_deg = 0;        ///< NaN-free: the latitude used (0 when the rate was given)
+  double latitude_deg = 0;  ///< NaN-free: the latitude used (0 when the rate was given)
   bool earth_rate_given = false;
-  double bias_deg_per_h = 0;      ///< mean − expected Earth rate
+  double bias_deg_per_h = 0;  ///< mean − expected Earth rate
   AllanResult allan;
   FitResult fit;
   SlopeReadout slope;
-  double slope_B_sigma = 0;       ///< standard error of σ_min/0.6643 from the EDF at σ_min
+  double slope_B_sigma = 0;  ///< standard error of σ_min/0.6643 from the EDF at σ_min
   DirectNResult direct;
   BlockSpreadResult avg100;
   double N_direct_discrepancy_sigma = 0;  ///< (N_direct − N_fit)/σ

@@ -16,14 +16,12 @@ namespace rwcalc {
 /// frequency decimated to τ = mτ0 (per `domain`) while 30 points remain, differencing up to twice;
 /// else the B1 ratio (Howe et al. 2000) for N = the estimator's terms, with R(n) = MVAR/AVAR telling
 /// white from flicker PM for MVAR. 0 (white FM) when the data are constant or too short to tell.
-int identify_noise(const PhaseSeries& x, std::int64_t m, Estimator est,
-                   NoiseIdDomain domain = NoiseIdDomain::Phase);
+int identify_noise(const PhaseSeries& x, std::int64_t m, Estimator est, NoiseIdDomain domain = NoiseIdDomain::Phase);
 
 /// Greenhall–Riley EDF for noise exponent alpha (+2 … −4, α + 2d > 1), difference order d (1, 2
 /// Allan, 3 Hadamard), stride 1 or m (overlapping), filter 1 or m (modified): the exact BasicSum up
 /// to J = 100 terms and the paper's asymptotic tables beyond, as Stable32; 0 when m leaves no term.
-double edf_greenhall(int alpha, int d, std::int64_t m, std::size_t n_phase, bool overlapping,
-                     bool modified);
+double edf_greenhall(int alpha, int d, std::int64_t m, std::size_t n_phase, bool overlapping, bool modified);
 
 /// EDF of an estimator at cluster size m (edf_greenhall, d = 2, the estimator's stride and filter).
 double edf_for(Estimator est, int alpha, std::int64_t m, std::size_t n_phase);

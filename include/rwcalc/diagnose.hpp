@@ -19,13 +19,13 @@ namespace rwcalc {
 class Progress;
 
 struct DiagnoseOptions {
-  AnalysisOptions analysis;          ///< the base fit (as `rwcalc analyze`)
-  std::size_t runs = 50;             ///< ensemble size K of each simulated band
-  std::size_t holdout_runs = 0;      ///< ensemble size of the out-of-sample check (0: K)
-  std::uint64_t seed = 1;            ///< base seed of every ensemble
-  double band_level = 0.95;          ///< central probability of the band (2.5–97.5 %)
-  double alpha = 0.01;               ///< false-alarm level of each detector
-  Progress* progress = nullptr;      ///< advanced once per simulated record (may be null)
+  AnalysisOptions analysis;      ///< the base fit (as `rwcalc analyze`)
+  std::size_t runs = 50;         ///< ensemble size K of each simulated band
+  std::size_t holdout_runs = 0;  ///< ensemble size of the out-of-sample check (0: K)
+  std::uint64_t seed = 1;        ///< base seed of every ensemble
+  double band_level = 0.95;      ///< central probability of the band (2.5–97.5 %)
+  double alpha = 0.01;           ///< false-alarm level of each detector
+  Progress* progress = nullptr;  ///< advanced once per simulated record (may be null)
 };
 
 /// The effects the diagnosis can name, in the order they are named and estimated.
@@ -39,24 +39,24 @@ std::string_view finding_name(Effect e);
 /// One τ of a band: the measured deviation against the ensemble's quantiles.
 struct BandPoint {
   double tau_s = 0;
-  double dev = 0;        ///< measured σ(τ), °/h
-  double edf = 0;        ///< EDF of the measured point
-  double low = 0;        ///< ensemble (1 − level)/2 quantile of σ, °/h
-  double high = 0;       ///< ensemble (1 + level)/2 quantile of σ, °/h
-  double median = 0;     ///< ensemble median of σ, °/h
-  double mean_var = 0;   ///< ensemble mean of σ², (°/h)²
+  double dev = 0;       ///< measured σ(τ), °/h
+  double edf = 0;       ///< EDF of the measured point
+  double low = 0;       ///< ensemble (1 − level)/2 quantile of σ, °/h
+  double high = 0;      ///< ensemble (1 + level)/2 quantile of σ, °/h
+  double median = 0;    ///< ensemble median of σ, °/h
+  double mean_var = 0;  ///< ensemble mean of σ², (°/h)²
 };
 
 /// One detector's verdict: its statistic on the measurement against the ensemble calibration.
 struct DetectorResult {
   Effect effect = Effect::Sinusoid;
-  double statistic = 0;      ///< on the measurement
-  double threshold = 0;      ///< the ensemble's (1 − α) quantile (never below the ensemble maximum)
+  double statistic = 0;  ///< on the measurement
+  double threshold = 0;  ///< the ensemble's (1 − α) quantile (never below the ensemble maximum)
   double ensemble_max = 0;
   double ensemble_median = 0;
-  bool fired = false;        ///< statistic > threshold
-  bool named = false;        ///< kept as a finding (a competing explanation may win)
-  std::string note;          ///< why it was not named although it fired, or not tested
+  bool fired = false;  ///< statistic > threshold
+  bool named = false;  ///< kept as a finding (a competing explanation may win)
+  std::string note;    ///< why it was not named although it fired, or not tested
 };
 
 /// A named effect: parameters (JSON keys as simulate's model reads them), 1σ uncertainties and
@@ -71,12 +71,13 @@ struct Finding {
 struct Gain {
   double misfit_base = 0, misfit_extended = 0;      ///< EDF-weighted AV misfit (≈ 1 when the model fits)
   double coverage_base = 0, coverage_extended = 0;  ///< share of measured τ inside the band
-  double holdout_misfit_base = 0, holdout_misfit_extended = 0;  ///< out of sample (fit on one block, predict a neighbour)
+  double holdout_misfit_base = 0,
+         holdout_misfit_extended = 0;  ///< out of sample (fit on one block, predict a neighbour)
 };
 
 struct DiagnoseResult {
-  AnalysisResult analysis;         ///< the base fit
-  SimulationSettings settings;     ///< length, rate, pulse weight of the simulations
+  AnalysisResult analysis;      ///< the base fit
+  SimulationSettings settings;  ///< length, rate, pulse weight of the simulations
   NoiseModel base;
   NoiseModel extended;
   std::vector<BandPoint> base_band;
@@ -89,7 +90,7 @@ struct DiagnoseResult {
   std::uint64_t seed = 0;
   double band_level = 0.95;
   double alpha = 0.01;
-  double seconds = 0;              ///< wall time of the diagnosis, s
+  double seconds = 0;  ///< wall time of the diagnosis, s
 };
 
 /// Run the diagnosis. Throws UsageError for clock data, AnalysisError when the record is too

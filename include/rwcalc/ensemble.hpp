@@ -14,7 +14,7 @@ class Progress;
 /// How simulate_ensemble runs.
 struct EnsembleOptions {
   SimulationPath path = SimulationPath::Ensemble;
-  Progress* progress = nullptr;   ///< advanced once per finished realisation (may be null)
+  Progress* progress = nullptr;  ///< advanced once per finished realisation (may be null)
 };
 
 /// Seed of realisation `run` of an ensemble whose base seed is `seed` (independent streams).

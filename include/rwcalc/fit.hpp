@@ -43,14 +43,14 @@ struct FitPoint {
 };
 
 struct FitOptions {
-  double tau_min_s = 0;                                         ///< fit range, s (inclusive)
-  double tau_max_s = std::numeric_limits<double>::infinity();   ///< fit range, s (inclusive)
+  double tau_min_s = 0;                                        ///< fit range, s (inclusive)
+  double tau_max_s = std::numeric_limits<double>::infinity();  ///< fit range, s (inclusive)
   double min_edf = 1.0;  ///< points with fewer EDF are left out of the fit (still listed)
   /// Model-error floor: EDF enter as 1/(1/ν + 1/edf_cap); 0: estimated from the residuals.
   double edf_cap = 0;
   std::array<bool, kTermCount> enabled{true, true, true, true, true};  ///< false: held at 0
-  double confidence = 0.95;  ///< two-sided
-  double dispersion = 1.0;   ///< constant variance inflation on top of the model-based one
+  double confidence = 0.95;                                            ///< two-sided
+  double dispersion = 1.0;  ///< constant variance inflation on top of the model-based one
   /// Profile deviance scaled by 1 + a/ν_i (ν_i the term's own EDF); calibrated by
   /// tests/slow_coverage_fit.cpp.
   double edf_inflation = 3.0;
@@ -75,17 +75,17 @@ struct Coefficient {
 
 struct FitResult {
   std::array<Coefficient, kTermCount> coef;
-  Eigen::Matrix<double, kTermCount, 1> c;                  ///< fit-scale squared coefficients
-  Eigen::Matrix<double, kTermCount, kTermCount> cov_c;     ///< their covariance (inflated; 0 rows for inactive terms)
-  double deviance = 0;         ///< Gamma deviance at the optimum
-  double chi2 = 0;             ///< deviance with the small-ν (Bartlett) correction, ≈ χ²_dof under the model
-  int dof = 0;                 ///< points − active terms
+  Eigen::Matrix<double, kTermCount, 1> c;               ///< fit-scale squared coefficients
+  Eigen::Matrix<double, kTermCount, kTermCount> cov_c;  ///< their covariance (inflated; 0 rows for inactive terms)
+  double deviance = 0;                                  ///< Gamma deviance at the optimum
+  double chi2 = 0;  ///< deviance with the small-ν (Bartlett) correction, ≈ χ²_dof under the model
+  int dof = 0;      ///< points − active terms
   double chi2_per_dof = 0;
-  double p_value = 1;          ///< P(χ²_dof ≥ chi2)
-  double corr_NQ = 0;          ///< correlation of the N² and Q² estimates
-  double corr_NB = 0;          ///< correlation of the N² and B² estimates
+  double p_value = 1;                                 ///< P(χ²_dof ≥ chi2)
+  double corr_NQ = 0;                                 ///< correlation of the N² and Q² estimates
+  double corr_NB = 0;                                 ///< correlation of the N² and B² estimates
   std::array<double, kTermCount> phi{1, 1, 1, 1, 1};  ///< variance inflation of each term
-  bool model_covariance = false;  ///< the model-based AV covariance was used
+  bool model_covariance = false;                      ///< the model-based AV covariance was used
   int iterations = 0;
   FitOptions options;
   std::vector<FitPoint> used;  ///< the points fitted (τ ascending; edf = the EDF the fit used)

@@ -19,10 +19,10 @@ struct MethodOptions {
 };
 
 struct MethodEstimate {
-  bool valid = false;    ///< false: the record is too short for the method
-  double value = 0;      ///< °/√h or °/h
-  double sigma = 0;      ///< standard error
-  double low = 0;        ///< 95 % bounds (≥ 0)
+  bool valid = false;  ///< false: the record is too short for the method
+  double value = 0;    ///< °/√h or °/h
+  double sigma = 0;    ///< standard error
+  double low = 0;      ///< 95 % bounds (≥ 0)
   double high = 0;
   bool resolved = true;  ///< false: value is an upper bound
 };
@@ -46,8 +46,8 @@ struct DirectNResult {
 DirectNResult direct_n(const PhaseSeries& x, const MethodOptions& options = {});
 
 struct BlockSpreadResult {
-  MethodEstimate spread;      ///< std of the block mean rates, °/h
-  double block_s = 0;         ///< the block used (whole samples)
+  MethodEstimate spread;  ///< std of the block mean rates, °/h
+  double block_s = 0;     ///< the block used (whole samples)
   std::size_t blocks = 0;
   double expected = 0;        ///< expectation under a fitted model (0: not computed)
   double expected_sigma = 0;  ///< its standard error from the fit covariance

@@ -20,9 +20,9 @@ enum class ReadoutMode {
 
 /// A sinusoidal rate Ω0·cos(2πf·t + φ); its angle is (Ω0/2πf)·sin(2πf·t + φ).
 struct Sinusoid {
-  double f_hz = 0.0;            ///< frequency, Hz
-  double amp_deg_per_h = 0.0;   ///< rate amplitude Ω0, °/h
-  double phase_rad = 0.0;       ///< phase φ at t = 0, rad
+  double f_hz = 0.0;           ///< frequency, Hz
+  double amp_deg_per_h = 0.0;  ///< rate amplitude Ω0, °/h
+  double phase_rad = 0.0;      ///< phase φ at t = 0, rad
 };
 
 /// First-order Gauss–Markov rate dε/dt = −ε/Tc + w, stationary from the start.
@@ -64,12 +64,12 @@ struct TemperatureBias {
 
 /// Everything the simulated gyro senses and how it is read out. Zero means "term absent".
 struct NoiseModel {
-  double arw_deg_per_sqrt_h = 0.0;           ///< N, °/√h (σ² = N²/τ)
-  double bias_instability_deg_per_h = 0.0;   ///< B, °/h (flicker floor σ² = 2B²ln2/π)
-  double rrw_deg_per_h_per_sqrt_h = 0.0;     ///< K, °/h/√h (σ² = K²τ/3)
-  double ramp_deg_per_h2 = 0.0;              ///< R, °/h² (σ² = R²τ²/2)
-  double bias_deg_per_h = 0.0;               ///< constant bias, °/h
-  double earth_rate_deg_per_h = 0.0;         ///< sensed Earth rate, °/h (see earth_rate_at)
+  double arw_deg_per_sqrt_h = 0.0;          ///< N, °/√h (σ² = N²/τ)
+  double bias_instability_deg_per_h = 0.0;  ///< B, °/h (flicker floor σ² = 2B²ln2/π)
+  double rrw_deg_per_h_per_sqrt_h = 0.0;    ///< K, °/h/√h (σ² = K²τ/3)
+  double ramp_deg_per_h2 = 0.0;             ///< R, °/h² (σ² = R²τ²/2)
+  double bias_deg_per_h = 0.0;              ///< constant bias, °/h
+  double earth_rate_deg_per_h = 0.0;        ///< sensed Earth rate, °/h (see earth_rate_at)
   ReadoutMode readout = ReadoutMode::Counting;
   /// Extra white angle noise added before counting (rms per sample), ″ (σ² = 3σ_θ²/τ²).
   double white_angle_arcsec = 0.0;
@@ -86,10 +86,10 @@ struct NoiseModel {
 
 /// Length, sampling and read-out of a simulated record.
 struct SimulationSettings {
-  double duration_s = 7200.0;    ///< record length, s (samples = round(duration·rate))
-  double rate_hz = 400.0;        ///< sample rate, Hz
-  double scale_arcsec = 0.92;    ///< pulse weight q, ″
-  std::uint64_t seed = 1;        ///< seed of every random stream
+  double duration_s = 7200.0;           ///< record length, s (samples = round(duration·rate))
+  double rate_hz = 400.0;               ///< sample rate, Hz
+  double scale_arcsec = 0.92;           ///< pulse weight q, ″
+  std::uint64_t seed = 1;               ///< seed of every random stream
   std::optional<double> temperature_c;  ///< nominal temperature (metadata; temperature bias), °C
   [[nodiscard]] std::size_t samples() const;
   [[nodiscard]] double tau0_s() const { return 1.0 / rate_hz; }
@@ -106,8 +106,7 @@ void validate(const NoiseModel& model, const SimulationSettings& settings);
 
 /// Theoretical Allan variance (°/h)² at τ = m·τ0 of the random and periodic terms as simulated
 /// (not steps, warm-ups, temperature bias, low-pass or the counting read-out).
-[[nodiscard]] double theoretical_avar(const NoiseModel& model, double tau0_s, double scale_arcsec,
-                                      std::size_t m);
+[[nodiscard]] double theoretical_avar(const NoiseModel& model, double tau0_s, double scale_arcsec, std::size_t m);
 
 /// Exact AV of the discrete (Kasdin) flicker with Q_d = B² at cluster size m, (°/h)².
 [[nodiscard]] double flicker_avar(double b_deg_per_h, std::size_t m);
@@ -124,8 +123,7 @@ void add_finding(const nlohmann::json& finding, NoiseModel& model);
 
 /// A model from `analyze --json` or diagnose JSON ("extended_model", else "base_model"); fills
 /// rate, duration and temperature of `settings` when present. Errors: InputError naming `name`.
-NoiseModel model_from_analysis_json(const nlohmann::json& j, const std::string& name,
-                                    SimulationSettings& settings);
+NoiseModel model_from_analysis_json(const nlohmann::json& j, const std::string& name, SimulationSettings& settings);
 /// The same from a JSON file (`simulate --from`), every value checked.
 NoiseModel model_from_analysis_file(const std::string& path, SimulationSettings& settings);
 

@@ -25,18 +25,18 @@ struct OutlierPosition {
 struct OutlierReport {
   OutlierAction action = OutlierAction::Keep;
   double threshold = kDefaultOutlierThreshold;
-  double scale_deg_per_h = 0;  ///< robust scale of the neighbour-median residuals, °/h
-  std::size_t count = 0;       ///< outliers found
-  std::size_t removed = 0;     ///< rate samples dropped (Remove)
-  std::size_t replaced = 0;    ///< rate samples replaced by their local median (Replace)
+  double scale_deg_per_h = 0;              ///< robust scale of the neighbour-median residuals, °/h
+  std::size_t count = 0;                   ///< outliers found
+  std::size_t removed = 0;                 ///< rate samples dropped (Remove)
+  std::size_t replaced = 0;                ///< rate samples replaced by their local median (Replace)
   std::vector<OutlierPosition> positions;  ///< the first kMaxOutlierPositions, in input order
 };
 inline constexpr std::size_t kMaxOutlierPositions = 1000;
 
 /// Detects and reports the outliers of `read`, then applies the action: returns `read` when the
 /// data stay as read, else `edited`. Throws UsageError for a threshold that is not positive.
-const Recording& screen_outliers(const Recording& read, OutlierAction action, double threshold,
-                                 OutlierReport& report, Recording& edited);
+const Recording& screen_outliers(const Recording& read, OutlierAction action, double threshold, OutlierReport& report,
+                                 Recording& edited);
 
 /// The "Outliers" section of the readable reports, and the JSON "outliers" object.
 std::string format_outliers(const OutlierReport& report);

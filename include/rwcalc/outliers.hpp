@@ -43,8 +43,7 @@ OutlierScale outlier_scale(const std::vector<double>& rates);
 OutlierScale outlier_scale(const PhaseSeries& phase);
 
 /// Isolated outliers of `rates`, sorted by index; `line` is 0. Fewer than 7 samples: none.
-std::vector<Outlier> find_outliers(const std::vector<double>& rates,
-                                   double threshold = kDefaultOutlierThreshold);
+std::vector<Outlier> find_outliers(const std::vector<double>& rates, double threshold = kDefaultOutlierThreshold);
 
 /// Same, with the robust scale already computed by outlier_scale(rates).
 std::vector<Outlier> find_outliers(const std::vector<double>& rates, double threshold, const OutlierScale& scale);
@@ -53,8 +52,7 @@ std::vector<Outlier> find_outliers(const std::vector<double>& rates, double thre
 std::vector<Outlier> find_outliers(const PhaseSeries& phase, double threshold, const OutlierScale& scale);
 
 /// Same, on a recording's rates, with the input line of each outlier filled in.
-std::vector<Outlier> find_outliers(const Recording& recording,
-                                   double threshold = kDefaultOutlierThreshold);
+std::vector<Outlier> find_outliers(const Recording& recording, double threshold = kDefaultOutlierThreshold);
 
 /// What to do with detected outliers.
 enum class OutlierAction {
@@ -72,7 +70,6 @@ std::vector<double> replace_outliers(const std::vector<double>& rates, const std
 /// A phase series with the outliers' increments removed or replaced (Keep: a copy). Exact pulse
 /// counts stay exact integers: a replacement count is the neighbour median rounded to the nearest
 /// integer (halves away from zero).
-PhaseSeries apply_outliers(const PhaseSeries& phase, const std::vector<Outlier>& outliers,
-                           OutlierAction action);
+PhaseSeries apply_outliers(const PhaseSeries& phase, const std::vector<Outlier>& outliers, OutlierAction action);
 
 }  // namespace rwcalc

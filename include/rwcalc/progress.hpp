@@ -30,8 +30,8 @@ class Progress {
   [[nodiscard]] std::uint64_t total() const noexcept { return total_; }
 
   /// "label: 12/50 (24%), 3.1 s, ~9.8 s left".
-  [[nodiscard]] static std::string format_line(const std::string& label, std::uint64_t done,
-                                               std::uint64_t total, double elapsed_s);
+  [[nodiscard]] static std::string format_line(const std::string& label, std::uint64_t done, std::uint64_t total,
+                                               double elapsed_s);
 
  private:
   void draw(std::uint64_t done) noexcept;

@@ -52,8 +52,8 @@ struct ReadOptions {
 enum class RateSource { Option, Metadata, TimeColumn, Default };
 
 struct Recording {
-  std::string source;  ///< the path as given ("-" for stdin)
-  PhaseSeries phase;   ///< the cumulative angle/phase, ready for the estimators
+  std::string source;      ///< the path as given ("-" for stdin)
+  PhaseSeries phase;       ///< the cumulative angle/phase, ready for the estimators
   double rate_hz = 400.0;  ///< sample rate, Hz (phase.tau0_s = 1/rate_hz)
   RateSource rate_source = RateSource::Default;
   std::size_t samples = 0;  ///< data lines read (samples of the selected column)
@@ -85,8 +85,7 @@ Recording read_recording(const std::string& path, const ReadOptions& options = {
 
 /// Read from text already in memory (used by tests and fuzzers); `name` labels errors.
 /// The text may be gzip-compressed (detected by its magic bytes).
-Recording read_recording_text(std::string_view text, const std::string& name,
-                              const ReadOptions& options = {});
+Recording read_recording_text(std::string_view text, const std::string& name, const ReadOptions& options = {});
 
 /// Parse names used on the command line; throw UsageError on anything else.
 InputMode parse_input_mode(std::string_view s);

@@ -39,8 +39,8 @@ struct PhaseSeries {
   /// Phase difference x_j − x_i in phase units, exact for counts.
   [[nodiscard]] double diff(std::size_t j, std::size_t i) const noexcept {
     if (!counts.empty()) {
-      const auto d = static_cast<std::int64_t>(static_cast<std::uint64_t>(counts[j]) -
-                                               static_cast<std::uint64_t>(counts[i]));
+      const auto d =
+          static_cast<std::int64_t>(static_cast<std::uint64_t>(counts[j]) - static_cast<std::uint64_t>(counts[i]));
       return static_cast<double>(d) * arcsec_per_count;
     }
     return values[j] - values[i] + rate_offset * (static_cast<double>(j) - static_cast<double>(i)) * tau0_s;

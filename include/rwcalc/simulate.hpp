@@ -15,7 +15,7 @@ namespace rwcalc {
 
 /// How a Simulator generates the flicker (bias-instability) rate.
 enum class SimulationPath {
-  Exact,     ///< Kasdin filter at τ0 over the whole record; every file `simulate` writes
+  Exact,  ///< Kasdin filter at τ0 over the whole record; every file `simulate` writes
   /// For ensembles: Kasdin flicker at D·τ0 held over D samples (AV: fast_flicker_avar).
   Ensemble,
 };
@@ -48,8 +48,7 @@ inline constexpr double kMaxSimulatedPulses = 2305843009213693952.0;
 class Simulator {
  public:
   /// Throws UsageError (validate). `path` chooses how the flicker term is generated.
-  explicit Simulator(NoiseModel model, SimulationSettings settings,
-                     SimulationPath path = SimulationPath::Exact);
+  explicit Simulator(NoiseModel model, SimulationSettings settings, SimulationPath path = SimulationPath::Exact);
   ~Simulator();
   Simulator(Simulator&&) noexcept;
   Simulator& operator=(Simulator&&) noexcept;

@@ -26,12 +26,12 @@ inline constexpr double sqrt_s_per_sqrt_h = 60.0;
 /// Unit labels as reports and figures show them: one place, so that another sensor's units can
 /// replace them.
 namespace label {
-inline constexpr const char* rate = "°/h";        ///< rate, Allan deviation, B
-inline constexpr const char* arw = "°/√h";        ///< N
-inline constexpr const char* rrw = "°/h/√h";      ///< K
-inline constexpr const char* ramp = "°/h²";       ///< R
-inline constexpr const char* angle = "″";         ///< angle, Q
-inline constexpr const char* angle2 = "″²";       ///< angle variance
+inline constexpr const char* rate = "°/h";    ///< rate, Allan deviation, B
+inline constexpr const char* arw = "°/√h";    ///< N
+inline constexpr const char* rrw = "°/h/√h";  ///< K
+inline constexpr const char* ramp = "°/h²";   ///< R
+inline constexpr const char* angle = "″";     ///< angle, Q
+inline constexpr const char* angle2 = "″²";   ///< angle variance
 inline constexpr const char* celsius = "°C";
 }  // namespace label
 

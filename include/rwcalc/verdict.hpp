@@ -48,7 +48,7 @@ struct VerdictOptions {
 /// An estimate's reported value (the upper bound when not resolved) and its distribution.
 struct EstimateInput {
   double value = 0;
-  double low = 0;   ///< 95 % bounds
+  double low = 0;  ///< 95 % bounds
   double high = 0;
   bool resolved = true;
   std::function<double(double)> cdf;  ///< P(true ≤ x); non-decreasing, 0 at x ≤ 0
@@ -57,27 +57,27 @@ struct EstimateInput {
 EstimateInput lognormal_estimate(double value, double sigma);
 
 struct ParameterVerdict {
-  std::string parameter;          ///< "B" or "N"
-  std::string unit;               ///< "deg/h" or "deg/sqrt(h)"
+  std::string parameter;  ///< "B" or "N"
+  std::string unit;       ///< "deg/h" or "deg/sqrt(h)"
   double value = 0;
   bool resolved = true;
-  std::optional<int> cls;         ///< empty: beyond the last class
-  std::optional<int> cls_strict;  ///< without the tolerance
-  std::vector<double> limit;      ///< per class, tolerance applied
-  std::vector<double> margin_pct; ///< (limit − value)/limit·100 per class
-  std::vector<double> p_meets;    ///< P(true ≤ limit) per class
-  std::vector<double> p_is;       ///< P(true class = k) per class, then P(beyond)
-  double p_class = 0;             ///< probability of the stated class
+  std::optional<int> cls;          ///< empty: beyond the last class
+  std::optional<int> cls_strict;   ///< without the tolerance
+  std::vector<double> limit;       ///< per class, tolerance applied
+  std::vector<double> margin_pct;  ///< (limit − value)/limit·100 per class
+  std::vector<double> p_meets;     ///< P(true ≤ limit) per class
+  std::vector<double> p_is;        ///< P(true class = k) per class, then P(beyond)
+  double p_class = 0;              ///< probability of the stated class
 };
 
 struct Verdict {
   ParameterVerdict B, N;
-  std::optional<int> cls;         ///< the worse of the two
+  std::optional<int> cls;  ///< the worse of the two
   std::optional<int> cls_strict;
-  std::vector<double> p_meets;    ///< joint (Gaussian copula) per class
-  std::vector<double> p_is;       ///< then P(beyond)
+  std::vector<double> p_meets;  ///< joint (Gaussian copula) per class
+  std::vector<double> p_is;     ///< then P(beyond)
   double p_class = 0;
-  double rho_BN = 0;              ///< correlation of the log-estimates in the copula
+  double rho_BN = 0;  ///< correlation of the log-estimates in the copula
   bool decisive = true;
   double decisive_threshold = 0.9;
   bool tolerance_changed = false;

@@ -31,9 +31,10 @@ double parse_number(std::string_view s, std::string_view spec) {
   const auto* end = s.data() + s.size();
   const auto [ptr, ec] = std::from_chars(s.data(), end, v);
   if (s.empty() || ec != std::errc() || ptr != end || !std::isfinite(v))
-    throw UsageError(fmt::format("--tau: '{}' in '{}' is not a number of seconds (expected octave, "
-                                 "decade, dense[:P], all, or a list such as 1,2,5)",
-                                 s, spec));
+    throw UsageError(
+        fmt::format("--tau: '{}' in '{}' is not a number of seconds (expected octave, "
+                    "decade, dense[:P], all, or a list such as 1,2,5)",
+                    s, spec));
   return v;
 }
 
@@ -103,8 +104,7 @@ std::int64_t term_count(Estimator est, std::int64_t m, std::size_t points) {
   return std::max<std::int64_t>(t, 0);
 }
 
-std::vector<std::int64_t> cluster_sizes(const TauGrid& grid, Estimator est, std::size_t points,
-                                        double tau0_s) {
+std::vector<std::int64_t> cluster_sizes(const TauGrid& grid, Estimator est, std::size_t points, double tau0_s) {
   std::int64_t limit = max_cluster_size(est, points);
   if (grid.max_m > 0) limit = std::min(limit, grid.max_m);
   std::vector<std::int64_t> ms;
@@ -136,9 +136,10 @@ std::vector<std::int64_t> cluster_sizes(const TauGrid& grid, Estimator est, std:
         if (m < 1 || std::fabs(r - m) > 1e-9 * std::max(1.0, m))
           throw UsageError(fmt::format("--tau {} s is not a whole number of samples (τ0 = {} s)", t, tau0_s));
         if (m > static_cast<double>(limit))
-          throw UsageError(fmt::format("--tau {} s (m = {}) is beyond the longest usable τ of this record, "
-                                       "{} s (m = {})",
-                                       t, m, static_cast<double>(limit) * tau0_s, limit));
+          throw UsageError(
+              fmt::format("--tau {} s (m = {}) is beyond the longest usable τ of this record, "
+                          "{} s (m = {})",
+                          t, m, static_cast<double>(limit) * tau0_s, limit));
         ms.push_back(static_cast<std::int64_t>(m));
       }
       std::sort(ms.begin(), ms.end());
@@ -205,8 +206,8 @@ double variance_at(const PhaseSeries& x, const CountData& data, std::int64_t m, 
 
 /// Overlapping sums of every m ≥ kAllExactBelow through FFT autocorrelations (allan_all.hpp),
 /// O(N log² N) instead of O(N²), for the `all` grid of a long record; empty otherwise.
-std::vector<double> all_grid_fft_sums(const PhaseSeries& x, const CountData& data, const TauGrid& grid,
-                                      Estimator est, std::int64_t max_m) {
+std::vector<double> all_grid_fft_sums(const PhaseSeries& x, const CountData& data, const TauGrid& grid, Estimator est,
+                                      std::int64_t max_m) {
   const std::size_t points = x.points();
   if (grid.kind != TauGrid::Kind::All || est != Estimator::Overlapping || max_m < kAllExactBelow ||
       points < kAllFftMinPoints)
@@ -250,7 +251,8 @@ std::vector<double> grid_variances(const PhaseSeries& x, const CountData& data, 
     else
       per_tau.push_back(i);
   }
-  parallel_for(per_tau.size(), [&](std::size_t j) { var[per_tau[j]] = variance_at(x, data, ms[per_tau[j]], est, nullptr); });
+  parallel_for(per_tau.size(),
+               [&](std::size_t j) { var[per_tau[j]] = variance_at(x, data, ms[per_tau[j]], est, nullptr); });
   return var;
 }
 
@@ -262,8 +264,8 @@ void check_options(const PhaseSeries& x, const AllanOptions& options) {
   if (!options.noise_id && (options.alpha < -2 || options.alpha > 2))
     throw UsageError(fmt::format("noise exponent alpha must lie in -2..2, got {}", options.alpha));
   if (max_cluster_size(options.estimator, x.points()) < 1)
-    throw AnalysisError(fmt::format("the record has {} phase point(s); the {} variance needs at least {}",
-                                    x.points(), long_name(options.estimator), 3));
+    throw AnalysisError(fmt::format("the record has {} phase point(s); the {} variance needs at least {}", x.points(),
+                                    long_name(options.estimator), 3));
 }
 
 }  // namespace

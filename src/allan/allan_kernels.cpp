@@ -44,7 +44,8 @@ u128 block_sumsq(const std::int64_t* c, std::int64_t len, std::int64_t m, std::i
 
 u128 second_diff_sumsq(const std::int64_t* c, std::int64_t n, std::int64_t m, std::int64_t stride) {
   u128 total = 0;
-  for (std::int64_t i0 = 0; i0 < n; i0 += kBlock) total += block_sumsq(c + i0 * stride, std::min(kBlock, n - i0), m, stride);
+  for (std::int64_t i0 = 0; i0 < n; i0 += kBlock)
+    total += block_sumsq(c + i0 * stride, std::min(kBlock, n - i0), m, stride);
   return total;
 }
 

@@ -47,8 +47,8 @@ Real sz(Real t, Real f, int alpha, int d) {
       return 6 * sx(t, f, alpha) - 4 * sx(t - 1, f, alpha) - 4 * sx(t + 1, f, alpha) + sx(t - 2, f, alpha) +
              sx(t + 2, f, alpha);
     case 3:
-      return 20 * sx(t, f, alpha) - 15 * sx(t - 1, f, alpha) - 15 * sx(t + 1, f, alpha) +
-             6 * sx(t - 2, f, alpha) + 6 * sx(t + 2, f, alpha) - sx(t - 3, f, alpha) - sx(t + 3, f, alpha);
+      return 20 * sx(t, f, alpha) - 15 * sx(t - 1, f, alpha) - 15 * sx(t + 1, f, alpha) + 6 * sx(t - 2, f, alpha) +
+             6 * sx(t + 2, f, alpha) - sx(t - 3, f, alpha) - sx(t + 3, f, alpha);
     default: throw AnalysisError(fmt::format("EDF: unsupported difference order d = {}", d));
   }
 }
@@ -100,15 +100,14 @@ double binomial(int n, int k) {
 
 }  // namespace
 
-double edf_greenhall(int alpha, int d, std::int64_t m, std::size_t n_phase, bool overlapping,
-                     bool modified) {
+double edf_greenhall(int alpha, int d, std::int64_t m, std::size_t n_phase, bool overlapping, bool modified) {
   if (d < 1 || d > 3) throw AnalysisError(fmt::format("EDF: unsupported difference order d = {}", d));
   if (alpha + 2 * d <= 1 || alpha > 2 || alpha < -4)
     throw AnalysisError(fmt::format("EDF: noise exponent alpha = {} not allowed with d = {}", alpha, d));
   const Real mr = static_cast<Real>(m);
-  const Real f = modified ? 1 : mr;                 // filter factor
-  const Real s = overlapping ? mr : 1;              // stride factor
-  const Real l = mr / f + mr * d;                   // filter length in phase samples
+  const Real f = modified ? 1 : mr;     // filter factor
+  const Real s = overlapping ? mr : 1;  // stride factor
+  const Real l = mr / f + mr * d;       // filter length in phase samples
   const Real nr = static_cast<Real>(n_phase);
   if (nr < l) return 0;
   const Real m_terms = 1 + std::floor(s * (nr - l) / mr);

@@ -47,7 +47,8 @@ struct RealPowerSpectrum::Impl {
   Twiddles tw;  // e^{−2πi e/nfft}
 
   explicit Impl(std::size_t n) : nfft(n) {
-    if (nfft < 4 || (nfft & (nfft - 1)) != 0) throw std::invalid_argument("RealPowerSpectrum: nfft must be a power of two >= 4");
+    if (nfft < 4 || (nfft & (nfft - 1)) != 0)
+      throw std::invalid_argument("RealPowerSpectrum: nfft must be a power of two >= 4");
     if (nfft < kFourStepFrom) {
       fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
       buf.assign(nfft, 0.0);

@@ -20,9 +20,8 @@ namespace rwcalc {
 namespace {
 
 nlohmann::json coef_json(const Coefficient& c) {
-  return {{"value", c.value},       {"sigma", c.sigma},       {"low95", c.low},
-          {"high95", c.high},       {"resolved", c.resolved}, {"estimate", c.estimate},
-          {"in_model", c.in_model}, {"fitted", c.enabled}};
+  return {{"value", c.value},       {"sigma", c.sigma},       {"low95", c.low},         {"high95", c.high},
+          {"resolved", c.resolved}, {"estimate", c.estimate}, {"in_model", c.in_model}, {"fitted", c.enabled}};
 }
 
 nlohmann::json method_json(const MethodEstimate& m) {
@@ -45,8 +44,8 @@ std::string coef_line(const Coefficient& c, std::string_view name, std::string_v
 }
 
 std::string verdict_param_line(const Verdict& v, const ParameterVerdict& p) {
-  std::string s = fmt::format("  {} = {}{} {}: {}", p.parameter, p.resolved ? "" : "< ", num(p.value, 3), p.unit,
-                              v.statement(p));
+  std::string s =
+      fmt::format("  {} = {}{} {}: {}", p.parameter, p.resolved ? "" : "< ", num(p.value, 3), p.unit, v.statement(p));
   if (p.cls != p.cls_strict)
     s += fmt::format("  [with the +{:g} % tolerance; strict: class {}]", v.tolerance_pct, class_label(p.cls_strict));
   s += "\n    P(meets class):";
@@ -197,7 +196,8 @@ void earth_rate_and_bias(const Recording& rec, const AnalysisOptions& options, A
   r.mean_rate_deg_per_h = rec.phase.diff(rec.phase.points() - 1, 0) / r.duration_s;
   r.earth_rate_given = options.earth_rate_deg_per_h.has_value();
   r.latitude_deg = r.earth_rate_given ? 0.0 : options.latitude_deg;
-  r.earth_rate_deg_per_h = r.earth_rate_given ? *options.earth_rate_deg_per_h : vertical_earth_rate(options.latitude_deg);
+  r.earth_rate_deg_per_h =
+      r.earth_rate_given ? *options.earth_rate_deg_per_h : vertical_earth_rate(options.latitude_deg);
   r.bias_deg_per_h = r.mean_rate_deg_per_h - r.earth_rate_deg_per_h;
 }
 
@@ -237,8 +237,8 @@ void cross_checks(const Recording& rec, const AnalysisOptions& options, Analysis
   if (r.avg100.spread.valid) {
     r.B_100s_discrepancy_sigma = discrepancy_sigma(r.avg100.spread.value, r.avg100.spread.sigma, fb.value, fb.sigma);
     if (r.avg100.expected > 0)
-      r.B_100s_vs_model_sigma = discrepancy_sigma(r.avg100.spread.value, r.avg100.spread.sigma, r.avg100.expected,
-                                                  r.avg100.expected_sigma);
+      r.B_100s_vs_model_sigma =
+          discrepancy_sigma(r.avg100.spread.value, r.avg100.spread.sigma, r.avg100.expected, r.avg100.expected_sigma);
   }
 }
 
@@ -246,16 +246,17 @@ void cross_checks(const Recording& rec, const AnalysisOptions& options, Analysis
 
 AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   if (read.phase.kind != PhaseKind::Gyro)
-    throw UsageError(fmt::format("{}: analyze needs gyro data (pulses, counter, angle in arcsec/deg/rad, or rate in "
-                                 "deg/h, deg/s, rad/s); this input is clock data",
-                                 read.source));
+    throw UsageError(
+        fmt::format("{}: analyze needs gyro data (pulses, counter, angle in arcsec/deg/rad, or rate in "
+                    "deg/h, deg/s, rad/s); this input is clock data",
+                    read.source));
   AnalysisResult r;
   Recording edited;
-  const Recording& rec =
-      screen_outliers(read, options.outlier_action, options.outlier_threshold, r.outliers, edited);
+  const Recording& rec = screen_outliers(read, options.outlier_action, options.outlier_threshold, r.outliers, edited);
   describe_record(rec, options, r);
   if (rec.phase.points() < 3)
-    throw AnalysisError(fmt::format("{}: the record holds {} sample(s); far too short to analyse", rec.source, rec.samples));
+    throw AnalysisError(
+        fmt::format("{}: the record holds {} sample(s); far too short to analyse", rec.source, rec.samples));
   earth_rate_and_bias(rec, options, r);
   allan_and_fit(rec, options, r);
   cross_checks(rec, options, r);
@@ -364,29 +365,34 @@ std::string format_report(const AnalysisResult& r) {
   s += fmt::format("  {:>11} {:>12} {:>12} {:>12} {:>10} {:>4} {:>12}\n", "tau (s)", "sigma (°/h)", "low (°/h)",
                    "high (°/h)", "EDF", "α", "model (°/h)");
   for (const auto& p : r.allan.points) {
-    const bool used = std::any_of(r.fit.used.begin(), r.fit.used.end(), [&](const FitPoint& u) { return u.tau_s == p.tau_s; });
-    s += fmt::format("  {:>11.5g} {:>12.5g} {:>12.5g} {:>12.5g} {:>10.4g} {:>4} {:>12.5g}{}\n", p.tau_s, p.dev, p.dev_low,
-                     p.dev_high, p.edf, p.alpha, std::sqrt(r.fit.model_var(p.tau_s)), used ? " *" : "");
+    const bool used =
+        std::any_of(r.fit.used.begin(), r.fit.used.end(), [&](const FitPoint& u) { return u.tau_s == p.tau_s; });
+    s += fmt::format("  {:>11.5g} {:>12.5g} {:>12.5g} {:>12.5g} {:>10.4g} {:>4} {:>12.5g}{}\n", p.tau_s, p.dev,
+                     p.dev_low, p.dev_high, p.edf, p.alpha, std::sqrt(r.fit.model_var(p.tau_s)), used ? " *" : "");
   }
   s += "\n";
 
   const auto& f = r.fit;
-  s += fmt::format("Noise coefficients (Gamma-deviance fit of {} octave points, tau {:g}..{:g} s; 95 % profile intervals)\n",
-                   f.used.size(), f.used.front().tau_s, f.used.back().tau_s);
+  s += fmt::format(
+      "Noise coefficients (Gamma-deviance fit of {} octave points, tau {:g}..{:g} s; 95 % profile intervals)\n",
+      f.used.size(), f.used.front().tau_s, f.used.back().tau_s);
   for (const Term t : kAllTerms)
-    s += coef_line(f[t], term_name(t), std::array{"arcsec", "°/√h", "°/h", "°/h/√h", "°/h²"}[static_cast<std::size_t>(t)]);
-  s += fmt::format("  chi2/dof = {:.2f} (dof {}, p = {:.3g}); corr(N,Q) = {:+.2f}, corr(N,B) = {:+.2f}\n", f.chi2_per_dof,
-                   f.dof, f.p_value, f.corr_NQ, f.corr_NB);
+    s += coef_line(f[t], term_name(t),
+                   std::array{"arcsec", "°/√h", "°/h", "°/h/√h", "°/h²"}[static_cast<std::size_t>(t)]);
+  s += fmt::format("  chi2/dof = {:.2f} (dof {}, p = {:.3g}); corr(N,Q) = {:+.2f}, corr(N,B) = {:+.2f}\n",
+                   f.chi2_per_dof, f.dof, f.p_value, f.corr_NQ, f.corr_NB);
   s += fmt::format("  (variance inflation for correlated AV points and few EDF: N x{:.2f}, B x{:.2f})\n\n",
                    f.phi[static_cast<std::size_t>(Term::N)], f.phi[static_cast<std::size_t>(Term::B)]);
 
   s += "Classic slope-line readout (single-term lines; biased where terms overlap)\n";
-  s += r.slope.N ? fmt::format("  N = {} °/√h (−½ line through tau = {:.3g} s, read at 1 h)\n", num(*r.slope.N, 3), r.slope.tau_N_s)
+  s += r.slope.N ? fmt::format("  N = {} °/√h (−½ line through tau = {:.3g} s, read at 1 h)\n", num(*r.slope.N, 3),
+                               r.slope.tau_N_s)
                  : std::string("  N: no part of the curve has slope −½\n");
   if (r.slope.B)
     s += fmt::format("  B = sigma_min/0.6643 = {} ± {} °/h (sigma_min {} °/h at tau = {:.4g} s)\n", num(*r.slope.B, 3),
                      num(r.slope_B_sigma, 2), num(r.slope.sigma_min, 3), r.slope.tau_min_s);
-  s += r.slope.K ? fmt::format("  K = {} °/h/√h (+½ line through tau = {:.3g} s, read at 3 h)\n", num(*r.slope.K, 3), r.slope.tau_K_s)
+  s += r.slope.K ? fmt::format("  K = {} °/h/√h (+½ line through tau = {:.3g} s, read at 3 h)\n", num(*r.slope.K, 3),
+                               r.slope.tau_K_s)
                  : std::string("  K: no part of the curve has slope +½\n");
   s += "\n";
 
@@ -398,12 +404,13 @@ std::string format_report(const AnalysisResult& r) {
   else
     s += "  N direct: record too short\n";
   if (r.avg100.spread.valid) {
-    s += fmt::format("  spread of {:g}-s mean rates ({} blocks): {} ± {} °/h; vs B (fit) {:+.1f} sigma\n", r.avg100.block_s,
-                     r.avg100.blocks, num(r.avg100.spread.value, 3), num(r.avg100.spread.sigma, 2),
+    s += fmt::format("  spread of {:g}-s mean rates ({} blocks): {} ± {} °/h; vs B (fit) {:+.1f} sigma\n",
+                     r.avg100.block_s, r.avg100.blocks, num(r.avg100.spread.value, 3), num(r.avg100.spread.sigma, 2),
                      r.B_100s_discrepancy_sigma);
     if (r.avg100.expected > 0)
-      s += fmt::format("    expected from the fitted model (all terms): {} ± {} °/h; measured vs expected {:+.1f} sigma\n",
-                       num(r.avg100.expected, 3), num(r.avg100.expected_sigma, 2), r.B_100s_vs_model_sigma);
+      s += fmt::format(
+          "    expected from the fitted model (all terms): {} ± {} °/h; measured vs expected {:+.1f} sigma\n",
+          num(r.avg100.expected, 3), num(r.avg100.expected_sigma, 2), r.B_100s_vs_model_sigma);
   } else {
     s += "  100-s averaging: record too short\n";
   }

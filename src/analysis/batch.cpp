@@ -58,9 +58,9 @@ json combine(const std::vector<json>& runs, const std::vector<int>& classes, con
   std::size_t s = classes.size();
   for (std::size_t k = 0; k < classes.size(); ++k)
     if (cls && classes[k] == *cls) s = k;
-  return {{"class", opt_json(cls)},     {"class_strict", opt_json(strict)},
-          {"p_meets", p_meets},         {"p_is", p_is},
-          {"p_class", p_is[s]},         {"statement", describe_class(p_is, cls, classes)}};
+  return {{"class", opt_json(cls)}, {"class_strict", opt_json(strict)},
+          {"p_meets", p_meets},     {"p_is", p_is},
+          {"p_class", p_is[s]},     {"statement", describe_class(p_is, cls, classes)}};
 }
 
 struct Series {
@@ -99,8 +99,11 @@ json trend(const std::vector<json>& runs, const Series& s) {
     if (!e) continue;
     const double v = e->at("value").get<double>();
     if (worst.is_null() || v > worst.at("value").get<double>())
-      worst = {{"value", v}, {"high95", e->at("high95")}, {"resolved", e->at("resolved")},
-               {"temperature_c", r.at("temperature_c")}, {"source", r.at("source")}};
+      worst = {{"value", v},
+               {"high95", e->at("high95")},
+               {"resolved", e->at("resolved")},
+               {"temperature_c", r.at("temperature_c")},
+               {"source", r.at("source")}};
     if (r.at("temperature_c").is_null() || !e->at("resolved").get<bool>()) continue;
     const double sig = e->at("sigma").get<double>();
     if (!(sig > 0)) continue;
@@ -137,7 +140,8 @@ std::string cell(const json& run, const std::vector<std::string>& path, int digi
 }
 
 std::string temp_cell(const json& run) {
-  return run.at("temperature_c").is_null() ? std::string("?") : fmt::format("{:+g}", run.at("temperature_c").get<double>());
+  return run.at("temperature_c").is_null() ? std::string("?")
+                                           : fmt::format("{:+g}", run.at("temperature_c").get<double>());
 }
 
 std::string class_cell(const json& v) { return v.is_null() ? std::string("none") : fmt::format("{}", v.get<int>()); }
@@ -152,8 +156,8 @@ std::string outliers_line(const json& run) {
   if (n == 0) return fmt::format("  {}: none found\n", source);
   const std::string action = o.value("action", std::string("keep"));
   std::string s = fmt::format("  {}: {} outlier(s) {}", source, n,
-                              action == "keep"     ? "kept"
-                              : action == "remove" ? "removed"
+                              action == "keep"      ? "kept"
+                              : action == "remove"  ? "removed"
                               : action == "replace" ? "replaced by the local median"
                                                     : "with action " + action);
   const auto& pos = o.at("positions");
@@ -246,8 +250,8 @@ std::string format_batch_text(const json& summary) {
                        ? fmt::format("; +{:g} % heading-gyro tolerance on B", ov.value("tolerance_pct", 0.0))
                        : std::string("; strict limits"));
   s += "Table 1: coefficients (±1 sigma; \"< x\": 95 % upper bound)\n";
-  s += fmt::format("  {:>6}  {:<22} {:<22} {:<22} {:<22} {}\n", "T, °C", "N (AV), °/√h", "N direct, °/√h", "B (AV), °/h",
-                   "100-s spread, °/h", "file");
+  s += fmt::format("  {:>6}  {:<22} {:<22} {:<22} {:<22} {}\n", "T, °C", "N (AV), °/√h", "N direct, °/√h",
+                   "B (AV), °/h", "100-s spread, °/h", "file");
   for (const auto& r : runs)
     s += fmt::format("  {:>6}  {:<22} {:<22} {:<22} {:<22} {}\n", temp_cell(r), cell(r, {"fit", "N_deg_per_sqrt_h"}),
                      cell(r, {"methods", "N_direct_deg_per_sqrt_h"}), cell(r, {"fit", "B_deg_per_h"}),
@@ -257,7 +261,8 @@ std::string format_batch_text(const json& summary) {
   for (const auto& r : runs) {
     const auto& v = r.at("verdict");
     std::string o = v.value("statement", class_cell(v.at("class")));
-    if (v.value("tolerance_changed", false)) o += fmt::format(" [tolerance; strict {}]", class_cell(v.at("class_strict")));
+    if (v.value("tolerance_changed", false))
+      o += fmt::format(" [tolerance; strict {}]", class_cell(v.at("class_strict")));
     s += fmt::format("  {:>6}  {:<30} {:<30} {}\n", temp_cell(r), v.value("statement_N", class_cell(v.at("class_N"))),
                      v.value("statement_B", class_cell(v.at("class_B"))), o);
   }
@@ -280,12 +285,13 @@ std::string format_batch_text(const json& summary) {
       s += " no trend (fewer than 3 runs with temperature);";
     if (!t.at("worst").is_null()) {
       const auto& w = t.at("worst");
-      s += fmt::format(" worst {}{:.3g} {} at {} °C", w.at("resolved").get<bool>() ? "" : "< ", w.at("value").get<double>(),
-                       t.at("unit").get<std::string>(), temp_cell(w));
+      s += fmt::format(" worst {}{:.3g} {} at {} °C", w.at("resolved").get<bool>() ? "" : "< ",
+                       w.at("value").get<double>(), t.at("unit").get<std::string>(), temp_cell(w));
     }
     s += "\n";
   }
-  s += "\nConventions: Q, N, B, K, R as in IEEE 952 (B from sigma² = (2 ln2/π)B²); intervals 95 % profile likelihood.\n";
+  s +=
+      "\nConventions: Q, N, B, K, R as in IEEE 952 (B from sigma² = (2 ln2/π)B²); intervals 95 % profile likelihood.\n";
   return s;
 }
 
@@ -293,7 +299,8 @@ std::string format_batch_markdown(const json& summary) {
   const auto& runs = summary.at("runs");
   const auto& ov = summary.at("overall");
   std::string s;
-  s += "| T, °C | N (AV), °/√h | N direct, °/√h | B (AV), °/h | 100-s spread, °/h | class by N | class by B | class |\n";
+  s +=
+      "| T, °C | N (AV), °/√h | N direct, °/√h | B (AV), °/h | 100-s spread, °/h | class by N | class by B | class |\n";
   s += "|---|---|---|---|---|---|---|---|\n";
   for (const auto& r : runs) {
     const auto& v = r.at("verdict");
@@ -339,14 +346,16 @@ std::string format_batch_csv(const json& summary) {
       for (const char* k : {"value", "sigma", "resolved"})
         if (std::string_view(k) != "resolved" || se.path[0] == "fit") values += val(r, se.path, k) + ",";
     s += fmt::format("{},{},{}{},{},{},{:.4f},{},{}\n", csv_escape(r.at("source").get<std::string>()),
-                     r.at("temperature_c").is_null() ? std::string("") : fmt::format("{:g}", r.at("temperature_c").get<double>()),
-                     values, cls(v.at("class_N")), cls(v.at("class_B")), cls(v.at("class")), v.at("p_class").get<double>(),
+                     r.at("temperature_c").is_null() ? std::string("")
+                                                     : fmt::format("{:g}", r.at("temperature_c").get<double>()),
+                     values, cls(v.at("class_N")), cls(v.at("class_B")), cls(v.at("class")),
+                     v.at("p_class").get<double>(),
                      o ? fmt::format("{}", o->value("count", std::size_t{0})) : std::string(),
                      o ? csv_escape(o->value("action", std::string())) : std::string());
   }
   const auto& ov = summary.at("overall");
-  s += fmt::format("overall,,,,,,,,,,,,{},{},{},{:.4f},,\n", cls(ov.at("class_N")), cls(ov.at("class_B")), cls(ov.at("class")),
-                   ov.at("p_class").get<double>());
+  s += fmt::format("overall,,,,,,,,,,,,{},{},{},{:.4f},,\n", cls(ov.at("class_N")), cls(ov.at("class_B")),
+                   cls(ov.at("class")), ov.at("p_class").get<double>());
   return s;
 }
 

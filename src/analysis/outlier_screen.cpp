@@ -29,9 +29,10 @@ namespace {
 
 void check_outlier_threshold(double threshold) {
   if (!(threshold >= kMinOutlierThreshold) || !std::isfinite(threshold))
-    throw UsageError(fmt::format("--outlier-threshold must be a finite number >= {:g} robust sigma (below it the "
-                                 "noise's own tails are flagged), got {}",
-                                 kMinOutlierThreshold, threshold));
+    throw UsageError(
+        fmt::format("--outlier-threshold must be a finite number >= {:g} robust sigma (below it the "
+                    "noise's own tails are flagged), got {}",
+                    kMinOutlierThreshold, threshold));
 }
 
 /// Refuse to remove or replace more than kMaxOutlierShare of the rate samples (outliers.hpp).
@@ -44,8 +45,8 @@ void check_outlier_share(const Recording& rec, OutlierAction action, double thre
       "{:g}: so many are not isolated outliers but the noise itself, a burst or a step; nothing was analysed. "
       "Raise --outlier-threshold (default {:g}) or use --outliers keep to see where they are",
       rec.source, action == OutlierAction::Remove ? "remove" : "replace", found, rates,
-      100.0 * static_cast<double>(found) / static_cast<double>(rates), 100.0 * kMaxOutlierShare,
-      threshold, kDefaultOutlierThreshold));
+      100.0 * static_cast<double>(found) / static_cast<double>(rates), 100.0 * kMaxOutlierShare, threshold,
+      kDefaultOutlierThreshold));
 }
 
 /// The rest of the report (action and threshold are set) of a finished scan, located in the input.
@@ -66,8 +67,8 @@ void report_outliers(const Recording& rec, OutlierAction action, const OutlierSc
 
 }  // namespace
 
-const Recording& screen_outliers(const Recording& read, OutlierAction action, double threshold,
-                                 OutlierReport& report, Recording& edited) {
+const Recording& screen_outliers(const Recording& read, OutlierAction action, double threshold, OutlierReport& report,
+                                 Recording& edited) {
   check_outlier_threshold(threshold);
   report = OutlierReport{};
   report.action = action;
@@ -96,7 +97,10 @@ const Recording& screen_outliers(const Recording& read, OutlierAction action, do
 nlohmann::json to_json(const OutlierReport& o) {
   nlohmann::json pos = nlohmann::json::array();
   for (const auto& p : o.positions)
-    pos.push_back({{"index", p.index}, {"time_s", p.time_s}, {"line", p.line}, {"value_deg_per_h", p.value},
+    pos.push_back({{"index", p.index},
+                   {"time_s", p.time_s},
+                   {"line", p.line},
+                   {"value_deg_per_h", p.value},
                    {"robust_z", p.robust_z}});
   return {{"action", std::string(to_string(o.action))},
           {"threshold_robust_z", o.threshold},
@@ -119,14 +123,16 @@ std::string format_outliers(const OutlierReport& o) {
   if (o.count == 0) return s + "  none found\n\n";
   switch (o.action) {
     case OutlierAction::Keep:
-      s += fmt::format("  {} found; KEPT in the analysis below (--outliers remove or replace to leave them out)\n", o.count);
+      s += fmt::format("  {} found; KEPT in the analysis below (--outliers remove or replace to leave them out)\n",
+                       o.count);
       break;
     case OutlierAction::Remove:
-      s += fmt::format("  {} found; {} REMOVED: the samples after each one move one period earlier (a splice)\n", o.count,
-                       o.removed);
+      s += fmt::format("  {} found; {} REMOVED: the samples after each one move one period earlier (a splice)\n",
+                       o.count, o.removed);
       break;
     case OutlierAction::Replace:
-      s += fmt::format("  {} found; {} REPLACED by the median of their four nearest good neighbours\n", o.count, o.replaced);
+      s += fmt::format("  {} found; {} REPLACED by the median of their four nearest good neighbours\n", o.count,
+                       o.replaced);
       break;
   }
   s += fmt::format("  {:>10} {:>12} {:>10} {:>14} {:>9}\n", "sample", "time (s)", "line", "rate (°/h)", "z");
@@ -135,7 +141,8 @@ std::string format_outliers(const OutlierReport& o) {
     s += fmt::format("  {:>10} {:>12.6g} {:>10} {:>14.6g} {:>+9.1f}\n", p.index, p.time_s, p.line, p.value, p.robust_z);
   }
   if (o.count > kReportOutliers)
-    s += fmt::format("  … and {} more (the first {} are listed in --json)\n", o.count - kReportOutliers, o.positions.size());
+    s += fmt::format("  … and {} more (the first {} are listed in --json)\n", o.count - kReportOutliers,
+                     o.positions.size());
   return s + "\n";
 }
 

@@ -16,7 +16,8 @@ namespace {
 /// "A:B" with either side optional → {a, b}; defaults for empty sides.
 std::pair<double, double> parse_range(const std::string& spec, const char* what, double lo_default, double hi_default) {
   const auto colon = spec.find(':');
-  if (colon == std::string::npos) throw UsageError(fmt::format("{} must be TMIN:TMAX in seconds, got '{}'", what, spec));
+  if (colon == std::string::npos)
+    throw UsageError(fmt::format("{} must be TMIN:TMAX in seconds, got '{}'", what, spec));
   auto num = [&](std::string s, double def) {
     if (s.empty()) return def;
     double v = 0;
@@ -38,21 +39,27 @@ void add_outlier_options(CLI::App& app, std::string& action, double& threshold) 
                  "Isolated outliers are always detected and reported (sample, time, line); then: keep "
                  "(default: analyse the data as read), remove (drop them; later samples move one period "
                  "earlier), or replace (by the median of the nearest good neighbours; keeps every sample)")
-      ->capture_default_str()->group("Outliers");
+      ->capture_default_str()
+      ->group("Outliers");
   app.add_option("--outlier-threshold", threshold,
                  "Detection threshold, robust sigma of the residual from the neighbour median")
-      ->check(real_in(kMinOutlierThreshold, 1e6, "robust sigma"))->capture_default_str()->group("Outliers");
+      ->check(real_in(kMinOutlierThreshold, 1e6, "robust sigma"))
+      ->capture_default_str()
+      ->group("Outliers");
 }
 
 CLI::Option* add_temperature_option(CLI::App& app, std::optional<double>& temperature, const std::string& help) {
-  return app.add_option("--temperature", temperature, help)->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"));
+  return app.add_option("--temperature", temperature, help)
+      ->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"));
 }
 
 void AnalyzeArgs::add_to(CLI::App& app) {
   app.add_option("--fit-range", fit_range, "Tau range of the fit, TMIN:TMAX in s (either may be empty; default: all)")
       ->group("Fit");
   app.add_option("--min-edf", min_edf, "Leave out AV points with fewer equivalent degrees of freedom")
-      ->check(real_in(0.0, 1e12, "", Ends::OpenLow))->capture_default_str()->group("Fit");
+      ->check(real_in(0.0, 1e12, "", Ends::OpenLow))
+      ->capture_default_str()
+      ->group("Fit");
   app.add_option("--terms", terms, "Terms to fit, a subset of QNBKR")->capture_default_str()->group("Fit");
   app.add_flag("--all-terms", keep_all_terms,
                "Keep every fitted term in the model (default: K, R, Q not supported by the data are "
@@ -61,21 +68,31 @@ void AnalyzeArgs::add_to(CLI::App& app) {
   app.add_option("--tau", tau,
                  "Tau grid of the reported Allan deviation: octave, decade, dense[:P] (P per decade, default 20, "
                  "up to N/10), all, or a list of seconds; the fit always uses the octave points")
-      ->capture_default_str()->group("Fit");
+      ->capture_default_str()
+      ->group("Fit");
   app.add_option("--latitude", latitude_deg, "Latitude for the vertical Earth rate, degrees")
-      ->check(real_in(-90.0, 90.0, "deg"))->capture_default_str()->group("Earth rate");
+      ->check(real_in(-90.0, 90.0, "deg"))
+      ->capture_default_str()
+      ->group("Earth rate");
   app.add_option("--earth-rate", earth_rate, "Expected sensed Earth rate, deg/h (overrides --latitude)")
-      ->check(real_in(-kMaxRateDegPerH, kMaxRateDegPerH, "deg/h"))->group("Earth rate");
+      ->check(real_in(-kMaxRateDegPerH, kMaxRateDegPerH, "deg/h"))
+      ->group("Earth rate");
   app.add_option("--b-estimate", b_estimate, "B estimate the verdict uses: fit, sigma-min or avg100")
-      ->capture_default_str()->group("Verdict");
+      ->capture_default_str()
+      ->group("Verdict");
   app.add_option("--tolerance", tolerance_pct,
                  "Accept a B up to PCT % above a class limit (the paper's heading-gyro rule, e.g. 50)")
-      ->check(real_in(0.0, 1000.0, "%"))->capture_default_str()->group("Verdict");
+      ->check(real_in(0.0, 1000.0, "%"))
+      ->capture_default_str()
+      ->group("Verdict");
   app.add_option("--limits", limits_file, "Class table as JSON (default: GOST RV 52339)")->group("Verdict");
   app.add_option("--block", block_s, "Block length of the averaging cross-check, s")
-      ->check(real_in(0.0, 1e9, "s", Ends::OpenLow))->capture_default_str()->group("Cross-checks");
+      ->check(real_in(0.0, 1e9, "s", Ends::OpenLow))
+      ->capture_default_str()
+      ->group("Cross-checks");
   app.add_option("--direct-range", direct_range, "Interval lengths of the direct N method, TMIN:TMAX in s")
-      ->capture_default_str()->group("Cross-checks");
+      ->capture_default_str()
+      ->group("Cross-checks");
   add_outlier_options(app, outliers, outlier_threshold);
 }
 

@@ -17,7 +17,7 @@ void add_outlier_options(CLI::App& app, std::string& action, double& threshold);
 CLI::Option* add_temperature_option(CLI::App& app, std::optional<double>& temperature, const std::string& help);
 
 struct AnalyzeArgs {
-  std::string fit_range;            ///< "TMIN:TMAX" (s; either side may be empty)
+  std::string fit_range;  ///< "TMIN:TMAX" (s; either side may be empty)
   double min_edf = 1.0;
   std::string terms = "QNBKR";
   bool keep_all_terms = false;
@@ -28,7 +28,7 @@ struct AnalyzeArgs {
   std::string limits_file;
   double block_s = 100.0;
   std::string direct_range = "1:100";
-  std::string tau = "octave";       ///< τ grid of the reported AV (the fit uses its octave points)
+  std::string tau = "octave";  ///< τ grid of the reported AV (the fit uses its octave points)
   std::string outliers = "keep";
   double outlier_threshold = kDefaultOutlierThreshold;
   void add_to(CLI::App& app);

@@ -5,8 +5,8 @@
 #include <CLI/CLI.hpp>
 #include <exception>
 #include <optional>
-#include <string_view>
 #include <ostream>
+#include <string_view>
 #include <vector>
 
 #include "cli/commands.hpp"
@@ -27,8 +27,8 @@ struct Command {
   void (*add)(CLI::App&, Runner&);
 };
 constexpr Command kCommands[] = {
-    {"allan", register_allan},       {"analyze", register_analyze}, {"batch", register_batch},
-    {"merge", register_merge},       {"simulate", register_simulate}, {"diagnose", register_diagnose},
+    {"allan", register_allan},   {"analyze", register_analyze},   {"batch", register_batch},
+    {"merge", register_merge},   {"simulate", register_simulate}, {"diagnose", register_diagnose},
     {"report", register_report},
 };
 

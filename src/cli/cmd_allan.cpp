@@ -48,14 +48,15 @@ std::string allan_json_text(const AllanResult& r, const Recording& rec, const Ou
   out += fmt::format("  \"confidence\": ");
   append_number(out, r.confidence);
   out += ",\n";
-  out += fmt::format("  \"convention\": {},\n",
-                     nlohmann::json(r.unit == "deg/h" ? "1 arcsec/s = 1 deg/h" : "deviation in input units per second")
-                         .dump());
+  out += fmt::format(
+      "  \"convention\": {},\n",
+      nlohmann::json(r.unit == "deg/h" ? "1 arcsec/s = 1 deg/h" : "deviation in input units per second").dump());
   out += fmt::format("  \"estimator\": {},\n", nlohmann::json(std::string(to_string(r.estimator))).dump());
   if (r.fft_from_m > 0) out += fmt::format("  \"fft_from_af\": {},\n", r.fft_from_m);
   // The outlier object one level in, as dump(2) writes a nested object.
   std::string outl = to_json(outliers).dump(2);
-  for (std::size_t at = outl.find('\n'); at != std::string::npos; at = outl.find('\n', at + 3)) outl.replace(at, 1, "\n  ");
+  for (std::size_t at = outl.find('\n'); at != std::string::npos; at = outl.find('\n', at + 3))
+    outl.replace(at, 1, "\n  ");
   out += "  \"outliers\": " + outl + ",\n";
   out += fmt::format("  \"phase_points\": {},\n", r.points_in);
   out += r.points.empty() ? "  \"points\": []" : "  \"points\": [";
@@ -89,9 +90,10 @@ std::string allan_json_text(const AllanResult& r, const Recording& rec, const Ou
 void require_finite(const AllanResult& r, const Recording& rec) {
   auto check = [&](const char* what, double v, double tau) {
     if (!std::isfinite(v))
-      throw AnalysisError(fmt::format("{}: the {} at tau = {:g} s is {} (the record's numbers overflow a double); "
-                                      "nothing was printed",
-                                      rec.source, what, tau, v));
+      throw AnalysisError(
+          fmt::format("{}: the {} at tau = {:g} s is {} (the record's numbers overflow a double); "
+                      "nothing was printed",
+                      rec.source, what, tau, v));
   };
   check("sample period tau0", r.tau0_s, r.tau0_s);
   for (const AllanPoint& p : r.points) {
@@ -116,8 +118,8 @@ int run_allan(const AllanArgs& a, Io& io) {
   const Recording& rec = screen_outliers(read, outlier_action, a.outlier_threshold, outliers, edited);
   // Increment and rate samples are frequency data for the noise identification, as Stable32
   // treats a frequency file; cumulative counters and angles are phase data.
-  o.noise_id_domain = (rec.mode == InputMode::Pulses || rec.mode == InputMode::Rate) ? NoiseIdDomain::Frequency
-                                                                                      : NoiseIdDomain::Phase;
+  o.noise_id_domain =
+      (rec.mode == InputMode::Pulses || rec.mode == InputMode::Rate) ? NoiseIdDomain::Frequency : NoiseIdDomain::Phase;
   const AllanResult res = compute_allan(rec.phase, o);
   require_finite(res, rec);
   if (a.json) {
@@ -152,7 +154,8 @@ void register_allan(CLI::App& app, Runner& runner) {
                   "seconds such as 0.01,1,10 (each a whole number of samples)")
       ->capture_default_str();
   sub->add_option("--confidence", args->confidence, "Two-sided confidence of the bounds (0..1)")
-      ->check(real_in(0.0, 1.0, "", Ends::Open))->capture_default_str();
+      ->check(real_in(0.0, 1.0, "", Ends::Open))
+      ->capture_default_str();
   add_outlier_options(*sub, args->outliers, args->outlier_threshold);
   auto* json = sub->add_flag("--json", args->json, "Print JSON instead of the table");
   auto* csv = sub->add_flag("--csv", args->csv, "Print CSV instead of the table");

@@ -51,7 +51,8 @@ void register_batch(CLI::App& app, Runner& runner) {
     runner = [cmd](Io& io) -> int {
       AnalysisOptions opt = cmd->analysis.options();
       if (cmd->temperature) {
-        if (cmd->files.size() != 1) throw UsageError("--temperature applies to a single file; name the temperature in each file instead");
+        if (cmd->files.size() != 1)
+          throw UsageError("--temperature applies to a single file; name the temperature in each file instead");
         opt.temperature_c = cmd->temperature;
       }
       cmd->plot.check(cmd->force, {{"-o", cmd->output}});

@@ -16,13 +16,13 @@
 #include "cli/analyze_args.hpp"
 #include "cli/commands.hpp"
 #include "cli/numeric_options.hpp"
-#include "rwcalc/printable.hpp"
 #include "rwcalc/batch.hpp"
 #include "rwcalc/diagnose.hpp"
-#include "rwcalc/reader.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/plot.hpp"
+#include "rwcalc/printable.hpp"
+#include "rwcalc/reader.hpp"
 #include "rwcalc/report.hpp"
 #include "rwcalc/saved_results.hpp"
 
@@ -100,7 +100,8 @@ void attach_saved_diagnoses(const SavedResults& saved, const std::vector<json>& 
 }
 
 /// The options behind the report, shown in its settings table.
-json settings_of(const ReportCmd& c, const std::vector<std::string>& recordings, const std::vector<std::string>& saved) {
+json settings_of(const ReportCmd& c, const std::vector<std::string>& recordings,
+                 const std::vector<std::string>& saved) {
   json s = json::object();
   if (!recordings.empty()) s["recordings"] = recordings;
   if (!saved.empty()) s["saved results"] = saved;
@@ -229,14 +230,14 @@ void register_report(CLI::App& app, Runner& runner) {
   sub->add_option("--title", cmd->title, "Title of the report");
   sub->add_flag("--diagnose", cmd->diagnose, "Also diagnose each recording (what the noise model misses)");
   sub->add_option("--diagnose-runs", cmd->diagnose_runs, "Simulated records per diagnosis ensemble")
-      ->check(whole_in(10, 100000))->capture_default_str();
+      ->check(whole_in(10, 100000))
+      ->capture_default_str();
   sub->add_option("--diagnose-seed", cmd->diagnose_seed, "Seed of the diagnosis ensembles")
-      ->check(whole_in(0, UINT64_MAX))->capture_default_str();
+      ->check(whole_in(0, UINT64_MAX))
+      ->capture_default_str();
   sub->add_flag("--no-figures", cmd->no_figures, "Tables only (needs no gnuplot)");
   sub->add_flag("--force", cmd->force, "Replace an existing report.html");
-  sub->callback([cmd, &runner] {
-    runner = [cmd](Io& io) -> int { return run_report(*cmd, io); };
-  });
+  sub->callback([cmd, &runner] { runner = [cmd](Io& io) -> int { return run_report(*cmd, io); }; });
 }
 
 }  // namespace rwcalc::cli

@@ -13,9 +13,9 @@
 
 #include "cli/commands.hpp"
 #include "cli/numeric_options.hpp"
-#include "rwcalc/printable.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/output.hpp"
+#include "rwcalc/printable.hpp"
 #include "rwcalc/pulse_writer.hpp"
 #include "rwcalc/simulate.hpp"
 #include "rwcalc/units.hpp"
@@ -102,7 +102,8 @@ Metadata metadata_of(const NoiseModel& m, const SimulationSettings& s) {
   term("lowpass_tc_s", m.lowpass_tc_s);
   term("output_lowpass_tc_s", m.output_lowpass_tc_s);
   for (const auto& x : m.sinusoids)
-    md.emplace_back("sinusoid", fmt::format("frequency_hz={} amplitude_deg_per_h={} phase_rad={}", x.f_hz, x.amp_deg_per_h, x.phase_rad));
+    md.emplace_back("sinusoid", fmt::format("frequency_hz={} amplitude_deg_per_h={} phase_rad={}", x.f_hz,
+                                            x.amp_deg_per_h, x.phase_rad));
   for (const auto& x : m.gauss_markov)
     md.emplace_back("gauss_markov", fmt::format("sigma_deg_per_h={} correlation_time_s={}", x.sigma_deg_per_h, x.tc_s));
   for (const auto& x : m.bias_steps)
@@ -114,8 +115,10 @@ Metadata metadata_of(const NoiseModel& m, const SimulationSettings& s) {
     const auto& p = tb.profile;
     md.emplace_back("temperature_bias",
                     p.kind == TemperatureProfile::Kind::Ramp
-                        ? fmt::format("coefficient_deg_per_h_per_c={} profile=ramp start_c={} end_c={}", tb.coefficient_deg_per_h_per_c, p.start_c, p.end_c)
-                        : fmt::format("coefficient_deg_per_h_per_c={} profile=cycle amplitude_c={} period_s={}", tb.coefficient_deg_per_h_per_c, p.amp_c, p.period_s));
+                        ? fmt::format("coefficient_deg_per_h_per_c={} profile=ramp start_c={} end_c={}",
+                                      tb.coefficient_deg_per_h_per_c, p.start_c, p.end_c)
+                        : fmt::format("coefficient_deg_per_h_per_c={} profile=cycle amplitude_c={} period_s={}",
+                                      tb.coefficient_deg_per_h_per_c, p.amp_c, p.period_s));
   }
   return md;
 }
@@ -152,14 +155,14 @@ struct AngleTerm {
 std::vector<AngleTerm> angle_bound_terms(const NoiseModel& m, const SimulationSettings& s) {
   const double T = s.duration_s;
   const double h = 1.0;  // deg/h -> arcsec/s (3600 arcsec per 3600 s)
-  std::vector<AngleTerm> t{
-      {"--bias", std::abs(m.bias_deg_per_h) * h * T},
-      {"--latitude", std::abs(m.earth_rate_deg_per_h) * h * T},
-      {"--ramp", std::abs(m.ramp_deg_per_h2) * T / 3600.0 * h * T},
-      {"--bias-instability", 10.0 * m.bias_instability_deg_per_h * h * T},
-      {"--arw", 10.0 * m.arw_deg_per_sqrt_h * units::sqrt_s_per_sqrt_h * std::sqrt(T)},  // deg/sqrt(h) = 60 arcsec/sqrt(s)
-      {"--rrw", 10.0 * m.rrw_deg_per_h_per_sqrt_h / units::sqrt_s_per_sqrt_h * T * std::sqrt(T)},
-      {"--white-angle", 10.0 * m.white_angle_arcsec}};
+  std::vector<AngleTerm> t{{"--bias", std::abs(m.bias_deg_per_h) * h * T},
+                           {"--latitude", std::abs(m.earth_rate_deg_per_h) * h * T},
+                           {"--ramp", std::abs(m.ramp_deg_per_h2) * T / 3600.0 * h * T},
+                           {"--bias-instability", 10.0 * m.bias_instability_deg_per_h * h * T},
+                           {"--arw", 10.0 * m.arw_deg_per_sqrt_h * units::sqrt_s_per_sqrt_h *
+                                         std::sqrt(T)},  // deg/sqrt(h) = 60 arcsec/sqrt(s)
+                           {"--rrw", 10.0 * m.rrw_deg_per_h_per_sqrt_h / units::sqrt_s_per_sqrt_h * T * std::sqrt(T)},
+                           {"--white-angle", 10.0 * m.white_angle_arcsec}};
   auto add = [&](const char* option, double deg_per_h) { t.push_back({option, deg_per_h * h * T}); };
   for (const auto& x : m.sinusoids) add("--sinusoid", std::abs(x.amp_deg_per_h));
   for (const auto& x : m.gauss_markov) add("--gauss-markov", 10.0 * x.sigma_deg_per_h);
@@ -167,7 +170,8 @@ std::vector<AngleTerm> angle_bound_terms(const NoiseModel& m, const SimulationSe
   for (const auto& x : m.warmups) add("--warmup", std::abs(x.amp_deg_per_h));
   if (m.temperature_bias) {
     const auto& p = m.temperature_bias->profile;
-    const double swing = std::abs(p.start_c) + std::abs(p.end_c) + std::abs(p.amp_c) + std::abs(s.temperature_c.value_or(0.0));
+    const double swing =
+        std::abs(p.start_c) + std::abs(p.end_c) + std::abs(p.amp_c) + std::abs(s.temperature_c.value_or(0.0));
     add("--temp-bias", std::abs(m.temperature_bias->coefficient_deg_per_h_per_c) * swing);
   }
   return t;
@@ -177,11 +181,13 @@ std::vector<AngleTerm> angle_bound_terms(const NoiseModel& m, const SimulationSe
 // message names the option whose term is largest.
 void check_record_range(const NoiseModel& m, const SimulationSettings& s) {
   if (!(s.duration_s * s.rate_hz <= kMaxSamples))
-    throw UsageError(fmt::format("--duration {:g} s at --rate {:g} Hz gives {:g} samples, more than the {:g} a record may have",
-                                 s.duration_s, s.rate_hz, s.duration_s * s.rate_hz, kMaxSamples));
+    throw UsageError(
+        fmt::format("--duration {:g} s at --rate {:g} Hz gives {:g} samples, more than the {:g} a record may have",
+                    s.duration_s, s.rate_hz, s.duration_s * s.rate_hz, kMaxSamples));
   for (const auto& x : m.bias_steps)
     if (x.t_s > s.duration_s)
-      throw UsageError(fmt::format("--bias-step: the time {:g} s is beyond the record's end ({:g} s)", x.t_s, s.duration_s));
+      throw UsageError(
+          fmt::format("--bias-step: the time {:g} s is beyond the record's end ({:g} s)", x.t_s, s.duration_s));
   const std::vector<AngleTerm> terms = angle_bound_terms(m, s);
   double angle = 0;
   for (const auto& t : terms) angle += t.arcsec;
@@ -204,10 +210,15 @@ void apply_settings(const SimulateArgs& a, const Take& take, SimulationSettings&
   if (take("--scale")) s.scale_arcsec = a.scale_arcsec;
   if (a.temperature_c) s.temperature_c = a.temperature_c;
   s.seed = a.seed;
-  if (!std::isfinite(s.duration_s) || s.duration_s <= 0) throw UsageError(fmt::format("--duration must be > 0 s, got {}", s.duration_s));
-  if (!std::isfinite(s.rate_hz) || s.rate_hz <= 0) throw UsageError(fmt::format("--rate must be > 0 Hz, got {}", s.rate_hz));
-  if (!std::isfinite(s.scale_arcsec) || s.scale_arcsec <= 0) throw UsageError(fmt::format("--scale must be > 0 arcsec, got {}", s.scale_arcsec));
-  if (s.samples() < 2) throw UsageError(fmt::format("--duration {} s at --rate {} Hz gives fewer than 2 samples", s.duration_s, s.rate_hz));
+  if (!std::isfinite(s.duration_s) || s.duration_s <= 0)
+    throw UsageError(fmt::format("--duration must be > 0 s, got {}", s.duration_s));
+  if (!std::isfinite(s.rate_hz) || s.rate_hz <= 0)
+    throw UsageError(fmt::format("--rate must be > 0 Hz, got {}", s.rate_hz));
+  if (!std::isfinite(s.scale_arcsec) || s.scale_arcsec <= 0)
+    throw UsageError(fmt::format("--scale must be > 0 arcsec, got {}", s.scale_arcsec));
+  if (s.samples() < 2)
+    throw UsageError(
+        fmt::format("--duration {} s at --rate {} Hz gives fewer than 2 samples", s.duration_s, s.rate_hz));
 }
 
 TemperatureBias temperature_bias(double coefficient, const std::string& profile) {
@@ -220,14 +231,17 @@ TemperatureBias temperature_bias(double coefficient, const std::string& profile)
     const auto v = fields("--temp-profile", rest, 2, 2, "ramp:START_C:END_C");
     for (const double c : v)
       if (c < kMinTemperatureC || c > kMaxTemperatureC)
-        throw UsageError(fmt::format("--temp-profile: {:g} deg C is outside {:g}..{:g} deg C", c, kMinTemperatureC, kMaxTemperatureC));
+        throw UsageError(fmt::format("--temp-profile: {:g} deg C is outside {:g}..{:g} deg C", c, kMinTemperatureC,
+                                     kMaxTemperatureC));
     tb.profile = {TemperatureProfile::Kind::Ramp, v[0], v[1], 0.0, 0.0};
   } else if (kind == "cycle") {
     const auto v = fields("--temp-profile", rest, 2, 2, "cycle:AMP_C:PERIOD_S");
-    if (!(v[1] >= 1.0 / kMaxRateHz)) throw UsageError(fmt::format("--temp-profile: the cycle period must be >= {:g} s", 1.0 / kMaxRateHz));
+    if (!(v[1] >= 1.0 / kMaxRateHz))
+      throw UsageError(fmt::format("--temp-profile: the cycle period must be >= {:g} s", 1.0 / kMaxRateHz));
     tb.profile = {TemperatureProfile::Kind::Cycle, 0.0, 0.0, v[0], v[1]};
   } else {
-    throw UsageError(fmt::format("--temp-profile: '{}' is neither ramp:START_C:END_C nor cycle:AMP_C:PERIOD_S", profile));
+    throw UsageError(
+        fmt::format("--temp-profile: '{}' is neither ramp:START_C:END_C nor cycle:AMP_C:PERIOD_S", profile));
   }
   return tb;
 }
@@ -257,7 +271,8 @@ void add_extended_terms(const SimulateArgs& a, NoiseModel& m) {
   }
   if (a.temp_bias) {
     if (!std::isfinite(*a.temp_bias)) throw UsageError("--temp-bias must be finite");
-    if (a.temp_profile.empty()) throw UsageError("--temp-bias needs --temp-profile ramp:START_C:END_C or cycle:AMP_C:PERIOD_S");
+    if (a.temp_profile.empty())
+      throw UsageError("--temp-bias needs --temp-profile ramp:START_C:END_C or cycle:AMP_C:PERIOD_S");
     m.temperature_bias = temperature_bias(*a.temp_bias, a.temp_profile);
   } else if (!a.temp_profile.empty()) {
     throw UsageError("--temp-profile needs --temp-bias COEF_DEG_PER_H_PER_C");
@@ -330,7 +345,8 @@ int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
     write_record(sim, sr, path, a.force);
     if (!a.truth.empty()) write_truth(path_of(a.truth, r), m, sr, path, a.force);
     if (path != "-")
-      io.out << fmt::format("wrote {} ({} samples, {} s at {} Hz, seed {})\n", printable(path), sr.samples(), sr.duration_s, sr.rate_hz, sr.seed);
+      io.out << fmt::format("wrote {} ({} samples, {} s at {} Hz, seed {})\n", printable(path), sr.samples(),
+                            sr.duration_s, sr.rate_hz, sr.seed);
   }
   return 0;
 }
@@ -347,50 +363,86 @@ void register_simulate(CLI::App& app, Runner& runner) {
   sub->add_option("-o,--output", a.output, "Output pulse file (FILE.csv or FILE.csv.gz; - for stdout)")->required();
   sub->add_option("--truth", a.truth, "Also write the ground truth (model JSON, seed, settings) to this file");
   sub->add_option("--from", a.from, "Take the model from 'rwcalc analyze --json' or 'rwcalc diagnose --json' output");
-  sub->add_option("--duration", a.duration_s, "Record length, s")->check(real_in(0.0, 1e9, "s", Ends::OpenLow))->capture_default_str()->group("Record");
-  sub->add_option("--rate", a.rate_hz, "Sample rate, Hz")->check(real_in(kMinRateHz, kMaxRateHz, "Hz"))->capture_default_str()->group("Record");
-  sub->add_option("--scale", a.scale_arcsec, "Pulse weight q, arcsec per pulse")->check(real_in(kMinScaleArcsec, kMaxScaleArcsec, "arcsec"))->capture_default_str()->group("Record");
-  sub->add_option("--seed", a.seed, "Seed of the random streams (same seed, same file)")->check(whole_in(0, UINT64_MAX))->capture_default_str()->group("Record");
+  sub->add_option("--duration", a.duration_s, "Record length, s")
+      ->check(real_in(0.0, 1e9, "s", Ends::OpenLow))
+      ->capture_default_str()
+      ->group("Record");
+  sub->add_option("--rate", a.rate_hz, "Sample rate, Hz")
+      ->check(real_in(kMinRateHz, kMaxRateHz, "Hz"))
+      ->capture_default_str()
+      ->group("Record");
+  sub->add_option("--scale", a.scale_arcsec, "Pulse weight q, arcsec per pulse")
+      ->check(real_in(kMinScaleArcsec, kMaxScaleArcsec, "arcsec"))
+      ->capture_default_str()
+      ->group("Record");
+  sub->add_option("--seed", a.seed, "Seed of the random streams (same seed, same file)")
+      ->check(whole_in(0, UINT64_MAX))
+      ->capture_default_str()
+      ->group("Record");
   sub->add_option("--temperature", a.temperature_c, "Nominal temperature written as metadata, deg C")
-      ->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"))->group("Record");
+      ->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"))
+      ->group("Record");
   sub->add_flag("--force", a.force, "Overwrite existing files")->group("Record");
-  sub->add_option("--runs", a.runs, "Write K realisations FILE_001… with seeds seed, seed+1, …")->check(whole_in(1, 100000))->capture_default_str()->group("Record");
-  sub->add_option("--arw", a.arw, "Angle random walk N, deg/sqrt(h)")->check(real_in(0.0, kMaxRateDegPerH, "deg/sqrt(h)"))->group("Noise terms");
-  sub->add_option("--bias-instability", a.bi, "Bias instability B (flicker rate noise), deg/h")->check(real_in(0.0, kMaxRateDegPerH, "deg/h"))->group("Noise terms");
-  sub->add_option("--rrw", a.rrw, "Rate random walk K, deg/h/sqrt(h)")->check(real_in(0.0, kMaxRateDegPerH, "deg/h/sqrt(h)"))->group("Noise terms");
-  sub->add_option("--ramp", a.ramp, "Rate ramp R, deg/h^2")->check(real_in(-kMaxRateDegPerH, kMaxRateDegPerH, "deg/h^2"))->group("Noise terms");
-  sub->add_option("--bias", a.bias, "Constant bias, deg/h")->check(real_in(-kMaxRateDegPerH, kMaxRateDegPerH, "deg/h"))->group("Noise terms");
+  sub->add_option("--runs", a.runs, "Write K realisations FILE_001… with seeds seed, seed+1, …")
+      ->check(whole_in(1, 100000))
+      ->capture_default_str()
+      ->group("Record");
+  sub->add_option("--arw", a.arw, "Angle random walk N, deg/sqrt(h)")
+      ->check(real_in(0.0, kMaxRateDegPerH, "deg/sqrt(h)"))
+      ->group("Noise terms");
+  sub->add_option("--bias-instability", a.bi, "Bias instability B (flicker rate noise), deg/h")
+      ->check(real_in(0.0, kMaxRateDegPerH, "deg/h"))
+      ->group("Noise terms");
+  sub->add_option("--rrw", a.rrw, "Rate random walk K, deg/h/sqrt(h)")
+      ->check(real_in(0.0, kMaxRateDegPerH, "deg/h/sqrt(h)"))
+      ->group("Noise terms");
+  sub->add_option("--ramp", a.ramp, "Rate ramp R, deg/h^2")
+      ->check(real_in(-kMaxRateDegPerH, kMaxRateDegPerH, "deg/h^2"))
+      ->group("Noise terms");
+  sub->add_option("--bias", a.bias, "Constant bias, deg/h")
+      ->check(real_in(-kMaxRateDegPerH, kMaxRateDegPerH, "deg/h"))
+      ->group("Noise terms");
   sub->add_option("--latitude", a.latitude, "Latitude for the vertical Earth rate 15.041*sin(lat) deg/h, deg")
-      ->check(real_in(-90.0, 90.0, "deg"))->capture_default_str()->group("Noise terms");
+      ->check(real_in(-90.0, 90.0, "deg"))
+      ->capture_default_str()
+      ->group("Noise terms");
   sub->add_flag("--no-earth-rate", a.no_earth_rate, "Do not add the Earth rate")->group("Noise terms");
   sub->add_flag("--white-readout", a.white_readout,
                 "Dither-like read-out: a fresh uniform phase per sample makes count errors white (Q = q/sqrt(6)); "
-                "default: counting with sawtooth errors")->group("Noise terms");
+                "default: counting with sawtooth errors")
+      ->group("Noise terms");
   sub->add_option("--white-angle", a.white_angle, "Extra white angle noise before counting, rms arcsec")
-      ->check(real_in(0.0, 1e12, "arcsec"))->group("Noise terms");
-  sub->add_option("--sinusoid", a.sinusoids, "Sinusoidal rate F_HZ:AMP_DEG_PER_H[:PHASE_RAD] (Hz, deg/h, rad); repeatable")
+      ->check(real_in(0.0, 1e12, "arcsec"))
+      ->group("Noise terms");
+  sub->add_option("--sinusoid", a.sinusoids,
+                  "Sinusoidal rate F_HZ:AMP_DEG_PER_H[:PHASE_RAD] (Hz, deg/h, rad); repeatable")
       ->group("Extended terms");
   sub->add_option("--gauss-markov", a.gauss_markov, "Gauss-Markov rate SIGMA_DEG_PER_H:TC_S (deg/h, s); repeatable")
       ->group("Extended terms");
   sub->add_option("--bias-step", a.bias_steps, "Bias step T_S:SIZE_DEG_PER_H (s from start, deg/h); repeatable")
       ->group("Extended terms");
-  sub->add_option("--warmup", a.warmups, "Warm-up transient AMP_DEG_PER_H:TC_S, rate amp*exp(-t/tc) (deg/h, s); repeatable")
+  sub->add_option("--warmup", a.warmups,
+                  "Warm-up transient AMP_DEG_PER_H:TC_S, rate amp*exp(-t/tc) (deg/h, s); repeatable")
       ->group("Extended terms");
   sub->add_option("--lowpass", a.lowpass, "First-order low-pass of the sensed rate inside the sensor, time constant s")
-      ->check(real_in(0.0, 1e9, "s"))->group("Extended terms");
+      ->check(real_in(0.0, 1e9, "s"))
+      ->group("Extended terms");
   sub->add_option("--output-lowpass", a.output_lowpass,
                   "First-order low-pass of the counted rate in the output chain, time constant s; the file then holds "
                   "the filtered angle in arcsec (column 'angle', read with --input angle)")
-      ->check(real_in(0.0, 1e9, "s"))->group("Extended terms");
-  sub->add_option("--temp-bias", a.temp_bias, "Temperature-driven bias coefficient, deg/h per deg C (needs --temp-profile)")
-      ->check(real_in(-kMaxRateDegPerH, kMaxRateDegPerH, "deg/h per deg C"))->group("Extended terms");
-  sub->add_option("--temp-profile", a.temp_profile,
-                  "Temperature during the record: ramp:START_C:END_C (linear) or cycle:AMP_C:PERIOD_S (about --temperature); "
-                  "bias = coef*(T(t) - T_nominal), T_nominal = --temperature (ramp: else START_C; cycle: else 0)")
+      ->check(real_in(0.0, 1e9, "s"))
       ->group("Extended terms");
-  sub->callback([&runner, args, sub] {
-    runner = [args, sub](Io& io) -> int { return run_simulate(*args, *sub, io); };
-  });
+  sub->add_option("--temp-bias", a.temp_bias,
+                  "Temperature-driven bias coefficient, deg/h per deg C (needs --temp-profile)")
+      ->check(real_in(-kMaxRateDegPerH, kMaxRateDegPerH, "deg/h per deg C"))
+      ->group("Extended terms");
+  sub->add_option(
+         "--temp-profile", a.temp_profile,
+         "Temperature during the record: ramp:START_C:END_C (linear) or cycle:AMP_C:PERIOD_S (about --temperature); "
+         "bias = coef*(T(t) - T_nominal), T_nominal = --temperature (ramp: else START_C; cycle: else 0)")
+      ->group("Extended terms");
+  sub->callback(
+      [&runner, args, sub] { runner = [args, sub](Io& io) -> int { return run_simulate(*args, *sub, io); }; });
 }
 
 }  // namespace rwcalc::cli

@@ -11,22 +11,31 @@ void InputArgs::add_to(CLI::App& app) {
                  "What the column holds: pulses (per-sample pulse increments), counter (cumulative "
                  "counter, wraps at --counter-bits), angle (cumulative angle/phase in --angle-unit), "
                  "rate (rate samples in --rate-unit)")
-      ->capture_default_str()->group("Input");
+      ->capture_default_str()
+      ->group("Input");
   app.add_option("--column", column, "Column to read: a header name or a 1-based index")->group("Input");
   app.add_option("--rate", rate_hz, "Sample rate, Hz (default: metadata, time column, or 400)")
-      ->check(real_in(kMinRateHz, kMaxRateHz, "Hz"))->group("Input");
+      ->check(real_in(kMinRateHz, kMaxRateHz, "Hz"))
+      ->group("Input");
   app.add_option("--scale", scale_arcsec, "Pulse weight, arcsec per pulse (default: metadata or 0.92)")
-      ->check(real_in(kMinScaleArcsec, kMaxScaleArcsec, "arcsec"))->group("Input");
+      ->check(real_in(kMinScaleArcsec, kMaxScaleArcsec, "arcsec"))
+      ->group("Input");
   app.add_option("--counter-bits", counter_bits, "Width of a wrapping counter, bits (counter input)")
-      ->check(whole_in(1, 64))->capture_default_str()->group("Input");
+      ->check(whole_in(1, 64))
+      ->capture_default_str()
+      ->group("Input");
   app.add_option("--angle-unit", angle_unit, "Unit of angle input: arcsec, deg, rad, or s (clock phase)")
-      ->capture_default_str()->group("Input");
+      ->capture_default_str()
+      ->group("Input");
   app.add_option("--rate-unit", rate_unit,
                  "Unit of rate input: deg/h, deg/s, rad/s, or 1 (dimensionless clock frequency)")
-      ->capture_default_str()->group("Input");
+      ->capture_default_str()
+      ->group("Input");
   app.add_option("--time-tolerance", time_tolerance,
                  "Allowed deviation of a time-column step from the sample period, fraction of it")
-      ->check(real_in(0.0, 0.5, ""))->capture_default_str()->group("Input");
+      ->check(real_in(0.0, 0.5, ""))
+      ->capture_default_str()
+      ->group("Input");
 }
 
 ReadOptions InputArgs::options() const {

@@ -5,8 +5,8 @@
 // PositiveNumber let "nan" through (every comparison with NaN is false), and its unsigned
 // conversion turns "-1" into 2^64 − 1, so they are not used.
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "rwcalc/limits.hpp"

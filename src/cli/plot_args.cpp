@@ -30,7 +30,8 @@ void draw(const PlotArgs& a, PlotResult (*plot)(const nlohmann::json&, const Plo
 
 void PlotArgs::add_to(CLI::App& app, const std::string& what) {
   app.add_option("--plot", plot,
-                 fmt::format("Draw {} into FILE with gnuplot; the format follows the extension: .svg, .png or .pdf", what))
+                 fmt::format("Draw {} into FILE with gnuplot; the format follows the extension: .svg, .png or .pdf",
+                             what))
       ->group("Figures");
   app.add_option("--plot-script", script,
                  "Write the gnuplot script of the figure (data inline) to FILE; alone it needs no gnuplot")

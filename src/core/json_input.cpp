@@ -72,7 +72,11 @@ class LocatingHandler {
  public:
   LocatingHandler(json& root, std::string_view text, const char* const& read_to, std::string file,
                   std::size_t first_line, std::unordered_map<std::string, std::size_t>& lines)
-      : dom_(root, true), text_(text), read_to_(read_to), file_(std::move(file)), first_line_(first_line),
+      : dom_(root, true),
+        text_(text),
+        read_to_(read_to),
+        file_(std::move(file)),
+        first_line_(first_line),
         lines_(lines) {}
 
   bool null() { return value() && dom_.null(); }
@@ -103,8 +107,8 @@ class LocatingHandler {
     const std::size_t line = line_at(position > 0 ? position - 1 : 0);
     // nlohmann refuses a number beyond a double (1e400) as out_of_range 406.
     if (e.id == 406)
-      throw InputError(file_, line, fmt::format("{}: the number {} is beyond the range of a double",
-                                                where(path_of_next()), token));
+      throw InputError(file_, line,
+                       fmt::format("{}: the number {} is beyond the range of a double", where(path_of_next()), token));
     throw InputError(file_, line, fmt::format("not valid JSON: {}", plain_message(e.what())));
   }
 
@@ -245,7 +249,8 @@ std::vector<Value> Value::elements() const {
   if (!value_->is_array()) wrong_type("an array");
   std::vector<Value> out;
   out.reserve(value_->size());
-  for (std::size_t i = 0; i < value_->size(); ++i) out.emplace_back(*doc_, (*value_)[i], fmt::format("{}[{}]", path_, i));
+  for (std::size_t i = 0; i < value_->size(); ++i)
+    out.emplace_back(*doc_, (*value_)[i], fmt::format("{}[{}]", path_, i));
   return out;
 }
 
@@ -268,16 +273,15 @@ double Value::positive() const {
   return v;
 }
 
-double Value::non_negative() const {
-  return number_in(0, std::numeric_limits<double>::max(), "a number >= 0");
-}
+double Value::non_negative() const { return number_in(0, std::numeric_limits<double>::max(), "a number >= 0"); }
 
 std::int64_t Value::integer(std::int64_t lo, std::int64_t hi) const {
   const auto domain = fmt::format("an integer in [{}, {}]", lo, hi);
   if (!value_->is_number()) wrong_type(domain);
   // 2.0 is an integer written as a float; 2.7 and 1e300 are not integers in the range.
   const double v = value_->get<double>();
-  if (value_->is_number_float() && (v != std::floor(v) || !(v >= static_cast<double>(lo) && v <= static_cast<double>(hi))))
+  if (value_->is_number_float() &&
+      (v != std::floor(v) || !(v >= static_cast<double>(lo) && v <= static_cast<double>(hi))))
     fail(fmt::format("must be {}, got {}", domain, shown(*value_)));
   if (value_->is_number_unsigned() && value_->get<std::uint64_t>() > static_cast<std::uint64_t>(hi))
     fail(fmt::format("must be {}, got {}", domain, shown(*value_)));

@@ -45,8 +45,8 @@ enum class Sink {
 
 struct Plan {
   Sink sink = Sink::Replace;
-  fs::path target;                   ///< the file written: a symbolic link's final target
-  std::optional<struct stat> old;    ///< the regular file replaced, if any
+  fs::path target;                 ///< the file written: a symbolic link's final target
+  std::optional<struct stat> old;  ///< the regular file replaced, if any
 };
 
 /// The final target of a chain of symbolic links (which may not exist: a dangling link).
@@ -67,8 +67,7 @@ void require_directory_of(const std::string& path, const fs::path& target) {
   fs::path dir = target.parent_path();
   if (dir.empty()) dir = ".";
   std::error_code ec;
-  if (!fs::is_directory(dir, ec))
-    throw OutputError(fmt::format("{}: directory {} does not exist", path, dir.string()));
+  if (!fs::is_directory(dir, ec)) throw OutputError(fmt::format("{}: directory {} does not exist", path, dir.string()));
 }
 
 /// What kind of file a non-regular target is, for the refusal.
@@ -117,12 +116,15 @@ void sync_directory(const fs::path& target, const std::string& path) {
   fs::path dir = target.parent_path();
   if (dir.empty()) dir = ".";
   const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd < 0) throw OutputError(fmt::format("{}: cannot open its directory {} to sync it: {}", path, dir.string(), reason(errno)));
+  if (fd < 0)
+    throw OutputError(
+        fmt::format("{}: cannot open its directory {} to sync it: {}", path, dir.string(), reason(errno)));
   // Some file systems cannot sync a directory (EINVAL): nothing more can be done there.
   if (::fsync(fd) != 0 && errno != EINVAL) {
     const int err = errno;
     ::close(fd);
-    throw OutputError(fmt::format("{}: written, but its directory {} could not be synced: {}", path, dir.string(), reason(err)));
+    throw OutputError(
+        fmt::format("{}: written, but its directory {} could not be synced: {}", path, dir.string(), reason(err)));
   }
   if (auto observer = detail::g_sync_observer.load()) observer(detail::SyncedKind::Directory, fd);
   ::close(fd);
@@ -143,9 +145,9 @@ struct AtomicOutput::State {
   std::string path;
   Plan plan;
   bool force = false;
-  fs::path tmp;                                   ///< Sink::Replace only
+  fs::path tmp;                                     ///< Sink::Replace only
   std::optional<detail::RemoveOnSignal> on_signal;  ///< the temporary file, while it exists
-  int fd = -1;       ///< the temporary file, the device or FIFO; for gzip, a duplicate kept to sync
+  int fd = -1;  ///< the temporary file, the device or FIFO; for gzip, a duplicate kept to sync
   gzFile gz = nullptr;
   std::string buffer;  ///< plain output collects small pieces into large writes
   bool committed = false;
@@ -166,7 +168,8 @@ void AtomicOutput::State::open_target() {
     if (fd < 0) throw OutputError(fmt::format("{}: cannot open for writing: {}", path, reason(errno)));
   } else {
     std::random_device rd;
-    const fs::path name = plan.target.parent_path() / fmt::format(".{}.tmp{:08x}", plan.target.filename().string(), rd());
+    const fs::path name =
+        plan.target.parent_path() / fmt::format(".{}.tmp{:08x}", plan.target.filename().string(), rd());
     on_signal.emplace(name.string(), detail::RemoveOnSignal::Kind::File);  // before it exists
     fd = ::open(name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd < 0) throw OutputError(fmt::format("{}: cannot write: {}", path, reason(errno)));
@@ -185,7 +188,8 @@ void AtomicOutput::State::open_target() {
     const int own = ::dup(fd);
     if (own < 0 || (gz = gzdopen(own, "wb6")) == nullptr) {
       if (own >= 0) ::close(own);
-      throw OutputError(fmt::format("{}: cannot start the compressed stream: {}", path, reason(errno ? errno : ENOMEM)));
+      throw OutputError(
+          fmt::format("{}: cannot start the compressed stream: {}", path, reason(errno ? errno : ENOMEM)));
     }
   }
 }
@@ -258,8 +262,8 @@ void AtomicOutput::write(std::string_view chunk) {
       if (gzwrite(s.gz, chunk.data(), n) != static_cast<int>(n)) {
         int zerr = Z_OK;
         const char* msg = gzerror(s.gz, &zerr);
-        throw OutputError(fmt::format("{}: compressed write failed: {}", s.path,
-                                      zerr == Z_ERRNO ? reason(errno) : std::string(msg)));
+        throw OutputError(
+            fmt::format("{}: compressed write failed: {}", s.path, zerr == Z_ERRNO ? reason(errno) : std::string(msg)));
       }
       chunk.remove_prefix(n);
     }
@@ -319,10 +323,10 @@ void check_output_targets(const std::vector<OutputTarget>& targets, bool force) 
     const std::string id = plan.sink == Sink::Stdout ? std::string("standard output") : identity_of(plan.target);
     for (const auto& [other_id, other] : seen)
       if (other_id == id)
-        throw UsageError(t.path == other->path
-                             ? fmt::format("{} and {} name the same file '{}'", other->option, t.option, t.path)
-                             : fmt::format("{} '{}' and {} '{}' are the same file", other->option, other->path,
-                                           t.option, t.path));
+        throw UsageError(
+            t.path == other->path
+                ? fmt::format("{} and {} name the same file '{}'", other->option, t.option, t.path)
+                : fmt::format("{} '{}' and {} '{}' are the same file", other->option, other->path, t.option, t.path));
     seen.emplace_back(id, &t);
   }
   for (const auto& t : targets)

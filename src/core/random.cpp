@@ -9,15 +9,16 @@ namespace {
 // Ziggurat tables for the standard normal, 256 layers of equal area v (Marsaglia & Tsang 2000).
 struct Ziggurat {
   static constexpr int kLayers = 256;
-  static constexpr double kR = 3.6541528853610088;     // start of the tail
-  static constexpr double kV = 0.00492867323399;       // area of each layer
+  static constexpr double kR = 3.6541528853610088;  // start of the tail
+  static constexpr double kV = 0.00492867323399;    // area of each layer
   double x[kLayers + 1];
   double ratio[kLayers];  // x[i+1]/x[i]: the fast-accept bound
   Ziggurat() {
     const double f = std::exp(-0.5 * kR * kR);
     x[0] = kV / f;
     x[1] = kR;
-    for (int i = 2; i < kLayers; ++i) x[i] = std::sqrt(-2.0 * std::log(kV / x[i - 1] + std::exp(-0.5 * x[i - 1] * x[i - 1])));
+    for (int i = 2; i < kLayers; ++i)
+      x[i] = std::sqrt(-2.0 * std::log(kV / x[i - 1] + std::exp(-0.5 * x[i - 1] * x[i - 1])));
     x[kLayers] = 0.0;
     for (int i = 0; i < kLayers; ++i) ratio[i] = x[i + 1] / x[i];
   }

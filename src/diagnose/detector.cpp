@@ -57,8 +57,9 @@ std::vector<std::unique_ptr<Detector>> make_detectors(const AnalysisResult& anal
   if (x.exact())
     skip = "whole pulse counts: no filter in the output chain";
   else if (lattice)
-    skip = "the samples are whole multiples of a step coarse against their scatter (pulse counts as numbers): no "
-           "filter in the output chain";
+    skip =
+        "the samples are whole multiples of a step coarse against their scatter (pulse counts as numbers): no "
+        "filter in the output chain";
   std::vector<std::unique_ptr<Detector>> d;
   d.push_back(sinusoid_detector());
   d.push_back(step_detector());

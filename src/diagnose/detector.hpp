@@ -38,8 +38,7 @@ struct LineEstimate : SinusoidEstimate {
 };
 /// Line search on the rate samples of a floating series from `f_min` to Nyquist, at the whole
 /// record's and at Welch resolutions. `f_hint` > 0: the whole record's resolution, ±3 bins.
-LineEstimate line_detect(const PhaseSeries& x, double f_min = kHighLineMinHz, double f_hint = 0,
-                         bool estimate = true);
+LineEstimate line_detect(const PhaseSeries& x, double f_min = kHighLineMinHz, double f_hint = 0, bool estimate = true);
 
 struct StepEstimate {
   double statistic = 0;  ///< max likelihood ratio of one change of the mean
@@ -87,12 +86,12 @@ struct Stretch {
   const DiagnoseOptions* opt = nullptr;
   NoiseModel base;
   Decimated dec;
-  Decimated clean;                  ///< dec without its own mean-shape candidate
-  MidTauReference ref;              ///< mid-τ AV reference of the base model's ensemble
-  MidTauReference clean_ref;        ///< the same of its records without their own candidate
+  Decimated clean;            ///< dec without its own mean-shape candidate
+  MidTauReference ref;        ///< mid-τ AV reference of the base model's ensemble
+  MidTauReference clean_ref;  ///< the same of its records without their own candidate
   std::vector<std::int64_t> octave_m;
-  SimulationSettings pilot;         ///< settings (and seed) of the base model's pilot ensemble
-  std::size_t pilot_runs = 0;       ///< 0: the extended model gets no pilot calibration
+  SimulationSettings pilot;    ///< settings (and seed) of the base model's pilot ensemble
+  std::size_t pilot_runs = 0;  ///< 0: the extended model gets no pilot calibration
   // What the whole record tells the estimates on a block of it:
   double sin_hint_hz = 0;   ///< a named sinusoid's frequency (0: search)
   double line_hint_hz = 0;  ///< a named coherent high-frequency line's frequency (0: search)
@@ -102,12 +101,12 @@ struct Stretch {
 
 /// The extended model under construction: the named terms, the findings in naming order.
 struct Extension {
-  NoiseModel det;                   ///< deterministic terms subtracted from the data
-  std::vector<Sinusoid> broad;      ///< broadened lines: in the model, not subtracted
+  NoiseModel det;               ///< deterministic terms subtracted from the data
+  std::vector<Sinusoid> broad;  ///< broadened lines: in the model, not subtracted
   std::optional<OutputLowpassEstimate> lowpass;
-  std::vector<double> mid_var;      ///< mid-τ AV of the data without the named terms
-  NoiseModel model;                 ///< extended model (time origin: the stretch start)
-  std::vector<Finding> findings;    ///< parameters only (the caller adds the evidence)
+  std::vector<double> mid_var;    ///< mid-τ AV of the data without the named terms
+  NoiseModel model;               ///< extended model (time origin: the stretch start)
+  std::vector<Finding> findings;  ///< parameters only (the caller adds the evidence)
 };
 
 /// One record as a detector's statistic reads it: the measurement or a simulated record.
@@ -123,7 +122,7 @@ struct Trial {
   RecordView data;
   const std::vector<RunStats>& runs;
   const Stretch& stretch;
-  const SimulationSettings& settings;  ///< of the base ensemble (alternatives reuse its seeds)
+  const SimulationSettings& settings;            ///< of the base ensemble (alternatives reuse its seeds)
   const std::vector<double>* mid_var = nullptr;  ///< mid-τ AV without candidate and named lines
 };
 

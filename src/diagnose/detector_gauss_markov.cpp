@@ -34,14 +34,16 @@ NoiseModel with_bump(const NoiseModel& base, const ShapeEstimate& est) {
 std::string implausible(const ShapeEstimate& gm) {
   if (!(gm.scale > 0)) return "no bump improves the fit of the mid-τ Allan variance";
   if (gm.excess < kGmMinExcess && gm.white_rest < 2.0 * gm.white_rest_sigma)
-    return fmt::format("the fitted shape raises the mid-τ Allan variance by at most {:.2g} ensemble standard "
-                       "deviations and leaves no white rate noise ({:.3g} ± {:.2g} (°/h)²·s): a deficit, not a "
-                       "Gauss–Markov bump",
-                       gm.excess, gm.white_rest, gm.white_rest_sigma);
+    return fmt::format(
+        "the fitted shape raises the mid-τ Allan variance by at most {:.2g} ensemble standard "
+        "deviations and leaves no white rate noise ({:.3g} ± {:.2g} (°/h)²·s): a deficit, not a "
+        "Gauss–Markov bump",
+        gm.excess, gm.white_rest, gm.white_rest_sigma);
   if (gm.peak_ratio < kGmMinPeakRatio)
-    return fmt::format("the bump's Allan variance at its peak is {:.2g} of the base model's there (at least {:g} "
-                       "needed): not told apart from the flicker and white noise",
-                       gm.peak_ratio, kGmMinPeakRatio);
+    return fmt::format(
+        "the bump's Allan variance at its peak is {:.2g} of the base model's there (at least {:g} "
+        "needed): not told apart from the flicker and white noise",
+        gm.peak_ratio, kGmMinPeakRatio);
   return {};
 }
 
@@ -80,8 +82,7 @@ class GaussMarkovDetector final : public Detector {
   /// naming conditions (a block's own likelihood-ratio test has too little power).
   [[nodiscard]] bool shows_in(const Trial& t) const override {
     const Stretch& s = t.stretch;
-    return implausible(shape_detect(decimated_avar(t.data.clean, s.ref.grid), s.ref, c_of(s.base), s.gm_tc_s))
-        .empty();
+    return implausible(shape_detect(decimated_avar(t.data.clean, s.ref.grid), s.ref, c_of(s.base), s.gm_tc_s)).empty();
   }
 
   void estimate(const Stretch& s, Extension& x) const override {

@@ -77,7 +77,8 @@ Resolution search(const std::vector<double>& y, std::size_t len, double t0, doub
   std::size_t segs = 0;
   r.P = mean_periodogram(y, len, nfft, segs, r.w2);
   r.K = static_cast<double>(segs);
-  const double med = r.K == 1 ? std::log(2.0) : boost::math::gamma_p_inv(r.K, 0.5) / r.K;  // of a mean of K exponentials
+  const double med =
+      r.K == 1 ? std::log(2.0) : boost::math::gamma_p_inv(r.K, 0.5) / r.K;  // of a mean of K exponentials
   std::vector<double> v;
   auto window = [&](std::size_t k) -> std::vector<double>& {
     level_window(r.P, k, r.pad, true, v);  // at the spectrum's end shifted inwards, keeping its size

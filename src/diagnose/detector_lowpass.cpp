@@ -25,9 +25,9 @@ double output_lowpass_rate_avar(std::size_t m, double tau0, double tf) {
   if (!(tf > 0)) return 1.0 / (md * tau0);
   // AR(1)-filtered rate samples of variance 1/τ0: AV = (Var of an m-sum − Cov of adjacent ones)/m².
   const double x = tau0 / tf;
-  const double a = -std::expm1(-x);                 // 1 − φ
+  const double a = -std::expm1(-x);  // 1 − φ
   const double phi = 1.0 - a;
-  const double b = -std::expm1(-md * x);            // 1 − φ^m
+  const double b = -std::expm1(-md * x);  // 1 − φ^m
   const double V = (1.0 / tau0) * a / (2.0 - a);
   const double var_sum = V * (md + 2.0 * phi * (md * a - b) / (a * a));
   const double cov = V * phi * b * b / (a * a);
@@ -42,7 +42,8 @@ struct NnFit {
   std::array<double, 3> c{0, 0, 0};
 };
 
-NnFit nn_fit3(const std::vector<double>& y, const std::vector<double>& w, const std::array<std::vector<double>, 3>& cols) {
+NnFit nn_fit3(const std::vector<double>& y, const std::vector<double>& w,
+              const std::array<std::vector<double>, 3>& cols) {
   NnFit best;
   for (int mask = 1; mask < 8; ++mask) {
     std::vector<std::vector<double>> cs;
@@ -58,7 +59,8 @@ NnFit nn_fit3(const std::vector<double>& y, const std::vector<double>& w, const 
     if (!ok || !(o.chi2 < best.chi2)) continue;
     best.chi2 = o.chi2;
     best.c = {0, 0, 0};
-    for (std::size_t k = 0; k < idx.size(); ++k) best.c[static_cast<std::size_t>(idx[k])] = o.coef(static_cast<Eigen::Index>(k));
+    for (std::size_t k = 0; k < idx.size(); ++k)
+      best.c[static_cast<std::size_t>(idx[k])] = o.coef(static_cast<Eigen::Index>(k));
   }
   if (!std::isfinite(best.chi2)) {
     best.chi2 = 0;
@@ -108,10 +110,8 @@ class LowpassDetector final : public RecordDetector {
     std::vector<double> v;
     for (const auto& p : s.analysis->allan.points) v.push_back(p.var);
     const auto est = LowpassDetector(*s.analysis, s.rec->phase.duration_s(), "").fit(v);
-    x.findings.push_back({Effect::Lowpass,
-                          {{"time_constant_s", est.tf}},
-                          {{"time_constant_s", 0.5 * (est.tf_high - est.tf_low)}},
-                          {}});
+    x.findings.push_back(
+        {Effect::Lowpass, {{"time_constant_s", est.tf}}, {{"time_constant_s", 0.5 * (est.tf_high - est.tf_low)}}, {}});
     x.lowpass = est;
   }
 
@@ -191,9 +191,17 @@ OutputLowpassEstimate output_lowpass_detect(const std::vector<std::int64_t>& m, 
     double f1 = fit_at(std::exp(c1), nullptr), f2 = fit_at(std::exp(c2), nullptr);
     for (int it = 0; it < 30; ++it) {
       if (f1 < f2) {
-        b = c2; c2 = c1; f2 = f1; c1 = b - gr * (b - a); f1 = fit_at(std::exp(c1), nullptr);
+        b = c2;
+        c2 = c1;
+        f2 = f1;
+        c1 = b - gr * (b - a);
+        f1 = fit_at(std::exp(c1), nullptr);
       } else {
-        a = c1; c1 = c2; f1 = f2; c2 = a + gr * (b - a); f2 = fit_at(std::exp(c2), nullptr);
+        a = c1;
+        c1 = c2;
+        f1 = f2;
+        c2 = a + gr * (b - a);
+        f2 = fit_at(std::exp(c2), nullptr);
       }
     }
     consider(std::exp(0.5 * (a + b)));

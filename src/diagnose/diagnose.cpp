@@ -22,11 +22,11 @@ constexpr double kPulseFitTauMin = 20.0;  ///< s, start of the base fit for puls
 struct Context {
   const Recording& rec;
   const DiagnoseOptions& opt;
-  AnalysisOptions aopt;              ///< the five-term fit's
-  EnsemblePlan plan;                 ///< octave sizes and mid-τ grid of the record
-  Stretch full;                      ///< the whole record as a stretch
-  std::vector<double> octave_var;    ///< measured octave AV
-  RobustBase rb;                     ///< base model, own candidate, B of the fit without it
+  AnalysisOptions aopt;            ///< the five-term fit's
+  EnsemblePlan plan;               ///< octave sizes and mid-τ grid of the record
+  Stretch full;                    ///< the whole record as a stretch
+  std::vector<double> octave_var;  ///< measured octave AV
+  RobustBase rb;                   ///< base model, own candidate, B of the fit without it
   std::vector<std::unique_ptr<Detector>> detectors;
   [[nodiscard]] RecordView view() const { return {rec.phase, full.dec, full.clean, octave_var}; }
 };
@@ -121,7 +121,9 @@ void recalibrate_under_high_b(const Context& c, const DiagnoseResult& r, std::ve
 
 /// A step and a transient that both fire are one change of the mean: the candidate is named.
 void one_mean_shape(const NoiseModel& candidate, std::vector<DetectorResult>& results) {
-  auto of = [&](Effect e) { return std::find_if(results.begin(), results.end(), [e](auto& d) { return d.effect == e; }); };
+  auto of = [&](Effect e) {
+    return std::find_if(results.begin(), results.end(), [e](auto& d) { return d.effect == e; });
+  };
   const auto step = of(Effect::BiasStep), warm = of(Effect::Warmup);
   if (step == results.end() || warm == results.end() || !step->fired || !warm->fired) return;
   if (!candidate.warmups.empty()) {
@@ -207,8 +209,8 @@ void extended_model(Context& c, const Named& named, DiagnoseResult& r) {
     r.extended_band = r.base_band;
     return;
   }
-  const auto ext_runs = run_ensemble(r.extended, r.settings, c.opt.runs, {c.plan.octave_m, c.plan.grid, false, {}},
-                                     c.opt.progress);
+  const auto ext_runs =
+      run_ensemble(r.extended, r.settings, c.opt.runs, {c.plan.octave_m, c.plan.grid, false, {}}, c.opt.progress);
   r.extended_band = make_band(r.analysis.allan.points, ext_runs, c.opt.band_level);
   refit_whole_band(r.extended, r.extended_band, r.analysis.allan.points, r.settings, c.opt.runs, c.plan, c.opt);
 }

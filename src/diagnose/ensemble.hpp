@@ -27,10 +27,10 @@ struct MidTauReference {
 };
 
 struct ShapeEstimate {
-  double statistic = 0;  ///< χ² drop when a Gauss–Markov bump joins the Q, N, B, K corrections
-  double scale = 0, scale_sigma = 0;             ///< its variance σ², (°/h)², and standard error
+  double statistic = 0;               ///< χ² drop when a Gauss–Markov bump joins the Q, N, B, K corrections
+  double scale = 0, scale_sigma = 0;  ///< its variance σ², (°/h)², and standard error
   double time = 0, time_low = 0, time_high = 0;  ///< its correlation time and Δχ² = 1 range, s
-  std::array<double, 4> dc{0, 0, 0, 0};  ///< corrections of the fit-scale Q², N², B², K²
+  std::array<double, 4> dc{0, 0, 0, 0};          ///< corrections of the fit-scale Q², N², B², K²
   /// White rate noise left beside the bump (fit scale, ≥ 0) and its standard error: a bump with
   /// none left is a low-pass of the white noise.
   double white_rest = 0, white_rest_sigma = 0;
@@ -58,9 +58,9 @@ double mid_deviance(const std::vector<double>& v, const MidTauReference& ref);
 
 /// What each simulated record of an ensemble is reduced to.
 struct EnsemblePlan {
-  std::vector<std::int64_t> octave_m;  ///< octave cluster sizes (the band)
-  std::vector<std::size_t> grid;       ///< mid-τ grid (decimated periods)
-  bool clean_mid = true;  ///< also the mid-τ AV without the record's own candidate
+  std::vector<std::int64_t> octave_m;         ///< octave cluster sizes (the band)
+  std::vector<std::size_t> grid;              ///< mid-τ grid (decimated periods)
+  bool clean_mid = true;                      ///< also the mid-τ AV without the record's own candidate
   std::vector<const RecordDetector*> scored;  ///< detectors whose statistic each record gets
 };
 

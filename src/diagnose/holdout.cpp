@@ -22,8 +22,9 @@ struct Fold {
 };
 
 std::vector<Fold> holdout_folds(std::size_t n, double tau0) {
-  const std::vector<std::size_t> splits =
-      static_cast<double>(n) * tau0 >= 3.0 * kMinDuration ? std::vector<std::size_t>{2, 3} : std::vector<std::size_t>{2};
+  const std::vector<std::size_t> splits = static_cast<double>(n) * tau0 >= 3.0 * kMinDuration
+                                              ? std::vector<std::size_t>{2, 3}
+                                              : std::vector<std::size_t>{2};
   std::vector<Fold> folds;
   for (const std::size_t nb : splits) {
     const double w = 1.0 / (static_cast<double>(splits.size()) * 2.0 * static_cast<double>(nb - 1));
@@ -135,8 +136,8 @@ Stretch fitting_stretch(const Stretch& full, const DiagnoseResult& r, const Name
 /// One fold's per-point scores of the base and the extended model. Both are simulated at the
 /// predicted block's measured mean rate (under a counting read-out the rate sets the short-τ AV);
 /// the level each predicts is scored once, against the base ensemble's spread of block means.
-std::pair<double, double> score_fold(const Stretch& full, const DiagnoseResult& r, const Named& named,
-                                     const Fold& f, std::size_t index) {
+std::pair<double, double> score_fold(const Stretch& full, const DiagnoseResult& r, const Named& named, const Fold& f,
+                                     std::size_t index) {
   const PhaseSeries& x = full.rec->phase;
   const DiagnoseOptions& opt = *full.opt;
   const std::size_t h = f.len, fa = f.fit * h, pa = f.pred * h;

@@ -116,8 +116,8 @@ ConstrainedFit constrained_fit(const MidTauProblem& p, const std::array<double, 
     for (std::size_t t = 0; t < 4; ++t) f.dc[t] = fixed[t] && free[t] ? -c_base[t] : 0.0;
     for (std::size_t k = 0; k < idx.size(); ++k) {
       f.dc[idx[k]] = o.coef(static_cast<Eigen::Index>(k)) / p.colscale[idx[k]];
-      if (idx[k] == 1) f.dn_var = o.inv(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)) /
-                                  (p.colscale[1] * p.colscale[1]);
+      if (idx[k] == 1)
+        f.dn_var = o.inv(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)) / (p.colscale[1] * p.colscale[1]);
     }
     if (shape) {
       const auto last = static_cast<Eigen::Index>(idx.size());

@@ -31,8 +31,8 @@ NoiseModel base_model(const AnalysisResult& a, const PhaseSeries& x) {
     // A dithered (white) read-out gives σ(τ0) ≈ 0.71·q/τ0, plain counting of a few pulses per
     // sample far less (0.18·q/τ0 at 13.5 pulses/s and 400 Hz): 0.45·q/τ0 separates them.
     const double q = x.arcsec_per_count;
-    const bool white = !a.allan.points.empty() && a.allan.points.front().m == 1 &&
-                       a.allan.points.front().dev * x.tau0_s / q > 0.45;
+    const bool white =
+        !a.allan.points.empty() && a.allan.points.front().m == 1 && a.allan.points.front().dev * x.tau0_s / q > 0.45;
     m.readout = white ? ReadoutMode::White : ReadoutMode::Counting;
     // Extra white angle noise only when the fitted Q clearly exceeds the read-out's own level.
     const double q_read = readout_q_arcsec(m.readout, q);
@@ -70,7 +70,8 @@ PhaseSeries slice(const PhaseSeries& x, std::size_t a, std::size_t b) {
     s.counts.resize(b - a + 1);
     for (std::size_t i = a; i <= b; ++i) s.counts[i - a] = x.count(i);
   } else {
-    s.values.assign(x.values.begin() + static_cast<std::ptrdiff_t>(a), x.values.begin() + static_cast<std::ptrdiff_t>(b) + 1);
+    s.values.assign(x.values.begin() + static_cast<std::ptrdiff_t>(a),
+                    x.values.begin() + static_cast<std::ptrdiff_t>(b) + 1);
   }
   return s;
 }

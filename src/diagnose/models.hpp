@@ -19,8 +19,8 @@ constexpr double kMinDuration = 1200.0;
 /// The effects named on the whole record and what they tell the blocks.
 struct Named {
   std::vector<const Detector*> detectors;  ///< in naming order (Effect)
-  double sin_hint_hz = 0;   ///< frequency of a named sinusoid
-  double line_hint_hz = 0;  ///< frequency of a named coherent high-frequency line
+  double sin_hint_hz = 0;                  ///< frequency of a named sinusoid
+  double line_hint_hz = 0;                 ///< frequency of a named coherent high-frequency line
 };
 
 /// Mean per-point prediction deviance of the base and the extended model over the folds.

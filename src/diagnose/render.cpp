@@ -21,8 +21,12 @@ json model_json(const NoiseModel& model, const std::vector<BandPoint>& band, dou
   to_json(m, model);
   m["band"] = json::array();
   for (const auto& b : band)
-    m["band"].push_back({{"tau_s", b.tau_s}, {"dev", b.dev}, {"band_low", b.low}, {"band_high", b.high},
-                         {"median", b.median}, {"edf", b.edf}});
+    m["band"].push_back({{"tau_s", b.tau_s},
+                         {"dev", b.dev},
+                         {"band_low", b.low},
+                         {"band_high", b.high},
+                         {"median", b.median},
+                         {"edf", b.edf}});
   m["band_level"] = level;
   m["misfit"] = misfit;
   m["coverage"] = coverage;
@@ -78,9 +82,13 @@ json to_json(const DiagnoseResult& r) {
   j["base_model"] = base;
   json det = json::array();
   for (const auto& d : r.detectors) {
-    json o = {{"effect", std::string(detector_name(d.effect))}, {"statistic", d.statistic},
-              {"threshold", d.threshold}, {"ensemble_max", d.ensemble_max},
-              {"ensemble_median", d.ensemble_median}, {"fired", d.fired}, {"named", d.named}};
+    json o = {{"effect", std::string(detector_name(d.effect))},
+              {"statistic", d.statistic},
+              {"threshold", d.threshold},
+              {"ensemble_max", d.ensemble_max},
+              {"ensemble_median", d.ensemble_median},
+              {"fired", d.fired},
+              {"named", d.named}};
     if (!d.note.empty()) o["note"] = d.note;
     det.push_back(o);
   }
@@ -109,10 +117,10 @@ json to_json(const DiagnoseResult& r) {
 std::string format_report(const DiagnoseResult& r) {
   std::string s;
   s += fmt::format("Diagnosis of {}\n", printable(r.analysis.source));
-  s += fmt::format("  record: {:.0f} s at {:g} Hz, pulse weight {:g}″; ensemble of {} simulated records per model "
-                   "(seed {}), band {:g} % per τ\n\n",
-                   r.settings.duration_s, r.settings.rate_hz, r.settings.scale_arcsec, r.runs, r.seed,
-                   r.band_level * 100);
+  s += fmt::format(
+      "  record: {:.0f} s at {:g} Hz, pulse weight {:g}″; ensemble of {} simulated records per model "
+      "(seed {}), band {:g} % per τ\n\n",
+      r.settings.duration_s, r.settings.rate_hz, r.settings.scale_arcsec, r.runs, r.seed, r.band_level * 100);
   s += format_outliers(r.analysis.outliers);
   const auto& m = r.base;
   s += "Base model (five-term fit): " + power_laws(m) +
@@ -131,8 +139,8 @@ std::string format_report(const DiagnoseResult& r) {
   s += fmt::format("  measured Allan deviation inside the base band at {} of {} τ\n", r.base_band.size() - outside,
                    r.base_band.size());
   s += rows;
-  s += "\nDetectors (statistic on the measurement against the ensemble-calibrated threshold, "
-       + fmt::format("false-alarm level {:g} % each):\n", r.alpha * 100);
+  s += "\nDetectors (statistic on the measurement against the ensemble-calibrated threshold, " +
+       fmt::format("false-alarm level {:g} % each):\n", r.alpha * 100);
   for (const auto& d : r.detectors)
     s += fmt::format("  {:<17} statistic {:>9.3f} (dimensionless), threshold {:>8.3f}, ensemble max {:>8.3f}: {}{}\n",
                      detector_name(d.effect), d.statistic, d.threshold, d.ensemble_max,
@@ -159,8 +167,8 @@ std::string format_report(const DiagnoseResult& r) {
                    r.gain.misfit_extended);
   s += fmt::format("  {:<44} {:>9.1f}% {:>9.1f}%\n", "measured τ inside the simulated band", 100 * r.gain.coverage_base,
                    100 * r.gain.coverage_extended);
-  s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", "out-of-sample misfit (dimensionless)",
-                   r.gain.holdout_misfit_base, r.gain.holdout_misfit_extended);
+  s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", "out-of-sample misfit (dimensionless)", r.gain.holdout_misfit_base,
+                   r.gain.holdout_misfit_extended);
   s += fmt::format("\n  ({:.1f} s)\n", r.seconds);
   return s;
 }

@@ -116,7 +116,8 @@ double ls_rss(const std::vector<double>& y, const std::vector<std::vector<double
   for (Eigen::Index i = 0; i < n; ++i) {
     X(i, 0) = 1.0;
     X(i, 1) = (static_cast<double>(i) - 0.5 * static_cast<double>(n - 1)) / static_cast<double>(n);
-    for (std::size_t c = 0; c < extra.size(); ++c) X(i, static_cast<Eigen::Index>(2 + c)) = extra[c][static_cast<std::size_t>(i)];
+    for (std::size_t c = 0; c < extra.size(); ++c)
+      X(i, static_cast<Eigen::Index>(2 + c)) = extra[c][static_cast<std::size_t>(i)];
     Y(i) = y[static_cast<std::size_t>(i)];
   }
   const Eigen::MatrixXd XtX = X.transpose() * X;

@@ -18,17 +18,17 @@ namespace {
 
 constexpr std::size_t kQuoteLimit = 40;
 
-constexpr TimeName kTimeNames[] = {
-    {"time_s", "s", 1},       {"time", "s", 1},     {"t", "s", 1},          {"t_s", "s", 1},
-    {"timestamp", "s", 1},    {"time_sec", "s", 1}, {"time_ms", "ms", 1e3}, {"t_ms", "ms", 1e3},
-    {"time_us", "us", 1e6},   {"t_us", "us", 1e6},  {"time_ns", "ns", 1e9}, {"t_ns", "ns", 1e9}};
+constexpr TimeName kTimeNames[] = {{"time_s", "s", 1},     {"time", "s", 1},       {"t", "s", 1},
+                                   {"t_s", "s", 1},        {"timestamp", "s", 1},  {"time_sec", "s", 1},
+                                   {"time_ms", "ms", 1e3}, {"t_ms", "ms", 1e3},    {"time_us", "us", 1e6},
+                                   {"t_us", "us", 1e6},    {"time_ns", "ns", 1e9}, {"t_ns", "ns", 1e9}};
 constexpr std::string_view kTemperatureNames[] = {"temperature_c", "temperature", "temp_c", "temp", "t_c"};
 
 // The names of a column that holds the samples, by InputMode.
 const std::vector<std::string_view> kValueNames[] = {{"pulses", "pulse", "counts", "count"},
-                                                      {"counter", "count", "counts", "pulses"},
-                                                      {"angle", "phase"},
-                                                      {"rate", "gyro", "frequency", "freq"}};
+                                                     {"counter", "count", "counts", "pulses"},
+                                                     {"angle", "phase"},
+                                                     {"rate", "gyro", "frequency", "freq"}};
 
 const TimeName* time_name(std::string_view field) {
   for (const TimeName& t : kTimeNames)
@@ -124,8 +124,8 @@ void Metadata::read(std::string_view body, std::size_t line, const std::string& 
   while (c < body.size() && (body[c] == ' ' || body[c] == '\t')) ++c;
   if (c >= body.size() || (body[c] != ':' && body[c] != '=')) return;
   const std::string canonical = canonical_key(body.substr(0, k));
-  const bool known = canonical == "rate_hz" || canonical == "scale_arcsec_per_pulse" ||
-                     canonical == "temperature_c" || canonical == "serial";
+  const bool known = canonical == "rate_hz" || canonical == "scale_arcsec_per_pulse" || canonical == "temperature_c" ||
+                     canonical == "serial";
   const std::string key = known ? canonical : std::string(body.substr(0, k));
   const std::string value(trim(body.substr(c + 1)));
 
@@ -138,15 +138,18 @@ void Metadata::read(std::string_view body, std::size_t line, const std::string& 
     double x = 0;
     const auto r = std::from_chars(v.data(), v.data() + v.size(), x);
     if (v.empty() || r.ec != std::errc() || r.ptr != v.data() + v.size() || !std::isfinite(x) || (positive && !(x > 0)))
-      throw InputError(file, line, fmt::format("metadata {}: {} is not a {}number", key, quoted(value),
-                                               positive ? "positive " : ""));
+      throw InputError(file, line,
+                       fmt::format("metadata {}: {} is not a {}number", key, quoted(value),
+                                   positive ? "positive " : ""));
     if (slot && *slot != x)
-      throw InputError(file, line, fmt::format("metadata {} given twice with different values ({} and {})", key,
-                                               quoted(all[key]), quoted(value)));
+      throw InputError(file, line,
+                       fmt::format("metadata {} given twice with different values ({} and {})", key, quoted(all[key]),
+                                   quoted(value)));
     slot = x;
     if (!(x >= lo && x <= hi))
-      throw InputError(file, line, fmt::format("metadata {}: {} {} is outside the usable range {:g}..{:g} {}", key,
-                                               quoted(value), unit, lo, hi, unit));
+      throw InputError(file, line,
+                       fmt::format("metadata {}: {} {} is outside the usable range {:g}..{:g} {}", key, quoted(value),
+                                   unit, lo, hi, unit));
   };
   if (key == "rate_hz") {
     set_known(rate_hz, true, kMinRateHz, kMaxRateHz, "Hz");
@@ -189,7 +192,8 @@ void Layout::choose(const ReadOptions& o, std::size_t where, const std::string& 
     // Headerless layouts: [value], [time, value], [time, value, temperature].
     if (o.column.empty()) {
       if (ncols > 3)
-        throw InputError(file, where, fmt::format("{} columns and no header row: choose the column with --column", ncols));
+        throw InputError(file, where,
+                         fmt::format("{} columns and no header row: choose the column with --column", ncols));
       value_col = ncols == 1 ? 0 : 1;
     }
     if ((ncols == 2 || ncols == 3) && value_col == 1) time_col = 0, time_unit = &kTimeNames[0];
@@ -210,15 +214,17 @@ void Layout::choose_given(const std::string& want, std::size_t where, const std:
     std::size_t idx = 0;
     std::from_chars(want.data(), want.data() + want.size(), idx);
     if (idx < 1 || idx > ncols)
-      throw InputError(file, where, fmt::format("--column {} is out of range: the file has {} column{}", want, ncols,
-                                                ncols == 1 ? "" : "s"));
+      throw InputError(file, where,
+                       fmt::format("--column {} is out of range: the file has {} column{}", want, ncols,
+                                   ncols == 1 ? "" : "s"));
     value_col = idx - 1;
     return;
   }
   if (header.empty())
-    throw InputError(file, where, fmt::format("--column '{}' names a column but the file has no header row; give a "
-                                              "1-based index instead",
-                                              want));
+    throw InputError(file, where,
+                     fmt::format("--column '{}' names a column but the file has no header row; give a "
+                                 "1-based index instead",
+                                 want));
   const auto named = columns_where(header, [&](std::string_view h) { return iequals(h, want); });
   if (named.empty())
     throw InputError(file, header_line,
@@ -243,8 +249,9 @@ void Layout::choose_by_name(const ReadOptions& o, bool value_given, const std::s
     const auto& names = kValueNames[static_cast<int>(o.mode)];
     const auto named = columns_where(header, [&](std::string_view h) { return any_named(h, names); });
     if (named.size() > 1)
-      throw InputError(file, header_line, fmt::format("columns {} could each hold the {} samples; choose one with --column",
-                                                      column_list(named), to_string(o.mode)));
+      throw InputError(file, header_line,
+                       fmt::format("columns {} could each hold the {} samples; choose one with --column",
+                                   column_list(named), to_string(o.mode)));
     std::vector<std::size_t> rest;
     for (std::size_t k = 0; k < ncols; ++k)
       if (std::count(times.begin(), times.end(), k) + std::count(temps.begin(), temps.end(), k) == 0) rest.push_back(k);
@@ -262,7 +269,8 @@ void Layout::choose_by_name(const ReadOptions& o, bool value_given, const std::s
   if (temps.size() > 1)
     throw InputError(file, header_line,
                      fmt::format("{} temperature columns ({}); rwcalc reports one temperature: remove or rename "
-                                 "the others", temps.size(), column_list(temps)));
+                                 "the others",
+                                 temps.size(), column_list(temps)));
   if (!times.empty()) time_col = times[0], time_unit = time_name(header[times[0]]);
   if (times.size() == 2) time2_col = times[1], time2_unit = time_name(header[times[1]]);
   if (!temps.empty()) temp_col = temps[0];

@@ -72,9 +72,9 @@ LineKind LineParser::parse(std::string_view text, std::size_t line, Sample& s) {
     layout_.choose(opt_, layout_.header_line ? layout_.header_line : line, file_);
   }
   if (fields_.size() != layout_.ncols)
-    fail(fmt::format("wrong number of columns: expected {} ({}-separated, as line {} has), found {}: {}",
-                     layout_.ncols, delim_name(layout_.delim),
-                     layout_.header_line ? layout_.header_line : first_data_line_, fields_.size(), quoted(t)));
+    fail(fmt::format("wrong number of columns: expected {} ({}-separated, as line {} has), found {}: {}", layout_.ncols,
+                     delim_name(layout_.delim), layout_.header_line ? layout_.header_line : first_data_line_,
+                     fields_.size(), quoted(t)));
   read_fields(s, true);
   return LineKind::Data;
 }

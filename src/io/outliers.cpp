@@ -47,7 +47,8 @@ struct RateSource {
 
   void fill(std::size_t from, std::size_t to, double* out) const {
     if (vector) {
-      std::copy(vector->begin() + static_cast<std::ptrdiff_t>(from), vector->begin() + static_cast<std::ptrdiff_t>(to), out);
+      std::copy(vector->begin() + static_cast<std::ptrdiff_t>(from), vector->begin() + static_cast<std::ptrdiff_t>(to),
+                out);
     } else if (phase->exact()) {
       for (std::size_t i = from; i < to; ++i) out[i - from] = phase->rate(i);
     } else {

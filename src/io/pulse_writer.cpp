@@ -44,7 +44,8 @@ void append_line(std::string& text, std::int64_t v) {
 
 // One line per count: the increment C_k − C_{k−1} (`previous` is C_{k−1}; updated). An increment
 // beyond 64 bits would be written wrapped, i.e. as a wrong number: refused.
-void append_increments(std::string& text, std::span<const std::int64_t> counts, std::int64_t& previous, LinePosition& at) {
+void append_increments(std::string& text, std::span<const std::int64_t> counts, std::int64_t& previous,
+                       LinePosition& at) {
   for (const std::int64_t c : counts) {
     ++at.line;
     std::int64_t d = 0;
@@ -84,7 +85,8 @@ std::string format_pulse_file(const Metadata& metadata, const PhaseSeries& serie
   if (!exact && series.values.empty()) throw AnalysisError("the series to write is empty");
   std::string text = header_text(metadata, exact ? "pulses" : "angle");
   // The first line is x_0 in the angle column, the increment of sample 1 in the pulses column.
-  LinePosition at{"the pulse file", static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')), exact ? 1u : 0u};
+  LinePosition at{"the pulse file", static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')),
+                  exact ? 1u : 0u};
   if (!exact) {
     append_angles(text, series.values, at);
     return text;
@@ -96,7 +98,9 @@ std::string format_pulse_file(const Metadata& metadata, const PhaseSeries& serie
 }
 
 PulseFileWriter::PulseFileWriter(const std::string& path, const Metadata& metadata, Column column, bool force)
-    : path_(path), out_(path, force), column_(column),
+    : path_(path),
+      out_(path, force),
+      column_(column),
       text_(header_text(metadata, column == Column::Pulses ? "pulses" : "angle")) {
   line_ = static_cast<std::size_t>(std::count(text_.begin(), text_.end(), '\n'));
   if (column_ == Column::Angle) {

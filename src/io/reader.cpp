@@ -48,7 +48,8 @@ struct TimeTrack {
   }
   [[nodiscard]] Step first_outside(double lo, double hi) const {
     const auto low = std::find_if(lows.begin(), lows.end(), [&](const Step& s) { return !(s.after - s.before >= lo); });
-    const auto high = std::find_if(highs.begin(), highs.end(), [&](const Step& s) { return !(s.after - s.before <= hi); });
+    const auto high =
+        std::find_if(highs.begin(), highs.end(), [&](const Step& s) { return !(s.after - s.before <= hi); });
     if (low == lows.end()) return *high;
     return high != highs.end() && high->sample < low->sample ? *high : *low;
   }
@@ -56,14 +57,22 @@ struct TimeTrack {
 
 template <class E>
 using NameTable = std::pair<E, std::string_view>[4];
-constexpr NameTable<InputMode> kModes{{InputMode::Pulses, "pulses"}, {InputMode::Counter, "counter"},
-                                      {InputMode::Angle, "angle"}, {InputMode::Rate, "rate"}};
-constexpr NameTable<AngleUnit> kAngleUnits{{AngleUnit::Arcsec, "arcsec"}, {AngleUnit::Deg, "deg"},
-                                           {AngleUnit::Rad, "rad"}, {AngleUnit::Second, "s"}};
-constexpr NameTable<RateUnit> kRateUnits{{RateUnit::DegPerHour, "deg/h"}, {RateUnit::DegPerSecond, "deg/s"},
-                                         {RateUnit::RadPerSecond, "rad/s"}, {RateUnit::Unitless, "1"}};
-constexpr NameTable<RateSource> kRateSources{{RateSource::Option, "option"}, {RateSource::Metadata, "metadata"},
-                                             {RateSource::TimeColumn, "time column"}, {RateSource::Default, "default"}};
+constexpr NameTable<InputMode> kModes{{InputMode::Pulses, "pulses"},
+                                      {InputMode::Counter, "counter"},
+                                      {InputMode::Angle, "angle"},
+                                      {InputMode::Rate, "rate"}};
+constexpr NameTable<AngleUnit> kAngleUnits{{AngleUnit::Arcsec, "arcsec"},
+                                           {AngleUnit::Deg, "deg"},
+                                           {AngleUnit::Rad, "rad"},
+                                           {AngleUnit::Second, "s"}};
+constexpr NameTable<RateUnit> kRateUnits{{RateUnit::DegPerHour, "deg/h"},
+                                         {RateUnit::DegPerSecond, "deg/s"},
+                                         {RateUnit::RadPerSecond, "rad/s"},
+                                         {RateUnit::Unitless, "1"}};
+constexpr NameTable<RateSource> kRateSources{{RateSource::Option, "option"},
+                                             {RateSource::Metadata, "metadata"},
+                                             {RateSource::TimeColumn, "time column"},
+                                             {RateSource::Default, "default"}};
 
 template <class E>
 E parse_name(const NameTable<E>& table, std::string_view s, std::string_view option) {
@@ -91,7 +100,7 @@ std::size_t line_in_runs(const Runs& runs, std::size_t k) {
 class Reader {
  public:
   Reader(const std::string& file, const ReadOptions& o) : parser_(file, o), opt_(o) {
-    if (o.mode == InputMode::Pulses) ints_.push_back(0);  // C_0
+    if (o.mode == InputMode::Pulses) ints_.push_back(0);   // C_0
     if (o.mode == InputMode::Rate) reals_.push_back(0.0);  // x_0
   }
   void read(detail::TextSource& src) {
@@ -296,8 +305,10 @@ void Reader::check_time_column() const {
     if (std::abs(est - period) > tol)
       fail(line, fmt::format("the sample rate {} Hz (from {}) is inconsistent with the time column {}, which steps "
                              "by {} s (~{:.6g} Hz), e.g. {} s at line {} then {} s",
-                             rate_hz_, rate_source_ == RateSource::Option ? "--rate" : fmt::format(
-                                 "metadata at line {}", parser_.metadata().rate_line),
+                             rate_hz_,
+                             rate_source_ == RateSource::Option
+                                 ? "--rate"
+                                 : fmt::format("metadata at line {}", parser_.metadata().rate_line),
                              tcol, est, 1.0 / est, t0, prev, t1));
   }
   if (dt == 0) fail(line, fmt::format("repeated time stamp {} s (also at line {}); no resampling is done", t1, prev));
@@ -311,7 +322,8 @@ void Reader::check_time_column() const {
 /// the Allan variance would square them to zero and call the record noiseless.
 void Reader::check_data_magnitude(const PhaseSeries& ph, const char* what) const {
   double largest = 0;
-  for (std::size_t i = 1; i < ph.values.size(); ++i) largest = std::max(largest, std::abs(ph.values[i] - ph.values[i - 1]));
+  for (std::size_t i = 1; i < ph.values.size(); ++i)
+    largest = std::max(largest, std::abs(ph.values[i] - ph.values[i - 1]));
   if (largest > 0 && largest < kMinDataStep)
     fail(0, fmt::format("the {} data are too small to analyse: the largest step between samples is {:g} {}, below "
                         "{:g}, where the squares in the Allan variance underflow; give the data in a larger unit",
@@ -332,7 +344,8 @@ void Reader::build_counts(PhaseSeries& ph, std::size_t& wraps) {
       total += c[i] < 0 ? (~v + 1) : v;
       c[i] = static_cast<std::int64_t>(acc);
       if (total > kLimit) [[unlikely]]
-        fail(line_of_sample(i - 1), "pulse counts too large to be summed exactly: the sum of |counts| exceeds 2^63-1 here");
+        fail(line_of_sample(i - 1),
+             "pulse counts too large to be summed exactly: the sum of |counts| exceeds 2^63-1 here");
     }
   } else {
     const int b = opt_.counter_bits;
@@ -422,14 +435,14 @@ Recording Reader::finish() {
   else
     build_values(ph);
   detail::Metadata& meta = parser_.metadata();
-  rec.phase.arcsec_per_count = opt_.scale_arcsec ? *opt_.scale_arcsec
+  rec.phase.arcsec_per_count = opt_.scale_arcsec   ? *opt_.scale_arcsec
                                : meta.scale_arcsec ? *meta.scale_arcsec
                                                    : units::gl2d_arcsec_per_pulse;
   rec.rate_hz = rate_hz_;
   rec.rate_source = rate_source_;
   rec.metadata = std::move(meta.all);
-  rec.temperature_c =
-      temp_n_ > 0 ? std::optional(static_cast<double>(temp_sum_ / static_cast<long double>(temp_n_))) : meta.temperature_c;
+  rec.temperature_c = temp_n_ > 0 ? std::optional(static_cast<double>(temp_sum_ / static_cast<long double>(temp_n_)))
+                                  : meta.temperature_c;
   const auto& h = layout_.header;
   rec.column_name = h.empty() ? fmt::format("column {}", layout_.value_col + 1) : h[layout_.value_col];
   if (layout_.time_col) rec.time_column = h.empty() ? std::string("column 1") : h[*layout_.time_col];
@@ -476,7 +489,9 @@ std::vector<double> Recording::rates() const {
   return r;
 }
 
-std::size_t Recording::line_of_sample(std::size_t k) const noexcept { return k < samples ? line_in_runs(line_runs, k) : 0; }
+std::size_t Recording::line_of_sample(std::size_t k) const noexcept {
+  return k < samples ? line_in_runs(line_runs, k) : 0;
+}
 
 std::size_t Recording::line_of_rate(std::size_t i) const noexcept {
   const bool readings = mode == InputMode::Counter || mode == InputMode::Angle;

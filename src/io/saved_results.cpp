@@ -198,13 +198,15 @@ void Checker::verdict(const Value& v) const {
   for (const char* key : {"p_class_B", "p_class_N"}) optional(v, key, as_probability);
   optional(v, "decisive", as_boolean);
   if (const auto t = v.find("tolerance_pct")) (void)t->number_in(0, 1000, "a percentage in [0, 1000]");
-  for (const char* key : {"statement", "statement_B", "statement_N", "b_estimate", "table"}) optional(v, key, as_string);
+  for (const char* key : {"statement", "statement_B", "statement_N", "b_estimate", "table"})
+    optional(v, key, as_string);
   optional(v, "tolerance_changed", as_boolean);
   if (const auto r = v.find("rho_BN")) (void)r->number_in(-1, 1, "a correlation in [-1, 1]");
   // Without "classes" (a hand-made verdict) the arrays cannot be sized against it.
   const auto n = classes.empty() ? std::nullopt : std::optional<std::size_t>(classes.size());
   if (const auto p = member(v, "p_meets")) array_of(*p, n, "class", as_probability);
-  if (const auto p = v.find("p_is")) array_of(*p, n ? std::optional(*n + 1) : std::nullopt, "class and 'outside'", as_probability);
+  if (const auto p = v.find("p_is"))
+    array_of(*p, n ? std::optional(*n + 1) : std::nullopt, "class and 'outside'", as_probability);
   for (const char* key : {"B", "N"}) {
     if (const auto p = member(v, key)) {
       parameter_verdict(*p, n);
@@ -299,9 +301,10 @@ void parse_saved_result(std::string_view text, const std::string& file, SavedRes
   Document doc(text, file);
   const Value root = doc.root();
   if (!root.json().is_object())
-    root.fail(fmt::format("must be a JSON object from 'rwcalc analyze --json', 'batch --json' or 'diagnose --json', "
-                          "got {}",
-                          json_input::type_name(root.json())));
+    root.fail(
+        fmt::format("must be a JSON object from 'rwcalc analyze --json', 'batch --json' or 'diagnose --json', "
+                    "got {}",
+                    json_input::type_name(root.json())));
   const json& j = root.json();
   const Checker shown(RunKeys::Shown);
   // A batch has an array of runs; a diagnosis also has "runs", the size of its ensemble.

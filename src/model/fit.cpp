@@ -193,7 +193,6 @@ double bartlett(double nu) {
   return -nu * (boost::math::digamma(nu / 2.0) - std::log(nu / 2.0));
 }
 
-
 /// Illinois false position for f(a)·f(b) < 0; returns the root to a relative tolerance.
 template <class F>
 double find_root(F&& f, double a, double fa, double b, double fb) {
@@ -442,8 +441,8 @@ void require_converged(const IrlsResult& r) {
 
 /// The points in the fit range with enough EDF, τ ascending; throws when too few remain.
 std::vector<FitPoint> points_in_range(std::span<const FitPoint> points, const FitOptions& options) {
-  if (!(options.dispersion > 0) || !(options.confidence > 0 && options.confidence < 1) ||
-      !(options.edf_cap >= 0) || !(options.edf_inflation >= 0))
+  if (!(options.dispersion > 0) || !(options.confidence > 0 && options.confidence < 1) || !(options.edf_cap >= 0) ||
+      !(options.edf_inflation >= 0))
     throw UsageError("fit options: dispersion and EDF cap must be positive, confidence in (0, 1)");
   int n_enabled = 0;
   for (bool e : options.enabled) n_enabled += e ? 1 : 0;
@@ -453,20 +452,20 @@ std::vector<FitPoint> points_in_range(std::span<const FitPoint> points, const Fi
     if (!(p.tau_s >= options.tau_min_s && p.tau_s <= options.tau_max_s)) continue;
     if (!(p.edf >= options.min_edf)) continue;
     if (!std::isfinite(p.var) || !(p.var > 0))
-      throw AnalysisError(fmt::format(
-          "the Allan variance at tau = {:g} s is {:g}: the record holds no noise there (constant "
-          "or perfectly regular data); no noise model can be fitted",
-          p.tau_s, p.var));
+      throw AnalysisError(
+          fmt::format("the Allan variance at tau = {:g} s is {:g}: the record holds no noise there (constant "
+                      "or perfectly regular data); no noise model can be fitted",
+                      p.tau_s, p.var));
     used.push_back(p);
   }
   std::sort(used.begin(), used.end(), [](const auto& a, const auto& b) { return a.tau_s < b.tau_s; });
   const int j = static_cast<int>(used.size());
   if (j < n_enabled + 1)
-    throw AnalysisError(fmt::format(
-        "only {} Allan-variance point(s) with at least {:g} degrees of freedom lie in the fit range "
-        "{:g}..{:g} s; a fit of {} terms needs at least {} (use a longer record or a wider "
-        "--fit-range)",
-        j, options.min_edf, options.tau_min_s, options.tau_max_s, n_enabled, n_enabled + 1));
+    throw AnalysisError(
+        fmt::format("only {} Allan-variance point(s) with at least {:g} degrees of freedom lie in the fit range "
+                    "{:g}..{:g} s; a fit of {} terms needs at least {} (use a longer record or a wider "
+                    "--fit-range)",
+                    j, options.min_edf, options.tau_min_s, options.tau_max_s, n_enabled, n_enabled + 1));
   return used;
 }
 
@@ -483,7 +482,8 @@ Stage fit_full_model(std::vector<FitPoint>& used, const FitOptions& options, boo
     const Eigen::MatrixXd cov0 = av_covariance(used, c0, true);  // only its diagonal is used
     for (std::size_t r = 0; r < used.size(); ++r) {
       const double v = cov0(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(r));
-      if (v > 0 && std::isfinite(v)) used[r].edf = 2.0 * mu0[static_cast<Eigen::Index>(r)] * mu0[static_cast<Eigen::Index>(r)] / v;
+      if (v > 0 && std::isfinite(v))
+        used[r].edf = 2.0 * mu0[static_cast<Eigen::Index>(r)] * mu0[static_cast<Eigen::Index>(r)] / v;
     }
     full.pr = make_problem(used, opt);
     full.fit = irls(full.pr, full.pr.enabled_mask, c0.cwiseQuotient(full.pr.scale), false);
@@ -600,7 +600,8 @@ Coefficient coefficient_interval(int i, const Stage& sel, const Stage& full, boo
   co.high = kf * upper_root(prof, i, t_hat, step, thr);
   co.value = co.resolved ? co.estimate : co.high;
   // Delta method for a resolved term: coefficient = k√c → sd = k·sd(c)/(2√c).
-  co.sigma = co.resolved ? kCoefScale[ui] * std::sqrt(res.cov_c(i, i)) / (2.0 * std::sqrt(res.c[i])) : co.high / (2.0 * z);
+  co.sigma =
+      co.resolved ? kCoefScale[ui] * std::sqrt(res.cov_c(i, i)) / (2.0 * std::sqrt(res.c[i])) : co.high / (2.0 * z);
   return co;
 }
 
@@ -612,8 +613,7 @@ std::string_view term_name(Term t) {
 }
 
 std::string_view term_unit(Term t) {
-  static constexpr std::array<std::string_view, P> u{"arcsec", "deg/sqrt(h)", "deg/h", "deg/h/sqrt(h)",
-                                                     "deg/h^2"};
+  static constexpr std::array<std::string_view, P> u{"arcsec", "deg/sqrt(h)", "deg/h", "deg/h/sqrt(h)", "deg/h^2"};
   return u[static_cast<std::size_t>(idx(t))];
 }
 
@@ -628,7 +628,9 @@ double term_basis(Term t, double tau_s) {
   return 0;
 }
 
-double coefficient_from_c(Term t, double c) { return kCoefScale[static_cast<std::size_t>(idx(t))] * std::sqrt(std::max(c, 0.0)); }
+double coefficient_from_c(Term t, double c) {
+  return kCoefScale[static_cast<std::size_t>(idx(t))] * std::sqrt(std::max(c, 0.0));
+}
 
 double c_from_coefficient(Term t, double value) {
   const double s = value / kCoefScale[static_cast<std::size_t>(idx(t))];
@@ -712,7 +714,8 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
   std::array<bool, P> dropped{};
   IrlsResult best = full.fit;
   res.options = opt;
-  if (options.select_terms) std::tie(res.options, best) = select_terms(res.used, opt, full.fit, phi_full, chi2_1, dropped);
+  if (options.select_terms)
+    std::tie(res.options, best) = select_terms(res.used, opt, full.fit, phi_full, chi2_1, dropped);
   Stage sel{make_problem(res.used, res.options), {}};
   sel.fit = irls(sel.pr, sel.pr.enabled_mask, best.d, false);
   require_converged(sel.fit);

@@ -122,8 +122,9 @@ DirectNResult direct_n(const PhaseSeries& x, const MethodOptions& o) {
   r.segments_used = static_cast<int>(slopes.size());
   if (slopes.size() < 3) return r;
   const double se_b = std::sqrt(sample_variance(slopes) / static_cast<double>(slopes.size()));
-  const double tq = boost::math::quantile(
-      boost::math::students_t_distribution<double>(static_cast<double>(slopes.size() - 1)), 0.975);
+  const double tq =
+      boost::math::quantile(boost::math::students_t_distribution<double>(static_cast<double>(slopes.size() - 1)),
+                            0.975);
 
   // b = N² in ″²/s = (°/h)²·s; N[°/√h] = √b / 60.
   auto& e = r.N;

@@ -76,10 +76,16 @@ ParameterVerdict decide_one(const std::string& name, const std::string& unit, co
 nlohmann::json opt_class(const std::optional<int>& c) { return c ? nlohmann::json(*c) : nlohmann::json(nullptr); }
 
 nlohmann::json param_json(const ParameterVerdict& p) {
-  return {{"value", p.value},         {"unit", p.unit},          {"resolved", p.resolved},
-          {"class", opt_class(p.cls)}, {"class_strict", opt_class(p.cls_strict)},
-          {"limits", p.limit},        {"margin_pct", p.margin_pct}, {"p_meets", p.p_meets},
-          {"p_is", p.p_is},           {"p_class", p.p_class}};
+  return {{"value", p.value},
+          {"unit", p.unit},
+          {"resolved", p.resolved},
+          {"class", opt_class(p.cls)},
+          {"class_strict", opt_class(p.cls_strict)},
+          {"limits", p.limit},
+          {"margin_pct", p.margin_pct},
+          {"p_meets", p.p_meets},
+          {"p_is", p.p_is},
+          {"p_class", p.p_class}};
 }
 
 }  // namespace
@@ -118,9 +124,10 @@ ClassTable ClassTable::parse(std::string_view text, const std::string& source) {
     if (!t.classes.empty()) {
       const auto& p = t.classes.back();
       if (l.cls <= p.cls || l.B_deg_per_h < p.B_deg_per_h || l.N_deg_per_sqrt_h < p.N_deg_per_sqrt_h)
-        c.fail(fmt::format("(class {}): classes must be listed best first, with ascending numbers and "
-                           "non-decreasing limits",
-                           l.cls));
+        c.fail(
+            fmt::format("(class {}): classes must be listed best first, with ascending numbers and "
+                        "non-decreasing limits",
+                        l.cls));
     }
     t.classes.push_back(l);
   }
@@ -230,7 +237,8 @@ std::string describe_class(const std::vector<double>& p_is, const std::optional<
                            const std::vector<int>& classes, double decisive) {
   if (p_is.size() != classes.size() + 1) throw UsageError("class probabilities do not match the class table");
   const std::size_t n = classes.size();
-  const std::size_t s = cls ? static_cast<std::size_t>(std::find(classes.begin(), classes.end(), *cls) - classes.begin()) : n;
+  const std::size_t s =
+      cls ? static_cast<std::size_t>(std::find(classes.begin(), classes.end(), *cls) - classes.begin()) : n;
   auto label = [&](std::size_t k) { return k < n ? fmt::format("{}", classes[k]) : std::string("outside"); };
   if (p_is[s] >= decisive || n == 0) {
     if (s == n) return fmt::format("outside class {} (P={:.2f})", classes.empty() ? 0 : classes.back(), p_is[s]);

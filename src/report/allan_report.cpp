@@ -26,7 +26,9 @@ std::string format_allan_table(const AllanResult& r, const AllanReportInfo& info
     out += fmt::format("   rate: {:g} Hz{}", info.rate_hz,
                        info.rate_source.empty() ? "" : fmt::format(" ({})", info.rate_source));
   out += "\n";
-  out += "# α: noise exponent of S(f) ∝ f^α: +2 white angle/PM, +1 flicker PM, 0 white rate/FM, −1 flicker FM, −2 random walk\n";
+  out +=
+      "# α: noise exponent of S(f) ∝ f^α: +2 white angle/PM, +1 flicker PM, 0 white rate/FM, −1 flicker FM, −2 random "
+      "walk\n";
   const std::string dev_hdr = fmt::format("σ ({})", u);
   out += fmt::format("{:>9} {:>13} {:>10} {:>3} {:>11} {:>13} {:>13} {:>13}\n", "AF", "τ (s)", "terms", "α", "EDF",
                      "σ_min", dev_hdr.size() <= 13 ? dev_hdr : std::string("σ"), "σ_max");

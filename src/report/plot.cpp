@@ -127,8 +127,8 @@ std::string loglog_preamble(const std::string& title, const std::string& ylabel,
       gnuplot_string(title), gnuplot_string(ylabel), x0, x1, y0, y1, rows);
 }
 
-Figure loglog_figure(const char* name, const PlotOptions& options, const std::string& title,
-                     const std::string& ylabel, const Bounds& b, const std::string& body, const PlotCommand& plot) {
+Figure loglog_figure(const char* name, const PlotOptions& options, const std::string& title, const std::string& ylabel,
+                     const Bounds& b, const std::string& body, const PlotCommand& plot) {
   Figure f;
   f.name = name;
   f.height_px = options.height_px;
@@ -195,9 +195,8 @@ void add_model(const json& fit, std::string& vars, PlotCommand& plot) {
                                        gnuplot_string(fmt::format("{} = {} {}", t.label, show(v), t.unit))));
     } else if (const double bound = c.high95.value_or(v); !c.resolved && bound > 0) {
       vars += fmt::format("{}_up95 = {:.8g}   # {}, 95 % upper bound\n", t.var, bound, t.unit);
-      term_lines.push_back(
-          fmt::format("{}(x, {}_up95) w l lw 1.2 dt 3 lc rgb '{}' t {}", t.fn, t.var, t.colour,
-                      gnuplot_string(fmt::format("{} < {} {} (95 %)", t.label, show(bound), t.unit))));
+      term_lines.push_back(fmt::format("{}(x, {}_up95) w l lw 1.2 dt 3 lc rgb '{}' t {}", t.fn, t.var, t.colour,
+                                       gnuplot_string(fmt::format("{} < {} {} (95 %)", t.label, show(bound), t.unit))));
     }
   }
   vars += model + ")\n";
@@ -296,17 +295,18 @@ Figure analysis_figure(const json& analysis, const PlotOptions& options) {
   const auto& allan = at(analysis, "allan");
   const auto rows = allan_rows(allan);
   if (rows.empty())
-    throw AnalysisError("the analysis has no Allan deviation points (allan.points with tau_s and dev): "
-                        "nothing to plot");
+    throw AnalysisError(
+        "the analysis has no Allan deviation points (allan.points with tau_s and dev): "
+        "nothing to plot");
   Bounds bounds;
   for (const auto& r : rows) bounds.x(r.tau), bounds.y(r.low, r.high);
   std::string body;
   append_allan_block(body, "allan", rows);
   PlotCommand plot;
   const auto conf = num(allan, "confidence");
-  plot.add(fmt::format("$allan u 1:2:3:4 w yerrorbars pt 7 ps 0.55 lw 1.2 lc rgb '#222222' t {}",
-                       gnuplot_string(conf ? fmt::format("measured σ(τ), {:g} % bounds", *conf * 100)
-                                           : "measured σ(τ)")));
+  plot.add(
+      fmt::format("$allan u 1:2:3:4 w yerrorbars pt 7 ps 0.55 lw 1.2 lc rgb '#222222' t {}",
+                  gnuplot_string(conf ? fmt::format("measured σ(τ), {:g} % bounds", *conf * 100) : "measured σ(τ)")));
   if (is_gyro(allan)) {
     body += kTermFunctions;
     if (const auto& fit = at(analysis, "fit"); fit.is_object()) add_model(fit, body, plot);
@@ -393,14 +393,14 @@ Figure batch_direct_figure(const json& runs, const PlotOptions& options) {
     if (slope) {
       vars += fmt::format("slope{0} = {1:.8g}   # {3}/s\nintercept{0} = {2:.8g}   # {3}\n", i + 1, *slope,
                           intercept.value_or(0.0), lbl::angle2);
-      plot.add(fmt::format("[0:{2:.6g}] intercept{0} + slope{0} * x w l lw 1.6 lc rgb '{1}' notitle", i + 1,
-                           colour, run_tmax));
+      plot.add(fmt::format("[0:{2:.6g}] intercept{0} + slope{0} * x w l lw 1.6 lc rgb '{1}' notitle", i + 1, colour,
+                           run_tmax));
     }
   }
   if (plot.elements.empty()) return f;
-  const std::string title = options.title.empty()
-                                ? "Direct method: variance of the angle over t (Earth rate removed), with regression lines"
-                                : options.title + " — direct method";
+  const std::string title =
+      options.title.empty() ? "Direct method: variance of the angle over t (Earth rate removed), with regression lines"
+                            : options.title + " — direct method";
   // The variance grows with t, so the upper-left corner is empty: the key goes there.
   f.script = fmt::format(
       "set encoding utf8\nset title {} noenhanced\n"
@@ -472,8 +472,9 @@ Figure diagnosis_figure(const json& diagnosis, const PlotOptions& options) {
   const auto base = band_rows(band_of(diagnosis, false));
   const auto ext = band_rows(band_of(diagnosis, true));
   if (base.empty())
-    throw AnalysisError("the diagnosis has no simulated band (band or base_model.band, with tau_s, band_low, "
-                        "band_high): nothing to plot");
+    throw AnalysisError(
+        "the diagnosis has no simulated band (band or base_model.band, with tau_s, band_low, "
+        "band_high): nothing to plot");
   std::string blocks;
   PlotCommand plot;
   Bounds bounds;

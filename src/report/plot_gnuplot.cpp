@@ -71,8 +71,8 @@ struct ProcessResult {
 
 /// Run `command args…` with stdin from /dev/null and stdout+stderr captured in `log`; in the
 /// directory `cwd` when it is not empty.
-ProcessResult run_process(const std::string& command, const std::vector<std::string>& args,
-                          const fs::path& log, const fs::path& cwd = {}) {
+ProcessResult run_process(const std::string& command, const std::vector<std::string>& args, const fs::path& log,
+                          const fs::path& cwd = {}) {
   ProcessResult r;
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
@@ -83,9 +83,8 @@ ProcessResult run_process(const std::string& command, const std::vector<std::str
   // A relative command path names a file from our directory, not from `cwd`.
   std::error_code ec;
   const auto absolute = fs::absolute(command, ec);
-  std::vector<std::string> storage{!cwd.empty() && command.find('/') != std::string::npos && !ec
-                                       ? absolute.string()
-                                       : command};
+  std::vector<std::string> storage{!cwd.empty() && command.find('/') != std::string::npos && !ec ? absolute.string()
+                                                                                                 : command};
   storage.insert(storage.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (auto& s : storage) argv.push_back(s.data());
@@ -111,10 +110,10 @@ ProcessResult run_process(const std::string& command, const std::vector<std::str
 /// Throws when gnuplot could not be started (a shell wrapper reports a missing binary as 127).
 void require_started(const ProcessResult& r, const std::string& command) {
   if (r.started && r.status != 127) return;
-  throw OutputError(fmt::format(
-      "cannot run gnuplot ('{}': {}): plots need gnuplot; install it (Debian: apt-get install "
-      "gnuplot-nox) or name the binary in the environment variable RWCALC_GNUPLOT",
-      command, std::strerror(r.started ? ENOENT : r.spawn_errno)));
+  throw OutputError(
+      fmt::format("cannot run gnuplot ('{}': {}): plots need gnuplot; install it (Debian: apt-get install "
+                  "gnuplot-nox) or name the binary in the environment variable RWCALC_GNUPLOT",
+                  command, std::strerror(r.started ? ENOENT : r.spawn_errno)));
 }
 
 /// The last `lines` lines of gnuplot's message (they carry the error) joined by " | ", without the
@@ -154,8 +153,8 @@ PlotFormat plot_format_for(std::string_view path) {
   if (ext == ".svg") return PlotFormat::Svg;
   if (ext == ".png") return PlotFormat::Png;
   if (ext == ".pdf") return PlotFormat::Pdf;
-  throw UsageError(fmt::format("{}: unknown figure format '{}'; name the file .svg, .png or .pdf",
-                               path, ext.empty() ? std::string("(no extension)") : ext));
+  throw UsageError(fmt::format("{}: unknown figure format '{}'; name the file .svg, .png or .pdf", path,
+                               ext.empty() ? std::string("(no extension)") : ext));
 }
 
 std::string gnuplot_command() {
@@ -194,9 +193,10 @@ std::string full_script(const std::vector<Figure>& figures, PlotFormat format, i
   s += "set encoding utf8\n";
   switch (format) {
     case PlotFormat::Svg:
-      s += fmt::format("set terminal svg size {},{} fixed enhanced font 'Helvetica,13' linewidth 1.2 "
-                       "background '#ffffff'\n",
-                       width_px, height);
+      s += fmt::format(
+          "set terminal svg size {},{} fixed enhanced font 'Helvetica,13' linewidth 1.2 "
+          "background '#ffffff'\n",
+          width_px, height);
       break;
     case PlotFormat::Png:
       // pngcairo draws anti-aliased lines; the plain gd png terminal is the fallback.
@@ -210,9 +210,10 @@ std::string full_script(const std::vector<Figure>& figures, PlotFormat format, i
           width_px, height);
       break;
     case PlotFormat::Pdf:
-      s += fmt::format("set terminal pdfcairo size {:.2f}in,{:.2f}in enhanced font 'Helvetica,9' "
-                       "linewidth 1.2 background '#ffffff'\n",
-                       width_px / 96.0, height / 96.0);
+      s += fmt::format(
+          "set terminal pdfcairo size {:.2f}in,{:.2f}in enhanced font 'Helvetica,9' "
+          "linewidth 1.2 background '#ffffff'\n",
+          width_px / 96.0, height / 96.0);
       break;
   }
   s += fmt::format("set output {}\n", gnuplot_string(output_path));
@@ -239,8 +240,9 @@ std::string render_figures(const std::vector<Figure>& figures, PlotFormat format
   ScratchDir dir;
   // gnuplot runs inside the scratch directory and names its files relative to it, so no path
   // (the temporary directory's comes from TMPDIR) is ever written into the script.
-  const std::string out_name = std::string("figure") +
-                               (format == PlotFormat::Svg ? ".svg" : format == PlotFormat::Png ? ".png" : ".pdf");
+  const std::string out_name = std::string("figure") + (format == PlotFormat::Svg   ? ".svg"
+                                                        : format == PlotFormat::Png ? ".png"
+                                                                                    : ".pdf");
   const fs::path out = dir.path() / out_name;
   const fs::path script = dir.path() / "figure.gp";
   {

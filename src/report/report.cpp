@@ -223,10 +223,12 @@ std::string table2(const std::vector<json>& a, const std::vector<std::size_t>& o
   }
   s += fmt::format(
       "<tr><th colspan=\"2\">over the temperature range</th><td class=\"num\"><b>{}</b></td><td></td>"
-      "<td class=\"num\"><b>{}</b></td><td></td><td class=\"num\"><b>{}</b></td><td>worst case over the runs</td></tr>\n",
+      "<td class=\"num\"><b>{}</b></td><td></td><td class=\"num\"><b>{}</b></td><td>worst case over the "
+      "runs</td></tr>\n",
       class_text(at(overall, "class_N")), class_text(at(overall, "class_B")), class_text(at(overall, "class")));
-  return s + "</table>\n<p class=\"meta\">Classes by N direct and by B 100-s compare the reported value with the "
-             "class limits only (no probability); the verdict uses the estimates named in the settings.</p>\n";
+  return s +
+         "</table>\n<p class=\"meta\">Classes by N direct and by B 100-s compare the reported value with the "
+         "class limits only (no probability); the verdict uses the estimates named in the settings.</p>\n";
 }
 
 std::string kv_row(std::string_view key, const std::string& value_html) {
@@ -288,7 +290,8 @@ std::string outliers_html(const json& outliers) {
 }
 
 std::string data_table(const json& run, std::size_t index) {
-  std::string s = fmt::format("<table class=\"run\" id=\"run{}-data\">\n<caption>Data and rates</caption>\n", index + 1);
+  std::string s =
+      fmt::format("<table class=\"run\" id=\"run{}-data\">\n<caption>Data and rates</caption>\n", index + 1);
   s += kv_row("file", esc(str(run, "source")));
   if (const auto n = num(run, "samples")) s += kv_row("samples", fmt::format("{:.0f}", *n));
   if (const auto r = num(run, "rate_hz")) s += kv_row("sample rate", fmt::format("{:g} Hz", *r));
@@ -306,10 +309,11 @@ std::string data_table(const json& run, std::size_t index) {
 }
 
 std::string fit_table(const json& fit, std::size_t index) {
-  std::string s = fmt::format("<table class=\"run\" id=\"run{}-fit\">\n<caption>Allan-variance fit "
-                              "σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)B² + K²τ/3 + R²τ²/2</caption>\n"
-                              "<tr><th>term</th><th>value ± standard error [95 %]</th><th>unit</th></tr>\n",
-                              index + 1);
+  std::string s = fmt::format(
+      "<table class=\"run\" id=\"run{}-fit\">\n<caption>Allan-variance fit "
+      "σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)B² + K²τ/3 + R²τ²/2</caption>\n"
+      "<tr><th>term</th><th>value ± standard error [95 %]</th><th>unit</th></tr>\n",
+      index + 1);
   static constexpr std::array<std::array<const char*, 3>, 5> kCoefficientRows{
       {{"Q_arcsec", "Q quantization", lbl::angle},
        {"N_deg_per_sqrt_h", "N angle random walk", lbl::arw},
@@ -338,10 +342,15 @@ std::string run_summary(const json& run, std::size_t index) {
 
 /// A number of a finding with the unit its key names as a suffix (frequency_hz, time_s…).
 std::string number_with_unit_key(std::string_view key, const json& v) {
-  static constexpr std::array<std::pair<const char*, const char*>, 9> kUnits{
-      {{"_deg_per_h_per_sqrt_h", lbl::rrw}, {"_deg_per_sqrt_h", lbl::arw}, {"_deg_per_h2", lbl::ramp},
-       {"_deg_per_h", lbl::rate}, {"_arcsec", lbl::angle}, {"_hz", "Hz"}, {"_s", "s"}, {"_c", lbl::celsius},
-       {"_pct", "%"}}};
+  static constexpr std::array<std::pair<const char*, const char*>, 9> kUnits{{{"_deg_per_h_per_sqrt_h", lbl::rrw},
+                                                                              {"_deg_per_sqrt_h", lbl::arw},
+                                                                              {"_deg_per_h2", lbl::ramp},
+                                                                              {"_deg_per_h", lbl::rate},
+                                                                              {"_arcsec", lbl::angle},
+                                                                              {"_hz", "Hz"},
+                                                                              {"_s", "s"},
+                                                                              {"_c", lbl::celsius},
+                                                                              {"_pct", "%"}}};
   if (!v.is_number()) return json_value_html(v);
   for (const auto& [suffix, unit] : kUnits)
     if (key.size() > std::string_view(suffix).size() && key.ends_with(suffix))
@@ -368,9 +377,10 @@ std::string findings_html(const json& findings, std::size_t index) {
 
 std::string gain_html(const json& gain, std::size_t index) {
   if (!gain.is_object()) return {};
-  std::string s = fmt::format("<table id=\"run{}-gain\">\n<caption>Gain of the extended model</caption>\n"
-                              "<tr><th>measure</th><th>base model</th><th>extended model</th></tr>\n",
-                              index + 1);
+  std::string s = fmt::format(
+      "<table id=\"run{}-gain\">\n<caption>Gain of the extended model</caption>\n"
+      "<tr><th>measure</th><th>base model</th><th>extended model</th></tr>\n",
+      index + 1);
   static constexpr std::array<std::array<const char*, 3>, 3> kRows{
       {{"Allan-variance misfit (EDF-weighted)", "misfit_base", "misfit_extended"},
        {"share of measured τ inside the simulated band", "coverage_base", "coverage_extended"},
@@ -416,9 +426,10 @@ std::string verdict_html(const std::vector<json>& a, const std::vector<std::size
   h += "</ul>\n";
   const auto& v0 = at(a[order.front()], "verdict");
   if (const auto t = num(v0, "tolerance_pct"); t && *t > 0)
-    h += fmt::format("<p class=\"note\">The seed paper's heading-gyro rule is applied: a B up to {:g} % above a "
-                     "class limit is accepted for that class.</p>\n",
-                     *t);
+    h += fmt::format(
+        "<p class=\"note\">The seed paper's heading-gyro rule is applied: a B up to {:g} % above a "
+        "class limit is accepted for that class.</p>\n",
+        *t);
   h += "<p class=\"meta\">P is the probability, from the estimates' uncertainty, that the true class is the one "
        "stated; where it is low the runner-up class is named.";
   if (auto table = str(v0, "table"); !table.empty()) h += " Class table: " + esc(table) + ".";
@@ -436,8 +447,9 @@ std::string batch_figures_html(const std::vector<json>& a, Figures& figures) {
                             fmt::format("Direct method: variance of the angle accumulated over t, Earth rate removed, "
                                         "with the regression line per temperature (slope (60·N)² {}/s)",
                                         lbl::angle2));
-  return h + "<p class=\"note\">The direct-method curves are not in the analysis results, so the angle-variance "
-             "figure is left out.</p>\n";
+  return h +
+         "<p class=\"note\">The direct-method curves are not in the analysis results, so the angle-variance "
+         "figure is left out.</p>\n";
 }
 
 std::string settings_html(const ReportOptions& options, const json& first) {
@@ -445,7 +457,8 @@ std::string settings_html(const ReportOptions& options, const json& first) {
   h += kv_row("rwcalc version", RWCALC_VERSION);
   if (options.settings.is_object())
     for (const auto& [k, v] : options.settings.items()) h += kv_row(k, json_value_html(v));
-  if (auto b = str(at(first, "verdict"), "b_estimate"); !b.empty()) h += kv_row("B estimate used by the verdict", esc(b));
+  if (auto b = str(at(first, "verdict"), "b_estimate"); !b.empty())
+    h += kv_row("B estimate used by the verdict", esc(b));
   if (const auto& conventions = at(first, "conventions"); conventions.is_object())
     for (const auto& [k, v] : conventions.items()) h += kv_row("convention: " + k, json_value_html(v));
   return h + "</table>\n";
@@ -459,7 +472,8 @@ std::string report_html(const ReportInput& input, const ReportOptions& options) 
   const auto order = view::by_temperature(a);
   json overall = input.overall;
   if (!overall.is_object())
-    overall = {{"class_B", worst_class(a, "class_B")}, {"class_N", worst_class(a, "class_N")},
+    overall = {{"class_B", worst_class(a, "class_B")},
+               {"class_N", worst_class(a, "class_N")},
                {"class", worst_class(a, "class")}};
   Figures figures{options.figures};
 

@@ -13,7 +13,6 @@ namespace rwcalc {
 
 namespace {
 
-
 // 1 − (3 − 4e^{−x} + e^{−2x})/(2x) without cancellation (x > 0).
 double gm_avar_factor(double x) {
   if (x < 0.5) {
@@ -60,7 +59,9 @@ void validate(const NoiseModel& m, const SimulationSettings& s) {
   check_positive(s.duration_s, "duration_s");
   check_positive(s.rate_hz, "rate_hz");
   check_positive(s.scale_arcsec, "scale_arcsec");
-  if (s.samples() < 2) throw UsageError(fmt::format("the record must hold at least 2 samples (duration {} s at {} Hz)", s.duration_s, s.rate_hz));
+  if (s.samples() < 2)
+    throw UsageError(
+        fmt::format("the record must hold at least 2 samples (duration {} s at {} Hz)", s.duration_s, s.rate_hz));
   if (s.samples() > (std::size_t{1} << 31)) throw UsageError("the record is too long (more than 2^31 samples)");
   if (s.temperature_c) check_finite(*s.temperature_c, "temperature_c");
   check_finite_nonneg(m.arw_deg_per_sqrt_h, "arw_deg_per_sqrt_h");
@@ -95,7 +96,8 @@ void validate(const NoiseModel& m, const SimulationSettings& s) {
     check_finite(tb.profile.start_c, "temperature profile start_c");
     check_finite(tb.profile.end_c, "temperature profile end_c");
     check_finite(tb.profile.amp_c, "temperature profile amp_c");
-    if (tb.profile.kind == TemperatureProfile::Kind::Cycle) check_positive(tb.profile.period_s, "temperature profile period_s");
+    if (tb.profile.kind == TemperatureProfile::Kind::Cycle)
+      check_positive(tb.profile.period_s, "temperature profile period_s");
   }
 }
 
@@ -126,9 +128,9 @@ double flicker_avar(double b, std::size_t m) {
 
 double theoretical_avar(const NoiseModel& model, double tau0, double q, std::size_t m) {
   const double tau = static_cast<double>(m) * tau0;
-  const double n_s = units::sqrt_s_per_sqrt_h * model.arw_deg_per_sqrt_h;     // ″/√s
+  const double n_s = units::sqrt_s_per_sqrt_h * model.arw_deg_per_sqrt_h;        // ″/√s
   const double k_s = model.rrw_deg_per_h_per_sqrt_h / units::sqrt_s_per_sqrt_h;  // ″/s/√s
-  const double r_s = model.ramp_deg_per_h2 / units::seconds_per_hour;        // ″/s²
+  const double r_s = model.ramp_deg_per_h2 / units::seconds_per_hour;            // ″/s²
   double av = n_s * n_s / tau + k_s * k_s * tau / 3.0 + r_s * r_s * tau * tau / 2.0;
   if (model.bias_instability_deg_per_h > 0) av += flicker_avar(model.bias_instability_deg_per_h, m);
   for (const auto& s : model.sinusoids) {

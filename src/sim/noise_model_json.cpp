@@ -2,10 +2,10 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <utility>
-#include <nlohmann/json.hpp>
 
 #include "core/json_input.hpp"
 #include "rwcalc/error.hpp"
@@ -108,8 +108,10 @@ void model_from(const Value& j, NoiseModel& m) {
     else
       readout->fail(fmt::format("must be \"counting\" or \"white\", got \"{}\"", r));
   }
-  for (const auto& [key, effect] : {std::pair{"sinusoids", "sinusoid"}, {"gauss_markov", "gauss_markov"},
-                                     {"bias_steps", "bias_step"}, {"warmups", "warmup"}})
+  for (const auto& [key, effect] : {std::pair{"sinusoids", "sinusoid"},
+                                    {"gauss_markov", "gauss_markov"},
+                                    {"bias_steps", "bias_step"},
+                                    {"warmups", "warmup"}})
     if (const auto list = j.find(key))
       for (const auto& x : list->elements()) add_effect(effect, x.object(), m);
   if (const auto terms = j.find("terms"))

@@ -33,7 +33,7 @@ double gm_angle_var_factor(double x) {
   if (x < 0.5) {
     // Series Σ_{n≥3} (−1)^{n+1}(2^{n−1} − 2) xⁿ/n!.
     double sum = 0.0, term = x * x / 2.0;  // x^n/n! for n = 2
-    double p2 = 2.0;                        // 2^{n−1} for n = 2
+    double p2 = 2.0;                       // 2^{n−1} for n = 2
     for (int n = 3; n < 40; ++n) {
       term *= x / n;
       p2 *= 2.0;
@@ -64,9 +64,9 @@ std::size_t good_fft_size(std::size_t n) {
 // two-sided PSD qc²: ε' = φε + u1, Δθ = Tc(1−φ)ε + u2, (u1, u2) Gaussian with the Cholesky
 // factor below. Used for Gauss–Markov rates and for low-pass-filtered white rate.
 struct GmStep {
-  double phi = 0.0, gain = 0.0;    // φ, Tc(1−φ)
+  double phi = 0.0, gain = 0.0;  // φ, Tc(1−φ)
   double l11 = 0.0, l21 = 0.0, l22 = 0.0;
-  double sigma0 = 0.0;             // stationary σ of ε
+  double sigma0 = 0.0;  // stationary σ of ε
   GmStep() = default;
   GmStep(double qc2, double tc, double tau0) {
     const double x = tau0 / tc;
@@ -102,13 +102,16 @@ double temperature_angle(const TemperatureBias& tb, double t, double t_nominal, 
 class OutputChainFilter {
  public:
   OutputChainFilter(double tf_s, double tau0_s, double q, std::int64_t last_count, std::size_t n)
-      : phi_(std::exp(-tau0_s / tf_s)), tau0_(tau0_s), q_(q),
+      : phi_(std::exp(-tau0_s / tf_s)),
+        tau0_(tau0_s),
+        q_(q),
         y_(static_cast<double>(last_count) * q / (static_cast<double>(n) * tau0_s)) {}
 
   // The angles θ of the next `len` counts (they follow the previous call's).
   void apply(const std::int64_t* counts, std::size_t len, double* angles) {
     for (std::size_t j = 0; j < len; ++j) {
-      const auto d = static_cast<std::int64_t>(static_cast<std::uint64_t>(counts[j]) - static_cast<std::uint64_t>(prev_));
+      const auto d =
+          static_cast<std::int64_t>(static_cast<std::uint64_t>(counts[j]) - static_cast<std::uint64_t>(prev_));
       const double r = static_cast<double>(d) * q_ / tau0_;
       y_ = phi_ * y_ + (1.0 - phi_) * r;
       theta_ += y_ * tau0_;
@@ -162,9 +165,9 @@ struct Simulator::Impl {
   NoiseModel model;
   SimulationSettings settings;
   SimulationPath path = SimulationPath::Exact;
-  std::size_t n = 0;      // samples
-  std::size_t flicker_n = 0;    // samples of the flicker rate (n, or ceil(n/D) when decimated)
-  std::size_t flicker_hold = 1; // samples each flicker rate value is held for (D)
+  std::size_t n = 0;             // samples
+  std::size_t flicker_n = 0;     // samples of the flicker rate (n, or ceil(n/D) when decimated)
+  std::size_t flicker_hold = 1;  // samples each flicker rate value is held for (D)
   double tau0 = 0.0;
   double q = 0.0;
   // Flicker: the Kasdin filter's spectrum, computed once per length.
@@ -181,8 +184,7 @@ struct Simulator::Impl {
   std::vector<std::vector<double>> warmup_steps;  // e^{−jτ0/Tc} for j < kBlock, per warm-up
   GmStep lowpass_arw;
 
-  Impl(NoiseModel m, SimulationSettings s, SimulationPath p)
-      : model(std::move(m)), settings(std::move(s)), path(p) {
+  Impl(NoiseModel m, SimulationSettings s, SimulationPath p) : model(std::move(m)), settings(std::move(s)), path(p) {
     validate(model, settings);
     n = settings.samples();
     flicker_n = n;
@@ -226,7 +228,8 @@ struct Simulator::Impl {
     const std::size_t taps = fft_size - flicker_n + 1;
     std::vector<double> h(fft_size, 0.0);
     h[0] = 1.0;
-    for (std::size_t k = 1; k < taps; ++k) h[k] = h[k - 1] * (0.5 + static_cast<double>(k) - 1.0) / static_cast<double>(k);
+    for (std::size_t k = 1; k < taps; ++k)
+      h[k] = h[k - 1] * (0.5 + static_cast<double>(k) - 1.0) / static_cast<double>(k);
     fft.fwd(filter_spectrum, h);
     spectrum.resize(filter_spectrum.size());
     flicker.resize(fft_size);
@@ -267,7 +270,9 @@ struct Simulator::Impl {
     double frac = 0.0;
     bool dither = false;
     explicit Pass(std::uint64_t seed)
-        : arw(seed, kArwStream), rrw(seed, kRrwStream), readout(seed, kReadoutStream),
+        : arw(seed, kArwStream),
+          rrw(seed, kRrwStream),
+          readout(seed, kReadoutStream),
           white(seed, kWhiteAngleStream),
           lp_arw(seed, kGaussMarkovStream0 + std::numeric_limits<std::uint32_t>::max()) {}
   };
@@ -317,8 +322,7 @@ struct Simulator::Impl {
       st.gm.emplace_back(seed, kGaussMarkovStream0 + i);
       st.gm_eps.push_back(st.gm.back().normal() * gm_steps[i].sigma0);  // stationary start
     }
-    if (model.lowpass_tc_s > 0 && model.arw_deg_per_sqrt_h > 0)
-      st.lp_arw_eps = lowpass_arw.sigma0 * st.lp_arw.normal();
+    if (model.lowpass_tc_s > 0 && model.arw_deg_per_sqrt_h > 0) st.lp_arw_eps = lowpass_arw.sigma0 * st.lp_arw.normal();
     start_quantize(st);
     double x[kBlock];
     std::int64_t counts[kBlock];
@@ -398,8 +402,8 @@ struct Simulator::Impl {
     }
     if (model.temperature_bias) {
       const auto& tb = *model.temperature_bias;
-      const double nominal = settings.temperature_c.value_or(
-          tb.profile.kind == TemperatureProfile::Kind::Ramp ? tb.profile.start_c : 0.0);
+      const double nominal =
+          settings.temperature_c.value_or(tb.profile.kind == TemperatureProfile::Kind::Ramp ? tb.profile.start_c : 0.0);
       const double record = static_cast<double>(n) * tau0;
       double prev = temperature_angle(tb, static_cast<double>(b) * tau0, nominal, record);
       for (std::size_t j = 0; j < len; ++j) {
@@ -472,7 +476,8 @@ struct Simulator::Impl {
     const std::string what = std::isfinite(pulses) ? fmt::format("is {:.6g} pulses", pulses) : "is not finite";
     throw UsageError(fmt::format(
         "the simulated angle at sample {} (t = {:.6g} s) {}, beyond the +-{:.6g} pulses a record can count, so the "
-        "record cannot be written; the model's terms (deg/h, arcsec) are too large for the pulse weight q = {:.6g} arcsec",
+        "record cannot be written; the model's terms (deg/h, arcsec) are too large for the pulse weight q = {:.6g} "
+        "arcsec",
         k, static_cast<double>(k) * tau0, what, kMaxSimulatedPulses, q));
   }
 

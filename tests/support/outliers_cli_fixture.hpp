@@ -13,16 +13,16 @@ namespace rwcalc::test {
 
 struct SpikedRecord {
   TempDir dir;
-  std::string clean;          ///< the simulated record
-  std::string spiked;         ///< the same with one spike
-  std::size_t spike_line = 0; ///< 1-based line of the spike in `spiked`
-  std::size_t samples = 0;    ///< data lines of either file
+  std::string clean;           ///< the simulated record
+  std::string spiked;          ///< the same with one spike
+  std::size_t spike_line = 0;  ///< 1-based line of the spike in `spiked`
+  std::size_t samples = 0;     ///< data lines of either file
 
   explicit SpikedRecord(double duration_s, std::uint64_t seed = 11) {
     clean = (dir.path() / "clean.csv").string();
     spiked = (dir.path() / "spiked.csv").string();
-    const auto r = run_exe({"simulate", "-o", clean, "--duration", std::to_string(duration_s), "--rate", "100",
-                            "--arw", "0.001", "--bias-instability", "0.005", "--seed", std::to_string(seed)});
+    const auto r = run_exe({"simulate", "-o", clean, "--duration", std::to_string(duration_s), "--rate", "100", "--arw",
+                            "0.001", "--bias-instability", "0.005", "--seed", std::to_string(seed)});
     EXPECT_EQ(r.status, 0) << r.err;
     std::istringstream in(slurp(clean));
     std::string text, line;

@@ -18,11 +18,11 @@ std::filesystem::path shared_data(const std::string& relative);
 std::filesystem::path source_path(const std::string& relative);
 
 /// Skip the current test with a clear message when the shared reference file is absent.
-#define RWCALC_REQUIRE_SHARED(path)                                                          \
-  do {                                                                                       \
-    if (!std::filesystem::exists(path))                                                      \
-      GTEST_SKIP() << "reference data not found: " << (path)                                 \
-                   << " (the ../shared folder beside the checkout is absent)";               \
+#define RWCALC_REQUIRE_SHARED(path)                                            \
+  do {                                                                         \
+    if (!std::filesystem::exists(path))                                        \
+      GTEST_SKIP() << "reference data not found: " << (path)                   \
+                   << " (the ../shared folder beside the checkout is absent)"; \
   } while (0)
 
 struct CliResult {
