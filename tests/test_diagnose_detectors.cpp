@@ -8,6 +8,7 @@
 #include "diagnose/detector.hpp"
 #include "rwcalc/allan.hpp"
 #include "rwcalc/simulate.hpp"
+#include "test_support.hpp"
 
 namespace {
 
@@ -36,15 +37,7 @@ SimulationSettings settings(std::uint64_t seed) {
 }
 
 /// A simulated record as a floating angle (the domain of the line and low-pass detectors).
-PhaseSeries record(const NoiseModel& m) {
-  const PhaseSeries x = simulate(m, settings(7));
-  PhaseSeries f;
-  f.tau0_s = x.tau0_s;
-  f.kind = x.kind;
-  f.values.resize(x.points());
-  for (std::size_t i = 0; i < x.points(); ++i) f.values[i] = x.diff(i, 0);
-  return f;
-}
+PhaseSeries record(const NoiseModel& m) { return test::floating_angle(simulate(m, settings(7))); }
 
 AnalysisResult octave_analysis(const PhaseSeries& x) {
   AnalysisResult a;

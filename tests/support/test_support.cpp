@@ -153,4 +153,14 @@ NoiseModel gl2d_model() {
   return m;
 }
 
+PhaseSeries floating_angle(const PhaseSeries& x) {
+  if (!x.exact()) return x;
+  PhaseSeries f;
+  f.tau0_s = x.tau0_s;
+  f.kind = x.kind;
+  f.values.resize(x.points());
+  for (std::size_t i = 0; i < x.points(); ++i) f.values[i] = x.diff(i, 0);
+  return f;
+}
+
 }  // namespace rwcalc::test

@@ -68,6 +68,10 @@ std::vector<std::string> gl2d_runs();
 /// `a` followed by `b`: argument lists put together.
 std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b);
 
+/// The same record as a floating angle x_i − x_0 (the domain of the line and low-pass detectors);
+/// a record that is already floating is returned as it is.
+PhaseSeries floating_angle(const PhaseSeries& x);
+
 /// Sets (or, with a null value, unsets) an environment variable for the lifetime of the object,
 /// then restores it.
 class ScopedEnv {
