@@ -100,6 +100,15 @@ TEST(AllanCli, GyroPulseFileGivesTableCsvAndJsonThatAgree) {
   const auto mdev = run_cli({"allan", gl2d().string(), "--estimator", "mdev", "--json", "--tau", "1,10"});
   ASSERT_EQ(mdev.status, 0) << mdev.err;
   EXPECT_EQ(nlohmann::json::parse(mdev.out).at("points").size(), 2u);
+  for (const char* est : {"ohdev", "hdev"}) {
+    const auto h = run_cli({"allan", gl2d().string(), "--estimator", est, "--json"});
+    ASSERT_EQ(h.status, 0) << h.err;
+    const auto hj = nlohmann::json::parse(h.out);
+    EXPECT_EQ(hj.at("estimator"), est);
+    EXPECT_GT(hj.at("points").size(), 15u);
+    const auto text = run_cli({"allan", gl2d().string(), "--estimator", est});
+    EXPECT_NE(text.out.find("Hadamard"), std::string::npos);
+  }
 }
 
 TEST(AllanCli, ErrorsAreReportedWithTheirExitStatus) {
@@ -116,7 +125,7 @@ TEST(AllanCli, ErrorsAreReportedWithTheirExitStatus) {
       {{"allan", file.string(), "--tau", "0.003"}, 2, "whole number of samples"},
       {{"allan", file.string(), "--tau", "10"}, 2, "beyond the longest"},
       {{"allan", file.string(), "--confidence", "1.5"}, 2, "confidence"},
-      {{"allan", file.string(), "--estimator", "hdev"}, 2, "estimator"},
+      {{"allan", file.string(), "--estimator", "tdev"}, 2, "ohdev or hdev"},
       {{"allan", file.string(), "--json", "--csv"}, 2, "excludes"},
       {{"allan", (dir.path() / "missing.txt").string()}, 2, "missing.txt"},
       {{"allan", two.string(), "--input", "angle"}, 1, "phase point"},

@@ -123,6 +123,8 @@ inline Estimator estimator_of(const Stable32Table& t) {
   if (t.sigma_type == "Allan") return Estimator::NonOverlapping;
   if (t.sigma_type == "Overlapping Allan") return Estimator::Overlapping;
   if (t.sigma_type == "Modified Allan") return Estimator::Modified;
+  if (t.sigma_type == "Overlapping Hadamard") return Estimator::OverlappingHadamard;
+  if (t.sigma_type == "Hadamard") return Estimator::NonOverlappingHadamard;
   throw std::runtime_error("unexpected Stable32 sigma type '" + t.sigma_type + "'");
 }
 

@@ -152,5 +152,28 @@ TEST(Stable32, OcxoOctaveBoundsAndNoiseType) {
     check_table(std::string("OCXO ") + f, x, clock_dir() / "ocxo" / f, /*sigma_exact=*/false);
 }
 
+// The Hadamard deviations (third differences, Greenhall–Riley EDF with d = 3) against the same
+// clock data: Stable32's "Hadamard" (non-overlapping) and "Overlapping Hadamard" tables.
+TEST(Stable32, HadamardGpsAndTimeIntervalCounter) {
+  const auto gps = clock_dir() / "gps/gps_1pps_phase_data.txt.gz";
+  const auto tic = clock_dir() / "Keysight53230A_ti_noise_floor";
+  RWCALC_REQUIRE_SHARED(gps);
+  RWCALC_REQUIRE_SHARED(tic / "tic_phase.txt");
+  const PhaseSeries g = phase_series(load_column(gps));
+  for (const char* f : {"stable32_HDEV_octave.txt", "stable32_OHDEV_octave.txt"})
+    check_table(std::string("GPS ") + f, g, clock_dir() / "gps" / f);
+  const PhaseSeries t = phase_series(load_column(tic / "tic_phase.txt"));
+  for (const char* f : {"tic_hdev.txt", "tic_ohdev.txt"}) check_table(std::string("TIC ") + f, t, tic / f);
+}
+
+TEST(Stable32, HadamardOcxoFrequency) {
+  RWCALC_REQUIRE_SHARED(clock_dir() / "ocxo/ocxo_frequency.txt");
+  const PhaseSeries x = ocxo_series();
+  for (const char* f : {"stable32_hdev_alltau.txt", "stable32_ohdev_alltau.txt"})
+    check_table(std::string("OCXO ") + f, x, clock_dir() / "ocxo" / f);
+  for (const char* f : {"hdev_octave.txt", "ohdev_octave.txt"})
+    check_table(std::string("OCXO ") + f, x, clock_dir() / "ocxo" / f, /*sigma_exact=*/false);
+}
+
 }  // namespace
 }  // namespace rwcalc::test

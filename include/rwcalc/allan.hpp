@@ -1,7 +1,7 @@
 #pragma once
 /// @file allan.hpp
 /// Allan-type variances of a PhaseSeries: fully overlapping AVAR (the workhorse), non-overlapping
-/// AVAR and modified AVAR, on a chosen τ grid, with noise identification, equivalent degrees of
+/// AVAR, modified AVAR and the Hadamard variance (overlapping and not), on a chosen τ grid, with noise identification, equivalent degrees of
 /// freedom and χ² confidence bounds as Stable32 computes them (NIST SP 1065; Greenhall & Riley 2003).
 ///
 /// For exact pulse data the second differences are formed in modular int64 arithmetic and their
@@ -18,7 +18,9 @@
 
 namespace rwcalc {
 
-enum class Estimator { Overlapping, NonOverlapping, Modified };
+/// The Hadamard variance takes third differences of the phase: a linear rate drift leaves it, and
+/// it converges for rate noise down to α = −4 (SP 1065 §5.2.8).
+enum class Estimator { Overlapping, NonOverlapping, Modified, OverlappingHadamard, NonOverlappingHadamard };
 
 /// τ grid: octave (m = 1, 2, 4, …; default), decade (Stable32's 1, 2, 4 per decade), dense[:P] (P
 /// log-spaced cluster sizes per decade; default 20), all (every m), or a list of τ in seconds.
@@ -34,12 +36,18 @@ struct TauGrid {
   static TauGrid parse(std::string_view spec);
 };
 
+/// True for the two Hadamard estimators.
+constexpr bool is_hadamard(Estimator e) {
+  return e == Estimator::OverlappingHadamard || e == Estimator::NonOverlappingHadamard;
+}
+
 /// Largest cluster size the estimator accepts for `points` phase points (at least one term: AVAR
-/// N − 2m ≥ 1, MVAR N − 3m + 1 ≥ 1); 0 when the record is too short for m = 1.
+/// N − 2m ≥ 1, MVAR N − 3m + 1 ≥ 1, HVAR N − 3m ≥ 1); 0 when the record is too short for m = 1.
 std::int64_t max_cluster_size(Estimator est, std::size_t points);
 
 /// Number of terms of the estimator's sum at cluster size m for `points` phase points
-/// (N − 2m overlapping, ⌊(N−1)/m⌋ − 1 non-overlapping, N − 3m + 1 modified; 0 if none).
+/// (N − 2m overlapping, ⌊(N−1)/m⌋ − 1 non-overlapping, N − 3m + 1 modified; Hadamard N − 3m
+/// overlapping, ⌊(N−1)/m⌋ − 2 non-overlapping; 0 if none).
 std::int64_t term_count(Estimator est, std::int64_t m, std::size_t points);
 
 /// The cluster sizes m of a grid for `points` phase points every tau0_s, increasing and distinct.
@@ -108,8 +116,9 @@ std::string format_allan_csv(const AllanResult& r);
 /// Unit label of the deviations for people: "°/h" for gyro data, "input units/s" otherwise.
 std::string unit_label(const AllanResult& r);
 
-std::string_view to_string(Estimator e);        ///< "oadev", "adev" or "mdev"
-std::string_view long_name(Estimator e);        ///< "overlapping Allan", "non-overlapping Allan", "modified Allan"
-Estimator parse_estimator(std::string_view s);  ///< "oadev"|"overlapping", "adev"|"nonoverlapping", "mdev"|"modified"
+std::string_view to_string(Estimator e);  ///< "oadev", "adev", "mdev", "ohdev" or "hdev" (Stable32's names)
+std::string_view long_name(Estimator e);  ///< "overlapping Allan", …, "overlapping Hadamard", "Hadamard"
+/// "oadev"|"overlapping", "adev"|"nonoverlapping", "mdev"|"modified", "ohdev", "hdev".
+Estimator parse_estimator(std::string_view s);
 
 }  // namespace rwcalc

@@ -88,6 +88,8 @@ std::int64_t max_cluster_size(Estimator est, std::size_t points) {
     case Estimator::Overlapping:
     case Estimator::NonOverlapping: return n >= 3 ? (n - 1) / 2 : 0;  // N − 2m ≥ 1
     case Estimator::Modified: return n >= 3 ? n / 3 : 0;              // N − 3m + 1 ≥ 1
+    case Estimator::OverlappingHadamard:
+    case Estimator::NonOverlappingHadamard: return n >= 4 ? (n - 1) / 3 : 0;  // N − 3m ≥ 1
   }
   return 0;
 }
@@ -100,6 +102,8 @@ std::int64_t term_count(Estimator est, std::int64_t m, std::size_t points) {
     case Estimator::Overlapping: t = n - 2 * m; break;
     case Estimator::NonOverlapping: t = n >= 1 ? (n - 1) / m - 1 : 0; break;
     case Estimator::Modified: t = n - 3 * m + 1; break;
+    case Estimator::OverlappingHadamard: t = n - 3 * m; break;
+    case Estimator::NonOverlappingHadamard: t = n >= 1 ? (n - 1) / m - 2 : 0; break;
   }
   return std::max<std::int64_t>(t, 0);
 }
@@ -198,7 +202,13 @@ double variance_at(const PhaseSeries& x, const CountData& data, std::int64_t m, 
                                    : detail::modified_sumsq(x.values.data(), n, m);
     return sumsq / (2.0 * md * md * tau * tau * static_cast<double>(n));
   }
-  const std::int64_t stride = est == Estimator::Overlapping ? 1 : m;
+  const bool overlapping = est == Estimator::Overlapping || est == Estimator::OverlappingHadamard;
+  const std::int64_t stride = overlapping ? 1 : m;
+  if (is_hadamard(est)) {  // HVAR = Σ (third difference)² / (6 τ² n)
+    const double sumsq = x.exact() ? static_cast<double>(detail::third_diff_sumsq(data.c, n, m, stride))
+                                   : detail::third_diff_sumsq(x.values.data(), n, m, stride);
+    return sumsq * sum_scale(x) / (6.0 * tau * tau * static_cast<double>(n));
+  }
   const double sumsq = x.exact() ? static_cast<double>(detail::second_diff_sumsq(data.c, n, m, stride))
                                  : detail::second_diff_sumsq(x.values.data(), n, m, stride);
   return avar_from_sum(sumsq, sum_scale(x), tau, n);
@@ -338,6 +348,8 @@ std::string_view to_string(Estimator e) {
     case Estimator::Overlapping: return "oadev";
     case Estimator::NonOverlapping: return "adev";
     case Estimator::Modified: return "mdev";
+    case Estimator::OverlappingHadamard: return "ohdev";
+    case Estimator::NonOverlappingHadamard: return "hdev";
   }
   return "?";
 }
@@ -347,6 +359,8 @@ std::string_view long_name(Estimator e) {
     case Estimator::Overlapping: return "overlapping Allan";
     case Estimator::NonOverlapping: return "non-overlapping Allan";
     case Estimator::Modified: return "modified Allan";
+    case Estimator::OverlappingHadamard: return "overlapping Hadamard";
+    case Estimator::NonOverlappingHadamard: return "Hadamard";
   }
   return "?";
 }
@@ -355,7 +369,9 @@ Estimator parse_estimator(std::string_view s) {
   if (s == "oadev" || s == "overlapping") return Estimator::Overlapping;
   if (s == "adev" || s == "nonoverlapping" || s == "non-overlapping") return Estimator::NonOverlapping;
   if (s == "mdev" || s == "modified") return Estimator::Modified;
-  throw UsageError(fmt::format("unknown estimator '{}' (expected oadev, adev or mdev)", s));
+  if (s == "ohdev") return Estimator::OverlappingHadamard;
+  if (s == "hdev") return Estimator::NonOverlappingHadamard;
+  throw UsageError(fmt::format("unknown estimator '{}' (expected oadev, adev, mdev, ohdev or hdev)", s));
 }
 
 }  // namespace rwcalc

@@ -18,35 +18,49 @@ constexpr std::uint64_t kHalfRange = std::uint64_t{1} << 26;
 // Terms per stretch of the sweep that one parallel_for item takes (a multiple of kBlock).
 constexpr std::int64_t kStretch = std::int64_t{1} << 16;
 
-inline std::uint64_t second_diff(const std::int64_t* c, std::int64_t k, std::int64_t m) {
-  return static_cast<std::uint64_t>(c[k + 2 * m]) - 2 * static_cast<std::uint64_t>(c[k + m]) +
-         static_cast<std::uint64_t>(c[k]);
+/// The d-th difference of the counts at lag m from k (2: Allan, 3: Hadamard), modulo 2^64: the
+/// signed difference whenever it fits in int64, whatever the counter's offset.
+template <int Order>
+inline std::uint64_t difference(const std::int64_t* c, std::int64_t k, std::int64_t m) {
+  auto at = [c, k, m](std::int64_t j) { return static_cast<std::uint64_t>(c[k + j * m]); };
+  if constexpr (Order == 2) return at(2) - 2 * at(1) + at(0);
+  else return at(3) - 3 * at(2) + 3 * at(1) - at(0);
 }
 
-/// Σ (C[k+2m] − 2C[k+m] + C[k])² over k = i·stride, i < len (len ≤ kBlock), exactly.
+/// Σ (d-th difference at k = i·stride)², i < len (len ≤ kBlock), exactly.
+template <int Order>
 u128 block_sumsq(const std::int64_t* c, std::int64_t len, std::int64_t m, std::int64_t stride) {
   std::uint64_t sum = 0, range = 0;
   for (std::int64_t i = 0; i < len; ++i) {
-    const std::uint64_t d = second_diff(c, i * stride, m);
+    const std::uint64_t d = difference<Order>(c, i * stride, m);
     range |= d + kHalfRange;  // below 2^27 for every d iff −2^26 ≤ d < 2^26
     sum += d * d;             // d² modulo 2^64: the square of the signed d
   }
   if ((range >> 27) == 0) return sum;
   u128 exact = 0;
   for (std::int64_t i = 0; i < len; ++i) {
-    const auto d = static_cast<std::int64_t>(second_diff(c, i * stride, m));
+    const auto d = static_cast<std::int64_t>(difference<Order>(c, i * stride, m));
     exact += static_cast<u128>(static_cast<i128>(d) * d);
   }
   return exact;
 }
 
+template <int Order>
+u128 difference_sumsq(const std::int64_t* c, std::int64_t n, std::int64_t m, std::int64_t stride) {
+  u128 total = 0;
+  for (std::int64_t i0 = 0; i0 < n; i0 += kBlock)
+    total += block_sumsq<Order>(c + i0 * stride, std::min(kBlock, n - i0), m, stride);
+  return total;
+}
+
 }  // namespace
 
 u128 second_diff_sumsq(const std::int64_t* c, std::int64_t n, std::int64_t m, std::int64_t stride) {
-  u128 total = 0;
-  for (std::int64_t i0 = 0; i0 < n; i0 += kBlock)
-    total += block_sumsq(c + i0 * stride, std::min(kBlock, n - i0), m, stride);
-  return total;
+  return difference_sumsq<2>(c, n, m, stride);
+}
+
+u128 third_diff_sumsq(const std::int64_t* c, std::int64_t n, std::int64_t m, std::int64_t stride) {
+  return difference_sumsq<3>(c, n, m, stride);
 }
 
 std::vector<u128> second_diff_sumsq_sweep(const std::int64_t* c, std::size_t points, std::span<const std::int64_t> ms) {
@@ -63,7 +77,7 @@ std::vector<u128> second_diff_sumsq_sweep(const std::int64_t* c, std::size_t poi
     for (std::int64_t k0 = from; k0 < to; k0 += kBlock) {
       for (std::size_t i = 0; i < count; ++i) {
         const std::int64_t n = np - 2 * ms[i];
-        if (k0 < n) out[i] += block_sumsq(c + k0, std::min(kBlock, n - k0), ms[i], 1);
+        if (k0 < n) out[i] += block_sumsq<2>(c + k0, std::min(kBlock, n - k0), ms[i], 1);
       }
     }
   });
@@ -96,6 +110,18 @@ double second_diff_sumsq(const double* x, std::int64_t n, std::int64_t m, std::i
       const double d = x[k + 2 * m] - 2.0 * x[k + m] + x[k];
       acc[i % kLanes] += d * d;
     }
+  }
+  double s = 0;
+  for (double v : acc) s += v;
+  return s;
+}
+
+double third_diff_sumsq(const double* x, std::int64_t n, std::int64_t m, std::int64_t stride) {
+  double acc[kLanes] = {};
+  for (std::int64_t i = 0; i < n; ++i) {
+    const std::int64_t k = i * stride;
+    const double d = x[k + 3 * m] - 3.0 * x[k + 2 * m] + 3.0 * x[k + m] - x[k];
+    acc[i % kLanes] += d * d;
   }
   double s = 0;
   for (double v : acc) s += v;

@@ -20,6 +20,11 @@ u128 second_diff_sumsq(const std::int64_t* c, std::int64_t n, std::int64_t m, st
 /// The same on floating phase (rounded sums).
 double second_diff_sumsq(const double* x, std::int64_t n, std::int64_t m, std::int64_t stride);
 
+/// Σ_{i<n} (C[k+3m] − 3C[k+2m] + 3C[k+m] − C[k])², k = i·stride (Hadamard), exactly; and on
+/// floating phase.
+u128 third_diff_sumsq(const std::int64_t* c, std::int64_t n, std::int64_t m, std::int64_t stride);
+double third_diff_sumsq(const double* x, std::int64_t n, std::int64_t m, std::int64_t stride);
+
 /// The overlapping sums second_diff_sumsq(c, points − 2m, m, 1) of every m of ms in one blocked
 /// sweep: each block of terms is taken for every m while it is in the core's cache, and stretches
 /// of the record run in parallel. Exact, so bit for bit the per-m sums.

@@ -168,6 +168,8 @@ double edf_for(Estimator est, int alpha, std::int64_t m, std::size_t n_phase) {
     case Estimator::Overlapping: return edf_greenhall(alpha, 2, m, n_phase, true, false);
     case Estimator::NonOverlapping: return edf_greenhall(alpha, 2, m, n_phase, false, false);
     case Estimator::Modified: return edf_greenhall(alpha, 2, m, n_phase, true, true);
+    case Estimator::OverlappingHadamard: return edf_greenhall(alpha, 3, m, n_phase, true, false);
+    case Estimator::NonOverlappingHadamard: return edf_greenhall(alpha, 3, m, n_phase, false, false);
   }
   return 0;
 }

@@ -147,7 +147,8 @@ void register_allan(CLI::App& app, Runner& runner) {
   sub->add_option("FILE", args->file, "Recording to read ('-' for standard input; .gz accepted)")->required();
   args->input.add_to(*sub);
   sub->add_option("--estimator", args->estimator,
-                  "oadev (fully overlapping Allan, default), adev (non-overlapping) or mdev (modified)")
+                  "oadev (fully overlapping Allan, default), adev (non-overlapping), mdev (modified), "
+                  "ohdev (overlapping Hadamard) or hdev (non-overlapping Hadamard)")
       ->capture_default_str();
   sub->add_option("--tau", args->tau,
                   "τ grid: octave, decade (1,2,4 per decade), dense[:P] (P per decade), all, or a list of "
