@@ -6,10 +6,33 @@
 using rwcalc::test::run_cli;
 using rwcalc::test::run_exe;
 
-TEST(Cli, VersionPrintsTheProjectVersion) {
+TEST(Cli, VersionPrintsTheProjectVersionAndCommit) {
   auto r = run_exe({"--version"});
   EXPECT_EQ(r.status, 0);
-  EXPECT_NE(r.out.find(std::string("rwcalc ") + RWCALC_VERSION), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(std::string("rwcalc ") + RWCALC_VERSION + " (commit "), std::string::npos) << r.out;
+}
+
+// The manual page and the completion come from the parser's own definitions: every command, and
+// every option of a command's --help, appears in both.
+TEST(Cli, ManualPageAndCompletionDescribeEveryCommandAndOption) {
+  const auto man = run_cli({"man"});
+  const auto completion = run_cli({"completion"});
+  ASSERT_EQ(man.status, 0) << man.err;
+  ASSERT_EQ(completion.status, 0) << completion.err;
+  EXPECT_TRUE(man.out.starts_with(".TH RWCALC 1 ")) << man.out.substr(0, 80);
+  for (const char* cmd : {"allan", "analyze", "batch", "simulate", "diagnose", "report", "merge"}) {
+    EXPECT_NE(man.out.find(std::string(".SS \"rwcalc ") + cmd + " "), std::string::npos) << cmd;
+    EXPECT_NE(completion.out.find(std::string("    ") + cmd + ") opts=\""), std::string::npos) << cmd;
+    const auto help = run_cli({cmd, "--help"});
+    for (std::size_t at = help.out.find("  --"); at != std::string::npos; at = help.out.find("  --", at + 1)) {
+      const std::string option = help.out.substr(at + 2, help.out.find_first_of(" ,=\n", at + 2) - at - 2);
+      std::string in_roff;  // minus signs are escaped in roff
+      for (char c : option) in_roff += c == '-' ? std::string("\\-") : std::string(1, c);
+      EXPECT_NE(man.out.find(in_roff), std::string::npos) << cmd << " " << option;
+      EXPECT_NE(completion.out.find(" " + option), std::string::npos) << cmd << " " << option;
+    }
+  }
+  EXPECT_NE(completion.out.find("complete -o filenames -F _rwcalc rwcalc"), std::string::npos);
 }
 
 TEST(Cli, HelpListsEveryCommand) {

@@ -13,6 +13,7 @@
 #include "rwcalc/error.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/printable.hpp"
+#include "rwcalc/version.hpp"
 
 namespace rwcalc::cli {
 
@@ -29,14 +30,14 @@ struct Command {
 constexpr Command kCommands[] = {
     {"allan", register_allan},   {"analyze", register_analyze},   {"batch", register_batch},
     {"merge", register_merge},   {"simulate", register_simulate}, {"diagnose", register_diagnose},
-    {"report", register_report},
+    {"report", register_report}, {"man", register_man},           {"completion", register_completion},
 };
 
 /// The commands, in the order of `rwcalc --help`. When the first argument names one, only that one
 /// is built (the parse is the same, without setting up the others' options); otherwise all, so
 /// that the overall help and the unknown-command message list every command.
 void build_app(CLI::App& app, Runner& runner, int argc, const char* const* argv) {
-  app.set_version_flag("-V,--version", std::string("rwcalc ") + RWCALC_VERSION);
+  app.set_version_flag("-V,--version", version_line());
   app.require_subcommand(1);
   app.fallthrough(false);
   if (argc > 1)
@@ -45,7 +46,7 @@ void build_app(CLI::App& app, Runner& runner, int argc, const char* const* argv)
         c.add(app, runner);
         return;
       }
-  for (const auto& c : kCommands) c.add(app, runner);
+  add_all_commands(app, runner);
 }
 
 /// Parse argv into `app`. Returns the exit status to stop with (help, version, a parse error),
@@ -62,7 +63,7 @@ std::optional<int> parse_args(CLI::App& app, int argc, const char* const* argv, 
     out << app.help("", CLI::AppFormatMode::All);
     return 0;
   } catch (const CLI::CallForVersion&) {
-    out << "rwcalc " << RWCALC_VERSION << "\n";
+    out << version_line() << "\n";
     return 0;
   } catch (const CLI::ParseError& e) {
     // Help requested on a subcommand comes through here as a Success-coded error.
@@ -85,7 +86,7 @@ std::optional<int> parse_args(CLI::App& app, int argc, const char* const* argv, 
 /// but an rwcalc error escapes: the argument-parsing fuzzer treats it as a finding.
 int parse_and_run(int argc, const char* const* argv, std::ostream& out, std::ostream& err, bool execute) {
   try {
-    CLI::App app{kDescription, "rwcalc"};
+    CLI::App app{app_description(), "rwcalc"};
     Runner runner;
     build_app(app, runner, argc, argv);
     if (const auto status = parse_args(app, argc, argv, out, err)) return *status;
@@ -110,6 +111,12 @@ int parse_and_run(int argc, const char* const* argv, std::ostream& out, std::ost
 }
 
 }  // namespace
+
+const char* app_description() { return kDescription; }
+
+void add_all_commands(CLI::App& app, Runner& runner) {
+  for (const auto& c : kCommands) c.add(app, runner);
+}
 
 void print_message(std::ostream& err, std::string_view text) { err << "rwcalc: " << printable(text) << "\n"; }
 

@@ -47,5 +47,12 @@ void register_merge(CLI::App& app, Runner& runner);
 void register_simulate(CLI::App& app, Runner& runner);
 void register_diagnose(CLI::App& app, Runner& runner);
 void register_report(CLI::App& app, Runner& runner);
+void register_man(CLI::App& app, Runner& runner);         // src/cli/cmd_docs.cpp
+void register_completion(CLI::App& app, Runner& runner);  // src/cli/cmd_docs.cpp
+
+/// rwcalc's one-paragraph description (the top of --help and of the manual).
+const char* app_description();
+/// Every command on `app`, in the order of `rwcalc --help`.
+void add_all_commands(CLI::App& app, Runner& runner);
 
 }  // namespace rwcalc::cli

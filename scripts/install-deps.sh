@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages rwcalc needs to build, test, package and draw figures, those not
+# installed yet: as root directly, otherwise through sudo. The one list of them (CI uses it too).
+set -euo pipefail
+PACKAGES=(cmake g++ make libeigen3-dev libcli11-dev libfmt-dev nlohmann-json3-dev zlib1g-dev libboost-dev
+          libgtest-dev libbenchmark-dev gnuplot-nox python3-numpy time dpkg-dev man-db)
+missing=()
+for p in "${PACKAGES[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done
+((${#missing[@]})) || exit 0
+if [[ $(id -u) -eq 0 ]]; then
+  as_root=()
+elif command -v sudo >/dev/null; then
+  as_root=(sudo)
+else
+  echo "install-deps.sh: installing ${missing[*]} needs root; run this as root or install sudo" >&2
+  exit 1
+fi
+echo "installing: ${missing[*]}"
+"${as_root[@]}" apt-get update -qq
+"${as_root[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}"
