@@ -111,19 +111,22 @@ TextSource::~TextSource() {
   if (gzip_) inflateEnd(&zs_);
 }
 
-// Up to `max` raw bytes into `to`; 0 at the end of the input.
+// Up to `max` raw bytes into `to`; 0 at the end of the input. Every byte passes the digest here.
 std::size_t TextSource::read_raw(char* to, std::size_t max) {
+  std::size_t n = 0;
   if (in_.fd < 0) {
-    const std::size_t n = std::min(max, memory_.size());
+    n = std::min(max, memory_.size());
     std::memcpy(to, memory_.data(), n);
     memory_.remove_prefix(n);
-    return n;
+  } else {
+    ssize_t got = -1;
+    while ((got = ::read(in_.fd, to, max)) < 0)
+      if (errno != EINTR) fail_errno(name_, "cannot read", errno);
+    n = static_cast<std::size_t>(got);
   }
-  for (;;) {
-    const ssize_t n = ::read(in_.fd, to, max);
-    if (n >= 0) return static_cast<std::size_t>(n);
-    if (errno != EINTR) fail_errno(name_, "cannot read", errno);
-  }
+  hash_.update(std::string_view(to, n));
+  raw_total_ += n;
+  return n;
 }
 
 bool TextSource::read(std::string& out) {

@@ -7,6 +7,8 @@
 #include <string>
 #include <string_view>
 
+#include "core/sha256.hpp"
+
 namespace rwcalc::detail {
 
 /// The longest line taken, in bytes without its line end: a stream without line ends is refused
@@ -48,6 +50,10 @@ class TextSource {
   /// Append the next piece of checked text to `out`; false once the input has ended.
   bool read(std::string& out);
   [[nodiscard]] const std::string& name() const noexcept { return name_; }
+  /// The input's bytes as stored (compressed, for gzip) read so far, and their SHA-256: once read()
+  /// has returned false, the file's size and the digest `sha256sum` prints.
+  [[nodiscard]] std::size_t raw_bytes() const noexcept { return raw_total_; }
+  [[nodiscard]] std::string sha256() const { return hash_.hex(); }
   /// The text's likely length in bytes: the input's size, for gzip times the ratio inflated so far;
   /// 0 when unknown (a pipe). An estimate only.
   [[nodiscard]] std::size_t size_estimate() const noexcept {
@@ -79,6 +85,8 @@ class TextSource {
   std::size_t magic_seen_ = 0;  // bytes of the next member's magic seen since a member ended
   std::size_t inflated_ = 0;
   TextCheck check_;
+  Sha256 hash_;
+  std::size_t raw_total_ = 0;
 };
 
 }  // namespace rwcalc::detail
