@@ -195,5 +195,20 @@ TEST(InputDefaults, AGapIsAnErrorWithTheLineAndTheMissingDuration) {
   EXPECT_TRUE(r.out.empty());
 }
 
+TEST(InputDefaults, ARateThatDisagreesWithTheTimeColumnNamesTheToleranceThatWouldAcceptIt) {
+  TempDir dir;
+  // Stamps at 101.5 Hz, --rate 100: the mean step is 1.48 % off the given period.
+  const auto f = dir.write("r.csv", table("time_s,gyro", 300, [](int k) {
+                             return fmt::format("{:.6f},{}", k / 101.5, noisy(0, k));
+                           }));
+  const auto r = run_cli({"allan", f.string(), "--input", "rate", "--rate", "100"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(has(r.err, "inconsistent with the time column 'time_s'")) << r.err;
+  EXPECT_TRUE(has(r.err, "a --time-tolerance of 0.0148 or more would accept it")) << r.err;
+  const auto ok = run_cli({"allan", f.string(), "--input", "rate", "--rate", "100", "--time-tolerance", "0.0148",
+                           "--tau", "decade"});
+  EXPECT_EQ(ok.status, 0) << ok.err;
+}
+
 }  // namespace
 }  // namespace rwcalc::test
