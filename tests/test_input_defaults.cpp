@@ -75,16 +75,14 @@ TEST(InputDefaults, NanosecondTimestampsByMagnitudeGiveTheRate) {
 
 TEST(InputDefaults, StampsNearZeroAreSecondsAndAmbiguousOnesAreAnError) {
   TempDir dir;
-  const auto s = dir.write("s.csv", table("time,gyro", 300, [](int k) {
-                             return fmt::format("{},{}", 0.005 * k, noisy(0, k));
-                           }));
+  const auto s =
+      dir.write("s.csv", table("time,gyro", 300, [](int k) { return fmt::format("{},{}", 0.005 * k, noisy(0, k)); }));
   const auto j = allan_json(run_cli({"allan", s.string(), "--input", "rate", "--json", "--tau", "decade"}));
   EXPECT_EQ(j["rate_hz"], 200.0);
   EXPECT_EQ(j["input"]["time_unit"], "s");
   // A first stamp of 5e6 is neither near 0 nor Unix time in any unit: no guess.
-  const auto m = dir.write("m.csv", table("time,gyro", 300, [](int k) {
-                             return fmt::format("{},{}", 5'000'000 + 10 * k, noisy(0, k));
-                           }));
+  const auto m = dir.write("m.csv", table("time,gyro", 300,
+                                          [](int k) { return fmt::format("{},{}", 5'000'000 + 10 * k, noisy(0, k)); }));
   const auto r = run_cli({"allan", m.string(), "--input", "rate"});
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(has(r.err, "cannot tell the unit of the time column 'time'")) << r.err;
@@ -108,12 +106,10 @@ TEST(InputDefaults, RosPercentTimeColumnIsNanosecondsSinceTheEpoch) {
 
 TEST(InputDefaults, MillisecondAndMicrosecondColumnsByName) {
   TempDir dir;
-  const auto ms = dir.write("ms.csv", table("time_ms,gyro", 300, [](int k) {
-                              return fmt::format("{},{}", 1000 + 4 * k, noisy(0, k));
-                            }));
-  const auto us = dir.write("us.csv", table("t_us,gyro", 300, [](int k) {
-                              return fmt::format("{},{}", 1000 * k, noisy(0, k));
-                            }));
+  const auto ms = dir.write("ms.csv", table("time_ms,gyro", 300,
+                                            [](int k) { return fmt::format("{},{}", 1000 + 4 * k, noisy(0, k)); }));
+  const auto us =
+      dir.write("us.csv", table("t_us,gyro", 300, [](int k) { return fmt::format("{},{}", 1000 * k, noisy(0, k)); }));
   const auto a = allan_json(run_cli({"allan", ms.string(), "--input", "rate", "--json", "--tau", "decade"}));
   EXPECT_EQ(a["rate_hz"], 250.0);
   EXPECT_EQ(a["input"]["time_unit"], "ms");
@@ -125,9 +121,8 @@ TEST(InputDefaults, MillisecondAndMicrosecondColumnsByName) {
 TEST(InputDefaults, DpsSuffixMeansDegreesPerSecondAndImpliesRateInput) {
   TempDir dir;
   // 1 °/s on average: the mean rate must come out 3600 °/h, not 1 °/h.
-  const auto f = dir.write("imu.csv", table("gyro_x_dps,acc_x_g", 40000, [](int k) {
-                             return fmt::format("{},{}", noisy(1.0, k), -1.0);
-                           }));
+  const auto f = dir.write("imu.csv", table("gyro_x_dps,acc_x_g", 40000,
+                                            [](int k) { return fmt::format("{},{}", noisy(1.0, k), -1.0); }));
   const auto r = run_cli({"analyze", f.string(), "--column", "gyro_x_dps", "--rate", "100", "--json"});
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
@@ -151,8 +146,8 @@ TEST(InputDefaults, DpsSuffixMeansDegreesPerSecondAndImpliesRateInput) {
 TEST(InputDefaults, AUnitThatContradictsTheColumnNameIsUsedWithAWarning) {
   TempDir dir;
   const auto f = dir.write("imu.csv", table("gyro_x_dps", 300, [](int k) { return fmt::format("{}", noisy(1, k)); }));
-  const auto r =
-      run_cli({"allan", f.string(), "--input", "rate", "--rate-unit", "deg/h", "--rate", "100", "--json", "--tau", "decade"});
+  const auto r = run_cli(
+      {"allan", f.string(), "--input", "rate", "--rate-unit", "deg/h", "--rate", "100", "--json", "--tau", "decade"});
   const auto j = allan_json(r);
   EXPECT_EQ(j["input"]["unit"], "deg/h");
   ASSERT_EQ(j["input"]["warnings"].size(), 1u);
@@ -174,9 +169,8 @@ TEST(InputDefaults, JitterIsAcceptedAndReported) {
   EXPECT_NEAR(j["input"]["jitter"]["rms_fraction"].get<double>(), 0.03 * std::sqrt(100.0 / 499), 1e-9);
   EXPECT_TRUE(has(r.err, "jitter: 100 time steps off the period")) << r.err;
   // Without jitter the record says so: no steps off.
-  const auto g = dir.write("even.csv", table("time_ms,gyro", 300, [](int k) {
-                             return fmt::format("{},{}", 10 * k, noisy(0, k));
-                           }));
+  const auto g = dir.write("even.csv",
+                           table("time_ms,gyro", 300, [](int k) { return fmt::format("{},{}", 10 * k, noisy(0, k)); }));
   const auto e = allan_json(run_cli({"allan", g.string(), "--input", "rate", "--json", "--tau", "decade"}));
   EXPECT_EQ(e["input"]["jitter"]["steps"], 0);
 }
@@ -198,15 +192,14 @@ TEST(InputDefaults, AGapIsAnErrorWithTheLineAndTheMissingDuration) {
 TEST(InputDefaults, ARateThatDisagreesWithTheTimeColumnNamesTheToleranceThatWouldAcceptIt) {
   TempDir dir;
   // Stamps at 101.5 Hz, --rate 100: the mean step is 1.48 % off the given period.
-  const auto f = dir.write("r.csv", table("time_s,gyro", 300, [](int k) {
-                             return fmt::format("{:.6f},{}", k / 101.5, noisy(0, k));
-                           }));
+  const auto f = dir.write("r.csv", table("time_s,gyro", 300,
+                                          [](int k) { return fmt::format("{:.6f},{}", k / 101.5, noisy(0, k)); }));
   const auto r = run_cli({"allan", f.string(), "--input", "rate", "--rate", "100"});
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(has(r.err, "inconsistent with the time column 'time_s'")) << r.err;
   EXPECT_TRUE(has(r.err, "a --time-tolerance of 0.0148 or more would accept it")) << r.err;
-  const auto ok = run_cli({"allan", f.string(), "--input", "rate", "--rate", "100", "--time-tolerance", "0.0148",
-                           "--tau", "decade"});
+  const auto ok = run_cli(
+      {"allan", f.string(), "--input", "rate", "--rate", "100", "--time-tolerance", "0.0148", "--tau", "decade"});
   EXPECT_EQ(ok.status, 0) << ok.err;
 }
 

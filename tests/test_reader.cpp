@@ -254,7 +254,8 @@ TEST(Reader, PulsesNearTwoToTheSixtyTwoStayExact) {
 
 TEST(Reader, AngleUnitsConvertToArcsecondsOrClockSeconds) {
   const std::string text = "1\n2\n4\n";
-  auto a = read_recording_text(text, "a", {.mode = InputMode::Angle, .rate_hz = 400.0, .angle_unit = AngleUnit::Arcsec});
+  auto a =
+      read_recording_text(text, "a", {.mode = InputMode::Angle, .rate_hz = 400.0, .angle_unit = AngleUnit::Arcsec});
   EXPECT_EQ(a.phase.values, (std::vector<double>{1, 2, 4}));
   EXPECT_EQ(a.phase.kind, PhaseKind::Gyro);
   auto d = read_recording_text(text, "a", {.mode = InputMode::Angle, .rate_hz = 400.0, .angle_unit = AngleUnit::Deg});
@@ -286,12 +287,12 @@ TEST(Reader, RateInputIsIntegratedToPhaseAsSp1065) {
   EXPECT_NEAR(c.phase.rate_offset, 7100.0 / 9.0, 1e-9);
   EXPECT_EQ(c.phase.kind, PhaseKind::Clock);
   // Gyro units: deg/s and rad/s become ″/s (= °/h).
-  const auto ds =
-      read_recording_text("0.5\n-0.25\n", "g", {.mode = InputMode::Rate, .rate_hz = 400.0, .rate_unit = RateUnit::DegPerSecond});
+  const auto ds = read_recording_text("0.5\n-0.25\n", "g",
+                                      {.mode = InputMode::Rate, .rate_hz = 400.0, .rate_unit = RateUnit::DegPerSecond});
   EXPECT_DOUBLE_EQ(ds.rates()[0], 1800.0);
   EXPECT_DOUBLE_EQ(ds.rates()[1], -900.0);
-  const auto rs =
-      read_recording_text("1e-5\n2e-5\n", "g", {.mode = InputMode::Rate, .rate_hz = 400.0, .rate_unit = RateUnit::RadPerSecond});
+  const auto rs = read_recording_text("1e-5\n2e-5\n", "g",
+                                      {.mode = InputMode::Rate, .rate_hz = 400.0, .rate_unit = RateUnit::RadPerSecond});
   EXPECT_NEAR(rs.rates()[1], 2e-5 * rwcalc::units::arcsec_per_rad, 1e-9);
 }
 

@@ -33,7 +33,7 @@ struct AnalysisResult {
   double rate_hz = 0;
   double duration_s = 0;
   std::string column;
-  nlohmann::json input;  ///< input_json() of the recording as read
+  nlohmann::json input;         ///< input_json() of the recording as read
   double arcsec_per_count = 0;  ///< pulse weight (0 when the input was not pulses/counter)
   std::optional<double> temperature_c;
   std::string temperature_source;  ///< "option", "column or metadata", "file name", or ""

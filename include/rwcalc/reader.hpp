@@ -42,9 +42,9 @@ struct ReadOptions {
   /// column named "pulses" (or counter/angle/phase/rate/gyro by mode), else the only non-time
   /// column, else an error asking for --column (also when two columns have such names).
   std::string column;
-  std::optional<double> rate_hz;       ///< --rate, Hz; overrides metadata; checked against a time column
-  std::optional<double> scale_arcsec;  ///< --scale: pulse weight, ″ per pulse; overrides metadata
-  int counter_bits = 32;               ///< wrap width of Counter mode (1..64)
+  std::optional<double> rate_hz;        ///< --rate, Hz; overrides metadata; checked against a time column
+  std::optional<double> scale_arcsec;   ///< --scale: pulse weight, ″ per pulse; overrides metadata
+  int counter_bits = 32;                ///< wrap width of Counter mode (1..64)
   std::optional<AngleUnit> angle_unit;  ///< unset: the column name's suffix (`_deg`), else arcsec
   std::optional<RateUnit> rate_unit;    ///< unset: the column name's suffix (`_dps`), else deg/h
   /// A time-column step off the period by more than this fraction of it is jitter (accepted and
@@ -58,9 +58,9 @@ enum class RateSource { Option, Metadata, TimeColumn, Default };
 /// Time-column steps that deviate from the period (the median step) by more than the time
 /// tolerance but less than half a period: accepted, and reported.
 struct TimeJitter {
-  std::size_t steps = 0;     ///< steps off by more than the tolerance
-  double max_fraction = 0;   ///< largest |step − period| / period over all steps
-  double rms_fraction = 0;   ///< rms of (step − period) / period over all steps
+  std::size_t steps = 0;    ///< steps off by more than the tolerance
+  double max_fraction = 0;  ///< largest |step − period| / period over all steps
+  double rms_fraction = 0;  ///< rms of (step − period) / period over all steps
 };
 
 struct Recording {
@@ -76,7 +76,7 @@ struct Recording {
   /// the time column that was checked, if any (the first of two, which were found to agree)
   std::optional<std::string> time_column;
   InputMode mode = InputMode::Pulses;
-  AngleUnit angle_unit = AngleUnit::Arcsec;  ///< the unit angle input was read in
+  AngleUnit angle_unit = AngleUnit::Arcsec;   ///< the unit angle input was read in
   RateUnit rate_unit = RateUnit::DegPerHour;  ///< the unit rate input was read in
   /// The time column's unit ("s", "ms", "us", "ns") and how it was decided ("name" or "magnitude").
   std::string time_unit, time_unit_source;

@@ -135,8 +135,8 @@ int run_allan(const AllanArgs& a, Io& io) {
     // The CSV holds the table only; the outliers found are said on standard error.
     if (outliers.count > 0) print_message(io.err, fmt::format("note: {}: {}", rec.source, format_outliers(outliers)));
   } else {
-    io.out << format_allan_table(
-        res, {rec.source, rec.samples, rec.rate_hz, std::string(to_string(rec.rate_source)), describe_input(read)});
+    io.out << format_allan_table(res, {rec.source, rec.samples, rec.rate_hz, std::string(to_string(rec.rate_source)),
+                                       describe_input(read)});
     io.out << "\n" << format_outliers(outliers);
   }
   return 0;

@@ -70,8 +70,8 @@ void print_input_notes(std::ostream& err, const nlohmann::json& analysis) {
   for (const char* kind : {"warnings", "notes"})
     for (const auto& line : in->value(kind, nlohmann::json::array()))
       if (line.is_string())
-        print_message(err, fmt::format("{}: {}: {}", kind[0] == 'w' ? "warning" : "note", source,
-                                       line.get<std::string>()));
+        print_message(err,
+                      fmt::format("{}: {}: {}", kind[0] == 'w' ? "warning" : "note", source, line.get<std::string>()));
 }
 
 }  // namespace rwcalc::cli

@@ -20,13 +20,15 @@ constexpr std::size_t kQuoteLimit = 40;
 
 // The first four are the units a stamp's magnitude can tell; "%time" is ROS's receive time (ns
 // since the epoch) in CSV exports of ROS bags.
-constexpr TimeName kTimeNames[] = {
-    {"time_s", "s", 1},          {"time_ms", "ms", 1e3},       {"time_us", "us", 1e6},
-    {"time_ns", "ns", 1e9},      {"time", "", 0},              {"t", "", 0},
-    {"timestamp", "", 0},        {"t_s", "s", 1},              {"time_sec", "s", 1},
-    {"timestamp_s", "s", 1},     {"t_ms", "ms", 1e3},          {"timestamp_ms", "ms", 1e3},
-    {"t_us", "us", 1e6},         {"timestamp_us", "us", 1e6},  {"t_ns", "ns", 1e9},
-    {"timestamp_ns", "ns", 1e9}, {"%time", "ns", 1e9}};
+constexpr TimeName kTimeNames[] = {{"time_s", "s", 1},     {"time_ms", "ms", 1e3},
+                                   {"time_us", "us", 1e6}, {"time_ns", "ns", 1e9},
+                                   {"time", "", 0},        {"t", "", 0},
+                                   {"timestamp", "", 0},   {"t_s", "s", 1},
+                                   {"time_sec", "s", 1},   {"timestamp_s", "s", 1},
+                                   {"t_ms", "ms", 1e3},    {"timestamp_ms", "ms", 1e3},
+                                   {"t_us", "us", 1e6},    {"timestamp_us", "us", 1e6},
+                                   {"t_ns", "ns", 1e9},    {"timestamp_ns", "ns", 1e9},
+                                   {"%time", "ns", 1e9}};
 constexpr const TimeName* kByMagnitude = &kTimeNames[4];  // "time": the headerless time column
 constexpr std::string_view kTemperatureNames[] = {"temperature_c", "temperature", "temp_c", "temp", "t_c"};
 
@@ -326,13 +328,18 @@ struct UnitSuffix {
   AngleUnit angle = AngleUnit::Arcsec;
   RateUnit rate = RateUnit::DegPerHour;
 };
-constexpr UnitSuffix kUnitSuffixes[] = {
-    {"_deg_s", InputMode::Rate, {}, RateUnit::DegPerSecond},  {"_degps", InputMode::Rate, {}, RateUnit::DegPerSecond},
-    {"_dps", InputMode::Rate, {}, RateUnit::DegPerSecond},    {"_deg_h", InputMode::Rate, {}, RateUnit::DegPerHour},
-    {"_degph", InputMode::Rate, {}, RateUnit::DegPerHour},    {"_dph", InputMode::Rate, {}, RateUnit::DegPerHour},
-    {"_rad_s", InputMode::Rate, {}, RateUnit::RadPerSecond},  {"_radps", InputMode::Rate, {}, RateUnit::RadPerSecond},
-    {"_rads", InputMode::Rate, {}, RateUnit::RadPerSecond},   {"_arcsec", InputMode::Angle, AngleUnit::Arcsec},
-    {"_deg", InputMode::Angle, AngleUnit::Deg},               {"_rad", InputMode::Angle, AngleUnit::Rad}};
+constexpr UnitSuffix kUnitSuffixes[] = {{"_deg_s", InputMode::Rate, {}, RateUnit::DegPerSecond},
+                                        {"_degps", InputMode::Rate, {}, RateUnit::DegPerSecond},
+                                        {"_dps", InputMode::Rate, {}, RateUnit::DegPerSecond},
+                                        {"_deg_h", InputMode::Rate, {}, RateUnit::DegPerHour},
+                                        {"_degph", InputMode::Rate, {}, RateUnit::DegPerHour},
+                                        {"_dph", InputMode::Rate, {}, RateUnit::DegPerHour},
+                                        {"_rad_s", InputMode::Rate, {}, RateUnit::RadPerSecond},
+                                        {"_radps", InputMode::Rate, {}, RateUnit::RadPerSecond},
+                                        {"_rads", InputMode::Rate, {}, RateUnit::RadPerSecond},
+                                        {"_arcsec", InputMode::Angle, AngleUnit::Arcsec},
+                                        {"_deg", InputMode::Angle, AngleUnit::Deg},
+                                        {"_rad", InputMode::Angle, AngleUnit::Rad}};
 constexpr std::string_view kAccelSuffixes[] = {"_mps2", "_m_s2", "_ms2", "_g"};
 
 bool ends_with_nocase(std::string_view s, std::string_view suffix) {

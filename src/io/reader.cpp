@@ -151,7 +151,8 @@ class Reader {
       more = src.read(buf);
       const std::size_t taken = take_lines(buf, !more);
       const auto lines = static_cast<double>(line_);
-      if (first && parser_.layout_known()) reserve(static_cast<double>(src.size_estimate()) / static_cast<double>(taken) * lines);
+      if (first && parser_.layout_known())
+        reserve(static_cast<double>(src.size_estimate()) / static_cast<double>(taken) * lines);
       first = first && !parser_.layout_known();
       buf.erase(0, taken);
     }
@@ -184,7 +185,8 @@ class Reader {
     integer_mode() ? ints_.reserve(n) : reals_.reserve(n);
   }
   void start_samples(const Sample& s);
-  [[nodiscard]] const detail::TimeName* time_unit_of(const detail::TimeName* named, double first, detail::Role role) const;
+  [[nodiscard]] const detail::TimeName* time_unit_of(const detail::TimeName* named, double first,
+                                                     detail::Role role) const;
   [[nodiscard]] std::string stamp(double t) const { return fmt::format("{} {}", t, tunit_->unit); }
   void finish_rate();
   void rate_from_time_column();
@@ -365,9 +367,8 @@ void Reader::check_time_columns_agree() const {
   fail(line_of_sample(gap_sample_),
        fmt::format("the time columns '{}' and '{}' disagree: {} {} and {} {} differ by {:g} s here (their largest "
                    "difference), more than the time tolerance ({} of the {:g}-s period); remove one of them{}",
-                   layout_.header[*layout_.time_col], layout_.header[*layout_.time2_col], gap_t_, tunit_->unit,
-                   gap_t2_, tunit2_->unit, gap_max_, opt_.time_tolerance, period,
-                   tolerance_hint(gap_max_ / period)));
+                   layout_.header[*layout_.time_col], layout_.header[*layout_.time2_col], gap_t_, tunit_->unit, gap_t2_,
+                   tunit2_->unit, gap_max_, opt_.time_tolerance, period, tolerance_hint(gap_max_ / period)));
 }
 
 // Every step must lie within half a period of the period: within the time tolerance it is exact,
@@ -394,16 +395,18 @@ void Reader::check_rate_against_time_column(const TimeTrack::Step& bad, double p
        fmt::format("the sample rate {} Hz (from {}) is inconsistent with the time column {}, which steps by {} {} "
                    "(~{:.6g} Hz), e.g. {} at line {} then {}{}",
                    rate_hz_,
-                   rate_source_ == RateSource::Option ? "--rate"
-                                                      : fmt::format("metadata at line {}", parser_.metadata().rate_line),
-                   tcol, est, tunit_->unit, tunit_->per_second / est, stamp(bad.before),
-                   line_of_sample(bad.sample - 1), stamp(bad.after), tolerance_hint(std::abs(est - period) / period)));
+                   rate_source_ == RateSource::Option
+                       ? "--rate"
+                       : fmt::format("metadata at line {}", parser_.metadata().rate_line),
+                   tcol, est, tunit_->unit, tunit_->per_second / est, stamp(bad.before), line_of_sample(bad.sample - 1),
+                   stamp(bad.after), tolerance_hint(std::abs(est - period) / period)));
 }
 
 [[noreturn]] void Reader::fail_step(const TimeTrack::Step& bad, double period) const {
   const double t0 = bad.before, t1 = bad.after, dt = t1 - t0;
   const std::size_t line = line_of_sample(bad.sample), prev = line_of_sample(bad.sample - 1);
-  if (dt == 0) fail(line, fmt::format("repeated time stamp {} (also at line {}); no resampling is done", stamp(t1), prev));
+  if (dt == 0)
+    fail(line, fmt::format("repeated time stamp {} (also at line {}); no resampling is done", stamp(t1), prev));
   if (dt < 0) fail(line, fmt::format("time goes backwards: {} at line {}, then {}", stamp(t0), prev, stamp(t1)));
   const double p_s = period / tunit_->per_second;
   if (dt < period)
@@ -411,13 +414,14 @@ void Reader::check_rate_against_time_column(const TimeTrack::Step& bad, double p
                            "within half a period of it are accepted as jitter); no resampling is done",
                            stamp(t0), prev, stamp(t1), dt / period, p_s));
   const double missing = std::round(dt / period - 1);
-  fail(line, fmt::format("gap in the time column: {} at line {}, then {}: {:.6g} s missing (~{:g} sample{}; a step "
-                         "of {:.6g} periods of {:g} s); rwcalc neither resamples nor analyses a record with gaps: cut the record at "
-                         "this line and analyse the parts separately (--time-tolerance only sets which steps within half a "
-                         "period count as jitter)",
-                         stamp(t0), prev, stamp(t1), (dt - period) / tunit_->per_second, missing, missing == 1 ? "" : "s",
-                         dt / period,
-                         p_s));
+  fail(line,
+       fmt::format(
+           "gap in the time column: {} at line {}, then {}: {:.6g} s missing (~{:g} sample{}; a step "
+           "of {:.6g} periods of {:g} s); rwcalc neither resamples nor analyses a record with gaps: cut the record at "
+           "this line and analyse the parts separately (--time-tolerance only sets which steps within half a "
+           "period count as jitter)",
+           stamp(t0), prev, stamp(t1), (dt - period) / tunit_->per_second, missing, missing == 1 ? "" : "s",
+           dt / period, p_s));
 }
 
 /// Floating data whose phase steps are all below kMinDataStep (limits.hpp) but not all zero:
@@ -568,15 +572,16 @@ void Reader::note_time_column(Recording& rec) const {
   const double t0 = times_.first;
   if (!by_name)
     rec.notes.push_back(fmt::format("time column '{}' in {} (by magnitude: {})", *rec.time_column, tunit_->unit,
-                                    std::abs(t0) >= 1e8 ? fmt::format("the first stamp {:.4g} is Unix time in {}", t0,
-                                                                      tunit_->unit)
-                                                        : std::string("the stamps start near 0")));
+                                    std::abs(t0) >= 1e8
+                                        ? fmt::format("the first stamp {:.4g} is Unix time in {}", t0, tunit_->unit)
+                                        : std::string("the stamps start near 0")));
   if (times_.n >= 2 && times_.median > 0) rec.jitter = times_.jitter();
   if (rec.jitter.steps > 0)
-    rec.notes.push_back(fmt::format("jitter: {} time step{} off the period by more than the time tolerance ({:g} %), "
-                                    "by up to {:.3g} % of the period (rms {:.2g} %)",
-                                    rec.jitter.steps, rec.jitter.steps == 1 ? "" : "s", 100 * opt_.time_tolerance,
-                                    100 * rec.jitter.max_fraction, 100 * rec.jitter.rms_fraction));
+    rec.notes.push_back(
+        fmt::format("jitter: {} time step{} off the period by more than the time tolerance ({:g} %), "
+                    "by up to {:.3g} % of the period (rms {:.2g} %)",
+                    rec.jitter.steps, rec.jitter.steps == 1 ? "" : "s", 100 * opt_.time_tolerance,
+                    100 * rec.jitter.max_fraction, 100 * rec.jitter.rms_fraction));
 }
 
 void validate(const ReadOptions& o) {
