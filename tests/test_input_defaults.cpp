@@ -47,6 +47,12 @@ TEST(InputDefaults, RateInputWithoutASampleRateIsAnErrorNamingTheThreeWays) {
     EXPECT_TRUE(has(r.err, "time column")) << r.err;
     EXPECT_TRUE(r.out.empty());
   }
+  // Without --input, fractional samples in a column without a unit are no pulse counts: the error
+  // says how to read them as rate or angle samples.
+  const auto g = run_cli({"allan", f.string()});
+  EXPECT_EQ(g.status, 2);
+  EXPECT_TRUE(has(g.err, "pulse counts must be integers")) << g.err;
+  EXPECT_TRUE(has(g.err, "give --input rate or --input angle")) << g.err;
   // Pulses keep the GL-2D default, and say so in every output.
   const auto p = dir.write("p.txt", table("pulses", 200, [](int k) { return std::to_string(k % 3); }));
   const auto j = allan_json(run_cli({"allan", p.string(), "--json", "--tau", "decade"}));

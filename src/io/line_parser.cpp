@@ -212,7 +212,10 @@ bool LineParser::read_integer(std::string_view f, std::string_view t, Sample& s,
       std::all_of(t.begin() + neg, t.end(), [](char c) { return c >= '0' && c <= '9'; }))
     fail(fmt::format("number out of range of a 64-bit integer in {}: {}", col, quoted(f)));
   if (looks_numeric(f, layout_.delim != Delim::Comma))
-    fail(fmt::format("{} counts must be integers: {} in {}", counter ? "counter" : "pulse", quoted(f), col));
+    fail(fmt::format("{} counts must be integers: {} in {}{}", counter ? "counter" : "pulse", quoted(f), col,
+                     opt_.mode ? ""
+                               : " (pulses is the default input; for rate or angle samples give --input rate or "
+                                 "--input angle, or a column name with a unit such as gyro_x_dps)"));
   fail(fmt::format("not a number in {}: {}", col, quoted(f)));
 }
 
