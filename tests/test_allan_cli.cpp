@@ -128,7 +128,7 @@ TEST(AllanCli, ErrorsAreReportedWithTheirExitStatus) {
       {{"allan", file.string(), "--estimator", "tdev"}, 2, "ohdev or hdev"},
       {{"allan", file.string(), "--json", "--csv"}, 2, "excludes"},
       {{"allan", (dir.path() / "missing.txt").string()}, 2, "missing.txt"},
-      {{"allan", two.string(), "--input", "angle"}, 1, "phase point"},
+      {{"allan", two.string(), "--input", "angle", "--rate", "400"}, 1, "phase point"},
   };
   for (const Case& c : cases) {
     const auto r = run_cli(c.args);

@@ -245,11 +245,11 @@ TEST(NumericOptionsExe, NonsenseScalesAreInputErrors) {
     rate += fmt::format("{:g}\n", 1e-300 * std::cos(1.3 * i) * (1 + i % 5));
   }
   const auto a = dir.write("tiny_angle.csv", angle);
-  const auto r1 = run_exe({"analyze", a.string(), "--input", "angle"});
+  const auto r1 = run_exe({"analyze", a.string(), "--input", "angle", "--rate", "400"});
   EXPECT_EQ(r1.status, 2) << r1.err;
   EXPECT_NE(r1.err.find("too small"), std::string::npos) << r1.err;
   const auto y = dir.write("tiny_rate.csv", rate);
-  const auto r2 = run_exe({"allan", y.string(), "--input", "rate"});
+  const auto r2 = run_exe({"allan", y.string(), "--input", "rate", "--rate", "400"});
   EXPECT_EQ(r2.status, 2) << r2.err;
   EXPECT_NE(r2.err.find("too small"), std::string::npos) << r2.err;
   // Metadata with a nonsense rate or scale is refused too, naming the key and the line.
@@ -324,8 +324,8 @@ TEST(NumericOptionsExe, RateOffsetTenToTheTwelveTimesTheNoiseKeepsSigmaTau0) {
   }
   const auto a = dir.write("plain.csv", plain);
   const auto b = dir.write("offset.csv", offset);
-  const CliResult ra = run_exe({"allan", a.string(), "--input", "rate", "--csv"});
-  const CliResult rb = run_exe({"allan", b.string(), "--input", "rate", "--csv"});
+  const CliResult ra = run_exe({"allan", a.string(), "--input", "rate", "--rate", "400", "--csv"});
+  const CliResult rb = run_exe({"allan", b.string(), "--input", "rate", "--rate", "400", "--csv"});
   ASSERT_EQ(ra.status, 0) << ra.err;
   ASSERT_EQ(rb.status, 0) << rb.err;
   const double sa = first_deviation(ra.out), sb = first_deviation(rb.out);

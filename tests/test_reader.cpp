@@ -103,7 +103,7 @@ TEST(Reader, RussianLocaleSpreadsheetExportWithDecimalComma) {
   expect_pulses(t);
   EXPECT_EQ(t.rate_source, RateSource::TimeColumn);
   // Decimal comma in rate samples, tab- and blank-separated.
-  ReadOptions rate{.mode = InputMode::Rate, .rate_unit = RateUnit::DegPerHour};
+  ReadOptions rate{.mode = InputMode::Rate, .rate_hz = 400.0, .rate_unit = RateUnit::DegPerHour};
   const auto a = read_recording_text("0,0025\t1,5\n0,005\t-2,25\n0,0075\t4\n", "tab.csv", rate);
   const auto b = read_recording_text("0,0025 1,5\n0,005 -2,25\n0,0075 4\n", "blank.csv", rate);
   const auto c = read_recording_text("0.0025,1.5\n0.005,-2.25\n0.0075,4\n", "point.csv", rate);
@@ -210,7 +210,7 @@ TEST(Reader, NumberSpellingsGiveIdenticalValues) {
     exotic += fmt::format("{:+.16e}\n", std::stod(fmt::format("{:.6f}", v)));
     expect.push_back(std::stod(fmt::format("{:.6f}", v)));
   }
-  const ReadOptions o{.mode = InputMode::Angle};
+  const ReadOptions o{.mode = InputMode::Angle, .rate_hz = 400.0};
   const auto a = read_recording_text(plain, "plain.txt", o);
   const auto b = read_recording_text(exotic, "exotic.txt", o);
   ASSERT_EQ(a.phase.values.size(), expect.size());
@@ -254,12 +254,13 @@ TEST(Reader, PulsesNearTwoToTheSixtyTwoStayExact) {
 
 TEST(Reader, AngleUnitsConvertToArcsecondsOrClockSeconds) {
   const std::string text = "1\n2\n4\n";
-  auto a = read_recording_text(text, "a", {.mode = InputMode::Angle, .angle_unit = AngleUnit::Arcsec});
+  auto a =
+      read_recording_text(text, "a", {.mode = InputMode::Angle, .rate_hz = 400.0, .angle_unit = AngleUnit::Arcsec});
   EXPECT_EQ(a.phase.values, (std::vector<double>{1, 2, 4}));
   EXPECT_EQ(a.phase.kind, PhaseKind::Gyro);
-  auto d = read_recording_text(text, "a", {.mode = InputMode::Angle, .angle_unit = AngleUnit::Deg});
+  auto d = read_recording_text(text, "a", {.mode = InputMode::Angle, .rate_hz = 400.0, .angle_unit = AngleUnit::Deg});
   EXPECT_EQ(d.phase.values, (std::vector<double>{3600, 7200, 14400}));
-  auto r = read_recording_text(text, "a", {.mode = InputMode::Angle, .angle_unit = AngleUnit::Rad});
+  auto r = read_recording_text(text, "a", {.mode = InputMode::Angle, .rate_hz = 400.0, .angle_unit = AngleUnit::Rad});
   EXPECT_DOUBLE_EQ(r.phase.values[2], 4 * 180.0 * 3600.0 / M_PI);
   auto s = read_recording_text(text, "a", {.mode = InputMode::Angle, .rate_hz = 1.0, .angle_unit = AngleUnit::Second});
   EXPECT_EQ(s.phase.values, (std::vector<double>{1, 2, 4}));
@@ -286,12 +287,12 @@ TEST(Reader, RateInputIsIntegratedToPhaseAsSp1065) {
   EXPECT_NEAR(c.phase.rate_offset, 7100.0 / 9.0, 1e-9);
   EXPECT_EQ(c.phase.kind, PhaseKind::Clock);
   // Gyro units: deg/s and rad/s become ″/s (= °/h).
-  const auto ds =
-      read_recording_text("0.5\n-0.25\n", "g", {.mode = InputMode::Rate, .rate_unit = RateUnit::DegPerSecond});
+  const auto ds = read_recording_text("0.5\n-0.25\n", "g",
+                                      {.mode = InputMode::Rate, .rate_hz = 400.0, .rate_unit = RateUnit::DegPerSecond});
   EXPECT_DOUBLE_EQ(ds.rates()[0], 1800.0);
   EXPECT_DOUBLE_EQ(ds.rates()[1], -900.0);
-  const auto rs =
-      read_recording_text("1e-5\n2e-5\n", "g", {.mode = InputMode::Rate, .rate_unit = RateUnit::RadPerSecond});
+  const auto rs = read_recording_text("1e-5\n2e-5\n", "g",
+                                      {.mode = InputMode::Rate, .rate_hz = 400.0, .rate_unit = RateUnit::RadPerSecond});
   EXPECT_NEAR(rs.rates()[1], 2e-5 * rwcalc::units::arcsec_per_rad, 1e-9);
 }
 

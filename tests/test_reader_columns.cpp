@@ -89,6 +89,7 @@ TEST(ReaderMetadataKeys, AKeyThatLooksLikeThePulseWeightIsRefusedOnlyWhenNothing
   EXPECT_EQ(read_recording_text("# scale_factor: 1.5\npulses\n1\n2\n", "m", o).phase.arcsec_per_count, 1.5);
   o = {};
   o.mode = rwcalc::InputMode::Rate;  // no pulse weight in rate input
+  o.rate_hz = 100.0;
   EXPECT_NO_THROW((void)read_recording_text("# scale_factor: 1.5\nrate\n1\n2\n", "m", o));
 }
 
@@ -103,10 +104,14 @@ TEST(ReaderTimeColumns, EveryUnitIsReadInItsUnit) {
     EXPECT_EQ(r.rate_hz, 250.0) << name;
     EXPECT_EQ(r.rate_source, rwcalc::RateSource::TimeColumn) << name;
     EXPECT_EQ(r.time_column.value_or(""), name);
-    // A gap is named in seconds, whatever the column's unit.
+    // A gap is named by its stamps as written (in the column's unit) and the time missing in seconds.
     const auto [msg, line] = error_of(name + ",pulses\n0,1\n" +
                                       fmt::format("{},1\n{},1\n{},1\n", 0.004 * per_s, 0.008 * per_s, 0.016 * per_s));
-    EXPECT_NE(msg.find("gap in the time column: 0.008 s at line 4, then 0.016 s"), std::string::npos)
+    const std::string unit = r.time_unit;
+    EXPECT_EQ(unit, name.substr(name.find('_') + 1) == "MS" ? "ms" : name.substr(name.find('_') + 1)) << name;
+    EXPECT_NE(msg.find(fmt::format("gap in the time column: {} {} at line 4, then {} {}: 0.004 s missing",
+                                   0.008 * per_s, unit, 0.016 * per_s, unit)),
+              std::string::npos)
         << name << ": " << msg;
     EXPECT_EQ(line, 5u) << name;
   }
@@ -141,6 +146,7 @@ TEST(ReaderColumns, TwoCandidateSampleColumnsAreAnErrorInEveryMode) {
   for (const auto& [mode, header] : cases) {
     ReadOptions o;
     o.mode = mode;
+    o.rate_hz = 400.0;
     const auto [msg, line] = error_of(header + "\n1,2\n3,4\n", o);
     EXPECT_NE(msg.find("could each hold the"), std::string::npos) << header << ": " << msg;
     EXPECT_NE(msg.find("choose one with --column"), std::string::npos) << msg;

@@ -106,6 +106,7 @@ struct AllanReportInfo {
   std::size_t samples = 0;  ///< samples read
   double rate_hz = 0;       ///< sample rate, Hz
   std::string rate_source;  ///< where the rate came from ("option", "metadata", …); may be empty
+  std::string input;        ///< what was read (describe_input in reader.hpp); may be empty
 };
 
 /// Human-readable table: a header block (source, estimator, confidence, unit convention, samples,

@@ -33,6 +33,7 @@ struct AnalysisResult {
   double rate_hz = 0;
   double duration_s = 0;
   std::string column;
+  nlohmann::json input;         ///< input_json() of the recording as read
   double arcsec_per_count = 0;  ///< pulse weight (0 when the input was not pulses/counter)
   std::optional<double> temperature_c;
   std::string temperature_source;  ///< "option", "column or metadata", "file name", or ""
@@ -56,6 +57,10 @@ struct AnalysisResult {
 
 /// Throws UsageError for clock data, AnalysisError for a record too short or without noise.
 AnalysisResult analyze(const Recording& rec, const AnalysisOptions& options = {});
+
+/// What was read and how (the `input` object of analyze and allan JSON): column, kind, unit, rate
+/// and its source, the time column and its unit, the jitter, and the reader's notes and warnings.
+nlohmann::json input_json(const Recording& rec);
 
 /// The JSON object of `rwcalc analyze --json` (keys in docs/analysis.md).
 nlohmann::json to_json(const AnalysisResult& r);

@@ -34,22 +34,34 @@ enum class AngleUnit { Arcsec, Deg, Rad, Second };
 /// Unit of Rate input. Unitless means dimensionless clock frequency (fractional frequency).
 enum class RateUnit { DegPerHour, DegPerSecond, RadPerSecond, Unitless };
 
+/// Unset options mean "not given": the column's name may then choose (see docs/input-formats.md).
 struct ReadOptions {
-  InputMode mode = InputMode::Pulses;
+  /// --input; unset: implied by a unit suffix of the column's name (`gyro_x_dps` → rate), else pulses
+  std::optional<InputMode> mode;
   /// Column holding the samples: a header name, or a 1-based index as text ("2"). Empty: the
   /// column named "pulses" (or counter/angle/phase/rate/gyro by mode), else the only non-time
   /// column, else an error asking for --column (also when two columns have such names).
   std::string column;
-  std::optional<double> rate_hz;       ///< --rate, Hz; overrides metadata; checked against a time column
-  std::optional<double> scale_arcsec;  ///< --scale: pulse weight, ″ per pulse; overrides metadata
-  int counter_bits = 32;               ///< wrap width of Counter mode (1..64)
-  AngleUnit angle_unit = AngleUnit::Arcsec;
-  RateUnit rate_unit = RateUnit::DegPerHour;
-  double time_tolerance = 0.01;  ///< allowed deviation of a time-column step, fraction of 1/rate
+  std::optional<double> rate_hz;        ///< --rate, Hz; overrides metadata; checked against a time column
+  std::optional<double> scale_arcsec;   ///< --scale: pulse weight, ″ per pulse; overrides metadata
+  int counter_bits = 32;                ///< wrap width of Counter mode (1..64)
+  std::optional<AngleUnit> angle_unit;  ///< unset: the column name's suffix (`_deg`), else arcsec
+  std::optional<RateUnit> rate_unit;    ///< unset: the column name's suffix (`_dps`), else deg/h
+  /// A time-column step off the period by more than this fraction of it is jitter (accepted and
+  /// reported) while it stays within half a period; 1.5 periods or more is a gap (an error).
+  double time_tolerance = 0.01;
 };
 
 /// Where the sample rate came from (reported in outputs).
 enum class RateSource { Option, Metadata, TimeColumn, Default };
+
+/// Time-column steps that deviate from the period (the median step) by more than the time
+/// tolerance but less than half a period: accepted, and reported.
+struct TimeJitter {
+  std::size_t steps = 0;    ///< steps off by more than the tolerance
+  double max_fraction = 0;  ///< largest |step − period| / period over all steps
+  double rms_fraction = 0;  ///< rms of (step − period) / period over all steps
+};
 
 struct Recording {
   std::string source;      ///< the path as given ("-" for stdin)
@@ -64,6 +76,16 @@ struct Recording {
   /// the time column that was checked, if any (the first of two, which were found to agree)
   std::optional<std::string> time_column;
   InputMode mode = InputMode::Pulses;
+  AngleUnit angle_unit = AngleUnit::Arcsec;   ///< the unit angle input was read in
+  RateUnit rate_unit = RateUnit::DegPerHour;  ///< the unit rate input was read in
+  /// The time column's unit ("s", "ms", "us", "ns") and how it was decided ("name" or "magnitude").
+  std::string time_unit, time_unit_source;
+  TimeJitter jitter;
+  /// The choices the reader made that no option fixed, one sentence each ("rate unit deg/s from the
+  /// column name 'gyro_x_dps'"); the commands print them and the JSON outputs carry them.
+  std::vector<std::string> notes;
+  /// Options that contradict the file (a --rate-unit other than the column name's): the option is used.
+  std::vector<std::string> warnings;
   /// Counter input: how many times the counter wrapped (a backwards step counts as a wrap).
   std::size_t counter_wraps = 0;
   /// Where each run of consecutive data lines starts: (sample index, 1-based line number), sorted
@@ -86,6 +108,12 @@ Recording read_recording(const std::string& path, const ReadOptions& options = {
 /// Read from text already in memory (used by tests and fuzzers); `name` labels errors.
 /// The text may be gzip-compressed (detected by its magic bytes).
 Recording read_recording_text(std::string_view text, const std::string& name, const ReadOptions& options = {});
+
+/// The unit the samples were read in: "pulse" or "count" (of Recording::phase.arcsec_per_count),
+/// the angle unit ("arcsec", "deg", "rad", "s") or the rate unit ("deg/h", "deg/s", "rad/s", "1").
+std::string_view input_unit(const Recording& rec);
+/// One line for output headers: "column 'gyro_x_dps': rate samples in deg/s".
+std::string describe_input(const Recording& rec);
 
 /// Parse names used on the command line; throw UsageError on anything else.
 InputMode parse_input_mode(std::string_view s);

@@ -116,6 +116,27 @@ nlohmann::json allan_json(const AllanResult& a) {
           {"points", pts}};
 }
 
+nlohmann::json input_json(const Recording& rec) {
+  nlohmann::json j = {{"column", rec.column_name},
+                      {"kind", std::string(to_string(rec.mode))},
+                      {"unit", std::string(input_unit(rec))},
+                      {"rate_hz", rec.rate_hz},
+                      {"rate_source", std::string(to_string(rec.rate_source))},
+                      {"notes", rec.notes},
+                      {"warnings", rec.warnings}};
+  if (rec.mode == InputMode::Pulses || rec.mode == InputMode::Counter)
+    j["arcsec_per_count"] = rec.phase.arcsec_per_count;
+  j["time_column"] = rec.time_column ? nlohmann::json(*rec.time_column) : nlohmann::json(nullptr);
+  if (rec.time_column) {
+    j["time_unit"] = rec.time_unit;
+    j["time_unit_source"] = rec.time_unit_source;
+    j["jitter"] = {{"steps", rec.jitter.steps},
+                   {"max_fraction", rec.jitter.max_fraction},
+                   {"rms_fraction", rec.jitter.rms_fraction}};
+  }
+  return j;
+}
+
 namespace {
 
 /// What the result says of its record: source, size, column, pulse weight and temperature (from the
@@ -254,6 +275,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   Recording edited;
   const Recording& rec = screen_outliers(read, options.outlier_action, options.outlier_threshold, r.outliers, edited);
   describe_record(rec, options, r);
+  r.input = input_json(read);  // as read: the outlier screen's copy keeps no notes
   if (rec.phase.points() < 3)
     throw AnalysisError(
         fmt::format("{}: the record holds {} sample(s); far too short to analyse", rec.source, rec.samples));
@@ -311,6 +333,7 @@ nlohmann::json to_json(const AnalysisResult& r) {
     b100["discrepancy_model_sigma"] = r.B_100s_vs_model_sigma;
   }
   return {{"source", r.source},
+          {"input", r.input},
           {"samples", r.samples},
           {"rate_hz", r.rate_hz},
           {"duration_s", r.duration_s},
@@ -344,6 +367,25 @@ nlohmann::json to_json(const AnalysisResult& r) {
             {"intervals", "95 % profile-likelihood; resolved=false: value is the 95 % upper bound"}}}};
 }
 
+namespace {
+
+// "  input: rate samples in deg/s from column 'gyro_x_dps'; sample rate from the time column
+// 'timestamp' (ns)": what was read, for the report's Data lines.
+std::string input_line(const nlohmann::json& in) {
+  if (!in.is_object()) return "";
+  const std::string kind = in.value("kind", ""), unit = in.value("unit", "");
+  std::string s = "  input: " + (kind == "pulses"    ? std::string("pulse counts")
+                                 : kind == "counter" ? std::string("counter readings")
+                                                     : fmt::format("{} samples in {}", kind, unit));
+  s += fmt::format(" from column '{}'; sample rate from {}", in.value("column", ""), in.value("rate_source", ""));
+  if (in.contains("time_unit"))
+    s += fmt::format(" ('{}', in {} by {})", in["time_column"].get<std::string>(), in.value("time_unit", ""),
+                     in.value("time_unit_source", ""));
+  return s + "\n";
+}
+
+}  // namespace
+
 std::string format_report(const AnalysisResult& r) {
   std::string s;
   s += fmt::format("rwcalc analyze: {}\n\n", printable(r.source));
@@ -352,6 +394,7 @@ std::string format_report(const AnalysisResult& r) {
                    1000.0 / r.rate_hz, r.duration_s, r.duration_s / 3600.0, r.column);
   if (r.arcsec_per_count > 0) s += fmt::format(", pulse weight {:g} arcsec", r.arcsec_per_count);
   s += "\n";
+  s += input_line(r.input);
   s += r.temperature_c ? fmt::format("  temperature {:g} °C (from {})\n", *r.temperature_c, r.temperature_source)
                        : std::string("  temperature unknown\n");
   s += fmt::format("  mean rate {:.4f} °/h; expected vertical Earth rate {:.4f} °/h ({}); bias {:+.4f} °/h\n\n",

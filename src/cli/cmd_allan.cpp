@@ -41,7 +41,15 @@ void append_number(std::string& out, double v) {
   if (out.find_first_of(".e", at) == std::string::npos) out += ".0";
 }
 
-std::string allan_json_text(const AllanResult& r, const Recording& rec, const OutlierReport& outliers) {
+// A JSON value one level in, as dump(2) writes a nested object.
+std::string nested(const nlohmann::json& j) {
+  std::string s = j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
+  for (std::size_t at = s.find('\n'); at != std::string::npos; at = s.find('\n', at + 3)) s.replace(at, 1, "\n  ");
+  return s;
+}
+
+std::string allan_json_text(const AllanResult& r, const Recording& rec, const Recording& read,
+                            const OutlierReport& outliers) {
   std::string out;
   out.reserve(256 + r.points.size() * 260);
   out += "{\n";
@@ -53,11 +61,8 @@ std::string allan_json_text(const AllanResult& r, const Recording& rec, const Ou
       nlohmann::json(r.unit == "deg/h" ? "1 arcsec/s = 1 deg/h" : "deviation in input units per second").dump());
   out += fmt::format("  \"estimator\": {},\n", nlohmann::json(std::string(to_string(r.estimator))).dump());
   if (r.fft_from_m > 0) out += fmt::format("  \"fft_from_af\": {},\n", r.fft_from_m);
-  // The outlier object one level in, as dump(2) writes a nested object.
-  std::string outl = to_json(outliers).dump(2);
-  for (std::size_t at = outl.find('\n'); at != std::string::npos; at = outl.find('\n', at + 3))
-    outl.replace(at, 1, "\n  ");
-  out += "  \"outliers\": " + outl + ",\n";
+  out += "  \"input\": " + nested(input_json(read)) + ",\n";
+  out += "  \"outliers\": " + nested(to_json(outliers)) + ",\n";
   out += fmt::format("  \"phase_points\": {},\n", r.points_in);
   out += r.points.empty() ? "  \"points\": []" : "  \"points\": [";
   for (std::size_t i = 0; i < r.points.size(); ++i) {
@@ -112,6 +117,7 @@ int run_allan(const AllanArgs& a, Io& io) {
   o.confidence = a.confidence;
   const OutlierAction outlier_action = parse_outlier_action(a.outliers);
   const Recording read = read_recording(a.file, a.input.options());
+  print_input_notes(io.err, read);
   // Outliers are looked for, reported and dealt with as by analyze (--outliers).
   OutlierReport outliers;
   Recording edited;
@@ -123,13 +129,14 @@ int run_allan(const AllanArgs& a, Io& io) {
   const AllanResult res = compute_allan(rec.phase, o);
   require_finite(res, rec);
   if (a.json) {
-    io.out << allan_json_text(res, rec, outliers);
+    io.out << allan_json_text(res, rec, read, outliers);
   } else if (a.csv) {
     io.out << format_allan_csv(res);
     // The CSV holds the table only; the outliers found are said on standard error.
     if (outliers.count > 0) print_message(io.err, fmt::format("note: {}: {}", rec.source, format_outliers(outliers)));
   } else {
-    io.out << format_allan_table(res, {rec.source, rec.samples, rec.rate_hz, std::string(to_string(rec.rate_source))});
+    io.out << format_allan_table(res, {rec.source, rec.samples, rec.rate_hz, std::string(to_string(rec.rate_source)),
+                                       describe_input(read)});
     io.out << "\n" << format_outliers(outliers);
   }
   return 0;

@@ -54,6 +54,7 @@ void register_analyze(CLI::App& app, Runner& runner) {
       // are reported before the analysis, and before anything is written.
       cmd->plot.check(cmd->force, {{"-o", cmd->output}});
       const Recording rec = read_recording(cmd->file, cmd->input.options());
+      print_input_notes(io.err, rec);
       const AnalysisResult res = analyze(rec, opt);
       const std::string text = [&] {
         const nlohmann::json j = to_json(res);

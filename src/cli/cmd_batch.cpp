@@ -58,6 +58,7 @@ void register_batch(CLI::App& app, Runner& runner) {
       cmd->plot.check(cmd->force, {{"-o", cmd->output}});
       auto runs = analyze_files(cmd->files, cmd->input.options(), opt);
       for (const auto& run : runs) require_finite(run, run.value("source", std::string("batch")));
+      for (const auto& run : runs) print_input_notes(io.err, run);
       if (cmd->plot.any()) cmd->plot.draw_batch(nlohmann::json{{"runs", runs}}, cmd->force, io);
       emit(io, cmd->format.render(std::move(runs)), cmd->output, cmd->force);
       return 0;

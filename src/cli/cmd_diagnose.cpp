@@ -67,6 +67,7 @@ void register_diagnose(CLI::App& app, Runner& runner) {
       opt.seed = cmd->seed;
       opt.alpha = cmd->alpha;
       const Recording rec = read_recording(cmd->file, cmd->input.options());
+      print_input_notes(io.err, rec);
       const std::size_t hold = cmd->runs;  // the out-of-sample ensembles are as large as the main one
       Progress progress("simulating", static_cast<std::uint64_t>(2 * cmd->runs + 7 * hold));
       opt.progress = &progress;

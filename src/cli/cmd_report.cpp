@@ -107,13 +107,14 @@ json settings_of(const ReportCmd& c, const std::vector<std::string>& recordings,
   if (!saved.empty()) s["saved results"] = saved;
   if (recordings.empty()) return s;  // the analysis options below apply to recordings only
   const auto& in = c.input;
-  s["input"] = in.input;
+  s["input"] = in.input.empty() ? std::string("pulses") : in.input;  // unless a column name implies rate or angle
   if (!in.column.empty()) s["column"] = in.column;
   if (in.rate_hz) s["rate (Hz)"] = *in.rate_hz;
   if (in.scale_arcsec) s["pulse weight (″)"] = *in.scale_arcsec;
   if (in.input == "counter") s["counter bits"] = in.counter_bits;
-  if (in.input == "angle") s["angle unit"] = in.angle_unit;
-  if (in.input == "rate") s["rate unit"] = in.rate_unit;
+  const std::string by_name = "from the column name, else ";
+  if (in.input == "angle") s["angle unit"] = in.angle_unit.empty() ? by_name + "arcsec" : in.angle_unit;
+  if (in.input == "rate") s["rate unit"] = in.rate_unit.empty() ? by_name + "deg/h" : in.rate_unit;
   const auto& a = c.analysis;
   s["fit range (s)"] = a.fit_range.empty() ? std::string("all τ") : a.fit_range;
   s["minimum EDF"] = a.min_edf;

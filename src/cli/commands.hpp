@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <iosfwd>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -27,17 +28,23 @@ void print_message(std::ostream& err, std::string_view text);
 
 /// Input options shared by every command that reads a recording (allan, analyze, batch, diagnose).
 struct InputArgs {
-  std::string input = "pulses";
+  std::string input;  ///< empty: not given (the column name may imply it; else pulses)
   std::string column;
   std::optional<double> rate_hz;
   std::optional<double> scale_arcsec;
   int counter_bits = 32;
-  std::string angle_unit = "arcsec";
-  std::string rate_unit = "deg/h";
+  std::string angle_unit;  ///< empty: not given (the column name's suffix, else arcsec)
+  std::string rate_unit;   ///< empty: not given (the column name's suffix, else deg/h)
   double time_tolerance = 0.01;
   void add_to(CLI::App& app);
   [[nodiscard]] ReadOptions options() const;  ///< throws UsageError on bad names
 };
+
+/// The reader's warnings and notes on a recording (Recording::warnings, notes), one line each:
+/// "rwcalc: warning: FILE: …", "rwcalc: note: FILE: …".
+void print_input_notes(std::ostream& err, const Recording& rec);
+/// The same from the `input` object of an analysis' JSON (batch).
+void print_input_notes(std::ostream& err, const nlohmann::json& analysis);
 
 // One per sub-command (src/cli/cmd_*.cpp). Each adds its subcommand to `app` and sets `runner`.
 void register_allan(CLI::App& app, Runner& runner);

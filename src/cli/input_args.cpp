@@ -1,5 +1,8 @@
 #include <fmt/format.h>
 
+#include <nlohmann/json.hpp>
+#include <ostream>
+
 #include "cli/commands.hpp"
 #include "cli/numeric_options.hpp"
 #include "rwcalc/error.hpp"
@@ -10,11 +13,13 @@ void InputArgs::add_to(CLI::App& app) {
   app.add_option("--input", input,
                  "What the column holds: pulses (per-sample pulse increments), counter (cumulative "
                  "counter, wraps at --counter-bits), angle (cumulative angle/phase in --angle-unit), "
-                 "rate (rate samples in --rate-unit)")
-      ->capture_default_str()
+                 "rate (rate samples in --rate-unit). Default: implied by a unit suffix of the column's name "
+                 "(gyro_x_dps: rate), else pulses")
       ->group("Input");
   app.add_option("--column", column, "Column to read: a header name or a 1-based index")->group("Input");
-  app.add_option("--rate", rate_hz, "Sample rate, Hz (default: metadata, time column, or 400)")
+  app.add_option("--rate", rate_hz,
+                 "Sample rate, Hz (default: metadata rate_hz, else a time column, else 400 for pulse and counter "
+                 "input; rate and angle input need one of these)")
       ->check(real_in(kMinRateHz, kMaxRateHz, "Hz"))
       ->group("Input");
   app.add_option("--scale", scale_arcsec, "Pulse weight, arcsec per pulse (default: metadata or 0.92)")
@@ -24,15 +29,17 @@ void InputArgs::add_to(CLI::App& app) {
       ->check(whole_in(1, 64))
       ->capture_default_str()
       ->group("Input");
-  app.add_option("--angle-unit", angle_unit, "Unit of angle input: arcsec, deg, rad, or s (clock phase)")
-      ->capture_default_str()
+  app.add_option("--angle-unit", angle_unit,
+                 "Unit of angle input: arcsec, deg, rad, or s (clock phase). Default: the column name's suffix "
+                 "(_deg, _rad, _arcsec), else arcsec")
       ->group("Input");
   app.add_option("--rate-unit", rate_unit,
-                 "Unit of rate input: deg/h, deg/s, rad/s, or 1 (dimensionless clock frequency)")
-      ->capture_default_str()
+                 "Unit of rate input: deg/h, deg/s, rad/s, or 1 (dimensionless clock frequency). Default: the "
+                 "column name's suffix (_dps, _dph, _rads, ...), else deg/h")
       ->group("Input");
   app.add_option("--time-tolerance", time_tolerance,
-                 "Allowed deviation of a time-column step from the sample period, fraction of it")
+                 "Time-column steps off the sample period by more than this fraction of it are reported as "
+                 "jitter (accepted up to half a period; 1.5 periods or more is a gap, an error)")
       ->check(real_in(0.0, 0.5, ""))
       ->capture_default_str()
       ->group("Input");
@@ -40,15 +47,31 @@ void InputArgs::add_to(CLI::App& app) {
 
 ReadOptions InputArgs::options() const {
   ReadOptions o;
-  o.mode = parse_input_mode(input);
+  if (!input.empty()) o.mode = parse_input_mode(input);
   o.column = column;
   o.rate_hz = rate_hz;
   o.scale_arcsec = scale_arcsec;
   o.counter_bits = counter_bits;
-  o.angle_unit = parse_angle_unit(angle_unit);
-  o.rate_unit = parse_rate_unit(rate_unit);
+  if (!angle_unit.empty()) o.angle_unit = parse_angle_unit(angle_unit);
+  if (!rate_unit.empty()) o.rate_unit = parse_rate_unit(rate_unit);
   o.time_tolerance = time_tolerance;
   return o;
+}
+
+void print_input_notes(std::ostream& err, const Recording& rec) {
+  for (const std::string& w : rec.warnings) print_message(err, fmt::format("warning: {}: {}", rec.source, w));
+  for (const std::string& n : rec.notes) print_message(err, fmt::format("note: {}: {}", rec.source, n));
+}
+
+void print_input_notes(std::ostream& err, const nlohmann::json& analysis) {
+  const auto in = analysis.find("input");
+  if (in == analysis.end() || !in->is_object()) return;
+  const std::string source = analysis.value("source", std::string());
+  for (const char* kind : {"warnings", "notes"})
+    for (const auto& line : in->value(kind, nlohmann::json::array()))
+      if (line.is_string())
+        print_message(err,
+                      fmt::format("{}: {}: {}", kind[0] == 'w' ? "warning" : "note", source, line.get<std::string>()));
 }
 
 }  // namespace rwcalc::cli

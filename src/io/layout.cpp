@@ -18,10 +18,18 @@ namespace {
 
 constexpr std::size_t kQuoteLimit = 40;
 
-constexpr TimeName kTimeNames[] = {{"time_s", "s", 1},     {"time", "s", 1},       {"t", "s", 1},
-                                   {"t_s", "s", 1},        {"timestamp", "s", 1},  {"time_sec", "s", 1},
-                                   {"time_ms", "ms", 1e3}, {"t_ms", "ms", 1e3},    {"time_us", "us", 1e6},
-                                   {"t_us", "us", 1e6},    {"time_ns", "ns", 1e9}, {"t_ns", "ns", 1e9}};
+// The first four are the units a stamp's magnitude can tell; "%time" is ROS's receive time (ns
+// since the epoch) in CSV exports of ROS bags.
+constexpr TimeName kTimeNames[] = {{"time_s", "s", 1},     {"time_ms", "ms", 1e3},
+                                   {"time_us", "us", 1e6}, {"time_ns", "ns", 1e9},
+                                   {"time", "", 0},        {"t", "", 0},
+                                   {"timestamp", "", 0},   {"t_s", "s", 1},
+                                   {"time_sec", "s", 1},   {"timestamp_s", "s", 1},
+                                   {"t_ms", "ms", 1e3},    {"timestamp_ms", "ms", 1e3},
+                                   {"t_us", "us", 1e6},    {"timestamp_us", "us", 1e6},
+                                   {"t_ns", "ns", 1e9},    {"timestamp_ns", "ns", 1e9},
+                                   {"%time", "ns", 1e9}};
+constexpr const TimeName* kByMagnitude = &kTimeNames[4];  // "time": the headerless time column
 constexpr std::string_view kTemperatureNames[] = {"temperature_c", "temperature", "temp_c", "temp", "t_c"};
 
 // The names of a column that holds the samples, by InputMode.
@@ -167,6 +175,14 @@ void Metadata::read(std::string_view body, std::size_t line, const std::string& 
   if (!inserted && it->second != value) it->second += "; " + value;  // nothing is dropped
 }
 
+const TimeName* time_unit_of_stamp(double first) {
+  const double a = std::abs(first);
+  if (a < 1e6) return &kTimeNames[0];  // seconds from near 0 (up to 11 days)
+  if (a < 1e8) return nullptr;         // neither near 0 nor epoch-like
+  const int decade = a < 1e11 ? 0 : a < 1e14 ? 1 : a < 1e17 ? 2 : 3;
+  return &kTimeNames[decade];
+}
+
 std::string_view delim_name(Delim d) {
   constexpr std::string_view kNames[] = {"comma", "semicolon", "tab", "blanks"};
   return kNames[static_cast<int>(d)];
@@ -196,7 +212,7 @@ void Layout::choose(const ReadOptions& o, std::size_t where, const std::string& 
                          fmt::format("{} columns and no header row: choose the column with --column", ncols));
       value_col = ncols == 1 ? 0 : 1;
     }
-    if ((ncols == 2 || ncols == 3) && value_col == 1) time_col = 0, time_unit = &kTimeNames[0];
+    if ((ncols == 2 || ncols == 3) && value_col == 1) time_col = 0, time_unit = kByMagnitude;
     if (ncols == 3 && value_col == 1) temp_col = 2;
   } else {
     choose_by_name(o, !o.column.empty(), file);
@@ -246,12 +262,13 @@ void Layout::choose_by_name(const ReadOptions& o, bool value_given, const std::s
     std::erase(times, value_col);
     std::erase(temps, value_col);
   } else {
-    const auto& names = kValueNames[static_cast<int>(o.mode)];
+    const InputMode mode = o.mode.value_or(InputMode::Pulses);
+    const auto& names = kValueNames[static_cast<int>(mode)];
     const auto named = columns_where(header, [&](std::string_view h) { return any_named(h, names); });
     if (named.size() > 1)
       throw InputError(file, header_line,
                        fmt::format("columns {} could each hold the {} samples; choose one with --column",
-                                   column_list(named), to_string(o.mode)));
+                                   column_list(named), to_string(mode)));
     std::vector<std::size_t> rest;
     for (std::size_t k = 0; k < ncols; ++k)
       if (std::count(times.begin(), times.end(), k) + std::count(temps.begin(), temps.end(), k) == 0) rest.push_back(k);
@@ -259,7 +276,7 @@ void Layout::choose_by_name(const ReadOptions& o, bool value_given, const std::s
       throw InputError(file, header_line,
                        fmt::format("cannot tell which column holds the {} samples; choose one with --column (the "
                                    "columns are {})",
-                                   to_string(o.mode), column_list(all_columns(ncols))));
+                                   to_string(mode), column_list(all_columns(ncols))));
     value_col = named.empty() ? rest.front() : named.front();
   }
   if (times.size() > 2)
@@ -295,6 +312,93 @@ std::string Layout::describe(Role role) const {
                                 : role == Role::Temperature ? "temperature column"
                                                             : "time column";
   return header.empty() ? fmt::format("{} {}", kind, index + 1) : fmt::format("{} '{}'", kind, header[index]);
+}
+
+}  // namespace rwcalc::detail
+
+namespace rwcalc::detail {
+
+namespace {
+
+// Unit suffixes of column names (IMU exports): the channel's kind and unit. Longer suffixes first,
+// so that `_deg_s` is not taken for `_s` nor `_rad_s` for `_rad`'s neighbours.
+struct UnitSuffix {
+  std::string_view suffix;
+  InputMode mode;
+  AngleUnit angle = AngleUnit::Arcsec;
+  RateUnit rate = RateUnit::DegPerHour;
+};
+constexpr UnitSuffix kUnitSuffixes[] = {{"_deg_s", InputMode::Rate, {}, RateUnit::DegPerSecond},
+                                        {"_degps", InputMode::Rate, {}, RateUnit::DegPerSecond},
+                                        {"_dps", InputMode::Rate, {}, RateUnit::DegPerSecond},
+                                        {"_deg_h", InputMode::Rate, {}, RateUnit::DegPerHour},
+                                        {"_degph", InputMode::Rate, {}, RateUnit::DegPerHour},
+                                        {"_dph", InputMode::Rate, {}, RateUnit::DegPerHour},
+                                        {"_rad_s", InputMode::Rate, {}, RateUnit::RadPerSecond},
+                                        {"_radps", InputMode::Rate, {}, RateUnit::RadPerSecond},
+                                        {"_rads", InputMode::Rate, {}, RateUnit::RadPerSecond},
+                                        {"_arcsec", InputMode::Angle, AngleUnit::Arcsec},
+                                        {"_deg", InputMode::Angle, AngleUnit::Deg},
+                                        {"_rad", InputMode::Angle, AngleUnit::Rad}};
+constexpr std::string_view kAccelSuffixes[] = {"_mps2", "_m_s2", "_ms2", "_g"};
+
+bool ends_with_nocase(std::string_view s, std::string_view suffix) {
+  return s.size() > suffix.size() && iequals(s.substr(s.size() - suffix.size()), suffix);
+}
+
+const UnitSuffix* unit_suffix(std::string_view column) {
+  for (const UnitSuffix& u : kUnitSuffixes)
+    if (ends_with_nocase(column, u.suffix)) return &u;
+  return nullptr;
+}
+
+// The unit of one kind (angle or rate): the option's, else the suffix's, else the default; each
+// choice the option did not make is said.
+template <class Unit>
+Unit choose_unit(std::optional<Unit> given, std::optional<Unit> named, Unit fallback, std::string_view what,
+                 std::string_view option, std::string_view column, InputChoice& c) {
+  if (given && named && *given != *named)
+    c.warnings.push_back(fmt::format("the column name '{}' says {} in {}, but {} {} is used as given", column, what,
+                                     to_string(*named), option, to_string(*given)));
+  if (given) return *given;
+  if (named) {
+    c.notes.push_back(fmt::format("{} unit {} from the column name '{}'", what, to_string(*named), column));
+    return *named;
+  }
+  c.notes.push_back(fmt::format("{} unit {} (the default: no {} and no unit suffix such as _dps in the column name)",
+                                what, to_string(fallback), option));
+  return fallback;
+}
+
+}  // namespace
+
+InputChoice choose_input(const ReadOptions& o, std::string_view column, const std::string& file, std::size_t line) {
+  for (const std::string_view a : kAccelSuffixes)
+    if (ends_with_nocase(column, a))
+      throw InputError(file, line,
+                       fmt::format("column '{}' is an accelerometer channel (unit '{}' in its name); accelerometer "
+                                   "channels are not supported by this command: choose a gyro column with --column",
+                                   column, a.substr(1)));
+  InputChoice c;
+  const UnitSuffix* u = unit_suffix(column);
+  if (o.mode) {
+    c.mode = *o.mode;
+    if (u && u->mode != c.mode)
+      c.warnings.push_back(fmt::format("the column name '{}' says {} input, but --input {} is used as given", column,
+                                       to_string(u->mode), to_string(c.mode)));
+  } else if (u) {
+    c.mode = u->mode;
+    c.notes.push_back(fmt::format("input {} from the column name '{}' (no --input given)", to_string(c.mode), column));
+  }
+  const bool angle = c.mode == InputMode::Angle, rate = c.mode == InputMode::Rate;
+  const bool named_angle = u && u->mode == InputMode::Angle, named_rate = u && u->mode == InputMode::Rate;
+  if (angle)
+    c.angle_unit = choose_unit(o.angle_unit, named_angle ? std::optional(u->angle) : std::nullopt, AngleUnit::Arcsec,
+                               "angle", "--angle-unit", column, c);
+  if (rate)
+    c.rate_unit = choose_unit(o.rate_unit, named_rate ? std::optional(u->rate) : std::nullopt, RateUnit::DegPerHour,
+                              "rate", "--rate-unit", column, c);
+  return c;
 }
 
 }  // namespace rwcalc::detail

@@ -48,9 +48,27 @@ enum class Role : unsigned char { Skip, Value, Time, Time2, Temperature };
 /// A time column's name and the unit it is in.
 struct TimeName {
   std::string_view name;
-  std::string_view unit;
-  double per_second;  ///< units per second
+  std::string_view unit;  ///< "" for a name without a unit: told by the stamps' magnitude
+  double per_second;      ///< units per second; 0 for a name without a unit
 };
+
+/// The unit of a time column whose name carries none, from its first stamp: epoch-like stamps tell
+/// their unit (Unix time is ~1.7e9 s, ~1.7e12 ms, ~1.7e15 us, ~1.7e18 ns); stamps below 1e6 are
+/// seconds from near 0. nullptr when the stamp tells nothing (1e6 up to 1e8).
+const TimeName* time_unit_of_stamp(double first);
+
+/// The input mode and units, with the options given and the selected column's name: a unit suffix
+/// (`gyro_x_dps`) chooses what no option fixed; what it chose is said in `notes`, an option that
+/// contradicts it in `warnings`.
+struct InputChoice {
+  InputMode mode = InputMode::Pulses;
+  AngleUnit angle_unit = AngleUnit::Arcsec;
+  RateUnit rate_unit = RateUnit::DegPerHour;
+  std::vector<std::string> notes, warnings;
+};
+/// `column`: the selected column's header name ("" without a header). Throws InputError at `line`
+/// for an accelerometer column (`acc_x_g`, `_mps2`).
+InputChoice choose_input(const ReadOptions& o, std::string_view column, const std::string& file, std::size_t line);
 
 struct Layout {
   Delim delim = Delim::Blanks;

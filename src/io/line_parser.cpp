@@ -69,7 +69,9 @@ LineKind LineParser::parse(std::string_view text, std::size_t line, Sample& s) {
     layout_.ncols = layout_.header.empty() ? fields_.size() : layout_.header.size();
     layout_known_ = true;
     first_data_line_ = line;
-    layout_.choose(opt_, layout_.header_line ? layout_.header_line : line, file_);
+    const std::size_t where = layout_.header_line ? layout_.header_line : line;
+    layout_.choose(opt_, where, file_);
+    input_ = choose_input(opt_, layout_.header.empty() ? "" : layout_.header[layout_.value_col], file_, where);
   }
   if (fields_.size() != layout_.ncols)
     fail(fmt::format("wrong number of columns: expected {} ({}-separated, as line {} has), found {}: {}", layout_.ncols,
@@ -92,7 +94,7 @@ bool LineParser::plain_integer(std::string_view t, Sample& s) const {
     v = v * 10 + d;
   }
   s.integer = neg ? -v : v;
-  return opt_.mode != InputMode::Counter || (s.integer >= counter_lo_ && s.integer <= counter_max_);
+  return input_.mode != InputMode::Counter || (s.integer >= counter_lo_ && s.integer <= counter_max_);
 }
 
 void LineParser::check_foreign_delimiters(std::string_view line) const {
@@ -189,7 +191,7 @@ bool LineParser::read_field(std::string_view f, Role role, Sample& s, bool repor
 // A pulse count or counter reading: exact, as an int64 (a 64-bit counter's reading above 2^63-1
 // as the same residue modulo 2^64).
 bool LineParser::read_integer(std::string_view f, std::string_view t, Sample& s, bool report) {
-  const bool counter = opt_.mode == InputMode::Counter;
+  const bool counter = input_.mode == InputMode::Counter;
   std::uint64_t u = 0;
   if (reads_whole(t, s.integer)) {
     if (!counter || (s.integer >= counter_lo_ && s.integer <= counter_max_)) return true;
@@ -210,7 +212,10 @@ bool LineParser::read_integer(std::string_view f, std::string_view t, Sample& s,
       std::all_of(t.begin() + neg, t.end(), [](char c) { return c >= '0' && c <= '9'; }))
     fail(fmt::format("number out of range of a 64-bit integer in {}: {}", col, quoted(f)));
   if (looks_numeric(f, layout_.delim != Delim::Comma))
-    fail(fmt::format("{} counts must be integers: {} in {}", counter ? "counter" : "pulse", quoted(f), col));
+    fail(fmt::format("{} counts must be integers: {} in {}{}", counter ? "counter" : "pulse", quoted(f), col,
+                     opt_.mode ? ""
+                               : " (pulses is the default input; for rate or angle samples give --input rate or "
+                                 "--input angle, or a column name with a unit such as gyro_x_dps)"));
   fail(fmt::format("not a number in {}: {}", col, quoted(f)));
 }
 

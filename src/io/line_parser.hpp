@@ -36,6 +36,9 @@ class LineParser {
   [[nodiscard]] std::size_t first_data_line() const noexcept { return first_data_line_; }
   [[nodiscard]] std::size_t content_lines() const noexcept { return content_lines_; }
   [[nodiscard]] const std::string& file() const noexcept { return file_; }
+  /// The input mode and units (known once the first data line fixed the columns).
+  [[nodiscard]] const InputChoice& input() const noexcept { return input_; }
+  [[nodiscard]] bool layout_known() const noexcept { return layout_known_; }
 
  private:
   [[noreturn]] void fail(const std::string& message) const;
@@ -47,7 +50,7 @@ class LineParser {
   bool plain_integer(std::string_view t, Sample& s) const;
   bool read_integer(std::string_view f, std::string_view t, Sample& s, bool report);
   [[nodiscard]] bool integer_mode() const noexcept {
-    return opt_.mode == InputMode::Pulses || opt_.mode == InputMode::Counter;
+    return input_.mode == InputMode::Pulses || input_.mode == InputMode::Counter;
   }
 
   std::string file_;
@@ -57,6 +60,7 @@ class LineParser {
   std::size_t first_data_line_ = 0;
   bool layout_known_ = false;
   Layout layout_;
+  InputChoice input_;
   Metadata meta_;
   std::int64_t counter_lo_ = 0, counter_max_ = 0;  // the readings a counter can give
   std::vector<std::string_view> fields_;

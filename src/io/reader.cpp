@@ -23,9 +23,10 @@ namespace {
 using detail::quoted;
 using detail::Sample;
 
-// The time column, checked without keeping every stamp: its first stamps (the rate estimate), its
-// span, and each step that is the smallest or the largest so far. The first step outside any band
-// around the period is among those, so it is found once the period is known.
+// The time column, checked without keeping every stamp (all in the column's own unit): its first
+// stamps (the rate estimate), its span, each step that is the smallest or the largest so far (the
+// first step outside any band around the period is among those, so it is found once the period is
+// known), and the jitter against the median of the first steps, counted as the stamps arrive.
 struct TimeTrack {
   struct Step {
     std::size_t sample;
@@ -37,14 +38,46 @@ struct TimeTrack {
   double min_dt = std::numeric_limits<double>::infinity(), max_dt = -std::numeric_limits<double>::infinity();
   std::size_t n = 0;
   std::vector<Step> lows, highs;
+  double tolerance = 0.01;  // fraction of the median step
+  double median = 0;        // of the first steps; 0 until known
+  double shift = 0;         // the first step: Σ(dt − shift) and Σ(dt − shift)² keep their digits
+  long double sum1 = 0, sum2 = 0;
+  std::size_t off = 0;  // steps off the median by more than the tolerance
+  bool median_known = false;
 
   void add(double t) {
     if (n == 0) first = t;
-    if (n > 0 && t - last < min_dt) min_dt = t - last, lows.push_back({n, last, t});
-    if (n > 0 && t - last > max_dt) max_dt = t - last, highs.push_back({n, last, t});
+    if (n > 0) step(t - last, t);
     if (n < kHead) head.push_back(t);
     last = t;
     ++n;
+    if (n == kHead) find_median();
+  }
+  void step(double dt, double t) {
+    if (n == 1) shift = dt;
+    if (dt < min_dt) min_dt = dt, lows.push_back({n, last, t});
+    if (dt > max_dt) max_dt = dt, highs.push_back({n, last, t});
+    const long double d = static_cast<long double>(dt) - shift;
+    sum1 += d, sum2 += d * d;
+    if (median > 0) count(dt);
+  }
+  void count(double dt) { off += std::abs(dt - median) > tolerance * median; }
+  // The median of the first steps (robust to one bad step); the steps so far are counted against it.
+  void find_median() {
+    median_known = true;
+    const std::size_t k = head.size() - 1;
+    std::vector<double> steps(k);
+    for (std::size_t i = 0; i < k; ++i) steps[i] = head[i + 1] - head[i];
+    std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(k / 2), steps.end());
+    median = steps[k / 2];
+    if (median > 0)
+      for (std::size_t i = 0; i < k; ++i) count(head[i + 1] - head[i]);
+  }
+  [[nodiscard]] TimeJitter jitter() const {
+    const auto k = static_cast<long double>(n - 1), c = static_cast<long double>(median) - shift;
+    const long double ss = std::max(0.0L, sum2 - 2 * c * sum1 + k * c * c);
+    return {off, std::max(max_dt - median, median - min_dt) / median,
+            static_cast<double>(std::sqrt(ss / k) / static_cast<long double>(median))};
   }
   [[nodiscard]] Step first_outside(double lo, double hi) const {
     const auto low = std::find_if(lows.begin(), lows.end(), [&](const Step& s) { return !(s.after - s.before >= lo); });
@@ -91,6 +124,16 @@ std::string_view name_of(const NameTable<E>& table, E e) {
 
 using Runs = std::vector<std::pair<std::size_t, std::size_t>>;
 
+// The largest --time-tolerance the command line takes.
+constexpr double kMaxTimeTolerance = 0.5;
+
+// Where a larger --time-tolerance (at most kMaxTimeTolerance) would accept a deviation of
+// `fraction` of the period, the hint that says so; else nothing.
+std::string tolerance_hint(double fraction) {
+  if (!(fraction < kMaxTimeTolerance)) return "";
+  return fmt::format(" (a --time-tolerance of {:.3g} or more would accept it)", fraction * 1.001);
+}
+
 // The line of sample k in runs of consecutive data lines (Recording::line_runs); 0 if before them.
 std::size_t line_in_runs(const Runs& runs, std::size_t k) {
   auto it = std::upper_bound(runs.begin(), runs.end(), k, [](std::size_t v, const auto& run) { return v < run.first; });
@@ -100,8 +143,7 @@ std::size_t line_in_runs(const Runs& runs, std::size_t k) {
 class Reader {
  public:
   Reader(const std::string& file, const ReadOptions& o) : parser_(file, o), opt_(o) {
-    if (o.mode == InputMode::Pulses) ints_.push_back(0);   // C_0
-    if (o.mode == InputMode::Rate) reals_.push_back(0.0);  // x_0
+    times_.tolerance = o.time_tolerance;
   }
   void read(detail::TextSource& src) {
     std::string buf;
@@ -109,8 +151,9 @@ class Reader {
       more = src.read(buf);
       const std::size_t taken = take_lines(buf, !more);
       const auto lines = static_cast<double>(line_);
-      if (first && line_ > 0) reserve(static_cast<double>(src.size_estimate()) / static_cast<double>(taken) * lines);
-      first = first && line_ == 0;
+      if (first && parser_.layout_known())
+        reserve(static_cast<double>(src.size_estimate()) / static_cast<double>(taken) * lines);
+      first = first && !parser_.layout_known();
       buf.erase(0, taken);
     }
     if (!buf.empty()) line(buf);  // the last line, without a line end
@@ -121,7 +164,8 @@ class Reader {
   [[noreturn]] void fail(std::size_t line, const std::string& message) const {
     throw InputError(parser_.file(), line, message);
   }
-  [[nodiscard]] bool integer_mode() const { return opt_.mode == InputMode::Pulses || opt_.mode == InputMode::Counter; }
+  [[nodiscard]] const detail::InputChoice& in() const { return parser_.input(); }
+  [[nodiscard]] bool integer_mode() const { return in().mode == InputMode::Pulses || in().mode == InputMode::Counter; }
   [[nodiscard]] std::size_t line_of_sample(std::size_t k) const { return line_in_runs(runs_, k); }
   std::size_t take_lines(std::string& buf, bool at_end);
   bool decide_line_end(std::string_view s, bool at_end);
@@ -140,10 +184,18 @@ class Reader {
     const auto n = static_cast<std::size_t>(std::min(lines * 1.05 + 2, 0x1p26));
     integer_mode() ? ints_.reserve(n) : reals_.reserve(n);
   }
+  void start_samples(const Sample& s);
+  [[nodiscard]] const detail::TimeName* time_unit_of(const detail::TimeName* named, double first,
+                                                     detail::Role role) const;
+  [[nodiscard]] std::string stamp(double t) const { return fmt::format("{} {}", t, tunit_->unit); }
   void finish_rate();
+  void rate_from_time_column();
+  void note_time_column(Recording& rec) const;
+  [[noreturn]] void fail_step(const TimeTrack::Step& bad, double period) const;
   void check_unread_keys() const;
   void check_time_columns_agree() const;
   void check_time_column() const;
+  void check_rate_against_time_column(const TimeTrack::Step& bad, double period) const;
   void build_counts(PhaseSeries& ph, std::size_t& wraps);
   void build_values(PhaseSeries& ph);
   void check_data_magnitude(const PhaseSeries& ph, const char* what) const;
@@ -160,6 +212,7 @@ class Reader {
   std::vector<std::int64_t> ints_;  // pulses (after C_0) or counter readings
   std::vector<double> reals_;       // angle samples, or rate samples after x_0
   TimeTrack times_;
+  const detail::TimeName *tunit_ = nullptr, *tunit2_ = nullptr;  // the time columns' units
   // Two time columns: where they differ most, and the two stamps there in their own units.
   double gap_max_ = 0, gap_t_ = 0, gap_t2_ = 0;
   std::size_t gap_sample_ = 0;
@@ -212,15 +265,33 @@ std::size_t Reader::mac_limit(std::string& buf, std::size_t from, bool at_end) c
   fail(1, fmt::format("stray carriage return (CR) at column {} inside the line", first_cr_column_));
 }
 
+// The first sample: the phase's starting point, and the time columns' units.
+void Reader::start_samples(const Sample& s) {
+  if (in().mode == InputMode::Pulses) ints_.push_back(0);   // C_0
+  if (in().mode == InputMode::Rate) reals_.push_back(0.0);  // x_0
+  if (layout_.time_col) tunit_ = time_unit_of(layout_.time_unit, s.time, detail::Role::Time);
+  if (layout_.time2_col) tunit2_ = time_unit_of(layout_.time2_unit, s.time2, detail::Role::Time2);
+}
+
+const detail::TimeName* Reader::time_unit_of(const detail::TimeName* named, double first, detail::Role role) const {
+  if (named->per_second > 0) return named;
+  if (const detail::TimeName* u = detail::time_unit_of_stamp(first)) return u;
+  fail(line_, fmt::format("cannot tell the unit of the {} from its stamps: the first, {}, is neither near 0 (seconds) "
+                          "nor like Unix time (~1.7e9 s, 1.7e12 ms, 1.7e15 us, 1.7e18 ns); name the column time_s, "
+                          "time_ms, time_us or time_ns",
+                          layout_.describe(role), first));
+}
+
 void Reader::push(const Sample& s) {
+  if (samples_ == 0) start_samples(s);
   if (new_run_) {
     runs_.emplace_back(samples_, line_);
     new_run_ = false;
   }
   integer_mode() ? ints_.push_back(s.integer) : reals_.push_back(s.real);
-  if (layout_.time_col) times_.add(s.time / layout_.time_unit->per_second);
+  if (layout_.time_col) times_.add(s.time);
   if (layout_.time2_col) {
-    const double d = std::abs(s.time / layout_.time_unit->per_second - s.time2 / layout_.time2_unit->per_second);
+    const double d = std::abs(s.time / tunit_->per_second - s.time2 / tunit2_->per_second);
     if (!(d <= gap_max_)) gap_max_ = d, gap_sample_ = samples_, gap_t_ = s.time, gap_t2_ = s.time2;
   }
   if (layout_.temp_col) temp_sum_ += s.temperature, ++temp_n_;
@@ -229,6 +300,7 @@ void Reader::push(const Sample& s) {
 
 void Reader::finish_rate() {
   const detail::Metadata& meta = parser_.metadata();
+  if (layout_.time_col && !times_.median_known) times_.find_median();
   if (opt_.rate_hz) {
     rate_hz_ = *opt_.rate_hz;
     rate_source_ = RateSource::Option;
@@ -236,31 +308,32 @@ void Reader::finish_rate() {
     rate_hz_ = *meta.rate_hz;
     rate_source_ = RateSource::Metadata;
   } else if (layout_.time_col) {
-    // Candidate period: the median of the first steps (robust to one bad step); refined by the
-    // whole span when that agrees, so long records give the rate to many digits.
-    const std::vector<double>& h = times_.head;
-    const std::size_t k = h.size() - 1;
-    std::vector<double> steps(k);
-    for (std::size_t i = 0; i < k; ++i) steps[i] = h[i + 1] - h[i];
-    std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(k / 2), steps.end());
-    const double candidate = steps[k / 2];
-    for (std::size_t i = 1; !(candidate > 0) && i < h.size(); ++i)
-      if (!(h[i] > h[i - 1]))
-        fail(line_of_sample(i), fmt::format("the time column does not increase: {} s at line {}, then {} s", h[i - 1],
-                                            line_of_sample(i - 1), h[i]));
-    const double span = (times_.last - times_.first) / static_cast<double>(times_.n - 1);
-    const double period = std::abs(span - candidate) <= opt_.time_tolerance * candidate ? span : candidate;
-    double rate = 1.0 / period;
-    // A rate within 1 ppm of a whole number of Hz is that number (time stamps are printed rounded).
-    if (rate >= 1 && std::abs(rate - std::round(rate)) <= 1e-6 * rate) rate = std::round(rate);
-    rate_hz_ = rate;
-    rate_source_ = RateSource::TimeColumn;
-    if (!(rate >= kMinRateHz && rate <= kMaxRateHz))
-      fail(parser_.first_data_line(),
-           fmt::format("the time column's step of {:g} s gives a sample rate of {:g} Hz, outside the usable range "
-                       "{:g}..{:g} Hz",
-                       period, rate, kMinRateHz, kMaxRateHz));
+    rate_from_time_column();
   }
+}
+
+// The period is the median of the first steps, refined by the whole span when that agrees and no
+// step is a gap, so long records give the rate to many digits.
+void Reader::rate_from_time_column() {
+  const std::vector<double>& h = times_.head;
+  const double candidate = times_.median;
+  for (std::size_t i = 1; !(candidate > 0) && i < h.size(); ++i)
+    if (!(h[i] > h[i - 1]))
+      fail(line_of_sample(i), fmt::format("the time column does not increase: {} at line {}, then {}", stamp(h[i - 1]),
+                                          line_of_sample(i - 1), stamp(h[i])));
+  const double span = (times_.last - times_.first) / static_cast<double>(times_.n - 1);
+  const bool gapless = times_.min_dt > 0.5 * candidate && times_.max_dt < 1.5 * candidate;
+  const double period = gapless && std::abs(span - candidate) <= opt_.time_tolerance * candidate ? span : candidate;
+  double rate = tunit_->per_second / period;
+  // A rate within 1 ppm of a whole number of Hz is that number (time stamps are printed rounded).
+  if (rate >= 1 && std::abs(rate - std::round(rate)) <= 1e-6 * rate) rate = std::round(rate);
+  rate_hz_ = rate;
+  rate_source_ = RateSource::TimeColumn;
+  if (!(rate >= kMinRateHz && rate <= kMaxRateHz))
+    fail(parser_.first_data_line(),
+         fmt::format("the time column's step of {:g} {} gives a sample rate of {:g} Hz, outside the usable range "
+                     "{:g}..{:g} Hz",
+                     period, tunit_->unit, rate, kMinRateHz, kMaxRateHz));
 }
 
 // A key that looks like a sample rate (or a pulse weight) but is not the one rwcalc reads, when
@@ -270,8 +343,15 @@ void Reader::check_unread_keys() const {
   if (rate_source_ == RateSource::Default && meta.unread_rate_key)
     fail(meta.unread_rate_key->second,
          fmt::format("metadata '{}' looks like the sample rate, but rwcalc reads the rate from rate_hz, a time "
-                     "column or --rate, and would otherwise use {:g} Hz; write '# rate_hz: VALUE' or give --rate",
-                     meta.unread_rate_key->first, units::gl2d_rate_hz));
+                     "column or --rate{}; write '# rate_hz: VALUE' or give --rate",
+                     meta.unread_rate_key->first,
+                     integer_mode() ? fmt::format(", and would otherwise use {:g} Hz", units::gl2d_rate_hz) : ""));
+  // Rate and angle samples carry no GL-2D default: 400 Hz would put every τ off by the ratio.
+  if (rate_source_ == RateSource::Default && !integer_mode())
+    fail(0, fmt::format("no sample rate: {} input takes it from --rate HZ, a '# rate_hz: HZ' metadata line or a time "
+                        "column (time_s, time_ms, time_us, time_ns, timestamp, %time, ...); the {:g}-Hz GL-2D default "
+                        "applies to pulse and counter input only",
+                        to_string(in().mode), units::gl2d_rate_hz));
   if (integer_mode() && !opt_.scale_arcsec && !meta.scale_arcsec && meta.unread_scale_key)
     fail(meta.unread_scale_key->second,
          fmt::format("metadata '{}' looks like the pulse weight, but rwcalc reads it from scale_arcsec_per_pulse "
@@ -286,36 +366,62 @@ void Reader::check_time_columns_agree() const {
   if (!layout_.time2_col || gap_max_ <= opt_.time_tolerance * period) return;
   fail(line_of_sample(gap_sample_),
        fmt::format("the time columns '{}' and '{}' disagree: {} {} and {} {} differ by {:g} s here (their largest "
-                   "difference), more than the time tolerance ({} of the {:g}-s period); remove one of them",
-                   layout_.header[*layout_.time_col], layout_.header[*layout_.time2_col], gap_t_,
-                   layout_.time_unit->unit, gap_t2_, layout_.time2_unit->unit, gap_max_, opt_.time_tolerance, period));
+                   "difference), more than the time tolerance ({} of the {:g}-s period); remove one of them{}",
+                   layout_.header[*layout_.time_col], layout_.header[*layout_.time2_col], gap_t_, tunit_->unit, gap_t2_,
+                   tunit2_->unit, gap_max_, opt_.time_tolerance, period, tolerance_hint(gap_max_ / period)));
 }
 
+// Every step must lie within half a period of the period: within the time tolerance it is exact,
+// beyond it jitter (accepted, and reported). A step of 1.5 periods or more is a gap, one of half a
+// period or less (repeated and backward stamps among them) an error: nothing is resampled.
 void Reader::check_time_column() const {
   if (!layout_.time_col || times_.n < 2) return;
-  const double period = 1.0 / rate_hz_;
+  const double period = tunit_->per_second / rate_hz_;
   const double tol = opt_.time_tolerance * period;
   if (times_.min_dt >= period - tol && times_.max_dt <= period + tol) return;
-  const TimeTrack::Step bad = times_.first_outside(period - tol, period + tol);
+  check_rate_against_time_column(times_.first_outside(period - tol, period + tol), period);
+  const double lo = std::nextafter(0.5 * period, period), hi = std::nextafter(1.5 * period, period);
+  if (times_.min_dt >= lo && times_.max_dt <= hi) return;
+  fail_step(times_.first_outside(lo, hi), period);
+}
+
+// --rate or rate_hz against the mean step of the time column.
+void Reader::check_rate_against_time_column(const TimeTrack::Step& bad, double period) const {
+  if (rate_source_ != RateSource::Option && rate_source_ != RateSource::Metadata) return;
+  const double est = (times_.last - times_.first) / static_cast<double>(times_.n - 1);
+  if (std::abs(est - period) <= opt_.time_tolerance * period) return;
+  const std::string tcol = layout_.header.empty() ? "column 1" : "'" + layout_.header[*layout_.time_col] + "'";
+  fail(line_of_sample(bad.sample),
+       fmt::format("the sample rate {} Hz (from {}) is inconsistent with the time column {}, which steps by {} {} "
+                   "(~{:.6g} Hz), e.g. {} at line {} then {}{}",
+                   rate_hz_,
+                   rate_source_ == RateSource::Option
+                       ? "--rate"
+                       : fmt::format("metadata at line {}", parser_.metadata().rate_line),
+                   tcol, est, tunit_->unit, tunit_->per_second / est, stamp(bad.before), line_of_sample(bad.sample - 1),
+                   stamp(bad.after), tolerance_hint(std::abs(est - period) / period)));
+}
+
+[[noreturn]] void Reader::fail_step(const TimeTrack::Step& bad, double period) const {
   const double t0 = bad.before, t1 = bad.after, dt = t1 - t0;
   const std::size_t line = line_of_sample(bad.sample), prev = line_of_sample(bad.sample - 1);
-  if (rate_source_ == RateSource::Option || rate_source_ == RateSource::Metadata) {
-    const double est = (times_.last - times_.first) / static_cast<double>(times_.n - 1);
-    const std::string tcol = layout_.header.empty() ? "column 1" : "'" + layout_.header[*layout_.time_col] + "'";
-    if (std::abs(est - period) > tol)
-      fail(line, fmt::format("the sample rate {} Hz (from {}) is inconsistent with the time column {}, which steps "
-                             "by {} s (~{:.6g} Hz), e.g. {} s at line {} then {} s",
-                             rate_hz_,
-                             rate_source_ == RateSource::Option
-                                 ? "--rate"
-                                 : fmt::format("metadata at line {}", parser_.metadata().rate_line),
-                             tcol, est, 1.0 / est, t0, prev, t1));
-  }
-  if (dt == 0) fail(line, fmt::format("repeated time stamp {} s (also at line {}); no resampling is done", t1, prev));
-  if (dt < 0) fail(line, fmt::format("time goes backwards: {} s at line {}, then {} s", t0, prev, t1));
-  fail(line, fmt::format("{}: {} s at line {}, then {} s (a step of {:.6g} periods of {} s; tolerance {}){}",
-                         dt > period ? "gap in the time column" : "time step too short", t0, prev, t1, dt / period,
-                         period, opt_.time_tolerance, dt > period ? "; no resampling is done" : ""));
+  if (dt == 0)
+    fail(line, fmt::format("repeated time stamp {} (also at line {}); no resampling is done", stamp(t1), prev));
+  if (dt < 0) fail(line, fmt::format("time goes backwards: {} at line {}, then {}", stamp(t0), prev, stamp(t1)));
+  const double p_s = period / tunit_->per_second;
+  if (dt < period)
+    fail(line, fmt::format("time step too short: {} at line {}, then {} (a step of {:.6g} periods of {:g} s; steps "
+                           "within half a period of it are accepted as jitter); no resampling is done",
+                           stamp(t0), prev, stamp(t1), dt / period, p_s));
+  const double missing = std::round(dt / period - 1);
+  fail(line,
+       fmt::format(
+           "gap in the time column: {} at line {}, then {}: {:.6g} s missing (~{:g} sample{}; a step "
+           "of {:.6g} periods of {:g} s); rwcalc neither resamples nor analyses a record with gaps: cut the record at "
+           "this line and analyse the parts separately (--time-tolerance only sets which steps within half a "
+           "period count as jitter)",
+           stamp(t0), prev, stamp(t1), (dt - period) / tunit_->per_second, missing, missing == 1 ? "" : "s",
+           dt / period, p_s));
 }
 
 /// Floating data whose phase steps are all below kMinDataStep (limits.hpp) but not all zero:
@@ -337,7 +443,7 @@ void Reader::build_counts(PhaseSeries& ph, std::size_t& wraps) {
   constexpr auto kLimit = static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
   std::vector<std::int64_t>& c = ints_;
   std::uint64_t acc = 0, total = 0;
-  if (opt_.mode == InputMode::Pulses) {
+  if (in().mode == InputMode::Pulses) {
     for (std::size_t i = 1; i < c.size(); ++i) {
       const auto v = static_cast<std::uint64_t>(c[i]);
       acc += v;
@@ -374,12 +480,12 @@ void Reader::build_values(PhaseSeries& ph) {
   // differences (|Δ²x| ≤ 4·max|x|) in the Allan variance; no instrument comes near it.
   constexpr double kMaxPhase = 1e150;
   std::vector<double>& x = reals_;
-  const bool angle = opt_.mode == InputMode::Angle;
-  const double f = angle ? (opt_.angle_unit == AngleUnit::Deg   ? units::arcsec_per_deg
-                            : opt_.angle_unit == AngleUnit::Rad ? units::arcsec_per_rad
+  const bool angle = in().mode == InputMode::Angle;
+  const double f = angle ? (in().angle_unit == AngleUnit::Deg   ? units::arcsec_per_deg
+                            : in().angle_unit == AngleUnit::Rad ? units::arcsec_per_rad
                                                                 : 1.0)
-                         : (opt_.rate_unit == RateUnit::DegPerSecond   ? units::arcsec_per_deg
-                            : opt_.rate_unit == RateUnit::RadPerSecond ? units::arcsec_per_rad
+                         : (in().rate_unit == RateUnit::DegPerSecond   ? units::arcsec_per_deg
+                            : in().rate_unit == RateUnit::RadPerSecond ? units::arcsec_per_rad
                                                                        : 1.0);  // rate: to ″/s = °/h
   for (std::size_t i = 0; angle && i < x.size(); ++i)
     if (!(std::abs(x[i] *= f) <= kMaxPhase)) [[unlikely]]
@@ -427,8 +533,8 @@ Recording Reader::finish() {
   rec.samples = samples_;
   PhaseSeries& ph = rec.phase;
   ph.tau0_s = 1.0 / rate_hz_;
-  const bool clock = (opt_.mode == InputMode::Angle && opt_.angle_unit == AngleUnit::Second) ||
-                     (opt_.mode == InputMode::Rate && opt_.rate_unit == RateUnit::Unitless);
+  const bool clock = (in().mode == InputMode::Angle && in().angle_unit == AngleUnit::Second) ||
+                     (in().mode == InputMode::Rate && in().rate_unit == RateUnit::Unitless);
   ph.kind = clock ? PhaseKind::Clock : PhaseKind::Gyro;
   if (integer_mode())
     build_counts(ph, rec.counter_wraps);
@@ -446,9 +552,36 @@ Recording Reader::finish() {
   const auto& h = layout_.header;
   rec.column_name = h.empty() ? fmt::format("column {}", layout_.value_col + 1) : h[layout_.value_col];
   if (layout_.time_col) rec.time_column = h.empty() ? std::string("column 1") : h[*layout_.time_col];
-  rec.mode = opt_.mode;
+  rec.mode = in().mode;
+  rec.angle_unit = in().angle_unit;
+  rec.rate_unit = in().rate_unit;
+  rec.notes = in().notes;
+  rec.warnings = in().warnings;
+  note_time_column(rec);
   rec.line_runs = std::move(runs_);
   return rec;
+}
+
+// The time column's unit (a note when its magnitude decided it) and the jitter. The rate's source
+// is in every output already ("(time column)", "(default)").
+void Reader::note_time_column(Recording& rec) const {
+  if (!layout_.time_col) return;
+  const bool by_name = layout_.time_unit->per_second > 0;
+  rec.time_unit = tunit_->unit;
+  rec.time_unit_source = by_name ? "name" : "magnitude";
+  const double t0 = times_.first;
+  if (!by_name)
+    rec.notes.push_back(fmt::format("time column '{}' in {} (by magnitude: {})", *rec.time_column, tunit_->unit,
+                                    std::abs(t0) >= 1e8
+                                        ? fmt::format("the first stamp {:.4g} is Unix time in {}", t0, tunit_->unit)
+                                        : std::string("the stamps start near 0")));
+  if (times_.n >= 2 && times_.median > 0) rec.jitter = times_.jitter();
+  if (rec.jitter.steps > 0)
+    rec.notes.push_back(
+        fmt::format("jitter: {} time step{} off the period by more than the time tolerance ({:g} %), "
+                    "by up to {:.3g} % of the period (rms {:.2g} %)",
+                    rec.jitter.steps, rec.jitter.steps == 1 ? "" : "s", 100 * opt_.time_tolerance,
+                    100 * rec.jitter.max_fraction, 100 * rec.jitter.rms_fraction));
 }
 
 void validate(const ReadOptions& o) {
@@ -496,6 +629,24 @@ std::size_t Recording::line_of_sample(std::size_t k) const noexcept {
 std::size_t Recording::line_of_rate(std::size_t i) const noexcept {
   const bool readings = mode == InputMode::Counter || mode == InputMode::Angle;
   return line_of_sample(readings ? i + 1 : i);
+}
+
+std::string_view input_unit(const Recording& rec) {
+  switch (rec.mode) {
+    case InputMode::Pulses: return "pulse";
+    case InputMode::Counter: return "count";
+    case InputMode::Angle: return to_string(rec.angle_unit);
+    case InputMode::Rate: return to_string(rec.rate_unit);
+  }
+  return "?";
+}
+
+std::string describe_input(const Recording& rec) {
+  if (rec.mode == InputMode::Pulses || rec.mode == InputMode::Counter)
+    return fmt::format("column '{}': {}, {:g} arcsec per {}", rec.column_name,
+                       rec.mode == InputMode::Pulses ? "pulse counts" : "counter readings", rec.phase.arcsec_per_count,
+                       input_unit(rec));
+  return fmt::format("column '{}': {} samples in {}", rec.column_name, to_string(rec.mode), input_unit(rec));
 }
 
 InputMode parse_input_mode(std::string_view s) { return parse_name(kModes, s, "--input"); }

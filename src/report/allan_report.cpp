@@ -13,6 +13,7 @@ std::string format_allan_table(const AllanResult& r, const AllanReportInfo& info
   const std::string u = unit_label(r);
   std::string out;
   out += fmt::format("# rwcalc allan: {}\n", info.source.empty() ? "-" : printable(info.source));
+  if (!info.input.empty()) out += fmt::format("# input: {}\n", printable(info.input));
   out += fmt::format("# estimator: {} deviation ({})\n", long_name(r.estimator), to_string(r.estimator));
   out += fmt::format("# confidence: {:g} (two-sided chi-square bounds, Greenhall-Riley EDF, lag-1 ACF noise id)\n",
                      r.confidence);
