@@ -11,6 +11,7 @@
 
 #include "core/sha256.hpp"
 #include "io/text_source.hpp"
+#include "rwcalc/reader.hpp"
 #include "test_support.hpp"
 
 namespace rwcalc {
@@ -57,6 +58,9 @@ TEST(Sha256, RecordingDigestEqualsSha256sumOfTheStoredBytes) {
     std::stringstream whole;
     whole << in.rdbuf();
     EXPECT_EQ(src.sha256(), digest_of(whole.str())) << f;
+    const Recording rec = read_recording(f.string());  // what the outputs report
+    EXPECT_EQ(rec.sha256, src.sha256()) << f;
+    EXPECT_EQ(rec.file_bytes, std::filesystem::file_size(f)) << f;
     if (const std::string tool = sha256sum(f); !tool.empty()) {
       EXPECT_EQ(src.sha256(), tool) << f;
     }

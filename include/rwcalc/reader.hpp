@@ -65,6 +65,9 @@ struct TimeJitter {
 
 struct Recording {
   std::string source;      ///< the path as given ("-" for stdin)
+  /// The input as stored (compressed bytes, for gzip): its size and SHA-256, as `sha256sum` prints it.
+  std::uint64_t file_bytes = 0;
+  std::string sha256;
   PhaseSeries phase;       ///< the cumulative angle/phase, ready for the estimators
   double rate_hz = 400.0;  ///< sample rate, Hz (phase.tau0_s = 1/rate_hz)
   RateSource rate_source = RateSource::Default;

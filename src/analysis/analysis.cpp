@@ -123,7 +123,9 @@ nlohmann::json input_json(const Recording& rec) {
                       {"rate_hz", rec.rate_hz},
                       {"rate_source", std::string(to_string(rec.rate_source))},
                       {"notes", rec.notes},
-                      {"warnings", rec.warnings}};
+                      {"warnings", rec.warnings},
+                      {"file_bytes", rec.file_bytes},
+                      {"sha256", rec.sha256}};
   if (rec.mode == InputMode::Pulses || rec.mode == InputMode::Counter)
     j["arcsec_per_count"] = rec.phase.arcsec_per_count;
   j["time_column"] = rec.time_column ? nlohmann::json(*rec.time_column) : nlohmann::json(nullptr);
@@ -381,6 +383,8 @@ std::string input_line(const nlohmann::json& in) {
   if (in.contains("time_unit"))
     s += fmt::format(" ('{}', in {} by {})", in["time_column"].get<std::string>(), in.value("time_unit", ""),
                      in.value("time_unit_source", ""));
+  if (in.contains("sha256"))
+    s += fmt::format("\n  file: {} bytes, SHA-256 {}", in.value("file_bytes", std::uint64_t{0}), in.value("sha256", ""));
   return s + "\n";
 }
 

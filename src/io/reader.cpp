@@ -600,6 +600,8 @@ Recording read_source(detail::TextSource&& src, const std::string& source, const
   reader.read(src);
   Recording rec = reader.finish();
   rec.source = source;
+  rec.file_bytes = src.raw_bytes();
+  rec.sha256 = src.sha256();
   return rec;
 }
 
