@@ -1,7 +1,9 @@
 // Unit tests of the cross-checks: direct N and the spread of 100-s mean rates.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include "rwcalc/fit.hpp"
@@ -50,20 +52,17 @@ TEST(DirectN, AgreesWithTheTruthOnPureArw) {
     ASSERT_TRUE(r.N.resolved);
     EXPECT_LT(std::abs(r.N.value - 0.05), 4.0 * r.N.sigma) << seed;
     inside += (r.N.low <= 0.05 && 0.05 <= r.N.high) ? 1 : 0;
-    EXPECT_NEAR(r.intercept_arcsec2, 0.0, 5.0 * 60 * 60 * 0.05 * 0.05);  // no white angle noise
-    // The regression's slope is N² in ″²/s, the points are the ones it was fitted to.
-    EXPECT_NEAR(std::sqrt(r.slope_arcsec2_per_s) / 60.0, r.N.value, 1e-12 * r.N.value);
-    ASSERT_GE(r.points.size(), 3u);
-    // At t = 1 s (1800 intervals, 3 % standard error) the line passes through the point.
-    EXPECT_NEAR(r.points.front().var_arcsec2 / (r.intercept_arcsec2 + r.slope_arcsec2_per_s * r.points.front().t_s),
-                1.0, 0.2);
+    // N is the regression's N″² coefficient.
+    EXPECT_NEAR(std::sqrt(r.n2_arcsec2_per_s) / 60.0, r.N.value, 1e-12);
+    ASSERT_GE(r.points.size(), 4u);
+    EXPECT_TRUE(r.straight.valid);
   }
   EXPECT_GE(inside, 8);
 }
 
-TEST(DirectN, WhiteAngleNoiseAndQuantizationGoIntoTheIntercept) {
+TEST(DirectN, WhiteAngleNoiseAndQuantizationGoIntoTheQTerm) {
   // 1″ rms white angle noise (a dither residue) before 0.92″ pulse quantization: the angle
-  // variance gains the constant 2(σφ² + q²/12) and the slope still gives N.
+  // variance gains the constant 2(σφ² + q²/12) and N is unchanged.
   const double q = 0.92;
   const double sphi = 1.0;
   PhaseSeries x = arw(0.02, 12.43, 3600.0, 100.0, 42);
@@ -73,14 +72,65 @@ TEST(DirectN, WhiteAngleNoiseAndQuantizationGoIntoTheIntercept) {
   const DirectNResult r = direct_n(quantize(x, q));
   ASSERT_TRUE(r.N.valid);
   EXPECT_LT(std::abs(r.N.value - 0.02), 4.0 * r.N.sigma);
-  const double a = 2.0 * (sphi * sphi + q * q / 12.0);
-  EXPECT_NEAR(r.intercept_arcsec2, a, 0.3 * a);
+  EXPECT_NEAR(r.q2_arcsec2, sphi * sphi + q * q / 12.0, 0.1);
 }
 
 TEST(DirectN, TooShortIsInvalidNotAnError) {
   const PhaseSeries x = arw(0.05, 0, 20.0, 100.0, 1);
   const DirectNResult r = direct_n(x);
   EXPECT_FALSE(r.N.valid);
+}
+
+/// Brute force: E[Σ(Δ_k − Δ̄)²]/(M − 1) from the O(M²) double sum of increment covariances
+/// −½ Σ a_i b_j D(i − j) over the generalized structure function D.
+IncrementBasis brute_force_basis(std::size_t t, std::size_t points, double step, bool overlapping) {
+  const std::size_t n = points - 1;
+  const std::size_t stride = overlapping ? 1 : t;
+  const std::size_t m = overlapping ? n - t + 1 : n / t;
+  auto d = [&](double u, int term) {
+    u = std::abs(u) * step;
+    if (u == 0) return 0.0;
+    return term == 0 ? 2.0 : term == 1 ? u : -u * u * std::log(u) / std::numbers::pi;
+  };
+  // Cov(Δ_k, Δ_l) with Δ_k = θ(k·stride + t) − θ(k·stride).
+  auto cov = [&](std::size_t k, std::size_t l, int term) {
+    const double a = static_cast<double>(k * stride), b = static_cast<double>(l * stride), td = static_cast<double>(t);
+    return 0.5 * (d(a + td - b, term) + d(a - b - td, term) - d(a - b, term) - d(a - b, term));
+  };
+  std::array<double, 3> e{};
+  for (int term = 0; term < 3; ++term) {
+    double diag = 0, all = 0;
+    for (std::size_t k = 0; k < m; ++k)
+      for (std::size_t l = 0; l < m; ++l) {
+        const double c = cov(k, l, term);
+        all += c;
+        if (k == l) diag += c;
+      }
+    e[static_cast<std::size_t>(term)] = (diag - all / static_cast<double>(m)) / static_cast<double>(m - 1);
+  }
+  return {e[0], e[1], e[2]};
+}
+
+TEST(IncrementBasis, MatchesTheBruteForceDoubleSum) {
+  for (const bool ovl : {true, false})
+    for (const std::size_t t : {1u, 3u, 7u})
+      for (const double step : {0.25, 1.0, 3.0}) {
+        const std::size_t points = 61;
+        const IncrementBasis g = increment_basis(t, points, step, ovl);
+        const IncrementBasis b = brute_force_basis(t, points, step, ovl);
+        EXPECT_NEAR(g.q, b.q, 1e-10 * std::abs(b.q) + 1e-12) << ovl << " " << t << " " << step;
+        EXPECT_NEAR(g.n, b.n, 1e-10 * std::abs(b.n)) << ovl << " " << t << " " << step;
+        EXPECT_NEAR(g.b, b.b, 1e-9 * std::abs(b.b)) << ovl << " " << t << " " << step;
+      }
+}
+
+TEST(IncrementBasis, LimitsOfEachTerm) {
+  // White angle: 2 (less 2t/M² for the mean); white rate: t (less t²/M-ish); flicker: ≈ t² ln(T/t)/π.
+  const std::size_t points = 100001;
+  const IncrementBasis g = increment_basis(100, points, 0.01, true);
+  EXPECT_NEAR(g.q, 2.0, 1e-3);
+  EXPECT_NEAR(g.n, 1.0, 0.02);
+  EXPECT_NEAR(g.b / (std::log(1000.0) / std::numbers::pi), 1.0, 0.2);
 }
 
 TEST(BlockSpread, ArwSpreadIsNOverRootBlock) {
