@@ -6,8 +6,11 @@
 #include <numbers>
 #include <random>
 
+#include <nlohmann/json.hpp>
+
 #include "rwcalc/fit.hpp"
 #include "rwcalc/methods.hpp"
+#include "test_support.hpp"
 
 namespace rwcalc {
 namespace {
@@ -164,6 +167,43 @@ TEST(BlockSpread, ExpectationUnderTheModel) {
   // Flicker: the spread of 100-s means grows with the number of blocks (ln T), unlike the AV.
   const V f = (V() << 0, 0, 3.6e-5, 0, 0).finished();
   EXPECT_GT(expected_block_variance(f, 100.0, 72), 1.5 * expected_block_variance(f, 100.0, 2));
+}
+
+TEST(CrossChecksCli, ShippedRunCarriesTheUnbiasedEstimatorsInTextAndJson) {
+  const std::string run = test::source_path("data/gl2d/gl2d_0C.csv.gz").string();
+  const auto text = test::run_cli({"analyze", run});
+  ASSERT_EQ(text.status, 0) << text.err;
+  EXPECT_NE(text.out.find("N direct (overlapping angle increments"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("N straight line (paper)"), std::string::npos);
+  EXPECT_NE(text.out.find("B from 100-s averages"), std::string::npos);
+  EXPECT_NE(text.out.find("biased: estimates sigma(tau_min)/0.6643"), std::string::npos);
+  EXPECT_EQ(text.out.find("vs B (fit)"), std::string::npos);  // the raw spread is no estimate of B
+
+  const auto js = test::run_cli({"analyze", run, "--json"});
+  ASSERT_EQ(js.status, 0) << js.err;
+  const auto j = nlohmann::json::parse(js.out);
+  const auto& m = j.at("methods");
+  // The shipped run's truth (scripts/make-gl2d-data.sh): N 0.00081 °/√h, B 0.0073 °/h.
+  const auto& n = m.at("N_direct_deg_per_sqrt_h");
+  EXPECT_LE(n.at("low95").get<double>(), 0.00081);
+  EXPECT_GE(n.at("high95").get<double>(), 0.00081);
+  const auto& b = m.at("B_100s_deg_per_h");
+  EXPECT_LE(b.at("low95").get<double>(), 0.0073);
+  EXPECT_GE(b.at("high95").get<double>(), 0.0073);
+  EXPECT_GT(b.at("edf").get<double>(), 1.0);
+  EXPECT_GT(m.at("N_straight_line_paper_deg_per_sqrt_h").at("bias_factor").get<double>(), 1.2);
+  EXPECT_FALSE(m.at("spread_100s_deg_per_h").contains("discrepancy_sigma"));
+  EXPECT_GT(m.at("spread_100s_deg_per_h").at("expected").get<double>(), 0.0);
+  const auto& s = j.at("slope_readout");
+  EXPECT_LE(s.at("tau_min_s").get<double>(), j.at("duration_s").get<double>() / 10.0);
+  EXPECT_GE(s.at("B_bias_factor").get<double>(), 1.0);
+  EXPECT_LT(s.at("B_low95").get<double>(), s.at("B_high95").get<double>());
+
+  // Saved results are read back: `report` of the JSON works with the new keys.
+  test::TempDir dir;
+  const auto saved = dir.write("run.json", js.out);
+  const auto rep = test::run_cli({"report", saved.string(), "-o", (dir.path() / "r.html").string()});
+  EXPECT_EQ(rep.status, 0) << rep.err;
 }
 
 TEST(Discrepancy, InSigma) {

@@ -17,7 +17,7 @@ struct MethodOptions {
   double direct_t_min_s = 1.0;    ///< shortest interval of the direct method
   double direct_t_max_s = 100.0;  ///< longest (also at most T/50)
   int direct_points = 12;         ///< interval lengths, log-spaced
-  int bootstrap_replicates = 96;  ///< parametric-bootstrap replicates of the direct N interval
+  int bootstrap_replicates = 64;  ///< parametric-bootstrap replicates of the direct N interval
   double block_s = 100.0;         ///< block of the averaging method
 };
 

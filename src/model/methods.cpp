@@ -3,6 +3,7 @@
 #include "rwcalc/methods.hpp"
 
 #include <algorithm>
+#include <array>
 #include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
 #include <numbers>
@@ -41,31 +42,71 @@ double sample_variance(const std::vector<double>& v) {
   return ss / static_cast<double>(v.size() - 1);
 }
 
-/// Sample variance of the M = n − t + 1 overlapping increments x_{k+t} − x_k, ″²: exact integer
-/// sums for pulse counts, the mean rate taken out first for floating phases.
-double overlapping_variance(const PhaseSeries& x, std::size_t t) {
-  const std::size_t n = x.points() - 1;
-  const std::size_t m = n - t + 1;
-  const auto md = static_cast<double>(m);
-  if (x.exact()) {
-    i128 s1 = 0, s2 = 0;
-    for (std::size_t k = 0; k < m; ++k) {
-      const auto d = static_cast<std::int64_t>(static_cast<std::uint64_t>(x.counts[k + t]) -
-                                               static_cast<std::uint64_t>(x.counts[k]));
-      s1 += d;
-      s2 += static_cast<i128>(d) * d;
-    }
-    const i128 mss = s2 * static_cast<i128>(m) - s1 * s1;  // M·Σ(Δ − Δ̄)², exact
-    return static_cast<double>(mss) / md / (md - 1.0) * x.arcsec_per_count * x.arcsec_per_count;
+/// Σd and Σd² of the increments d_k = C_{k+t} − C_k, k in [k0, k1): int64 sums while every
+/// |d| < 2^24 (blocks of 2^14 cannot overflow then), 128-bit ones for a block with a larger one.
+void add_increment_sums(const std::int64_t* c, std::size_t t, std::size_t k0, std::size_t k1, i128& s1, i128& s2) {
+  std::uint64_t b1 = 0, b2 = 0, big = 0;  // modular: exact whenever no |d| reaches 2^24
+  for (std::size_t k = k0; k < k1; ++k) {
+    const std::uint64_t d = static_cast<std::uint64_t>(c[k + t]) - static_cast<std::uint64_t>(c[k]);
+    big |= d + (std::uint64_t{1} << 24);
+    b1 += d;
+    b2 += d * d;
   }
-  const double shift = x.diff(n, 0) * static_cast<double>(t) / static_cast<double>(n);
-  double s1 = 0, s2 = 0;
-  for (std::size_t k = 0; k < m; ++k) {
-    const double d = x.diff(k + t, k) - shift;
+  if (big < (std::uint64_t{1} << 25)) {
+    s1 += static_cast<std::int64_t>(b1);
+    s2 += static_cast<std::int64_t>(b2);
+    return;
+  }
+  for (std::size_t k = k0; k < k1; ++k) {
+    const auto d = static_cast<std::int64_t>(static_cast<std::uint64_t>(c[k + t]) - static_cast<std::uint64_t>(c[k]));
     s1 += d;
-    s2 += d * d;
+    s2 += static_cast<i128>(d) * d;
   }
-  return (s2 - s1 * s1 / md) / (md - 1.0);
+}
+
+/// Sample variances of the M = n − t + 1 overlapping increments x_{k+t} − x_k for every t in ts,
+/// ″². Pulse counts: exact integer sums, all lengths in one sweep over the record in short blocks
+/// (the longest interval's window stays in cache); integer sums make the result independent of
+/// the split between threads. Floating phases: the mean rate taken out first.
+std::vector<double> overlapping_variances(const PhaseSeries& x, const std::vector<std::size_t>& ts) {
+  const std::size_t n = x.points() - 1;
+  std::vector<double> out(ts.size());
+  if (!x.exact()) {
+    parallel_for(ts.size(), [&](std::size_t i) {
+      const std::size_t t = ts[i], m = n - t + 1;
+      const double shift = x.diff(n, 0) * static_cast<double>(t) / static_cast<double>(n);
+      double s1 = 0, s2 = 0;
+      for (std::size_t k = 0; k < m; ++k) {
+        const double d = x.diff(k + t, k) - shift;
+        s1 += d;
+        s2 += d * d;
+      }
+      out[i] = (s2 - s1 * s1 / static_cast<double>(m)) / (static_cast<double>(m) - 1.0);
+    });
+    return out;
+  }
+  constexpr std::size_t kBlock = std::size_t{1} << 14, kChunk = kBlock * 32;
+  const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  std::vector<std::vector<std::array<i128, 2>>> part(chunks, std::vector<std::array<i128, 2>>(ts.size()));
+  parallel_for(chunks, [&](std::size_t ci) {
+    for (std::size_t k0 = ci * kChunk; k0 < std::min(n, (ci + 1) * kChunk); k0 += kBlock)
+      for (std::size_t i = 0; i < ts.size(); ++i) {
+        const std::size_t k1 = std::min({k0 + kBlock, (ci + 1) * kChunk, n - ts[i] + 1});
+        if (k1 > k0) add_increment_sums(x.counts.data(), ts[i], k0, k1, part[ci][i][0], part[ci][i][1]);
+      }
+  });
+  const double q2 = x.arcsec_per_count * x.arcsec_per_count;
+  for (std::size_t i = 0; i < ts.size(); ++i) {
+    i128 s1 = 0, s2 = 0;
+    for (const auto& p : part) {
+      s1 += p[i][0];
+      s2 += p[i][1];
+    }
+    const std::size_t m = n - ts[i] + 1;
+    const i128 mss = s2 * static_cast<i128>(m) - s1 * s1;  // M·Σ(d − d̄)², exact
+    out[i] = static_cast<double>(mss) / static_cast<double>(m) / (static_cast<double>(m) - 1.0) * q2;
+  }
+  return out;
 }
 
 /// Weighted regression s² = X·β, weights (n/t)/model² (the EDF of s²(t) falls as t/T), iterated
@@ -141,11 +182,10 @@ namespace {
 
 /// Overlapping increment variances at the lengths ts (sample steps) of x.
 std::vector<DirectPoint> overlapping_points(const PhaseSeries& x, const std::vector<std::size_t>& ts) {
+  const std::vector<double> v = overlapping_variances(x, ts);
   std::vector<DirectPoint> pts(ts.size());
   const std::size_t n = x.points() - 1;
-  parallel_for(ts.size(), [&](std::size_t i) {
-    pts[i] = {static_cast<double>(ts[i]) * x.tau0_s, n - ts[i] + 1, overlapping_variance(x, ts[i])};
-  });
+  for (std::size_t i = 0; i < ts.size(); ++i) pts[i] = {static_cast<double>(ts[i]) * x.tau0_s, n - ts[i] + 1, v[i]};
   return pts;
 }
 
@@ -210,6 +250,8 @@ double bootstrap_n2_sd(const DirectNResult& r, const std::vector<std::size_t>& t
   settings.duration_s = static_cast<double>(nb) * step;
   settings.scale_arcsec = 1e-6;  // counting error 1e-6″: negligible
   std::vector<Vec3> xb(ts.size());
+  std::vector<std::size_t> coarse(ts.size());
+  for (std::size_t i = 0; i < ts.size(); ++i) coarse[i] = ts[i] / base;
   std::vector<double> white_sd(ts.size());
   for (std::size_t i = 0; i < ts.size(); ++i) {
     const IncrementBasis gc = increment_basis(ts[i] / base, nb + 1, step);
@@ -219,7 +261,9 @@ double bootstrap_n2_sd(const DirectNResult& r, const std::vector<std::size_t>& t
     const double rate_part = r.basis[i].n * n2 + r.basis[i].b * b2;
     white_sd[i] = std::sqrt((4.0 * q2 * q2 + 8.0 * q2 * rate_part) / md);
   }
-  constexpr std::size_t kChunks = 8;
+  // One simulator per worker (its flicker filter is made once); each replicate has its own seed,
+  // so the result does not depend on the split.
+  const std::size_t kChunks = std::max(1u, worker_count());
   std::vector<double> n2s(static_cast<std::size_t>(replicates), 0.0);
   std::vector<char> ok(n2s.size(), 0);
   parallel_for(kChunks, [&](std::size_t c) {
@@ -229,8 +273,9 @@ double bootstrap_n2_sd(const DirectNResult& r, const std::vector<std::size_t>& t
       sim.run(0x5eedu + rep, x);
       Rng rng(0xb007u + rep);
       std::vector<DirectPoint> pts(ts.size());
+      const std::vector<double> rate_part = overlapping_variances(x, coarse);
       for (std::size_t i = 0; i < ts.size(); ++i) {
-        const double v = overlapping_variance(x, ts[i] / base) + r.basis[i].q * q2 + white_sd[i] * rng.normal();
+        const double v = rate_part[i] + r.basis[i].q * q2 + white_sd[i] * rng.normal();
         pts[i] = {r.points[i].t_s, r.points[i].intervals, v};
       }
       Vec3 beta;
@@ -255,8 +300,8 @@ DirectNResult direct_n(const PhaseSeries& x, const MethodOptions& o) {
   const double t_max = std::min(o.direct_t_max_s, t_total / 50.0);
   const double t_min = std::max(o.direct_t_min_s, x.tau0_s);
   if (n < 20 || !(t_max > t_min)) return r;
-  // The bootstrap's coarse step: half the shortest interval, whole samples.
-  const auto base = static_cast<std::size_t>(std::max(1.0, std::floor(t_min / (2.0 * x.tau0_s))));
+  // The bootstrap's coarse step: the shortest interval, whole samples.
+  const auto base = static_cast<std::size_t>(std::max(1.0, std::floor(t_min / x.tau0_s)));
   const std::vector<std::size_t> ts = interval_grid(t_min, t_max, o.direct_points, x.tau0_s, base);
 
   // The paper's straight line through non-overlapping variances.
