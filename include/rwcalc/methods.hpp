@@ -28,6 +28,7 @@ struct MethodEstimate {
   double low = 0;      ///< 95 % bounds (≥ 0)
   double high = 0;
   bool resolved = true;  ///< false: value is an upper bound
+  double estimate = 0;   ///< the point estimate √max(0, ·²) even when not resolved (mean-unbiased)
 };
 
 /// Interval t, number of increments, variance of the angle increments (″²) about their mean.
@@ -57,14 +58,14 @@ struct StraightLineN {
 };
 
 struct DirectNResult {
-  MethodEstimate N;                     ///< unbiased N² regression; interval by parametric bootstrap
-  double q2_arcsec2 = 0;                ///< fitted white-angle coefficient Q² (may be < 0)
-  double n2_arcsec2_per_s = 0;          ///< fitted N″² = (60·N)² (may be < 0)
-  double b2_arcsec2_per_s2 = 0;         ///< fitted B² (may be < 0)
-  std::vector<DirectPoint> points;      ///< overlapping increments
-  std::vector<IncrementBasis> basis;    ///< g at each point
-  int replicates = 0;                   ///< bootstrap replicates used
-  StraightLineN straight;               ///< the paper's straight line
+  MethodEstimate N;                   ///< unbiased N² regression; interval by parametric bootstrap
+  double q2_arcsec2 = 0;              ///< fitted white-angle coefficient Q² (may be < 0)
+  double n2_arcsec2_per_s = 0;        ///< fitted N″² = (60·N)² (may be < 0)
+  double b2_arcsec2_per_s2 = 0;       ///< fitted B² (may be < 0)
+  std::vector<DirectPoint> points;    ///< overlapping increments
+  std::vector<IncrementBasis> basis;  ///< g at each point
+  int replicates = 0;                 ///< bootstrap replicates used
+  StraightLineN straight;             ///< the paper's straight line
 };
 
 /// Direct N of a phase series in ″. Invalid (not thrown) when fewer than four lengths fit.
@@ -77,12 +78,12 @@ void attach_straight_line_bias(DirectNResult& r, const FitResult& fit, double du
 /// fitted white terms removed: B² = [σ²(τ) − N″²/τ − 3Q²/τ²]/(2 ln2/π); χ² interval with the EDF of
 /// σ̂²(τ) under the fitted model.
 struct AvBEstimate {
-  MethodEstimate B;   ///< °/h
-  double tau_s = 0;   ///< τ of the AV used
-  double var = 0;     ///< σ̂²(τ), (°/h)²
-  double white = 0;   ///< N″²/τ + 3Q²/τ² removed, (°/h)²
-  double edf = 0;     ///< model-based EDF of σ̂²(τ)
-  double bias_factor = 1;  ///< expected value/true B under the fitted model (1: unbiased)
+  MethodEstimate B;                          ///< °/h
+  double tau_s = 0;                          ///< τ of the AV used
+  double var = 0;                            ///< σ̂²(τ), (°/h)²
+  double white = 0;                          ///< N″²/τ + 3Q²/τ² removed, (°/h)²
+  double edf = 0;                            ///< model-based EDF of σ̂²(τ)
+  double bias_factor = 1;                    ///< expected value/true B under the fitted model (1: unbiased)
   [[nodiscard]] double cdf(double b) const;  ///< confidence distribution P(true B ≤ b)
 };
 AvBEstimate b_from_averages(const PhaseSeries& x, const FitResult& fit, double block_s);

@@ -26,7 +26,8 @@ nlohmann::json coef_json(const Coefficient& c) {
 
 nlohmann::json method_json(const MethodEstimate& m) {
   if (!m.valid) return nullptr;
-  return {{"value", m.value}, {"sigma", m.sigma}, {"low95", m.low}, {"high95", m.high}, {"resolved", m.resolved}};
+  return {{"value", m.value}, {"sigma", m.sigma},       {"low95", m.low},
+          {"high95", m.high}, {"resolved", m.resolved}, {"estimate", m.estimate}};
 }
 
 nlohmann::json opt_num(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
@@ -252,7 +253,8 @@ void cross_checks(const Recording& rec, const AnalysisOptions& options, Analysis
   const auto& fb = r.fit[Term::B];
   if (r.direct.N.valid)
     r.N_direct_discrepancy_sigma = discrepancy_sigma(r.direct.N.value, r.direct.N.sigma, fn.value, fn.sigma);
-  if (r.b100.B.valid) r.B_100s_discrepancy_sigma = discrepancy_sigma(r.b100.B.value, r.b100.B.sigma, fb.value, fb.sigma);
+  if (r.b100.B.valid)
+    r.B_100s_discrepancy_sigma = discrepancy_sigma(r.b100.B.value, r.b100.B.sigma, fb.value, fb.sigma);
   if (r.avg100.spread.valid && r.avg100.expected > 0)
     r.B_100s_vs_model_sigma =
         discrepancy_sigma(r.avg100.spread.value, r.avg100.spread.sigma, r.avg100.expected, r.avg100.expected_sigma);
@@ -444,10 +446,11 @@ std::string format_report(const AnalysisResult& r) {
                                r.slope.tau_N_s)
                  : std::string("  N: no part of the curve has slope −½\n");
   if (r.b_min.B.valid) {
-    s += fmt::format("  B = sigma_min/0.6643 = {}{} °/h [{}, {}] (95 %, EDF {:.3g} under the fitted model; sigma_min {} °/h "
-                     "at tau = {:.4g} s <= T/10)\n",
-                     r.b_min.B.resolved ? "" : "< ", num(r.b_min.B.value, 3), num(r.b_min.B.low, 3),
-                     num(r.b_min.B.high, 3), r.b_min.edf, num(r.slope.sigma_min, 3), r.slope.tau_min_s);
+    s += fmt::format(
+        "  B = sigma_min/0.6643 = {}{} °/h [{}, {}] (95 %, EDF {:.3g} under the fitted model; sigma_min {} °/h "
+        "at tau = {:.4g} s <= T/10)\n",
+        r.b_min.B.resolved ? "" : "< ", num(r.b_min.B.value, 3), num(r.b_min.B.low, 3), num(r.b_min.B.high, 3),
+        r.b_min.edf, num(r.slope.sigma_min, 3), r.slope.tau_min_s);
     if (r.b_min.bias_factor > 0)
       s += fmt::format("    biased: estimates sigma(tau_min)/0.6643 = {:.2f} x B under the fitted model\n",
                        r.b_min.bias_factor);

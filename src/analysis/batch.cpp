@@ -308,16 +308,16 @@ std::string format_batch_markdown(const json& summary) {
   const auto& runs = summary.at("runs");
   const auto& ov = summary.at("overall");
   std::string s;
-  s +=
-      "| T, °C | N (AV), °/√h | N direct [95 %], °/√h | B (AV), °/h | B 100-s avg [95 %], °/h | class by N | class by B "
-      "| class |\n";
+  s += "| T, °C | N (AV), °/√h | N direct [95 %], °/√h | B (AV), °/h | B 100-s avg [95 %], °/h | class by N | class by "
+       "B "
+       "| class |\n";
   s += "|---|---|---|---|---|---|---|---|\n";
   for (const auto& r : runs) {
     const auto& v = r.at("verdict");
     s += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", temp_cell(r), cell(r, {"fit", "N_deg_per_sqrt_h"}),
                      interval_cell(r, {"methods", "N_direct_deg_per_sqrt_h"}), cell(r, {"fit", "B_deg_per_h"}),
-                     interval_cell(r, {"methods", "B_100s_deg_per_h"}), v.value("statement_N", ""), v.value("statement_B", ""),
-                     v.value("statement", ""));
+                     interval_cell(r, {"methods", "B_100s_deg_per_h"}), v.value("statement_N", ""),
+                     v.value("statement_B", ""), v.value("statement", ""));
   }
   s += fmt::format("| overall | | | | | {} | {} | {} |\n", ov.at("N").at("statement").get<std::string>(),
                    ov.at("B").at("statement").get<std::string>(), ov.at("statement").get<std::string>());

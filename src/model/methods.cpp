@@ -335,6 +335,7 @@ DirectNResult direct_n(const PhaseSeries& x, const MethodOptions& o) {
   e.high = hi > 0 ? std::sqrt(hi) / 60.0 : 0.0;
   e.resolved = lo > 0;
   e.low = e.resolved ? std::sqrt(lo) / 60.0 : 0.0;
+  e.estimate = beta[1] > 0 ? std::sqrt(beta[1]) / 60.0 : 0.0;
   if (e.resolved) {
     e.value = std::sqrt(beta[1]) / 60.0;
     e.sigma = sd / (2.0 * std::sqrt(beta[1])) / 60.0;
@@ -380,7 +381,8 @@ void finish_av_estimate(AvBEstimate& e) {
   m.low = to_b(ci.low * ci.low);
   m.high = to_b(ci.high * ci.high);
   m.resolved = m.low > 0;
-  m.value = m.resolved ? to_b(e.var) : m.high;
+  m.estimate = to_b(e.var);
+  m.value = m.resolved ? m.estimate : m.high;
   m.sigma = (m.high - m.low) / (2.0 * kZ95);
 }
 
@@ -457,6 +459,7 @@ BlockSpreadResult block_spread(const PhaseSeries& x, double block_s) {
   e.valid = true;
   e.value = std::sqrt(sample_variance(y));
   e.sigma = e.value / std::sqrt(2.0 * static_cast<double>(k - 1));
+  e.estimate = e.value;
   e.low = e.value * std::exp(-kZ95 * e.sigma / e.value);
   e.high = e.value * std::exp(kZ95 * e.sigma / e.value);
   if (!(e.value > 0)) e.low = e.high = 0;
