@@ -10,6 +10,7 @@
 
 #include "rwcalc/fit.hpp"
 #include "rwcalc/methods.hpp"
+#include "rwcalc/simulate.hpp"
 #include "test_support.hpp"
 
 namespace rwcalc {
@@ -167,6 +168,54 @@ TEST(BlockSpread, ExpectationUnderTheModel) {
   // Flicker: the spread of 100-s means grows with the number of blocks (ln T), unlike the AV.
   const V f = (V() << 0, 0, 3.6e-5, 0, 0).finished();
   EXPECT_GT(expected_block_variance(f, 100.0, 72), 1.5 * expected_block_variance(f, 100.0, 2));
+}
+
+TEST(IncrementBasis, ReproducesTheMonteCarloMeanOfSingleTermRecords) {
+  // Simulated single-term records (1000 s at 10 Hz, pulse weight 1e-6″): the mean of the overlapping
+  // increment variances over 300 records against g at unit coefficient times the term's c.
+  struct Case {
+    NoiseModel model;
+    double c_q, c_n, c_b;
+  };
+  std::vector<Case> cases(3);
+  cases[0].model.white_angle_arcsec = 1.0;
+  cases[0].c_q = 1.0;
+  cases[1].model.arw_deg_per_sqrt_h = 0.05;
+  cases[1].c_n = 3600.0 * 0.05 * 0.05;
+  cases[2].model.bias_instability_deg_per_h = 0.01;
+  cases[2].c_b = 1e-4;
+  SimulationSettings settings;
+  settings.duration_s = 1000.0;
+  settings.rate_hz = 10.0;
+  settings.scale_arcsec = 1e-6;
+  MethodOptions o;
+  o.direct_t_max_s = 20.0;
+  o.bootstrap_replicates = 0;  // the points and g only
+  constexpr int kRecords = 300;
+  for (std::size_t ci = 0; ci < cases.size(); ++ci) {
+    Simulator sim(cases[ci].model, settings);
+    PhaseSeries x;
+    std::vector<double> sum, sum2;
+    DirectNResult r;
+    for (int k = 0; k < kRecords; ++k) {
+      sim.run(1000 + static_cast<std::uint64_t>(k), x);
+      r = direct_n(x, o);
+      sum.resize(r.points.size(), 0.0);
+      sum2.resize(r.points.size(), 0.0);
+      for (std::size_t i = 0; i < r.points.size(); ++i) {
+        sum[i] += r.points[i].var_arcsec2;
+        sum2[i] += r.points[i].var_arcsec2 * r.points[i].var_arcsec2;
+      }
+    }
+    ASSERT_GE(r.points.size(), 4u);
+    for (std::size_t i = 0; i < r.points.size(); ++i) {
+      const double mean = sum[i] / kRecords;
+      const double se = std::sqrt((sum2[i] / kRecords - mean * mean) / (kRecords - 1));
+      const auto& g = r.basis[i];
+      const double expect = g.q * cases[ci].c_q + g.n * cases[ci].c_n + g.b * cases[ci].c_b;
+      EXPECT_NEAR(mean, expect, 4.0 * se + 1e-3 * expect) << "case " << ci << ", t = " << r.points[i].t_s << " s";
+    }
+  }
 }
 
 TEST(CrossChecksCli, ShippedRunCarriesTheUnbiasedEstimatorsInTextAndJson) {
