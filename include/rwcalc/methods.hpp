@@ -75,13 +75,13 @@ DirectNResult direct_n(const PhaseSeries& x, const MethodOptions& options = {});
 void attach_straight_line_bias(DirectNResult& r, const FitResult& fit, double duration_s, double tau0_s);
 
 /// B from the overlapping AV at the block length (what the block-average method measures) with the
-/// fitted white terms removed: B² = [σ²(τ) − N″²/τ − 3Q²/τ²]/(2 ln2/π); χ² interval with the EDF of
-/// σ̂²(τ) under the fitted model.
+/// fitted white terms removed: B² = [σ²(τ) − N″²/τ − 3Q²/τ²]/(2 ln2/π) (and K²τ/3, R²τ²/2 when the
+/// fit keeps them); χ² interval with the EDF of σ̂²(τ) under the fitted model.
 struct AvBEstimate {
   MethodEstimate B;                          ///< °/h
   double tau_s = 0;                          ///< τ of the AV used
   double var = 0;                            ///< σ̂²(τ), (°/h)²
-  double white = 0;                          ///< N″²/τ + 3Q²/τ² removed, (°/h)²
+  double white = 0;                          ///< the fitted other terms at τ removed, (°/h)²
   double edf = 0;                            ///< model-based EDF of σ̂²(τ)
   double bias_factor = 1;                    ///< expected value/true B under the fitted model (1: unbiased)
   [[nodiscard]] double cdf(double b) const;  ///< confidence distribution P(true B ≤ b)

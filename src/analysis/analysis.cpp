@@ -344,7 +344,7 @@ nlohmann::json to_json(const AnalysisResult& r) {
                 {"note", "biased: expected value/true N = bias_factor under the fitted Q, N, B"}};
   json b100 = method_json(r.b100.B);
   if (!b100.is_null()) {
-    b100["estimator"] = "overlapping AV at the block length minus the fitted white terms";
+    b100["estimator"] = "overlapping AV at the block length minus the fitted terms other than B";
     b100["tau_s"] = r.b100.tau_s;
     b100["avar"] = r.b100.var;
     b100["white_removed"] = r.b100.white;
@@ -478,7 +478,8 @@ std::string format_report(const AnalysisResult& r) {
   }
   if (r.b100.B.valid)
     s += fmt::format(
-        "  B from {:g}-s averages (AV at {:g} s minus the fitted white terms): {}{} °/h [{}, {}] (EDF {:.3g}); "
+        "  B from {:g}-s averages (AV at {:g} s minus the fitted white and other non-B terms): {}{} °/h [{}, {}] (EDF "
+        "{:.3g}); "
         "vs AV fit {:+.1f} sigma\n",
         r.b100.tau_s, r.b100.tau_s, r.b100.B.resolved ? "" : "< ", num(r.b100.B.value, 3), num(r.b100.B.low, 3),
         num(r.b100.B.high, 3), r.b100.edf, r.B_100s_discrepancy_sigma);

@@ -408,10 +408,10 @@ AvBEstimate b_from_averages(const PhaseSeries& x, const FitResult& fit, double b
   e.var = allan_variance(x, m, Estimator::Overlapping, &terms);
   e.tau_s = static_cast<double>(m) * x.tau0_s;
   if (terms <= 0 || !(e.var > 0)) return e;
-  // The fitted white terms at τ, with the variance of that estimate from the fit covariance.
-  Eigen::Matrix<double, kTermCount, 1> h = Eigen::Matrix<double, kTermCount, 1>::Zero();
-  h[0] = term_basis(Term::Q, e.tau_s);
-  h[1] = term_basis(Term::N, e.tau_s);
+  // The fitted terms other than B at τ (the white ones; K and R when the fit keeps them), with the
+  // variance of that estimate from the fit covariance.
+  Eigen::Matrix<double, kTermCount, 1> h;
+  for (const Term t : kAllTerms) h[static_cast<int>(t)] = t == Term::B ? 0.0 : term_basis(t, e.tau_s);
   e.white = h.dot(fit.c);
   const double white_var = std::max(0.0, h.dot(fit.cov_c * h));
   e.edf = model_edf({e.tau_s, e.var, 0.0, m, terms}, fit, white_var);
