@@ -308,9 +308,8 @@ std::string format_batch_markdown(const json& summary) {
   const auto& runs = summary.at("runs");
   const auto& ov = summary.at("overall");
   std::string s;
-  s += "| T, °C | N (AV), °/√h | N direct [95 %], °/√h | B (AV), °/h | B 100-s avg [95 %], °/h | class by N | class by "
-       "B "
-       "| class |\n";
+  s += "| T, °C | N (AV), °/√h | N direct [95 %], °/√h | B (AV), °/h | B 100-s avg [95 %], °/h "
+       "| class by N | class by B | class |\n";
   s += "|---|---|---|---|---|---|---|---|\n";
   for (const auto& r : runs) {
     const auto& v = r.at("verdict");
