@@ -300,8 +300,11 @@ DirectNResult direct_n(const PhaseSeries& x, const MethodOptions& o) {
   const double t_max = std::min(o.direct_t_max_s, t_total / 50.0);
   const double t_min = std::max(o.direct_t_min_s, x.tau0_s);
   if (n < 20 || !(t_max > t_min)) return r;
-  // The bootstrap's coarse step: the shortest interval, whole samples.
-  const auto base = static_cast<std::size_t>(std::max(1.0, std::floor(t_min / x.tau0_s)));
+  // The bootstrap's coarse step: the shortest interval, whole samples, but no finer than T/16384 so that
+  // a replicate stays cheap (a shorter requested t_min is raised to it).
+  constexpr std::size_t kMaxCoarse = 16384;
+  const auto base = std::max(static_cast<std::size_t>(std::max(1.0, std::floor(t_min / x.tau0_s))),
+                             (n + kMaxCoarse - 1) / kMaxCoarse);
   const std::vector<std::size_t> ts = interval_grid(t_min, t_max, o.direct_points, x.tau0_s, base);
 
   // The paper's straight line through non-overlapping variances.
