@@ -45,11 +45,13 @@ struct AnalysisResult {
   AllanResult allan;
   FitResult fit;
   SlopeReadout slope;
-  double slope_B_sigma = 0;  ///< standard error of σ_min/0.6643 from the EDF at σ_min
-  DirectNResult direct;
-  BlockSpreadResult avg100;
+  double slope_B_sigma = 0;               ///< standard error of σ_min/0.6643 (from b_min)
+  AvBEstimate b_min;                      ///< σ_min/0.6643 with its model-EDF interval and bias factor
+  DirectNResult direct;                   ///< unbiased direct N and the paper's straight line
+  AvBEstimate b100;                       ///< B from the 100-s averages (unbiased in B²)
+  BlockSpreadResult avg100;               ///< raw spread of 100-s mean rates (≈ 1.5 B), beside its expectation
   double N_direct_discrepancy_sigma = 0;  ///< (N_direct − N_fit)/σ
-  double B_100s_discrepancy_sigma = 0;    ///< (spread − B_fit)/σ (not like for like, see docs)
+  double B_100s_discrepancy_sigma = 0;    ///< (B from 100-s averages − B_fit)/σ
   double B_100s_vs_model_sigma = 0;       ///< (spread − its expectation under the fit)/σ
   OutlierReport outliers;
   Verdict verdict;

@@ -113,8 +113,8 @@ std::vector<FitPoint> fit_points(const AllanResult& allan);
 /// not a positive finite variance, or the fit does not converge.
 FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options = {});
 
-/// The slope-line readout (IEEE 952 Annex C): N at 1 h of the −½ line, B = σ_min/0.6643, K at 3 h
-/// of the +½ line; empty when no part of the curve has the slope within ±0.25.
+/// The slope-line readout (IEEE 952 Annex C): N at 1 h of the −½ line, B = σ_min/0.6643 (minimum
+/// over τ ≤ T/10), K at 3 h of the +½ line; empty when no part of the curve has the slope within ±0.25.
 struct SlopeReadout {
   std::optional<double> N;  ///< °/√h
   double tau_N_s = 0;       ///< τ of the point the −½ line goes through, s

@@ -26,7 +26,8 @@ nlohmann::json coef_json(const Coefficient& c) {
 
 nlohmann::json method_json(const MethodEstimate& m) {
   if (!m.valid) return nullptr;
-  return {{"value", m.value}, {"sigma", m.sigma}, {"low95", m.low}, {"high95", m.high}, {"resolved", m.resolved}};
+  return {{"value", m.value}, {"sigma", m.sigma},       {"low95", m.low},
+          {"high95", m.high}, {"resolved", m.resolved}, {"estimate", m.estimate}};
 }
 
 nlohmann::json opt_num(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
@@ -180,6 +181,17 @@ AllanResult octave_points_of(const AllanResult& all, const AllanOptions& aopt) {
   return octave_points;
 }
 
+/// A B estimate from one AV point as the verdict's input: its χ² confidence distribution.
+EstimateInput av_estimate_input(const AvBEstimate& b) {
+  EstimateInput e;
+  e.value = b.B.value;
+  e.low = b.B.low;
+  e.high = b.B.high;
+  e.resolved = b.B.resolved;
+  e.cdf = [b](double x) { return b.cdf(x); };
+  return e;
+}
+
 /// The class verdict from the fit's N and the B estimate the options choose.
 Verdict verdict_of(const AnalysisResult& r, const AnalysisOptions& options) {
   const FitResult& fit = r.fit;
@@ -201,14 +213,15 @@ Verdict verdict_of(const AnalysisResult& r, const AnalysisOptions& options) {
       rho = fit.log_correlation(Term::B, Term::N);
       break;
     case BEstimate::SigmaMin:
-      if (!r.slope.B) throw AnalysisError(fmt::format("{}: no Allan deviation minimum to read B from", r.source));
-      b_in = lognormal_estimate(*r.slope.B, r.slope_B_sigma);
+      if (!r.b_min.B.valid)
+        throw AnalysisError(fmt::format("{}: no Allan deviation minimum at tau <= T/10 to read B from", r.source));
+      b_in = av_estimate_input(r.b_min);
       break;
     case BEstimate::Avg100:
-      if (!r.avg100.spread.valid)
+      if (!r.b100.B.valid)
         throw AnalysisError(fmt::format("{}: the record is shorter than three {:g}-s blocks; use --b-estimate fit",
                                         r.source, options.methods.block_s));
-      b_in = lognormal_estimate(r.avg100.spread.value, r.avg100.spread.sigma);
+      b_in = av_estimate_input(r.b100);
       break;
   }
   return decide(b_in, from_fit(Term::N), rho, options.verdict);
@@ -248,21 +261,26 @@ void allan_and_fit(const Recording& rec, const AnalysisOptions& options, Analysi
     if (p.tau_s == r.slope.tau_min_s && p.edf > 0 && r.slope.B) r.slope_B_sigma = *r.slope.B / std::sqrt(2.0 * p.edf);
 }
 
-/// The paper's methods (direct N, spread of 100-s means) and their discrepancies from the fit.
+/// The paper's methods as unbiased estimators (direct N, B from the 100-s averages, σ_min/0.6643
+/// with its bias factor) and their discrepancies from the fit; the raw spread of 100-s means
+/// beside its expectation under the fit.
 void cross_checks(const Recording& rec, const AnalysisOptions& options, AnalysisResult& r) {
   r.direct = direct_n(rec.phase, options.methods);
+  attach_straight_line_bias(r.direct, r.fit, r.duration_s, rec.phase.tau0_s);
+  r.b100 = b_from_averages(rec.phase, r.fit, options.methods.block_s);
+  r.b_min = b_from_minimum(r.allan, r.slope, r.fit);
+  if (r.b_min.B.valid) r.slope_B_sigma = r.b_min.B.sigma;
   r.avg100 = block_spread(rec.phase, options.methods.block_s);
   attach_expectation(r.avg100, r.fit);
   const auto& fn = r.fit[Term::N];
   const auto& fb = r.fit[Term::B];
   if (r.direct.N.valid)
     r.N_direct_discrepancy_sigma = discrepancy_sigma(r.direct.N.value, r.direct.N.sigma, fn.value, fn.sigma);
-  if (r.avg100.spread.valid) {
-    r.B_100s_discrepancy_sigma = discrepancy_sigma(r.avg100.spread.value, r.avg100.spread.sigma, fb.value, fb.sigma);
-    if (r.avg100.expected > 0)
-      r.B_100s_vs_model_sigma =
-          discrepancy_sigma(r.avg100.spread.value, r.avg100.spread.sigma, r.avg100.expected, r.avg100.expected_sigma);
-  }
+  if (r.b100.B.valid)
+    r.B_100s_discrepancy_sigma = discrepancy_sigma(r.b100.B.value, r.b100.B.sigma, fb.value, fb.sigma);
+  if (r.avg100.spread.valid && r.avg100.expected > 0)
+    r.B_100s_vs_model_sigma =
+        discrepancy_sigma(r.avg100.spread.value, r.avg100.spread.sigma, r.avg100.expected, r.avg100.expected_sigma);
 }
 
 }  // namespace
@@ -313,26 +331,57 @@ nlohmann::json to_json(const AnalysisResult& r) {
               {"confidence", f.options.confidence}};
   json n_direct = method_json(r.direct.N);
   if (!n_direct.is_null()) {
+    n_direct["estimator"] = "overlapping increments, regression on the exact expectations of Q, N, B";
+    n_direct["interval"] = "parametric bootstrap";
+    n_direct["replicates"] = r.direct.replicates;
     n_direct["discrepancy_sigma"] = r.N_direct_discrepancy_sigma;
-    n_direct["intercept_arcsec2"] = r.direct.intercept_arcsec2;
-    n_direct["slope_arcsec2_per_s"] = r.direct.slope_arcsec2_per_s;
+    n_direct["Q2_arcsec2"] = r.direct.q2_arcsec2;
+    n_direct["N2_arcsec2_per_s"] = r.direct.n2_arcsec2_per_s;
+    n_direct["B2_arcsec2_per_s2"] = r.direct.b2_arcsec2_per_s2;
     // The points of the regression (the seed paper's Fig. 2): interval length, number of
-    // intervals and the variance of the angle over them, Earth rate and bias removed.
+    // overlapping increments, their variance about the mean (Earth rate and bias removed) and the
+    // regression's value there. The line drawn with them is the paper's straight line.
     nlohmann::json curve = nlohmann::json::array();
-    for (const auto& p : r.direct.points)
-      curve.push_back({{"t_s", p.t_s}, {"intervals", p.intervals}, {"var_arcsec2", p.var_arcsec2}});
+    for (std::size_t i = 0; i < r.direct.points.size(); ++i) {
+      const auto& p = r.direct.points[i];
+      const auto& g = r.direct.basis[i];
+      curve.push_back({{"t_s", p.t_s},
+                       {"intervals", p.intervals},
+                       {"var_arcsec2", p.var_arcsec2},
+                       {"model_arcsec2", g.q * r.direct.q2_arcsec2 + g.n * r.direct.n2_arcsec2_per_s +
+                                             g.b * r.direct.b2_arcsec2_per_s2}});
+    }
     n_direct["curve"] = std::move(curve);
     n_direct["t_min_s"] = r.direct.points.front().t_s;
     n_direct["t_max_s"] = r.direct.points.back().t_s;
+    if (r.direct.straight.valid) {
+      n_direct["intercept_arcsec2"] = r.direct.straight.intercept_arcsec2;
+      n_direct["slope_arcsec2_per_s"] = r.direct.straight.slope_arcsec2_per_s;
+    }
   }
-  json b100 = method_json(r.avg100.spread);
+  json straight = nullptr;
+  if (r.direct.straight.valid)
+    straight = {{"value", r.direct.straight.value},
+                {"intercept_arcsec2", r.direct.straight.intercept_arcsec2},
+                {"slope_arcsec2_per_s", r.direct.straight.slope_arcsec2_per_s},
+                {"bias_factor", r.direct.straight.bias_factor},
+                {"note", "biased: expected value/true N = bias_factor under the fitted Q, N, B"}};
+  json b100 = method_json(r.b100.B);
   if (!b100.is_null()) {
-    b100["blocks"] = r.avg100.blocks;
-    b100["block_s"] = r.avg100.block_s;
-    b100["expected"] = r.avg100.expected;
-    b100["expected_sigma"] = r.avg100.expected_sigma;
+    b100["estimator"] = "overlapping AV at the block length minus the fitted terms other than B";
+    b100["tau_s"] = r.b100.tau_s;
+    b100["avar"] = r.b100.var;
+    b100["white_removed"] = r.b100.white;
+    b100["edf"] = r.b100.edf;
     b100["discrepancy_sigma"] = r.B_100s_discrepancy_sigma;
-    b100["discrepancy_model_sigma"] = r.B_100s_vs_model_sigma;
+  }
+  json spread = method_json(r.avg100.spread);
+  if (!spread.is_null()) {
+    spread["blocks"] = r.avg100.blocks;
+    spread["block_s"] = r.avg100.block_s;
+    spread["expected"] = r.avg100.expected;
+    spread["expected_sigma"] = r.avg100.expected_sigma;
+    spread["discrepancy_model_sigma"] = r.B_100s_vs_model_sigma;
   }
   return {{"source", r.source},
           {"input", r.input},
@@ -352,11 +401,19 @@ nlohmann::json to_json(const AnalysisResult& r) {
             {"tau_N_s", r.slope.tau_N_s},
             {"B_deg_per_h", opt_num(r.slope.B)},
             {"B_sigma", r.slope_B_sigma},
+            {"B_low95", r.b_min.B.valid ? json(r.b_min.B.low) : json(nullptr)},
+            {"B_high95", r.b_min.B.valid ? json(r.b_min.B.high) : json(nullptr)},
+            {"B_edf", r.b_min.edf},
+            {"B_bias_factor", r.b_min.bias_factor},
             {"sigma_min_deg_per_h", r.slope.sigma_min},
             {"tau_min_s", r.slope.tau_min_s},
             {"K_deg_per_h_per_sqrt_h", opt_num(r.slope.K)},
             {"tau_K_s", r.slope.tau_K_s}}},
-          {"methods", {{"N_direct_deg_per_sqrt_h", n_direct}, {"B_100s_deg_per_h", b100}}},
+          {"methods",
+           {{"N_direct_deg_per_sqrt_h", n_direct},
+            {"N_straight_line_paper_deg_per_sqrt_h", straight},
+            {"B_100s_deg_per_h", b100},
+            {"spread_100s_deg_per_h", spread}}},
           {"outliers", to_json(r.outliers)},
           {"verdict", to_json(r.verdict)},
           {"conventions",
@@ -435,32 +492,52 @@ std::string format_report(const AnalysisResult& r) {
   s += r.slope.N ? fmt::format("  N = {} °/√h (−½ line through tau = {:.3g} s, read at 1 h)\n", num(*r.slope.N, 3),
                                r.slope.tau_N_s)
                  : std::string("  N: no part of the curve has slope −½\n");
-  if (r.slope.B)
-    s += fmt::format("  B = sigma_min/0.6643 = {} ± {} °/h (sigma_min {} °/h at tau = {:.4g} s)\n", num(*r.slope.B, 3),
-                     num(r.slope_B_sigma, 2), num(r.slope.sigma_min, 3), r.slope.tau_min_s);
+  if (r.b_min.B.valid) {
+    s += fmt::format(
+        "  B = sigma_min/0.6643 = {}{} °/h [{}, {}] (95 %, EDF {:.3g} under the fitted model; sigma_min {} °/h "
+        "at tau = {:.4g} s <= T/10)\n",
+        r.b_min.B.resolved ? "" : "< ", num(r.b_min.B.value, 3), num(r.b_min.B.low, 3), num(r.b_min.B.high, 3),
+        r.b_min.edf, num(r.slope.sigma_min, 3), r.slope.tau_min_s);
+    if (r.b_min.bias_factor > 0)
+      s += fmt::format("    biased: estimates sigma(tau_min)/0.6643 = {:.2f} x B under the fitted model\n",
+                       r.b_min.bias_factor);
+  }
   s += r.slope.K ? fmt::format("  K = {} °/h/√h (+½ line through tau = {:.3g} s, read at 3 h)\n", num(*r.slope.K, 3),
                                r.slope.tau_K_s)
                  : std::string("  K: no part of the curve has slope +½\n");
   s += "\n";
 
-  s += "Cross-checks (the paper's methods)\n";
-  if (r.direct.N.valid)
-    s += fmt::format("  N direct (angle variance vs interval, {:g}..{:g} s): {}{} ± {} °/√h; vs AV fit {:+.1f} sigma\n",
-                     r.direct.points.front().t_s, r.direct.points.back().t_s, r.direct.N.resolved ? "" : "< ",
-                     num(r.direct.N.value, 3), num(r.direct.N.sigma, 2), r.N_direct_discrepancy_sigma);
+  s += "Cross-checks (the paper's methods as unbiased estimators; 95 % intervals)\n";
+  const auto& d = r.direct;
+  if (d.N.valid)
+    s += fmt::format(
+        "  N direct (overlapping angle increments, {:g}..{:g} s, exact Q/N/B expectations): {}{} °/√h [{}, {}] "
+        "(bootstrap, {} replicates); vs AV fit {:+.1f} sigma\n",
+        d.points.front().t_s, d.points.back().t_s, d.N.resolved ? "" : "< ", num(d.N.value, 3), num(d.N.low, 3),
+        num(d.N.high, 3), d.replicates, r.N_direct_discrepancy_sigma);
   else
     s += "  N direct: record too short\n";
-  if (r.avg100.spread.valid) {
-    s += fmt::format("  spread of {:g}-s mean rates ({} blocks): {} ± {} °/h; vs B (fit) {:+.1f} sigma\n",
-                     r.avg100.block_s, r.avg100.blocks, num(r.avg100.spread.value, 3), num(r.avg100.spread.sigma, 2),
-                     r.B_100s_discrepancy_sigma);
-    if (r.avg100.expected > 0)
-      s += fmt::format(
-          "    expected from the fitted model (all terms): {} ± {} °/h; measured vs expected {:+.1f} sigma\n",
-          num(r.avg100.expected, 3), num(r.avg100.expected_sigma, 2), r.B_100s_vs_model_sigma);
-  } else {
-    s += "  100-s averaging: record too short\n";
+  if (d.straight.valid) {
+    s += fmt::format("  N straight line (paper): {} °/√h", num(d.straight.value, 3));
+    s += d.straight.bias_factor > 0
+             ? fmt::format("; biased, expected {:.2f} x N under the fitted Q, N, B\n", d.straight.bias_factor)
+             : std::string("; biased (the flicker term is not linear in t)\n");
   }
+  if (r.b100.B.valid)
+    s += fmt::format(
+        "  B from {:g}-s averages (AV at {:g} s minus the fitted white and other non-B terms): {}{} °/h [{}, {}] (EDF "
+        "{:.3g}); "
+        "vs AV fit {:+.1f} sigma\n",
+        r.b100.tau_s, r.b100.tau_s, r.b100.B.resolved ? "" : "< ", num(r.b100.B.value, 3), num(r.b100.B.low, 3),
+        num(r.b100.B.high, 3), r.b100.edf, r.B_100s_discrepancy_sigma);
+  else
+    s += "  B from 100-s averages: record too short\n";
+  if (r.avg100.spread.valid && r.avg100.expected > 0)
+    s += fmt::format(
+        "  spread of {:g}-s mean rates ({} blocks): {} ± {} °/h; expected from the fitted model {} ± {} °/h; "
+        "{:+.1f} sigma\n",
+        r.avg100.block_s, r.avg100.blocks, num(r.avg100.spread.value, 3), num(r.avg100.spread.sigma, 2),
+        num(r.avg100.expected, 3), num(r.avg100.expected_sigma, 2), r.B_100s_vs_model_sigma);
   s += "\n";
 
   const auto& v = r.verdict;

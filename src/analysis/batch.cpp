@@ -75,7 +75,7 @@ const std::vector<Series>& series_list() {
       {"N_fit", "N (AV fit)", "deg/sqrt(h)", {"fit", "N_deg_per_sqrt_h"}},
       {"N_direct", "N (direct)", "deg/sqrt(h)", {"methods", "N_direct_deg_per_sqrt_h"}},
       {"B_fit", "B (AV fit)", "deg/h", {"fit", "B_deg_per_h"}},
-      {"B_100s", "100-s spread", "deg/h", {"methods", "B_100s_deg_per_h"}},
+      {"B_100s", "B (100-s avg)", "deg/h", {"methods", "B_100s_deg_per_h"}},
   };
   return s;
 }
@@ -137,6 +137,15 @@ std::string cell(const json& run, const std::vector<std::string>& path, int digi
   const double sg = e->at("sigma").get<double>();
   if (!e->at("resolved").get<bool>()) return fmt::format("< {:.{}g}", v, digits + 1);
   return fmt::format("{:.{}g} ± {:.{}g}", v, digits + 1, sg, 1 + (sg < 0.15 * v ? 1 : 0));
+}
+
+/// A cross-check's cell: value and 95 % interval ("< x" when not resolved).
+std::string interval_cell(const json& run, const std::vector<std::string>& path) {
+  const json* e = lookup(run, path);
+  if (!e) return "n/a";
+  const double v = e->at("value").get<double>();
+  if (!e->at("resolved").get<bool>()) return fmt::format("< {:.3g}", v);
+  return fmt::format("{:.3g} [{:.3g}, {:.3g}]", v, e->at("low95").get<double>(), e->at("high95").get<double>());
 }
 
 std::string temp_cell(const json& run) {
@@ -249,13 +258,13 @@ std::string format_batch_text(const json& summary) {
                    ov.value("tolerance_pct", 0.0) > 0
                        ? fmt::format("; +{:g} % heading-gyro tolerance on B", ov.value("tolerance_pct", 0.0))
                        : std::string("; strict limits"));
-  s += "Table 1: coefficients (±1 sigma; \"< x\": 95 % upper bound)\n";
-  s += fmt::format("  {:>6}  {:<22} {:<22} {:<22} {:<22} {}\n", "T, °C", "N (AV), °/√h", "N direct, °/√h",
-                   "B (AV), °/h", "100-s spread, °/h", "file");
+  s += "Table 1: coefficients (AV fit ±1 sigma; cross-checks [95 % interval]; \"< x\": 95 % upper bound)\n";
+  s += fmt::format("  {:>6}  {:<22} {:<30} {:<22} {:<30} {}\n", "T, °C", "N (AV), °/√h", "N direct, °/√h",
+                   "B (AV), °/h", "B 100-s avg, °/h", "file");
   for (const auto& r : runs)
-    s += fmt::format("  {:>6}  {:<22} {:<22} {:<22} {:<22} {}\n", temp_cell(r), cell(r, {"fit", "N_deg_per_sqrt_h"}),
-                     cell(r, {"methods", "N_direct_deg_per_sqrt_h"}), cell(r, {"fit", "B_deg_per_h"}),
-                     cell(r, {"methods", "B_100s_deg_per_h"}), printable(r.at("source").get<std::string>()));
+    s += fmt::format("  {:>6}  {:<22} {:<30} {:<22} {:<30} {}\n", temp_cell(r), cell(r, {"fit", "N_deg_per_sqrt_h"}),
+                     interval_cell(r, {"methods", "N_direct_deg_per_sqrt_h"}), cell(r, {"fit", "B_deg_per_h"}),
+                     interval_cell(r, {"methods", "B_100s_deg_per_h"}), printable(r.at("source").get<std::string>()));
   s += "\nTable 2: class per parameter (probability of the stated class)\n";
   s += fmt::format("  {:>6}  {:<30} {:<30} {}\n", "T, °C", "by N", "by B", "overall");
   for (const auto& r : runs) {
@@ -299,15 +308,15 @@ std::string format_batch_markdown(const json& summary) {
   const auto& runs = summary.at("runs");
   const auto& ov = summary.at("overall");
   std::string s;
-  s +=
-      "| T, °C | N (AV), °/√h | N direct, °/√h | B (AV), °/h | 100-s spread, °/h | class by N | class by B | class |\n";
+  s += "| T, °C | N (AV), °/√h | N direct [95 %], °/√h | B (AV), °/h | B 100-s avg [95 %], °/h "
+       "| class by N | class by B | class |\n";
   s += "|---|---|---|---|---|---|---|---|\n";
   for (const auto& r : runs) {
     const auto& v = r.at("verdict");
     s += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", temp_cell(r), cell(r, {"fit", "N_deg_per_sqrt_h"}),
-                     cell(r, {"methods", "N_direct_deg_per_sqrt_h"}), cell(r, {"fit", "B_deg_per_h"}),
-                     cell(r, {"methods", "B_100s_deg_per_h"}), v.value("statement_N", ""), v.value("statement_B", ""),
-                     v.value("statement", ""));
+                     interval_cell(r, {"methods", "N_direct_deg_per_sqrt_h"}), cell(r, {"fit", "B_deg_per_h"}),
+                     interval_cell(r, {"methods", "B_100s_deg_per_h"}), v.value("statement_N", ""),
+                     v.value("statement_B", ""), v.value("statement", ""));
   }
   s += fmt::format("| overall | | | | | {} | {} | {} |\n", ov.at("N").at("statement").get<std::string>(),
                    ov.at("B").at("statement").get<std::string>(), ov.at("statement").get<std::string>());

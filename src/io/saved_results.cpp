@@ -112,10 +112,17 @@ void Checker::fit(const Value& f) const {
 
 void Checker::methods(const Value& m) const {
   m.object();
-  for (const char* key : {"N_direct_deg_per_sqrt_h", "B_100s_deg_per_h"}) {
+  if (const auto sl = m.find("N_straight_line_paper_deg_per_sqrt_h")) {
+    sl->object();
+    for (const char* k : {"value", "bias_factor"}) optional(*sl, k, as_non_negative);
+    for (const char* k : {"intercept_arcsec2", "slope_arcsec2_per_s"}) optional(*sl, k, as_number);
+  }
+  for (const char* key : {"N_direct_deg_per_sqrt_h", "B_100s_deg_per_h", "spread_100s_deg_per_h"}) {
     const auto e = m.find(key);
     if (!e) continue;
     estimate(*e);
+    for (const char* k : {"edf", "tau_s", "avar", "white_removed", "replicates", "expected", "expected_sigma"})
+      optional(*e, k, as_non_negative);
     if (const auto curve = e->find("curve"))
       for (const auto& p : curve->elements()) {
         p.object();

@@ -746,10 +746,14 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
 SlopeReadout slope_readout(const AllanResult& allan) {
   SlopeReadout s;
   const auto& p = allan.points;
+  // The minimum is searched at τ ≤ T/10 only: beyond, a point has a handful of EDF and the
+  // smallest of several such points is mostly chance.
+  const double t_total = allan.points_in > 1 ? static_cast<double>(allan.points_in - 1) * allan.tau0_s : 0.0;
+  const double tau_cap = t_total > 0 ? t_total / 10.0 : std::numeric_limits<double>::infinity();
   std::size_t imin = 0;
   bool any = false;
   for (std::size_t k = 0; k < p.size(); ++k) {
-    if (!(p[k].dev > 0)) continue;
+    if (!(p[k].dev > 0) || p[k].tau_s > tau_cap * (1 + 1e-12)) continue;
     if (!any || p[k].dev < p[imin].dev) imin = k;
     any = true;
   }

@@ -1,22 +1,36 @@
-// The paper's cross-checks: direct N from angle variances, spread of 100-s mean rates.
+// The paper's cross-checks as unbiased estimators: direct N from the overlapping angle-increment
+// variances, B from the 100-s averages and from the ADEV minimum, the spread of block means.
 #include "rwcalc/methods.hpp"
 
 #include <algorithm>
-#include <boost/math/distributions/students_t.hpp>
+#include <array>
+#include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
 #include <numbers>
+
+#include "rwcalc/confidence.hpp"
+#include "rwcalc/noise_model.hpp"
+#include "rwcalc/parallel.hpp"
+#include "rwcalc/random.hpp"
+#include "rwcalc/simulate.hpp"
 
 namespace rwcalc {
 
 namespace {
 
-constexpr double kZ95 = 1.959963984540054;
+__extension__ typedef __int128 i128;
 
-struct LineFit {
-  double a = 0;
-  double b = 0;
-  bool ok = false;
-};
+constexpr double kZ95 = 1.959963984540054;
+constexpr double kFlicker = 2.0 * std::numbers::ln2 / std::numbers::pi;  // AV of B at unit B²
+using Vec3 = Eigen::Vector3d;
+
+/// Generalized structure functions E[(θ(s+u) − θ(s))²] at unit coefficient, u in s (u > 0): white
+/// angle 2 (per sample variance Q²), white rate u, flicker rate −u² ln u/π (its u² part depends on
+/// the low-frequency cut-off and cancels from every mean-removed statistic).
+Vec3 structure(double u) {
+  if (!(u > 0)) return Vec3::Zero();
+  return {2.0, u, -u * u * std::log(u) / std::numbers::pi};
+}
 
 /// Sample variance (divisor n − 1) of `v`, n ≥ 2.
 double sample_variance(const std::vector<double>& v) {
@@ -28,14 +42,161 @@ double sample_variance(const std::vector<double>& v) {
   return ss / static_cast<double>(v.size() - 1);
 }
 
-/// Weighted regression s²(t) = a + b t with model-based weights (n − 1)/(a + b t)², iterated.
-LineFit fit_line(const std::vector<DirectPoint>& pts) {
-  LineFit f;
+/// Σd and Σd² of the increments d_k = C_{k+t} − C_k, k in [k0, k1): int64 sums while every
+/// |d| < 2^24 (blocks of 2^14 cannot overflow then), 128-bit ones for a block with a larger one.
+void add_increment_sums(const std::int64_t* c, std::size_t t, std::size_t k0, std::size_t k1, i128& s1, i128& s2) {
+  std::uint64_t b1 = 0, b2 = 0, big = 0;  // modular: exact whenever no |d| reaches 2^24
+  for (std::size_t k = k0; k < k1; ++k) {
+    const std::uint64_t d = static_cast<std::uint64_t>(c[k + t]) - static_cast<std::uint64_t>(c[k]);
+    big |= d + (std::uint64_t{1} << 24);
+    b1 += d;
+    b2 += d * d;
+  }
+  if (big < (std::uint64_t{1} << 25)) {
+    s1 += static_cast<std::int64_t>(b1);
+    s2 += static_cast<std::int64_t>(b2);
+    return;
+  }
+  for (std::size_t k = k0; k < k1; ++k) {
+    const auto d = static_cast<std::int64_t>(static_cast<std::uint64_t>(c[k + t]) - static_cast<std::uint64_t>(c[k]));
+    s1 += d;
+    s2 += static_cast<i128>(d) * d;
+  }
+}
+
+/// Sample variances of the M = n − t + 1 overlapping increments x_{k+t} − x_k for every t in ts,
+/// ″². Pulse counts: exact integer sums, all lengths in one sweep over the record in short blocks
+/// (the longest interval's window stays in cache); integer sums make the result independent of
+/// the split between threads. Floating phases: the mean rate taken out first.
+std::vector<double> overlapping_variances(const PhaseSeries& x, const std::vector<std::size_t>& ts) {
+  const std::size_t n = x.points() - 1;
+  std::vector<double> out(ts.size());
+  if (!x.exact()) {
+    parallel_for(ts.size(), [&](std::size_t i) {
+      const std::size_t t = ts[i], m = n - t + 1;
+      const double shift = x.diff(n, 0) * static_cast<double>(t) / static_cast<double>(n);
+      double s1 = 0, s2 = 0;
+      for (std::size_t k = 0; k < m; ++k) {
+        const double d = x.diff(k + t, k) - shift;
+        s1 += d;
+        s2 += d * d;
+      }
+      out[i] = (s2 - s1 * s1 / static_cast<double>(m)) / (static_cast<double>(m) - 1.0);
+    });
+    return out;
+  }
+  constexpr std::size_t kBlock = std::size_t{1} << 14, kChunk = kBlock * 32;
+  const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  std::vector<std::vector<std::array<i128, 2>>> part(chunks, std::vector<std::array<i128, 2>>(ts.size()));
+  parallel_for(chunks, [&](std::size_t ci) {
+    for (std::size_t k0 = ci * kChunk; k0 < std::min(n, (ci + 1) * kChunk); k0 += kBlock)
+      for (std::size_t i = 0; i < ts.size(); ++i) {
+        const std::size_t k1 = std::min({k0 + kBlock, (ci + 1) * kChunk, n - ts[i] + 1});
+        if (k1 > k0) add_increment_sums(x.counts.data(), ts[i], k0, k1, part[ci][i][0], part[ci][i][1]);
+      }
+  });
+  const double q2 = x.arcsec_per_count * x.arcsec_per_count;
+  for (std::size_t i = 0; i < ts.size(); ++i) {
+    i128 s1 = 0, s2 = 0;
+    for (const auto& p : part) {
+      s1 += p[i][0];
+      s2 += p[i][1];
+    }
+    const std::size_t m = n - ts[i] + 1;
+    const i128 mss = s2 * static_cast<i128>(m) - s1 * s1;  // M·Σ(d − d̄)², exact
+    out[i] = static_cast<double>(mss) / static_cast<double>(m) / (static_cast<double>(m) - 1.0) * q2;
+  }
+  return out;
+}
+
+/// Weighted regression s² = X·β, weights (n/t)/model² (the EDF of s²(t) falls as t/T), iterated
+/// from the data's own variances. Unconstrained, so linear and unbiased in s² for fixed weights.
+bool regress(const std::vector<DirectPoint>& pts, const std::vector<Vec3>& x, Vec3& beta) {
+  const std::size_t k = pts.size();
+  std::vector<double> w(k);
+  for (std::size_t i = 0; i < k; ++i) w[i] = 1.0 / (pts[i].t_s * pts[i].var_arcsec2 * pts[i].var_arcsec2 + 1e-300);
+  for (int it = 0; it < 4; ++it) {
+    Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+    Vec3 rhs = Vec3::Zero();
+    for (std::size_t i = 0; i < k; ++i) {
+      a += w[i] * x[i] * x[i].transpose();
+      rhs += w[i] * pts[i].var_arcsec2 * x[i];
+    }
+    const Eigen::LDLT<Eigen::Matrix3d> ldlt(a);
+    if (ldlt.info() != Eigen::Success) return false;
+    beta = ldlt.solve(rhs);
+    if (!beta.allFinite()) return false;
+    for (std::size_t i = 0; i < k; ++i) {
+      const double m = x[i].dot(beta);
+      const double v = m > 0 ? m : pts[i].var_arcsec2;
+      w[i] = 1.0 / (pts[i].t_s * v * v + 1e-300);
+    }
+  }
+  return true;
+}
+
+Vec3 as_vec(const IncrementBasis& g) { return {g.q, g.n, g.b}; }
+
+/// Interval lengths (sample steps), log-spaced over [t_min, t_max], multiples of `base`.
+std::vector<std::size_t> interval_grid(double t_min, double t_max, int count, double tau0, std::size_t base) {
+  std::vector<std::size_t> ts;
+  for (int i = 0; i < count; ++i) {
+    const double t = t_min * std::pow(t_max / t_min, count > 1 ? double(i) / (count - 1) : 0.0);
+    const auto j = static_cast<std::size_t>(std::max(1.0, std::round(t / tau0 / static_cast<double>(base))));
+    if (ts.empty() || j * base != ts.back()) ts.push_back(j * base);
+  }
+  return ts;
+}
+
+}  // namespace
+
+IncrementBasis increment_basis(std::size_t t, std::size_t points, double step, bool overlapping) {
+  const std::size_t n = points > 0 ? points - 1 : 0;
+  const double ts = static_cast<double>(t) * step;
+  Vec3 e = Vec3::Zero();
+  if (!overlapping) {
+    // k blocks; Σ Δ_j = θ(k·t) − θ(0).
+    const std::size_t k = t > 0 ? n / t : 0;
+    if (k < 2) return {};
+    const auto kd = static_cast<double>(k);
+    e = (kd * structure(ts) - structure(kd * ts) / kd) / (kd - 1.0);
+    return {e[0], e[1], e[2]};
+  }
+  if (t == 0 || n + 1 < 2 * t) return {};
+  const std::size_t m = n - t + 1;
+  const auto md = static_cast<double>(m);
+  // Σ Δ_k = (last t phases) − (first t phases): Var = −½ Σ a_i a_j D(i − j).
+  Vec3 v = Vec3::Zero();
+  const auto td = static_cast<double>(t);
+  for (std::size_t h = 1; h < t; ++h) {
+    const double w = td - static_cast<double>(h);
+    v += w * (structure((md + static_cast<double>(h)) * step) + structure((md - static_cast<double>(h)) * step)) -
+         2.0 * w * structure(static_cast<double>(h) * step);
+  }
+  v += td * structure(md * step);
+  e = (md * structure(ts) - v / md) / (md - 1.0);
+  return {e[0], e[1], e[2]};
+}
+
+namespace {
+
+/// Overlapping increment variances at the lengths ts (sample steps) of x.
+std::vector<DirectPoint> overlapping_points(const PhaseSeries& x, const std::vector<std::size_t>& ts) {
+  const std::vector<double> v = overlapping_variances(x, ts);
+  std::vector<DirectPoint> pts(ts.size());
+  const std::size_t n = x.points() - 1;
+  for (std::size_t i = 0; i < ts.size(); ++i) pts[i] = {static_cast<double>(ts[i]) * x.tau0_s, n - ts[i] + 1, v[i]};
+  return pts;
+}
+
+/// The paper's line: non-overlapping variances, weighted straight line a + b·t.
+bool fit_straight(const std::vector<DirectPoint>& pts, double& a, double& b) {
+  double s0 = 0, s1 = 0, s2 = 0, sy = 0, sty = 0;
   std::vector<double> w(pts.size());
   for (std::size_t i = 0; i < pts.size(); ++i)
     w[i] = static_cast<double>(pts[i].intervals - 1) / (pts[i].var_arcsec2 * pts[i].var_arcsec2 + 1e-300);
   for (int it = 0; it < 4; ++it) {
-    double s0 = 0, s1 = 0, s2 = 0, sy = 0, sty = 0;
+    s0 = s1 = s2 = sy = sty = 0;
     for (std::size_t i = 0; i < pts.size(); ++i) {
       const double t = pts[i].t_s;
       s0 += w[i];
@@ -45,43 +206,89 @@ LineFit fit_line(const std::vector<DirectPoint>& pts) {
       sty += w[i] * t * pts[i].var_arcsec2;
     }
     const double det = s0 * s2 - s1 * s1;
-    if (!(det > 0)) return f;
-    f.b = (s0 * sty - s1 * sy) / det;
-    f.a = (sy - f.b * s1) / s0;
-    f.ok = std::isfinite(f.a) && std::isfinite(f.b);
+    if (!(det > 0)) return false;
+    b = (s0 * sty - s1 * sy) / det;
+    a = (sy - b * s1) / s0;
     for (std::size_t i = 0; i < pts.size(); ++i) {
-      const double m = f.a + f.b * pts[i].t_s;
+      const double m = a + b * pts[i].t_s;
       const double v = m > 0 ? m : pts[i].var_arcsec2;
       w[i] = static_cast<double>(pts[i].intervals - 1) / (v * v + 1e-300);
     }
   }
-  return f;
+  return std::isfinite(a) && std::isfinite(b);
 }
 
-/// Direct-method points on x[begin … end] (phase indices) for cluster sizes ms.
-std::vector<DirectPoint> direct_points(const PhaseSeries& x, std::size_t begin, std::size_t end,
-                                       const std::vector<std::size_t>& ms) {
+/// Non-overlapping increment variances at lengths ts (the paper's points).
+std::vector<DirectPoint> block_points(const PhaseSeries& x, const std::vector<std::size_t>& ts) {
   std::vector<DirectPoint> pts;
-  const std::size_t len = end - begin;  // number of sample intervals
-  for (std::size_t m : ms) {
-    const std::size_t k = len / m;
+  const std::size_t n = x.points() - 1;
+  for (std::size_t m : ts) {
+    const std::size_t k = n / m;
     if (k < 10) continue;
-    // The variance about the mean increment (Earth rate + bias).
     std::vector<double> d(k);
-    for (std::size_t j = 0; j < k; ++j) d[j] = x.diff(begin + (j + 1) * m, begin + j * m);
+    for (std::size_t j = 0; j < k; ++j) d[j] = x.diff((j + 1) * m, j * m);
     pts.push_back({static_cast<double>(m) * x.tau0_s, k, sample_variance(d)});
   }
   return pts;
 }
 
-void lognormal_bounds(MethodEstimate& e) {
-  if (e.value > 0 && e.sigma > 0) {
-    const double s = e.sigma / e.value;
-    e.low = e.value * std::exp(-kZ95 * s);
-    e.high = e.value * std::exp(kZ95 * s);
-  } else {
-    e.low = e.high = e.value;
+/// Standard deviation of N″² over a parametric bootstrap from the fitted (Q², N″², B²): the rate
+/// terms are simulated at the coarse step `base` (the interval grid is a multiple of it) and their
+/// overlapping variances computed there; the white-angle part, whose sampling noise at the data's
+/// stride is tiny, enters per point as its expectation plus a normal with its exact variance.
+double bootstrap_n2_sd(const DirectNResult& r, const std::vector<std::size_t>& ts, std::size_t base, double tau0,
+                       std::size_t n, int replicates) {
+  const double step = static_cast<double>(base) * tau0;
+  const std::size_t nb = n / base;
+  const double q2 = std::max(0.0, r.q2_arcsec2), n2 = std::max(0.0, r.n2_arcsec2_per_s);
+  const double b2 = std::max(0.0, r.b2_arcsec2_per_s2);
+  NoiseModel model;
+  model.arw_deg_per_sqrt_h = std::sqrt(n2) / 60.0;
+  model.bias_instability_deg_per_h = std::sqrt(b2);
+  SimulationSettings settings;
+  settings.rate_hz = 1.0 / step;
+  settings.duration_s = static_cast<double>(nb) * step;
+  settings.scale_arcsec = 1e-6;  // counting error 1e-6″: negligible
+  std::vector<Vec3> xb(ts.size());
+  std::vector<std::size_t> coarse(ts.size());
+  for (std::size_t i = 0; i < ts.size(); ++i) coarse[i] = ts[i] / base;
+  std::vector<double> white_sd(ts.size());
+  for (std::size_t i = 0; i < ts.size(); ++i) {
+    const IncrementBasis gc = increment_basis(ts[i] / base, nb + 1, step);
+    xb[i] = {r.basis[i].q, gc.n, gc.b};
+    // Var of the white-angle part (its t-dependent half) and of its cross term with the rate part.
+    const double md = static_cast<double>(r.points[i].intervals);
+    const double rate_part = r.basis[i].n * n2 + r.basis[i].b * b2;
+    white_sd[i] = std::sqrt((4.0 * q2 * q2 + 8.0 * q2 * rate_part) / md);
   }
+  // One simulator per worker (its flicker filter is made once); each replicate has its own seed,
+  // so the result does not depend on the split.
+  const std::size_t kChunks = std::max(1u, worker_count());
+  std::vector<double> n2s(static_cast<std::size_t>(replicates), 0.0);
+  std::vector<char> ok(n2s.size(), 0);
+  parallel_for(kChunks, [&](std::size_t c) {
+    Simulator sim(model, settings);
+    PhaseSeries x;
+    for (std::size_t rep = c; rep < n2s.size(); rep += kChunks) {
+      sim.run(0x5eedu + rep, x);
+      Rng rng(0xb007u + rep);
+      std::vector<DirectPoint> pts(ts.size());
+      const std::vector<double> rate_part = overlapping_variances(x, coarse);
+      for (std::size_t i = 0; i < ts.size(); ++i) {
+        const double v = rate_part[i] + r.basis[i].q * q2 + white_sd[i] * rng.normal();
+        pts[i] = {r.points[i].t_s, r.points[i].intervals, v};
+      }
+      Vec3 beta;
+      if (regress(pts, xb, beta)) {
+        n2s[rep] = beta[1];
+        ok[rep] = 1;
+      }
+    }
+  });
+  std::vector<double> good;
+  for (std::size_t i = 0; i < n2s.size(); ++i)
+    if (ok[i]) good.push_back(n2s[i]);
+  return good.size() >= 8 ? std::sqrt(sample_variance(good)) : 0.0;
 }
 
 }  // namespace
@@ -93,60 +300,145 @@ DirectNResult direct_n(const PhaseSeries& x, const MethodOptions& o) {
   const double t_max = std::min(o.direct_t_max_s, t_total / 50.0);
   const double t_min = std::max(o.direct_t_min_s, x.tau0_s);
   if (n < 20 || !(t_max > t_min)) return r;
-  std::vector<std::size_t> ms;
-  for (int i = 0; i < o.direct_points; ++i) {
-    const double t = t_min * std::pow(t_max / t_min, o.direct_points > 1 ? double(i) / (o.direct_points - 1) : 0.0);
-    // t ≤ t_max ≤ the record's length / 50: m fits the sample count.
-    const auto m = static_cast<std::size_t>(std::max(1.0, std::round(std::min(t / x.tau0_s, static_cast<double>(n)))));
-    if (ms.empty() || m != ms.back()) ms.push_back(m);
-  }
-  r.points = direct_points(x, 0, n, ms);
-  if (r.points.size() < 3) return r;
-  const LineFit full = fit_line(r.points);
-  if (!full.ok) return r;
-  r.intercept_arcsec2 = full.a;
-  r.slope_arcsec2_per_s = full.b;
+  // The bootstrap's coarse step: the shortest interval, whole samples, but no finer than T/16384 so that
+  // a replicate stays cheap (a shorter requested t_min is raised to it).
+  constexpr std::size_t kMaxCoarse = 16384;
+  const auto base = std::max(static_cast<std::size_t>(std::max(1.0, std::floor(t_min / x.tau0_s))),
+                             (n + kMaxCoarse - 1) / kMaxCoarse);
+  const std::vector<std::size_t> ts = interval_grid(t_min, t_max, o.direct_points, x.tau0_s, base);
 
-  // Standard error of the slope from contiguous segments (each analysed like the whole record,
-  // with the same interval lengths; a segment keeps those with ≥ 10 intervals).
-  std::vector<double> slopes;
-  const int kseg = std::max(2, o.direct_segments);
-  for (int s = 0; s < kseg; ++s) {
-    const std::size_t b = n * static_cast<std::size_t>(s) / static_cast<std::size_t>(kseg);
-    const std::size_t e = n * static_cast<std::size_t>(s + 1) / static_cast<std::size_t>(kseg);
-    const auto pts = direct_points(x, b, e, ms);
-    if (pts.size() < 3) continue;
-    const LineFit f = fit_line(pts);
-    if (f.ok) slopes.push_back(f.b);
+  // The paper's straight line through non-overlapping variances.
+  auto& sl = r.straight;
+  sl.points = block_points(x, ts);
+  if (sl.points.size() >= 3 && fit_straight(sl.points, sl.intercept_arcsec2, sl.slope_arcsec2_per_s)) {
+    sl.valid = true;
+    sl.value = sl.slope_arcsec2_per_s > 0 ? std::sqrt(sl.slope_arcsec2_per_s) / 60.0 : 0.0;
   }
-  r.segments_used = static_cast<int>(slopes.size());
-  if (slopes.size() < 3) return r;
-  const double se_b = std::sqrt(sample_variance(slopes) / static_cast<double>(slopes.size()));
-  const double tq =
-      boost::math::quantile(boost::math::students_t_distribution<double>(static_cast<double>(slopes.size() - 1)),
-                            0.975);
 
-  // b = N² in ″²/s = (°/h)²·s; N[°/√h] = √b / 60.
+  if (ts.size() < 4) return r;
+  r.points = overlapping_points(x, ts);
+  std::vector<Vec3> xs;
+  for (std::size_t t : ts) {
+    r.basis.push_back(increment_basis(t, n + 1, x.tau0_s));
+    xs.push_back(as_vec(r.basis.back()));
+  }
+  Vec3 beta;
+  if (!regress(r.points, xs, beta)) return r;
+  r.q2_arcsec2 = beta[0];
+  r.n2_arcsec2_per_s = beta[1];
+  r.b2_arcsec2_per_s2 = beta[2];
+  r.replicates = std::max(0, o.bootstrap_replicates);
+  const double sd = r.replicates > 0 ? bootstrap_n2_sd(r, ts, base, x.tau0_s, n, r.replicates) : 0.0;
+
+  // N″² ± 1.96 sd, mapped through √ (N = √(N″²)/60); the low end may reach 0.
   auto& e = r.N;
-  e.valid = true;
-  if (full.b > 0) {
-    e.value = std::sqrt(full.b) / 60.0;
-    e.sigma = se_b / (2.0 * std::sqrt(full.b)) / 60.0;
-    // Bounds of b by Student t, mapped through √ (b's low end may reach 0).
-    const double lo = full.b - tq * se_b;
-    const double hi = full.b + tq * se_b;
-    e.low = lo > 0 ? std::sqrt(lo) / 60.0 : 0.0;
-    e.high = std::sqrt(hi) / 60.0;
-    e.resolved = lo > 0;
-    if (!e.resolved) e.value = e.high;
+  e.valid = sd > 0;
+  if (!e.valid) return r;
+  const double lo = beta[1] - kZ95 * sd, hi = beta[1] + kZ95 * sd;
+  e.high = hi > 0 ? std::sqrt(hi) / 60.0 : 0.0;
+  e.resolved = lo > 0;
+  e.low = e.resolved ? std::sqrt(lo) / 60.0 : 0.0;
+  e.estimate = beta[1] > 0 ? std::sqrt(beta[1]) / 60.0 : 0.0;
+  if (e.resolved) {
+    e.value = std::sqrt(beta[1]) / 60.0;
+    e.sigma = sd / (2.0 * std::sqrt(beta[1])) / 60.0;
   } else {
-    e.resolved = false;
-    const double hi = full.b + tq * se_b;
-    e.high = hi > 0 ? std::sqrt(hi) / 60.0 : 0.0;
     e.value = e.high;
     e.sigma = e.high / (2.0 * kZ95);
   }
   return r;
+}
+
+void attach_straight_line_bias(DirectNResult& r, const FitResult& fit, double duration_s, double tau0_s) {
+  auto& sl = r.straight;
+  const double n2 = fit.c[1];
+  if (!sl.valid || !(n2 > 0) || !(tau0_s > 0)) return;
+  const auto points = static_cast<std::size_t>(std::llround(duration_s / tau0_s)) + 1;
+  std::vector<DirectPoint> expected = sl.points;
+  for (auto& p : expected) {
+    const auto t = static_cast<std::size_t>(std::llround(p.t_s / tau0_s));
+    const IncrementBasis g = increment_basis(t, points, tau0_s, false);
+    p.var_arcsec2 = g.q * fit.c[0] + g.n * fit.c[1] + g.b * fit.c[2];
+  }
+  double a = 0, b = 0;
+  if (fit_straight(expected, a, b) && b > 0) sl.bias_factor = std::sqrt(b / n2);
+}
+
+double AvBEstimate::cdf(double b) const {
+  if (!(b > 0)) return 0.0;
+  if (!(edf > 0) || !(var > 0)) return b >= B.value ? 1.0 : 0.0;
+  // P(σ²_true ≤ s) = P(χ²_ν ≥ ν·σ̂²/s), s = white + (2 ln2/π)·b²: the χ² interval's distribution.
+  const double s = white + kFlicker * b * b;
+  const boost::math::chi_squared dist(edf);
+  return boost::math::cdf(boost::math::complement(dist, edf * var / s));
+}
+
+namespace {
+
+/// Fills B's value and 95 % bounds from σ̂², the removed white part and the EDF.
+void finish_av_estimate(AvBEstimate& e) {
+  const DevInterval ci = chi2_interval(e.var, e.edf, 0.95);  // deviation bounds
+  auto to_b = [&](double s2) { return s2 > e.white ? std::sqrt((s2 - e.white) / kFlicker) : 0.0; };
+  auto& m = e.B;
+  m.valid = true;
+  m.low = to_b(ci.low * ci.low);
+  m.high = to_b(ci.high * ci.high);
+  m.resolved = m.low > 0;
+  m.estimate = to_b(e.var);
+  m.value = m.resolved ? m.estimate : m.high;
+  m.sigma = (m.high - m.low) / (2.0 * kZ95);
+}
+
+/// Model-based EDF of the overlapping AV at one point: 2σ⁴/Var(σ̂²), Var from av_covariance, plus
+/// `extra_var` (the uncertainty of a part subtracted from it).
+double model_edf(const FitPoint& p, const FitResult& fit, double extra_var) {
+  const double mu = fit.model_var(p.tau_s);
+  if (p.m <= 0 || p.terms <= 0 || !(mu > 0)) return p.edf;
+  const std::vector<FitPoint> one{p};
+  const double v = av_covariance(one, fit.c, true)(0, 0) + extra_var;
+  return v > 0 && std::isfinite(v) ? 2.0 * mu * mu / v : p.edf;
+}
+
+}  // namespace
+
+AvBEstimate b_from_averages(const PhaseSeries& x, const FitResult& fit, double block_s) {
+  AvBEstimate e;
+  const std::size_t n = x.points() > 0 ? x.points() - 1 : 0;
+  const double per_block = std::max(1.0, std::round(block_s / x.tau0_s));
+  if (!(3.0 * per_block <= static_cast<double>(n))) return e;
+  const auto m = static_cast<std::int64_t>(per_block);
+  std::int64_t terms = 0;
+  e.var = allan_variance(x, m, Estimator::Overlapping, &terms);
+  e.tau_s = static_cast<double>(m) * x.tau0_s;
+  if (terms <= 0 || !(e.var > 0)) return e;
+  // The fitted terms other than B at τ (the white ones; K and R when the fit keeps them), with the
+  // variance of that estimate from the fit covariance.
+  Eigen::Matrix<double, kTermCount, 1> h;
+  for (const Term t : kAllTerms) h[static_cast<int>(t)] = t == Term::B ? 0.0 : term_basis(t, e.tau_s);
+  e.white = h.dot(fit.c);
+  const double white_var = std::max(0.0, h.dot(fit.cov_c * h));
+  e.edf = model_edf({e.tau_s, e.var, 0.0, m, terms}, fit, white_var);
+  if (!(e.edf > 0)) return e;
+  finish_av_estimate(e);
+  return e;
+}
+
+AvBEstimate b_from_minimum(const AllanResult& allan, const SlopeReadout& s, const FitResult& fit) {
+  AvBEstimate e;
+  if (!s.B) return e;
+  const auto it = std::find_if(allan.points.begin(), allan.points.end(),
+                               [&](const AllanPoint& p) { return p.tau_s == s.tau_min_s; });
+  if (it == allan.points.end()) return e;
+  const bool ovl = allan.estimator == Estimator::Overlapping;
+  e.tau_s = it->tau_s;
+  e.var = it->var;
+  e.edf = model_edf({it->tau_s, it->var, it->edf, ovl ? it->m : 0, ovl ? it->n : 0}, fit, 0.0);
+  if (!(e.edf > 0)) return e;
+  finish_av_estimate(e);
+  // σ(τ_min)/0.6643 estimates √(σ²_model(τ_min)/(2 ln2/π)), above B where other terms contribute.
+  const double b_fit = std::sqrt(std::max(0.0, fit.c[2]));
+  e.bias_factor = b_fit > 0 ? std::sqrt(fit.model_var(e.tau_s) / kFlicker) / b_fit : 0.0;
+  return e;
 }
 
 BlockSpreadResult block_spread(const PhaseSeries& x, double block_s) {
@@ -170,7 +462,10 @@ BlockSpreadResult block_spread(const PhaseSeries& x, double block_s) {
   e.valid = true;
   e.value = std::sqrt(sample_variance(y));
   e.sigma = e.value / std::sqrt(2.0 * static_cast<double>(k - 1));
-  lognormal_bounds(e);
+  e.estimate = e.value;
+  e.low = e.value * std::exp(-kZ95 * e.sigma / e.value);
+  e.high = e.value * std::exp(kZ95 * e.sigma / e.value);
+  if (!(e.value > 0)) e.low = e.high = 0;
   return r;
 }
 
