@@ -4,9 +4,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
-#include "diagnose/detector.hpp"  // the first-order output-filter AV (output_lowpass_*_avar)
+#include "diagnose/detector.hpp"  // the first-order output filter's AV of white rate (output_lowpass_rate_avar)
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/printable.hpp"
@@ -25,6 +27,8 @@ constexpr double kRollOffSigmas = 5;
 /// The fit starts at this many filter time constants (the filter's AV deficit, ≈ 1.5 τf/τ, is
 /// then below 15 % at the first point and falls as 1/τ).
 constexpr double kFilterTaus = 10;
+/// The extrapolating fit must start beyond this many τf for the filter's estimate to hold.
+constexpr double kReferenceFilterTaus = 30;
 
 /// α of S_y(f) ∝ f^α for each term (R, a drift, shown as −2 like K).
 constexpr int kTermAlpha[kTermCount] = {2, 0, -1, -2, -2};
@@ -36,12 +40,17 @@ double extrapolation_variance(const FitResult& f, double tau_s) {
 }
 
 /// Time constant of a first-order output filter that brings the model's Q and N parts at τ0 down
-/// to the measured AV (the other terms are not filtered at τ0); bisection in ln τf.
+/// to the measured AV (the other terms are not filtered at τ0); bisection in ln τf. The fit beyond
+/// the filter sees white angle noise already filtered (its AV scaled by (1 − φ)/(1 + φ) at every τ,
+/// φ = e^(−τ0/τf)): its Q part at τ0 is that of the long-τ limit times (3 − 4φ + φ²)/3. White rate
+/// noise keeps its long-τ AV: its part at τ0 is output_lowpass_rate_avar.
 double filter_time_constant(const FitResult& f, double tau0, double measured) {
   const double q = f.c[static_cast<int>(Term::Q)], n = f.c[static_cast<int>(Term::N)];
-  const double rest = f.model_var(tau0) - q * term_basis(Term::Q, tau0) - n * term_basis(Term::N, tau0);
+  const double q_part = q * term_basis(Term::Q, tau0);
+  const double rest = f.model_var(tau0) - q_part - n * term_basis(Term::N, tau0);
   auto filtered = [&](double tf) {
-    return q * diag::output_lowpass_angle_avar(1, tau0, tf) + n * diag::output_lowpass_rate_avar(1, tau0, tf) + rest;
+    const double phi = std::exp(-tau0 / tf);
+    return q_part * (3.0 - 4.0 * phi + phi * phi) / 3.0 + n * diag::output_lowpass_rate_avar(1, tau0, tf) + rest;
   };
   double lo = std::log(tau0 * 1e-3), hi = std::log(tau0 * 1e3);
   if (filtered(std::exp(hi)) > measured) return std::exp(hi);
@@ -67,24 +76,25 @@ std::string shell_word(const std::string& path) {
 
 double filter_free_tau_s(double tc_s) { return kFilterTaus * tc_s; }
 
-OutputFilterCheck check_output_filter(std::span<const FitPoint> octave, const FitOptions& fit) {
+namespace {
+
+/// The short-τ points against the model fitted from `reference_tau_s`.
+OutputFilterCheck compare_short_tau(std::span<const FitPoint> octave, const FitOptions& fit, double reference_tau_s) {
   OutputFilterCheck c;
-  if (octave.empty() || octave.front().m != 1 || !(octave.front().edf > 0) || !(octave.front().var > 0)) return c;
   const FitPoint& first = octave.front();
   FitOptions ref = fit;
-  ref.tau_min_s = kReferenceTaus * first.tau_s * (1 - 1e-9);
+  ref.tau_min_s = reference_tau_s * (1 - 1e-9);
   FitResult f;
   try {
     f = fit_noise(octave, ref);
   } catch (const AnalysisError&) {
-    return c;  // too few points beyond 16 τ0: no test
+    return c;  // too few points beyond the reference τ: no test
   }
   c.reference_tau_s = f.used.front().tau_s;
-  // Each point below the reference range against the extrapolation.
   for (const FitPoint& p : octave) {
     if (p.tau_s >= c.reference_tau_s) break;
     const double pred = f.model_var(p.tau_s);
-    if (!(pred > 0) || !(p.edf > 0)) return c;
+    if (!(pred > 0) || !(p.edf > 0)) return OutputFilterCheck{};
     const double ratio = p.var / pred;
     const double z = (p.var - pred) / std::sqrt(2.0 * pred * pred / p.edf + extrapolation_variance(f, p.tau_s));
     if (&p == &first) c.ratio = ratio;
@@ -103,23 +113,78 @@ OutputFilterCheck check_output_filter(std::span<const FitPoint> octave, const Fi
   return c;
 }
 
-bool apply_model_bounds(AllanResult& allan, const FitResult& fit) {
+}  // namespace
+
+OutputFilterCheck check_output_filter(std::span<const FitPoint> octave, const FitOptions& fit) {
+  if (octave.empty() || octave.front().m != 1 || !(octave.front().edf > 0) || !(octave.front().var > 0)) return {};
+  // A filter slow enough to bend the reference range too is underestimated: the reference moves
+  // up an octave at a time until it starts beyond 30 τf.
+  double reference = kReferenceTaus * octave.front().tau_s;
+  OutputFilterCheck c = compare_short_tau(octave, fit, reference);
+  for (int k = 0; k < 4 && c.found && c.tc_s * kReferenceFilterTaus > c.reference_tau_s; ++k) {
+    reference = 2.0 * c.reference_tau_s;
+    const OutputFilterCheck next = compare_short_tau(octave, fit, reference);
+    if (next.reference_tau_s == 0) break;  // no fit that far up
+    c = next;
+  }
+  return c;
+}
+
+double white_phase_excess_kurtosis(const PhaseSeries& x, const FitResult& fit) {
+  const double q2 = fit.c[static_cast<int>(Term::Q)];
+  const double tau0 = x.tau0_s;
+  const double share = q2 * term_basis(Term::Q, tau0) / fit.model_var(tau0);
+  if (!(q2 > 0) || x.points() < 1000 || !(share >= 0.5)) return 0.0;
+  // Var(Σ d_i²) per term of the τ0 second differences d, taken from the data over the lags at which
+  // two terms share phase samples (|l| ≤ 2), against the Gaussian value 2·Σ Cov(d_i, d_(i+l))². The
+  // products are taken against lag 3 (disjoint terms) rather than E[d²]²: a pulse read-out's error
+  // variance follows the fraction of a pulse the angle stands at, and that slow part is averaged by
+  // the AV, not random per term.
+  std::array<double, 4> c{}, p{};  // Σ d_i·d_(i+l), Σ d_i²·d_(i+l)², l = 0 … 3
+  const std::size_t n = x.points() - 5;
+  auto second_difference = [&x](std::size_t i) { return x.diff(i + 2, i + 1) - x.diff(i + 1, i); };
+  std::array<double, 4> d{second_difference(0), second_difference(1), second_difference(2), 0.0};
+  for (std::size_t i = 0; i < n; ++i) {
+    d[3] = second_difference(i + 3);
+    for (std::size_t l = 0; l < 4; ++l) {
+      c[l] += d[0] * d[l];
+      p[l] += d[0] * d[0] * d[l] * d[l];
+    }
+    d = {d[1], d[2], d[3], 0.0};
+  }
+  const double nn = static_cast<double>(n);
+  const double m2 = c[0] / nn;
+  const double measured = (p[0] + 2.0 * p[1] + 2.0 * p[2]) / nn - 5.0 * m2 * m2;
+  const double gaussian = 2.0 * (c[0] * c[0] + 2.0 * c[1] * c[1] + 2.0 * c[2] * c[2]) / (nn * nn);
+  if (!(gaussian > 0)) return 0.0;
+  // As an excess kurtosis γ of white phase noise: Var per term = (140 + 36γ)·Q⁴ (Gaussian: 140 Q⁴),
+  // the Q part's share of the Gaussian variance being share².
+  const double gamma = (measured / gaussian - 1.0) * 140.0 / 36.0 / (share * share);
+  return std::clamp(gamma, -2.0, 10.0);
+}
+
+bool apply_model_bounds(AllanResult& allan, const FitResult& fit, double white_pm_kurtosis) {
   if (allan.estimator != Estimator::Overlapping || allan.points.empty()) return false;
   const std::vector<FitPoint> pts = fit_points(allan);
   const Eigen::MatrixXd cov = av_covariance(pts, fit.c, true);
+  const double q2 = fit.c[static_cast<int>(Term::Q)];
   for (std::size_t i = 0; i < allan.points.size(); ++i) {
     AllanPoint& p = allan.points[i];
     const double model = fit.model_var(p.tau_s);
-    const double var = cov(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i));
+    // Gaussian variance, plus the fourth cumulant of white phase noise: γ·σ⁴_Q/M for M terms
+    // (each phase sample enters three second differences with weights 1, −2, 1).
+    const double q_part = q2 * term_basis(Term::Q, p.tau_s);
+    const double var = cov(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) +
+                       (p.n > 0 ? white_pm_kurtosis * q_part * q_part / static_cast<double>(p.n) : 0.0);
     if (!(model > 0) || !(var > 0)) continue;
     p.edf = 2.0 * model * model / var;
-    int dominant = 0;
+    int leading = 0;
     double largest = -1;
     for (int t = 0; t < kTermCount; ++t) {
       const double part = fit.c[t] * term_basis(kAllTerms[static_cast<std::size_t>(t)], p.tau_s);
-      if (part > largest) largest = part, dominant = t;
+      if (part > largest) largest = part, leading = t;
     }
-    p.alpha = kTermAlpha[dominant];
+    p.alpha = kTermAlpha[leading];
     const DevInterval ci = chi2_interval(p.var, p.edf, allan.confidence);
     p.dev_low = ci.low;
     p.dev_high = ci.high;
