@@ -61,7 +61,8 @@ int records(const char* env, int fallback) {
   return e ? std::max(20, std::atoi(e)) : fallback;
 }
 
-/// Coverage per octave τ over `count` records; asserts 60–76 % for the model's bounds when `strict`.
+/// Coverage per octave τ over `count` records: 60–76 % for the model's bounds at every τ when `strict`,
+/// else within 4 binomial standard errors of 68.3 % at every τ and 63–74 % pooled over the τ.
 void coverage(int count, double duration, double rate, double scale, std::uint64_t seed0, bool strict) {
   const double tau0 = 1.0 / rate;
   Hits h;
@@ -79,6 +80,8 @@ void coverage(int count, double duration, double rate, double scale, std::uint64
   std::printf("%d records of %g s at %g Hz, pulse %g arcsec: coverage of the 68.3 %% bounds\n", count, duration, rate,
               scale);
   std::printf("%12s %10s %10s\n", "tau (s)", "model", "Stable32");
+  const double se = std::sqrt(0.683 * 0.317 / count);
+  double pooled = 0;
   for (std::size_t i = 0; i < h.tau.size(); ++i) {
     int a = 0, b = 0;
     for (int k = 0; k < count; ++k) {
@@ -87,19 +90,27 @@ void coverage(int count, double duration, double rate, double scale, std::uint64
     }
     const double ca = double(a) / count, cb = double(b) / count;
     std::printf("%12.5g %10.3f %10.3f\n", h.tau[i], ca, cb);
+    pooled += ca / static_cast<double>(h.tau.size());
     if (strict) {
       EXPECT_GE(ca, 0.60) << "tau " << h.tau[i];
       EXPECT_LE(ca, 0.76) << "tau " << h.tau[i];
+    } else {
+      EXPECT_NEAR(ca, 0.683, 4.0 * se) << "tau " << h.tau[i];
     }
+  }
+  std::printf("pooled over the tau: model %.3f\n", pooled);
+  if (!strict) {
+    EXPECT_GE(pooled, 0.63);
+    EXPECT_LE(pooled, 0.74);
   }
 }
 
 TEST(SlowCoverageBounds, ModelBoundsHoldTheTruthAtEveryOctaveTau) {
-  coverage(records("RWCALC_BOUNDS_RECORDS", 400), 1800.0, 100.0, 0.2, 5000, true);
+  coverage(records("RWCALC_BOUNDS_RECORDS", 250), 1800.0, 100.0, 0.2, 5000, true);
 }
 
 TEST(SlowCoverageBounds, FullLengthGl2dLikeRecords) {
-  // 2-h 400-Hz records with the GL-2D pulse weight: fewer of them, so a wider band (±4 binomial s.e.).
+  // 2-h 400-Hz records with the GL-2D pulse weight (about 2.5 s each): fewer of them, so a wider band.
   const int count = records("RWCALC_BOUNDS_FULL_RECORDS", 40);
   coverage(count, 7200.0, 400.0, 0.92, 7000, false);
 }

@@ -276,7 +276,7 @@ void allan_and_fit(const Recording& rec, const AnalysisOptions& options, Analysi
   r.slope = slope_readout(fitted);
   for (const auto& p : fitted.points)
     if (p.tau_s == r.slope.tau_min_s && p.edf > 0 && r.slope.B) r.slope_B_sigma = *r.slope.B / std::sqrt(2.0 * p.edf);
-  r.model_bounds = apply_model_bounds(r.allan, r.fit, white_phase_excess_kurtosis(rec.phase, r.fit));
+  r.model_bounds = apply_model_bounds(r.allan, r.fit, &rec.phase);
 }
 
 /// The paper's methods (direct N, spread of 100-s means) and their discrepancies from the fit.

@@ -130,40 +130,31 @@ OutputFilterCheck check_output_filter(std::span<const FitPoint> octave, const Fi
   return c;
 }
 
-double white_phase_excess_kurtosis(const PhaseSeries& x, const FitResult& fit) {
-  const double q2 = fit.c[static_cast<int>(Term::Q)];
-  const double tau0 = x.tau0_s;
-  const double share = q2 * term_basis(Term::Q, tau0) / fit.model_var(tau0);
-  if (!(q2 > 0) || x.points() < 1000 || !(share >= 0.5)) return 0.0;
-  // Var(Σ d_i²) per term of the τ0 second differences d, taken from the data over the lags at which
-  // two terms share phase samples (|l| ≤ 2), against the Gaussian value 2·Σ Cov(d_i, d_(i+l))². The
-  // products are taken against lag 3 (disjoint terms) rather than E[d²]²: a pulse read-out's error
-  // variance follows the fraction of a pulse the angle stands at, and that slow part is averaged by
-  // the AV, not random per term.
-  std::array<double, 4> c{}, p{};  // Σ d_i·d_(i+l), Σ d_i²·d_(i+l)², l = 0 … 3
-  const std::size_t n = x.points() - 5;
-  auto second_difference = [&x](std::size_t i) { return x.diff(i + 2, i + 1) - x.diff(i + 1, i); };
-  std::array<double, 4> d{second_difference(0), second_difference(1), second_difference(2), 0.0};
+double measured_variance_ratio(const PhaseSeries& x, std::int64_t m) {
+  const auto um = static_cast<std::size_t>(m);
+  if (x.points() < 8 * um + 2) return 1.0;
+  const std::size_t n = x.points() - 5 * um;  // terms with a partner 3m on
+  auto d = [&x, um](std::size_t i) { return x.diff(i + 2 * um, i + um) - x.diff(i + um, i); };
+  // Σ d_i·d_(i+l) and Σ d_i²·d_(i+l)² at l = 0, m, 2m (the lags at which two terms of white phase
+  // noise share phase samples) and 3m (disjoint: the baseline).
+  std::array<double, 4> c{}, p{};
   for (std::size_t i = 0; i < n; ++i) {
-    d[3] = second_difference(i + 3);
+    const double a = d(i);
     for (std::size_t l = 0; l < 4; ++l) {
-      c[l] += d[0] * d[l];
-      p[l] += d[0] * d[0] * d[l] * d[l];
+      const double b = l == 0 ? a : d(i + l * um);
+      c[l] += a * b;
+      p[l] += a * a * b * b;
     }
-    d = {d[1], d[2], d[3], 0.0};
   }
   const double nn = static_cast<double>(n);
-  const double m2 = c[0] / nn;
-  const double measured = (p[0] + 2.0 * p[1] + 2.0 * p[2]) / nn - 5.0 * m2 * m2;
+  // Per term: Σ_|l|≤2m Cov(d_i², d_(i+l)²) from the data, against its Gaussian value 2·Σ Cov(d_i, d_(i+l))².
+  const double measured = (p[0] + 2.0 * p[1] + 2.0 * p[2] - 5.0 * p[3]) / nn;
   const double gaussian = 2.0 * (c[0] * c[0] + 2.0 * c[1] * c[1] + 2.0 * c[2] * c[2]) / (nn * nn);
-  if (!(gaussian > 0)) return 0.0;
-  // As an excess kurtosis γ of white phase noise: Var per term = (140 + 36γ)·Q⁴ (Gaussian: 140 Q⁴),
-  // the Q part's share of the Gaussian variance being share².
-  const double gamma = (measured / gaussian - 1.0) * 140.0 / 36.0 / (share * share);
-  return std::clamp(gamma, -2.0, 10.0);
+  if (!(gaussian > 0) || !(measured > 0)) return 1.0;
+  return std::clamp(measured / gaussian, 0.25, 4.0);
 }
 
-bool apply_model_bounds(AllanResult& allan, const FitResult& fit, double white_pm_kurtosis) {
+bool apply_model_bounds(AllanResult& allan, const FitResult& fit, const PhaseSeries* x) {
   if (allan.estimator != Estimator::Overlapping || allan.points.empty()) return false;
   const std::vector<FitPoint> pts = fit_points(allan);
   const Eigen::MatrixXd cov = av_covariance(pts, fit.c, true);
@@ -171,11 +162,9 @@ bool apply_model_bounds(AllanResult& allan, const FitResult& fit, double white_p
   for (std::size_t i = 0; i < allan.points.size(); ++i) {
     AllanPoint& p = allan.points[i];
     const double model = fit.model_var(p.tau_s);
-    // Gaussian variance, plus the fourth cumulant of white phase noise: γ·σ⁴_Q/M for M terms
-    // (each phase sample enters three second differences with weights 1, −2, 1).
-    const double q_part = q2 * term_basis(Term::Q, p.tau_s);
-    const double var = cov(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) +
-                       (p.n > 0 ? white_pm_kurtosis * q_part * q_part / static_cast<double>(p.n) : 0.0);
+    double var = cov(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i));
+    // Where white phase noise leads, its read-out's non-Gaussian errors set the variance.
+    if (x && q2 * term_basis(Term::Q, p.tau_s) >= 0.5 * model) var *= measured_variance_ratio(*x, p.m);
     if (!(model > 0) || !(var > 0)) continue;
     p.edf = 2.0 * model * model / var;
     int leading = 0;

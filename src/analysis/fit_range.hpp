@@ -29,16 +29,18 @@ OutputFilterCheck check_output_filter(std::span<const FitPoint> octave, const Fi
 /// The fit's lower τ that leaves a filter of time constant tc_s out (10·τf).
 double filter_free_tau_s(double tc_s);
 
-/// Excess kurtosis γ of the white phase noise (the Q term) from the fourth cumulant of the τ0
-/// second differences, when Q carries at least half the model AV at τ0 (else 0): a pulse read-out's
-/// count errors are far from Gaussian (uniform: γ = −1.2) and the AV's variance follows them.
-double white_phase_excess_kurtosis(const PhaseSeries& x, const FitResult& fit);
+/// Variance of the overlapping AV estimate at cluster size m measured from the data, relative to
+/// its Gaussian value, over the lags at which white phase noise makes two terms share samples (0, m,
+/// 2m; products taken against the disjoint lag 3m). A pulse read-out's count errors are far from
+/// Gaussian and their variance follows the fraction of a pulse the angle stands at: the AV of
+/// quantization-led points varies less than a Gaussian model says. 1 when the record is too short.
+double measured_variance_ratio(const PhaseSeries& x, std::int64_t m);
 
 /// EDF, bounds (at allan.confidence) and α of each overlapping AV point under the fitted model:
-/// EDF = 2σ⁴_model/Var(σ̂²), Var from av_covariance (Gaussian) plus γ·σ⁴_Q/M for white phase noise
-/// of excess kurtosis γ over M terms; α of the term that leads σ²_model. Other estimators are left
-/// as computed (Stable32's noise id). Returns whether it applied.
-bool apply_model_bounds(AllanResult& allan, const FitResult& fit, double white_pm_kurtosis);
+/// EDF = 2σ⁴_model/Var(σ̂²), Var from av_covariance (Gaussian), times measured_variance_ratio where
+/// white phase noise carries at least half the model AV (when `x` is given); α of the term that leads
+/// σ²_model. Other estimators are left as computed (Stable32's noise id). Returns whether it applied.
+bool apply_model_bounds(AllanResult& allan, const FitResult& fit, const PhaseSeries* x);
 
 /// The warnings of a result's fit range and goodness of fit.
 std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r);
