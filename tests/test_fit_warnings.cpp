@@ -5,8 +5,12 @@
 
 #include <boost/math/distributions/fisher_f.hpp>
 #include <cmath>
+#include <cstdio>
+#include <utility>
+#include <vector>
 #include <nlohmann/json.hpp>
 
+#include "rwcalc/fit.hpp"
 #include "test_support.hpp"
 
 namespace rwcalc {
@@ -117,8 +121,31 @@ TEST(FitWarnings, AllanBoundsOfAnalyzeComeFromTheModel) {
   EXPECT_LT(j["allan"]["points"].back()["edf"].get<double>(), 3.0);
 }
 
+/// Relative variance of the fitted model's σ²(τ) from its coefficients' standard errors (delta method,
+/// correlations left out): the simulated record follows an estimated model.
+double model_log_variance(const json& fit, double tau) {
+  const std::pair<Term, const char*> keys[] = {{Term::Q, "Q_arcsec"},
+                                               {Term::N, "N_deg_per_sqrt_h"},
+                                               {Term::B, "B_deg_per_h"},
+                                               {Term::K, "K_deg_per_h_per_sqrt_h"},
+                                               {Term::R, "R_deg_per_h2"}};
+  double total = 0, v = 0;
+  std::vector<std::pair<double, double>> parts;
+  for (const auto& [t, key] : keys) {
+    const auto& c = fit[key];
+    if (!c["in_model"].get<bool>() || !c["resolved"].get<bool>()) continue;
+    const double value = c["value"], sigma = c["sigma"];
+    const double part = term_basis(t, tau) * c_from_coefficient(t, value);
+    total += part;
+    parts.emplace_back(part, 2.0 * sigma / value);
+  }
+  for (const auto& [part, rel] : parts) v += (part / total) * (part / total) * rel * rel;
+  return v;
+}
+
 /// analyze → simulate --from → analyze: the simulated record's AV and the measured one agree within
-/// the 95 % band of two independent estimates (F distribution with the model's EDFs) at every τ.
+/// the 95 % band at every τ: two independent estimates (F distribution with the model's EDFs) of an
+/// estimated model (its coefficients' standard errors, added in quadrature in ln σ²).
 int points_outside_band(const json& measured, const json& simulated) {
   int outside = 0;
   const auto& a = measured["allan"]["points"];
@@ -127,8 +154,15 @@ int points_outside_band(const json& measured, const json& simulated) {
   for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) {
     const double ea = a[i]["edf"], eb = b[i]["edf"];
     const boost::math::fisher_f f(eb, ea);
-    const double ratio = b[i]["var"].get<double>() / a[i]["var"].get<double>();
-    if (ratio < boost::math::quantile(f, 0.025) || ratio > boost::math::quantile(f, 0.975)) ++outside;
+    const double model = 1.96 * std::sqrt(model_log_variance(measured["fit"], a[i]["tau_s"].get<double>()));
+    const double lo = -std::hypot(std::log(boost::math::quantile(f, 0.025)), model);
+    const double hi = std::hypot(std::log(boost::math::quantile(f, 0.975)), model);
+    const double ratio = std::log(b[i]["var"].get<double>() / a[i]["var"].get<double>());
+    if (ratio < lo || ratio > hi) {
+      ++outside;
+      std::printf("tau %g s: ln(simulated/measured AV) %.3g outside [%.3g, %.3g]\n", a[i]["tau_s"].get<double>(), ratio,
+                  lo, hi);
+    }
   }
   return outside;
 }

@@ -29,6 +29,10 @@ struct AnalysisOptions {
   /// The user chose the fit range (`--fit-range`): it is kept as given. Otherwise, with the
   /// default range, an output filter seen in the short-τ points moves the fit's lower end.
   bool fit_range_given = false;
+  /// The checks of the fit (short-τ range, scaling of a rejected fit, warnings) and the per-τ bounds
+  /// from the fitted model. Off: the plain five-term fit over the range given and Stable32's bounds
+  /// (diagnose's base model, whose departures its detectors explain).
+  bool fit_checks = true;
 };
 
 /// Something the reader must know about a result: a stable code, a sentence, and a command that

@@ -231,7 +231,7 @@ void fit_with_checks(const std::vector<FitPoint>& points, const AnalysisOptions&
   const bool default_range = fopt.tau_min_s == 0 && std::isinf(fopt.tau_max_s);
   if (options.fit_range_given || !default_range) {
     range.source = FitRangeChoice::Source::Option;
-  } else if (!exact_counts) {  // pulse counts have no output filter: their short τ is the read-out
+  } else if (options.fit_checks && !exact_counts) {  // pulse counts have no output filter: their short τ is the read-out
     const OutputFilterCheck check = check_output_filter(points, fopt);
     if (check.found || check.departures) {
       range.source = FitRangeChoice::Source::ShortTau;
@@ -244,7 +244,7 @@ void fit_with_checks(const std::vector<FitPoint>& points, const AnalysisOptions&
     }
   }
   r.fit = fit_noise(points, fopt);
-  if (r.fit.p_value < 0.001 && r.fit.chi2_per_dof > 1) {
+  if (options.fit_checks && r.fit.p_value < 0.001 && r.fit.chi2_per_dof > 1) {
     range.intervals_scaled = true;
     range.interval_scale = std::sqrt(r.fit.chi2_per_dof);
     fopt.dispersion *= r.fit.chi2_per_dof;
@@ -276,7 +276,7 @@ void allan_and_fit(const Recording& rec, const AnalysisOptions& options, Analysi
   r.slope = slope_readout(fitted);
   for (const auto& p : fitted.points)
     if (p.tau_s == r.slope.tau_min_s && p.edf > 0 && r.slope.B) r.slope_B_sigma = *r.slope.B / std::sqrt(2.0 * p.edf);
-  r.model_bounds = apply_model_bounds(r.allan, r.fit, &rec.phase);
+  if (options.fit_checks) r.model_bounds = apply_model_bounds(r.allan, r.fit, &rec.phase);
 }
 
 /// The paper's methods (direct N, spread of 100-s means) and their discrepancies from the fit.
@@ -315,7 +315,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   allan_and_fit(rec, options, r);
   cross_checks(rec, options, r);
   r.verdict = verdict_of(r, options);
-  r.warnings = fit_warnings(r);
+  if (options.fit_checks) r.warnings = fit_warnings(r);
   return r;
 }
 

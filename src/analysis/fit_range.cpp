@@ -192,7 +192,7 @@ std::string short_tau_findings(const FitRangeChoice& c) {
                     100.0 * c.shortest_ratio, c.reference_tau_s, c.filter_tc_s);
   if (c.departure_tau_s > 0)
     s += fmt::format("{}the AV at {:g} s is {:.0f} % of the extrapolation of the model fitted from {:g} s (short-tau "
-                     "structure the five-term model lacks: a line, a resonance or a filter)",
+                     "structure the five-term model lacks: a spectral line, a bump or a filter)",
                      s.empty() ? "" : "; ", c.departure_tau_s, 100.0 * c.departure_ratio, c.reference_tau_s);
   return s;
 }
