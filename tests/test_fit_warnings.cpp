@@ -67,6 +67,25 @@ TEST(FitWarnings, RejectedFitIsSaidAndItsIntervalsScaled) {
   EXPECT_NE(text.out.find("scaled by sqrt(chi2/dof)"), std::string::npos);
 }
 
+TEST(FitWarnings, BatchAndReportShowARunsWarnings) {
+  TempDir dir;
+  const std::string rec = bump_record(dir);
+  const auto b = run_cli({"batch", rec});
+  ASSERT_EQ(b.status, 0) << b.err;
+  EXPECT_NE(b.out.find("Warnings (see 'rwcalc analyze' for each run)"), std::string::npos) << b.out;
+  EXPECT_NE(b.out.find("[fit_rejected]"), std::string::npos);
+  const std::string analysis = (dir.path() / "a.json").string();
+  ASSERT_EQ(run_cli({"analyze", rec, "--json", "-o", analysis}).status, 0);
+  const auto out = dir.path() / "report";
+  const auto r = run_cli({"report", analysis, "-o", out.string(), "--no-figures"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string html = slurp(out / "report.html");
+  EXPECT_NE(html.find("<div class=\"warning\"><b>Warnings</b>"), std::string::npos);
+  EXPECT_NE(html.find("<b>fit_rejected</b>"), std::string::npos);
+  EXPECT_NE(html.find("scaled by √(χ²/dof)"), std::string::npos);
+  EXPECT_NE(html.find("<td>fit range</td>"), std::string::npos);
+}
+
 TEST(FitWarnings, GoodFitsOfTheShippedRunsSayNothing) {
   for (const auto& run : gl2d_runs()) {
     const auto r = run_cli({"analyze", run, "--json"});
