@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
+#include <map>
 #include <cmath>
 
 #include "diagnose/detector.hpp"  // the first-order output filter's AV of white rate (output_lowpass_rate_avar)
@@ -157,14 +159,20 @@ double measured_variance_ratio(const PhaseSeries& x, std::int64_t m) {
 bool apply_model_bounds(AllanResult& allan, const FitResult& fit, const PhaseSeries* x) {
   if (allan.estimator != Estimator::Overlapping || allan.points.empty()) return false;
   const std::vector<FitPoint> pts = fit_points(allan);
-  const Eigen::MatrixXd cov = av_covariance(pts, fit.c, true);
   const double q2 = fit.c[static_cast<int>(Term::Q)];
+  std::map<std::int64_t, double> ratio_at_octave;  // measured_variance_ratio of the octave m ≤ each m
   for (std::size_t i = 0; i < allan.points.size(); ++i) {
     AllanPoint& p = allan.points[i];
     const double model = fit.model_var(p.tau_s);
-    double var = cov(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i));
+    // One point at a time: a dense grid would not fit a full covariance matrix in memory.
+    double var = av_covariance(std::span(&pts[i], 1), fit.c, true)(0, 0);
     // Where white phase noise leads, its read-out's non-Gaussian errors set the variance.
-    if (x && q2 * term_basis(Term::Q, p.tau_s) >= 0.5 * model) var *= measured_variance_ratio(*x, p.m);
+    if (x && q2 * term_basis(Term::Q, p.tau_s) >= 0.5 * model) {
+      const std::int64_t octave = std::int64_t{1} << (std::bit_width(static_cast<std::uint64_t>(p.m)) - 1);
+      auto [it, fresh] = ratio_at_octave.try_emplace(octave, 1.0);
+      if (fresh) it->second = measured_variance_ratio(*x, octave);
+      var *= it->second;
+    }
     if (!(model > 0) || !(var > 0)) continue;
     p.edf = 2.0 * model * model / var;
     int leading = 0;
