@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "rwcalc/allan.hpp"
 #include "rwcalc/fit.hpp"
@@ -25,6 +26,40 @@ struct AnalysisOptions {
   std::optional<double> temperature_c;                  ///< overrides the recording's temperature
   OutlierAction outlier_action = OutlierAction::Keep;   ///< outliers are always reported
   double outlier_threshold = kDefaultOutlierThreshold;  ///< robust z (see outliers.hpp)
+  /// The user chose the fit range (`--fit-range`): it is kept as given. Otherwise, with the
+  /// default range, an output filter seen in the short-τ points moves the fit's lower end.
+  bool fit_range_given = false;
+  /// The checks of the fit (short-τ range, scaling of a rejected fit, warnings) and the per-τ bounds
+  /// from the fitted model. Off: the plain five-term fit over the range given and Stable32's bounds
+  /// (diagnose's base model, whose departures its detectors explain).
+  bool fit_checks = true;
+};
+
+/// Something the reader must know about a result: a stable code, a sentence, and a command that
+/// helps (may be empty).
+struct AnalysisWarning {
+  std::string code;     ///< "fit_rejected", "output_filter"
+  std::string message;  ///< one or two sentences, with the numbers
+  std::string command;  ///< a suggested command line ("" when none)
+};
+
+/// How the fit's τ range was chosen.
+struct FitRangeChoice {
+  enum class Source { All, Option, ShortTau } source = Source::All;
+  double tau_min_s = 0;  ///< as applied, s
+  double tau_max_s = 0;  ///< as applied, s (infinite: no upper limit)
+  /// ShortTau: the short-τ points depart from the extrapolation of the model fitted from
+  /// reference_tau_s: an output filter (the AV at τ0 is shortest_ratio of it; equivalent first-order
+  /// time constant filter_tc_s, 0: none) and/or a departure up to departure_tau_s (AV ratio there).
+  double shortest_ratio = 1;
+  double filter_tc_s = 0;
+  double departure_tau_s = 0;
+  double departure_ratio = 1;
+  double reference_tau_s = 0;
+  /// The fit was rejected (p < 0.001) and its intervals scaled by √(χ²/dof) (FitOptions::dispersion).
+  bool intervals_scaled = false;
+  double interval_scale = 1;  ///< √(χ²/dof) of the unscaled fit, when scaled
+  [[nodiscard]] std::string reason() const;  ///< why the range is what it is, one sentence
 };
 
 struct AnalysisResult {
@@ -42,8 +77,12 @@ struct AnalysisResult {
   double latitude_deg = 0;  ///< NaN-free: the latitude used (0 when the rate was given)
   bool earth_rate_given = false;
   double bias_deg_per_h = 0;  ///< mean − expected Earth rate
+  /// Allan deviation; for the overlapping estimator its EDF, bounds and α come from the fitted
+  /// model (EDF = 2σ⁴/Var(σ̂²) under the fit, α of the dominant term), not Stable32's noise id.
   AllanResult allan;
+  bool model_bounds = false;  ///< allan's EDF and bounds are the fitted model's
   FitResult fit;
+  FitRangeChoice fit_range;
   SlopeReadout slope;
   double slope_B_sigma = 0;               ///< standard error of σ_min/0.6643 (from b_min)
   AvBEstimate b_min;                      ///< σ_min/0.6643 with its model-EDF interval and bias factor
@@ -55,6 +94,7 @@ struct AnalysisResult {
   double B_100s_vs_model_sigma = 0;       ///< (spread − its expectation under the fit)/σ
   OutlierReport outliers;
   Verdict verdict;
+  std::vector<AnalysisWarning> warnings;
 };
 
 /// Throws UsageError for clock data, AnalysisError for a record too short or without noise.
@@ -69,6 +109,9 @@ nlohmann::json to_json(const AnalysisResult& r);
 
 /// The readable report.
 std::string format_report(const AnalysisResult& r);
+
+/// "WARNINGS" block of the readable report (empty when there are none).
+std::string format_warnings(const std::vector<AnalysisWarning>& warnings);
 
 /// Temperature from a file name: m50C → −50, p25C → 25, -50C, +25C, _0C (°C). Empty if none.
 std::optional<double> temperature_from_name(std::string_view path);

@@ -123,8 +123,13 @@ void add_finding(const nlohmann::json& finding, NoiseModel& model);
 
 /// A model from `analyze --json` or diagnose JSON ("extended_model", else "base_model"); fills
 /// rate, duration and temperature of `settings` when present. Errors: InputError naming `name`.
-NoiseModel model_from_analysis_json(const nlohmann::json& j, const std::string& name, SimulationSettings& settings);
+/// The fitted model: terms in it at their estimates; terms the fit left out or could not resolve
+/// without an estimate are left out, or with `upper_bounds` put in at their 95 % upper bounds.
+/// `notes` (if given) receives one line per term left out or at its bound.
+NoiseModel model_from_analysis_json(const nlohmann::json& j, const std::string& name, SimulationSettings& settings,
+                                    bool upper_bounds = false, std::vector<std::string>* notes = nullptr);
 /// The same from a JSON file (`simulate --from`), every value checked.
-NoiseModel model_from_analysis_file(const std::string& path, SimulationSettings& settings);
+NoiseModel model_from_analysis_file(const std::string& path, SimulationSettings& settings, bool upper_bounds = false,
+                                    std::vector<std::string>* notes = nullptr);
 
 }  // namespace rwcalc

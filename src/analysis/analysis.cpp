@@ -10,6 +10,7 @@
 #include <numbers>
 #include <optional>
 
+#include "analysis/fit_range.hpp"
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/printable.hpp"
@@ -34,6 +35,15 @@ nlohmann::json opt_num(const std::optional<double>& v) { return v ? nlohmann::js
 
 /// A number with a sensible count of significant digits (never NaN: callers ensure finiteness).
 std::string num(double v, int sig = 4) { return fmt::format("{:.{}g}", v, sig); }
+
+std::string_view range_source_name(FitRangeChoice::Source s) {
+  switch (s) {
+    case FitRangeChoice::Source::Option: return "option";
+    case FitRangeChoice::Source::ShortTau: return "short_tau_check";
+    case FitRangeChoice::Source::All: break;
+  }
+  return "all";
+}
 
 std::string coef_line(const Coefficient& c, std::string_view name, std::string_view unit) {
   if (!c.enabled) return fmt::format("  {:<2} not fitted\n", name);
@@ -60,6 +70,16 @@ std::string verdict_param_line(const Verdict& v, const ParameterVerdict& p) {
 }
 
 }  // namespace
+
+std::string format_warnings(const std::vector<AnalysisWarning>& warnings) {
+  if (warnings.empty()) return {};
+  std::string s = "WARNINGS\n";
+  for (const auto& w : warnings) {
+    s += fmt::format("  [{}] {}\n", w.code, w.message);
+    if (!w.command.empty()) s += fmt::format("    try: {}\n", w.command);
+  }
+  return s + "\n";
+}
 
 double vertical_earth_rate(double latitude_deg) {
   return units::earth_rate_deg_per_h * std::sin(latitude_deg * std::numbers::pi / 180.0);
@@ -237,9 +257,42 @@ void earth_rate_and_bias(const Recording& rec, const AnalysisOptions& options, A
   r.bias_deg_per_h = r.mean_rate_deg_per_h - r.earth_rate_deg_per_h;
 }
 
+/// The fit of the octave points: over the range the user gave, else from 10 τf when the shortest τ
+/// shows an output filter (check_output_filter), else over every point; a fit the goodness of fit
+/// rejects (p < 0.001) is refitted with its intervals scaled by √(χ²/dof) (FitOptions::dispersion).
+void fit_with_checks(const std::vector<FitPoint>& points, const AnalysisOptions& options, bool exact_counts,
+                     AnalysisResult& r) {
+  FitOptions fopt = options.fit;
+  FitRangeChoice& range = r.fit_range;
+  const bool default_range = fopt.tau_min_s == 0 && std::isinf(fopt.tau_max_s);
+  if (options.fit_range_given || !default_range) {
+    range.source = FitRangeChoice::Source::Option;
+  } else if (options.fit_checks && !exact_counts) {  // pulse counts have no output filter: their short τ is the read-out
+    const OutputFilterCheck check = check_output_filter(points, fopt);
+    if (check.found || check.departures) {
+      range.source = FitRangeChoice::Source::ShortTau;
+      range.shortest_ratio = check.ratio;
+      range.filter_tc_s = check.found ? check.tc_s : 0.0;
+      range.departure_tau_s = check.departure_tau_s;
+      range.departure_ratio = check.departure_ratio;
+      range.reference_tau_s = check.reference_tau_s;
+      fopt.tau_min_s = check.tau_min_s;
+    }
+  }
+  r.fit = fit_noise(points, fopt);
+  if (options.fit_checks && r.fit.p_value < 0.001 && r.fit.chi2_per_dof > 1) {
+    range.intervals_scaled = true;
+    range.interval_scale = std::sqrt(r.fit.chi2_per_dof);
+    fopt.dispersion *= r.fit.chi2_per_dof;
+    r.fit = fit_noise(points, fopt);
+  }
+  range.tau_min_s = fopt.tau_min_s;
+  range.tau_max_s = fopt.tau_max_s;
+}
+
 /// Allan variance, fit and classic readout. A finer grid (--tau) is reported in full, but the fit
 /// and the slope readout use its octave points, so the coefficients and the verdict do not depend
-/// on the grid.
+/// on the grid. The reported bounds of the overlapping AV are the fitted model's (apply_model_bounds).
 void allan_and_fit(const Recording& rec, const AnalysisOptions& options, AnalysisResult& r) {
   AllanOptions aopt = options.allan;
   const bool octave = aopt.grid.kind == TauGrid::Kind::Octave;
@@ -252,13 +305,14 @@ void allan_and_fit(const Recording& rec, const AnalysisOptions& options, Analysi
   const AllanResult octave_points = octave ? AllanResult{} : octave_points_of(r.allan, aopt);
   const AllanResult& fitted = octave ? r.allan : octave_points;
   try {
-    r.fit = fit_noise(fit_points(fitted), options.fit);
+    fit_with_checks(fit_points(fitted), options, rec.phase.exact(), r);
   } catch (const AnalysisError& e) {
     throw AnalysisError(fmt::format("{}: {}", rec.source, e.what()));
   }
   r.slope = slope_readout(fitted);
   for (const auto& p : fitted.points)
     if (p.tau_s == r.slope.tau_min_s && p.edf > 0 && r.slope.B) r.slope_B_sigma = *r.slope.B / std::sqrt(2.0 * p.edf);
+  if (options.fit_checks) r.model_bounds = apply_model_bounds(r.allan, r.fit, &rec.phase);
 }
 
 /// The paper's methods as unbiased estimators (direct N, B from the 100-s averages, σ_min/0.6643
@@ -303,6 +357,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   allan_and_fit(rec, options, r);
   cross_checks(rec, options, r);
   r.verdict = verdict_of(r, options);
+  if (options.fit_checks) r.warnings = fit_warnings(r);
   return r;
 }
 
@@ -328,7 +383,25 @@ nlohmann::json to_json(const AnalysisResult& r) {
               {"edf_cap", f.options.edf_cap},
               {"phi_N", f.phi[static_cast<std::size_t>(Term::N)]},
               {"phi_B", f.phi[static_cast<std::size_t>(Term::B)]},
-              {"confidence", f.options.confidence}};
+              {"confidence", f.options.confidence},
+              {"range",
+               {{"tau_min_s", r.fit_range.tau_min_s},
+                {"tau_max_s", std::isinf(r.fit_range.tau_max_s) ? json(nullptr) : json(r.fit_range.tau_max_s)},
+                {"chosen_by", range_source_name(r.fit_range.source)},
+                {"reason", r.fit_range.reason()},
+                {"shortest_tau_ratio", r.fit_range.shortest_ratio},
+                {"filter_time_constant_s", r.fit_range.filter_tc_s},
+                {"departure_tau_s", r.fit_range.departure_tau_s},
+                {"departure_ratio", r.fit_range.departure_ratio},
+                {"reference_tau_min_s", r.fit_range.reference_tau_s}}},
+              {"intervals_scaled", r.fit_range.intervals_scaled},
+              {"interval_scale", r.fit_range.interval_scale}};
+  json warnings = json::array();
+  for (const auto& w : r.warnings)
+    warnings.push_back({{"code", w.code}, {"message", w.message}, {"command", w.command}});
+  json allan = allan_json(r.allan);
+  allan["bounds"] = r.model_bounds ? "fitted model: EDF = 2 sigma^4/Var(sigma^2 estimate), alpha of the leading term"
+                                   : "Stable32 noise identification and Greenhall-Riley EDF";
   json n_direct = method_json(r.direct.N);
   if (!n_direct.is_null()) {
     n_direct["estimator"] = "overlapping increments, regression on the exact expectations of Q, N, B";
@@ -394,7 +467,8 @@ nlohmann::json to_json(const AnalysisResult& r) {
           {"earth_rate_deg_per_h", r.earth_rate_deg_per_h},
           {"latitude_deg", r.earth_rate_given ? json(nullptr) : json(r.latitude_deg)},
           {"bias_deg_per_h", r.bias_deg_per_h},
-          {"allan", allan_json(r.allan)},
+          {"warnings", warnings},
+          {"allan", allan},
           {"fit", fit},
           {"slope_readout",
            {{"N_deg_per_sqrt_h", opt_num(r.slope.N)},
@@ -450,6 +524,7 @@ std::string input_line(const nlohmann::json& in) {
 std::string format_report(const AnalysisResult& r) {
   std::string s;
   s += fmt::format("rwcalc analyze: {}\n\n", printable(r.source));
+  s += format_warnings(r.warnings);
   s += "Data\n";
   s += fmt::format("  {} samples at {:g} Hz (tau0 = {:g} ms), {:.1f} s ({:.2f} h), column '{}'", r.samples, r.rate_hz,
                    1000.0 / r.rate_hz, r.duration_s, r.duration_s / 3600.0, r.column);
@@ -464,8 +539,9 @@ std::string format_report(const AnalysisResult& r) {
                    r.bias_deg_per_h);
   s += format_outliers(r.outliers);
 
-  s += fmt::format("Allan deviation ({}, bounds at {:g} %; * = used in the fit)\n", to_string(r.allan.estimator),
-                   100.0 * r.allan.confidence);
+  s += fmt::format("Allan deviation ({}, bounds at {:g} %{}; * = used in the fit)\n", to_string(r.allan.estimator),
+                   100.0 * r.allan.confidence,
+                   r.model_bounds ? " from the fitted model's EDF; α of its leading term" : "");
   s += fmt::format("  {:>11} {:>12} {:>12} {:>12} {:>10} {:>4} {:>12}\n", "tau (s)", "sigma (°/h)", "low (°/h)",
                    "high (°/h)", "EDF", "α", "model (°/h)");
   for (const auto& p : r.allan.points) {
@@ -477,9 +553,13 @@ std::string format_report(const AnalysisResult& r) {
   s += "\n";
 
   const auto& f = r.fit;
-  s += fmt::format(
-      "Noise coefficients (Gamma-deviance fit of {} octave points, tau {:g}..{:g} s; 95 % profile intervals)\n",
-      f.used.size(), f.used.front().tau_s, f.used.back().tau_s);
+  s += fmt::format("Noise coefficients (Gamma-deviance fit of {} octave points, tau {:g}..{:g} s; 95 % profile "
+                   "intervals{})\n",
+                   f.used.size(), f.used.front().tau_s, f.used.back().tau_s,
+                   r.fit_range.intervals_scaled
+                       ? fmt::format(", scaled by sqrt(chi2/dof) = {:.3g}", r.fit_range.interval_scale)
+                       : std::string());
+  s += fmt::format("  fit range: {}\n", r.fit_range.reason());
   for (const Term t : kAllTerms)
     s += coef_line(f[t], term_name(t),
                    std::array{"arcsec", "°/√h", "°/h", "°/h/√h", "°/h²"}[static_cast<std::size_t>(t)]);

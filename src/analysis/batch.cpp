@@ -156,6 +156,17 @@ std::string temp_cell(const json& run) {
 std::string class_cell(const json& v) { return v.is_null() ? std::string("none") : fmt::format("{}", v.get<int>()); }
 
 /// One run's line of the batch text's outlier section: count, action, the first input lines.
+/// "  file: [code] message" for each warning of a run (analyze's "warnings"); empty when none.
+std::string warning_lines(const json& run) {
+  std::string s;
+  const auto w = run.find("warnings");
+  if (w == run.end() || !w->is_array()) return s;
+  for (const auto& x : *w)
+    s += fmt::format("  {}: [{}] {}\n", printable(run.at("source").get<std::string>()), x.value("code", ""),
+                     printable(x.value("message", "")));
+  return s;
+}
+
 std::string outliers_line(const json& run) {
   const std::string source = printable(run.at("source").get<std::string>());
   if (!run.contains("outliers") || !run.at("outliers").is_object())
@@ -278,6 +289,9 @@ std::string format_batch_text(const json& summary) {
   // Outliers are never passed over in silence: one line per run.
   s += "\nOutliers (see 'rwcalc analyze' for each; --outliers keep|remove|replace)\n";
   for (const auto& r : runs) s += outliers_line(r);
+  std::string warnings;
+  for (const auto& r : runs) warnings += warning_lines(r);
+  if (!warnings.empty()) s += "\nWarnings (see 'rwcalc analyze' for each run)\n" + warnings;
   s += fmt::format("\nOverall over the runs: {}", ov.at("statement").get<std::string>());
   if (ov.value("tolerance_changed", false))
     s += fmt::format("  [with the +{:g} % tolerance on B; strict: class {}]", ov.value("tolerance_pct", 0.0),
@@ -325,6 +339,16 @@ std::string format_batch_markdown(const json& summary) {
     std::string item = outliers_line(r);  // "  file: …" → "- file: …", a Markdown list item
     item[0] = '-';
     s += item;
+  }
+  std::string warnings;
+  for (const auto& r : runs) warnings += warning_lines(r);
+  if (!warnings.empty()) {
+    s += "\nWarnings:\n\n";
+    for (std::size_t at = 0; at < warnings.size();) {  // "  file: …" → "- file: …" line by line
+      const std::size_t end = warnings.find('\n', at);
+      s += "- " + warnings.substr(at + 2, end - at - 1);
+      at = end + 1;
+    }
   }
   return s;
 }

@@ -54,7 +54,8 @@ CLI::Option* add_temperature_option(CLI::App& app, std::optional<double>& temper
 }
 
 void AnalyzeArgs::add_to(CLI::App& app) {
-  app.add_option("--fit-range", fit_range, "Tau range of the fit, TMIN:TMAX in s (either may be empty; default: all)")
+  app.add_option("--fit-range", fit_range, "Tau range of the fit, TMIN:TMAX in s (either may be empty; default: all octave points, or "
+                 "tau >= 10 tau_f when the shortest tau shows an output filter of time constant tau_f)")
       ->group("Fit");
   app.add_option("--min-edf", min_edf, "Leave out AV points with fewer equivalent degrees of freedom")
       ->check(real_in(0.0, 1e12, "", Ends::OpenLow))
@@ -102,6 +103,7 @@ AnalysisOptions AnalyzeArgs::options() const {
     const auto [a, b] = parse_range(fit_range, "--fit-range", 0.0, std::numeric_limits<double>::infinity());
     o.fit.tau_min_s = a;
     o.fit.tau_max_s = b;
+    o.fit_range_given = true;
   }
   o.allan.grid = TauGrid::parse(tau);
   o.fit.min_edf = min_edf;

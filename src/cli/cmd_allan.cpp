@@ -128,6 +128,17 @@ int run_allan(const AllanArgs& a, Io& io) {
       (rec.mode == InputMode::Pulses || rec.mode == InputMode::Rate) ? NoiseIdDomain::Frequency : NoiseIdDomain::Phase;
   const AllanResult res = compute_allan(rec.phase, o);
   require_finite(res, rec);
+  // Where fewer than 10 averages of τ fit in the record, Stable32's noise identification (the B1 ratio,
+  // taken for the number of terms as Stable32 does) and the EDF that follows are weak: said on stderr,
+  // so the table stays Stable32's.
+  for (const auto& p : res.points)
+    if ((rec.phase.points() - 1) / static_cast<std::size_t>(p.m) < 10) {
+      print_message(io.err, fmt::format("note: {}: from tau = {:g} s on fewer than 10 averages remain; the noise "
+                                        "type and the bounds there rest on few data ('rwcalc analyze' takes them "
+                                        "from the fitted model)",
+                                        rec.source, p.tau_s));
+      break;
+    }
   if (a.json) {
     io.out << allan_json_text(res, rec, read, outliers);
   } else if (a.csv) {

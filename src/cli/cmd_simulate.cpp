@@ -28,6 +28,7 @@ struct SimulateArgs {
   std::string output;
   std::string truth;
   std::string from;
+  bool upper_bounds = false;
   double duration_s = 7200.0;
   double rate_hz = units::gl2d_rate_hz;
   double scale_arcsec = units::gl2d_arcsec_per_pulse;
@@ -320,7 +321,11 @@ int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
   NoiseModel m;
   if (!a.from.empty()) {
     s.scale_arcsec = a.scale_arcsec;
-    m = model_from_analysis_file(a.from, s);
+    std::vector<std::string> notes;
+    m = model_from_analysis_file(a.from, s, a.upper_bounds, &notes);
+    for (const auto& n : notes) print_message(io.err, fmt::format("--from {}: {}", a.from, n));
+  } else if (a.upper_bounds) {
+    throw UsageError("--upper-bounds needs --from");
   }
   apply_settings(a, take, s);
   apply_model(a, take, m);
@@ -362,7 +367,12 @@ void register_simulate(CLI::App& app, Runner& runner) {
   auto& a = *args;
   sub->add_option("-o,--output", a.output, "Output pulse file (FILE.csv or FILE.csv.gz; - for stdout)")->required();
   sub->add_option("--truth", a.truth, "Also write the ground truth (model JSON, seed, settings) to this file");
-  sub->add_option("--from", a.from, "Take the model from 'rwcalc analyze --json' or 'rwcalc diagnose --json' output");
+  sub->add_option("--from", a.from,
+                  "Take the model from 'rwcalc analyze --json' or 'rwcalc diagnose --json' output: the fitted model "
+                  "(terms at their estimates; terms the fit left out or did not resolve are left out)");
+  sub->add_flag("--upper-bounds", a.upper_bounds,
+                "With --from: put the terms the fit did not resolve in at their 95 % upper bounds (a pessimistic "
+                "model, not the fitted one)");
   sub->add_option("--duration", a.duration_s, "Record length, s")
       ->check(real_in(0.0, 1e9, "s", Ends::OpenLow))
       ->capture_default_str()

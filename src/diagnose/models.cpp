@@ -49,7 +49,9 @@ double sim_scale(const PhaseSeries& x, const AnalysisResult& a) {
   return std::max(1e-6, 1e-3 * term_value(a.fit, Term::Q));
 }
 
-AnalysisResult analyze_for_base(const Recording& rec, const AnalysisOptions& aopt) {
+AnalysisResult analyze_for_base(const Recording& rec, const AnalysisOptions& options) {
+  AnalysisOptions aopt = options;
+  aopt.fit_checks = false;  // the base model is the plain five-term fit: the detectors explain its misfit
   try {
     return analyze(rec, aopt);
   } catch (const AnalysisError&) {

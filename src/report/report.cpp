@@ -151,6 +151,7 @@ caption { caption-side: top; text-align: left; font-weight: bold; padding-bottom
 .na { color: #999; }
 .verdict { font-size: 1.15em; padding: 0.6em 0.9em; border-left: 5px solid #2c7bb6; background: #f4f8fb; }
 .note { color: #7a4b00; background: #fff6e0; padding: 0.3em 0.6em; border-left: 4px solid #e6a000; }
+.warning { color: #7a0000; background: #fff0f0; padding: 0.3em 0.6em; border-left: 4px solid #c00000; }
 figure { margin: 1em 0; }
 figure img { width: 100%; max-width: 960px; height: auto; border: 1px solid #eee; }
 figcaption { color: #444; font-size: 0.92em; }
@@ -329,11 +330,30 @@ std::string fit_table(const json& fit, std::size_t index) {
       gof += fmt::format("; τ fitted {:g}–{:g} s", *lo, *hi);
     s += fmt::format("<tr><td>goodness of fit</td><td colspan=\"2\">{}</td></tr>\n", gof);
   }
+  if (const auto& range = at(fit, "range"); range.is_object())
+    s += fmt::format("<tr><td>fit range</td><td colspan=\"2\">{}</td></tr>\n", esc(str(range, "reason")));
+  if (const auto& scaled = at(fit, "intervals_scaled"); scaled.is_boolean() && scaled.get<bool>())
+    s += fmt::format(
+        "<tr><td>intervals</td><td colspan=\"2\">scaled by √(χ²/dof) = {}: the model is rejected</td></tr>\n",
+        g(num(fit, "interval_scale").value_or(1.0)));
   return s + "</table>\n";
 }
 
+/// The run's warnings (analysis JSON "warnings": code, message, suggested command), if any.
+std::string warnings_html(const json& run) {
+  const auto& w = at(run, "warnings");
+  if (!w.is_array() || w.empty()) return {};
+  std::string s = "<div class=\"warning\"><b>Warnings</b><ul>\n";
+  for (const auto& x : w) {
+    s += fmt::format("<li><b>{}</b>: {}", esc(str(x, "code")), esc(str(x, "message")));
+    if (const std::string c = str(x, "command"); !c.empty()) s += fmt::format(" <code>{}</code>", esc(c));
+    s += "</li>\n";
+  }
+  return s + "</ul></div>\n";
+}
+
 std::string run_summary(const json& run, std::size_t index) {
-  std::string s = data_table(run, index) + fit_table(at(run, "fit"), index);
+  std::string s = warnings_html(run) + data_table(run, index) + fit_table(at(run, "fit"), index);
   if (const auto& v = at(run, "verdict"); v.is_object())
     s += "<p>Verdict: <b>" + esc(statement_text(v)) + "</b>" +
          by_parameter(str(v, "statement_B"), str(v, "statement_N")) + ".</p>\n";

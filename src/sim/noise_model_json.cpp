@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "core/json_input.hpp"
 #include "rwcalc/error.hpp"
@@ -24,12 +25,40 @@ double num(const Value& object, const char* key, double fallback = 0.0) {
   return v ? v->number() : fallback;
 }
 
-// Value of a fitted coefficient object {"value": …} (or a bare number); 0 when absent or null.
-double fitted(const Value& fit, const char* key) {
+/// How `simulate --from` takes the fitted coefficients, and what it says about them.
+struct CoefficientPolicy {
+  bool upper_bounds = false;                ///< unresolved terms at their 95 % upper bounds
+  std::vector<std::string>* notes = nullptr;  ///< one line per term left out or at its bound
+};
+
+// A fitted coefficient {"value", "estimate", "resolved", "in_model", …} (or a bare number) as the
+// fitted model has it: a term in the model at its estimate; one the term selection left out, or
+// one not resolved that has no estimate, at 0, or with `upper_bounds` at its upper bound ("value").
+// Absent keys: in the model and resolved (a hand-written {"value": …}); absent or null: 0.
+double fitted(const Value& fit, const char* key, const CoefficientPolicy& policy) {
   const auto v = fit.find(key);
   if (!v) return 0.0;
-  if (v->json().is_object()) return num(*v, "value");
-  return v->number();
+  if (!v->json().is_object()) return v->number();
+  auto flag = [&](const char* k) {
+    const auto f = v->find(k);
+    return !f || f->boolean();
+  };
+  const bool in_model = flag("in_model"), resolved = flag("resolved");
+  const double value = num(*v, "value");
+  if (in_model && resolved) return num(*v, "estimate", value);
+  const double estimate = in_model ? num(*v, "estimate") : 0.0;
+  auto note = [&](std::string line) {
+    if (policy.notes) policy.notes->push_back(std::move(line));
+  };
+  if (policy.upper_bounds && value > estimate) {
+    note(fmt::format("{} = {:g}: its 95 % upper bound (not resolved; --upper-bounds)", key, value));
+    return value;
+  }
+  if (value > 0)
+    note(estimate > 0 ? fmt::format("{} = {:g}: its estimate (not resolved; 95 % upper bound {:g})", key, estimate, value)
+                      : fmt::format("{} left out ({}; 95 % upper bound {:g}; --upper-bounds takes it)", key,
+                                    in_model ? "not resolved" : "left out of the model by the fit", value));
+  return estimate;
 }
 
 /// The model's scalar terms and their JSON keys, in the order they are read.
@@ -172,7 +201,7 @@ void to_json(json& j, const SimulationSettings& s) {
 
 namespace {
 
-NoiseModel model_from_analysis(const Value& j, SimulationSettings& settings) {
+NoiseModel model_from_analysis(const Value& j, SimulationSettings& settings, const CoefficientPolicy& policy) {
   j.object();
   // Diagnose output: take its extended model (else the base model).
   auto model = [&](const char* key) -> std::optional<Value> {
@@ -194,14 +223,14 @@ NoiseModel model_from_analysis(const Value& j, SimulationSettings& settings) {
   NoiseModel m;
   if (const auto fit = root.find("fit")) {
     fit->object();
-    m.arw_deg_per_sqrt_h = fitted(*fit, "N_deg_per_sqrt_h");
-    m.bias_instability_deg_per_h = fitted(*fit, "B_deg_per_h");
-    m.rrw_deg_per_h_per_sqrt_h = fitted(*fit, "K_deg_per_h_per_sqrt_h");
-    m.ramp_deg_per_h2 = fitted(*fit, "R_deg_per_h2");
+    m.arw_deg_per_sqrt_h = fitted(*fit, "N_deg_per_sqrt_h", policy);
+    m.bias_instability_deg_per_h = fitted(*fit, "B_deg_per_h", policy);
+    m.rrw_deg_per_h_per_sqrt_h = fitted(*fit, "K_deg_per_h_per_sqrt_h", policy);
+    m.ramp_deg_per_h2 = fitted(*fit, "R_deg_per_h2", policy);
     // The fitted Q is white angle noise: a white read-out contributes q/√6 of it, the rest
     // is added as extra white angle noise before counting.
     m.readout = ReadoutMode::White;
-    const double q_fit = fitted(*fit, "Q_arcsec");
+    const double q_fit = fitted(*fit, "Q_arcsec", policy);
     const double q_read = readout_q_arcsec(ReadoutMode::White, settings.scale_arcsec);
     if (q_fit > q_read) m.white_angle_arcsec = std::sqrt(q_fit * q_fit - q_read * q_read);
     const double earth = num(root, "earth_rate_deg_per_h", num(j, "earth_rate_deg_per_h"));
@@ -220,14 +249,16 @@ NoiseModel model_from_analysis(const Value& j, SimulationSettings& settings) {
 
 }  // namespace
 
-NoiseModel model_from_analysis_json(const json& j, const std::string& name, SimulationSettings& settings) {
+NoiseModel model_from_analysis_json(const json& j, const std::string& name, SimulationSettings& settings,
+                                    bool upper_bounds, std::vector<std::string>* notes) {
   const auto doc = json_input::Document::of_value(j, name);
-  return model_from_analysis(doc.root(), settings);
+  return model_from_analysis(doc.root(), settings, {upper_bounds, notes});
 }
 
-NoiseModel model_from_analysis_file(const std::string& path, SimulationSettings& settings) {
+NoiseModel model_from_analysis_file(const std::string& path, SimulationSettings& settings, bool upper_bounds,
+                                    std::vector<std::string>* notes) {
   const auto doc = json_input::Document::load(path);
-  return model_from_analysis(doc.root(), settings);
+  return model_from_analysis(doc.root(), settings, {upper_bounds, notes});
 }
 
 }  // namespace rwcalc

@@ -1,0 +1,242 @@
+// The output-filter test that chooses the fit's lower τ, the per-τ bounds from the fitted model,
+// and the warnings of a fit that fails (docs/analysis.md, "Per-τ bounds", "When the fit fails").
+#include "analysis/fit_range.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <map>
+#include <cmath>
+
+#include "diagnose/detector.hpp"  // the first-order output filter's AV of white rate (output_lowpass_rate_avar)
+#include "rwcalc/confidence.hpp"
+#include "rwcalc/error.hpp"
+#include "rwcalc/printable.hpp"
+
+namespace rwcalc {
+
+namespace {
+
+/// The extrapolating fit starts at this many τ0: beyond the reach of any filter that would still
+/// leave the record's first octave points usable.
+constexpr double kReferenceTaus = 16;
+/// A roll-off: the AV at τ0 at most this fraction of the extrapolation, and that many standard
+/// errors below it (the EDF of the point and the extrapolation's own variance).
+constexpr double kRollOffRatio = 0.9;
+constexpr double kRollOffSigmas = 5;
+/// The fit starts at this many filter time constants (the filter's AV deficit, ≈ 1.5 τf/τ, is
+/// then below 15 % at the first point and falls as 1/τ).
+constexpr double kFilterTaus = 10;
+/// The extrapolating fit must start beyond this many τf for the filter's estimate to hold.
+constexpr double kReferenceFilterTaus = 30;
+
+/// α of S_y(f) ∝ f^α for each term (R, a drift, shown as −2 like K).
+constexpr int kTermAlpha[kTermCount] = {2, 0, -1, -2, -2};
+
+double extrapolation_variance(const FitResult& f, double tau_s) {
+  Eigen::Matrix<double, kTermCount, 1> b;
+  for (int i = 0; i < kTermCount; ++i) b[i] = term_basis(kAllTerms[static_cast<std::size_t>(i)], tau_s);
+  return b.dot(f.cov_c * b);
+}
+
+/// Time constant of a first-order output filter that brings the model's Q and N parts at τ0 down
+/// to the measured AV (the other terms are not filtered at τ0); bisection in ln τf. The fit beyond
+/// the filter sees white angle noise already filtered (its AV scaled by (1 − φ)/(1 + φ) at every τ,
+/// φ = e^(−τ0/τf)): its Q part at τ0 is that of the long-τ limit times (3 − 4φ + φ²)/3. White rate
+/// noise keeps its long-τ AV: its part at τ0 is output_lowpass_rate_avar.
+double filter_time_constant(const FitResult& f, double tau0, double measured) {
+  const double q = f.c[static_cast<int>(Term::Q)], n = f.c[static_cast<int>(Term::N)];
+  const double q_part = q * term_basis(Term::Q, tau0);
+  const double rest = f.model_var(tau0) - q_part - n * term_basis(Term::N, tau0);
+  auto filtered = [&](double tf) {
+    const double phi = std::exp(-tau0 / tf);
+    return q_part * (3.0 - 4.0 * phi + phi * phi) / 3.0 + n * diag::output_lowpass_rate_avar(1, tau0, tf) + rest;
+  };
+  double lo = std::log(tau0 * 1e-3), hi = std::log(tau0 * 1e3);
+  if (filtered(std::exp(hi)) > measured) return std::exp(hi);
+  for (int it = 0; it < 60; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (filtered(std::exp(mid)) > measured ? lo : hi) = mid;
+  }
+  return std::exp(0.5 * (lo + hi));
+}
+
+/// The file name as a shell word (quoted when it holds anything beyond [A-Za-z0-9/._+,-]).
+std::string shell_word(const std::string& path) {
+  const std::string p = printable(path);
+  const bool plain = !p.empty() && p.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
+                                                       "0123456789/._+,-") == std::string::npos;
+  if (plain) return p;
+  std::string q = "'";
+  for (const char ch : p) q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+  return q + "'";
+}
+
+}  // namespace
+
+double filter_free_tau_s(double tc_s) { return kFilterTaus * tc_s; }
+
+namespace {
+
+/// The short-τ points against the model fitted from `reference_tau_s`.
+OutputFilterCheck compare_short_tau(std::span<const FitPoint> octave, const FitOptions& fit, double reference_tau_s) {
+  OutputFilterCheck c;
+  const FitPoint& first = octave.front();
+  FitOptions ref = fit;
+  ref.tau_min_s = reference_tau_s * (1 - 1e-9);
+  FitResult f;
+  try {
+    f = fit_noise(octave, ref);
+  } catch (const AnalysisError&) {
+    return c;  // too few points beyond the reference τ: no test
+  }
+  c.reference_tau_s = f.used.front().tau_s;
+  for (const FitPoint& p : octave) {
+    if (p.tau_s >= c.reference_tau_s) break;
+    const double pred = f.model_var(p.tau_s);
+    if (!(pred > 0) || !(p.edf > 0)) return OutputFilterCheck{};
+    const double ratio = p.var / pred;
+    const double z = (p.var - pred) / std::sqrt(2.0 * pred * pred / p.edf + extrapolation_variance(f, p.tau_s));
+    if (&p == &first) c.ratio = ratio;
+    if (std::abs(ratio - 1.0) < 1.0 - kRollOffRatio || std::abs(z) < kRollOffSigmas) continue;
+    if (&p == &first && ratio < 1.0) {
+      c.found = true;
+      c.tc_s = filter_time_constant(f, first.tau_s, first.var);
+      c.tau_min_s = std::max(c.tau_min_s, filter_free_tau_s(c.tc_s));
+    } else {
+      c.departures = true;
+      c.departure_tau_s = p.tau_s;
+      c.departure_ratio = ratio;
+      c.tau_min_s = std::max(c.tau_min_s, 2.0 * p.tau_s * (1 - 1e-9));
+    }
+  }
+  return c;
+}
+
+}  // namespace
+
+OutputFilterCheck check_output_filter(std::span<const FitPoint> octave, const FitOptions& fit) {
+  if (octave.empty() || octave.front().m != 1 || !(octave.front().edf > 0) || !(octave.front().var > 0)) return {};
+  // A filter slow enough to bend the reference range too is underestimated: the reference moves
+  // up an octave at a time until it starts beyond 30 τf.
+  double reference = kReferenceTaus * octave.front().tau_s;
+  OutputFilterCheck c = compare_short_tau(octave, fit, reference);
+  for (int k = 0; k < 4 && c.found && c.tc_s * kReferenceFilterTaus > c.reference_tau_s; ++k) {
+    reference = 2.0 * c.reference_tau_s;
+    const OutputFilterCheck next = compare_short_tau(octave, fit, reference);
+    if (next.reference_tau_s == 0) break;  // no fit that far up
+    c = next;
+  }
+  return c;
+}
+
+double measured_variance_ratio(const PhaseSeries& x, std::int64_t m) {
+  const auto um = static_cast<std::size_t>(m);
+  if (x.points() < 8 * um + 2) return 1.0;
+  const std::size_t n = x.points() - 5 * um;  // terms with a partner 3m on
+  auto d = [&x, um](std::size_t i) { return x.diff(i + 2 * um, i + um) - x.diff(i + um, i); };
+  // Σ d_i·d_(i+l) and Σ d_i²·d_(i+l)² at l = 0, m, 2m (the lags at which two terms of white phase
+  // noise share phase samples) and 3m (disjoint: the baseline).
+  std::array<double, 4> c{}, p{};
+  for (std::size_t i = 0; i < n; ++i) {
+    const double a = d(i);
+    for (std::size_t l = 0; l < 4; ++l) {
+      const double b = l == 0 ? a : d(i + l * um);
+      c[l] += a * b;
+      p[l] += a * a * b * b;
+    }
+  }
+  const double nn = static_cast<double>(n);
+  // Per term: Σ_|l|≤2m Cov(d_i², d_(i+l)²) from the data, against its Gaussian value 2·Σ Cov(d_i, d_(i+l))².
+  const double measured = (p[0] + 2.0 * p[1] + 2.0 * p[2] - 5.0 * p[3]) / nn;
+  const double gaussian = 2.0 * (c[0] * c[0] + 2.0 * c[1] * c[1] + 2.0 * c[2] * c[2]) / (nn * nn);
+  if (!(gaussian > 0) || !(measured > 0)) return 1.0;
+  return std::clamp(measured / gaussian, 0.25, 4.0);
+}
+
+bool apply_model_bounds(AllanResult& allan, const FitResult& fit, const PhaseSeries* x) {
+  if (allan.estimator != Estimator::Overlapping || allan.points.empty()) return false;
+  const std::vector<FitPoint> pts = fit_points(allan);
+  const double q2 = fit.c[static_cast<int>(Term::Q)];
+  std::map<std::int64_t, double> ratio_at_octave;  // measured_variance_ratio of the octave m ≤ each m
+  for (std::size_t i = 0; i < allan.points.size(); ++i) {
+    AllanPoint& p = allan.points[i];
+    const double model = fit.model_var(p.tau_s);
+    // One point at a time: a dense grid would not fit a full covariance matrix in memory.
+    double var = av_covariance(std::span(&pts[i], 1), fit.c, true)(0, 0);
+    // Where white phase noise leads, its read-out's non-Gaussian errors set the variance.
+    if (x && q2 * term_basis(Term::Q, p.tau_s) >= 0.5 * model) {
+      const std::int64_t octave = std::int64_t{1} << (std::bit_width(static_cast<std::uint64_t>(p.m)) - 1);
+      auto [it, fresh] = ratio_at_octave.try_emplace(octave, 1.0);
+      if (fresh) it->second = measured_variance_ratio(*x, octave);
+      var *= it->second;
+    }
+    if (!(model > 0) || !(var > 0)) continue;
+    p.edf = 2.0 * model * model / var;
+    int leading = 0;
+    double largest = -1;
+    for (int t = 0; t < kTermCount; ++t) {
+      const double part = fit.c[t] * term_basis(kAllTerms[static_cast<std::size_t>(t)], p.tau_s);
+      if (part > largest) largest = part, leading = t;
+    }
+    p.alpha = kTermAlpha[leading];
+    const DevInterval ci = chi2_interval(p.var, p.edf, allan.confidence);
+    p.dev_low = ci.low;
+    p.dev_high = ci.high;
+  }
+  return true;
+}
+
+namespace {
+
+/// What the short-τ check saw, one clause per finding.
+std::string short_tau_findings(const FitRangeChoice& c) {
+  std::string s;
+  if (c.filter_tc_s > 0)
+    s = fmt::format("the AV at tau0 is {:.0f} % of the extrapolation of the model fitted from {:g} s, the roll-off "
+                    "of an output filter of time constant tau_f = {:.3g} s",
+                    100.0 * c.shortest_ratio, c.reference_tau_s, c.filter_tc_s);
+  if (c.departure_tau_s > 0)
+    s += fmt::format("{}the AV at {:g} s is {:.0f} % of the extrapolation of the model fitted from {:g} s (short-tau "
+                     "structure the five-term model lacks: a spectral line, a bump or a filter)",
+                     s.empty() ? "" : "; ", c.departure_tau_s, 100.0 * c.departure_ratio, c.reference_tau_s);
+  return s;
+}
+
+}  // namespace
+
+std::string FitRangeChoice::reason() const {
+  switch (source) {
+    case Source::Option: return "the range given by --fit-range";
+    case Source::ShortTau:
+      return fmt::format("tau >= {:g} s ({}): {}", tau_min_s,
+                         filter_tc_s > 0 && 10.0 * filter_tc_s >= 2.0 * departure_tau_s ? "10 tau_f"
+                                                                                         : "beyond the departing points",
+                         short_tau_findings(*this));
+    case Source::All: break;
+  }
+  return "every octave point (the short-tau points agree with the model)";
+}
+
+std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r) {
+  std::vector<AnalysisWarning> w;
+  const std::string src = shell_word(r.source);
+  const FitRangeChoice& fr = r.fit_range;
+  if (fr.source == FitRangeChoice::Source::ShortTau)
+    w.push_back({fr.filter_tc_s > 0 ? "output_filter" : "short_tau_structure",
+                 fmt::format("The fit uses tau >= {:g} s only: {}. Give --fit-range to choose the range yourself.",
+                             fr.tau_min_s, short_tau_findings(fr)),
+                 fmt::format("rwcalc analyze {} [input options] --fit-range 0:", src)});
+  if (r.fit.p_value < 0.001)
+    w.push_back({"fit_rejected",
+                 fmt::format("The five-term model does not describe the Allan variance: chi2/dof = {:.3g} "
+                             "(dof {}, p = {:.2g}). The coefficients' intervals are scaled by sqrt(chi2/dof) = "
+                             "{:.3g}; look for what the model misses.",
+                             r.fit.chi2_per_dof, r.fit.dof, r.fit.p_value, fr.interval_scale),
+                 fmt::format("rwcalc diagnose {} [input options]", src)});
+  return w;
+}
+
+}  // namespace rwcalc

@@ -1,0 +1,222 @@
+// analyze's fit checks end to end: the warning of a rejected fit (text and JSON), the range an
+// output filter moves and the --fit-range that overrides it, the model-based per-τ bounds, and
+// `simulate --from` of an analysis reproducing the measured Allan deviation.
+#include <gtest/gtest.h>
+
+#include <boost/math/distributions/fisher_f.hpp>
+#include <cmath>
+#include <cstdio>
+#include <utility>
+#include <vector>
+#include <nlohmann/json.hpp>
+
+#include "rwcalc/fit.hpp"
+#include "test_support.hpp"
+
+namespace rwcalc {
+namespace {
+
+using nlohmann::json;
+using namespace rwcalc::test;
+
+/// A 30-min 100-Hz pulse record with a strong Gauss–Markov bump the five-term model cannot follow.
+std::string bump_record(const TempDir& dir) {
+  const std::string path = (dir.path() / "bump.csv").string();
+  const auto r = run_cli({"simulate", "-o", path, "--duration", "1800", "--rate", "100", "--scale", "0.2", "--arw",
+                          "0.001", "--bias-instability", "0.005", "--gauss-markov", "0.5:10", "--white-readout"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  return path;
+}
+
+/// A 30-min 100-Hz floating-angle record through a 20-ms output filter.
+std::string filtered_record(const TempDir& dir) {
+  const std::string path = (dir.path() / "lp.csv").string();
+  const auto r = run_cli({"simulate", "-o", path, "--duration", "1800", "--rate", "100", "--scale", "0.2", "--arw",
+                          "0.002", "--bias-instability", "0.005", "--output-lowpass", "0.02", "--white-readout"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  return path;
+}
+
+const json* warning(const json& j, const std::string& code) {
+  for (const auto& w : j.at("warnings"))
+    if (w.at("code") == code) return &w;
+  return nullptr;
+}
+
+TEST(FitWarnings, RejectedFitIsSaidAndItsIntervalsScaled) {
+  TempDir dir;
+  const std::string rec = bump_record(dir);
+  const auto r = run_cli({"analyze", rec, "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  const json* w = warning(j, "fit_rejected");
+  ASSERT_NE(w, nullptr) << r.out.substr(0, 2000);
+  for (const char* k : {"code", "message", "command"}) EXPECT_TRUE(w->contains(k)) << k;
+  EXPECT_NE(w->at("command").get<std::string>().find("rwcalc diagnose"), std::string::npos);
+  EXPECT_LT(j["fit"]["p_value"].get<double>(), 0.001);
+  EXPECT_TRUE(j["fit"]["intervals_scaled"].get<bool>());
+  const double chi2 = j["fit"]["chi2_per_dof"].get<double>();
+  EXPECT_GT(chi2, 2.0);
+  EXPECT_NEAR(j["fit"]["interval_scale"].get<double>(), std::sqrt(chi2), 0.5 * std::sqrt(chi2));
+  EXPECT_GT(j["fit"]["dispersion"].get<double>(), 2.0);
+  // The unscaled fit (--fit-range given changes nothing here: it is the same range) has narrower intervals.
+  const auto text = run_cli({"analyze", rec});
+  ASSERT_EQ(text.status, 0) << text.err;
+  EXPECT_NE(text.out.find("WARNINGS"), std::string::npos);
+  EXPECT_NE(text.out.find("[fit_rejected]"), std::string::npos);
+  EXPECT_NE(text.out.find("scaled by sqrt(chi2/dof)"), std::string::npos);
+}
+
+TEST(FitWarnings, BatchAndReportShowARunsWarnings) {
+  TempDir dir;
+  const std::string rec = bump_record(dir);
+  const auto b = run_cli({"batch", rec});
+  ASSERT_EQ(b.status, 0) << b.err;
+  EXPECT_NE(b.out.find("Warnings (see 'rwcalc analyze' for each run)"), std::string::npos) << b.out;
+  EXPECT_NE(b.out.find("[fit_rejected]"), std::string::npos);
+  const std::string analysis = (dir.path() / "a.json").string();
+  ASSERT_EQ(run_cli({"analyze", rec, "--json", "-o", analysis}).status, 0);
+  const auto out = dir.path() / "report";
+  const auto r = run_cli({"report", analysis, "-o", out.string(), "--no-figures"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string html = slurp(out / "report.html");
+  EXPECT_NE(html.find("<div class=\"warning\"><b>Warnings</b>"), std::string::npos);
+  EXPECT_NE(html.find("<b>fit_rejected</b>"), std::string::npos);
+  EXPECT_NE(html.find("scaled by √(χ²/dof)"), std::string::npos);
+  EXPECT_NE(html.find("<td>fit range</td>"), std::string::npos);
+}
+
+TEST(FitWarnings, GoodFitsOfTheShippedRunsSayNothing) {
+  for (const auto& run : gl2d_runs()) {
+    const auto r = run_cli({"analyze", run, "--json"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const json j = json::parse(r.out);
+    EXPECT_TRUE(j.at("warnings").empty()) << run << ": " << j.at("warnings").dump();
+    EXPECT_EQ(j["fit"]["range"]["chosen_by"], "all") << run;
+    EXPECT_FALSE(j["fit"]["intervals_scaled"].get<bool>()) << run;
+  }
+}
+
+TEST(FitWarnings, OutputFilterMovesTheRangeUnlessTheUserGivesOne) {
+  TempDir dir;
+  const std::string rec = filtered_record(dir);
+  const auto r = run_cli({"analyze", rec, "--input", "angle", "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  const json* w = warning(j, "output_filter");
+  ASSERT_NE(w, nullptr) << j.at("warnings").dump();
+  EXPECT_NE(w->at("command").get<std::string>().find("--fit-range"), std::string::npos);
+  EXPECT_EQ(j["fit"]["range"]["chosen_by"], "short_tau_check");
+  // The filter (20 ms) is found and left out (τ ≥ 10 τf), and N is the simulated 0.002 °/√h within
+  // 3 standard errors (over the full range the fit gives 0.0025, 25 % high).
+  EXPECT_NEAR(j["fit"]["range"]["filter_time_constant_s"].get<double>(), 0.02, 0.004);
+  EXPECT_GE(j["fit"]["tau_min_s"].get<double>(), 0.16);
+  const auto& n = j["fit"]["N_deg_per_sqrt_h"];
+  EXPECT_NEAR(n["value"].get<double>(), 0.002, 3.0 * n["sigma"].get<double>());
+  const auto text = run_cli({"analyze", rec, "--input", "angle"});
+  EXPECT_NE(text.out.find("fit range: tau >= "), std::string::npos);
+  EXPECT_NE(text.out.find("[output_filter]"), std::string::npos);
+  // --fit-range wins, and is stated.
+  const auto given = run_cli({"analyze", rec, "--input", "angle", "--fit-range", "0:", "--json"});
+  ASSERT_EQ(given.status, 0) << given.err;
+  const json g = json::parse(given.out);
+  EXPECT_EQ(g["fit"]["range"]["chosen_by"], "option");
+  EXPECT_EQ(warning(g, "output_filter"), nullptr);
+  EXPECT_EQ(g["fit"]["tau_min_s"].get<double>(), 0.01);
+  EXPECT_NE(g["fit"]["range"]["reason"].get<std::string>().find("--fit-range"), std::string::npos);
+}
+
+TEST(FitWarnings, AllanBoundsOfAnalyzeComeFromTheModel) {
+  const auto r = run_cli({"analyze", source_path("data/gl2d/gl2d_0C.csv.gz").string(), "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_NE(j["allan"]["bounds"].get<std::string>().find("fitted model"), std::string::npos);
+  for (const auto& p : j["allan"]["points"]) {
+    EXPECT_LE(p["dev_low"].get<double>(), p["dev"].get<double>());
+    EXPECT_GE(p["dev_high"].get<double>(), p["dev"].get<double>());
+    EXPECT_GT(p["edf"].get<double>(), 0.0);
+  }
+  // The longest τ (2621 s of a 7200-s record): under two averages' worth of EDF, not Stable32's B1 guess.
+  EXPECT_LT(j["allan"]["points"].back()["edf"].get<double>(), 3.0);
+}
+
+/// Relative variance of the fitted model's σ²(τ) from its coefficients' standard errors (delta method,
+/// correlations left out): the simulated record follows an estimated model.
+double model_log_variance(const json& fit, double tau) {
+  const std::pair<Term, const char*> keys[] = {{Term::Q, "Q_arcsec"},
+                                               {Term::N, "N_deg_per_sqrt_h"},
+                                               {Term::B, "B_deg_per_h"},
+                                               {Term::K, "K_deg_per_h_per_sqrt_h"},
+                                               {Term::R, "R_deg_per_h2"}};
+  double total = 0, v = 0;
+  std::vector<std::pair<double, double>> parts;
+  for (const auto& [t, key] : keys) {
+    const auto& c = fit[key];
+    if (!c["in_model"].get<bool>() || !c["resolved"].get<bool>()) continue;
+    const double value = c["value"], sigma = c["sigma"];
+    const double part = term_basis(t, tau) * c_from_coefficient(t, value);
+    total += part;
+    parts.emplace_back(part, 2.0 * sigma / value);
+  }
+  for (const auto& [part, rel] : parts) v += (part / total) * (part / total) * rel * rel;
+  return v;
+}
+
+/// analyze → simulate --from → analyze: the simulated record's AV and the measured one agree within
+/// the 95 % band at every τ: two independent estimates (F distribution with the model's EDFs) of an
+/// estimated model (its coefficients' standard errors, added in quadrature in ln σ²).
+int points_outside_band(const json& measured, const json& simulated) {
+  int outside = 0;
+  const auto& a = measured["allan"]["points"];
+  const auto& b = simulated["allan"]["points"];
+  EXPECT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) {
+    const double ea = a[i]["edf"], eb = b[i]["edf"];
+    const boost::math::fisher_f f(eb, ea);
+    const double model = 1.96 * std::sqrt(model_log_variance(measured["fit"], a[i]["tau_s"].get<double>()));
+    const double lo = -std::hypot(std::log(boost::math::quantile(f, 0.025)), model);
+    const double hi = std::hypot(std::log(boost::math::quantile(f, 0.975)), model);
+    const double ratio = std::log(b[i]["var"].get<double>() / a[i]["var"].get<double>());
+    if (ratio < lo || ratio > hi) {
+      ++outside;
+      std::printf("tau %g s: ln(simulated/measured AV) %.3g outside [%.3g, %.3g]\n", a[i]["tau_s"].get<double>(), ratio,
+                  lo, hi);
+    }
+  }
+  return outside;
+}
+
+TEST(SimulateFrom, FittedModelReproducesTheMeasuredAllanDeviation) {
+  TempDir dir;
+  const std::string analysis = (dir.path() / "a.json").string();
+  ASSERT_EQ(run_cli({"analyze", source_path("data/gl2d/gl2d_p25C.csv.gz").string(), "--json", "-o", analysis}).status,
+            0);
+  const json a = json::parse(slurp(analysis));
+  ASSERT_FALSE(a["fit"]["K_deg_per_h_per_sqrt_h"]["in_model"].get<bool>());
+  auto round_trip = [&](bool upper) {
+    const std::string sim = (dir.path() / (upper ? "u.csv.gz" : "s.csv.gz")).string();
+    std::vector<std::string> args{"simulate", "--from", analysis, "-o", sim, "--seed", "3"};
+    if (upper) args.push_back("--upper-bounds");
+    const auto s = run_cli(args);
+    EXPECT_EQ(s.status, 0) << s.err;
+    EXPECT_NE(s.err.find(upper ? "upper bound" : "left out"), std::string::npos) << s.err;
+    const auto r = run_cli({"analyze", sim, "--json"});
+    EXPECT_EQ(r.status, 0) << r.err;
+    return json::parse(r.out);
+  };
+  EXPECT_EQ(points_outside_band(a, round_trip(false)), 0);
+  // With the unresolved K and R at their upper bounds the long-τ AV is far above the measured one.
+  const json u = round_trip(true);
+  EXPECT_GT(u["allan"]["points"].back()["dev"].get<double>(), 5.0 * a["allan"]["points"].back()["dev"].get<double>());
+  EXPECT_GE(points_outside_band(a, u), 2);
+}
+
+TEST(SimulateFrom, UpperBoundsNeedFrom) {
+  TempDir dir;
+  const auto r = run_cli({"simulate", "-o", (dir.path() / "x.csv").string(), "--upper-bounds"});
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("--from"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rwcalc
