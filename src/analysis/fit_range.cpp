@@ -10,7 +10,7 @@
 #include <map>
 #include <cmath>
 
-#include "diagnose/detector.hpp"  // the first-order output filter's AV of white rate (output_lowpass_rate_avar)
+#include "model/output_filter.hpp"
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/printable.hpp"
@@ -52,7 +52,7 @@ double filter_time_constant(const FitResult& f, double tau0, double measured) {
   const double rest = f.model_var(tau0) - q_part - n * term_basis(Term::N, tau0);
   auto filtered = [&](double tf) {
     const double phi = std::exp(-tau0 / tf);
-    return q_part * (3.0 - 4.0 * phi + phi * phi) / 3.0 + n * diag::output_lowpass_rate_avar(1, tau0, tf) + rest;
+    return q_part * (3.0 - 4.0 * phi + phi * phi) / 3.0 + n * output_lowpass_rate_avar(1, tau0, tf) + rest;
   };
   double lo = std::log(tau0 * 1e-3), hi = std::log(tau0 * 1e3);
   if (filtered(std::exp(hi)) > measured) return std::exp(hi);

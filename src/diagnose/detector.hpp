@@ -9,6 +9,7 @@
 
 #include "diagnose/ensemble.hpp"
 #include "diagnose/signal.hpp"
+#include "model/output_filter.hpp"
 #include "rwcalc/diagnose.hpp"
 
 namespace rwcalc::diag {
@@ -59,10 +60,6 @@ WarmupEstimate warmup_detect(const Decimated& d);
 NoiseModel own_candidates(const Decimated& d);
 Decimated without_own_candidates(const Decimated& d);
 
-/// Overlapping AV at cluster size m of unit white angle noise and of a unit white rate after a
-/// first-order output-chain low-pass of time constant tf (0: none).
-double output_lowpass_angle_avar(std::size_t m, double tau0, double tf);
-double output_lowpass_rate_avar(std::size_t m, double tau0, double tf);
 
 struct OutputLowpassEstimate {
   double statistic = 0;                    ///< χ² drop of the short-τ octave AV with the filter
