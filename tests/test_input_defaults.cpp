@@ -209,5 +209,30 @@ TEST(InputDefaults, ARateThatDisagreesWithTheTimeColumnNamesTheToleranceThatWoul
   EXPECT_EQ(ok.status, 0) << ok.err;
 }
 
+// The gyro and the test are identified from the file's metadata, and the command line takes the
+// place of a key (with a note); text and JSON carry them, with the file's size and SHA-256.
+TEST(InputDefaults, SerialOperatorDateAndConditionsFromMetadataOrOptions) {
+  TempDir dir;
+  std::string body = "# rate_hz: 400\n# Serial: GL2D-0421\n# operator: Ivanov\npulses\n";
+  for (int i = 0; i < 24000; ++i) body += std::to_string(i % 5 - 2) + "\n";
+  const auto f = dir.write("run.csv", body);
+  const auto text = run_cli({"analyze", f.string(), "--operator", "Petrov", "--test-date", "2026-11-27"});
+  ASSERT_EQ(text.status, 0) << text.err;
+  EXPECT_NE(text.out.find("gyro and test: serial GL2D-0421; operator Petrov; test date 2026-11-27"),
+            std::string::npos)
+      << text.out;
+  EXPECT_NE(text.err.find("operator 'Petrov' from the command line, not the file's 'Ivanov'"), std::string::npos)
+      << text.err;
+  const auto js = run_cli({"analyze", f.string(), "--json", "--conditions", "static, +25 °C"});
+  ASSERT_EQ(js.status, 0) << js.err;
+  const auto in = nlohmann::json::parse(js.out).at("input");
+  EXPECT_EQ(in.at("identification").at("serial"), "GL2D-0421");
+  EXPECT_EQ(in.at("identification").at("operator"), "Ivanov");
+  EXPECT_EQ(in.at("identification").at("conditions"), "static, +25 °C");
+  EXPECT_TRUE(in.at("identification").at("test_date").is_null());
+  EXPECT_EQ(in.at("file_bytes").get<std::uintmax_t>(), std::filesystem::file_size(f));
+  EXPECT_EQ(in.at("sha256").get<std::string>().size(), 64u);
+}
+
 }  // namespace
 }  // namespace rwcalc::test

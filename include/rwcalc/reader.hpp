@@ -50,6 +50,10 @@ struct ReadOptions {
   /// A time-column step off the period by more than this fraction of it is jitter (accepted and
   /// reported) while it stays within half a period; 1.5 periods or more is a gap (an error).
   double time_tolerance = 0.01;
+  /// What identifies the gyro and the test, given on the command line (--serial, --operator,
+  /// --test-date, --conditions): keys "serial", "operator", "test_date", "conditions". They take
+  /// the place of the file's metadata of the same name (a note says so when that differs).
+  std::map<std::string, std::string> identification;
 };
 
 /// Where the sample rate came from (reported in outputs).
@@ -104,6 +108,9 @@ struct Recording {
   /// pulse and rate input, sample i+1 (the later reading) for counter and angle input.
   [[nodiscard]] std::size_t line_of_rate(std::size_t i) const noexcept;
 };
+
+/// The identification keys a test report shows, in order: serial, operator, test_date, conditions.
+inline constexpr std::string_view kIdentificationKeys[] = {"serial", "operator", "test_date", "conditions"};
 
 /// Read a file (or "-" for stdin). Throws InputError (file, line, message) on any malformed input.
 Recording read_recording(const std::string& path, const ReadOptions& options = {});

@@ -147,6 +147,12 @@ nlohmann::json input_json(const Recording& rec) {
                       {"warnings", rec.warnings},
                       {"file_bytes", rec.file_bytes},
                       {"sha256", rec.sha256}};
+  nlohmann::json id = nlohmann::json::object();
+  for (std::string_view key : kIdentificationKeys) {
+    const auto it = rec.metadata.find(std::string(key));
+    id[std::string(key)] = it == rec.metadata.end() ? nlohmann::json(nullptr) : nlohmann::json(it->second);
+  }
+  j["identification"] = std::move(id);
   if (rec.mode == InputMode::Pulses || rec.mode == InputMode::Counter)
     j["arcsec_per_count"] = rec.phase.arcsec_per_count;
   j["time_column"] = rec.time_column ? nlohmann::json(*rec.time_column) : nlohmann::json(nullptr);
@@ -267,7 +273,8 @@ void fit_with_checks(const std::vector<FitPoint>& points, const AnalysisOptions&
   const bool default_range = fopt.tau_min_s == 0 && std::isinf(fopt.tau_max_s);
   if (options.fit_range_given || !default_range) {
     range.source = FitRangeChoice::Source::Option;
-  } else if (options.fit_checks && !exact_counts) {  // pulse counts have no output filter: their short τ is the read-out
+  } else if (options.fit_checks &&
+             !exact_counts) {  // pulse counts have no output filter: their short τ is the read-out
     const OutputFilterCheck check = check_output_filter(points, fopt);
     if (check.found || check.departures) {
       range.source = FitRangeChoice::Source::ShortTau;
@@ -361,47 +368,63 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   return r;
 }
 
-nlohmann::json to_json(const AnalysisResult& r) {
-  using nlohmann::json;
+namespace {
+
+using nlohmann::json;
+
+json fit_json(const AnalysisResult& r) {
   const auto& f = r.fit;
-  json fit = {{"Q_arcsec", coef_json(f[Term::Q])},
-              {"N_deg_per_sqrt_h", coef_json(f[Term::N])},
-              {"B_deg_per_h", coef_json(f[Term::B])},
-              {"K_deg_per_h_per_sqrt_h", coef_json(f[Term::K])},
-              {"R_deg_per_h2", coef_json(f[Term::R])},
-              {"chi2_per_dof", f.chi2_per_dof},
-              {"chi2", f.chi2},
-              {"dof", f.dof},
-              {"p_value", f.p_value},
-              {"corr_NQ", f.corr_NQ},
-              {"corr_NB", f.corr_NB},
-              {"points", f.used.size()},
-              {"tau_min_s", f.used.empty() ? 0.0 : f.used.front().tau_s},
-              {"tau_max_s", f.used.empty() ? 0.0 : f.used.back().tau_s},
-              {"dispersion", f.options.dispersion},
-              {"edf_inflation", f.options.edf_inflation},
-              {"edf_cap", f.options.edf_cap},
-              {"phi_N", f.phi[static_cast<std::size_t>(Term::N)]},
-              {"phi_B", f.phi[static_cast<std::size_t>(Term::B)]},
-              {"confidence", f.options.confidence},
-              {"range",
-               {{"tau_min_s", r.fit_range.tau_min_s},
-                {"tau_max_s", std::isinf(r.fit_range.tau_max_s) ? json(nullptr) : json(r.fit_range.tau_max_s)},
-                {"chosen_by", range_source_name(r.fit_range.source)},
-                {"reason", r.fit_range.reason()},
-                {"shortest_tau_ratio", r.fit_range.shortest_ratio},
-                {"filter_time_constant_s", r.fit_range.filter_tc_s},
-                {"departure_tau_s", r.fit_range.departure_tau_s},
-                {"departure_ratio", r.fit_range.departure_ratio},
-                {"reference_tau_min_s", r.fit_range.reference_tau_s}}},
-              {"intervals_scaled", r.fit_range.intervals_scaled},
-              {"interval_scale", r.fit_range.interval_scale}};
+  return {{"Q_arcsec", coef_json(f[Term::Q])},
+          {"N_deg_per_sqrt_h", coef_json(f[Term::N])},
+          {"B_deg_per_h", coef_json(f[Term::B])},
+          {"K_deg_per_h_per_sqrt_h", coef_json(f[Term::K])},
+          {"R_deg_per_h2", coef_json(f[Term::R])},
+          {"chi2_per_dof", f.chi2_per_dof},
+          {"chi2", f.chi2},
+          {"dof", f.dof},
+          {"p_value", f.p_value},
+          {"corr_NQ", f.corr_NQ},
+          {"corr_NB", f.corr_NB},
+          {"points", f.used.size()},
+          {"tau_min_s", f.used.empty() ? 0.0 : f.used.front().tau_s},
+          {"tau_max_s", f.used.empty() ? 0.0 : f.used.back().tau_s},
+          {"dispersion", f.options.dispersion},
+          {"edf_inflation", f.options.edf_inflation},
+          {"edf_cap", f.options.edf_cap},
+          {"phi_N", f.phi[static_cast<std::size_t>(Term::N)]},
+          {"phi_B", f.phi[static_cast<std::size_t>(Term::B)]},
+          {"confidence", f.options.confidence},
+          {"range",
+           {{"tau_min_s", r.fit_range.tau_min_s},
+            {"tau_max_s", std::isinf(r.fit_range.tau_max_s) ? json(nullptr) : json(r.fit_range.tau_max_s)},
+            {"chosen_by", range_source_name(r.fit_range.source)},
+            {"reason", r.fit_range.reason()},
+            {"shortest_tau_ratio", r.fit_range.shortest_ratio},
+            {"filter_time_constant_s", r.fit_range.filter_tc_s},
+            {"departure_tau_s", r.fit_range.departure_tau_s},
+            {"departure_ratio", r.fit_range.departure_ratio},
+            {"reference_tau_min_s", r.fit_range.reference_tau_s}}},
+          {"intervals_scaled", r.fit_range.intervals_scaled},
+          {"interval_scale", r.fit_range.interval_scale}};
+}
+
+json warnings_json(const AnalysisResult& r) {
   json warnings = json::array();
   for (const auto& w : r.warnings)
     warnings.push_back({{"code", w.code}, {"message", w.message}, {"command", w.command}});
+  return warnings;
+}
+
+json allan_bounds_json(const AnalysisResult& r) {
   json allan = allan_json(r.allan);
   allan["bounds"] = r.model_bounds ? "fitted model: EDF = 2 sigma^4/Var(sigma^2 estimate), alpha of the leading term"
                                    : "Stable32 noise identification and Greenhall-Riley EDF";
+  return allan;
+}
+
+/// Direct N: the unbiased estimate, its regression curve (the seed paper's Fig. 2) and, for the
+/// figure, the paper's straight line.
+json direct_n_json(const AnalysisResult& r) {
   json n_direct = method_json(r.direct.N);
   if (!n_direct.is_null()) {
     n_direct["estimator"] = "overlapping increments, regression on the exact expectations of Q, N, B";
@@ -432,6 +455,11 @@ nlohmann::json to_json(const AnalysisResult& r) {
       n_direct["slope_arcsec2_per_s"] = r.direct.straight.slope_arcsec2_per_s;
     }
   }
+  return n_direct;
+}
+
+json methods_json(const AnalysisResult& r) {
+  json n_direct = direct_n_json(r);
   json straight = nullptr;
   if (r.direct.straight.valid)
     straight = {{"value", r.direct.straight.value},
@@ -456,6 +484,40 @@ nlohmann::json to_json(const AnalysisResult& r) {
     spread["expected_sigma"] = r.avg100.expected_sigma;
     spread["discrepancy_model_sigma"] = r.B_100s_vs_model_sigma;
   }
+  return {{"N_direct_deg_per_sqrt_h", n_direct},
+          {"N_straight_line_paper_deg_per_sqrt_h", straight},
+          {"B_100s_deg_per_h", b100},
+          {"spread_100s_deg_per_h", spread}};
+}
+
+json slope_json(const AnalysisResult& r) {
+  return {{"N_deg_per_sqrt_h", opt_num(r.slope.N)},
+          {"tau_N_s", r.slope.tau_N_s},
+          {"B_deg_per_h", opt_num(r.slope.B)},
+          {"B_sigma", r.slope_B_sigma},
+          {"B_low95", r.b_min.B.valid ? json(r.b_min.B.low) : json(nullptr)},
+          {"B_high95", r.b_min.B.valid ? json(r.b_min.B.high) : json(nullptr)},
+          {"B_edf", r.b_min.edf},
+          {"B_bias_factor", r.b_min.bias_factor},
+          {"sigma_min_deg_per_h", r.slope.sigma_min},
+          {"tau_min_s", r.slope.tau_min_s},
+          {"K_deg_per_h_per_sqrt_h", opt_num(r.slope.K)},
+          {"tau_K_s", r.slope.tau_K_s}};
+}
+
+json conventions_json() {
+  return {{"Q", "rms white angle error, sigma^2 = 3 Q^2/tau^2 (IEEE 952); the paper's eq. (2) Q is sqrt(3) Q"},
+          {"N", "sigma^2 = N^2/tau; N = sigma at tau = 1 h"},
+          {"B", "sigma^2 = (2 ln2/pi) B^2, floor 0.6643 B (the paper prints B where B^2 is meant)"},
+          {"K", "sigma^2 = K^2 tau/3; K = sigma at tau = 3 h"},
+          {"R", "sigma^2 = R^2 tau^2/2"},
+          {"deviation_unit", "deg/h (1 arcsec/s = 1 deg/h)"},
+          {"intervals", "95 % profile-likelihood; resolved=false: value is the 95 % upper bound"}};
+}
+
+}  // namespace
+
+nlohmann::json to_json(const AnalysisResult& r) {
   return {{"source", r.source},
           {"input", r.input},
           {"samples", r.samples},
@@ -467,37 +529,14 @@ nlohmann::json to_json(const AnalysisResult& r) {
           {"earth_rate_deg_per_h", r.earth_rate_deg_per_h},
           {"latitude_deg", r.earth_rate_given ? json(nullptr) : json(r.latitude_deg)},
           {"bias_deg_per_h", r.bias_deg_per_h},
-          {"warnings", warnings},
-          {"allan", allan},
-          {"fit", fit},
-          {"slope_readout",
-           {{"N_deg_per_sqrt_h", opt_num(r.slope.N)},
-            {"tau_N_s", r.slope.tau_N_s},
-            {"B_deg_per_h", opt_num(r.slope.B)},
-            {"B_sigma", r.slope_B_sigma},
-            {"B_low95", r.b_min.B.valid ? json(r.b_min.B.low) : json(nullptr)},
-            {"B_high95", r.b_min.B.valid ? json(r.b_min.B.high) : json(nullptr)},
-            {"B_edf", r.b_min.edf},
-            {"B_bias_factor", r.b_min.bias_factor},
-            {"sigma_min_deg_per_h", r.slope.sigma_min},
-            {"tau_min_s", r.slope.tau_min_s},
-            {"K_deg_per_h_per_sqrt_h", opt_num(r.slope.K)},
-            {"tau_K_s", r.slope.tau_K_s}}},
-          {"methods",
-           {{"N_direct_deg_per_sqrt_h", n_direct},
-            {"N_straight_line_paper_deg_per_sqrt_h", straight},
-            {"B_100s_deg_per_h", b100},
-            {"spread_100s_deg_per_h", spread}}},
+          {"warnings", warnings_json(r)},
+          {"allan", allan_bounds_json(r)},
+          {"fit", fit_json(r)},
+          {"slope_readout", slope_json(r)},
+          {"methods", methods_json(r)},
           {"outliers", to_json(r.outliers)},
           {"verdict", to_json(r.verdict)},
-          {"conventions",
-           {{"Q", "rms white angle error, sigma^2 = 3 Q^2/tau^2 (IEEE 952); the paper's eq. (2) Q is sqrt(3) Q"},
-            {"N", "sigma^2 = N^2/tau; N = sigma at tau = 1 h"},
-            {"B", "sigma^2 = (2 ln2/pi) B^2, floor 0.6643 B (the paper prints B where B^2 is meant)"},
-            {"K", "sigma^2 = K^2 tau/3; K = sigma at tau = 3 h"},
-            {"R", "sigma^2 = R^2 tau^2/2"},
-            {"deviation_unit", "deg/h (1 arcsec/s = 1 deg/h)"},
-            {"intervals", "95 % profile-likelihood; resolved=false: value is the 95 % upper bound"}}}};
+          {"conventions", conventions_json()}};
 }
 
 namespace {
@@ -514,8 +553,17 @@ std::string input_line(const nlohmann::json& in) {
   if (in.contains("time_unit"))
     s += fmt::format(" ('{}', in {} by {})", in["time_column"].get<std::string>(), in.value("time_unit", ""),
                      in.value("time_unit_source", ""));
+  if (const auto id = in.find("identification"); id != in.end() && id->is_object()) {
+    std::string who;
+    for (const auto& [key, label] : {std::pair{"serial", "serial"}, std::pair{"operator", "operator"},
+                                     std::pair{"test_date", "test date"}, std::pair{"conditions", "conditions"}})
+      if (id->contains(key) && (*id)[key].is_string())
+        who += fmt::format("{}{} {}", who.empty() ? "" : "; ", label, printable((*id)[key].get<std::string>()));
+    if (!who.empty()) s += "\n  gyro and test: " + who;
+  }
   if (in.contains("sha256"))
-    s += fmt::format("\n  file: {} bytes, SHA-256 {}", in.value("file_bytes", std::uint64_t{0}), in.value("sha256", ""));
+    s +=
+        fmt::format("\n  file: {} bytes, SHA-256 {}", in.value("file_bytes", std::uint64_t{0}), in.value("sha256", ""));
   return s + "\n";
 }
 
@@ -553,12 +601,12 @@ std::string format_report(const AnalysisResult& r) {
   s += "\n";
 
   const auto& f = r.fit;
-  s += fmt::format("Noise coefficients (Gamma-deviance fit of {} octave points, tau {:g}..{:g} s; 95 % profile "
-                   "intervals{})\n",
-                   f.used.size(), f.used.front().tau_s, f.used.back().tau_s,
-                   r.fit_range.intervals_scaled
-                       ? fmt::format(", scaled by sqrt(chi2/dof) = {:.3g}", r.fit_range.interval_scale)
-                       : std::string());
+  s += fmt::format(
+      "Noise coefficients (Gamma-deviance fit of {} octave points, tau {:g}..{:g} s; 95 % profile "
+      "intervals{})\n",
+      f.used.size(), f.used.front().tau_s, f.used.back().tau_s,
+      r.fit_range.intervals_scaled ? fmt::format(", scaled by sqrt(chi2/dof) = {:.3g}", r.fit_range.interval_scale)
+                                   : std::string());
   s += fmt::format("  fit range: {}\n", r.fit_range.reason());
   for (const Term t : kAllTerms)
     s += coef_line(f[t], term_name(t),

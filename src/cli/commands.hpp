@@ -36,6 +36,7 @@ struct InputArgs {
   std::string angle_unit;  ///< empty: not given (the column name's suffix, else arcsec)
   std::string rate_unit;   ///< empty: not given (the column name's suffix, else deg/h)
   double time_tolerance = 0.01;
+  std::string serial, operator_name, test_date, conditions;  ///< empty: the file's metadata, if any
   void add_to(CLI::App& app);
   [[nodiscard]] ReadOptions options() const;  ///< throws UsageError on bad names
 };

@@ -9,7 +9,15 @@
 
 namespace rwcalc::cli {
 
+namespace {
+constexpr const char* kIdGroup = "Identification (else the file's # serial:, # operator:, # test_date:, # conditions:)";
+}
+
 void InputArgs::add_to(CLI::App& app) {
+  app.add_option("--serial", serial, "Serial number of the gyro under test")->group(kIdGroup);
+  app.add_option("--operator", operator_name, "Who ran the test")->group(kIdGroup);
+  app.add_option("--test-date", test_date, "Date of the test, e.g. 2026-11-27")->group(kIdGroup);
+  app.add_option("--conditions", conditions, "Test conditions, e.g. 'static, +25 °C, vertical axis'")->group(kIdGroup);
   app.add_option("--input", input,
                  "What the column holds: pulses (per-sample pulse increments), counter (cumulative "
                  "counter, wraps at --counter-bits), angle (cumulative angle/phase in --angle-unit), "
@@ -55,6 +63,9 @@ ReadOptions InputArgs::options() const {
   if (!angle_unit.empty()) o.angle_unit = parse_angle_unit(angle_unit);
   if (!rate_unit.empty()) o.rate_unit = parse_rate_unit(rate_unit);
   o.time_tolerance = time_tolerance;
+  const std::string* given[] = {&serial, &operator_name, &test_date, &conditions};
+  for (std::size_t i = 0; i < std::size(given); ++i)
+    if (!given[i]->empty()) o.identification[std::string(kIdentificationKeys[i])] = *given[i];
   return o;
 }
 

@@ -133,7 +133,8 @@ void Metadata::read(std::string_view body, std::size_t line, const std::string& 
   if (c >= body.size() || (body[c] != ':' && body[c] != '=')) return;
   const std::string canonical = canonical_key(body.substr(0, k));
   const bool known = canonical == "rate_hz" || canonical == "scale_arcsec_per_pulse" || canonical == "temperature_c" ||
-                     canonical == "serial";
+                     std::find(std::begin(kIdentificationKeys), std::end(kIdentificationKeys), canonical) !=
+                         std::end(kIdentificationKeys);
   const std::string key = known ? canonical : std::string(body.substr(0, k));
   const std::string value(trim(body.substr(c + 1)));
 

@@ -557,6 +557,12 @@ Recording Reader::finish() {
   rec.rate_unit = in().rate_unit;
   rec.notes = in().notes;
   rec.warnings = in().warnings;
+  for (const auto& [key, value] : opt_.identification) {
+    auto& slot = rec.metadata[key];
+    if (!slot.empty() && slot != value)
+      rec.notes.push_back(fmt::format("{} '{}' from the command line, not the file's '{}'", key, value, slot));
+    slot = value;
+  }
   note_time_column(rec);
   rec.line_runs = std::move(runs_);
   return rec;
