@@ -155,13 +155,31 @@ TEST_F(ReportOfGl2d, EveryFigureIsInlineValidSvgWithItsSeries) {
 TEST_F(ReportOfGl2d, SettingsAndVersionAreStated) {
   const auto s = element(html_, "table", "settings-table");
   ASSERT_FALSE(s.empty());
-  EXPECT_NE(s.find(std::string("<tr><th>rwcalc version</th><td>") + RWCALC_VERSION + "</td></tr>"), std::string::npos);
+  EXPECT_NE(s.find(std::string("<tr><th>rwcalc version</th><td>rwcalc ") + RWCALC_VERSION + " (commit "),
+            std::string::npos);
+  std::size_t b_rows = 0;  // the B estimate is stated once
+  for (auto at = s.find("<th>B estimate"); at != std::string::npos; at = s.find("<th>B estimate", at + 1)) ++b_rows;
+  EXPECT_EQ(b_rows, 1u) << s;
   EXPECT_NE(s.find("<tr><th>tolerance on B (%)</th><td>50</td></tr>"), std::string::npos) << s;
   EXPECT_NE(s.find("<tr><th>input</th><td>pulses</td></tr>"), std::string::npos) << s;
   EXPECT_NE(s.find("<tr><th>latitude (°)</th><td>55.75</td></tr>"), std::string::npos) << s;
   EXPECT_NE(s.find("<tr><th>B estimate</th><td>fit</td></tr>"), std::string::npos) << s;
   EXPECT_NE(s.find("gl2d_m50C.csv.gz"), std::string::npos) << s;
   EXPECT_NE(html_.find(" UTC"), std::string::npos) << "the generated time stamp";
+}
+
+// Each run names its gyro (here by option) and its file by size and SHA-256, as the analysis JSON does.
+TEST_F(ReportOfGl2d, EachRunNamesItsGyroAndItsFileDigest) {
+  const auto out = dir() / "identified";
+  const auto r = run_cli({"report", gl2d_all().front(), "-o", out.string(), "--no-figures", "--serial", "GL2D-0421",
+                          "--operator", "A. Ivanov"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto html = slurp(out / "report.html");
+  EXPECT_NE(html.find("<tr><th>gyro serial</th><td>GL2D-0421</td></tr>"), std::string::npos);
+  EXPECT_NE(html.find("<tr><th>operator</th><td>A. Ivanov</td></tr>"), std::string::npos);
+  const auto a = run_cli({"analyze", gl2d_all().front(), "--json"});
+  const auto sha = nlohmann::json::parse(a.out).at("input").at("sha256").get<std::string>();
+  EXPECT_NE(html.find("<code>" + sha + "</code>"), std::string::npos) << sha;
 }
 
 TEST_F(ReportOfGl2d, SavedBatchJsonGivesTheSameTablesAndVerdict) {

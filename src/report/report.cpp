@@ -1,5 +1,6 @@
 // The HTML test report: tables from the analysis JSON, figures by gnuplot, all in one file.
 #include "rwcalc/report.hpp"
+#include "rwcalc/version.hpp"
 
 #include <fmt/format.h>
 
@@ -294,6 +295,14 @@ std::string data_table(const json& run, std::size_t index) {
   std::string s =
       fmt::format("<table class=\"run\" id=\"run{}-data\">\n<caption>Data and rates</caption>\n", index + 1);
   s += kv_row("file", esc(str(run, "source")));
+  const json& input = at(run, "input");
+  if (const json& id = at(input, "identification"); id.is_object())
+    for (const auto& [key, label] : {std::pair{"serial", "gyro serial"}, std::pair{"operator", "operator"},
+                                     std::pair{"test_date", "test date"}, std::pair{"conditions", "test conditions"}})
+      if (const auto v = str(id, key); !v.empty()) s += kv_row(label, esc(v));
+  if (const auto sha = str(input, "sha256"); !sha.empty())
+    s += kv_row("file size, SHA-256", fmt::format("{:.0f} bytes, <code>{}</code>", num(input, "file_bytes").value_or(0),
+                                                  esc(sha)));
   if (const auto n = num(run, "samples")) s += kv_row("samples", fmt::format("{:.0f}", *n));
   if (const auto r = num(run, "rate_hz")) s += kv_row("sample rate", fmt::format("{:g} Hz", *r));
   if (const auto d = num(run, "duration_s")) s += kv_row("duration", fmt::format("{:.1f} s ({:.2f} h)", *d, *d / 3600));
@@ -474,10 +483,11 @@ std::string batch_figures_html(const std::vector<json>& a, Figures& figures) {
 
 std::string settings_html(const ReportOptions& options, const json& first) {
   std::string h = "<h2 id=\"settings\">Settings and conventions</h2>\n<table id=\"settings-table\">\n";
-  h += kv_row("rwcalc version", RWCALC_VERSION);
+  h += kv_row("rwcalc version", esc(version_line()));
   if (options.settings.is_object())
     for (const auto& [k, v] : options.settings.items()) h += kv_row(k, json_value_html(v));
-  if (auto b = str(at(first, "verdict"), "b_estimate"); !b.empty())
+  const bool b_in_settings = options.settings.is_object() && options.settings.contains("B estimate");
+  if (auto b = str(at(first, "verdict"), "b_estimate"); !b.empty() && !b_in_settings)
     h += kv_row("B estimate used by the verdict", esc(b));
   if (const auto& conventions = at(first, "conventions"); conventions.is_object())
     for (const auto& [k, v] : conventions.items()) h += kv_row("convention: " + k, json_value_html(v));
