@@ -18,6 +18,7 @@
 
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/simulate.hpp"
+#include "test_support.hpp"
 
 namespace rwcalc {
 namespace {
@@ -46,32 +47,17 @@ int env_count(const char* name, int fallback) {
   return e ? std::max(20, std::atoi(e)) : fallback;
 }
 
-std::optional<int> true_class(double b, double n, const ClassTable& t) {
-  for (const auto& c : t.classes)
-    if (b <= c.B_deg_per_h && n <= c.N_deg_per_sqrt_h) return c.cls;
-  return std::nullopt;
-}
-
 double probit(double p) {
   return boost::math::quantile(boost::math::normal_distribution<double>(), std::clamp(p, 1e-15, 1.0 - 1e-15));
 }
 
 Outcome run_one(const RecordSet& set, std::uint64_t seed, double n, double b) {
-  NoiseModel m;
-  m.arw_deg_per_sqrt_h = n;
-  m.bias_instability_deg_per_h = b;
-  m.readout = ReadoutMode::White;
-  m.earth_rate_deg_per_h = earth_rate_at(55.75);
   SimulationSettings s;
   s.duration_s = set.duration_s;
   s.rate_hz = set.rate_hz;
   s.scale_arcsec = set.scale_arcsec;
   s.seed = seed;
-  Recording rec;
-  rec.source = "sim";
-  rec.phase = simulate(m, s);
-  rec.rate_hz = set.rate_hz;
-  rec.samples = rec.phase.points() - 1;
+  const Recording rec = test::simulated_gyro(n, b, s);
   AnalysisOptions o;
   const AnalysisResult r = analyze(rec, o);
   Outcome out{};
@@ -80,7 +66,7 @@ Outcome run_one(const RecordSet& set, std::uint64_t seed, double n, double b) {
   out.n_in = r.fit[Term::N].low <= n && n <= r.fit[Term::N].high;
   out.b_in = r.fit[Term::B].low <= b && b <= r.fit[Term::B].high;
   out.p_class = r.verdict.p_class;
-  out.class_right = true_class(b, n, o.verdict.table) == r.verdict.cls;
+  out.class_right = test::true_class(b, n, o.verdict.table) == r.verdict.cls;
   out.p_b2 = r.verdict.B.p_meets[1];
   out.b2_true = b <= 0.008;
   return out;

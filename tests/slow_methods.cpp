@@ -13,6 +13,7 @@
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/parallel.hpp"
 #include "rwcalc/simulate.hpp"
+#include "test_support.hpp"
 
 namespace rwcalc {
 namespace {
@@ -20,12 +21,6 @@ namespace {
 int records() {
   const char* e = std::getenv("RWCALC_METHODS_RECORDS");
   return e ? std::max(20, std::atoi(e)) : 48;
-}
-
-std::optional<int> true_class(double b, double n, const ClassTable& t) {
-  for (const auto& c : t.classes)
-    if (b <= c.B_deg_per_h && n <= c.N_deg_per_sqrt_h) return c.cls;
-  return std::nullopt;
 }
 
 struct Outcome {
@@ -39,25 +34,16 @@ Outcome run_one(int i) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const double n = 0.0007 * std::pow(0.0013 / 0.0007, u(draw));
   const double b = 0.005 * std::pow(0.012 / 0.005, u(draw));
-  NoiseModel m;
-  m.arw_deg_per_sqrt_h = n;
-  m.bias_instability_deg_per_h = b;
-  m.readout = ReadoutMode::White;
-  m.earth_rate_deg_per_h = earth_rate_at(55.75);
   SimulationSettings s;
   s.seed = 0x4d455448u + static_cast<std::uint64_t>(i);
-  Recording rec;
-  rec.source = "sim";
-  rec.phase = simulate(m, s);
-  rec.rate_hz = s.rate_hz;
-  rec.samples = rec.phase.points() - 1;
+  const Recording rec = test::simulated_gyro(n, b, s);
   Outcome o;
   const std::array kinds{BEstimate::Fit, BEstimate::SigmaMin, BEstimate::Avg100};
   for (std::size_t k = 0; k < kinds.size(); ++k) {
     AnalysisOptions opt;
     opt.verdict.b_estimate = kinds[k];
     const AnalysisResult r = analyze(rec, opt);
-    o.right[k] = true_class(b, n, opt.verdict.table) == r.verdict.cls;
+    o.right[k] = test::true_class(b, n, opt.verdict.table) == r.verdict.cls;
     if (k != 0) continue;
     const auto& dn = r.direct.N;
     EXPECT_TRUE(dn.valid && r.b100.B.valid && r.b_min.B.valid) << i;

@@ -14,6 +14,8 @@
 #include <sstream>
 
 #include "rwcalc/cli.hpp"
+#include "rwcalc/reader.hpp"
+#include "rwcalc/verdict.hpp"
 
 namespace rwcalc::test {
 
@@ -151,6 +153,26 @@ NoiseModel gl2d_model() {
   m.earth_rate_deg_per_h = earth_rate_at(55.75);
   m.readout = ReadoutMode::White;
   return m;
+}
+
+Recording simulated_gyro(double n, double b, const SimulationSettings& settings) {
+  NoiseModel m;
+  m.arw_deg_per_sqrt_h = n;
+  m.bias_instability_deg_per_h = b;
+  m.readout = ReadoutMode::White;
+  m.earth_rate_deg_per_h = earth_rate_at(55.75);
+  Recording rec;
+  rec.source = "sim";
+  rec.phase = simulate(m, settings);
+  rec.rate_hz = settings.rate_hz;
+  rec.samples = rec.phase.points() - 1;
+  return rec;
+}
+
+std::optional<int> true_class(double b, double n, const ClassTable& table) {
+  for (const auto& c : table.classes)
+    if (b <= c.B_deg_per_h && n <= c.N_deg_per_sqrt_h) return c.cls;
+  return std::nullopt;
 }
 
 PhaseSeries floating_angle(const PhaseSeries& x) {

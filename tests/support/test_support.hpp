@@ -9,6 +9,11 @@
 
 #include "rwcalc/simulate.hpp"
 
+namespace rwcalc {
+struct Recording;   // rwcalc/reader.hpp
+struct ClassTable;  // rwcalc/verdict.hpp
+}  // namespace rwcalc
+
 namespace rwcalc::test {
 
 /// Path of a file under ../shared/data (the read-only reference material).
@@ -71,6 +76,13 @@ std::vector<std::string> concat(std::vector<std::string> a, const std::vector<st
 /// The same record as a floating angle x_i − x_0 (the domain of the line and low-pass detectors);
 /// a record that is already floating is returned as it is.
 PhaseSeries floating_angle(const PhaseSeries& x);
+
+/// A GL-2D-like record of the coverage tests: ARW n (°/√h), flicker b (°/h), white read-out, the
+/// vertical Earth rate at 55.75°, simulated with `settings` (its seed, length, rate, pulse weight).
+Recording simulated_gyro(double n, double b, const SimulationSettings& settings);
+
+/// The class a gyro with these true B and N belongs to (none: beyond the table).
+std::optional<int> true_class(double b, double n, const ClassTable& table);
 
 /// Sets (or, with a null value, unsets) an environment variable for the lifetime of the object,
 /// then restores it.
