@@ -57,9 +57,13 @@ TEST(ReaderMetadataKeys, TwoSpellingsOfOneKeyMustAgree) {
   EXPECT_EQ(read_recording_text("# rate_hz: 100\n# Rate_Hz = 100\npulses\n1\n2\n", "m").rate_hz, 100.0);
 }
 
-TEST(ReaderMetadataKeys, OtherKeysAreKeptAsWritten) {
-  const auto r = read_recording_text("# Operator = Fomin\n# GL-2D bench run: static\npulses\n1\n2\n", "m");
-  EXPECT_EQ(r.metadata.at("Operator"), "Fomin");
+TEST(ReaderMetadataKeys, OtherKeysAreKeptAsWrittenAndIdentificationKeysCanonical) {
+  const auto r = read_recording_text(
+      "# Bench_ID = B-12\n# Operator = Fomin\n# Test-Date: 2021-05-01\n# GL-2D bench run: static\npulses\n1\n2\n",
+      "m");
+  EXPECT_EQ(r.metadata.at("Bench_ID"), "B-12");
+  EXPECT_EQ(r.metadata.at("operator"), "Fomin");  // an identification key, under its own spelling
+  EXPECT_EQ(r.metadata.at("test_date"), "2021-05-01");
   EXPECT_EQ(r.metadata.count("GL-2D bench run"), 0u);
 }
 
