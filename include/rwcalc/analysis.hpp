@@ -33,6 +33,9 @@ struct AnalysisOptions {
   /// from the fitted model. Off: the plain five-term fit over the range given and Stable32's bounds
   /// (diagnose's base model, whose departures its detectors explain).
   bool fit_checks = true;
+  /// The paper's cross-checks and the class verdict; off for a fit that only feeds a model (the
+  /// diagnosis's base fits), where the direct-N bootstrap would be spent for nothing.
+  bool cross_checks = true;
 };
 
 /// Something the reader must know about a result: a stable code, a sentence, and a command that

@@ -317,8 +317,6 @@ void allan_and_fit(const Recording& rec, const AnalysisOptions& options, Analysi
     throw AnalysisError(fmt::format("{}: {}", rec.source, e.what()));
   }
   r.slope = slope_readout(fitted);
-  for (const auto& p : fitted.points)
-    if (p.tau_s == r.slope.tau_min_s && p.edf > 0 && r.slope.B) r.slope_B_sigma = *r.slope.B / std::sqrt(2.0 * p.edf);
   if (options.fit_checks) r.model_bounds = apply_model_bounds(r.allan, r.fit, &rec.phase);
 }
 
@@ -362,8 +360,10 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
         fmt::format("{}: the record holds {} sample(s); far too short to analyse", rec.source, rec.samples));
   earth_rate_and_bias(rec, options, r);
   allan_and_fit(rec, options, r);
-  cross_checks(rec, options, r);
-  r.verdict = verdict_of(r, options);
+  if (options.cross_checks) {
+    cross_checks(rec, options, r);
+    r.verdict = verdict_of(r, options);
+  }
   if (options.fit_checks) r.warnings = fit_warnings(r);
   return r;
 }

@@ -52,6 +52,7 @@ double sim_scale(const PhaseSeries& x, const AnalysisResult& a) {
 AnalysisResult analyze_for_base(const Recording& rec, const AnalysisOptions& options) {
   AnalysisOptions aopt = options;
   aopt.fit_checks = false;  // the base model is the plain five-term fit: the detectors explain its misfit
+  aopt.cross_checks = false;
   try {
     return analyze(rec, aopt);
   } catch (const AnalysisError&) {
