@@ -76,7 +76,7 @@ TEST(Report, IsWellFormedAndHasEveryTableAndSection) {
   }
   EXPECT_NE(html.find(std::string("rwcalc ") + RWCALC_VERSION), std::string::npos);
   EXPECT_NE(html.find("@media print"), std::string::npos);
-  EXPECT_NE(html.find("generated 2026-01-01 00:00 UTC"), std::string::npos);
+  EXPECT_NE(html.find("<tr><th>report generated</th><td>2026-01-01 00:00 UTC · rwcalc "), std::string::npos);
   EXPECT_NE(html.find("<tr><th>latitude_deg</th><td>55.75</td></tr>"), std::string::npos);
   EXPECT_NE(html.find("<tr><th>files</th><td>a.csv, b.csv</td></tr>"), std::string::npos);
   EXPECT_NE(html.find("Figures were left out"), std::string::npos);
@@ -183,7 +183,7 @@ TEST(ReportFigures, EveryFigureIsInlineValidSvgWithItsSeries) {
     EXPECT_EQ(svg_series(figs.at(id)).size(), 9u) << id;
   }
   // Figures are numbered in order and the diagnosis tables are there.
-  for (int n = 1; n <= 8; ++n) EXPECT_NE(html.find(fmt::format("<b>Fig. {}.</b>", n)), std::string::npos) << n;
+  for (int n = 1; n <= 8; ++n) EXPECT_NE(html.find(fmt::format("<b>Figure {}.</b>", n)), std::string::npos) << n;
   for (const char* id : {"id=\"run2-diagnosis\"", "id=\"run2-findings\"", "id=\"run2-gain\""})
     EXPECT_NE(html.find(id), std::string::npos) << id;
   EXPECT_NE(html.find("amplitude_deg_per_h = 0.03 °/h; evidence = PSD line 40 times the background; "

@@ -149,7 +149,7 @@ TEST_F(ReportOfGl2d, EveryFigureIsInlineValidSvgWithItsSeries) {
     ASSERT_TRUE(figs.count(id)) << id;
     EXPECT_GE(svg_series(figs.at(id)).size(), 2u + 3u + limits) << id;  // measured, model, Q N B, floors
   }
-  for (int n = 1; n <= 7; ++n) EXPECT_NE(html_.find(fmt::format("<b>Fig. {}.</b>", n)), std::string::npos) << n;
+  for (int n = 1; n <= 7; ++n) EXPECT_NE(html_.find(fmt::format("<b>Figure {}.</b>", n)), std::string::npos) << n;
 }
 
 TEST_F(ReportOfGl2d, SettingsAndVersionAreStated) {

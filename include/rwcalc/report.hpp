@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "rwcalc/i18n.hpp"
+
 namespace rwcalc {
 
 struct ReportInput {
@@ -17,7 +19,9 @@ struct ReportInput {
 };
 
 struct ReportOptions {
-  std::string title = "Gyro noise test report";
+  std::string title = N_("Gyro noise test report");  ///< the default is shown translated
+  std::string lab;   ///< the laboratory, for the title block; empty: from the metadata "lab", if any
+  std::string gyro;  ///< the gyro's type or name, for the title block
   nlohmann::json settings = nlohmann::json::object();  ///< option name → value, shown as is
   bool figures = true;                                 ///< embed figures (needs gnuplot)
   std::string generated;                               ///< time stamp; empty: left out
@@ -29,6 +33,11 @@ std::string report_html(const ReportInput& input, const ReportOptions& options);
 /// Writes report_html to DIR/report.html (DIR created when missing) atomically; an existing
 /// report is replaced only with `force`. Returns the path.
 std::string write_report(const std::string& dir, const ReportInput& input, const ReportOptions& options, bool force);
+
+/// Prints the HTML report at `html_path` to `pdf_path` with a headless Chromium (RWCALC_CHROMIUM,
+/// else chromium, chromium-browser or google-chrome in PATH), run without a shell. Returns false
+/// when none is installed; throws OutputError when it fails or the PDF exists without `force`.
+bool print_to_pdf(const std::string& html_path, const std::string& pdf_path, bool force);
 
 /// Standard base64 (RFC 4648, padded), for inline figures.
 std::string base64_encode(std::string_view bytes);

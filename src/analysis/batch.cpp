@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/parallel.hpp"
 #include "rwcalc/printable.hpp"
 
@@ -72,10 +73,10 @@ struct Series {
 
 const std::vector<Series>& series_list() {
   static const std::vector<Series> s{
-      {"N_fit", "N (AV fit)", "deg/sqrt(h)", {"fit", "N_deg_per_sqrt_h"}},
-      {"N_direct", "N (direct)", "deg/sqrt(h)", {"methods", "N_direct_deg_per_sqrt_h"}},
-      {"B_fit", "B (AV fit)", "deg/h", {"fit", "B_deg_per_h"}},
-      {"B_100s", "B (100-s avg)", "deg/h", {"methods", "B_100s_deg_per_h"}},
+      {"N_fit", N_("N (AV fit)"), N_("deg/sqrt(h)"), {"fit", "N_deg_per_sqrt_h"}},
+      {"N_direct", N_("N (direct)"), N_("deg/sqrt(h)"), {"methods", "N_direct_deg_per_sqrt_h"}},
+      {"B_fit", N_("B (AV fit)"), N_("deg/h"), {"fit", "B_deg_per_h"}},
+      {"B_100s", N_("B (100-s avg)"), N_("deg/h"), {"methods", "B_100s_deg_per_h"}},
   };
   return s;
 }
@@ -153,7 +154,9 @@ std::string temp_cell(const json& run) {
                                            : fmt::format("{:+g}", run.at("temperature_c").get<double>());
 }
 
-std::string class_cell(const json& v) { return v.is_null() ? std::string("none") : fmt::format("{}", v.get<int>()); }
+std::string class_cell(const json& v) {
+  return v.is_null() ? std::string(tr("none")) : fmt::format("{}", v.get<int>());
+}
 
 /// One run's line of the batch text's outlier section: count, action, the first input lines.
 /// "  file: [code] message" for each warning of a run (analyze's "warnings"); empty when none.
@@ -170,20 +173,20 @@ std::string warning_lines(const json& run) {
 std::string outliers_line(const json& run) {
   const std::string source = printable(run.at("source").get<std::string>());
   if (!run.contains("outliers") || !run.at("outliers").is_object())
-    return fmt::format("  {}: not in the results (no outlier summary)\n", source);
+    return trf("  {}: not in the results (no outlier summary)\n", source);
   const auto& o = run.at("outliers");
   const auto n = o.value("count", std::size_t{0});
-  if (n == 0) return fmt::format("  {}: none found\n", source);
+  if (n == 0) return trf("  {}: none found\n", source);
   const std::string action = o.value("action", std::string("keep"));
-  std::string s = fmt::format("  {}: {} outlier(s) {}", source, n,
-                              action == "keep"      ? "kept"
-                              : action == "remove"  ? "removed"
-                              : action == "replace" ? "replaced by the local median"
-                                                    : "with action " + action);
+  std::string s = trf("  {}: {} outlier(s) {}", source, n,
+                      action == "keep"      ? tr("kept")
+                      : action == "remove"  ? tr("removed")
+                      : action == "replace" ? tr("replaced by the local median")
+                                            : tr("with action ") + action);
   const auto& pos = o.at("positions");
   for (std::size_t k = 0; k < pos.size() && k < 5; ++k)
-    s += fmt::format("{} line {} ({:g} s)", k ? "," : ": at", pos[k].at("line").get<std::size_t>(),
-                     pos[k].at("time_s").get<double>());
+    s += trf("{} line {} ({:g} s)", k ? "," : tr(": at"), pos[k].at("line").get<std::size_t>(),
+             pos[k].at("time_s").get<double>());
   return s + (n > 5 ? ", …\n" : "\n");
 }
 
@@ -264,57 +267,58 @@ std::string format_batch_text(const json& summary) {
   const auto& runs = summary.at("runs");
   const auto& ov = summary.at("overall");
   std::string s;
-  s += fmt::format("rwcalc batch: {} run(s); class table {}; B from {}{}\n\n", runs.size(), ov.value("table", ""),
-                   ov.value("b_estimate", "fit"),
-                   ov.value("tolerance_pct", 0.0) > 0
-                       ? fmt::format("; +{:g} % heading-gyro tolerance on B", ov.value("tolerance_pct", 0.0))
-                       : std::string("; strict limits"));
-  s += "Table 1: coefficients (AV fit ±1 sigma; cross-checks [95 % interval]; \"< x\": 95 % upper bound)\n";
-  s += fmt::format("  {:>6}  {:<22} {:<30} {:<22} {:<30} {}\n", "T, °C", "N (AV), °/√h", "N direct, °/√h",
-                   "B (AV), °/h", "B 100-s avg, °/h", "file");
+  s += trf("rwcalc batch: {} run(s); class table {}; B from {}{}\n\n", runs.size(),
+           tr(ov.value("table", std::string())), ov.value("b_estimate", "fit"),
+           ov.value("tolerance_pct", 0.0) > 0
+               ? trf("; +{:g} % heading-gyro tolerance on B", ov.value("tolerance_pct", 0.0))
+               : std::string(tr("; strict limits")));
+  s += tr("Table 1: coefficients (AV fit ±1 sigma; cross-checks [95 % interval]; \"< x\": 95 % upper bound)\n");
+  s += fmt::format("  {:>6}  {:<22} {:<30} {:<22} {:<30} {}\n", tr("T, °C"), tr("N (AV), °/√h"), tr("N direct, °/√h"),
+                   tr("B (AV), °/h"), tr("B 100-s avg, °/h"), tr("file"));
   for (const auto& r : runs)
     s += fmt::format("  {:>6}  {:<22} {:<30} {:<22} {:<30} {}\n", temp_cell(r), cell(r, {"fit", "N_deg_per_sqrt_h"}),
                      interval_cell(r, {"methods", "N_direct_deg_per_sqrt_h"}), cell(r, {"fit", "B_deg_per_h"}),
                      interval_cell(r, {"methods", "B_100s_deg_per_h"}), printable(r.at("source").get<std::string>()));
-  s += "\nTable 2: class per parameter (probability of the stated class)\n";
-  s += fmt::format("  {:>6}  {:<30} {:<30} {}\n", "T, °C", "by N", "by B", "overall");
+  s += tr("\nTable 2: class per parameter (probability of the stated class)\n");
+  s += fmt::format("  {:>6}  {:<30} {:<30} {}\n", tr("T, °C"), tr("by N"), tr("by B"), tr("overall"));
   for (const auto& r : runs) {
     const auto& v = r.at("verdict");
     std::string o = v.value("statement", class_cell(v.at("class")));
-    if (v.value("tolerance_changed", false))
-      o += fmt::format(" [tolerance; strict {}]", class_cell(v.at("class_strict")));
+    if (v.value("tolerance_changed", false)) o += trf(" [tolerance; strict {}]", class_cell(v.at("class_strict")));
     s += fmt::format("  {:>6}  {:<30} {:<30} {}\n", temp_cell(r), v.value("statement_N", class_cell(v.at("class_N"))),
                      v.value("statement_B", class_cell(v.at("class_B"))), o);
   }
   // Outliers are never passed over in silence: one line per run.
-  s += "\nOutliers (see 'rwcalc analyze' for each; --outliers keep|remove|replace)\n";
+  s += tr("\nOutliers (see 'rwcalc analyze' for each; --outliers keep|remove|replace)\n");
   for (const auto& r : runs) s += outliers_line(r);
   std::string warnings;
   for (const auto& r : runs) warnings += warning_lines(r);
-  if (!warnings.empty()) s += "\nWarnings (see 'rwcalc analyze' for each run)\n" + warnings;
-  s += fmt::format("\nOverall over the runs: {}", ov.at("statement").get<std::string>());
+  if (!warnings.empty()) s += tr("\nWarnings (see 'rwcalc analyze' for each run)\n") + warnings;
+  s += trf("\nOverall over the runs: {}", ov.at("statement").get<std::string>());
   if (ov.value("tolerance_changed", false))
-    s += fmt::format("  [with the +{:g} % tolerance on B; strict: class {}]", ov.value("tolerance_pct", 0.0),
-                     class_cell(ov.at("class_strict")));
-  s += fmt::format("\n  by N: {}; by B: {}\n", ov.at("N").at("statement").get<std::string>(),
-                   ov.at("B").at("statement").get<std::string>());
-  s += "\nTrend with temperature (weighted linear fit) and worst case\n";
+    s += trf("  [with the +{:g} % tolerance on B; strict: class {}]", ov.value("tolerance_pct", 0.0),
+             class_cell(ov.at("class_strict")));
+  s += trf("\n  by N: {}; by B: {}\n", ov.at("N").at("statement").get<std::string>(),
+           ov.at("B").at("statement").get<std::string>());
+  s += tr("\nTrend with temperature (weighted linear fit) and worst case\n");
   for (const auto& [key, t] : summary.at("trends").items()) {
-    s += fmt::format("  {:<14}", t.at("label").get<std::string>());
+    const std::string unit = tr(t.at("unit").get<std::string>());
+    s += fmt::format("  {:<14}", tr(t.at("label").get<std::string>()));
     if (t.contains("slope_per_10C"))
-      s += fmt::format(" {:+.3g} ± {:.2g} {} per 10 °C;", t.at("slope_per_10C").get<double>(),
-                       t.at("slope_per_10C_sigma").get<double>(), t.at("unit").get<std::string>());
+      s += trf(" {:+.3g} ± {:.2g} {} per 10 °C;", t.at("slope_per_10C").get<double>(),
+               t.at("slope_per_10C_sigma").get<double>(), unit);
     else
-      s += " no trend (fewer than 3 runs with temperature);";
+      s += tr(" no trend (fewer than 3 runs with temperature);");
     if (!t.at("worst").is_null()) {
       const auto& w = t.at("worst");
-      s += fmt::format(" worst {}{:.3g} {} at {} °C", w.at("resolved").get<bool>() ? "" : "< ",
-                       w.at("value").get<double>(), t.at("unit").get<std::string>(), temp_cell(w));
+      s += trf(" worst {}{:.3g} {} at {} °C", w.at("resolved").get<bool>() ? "" : "< ", w.at("value").get<double>(),
+               unit, temp_cell(w));
     }
     s += "\n";
   }
   s +=
-      "\nConventions: Q, N, B, K, R as in IEEE 952 (B from sigma² = (2 ln2/π)B²); intervals 95 % profile likelihood.\n";
+      tr("\nConventions: Q, N, B, K, R as in IEEE 952 (B from sigma² = (2 ln2/π)B²); intervals 95 % profile "
+         "likelihood.\n");
   return s;
 }
 

@@ -9,6 +9,7 @@
 
 #include "cli/commands.hpp"
 #include "rwcalc/batch.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"
 
 namespace rwcalc::cli {
@@ -36,8 +37,9 @@ struct TableFormat {
     const nlohmann::json summary = summarize_runs(std::move(runs));
     if (json) return summary.dump(2, ' ', false, kInvalidUtf8) + "\n";
     if (csv) return format_batch_csv(summary);
-    if (markdown) return format_batch_markdown(summary);
-    return format_batch_text(summary);
+    // The readable formats in the chosen language's number style; JSON and CSV keep the point.
+    if (markdown) return localize_numbers(format_batch_markdown(summary));
+    return localize_numbers(format_batch_text(summary));
   }
 };
 

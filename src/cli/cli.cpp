@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
+#include <cstdlib>
 #include <exception>
 #include <optional>
 #include <ostream>
@@ -11,6 +12,7 @@
 
 #include "cli/commands.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/printable.hpp"
 #include "rwcalc/version.hpp"
@@ -33,6 +35,27 @@ constexpr Command kCommands[] = {
     {"report", register_report}, {"man", register_man},           {"completion", register_completion},
 };
 
+/// --lang on every command that writes results or messages (not man and completion, which
+/// describe the options themselves).
+void add_language_option(CLI::App& sub) {
+  const std::string name = sub.get_name();
+  if (name == "man" || name == "completion") return;
+  sub.add_option("--lang",
+                 "Language of the text, tables, report and messages: en (default) or ru; "
+                 "default from RWCALC_LANG")
+      ->check(CLI::IsMember({"en", "ru"}))
+      ->option_text("en|ru");
+}
+
+/// The language asked for: --lang, else RWCALC_LANG when it names one, else English.
+Language chosen_language(const CLI::App& app) {
+  for (const auto* sub : app.get_subcommands())
+    if (const auto* opt = sub->get_option_no_throw("--lang"); opt && opt->count() > 0)
+      return parse_language(opt->as<std::string>()).value_or(Language::English);
+  if (const char* env = std::getenv("RWCALC_LANG")) return parse_language(env).value_or(Language::English);
+  return Language::English;
+}
+
 /// The commands, in the order of `rwcalc --help`. When the first argument names one, only that one
 /// is built (the parse is the same, without setting up the others' options); otherwise all, so
 /// that the overall help and the unknown-command message list every command.
@@ -44,6 +67,7 @@ void build_app(CLI::App& app, Runner& runner, int argc, const char* const* argv)
     for (const auto& c : kCommands)
       if (std::string_view(argv[1]) == c.name) {
         c.add(app, runner);
+        add_language_option(*app.get_subcommand(c.name));
         return;
       }
   add_all_commands(app, runner);
@@ -85,27 +109,29 @@ std::optional<int> parse_args(CLI::App& app, int argc, const char* const* argv, 
 /// Parse argv and, when `execute`, run the command; the exit status. Without `execute`, anything
 /// but an rwcalc error escapes: the argument-parsing fuzzer treats it as a finding.
 int parse_and_run(int argc, const char* const* argv, std::ostream& out, std::ostream& err, bool execute) {
+  const LanguageScope restore(language());  // the command sets its language; the caller's comes back after
   try {
     CLI::App app{app_description(), "rwcalc"};
     Runner runner;
     build_app(app, runner, argc, argv);
     if (const auto status = parse_args(app, argc, argv, out, err)) return *status;
+    set_language(chosen_language(app));
     if (!runner) {
-      print_message(err, "no command given; run 'rwcalc --help'");
+      print_message(err, tr("no command given; run 'rwcalc --help'"));
       return static_cast<int>(ExitCode::BadInput);
     }
     Io io{out, err};
     return execute ? runner(io) : 0;
   } catch (const Error& e) {
-    print_message(err, fmt::format("error: {}", e.what()));
+    print_message(err, trf("error: {}", e.what()));
     return static_cast<int>(e.code());
   } catch (const std::bad_alloc&) {
     if (!execute) throw;
-    print_message(err, "error: out of memory");
+    print_message(err, tr("error: out of memory"));
     return static_cast<int>(ExitCode::AnalysisFailed);
   } catch (const std::exception& e) {
     if (!execute) throw;
-    print_message(err, fmt::format("internal error: {}", e.what()));
+    print_message(err, trf("internal error: {}", e.what()));
     return static_cast<int>(ExitCode::AnalysisFailed);
   }
 }
@@ -115,10 +141,15 @@ int parse_and_run(int argc, const char* const* argv, std::ostream& out, std::ost
 const char* app_description() { return kDescription; }
 
 void add_all_commands(CLI::App& app, Runner& runner) {
-  for (const auto& c : kCommands) c.add(app, runner);
+  for (const auto& c : kCommands) {
+    c.add(app, runner);
+    add_language_option(*app.get_subcommand(c.name));
+  }
 }
 
-void print_message(std::ostream& err, std::string_view text) { err << "rwcalc: " << printable(text) << "\n"; }
+void print_message(std::ostream& err, std::string_view text) {
+  err << "rwcalc: " << localize_numbers(printable(text)) << "\n";
+}
 
 int parse_only(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   return parse_and_run(argc, argv, out, err, false);

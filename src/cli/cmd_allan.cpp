@@ -14,6 +14,7 @@
 #include "rwcalc/allan.hpp"
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/reader.hpp"
 
 namespace rwcalc::cli {
@@ -133,10 +134,9 @@ int run_allan(const AllanArgs& a, Io& io) {
   // so the table stays Stable32's.
   for (const auto& p : res.points)
     if ((rec.phase.points() - 1) / static_cast<std::size_t>(p.m) < 10) {
-      print_message(io.err, fmt::format("note: {}: from tau = {:g} s on fewer than 10 averages remain; the noise "
-                                        "type and the bounds there rest on few data ('rwcalc analyze' takes them "
-                                        "from the fitted model)",
-                                        rec.source, p.tau_s));
+      print_message(io.err, trf("note: {}: from tau = {:g} s on fewer than 10 averages remain; the noise type and "
+                                "the bounds there rest on few data ('rwcalc analyze' takes them from the fitted model)",
+                                rec.source, p.tau_s));
       break;
     }
   if (a.json) {
@@ -144,11 +144,12 @@ int run_allan(const AllanArgs& a, Io& io) {
   } else if (a.csv) {
     io.out << format_allan_csv(res);
     // The CSV holds the table only; the outliers found are said on standard error.
-    if (outliers.count > 0) print_message(io.err, fmt::format("note: {}: {}", rec.source, format_outliers(outliers)));
+    if (outliers.count > 0) print_message(io.err, trf("note: {}: {}", rec.source, format_outliers(outliers)));
   } else {
-    io.out << format_allan_table(res, {rec.source, rec.samples, rec.rate_hz, std::string(to_string(rec.rate_source)),
-                                       describe_input(read)});
-    io.out << "\n" << format_outliers(outliers);
+    io.out << localize_numbers(
+        format_allan_table(res, {rec.source, rec.samples, rec.rate_hz, std::string(to_string(rec.rate_source)),
+                                 describe_input(read)}));
+    io.out << "\n" << localize_numbers(format_outliers(outliers));
   }
   return 0;
 }

@@ -12,6 +12,7 @@
 #include "cli/plot_args.hpp"
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"
 
 namespace rwcalc::cli {
@@ -59,10 +60,11 @@ void register_analyze(CLI::App& app, Runner& runner) {
       const std::string text = [&] {
         const nlohmann::json j = to_json(res);
         require_finite(j, rec.source);
-        if (!cmd->json && !cmd->plot.any()) return format_report(res);
+        if (!cmd->json && !cmd->plot.any()) return localize_numbers(format_report(res));
         cmd->plot.draw_analysis(j, cmd->force, io);
         // A file name that is not UTF-8 is written with U+FFFD for its invalid bytes, not refused.
-        return cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n" : format_report(res);
+        return cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"
+                         : localize_numbers(format_report(res));
       }();
       emit(io, text, cmd->output, cmd->force);
       return 0;

@@ -9,6 +9,7 @@
 #include "cli/plot_args.hpp"
 #include "rwcalc/diagnose.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/progress.hpp"
 
@@ -75,8 +76,8 @@ void register_diagnose(CLI::App& app, Runner& runner) {
       progress.finish();
       const nlohmann::json j = to_json(res);
       // A file name that is not UTF-8 is written with U+FFFD for its invalid bytes, not refused.
-      const std::string text =
-          cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n" : format_report(res);
+      const std::string text = cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"
+                                         : localize_numbers(format_report(res));
       if (cmd->output == "-")
         io.out << text;
       else

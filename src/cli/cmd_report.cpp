@@ -19,6 +19,7 @@
 #include "rwcalc/batch.hpp"
 #include "rwcalc/diagnose.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/plot.hpp"
 #include "rwcalc/printable.hpp"
@@ -40,6 +41,9 @@ struct ReportCmd {
   std::optional<double> temperature;
   std::string dir;
   std::string title;
+  std::string lab;
+  std::string gyro;
+  bool pdf = false;
   bool diagnose = false;
   std::size_t diagnose_runs = 50;
   std::uint64_t diagnose_seed = 1;
@@ -103,35 +107,36 @@ void attach_saved_diagnoses(const SavedResults& saved, const std::vector<json>& 
 json settings_of(const ReportCmd& c, const std::vector<std::string>& recordings,
                  const std::vector<std::string>& saved) {
   json s = json::object();
-  if (!recordings.empty()) s["recordings"] = recordings;
-  if (!saved.empty()) s["saved results"] = saved;
+  if (!recordings.empty()) s[N_("recordings")] = recordings;
+  if (!saved.empty()) s[N_("saved results")] = saved;
   if (recordings.empty()) return s;  // the analysis options below apply to recordings only
   const auto& in = c.input;
-  s["input"] = in.input.empty() ? std::string("pulses") : in.input;  // unless a column name implies rate or angle
-  if (!in.column.empty()) s["column"] = in.column;
-  if (in.rate_hz) s["rate (Hz)"] = *in.rate_hz;
-  if (in.scale_arcsec) s["pulse weight (″)"] = *in.scale_arcsec;
-  if (in.input == "counter") s["counter bits"] = in.counter_bits;
-  const std::string by_name = "from the column name, else ";
-  if (in.input == "angle") s["angle unit"] = in.angle_unit.empty() ? by_name + "arcsec" : in.angle_unit;
-  if (in.input == "rate") s["rate unit"] = in.rate_unit.empty() ? by_name + "deg/h" : in.rate_unit;
+  s[N_("input")] = in.input.empty() ? std::string("pulses") : in.input;  // unless a column name implies rate or angle
+  if (!in.column.empty()) s[N_("column")] = in.column;
+  if (in.rate_hz) s[N_("rate (Hz)")] = *in.rate_hz;
+  if (in.scale_arcsec) s[N_("pulse weight (″)")] = *in.scale_arcsec;
+  if (in.input == "counter") s[N_("counter bits")] = in.counter_bits;
+  const std::string by_name = tr("from the column name, else ");
+  if (in.input == "angle") s[N_("angle unit")] = in.angle_unit.empty() ? by_name + "arcsec" : in.angle_unit;
+  if (in.input == "rate") s[N_("rate unit")] = in.rate_unit.empty() ? by_name + "deg/h" : in.rate_unit;
   const auto& a = c.analysis;
-  s["fit range (s)"] = a.fit_range.empty() ? std::string("all τ") : a.fit_range;
-  s["minimum EDF"] = a.min_edf;
-  s["terms"] = a.terms;
-  s["term selection"] = a.keep_all_terms ? "all fitted terms kept" : "unsupported K, R, Q left out (upper bounds)";
+  s[N_("fit range (s)")] = a.fit_range.empty() ? std::string(tr("all τ")) : a.fit_range;
+  s[N_("minimum EDF")] = a.min_edf;
+  s[N_("terms")] = a.terms;
+  s[N_("term selection")] =
+      a.keep_all_terms ? tr("all fitted terms kept") : tr("unsupported K, R, Q left out (upper bounds)");
   if (a.earth_rate)
-    s["Earth rate (°/h)"] = *a.earth_rate;
+    s[N_("Earth rate (°/h)")] = *a.earth_rate;
   else
-    s["latitude (°)"] = a.latitude_deg;
-  s["B estimate"] = a.b_estimate;
-  s["tolerance on B (%)"] = a.tolerance_pct;
-  s["class table"] = a.limits_file.empty() ? std::string("GOST RV 52339 (built in)") : a.limits_file;
-  s["averaging block (s)"] = a.block_s;
-  s["direct method t range (s)"] = a.direct_range;
-  s["outliers"] = a.outliers;
-  s["outlier threshold (robust σ)"] = a.outlier_threshold;
-  if (c.temperature) s["temperature (°C)"] = *c.temperature;
+    s[N_("latitude (°)")] = a.latitude_deg;
+  s[N_("B estimate")] = a.b_estimate;
+  s[N_("tolerance on B (%)")] = a.tolerance_pct;
+  s[N_("class table")] = a.limits_file.empty() ? std::string(tr("GOST RV 52339 (built in)")) : a.limits_file;
+  s[N_("averaging block (s)")] = a.block_s;
+  s[N_("direct method t range (s)")] = a.direct_range;
+  s[N_("outliers")] = a.outliers;
+  s[N_("outlier threshold (robust σ)")] = a.outlier_threshold;
+  if (c.temperature) s[N_("temperature (°C)")] = *c.temperature;
   return s;
 }
 
@@ -170,9 +175,9 @@ ReportInput report_input(const ReportCmd& c, const std::vector<std::string>& rec
     } catch (const InputError& e) {
       // Saved results without the verdict's class probabilities (older or hand-made JSON): the
       // report still states the worst class over the runs, without a combined probability.
-      print_message(io.err, fmt::format("note: no combined verdict over the runs ({}); the report states the worst "
-                                        "class over the runs",
-                                        e.what()));
+      print_message(io.err, trf("note: no combined verdict over the runs ({}); the report states the worst class "
+                                "over the runs",
+                                e.what()));
     }
   }
   return in;
@@ -196,19 +201,32 @@ int run_report(const ReportCmd& c, Io& io) {
   // Fail before the analysis: a report.html that cannot be written (existing without --force, a
   // directory…; a missing DIR is created later), no gnuplot for the figures.
   std::error_code ec;
-  if (fs::is_directory(c.dir, ec)) check_output_targets({{"-o", (fs::path(c.dir) / "report.html").string()}}, c.force);
+  if (fs::is_directory(c.dir, ec)) {
+    check_output_targets({{"-o", (fs::path(c.dir) / "report.html").string()}}, c.force);
+    if (c.pdf) check_output_targets({{"--pdf", (fs::path(c.dir) / "report.pdf").string()}}, c.force);
+  }
   if (!c.no_figures) require_gnuplot();
 
   const ReportInput in = report_input(c, recordings, saved_files, read, opt, io);
 
   ReportOptions ro;
   if (!c.title.empty()) ro.title = c.title;
+  ro.lab = c.lab;
+  ro.gyro = c.gyro;
   ro.settings = settings_of(c, recordings, saved_files);
   ro.figures = !c.no_figures;
   ro.generated = utc_now();
   const auto path = write_report(c.dir, in, ro, c.force);
-  io.out << fmt::format("report written to {} ({} run(s){})\n", printable(path), in.analyses.size(),
-                        c.no_figures ? ", no figures" : "");
+  io.out << localize_numbers(trf("report written to {} ({} run(s){})\n", printable(path), in.analyses.size(),
+                                 c.no_figures ? tr(", no figures") : ""));
+  if (c.pdf) {
+    const std::string pdf = (fs::path(c.dir) / "report.pdf").string();
+    if (print_to_pdf(path, pdf, c.force))
+      io.out << trf("PDF written to {}\n", printable(pdf));
+    else
+      print_message(io.err, tr("note: --pdf: no headless Chromium found (chromium, chromium-browser or google-chrome "
+                               "in PATH, or RWCALC_CHROMIUM); the HTML report prints to PDF from any browser"));
+  }
   return 0;
 }
 
@@ -229,6 +247,9 @@ void register_report(CLI::App& app, Runner& runner) {
   cmd->analysis.add_to(*sub);
   add_temperature_option(*sub, cmd->temperature, "Temperature, °C (only with a single recording)");
   sub->add_option("--title", cmd->title, "Title of the report");
+  sub->add_option("--lab", cmd->lab, "Laboratory, for the title block (default: the recordings' '# lab:' metadata)");
+  sub->add_option("--gyro", cmd->gyro, "The gyro's type or name, for the title block (e.g. GL-2D)");
+  sub->add_flag("--pdf", cmd->pdf, "Also print DIR/report.pdf with a headless Chromium, when one is installed");
   sub->add_flag("--diagnose", cmd->diagnose, "Also diagnose each recording (what the noise model misses)");
   sub->add_option("--diagnose-runs", cmd->diagnose_runs, "Simulated records per diagnosis ensemble")
       ->check(whole_in(10, 100000))

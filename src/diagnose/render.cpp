@@ -6,6 +6,7 @@
 
 #include "rwcalc/diagnose.hpp"
 #include "rwcalc/fit.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/printable.hpp"
 
 namespace rwcalc {
@@ -43,15 +44,15 @@ json clean_json(json j) {
 
 /// N, B, K and R of a model, as the report prints them.
 std::string power_laws(const NoiseModel& m) {
-  return fmt::format("N = {:.4g} °/√h, B = {:.4g} °/h, K = {:.4g} °/h/√h, R = {:.4g} °/h²", m.arw_deg_per_sqrt_h,
-                     m.bias_instability_deg_per_h, m.rrw_deg_per_h_per_sqrt_h, m.ramp_deg_per_h2);
+  return trf("N = {:.4g} °/√h, B = {:.4g} °/h, K = {:.4g} °/h/√h, R = {:.4g} °/h²", m.arw_deg_per_sqrt_h,
+             m.bias_instability_deg_per_h, m.rrw_deg_per_h_per_sqrt_h, m.ramp_deg_per_h2);
 }
 
 std::string unit_of(const std::string& key) {
-  if (key.ends_with("_hz")) return "Hz";
-  if (key.ends_with("_deg_per_h")) return "°/h";
-  if (key.ends_with("_s")) return "s";
-  if (key.ends_with("_rad")) return "rad";
+  if (key.ends_with("_hz")) return tr("Hz");
+  if (key.ends_with("_deg_per_h")) return tr("°/h");
+  if (key.ends_with("_s")) return tr("s");
+  if (key.ends_with("_rad")) return tr("rad");
   return "";
 }
 
@@ -116,38 +117,38 @@ json to_json(const DiagnoseResult& r) {
 
 std::string format_report(const DiagnoseResult& r) {
   std::string s;
-  s += fmt::format("Diagnosis of {}\n", printable(r.analysis.source));
-  s += fmt::format(
-      "  record: {:.0f} s at {:g} Hz, pulse weight {:g}″; ensemble of {} simulated records per model "
-      "(seed {}), band {:g} % per τ\n\n",
-      r.settings.duration_s, r.settings.rate_hz, r.settings.scale_arcsec, r.runs, r.seed, r.band_level * 100);
+  s += trf("Diagnosis of {}\n", printable(r.analysis.source));
+  s +=
+      trf("  record: {:.0f} s at {:g} Hz, pulse weight {:g}″; ensemble of {} simulated records per model "
+          "(seed {}), band {:g} % per τ\n\n",
+          r.settings.duration_s, r.settings.rate_hz, r.settings.scale_arcsec, r.runs, r.seed, r.band_level * 100);
   s += format_outliers(r.analysis.outliers);
   const auto& m = r.base;
-  s += "Base model (five-term fit): " + power_laws(m) +
-       fmt::format(", white angle {:.4g}″, {} read-out, Earth rate {:.4g} °/h, bias {:.4g} °/h\n", m.white_angle_arcsec,
-                   m.readout == ReadoutMode::Counting ? "counting" : "white", m.earth_rate_deg_per_h, m.bias_deg_per_h);
+  s += tr("Base model (five-term fit): ") + power_laws(m) +
+       trf(", white angle {:.4g}″, {} read-out, Earth rate {:.4g} °/h, bias {:.4g} °/h\n", m.white_angle_arcsec,
+           m.readout == ReadoutMode::Counting ? tr("counting") : tr("white"), m.earth_rate_deg_per_h, m.bias_deg_per_h);
   std::size_t outside = 0;
   std::string rows;
   for (const auto& b : r.base_band) {
     if (b.dev >= b.low && b.dev <= b.high) continue;
     ++outside;
     const bool above = b.dev > b.high;
-    rows += fmt::format("    τ = {:>9.4g} s: σ = {:.4g} °/h, {:.1f} % {} the band's {} edge {:.4g} °/h\n", b.tau_s,
-                        b.dev, 100 * (above ? b.dev / b.high - 1 : 1 - b.dev / b.low), above ? "above" : "below",
-                        above ? "upper" : "lower", above ? b.high : b.low);
+    rows += trf("    τ = {:>9.4g} s: σ = {:.4g} °/h, {:.1f} % {} the band's {} edge {:.4g} °/h\n", b.tau_s, b.dev,
+                100 * (above ? b.dev / b.high - 1 : 1 - b.dev / b.low), above ? tr("above") : tr("below"),
+                above ? tr("upper") : tr("lower"), above ? b.high : b.low);
   }
-  s += fmt::format("  measured Allan deviation inside the base band at {} of {} τ\n", r.base_band.size() - outside,
-                   r.base_band.size());
+  s += trf("  measured Allan deviation inside the base band at {} of {} τ\n", r.base_band.size() - outside,
+           r.base_band.size());
   s += rows;
-  s += "\nDetectors (statistic on the measurement against the ensemble-calibrated threshold, " +
-       fmt::format("false-alarm level {:g} % each):\n", r.alpha * 100);
+  s += tr("\nDetectors (statistic on the measurement against the ensemble-calibrated threshold, ") +
+       trf("false-alarm level {:g} % each):\n", r.alpha * 100);
   for (const auto& d : r.detectors)
-    s += fmt::format("  {:<17} statistic {:>9.3f} (dimensionless), threshold {:>8.3f}, ensemble max {:>8.3f}: {}{}\n",
-                     detector_name(d.effect), d.statistic, d.threshold, d.ensemble_max,
-                     d.named ? "FOUND" : (d.fired ? "fired, not named" : "not found"),
-                     d.note.empty() ? "" : " (" + d.note + ")");
-  s += "\nFindings:\n";
-  if (r.findings.empty()) s += "  none: the base model's simulations explain the measurement\n";
+    s += trf("  {:<17} statistic {:>9.3f} (dimensionless), threshold {:>8.3f}, ensemble max {:>8.3f}: {}{}\n",
+             detector_name(d.effect), d.statistic, d.threshold, d.ensemble_max,
+             d.named ? tr("FOUND") : (d.fired ? tr("fired, not named") : tr("not found")),
+             d.note.empty() ? "" : " (" + d.note + ")");
+  s += tr("\nFindings:\n");
+  if (r.findings.empty()) s += tr("  none: the base model's simulations explain the measurement\n");
   for (const auto& f : r.findings) {
     s += fmt::format("  {}:", finding_name(f.effect));
     for (const auto& [k, v] : f.params.items()) {
@@ -160,15 +161,15 @@ std::string format_report(const DiagnoseResult& r) {
     s.pop_back();
     s += "\n";
   }
-  s += "\nExtended model: " + power_laws(r.extended) + fmt::format(", {} extra term(s)\n", r.findings.size());
-  s += "\nGain (misfit: mean EDF-weighted Gamma deviance per τ, about 1 (dimensionless) when the model fits):\n";
-  s += fmt::format("  {:<44} {:>10} {:>10}\n", "", "base", "extended");
-  s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", "Allan-variance misfit (dimensionless)", r.gain.misfit_base,
+  s += tr("\nExtended model: ") + power_laws(r.extended) + trf(", {} extra term(s)\n", r.findings.size());
+  s += tr("\nGain (misfit: mean EDF-weighted Gamma deviance per τ, about 1 (dimensionless) when the model fits):\n");
+  s += fmt::format("  {:<44} {:>10} {:>10}\n", "", tr("base"), tr("extended"));
+  s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", tr("Allan-variance misfit (dimensionless)"), r.gain.misfit_base,
                    r.gain.misfit_extended);
-  s += fmt::format("  {:<44} {:>9.1f}% {:>9.1f}%\n", "measured τ inside the simulated band", 100 * r.gain.coverage_base,
-                   100 * r.gain.coverage_extended);
-  s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", "out-of-sample misfit (dimensionless)", r.gain.holdout_misfit_base,
-                   r.gain.holdout_misfit_extended);
+  s += fmt::format("  {:<44} {:>9.1f}% {:>9.1f}%\n", tr("measured τ inside the simulated band"),
+                   100 * r.gain.coverage_base, 100 * r.gain.coverage_extended);
+  s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", tr("out-of-sample misfit (dimensionless)"),
+                   r.gain.holdout_misfit_base, r.gain.holdout_misfit_extended);
   s += fmt::format("\n  ({:.1f} s)\n", r.seconds);
   return s;
 }

@@ -12,6 +12,7 @@
 
 #include "core/json_input.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 
 namespace rwcalc {
 
@@ -91,7 +92,7 @@ nlohmann::json param_json(const ParameterVerdict& p) {
 }  // namespace
 
 ClassTable ClassTable::gost() {
-  return {"GOST RV 52339-2005 (as reported by Bolotnov & Fomin 2021)",
+  return {N_("GOST RV 52339-2005 (as reported by Bolotnov & Fomin 2021)"),
           {{1, 0.90, 0.005, 0.0010}, {2, 1.85, 0.008, 0.0015}, {3, 3.70, 0.015, 0.0030}}};
 }
 
@@ -194,7 +195,7 @@ double bivariate_normal_cdf(double a, double b, double rho) {
   return std::clamp(sum * h / 3.0 / std::sqrt(2.0 * std::numbers::pi), 0.0, 1.0);
 }
 
-std::string class_label(const std::optional<int>& c) { return c ? fmt::format("{}", *c) : std::string("none"); }
+std::string class_label(const std::optional<int>& c) { return c ? fmt::format("{}", *c) : std::string(tr("none")); }
 
 Verdict decide(const EstimateInput& B, const EstimateInput& N, double rho_BN, const VerdictOptions& options) {
   const ClassTable& t = options.table;
@@ -239,10 +240,10 @@ std::string describe_class(const std::vector<double>& p_is, const std::optional<
   const std::size_t n = classes.size();
   const std::size_t s =
       cls ? static_cast<std::size_t>(std::find(classes.begin(), classes.end(), *cls) - classes.begin()) : n;
-  auto label = [&](std::size_t k) { return k < n ? fmt::format("{}", classes[k]) : std::string("outside"); };
+  auto label = [&](std::size_t k) { return k < n ? fmt::format("{}", classes[k]) : std::string(tr("outside")); };
   if (p_is[s] >= decisive || n == 0) {
-    if (s == n) return fmt::format("outside class {} (P={:.2f})", classes.empty() ? 0 : classes.back(), p_is[s]);
-    return fmt::format("class {} (P={:.2f})", label(s), p_is[s]);
+    if (s == n) return trf("outside class {} (P={:.2f})", classes.empty() ? 0 : classes.back(), p_is[s]);
+    return trf("class {} (P={:.2f})", label(s), p_is[s]);
   }
   // Runner-up: the more probable neighbour.
   std::size_t r = s;
@@ -250,9 +251,8 @@ std::string describe_class(const std::vector<double>& p_is, const std::optional<
   if (s + 1 <= n && (r == s || p_is[s + 1] > p_is[r])) r = s + 1;
   const std::size_t a = std::min(s, r);
   const std::size_t b = std::max(s, r);
-  if (b == n)
-    return fmt::format("class {} or outside class {} (P={:.2f}/{:.2f})", label(a), classes.back(), p_is[a], p_is[b]);
-  return fmt::format("class {} or {} (P={:.2f}/{:.2f})", label(a), label(b), p_is[a], p_is[b]);
+  if (b == n) return trf("class {} or outside class {} (P={:.2f}/{:.2f})", label(a), classes.back(), p_is[a], p_is[b]);
+  return trf("class {} or {} (P={:.2f}/{:.2f})", label(a), label(b), p_is[a], p_is[b]);
 }
 
 std::string Verdict::statement() const { return describe_class(p_is, cls, class_numbers, decisive_threshold); }

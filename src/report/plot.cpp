@@ -12,6 +12,7 @@
 
 #include "report/json_view.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"
 
 namespace rwcalc {
@@ -70,6 +71,9 @@ std::vector<AllanRow> allan_rows(const json& allan) {
 /// A number for display: 4 significant digits.
 std::string show(double v) { return fmt::format("{:.4g}", v); }
 
+/// A title, label or key entry as a gnuplot string, in the chosen language's number style.
+std::string label_text(std::string_view text) { return gnuplot_string(localize_numbers(std::string(text))); }
+
 /// The data range of a log-log figure, widened to whole decades so the 10^n ticks frame it.
 struct Bounds {
   double xlo = std::numeric_limits<double>::infinity(), xhi = 0;
@@ -120,11 +124,11 @@ std::string loglog_preamble(const std::string& title, const std::string& ylabel,
       "set format x '10^{{%L}}'\nset format y '10^{{%L}}'\n"
       "set xtics nomirror\nset ytics nomirror\nset mxtics 10\nset mytics 10\n"
       "set grid xtics ytics mxtics mytics lw 0.6 lc rgb '#d9d9d9', lw 0.4 lc rgb '#eeeeee'\n"
-      "set border 3 lw 1\nset xlabel 'τ (s)' noenhanced offset 0,0.7\nset ylabel {} noenhanced\n"
+      "set border 3 lw 1\nset xlabel {} noenhanced offset 0,0.7\nset ylabel {} noenhanced\n"
       "set xrange [{:.6g}:{:.6g}]\nset yrange [{:.6g}:{:.6g}]\n"
       "set key outside below center vertical maxrows {} Left reverse noenhanced samplen 2.5 "
       "spacing 1.05 width 2 height 1 nobox\nset samples 250\n",
-      gnuplot_string(title), gnuplot_string(ylabel), x0, x1, y0, y1, rows);
+      label_text(title), label_text(tr("τ (s)")), label_text(ylabel), x0, x1, y0, y1, rows);
 }
 
 Figure loglog_figure(const char* name, const PlotOptions& options, const std::string& title, const std::string& ylabel,
@@ -144,9 +148,9 @@ bool is_gyro(const json& allan) {
 
 std::string allan_ylabel(const json& allan) {
   const auto unit = view::str(allan, "unit");
-  if (is_gyro(allan)) return fmt::format("Allan deviation σ(τ) ({})", lbl::rate);
-  if (unit == "1") return "Allan deviation σ(τ)";
-  return fmt::format("Allan deviation σ(τ) ({})", unit);
+  if (is_gyro(allan)) return trf("Allan deviation σ(τ) ({})", tr(lbl::rate));
+  if (unit == "1") return tr("Allan deviation σ(τ)");
+  return trf("Allan deviation σ(τ) ({})", unit);
 }
 
 /// √(2 ln2/π): the flicker floor of σ per unit B.
@@ -167,11 +171,11 @@ struct Term {
   const char *key, *var, *fn, *label, *unit, *colour;  // fit key, gnuplot variable and function
 };
 constexpr std::array<Term, 5> kTerms{{
-    {"Q_arcsec", "Q", "sQ", "quantization Q", lbl::angle, "#7b3294"},
-    {"N_deg_per_sqrt_h", "N", "sN", "angle random walk N", lbl::arw, "#1f77b4"},
-    {"B_deg_per_h", "B", "sB", "bias instability B", lbl::rate, "#2ca02c"},
-    {"K_deg_per_h_per_sqrt_h", "K", "sK", "rate random walk K", lbl::rrw, "#ff7f0e"},
-    {"R_deg_per_h2", "R", "sR", "rate ramp R", lbl::ramp, "#8c564b"},
+    {"Q_arcsec", "Q", "sQ", N_("quantization Q"), lbl::angle, "#7b3294"},
+    {"N_deg_per_sqrt_h", "N", "sN", N_("angle random walk N"), lbl::arw, "#1f77b4"},
+    {"B_deg_per_h", "B", "sB", N_("bias instability B"), lbl::rate, "#2ca02c"},
+    {"K_deg_per_h_per_sqrt_h", "K", "sK", N_("rate random walk K"), lbl::rrw, "#ff7f0e"},
+    {"R_deg_per_h2", "R", "sR", N_("rate ramp R"), lbl::ramp, "#8c564b"},
 }};
 
 void append_allan_block(std::string& s, const std::string& name, const std::vector<AllanRow>& rows) {
@@ -192,17 +196,18 @@ void add_model(const json& fit, std::string& vars, PlotCommand& plot) {
     const double v = c.value.value_or(0.0);
     if (c.resolved && v > 0) {
       term_lines.push_back(fmt::format("{}(x, {}) w l lw 1.4 lc rgb '{}' t {}", t.fn, t.var, t.colour,
-                                       gnuplot_string(fmt::format("{} = {} {}", t.label, show(v), t.unit))));
+                                       label_text(fmt::format("{} = {} {}", tr(t.label), show(v), tr(t.unit)))));
     } else if (const double bound = c.high95.value_or(v); !c.resolved && bound > 0) {
       vars += fmt::format("{}_up95 = {:.8g}   # {}, 95 % upper bound\n", t.var, bound, t.unit);
-      term_lines.push_back(fmt::format("{}(x, {}_up95) w l lw 1.2 dt 3 lc rgb '{}' t {}", t.fn, t.var, t.colour,
-                                       gnuplot_string(fmt::format("{} < {} {} (95 %)", t.label, show(bound), t.unit))));
+      term_lines.push_back(
+          fmt::format("{}(x, {}_up95) w l lw 1.2 dt 3 lc rgb '{}' t {}", t.fn, t.var, t.colour,
+                      label_text(fmt::format("{} < {} {} (95 %)", tr(t.label), show(bound), tr(t.unit)))));
     }
   }
   vars += model + ")\n";
   const auto chi2 = num(fit, "chi2_per_dof");
   plot.add(fmt::format("model(x) w l lw 2.2 lc rgb '#000000' t {}",
-                       gnuplot_string(chi2 ? fmt::format("fitted model (χ²/dof = {:.3g})", *chi2) : "fitted model")));
+                       label_text(chi2 ? trf("fitted model (χ²/dof = {:.3g})", *chi2) : tr("fitted model"))));
   for (auto& l : term_lines) plot.add(std::move(l));
 }
 
@@ -210,13 +215,13 @@ void add_model(const json& fit, std::string& vars, PlotCommand& plot) {
 void add_class_floors(const json& analysis, std::string& vars, PlotCommand& plot, Bounds& bounds) {
   static constexpr std::array<const char*, 3> kDash{"2", "4", "5"};  // dots (3) mark upper bounds
   const auto t = num(at(analysis, "verdict"), "tolerance_pct");
-  const std::string tolerance = t && *t > 0 ? fmt::format(" (+{:g} % tolerance)", *t) : std::string();
+  const std::string tolerance = t && *t > 0 ? trf(" (+{:g} % tolerance)", *t) : std::string();
   std::size_t i = 0;
   for (const auto& [cls, b] : view::class_limits(analysis, "B")) {
     vars += fmt::format("B_class{} = {:.6g}   # {}, class {} limit for B\n", cls, b, lbl::rate, cls);
     plot.add(fmt::format("sB(x, B_class{0}) w l lw 1.3 dt {1} lc rgb '#d62728' t {2}", cls, kDash[i++ % kDash.size()],
-                         gnuplot_string(fmt::format("class {0} limit B = {1} {2}{3} (floor {4} {2})", cls, show(b),
-                                                    lbl::rate, tolerance, show(kFloorPerB * b)))));
+                         label_text(trf("class {0} limit B = {1} {2}{3} (floor {4} {2})", cls, show(b), tr(lbl::rate),
+                                        tolerance, show(kFloorPerB * b)))));
     bounds.y(kFloorPerB * b, 0);
   }
 }
@@ -228,9 +233,9 @@ std::string file_name(const json& a) {
 }
 
 std::string default_analysis_title(const json& a) {
-  std::string t = "Allan deviation";
-  if (const auto src = file_name(a); !src.empty()) t += " of " + src;
-  if (const auto temp = view::temperature_label(at(a, "temperature_c")); !temp.empty()) t += " at " + temp;
+  std::string t = tr("Allan deviation");
+  if (const auto src = file_name(a); !src.empty()) t += trf(" of {}", src);
+  if (const auto temp = view::temperature_label(at(a, "temperature_c")); !temp.empty()) t += trf(" at {}", temp);
   return t;
 }
 
@@ -238,7 +243,7 @@ std::string run_label(const json& run, std::size_t index) {
   const auto t = view::temperature_label(at(run, "temperature_c"));
   const auto src = file_name(run);
   if (!t.empty()) return src.empty() ? t : fmt::format("{} ({})", t, src);
-  return src.empty() ? fmt::format("run {}", index + 1) : src;
+  return src.empty() ? trf("run {}", index + 1) : src;
 }
 
 void write_outputs(const std::vector<Figure>& figures, const PlotOptions& options, PlotResult& result) {
@@ -304,9 +309,8 @@ Figure analysis_figure(const json& analysis, const PlotOptions& options) {
   append_allan_block(body, "allan", rows);
   PlotCommand plot;
   const auto conf = num(allan, "confidence");
-  plot.add(
-      fmt::format("$allan u 1:2:3:4 w yerrorbars pt 7 ps 0.55 lw 1.2 lc rgb '#222222' t {}",
-                  gnuplot_string(conf ? fmt::format("measured σ(τ), {:g} % bounds", *conf * 100) : "measured σ(τ)")));
+  plot.add(fmt::format("$allan u 1:2:3:4 w yerrorbars pt 7 ps 0.55 lw 1.2 lc rgb '#222222' t {}",
+                       label_text(conf ? trf("measured σ(τ), {:g} % bounds", *conf * 100) : tr("measured σ(τ)"))));
   if (is_gyro(allan)) {
     body += kTermFunctions;
     if (const auto& fit = at(analysis, "fit"); fit.is_object()) add_model(fit, body, plot);
@@ -334,7 +338,7 @@ Figure batch_allan_figure(const json& runs, const PlotOptions& options) {
     for (const auto& r : rows) bounds.x(r.tau), bounds.y(r.low, r.high);
     plot.add(fmt::format("${} u 1:2:3:4 w yerrorlines pt {} ps 0.6 lw 1.4 lc rgb '{}' t {}", name,
                          kPointTypes[i % kPointTypes.size()], temperature_colour(at(run, "temperature_c"), i),
-                         gnuplot_string(run_label(run, i))));
+                         label_text(run_label(run, i))));
   }
   if (plot.elements.empty())
     throw AnalysisError("no run of the batch has Allan deviation points (runs[].allan.points): nothing to plot");
@@ -343,7 +347,7 @@ Figure batch_allan_figure(const json& runs, const PlotOptions& options) {
     add_class_floors(runs[order.front()], blocks, plot, bounds);
   }
   return loglog_figure("batch-allan", options,
-                       options.title.empty() ? "Allan deviation at each test temperature" : options.title, ylabel,
+                       options.title.empty() ? tr("Allan deviation at each test temperature") : options.title, ylabel,
                        bounds, blocks, plot);
 }
 
@@ -387,9 +391,9 @@ Figure batch_direct_figure(const json& runs, const PlotOptions& options) {
     if (!intercept) intercept = num(direct, "intercept");
     // One key entry per run: the points carry the label, the line shares their colour.
     std::string label = run_label(run, i);
-    if (n_val) label += fmt::format(": N {} {} {}", n_resolved ? "=" : "<", show(*n_val), lbl::arw);
+    if (n_val) label += fmt::format(": N {} {} {}", n_resolved ? "=" : "<", show(*n_val), tr(lbl::arw));
     plot.add(fmt::format("${} u 1:2 w p pt {} ps 0.8 lc rgb '{}' t {}", name, kPointTypes[i % kPointTypes.size()],
-                         colour, gnuplot_string(label)));
+                         colour, label_text(label)));
     if (slope) {
       vars += fmt::format("slope{0} = {1:.8g}   # {3}/s\nintercept{0} = {2:.8g}   # {3}\n", i + 1, *slope,
                           intercept.value_or(0.0), lbl::angle2);
@@ -399,18 +403,21 @@ Figure batch_direct_figure(const json& runs, const PlotOptions& options) {
   }
   if (plot.elements.empty()) return f;
   const std::string title =
-      options.title.empty() ? "Direct method: variance of the angle over t (Earth rate removed), with regression lines"
-                            : options.title + " — direct method";
+      options.title.empty()
+          ? tr("Direct method: variance of the angle over t (Earth rate removed), with regression lines")
+          : options.title + tr(" — direct method");
   // The variance grows with t, so the upper-left corner is empty: the key goes there.
   f.script = fmt::format(
       "set encoding utf8\nset title {} noenhanced\n"
       "set xtics nomirror\nset ytics nomirror\nset mxtics\nset mytics\n"
       "set grid xtics ytics lw 0.6 lc rgb '#d9d9d9'\nset border 3 lw 1\n"
-      "set xlabel 'interval length t (s)' noenhanced\nset ylabel 'angle variance D(t) ({})' noenhanced\n"
+      "set xlabel {} noenhanced\nset ylabel {} noenhanced\n{}"
       "set xrange [0:{:.6g}]\nset yrange [0:{:.6g}]\n"
       "set key inside left top vertical Left reverse noenhanced samplen 2.5 spacing 1.1 opaque "
       "box lc rgb '#bbbbbb'\n",
-      gnuplot_string(title), lbl::angle2, tmax * 1.02, vmax * 1.25);
+      label_text(title), label_text(tr("interval length t (s)")),
+      label_text(trf("angle variance D(t) ({})", tr(lbl::angle2))),
+      language() == Language::Russian ? "set decimalsign ','\n" : "", tmax * 1.02, vmax * 1.25);
   f.script += blocks + vars + plot.text();
   f.series = static_cast<int>(plot.elements.size());
   return f;
@@ -450,9 +457,10 @@ std::string band_label(const char* what, const json& model, const std::vector<Ba
     inside += (r.dev >= r.low && r.dev <= r.high) ? 1 : 0;
   }
   const auto level = num(model, "band_level");
-  std::string s =
-      fmt::format("{} model: simulated {}band", what, level ? fmt::format("{:g} % ", *level * 100) : std::string());
-  if (measured > 0) s += fmt::format(", {} of {} τ inside", inside, measured);
+  const std::string percent = level ? fmt::format("{:g} % ", *level * 100) : std::string();
+  std::string s = std::string_view(what) == "base" ? trf("base model: simulated {}band", percent)
+                                                   : trf("extended model: simulated {}band", percent);
+  if (measured > 0) s += trf(", {} of {} τ inside", inside, measured);
   return s;
 }
 
@@ -462,8 +470,8 @@ std::string diagnosis_title(const json& diagnosis) {
   if (findings.is_array())
     for (const auto& f : findings)
       if (auto e = view::str(f, "effect"); !e.empty()) effects.push_back(e);
-  return "Measurement against simulations of the noise model" +
-         (effects.empty() ? std::string(" (no finding)") : fmt::format(" (findings: {})", fmt::join(effects, ", ")));
+  return tr("Measurement against simulations of the noise model") +
+         (effects.empty() ? std::string(tr(" (no finding)")) : trf(" (findings: {})", fmt::join(effects, ", ")));
 }
 
 }  // namespace
@@ -489,23 +497,25 @@ Figure diagnosis_figure(const json& diagnosis, const PlotOptions& options) {
   };
   add_band("base", base);
   plot.add(fmt::format("$base u 1:3:4 w filledcurves fs transparent solid 0.30 noborder lc rgb '#1f77b4' t {}",
-                       gnuplot_string(band_label("base", at(diagnosis, "base_model"), base))));
+                       label_text(band_label("base", at(diagnosis, "base_model"), base))));
   if (std::all_of(base.begin(), base.end(), [](const BandRow& r) { return r.median > 0; }))
-    plot.add("$base u 1:5 w l lw 1.2 dt 2 lc rgb '#1f77b4' t 'base model: simulated median'");
+    plot.add("$base u 1:5 w l lw 1.2 dt 2 lc rgb '#1f77b4' t " + label_text(tr("base model: simulated median")));
   if (!ext.empty()) {
     add_band("extended", ext);
     plot.add(fmt::format(
         "$extended u 1:3:4 w filledcurves fs transparent pattern 5 border lc rgb '#e6550d' lc rgb '#e6550d' t {}",
-        gnuplot_string(band_label("extended", at(diagnosis, "extended_model"), ext))));
+        label_text(band_label("extended", at(diagnosis, "extended_model"), ext))));
   }
   // The τ where the measurement leaves the base band are marked so that they stand out.
   std::string outside;
   for (const auto& r : base)
     if (r.dev > 0 && (r.dev < r.low || r.dev > r.high)) outside += fmt::format("{:.10g} {:.10g}\n", r.tau, r.dev);
-  plot.add("$base u 1:($2 > 0 ? $2 : NaN) w lp pt 7 ps 0.6 lw 1.4 lc rgb '#000000' t 'measured σ(τ)'");
+  plot.add("$base u 1:($2 > 0 ? $2 : NaN) w lp pt 7 ps 0.6 lw 1.4 lc rgb '#000000' t " +
+           label_text(tr("measured σ(τ)")));
   if (!outside.empty()) {
     blocks += "$outside << EOD\n# tau_s dev (outside the base band)\n" + outside + "EOD\n";
-    plot.add("$outside u 1:2 w p pt 6 ps 1.6 lw 1.6 lc rgb '#d62728' t 'measured, outside the base band'");
+    plot.add("$outside u 1:2 w p pt 6 ps 1.6 lw 1.6 lc rgb '#d62728' t " +
+             label_text(tr("measured, outside the base band")));
   }
   return loglog_figure("diagnosis", options, options.title.empty() ? diagnosis_title(diagnosis) : options.title,
                        fmt::format("Allan deviation σ(τ) ({})", lbl::rate), bounds, blocks, plot);

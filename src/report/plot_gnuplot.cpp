@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/cleanup.hpp"
+#include "report/process.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/plot.hpp"
 #include "rwcalc/printable.hpp"
@@ -27,7 +28,52 @@ namespace rwcalc {
 
 namespace fs = std::filesystem;
 
+namespace detail {
+ProcessResult run_process(const std::string& command, const std::vector<std::string>& args, const fs::path& log,
+                          const fs::path& cwd) {
+  ProcessResult r;
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  if (!cwd.empty()) posix_spawn_file_actions_addchdir_np(&actions, cwd.c_str());
+  // A relative command path names a file from our directory, not from `cwd`.
+  std::error_code ec;
+  const auto absolute = fs::absolute(command, ec);
+  std::vector<std::string> storage{!cwd.empty() && command.find('/') != std::string::npos && !ec ? absolute.string()
+                                                                                                 : command};
+  storage.insert(storage.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& s : storage) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  const int rc = posix_spawnp(&pid, storage.front().c_str(), &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) {
+    r.spawn_errno = rc;
+    return r;
+  }
+  r.started = true;
+  int wstatus = 0;
+  pid_t waited = 0;
+  while ((waited = waitpid(pid, &wstatus, 0)) < 0 && errno == EINTR) {
+  }
+  if (waited < 0) return r;  // status -1
+  r.status = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : 128 + WTERMSIG(wstatus);
+  std::ifstream in(log, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  r.err = ss.str();
+  return r;
+}
+
+}  // namespace detail
+
 namespace {
+
+using detail::ProcessResult;
+using detail::run_process;
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -61,51 +107,6 @@ class ScratchDir {
   fs::path path_;
   std::deque<detail::RemoveOnSignal> on_signal_;  ///< unregistered after the removal above
 };
-
-struct ProcessResult {
-  bool started = false;
-  int spawn_errno = 0;
-  int status = -1;  ///< exit status, or 128 + signal
-  std::string err;  ///< what the process wrote to stderr
-};
-
-/// Run `command args…` with stdin from /dev/null and stdout+stderr captured in `log`; in the
-/// directory `cwd` when it is not empty.
-ProcessResult run_process(const std::string& command, const std::vector<std::string>& args, const fs::path& log,
-                          const fs::path& cwd = {}) {
-  ProcessResult r;
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  if (!cwd.empty()) posix_spawn_file_actions_addchdir_np(&actions, cwd.c_str());
-  // A relative command path names a file from our directory, not from `cwd`.
-  std::error_code ec;
-  const auto absolute = fs::absolute(command, ec);
-  std::vector<std::string> storage{!cwd.empty() && command.find('/') != std::string::npos && !ec ? absolute.string()
-                                                                                                 : command};
-  storage.insert(storage.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& s : storage) argv.push_back(s.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  const int rc = posix_spawnp(&pid, storage.front().c_str(), &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0) {
-    r.spawn_errno = rc;
-    return r;
-  }
-  r.started = true;
-  int wstatus = 0;
-  pid_t waited = 0;
-  while ((waited = waitpid(pid, &wstatus, 0)) < 0 && errno == EINTR) {
-  }
-  if (waited < 0) return r;  // status -1
-  r.status = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : 128 + WTERMSIG(wstatus);
-  r.err = slurp(log);
-  return r;
-}
 
 /// Throws when gnuplot could not be started (a shell wrapper reports a missing binary as 127).
 void require_started(const ProcessResult& r, const std::string& command) {

@@ -11,6 +11,7 @@
 
 #include "report/json_view.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/plot.hpp"
 #include "rwcalc/printable.hpp"
@@ -70,6 +71,9 @@ std::string esc(std::string_view text) {
 
 std::string g(double v, int digits = 3) { return fmt::format("{:.{}g}", v, digits); }
 
+/// A unit label of units.hpp in the report's language (°/h → °/ч).
+std::string unit(const char* label) { return tr(label); }
+
 constexpr const char* kNotAvailable = "<span class=\"na\">—</span>";
 
 /// A coefficient cell: "value ± σ" with the 95 % interval below, or "< bound" when unresolved.
@@ -78,7 +82,7 @@ std::string coef_cell(const json& c) {
   if (!v) return kNotAvailable;
   const auto& resolved = at(c, "resolved");
   if (resolved.is_boolean() && !resolved.get<bool>())
-    return fmt::format("&lt; {} <span class=\"ci\">95 % upper bound</span>", g(*v));
+    return fmt::format("&lt; {} <span class=\"ci\">{}</span>", g(*v), tr("95 % upper bound"));
   std::string s = g(*v);
   if (const auto sigma = num(c, "sigma"); sigma && *sigma > 0) s += fmt::format(" ± {}", g(*sigma, 2));
   const auto lo = num(c, "low95"), hi = num(c, "high95");
@@ -88,29 +92,50 @@ std::string coef_cell(const json& c) {
 
 std::string temperature_text(const json& run) {
   const auto t = view::temperature_label(at(run, "temperature_c"));
-  return t.empty() ? "not given" : t;
+  return t.empty() ? tr("not given") : t;
 }
 
 std::string class_text(const json& c) {
   if (c.is_number_integer()) return fmt::format("{}", c.get<int>());
-  if (c.is_null()) return "outside";
+  if (c.is_null()) return tr("outside");
   return kNotAvailable;
 }
 
 /// The verdict's statement, else its class (plain text).
 std::string statement_text(const json& v) {
   const auto st = str(v, "statement");
-  return st.empty() ? "class " + class_text(at(v, "class")) : st;
+  return st.empty() ? trf("class {}", class_text(at(v, "class"))) : st;
 }
 
 /// "; by B: …; by N: …" from two statements, each left out when absent.
 std::string by_parameter(const std::string& b, const std::string& n) {
-  return (b.empty() ? "" : "; by B: " + esc(b)) + (n.empty() ? "" : "; by N: " + esc(n));
+  return (b.empty() ? "" : trf("; by B: {}", esc(b))) + (n.empty() ? "" : trf("; by N: {}", esc(n)));
+}
+
+/// A verdict in words: the class, its probability in per cent and, when that is not decisive
+/// (below 90 %), the runner-up; from the verdict's "class", "p_is" and "classes" (empty without).
+std::string verdict_in_words(const json& v, const json& classes_json) {
+  const auto& p_is = at(v, "p_is");
+  if (!p_is.is_array() || !classes_json.is_array() || p_is.size() != classes_json.size() + 1) return {};
+  const auto classes = classes_json.get<std::vector<int>>();
+  const auto& c = at(v, "class");
+  std::size_t s = classes.size();
+  for (std::size_t k = 0; k < classes.size(); ++k)
+    if (c.is_number_integer() && classes[k] == c.get<int>()) s = k;
+  auto name = [&](std::size_t k) {
+    return k < classes.size() ? trf("accuracy class {}", classes[k]) : trf("outside class {}", classes.back());
+  };
+  auto pct = [&](std::size_t k) { return 100.0 * p_is[k].get<double>(); };
+  std::string w = trf("{} with a probability of {:.0f} %", name(s), pct(s));
+  if (pct(s) >= 90.0 || classes.empty()) return w;
+  std::size_t r = s > 0 ? s - 1 : s + 1;
+  if (s > 0 && s + 1 <= classes.size() && pct(s + 1) > pct(s - 1)) r = s + 1;
+  return w + trf("; the next most probable: {} ({:.0f} %)", name(r), pct(r));
 }
 
 std::string source_name(const json& a) {
   const auto s = str(a, "source");
-  return s.empty() ? std::string("(unnamed run)") : std::filesystem::path(s).filename().string();
+  return s.empty() ? std::string(tr("(unnamed run)")) : std::filesystem::path(s).filename().string();
 }
 
 /// The class an estimate's reported value falls in (no probability): for the cross-check methods.
@@ -119,51 +144,73 @@ std::string class_by_value(const json& estimate, const json& run, const char* pa
   if (!v) return kNotAvailable;
   for (const auto& [cls, limit] : view::class_limits(run, parameter))
     if (*v <= limit) return fmt::format("{}", cls);
-  return "outside";
+  return tr("outside");
 }
 
-/// Figures are numbered in the order they appear on the page.
-struct Figures {
-  bool enabled = true;
-  int next = 1;
-  std::string html(const std::string& id, const std::vector<Figure>& figures, const std::string& caption) {
+/// Tables and figures are numbered in the order they appear on the page, as in a filed report.
+struct Numbering {
+  bool figures_enabled = true;
+  int next_table = 1;
+  int next_figure = 1;
+  int next_section = 1;
+  /// "<h2 id=…>N. title</h2>" (the title is plain text).
+  std::string section(const char* id, const std::string& title) {
+    return fmt::format("<h2 id=\"{}\">{}. {}</h2>\n", id, next_section++, esc(title));
+  }
+  /// "<table id=…><caption>Table N. caption</caption>" (the caption is HTML).
+  std::string table(const std::string& id, const std::string& caption_html, const char* css_class = nullptr) {
+    return fmt::format("<table id=\"{}\"{}>\n<caption><b>{}.</b> {}</caption>\n", id,
+                       css_class ? fmt::format(" class=\"{}\"", css_class) : std::string(),
+                       trf("Table {}", next_table++), caption_html);
+  }
+  std::string figure(const std::string& id, const std::vector<Figure>& figures, const std::string& caption) {
     const auto svg = render_figures(figures, PlotFormat::Svg, 960);
     return fmt::format(
         "<figure id=\"{0}\">\n<img alt=\"{1}\" src=\"data:image/svg+xml;base64,{2}\"/>\n"
-        "<figcaption><b>Fig. {3}.</b> {1}</figcaption>\n</figure>\n",
-        id, esc(caption), base64_encode(svg), next++);
+        "<figcaption><b>{3}.</b> {1}</figcaption>\n</figure>\n",
+        id, esc(caption), base64_encode(svg), trf("Figure {}", next_figure++));
   }
 };
 
+/// The page style; @page gives the A4 print layout with the page number in its bottom margin
+/// (the words of "Page N of M" are inserted: kStyle is a format string).
 constexpr const char* kStyle = R"(
-body { font-family: "DejaVu Sans", Helvetica, Arial, sans-serif; font-size: 14px; color: #222;
-       max-width: 1100px; margin: 1.5em auto; padding: 0 1em; line-height: 1.4; }
-h1 { font-size: 1.6em; margin-bottom: 0.2em; }
-h2 { font-size: 1.25em; border-bottom: 1px solid #ccc; padding-bottom: 0.2em; margin-top: 1.6em; }
-h3 { font-size: 1.05em; margin-top: 1.2em; }
-.meta { color: #555; }
-table { border-collapse: collapse; margin: 0.6em 0 1em; font-size: 0.95em; }
-th, td { border: 1px solid #bbb; padding: 0.3em 0.6em; text-align: left; vertical-align: top;
-         overflow-wrap: break-word; }
-th { background: #f0f0f0; }
-td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
-caption { caption-side: top; text-align: left; font-weight: bold; padding-bottom: 0.3em; }
-.ci { display: block; color: #666; font-size: 0.85em; }
-.na { color: #999; }
-.verdict { font-size: 1.15em; padding: 0.6em 0.9em; border-left: 5px solid #2c7bb6; background: #f4f8fb; }
-.note { color: #7a4b00; background: #fff6e0; padding: 0.3em 0.6em; border-left: 4px solid #e6a000; }
-.warning { color: #7a0000; background: #fff0f0; padding: 0.3em 0.6em; border-left: 4px solid #c00000; }
-figure { margin: 1em 0; }
-figure img { width: 100%; max-width: 960px; height: auto; border: 1px solid #eee; }
-figcaption { color: #444; font-size: 0.92em; }
-footer { margin-top: 2em; color: #777; font-size: 0.85em; border-top: 1px solid #ddd; padding-top: 0.5em; }
-@media print {
-  body { max-width: none; margin: 0; font-size: 11px; }
-  h2 { page-break-after: avoid; }
-  table, figure, .verdict { page-break-inside: avoid; }
-  figure img { max-width: 100%; border: none; }
-  a { color: inherit; text-decoration: none; }
-}
+body {{ font-family: "DejaVu Sans", "Liberation Sans", Helvetica, Arial, sans-serif; font-size: 14px; color: #222;
+       max-width: 1100px; margin: 1.5em auto; padding: 0 1em; line-height: 1.4; }}
+h1 {{ font-size: 1.6em; margin: 0 0 0.3em; }}
+h2 {{ font-size: 1.25em; border-bottom: 1px solid #ccc; padding-bottom: 0.2em; margin-top: 1.6em; }}
+h3 {{ font-size: 1.05em; margin-top: 1.2em; }}
+.meta {{ color: #555; }}
+header.title {{ border: 2px solid #333; padding: 0.8em 1em; margin-bottom: 1.2em; }}
+header.title table {{ margin: 0.4em 0 0; border: none; width: 100%; }}
+header.title th, header.title td {{ border: none; border-bottom: 1px dotted #bbb; padding: 0.2em 0.6em 0.2em 0; }}
+header.title th {{ background: none; width: 28%; font-weight: normal; color: #555; }}
+table {{ border-collapse: collapse; margin: 0.6em 0 1em; font-size: 0.95em; }}
+th, td {{ border: 1px solid #bbb; padding: 0.3em 0.6em; text-align: left; vertical-align: top;
+         overflow-wrap: anywhere; }}
+th {{ background: #f0f0f0; }}
+td.num {{ text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }}
+caption {{ caption-side: top; text-align: left; padding-bottom: 0.3em; }}
+.ci {{ display: block; color: #666; font-size: 0.85em; }}
+.na {{ color: #999; }}
+.verdict {{ font-size: 1.15em; padding: 0.6em 0.9em; border-left: 5px solid #2c7bb6; background: #f4f8fb; }}
+.note {{ color: #7a4b00; background: #fff6e0; padding: 0.3em 0.6em; border-left: 4px solid #e6a000; }}
+.warning {{ color: #7a0000; background: #fff0f0; padding: 0.3em 0.6em; border-left: 4px solid #c00000; }}
+.formula {{ font-family: "DejaVu Serif", "Times New Roman", serif; white-space: nowrap; }}
+code {{ overflow-wrap: anywhere; }}
+figure {{ margin: 1em 0; }}
+figure img {{ width: 100%; max-width: 960px; height: auto; border: 1px solid #eee; }}
+figcaption {{ color: #444; font-size: 0.92em; }}
+footer {{ margin-top: 2em; color: #777; font-size: 0.85em; border-top: 1px solid #ddd; padding-top: 0.5em; }}
+@page {{ size: A4; margin: 16mm 14mm 18mm 16mm;
+        @bottom-center {{ content: "{0} " counter(page) " {1} " counter(pages); font-size: 9pt; color: #555; }} }}
+@media print {{
+  body {{ max-width: none; margin: 0; padding: 0; font-size: 10.5px; }}
+  h2 {{ page-break-after: avoid; }}
+  table, figure, .verdict, header.title {{ page-break-inside: avoid; }}
+  figure img {{ max-width: 100%; border: none; }}
+  a {{ color: inherit; text-decoration: none; }}
+}}
 )";
 
 /// Worst (highest) class over runs; null when any run is outside the table or unclassified.
@@ -184,12 +231,13 @@ std::string run_row(const json& run, const std::vector<std::string>& cells, std:
   return s + std::string(tail) + "</tr>\n";
 }
 
-std::string table1(const std::vector<json>& a, const std::vector<std::size_t>& order) {
-  std::string s = fmt::format(
-      "<table id=\"table1\">\n<caption>Table 1. Noise coefficients per temperature: value ± standard error "
-      "[95 % interval]</caption>\n<tr><th>run</th><th>temperature</th><th>N by Allan variance ({0})</th>"
-      "<th>N direct method ({0})</th><th>B by Allan variance ({1})</th><th>B by 100-s averaging ({1})</th></tr>\n",
-      lbl::arw, lbl::rate);
+std::string table1(const std::vector<json>& a, const std::vector<std::size_t>& order, Numbering& numbering) {
+  std::string s = numbering.table("table1", tr("Noise coefficients per temperature: value ± standard error [95 % "
+                                               "interval]"));
+  s +=
+      trf("<tr><th>run</th><th>temperature</th><th>N by Allan variance ({0})</th><th>N direct method ({0})</th>"
+          "<th>B by Allan variance ({1})</th><th>B by 100-s averaging ({1})</th></tr>\n",
+          unit(lbl::arw), unit(lbl::rate));
   for (auto i : order) {
     const auto& fit = at(a[i], "fit");
     const auto& methods = at(a[i], "methods");
@@ -199,12 +247,14 @@ std::string table1(const std::vector<json>& a, const std::vector<std::size_t>& o
   return s + "</table>\n";
 }
 
-std::string table2(const std::vector<json>& a, const std::vector<std::size_t>& order, const json& overall) {
-  std::string s =
-      "<table id=\"table2\">\n<caption>Table 2. Accuracy class per parameter (1 best; “outside”: beyond the "
-      "last class)</caption>\n<tr><th>run</th><th>temperature</th><th>class by N (AV)</th>"
-      "<th>class by N direct</th><th>class by B (verdict estimate)</th><th>class by B 100-s</th>"
-      "<th>class</th><th>verdict with probability</th></tr>\n";
+std::string table2(const std::vector<json>& a, const std::vector<std::size_t>& order, const json& overall,
+                   Numbering& numbering) {
+  std::string s = numbering.table("table2", tr("Accuracy class per parameter (1 best; “outside”: beyond the last "
+                                               "class)"));
+  s +=
+      tr("<tr><th>run</th><th>temperature</th><th>class by N (AV)</th><th>class by N direct</th>"
+         "<th>class by B (verdict estimate)</th><th>class by B 100-s</th><th>class</th>"
+         "<th>verdict with probability</th></tr>\n");
   for (auto i : order) {
     const auto& run = a[i];
     const auto& v = at(run, "verdict");
@@ -212,11 +262,11 @@ std::string table2(const std::vector<json>& a, const std::vector<std::size_t>& o
     std::string statement = esc(str(v, "statement"));
     if (statement.empty()) {
       const auto p = num(v, "p_class");
-      statement = p ? fmt::format("class {} (P = {:.2f})", class_text(at(v, "class")), *p) : kNotAvailable;
+      statement = p ? trf("class {} (P = {:.2f})", class_text(at(v, "class")), *p) : kNotAvailable;
     }
     if (const auto& changed = at(v, "tolerance_changed"); changed.is_boolean() && changed.get<bool>())
-      statement += fmt::format(" <span class=\"note\">changed by the +{:g} % B tolerance</span>",
-                               num(v, "tolerance_pct").value_or(0.0));
+      statement += fmt::format(" <span class=\"note\">{}</span>",
+                               trf("changed by the +{:g} % B tolerance", num(v, "tolerance_pct").value_or(0.0)));
     s += run_row(run,
                  {class_text(at(v, "class_N")), class_by_value(at(methods, "N_direct_deg_per_sqrt_h"), run, "N"),
                   class_text(at(v, "class_B")), class_by_value(at(methods, "B_100s_deg_per_h"), run, "B"),
@@ -224,13 +274,14 @@ std::string table2(const std::vector<json>& a, const std::vector<std::size_t>& o
                  "<td>" + statement + "</td>");
   }
   s += fmt::format(
-      "<tr><th colspan=\"2\">over the temperature range</th><td class=\"num\"><b>{}</b></td><td></td>"
-      "<td class=\"num\"><b>{}</b></td><td></td><td class=\"num\"><b>{}</b></td><td>worst case over the "
-      "runs</td></tr>\n",
-      class_text(at(overall, "class_N")), class_text(at(overall, "class_B")), class_text(at(overall, "class")));
-  return s +
-         "</table>\n<p class=\"meta\">Classes by N direct and by B 100-s compare the reported value with the "
-         "class limits only (no probability); the verdict uses the estimates named in the settings.</p>\n";
+      "<tr><th colspan=\"2\">{}</th><td class=\"num\"><b>{}</b></td><td></td><td class=\"num\"><b>{}</b></td><td></td>"
+      "<td class=\"num\"><b>{}</b></td><td>{}</td></tr>\n",
+      tr("over the temperature range"), class_text(at(overall, "class_N")), class_text(at(overall, "class_B")),
+      class_text(at(overall, "class")), tr("worst case over the runs"));
+  return s + "</table>\n<p class=\"meta\">" +
+         tr("Classes by N direct and by B 100-s compare the reported value with the class limits only (no "
+            "probability); the verdict uses the estimates named in the settings.") +
+         "</p>\n";
 }
 
 std::string kv_row(std::string_view key, const std::string& value_html) {
@@ -238,7 +289,7 @@ std::string kv_row(std::string_view key, const std::string& value_html) {
 }
 
 std::string json_value_html(const json& v) {
-  if (v.is_string()) return esc(v.get<std::string>());
+  if (v.is_string()) return esc(tr(v.get<std::string>()));
   if (v.is_number_float()) return g(v.get<double>(), 6);
   if (v.is_null()) return kNotAvailable;
   if (v.is_array()) {  // one item after another, so long lists wrap
@@ -253,28 +304,30 @@ std::string json_value_html(const json& v) {
 /// What was done with the outliers, in words.
 std::string outlier_action_html(const json& outliers, std::size_t count) {
   const std::string action = str(outliers, "action");
-  if (action == "keep") return "kept in the analysis (--outliers remove or replace leaves them out)";
+  if (action == "keep") return tr("kept in the analysis (--outliers remove or replace leaves them out)");
   if (action == "remove")
-    return fmt::format("{:.0f} removed before the analysis (later samples move one period earlier)",
-                       num(outliers, "removed").value_or(static_cast<double>(count)));
+    return trf("{:.0f} removed before the analysis (later samples move one period earlier)",
+               num(outliers, "removed").value_or(static_cast<double>(count)));
   if (action == "replace")
-    return fmt::format("{:.0f} replaced by the median of their nearest good neighbours before the analysis",
-                       num(outliers, "replaced").value_or(static_cast<double>(count)));
-  return "action " + (action.empty() ? std::string(kNotAvailable) : esc(action));
+    return trf("{:.0f} replaced by the median of their nearest good neighbours before the analysis",
+               num(outliers, "replaced").value_or(static_cast<double>(count)));
+  return trf("action {}", action.empty() ? std::string(kNotAvailable) : esc(action));
 }
 
 constexpr std::size_t kReportOutlierPositions = 10;  ///< positions listed per run (the JSON has more)
 
 /// The outlier line of a run or a diagnosis: count, action and the first positions.
 std::string outliers_html(const json& outliers) {
-  if (!outliers.is_object()) return "<span class=\"na\">not in these results (no outlier summary)</span>";
+  if (!outliers.is_object())
+    return fmt::format("<span class=\"na\">{}</span>", tr("not in these results (no outlier summary)"));
   const auto count_value = num(outliers, "count");
   if (!count_value) return kNotAvailable;
   const auto count = static_cast<std::size_t>(*count_value);
   const auto z = num(outliers, "threshold_robust_z");
-  const std::string threshold = z ? fmt::format(" (threshold {:g} robust σ)", *z) : std::string();
-  if (count == 0) return "none found" + threshold;
-  std::string s = fmt::format("<b>{} found</b>{}; {}", count, threshold, outlier_action_html(outliers, count));
+  const std::string threshold = z ? trf(" (threshold {:g} robust σ)", *z) : std::string();
+  if (count == 0) return tr("none found") + threshold;
+  std::string s =
+      fmt::format("<b>{}</b>{}; {}", trf("{} found", count), threshold, outlier_action_html(outliers, count));
   const auto& positions = at(outliers, "positions");
   std::size_t listed = 0;
   if (positions.is_array()) {
@@ -282,69 +335,76 @@ std::string outliers_html(const json& outliers) {
       if (listed == kReportOutlierPositions) break;
       const auto line = num(p, "line"), time = num(p, "time_s"), value = num(p, "value_deg_per_h");
       s += listed++ ? ", " : ": ";
-      s += line ? fmt::format("line {:.0f}", *line) : std::string("line ") + kNotAvailable;
-      if (time)
-        s += fmt::format(" (t = {:g} s", *time) + (value ? fmt::format(", {:.6g} {})", *value, lbl::rate) : ")");
+      s += line ? trf("line {:.0f}", *line) : trf("line {}", kNotAvailable);
+      if (time) s += trf(" (t = {:g} s", *time) + (value ? fmt::format(", {:.6g} {})", *value, unit(lbl::rate)) : ")");
     }
   }
-  if (count > listed) s += fmt::format("{}… {} more in the JSON results", listed ? ", " : ": ", count - listed);
+  if (count > listed) s += (listed ? ", " : ": ") + trf("… {} more in the JSON results", count - listed);
   return s;
 }
 
-std::string data_table(const json& run, std::size_t index) {
-  std::string s =
-      fmt::format("<table class=\"run\" id=\"run{}-data\">\n<caption>Data and rates</caption>\n", index + 1);
-  s += kv_row("file", esc(str(run, "source")));
+/// The identification keys of the input metadata, with their labels.
+constexpr std::array<std::pair<const char*, const char*>, 4> kIdentification{{{"serial", N_("gyro serial")},
+                                                                              {"operator", N_("operator")},
+                                                                              {"test_date", N_("test date")},
+                                                                              {"conditions", N_("test conditions")}}};
+
+std::string data_table(const json& run, std::size_t index, Numbering& numbering) {
+  std::string s = numbering.table(fmt::format("run{}-data", index + 1),
+                                  trf("Data and identification: {}", esc(source_name(run))), "run");
+  s += kv_row(tr("file"), esc(str(run, "source")));
   const json& input = at(run, "input");
   if (const json& id = at(input, "identification"); id.is_object())
-    for (const auto& [key, label] : {std::pair{"serial", "gyro serial"}, std::pair{"operator", "operator"},
-                                     std::pair{"test_date", "test date"}, std::pair{"conditions", "test conditions"}})
-      if (const auto v = str(id, key); !v.empty()) s += kv_row(label, esc(v));
+    for (const auto& [key, label] : kIdentification)
+      if (const auto v = str(id, key); !v.empty()) s += kv_row(tr(label), esc(v));
   if (const auto sha = str(input, "sha256"); !sha.empty())
-    s += kv_row("file size, SHA-256", fmt::format("{:.0f} bytes, <code>{}</code>", num(input, "file_bytes").value_or(0),
-                                                  esc(sha)));
-  if (const auto n = num(run, "samples")) s += kv_row("samples", fmt::format("{:.0f}", *n));
-  if (const auto r = num(run, "rate_hz")) s += kv_row("sample rate", fmt::format("{:g} Hz", *r));
-  if (const auto d = num(run, "duration_s")) s += kv_row("duration", fmt::format("{:.1f} s ({:.2f} h)", *d, *d / 3600));
-  s += kv_row("temperature", temperature_text(run));
+    s += kv_row(tr("file size, SHA-256"),
+                trf("{:.0f} bytes, <code>{}</code>", num(input, "file_bytes").value_or(0), esc(sha)));
+  if (const auto n = num(run, "samples")) s += kv_row(tr("samples"), fmt::format("{:.0f}", *n));
+  if (const auto r = num(run, "rate_hz")) s += kv_row(tr("sample rate"), trf("{:g} Hz", *r));
+  if (const auto d = num(run, "duration_s")) s += kv_row(tr("duration"), trf("{:.1f} s ({:.2f} h)", *d, *d / 3600));
+  s += kv_row(tr("temperature"), temperature_text(run));
   auto rate = [&](const char* key, const char* name, int digits) {
-    if (const auto v = num(run, key)) s += kv_row(name, fmt::format("{} {}", g(*v, digits), lbl::rate));
+    if (const auto v = num(run, key)) s += kv_row(tr(name), fmt::format("{} {}", g(*v, digits), unit(lbl::rate)));
   };
-  rate("mean_rate_deg_per_h", "mean rate", 5);
-  rate("earth_rate_deg_per_h", "expected Earth rate", 5);
-  rate("bias_deg_per_h", "bias (mean − Earth rate)", 4);
-  s += fmt::format("<tr id=\"run{}-outliers\"><th>outliers</th><td>{}</td></tr>\n", index + 1,
+  rate("mean_rate_deg_per_h", N_("mean rate"), 5);
+  rate("earth_rate_deg_per_h", N_("expected Earth rate"), 5);
+  rate("bias_deg_per_h", N_("bias (mean − Earth rate)"), 4);
+  s += fmt::format("<tr id=\"run{}-outliers\"><th>{}</th><td>{}</td></tr>\n", index + 1, tr("outliers"),
                    outliers_html(at(run, "outliers")));
   return s + "</table>\n";
 }
 
-std::string fit_table(const json& fit, std::size_t index) {
-  std::string s = fmt::format(
-      "<table class=\"run\" id=\"run{}-fit\">\n<caption>Allan-variance fit "
-      "σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)B² + K²τ/3 + R²τ²/2</caption>\n"
-      "<tr><th>term</th><th>value ± standard error [95 %]</th><th>unit</th></tr>\n",
-      index + 1);
+/// The five-term model, typeset.
+constexpr const char* kModelFormula = "σ²(τ) = 3Q²/τ² + N²/τ + (2 ln 2/π)·B² + K²τ/3 + R²τ²/2";
+
+std::string fit_table(const json& fit, std::size_t index, Numbering& numbering) {
+  std::string s = numbering.table(fmt::format("run{}-fit", index + 1),
+                                  trf("Allan-variance fit <span class=\"formula\">{}</span>", kModelFormula), "run");
+  s += tr("<tr><th>term</th><th>value ± standard error [95 %]</th><th>unit</th></tr>\n");
   static constexpr std::array<std::array<const char*, 3>, 5> kCoefficientRows{
-      {{"Q_arcsec", "Q quantization", lbl::angle},
-       {"N_deg_per_sqrt_h", "N angle random walk", lbl::arw},
-       {"B_deg_per_h", "B bias instability", lbl::rate},
-       {"K_deg_per_h_per_sqrt_h", "K rate random walk", lbl::rrw},
-       {"R_deg_per_h2", "R rate ramp", lbl::ramp}}};
-  for (const auto& [key, name, unit] : kCoefficientRows)
-    s += fmt::format("<tr><td>{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n", name, coef_cell(at(fit, key)), unit);
+      {{"Q_arcsec", N_("Q quantization noise"), lbl::angle},
+       {"N_deg_per_sqrt_h", N_("N angle random walk"), lbl::arw},
+       {"B_deg_per_h", N_("B bias instability"), lbl::rate},
+       {"K_deg_per_h_per_sqrt_h", N_("K rate random walk"), lbl::rrw},
+       {"R_deg_per_h2", N_("R rate ramp"), lbl::ramp}}};
+  for (const auto& [key, name, u] : kCoefficientRows)
+    s += fmt::format("<tr><td>{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n", tr(name), coef_cell(at(fit, key)),
+                     unit(u));
+  auto row = [&](const char* name, const std::string& html) {
+    s += fmt::format("<tr><td>{}</td><td colspan=\"2\">{}</td></tr>\n", tr(name), html);
+  };
   if (const auto c = num(fit, "chi2_per_dof")) {
     std::string gof = fmt::format("χ²/dof = {:.3g}", *c);
     if (const auto p = num(fit, "p_value")) gof += fmt::format(", p = {:.3g}", *p);
     if (const auto lo = num(fit, "tau_min_s"), hi = num(fit, "tau_max_s"); lo && hi)
-      gof += fmt::format("; τ fitted {:g}–{:g} s", *lo, *hi);
-    s += fmt::format("<tr><td>goodness of fit</td><td colspan=\"2\">{}</td></tr>\n", gof);
+      gof += trf("; τ fitted {:g}–{:g} s", *lo, *hi);
+    row(N_("goodness of fit"), gof);
   }
-  if (const auto& range = at(fit, "range"); range.is_object())
-    s += fmt::format("<tr><td>fit range</td><td colspan=\"2\">{}</td></tr>\n", esc(str(range, "reason")));
+  if (const auto& range = at(fit, "range"); range.is_object()) row(N_("fit range"), esc(str(range, "reason")));
   if (const auto& scaled = at(fit, "intervals_scaled"); scaled.is_boolean() && scaled.get<bool>())
-    s += fmt::format(
-        "<tr><td>intervals</td><td colspan=\"2\">scaled by √(χ²/dof) = {}: the model is rejected</td></tr>\n",
-        g(num(fit, "interval_scale").value_or(1.0)));
+    row(N_("intervals"),
+        trf("scaled by √(χ²/dof) = {}: the model is rejected", g(num(fit, "interval_scale").value_or(1.0))));
   return s + "</table>\n";
 }
 
@@ -352,7 +412,7 @@ std::string fit_table(const json& fit, std::size_t index) {
 std::string warnings_html(const json& run) {
   const auto& w = at(run, "warnings");
   if (!w.is_array() || w.empty()) return {};
-  std::string s = "<div class=\"warning\"><b>Warnings</b><ul>\n";
+  std::string s = fmt::format("<div class=\"warning\"><b>{}</b><ul>\n", tr("Warnings"));
   for (const auto& x : w) {
     s += fmt::format("<li><b>{}</b>: {}", esc(str(x, "code")), esc(str(x, "message")));
     if (const std::string c = str(x, "command"); !c.empty()) s += fmt::format(" <code>{}</code>", esc(c));
@@ -361,11 +421,14 @@ std::string warnings_html(const json& run) {
   return s + "</ul></div>\n";
 }
 
-std::string run_summary(const json& run, std::size_t index) {
-  std::string s = warnings_html(run) + data_table(run, index) + fit_table(at(run, "fit"), index);
-  if (const auto& v = at(run, "verdict"); v.is_object())
-    s += "<p>Verdict: <b>" + esc(statement_text(v)) + "</b>" +
-         by_parameter(str(v, "statement_B"), str(v, "statement_N")) + ".</p>\n";
+std::string run_summary(const json& run, std::size_t index, Numbering& numbering) {
+  std::string s = warnings_html(run) + data_table(run, index, numbering) + fit_table(at(run, "fit"), index, numbering);
+  if (const auto& v = at(run, "verdict"); v.is_object()) {
+    s += fmt::format("<p>{} <b>{}</b>{}.", tr("Verdict:"), esc(statement_text(v)),
+                     by_parameter(str(v, "statement_B"), str(v, "statement_N")));
+    if (const auto words = verdict_in_words(v, at(v, "classes")); !words.empty()) s += " " + esc(words) + ".";
+    s += "</p>\n";
+  }
   return s;
 }
 
@@ -376,23 +439,22 @@ std::string number_with_unit_key(std::string_view key, const json& v) {
                                                                               {"_deg_per_h2", lbl::ramp},
                                                                               {"_deg_per_h", lbl::rate},
                                                                               {"_arcsec", lbl::angle},
-                                                                              {"_hz", "Hz"},
-                                                                              {"_s", "s"},
+                                                                              {"_hz", N_("Hz")},
+                                                                              {"_s", N_("s")},
                                                                               {"_c", lbl::celsius},
                                                                               {"_pct", "%"}}};
   if (!v.is_number()) return json_value_html(v);
-  for (const auto& [suffix, unit] : kUnits)
+  for (const auto& [suffix, u] : kUnits)
     if (key.size() > std::string_view(suffix).size() && key.ends_with(suffix))
-      return fmt::format("{} {}", g(v.get<double>(), 4), unit);
+      return fmt::format("{} {}", g(v.get<double>(), 4), unit(u));
   return g(v.get<double>(), 4);
 }
 
-std::string findings_html(const json& findings, std::size_t index) {
+std::string findings_html(const json& findings, std::size_t index, Numbering& numbering) {
   if (!findings.is_array() || findings.empty())
-    return "<p>No finding: the five-term model's simulations explain the measurement.</p>\n";
-  std::string s = fmt::format(
-      "<table id=\"run{}-findings\">\n<caption>Findings</caption>\n<tr><th>effect</th><th>parameters</th></tr>\n",
-      index + 1);
+    return fmt::format("<p>{}</p>\n", tr("No finding: the five-term model's simulations explain the measurement."));
+  std::string s = numbering.table(fmt::format("run{}-findings", index + 1), tr("Findings"));
+  s += tr("<tr><th>effect</th><th>parameters</th></tr>\n");
   for (const auto& f : findings) {
     std::string params;
     if (f.is_object())
@@ -404,145 +466,210 @@ std::string findings_html(const json& findings, std::size_t index) {
   return s + "</table>\n";
 }
 
-std::string gain_html(const json& gain, std::size_t index) {
+std::string gain_html(const json& gain, std::size_t index, Numbering& numbering) {
   if (!gain.is_object()) return {};
-  std::string s = fmt::format(
-      "<table id=\"run{}-gain\">\n<caption>Gain of the extended model</caption>\n"
-      "<tr><th>measure</th><th>base model</th><th>extended model</th></tr>\n",
-      index + 1);
+  std::string s = numbering.table(fmt::format("run{}-gain", index + 1), tr("Gain of the extended model"));
+  s += tr("<tr><th>measure</th><th>base model</th><th>extended model</th></tr>\n");
   static constexpr std::array<std::array<const char*, 3>, 3> kRows{
-      {{"Allan-variance misfit (EDF-weighted)", "misfit_base", "misfit_extended"},
-       {"share of measured τ inside the simulated band", "coverage_base", "coverage_extended"},
-       {"out-of-sample misfit (fit on one part, predict the other)", "holdout_misfit_base",
+      {{N_("Allan-variance misfit (EDF-weighted)"), "misfit_base", "misfit_extended"},
+       {N_("share of measured τ inside the simulated band"), "coverage_base", "coverage_extended"},
+       {N_("out-of-sample misfit (fit on one part, predict the other)"), "holdout_misfit_base",
         "holdout_misfit_extended"}}};
   auto cell = [&](const char* key) {
     const auto v = num(gain, key);
     return v ? g(*v, 4) : std::string(kNotAvailable);
   };
   for (const auto& [name, base, ext] : kRows)
-    s += fmt::format("<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>\n", name, cell(base),
+    s += fmt::format("<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>\n", tr(name), cell(base),
                      cell(ext));
   return s + "</table>\n";
 }
 
-std::string diagnosis_html(const json& d, std::size_t index, const json& run, Figures& figures) {
-  std::string s = fmt::format("<h3 id=\"run{}-diagnosis\">Diagnosis: what the noise model misses</h3>\n", index + 1);
-  s += fmt::format("<p id=\"run{}-diagnosis-outliers\">Outliers of the diagnosed record: {}.</p>\n", index + 1,
-                   outliers_html(at(d, "outliers")));
-  s += findings_html(at(d, "findings"), index) + gain_html(at(d, "gain"), index);
-  if (figures.enabled && (at(at(d, "base_model"), "band").is_array() || at(d, "band").is_array()))
-    s += figures.html(fmt::format("fig-run{}-diagnosis", index + 1), {diagnosis_figure(d, PlotOptions{})},
-                      fmt::format("{}: measured Allan deviation against the simulated bands of the base and the "
-                                  "extended model",
-                                  source_name(run)));
+std::string diagnosis_html(const json& d, std::size_t index, const json& run, Numbering& numbering) {
+  std::string s =
+      fmt::format("<h3 id=\"run{}-diagnosis\">{}</h3>\n", index + 1, tr("Diagnosis: what the noise model misses"));
+  s += fmt::format("<p id=\"run{}-diagnosis-outliers\">{}</p>\n", index + 1,
+                   trf("Outliers of the diagnosed record: {}.", outliers_html(at(d, "outliers"))));
+  s += findings_html(at(d, "findings"), index, numbering) + gain_html(at(d, "gain"), index, numbering);
+  if (numbering.figures_enabled && (at(at(d, "base_model"), "band").is_array() || at(d, "band").is_array()))
+    s += numbering.figure(
+        fmt::format("fig-run{}-diagnosis", index + 1), {diagnosis_figure(d, PlotOptions{})},
+        trf("{}: measured Allan deviation against the simulated bands of the base and the extended model",
+            source_name(run)));
   return s;
 }
 
 /// The verdict first: it is what the report is for.
-std::string verdict_html(const std::vector<json>& a, const std::vector<std::size_t>& order, const json& overall) {
-  std::string h = "<h2 id=\"verdict\">Verdict</h2>\n";
-  h += fmt::format("<p class=\"verdict\">Overall class over {}: <b>{}</b> (by B: {}, by N: {}).</p>\n",
-                   a.size() == 1 ? "the run" : "the temperature range", class_text(at(overall, "class")),
-                   class_text(at(overall, "class_B")), class_text(at(overall, "class_N")));
+std::string verdict_html(const std::vector<json>& a, const std::vector<std::size_t>& order, const json& overall,
+                         Numbering& numbering) {
+  std::string h = numbering.section("verdict", tr("Verdict"));
+  h += fmt::format("<p class=\"verdict\">{}</p>\n",
+                   trf("Overall class over {}: <b>{}</b> (by B: {}, by N: {}).",
+                       a.size() == 1 ? tr("the run") : tr("the temperature range"), class_text(at(overall, "class")),
+                       class_text(at(overall, "class_B")), class_text(at(overall, "class_N"))));
+  const auto& v0 = at(a[order.front()], "verdict");
+  const json& classes = at(overall, "classes").is_array() ? at(overall, "classes") : at(v0, "classes");
+  if (const auto words = verdict_in_words(overall, classes); !words.empty())
+    h += fmt::format("<p id=\"verdict-words\">{}</p>\n",
+                     trf("In words: the gyro is of {} by GOST RV 52339-2005.", esc(words)));
   // A batch's combined verdict states its probability (the product of the runs' probabilities).
   if (const auto st = str(overall, "statement"); !st.empty())
-    h += "<p id=\"verdict-probability\">Over all runs: <b>" + esc(st) + "</b>" +
-         by_parameter(str(at(overall, "B"), "statement"), str(at(overall, "N"), "statement")) + ".</p>\n";
+    h += fmt::format("<p id=\"verdict-probability\">{} <b>{}</b>{}.</p>\n", tr("Over all runs:"), esc(st),
+                     by_parameter(str(at(overall, "B"), "statement"), str(at(overall, "N"), "statement")));
   h += "<ul>\n";
   for (auto i : order)
     h += fmt::format("<li>{} ({}): {}</li>\n", esc(source_name(a[i])), temperature_text(a[i]),
                      esc(statement_text(at(a[i], "verdict"))));
   h += "</ul>\n";
-  const auto& v0 = at(a[order.front()], "verdict");
   if (const auto t = num(v0, "tolerance_pct"); t && *t > 0)
-    h += fmt::format(
-        "<p class=\"note\">The seed paper's heading-gyro rule is applied: a B up to {:g} % above a "
-        "class limit is accepted for that class.</p>\n",
-        *t);
-  h += "<p class=\"meta\">P is the probability, from the estimates' uncertainty, that the true class is the one "
-       "stated; where it is low the runner-up class is named.";
-  if (auto table = str(v0, "table"); !table.empty()) h += " Class table: " + esc(table) + ".";
+    h += fmt::format("<p class=\"note\">{}</p>\n",
+                     trf("The seed paper's heading-gyro rule is applied: a B up to {:g} % above a class limit is "
+                         "accepted for that class.",
+                         *t));
+  h += "<p class=\"meta\">" +
+       std::string(tr("P is the probability, from the estimates' uncertainty, that the true class is the one stated; "
+                      "where it is low the runner-up class is named."));
+  if (auto table = str(v0, "table"); !table.empty()) h += " " + trf("Class table: {}.", esc(tr(table)));
   return h + "</p>\n";
 }
 
-std::string batch_figures_html(const std::vector<json>& a, Figures& figures) {
+std::string batch_figures_html(const std::vector<json>& a, Numbering& numbering) {
   const json runs(a);
-  std::string h = "<h2 id=\"figures\">Figures over the temperature range</h2>\n";
-  h += figures.html("fig-batch-allan", {batch_allan_figure(runs, PlotOptions{})},
-                    "Allan deviation at each temperature with 68 % confidence bars and the class limits for B drawn "
-                    "at their floor levels 0.6643·B");
+  std::string h = numbering.section("figures", tr("Figures over the temperature range"));
+  h += numbering.figure("fig-batch-allan", {batch_allan_figure(runs, PlotOptions{})},
+                        tr("Allan deviation at each temperature with 68 % confidence bars and the class limits for B "
+                           "drawn at their floor levels 0.6643·B"));
   if (auto direct = batch_direct_figure(runs, PlotOptions{}); direct.series > 0)
-    return h + figures.html("fig-batch-direct", {direct},
-                            fmt::format("Direct method: variance of the angle accumulated over t, Earth rate removed, "
-                                        "with the regression line per temperature (slope (60·N)² {}/s)",
-                                        lbl::angle2));
-  return h +
-         "<p class=\"note\">The direct-method curves are not in the analysis results, so the angle-variance "
-         "figure is left out.</p>\n";
+    return h + numbering.figure("fig-batch-direct", {direct},
+                                trf("Direct method: variance of the angle accumulated over t, Earth rate removed, "
+                                    "with the regression line per temperature (slope (60·N)² {}/s)",
+                                    unit(lbl::angle2)));
+  return h + fmt::format("<p class=\"note\">{}</p>\n",
+                         tr("The direct-method curves are not in the analysis results, so the angle-variance figure "
+                            "is left out."));
 }
 
-std::string settings_html(const ReportOptions& options, const json& first) {
-  std::string h = "<h2 id=\"settings\">Settings and conventions</h2>\n<table id=\"settings-table\">\n";
-  h += kv_row("rwcalc version", esc(version_line()));
-  if (options.settings.is_object())
-    for (const auto& [k, v] : options.settings.items()) h += kv_row(k, json_value_html(v));
-  const bool b_in_settings = options.settings.is_object() && options.settings.contains("B estimate");
-  if (auto b = str(at(first, "verdict"), "b_estimate"); !b.empty() && !b_in_settings)
-    h += kv_row("B estimate used by the verdict", esc(b));
-  if (const auto& conventions = at(first, "conventions"); conventions.is_object())
-    for (const auto& [k, v] : conventions.items()) h += kv_row("convention: " + k, json_value_html(v));
-  return h + "</table>\n";
+/// The conventions of the results, typeset (the JSON's "conventions" say the same in ASCII);
+/// a convention this list does not know is shown as the JSON gives it.
+std::string conventions_rows(const json& conventions) {
+  static constexpr std::array<std::array<const char*, 3>, 7> kConventions{
+      {{"Q", N_("Q, quantization noise"),
+        N_("σ²(τ) = 3Q²/τ², Q the rms white angle error (IEEE 952); the paper's "
+           "eq. (2) gives √3·Q")},
+       {"N", N_("N, angle random walk"), N_("σ²(τ) = N²/τ; N = σ(τ = 1 h)")},
+       {"B", N_("B, bias instability"),
+        N_("σ² = (2 ln 2/π)·B², floor 0.6643·B (the paper prints B where B² is meant)")},
+       {"K", N_("K, rate random walk"), N_("σ²(τ) = K²τ/3; K = σ(τ = 3 h)")},
+       {"R", N_("R, rate ramp"), N_("σ²(τ) = R²τ²/2")},
+       {"deviation_unit", N_("unit of the Allan deviation"), N_("°/h (1″/s = 1 °/h)")},
+       {"intervals", N_("intervals"), N_("95 % profile likelihood; “< x”: not resolved, x is the 95 % upper bound")}}};
+  std::string h;
+  for (const auto& [key, name, text] : kConventions) h += kv_row(tr(name), esc(tr(text)));
+  if (conventions.is_object())
+    for (const auto& [k, v] : conventions.items())
+      if (std::none_of(kConventions.begin(), kConventions.end(), [&](const auto& c) { return k == c[0]; }))
+        h += kv_row(k, json_value_html(v));
+  return h;
+}
+
+std::string settings_html(const ReportOptions& options, const json& first, Numbering& numbering) {
+  std::string h = numbering.section("settings", tr("Settings and conventions"));
+  h += numbering.table("settings-table", tr("Settings of the analysis"));
+  h += kv_row(tr("rwcalc version"), esc(version_line()));
+  const bool have_settings = options.settings.is_object();
+  if (have_settings)
+    for (const auto& [k, v] : options.settings.items()) h += kv_row(tr(k), json_value_html(v));
+  if (auto b = str(at(first, "verdict"), "b_estimate");
+      !b.empty() && !(have_settings && options.settings.contains("B estimate")))
+    h += kv_row(tr("B estimate"), esc(b));
+  h += "</table>\n" + numbering.table("conventions-table", tr("Conventions of the results"));
+  return h + conventions_rows(at(first, "conventions")) + "</table>\n";
+}
+
+/// The distinct values of an identification key over the runs, in run order, joined by "; ".
+std::string identification_values(const std::vector<json>& a, const char* key) {
+  std::vector<std::string> seen;
+  for (const auto& run : a)
+    if (const auto v = str(at(at(run, "input"), "identification"), key); !v.empty())
+      if (std::find(seen.begin(), seen.end(), v) == seen.end()) seen.push_back(v);
+  std::string s;
+  for (const auto& v : seen) s += (s.empty() ? "" : "; ") + esc(v);
+  return s;
+}
+
+/// The title block: what a filed report names first (laboratory, gyro, serial, test, date).
+std::string title_block(const std::vector<json>& a, const ReportOptions& options, const std::string& title) {
+  std::string h = fmt::format("<header class=\"title\">\n<h1>{}</h1>\n<table id=\"title-block\">\n", esc(title));
+  const std::string lab = options.lab.empty() ? identification_values(a, "lab") : esc(options.lab);
+  auto row = [&](const char* name, const std::string& html) {
+    h += kv_row(tr(name), html.empty() ? std::string(kNotAvailable) : html);
+  };
+  row(N_("laboratory"), lab);
+  row(N_("gyro"), options.gyro.empty() ? std::string() : esc(options.gyro));
+  row(N_("gyro serial"), identification_values(a, "serial"));
+  row(N_("test date"), identification_values(a, "test_date"));
+  row(N_("operator"), identification_values(a, "operator"));
+  row(N_("test conditions"), identification_values(a, "conditions"));
+  row(N_("runs"), trf("{} (each recording's size and SHA-256 under “Runs”)", a.size()));
+  row(N_("report generated"), esc(options.generated) + " · " + esc(version_line()));
+  return h + "</table>\n</header>\n";
 }
 
 }  // namespace
 
 std::string report_html(const ReportInput& input, const ReportOptions& options) {
   const auto& a = input.analyses;
-  if (a.empty()) throw AnalysisError("a report needs at least one analysed run");
+  if (a.empty()) throw AnalysisError(tr("a report needs at least one analysed run"));
   const auto order = view::by_temperature(a);
   json overall = input.overall;
   if (!overall.is_object())
     overall = {{"class_B", worst_class(a, "class_B")},
                {"class_N", worst_class(a, "class_N")},
                {"class", worst_class(a, "class")}};
-  Figures figures{options.figures};
+  Numbering numbering{options.figures};
+  // The default title is the program's text, translated; a title given is the user's own.
+  const std::string title = options.title == ReportOptions{}.title ? tr(options.title) : options.title;
 
   std::string h = fmt::format(
-      "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\"/>\n"
+      "<!DOCTYPE html>\n<html lang=\"{0}\">\n<head>\n<meta charset=\"utf-8\"/>\n"
       "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"/>\n"
-      "<meta name=\"generator\" content=\"rwcalc {0}\"/>\n<title>{1}</title>\n<style>{2}</style>\n</head>\n<body>\n"
-      "<h1>{1}</h1>\n<p class=\"meta\">rwcalc {0} · {3} run{4}",
-      RWCALC_VERSION, esc(options.title), kStyle, a.size(), a.size() == 1 ? "" : "s");
-  if (!options.generated.empty()) h += " · generated " + esc(options.generated);
-  h += "</p>\n" + verdict_html(a, order, overall);
-  h += "<h2 id=\"tables\">Tables 1 and 2</h2>\n" + table1(a, order) + table2(a, order, overall);
-  if (options.figures && a.size() > 1) h += batch_figures_html(a, figures);
-  h += "<h2 id=\"runs\">Runs</h2>\n";
+      "<meta name=\"generator\" content=\"rwcalc {1}\"/>\n<title>{2}</title>\n<style>{3}</style>\n</head>\n<body>\n",
+      language_code(), RWCALC_VERSION, esc(title), fmt::format(fmt::runtime(kStyle), tr("Page"), tr("of")));
+  h += title_block(a, options, title) + verdict_html(a, order, overall, numbering);
+  h += numbering.section("tables", tr("Tables 1 and 2")) + table1(a, order, numbering) +
+       table2(a, order, overall, numbering);
+  if (options.figures && a.size() > 1) h += batch_figures_html(a, numbering);
+  const int runs_section = numbering.next_section;
+  h += numbering.section("runs", tr("Runs"));
+  std::size_t k = 0;
   for (auto i : order) {
     const auto& run = a[i];
-    h += fmt::format("<h3 id=\"run{}\">{} at {}</h3>\n", i + 1, esc(source_name(run)), temperature_text(run));
-    h += run_summary(run, i);
+    h += fmt::format("<h3 id=\"run{}\">{}.{}. {}</h3>\n", i + 1, runs_section, ++k,
+                     trf("{} at {}", esc(source_name(run)), temperature_text(run)));
+    h += run_summary(run, i, numbering);
     if (options.figures)
-      h += figures.html(fmt::format("fig-run{}-allan", i + 1), {analysis_figure(run, PlotOptions{})},
-                        fmt::format("{}: Allan deviation with confidence bars, the fitted model and its terms, and "
-                                    "the class limits for B",
-                                    source_name(run)));
+      h += numbering.figure(fmt::format("fig-run{}-allan", i + 1), {analysis_figure(run, PlotOptions{})},
+                            trf("{}: Allan deviation with confidence bars, the fitted model and its terms, and the "
+                                "class limits for B",
+                                source_name(run)));
     if (i < input.diagnoses.size() && input.diagnoses[i].is_object())
-      h += diagnosis_html(input.diagnoses[i], i, run, figures);
+      h += diagnosis_html(input.diagnoses[i], i, run, numbering);
   }
-  if (!options.figures) h += "<p class=\"note\">Figures were left out of this report (--no-figures).</p>\n";
-  h += settings_html(options, a[order.front()]);
-  h += fmt::format("<footer>Generated by rwcalc {}. Allan deviations in {} (1{}/s = 1 {}); τ in s.</footer>\n",
-                   RWCALC_VERSION, lbl::rate, lbl::angle, lbl::rate);
-  return h + "</body>\n</html>\n";
+  if (!options.figures)
+    h += fmt::format("<p class=\"note\">{}</p>\n", tr("Figures were left out of this report (--no-figures)."));
+  h += settings_html(options, a[order.front()], numbering);
+  h += fmt::format("<footer>{}</footer>\n",
+                   trf("Generated by rwcalc {}. Allan deviations in {} (1 {}/s = 1 {}); τ in s.", RWCALC_VERSION,
+                       unit(lbl::rate), unit(lbl::angle), unit(lbl::rate)));
+  return localize_html(h + "</body>\n</html>\n");
 }
 
 std::string write_report(const std::string& dir, const ReportInput& input, const ReportOptions& options, bool force) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec || !std::filesystem::is_directory(dir))
-    throw OutputError(fmt::format("{}: cannot create the report directory: {}", dir,
-                                  ec ? ec.message() : std::string("not a directory")));
+    throw OutputError(
+        trf("{}: cannot create the report directory: {}", dir, ec ? ec.message() : std::string(tr("not a directory"))));
   const auto path = (std::filesystem::path(dir) / "report.html").string();
   write_file_atomic(path, report_html(input, options), force);
   return path;

@@ -1,0 +1,76 @@
+#pragma once
+/// @file i18n.hpp
+/// The language of rwcalc's human-readable output: English (the default) or Russian.
+///
+/// Every message is written in the code in English and passed through tr() (trf() when it is a
+/// format string); the Russian text comes from po/ru.po, a GNU gettext catalogue compiled into the
+/// program, so that no system locale is needed. JSON and CSV keep their English keys and the
+/// decimal point; human-readable text in Russian uses the decimal comma (localize_numbers).
+#include <fmt/format.h>
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace rwcalc {
+
+enum class Language { English, Russian };
+
+/// "en" or "ru" (also a locale name such as "ru_RU.UTF-8"); nothing for anything else.
+[[nodiscard]] std::optional<Language> parse_language(std::string_view name);
+/// The language of the messages and reports (process-wide; English until set).
+[[nodiscard]] Language language();
+void set_language(Language lang);
+/// The HTML lang attribute of the current language ("en", "ru").
+[[nodiscard]] const char* language_code();
+
+/// The message in the current language: its catalogue entry, else the English text itself.
+/// The pointer stays valid for the life of the program.
+[[nodiscard]] const char* tr(const char* english);
+
+/// The same for a text known only at run time (a label read from JSON); a copy, since the
+/// argument may be a temporary.
+[[nodiscard]] std::string tr(const std::string& english);
+
+/// Marks a text for the catalogue where it is defined, translated later where it is shown with
+/// tr() (the label of a JSON field, which itself stays English): GNU gettext's N_().
+constexpr const char* N_(const char* english) { return english; }
+
+/// fmt::format with a translated format string; the catalogue test checks that each translation
+/// has the same replacement fields as its English original.
+template <typename... Args>
+[[nodiscard]] std::string trf(const char* english, Args&&... args) {
+  return fmt::format(fmt::runtime(tr(english)), std::forward<Args>(args)...);
+}
+
+/// Human-readable text with the decimal comma when the language asks for it: every decimal
+/// number standing alone (not part of a name, a path or a version such as 0.1.0) is rewritten
+/// "3.14" → "3,14". Unchanged in English.
+[[nodiscard]] std::string localize_numbers(std::string text);
+/// The same for an HTML page: only text between tags, and never inside <style> or <script>.
+[[nodiscard]] std::string localize_html(std::string html);
+
+/// The language while it lives, the previous one restored after (a command run in-process).
+class LanguageScope {
+ public:
+  explicit LanguageScope(Language lang) : saved_(language()) { set_language(lang); }
+  ~LanguageScope() { set_language(saved_); }
+  LanguageScope(const LanguageScope&) = delete;
+  LanguageScope& operator=(const LanguageScope&) = delete;
+
+ private:
+  Language saved_;
+};
+
+namespace i18n_detail {
+/// The catalogue's entries (msgid → msgstr, untranslated ones left out), for the tests.
+struct Entry {
+  std::string id, text;
+};
+[[nodiscard]] const std::vector<Entry>& russian_entries();
+/// Parse the text of a .po file (msgid/msgstr with their continuation lines and C escapes).
+[[nodiscard]] std::vector<Entry> parse_po(std::string_view po);
+}  // namespace i18n_detail
+
+}  // namespace rwcalc

@@ -1,0 +1,208 @@
+// The message catalogue: po/ru.po compiled in (generated/catalog_ru.cpp), read once on first use.
+#include "rwcalc/i18n.hpp"
+
+#include <atomic>
+#include <cctype>
+#include <unordered_map>
+#include <utility>
+
+namespace rwcalc {
+
+std::string_view embedded_russian_po();  // generated from po/ru.po by cmake/catalog.cmake
+
+namespace {
+
+std::atomic<Language> g_language{Language::English};
+
+/// The unit labels of units.hpp (one place for every sensor), translated where they are shown.
+[[maybe_unused]] constexpr const char* kUnitLabels[] = {N_("°/h"),  N_("°/√h"), N_("°/h/√h"),
+                                                        N_("°/h²"), N_("″"),    N_("″²")};
+
+/// The body of a quoted .po string with its C escapes resolved ("" when the line holds none).
+std::string unquote(std::string_view line) {
+  const auto open = line.find('"');
+  const auto close = line.rfind('"');
+  if (open == std::string_view::npos || close <= open) return {};
+  std::string out;
+  for (std::size_t i = open + 1; i < close; ++i) {
+    if (line[i] != '\\' || i + 1 >= close) {
+      out += line[i];
+      continue;
+    }
+    switch (const char c = line[++i]) {
+      case 'n': out += '\n'; break;
+      case 't': out += '\t'; break;
+      default: out += c;  // \" and \\ and anything else: the character itself
+    }
+  }
+  return out;
+}
+
+struct Catalogue {
+  std::vector<i18n_detail::Entry> entries;
+  std::unordered_map<std::string, std::string> russian;
+  Catalogue() : entries(i18n_detail::parse_po(embedded_russian_po())) {
+    for (const auto& e : entries) russian.emplace(e.id, e.text);
+  }
+};
+
+const Catalogue& catalogue() {
+  static const Catalogue c;  // thread-safe initialisation
+  return c;
+}
+
+bool word_byte(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+bool digit(char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; }
+
+/// Where a decimal number standing alone starts at i: not inside a word, a name or a version.
+bool number_starts(const std::string& t, std::size_t i) {
+  if (!digit(t[i])) return false;
+  if (i == 0) return true;
+  char prev = t[i - 1];
+  if ((prev == '-' || prev == '+') && i >= 2) prev = t[i - 2];  // a sign
+  return !word_byte(prev) && prev != '.' && prev != '\\';
+}
+
+/// The end of the number starting at i and whether it has a fractional part (at `point`).
+std::size_t number_end(const std::string& t, std::size_t i, std::size_t& point) {
+  point = std::string::npos;
+  while (i < t.size() && digit(t[i])) ++i;
+  if (i + 1 < t.size() && t[i] == '.' && digit(t[i + 1])) {
+    point = i++;
+    while (i < t.size() && digit(t[i])) ++i;
+  }
+  if (i + 1 < t.size() && (t[i] == 'e' || t[i] == 'E')) {
+    std::size_t j = i + 1;
+    if (j < t.size() && (t[j] == '-' || t[j] == '+')) ++j;
+    if (j < t.size() && digit(t[j])) {
+      while (j < t.size() && digit(t[j])) ++j;
+      i = j;
+    }
+  }
+  return i;
+}
+
+/// Followed by a letter or by ".x" (a version, a file extension): not a number on its own.
+bool number_ends_alone(const std::string& t, std::size_t end) {
+  if (end >= t.size()) return true;
+  if (word_byte(t[end])) return false;
+  return !(t[end] == '.' && end + 1 < t.size() && word_byte(t[end + 1]));
+}
+
+/// Rewrite t[from, to) in place: decimal points of numbers to commas, and ", " between two numbers
+/// of which one has a decimal comma to "; " (so that "[0,1; 0,2]" stays readable).
+void localize_span(std::string& t, std::size_t from, std::size_t to) {
+  bool last_had_point = false;
+  std::size_t last_end = std::string::npos;
+  for (std::size_t i = from; i < to;) {
+    if (!number_starts(t, i)) {
+      ++i;
+      continue;
+    }
+    std::size_t point = 0;
+    const std::size_t end = number_end(t, i, point);
+    if (!number_ends_alone(t, end)) {
+      i = end;
+      while (i < to && (word_byte(t[i]) || t[i] == '.')) ++i;  // skip the rest of the name
+      last_end = std::string::npos;
+      continue;
+    }
+    const bool has_point = point != std::string::npos;
+    if (has_point) t[point] = ',';
+    std::size_t start = i;
+    if (start > from && (t[start - 1] == '-' || t[start - 1] == '+')) --start;
+    if (last_end != std::string::npos && start == last_end + 2 && t[last_end] == ',' && t[last_end + 1] == ' ' &&
+        (has_point || last_had_point))
+      t[last_end] = ';';
+    last_end = end;
+    last_had_point = has_point;
+    i = end;
+  }
+}
+
+}  // namespace
+
+std::optional<Language> parse_language(std::string_view name) {
+  const auto lang = name.substr(0, name.find_first_of("_.@-"));
+  if (lang == "en" || lang == "C" || lang == "POSIX") return Language::English;
+  if (lang == "ru") return Language::Russian;
+  return std::nullopt;
+}
+
+Language language() { return g_language.load(std::memory_order_relaxed); }
+void set_language(Language lang) { g_language.store(lang, std::memory_order_relaxed); }
+const char* language_code() { return language() == Language::Russian ? "ru" : "en"; }
+
+const char* tr(const char* english) {
+  if (language() == Language::English) return english;
+  const auto& map = catalogue().russian;
+  const auto it = map.find(english);
+  return it == map.end() ? english : it->second.c_str();
+}
+
+std::string tr(const std::string& english) { return tr(english.c_str()); }
+
+std::string localize_numbers(std::string text) {
+  if (language() == Language::Russian) localize_span(text, 0, text.size());
+  return text;
+}
+
+std::string localize_html(std::string html) {
+  if (language() != Language::Russian) return html;
+  std::size_t i = 0;
+  while (i < html.size()) {
+    const std::size_t tag = html.find('<', i);
+    localize_span(html, i, tag == std::string::npos ? html.size() : tag);
+    if (tag == std::string::npos) break;
+    // Element content of <style> and <script> is not text: skip to its closing tag.
+    std::size_t after = html.find('>', tag);
+    if (after == std::string::npos) break;
+    for (const char* raw : {"<style", "<script"})
+      if (html.compare(tag, std::string_view(raw).size(), raw) == 0) {
+        const auto close = html.find(std::string("</") + (raw + 1), after);
+        after = close == std::string::npos ? html.size() - 1 : html.find('>', close);
+      }
+    i = after + 1;
+  }
+  return html;
+}
+
+namespace i18n_detail {
+
+const std::vector<Entry>& russian_entries() { return catalogue().entries; }
+
+std::vector<Entry> parse_po(std::string_view po) {
+  std::vector<Entry> out;
+  std::string id, text, *field = nullptr;
+  bool fuzzy = false, next_fuzzy = false;
+  auto finish = [&] {
+    if (!id.empty() && !text.empty() && !fuzzy) out.push_back({id, text});
+    id.clear();
+    text.clear();
+  };
+  for (std::size_t at = 0; at < po.size();) {
+    std::size_t eol = po.find('\n', at);
+    if (eol == std::string_view::npos) eol = po.size();
+    const std::string_view line = po.substr(at, eol - at);
+    at = eol + 1;
+    if (line.starts_with("msgid ")) {
+      finish();
+      fuzzy = std::exchange(next_fuzzy, false);
+      field = &id;
+    } else if (line.starts_with("msgstr ")) {
+      field = &text;
+    } else if (!line.starts_with("\"")) {
+      if (line.starts_with("#,") && line.find("fuzzy") != std::string_view::npos) next_fuzzy = true;
+      if (!line.starts_with("#~")) continue;  // comments; obsolete entries end the one before
+      field = nullptr;
+      continue;
+    }
+    if (field) *field += unquote(line);
+  }
+  finish();
+  return out;
+}
+
+}  // namespace i18n_detail
+
+}  // namespace rwcalc

@@ -1,0 +1,75 @@
+// The report as PDF: printed by a headless Chromium, when one is installed (optional).
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "report/process.hpp"
+#include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
+#include "rwcalc/output.hpp"
+#include "rwcalc/printable.hpp"
+#include "rwcalc/report.hpp"
+
+namespace rwcalc {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// RWCALC_CHROMIUM, else the first of the usual names found in PATH; empty when none.
+std::string find_chromium() {
+  if (const char* named = std::getenv("RWCALC_CHROMIUM"); named && *named) return named;
+  const char* path = std::getenv("PATH");
+  if (!path) return {};
+  for (const char* name : {"chromium", "chromium-browser", "google-chrome", "google-chrome-stable"}) {
+    std::string dirs = path;
+    for (std::size_t at = 0; at <= dirs.size();) {
+      const std::size_t end = std::min(dirs.find(':', at), dirs.size());
+      const fs::path candidate = fs::path(dirs.substr(at, end - at)) / name;
+      if (end > at && access(candidate.c_str(), X_OK) == 0) return candidate.string();
+      at = end + 1;
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+bool print_to_pdf(const std::string& html_path, const std::string& pdf_path, bool force) {
+  const std::string chromium = find_chromium();
+  if (chromium.empty()) return false;
+  check_output_targets({{"--pdf", pdf_path}}, force);
+  // A private profile and output: Chromium writes into its profile, and the PDF is moved into
+  // place only when complete.
+  std::string scratch_template = (fs::temp_directory_path() / "rwcalc-pdf-XXXXXX").string();
+  if (mkdtemp(scratch_template.data()) == nullptr)
+    throw OutputError(trf("cannot create a temporary directory for the PDF: {}", std::strerror(errno)));
+  const fs::path scratch = scratch_template;
+  const fs::path pdf = scratch / "report.pdf";
+  const auto r = detail::run_process(chromium,
+                                     {"--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
+                                      "--no-pdf-header-footer", "--user-data-dir=" + (scratch / "profile").string(),
+                                      "--print-to-pdf=" + pdf.string(), "file://" + fs::absolute(html_path).string()},
+                                     scratch / "log");
+  std::error_code ec;
+  if (!r.started || r.status != 0 || !fs::exists(pdf)) {
+    fs::remove_all(scratch, ec);
+    throw OutputError(trf("{}: printing the report to PDF failed (exit status {}): {}", printable(chromium), r.status,
+                          printable(r.err.substr(0, 300))));
+  }
+  std::string bytes(static_cast<std::size_t>(fs::file_size(pdf)), '\0');
+  if (FILE* f = std::fopen(pdf.c_str(), "rb")) {
+    bytes.resize(std::fread(bytes.data(), 1, bytes.size(), f));
+    std::fclose(f);
+  }
+  fs::remove_all(scratch, ec);
+  write_file_atomic(pdf_path, bytes, force);
+  return true;
+}
+
+}  // namespace rwcalc

@@ -1,0 +1,192 @@
+// The Russian output: the message catalogue (po/ru.po compiled in), the decimal comma, and the
+// commands under --lang ru and RWCALC_LANG. That every message of the code has a Russian entry is
+// checked by scripts/update-po.sh --check (the test i18n_catalogue_complete).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include "rwcalc/i18n.hpp"
+#include "test_support.hpp"
+
+using rwcalc::Language;
+using rwcalc::LanguageScope;
+using rwcalc::localize_html;
+using rwcalc::localize_numbers;
+using rwcalc::test::run_cli;
+using rwcalc::test::slurp;
+using rwcalc::test::TempDir;
+
+namespace {
+
+/// The replacement fields of a format string ("{}", "{:.2f}", "{0}"), sorted.
+std::vector<std::string> fields(const std::string& text) {
+  std::vector<std::string> out;
+  static const std::regex field(R"(\{[^{}]*\})");
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), field); it != std::sregex_iterator(); ++it)
+    out.push_back(it->str());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+}  // namespace
+
+TEST(Catalogue, EveryEntryKeepsTheReplacementFieldsAndLineBreaks) {
+  const auto& entries = rwcalc::i18n_detail::russian_entries();
+  ASSERT_GT(entries.size(), 250U);
+  for (const auto& e : entries) {
+    EXPECT_EQ(fields(e.id), fields(e.text)) << e.id;
+    EXPECT_EQ(std::count(e.id.begin(), e.id.end(), '\n'), std::count(e.text.begin(), e.text.end(), '\n')) << e.id;
+    // A message that starts or ends with a space or a line break is a piece of a longer text.
+    EXPECT_EQ(e.id.front() == ' ', e.text.front() == ' ') << e.id;
+    EXPECT_EQ(e.id.back() == '\n', e.text.back() == '\n') << e.id;
+  }
+}
+
+TEST(Catalogue, ReadsContinuationLinesEscapesAndSkipsFuzzyAndObsoleteEntries) {
+  const auto e = rwcalc::i18n_detail::parse_po(
+      "msgid \"\"\nmsgstr \"Language: ru\\n\"\n\n"
+      "#: a.cpp:1\nmsgid \"\"\n\"two \\\"lines\\\"\\n\"\n\"end\"\nmsgstr \"\"\n\"две\\n\"\n\"конец\\\\\"\n\n"
+      "#, fuzzy\nmsgid \"guess\"\nmsgstr \"догадка\"\n\n"
+      "msgid \"untranslated\"\nmsgstr \"\"\n\n"
+      "#~ msgid \"old\"\n#~ msgstr \"старое\"\n");
+  ASSERT_EQ(e.size(), 1U);
+  EXPECT_EQ(e[0].id, "two \"lines\"\nend");
+  EXPECT_EQ(e[0].text, "две\nконец\\");
+}
+
+TEST(Catalogue, TranslatesOnlyInRussianAndFallsBackToEnglish) {
+  const char* table = "Table {}";
+  EXPECT_STREQ(rwcalc::tr(table), table);
+  const LanguageScope ru(Language::Russian);
+  EXPECT_STREQ(rwcalc::tr(table), "Таблица {}");
+  EXPECT_EQ(rwcalc::trf(table, 2), "Таблица 2");
+  EXPECT_STREQ(rwcalc::tr("a text not in the catalogue"), "a text not in the catalogue");
+  EXPECT_STREQ(rwcalc::language_code(), "ru");
+}
+
+TEST(Language, ParsesCodesAndLocaleNames) {
+  EXPECT_EQ(rwcalc::parse_language("ru"), Language::Russian);
+  EXPECT_EQ(rwcalc::parse_language("ru_RU.UTF-8"), Language::Russian);
+  EXPECT_EQ(rwcalc::parse_language("en_GB.UTF-8"), Language::English);
+  EXPECT_EQ(rwcalc::parse_language("C"), Language::English);
+  EXPECT_FALSE(rwcalc::parse_language("de"));
+}
+
+TEST(DecimalComma, NumbersOnTheirOwnOnlyAndNeverInEnglish) {
+  const std::string text = "N 0.000849 ± 2.1e-05 °/h [0.1, 0.2] P=0.93/0.05 -1.5 rwcalc 0.1.0 gl2d_0.5C.csv v2.5 1, 2";
+  EXPECT_EQ(localize_numbers(text), text);
+  const LanguageScope ru(Language::Russian);
+  EXPECT_EQ(localize_numbers(text),
+            "N 0,000849 ± 2,1e-05 °/h [0,1; 0,2] P=0,93/0,05 -1,5 rwcalc 0.1.0 gl2d_0.5C.csv v2.5 1, 2");
+  EXPECT_EQ(localize_numbers("ends 3.5.\nx.5 a.b 7.25"), "ends 3,5.\nx.5 a.b 7,25");
+}
+
+TEST(DecimalComma, HtmlTextOnlyNotMarkupStylesOrScripts) {
+  const std::string page =
+      "<style>p { margin: 0.5em; }</style><p style=\"width: 1.5em\">σ = 0.25 °/h</p>"
+      "<script>var x = 2.5;</script><img alt=\"0.5\"/>1.25";
+  const LanguageScope ru(Language::Russian);
+  EXPECT_EQ(localize_html(page),
+            "<style>p { margin: 0.5em; }</style><p style=\"width: 1.5em\">σ = 0,25 °/h</p>"
+            "<script>var x = 2.5;</script><img alt=\"0.5\"/>1,25");
+}
+
+TEST(RussianCli, BatchPrintsThePapersTablesInRussianWithRussianUnits) {
+  const auto r = run_cli(rwcalc::test::concat({"batch", "--lang", "ru"}, rwcalc::test::gl2d_runs()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* part : {"Таблица 1.", "Таблица 2.", "N (ВА), °/√ч", "B (ВА), °/ч", "N прямой, °/√ч",
+                           "B осредн. 100 с, °/ч", "класс", "Итог по всем запускам", "по N", "по B"})
+    EXPECT_TRUE(contains(r.out, part)) << part << "\n" << r.out;
+  for (const char* english : {"Table 1", "Table 2", "Overall over the runs", "deg/h", "class table", "°/h"})
+    EXPECT_FALSE(contains(r.out, english)) << english << "\n" << r.out;
+  // Decimal comma in the table (N by the fit of the −50 °C run is 0.000849 °/√h), no decimal point.
+  EXPECT_TRUE(contains(r.out, "0,000849")) << r.out;
+  EXPECT_FALSE(std::regex_search(r.out, std::regex(R"(\b\d+\.\d+\b)"))) << r.out;
+}
+
+TEST(RussianCli, EnvironmentChoosesTheLanguageAndEnglishStaysTheDefault) {
+  const auto args = rwcalc::test::concat({"batch"}, rwcalc::test::gl2d_runs());
+  const auto english = run_cli(args);
+  ASSERT_EQ(english.status, 0);
+  EXPECT_TRUE(contains(english.out, "Table 1: coefficients"));
+  EXPECT_EQ(run_cli(rwcalc::test::concat({"batch", "--lang", "en"}, rwcalc::test::gl2d_runs())).out, english.out);
+  ::setenv("RWCALC_LANG", "ru_RU.UTF-8", 1);
+  const auto russian = run_cli(args);
+  const auto forced = run_cli(rwcalc::test::concat({"batch", "--lang", "en"}, rwcalc::test::gl2d_runs()));
+  ::unsetenv("RWCALC_LANG");
+  EXPECT_TRUE(contains(russian.out, "Таблица 1.")) << russian.out;
+  EXPECT_EQ(forced.out, english.out);         // --lang wins over the environment
+  EXPECT_EQ(run_cli(args).out, english.out);  // and nothing stays behind in the process
+}
+
+TEST(RussianCli, JsonAndCsvKeepTheirKeysAndTheDecimalPoint) {
+  const auto file = rwcalc::test::gl2d_runs().front();
+  const auto en = run_cli({"analyze", "--json", file});
+  const auto ru = run_cli({"analyze", "--json", "--lang", "ru", file});
+  ASSERT_EQ(ru.status, 0) << ru.err;
+  const auto a = nlohmann::json::parse(en.out), b = nlohmann::json::parse(ru.out);
+  EXPECT_EQ(a["fit"], b["fit"]);
+  EXPECT_EQ(a["methods"], b["methods"]);
+  EXPECT_EQ(a["verdict"]["p_is"], b["verdict"]["p_is"]);
+  const auto csv_en = run_cli(rwcalc::test::concat({"batch", "--csv"}, rwcalc::test::gl2d_runs()));
+  const auto csv_ru = run_cli(rwcalc::test::concat({"batch", "--csv", "--lang", "ru"}, rwcalc::test::gl2d_runs()));
+  EXPECT_EQ(csv_en.out, csv_ru.out);
+}
+
+TEST(RussianCli, AnalyzeTextAndErrorsInRussian) {
+  const auto r = run_cli({"analyze", "--lang", "ru", rwcalc::test::gl2d_runs().front()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* part : {"Данные", "Коэффициенты шумов", "Проверка методами статьи", "Заключение", "°/√ч"})
+    EXPECT_TRUE(contains(r.out, part)) << part;
+  const auto bad = run_cli({"analyze", "--lang", "ru", "/nonexistent/run.csv"});
+  EXPECT_NE(bad.status, 0);
+  EXPECT_TRUE(bad.err.starts_with("rwcalc: ошибка: ")) << bad.err;
+  const auto wrong = run_cli({"analyze", "--lang", "de", rwcalc::test::gl2d_runs().front()});
+  EXPECT_EQ(wrong.status, 2);
+}
+
+TEST(RussianCli, ReportIsInRussianWithoutEnglishHeadings) {
+  TempDir dir;
+  auto args = rwcalc::test::concat({"report", "--lang", "ru", "--no-figures", "--lab", "Лаборатория 1", "-o",
+                                    dir.path().string()},
+                                   rwcalc::test::gl2d_runs());
+  const auto r = run_cli(args);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto html = slurp(dir.path() / "report.html");
+  for (const char* part :
+       {"<html lang=\"ru\">", "вариации Аллана", "случайное блуждание угла", "нестабильность смещения нуля",
+        "случайное блуждание скорости", "класс точности БИНС по ГОСТ РВ 52339-2005", "Таблица 1.", "Таблица 2.", "°/ч",
+        "°/√ч", "угл. с", "Лаборатория 1", "Страница", "с вероятностью"})
+    EXPECT_TRUE(contains(html, part)) << part;
+  for (const char* english : {"lang=\"en\"",
+                              "Table 1",
+                              "Table 2",
+                              "Verdict",
+                              "Runs",
+                              "Settings and conventions",
+                              "Noise coefficients",
+                              "Accuracy class per parameter",
+                              "Data and identification",
+                              "Allan-variance fit",
+                              "angle random walk",
+                              "bias instability",
+                              "rate random walk",
+                              "quantization",
+                              "temperature",
+                              "Warnings",
+                              "Figure",
+                              "°/h",
+                              "Generated by",
+                              "upper bound",
+                              "with a probability",
+                              "sigma^2",
+                              "Page"})
+    EXPECT_FALSE(contains(html, english)) << english;
+}
