@@ -13,6 +13,7 @@
 #include "model/output_filter.hpp"
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/printable.hpp"
 
 namespace rwcalc {
@@ -195,13 +196,15 @@ namespace {
 std::string short_tau_findings(const FitRangeChoice& c) {
   std::string s;
   if (c.filter_tc_s > 0)
-    s = fmt::format("the AV at tau0 is {:.0f} % of the extrapolation of the model fitted from {:g} s, the roll-off "
-                    "of an output filter of time constant tau_f = {:.3g} s",
-                    100.0 * c.shortest_ratio, c.reference_tau_s, c.filter_tc_s);
+    s =
+        trf("the AV at tau0 is {:.0f} % of the extrapolation of the model fitted from {:g} s, the roll-off "
+            "of an output filter of time constant tau_f = {:.3g} s",
+            100.0 * c.shortest_ratio, c.reference_tau_s, c.filter_tc_s);
   if (c.departure_tau_s > 0)
-    s += fmt::format("{}the AV at {:g} s is {:.0f} % of the extrapolation of the model fitted from {:g} s (short-tau "
-                     "structure the five-term model lacks: a spectral line, a bump or a filter)",
-                     s.empty() ? "" : "; ", c.departure_tau_s, 100.0 * c.departure_ratio, c.reference_tau_s);
+    s +=
+        trf("{}the AV at {:g} s is {:.0f} % of the extrapolation of the model fitted from {:g} s (short-tau "
+            "structure the five-term model lacks: a spectral line, a bump or a filter)",
+            s.empty() ? "" : "; ", c.departure_tau_s, 100.0 * c.departure_ratio, c.reference_tau_s);
   return s;
 }
 
@@ -209,15 +212,15 @@ std::string short_tau_findings(const FitRangeChoice& c) {
 
 std::string FitRangeChoice::reason() const {
   switch (source) {
-    case Source::Option: return "the range given by --fit-range";
+    case Source::Option: return tr("the range given by --fit-range");
     case Source::ShortTau:
-      return fmt::format("tau >= {:g} s ({}): {}", tau_min_s,
-                         filter_tc_s > 0 && 10.0 * filter_tc_s >= 2.0 * departure_tau_s ? "10 tau_f"
-                                                                                         : "beyond the departing points",
-                         short_tau_findings(*this));
+      return trf("tau >= {:g} s ({}): {}", tau_min_s,
+                 filter_tc_s > 0 && 10.0 * filter_tc_s >= 2.0 * departure_tau_s ? tr("10 tau_f")
+                                                                                : tr("beyond the departing points"),
+                 short_tau_findings(*this));
     case Source::All: break;
   }
-  return "every octave point (the short-tau points agree with the model)";
+  return tr("every octave point (the short-tau points agree with the model)");
 }
 
 std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r) {
@@ -226,15 +229,15 @@ std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r) {
   const FitRangeChoice& fr = r.fit_range;
   if (fr.source == FitRangeChoice::Source::ShortTau)
     w.push_back({fr.filter_tc_s > 0 ? "output_filter" : "short_tau_structure",
-                 fmt::format("The fit uses tau >= {:g} s only: {}. Give --fit-range to choose the range yourself.",
-                             fr.tau_min_s, short_tau_findings(fr)),
+                 trf("The fit uses tau >= {:g} s only: {}. Give --fit-range to choose the range yourself.",
+                     fr.tau_min_s, short_tau_findings(fr)),
                  fmt::format("rwcalc analyze {} [input options] --fit-range 0:", src)});
   if (r.fit.p_value < 0.001)
     w.push_back({"fit_rejected",
-                 fmt::format("The five-term model does not describe the Allan variance: chi2/dof = {:.3g} "
-                             "(dof {}, p = {:.2g}). The coefficients' intervals are scaled by sqrt(chi2/dof) = "
-                             "{:.3g}; look for what the model misses.",
-                             r.fit.chi2_per_dof, r.fit.dof, r.fit.p_value, fr.interval_scale),
+                 trf("The five-term model does not describe the Allan variance: chi2/dof = {:.3g} "
+                     "(dof {}, p = {:.2g}). The coefficients' intervals are scaled by sqrt(chi2/dof) = "
+                     "{:.3g}; look for what the model misses.",
+                     r.fit.chi2_per_dof, r.fit.dof, r.fit.p_value, fr.interval_scale),
                  fmt::format("rwcalc diagnose {} [input options]", src)});
   return w;
 }

@@ -126,11 +126,18 @@ std::string verdict_in_words(const json& v, const json& classes_json) {
     return k < classes.size() ? trf("accuracy class {}", classes[k]) : trf("outside class {}", classes.back());
   };
   auto pct = [&](std::size_t k) { return 100.0 * p_is[k].get<double>(); };
-  std::string w = trf("{} with a probability of {:.0f} %", name(s), pct(s));
+  // Rounding must not turn 99.7 % into a certainty, nor 0.3 % into an impossibility.
+  auto words = [&](std::size_t k) {
+    const double p = pct(k);
+    return p > 99.5 && p < 100 ? std::string(tr("more than 99 %"))
+           : p < 0.5 && p > 0  ? std::string(tr("less than 1 %"))
+                               : fmt::format("{:.0f} %", p);
+  };
+  std::string w = trf("{} with a probability of {}", name(s), words(s));
   if (pct(s) >= 90.0 || classes.empty()) return w;
   std::size_t r = s > 0 ? s - 1 : s + 1;
   if (s > 0 && s + 1 <= classes.size() && pct(s + 1) > pct(s - 1)) r = s + 1;
-  return w + trf("; the next most probable: {} ({:.0f} %)", name(r), pct(r));
+  return w + trf("; the next most probable: {} ({})", name(r), words(r));
 }
 
 std::string source_name(const json& a) {
@@ -187,7 +194,7 @@ header.title th, header.title td {{ border: none; border-bottom: 1px dotted #bbb
 header.title th {{ background: none; width: 28%; font-weight: normal; color: #555; }}
 table {{ border-collapse: collapse; margin: 0.6em 0 1em; font-size: 0.95em; }}
 th, td {{ border: 1px solid #bbb; padding: 0.3em 0.6em; text-align: left; vertical-align: top;
-         overflow-wrap: anywhere; }}
+         overflow-wrap: break-word; }}
 th {{ background: #f0f0f0; }}
 td.num {{ text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }}
 caption {{ caption-side: top; text-align: left; padding-bottom: 0.3em; }}
@@ -196,14 +203,17 @@ caption {{ caption-side: top; text-align: left; padding-bottom: 0.3em; }}
 .verdict {{ font-size: 1.15em; padding: 0.6em 0.9em; border-left: 5px solid #2c7bb6; background: #f4f8fb; }}
 .note {{ color: #7a4b00; background: #fff6e0; padding: 0.3em 0.6em; border-left: 4px solid #e6a000; }}
 .warning {{ color: #7a0000; background: #fff0f0; padding: 0.3em 0.6em; border-left: 4px solid #c00000; }}
+.unit {{ white-space: nowrap; }}
 .formula {{ font-family: "DejaVu Serif", "Times New Roman", serif; white-space: nowrap; }}
 code {{ overflow-wrap: anywhere; }}
+#table1, #table2 {{ width: 100%; }}
 figure {{ margin: 1em 0; }}
 figure img {{ width: 100%; max-width: 960px; height: auto; border: 1px solid #eee; }}
 figcaption {{ color: #444; font-size: 0.92em; }}
 footer {{ margin-top: 2em; color: #777; font-size: 0.85em; border-top: 1px solid #ddd; padding-top: 0.5em; }}
 @page {{ size: A4; margin: 16mm 14mm 18mm 16mm;
-        @bottom-center {{ content: "{0} " counter(page) " {1} " counter(pages); font-size: 9pt; color: #555; }} }}
+        @bottom-center {{ content: "{0} " counter(page) " {1} " counter(pages); font-size: 9pt; color: #555;
+                          font-family: "DejaVu Sans", "Liberation Sans", Helvetica, Arial, sans-serif; }} }}
 @media print {{
   body {{ max-width: none; margin: 0; padding: 0; font-size: 10.5px; }}
   h2 {{ page-break-after: avoid; }}
@@ -237,7 +247,7 @@ std::string table1(const std::vector<json>& a, const std::vector<std::size_t>& o
   s +=
       trf("<tr><th>run</th><th>temperature</th><th>N by Allan variance ({0})</th><th>N direct method ({0})</th>"
           "<th>B by Allan variance ({1})</th><th>B by 100-s averaging ({1})</th></tr>\n",
-          unit(lbl::arw), unit(lbl::rate));
+          "<span class=\"unit\">" + unit(lbl::arw) + "</span>", "<span class=\"unit\">" + unit(lbl::rate) + "</span>");
   for (auto i : order) {
     const auto& fit = at(a[i], "fit");
     const auto& methods = at(a[i], "methods");
@@ -395,7 +405,7 @@ std::string fit_table(const json& fit, std::size_t index, Numbering& numbering) 
     s += fmt::format("<tr><td>{}</td><td colspan=\"2\">{}</td></tr>\n", tr(name), html);
   };
   if (const auto c = num(fit, "chi2_per_dof")) {
-    std::string gof = fmt::format("χ²/dof = {:.3g}", *c);
+    std::string gof = trf("χ²/dof = {:.3g}", *c);
     if (const auto p = num(fit, "p_value")) gof += fmt::format(", p = {:.3g}", *p);
     if (const auto lo = num(fit, "tau_min_s"), hi = num(fit, "tau_max_s"); lo && hi)
       gof += trf("; τ fitted {:g}–{:g} s", *lo, *hi);
@@ -422,12 +432,14 @@ std::string warnings_html(const json& run) {
 }
 
 std::string run_summary(const json& run, std::size_t index, Numbering& numbering) {
-  std::string s = warnings_html(run) + data_table(run, index, numbering) + fit_table(at(run, "fit"), index, numbering);
+  std::string s = warnings_html(run);
+  s += data_table(run, index, numbering);  // one statement each: the tables are numbered in order
+  s += fit_table(at(run, "fit"), index, numbering);
   if (const auto& v = at(run, "verdict"); v.is_object()) {
-    s += fmt::format("<p>{} <b>{}</b>{}.", tr("Verdict:"), esc(statement_text(v)),
+    s += fmt::format("<p>{} <b>{}</b>{}.</p>\n", tr("Verdict:"), esc(statement_text(v)),
                      by_parameter(str(v, "statement_B"), str(v, "statement_N")));
-    if (const auto words = verdict_in_words(v, at(v, "classes")); !words.empty()) s += " " + esc(words) + ".";
-    s += "</p>\n";
+    if (const auto words = verdict_in_words(v, at(v, "classes")); !words.empty())
+      s += fmt::format("<p>{}</p>\n", esc(trf("In words: {}.", words)));
   }
   return s;
 }
@@ -490,7 +502,8 @@ std::string diagnosis_html(const json& d, std::size_t index, const json& run, Nu
       fmt::format("<h3 id=\"run{}-diagnosis\">{}</h3>\n", index + 1, tr("Diagnosis: what the noise model misses"));
   s += fmt::format("<p id=\"run{}-diagnosis-outliers\">{}</p>\n", index + 1,
                    trf("Outliers of the diagnosed record: {}.", outliers_html(at(d, "outliers"))));
-  s += findings_html(at(d, "findings"), index, numbering) + gain_html(at(d, "gain"), index, numbering);
+  s += findings_html(at(d, "findings"), index, numbering);
+  s += gain_html(at(d, "gain"), index, numbering);
   if (numbering.figures_enabled && (at(at(d, "base_model"), "band").is_array() || at(d, "band").is_array()))
     s += numbering.figure(
         fmt::format("fig-run{}-diagnosis", index + 1), {diagnosis_figure(d, PlotOptions{})},
@@ -636,15 +649,18 @@ std::string report_html(const ReportInput& input, const ReportOptions& options) 
       "<meta name=\"generator\" content=\"rwcalc {1}\"/>\n<title>{2}</title>\n<style>{3}</style>\n</head>\n<body>\n",
       language_code(), RWCALC_VERSION, esc(title), fmt::format(fmt::runtime(kStyle), tr("Page"), tr("of")));
   h += title_block(a, options, title) + verdict_html(a, order, overall, numbering);
-  h += numbering.section("tables", tr("Tables 1 and 2")) + table1(a, order, numbering) +
-       table2(a, order, overall, numbering);
+  // One statement each: the tables are numbered in the order they are made.
+  h += numbering.section("tables", tr("Tables 1 and 2"));
+  h += table1(a, order, numbering);
+  h += table2(a, order, overall, numbering);
   if (options.figures && a.size() > 1) h += batch_figures_html(a, numbering);
   const int runs_section = numbering.next_section;
   h += numbering.section("runs", tr("Runs"));
   std::size_t k = 0;
   for (auto i : order) {
     const auto& run = a[i];
-    h += fmt::format("<h3 id=\"run{}\">{}.{}. {}</h3>\n", i + 1, runs_section, ++k,
+    // "4&#46;1." : the entity keeps the decimal comma of Russian text out of the heading number.
+    h += fmt::format("<h3 id=\"run{}\">{}&#46;{}. {}</h3>\n", i + 1, runs_section, ++k,
                      trf("{} at {}", esc(source_name(run)), temperature_text(run)));
     h += run_summary(run, i, numbering);
     if (options.figures)
