@@ -20,7 +20,7 @@ struct ReportInput {
 
 struct ReportOptions {
   std::string title = N_("Gyro noise test report");  ///< the default is shown translated
-  std::string lab;   ///< the laboratory, for the title block; empty: from the metadata "lab", if any
+  std::string lab;   ///< the testing laboratory, for the title block
   std::string gyro;  ///< the gyro's type or name, for the title block
   nlohmann::json settings = nlohmann::json::object();  ///< option name → value, shown as is
   bool figures = true;                                 ///< embed figures (needs gnuplot)

@@ -247,7 +247,7 @@ void register_report(CLI::App& app, Runner& runner) {
   cmd->analysis.add_to(*sub);
   add_temperature_option(*sub, cmd->temperature, "Temperature, °C (only with a single recording)");
   sub->add_option("--title", cmd->title, "Title of the report");
-  sub->add_option("--lab", cmd->lab, "Laboratory, for the title block (default: the recordings' '# lab:' metadata)");
+  sub->add_option("--lab", cmd->lab, "The testing laboratory, for the title block");
   sub->add_option("--gyro", cmd->gyro, "The gyro's type or name, for the title block (e.g. GL-2D)");
   sub->add_flag("--pdf", cmd->pdf, "Also print DIR/report.pdf with a headless Chromium, when one is installed");
   sub->add_flag("--diagnose", cmd->diagnose, "Also diagnose each recording (what the noise model misses)");

@@ -613,11 +613,10 @@ std::string identification_values(const std::vector<json>& a, const char* key) {
 /// The title block: what a filed report names first (laboratory, gyro, serial, test, date).
 std::string title_block(const std::vector<json>& a, const ReportOptions& options, const std::string& title) {
   std::string h = fmt::format("<header class=\"title\">\n<h1>{}</h1>\n<table id=\"title-block\">\n", esc(title));
-  const std::string lab = options.lab.empty() ? identification_values(a, "lab") : esc(options.lab);
   auto row = [&](const char* name, const std::string& html) {
     h += kv_row(tr(name), html.empty() ? std::string(kNotAvailable) : html);
   };
-  row(N_("laboratory"), lab);
+  row(N_("laboratory"), esc(options.lab));
   row(N_("gyro"), options.gyro.empty() ? std::string() : esc(options.gyro));
   row(N_("gyro serial"), identification_values(a, "serial"));
   row(N_("test date"), identification_values(a, "test_date"));
