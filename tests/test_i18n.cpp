@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <string>
@@ -195,4 +196,38 @@ TEST(RussianCli, ReportIsInRussianWithoutEnglishHeadings) {
                               "sigma^2",
                               "Page"})
     EXPECT_FALSE(contains(html, english)) << english;
+}
+
+TEST(ReportPdf, WithoutChromiumTheHtmlIsWrittenAndTheMissingPdfSaid) {
+  TempDir dir;
+  const std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
+  ::setenv("PATH", dir.path().c_str(), 1);  // a directory with no browser in it
+  ::unsetenv("RWCALC_CHROMIUM");
+  const auto r = run_cli(
+      {"report", "--pdf", "--no-figures", "-o", (dir.path() / "out").string(), rwcalc::test::gl2d_runs().front()});
+  ::setenv("PATH", path.c_str(), 1);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "out" / "report.html"));
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "report.pdf"));
+  EXPECT_TRUE(contains(r.err, "no headless Chromium found")) << r.err;
+}
+
+TEST(ReportPdf, PrintedByHeadlessChromiumWhenInstalled) {
+  if (std::system("command -v chromium >/dev/null 2>&1") != 0) GTEST_SKIP() << "no chromium in PATH";
+  TempDir dir;
+  // A title with shell metacharacters: the browser is run from an argument vector, never a shell.
+  const auto out = dir.path() / "out $(touch pwned) ; 'x'";
+  const auto r = run_cli({"report", "--lang", "ru", "--pdf", "--no-figures", "--title", "`touch pwned2`", "-o",
+                          out.string(), rwcalc::test::gl2d_runs().front()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string pdf = slurp(out / "report.pdf");
+  ASSERT_GT(pdf.size(), 1000U);
+  EXPECT_TRUE(pdf.starts_with("%PDF-"));
+  EXPECT_FALSE(std::filesystem::exists("pwned"));
+  EXPECT_FALSE(std::filesystem::exists("pwned2"));
+  EXPECT_TRUE(contains(r.out, "PDF записан в")) << r.out;
+  // Written again only with --force.
+  const auto again =
+      run_cli({"report", "--pdf", "--no-figures", "-o", out.string(), rwcalc::test::gl2d_runs().front()});
+  EXPECT_EQ(again.status, 3) << again.err;
 }
