@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -24,14 +25,30 @@ using rwcalc::test::TempDir;
 
 namespace {
 
-/// The replacement fields of a format string ("{}", "{:.2f}", "{0}"), sorted.
+/// The replacement fields of a format string ("{}", "{:.2f}", "{0}"), in order.
 std::vector<std::string> fields(const std::string& text) {
   std::vector<std::string> out;
   static const std::regex field(R"(\{[^{}]*\})");
   for (auto it = std::sregex_iterator(text.begin(), text.end(), field); it != std::sregex_iterator(); ++it)
     out.push_back(it->str());
-  std::sort(out.begin(), out.end());
   return out;
+}
+
+/// "" when the translation formats the English message's arguments correctly: with automatic
+/// numbering the same fields in the same order; with explicit indices ("{1} … {0}", to reorder
+/// or leave out a word such as a plural suffix) each index names an argument with the same spec.
+std::string field_problem(const std::string& english, const std::string& russian) {
+  const auto e = fields(english), r = fields(russian);
+  const bool explicit_r = std::any_of(r.begin(), r.end(), [](const std::string& f) { return std::isdigit(f[1]); });
+  if (!explicit_r) return e == r ? "" : "fields differ or are reordered without indices";
+  auto spec = [](const std::string& f) { return f.substr(f.find_first_not_of("0123456789", 1)); };
+  for (const auto& f : r) {
+    if (!std::isdigit(f[1])) return "automatic and explicit indices mixed";
+    const auto k = std::stoul(f.substr(1));
+    if (k >= e.size()) return "index beyond the arguments: " + f;
+    if (spec(f) != spec(e[k])) return "spec differs from the English field: " + f;
+  }
+  return "";
 }
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
@@ -42,7 +59,7 @@ TEST(Catalogue, EveryEntryKeepsTheReplacementFieldsAndLineBreaks) {
   const auto& entries = rwcalc::i18n_detail::russian_entries();
   ASSERT_GT(entries.size(), 250U);
   for (const auto& e : entries) {
-    EXPECT_EQ(fields(e.id), fields(e.text)) << e.id;
+    EXPECT_EQ(field_problem(e.id, e.text), "") << e.id;
     EXPECT_EQ(std::count(e.id.begin(), e.id.end(), '\n'), std::count(e.text.begin(), e.text.end(), '\n')) << e.id;
     // A message that starts or ends with a space or a line break is a piece of a longer text.
     EXPECT_EQ(e.id.front() == ' ', e.text.front() == ' ') << e.id;

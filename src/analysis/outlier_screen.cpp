@@ -1,5 +1,6 @@
 // Outlier screening of a record: detection, its report and the chosen action (outlier_screen.hpp).
 #include "rwcalc/outlier_screen.hpp"
+#include "rwcalc/i18n.hpp"
 
 #include <fmt/format.h>
 
@@ -117,32 +118,30 @@ constexpr std::size_t kReportOutliers = 20;  // rows of the readable list; the J
 }  // namespace
 
 std::string format_outliers(const OutlierReport& o) {
-  std::string s = fmt::format(
-      "Outliers (rate samples more than {:g} robust sigma from the median of their 6 neighbours; scale {} °/h)\n",
-      o.threshold, fmt::format("{:.3g}", o.scale_deg_per_h));
-  if (o.count == 0) return s + "  none found\n\n";
+  std::string s =
+      trf("Outliers (rate samples more than {:g} robust sigma from the median of their 6 neighbours; scale {} °/h)\n",
+          o.threshold, fmt::format("{:.3g}", o.scale_deg_per_h));
+  if (o.count == 0) return s + tr("  none found\n\n");
   switch (o.action) {
     case OutlierAction::Keep:
-      s += fmt::format("  {} found; KEPT in the analysis below (--outliers remove or replace to leave them out)\n",
-                       o.count);
+      s += trf("  {} found; KEPT in the analysis below (--outliers remove or replace to leave them out)\n", o.count);
       break;
     case OutlierAction::Remove:
-      s += fmt::format("  {} found; {} REMOVED: the samples after each one move one period earlier (a splice)\n",
-                       o.count, o.removed);
+      s += trf("  {} found; {} REMOVED: the samples after each one move one period earlier (a splice)\n", o.count,
+               o.removed);
       break;
     case OutlierAction::Replace:
-      s += fmt::format("  {} found; {} REPLACED by the median of their four nearest good neighbours\n", o.count,
-                       o.replaced);
+      s += trf("  {} found; {} REPLACED by the median of their four nearest good neighbours\n", o.count, o.replaced);
       break;
   }
-  s += fmt::format("  {:>10} {:>12} {:>10} {:>14} {:>9}\n", "sample", "time (s)", "line", "rate (°/h)", "z");
+  s += fmt::format("  {:>10} {:>12} {:>10} {:>14} {:>9}\n", tr("sample"), tr("time (s)"), tr("line"), tr("rate (°/h)"),
+                   "z");
   for (std::size_t k = 0; k < o.positions.size() && k < kReportOutliers; ++k) {
     const auto& p = o.positions[k];
     s += fmt::format("  {:>10} {:>12.6g} {:>10} {:>14.6g} {:>+9.1f}\n", p.index, p.time_s, p.line, p.value, p.robust_z);
   }
   if (o.count > kReportOutliers)
-    s += fmt::format("  … and {} more (the first {} are listed in --json)\n", o.count - kReportOutliers,
-                     o.positions.size());
+    s += trf("  … and {} more (the first {} are listed in --json)\n", o.count - kReportOutliers, o.positions.size());
   return s + "\n";
 }
 

@@ -8,6 +8,7 @@
 
 #include "cli/numeric_options.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 
 namespace rwcalc::cli {
 
@@ -16,19 +17,18 @@ namespace {
 /// "A:B" with either side optional → {a, b}; defaults for empty sides.
 std::pair<double, double> parse_range(const std::string& spec, const char* what, double lo_default, double hi_default) {
   const auto colon = spec.find(':');
-  if (colon == std::string::npos)
-    throw UsageError(fmt::format("{} must be TMIN:TMAX in seconds, got '{}'", what, spec));
+  if (colon == std::string::npos) throw UsageError(trf("{} must be TMIN:TMAX in seconds, got '{}'", what, spec));
   auto num = [&](std::string s, double def) {
     if (s.empty()) return def;
     double v = 0;
     const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
     if (r.ec != std::errc() || r.ptr != s.data() + s.size() || !std::isfinite(v) || v < 0)
-      throw UsageError(fmt::format("{}: '{}' is not a non-negative number of seconds", what, s));
+      throw UsageError(trf("{}: '{}' is not a non-negative number of seconds", what, s));
     return v;
   };
   const double a = num(spec.substr(0, colon), lo_default);
   const double b = num(spec.substr(colon + 1), hi_default);
-  if (!(a < b)) throw UsageError(fmt::format("{}: TMIN must be below TMAX (got '{}')", what, spec));
+  if (!(a < b)) throw UsageError(trf("{}: TMIN must be below TMAX (got '{}')", what, spec));
   return {a, b};
 }
 
@@ -108,14 +108,15 @@ AnalysisOptions AnalyzeArgs::options() const {
   o.allan.grid = TauGrid::parse(tau);
   o.fit.min_edf = min_edf;
   o.fit.enabled = {false, false, false, false, false};
-  if (terms.empty()) throw UsageError("--terms: give at least one of Q, N, B, K, R");
+  if (terms.empty()) throw UsageError(tr("--terms: give at least one of Q, N, B, K, R"));
   for (char c : terms) {
     const std::string names = "QNBKR";
     const auto p = names.find(static_cast<char>(std::toupper(static_cast<unsigned char>(c))));
-    if (p == std::string::npos) throw UsageError(fmt::format("--terms: unknown term '{}' (use Q, N, B, K, R)", c));
+    if (p == std::string::npos) throw UsageError(trf("--terms: unknown term '{}' (use Q, N, B, K, R)", c));
     o.fit.enabled[p] = true;
   }
-  if (!o.fit.enabled[1] || !o.fit.enabled[2]) throw UsageError("--terms must include N and B (the verdict needs both)");
+  if (!o.fit.enabled[1] || !o.fit.enabled[2])
+    throw UsageError(tr("--terms must include N and B (the verdict needs both)"));
   o.fit.select_terms = !keep_all_terms;
   o.latitude_deg = latitude_deg;
   o.earth_rate_deg_per_h = earth_rate;
@@ -124,7 +125,7 @@ AnalysisOptions AnalyzeArgs::options() const {
   if (!limits_file.empty()) o.verdict.table = ClassTable::load(limits_file);
   o.methods.block_s = block_s;
   const auto [dl, dh] = parse_range(direct_range, "--direct-range", 1.0, 100.0);
-  if (!(dl > 0)) throw UsageError("--direct-range: TMIN must be positive");
+  if (!(dl > 0)) throw UsageError(tr("--direct-range: TMIN must be positive"));
   o.methods.direct_t_min_s = dl;
   o.methods.direct_t_max_s = dh;
   o.outlier_action = parse_outlier_action(outliers);

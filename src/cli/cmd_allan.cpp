@@ -97,9 +97,9 @@ void require_finite(const AllanResult& r, const Recording& rec) {
   auto check = [&](const char* what, double v, double tau) {
     if (!std::isfinite(v))
       throw AnalysisError(
-          fmt::format("{}: the {} at tau = {:g} s is {} (the record's numbers overflow a double); "
-                      "nothing was printed",
-                      rec.source, what, tau, v));
+          trf("{}: the {} at tau = {:g} s is {} (the record's numbers overflow a double); "
+              "nothing was printed",
+              rec.source, what, tau, v));
   };
   check("sample period tau0", r.tau0_s, r.tau0_s);
   for (const AllanPoint& p : r.points) {

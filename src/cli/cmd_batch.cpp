@@ -14,6 +14,7 @@
 #include "cli/plot_args.hpp"
 #include "rwcalc/batch.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"
 
 namespace rwcalc::cli {
@@ -52,7 +53,7 @@ void register_batch(CLI::App& app, Runner& runner) {
       AnalysisOptions opt = cmd->analysis.options();
       if (cmd->temperature) {
         if (cmd->files.size() != 1)
-          throw UsageError("--temperature applies to a single file; name the temperature in each file instead");
+          throw UsageError(tr("--temperature applies to a single file; name the temperature in each file instead"));
         opt.temperature_c = cmd->temperature;
       }
       cmd->plot.check(cmd->force, {{"-o", cmd->output}});

@@ -93,12 +93,12 @@ void attach_saved_diagnoses(const SavedResults& saved, const std::vector<json>& 
     if (!target && analyses.size() == 1) target = 0;
     if (!target)
       throw InputError(path, 0,
-                       fmt::format("the diagnosis of '{}' matches no run of the report; give the run's recording or "
-                                   "its analysis JSON too",
-                                   name.empty() ? std::string("(no source)") : name));
+                       trf("the diagnosis of '{}' matches no run of the report; give the run's recording or "
+                           "its analysis JSON too",
+                           name.empty() ? std::string(tr("(no source)")) : name));
     diagnoses.resize(analyses.size());
     if (diagnoses[*target].is_object())
-      throw InputError(path, 0, fmt::format("a second diagnosis for '{}'", file_name(analyses[*target])));
+      throw InputError(path, 0, trf("a second diagnosis for '{}'", file_name(analyses[*target])));
     diagnoses[*target] = d;
   }
 }
@@ -161,7 +161,7 @@ ReportInput report_input(const ReportCmd& c, const std::vector<std::string>& rec
   if (!recordings.empty()) in.analyses = analyze_files(recordings, read, opt);
   for (auto& a : saved.analyses) in.analyses.push_back(std::move(a.run));
   if (in.analyses.empty())
-    throw UsageError("report: no run to report; give recordings or saved analyses (the diagnoses need their runs)");
+    throw UsageError(tr("report: no run to report; give recordings or saved analyses (the diagnoses need their runs)"));
   diagnoses.resize(in.analyses.size());
   attach_saved_diagnoses(saved, in.analyses, diagnoses);
   if (std::any_of(diagnoses.begin(), diagnoses.end(), [](const json& d) { return d.is_object(); }))
@@ -185,19 +185,20 @@ ReportInput report_input(const ReportCmd& c, const std::vector<std::string>& rec
 
 int run_report(const ReportCmd& c, Io& io) {
   if (c.dir.empty())
-    throw UsageError("report: -o DIR is required (the directory that receives report.html; created when missing)");
+    throw UsageError(tr("report: -o DIR is required (the directory that receives report.html; created when missing)"));
   std::vector<std::string> recordings, saved_files;
   for (const auto& f : c.files) (is_json_path(f) ? saved_files : recordings).push_back(f);
   AnalysisOptions opt = c.analysis.options();
   if (c.temperature) {
     if (recordings.size() != 1)
-      throw UsageError("--temperature applies to a single recording; name the temperature in each file instead");
+      throw UsageError(tr("--temperature applies to a single recording; name the temperature in each file instead"));
     opt.temperature_c = c.temperature;
   }
   if (c.diagnose && recordings.empty())
-    throw UsageError("--diagnose needs recordings; saved diagnoses are given as 'rwcalc diagnose --json' files");
+    throw UsageError(tr("--diagnose needs recordings; saved diagnoses are given as 'rwcalc diagnose --json' files"));
   const ReadOptions read = c.input.options();
-  if (c.diagnose && c.diagnose_runs < 10) throw UsageError("--diagnose-runs: at least 10 simulated records are needed");
+  if (c.diagnose && c.diagnose_runs < 10)
+    throw UsageError(tr("--diagnose-runs: at least 10 simulated records are needed"));
   // Fail before the analysis: a report.html that cannot be written (existing without --force, a
   // directory…; a missing DIR is created later), no gnuplot for the figures.
   std::error_code ec;

@@ -14,6 +14,7 @@
 #include "cli/commands.hpp"
 #include "cli/numeric_options.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/printable.hpp"
 #include "rwcalc/pulse_writer.hpp"
@@ -64,7 +65,7 @@ std::vector<double> fields(const std::string& option, const std::string& text, s
     }
     start = colon + 1;
   }
-  throw UsageError(fmt::format("{}: '{}' is not of the form {}", option, text, form));
+  throw UsageError(trf("{}: '{}' is not of the form {}", option, text, form));
 }
 
 // FILE with _001 inserted before the extension (everything from the first dot of the name).
@@ -182,24 +183,22 @@ std::vector<AngleTerm> angle_bound_terms(const NoiseModel& m, const SimulationSe
 // message names the option whose term is largest.
 void check_record_range(const NoiseModel& m, const SimulationSettings& s) {
   if (!(s.duration_s * s.rate_hz <= kMaxSamples))
-    throw UsageError(
-        fmt::format("--duration {:g} s at --rate {:g} Hz gives {:g} samples, more than the {:g} a record may have",
-                    s.duration_s, s.rate_hz, s.duration_s * s.rate_hz, kMaxSamples));
+    throw UsageError(trf("--duration {:g} s at --rate {:g} Hz gives {:g} samples, more than the {:g} a record may have",
+                         s.duration_s, s.rate_hz, s.duration_s * s.rate_hz, kMaxSamples));
   for (const auto& x : m.bias_steps)
     if (x.t_s > s.duration_s)
-      throw UsageError(
-          fmt::format("--bias-step: the time {:g} s is beyond the record's end ({:g} s)", x.t_s, s.duration_s));
+      throw UsageError(trf("--bias-step: the time {:g} s is beyond the record's end ({:g} s)", x.t_s, s.duration_s));
   const std::vector<AngleTerm> terms = angle_bound_terms(m, s);
   double angle = 0;
   for (const auto& t : terms) angle += t.arcsec;
   if (angle / s.scale_arcsec <= kMaxPulses) return;
   const auto largest = std::max_element(terms.begin(), terms.end(),
                                         [](const AngleTerm& a, const AngleTerm& b) { return a.arcsec < b.arcsec; });
-  throw UsageError(fmt::format(
-      "{}: the record's angle may reach {:g} arcsec over {:g} s (rate terms at their largest, random terms at ten "
-      "sigma), {:g} pulses of {:g} arcsec: beyond the {:g} (2^60) pulses a record can count. Lower {}, shorten "
-      "--duration or raise --scale",
-      largest->option, angle, s.duration_s, angle / s.scale_arcsec, s.scale_arcsec, kMaxPulses, largest->option));
+  throw UsageError(
+      trf("{}: the record's angle may reach {:g} arcsec over {:g} s (rate terms at their largest, random terms at ten "
+          "sigma), {:g} pulses of {:g} arcsec: beyond the {:g} (2^60) pulses a record can count. Lower {}, shorten "
+          "--duration or raise --scale",
+          largest->option, angle, s.duration_s, angle / s.scale_arcsec, s.scale_arcsec, kMaxPulses, largest->option));
 }
 
 using Take = std::function<bool(const char*)>;
@@ -212,14 +211,12 @@ void apply_settings(const SimulateArgs& a, const Take& take, SimulationSettings&
   if (a.temperature_c) s.temperature_c = a.temperature_c;
   s.seed = a.seed;
   if (!std::isfinite(s.duration_s) || s.duration_s <= 0)
-    throw UsageError(fmt::format("--duration must be > 0 s, got {}", s.duration_s));
-  if (!std::isfinite(s.rate_hz) || s.rate_hz <= 0)
-    throw UsageError(fmt::format("--rate must be > 0 Hz, got {}", s.rate_hz));
+    throw UsageError(trf("--duration must be > 0 s, got {}", s.duration_s));
+  if (!std::isfinite(s.rate_hz) || s.rate_hz <= 0) throw UsageError(trf("--rate must be > 0 Hz, got {}", s.rate_hz));
   if (!std::isfinite(s.scale_arcsec) || s.scale_arcsec <= 0)
-    throw UsageError(fmt::format("--scale must be > 0 arcsec, got {}", s.scale_arcsec));
+    throw UsageError(trf("--scale must be > 0 arcsec, got {}", s.scale_arcsec));
   if (s.samples() < 2)
-    throw UsageError(
-        fmt::format("--duration {} s at --rate {} Hz gives fewer than 2 samples", s.duration_s, s.rate_hz));
+    throw UsageError(trf("--duration {} s at --rate {} Hz gives fewer than 2 samples", s.duration_s, s.rate_hz));
 }
 
 TemperatureBias temperature_bias(double coefficient, const std::string& profile) {
@@ -232,17 +229,16 @@ TemperatureBias temperature_bias(double coefficient, const std::string& profile)
     const auto v = fields("--temp-profile", rest, 2, 2, "ramp:START_C:END_C");
     for (const double c : v)
       if (c < kMinTemperatureC || c > kMaxTemperatureC)
-        throw UsageError(fmt::format("--temp-profile: {:g} deg C is outside {:g}..{:g} deg C", c, kMinTemperatureC,
-                                     kMaxTemperatureC));
+        throw UsageError(
+            trf("--temp-profile: {:g} deg C is outside {:g}..{:g} deg C", c, kMinTemperatureC, kMaxTemperatureC));
     tb.profile = {TemperatureProfile::Kind::Ramp, v[0], v[1], 0.0, 0.0};
   } else if (kind == "cycle") {
     const auto v = fields("--temp-profile", rest, 2, 2, "cycle:AMP_C:PERIOD_S");
     if (!(v[1] >= 1.0 / kMaxRateHz))
-      throw UsageError(fmt::format("--temp-profile: the cycle period must be >= {:g} s", 1.0 / kMaxRateHz));
+      throw UsageError(trf("--temp-profile: the cycle period must be >= {:g} s", 1.0 / kMaxRateHz));
     tb.profile = {TemperatureProfile::Kind::Cycle, 0.0, 0.0, v[0], v[1]};
   } else {
-    throw UsageError(
-        fmt::format("--temp-profile: '{}' is neither ramp:START_C:END_C nor cycle:AMP_C:PERIOD_S", profile));
+    throw UsageError(trf("--temp-profile: '{}' is neither ramp:START_C:END_C nor cycle:AMP_C:PERIOD_S", profile));
   }
   return tb;
 }
@@ -252,38 +248,38 @@ void add_extended_terms(const SimulateArgs& a, NoiseModel& m) {
   for (const auto& t : a.sinusoids) {
     const auto v = fields("--sinusoid", t, 2, 3, "F_HZ:AMP_DEG_PER_H[:PHASE_RAD]");
     if (v[0] <= 0 || v[0] > kMaxRateHz)
-      throw UsageError(fmt::format("--sinusoid: the frequency must be in (0, {:g}] Hz in '{}'", kMaxRateHz, t));
+      throw UsageError(trf("--sinusoid: the frequency must be in (0, {:g}] Hz in '{}'", kMaxRateHz, t));
     m.sinusoids.push_back({v[0], v[1], v.size() > 2 ? v[2] : 0.0});
   }
   for (const auto& t : a.gauss_markov) {
     const auto v = fields("--gauss-markov", t, 2, 2, "SIGMA_DEG_PER_H:TC_S");
-    if (v[0] < 0 || v[1] <= 0) throw UsageError(fmt::format("--gauss-markov: need sigma >= 0 and TC_S > 0 in '{}'", t));
+    if (v[0] < 0 || v[1] <= 0) throw UsageError(trf("--gauss-markov: need sigma >= 0 and TC_S > 0 in '{}'", t));
     m.gauss_markov.push_back({v[0], v[1]});
   }
   for (const auto& t : a.bias_steps) {
     const auto v = fields("--bias-step", t, 2, 2, "T_S:SIZE_DEG_PER_H");
-    if (v[0] < 0) throw UsageError(fmt::format("--bias-step: the time must be >= 0 s in '{}'", t));
+    if (v[0] < 0) throw UsageError(trf("--bias-step: the time must be >= 0 s in '{}'", t));
     m.bias_steps.push_back({v[0], v[1]});
   }
   for (const auto& t : a.warmups) {
     const auto v = fields("--warmup", t, 2, 2, "AMP_DEG_PER_H:TC_S");
-    if (v[1] <= 0) throw UsageError(fmt::format("--warmup: the time constant must be > 0 s in '{}'", t));
+    if (v[1] <= 0) throw UsageError(trf("--warmup: the time constant must be > 0 s in '{}'", t));
     m.warmups.push_back({v[0], v[1]});
   }
   if (a.temp_bias) {
-    if (!std::isfinite(*a.temp_bias)) throw UsageError("--temp-bias must be finite");
+    if (!std::isfinite(*a.temp_bias)) throw UsageError(tr("--temp-bias must be finite"));
     if (a.temp_profile.empty())
-      throw UsageError("--temp-bias needs --temp-profile ramp:START_C:END_C or cycle:AMP_C:PERIOD_S");
+      throw UsageError(tr("--temp-bias needs --temp-profile ramp:START_C:END_C or cycle:AMP_C:PERIOD_S"));
     m.temperature_bias = temperature_bias(*a.temp_bias, a.temp_profile);
   } else if (!a.temp_profile.empty()) {
-    throw UsageError("--temp-profile needs --temp-bias COEF_DEG_PER_H_PER_C");
+    throw UsageError(tr("--temp-profile needs --temp-bias COEF_DEG_PER_H_PER_C"));
   }
 }
 
 /// The noise model from the options taken (`m` holds that of --from, if any).
 void apply_model(const SimulateArgs& a, const Take& take, NoiseModel& m) {
   auto nonneg = [](const char* opt, double v) {
-    if (!std::isfinite(v) || v < 0) throw UsageError(fmt::format("{} must be >= 0, got {}", opt, v));
+    if (!std::isfinite(v) || v < 0) throw UsageError(trf("{} must be >= 0, got {}", opt, v));
     return v;
   };
   if (take("--arw")) m.arw_deg_per_sqrt_h = nonneg("--arw", a.arw);
@@ -293,7 +289,7 @@ void apply_model(const SimulateArgs& a, const Take& take, NoiseModel& m) {
   if (take("--bias")) m.bias_deg_per_h = a.bias;
   if (take("--latitude") || take("--no-earth-rate")) {
     if (!std::isfinite(a.latitude) || std::abs(a.latitude) > 90.0)
-      throw UsageError(fmt::format("--latitude must be within -90..90 deg, got {}", a.latitude));
+      throw UsageError(trf("--latitude must be within -90..90 deg, got {}", a.latitude));
     m.earth_rate_deg_per_h = a.no_earth_rate ? 0.0 : earth_rate_at(a.latitude);
   }
   if (a.white_readout) m.readout = ReadoutMode::White;
@@ -325,13 +321,13 @@ int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
     m = model_from_analysis_file(a.from, s, a.upper_bounds, &notes);
     for (const auto& n : notes) print_message(io.err, fmt::format("--from {}: {}", a.from, n));
   } else if (a.upper_bounds) {
-    throw UsageError("--upper-bounds needs --from");
+    throw UsageError(tr("--upper-bounds needs --from"));
   }
   apply_settings(a, take, s);
   apply_model(a, take, m);
-  if (a.runs < 1) throw UsageError(fmt::format("--runs must be >= 1, got {}", a.runs));
+  if (a.runs < 1) throw UsageError(trf("--runs must be >= 1, got {}", a.runs));
   check_record_range(m, s);
-  if (a.output == "-" && a.runs > 1) throw UsageError("--runs > 1 needs a file name for -o");
+  if (a.output == "-" && a.runs > 1) throw UsageError(tr("--runs > 1 needs a file name for -o"));
 
   auto path_of = [&](const std::string& p, int r) { return a.runs > 1 ? numbered(p, r, a.runs) : p; };
   // Refuse before writing anything when any target exists or two name the same file (no
@@ -350,8 +346,8 @@ int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
     write_record(sim, sr, path, a.force);
     if (!a.truth.empty()) write_truth(path_of(a.truth, r), m, sr, path, a.force);
     if (path != "-")
-      io.out << fmt::format("wrote {} ({} samples, {} s at {} Hz, seed {})\n", printable(path), sr.samples(),
-                            sr.duration_s, sr.rate_hz, sr.seed);
+      io.out << trf("wrote {} ({} samples, {} s at {} Hz, seed {})\n", printable(path), sr.samples(), sr.duration_s,
+                    sr.rate_hz, sr.seed);
   }
   return 0;
 }

@@ -6,6 +6,7 @@
 #include "cli/commands.hpp"
 #include "cli/numeric_options.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 
 namespace rwcalc::cli {
 
@@ -70,8 +71,8 @@ ReadOptions InputArgs::options() const {
 }
 
 void print_input_notes(std::ostream& err, const Recording& rec) {
-  for (const std::string& w : rec.warnings) print_message(err, fmt::format("warning: {}: {}", rec.source, w));
-  for (const std::string& n : rec.notes) print_message(err, fmt::format("note: {}: {}", rec.source, n));
+  for (const std::string& w : rec.warnings) print_message(err, trf("warning: {}: {}", rec.source, w));
+  for (const std::string& n : rec.notes) print_message(err, trf("note: {}: {}", rec.source, n));
 }
 
 void print_input_notes(std::ostream& err, const nlohmann::json& analysis) {
@@ -81,8 +82,8 @@ void print_input_notes(std::ostream& err, const nlohmann::json& analysis) {
   for (const char* kind : {"warnings", "notes"})
     for (const auto& line : in->value(kind, nlohmann::json::array()))
       if (line.is_string())
-        print_message(err,
-                      fmt::format("{}: {}: {}", kind[0] == 'w' ? "warning" : "note", source, line.get<std::string>()));
+        print_message(err, kind[0] == 'w' ? trf("warning: {}: {}", source, line.get<std::string>())
+                                          : trf("note: {}: {}", source, line.get<std::string>()));
 }
 
 }  // namespace rwcalc::cli

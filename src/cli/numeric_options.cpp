@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 
 namespace rwcalc::cli {
 
@@ -74,8 +75,8 @@ void find_non_finite(const nlohmann::json& j, const std::string& path, const std
   if (j.is_number_float()) {
     const double v = j.get<double>();
     if (!std::isfinite(v))
-      throw AnalysisError(fmt::format("{}: the result {} is {} (a number overflowed a double); nothing was printed",
-                                      source, path.empty() ? "value" : path, v));
+      throw AnalysisError(trf("{}: the result {} is {} (a number overflowed a double); nothing was printed", source,
+                              path.empty() ? "value" : path, v));
   } else if (j.is_object()) {
     for (const auto& [key, value] : j.items()) find_non_finite(value, path.empty() ? key : path + "." + key, source);
   } else if (j.is_array()) {

@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/limits.hpp"
 
 namespace rwcalc::detail {
@@ -148,17 +149,16 @@ void Metadata::read(std::string_view body, std::size_t line, const std::string& 
     const auto r = std::from_chars(v.data(), v.data() + v.size(), x);
     if (v.empty() || r.ec != std::errc() || r.ptr != v.data() + v.size() || !std::isfinite(x) || (positive && !(x > 0)))
       throw InputError(file, line,
-                       fmt::format("metadata {}: {} is not a {}number", key, quoted(value),
-                                   positive ? "positive " : ""));
+                       trf("metadata {}: {} is not a {}number", key, quoted(value), positive ? tr("positive ") : ""));
     if (slot && *slot != x)
       throw InputError(file, line,
-                       fmt::format("metadata {} given twice with different values ({} and {})", key, quoted(all[key]),
-                                   quoted(value)));
+                       trf("metadata {} given twice with different values ({} and {})", key, quoted(all[key]),
+                           quoted(value)));
     slot = x;
     if (!(x >= lo && x <= hi))
       throw InputError(file, line,
-                       fmt::format("metadata {}: {} {} is outside the usable range {:g}..{:g} {}", key, quoted(value),
-                                   unit, lo, hi, unit));
+                       trf("metadata {}: {} {} is outside the usable range {:g}..{:g} {}", key, quoted(value), unit, lo,
+                           hi, unit));
   };
   if (key == "rate_hz") {
     set_known(rate_hz, true, kMinRateHz, kMaxRateHz, "Hz");
@@ -209,8 +209,7 @@ void Layout::choose(const ReadOptions& o, std::size_t where, const std::string& 
     // Headerless layouts: [value], [time, value], [time, value, temperature].
     if (o.column.empty()) {
       if (ncols > 3)
-        throw InputError(file, where,
-                         fmt::format("{} columns and no header row: choose the column with --column", ncols));
+        throw InputError(file, where, trf("{} columns and no header row: choose the column with --column", ncols));
       value_col = ncols == 1 ? 0 : 1;
     }
     if ((ncols == 2 || ncols == 3) && value_col == 1) time_col = 0, time_unit = kByMagnitude;
@@ -232,24 +231,24 @@ void Layout::choose_given(const std::string& want, std::size_t where, const std:
     std::from_chars(want.data(), want.data() + want.size(), idx);
     if (idx < 1 || idx > ncols)
       throw InputError(file, where,
-                       fmt::format("--column {} is out of range: the file has {} column{}", want, ncols,
-                                   ncols == 1 ? "" : "s"));
+                       trf("--column {} is out of range: the file has {} column{}", want, ncols,
+                           ncols == 1 ? "" : "s"));
     value_col = idx - 1;
     return;
   }
   if (header.empty())
     throw InputError(file, where,
-                     fmt::format("--column '{}' names a column but the file has no header row; give a "
-                                 "1-based index instead",
-                                 want));
+                     trf("--column '{}' names a column but the file has no header row; give a "
+                         "1-based index instead",
+                         want));
   const auto named = columns_where(header, [&](std::string_view h) { return iequals(h, want); });
   if (named.empty())
     throw InputError(file, header_line,
-                     fmt::format("no column named '{}'; the columns are {}", want, column_list(all_columns(ncols))));
+                     trf("no column named '{}'; the columns are {}", want, column_list(all_columns(ncols))));
   if (named.size() > 1)
     throw InputError(file, header_line,
-                     fmt::format("{} columns are named '{}' (columns {}); choose one by its index with --column",
-                                 named.size(), want, column_list(named)));
+                     trf("{} columns are named '{}' (columns {}); choose one by its index with --column", named.size(),
+                         want, column_list(named)));
   value_col = named.front();
 }
 
@@ -268,27 +267,27 @@ void Layout::choose_by_name(const ReadOptions& o, bool value_given, const std::s
     const auto named = columns_where(header, [&](std::string_view h) { return any_named(h, names); });
     if (named.size() > 1)
       throw InputError(file, header_line,
-                       fmt::format("columns {} could each hold the {} samples; choose one with --column",
-                                   column_list(named), to_string(mode)));
+                       trf("columns {} could each hold the {} samples; choose one with --column", column_list(named),
+                           to_string(mode)));
     std::vector<std::size_t> rest;
     for (std::size_t k = 0; k < ncols; ++k)
       if (std::count(times.begin(), times.end(), k) + std::count(temps.begin(), temps.end(), k) == 0) rest.push_back(k);
     if (named.empty() && rest.size() != 1)
       throw InputError(file, header_line,
-                       fmt::format("cannot tell which column holds the {} samples; choose one with --column (the "
-                                   "columns are {})",
-                                   to_string(mode), column_list(all_columns(ncols))));
+                       trf("cannot tell which column holds the {} samples; choose one with --column (the "
+                           "columns are {})",
+                           to_string(mode), column_list(all_columns(ncols))));
     value_col = named.empty() ? rest.front() : named.front();
   }
   if (times.size() > 2)
     throw InputError(file, header_line,
-                     fmt::format("{} time columns ({}); rwcalc reads one, or two that agree: remove the others",
-                                 times.size(), column_list(times)));
+                     trf("{} time columns ({}); rwcalc reads one, or two that agree: remove the others", times.size(),
+                         column_list(times)));
   if (temps.size() > 1)
     throw InputError(file, header_line,
-                     fmt::format("{} temperature columns ({}); rwcalc reports one temperature: remove or rename "
-                                 "the others",
-                                 temps.size(), column_list(temps)));
+                     trf("{} temperature columns ({}); rwcalc reports one temperature: remove or rename "
+                         "the others",
+                         temps.size(), column_list(temps)));
   if (!times.empty()) time_col = times[0], time_unit = time_name(header[times[0]]);
   if (times.size() == 2) time2_col = times[1], time2_unit = time_name(header[times[1]]);
   if (!temps.empty()) temp_col = temps[0];
@@ -377,9 +376,9 @@ InputChoice choose_input(const ReadOptions& o, std::string_view column, const st
   for (const std::string_view a : kAccelSuffixes)
     if (ends_with_nocase(column, a))
       throw InputError(file, line,
-                       fmt::format("column '{}' is an accelerometer channel (unit '{}' in its name); accelerometer "
-                                   "channels are not supported by this command: choose a gyro column with --column",
-                                   column, a.substr(1)));
+                       trf("column '{}' is an accelerometer channel (unit '{}' in its name); accelerometer "
+                           "channels are not supported by this command: choose a gyro column with --column",
+                           column, a.substr(1)));
   InputChoice c;
   const UnitSuffix* u = unit_suffix(column);
   if (o.mode) {

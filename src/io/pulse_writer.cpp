@@ -1,4 +1,5 @@
 #include "rwcalc/pulse_writer.hpp"
+#include "rwcalc/i18n.hpp"
 
 #include <fmt/format.h>
 
@@ -32,7 +33,7 @@ struct LinePosition {
 
 [[noreturn]] void throw_unwritable(const LinePosition& at, const std::string& cause) {
   throw UsageError(
-      fmt::format("{}: line {} (sample {}): {}; the file was not written", at.file, at.line, at.next_sample, cause));
+      trf("{}: line {} (sample {}): {}; the file was not written", at.file, at.line, at.next_sample, cause));
 }
 
 void append_line(std::string& text, std::int64_t v) {
@@ -82,7 +83,7 @@ std::string format_pulse_file(const Metadata& metadata, const PhaseSeries& serie
   const bool exact = series.exact();
   // A floating series (an output-chain filter gives sub-pulse resolution): the cumulative
   // angle in ″ under the header `angle`, from x_0.
-  if (!exact && series.values.empty()) throw AnalysisError("the series to write is empty");
+  if (!exact && series.values.empty()) throw AnalysisError(tr("the series to write is empty"));
   std::string text = header_text(metadata, exact ? "pulses" : "angle");
   // The first line is x_0 in the angle column, the increment of sample 1 in the pulses column.
   LinePosition at{"the pulse file", static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')),
@@ -113,7 +114,7 @@ PulseFileWriter::PulseFileWriter(const std::string& path, const Metadata& metada
 }
 
 void PulseFileWriter::add_counts(std::span<const std::int64_t> counts) {
-  if (column_ != Column::Pulses) throw AnalysisError(fmt::format("{}: pulse counts given for an angle file", path_));
+  if (column_ != Column::Pulses) throw AnalysisError(trf("{}: pulse counts given for an angle file", path_));
   LinePosition at{path_, line_, sample_ + 1};
   append_increments(text_, counts, previous_, at);
   line_ = at.line;
@@ -122,7 +123,7 @@ void PulseFileWriter::add_counts(std::span<const std::int64_t> counts) {
 }
 
 void PulseFileWriter::add_angles(std::span<const double> angles) {
-  if (column_ != Column::Angle) throw AnalysisError(fmt::format("{}: angles given for a pulse file", path_));
+  if (column_ != Column::Angle) throw AnalysisError(trf("{}: angles given for a pulse file", path_));
   LinePosition at{path_, line_, sample_ + 1};
   append_angles(text_, angles, at);
   line_ = at.line;

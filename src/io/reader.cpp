@@ -2,6 +2,7 @@
 // through the one LineParser; the reader keeps only the selected column's values (8 bytes per
 // sample) and running statistics of the time column, then checks the rate and builds the phase.
 #include "rwcalc/reader.hpp"
+#include "rwcalc/i18n.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -111,8 +112,8 @@ template <class E>
 E parse_name(const NameTable<E>& table, std::string_view s, std::string_view option) {
   for (const auto& [value, name] : table)
     if (name == s) return value;
-  throw UsageError(fmt::format("unknown {} '{}': expected {}, {}, {} or {}", option, s, table[0].second,
-                               table[1].second, table[2].second, table[3].second));
+  throw UsageError(trf("unknown {} '{}': expected {}, {}, {} or {}", option, s, table[0].second, table[1].second,
+                       table[2].second, table[3].second));
 }
 
 template <class E>
@@ -592,13 +593,13 @@ void Reader::note_time_column(Recording& rec) const {
 
 void validate(const ReadOptions& o) {
   if (o.rate_hz && !(std::isfinite(*o.rate_hz) && *o.rate_hz > 0))
-    throw UsageError(fmt::format("--rate must be a positive number of Hz, got {}", *o.rate_hz));
+    throw UsageError(trf("--rate must be a positive number of Hz, got {}", *o.rate_hz));
   if (o.scale_arcsec && !(std::isfinite(*o.scale_arcsec) && *o.scale_arcsec > 0))
-    throw UsageError(fmt::format("--scale must be a positive number of arcsec, got {}", *o.scale_arcsec));
+    throw UsageError(trf("--scale must be a positive number of arcsec, got {}", *o.scale_arcsec));
   if (o.counter_bits < 1 || o.counter_bits > 64)
-    throw UsageError(fmt::format("--counter-bits must be 1..64, got {}", o.counter_bits));
+    throw UsageError(trf("--counter-bits must be 1..64, got {}", o.counter_bits));
   if (!(o.time_tolerance >= 0 && o.time_tolerance < 1))
-    throw UsageError(fmt::format("--time-tolerance must be in [0, 1), got {}", o.time_tolerance));
+    throw UsageError(trf("--time-tolerance must be in [0, 1), got {}", o.time_tolerance));
 }
 
 Recording read_source(detail::TextSource&& src, const std::string& source, const ReadOptions& options) {

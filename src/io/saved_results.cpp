@@ -1,5 +1,6 @@
 // Reading back rwcalc's own JSON results, every value checked against its domain.
 #include "rwcalc/saved_results.hpp"
+#include "rwcalc/i18n.hpp"
 
 #include <fmt/format.h>
 
@@ -338,8 +339,8 @@ void parse_saved_result(std::string_view text, const std::string& file, SavedRes
     into.diagnoses.push_back({doc.take(), file, 1});
   } else {
     throw InputError(file, 1,
-                     "not an rwcalc result: expected the JSON of 'rwcalc analyze --json' (\"allan\", \"verdict\"), "
-                     "'batch --json' (\"runs\") or 'diagnose --json' (\"base_model\", \"findings\")");
+                     tr("not an rwcalc result: expected the JSON of 'rwcalc analyze --json' (\"allan\", \"verdict\"), "
+                        "'batch --json' (\"runs\") or 'diagnose --json' (\"base_model\", \"findings\")"));
   }
 }
 
@@ -358,14 +359,15 @@ std::vector<SavedRun> parse_json_lines(std::string_view text, const std::string&
     const Value root = doc.root();
     if (!root.json().is_object())
       throw InputError(file, no,
-                       fmt::format("not an analyze object but {}; write the lines with `rwcalc batch --jsonl`",
-                                   json_input::type_name(root.json())));
+                       trf("not an analyze object but {}; write the lines with `rwcalc batch --jsonl`",
+                           json_input::type_name(root.json())));
     if (!root.json().contains("verdict"))
-      throw InputError(file, no, "not an analyze object (no \"verdict\"); write the lines with `rwcalc batch --jsonl`");
+      throw InputError(file, no,
+                       tr("not an analyze object (no \"verdict\"); write the lines with `rwcalc batch --jsonl`"));
     checker.run(root);
     out.push_back({doc.take(), file, no});
   }
-  if (out.empty()) throw InputError(file, 0, "no JSON lines");
+  if (out.empty()) throw InputError(file, 0, tr("no JSON lines"));
   return out;
 }
 
@@ -398,14 +400,14 @@ std::vector<std::size_t> distinct_runs(const std::vector<SavedRun>& runs, bool d
     const auto& first = runs[it->second];
     if (!dedupe)
       throw InputError(r.file, r.line,
-                       fmt::format("run '{}' is already given at {}: each run is counted once (--dedupe drops a "
-                                   "repeated identical line)",
-                                   source_of(r), place(first)));
+                       trf("run '{}' is already given at {}: each run is counted once (--dedupe drops a "
+                           "repeated identical line)",
+                           source_of(r), place(first)));
     if (r.run != first.run)
       throw InputError(r.file, r.line,
-                       fmt::format("run '{}' is also given at {}, with different results: merge cannot tell which "
-                                   "one holds",
-                                   source_of(r), place(first)));
+                       trf("run '{}' is also given at {}, with different results: merge cannot tell which "
+                           "one holds",
+                           source_of(r), place(first)));
   }
   return kept;
 }
@@ -423,8 +425,8 @@ void require_one_class_table(const std::vector<SavedRun>& runs, const std::vecto
       const bool in0 = v0.contains(ptr), in = v.contains(ptr);
       if (in0 == in && (!in || v0.at(ptr) == v.at(ptr))) continue;
       throw InputError(runs[i].file, runs[i].line,
-                       fmt::format("run '{}' was judged against another class table (\"{}\") than run '{}' at {}",
-                                   source_of(runs[i]), name, source_of(first), place(first)));
+                       trf("run '{}' was judged against another class table (\"{}\") than run '{}' at {}",
+                           source_of(runs[i]), name, source_of(first), place(first)));
     }
   }
 }
@@ -432,7 +434,7 @@ void require_one_class_table(const std::vector<SavedRun>& runs, const std::vecto
 }  // namespace
 
 std::vector<nlohmann::json> merge_runs(std::vector<SavedRun> runs, bool dedupe) {
-  if (runs.empty()) throw UsageError("merge: no runs");
+  if (runs.empty()) throw UsageError(tr("merge: no runs"));
   const auto kept = distinct_runs(runs, dedupe);
   require_one_class_table(runs, kept);
   std::vector<nlohmann::json> out;

@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 
 namespace rwcalc::detail {
 
@@ -65,9 +66,9 @@ void TextCheck::check(std::string_view piece) {
   const auto reach = offset_ + static_cast<std::size_t>(first_line_end(b, stop) - b) - std::max(after_lf_, after_cr_);
   if (reach > kMaxLineBytes)
     throw InputError(name_, line(),
-                     fmt::format("line too long: more than {} bytes (1 MiB) without a line end; this is not a "
-                                 "text recording",
-                                 kMaxLineBytes));
+                     trf("line too long: more than {} bytes (1 MiB) without a line end; this is not a "
+                         "text recording",
+                         kMaxLineBytes));
   lf_ += static_cast<std::size_t>(std::count(b, stop, '\n'));
   cr_ += static_cast<std::size_t>(std::count(b, stop, '\r'));
   after_lf_ = after_last(b, stop, '\n', offset_, after_lf_);
@@ -79,9 +80,9 @@ void TextCheck::check(std::string_view piece) {
     std::size_t start = lf_ > 0 ? after_lf_ : cr_ > 0 ? after_cr_ : 0;
     if (start == 0 && bom_ && at >= 3) start = 3;
     throw InputError(name_, line(),
-                     fmt::format("binary data (byte 0x{:02x} at column {}): this is not a text recording; a "
-                                 "compressed file other than gzip?",
-                                 static_cast<unsigned char>(*bad), at - start + 1));
+                     trf("binary data (byte 0x{:02x} at column {}): this is not a text recording; a "
+                         "compressed file other than gzip?",
+                         static_cast<unsigned char>(*bad), at - start + 1));
   }
   offset_ += piece.size();
 }
@@ -91,13 +92,13 @@ TextSource::TextSource(const std::string& path) : name_(display_name(path)), che
     in_.fd = STDIN_FILENO;
     return;
   }
-  if (path.empty()) throw InputError("(empty path)", 0, "no input file given");
+  if (path.empty()) throw InputError(tr("(empty path)"), 0, tr("no input file given"));
   in_.fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (in_.fd < 0) fail_errno(name_, "cannot open", errno);
   in_.own = true;
   struct stat st {};
   if (::fstat(in_.fd, &st) != 0) fail_errno(name_, "cannot stat", errno);
-  if (S_ISDIR(st.st_mode)) throw InputError(name_, 0, "is a directory, not a recording");
+  if (S_ISDIR(st.st_mode)) throw InputError(name_, 0, tr("is a directory, not a recording"));
   if (S_ISREG(st.st_mode)) bytes_ = static_cast<std::size_t>(st.st_size);
 }
 
@@ -153,7 +154,7 @@ bool TextSource::start(std::string& out) {
     return n > 0;
   }
   // 16 + MAX_WBITS: the gzip wrapper only.
-  if (inflateInit2(&zs_, 16 + MAX_WBITS) != Z_OK) throw InputError(name_, 0, "cannot initialise zlib");
+  if (inflateInit2(&zs_, 16 + MAX_WBITS) != Z_OK) throw InputError(name_, 0, tr("cannot initialise zlib"));
   zs_.next_in = reinterpret_cast<Bytef*>(raw_.data());
   zs_.avail_in = static_cast<uInt>(raw_.size());
   return inflate_piece(out);
@@ -180,7 +181,7 @@ bool TextSource::inflate_piece(std::string& out) {
     // After a member's end only another member may follow: its magic bytes, maybe split by a read.
     for (uInt i = 0; !in_member_ && magic_seen_ < 2 && i < zs_.avail_in; ++i, ++magic_seen_)
       if (zs_.next_in[i] != (magic_seen_ == 0 ? 0x1f : 0x8b))
-        throw InputError(name_, 0, "unexpected bytes after the end of the gzip data");
+        throw InputError(name_, 0, tr("unexpected bytes after the end of the gzip data"));
     in_member_ = in_member_ || magic_seen_ == 2;
     const int rc = inflate(&zs_, Z_NO_FLUSH);
     if (rc == Z_STREAM_END) {
@@ -188,15 +189,15 @@ bool TextSource::inflate_piece(std::string& out) {
       in_member_ = false;
       magic_seen_ = 0;
     } else if (rc != Z_OK && rc != Z_BUF_ERROR) {  // Z_BUF_ERROR: more input is needed
-      throw InputError(name_, 0, std::string("corrupt gzip data: ") + (zs_.msg ? zs_.msg : "inflate failed"));
+      throw InputError(name_, 0, std::string(tr("corrupt gzip data: ")) + (zs_.msg ? zs_.msg : "inflate failed"));
     }
   }
   const std::size_t n = kPieceBytes - zs_.avail_out;
   if (ended && (in_member_ || magic_seen_ > 0))
     throw InputError(name_, 0,
-                     fmt::format("truncated gzip data: the compressed stream ends before its end marker ({} bytes "
-                                 "decompressed); the file is incomplete",
-                                 inflated_ + n));
+                     trf("truncated gzip data: the compressed stream ends before its end marker ({} bytes "
+                         "decompressed); the file is incomplete",
+                         inflated_ + n));
   out.resize(before + n);
   inflated_ += n;
   check_.check(std::string_view(out).substr(before));
