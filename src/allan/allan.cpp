@@ -1,6 +1,7 @@
 // Allan-variance engine: τ grids, the three estimators, and the per-τ noise id / EDF / bounds,
 // computed in parallel across τ.
 #include "rwcalc/allan.hpp"
+#include "rwcalc/i18n.hpp"
 
 #include <fmt/format.h>
 
@@ -32,9 +33,9 @@ double parse_number(std::string_view s, std::string_view spec) {
   const auto [ptr, ec] = std::from_chars(s.data(), end, v);
   if (s.empty() || ec != std::errc() || ptr != end || !std::isfinite(v))
     throw UsageError(
-        fmt::format("--tau: '{}' in '{}' is not a number of seconds (expected octave, "
-                    "decade, dense[:P], all, or a list such as 1,2,5)",
-                    s, spec));
+        trf("--tau: '{}' in '{}' is not a number of seconds (expected octave, "
+            "decade, dense[:P], all, or a list such as 1,2,5)",
+            s, spec));
   return v;
 }
 
@@ -64,7 +65,7 @@ TauGrid TauGrid::parse(std::string_view spec) {
       int v = 0;
       const auto [ptr, ec] = std::from_chars(p.data(), p.data() + p.size(), v);
       if (p.empty() || ec != std::errc() || ptr != p.data() + p.size() || v < 1 || v > 1000)
-        throw UsageError(fmt::format("--tau: '{}': P in dense:P must be an integer from 1 to 1000", spec));
+        throw UsageError(trf("--tau: '{}': P in dense:P must be an integer from 1 to 1000", spec));
       g.per_decade = v;
     }
     return g;
@@ -74,7 +75,7 @@ TauGrid TauGrid::parse(std::string_view spec) {
   while (true) {
     const auto comma = rest.find(',');
     const double t = parse_number(rest.substr(0, comma), spec);
-    if (!(t > 0)) throw UsageError(fmt::format("--tau: τ must be positive, got {} in '{}'", t, spec));
+    if (!(t > 0)) throw UsageError(trf("--tau: τ must be positive, got {} in '{}'", t, spec));
     g.taus_s.push_back(t);
     if (comma == std::string_view::npos) break;
     rest = rest.substr(comma + 1);
@@ -138,12 +139,12 @@ std::vector<std::int64_t> cluster_sizes(const TauGrid& grid, Estimator est, std:
         const double r = t / tau0_s;
         const double m = std::round(r);
         if (m < 1 || std::fabs(r - m) > 1e-9 * std::max(1.0, m))
-          throw UsageError(fmt::format("--tau {} s is not a whole number of samples (τ0 = {} s)", t, tau0_s));
+          throw UsageError(trf("--tau {} s is not a whole number of samples (τ0 = {} s)", t, tau0_s));
         if (m > static_cast<double>(limit))
           throw UsageError(
-              fmt::format("--tau {} s (m = {}) is beyond the longest usable τ of this record, "
-                          "{} s (m = {})",
-                          t, m, static_cast<double>(limit) * tau0_s, limit));
+              trf("--tau {} s (m = {}) is beyond the longest usable τ of this record, "
+                  "{} s (m = {})",
+                  t, m, static_cast<double>(limit) * tau0_s, limit));
         ms.push_back(static_cast<std::int64_t>(m));
       }
       std::sort(ms.begin(), ms.end());
@@ -268,14 +269,14 @@ std::vector<double> grid_variances(const PhaseSeries& x, const CountData& data, 
 
 void check_options(const PhaseSeries& x, const AllanOptions& options) {
   if (!(options.confidence > 0 && options.confidence < 1))
-    throw UsageError(fmt::format("--confidence must lie strictly between 0 and 1, got {}", options.confidence));
+    throw UsageError(trf("--confidence must lie strictly between 0 and 1, got {}", options.confidence));
   if (!(x.tau0_s > 0) || !std::isfinite(x.tau0_s))
-    throw UsageError(fmt::format("sample period must be positive, got {} s", x.tau0_s));
+    throw UsageError(trf("sample period must be positive, got {} s", x.tau0_s));
   if (!options.noise_id && (options.alpha < -2 || options.alpha > 2))
-    throw UsageError(fmt::format("noise exponent alpha must lie in -2..2, got {}", options.alpha));
+    throw UsageError(trf("noise exponent alpha must lie in -2..2, got {}", options.alpha));
   if (max_cluster_size(options.estimator, x.points()) < 1)
-    throw AnalysisError(fmt::format("the record has {} phase point(s); the {} variance needs at least {}", x.points(),
-                                    long_name(options.estimator), 3));
+    throw AnalysisError(trf("the record has {} phase point(s); the {} variance needs at least {}", x.points(),
+                            long_name(options.estimator), 3));
 }
 
 }  // namespace
@@ -289,7 +290,7 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
   const Estimator est = options.estimator;
   const std::size_t points = x.points();
   const std::vector<std::int64_t> ms = cluster_sizes(options.grid, est, points, x.tau0_s);
-  if (ms.empty()) throw AnalysisError("no cluster size of the τ grid fits this record");
+  if (ms.empty()) throw AnalysisError(tr("no cluster size of the τ grid fits this record"));
 
   AllanResult result;
   result.estimator = est;
@@ -371,7 +372,7 @@ Estimator parse_estimator(std::string_view s) {
   if (s == "mdev" || s == "modified") return Estimator::Modified;
   if (s == "ohdev") return Estimator::OverlappingHadamard;
   if (s == "hdev") return Estimator::NonOverlappingHadamard;
-  throw UsageError(fmt::format("unknown estimator '{}' (expected oadev, adev, mdev, ohdev or hdev)", s));
+  throw UsageError(trf("unknown estimator '{}' (expected oadev, adev, mdev, ohdev or hdev)", s));
 }
 
 }  // namespace rwcalc

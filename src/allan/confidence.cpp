@@ -1,6 +1,7 @@
 // Greenhall–Riley equivalent degrees of freedom and χ² confidence bounds of Allan-type variances,
 // following Stable32's choices so that its tables are reproduced.
 #include "rwcalc/confidence.hpp"
+#include "rwcalc/i18n.hpp"
 
 #include <fmt/format.h>
 
@@ -29,7 +30,7 @@ Real sw(Real t, int alpha) {
     case -2: return at * at * at * at * at;
     case -3: return t == 0 ? 0 : t * t * t * t * t * t * std::log(at);
     case -4: return at * at * at * at * at * at * at;
-    default: throw AnalysisError(fmt::format("EDF: unsupported noise exponent alpha = {}", alpha));
+    default: throw AnalysisError(trf("EDF: unsupported noise exponent alpha = {}", alpha));
   }
 }
 
@@ -49,7 +50,7 @@ Real sz(Real t, Real f, int alpha, int d) {
     case 3:
       return 20 * sx(t, f, alpha) - 15 * sx(t - 1, f, alpha) - 15 * sx(t + 1, f, alpha) + 6 * sx(t - 2, f, alpha) +
              6 * sx(t + 2, f, alpha) - sx(t - 3, f, alpha) - sx(t + 3, f, alpha);
-    default: throw AnalysisError(fmt::format("EDF: unsupported difference order d = {}", d));
+    default: throw AnalysisError(trf("EDF: unsupported difference order d = {}", d));
   }
 }
 
@@ -101,9 +102,9 @@ double binomial(int n, int k) {
 }  // namespace
 
 double edf_greenhall(int alpha, int d, std::int64_t m, std::size_t n_phase, bool overlapping, bool modified) {
-  if (d < 1 || d > 3) throw AnalysisError(fmt::format("EDF: unsupported difference order d = {}", d));
+  if (d < 1 || d > 3) throw AnalysisError(trf("EDF: unsupported difference order d = {}", d));
   if (alpha + 2 * d <= 1 || alpha > 2 || alpha < -4)
-    throw AnalysisError(fmt::format("EDF: noise exponent alpha = {} not allowed with d = {}", alpha, d));
+    throw AnalysisError(trf("EDF: noise exponent alpha = {} not allowed with d = {}", alpha, d));
   const Real mr = static_cast<Real>(m);
   const Real f = modified ? 1 : mr;     // filter factor
   const Real s = overlapping ? mr : 1;  // stride factor
@@ -175,7 +176,7 @@ double edf_for(Estimator est, int alpha, std::int64_t m, std::size_t n_phase) {
 }
 
 DevInterval chi2_interval(double var, double edf, double p) {
-  if (!(p > 0 && p < 1)) throw UsageError(fmt::format("confidence must lie strictly between 0 and 1, got {}", p));
+  if (!(p > 0 && p < 1)) throw UsageError(trf("confidence must lie strictly between 0 and 1, got {}", p));
   if (!(edf > 0) || !(var >= 0)) return {0.0, 0.0};
   const boost::math::chi_squared dist(edf);
   const double chi_hi = boost::math::quantile(dist, 0.5 * (1 + p));

@@ -241,13 +241,13 @@ Verdict verdict_of(const AnalysisResult& r, const AnalysisOptions& options) {
       break;
     case BEstimate::SigmaMin:
       if (!r.b_min.B.valid)
-        throw AnalysisError(fmt::format("{}: no Allan deviation minimum at tau <= T/10 to read B from", r.source));
+        throw AnalysisError(trf("{}: no Allan deviation minimum at tau <= T/10 to read B from", r.source));
       b_in = av_estimate_input(r.b_min);
       break;
     case BEstimate::Avg100:
       if (!r.b100.B.valid)
-        throw AnalysisError(fmt::format("{}: the record is shorter than three {:g}-s blocks; use --b-estimate fit",
-                                        r.source, options.methods.block_s));
+        throw AnalysisError(trf("{}: the record is shorter than three {:g}-s blocks; use --b-estimate fit", r.source,
+                                options.methods.block_s));
       b_in = av_estimate_input(r.b100);
       break;
   }
@@ -348,17 +348,16 @@ void cross_checks(const Recording& rec, const AnalysisOptions& options, Analysis
 AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   if (read.phase.kind != PhaseKind::Gyro)
     throw UsageError(
-        fmt::format("{}: analyze needs gyro data (pulses, counter, angle in arcsec/deg/rad, or rate in "
-                    "deg/h, deg/s, rad/s); this input is clock data",
-                    read.source));
+        trf("{}: analyze needs gyro data (pulses, counter, angle in arcsec/deg/rad, or rate in "
+            "deg/h, deg/s, rad/s); this input is clock data",
+            read.source));
   AnalysisResult r;
   Recording edited;
   const Recording& rec = screen_outliers(read, options.outlier_action, options.outlier_threshold, r.outliers, edited);
   describe_record(rec, options, r);
   r.input = input_json(read);  // as read: the outlier screen's copy keeps no notes
   if (rec.phase.points() < 3)
-    throw AnalysisError(
-        fmt::format("{}: the record holds {} sample(s); far too short to analyse", rec.source, rec.samples));
+    throw AnalysisError(trf("{}: the record holds {} sample(s); far too short to analyse", rec.source, rec.samples));
   earth_rate_and_bias(rec, options, r);
   allan_and_fit(rec, options, r);
   if (options.cross_checks) {

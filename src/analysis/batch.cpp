@@ -45,7 +45,7 @@ json combine(const std::vector<json>& runs, const std::vector<int>& classes, con
     cls = worse(cls, c);
     strict = worse(strict, cs);
     const auto pm = src.at("p_meets").get<std::vector<double>>();
-    if (pm.size() != classes.size()) throw InputError(r.value("source", "?"), 0, "runs use different class tables");
+    if (pm.size() != classes.size()) throw InputError(r.value("source", "?"), 0, tr("runs use different class tables"));
     for (std::size_t k = 0; k < classes.size(); ++k) p_meets[k] *= pm[k];
   }
   std::vector<double> p_is;
@@ -194,7 +194,7 @@ std::string outliers_line(const json& run) {
 
 std::vector<json> analyze_files(const std::vector<std::string>& files, const ReadOptions& read,
                                 const AnalysisOptions& options) {
-  if (files.empty()) throw UsageError("batch: no input files");
+  if (files.empty()) throw UsageError(tr("batch: no input files"));
   // Files are independent: each is read and analysed on its own (the loops inside an analysis
   // then run serially, parallel_for being nested). Results and errors are kept per file.
   std::vector<json> out(files.size());
@@ -221,11 +221,11 @@ std::vector<json> analyze_files(const std::vector<std::string>& files, const Rea
 }
 
 json summarize_runs(std::vector<json> runs, const std::string& source) {
-  if (runs.empty()) throw InputError(source, 0, "no runs to summarize");
+  if (runs.empty()) throw InputError(source, 0, tr("no runs to summarize"));
   for (const auto& r : runs)
     for (const char* k : {"source", "temperature_c", "fit", "methods", "verdict"})
       if (!r.is_object() || !r.contains(k))
-        throw InputError(source, 0, fmt::format("a run lacks the key \"{}\" of `rwcalc analyze --json`", k));
+        throw InputError(source, 0, trf("a run lacks the key \"{}\" of `rwcalc analyze --json`", k));
   std::stable_sort(runs.begin(), runs.end(), [](const json& a, const json& b) {
     const bool na = a.at("temperature_c").is_null(), nb = b.at("temperature_c").is_null();
     if (na != nb) return nb;
@@ -237,7 +237,7 @@ json summarize_runs(std::vector<json> runs, const std::string& source) {
     classes = runs.front().at("verdict").at("classes").get<std::vector<int>>();
     for (const auto& r : runs)
       if (r.at("verdict").at("classes").get<std::vector<int>>() != classes)
-        throw InputError(source, 0, "runs were judged against different class tables");
+        throw InputError(source, 0, tr("runs were judged against different class tables"));
     json overall = combine(runs, classes, nullptr);
     overall["class_B"] = combine(runs, classes, "B").at("class");
     overall["class_N"] = combine(runs, classes, "N").at("class");
@@ -259,7 +259,7 @@ json summarize_runs(std::vector<json> runs, const std::string& source) {
     out["trends"] = std::move(trends);
     return out;
   } catch (const json::exception& e) {
-    throw InputError(source, 0, fmt::format("malformed run object: {}", e.what()));
+    throw InputError(source, 0, trf("malformed run object: {}", e.what()));
   }
 }
 

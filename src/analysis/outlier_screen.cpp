@@ -14,7 +14,7 @@ OutlierAction parse_outlier_action(std::string_view s) {
   if (s == "keep") return OutlierAction::Keep;
   if (s == "remove") return OutlierAction::Remove;
   if (s == "replace") return OutlierAction::Replace;
-  throw UsageError(fmt::format("--outliers: '{}' is not one of keep, remove, replace", s));
+  throw UsageError(trf("--outliers: '{}' is not one of keep, remove, replace", s));
 }
 
 std::string_view to_string(OutlierAction a) {
@@ -31,9 +31,9 @@ namespace {
 void check_outlier_threshold(double threshold) {
   if (!(threshold >= kMinOutlierThreshold) || !std::isfinite(threshold))
     throw UsageError(
-        fmt::format("--outlier-threshold must be a finite number >= {:g} robust sigma (below it the "
-                    "noise's own tails are flagged), got {}",
-                    kMinOutlierThreshold, threshold));
+        trf("--outlier-threshold must be a finite number >= {:g} robust sigma (below it the "
+            "noise's own tails are flagged), got {}",
+            kMinOutlierThreshold, threshold));
 }
 
 /// Refuse to remove or replace more than kMaxOutlierShare of the rate samples (outliers.hpp).
@@ -41,13 +41,13 @@ void check_outlier_share(const Recording& rec, OutlierAction action, double thre
   const std::size_t rates = rec.phase.points() - 1;
   if (action == OutlierAction::Keep || static_cast<double>(found) <= kMaxOutlierShare * static_cast<double>(rates))
     return;
-  throw UsageError(fmt::format(
-      "{}: --outliers {} would change {} of {} rate samples ({:.3g} %, more than {:g} %) at --outlier-threshold "
-      "{:g}: so many are not isolated outliers but the noise itself, a burst or a step; nothing was analysed. "
-      "Raise --outlier-threshold (default {:g}) or use --outliers keep to see where they are",
-      rec.source, action == OutlierAction::Remove ? "remove" : "replace", found, rates,
-      100.0 * static_cast<double>(found) / static_cast<double>(rates), 100.0 * kMaxOutlierShare, threshold,
-      kDefaultOutlierThreshold));
+  throw UsageError(
+      trf("{}: --outliers {} would change {} of {} rate samples ({:.3g} %, more than {:g} %) at --outlier-threshold "
+          "{:g}: so many are not isolated outliers but the noise itself, a burst or a step; nothing was analysed. "
+          "Raise --outlier-threshold (default {:g}) or use --outliers keep to see where they are",
+          rec.source, action == OutlierAction::Remove ? "remove" : "replace", found, rates,
+          100.0 * static_cast<double>(found) / static_cast<double>(rates), 100.0 * kMaxOutlierShare, threshold,
+          kDefaultOutlierThreshold));
 }
 
 /// The rest of the report (action and threshold are set) of a finished scan, located in the input.

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 
 namespace rwcalc::json_input {
 
@@ -87,7 +88,7 @@ class LocatingHandler {
     value();
     if (!std::isfinite(v))
       throw InputError(file_, current_line(),
-                       fmt::format("{}: the number {} is beyond the range of a double", where(last_path_), s));
+                       trf("{}: the number {} is beyond the range of a double", where(last_path_), s));
     return dom_.number_float(v, s);
   }
   bool string(json::string_t& s) { return value() && dom_.string(s); }
@@ -97,7 +98,7 @@ class LocatingHandler {
     frames_.back().key = k;
     // nlohmann keeps the last of two equal keys: a second "p_meets" would silently replace the first.
     if (lines_.count(path_of_next()) != 0)
-      throw InputError(file_, current_line(), fmt::format("{} is given twice in one object", where(path_of_next())));
+      throw InputError(file_, current_line(), trf("{} is given twice in one object", where(path_of_next())));
     return dom_.key(k);
   }
   bool end_object() { return pop() && dom_.end_object(); }
@@ -108,8 +109,8 @@ class LocatingHandler {
     // nlohmann refuses a number beyond a double (1e400) as out_of_range 406.
     if (e.id == 406)
       throw InputError(file_, line,
-                       fmt::format("{}: the number {} is beyond the range of a double", where(path_of_next()), token));
-    throw InputError(file_, line, fmt::format("not valid JSON: {}", plain_message(e.what())));
+                       trf("{}: the number {} is beyond the range of a double", where(path_of_next()), token));
+    throw InputError(file_, line, trf("not valid JSON: {}", plain_message(e.what())));
   }
 
  private:
@@ -130,7 +131,7 @@ class LocatingHandler {
   /// Enters an object or array (always true).
   bool push(bool array) {
     if (frames_.size() >= kMaxDepth)
-      throw InputError(file_, current_line(), fmt::format("nested deeper than {} levels", kMaxDepth));
+      throw InputError(file_, current_line(), trf("nested deeper than {} levels", kMaxDepth));
     frames_.push_back({array, last_path_, {}, 0});
     return true;
   }
@@ -192,10 +193,10 @@ Document::Document(std::string_view text, std::string file, std::size_t first_li
 
 std::string read_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, 0, "cannot open the file");
+  if (!in) throw InputError(path, 0, tr("cannot open the file"));
   std::ostringstream ss;
   ss << in.rdbuf();
-  if (in.bad()) throw InputError(path, 0, "cannot read the file");
+  if (in.bad()) throw InputError(path, 0, tr("cannot read the file"));
   return ss.str();
 }
 

@@ -1,4 +1,5 @@
 #include "rwcalc/output.hpp"
+#include "rwcalc/i18n.hpp"
 
 #include <fcntl.h>
 #include <fmt/format.h>
@@ -57,17 +58,17 @@ fs::path follow_links(const std::string& path) {
     if (::lstat(p.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) return p;
     std::error_code ec;
     const fs::path next = fs::read_symlink(p, ec);
-    if (ec) throw OutputError(fmt::format("{}: cannot read the symbolic link {}: {}", path, p.string(), ec.message()));
+    if (ec) throw OutputError(trf("{}: cannot read the symbolic link {}: {}", path, p.string(), ec.message()));
     p = next.is_absolute() ? next : p.parent_path() / next;
   }
-  throw OutputError(fmt::format("{}: cannot follow the symbolic links: {}", path, reason(ELOOP)));
+  throw OutputError(trf("{}: cannot follow the symbolic links: {}", path, reason(ELOOP)));
 }
 
 void require_directory_of(const std::string& path, const fs::path& target) {
   fs::path dir = target.parent_path();
   if (dir.empty()) dir = ".";
   std::error_code ec;
-  if (!fs::is_directory(dir, ec)) throw OutputError(fmt::format("{}: directory {} does not exist", path, dir.string()));
+  if (!fs::is_directory(dir, ec)) throw OutputError(trf("{}: directory {} does not exist", path, dir.string()));
 }
 
 /// What kind of file a non-regular target is, for the refusal.
@@ -83,31 +84,31 @@ Plan plan_output(const std::string& path, bool force) {
   if (path == "-") return {Sink::Stdout, path, std::nullopt};
   struct stat st {};
   if (::lstat(path.c_str(), &st) != 0) {
-    if (errno != ENOENT) throw OutputError(fmt::format("{}: cannot examine the target: {}", path, reason(errno)));
+    if (errno != ENOENT) throw OutputError(trf("{}: cannot examine the target: {}", path, reason(errno)));
     require_directory_of(path, path);
     return {Sink::Replace, path, std::nullopt};
   }
   const bool link = S_ISLNK(st.st_mode);
   if (link && ::stat(path.c_str(), &st) != 0) {
-    if (errno != ENOENT) throw OutputError(fmt::format("{}: cannot follow the symbolic link: {}", path, reason(errno)));
+    if (errno != ENOENT) throw OutputError(trf("{}: cannot follow the symbolic link: {}", path, reason(errno)));
     const fs::path final_target = follow_links(path);
     if (!force)
-      throw OutputError(fmt::format("{}: exists (a symbolic link to the missing {}); use --force to create that file",
-                                    path, final_target.string()));
+      throw OutputError(trf("{}: exists (a symbolic link to the missing {}); use --force to create that file", path,
+                            final_target.string()));
     require_directory_of(path, final_target);
     return {Sink::Replace, final_target, std::nullopt};
   }
   if (S_ISCHR(st.st_mode) || S_ISFIFO(st.st_mode)) return {Sink::Stream, path, std::nullopt};
   if (!S_ISREG(st.st_mode))
-    throw OutputError(fmt::format("{}: is {}; rwcalc writes regular files, character devices and FIFOs only", path,
-                                  kind_name(st.st_mode)));
-  if (!force) throw OutputError(fmt::format("{}: exists; use --force to overwrite it", path));
+    throw OutputError(
+        trf("{}: is {}; rwcalc writes regular files, character devices and FIFOs only", path, kind_name(st.st_mode)));
+  if (!force) throw OutputError(trf("{}: exists; use --force to overwrite it", path));
   return {Sink::Replace, link ? follow_links(path) : fs::path(path), st};
 }
 
 /// fsync `fd`, tell the test seam, and throw OutputError with `what` on failure.
 void sync_or_throw(int fd, detail::SyncedKind kind, const std::string& path, const char* what) {
-  if (::fsync(fd) != 0) throw OutputError(fmt::format("{}: cannot sync {} to disk: {}", path, what, reason(errno)));
+  if (::fsync(fd) != 0) throw OutputError(trf("{}: cannot sync {} to disk: {}", path, what, reason(errno)));
   if (auto observer = detail::g_sync_observer.load()) observer(kind, fd);
 }
 
@@ -117,14 +118,13 @@ void sync_directory(const fs::path& target, const std::string& path) {
   if (dir.empty()) dir = ".";
   const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (fd < 0)
-    throw OutputError(
-        fmt::format("{}: cannot open its directory {} to sync it: {}", path, dir.string(), reason(errno)));
+    throw OutputError(trf("{}: cannot open its directory {} to sync it: {}", path, dir.string(), reason(errno)));
   // Some file systems cannot sync a directory (EINVAL): nothing more can be done there.
   if (::fsync(fd) != 0 && errno != EINVAL) {
     const int err = errno;
     ::close(fd);
     throw OutputError(
-        fmt::format("{}: written, but its directory {} could not be synced: {}", path, dir.string(), reason(err)));
+        trf("{}: written, but its directory {} could not be synced: {}", path, dir.string(), reason(err)));
   }
   if (auto observer = detail::g_sync_observer.load()) observer(detail::SyncedKind::Directory, fd);
   ::close(fd);
@@ -134,7 +134,7 @@ void write_all(int fd, std::string_view data, const std::string& path) {
   while (!data.empty()) {
     const ssize_t n = ::write(fd, data.data(), data.size());
     if (n < 0 && errno == EINTR) continue;
-    if (n < 0) throw OutputError(fmt::format("{}: write failed: {}", path, reason(errno)));
+    if (n < 0) throw OutputError(trf("{}: write failed: {}", path, reason(errno)));
     data.remove_prefix(static_cast<std::size_t>(n));
   }
 }
@@ -165,14 +165,14 @@ struct AtomicOutput::State {
 void AtomicOutput::State::open_target() {
   if (plan.sink == Sink::Stream) {
     fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
-    if (fd < 0) throw OutputError(fmt::format("{}: cannot open for writing: {}", path, reason(errno)));
+    if (fd < 0) throw OutputError(trf("{}: cannot open for writing: {}", path, reason(errno)));
   } else {
     std::random_device rd;
     const fs::path name =
         plan.target.parent_path() / fmt::format(".{}.tmp{:08x}", plan.target.filename().string(), rd());
     on_signal.emplace(name.string(), detail::RemoveOnSignal::Kind::File);  // before it exists
     fd = ::open(name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd < 0) throw OutputError(fmt::format("{}: cannot write: {}", path, reason(errno)));
+    if (fd < 0) throw OutputError(trf("{}: cannot write: {}", path, reason(errno)));
     tmp = name;  // ours from here on: removed unless committed
     if (plan.old) {
       // The replacement keeps the replaced file's permissions (not the set-id bits) and, where the
@@ -180,7 +180,7 @@ void AtomicOutput::State::open_target() {
       if (plan.old->st_uid != ::geteuid() || plan.old->st_gid != ::getegid())
         (void)::fchown(fd, plan.old->st_uid, plan.old->st_gid);
       if (::fchmod(fd, plan.old->st_mode & 01777) != 0)
-        throw OutputError(fmt::format("{}: cannot keep the permissions of the replaced file: {}", path, reason(errno)));
+        throw OutputError(trf("{}: cannot keep the permissions of the replaced file: {}", path, reason(errno)));
     }
   }
   if (path.ends_with(".gz")) {
@@ -188,8 +188,7 @@ void AtomicOutput::State::open_target() {
     const int own = ::dup(fd);
     if (own < 0 || (gz = gzdopen(own, "wb6")) == nullptr) {
       if (own >= 0) ::close(own);
-      throw OutputError(
-          fmt::format("{}: cannot start the compressed stream: {}", path, reason(errno ? errno : ENOMEM)));
+      throw OutputError(trf("{}: cannot start the compressed stream: {}", path, reason(errno ? errno : ENOMEM)));
     }
   }
 }
@@ -198,14 +197,14 @@ void AtomicOutput::State::finish_writing() {
   if (gz != nullptr) {
     const int rc = gzclose(gz);
     gz = nullptr;
-    if (rc != Z_OK) throw OutputError(fmt::format("{}: compressed write failed (zlib error {})", path, rc));
+    if (rc != Z_OK) throw OutputError(trf("{}: compressed write failed (zlib error {})", path, rc));
   } else {
     flush_buffer();
   }
   if (plan.sink == Sink::Replace) sync_or_throw(fd, detail::SyncedKind::File, path, "the written file");
   const int rc = ::close(fd);
   fd = -1;
-  if (rc != 0) throw OutputError(fmt::format("{}: write failed: {}", path, reason(errno)));
+  if (rc != 0) throw OutputError(trf("{}: write failed: {}", path, reason(errno)));
 }
 
 void AtomicOutput::State::move_into_place() {
@@ -215,12 +214,12 @@ void AtomicOutput::State::move_into_place() {
     // appeared while the content was written): move into place only if nothing is there.
     if (::renameat2(AT_FDCWD, tmp.c_str(), AT_FDCWD, target.c_str(), RENAME_NOREPLACE) == 0) return;
     const int err = errno;
-    if (err == EEXIST) throw OutputError(fmt::format("{}: exists; use --force to overwrite it", path));
+    if (err == EEXIST) throw OutputError(trf("{}: exists; use --force to overwrite it", path));
     if (err != EINVAL && err != ENOSYS)  // else: the file system cannot refuse; plain rename below
-      throw OutputError(fmt::format("{}: cannot move the finished file into place: {}", path, reason(err)));
+      throw OutputError(trf("{}: cannot move the finished file into place: {}", path, reason(err)));
   }
   if (::rename(tmp.c_str(), target.c_str()) != 0)
-    throw OutputError(fmt::format("{}: cannot move the finished file into place: {}", path, reason(errno)));
+    throw OutputError(trf("{}: cannot move the finished file into place: {}", path, reason(errno)));
 }
 
 void AtomicOutput::State::discard() noexcept {
@@ -251,7 +250,7 @@ AtomicOutput::~AtomicOutput() {
 
 void AtomicOutput::write(std::string_view chunk) {
   State& s = *state_;
-  if (s.committed) throw OutputError(fmt::format("{}: written after it was finished", s.path));
+  if (s.committed) throw OutputError(trf("{}: written after it was finished", s.path));
   if (s.plan.sink == Sink::Stdout) {
     std::cout.write(chunk.data(), static_cast<std::streamsize>(chunk.size()));
     return;
@@ -263,7 +262,7 @@ void AtomicOutput::write(std::string_view chunk) {
         int zerr = Z_OK;
         const char* msg = gzerror(s.gz, &zerr);
         throw OutputError(
-            fmt::format("{}: compressed write failed: {}", s.path, zerr == Z_ERRNO ? reason(errno) : std::string(msg)));
+            trf("{}: compressed write failed: {}", s.path, zerr == Z_ERRNO ? reason(errno) : std::string(msg)));
       }
       chunk.remove_prefix(n);
     }
@@ -325,8 +324,8 @@ void check_output_targets(const std::vector<OutputTarget>& targets, bool force) 
       if (other_id == id)
         throw UsageError(
             t.path == other->path
-                ? fmt::format("{} and {} name the same file '{}'", other->option, t.option, t.path)
-                : fmt::format("{} '{}' and {} '{}' are the same file", other->option, other->path, t.option, t.path));
+                ? trf("{} and {} name the same file '{}'", other->option, t.option, t.path)
+                : trf("{} '{}' and {} '{}' are the same file", other->option, other->path, t.option, t.path));
     seen.emplace_back(id, &t);
   }
   for (const auto& t : targets)
@@ -387,8 +386,8 @@ void flush_standard_output(std::ostream& out) {
     }
   }
   if (!failed) return;
-  throw OutputError(fmt::format("standard output: write failed: {}",
-                                err != 0 ? reason(err) : std::string("the stream reported an error")));
+  throw OutputError(trf("standard output: write failed: {}",
+                        err != 0 ? reason(err) : std::string(tr("the stream reported an error"))));
 }
 
 bool stderr_is_terminal() { return isatty(STDERR_FILENO) != 0; }

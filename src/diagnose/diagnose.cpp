@@ -1,6 +1,7 @@
 // The diagnosis pipeline: base fit → ensemble band and detector calibration → findings →
 // extended model → its band and the gain in and out of sample (render.cpp writes the results).
 #include "rwcalc/diagnose.hpp"
+#include "rwcalc/i18n.hpp"
 
 #include <fmt/format.h>
 
@@ -36,14 +37,14 @@ struct Context {
 const Recording& screened(const Recording& read, const DiagnoseOptions& opt, OutlierReport& outliers,
                           Recording& edited) {
   if (read.phase.kind != PhaseKind::Gyro)
-    throw UsageError("diagnose needs gyro data (clock phase/frequency cannot be simulated as a gyro)");
-  if (opt.runs < 10) throw UsageError(fmt::format("--runs must be at least 10 (got {})", opt.runs));
+    throw UsageError(tr("diagnose needs gyro data (clock phase/frequency cannot be simulated as a gyro)"));
+  if (opt.runs < 10) throw UsageError(trf("--runs must be at least 10 (got {})", opt.runs));
   const Recording& rec =
       screen_outliers(read, opt.analysis.outlier_action, opt.analysis.outlier_threshold, outliers, edited);
   const double T = rec.phase.duration_s();
   if (T < kMinDuration)
     throw AnalysisError(
-        fmt::format("{}: the record lasts {:.4g} s; the diagnosis needs at least {:g} s", rec.source, T, kMinDuration));
+        trf("{}: the record lasts {:.4g} s; the diagnosis needs at least {:g} s", rec.source, T, kMinDuration));
   return rec;
 }
 

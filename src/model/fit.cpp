@@ -1,6 +1,7 @@
 // Gamma-deviance (scaled-χ² likelihood) fit of the five-term IEEE 952 model with non-negative
 // squared coefficients, profile-likelihood intervals and the classic slope-line readout.
 #include "rwcalc/fit.hpp"
+#include "rwcalc/i18n.hpp"
 
 #include <fmt/format.h>
 
@@ -436,36 +437,36 @@ struct Stage {
 };
 
 void require_converged(const IrlsResult& r) {
-  if (!std::isfinite(r.dev) || !r.d.allFinite()) throw AnalysisError("the noise-model fit did not converge");
+  if (!std::isfinite(r.dev) || !r.d.allFinite()) throw AnalysisError(tr("the noise-model fit did not converge"));
 }
 
 /// The points in the fit range with enough EDF, τ ascending; throws when too few remain.
 std::vector<FitPoint> points_in_range(std::span<const FitPoint> points, const FitOptions& options) {
   if (!(options.dispersion > 0) || !(options.confidence > 0 && options.confidence < 1) || !(options.edf_cap >= 0) ||
       !(options.edf_inflation >= 0))
-    throw UsageError("fit options: dispersion and EDF cap must be positive, confidence in (0, 1)");
+    throw UsageError(tr("fit options: dispersion and EDF cap must be positive, confidence in (0, 1)"));
   int n_enabled = 0;
   for (bool e : options.enabled) n_enabled += e ? 1 : 0;
-  if (n_enabled == 0) throw UsageError("fit: no term enabled");
+  if (n_enabled == 0) throw UsageError(tr("fit: no term enabled"));
   std::vector<FitPoint> used;
   for (const auto& p : points) {
     if (!(p.tau_s >= options.tau_min_s && p.tau_s <= options.tau_max_s)) continue;
     if (!(p.edf >= options.min_edf)) continue;
     if (!std::isfinite(p.var) || !(p.var > 0))
       throw AnalysisError(
-          fmt::format("the Allan variance at tau = {:g} s is {:g}: the record holds no noise there (constant "
-                      "or perfectly regular data); no noise model can be fitted",
-                      p.tau_s, p.var));
+          trf("the Allan variance at tau = {:g} s is {:g}: the record holds no noise there (constant "
+              "or perfectly regular data); no noise model can be fitted",
+              p.tau_s, p.var));
     used.push_back(p);
   }
   std::sort(used.begin(), used.end(), [](const auto& a, const auto& b) { return a.tau_s < b.tau_s; });
   const int j = static_cast<int>(used.size());
   if (j < n_enabled + 1)
     throw AnalysisError(
-        fmt::format("only {} Allan-variance point(s) with at least {:g} degrees of freedom lie in the fit range "
-                    "{:g}..{:g} s; a fit of {} terms needs at least {} (use a longer record or a wider "
-                    "--fit-range)",
-                    j, options.min_edf, options.tau_min_s, options.tau_max_s, n_enabled, n_enabled + 1));
+        trf("only {} Allan-variance point(s) with at least {:g} degrees of freedom lie in the fit range "
+            "{:g}..{:g} s; a fit of {} terms needs at least {} (use a longer record or a wider "
+            "--fit-range)",
+            j, options.min_edf, options.tau_min_s, options.tau_max_s, n_enabled, n_enabled + 1));
   return used;
 }
 
@@ -738,7 +739,7 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
     }
     co = coefficient_interval(i, sel, full, dropped[ui], res, z, chi2_1);
     if (!std::isfinite(co.value) || !std::isfinite(co.sigma) || !std::isfinite(co.low) || !std::isfinite(co.high))
-      throw AnalysisError(fmt::format("the data do not bound the {} coefficient", term_name(kAllTerms[ui])));
+      throw AnalysisError(trf("the data do not bound the {} coefficient", term_name(kAllTerms[ui])));
   }
   return res;
 }

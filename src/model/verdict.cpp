@@ -137,7 +137,7 @@ ClassTable ClassTable::parse(std::string_view text, const std::string& source) {
 
 ClassTable ClassTable::load(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, 0, "cannot open the class-limits file");
+  if (!in) throw InputError(path, 0, tr("cannot open the class-limits file"));
   std::stringstream ss;
   ss << in.rdbuf();
   return parse(ss.str(), path);
@@ -156,7 +156,7 @@ BEstimate parse_b_estimate(std::string_view s) {
   if (s == "fit") return BEstimate::Fit;
   if (s == "sigma-min") return BEstimate::SigmaMin;
   if (s == "avg100") return BEstimate::Avg100;
-  throw UsageError(fmt::format("unknown B estimate '{}' (use fit, sigma-min or avg100)", s));
+  throw UsageError(trf("unknown B estimate '{}' (use fit, sigma-min or avg100)", s));
 }
 
 EstimateInput lognormal_estimate(double value, double sigma) {
@@ -199,9 +199,9 @@ std::string class_label(const std::optional<int>& c) { return c ? fmt::format("{
 
 Verdict decide(const EstimateInput& B, const EstimateInput& N, double rho_BN, const VerdictOptions& options) {
   const ClassTable& t = options.table;
-  if (t.classes.empty()) throw UsageError("the class table is empty");
+  if (t.classes.empty()) throw UsageError(tr("the class table is empty"));
   if (!(options.tolerance_pct >= 0) || !std::isfinite(options.tolerance_pct))
-    throw UsageError("--tolerance must be a non-negative percentage");
+    throw UsageError(tr("--tolerance must be a non-negative percentage"));
   Verdict v;
   v.table_name = t.name;
   for (const auto& c : t.classes) v.class_numbers.push_back(c.cls);
@@ -236,7 +236,7 @@ Verdict decide(const EstimateInput& B, const EstimateInput& N, double rho_BN, co
 
 std::string describe_class(const std::vector<double>& p_is, const std::optional<int>& cls,
                            const std::vector<int>& classes, double decisive) {
-  if (p_is.size() != classes.size() + 1) throw UsageError("class probabilities do not match the class table");
+  if (p_is.size() != classes.size() + 1) throw UsageError(tr("class probabilities do not match the class table"));
   const std::size_t n = classes.size();
   const std::size_t s =
       cls ? static_cast<std::size_t>(std::find(classes.begin(), classes.end(), *cls) - classes.begin()) : n;

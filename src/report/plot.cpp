@@ -341,7 +341,7 @@ Figure batch_allan_figure(const json& runs, const PlotOptions& options) {
                          label_text(run_label(run, i))));
   }
   if (plot.elements.empty())
-    throw AnalysisError("no run of the batch has Allan deviation points (runs[].allan.points): nothing to plot");
+    throw AnalysisError(tr("no run of the batch has Allan deviation points (runs[].allan.points): nothing to plot"));
   if (gyro) {
     blocks += kTermFunctions;
     add_class_floors(runs[order.front()], blocks, plot, bounds);
@@ -530,7 +530,7 @@ PlotResult plot_analysis(const json& analysis, const PlotOptions& options) {
 PlotResult plot_batch(const json& batch, const PlotOptions& options) {
   const auto& runs = batch.is_array() ? batch : at(batch, "runs");
   if (!runs.is_array() || runs.empty())
-    throw AnalysisError("the batch has no runs (\"runs\": [analysis objects]): nothing to plot");
+    throw AnalysisError(tr("the batch has no runs (\"runs\": [analysis objects]): nothing to plot"));
   PlotResult r;
   std::vector<Figure> figures{batch_allan_figure(runs, options)};
   if (auto direct = batch_direct_figure(runs, options); direct.series > 0)

@@ -19,6 +19,7 @@
 #include "core/cleanup.hpp"
 #include "report/process.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/plot.hpp"
 #include "rwcalc/printable.hpp"
 
@@ -89,7 +90,7 @@ class ScratchDir {
   ScratchDir() {
     std::string templ = (fs::temp_directory_path() / "rwcalc-plot-XXXXXX").string();
     if (mkdtemp(templ.data()) == nullptr)
-      throw OutputError(fmt::format("cannot create a temporary directory for gnuplot: {}", std::strerror(errno)));
+      throw OutputError(trf("cannot create a temporary directory for gnuplot: {}", std::strerror(errno)));
     path_ = templ;
     on_signal_.emplace_back(path_.string(), detail::RemoveOnSignal::Kind::Directory);
     for (const char* name : {"log", "gnuplot.log", "figure.gp", "figure.svg", "figure.png", "figure.pdf"})
@@ -112,9 +113,9 @@ class ScratchDir {
 void require_started(const ProcessResult& r, const std::string& command) {
   if (r.started && r.status != 127) return;
   throw OutputError(
-      fmt::format("cannot run gnuplot ('{}': {}): plots need gnuplot; install it (Debian: apt-get install "
-                  "gnuplot-nox) or name the binary in the environment variable RWCALC_GNUPLOT",
-                  command, std::strerror(r.started ? ENOENT : r.spawn_errno)));
+      trf("cannot run gnuplot ('{}': {}): plots need gnuplot; install it (Debian: apt-get install "
+          "gnuplot-nox) or name the binary in the environment variable RWCALC_GNUPLOT",
+          command, std::strerror(r.started ? ENOENT : r.spawn_errno)));
 }
 
 /// The last `lines` lines of gnuplot's message (they carry the error) joined by " | ", without the
@@ -154,8 +155,8 @@ PlotFormat plot_format_for(std::string_view path) {
   if (ext == ".svg") return PlotFormat::Svg;
   if (ext == ".png") return PlotFormat::Png;
   if (ext == ".pdf") return PlotFormat::Pdf;
-  throw UsageError(fmt::format("{}: unknown figure format '{}'; name the file .svg, .png or .pdf", path,
-                               ext.empty() ? std::string("(no extension)") : ext));
+  throw UsageError(trf("{}: unknown figure format '{}'; name the file .svg, .png or .pdf", path,
+                       ext.empty() ? std::string(tr("(no extension)")) : ext));
 }
 
 std::string gnuplot_command() {
@@ -178,8 +179,8 @@ void require_gnuplot() {
   const auto r = run_process(command, {"--version"}, dir.path() / "log");
   require_started(r, command);
   if (r.status != 0)
-    throw OutputError(fmt::format("gnuplot ('{}') does not run: '{} --version' failed with status {}: {}", command,
-                                  command, r.status, tail_lines(r.err, 4)));
+    throw OutputError(trf("gnuplot ('{}') does not run: '{} --version' failed with status {}: {}", command, command,
+                          r.status, tail_lines(r.err, 4)));
 }
 
 std::string full_script(const std::vector<Figure>& figures, PlotFormat format, int width_px,
@@ -249,16 +250,16 @@ std::string render_figures(const std::vector<Figure>& figures, PlotFormat format
   {
     std::ofstream f(script, std::ios::binary);
     f << full_script(figures, format, width_px, out_name);
-    if (!f) throw OutputError(fmt::format("{}: cannot write the gnuplot script", script.string()));
+    if (!f) throw OutputError(trf("{}: cannot write the gnuplot script", script.string()));
   }
   const auto command = gnuplot_command();
   const auto r = run_process(command, {"figure.gp"}, dir.path() / "gnuplot.log", dir.path());
   require_started(r, command);
   if (r.status != 0)
-    throw OutputError(fmt::format("gnuplot ('{}') failed with status {}: {}", command, r.status, tail_lines(r.err, 4)));
+    throw OutputError(trf("gnuplot ('{}') failed with status {}: {}", command, r.status, tail_lines(r.err, 4)));
   std::error_code ec;
   if (!fs::exists(out, ec) || fs::file_size(out, ec) == 0)
-    throw OutputError(fmt::format("gnuplot ('{}') produced no figure: {}", command, tail_lines(r.err, 4)));
+    throw OutputError(trf("gnuplot ('{}') produced no figure: {}", command, tail_lines(r.err, 4)));
   return slurp(out);
 }
 

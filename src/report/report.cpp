@@ -631,7 +631,7 @@ std::string title_block(const std::vector<json>& a, const ReportOptions& options
 
 std::string report_html(const ReportInput& input, const ReportOptions& options) {
   const auto& a = input.analyses;
-  if (a.empty()) throw AnalysisError(tr("a report needs at least one analysed run"));
+  if (a.empty()) throw AnalysisError(tr(tr("a report needs at least one analysed run")));
   const auto order = view::by_temperature(a);
   json overall = input.overall;
   if (!overall.is_object())

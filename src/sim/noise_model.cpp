@@ -1,5 +1,6 @@
 // The noise model's own facts: its checks and the Allan variance its terms have in theory.
 #include "rwcalc/noise_model.hpp"
+#include "rwcalc/i18n.hpp"
 
 #include <fmt/format.h>
 
@@ -31,13 +32,13 @@ double gm_avar_factor(double x) {
 }
 
 void check_finite_nonneg(double v, const char* what) {
-  if (!std::isfinite(v) || v < 0.0) throw UsageError(fmt::format("{} must be a finite value >= 0, got {}", what, v));
+  if (!std::isfinite(v) || v < 0.0) throw UsageError(trf("{} must be a finite value >= 0, got {}", what, v));
 }
 void check_finite(double v, const char* what) {
-  if (!std::isfinite(v)) throw UsageError(fmt::format("{} must be finite, got {}", what, v));
+  if (!std::isfinite(v)) throw UsageError(trf("{} must be finite, got {}", what, v));
 }
 void check_positive(double v, const char* what) {
-  if (!std::isfinite(v) || v <= 0.0) throw UsageError(fmt::format("{} must be a finite value > 0, got {}", what, v));
+  if (!std::isfinite(v) || v <= 0.0) throw UsageError(trf("{} must be a finite value > 0, got {}", what, v));
 }
 
 }  // namespace
@@ -60,9 +61,8 @@ void validate(const NoiseModel& m, const SimulationSettings& s) {
   check_positive(s.rate_hz, "rate_hz");
   check_positive(s.scale_arcsec, "scale_arcsec");
   if (s.samples() < 2)
-    throw UsageError(
-        fmt::format("the record must hold at least 2 samples (duration {} s at {} Hz)", s.duration_s, s.rate_hz));
-  if (s.samples() > (std::size_t{1} << 31)) throw UsageError("the record is too long (more than 2^31 samples)");
+    throw UsageError(trf("the record must hold at least 2 samples (duration {} s at {} Hz)", s.duration_s, s.rate_hz));
+  if (s.samples() > (std::size_t{1} << 31)) throw UsageError(tr("the record is too long (more than 2^31 samples)"));
   if (s.temperature_c) check_finite(*s.temperature_c, "temperature_c");
   check_finite_nonneg(m.arw_deg_per_sqrt_h, "arw_deg_per_sqrt_h");
   check_finite_nonneg(m.bias_instability_deg_per_h, "bias_instability_deg_per_h");

@@ -1,5 +1,6 @@
 // Exact discrete-time simulation of gyro pulse records (noise-models.md §3; docs/simulation.md).
 #include "rwcalc/simulate.hpp"
+#include "rwcalc/i18n.hpp"
 
 #include <fmt/format.h>
 
@@ -474,11 +475,11 @@ struct Simulator::Impl {
 
   [[noreturn]] static void throw_uncountable(std::size_t k, double pulses, double tau0, double q) {
     const std::string what = std::isfinite(pulses) ? fmt::format("is {:.6g} pulses", pulses) : "is not finite";
-    throw UsageError(fmt::format(
-        "the simulated angle at sample {} (t = {:.6g} s) {}, beyond the +-{:.6g} pulses a record can count, so the "
-        "record cannot be written; the model's terms (deg/h, arcsec) are too large for the pulse weight q = {:.6g} "
-        "arcsec",
-        k, static_cast<double>(k) * tau0, what, kMaxSimulatedPulses, q));
+    throw UsageError(
+        trf("the simulated angle at sample {} (t = {:.6g} s) {}, beyond the +-{:.6g} pulses a record can count, so the "
+            "record cannot be written; the model's terms (deg/h, arcsec) are too large for the pulse weight q = {:.6g} "
+            "arcsec",
+            k, static_cast<double>(k) * tau0, what, kMaxSimulatedPulses, q));
   }
 
   void quantize_block(Pass& st, std::size_t b, std::size_t len, double* x, std::int64_t* c) const {
