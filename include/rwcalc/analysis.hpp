@@ -12,6 +12,7 @@
 #include "rwcalc/methods.hpp"
 #include "rwcalc/outlier_screen.hpp"
 #include "rwcalc/reader.hpp"
+#include "rwcalc/sensor.hpp"
 #include "rwcalc/verdict.hpp"
 
 namespace rwcalc {
@@ -67,6 +68,9 @@ struct FitRangeChoice {
 
 struct AnalysisResult {
   std::string source;
+  /// Gyro or accelerometer: the fit's coefficients are in the kind's fit-scale units (sensor.hpp);
+  /// accelerometers have no Earth rate and no class verdict.
+  SensorKind sensor = SensorKind::Gyro;
   std::size_t samples = 0;
   double rate_hz = 0;
   double duration_s = 0;
@@ -100,7 +104,8 @@ struct AnalysisResult {
   std::vector<AnalysisWarning> warnings;
 };
 
-/// Throws UsageError for clock data, AnalysisError for a record too short or without noise.
+/// Gyro or accelerometer data. Throws UsageError for clock data, AnalysisError for a record too short
+/// or without noise.
 AnalysisResult analyze(const Recording& rec, const AnalysisOptions& options = {});
 
 /// What was read and how (the `input` object of analyze and allan JSON): column, kind, unit, rate

@@ -256,6 +256,10 @@ Verdict verdict_of(const AnalysisResult& r, const AnalysisOptions& options) {
 /// Mean rate, expected Earth rate and the bias between them.
 void earth_rate_and_bias(const Recording& rec, const AnalysisOptions& options, AnalysisResult& r) {
   r.mean_rate_deg_per_h = rec.phase.diff(rec.phase.points() - 1, 0) / r.duration_s;
+  if (r.sensor != SensorKind::Gyro) {  // gravity's projection is not removed: the mean is the bias
+    r.bias_deg_per_h = r.mean_rate_deg_per_h;
+    return;
+  }
   r.earth_rate_given = options.earth_rate_deg_per_h.has_value();
   r.latitude_deg = r.earth_rate_given ? 0.0 : options.latitude_deg;
   r.earth_rate_deg_per_h =
@@ -345,12 +349,14 @@ void cross_checks(const Recording& rec, const AnalysisOptions& options, Analysis
 }  // namespace
 
 AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
-  if (read.phase.kind != PhaseKind::Gyro)
+  const std::optional<SensorKind> sensor = sensor_kind(read.phase.kind);
+  if (!sensor)
     throw UsageError(
         fmt::format("{}: analyze needs gyro data (pulses, counter, angle in arcsec/deg/rad, or rate in "
-                    "deg/h, deg/s, rad/s); this input is clock data",
+                    "deg/h, deg/s, rad/s) or accelerometer data (m/s^2, g, mg, ug); this input is clock data",
                     read.source));
   AnalysisResult r;
+  r.sensor = *sensor;
   Recording edited;
   const Recording& rec = screen_outliers(read, options.outlier_action, options.outlier_threshold, r.outliers, edited);
   describe_record(rec, options, r);
@@ -362,7 +368,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   allan_and_fit(rec, options, r);
   if (options.cross_checks) {
     cross_checks(rec, options, r);
-    r.verdict = verdict_of(r, options);
+    if (r.sensor == SensorKind::Gyro) r.verdict = verdict_of(r, options);
   }
   if (options.fit_checks) r.warnings = fit_warnings(r);
   return r;

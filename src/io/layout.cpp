@@ -338,10 +338,16 @@ constexpr UnitSuffix kUnitSuffixes[] = {{"_deg_s", InputMode::Rate, {}, RateUnit
                                         {"_rad_s", InputMode::Rate, {}, RateUnit::RadPerSecond},
                                         {"_radps", InputMode::Rate, {}, RateUnit::RadPerSecond},
                                         {"_rads", InputMode::Rate, {}, RateUnit::RadPerSecond},
+                                        {"_m_s2", InputMode::Rate, {}, RateUnit::MetrePerSecond2},
+                                        {"_mps2", InputMode::Rate, {}, RateUnit::MetrePerSecond2},
+                                        {"_ms2", InputMode::Rate, {}, RateUnit::MetrePerSecond2},
+                                        {"_mg", InputMode::Rate, {}, RateUnit::MilliG},
+                                        {"_ug", InputMode::Rate, {}, RateUnit::MicroG},
+                                        {"_g", InputMode::Rate, {}, RateUnit::G},
+                                        {"_mps", InputMode::Angle, AngleUnit::MetrePerSecond},
                                         {"_arcsec", InputMode::Angle, AngleUnit::Arcsec},
                                         {"_deg", InputMode::Angle, AngleUnit::Deg},
                                         {"_rad", InputMode::Angle, AngleUnit::Rad}};
-constexpr std::string_view kAccelSuffixes[] = {"_mps2", "_m_s2", "_ms2", "_g"};
 
 bool ends_with_nocase(std::string_view s, std::string_view suffix) {
   return s.size() > suffix.size() && iequals(s.substr(s.size() - suffix.size()), suffix);
@@ -373,13 +379,8 @@ Unit choose_unit(std::optional<Unit> given, std::optional<Unit> named, Unit fall
 
 }  // namespace
 
-InputChoice choose_input(const ReadOptions& o, std::string_view column, const std::string& file, std::size_t line) {
-  for (const std::string_view a : kAccelSuffixes)
-    if (ends_with_nocase(column, a))
-      throw InputError(file, line,
-                       fmt::format("column '{}' is an accelerometer channel (unit '{}' in its name); accelerometer "
-                                   "channels are not supported by this command: choose a gyro column with --column",
-                                   column, a.substr(1)));
+InputChoice choose_input(const ReadOptions& o, std::string_view column, const std::string& /*file*/,
+                         std::size_t /*line*/) {
   InputChoice c;
   const UnitSuffix* u = unit_suffix(column);
   if (o.mode) {

@@ -7,7 +7,9 @@
 
 namespace rwcalc {
 
-std::string unit_label(const AllanResult& r) { return r.unit == "deg/h" ? units::label::rate : "input units/s"; }
+std::string unit_label(const AllanResult& r) {
+  return r.unit == "deg/h" ? units::label::rate : r.unit == "m/s/h" ? "m/s/h" : "input units/s";
+}
 
 std::string format_allan_table(const AllanResult& r, const AllanReportInfo& info) {
   const std::string u = unit_label(r);
@@ -20,6 +22,8 @@ std::string format_allan_table(const AllanResult& r, const AllanReportInfo& info
   if (r.unit == "deg/h")
     out += fmt::format("# units: deviations in {0} (convention 1{1}/s = 1 {0} exactly); τ in s\n", units::label::rate,
                        units::label::angle);
+  else if (r.unit == "m/s/h")  // accelerometer (units.hpp): 1 m/s/h = 1/3600 m/s² = 28.33 µg
+    out += "# units: deviations in m/s/h (accelerometer; 1 m/s/h = 1/3600 m/s^2); τ in s\n";
   else
     out += "# units: deviations in input units per second (dimensionless for phase in s); τ in s\n";
   out += fmt::format("# samples: {}   phase points: {}   τ0: {:g} s", info.samples, r.points_in, r.tau0_s);

@@ -1,0 +1,136 @@
+// 'rwcalc imu FILE': every gyro and accelerometer column of one static IMU recording analysed, one
+// table per sensor kind, the JSON `channels` list and the Kalibr/OpenVINS noise file.
+#include <fmt/format.h>
+
+#include <memory>
+#include <ostream>
+
+#include "cli/analyze_args.hpp"
+#include "cli/batch_format.hpp"
+#include "cli/commands.hpp"
+#include "cli/numeric_options.hpp"
+#include "cli/plot_args.hpp"
+#include "rwcalc/error.hpp"
+#include "rwcalc/imu.hpp"
+#include "rwcalc/output.hpp"
+
+namespace rwcalc::cli {
+
+namespace {
+
+struct ImuCmd {
+  std::string file;
+  std::optional<double> rate_hz;
+  double time_tolerance = 0.01;
+  std::vector<std::string> gyro, accel;
+  std::string gyro_unit, accel_unit;
+  std::vector<std::string> shown_units;
+  AnalyzeArgs analysis;
+  bool json = false;
+  std::string output = "-";
+  std::string kalibr, rostopic = "/imu0", combine = "worst";
+  PlotArgs plot;
+  bool force = false;
+
+  [[nodiscard]] ImuOptions options() const {
+    ImuOptions o;
+    o.read.rate_hz = rate_hz;
+    o.read.time_tolerance = time_tolerance;
+    o.gyro_columns = gyro;
+    o.accel_columns = accel;
+    if (!gyro_unit.empty()) o.gyro_unit = parse_rate_unit(gyro_unit);
+    if (!accel_unit.empty()) o.accel_unit = parse_rate_unit(accel_unit);
+    if (o.gyro_unit && is_accelerometer_unit(*o.gyro_unit))
+      throw UsageError(fmt::format("--gyro-unit {} is an accelerometer unit: expected deg/h, deg/s or rad/s", gyro_unit));
+    if (o.accel_unit && !is_accelerometer_unit(*o.accel_unit))
+      throw UsageError(fmt::format("--accel-unit {} is not an accelerometer unit: expected m/s^2, g, mg or ug",
+                                   accel_unit));
+    // Each --output-unit belongs to the kind whose unit it is.
+    for (const auto& u : shown_units) {
+      try {
+        (void)rwcalc::output_units(SensorKind::Gyro, u);
+        o.gyro_output_unit = u;
+      } catch (const UsageError&) {
+        (void)rwcalc::output_units(SensorKind::Accelerometer, u);  // throws for a unit of neither kind
+        o.accel_output_unit = u;
+      }
+    }
+    o.analysis = analysis.options();
+    return o;
+  }
+};
+
+}  // namespace
+
+void register_imu(CLI::App& app, Runner& runner) {
+  auto cmd = std::make_shared<ImuCmd>();
+  auto* sub = app.add_subcommand(
+      "imu",
+      "A whole IMU from one static recording: every gyro and accelerometer column's noise coefficients with "
+      "95 % intervals, one table per sensor kind, and the Kalibr/OpenVINS noise file");
+  sub->add_option("FILE", cmd->file, "Recording with one column per axis ('-' for standard input)")->required();
+  sub->add_option("--rate", cmd->rate_hz, "Sample rate, Hz (else metadata rate_hz or a time column)")
+      ->check(real_in(kMinRateHz, kMaxRateHz, "Hz"))
+      ->group("Input");
+  sub->add_option("--time-tolerance", cmd->time_tolerance,
+                  "Time-column steps off the sample period by more than this fraction of it are reported as jitter")
+      ->check(real_in(0.0, 0.5, ""))
+      ->capture_default_str()
+      ->group("Input");
+  sub->add_option("--gyro", cmd->gyro, "Gyro columns: header names or 1-based indices, comma-separated")
+      ->delimiter(',')
+      ->group("Input");
+  sub->add_option("--gyro-unit", cmd->gyro_unit,
+                  "Unit of the gyro columns: deg/h, deg/s or rad/s (default: each name's suffix, _dps ...)")
+      ->group("Input");
+  sub->add_option("--accel", cmd->accel, "Accelerometer columns: header names or 1-based indices, comma-separated")
+      ->delimiter(',')
+      ->group("Input");
+  sub->add_option("--accel-unit", cmd->accel_unit,
+                  "Unit of the accelerometer columns: m/s^2, g, mg or ug (default: each name's suffix, _g, _mps2 ...)")
+      ->group("Input");
+  sub->add_option("--output-unit", cmd->shown_units,
+                  "Units the results are shown in, one per sensor kind: deg/h, deg/s, rad/s (gyro); m/s^2, g, mg, ug "
+                  "(accelerometer). Default: °/h with N in °/√h; µg with N in m/s/√h")
+      ->delimiter(',')
+      ->group("Output");
+  cmd->analysis.add_to(*sub);
+  sub->add_flag("--json", cmd->json, "Print the JSON object instead of the tables")->group("Output");
+  sub->add_option("--kalibr", cmd->kalibr,
+                  "Write the Kalibr/OpenVINS IMU noise file (imu.yaml: noise densities and random walks in SI)")
+      ->group("Output");
+  sub->add_option("--rostopic", cmd->rostopic, "rostopic written into the --kalibr file")
+      ->capture_default_str()
+      ->group("Output");
+  sub->add_option("--combine", cmd->combine,
+                  "How the --kalibr file combines the axes of a kind: worst (the largest) or mean")
+      ->check(CLI::IsMember({"worst", "mean"}))
+      ->capture_default_str()
+      ->group("Output");
+  add_output_options(*sub, cmd->output, cmd->force);
+  cmd->plot.add_to(*sub, "one panel per sensor kind with every axis' Allan deviation and its confidence bars");
+  sub->callback([cmd, &runner] {
+    runner = [cmd](Io& io) -> int {
+      const ImuOptions opt = cmd->options();
+      cmd->plot.check(cmd->force, {{"-o", cmd->output}, {"--kalibr", cmd->kalibr}});
+      const ImuResult res = analyze_imu(cmd->file, opt);
+      for (const auto& c : res.channels)
+        print_input_notes(io.err, nlohmann::json{{"source", c.result.source}, {"input", c.result.input}});
+      const nlohmann::json j = to_json(res);
+      require_finite(j, res.source);
+      cmd->plot.draw_imu(j, cmd->force, io);
+      if (!cmd->kalibr.empty()) {
+        KalibrOptions k;
+        k.rostopic = cmd->rostopic;
+        k.combine = cmd->combine == "mean" ? AxisCombination::Mean : AxisCombination::Worst;
+        write_file_atomic(cmd->kalibr, kalibr_yaml(res, k), cmd->force);
+        print_message(io.err, fmt::format("noise file written to {}", cmd->kalibr));
+      }
+      emit(io, cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n" : format_imu(res),
+           cmd->output, cmd->force);
+      return 0;
+    };
+  });
+}
+
+}  // namespace rwcalc::cli

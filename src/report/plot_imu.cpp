@@ -1,0 +1,43 @@
+// The figures of `rwcalc imu`: one panel per sensor kind, every axis' Allan deviation in it.
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "rwcalc/error.hpp"
+#include "rwcalc/output.hpp"
+#include "rwcalc/plot.hpp"
+
+namespace rwcalc {
+
+PlotResult plot_imu(const nlohmann::json& imu, const PlotOptions& options) {
+  std::vector<Figure> figures;
+  for (const std::string_view kind : {"gyro", "accelerometer"}) {
+    nlohmann::json runs = nlohmann::json::array();
+    for (const auto& c : imu.at("channels"))
+      if (c.value("sensor", "") == kind) runs.push_back(c);
+    if (runs.empty()) continue;
+    PlotOptions o = options;
+    if (o.title.empty()) o.title = fmt::format("{} axes of {}", kind == "gyro" ? "Gyro" : "Accelerometer",
+                                               std::filesystem::path(imu.value("source", "")).filename().string());
+    Figure f = batch_allan_figure(runs, o);
+    f.name = fmt::format("imu-{}", kind);
+    figures.push_back(std::move(f));
+  }
+  if (figures.empty()) throw AnalysisError("the imu result has no channels: nothing to plot");
+  PlotResult result;
+  for (const auto& f : figures) result.series += f.series;
+  check_output_targets({{"--plot", options.output}, {"--plot-script", options.script}}, options.force);
+  const PlotFormat format = options.output.empty() ? PlotFormat::Svg : plot_format_for(options.output);
+  if (!options.script.empty()) {
+    const std::string target = options.output.empty()
+                                   ? std::filesystem::path(options.script).replace_extension(".svg").string()
+                                   : options.output;
+    write_file_atomic(options.script, full_script(figures, format, options.width_px, target), options.force);
+  }
+  if (!options.output.empty())
+    write_file_atomic(options.output, render_figures(figures, format, options.width_px), options.force);
+  return result;
+}
+
+}  // namespace rwcalc
