@@ -192,5 +192,43 @@ TEST(Imu, AColumnOfTheWrongKindIsAnError) {
   EXPECT_NE(p.status, 0);
 }
 
+TEST(Imu, EarthRateAndVerdictOnlyForPulsesOrWhenAsked) {
+  TempDir dir;
+  const auto f = dir.write("imu.csv", imu_csv(kHeader));
+  // A rate gyro: neither, and the output says so and how to ask.
+  const auto off = run_cli({"analyze", f.string(), "--column", "gyro_x_dps", "--rate", "100", "--json"});
+  const auto j = parse_ok(off);
+  EXPECT_EQ(j["earth_rate_subtracted"], false);
+  EXPECT_EQ(j["earth_rate_deg_per_h"].get<double>(), 0.0);
+  EXPECT_NEAR(j["bias_deg_per_h"].get<double>(), 360.0, 5.0);  // the mean, 0.1 °/s
+  EXPECT_EQ(j["verdict"]["applies"], false);
+  EXPECT_TRUE(has(j["not_applied_reason"].get<std::string>(), "--vertical")) << j["not_applied_reason"];
+  const auto t = run_cli({"analyze", f.string(), "--column", "gyro_x_dps", "--rate", "100"});
+  EXPECT_TRUE(has(t.out, "Verdict: not given (rate input")) << t.out;
+  EXPECT_FALSE(has(t.out, "P(meets class)")) << t.out;
+  EXPECT_TRUE(has(t.out, "(no Earth rate subtracted)")) << t.out;
+  // --vertical: both, as for pulse input (no not_applied keys at all).
+  const auto v = parse_ok(run_cli({"analyze", f.string(), "--column", "gyro_x_dps", "--rate", "100", "--json",
+                                   "--vertical"}));
+  EXPECT_FALSE(v.contains("not_applied_reason"));
+  EXPECT_NEAR(v["earth_rate_deg_per_h"].get<double>(), 12.43, 0.01);
+  // --earth-rate alone: the Earth rate, still no verdict.
+  const auto e = parse_ok(run_cli({"analyze", f.string(), "--column", "gyro_x_dps", "--rate", "100", "--json",
+                                   "--earth-rate", "10"}));
+  EXPECT_EQ(e["earth_rate_subtracted"], true);
+  EXPECT_EQ(e["verdict"]["applies"], false);
+  // Pulse input keeps both.
+  const auto p = parse_ok(run_cli({"analyze", source_path("data/gl2d/gl2d_p25C.csv.gz").string(), "--json"}));
+  EXPECT_FALSE(p.contains("not_applied_reason"));
+  EXPECT_TRUE(p["verdict"].contains("class"));
+  // imu: only the gyro said to be vertical.
+  const auto i = parse_ok(run_cli({"imu", f.string(), "--rate", "100", "--gyro", "gyro_x_dps,gyro_z_dps",
+                                   "--vertical-gyro", "gyro_z_dps", "--json"}));
+  EXPECT_TRUE(i["channels"][0]["verdict"].is_null());
+  EXPECT_TRUE(i["channels"][0]["earth_rate_subtracted"].is_null());
+  EXPECT_TRUE(i["channels"][1]["verdict"].is_object());
+  EXPECT_NEAR(i["channels"][1]["earth_rate_subtracted"].get<double>(), 12.43, 0.01);
+}
+
 }  // namespace
 }  // namespace rwcalc::test

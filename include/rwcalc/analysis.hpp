@@ -22,6 +22,11 @@ struct AnalysisOptions {
   FitOptions fit;
   MethodOptions methods;
   VerdictOptions verdict;
+  /// The Earth-rate removal and the class verdict: unset, on for pulse or counter input (a
+  /// ring-laser gyro on the test stand's vertical axis) and off for other input, a MEMS or other
+  /// gyro whose orientation and class table nobody gave; true asks for them (--vertical,
+  /// --earth-rate, --latitude; --limits). Never for an accelerometer.
+  std::optional<bool> earth_rate, verdict_wanted;
   double latitude_deg = 55.75;                          ///< for the vertical Earth rate Ω_E·sin(lat)
   std::optional<double> earth_rate_deg_per_h;           ///< overrides the latitude
   std::optional<double> temperature_c;                  ///< overrides the recording's temperature
@@ -83,6 +88,11 @@ struct AnalysisResult {
   double earth_rate_deg_per_h = 0;
   double latitude_deg = 0;  ///< NaN-free: the latitude used (0 when the rate was given)
   bool earth_rate_given = false;
+  /// Whether the Earth rate was subtracted and the class verdict applies (AnalysisOptions), and why
+  /// not when they are off (one sentence; empty when both are on).
+  bool earth_rate_applied = true;
+  bool verdict_applies = true;
+  std::string not_applied_reason;
   double bias_deg_per_h = 0;  ///< mean − expected Earth rate
   /// Allan deviation; for the overlapping estimator its EDF, bounds and α come from the fitted
   /// model (EDF = 2σ⁴/Var(σ̂²) under the fit, α of the dominant term), not Stable32's noise id.

@@ -19,6 +19,9 @@ struct ImuOptions {
   std::vector<std::string> gyro_columns, accel_columns;  ///< header names or 1-based indices
   std::optional<RateUnit> gyro_unit, accel_unit;         ///< unset: each column name's suffix
   std::string gyro_output_unit, accel_output_unit;       ///< "" : the kind's usual units (sensor.hpp)
+  /// The gyro column (as given in gyro_columns) whose axis is vertical: the Earth rate is subtracted
+  /// from it and the class verdict given (AnalysisOptions::earth_rate, verdict_wanted).
+  std::string vertical_gyro;
   AnalysisOptions analysis;
 };
 

@@ -95,8 +95,13 @@ std::string units_line(const UnitSet& u) {
 // Earth rate and class verdict: what was done for this channel, one phrase.
 std::string earth_and_verdict(const AnalysisResult& r) {
   if (r.sensor != SensorKind::Gyro) return "no Earth rate, no class verdict (accelerometer)";
-  return fmt::format("Earth rate {} °/h subtracted; class verdict: {}", imu_num(r.earth_rate_deg_per_h, 4),
-                     r.verdict.statement());
+  const std::string earth = r.earth_rate_applied
+                                ? fmt::format("Earth rate {} °/h subtracted", imu_num(r.earth_rate_deg_per_h, 4))
+                                : std::string("no Earth rate subtracted");
+  const std::string verdict = r.verdict_applies ? fmt::format("class verdict: {}", r.verdict.statement())
+                                                : std::string("no class verdict");
+  return fmt::format("{}; {}{}", earth, verdict,
+                     r.not_applied_reason.empty() ? "" : " (ask with --vertical or imu --vertical-gyro COL, --limits, --earth-rate)");
 }
 
 }  // namespace imu_impl
@@ -108,6 +113,10 @@ ImuResult analyze_imu(const std::string& path, const ImuOptions& options) {
   for (const auto& c : options.gyro_columns) specs.push_back({c, SensorKind::Gyro});
   for (const auto& c : options.accel_columns) specs.push_back({c, SensorKind::Accelerometer});
   if (specs.empty()) throw UsageError("imu needs at least one column: give --gyro COLS and/or --accel COLS");
+  if (!options.vertical_gyro.empty() &&
+      std::find(options.gyro_columns.begin(), options.gyro_columns.end(), options.vertical_gyro) ==
+          options.gyro_columns.end())
+    throw UsageError(fmt::format("--vertical-gyro {}: not one of the --gyro columns", options.vertical_gyro));
   ImuResult out;
   out.source = path;
   out.gyro_units = output_units(SensorKind::Gyro, options.gyro_output_unit);
@@ -117,7 +126,11 @@ ImuResult analyze_imu(const std::string& path, const ImuOptions& options) {
   parallel_for(specs.size(), [&](std::size_t i) {
     const Recording rec = read_recording_text(bytes, path, channel_read(options, specs[i]));
     check_kind(rec, specs[i]);
-    out.channels[i] = {specs[i].column, specs[i].kind, analyze(rec, options.analysis)};
+    AnalysisOptions a = options.analysis;
+    if (!options.vertical_gyro.empty() && specs[i].kind == SensorKind::Gyro &&
+        (specs[i].column == options.vertical_gyro || rec.column_name == options.vertical_gyro))
+      a.earth_rate = a.verdict_wanted = true;
+    out.channels[i] = {rec.column_name, specs[i].kind, analyze(rec, a)};
   });
   return out;
 }
@@ -141,7 +154,6 @@ nlohmann::json channel_json(const AnalysisResult& r, const UnitSet& shown) {
   fit["intervals_scaled"] = r.fit_range.intervals_scaled;
   nlohmann::json warnings = nlohmann::json::array();
   for (const auto& w : r.warnings) warnings.push_back({{"code", w.code}, {"message", w.message}});
-  const bool gyro = r.sensor == SensorKind::Gyro;
   return {{"source", r.column},
           {"file", r.source},
           {"column", r.column},
@@ -151,8 +163,10 @@ nlohmann::json channel_json(const AnalysisResult& r, const UnitSet& shown) {
           {"rate_hz", r.rate_hz},
           {"duration_s", r.duration_s},
           {"mean", {{"value", r.mean_rate_deg_per_h * shown.deviation.factor}, {"unit", shown.deviation.ascii}}},
-          {"earth_rate_subtracted", gyro ? nlohmann::json(r.earth_rate_deg_per_h * shown.deviation.factor) : nullptr},
-          {"verdict", gyro ? nlohmann::json(r.verdict.statement()) : nlohmann::json(nullptr)},
+          {"earth_rate_subtracted",
+           r.earth_rate_applied ? nlohmann::json(r.earth_rate_deg_per_h * shown.deviation.factor) : nullptr},
+          {"verdict", r.verdict_applies ? to_json(r.verdict) : nlohmann::json(nullptr)},
+          {"not_applied_reason", r.not_applied_reason},
           {"allan", allan_shown(r.allan, shown.deviation)},
           {"fit", std::move(fit)},
           {"warnings", std::move(warnings)}};
@@ -234,6 +248,7 @@ std::string kind_table(const std::vector<const ImuChannel*>& axes, const UnitSet
 struct AxisNoise {
   std::string column;
   Coefficient N, K;  ///< in SI (factor applied)
+  double rejected_chi2 = 0;  ///< χ²/dof of a fit the goodness of fit rejected (its intervals scaled), else 0
 };
 
 Coefficient scaled(const Coefficient& c, double f) {
@@ -247,7 +262,8 @@ std::vector<AxisNoise> axis_noise(const ImuResult& r, SensorKind kind) {
   std::vector<AxisNoise> out;
   for (const auto* c : of_kind(r, kind))
     out.push_back({c->column, scaled(c->result.fit[Term::N], si[Term::N].factor),
-                   scaled(c->result.fit[Term::K], si[Term::K].factor)});
+                   scaled(c->result.fit[Term::K], si[Term::K].factor),
+                   c->result.fit_range.intervals_scaled ? c->result.fit.chi2_per_dof : 0.0});
   return out;
 }
 
@@ -262,13 +278,17 @@ struct Combined {
 Combined combine(const std::vector<AxisNoise>& axes, Coefficient AxisNoise::*which, AxisCombination how) {
   Combined c;
   double sum = 0;
+  bool any_bound = false;
   for (const auto& a : axes) {
     const Coefficient& k = a.*which;
     sum += k.value;
-    c.bound = c.bound || !k.resolved;
-    if (k.value >= c.value) c.value = k.value, c.from = a.column;
+    any_bound = any_bound || !k.resolved;
+    if (k.value >= c.value) c.value = k.value, c.from = a.column, c.bound = !k.resolved;
   }
-  if (how == AxisCombination::Mean && !axes.empty()) c.value = sum / static_cast<double>(axes.size());
+  if (how == AxisCombination::Mean && !axes.empty()) {
+    c.value = sum / static_cast<double>(axes.size());
+    c.bound = any_bound;
+  }
   return c;
 }
 
@@ -282,7 +302,8 @@ nlohmann::json noise_json(const std::vector<AxisNoise>& axes, SensorKind kind) {
   for (const auto& a : axes)
     list.push_back({{"column", a.column},
                     {"noise_density", coef(a.N, si[Term::N])},
-                    {"random_walk", coef(a.K, si[Term::K])}});
+                    {"random_walk", coef(a.K, si[Term::K])},
+                    {"fit_rejected", a.rejected_chi2 > 0}});
   const Combined n = combine(axes, &AxisNoise::N, AxisCombination::Worst);
   const Combined k = combine(axes, &AxisNoise::K, AxisCombination::Worst);
   return {{"axes", std::move(list)},
@@ -362,6 +383,10 @@ std::string kalibr_yaml(const ImuResult& r, const KalibrOptions& options) {
                           : fmt::format("< {} (not resolved: 95 % upper bound)", yaml_num(c.value));
       };
       s += fmt::format("#   {}: N {}; K {}\n", printable(a.column), one(a.N), one(a.K));
+      if (a.rejected_chi2 > 0)
+        s += fmt::format("#     the five-term model does not describe this axis (chi2/dof {:.3g}): its values are "
+                         "doubtful; see rwcalc diagnose\n",
+                         a.rejected_chi2);
     }
     const Combined n = combine(axes, &AxisNoise::N, options.combine);
     const Combined k = combine(axes, &AxisNoise::K, options.combine);
@@ -370,9 +395,9 @@ std::string kalibr_yaml(const ImuResult& r, const KalibrOptions& options) {
       return worst ? fmt::format(" worst axis {}", printable(c.from)) : fmt::format(" mean of {} axes", axes.size());
     };
     keys += fmt::format("{}_noise_density: {}  # [{}]{}{}\n", prefix, yaml_num(n.value), si[Term::N].ascii, from(n),
-                        n.bound ? "; includes an upper bound: N not resolved on an axis" : "");
+                        n.bound ? "; UPPER BOUND: N not resolved (its 95 % bound used)" : "");
     keys += fmt::format("{}_random_walk: {}  # [{}]{}{}\n", prefix, yaml_num(k.value), si[Term::K].ascii, from(k),
-                        k.bound ? "; UPPER BOUND: K not resolved on an axis (its 95 % bound used)" : "");
+                        k.bound ? "; UPPER BOUND: K not resolved (its 95 % bound used)" : "");
   }
   return s + keys;
 }

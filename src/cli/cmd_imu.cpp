@@ -23,6 +23,7 @@ struct ImuCmd {
   std::optional<double> rate_hz;
   double time_tolerance = 0.01;
   std::vector<std::string> gyro, accel;
+  std::string vertical_gyro;
   std::string gyro_unit, accel_unit;
   std::vector<std::string> shown_units;
   AnalyzeArgs analysis;
@@ -38,6 +39,7 @@ struct ImuCmd {
     o.read.time_tolerance = time_tolerance;
     o.gyro_columns = gyro;
     o.accel_columns = accel;
+    o.vertical_gyro = vertical_gyro;
     if (!gyro_unit.empty()) o.gyro_unit = parse_rate_unit(gyro_unit);
     if (!accel_unit.empty()) o.accel_unit = parse_rate_unit(accel_unit);
     if (o.gyro_unit && is_accelerometer_unit(*o.gyro_unit))
@@ -82,6 +84,10 @@ void register_imu(CLI::App& app, Runner& runner) {
       ->group("Input");
   sub->add_option("--gyro-unit", cmd->gyro_unit,
                   "Unit of the gyro columns: deg/h, deg/s or rad/s (default: each name's suffix, _dps ...)")
+      ->group("Input");
+  sub->add_option("--vertical-gyro", cmd->vertical_gyro,
+                  "The gyro column whose axis is vertical: the vertical Earth rate is subtracted from it and the "
+                  "class verdict given (default: none, unless the input is pulses)")
       ->group("Input");
   sub->add_option("--accel", cmd->accel, "Accelerometer columns: header names or 1-based indices, comma-separated")
       ->delimiter(',')

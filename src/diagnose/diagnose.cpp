@@ -52,6 +52,9 @@ const Recording& screened(const Recording& read, const DiagnoseOptions& opt, Out
 void fit_base(Context& c, DiagnoseResult& r, OutlierReport outliers) {
   c.aopt = c.opt.analysis;
   c.aopt.outlier_action = OutlierAction::Keep;
+  // The Earth-rate choice is the recording's (pulse input: on), kept for the cleaned and sliced
+  // floating series the stages analyse.
+  if (!c.aopt.earth_rate) c.aopt.earth_rate = c.rec.mode == InputMode::Pulses || c.rec.mode == InputMode::Counter;
   const PhaseSeries& x = c.rec.phase;
   if (x.exact() && c.aopt.fit.tau_min_s <= 0) c.aopt.fit.tau_min_s = kPulseFitTauMin;
   r.analysis = analyze_for_base(c.rec, c.aopt);
