@@ -14,8 +14,15 @@ PlotResult plot_imu(const nlohmann::json& imu, const PlotOptions& options) {
   std::vector<Figure> figures;
   for (const std::string_view kind : {"gyro", "accelerometer"}) {
     nlohmann::json runs = nlohmann::json::array();
-    for (const auto& c : imu.at("channels"))
-      if (c.value("sensor", "") == kind) runs.push_back(c);
+    for (const auto& c : imu.at("channels")) {
+      if (c.value("sensor", "") != kind) continue;
+      nlohmann::json run = c;
+      // The axis label in the unit's printed form; as a non-gyro unit it also keeps the class
+      // limits (a ring-laser table) out of a figure of several axes.
+      const std::string unit = c.at("allan").value("unit", "");
+      run["allan"]["unit"] = unit == "deg/h" ? "°/h" : unit == "deg/s" ? "°/s" : unit == "ug" ? "µg" : unit == "m/s^2" ? "m/s²" : unit;
+      runs.push_back(std::move(run));
+    }
     if (runs.empty()) continue;
     PlotOptions o = options;
     if (o.title.empty()) o.title = fmt::format("{} axes of {}", kind == "gyro" ? "Gyro" : "Accelerometer",
