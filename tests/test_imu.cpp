@@ -230,5 +230,37 @@ TEST(Imu, EarthRateAndVerdictOnlyForPulsesOrWhenAsked) {
   EXPECT_NEAR(i["channels"][1]["earth_rate_subtracted"].get<double>(), 12.43, 0.01);
 }
 
+TEST(Imu, IncrementsGiveWhatTheRatesGive) {
+  // The same axes as rates and as per-sample increments (Δθ = ω·τ0 in rad, Δv = a·τ0 in m/s).
+  TempDir dir;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> z;
+  std::string s = "w_rads,a_g,dtheta,dv\n";
+  for (int k = 0; k < kSamples; ++k) {
+    const double w = 0.001 + 0.0009 * z(rng), a = -1 + kAccelSd * z(rng);
+    s += fmt::format("{:.12g},{:.12g},{:.12g},{:.12g}\n", w, a, w / kRateHz, a * kG / kRateHz);
+  }
+  const auto f = dir.write("inc.csv", s);
+  const auto j = parse_ok(run_cli({"imu", f.string(), "--rate", "100", "--gyro", "w_rads", "--accel", "a_g", "--json"}));
+  ASSERT_EQ(j["channels"].size(), 2u);
+  const auto g = parse_ok(run_cli({"imu", f.string(), "--rate", "100", "--gyro", "dtheta", "--gyro-unit", "rad",
+                                   "--accel", "dv", "--accel-unit", "m/s", "--json"}));
+  const auto& rate = j["channels"];
+  EXPECT_EQ(g["channels"][0]["input"]["kind"], "increment");
+  EXPECT_EQ(g["channels"][1]["input"]["unit"], "m/s");
+  EXPECT_EQ(g["channels"][1]["sensor"], "accelerometer");
+  for (const char* t : {"N", "B"}) {
+    EXPECT_NEAR(g["channels"][0]["fit"][t]["si"]["value"].get<double>() /
+                    rate[0]["fit"][t]["si"]["value"].get<double>(), 1.0, 1e-6) << t;
+    EXPECT_NEAR(g["channels"][1]["fit"][t]["si"]["value"].get<double>() /
+                    rate[1]["fit"][t]["si"]["value"].get<double>(), 1.0, 1e-6) << t;
+  }
+  EXPECT_NEAR(g["channels"][1]["mean"]["value"].get<double>(), -1e6, 2e3);  // µg
+  // analyze takes them too: --input increment --angle-unit m/s.
+  const auto a = parse_ok(run_cli({"analyze", f.string(), "--column", "dv", "--input", "increment", "--angle-unit",
+                                   "m/s", "--rate", "100", "--json"}));
+  EXPECT_EQ(a["sensor"], "accelerometer");
+}
+
 }  // namespace
 }  // namespace rwcalc::test

@@ -18,6 +18,8 @@ struct ImuOptions {
   ReadOptions read;  ///< rate, time tolerance, identification; column, input mode and unit are set per channel
   std::vector<std::string> gyro_columns, accel_columns;  ///< header names or 1-based indices
   std::optional<RateUnit> gyro_unit, accel_unit;         ///< unset: each column name's suffix
+  /// Per-sample increments instead of rates: Δθ in an angle unit, Δv in m/s (InputMode::Increment)
+  std::optional<AngleUnit> gyro_increment_unit, accel_increment_unit;
   std::string gyro_output_unit, accel_output_unit;       ///< "" : the kind's usual units (sensor.hpp)
   /// The gyro column (as given in gyro_columns) whose axis is vertical: the Earth rate is subtracted
   /// from it and the class verdict given (AnalysisOptions::earth_rate, verdict_wanted).

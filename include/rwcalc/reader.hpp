@@ -28,6 +28,8 @@ enum class InputMode {
   Counter,  ///< a cumulative counter reading that wraps at 2^counter_bits
   Angle,    ///< cumulative angle or phase samples, in angle_unit
   Rate,     ///< rate samples, in rate_unit (or dimensionless frequency for clocks)
+  /// per-sample increments of angle (Δθ) or velocity (Δv), in angle_unit: an IMU's integrated output
+  Increment,
 };
 /// Unit of Angle input. Second means clock phase (time error) in seconds; MetrePerSecond is an
 /// accelerometer's cumulative velocity (integrated Δv).

@@ -39,10 +39,13 @@ struct ChannelSpec {
 ReadOptions channel_read(const ImuOptions& o, const ChannelSpec& c) {
   ReadOptions r = o.read;
   r.column = c.column;
-  const std::optional<RateUnit> unit = c.kind == SensorKind::Gyro ? o.gyro_unit : o.accel_unit;
-  if (unit) {
+  const bool gyro = c.kind == SensorKind::Gyro;
+  if (const std::optional<RateUnit> unit = gyro ? o.gyro_unit : o.accel_unit) {
     r.mode = InputMode::Rate;
     r.rate_unit = unit;
+  } else if (const std::optional<AngleUnit> inc = gyro ? o.gyro_increment_unit : o.accel_increment_unit) {
+    r.mode = InputMode::Increment;
+    r.angle_unit = inc;
   }
   return r;
 }

@@ -40,13 +40,23 @@ struct ImuCmd {
     o.gyro_columns = gyro;
     o.accel_columns = accel;
     o.vertical_gyro = vertical_gyro;
-    if (!gyro_unit.empty()) o.gyro_unit = parse_rate_unit(gyro_unit);
-    if (!accel_unit.empty()) o.accel_unit = parse_rate_unit(accel_unit);
-    if (o.gyro_unit && is_accelerometer_unit(*o.gyro_unit))
-      throw UsageError(fmt::format("--gyro-unit {} is an accelerometer unit: expected deg/h, deg/s or rad/s", gyro_unit));
+    // A rate unit means rate samples; an angle (velocity) unit per-sample increments Δθ (Δv).
+    if (gyro_unit == "arcsec" || gyro_unit == "deg" || gyro_unit == "rad")
+      o.gyro_increment_unit = parse_angle_unit(gyro_unit);
+    else if (!gyro_unit.empty())
+      o.gyro_unit = parse_rate_unit(gyro_unit);
+    if (accel_unit == "m/s")
+      o.accel_increment_unit = AngleUnit::MetrePerSecond;
+    else if (!accel_unit.empty())
+      o.accel_unit = parse_rate_unit(accel_unit);
+    if ((o.gyro_unit && (is_accelerometer_unit(*o.gyro_unit) || *o.gyro_unit == RateUnit::Unitless)))
+      throw UsageError(fmt::format(
+          "--gyro-unit {} is not a gyro unit: expected deg/h, deg/s, rad/s (rates) or arcsec, deg, rad (increments)",
+          gyro_unit));
     if (o.accel_unit && !is_accelerometer_unit(*o.accel_unit))
-      throw UsageError(fmt::format("--accel-unit {} is not an accelerometer unit: expected m/s^2, g, mg or ug",
-                                   accel_unit));
+      throw UsageError(fmt::format(
+          "--accel-unit {} is not an accelerometer unit: expected m/s^2, g, mg, ug (rates) or m/s (increments)",
+          accel_unit));
     // Each --output-unit belongs to the kind whose unit it is.
     for (const auto& u : shown_units) {
       try {
@@ -83,7 +93,8 @@ void register_imu(CLI::App& app, Runner& runner) {
       ->delimiter(',')
       ->group("Input");
   sub->add_option("--gyro-unit", cmd->gyro_unit,
-                  "Unit of the gyro columns: deg/h, deg/s or rad/s (default: each name's suffix, _dps ...)")
+                  "Unit of the gyro columns: deg/h, deg/s, rad/s for rates; arcsec, deg, rad for per-sample angle "
+                  "increments (delta theta). Default: each name's suffix (_dps, _rads ...)")
       ->group("Input");
   sub->add_option("--vertical-gyro", cmd->vertical_gyro,
                   "The gyro column whose axis is vertical: the vertical Earth rate is subtracted from it and the "
@@ -93,7 +104,8 @@ void register_imu(CLI::App& app, Runner& runner) {
       ->delimiter(',')
       ->group("Input");
   sub->add_option("--accel-unit", cmd->accel_unit,
-                  "Unit of the accelerometer columns: m/s^2, g, mg or ug (default: each name's suffix, _g, _mps2 ...)")
+                  "Unit of the accelerometer columns: m/s^2, g, mg, ug for accelerations; m/s for per-sample velocity "
+                  "increments (delta v). Default: each name's suffix (_g, _mps2 ...)")
       ->group("Input");
   sub->add_option("--output-unit", cmd->shown_units,
                   "Units the results are shown in, one per sensor kind: deg/h, deg/s, rad/s (gyro); m/s^2, g, mg, ug "

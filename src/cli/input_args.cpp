@@ -21,8 +21,9 @@ void InputArgs::add_to(CLI::App& app) {
   app.add_option("--input", input,
                  "What the column holds: pulses (per-sample pulse increments), counter (cumulative "
                  "counter, wraps at --counter-bits), angle (cumulative angle/phase in --angle-unit), "
-                 "rate (rate samples in --rate-unit). Default: implied by a unit suffix of the column's name "
-                 "(gyro_x_dps: rate), else pulses")
+                 "rate (rate samples in --rate-unit), increment (per-sample angle or velocity increments in "
+                 "--angle-unit: an IMU's delta theta or delta v). Default: implied by a unit suffix of the column's "
+                 "name (gyro_x_dps: rate), else pulses")
       ->group("Input");
   app.add_option("--column", column, "Column to read: a header name or a 1-based index")->group("Input");
   app.add_option("--rate", rate_hz,

@@ -36,7 +36,8 @@ constexpr std::string_view kTemperatureNames[] = {"temperature_c", "temperature"
 const std::vector<std::string_view> kValueNames[] = {{"pulses", "pulse", "counts", "count"},
                                                      {"counter", "count", "counts", "pulses"},
                                                      {"angle", "phase"},
-                                                     {"rate", "gyro", "frequency", "freq"}};
+                                                     {"rate", "gyro", "frequency", "freq"},
+                                                     {"increment", "delta", "dtheta", "dv"}};
 
 const TimeName* time_name(std::string_view field) {
   for (const TimeName& t : kTimeNames)
@@ -392,7 +393,7 @@ InputChoice choose_input(const ReadOptions& o, std::string_view column, const st
     c.mode = u->mode;
     c.notes.push_back(fmt::format("input {} from the column name '{}' (no --input given)", to_string(c.mode), column));
   }
-  const bool angle = c.mode == InputMode::Angle, rate = c.mode == InputMode::Rate;
+  const bool angle = c.mode == InputMode::Angle || c.mode == InputMode::Increment, rate = c.mode == InputMode::Rate;
   const bool named_angle = u && u->mode == InputMode::Angle, named_rate = u && u->mode == InputMode::Rate;
   if (angle)
     c.angle_unit = choose_unit(o.angle_unit, named_angle ? std::optional(u->angle) : std::nullopt, AngleUnit::Arcsec,

@@ -90,10 +90,11 @@ struct TimeTrack {
 
 template <class E, std::size_t Size = 4>
 using NameTable = std::pair<E, std::string_view>[Size];
-constexpr NameTable<InputMode> kModes{{InputMode::Pulses, "pulses"},
-                                      {InputMode::Counter, "counter"},
-                                      {InputMode::Angle, "angle"},
-                                      {InputMode::Rate, "rate"}};
+constexpr NameTable<InputMode, 5> kModes{{InputMode::Pulses, "pulses"},
+                                         {InputMode::Counter, "counter"},
+                                         {InputMode::Angle, "angle"},
+                                         {InputMode::Rate, "rate"},
+                                         {InputMode::Increment, "increment"}};
 constexpr NameTable<AngleUnit, 5> kAngleUnits{{AngleUnit::Arcsec, "arcsec"},
                                               {AngleUnit::Deg, "deg"},
                                               {AngleUnit::Rad, "rad"},
@@ -271,7 +272,7 @@ std::size_t Reader::mac_limit(std::string& buf, std::size_t from, bool at_end) c
 // The first sample: the phase's starting point, and the time columns' units.
 void Reader::start_samples(const Sample& s) {
   if (in().mode == InputMode::Pulses) ints_.push_back(0);   // C_0
-  if (in().mode == InputMode::Rate) reals_.push_back(0.0);  // x_0
+  if (in().mode == InputMode::Rate || in().mode == InputMode::Increment) reals_.push_back(0.0);  // x_0
   if (layout_.time_col) tunit_ = time_unit_of(layout_.time_unit, s.time, detail::Role::Time);
   if (layout_.time2_col) tunit2_ = time_unit_of(layout_.time2_unit, s.time2, detail::Role::Time2);
 }
@@ -513,7 +514,8 @@ void Reader::build_values(PhaseSeries& ph) {
   constexpr double kMaxPhase = 1e150;
   std::vector<double>& x = reals_;
   const bool angle = in().mode == InputMode::Angle;
-  const double f = angle ? phase_factor(in().angle_unit) : phase_factor(in().rate_unit);
+  const bool increments = in().mode == InputMode::Increment;  // summed like rates, without the τ0
+  const double f = angle || increments ? phase_factor(in().angle_unit) : phase_factor(in().rate_unit);
   for (std::size_t i = 0; angle && i < x.size(); ++i)
     if (!(std::abs(x[i] *= f) <= kMaxPhase)) [[unlikely]]
       fail(line_of_sample(i), fmt::format("angle out of range: {} is beyond ±{:g} arcsec, where the Allan "
@@ -523,7 +525,7 @@ void Reader::build_values(PhaseSeries& ph) {
     // x_0 = 0, x_j = τ0·Σ_{i<j} (y_i − ȳ), accumulated in long double. The mean rate ȳ goes into
     // rate_offset (series.hpp): a phase that kept it would grow to ȳ·T and round its noise away
     // once the offset is many orders above the noise.
-    const long double k = static_cast<long double>(ph.tau0_s) * f;
+    const long double k = increments ? static_cast<long double>(f) : static_cast<long double>(ph.tau0_s) * f;
     long double sum = 0, acc = 0;
     for (std::size_t i = 1; i < x.size(); ++i) sum += x[i];
     const double mean = x.size() > 1 ? static_cast<double>(sum / static_cast<long double>(x.size() - 1)) : 0.0;
@@ -538,7 +540,7 @@ void Reader::build_values(PhaseSeries& ph) {
                          "Allan variance would overflow) at this sample, {}",
                          static_cast<double>(whole), kMaxPhase, quoted(fmt::format("{:g}", y))));
     }
-    ph.rate_offset = mean * f;
+    ph.rate_offset = increments ? mean * f / ph.tau0_s : mean * f;
   }
   ph.values = std::move(x);
   check_data_magnitude(ph, angle ? "angle" : "rate");
@@ -560,9 +562,11 @@ Recording Reader::finish() {
   rec.samples = samples_;
   PhaseSeries& ph = rec.phase;
   ph.tau0_s = 1.0 / rate_hz_;
-  const bool clock = (in().mode == InputMode::Angle && in().angle_unit == AngleUnit::Second) ||
+  const bool clock = ((in().mode == InputMode::Angle || in().mode == InputMode::Increment) &&
+                      in().angle_unit == AngleUnit::Second) ||
                      (in().mode == InputMode::Rate && in().rate_unit == RateUnit::Unitless);
-  const bool accel = (in().mode == InputMode::Angle && is_accelerometer_unit(in().angle_unit)) ||
+  const bool accel = ((in().mode == InputMode::Angle || in().mode == InputMode::Increment) &&
+                      is_accelerometer_unit(in().angle_unit)) ||
                      (in().mode == InputMode::Rate && is_accelerometer_unit(in().rate_unit));
   ph.kind = clock ? PhaseKind::Clock : accel ? PhaseKind::Accelerometer : PhaseKind::Gyro;
   if (integer_mode())
@@ -672,7 +676,8 @@ std::string_view input_unit(const Recording& rec) {
   switch (rec.mode) {
     case InputMode::Pulses: return "pulse";
     case InputMode::Counter: return "count";
-    case InputMode::Angle: return to_string(rec.angle_unit);
+    case InputMode::Angle:
+    case InputMode::Increment: return to_string(rec.angle_unit);
     case InputMode::Rate: return to_string(rec.rate_unit);
   }
   return "?";
