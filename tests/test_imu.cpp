@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fmt/format.h>
 #include <functional>
 #include <nlohmann/json.hpp>
@@ -260,6 +261,22 @@ TEST(Imu, IncrementsGiveWhatTheRatesGive) {
   const auto a = parse_ok(run_cli({"analyze", f.string(), "--column", "dv", "--input", "increment", "--angle-unit",
                                    "m/s", "--rate", "100", "--json"}));
   EXPECT_EQ(a["sensor"], "accelerometer");
+}
+
+TEST(Imu, ReportDirectoryHoldsTheWholeResult) {
+  TempDir dir;
+  const auto f = dir.write("imu.csv", imu_csv(kHeader));
+  const auto out = dir.path() / "report";
+  const auto r = run_cli({"imu", f.string(), "--rate", "100", "--gyro", "1,2,3", "--accel", "4,5,6", "--report",
+                          out.string(), "-o", (dir.path() / "tables.txt").string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* name : {"index.html", "imu.txt", "imu.json", "imu.yaml"})
+    EXPECT_TRUE(std::filesystem::exists(out / name)) << name;
+  EXPECT_EQ(slurp(out / "imu.txt"), slurp(dir.path() / "tables.txt"));
+  const std::string html = slurp(out / "index.html");
+  EXPECT_TRUE(has(html, "Accelerometer (3 axes;")) << html;
+  EXPECT_TRUE(has(html, "<a href=\"imu.yaml\">")) << html;
+  EXPECT_EQ(nlohmann::json::parse(slurp(out / "imu.json"))["channels"].size(), 6u);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // table per sensor kind, the JSON `channels` list and the Kalibr/OpenVINS noise file.
 #include <fmt/format.h>
 
+#include <filesystem>
 #include <memory>
 #include <ostream>
 
@@ -12,7 +13,10 @@
 #include "cli/plot_args.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/imu.hpp"
+#include "rwcalc/printable.hpp"
 #include "rwcalc/output.hpp"
+#include "rwcalc/plot.hpp"
+#include "rwcalc/version.hpp"
 
 namespace rwcalc::cli {
 
@@ -30,6 +34,7 @@ struct ImuCmd {
   bool json = false;
   std::string output = "-";
   std::string kalibr, rostopic = "/imu0", combine = "worst";
+  std::string report_dir;
   PlotArgs plot;
   bool force = false;
 
@@ -71,6 +76,56 @@ struct ImuCmd {
     return o;
   }
 };
+
+std::string html_escaped(std::string_view text) {
+  std::string out;
+  for (const char c : text) {
+    switch (c) {
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '&': out += "&amp;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+// --report DIR: the tables as a page (index.html, with the figure when gnuplot is there), the
+// JSON, the noise file and the figure beside it, so that one directory holds the whole result.
+void write_report(const std::string& dir, const ImuResult& res, const nlohmann::json& j, const KalibrOptions& k,
+                  bool force, Io& io) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir))
+    throw OutputError(fmt::format("{}: cannot create the report directory: {}", dir,
+                                  ec ? ec.message() : std::string("not a directory")));
+  const auto at = [&dir](const char* name) { return (fs::path(dir) / name).string(); };
+  const std::string text = format_imu(res);
+  write_file_atomic(at("imu.txt"), text, force);
+  write_file_atomic(at("imu.json"), j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n", force);
+  write_file_atomic(at("imu.yaml"), kalibr_yaml(res, k), force);
+  std::string figure;
+  try {
+    PlotOptions o;
+    o.output = at("imu.svg");
+    o.force = force;
+    plot_imu(j, o);
+    figure = "<p><img src=\"imu.svg\" alt=\"Allan deviation of every axis\"></p>\n";
+  } catch (const OutputError& e) {  // no gnuplot: the page without the figure
+    print_message(io.err, fmt::format("note: --report without the figure: {}", e.what()));
+  }
+  write_file_atomic(at("index.html"),
+                    fmt::format("<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>rwcalc imu: {0}</title>"
+                                "</head>\n<body>\n<h1>IMU noise: {0}</h1>\n{1}<pre>{2}</pre>\n<p>Noise file for Kalibr and "
+                                "OpenVINS: <a href=\"imu.yaml\">imu.yaml</a>; all results: <a href=\"imu.json\">imu.json"
+                                "</a>.</p>\n<p>{3}</p>\n</body></html>\n",
+                                html_escaped(printable(res.source)), figure, html_escaped(text),
+                                html_escaped(version_line())),
+                    force);
+  print_message(io.err, fmt::format("report written to {}", at("index.html")));
+}
 
 }  // namespace
 
@@ -125,6 +180,10 @@ void register_imu(CLI::App& app, Runner& runner) {
       ->check(CLI::IsMember({"worst", "mean"}))
       ->capture_default_str()
       ->group("Output");
+  sub->add_option("--report", cmd->report_dir,
+                  "Write the whole result into DIR: index.html (tables and figure), imu.txt, imu.json, imu.yaml, "
+                  "imu.svg (created when missing)")
+      ->group("Output");
   add_output_options(*sub, cmd->output, cmd->force);
   cmd->plot.add_to(*sub, "one panel per sensor kind with every axis' Allan deviation and its confidence bars");
   sub->callback([cmd, &runner] {
@@ -137,13 +196,14 @@ void register_imu(CLI::App& app, Runner& runner) {
       const nlohmann::json j = to_json(res);
       require_finite(j, res.source);
       cmd->plot.draw_imu(j, cmd->force, io);
+      KalibrOptions k;
+      k.rostopic = cmd->rostopic;
+      k.combine = cmd->combine == "mean" ? AxisCombination::Mean : AxisCombination::Worst;
       if (!cmd->kalibr.empty()) {
-        KalibrOptions k;
-        k.rostopic = cmd->rostopic;
-        k.combine = cmd->combine == "mean" ? AxisCombination::Mean : AxisCombination::Worst;
         write_file_atomic(cmd->kalibr, kalibr_yaml(res, k), cmd->force);
         print_message(io.err, fmt::format("noise file written to {}", cmd->kalibr));
       }
+      if (!cmd->report_dir.empty()) write_report(cmd->report_dir, res, j, k, cmd->force, io);
       emit(io, cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n" : format_imu(res),
            cmd->output, cmd->force);
       return 0;
