@@ -116,6 +116,13 @@ TEST(Imu, OutputUnitChoosesTheShownUnitsOfEitherKind) {
       run_cli({"analyze", f.string(), "--column", "acc_z_g", "--rate", "100", "--json", "--output-unit", "mg"}));
   EXPECT_EQ(a["fit"]["B"]["unit"], "mg");
   EXPECT_NEAR(a["mean"]["value"].get<double>(), -1000.0, 2.0);
+  // imu: one unit per kind, in either order.
+  const auto i = parse_ok(run_cli({"imu", f.string(), "--rate", "100", "--gyro", "1", "--accel", "6", "--json",
+                                   "--output-unit", "mg,rad/s"}));
+  EXPECT_EQ(i["channels"][0]["fit"]["N"]["unit"], "rad/s/sqrt(Hz)");
+  EXPECT_NEAR(i["channels"][0]["fit"]["N"]["value"].get<double>() / gyro_n_si(), 1.0, 0.05);
+  EXPECT_EQ(i["channels"][1]["allan"]["unit"], "mg");
+  EXPECT_NEAR(i["channels"][1]["mean"]["value"].get<double>(), -1000.0, 2.0);
   const auto bad = run_cli({"analyze", f.string(), "--column", "acc_z_g", "--rate", "100", "--output-unit", "deg/s"});
   EXPECT_EQ(bad.status, 2);
   EXPECT_TRUE(has(bad.err, "output unit 'deg/s' is an gyro unit")) << bad.err;
@@ -201,6 +208,7 @@ TEST(Imu, EarthRateAndVerdictOnlyForPulsesOrWhenAsked) {
   const auto j = parse_ok(off);
   EXPECT_EQ(j["earth_rate_subtracted"], false);
   EXPECT_EQ(j["earth_rate_deg_per_h"].get<double>(), 0.0);
+  EXPECT_TRUE(j["latitude_deg"].is_null());
   EXPECT_NEAR(j["bias_deg_per_h"].get<double>(), 360.0, 5.0);  // the mean, 0.1 °/s
   EXPECT_EQ(j["verdict"]["applies"], false);
   EXPECT_TRUE(has(j["not_applied_reason"].get<std::string>(), "--vertical")) << j["not_applied_reason"];

@@ -564,7 +564,7 @@ static nlohmann::json to_json_fields(const AnalysisResult& r) {
           {"temperature_source", r.temperature_source},
           {"mean_rate_deg_per_h", r.mean_rate_deg_per_h},
           {"earth_rate_deg_per_h", r.earth_rate_deg_per_h},
-          {"latitude_deg", r.earth_rate_given ? json(nullptr) : json(r.latitude_deg)},
+          {"latitude_deg", r.earth_rate_given || !r.earth_rate_applied ? json(nullptr) : json(r.latitude_deg)},
           {"bias_deg_per_h", r.bias_deg_per_h},
           {"warnings", warnings_json(r)},
           {"allan", allan_bounds_json(r)},
