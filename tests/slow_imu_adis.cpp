@@ -3,9 +3,9 @@
 // (Hann windows of 4096 samples, half overlap) averaged over 1–5 Hz, density √(S/2).
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
 #include <cmath>
 #include <complex>
-#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <sstream>

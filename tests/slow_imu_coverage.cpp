@@ -1,15 +1,15 @@
 // A simulated six-axis IMU with known truth through `rwcalc imu`: every coefficient the fit resolves
 // (its 95 % interval above 0) must hold the truth in at least 90 % of the seeded cases, for each
-// term and sensor kind (with every term kept; the default term selection is measured beside it). Each axis is an exact simulator record (white noise N, flicker B, rate or
-// acceleration random walk K, a fine white read-out) written as a rate column: gyros in deg/s,
-// accelerometers in m/s^2 (the simulated angle in ″ read as velocity in 1/3600 m/s, units.hpp).
-// RWCALC_IMU_COVERAGE_CASES overrides the count of cases (default 50).
+// term and sensor kind (with every term kept; the default term selection is measured beside it). Each axis is an exact
+// simulator record (white noise N, flicker B, rate or acceleration random walk K, a fine white read-out) written as a
+// rate column: gyros in deg/s, accelerometers in m/s^2 (the simulated angle in ″ read as velocity in 1/3600 m/s,
+// units.hpp). RWCALC_IMU_COVERAGE_CASES overrides the count of cases (default 50).
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
 #include <algorithm>
 #include <array>
 #include <cstdlib>
-#include <fmt/format.h>
 #include <map>
 #include <nlohmann/json.hpp>
 
@@ -78,8 +78,8 @@ Tally run_cases(int n_cases, const std::vector<std::string>& extra) {
   for (int c = 0; c < n_cases; ++c) {
     TempDir dir;
     const auto f = dir.write("imu.csv", imu_file(1000 + c));
-    std::vector<std::string> args{"imu", f.string(), "--rate", fmt::format("{:g}", kRateHz), "--gyro", "1,2,3",
-                                  "--accel", "4,5,6", "--json"};
+    std::vector<std::string> args{"imu",     f.string(), "--rate", fmt::format("{:g}", kRateHz), "--gyro", "1,2,3",
+                                  "--accel", "4,5,6",    "--json"};
     args.insert(args.end(), extra.begin(), extra.end());
     const auto r = run_cli(args);
     EXPECT_EQ(r.status, 0) << r.err;
@@ -110,9 +110,10 @@ double coverage_of(Tally& t, const std::string& name, int n_cases, const char* l
   auto& q = t.ratio[name];
   std::sort(q.begin(), q.end());
   const double coverage = resolved ? static_cast<double>(inside) / resolved : 0.0;
-  std::cout << fmt::format("{:<10} {:<16} resolved in {:3} of {} axis-cases, truth inside {:.3f}; median "
-                           "estimate/truth {:.3f}\n",
-                           label, name, resolved, 3 * n_cases, coverage, q.empty() ? 0.0 : q[q.size() / 2]);
+  std::cout << fmt::format(
+      "{:<10} {:<16} resolved in {:3} of {} axis-cases, truth inside {:.3f}; median "
+      "estimate/truth {:.3f}\n",
+      label, name, resolved, 3 * n_cases, coverage, q.empty() ? 0.0 : q[q.size() / 2]);
   return coverage;
 }
 

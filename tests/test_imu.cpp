@@ -3,10 +3,10 @@
 // and the Kalibr/OpenVINS noise file.
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <fmt/format.h>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <numbers>
@@ -117,8 +117,8 @@ TEST(Imu, OutputUnitChoosesTheShownUnitsOfEitherKind) {
   EXPECT_EQ(a["fit"]["B"]["unit"], "mg");
   EXPECT_NEAR(a["mean"]["value"].get<double>(), -1000.0, 2.0);
   // imu: one unit per kind, in either order.
-  const auto i = parse_ok(run_cli({"imu", f.string(), "--rate", "100", "--gyro", "1", "--accel", "6", "--json",
-                                   "--output-unit", "mg,rad/s"}));
+  const auto i = parse_ok(run_cli(
+      {"imu", f.string(), "--rate", "100", "--gyro", "1", "--accel", "6", "--json", "--output-unit", "mg,rad/s"}));
   EXPECT_EQ(i["channels"][0]["fit"]["N"]["unit"], "rad/s/sqrt(Hz)");
   EXPECT_NEAR(i["channels"][0]["fit"]["N"]["value"].get<double>() / gyro_n_si(), 1.0, 0.05);
   EXPECT_EQ(i["channels"][1]["allan"]["unit"], "mg");
@@ -158,14 +158,14 @@ TEST(Imu, EveryAxisInOneCommandWithTheNoiseFile) {
   EXPECT_TRUE(has(y, "#   acc_y_g: N ")) << y;
   // A YAML parser reads it as numbers (PyYAML when python3 has it).
   if (std::system("python3 -c 'import yaml' >/dev/null 2>&1") == 0) {
-    const auto py = dir.write(
-        "check.py",
-        "import sys, yaml\nd = yaml.safe_load(open(sys.argv[1]))\n"
-        "keys = ['gyroscope_noise_density', 'gyroscope_random_walk', 'accelerometer_noise_density',\n"
-        "        'accelerometer_random_walk', 'update_rate']\n"
-        "assert all(isinstance(d[k], float) and d[k] > 0 for k in keys), d\n"
-        "assert d['rostopic'] == '/imu0'\n"
-        "print(d['gyroscope_noise_density'])\n");
+    const auto py =
+        dir.write("check.py",
+                  "import sys, yaml\nd = yaml.safe_load(open(sys.argv[1]))\n"
+                  "keys = ['gyroscope_noise_density', 'gyroscope_random_walk', 'accelerometer_noise_density',\n"
+                  "        'accelerometer_random_walk', 'update_rate']\n"
+                  "assert all(isinstance(d[k], float) and d[k] > 0 for k in keys), d\n"
+                  "assert d['rostopic'] == '/imu0'\n"
+                  "print(d['gyroscope_noise_density'])\n");
     EXPECT_EQ(std::system(fmt::format("python3 '{}' '{}' >/dev/null", py.string(), yaml.string()).c_str()), 0);
   }
   // The tables: one per kind.
@@ -217,13 +217,13 @@ TEST(Imu, EarthRateAndVerdictOnlyForPulsesOrWhenAsked) {
   EXPECT_FALSE(has(t.out, "P(meets class)")) << t.out;
   EXPECT_TRUE(has(t.out, "(no Earth rate subtracted)")) << t.out;
   // --vertical: both, as for pulse input (no not_applied keys at all).
-  const auto v = parse_ok(run_cli({"analyze", f.string(), "--column", "gyro_x_dps", "--rate", "100", "--json",
-                                   "--vertical"}));
+  const auto v =
+      parse_ok(run_cli({"analyze", f.string(), "--column", "gyro_x_dps", "--rate", "100", "--json", "--vertical"}));
   EXPECT_FALSE(v.contains("not_applied_reason"));
   EXPECT_NEAR(v["earth_rate_deg_per_h"].get<double>(), 12.43, 0.01);
   // --earth-rate alone: the Earth rate, still no verdict.
-  const auto e = parse_ok(run_cli({"analyze", f.string(), "--column", "gyro_x_dps", "--rate", "100", "--json",
-                                   "--earth-rate", "10"}));
+  const auto e = parse_ok(
+      run_cli({"analyze", f.string(), "--column", "gyro_x_dps", "--rate", "100", "--json", "--earth-rate", "10"}));
   EXPECT_EQ(e["earth_rate_subtracted"], true);
   EXPECT_EQ(e["verdict"]["applies"], false);
   // Pulse input keeps both.
@@ -250,7 +250,8 @@ TEST(Imu, IncrementsGiveWhatTheRatesGive) {
     s += fmt::format("{:.12g},{:.12g},{:.12g},{:.12g}\n", w, a, w / kRateHz, a * kG / kRateHz);
   }
   const auto f = dir.write("inc.csv", s);
-  const auto j = parse_ok(run_cli({"imu", f.string(), "--rate", "100", "--gyro", "w_rads", "--accel", "a_g", "--json"}));
+  const auto j =
+      parse_ok(run_cli({"imu", f.string(), "--rate", "100", "--gyro", "w_rads", "--accel", "a_g", "--json"}));
   ASSERT_EQ(j["channels"].size(), 2u);
   const auto g = parse_ok(run_cli({"imu", f.string(), "--rate", "100", "--gyro", "dtheta", "--gyro-unit", "rad",
                                    "--accel", "dv", "--accel-unit", "m/s", "--json"}));
@@ -260,9 +261,13 @@ TEST(Imu, IncrementsGiveWhatTheRatesGive) {
   EXPECT_EQ(g["channels"][1]["sensor"], "accelerometer");
   for (const char* t : {"N", "B"}) {
     EXPECT_NEAR(g["channels"][0]["fit"][t]["si"]["value"].get<double>() /
-                    rate[0]["fit"][t]["si"]["value"].get<double>(), 1.0, 1e-6) << t;
+                    rate[0]["fit"][t]["si"]["value"].get<double>(),
+                1.0, 1e-6)
+        << t;
     EXPECT_NEAR(g["channels"][1]["fit"][t]["si"]["value"].get<double>() /
-                    rate[1]["fit"][t]["si"]["value"].get<double>(), 1.0, 1e-6) << t;
+                    rate[1]["fit"][t]["si"]["value"].get<double>(),
+                1.0, 1e-6)
+        << t;
   }
   EXPECT_NEAR(g["channels"][1]["mean"]["value"].get<double>(), -1e6, 2e3);  // µg
   // analyze takes them too: --input increment --angle-unit m/s.

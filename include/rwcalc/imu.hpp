@@ -20,7 +20,7 @@ struct ImuOptions {
   std::optional<RateUnit> gyro_unit, accel_unit;         ///< unset: each column name's suffix
   /// Per-sample increments instead of rates: Δθ in an angle unit, Δv in m/s (InputMode::Increment)
   std::optional<AngleUnit> gyro_increment_unit, accel_increment_unit;
-  std::string gyro_output_unit, accel_output_unit;       ///< "" : the kind's usual units (sensor.hpp)
+  std::string gyro_output_unit, accel_output_unit;  ///< "" : the kind's usual units (sensor.hpp)
   /// The gyro column (as given in gyro_columns) whose axis is vertical: the Earth rate is subtracted
   /// from it and the class verdict given (AnalysisOptions::earth_rate, verdict_wanted).
   std::string vertical_gyro;

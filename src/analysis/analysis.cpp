@@ -263,12 +263,13 @@ void decide_applicability(const Recording& rec, const AnalysisOptions& options, 
   if (!gyro)
     r.not_applied_reason = "an accelerometer: no Earth rate and no gyro class table";
   else if (!r.earth_rate_applied || !r.verdict_applies)
-    r.not_applied_reason = fmt::format(
-        "{} input, not a ring-laser gyro's pulses: {}{}{} (--vertical asks for both{})", to_string(rec.mode),
-        r.earth_rate_applied ? "" : "the Earth rate is not subtracted",
-        !r.earth_rate_applied && !r.verdict_applies ? " and " : "",
-        r.verdict_applies ? "" : "the GOST RV 52339 class verdict is not given",
-        !r.verdict_applies ? "; --limits FILE for the verdict" : "; --earth-rate or --latitude for the Earth rate");
+    r.not_applied_reason =
+        fmt::format("{} input, not a ring-laser gyro's pulses: {}{}{} (--vertical asks for both{})",
+                    to_string(rec.mode), r.earth_rate_applied ? "" : "the Earth rate is not subtracted",
+                    !r.earth_rate_applied && !r.verdict_applies ? " and " : "",
+                    r.verdict_applies ? "" : "the GOST RV 52339 class verdict is not given",
+                    !r.verdict_applies ? "; --limits FILE for the verdict"
+                                       : "; --earth-rate or --latitude for the Earth rate");
 }
 
 /// Mean rate, expected Earth rate and the bias between them.

@@ -63,9 +63,10 @@ void check_kind(const Recording& rec, const ChannelSpec& c) {
 std::string imu_num(double v, int sig = 4) { return fmt::format("{:.{}g}", v, sig); }
 
 nlohmann::json shown_coef(const Coefficient& c, const ShownUnit& u) {
-  return {{"value", c.value * u.factor},  {"low95", c.low * u.factor},  {"high95", c.high * u.factor},
-          {"sigma", c.sigma * u.factor},  {"resolved", c.resolved},     {"in_model", c.in_model},
-          {"fitted", c.enabled},          {"unit", u.ascii}};
+  return {{"value", c.value * u.factor}, {"low95", c.low * u.factor},
+          {"high95", c.high * u.factor}, {"sigma", c.sigma * u.factor},
+          {"resolved", c.resolved},      {"in_model", c.in_model},
+          {"fitted", c.enabled},         {"unit", u.ascii}};
 }
 
 nlohmann::json allan_shown(const AllanResult& a, const ShownUnit& u) {
@@ -87,12 +88,13 @@ nlohmann::json allan_shown(const AllanResult& a, const ShownUnit& u) {
 std::string cell(const Coefficient& c, double factor) {
   if (!c.enabled) return "-";
   if (!c.resolved) return fmt::format("< {}", imu_num(c.value * factor, 3));
-  return fmt::format("{} [{}, {}]", imu_num(c.value * factor, 4), imu_num(c.low * factor, 3), imu_num(c.high * factor, 3));
+  return fmt::format("{} [{}, {}]", imu_num(c.value * factor, 4), imu_num(c.low * factor, 3),
+                     imu_num(c.high * factor, 3));
 }
 
 std::string units_line(const UnitSet& u) {
-  return fmt::format("Q {}, N {}, B {}, K {}, R {}; mean and Allan deviation in {}", u[Term::Q].label,
-                     u[Term::N].label, u[Term::B].label, u[Term::K].label, u[Term::R].label, u.deviation.label);
+  return fmt::format("Q {}, N {}, B {}, K {}, R {}; mean and Allan deviation in {}", u[Term::Q].label, u[Term::N].label,
+                     u[Term::B].label, u[Term::K].label, u[Term::R].label, u.deviation.label);
 }
 
 // Earth rate and class verdict: what was done for this channel, one phrase.
@@ -101,10 +103,12 @@ std::string earth_and_verdict(const AnalysisResult& r) {
   const std::string earth = r.earth_rate_applied
                                 ? fmt::format("Earth rate {} °/h subtracted", imu_num(r.earth_rate_deg_per_h, 4))
                                 : std::string("no Earth rate subtracted");
-  const std::string verdict = r.verdict_applies ? fmt::format("class verdict: {}", r.verdict.statement())
-                                                : std::string("no class verdict");
+  const std::string verdict =
+      r.verdict_applies ? fmt::format("class verdict: {}", r.verdict.statement()) : std::string("no class verdict");
   return fmt::format("{}; {}{}", earth, verdict,
-                     r.not_applied_reason.empty() ? "" : " (ask with --vertical or imu --vertical-gyro COL, --limits, --earth-rate)");
+                     r.not_applied_reason.empty()
+                         ? ""
+                         : " (ask with --vertical or imu --vertical-gyro COL, --limits, --earth-rate)");
 }
 
 }  // namespace imu_impl
@@ -116,9 +120,8 @@ ImuResult analyze_imu(const std::string& path, const ImuOptions& options) {
   for (const auto& c : options.gyro_columns) specs.push_back({c, SensorKind::Gyro});
   for (const auto& c : options.accel_columns) specs.push_back({c, SensorKind::Accelerometer});
   if (specs.empty()) throw UsageError("imu needs at least one column: give --gyro COLS and/or --accel COLS");
-  if (!options.vertical_gyro.empty() &&
-      std::find(options.gyro_columns.begin(), options.gyro_columns.end(), options.vertical_gyro) ==
-          options.gyro_columns.end())
+  if (!options.vertical_gyro.empty() && std::find(options.gyro_columns.begin(), options.gyro_columns.end(),
+                                                  options.vertical_gyro) == options.gyro_columns.end())
     throw UsageError(fmt::format("--vertical-gyro {}: not one of the --gyro columns", options.vertical_gyro));
   ImuResult out;
   out.source = path;
@@ -185,11 +188,11 @@ std::string format_channel(const AnalysisResult& r, const UnitSet& shown) {
                    to_string(r.allan.estimator), 100 * r.allan.confidence, "tau (s)", "sigma", "low", "high");
   const double k = shown.deviation.factor;
   for (const auto& p : r.allan.points)
-    s += fmt::format("  {:>11.5g} {:>12.5g} {:>12.5g} {:>12.5g}\n", p.tau_s, p.dev * k, p.dev_low * k,
-                     p.dev_high * k);
-  s += fmt::format("  (in {})\n\nNoise coefficients (fit over tau {:g}..{:g} s; 95 % profile intervals; < : not "
-                   "resolved, 95 % upper bound)\n",
-                   shown.deviation.label, r.fit.used.front().tau_s, r.fit.used.back().tau_s);
+    s += fmt::format("  {:>11.5g} {:>12.5g} {:>12.5g} {:>12.5g}\n", p.tau_s, p.dev * k, p.dev_low * k, p.dev_high * k);
+  s += fmt::format(
+      "  (in {})\n\nNoise coefficients (fit over tau {:g}..{:g} s; 95 % profile intervals; < : not "
+      "resolved, 95 % upper bound)\n",
+      shown.deviation.label, r.fit.used.front().tau_s, r.fit.used.back().tau_s);
   const UnitSet si = si_units(r.sensor);
   for (const Term t : kAllTerms)
     s += fmt::format("  {} {:<26} {:<28} {:<12} = {} {}\n", term_name(t), term_meaning(r.sensor, t),
@@ -250,7 +253,7 @@ std::string kind_table(const std::vector<const ImuChannel*>& axes, const UnitSet
 // Each axis' noise density (N) and random walk (K) in SI, and the value the noise file uses.
 struct AxisNoise {
   std::string column;
-  Coefficient N, K;  ///< in SI (factor applied)
+  Coefficient N, K;          ///< in SI (factor applied)
   double rejected_chi2 = 0;  ///< χ²/dof of a fit the goodness of fit rejected (its intervals scaled), else 0
 };
 
@@ -298,8 +301,8 @@ Combined combine(const std::vector<AxisNoise>& axes, Coefficient AxisNoise::*whi
 nlohmann::json noise_json(const std::vector<AxisNoise>& axes, SensorKind kind) {
   const UnitSet si = si_units(kind);
   auto coef = [](const Coefficient& c, const ShownUnit& u) {
-    return nlohmann::json{{"value", c.value}, {"low95", c.low},          {"high95", c.high},
-                          {"resolved", c.resolved}, {"unit", u.ascii}};
+    return nlohmann::json{
+        {"value", c.value}, {"low95", c.low}, {"high95", c.high}, {"resolved", c.resolved}, {"unit", u.ascii}};
   };
   nlohmann::json list = nlohmann::json::array();
   for (const auto& a : axes)
@@ -368,8 +371,8 @@ std::string kalibr_yaml(const ImuResult& r, const KalibrOptions& options) {
       "# walk; sigma^2 = K^2 tau/3), each axis fitted with 95 % intervals; the values used are the {}.\n",
       printable(r.source), first.input.value("sha256", std::string()), first.samples, first.rate_hz,
       options.combine == AxisCombination::Worst ? "worst axis' (the largest)" : "mean over the axes");
-  std::string keys = fmt::format("rostopic: {}\nupdate_rate: {:.6f}  # Hz\n", nlohmann::json(options.rostopic).dump(),
-                                 first.rate_hz);
+  std::string keys =
+      fmt::format("rostopic: {}\nupdate_rate: {:.6f}  # Hz\n", nlohmann::json(options.rostopic).dump(), first.rate_hz);
   for (const SensorKind kind : {SensorKind::Accelerometer, SensorKind::Gyro}) {
     const auto axes = axis_noise(r, kind);
     const bool gyro = kind == SensorKind::Gyro;
@@ -387,9 +390,10 @@ std::string kalibr_yaml(const ImuResult& r, const KalibrOptions& options) {
       };
       s += fmt::format("#   {}: N {}; K {}\n", printable(a.column), one(a.N), one(a.K));
       if (a.rejected_chi2 > 0)
-        s += fmt::format("#     the five-term model does not describe this axis (chi2/dof {:.3g}): its values are "
-                         "doubtful; see rwcalc diagnose\n",
-                         a.rejected_chi2);
+        s += fmt::format(
+            "#     the five-term model does not describe this axis (chi2/dof {:.3g}): its values are "
+            "doubtful; see rwcalc diagnose\n",
+            a.rejected_chi2);
     }
     const Combined n = combine(axes, &AxisNoise::N, options.combine);
     const Combined k = combine(axes, &AxisNoise::K, options.combine);

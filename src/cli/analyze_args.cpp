@@ -72,8 +72,8 @@ void AnalyzeArgs::add_to(CLI::App& app) {
       ->capture_default_str()
       ->group("Fit");
   latitude_option = app.add_option("--latitude", latitude_deg,
-                                    "Latitude for the vertical Earth rate, degrees (given: the Earth rate is "
-                                    "subtracted whatever the input)")
+                                   "Latitude for the vertical Earth rate, degrees (given: the Earth rate is "
+                                   "subtracted whatever the input)")
                         ->check(real_in(-90.0, 90.0, "deg"))
                         ->capture_default_str()
                         ->group("Earth rate");

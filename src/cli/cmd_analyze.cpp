@@ -66,8 +66,9 @@ void register_analyze(CLI::App& app, Runner& runner) {
         const nlohmann::json j = channel_json(res, shown);
         require_finite(j, rec.source);
         cmd->plot.draw_analysis(j, cmd->force, io);
-        emit(io, cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"
-                           : format_channel(res, shown),
+        emit(io,
+             cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"
+                       : format_channel(res, shown),
              cmd->output, cmd->force);
         return 0;
       }

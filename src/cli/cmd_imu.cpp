@@ -13,9 +13,9 @@
 #include "cli/plot_args.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/imu.hpp"
-#include "rwcalc/printable.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/plot.hpp"
+#include "rwcalc/printable.hpp"
 #include "rwcalc/version.hpp"
 
 namespace rwcalc::cli {
@@ -116,14 +116,14 @@ void write_report(const std::string& dir, const ImuResult& res, const nlohmann::
   } catch (const OutputError& e) {  // no gnuplot: the page without the figure
     print_message(io.err, fmt::format("note: --report without the figure: {}", e.what()));
   }
-  write_file_atomic(at("index.html"),
-                    fmt::format("<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>rwcalc imu: {0}</title>"
-                                "</head>\n<body>\n<h1>IMU noise: {0}</h1>\n{1}<pre>{2}</pre>\n<p>Noise file for Kalibr and "
-                                "OpenVINS: <a href=\"imu.yaml\">imu.yaml</a>; all results: <a href=\"imu.json\">imu.json"
-                                "</a>.</p>\n<p>{3}</p>\n</body></html>\n",
-                                html_escaped(printable(res.source)), figure, html_escaped(text),
-                                html_escaped(version_line())),
-                    force);
+  write_file_atomic(
+      at("index.html"),
+      fmt::format("<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>rwcalc imu: {0}</title>"
+                  "</head>\n<body>\n<h1>IMU noise: {0}</h1>\n{1}<pre>{2}</pre>\n<p>Noise file for Kalibr and "
+                  "OpenVINS: <a href=\"imu.yaml\">imu.yaml</a>; all results: <a href=\"imu.json\">imu.json"
+                  "</a>.</p>\n<p>{3}</p>\n</body></html>\n",
+                  html_escaped(printable(res.source)), figure, html_escaped(text), html_escaped(version_line())),
+      force);
   print_message(io.err, fmt::format("report written to {}", at("index.html")));
 }
 

@@ -36,8 +36,9 @@ struct Context {
 const Recording& screened(const Recording& read, const DiagnoseOptions& opt, OutlierReport& outliers,
                           Recording& edited) {
   if (read.phase.kind == PhaseKind::Accelerometer)
-    throw UsageError("diagnose needs gyro data: an accelerometer column is analysed by analyze and imu, not yet "
-                     "diagnosed");
+    throw UsageError(
+        "diagnose needs gyro data: an accelerometer column is analysed by analyze and imu, not yet "
+        "diagnosed");
   if (read.phase.kind != PhaseKind::Gyro)
     throw UsageError("diagnose needs gyro data (clock phase/frequency cannot be simulated as a gyro)");
   if (opt.runs < 10) throw UsageError(fmt::format("--runs must be at least 10 (got {})", opt.runs));

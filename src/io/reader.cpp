@@ -100,10 +100,14 @@ constexpr NameTable<AngleUnit, 5> kAngleUnits{{AngleUnit::Arcsec, "arcsec"},
                                               {AngleUnit::Rad, "rad"},
                                               {AngleUnit::Second, "s"},
                                               {AngleUnit::MetrePerSecond, "m/s"}};
-constexpr NameTable<RateUnit, 8> kRateUnits{{RateUnit::DegPerHour, "deg/h"},  {RateUnit::DegPerSecond, "deg/s"},
-                                            {RateUnit::RadPerSecond, "rad/s"}, {RateUnit::Unitless, "1"},
-                                            {RateUnit::MetrePerSecond2, "m/s^2"}, {RateUnit::G, "g"},
-                                            {RateUnit::MilliG, "mg"},          {RateUnit::MicroG, "ug"}};
+constexpr NameTable<RateUnit, 8> kRateUnits{{RateUnit::DegPerHour, "deg/h"},
+                                            {RateUnit::DegPerSecond, "deg/s"},
+                                            {RateUnit::RadPerSecond, "rad/s"},
+                                            {RateUnit::Unitless, "1"},
+                                            {RateUnit::MetrePerSecond2, "m/s^2"},
+                                            {RateUnit::G, "g"},
+                                            {RateUnit::MilliG, "mg"},
+                                            {RateUnit::MicroG, "ug"}};
 constexpr NameTable<RateSource> kRateSources{{RateSource::Option, "option"},
                                              {RateSource::Metadata, "metadata"},
                                              {RateSource::TimeColumn, "time column"},
@@ -562,9 +566,9 @@ Recording Reader::finish() {
   rec.samples = samples_;
   PhaseSeries& ph = rec.phase;
   ph.tau0_s = 1.0 / rate_hz_;
-  const bool clock = ((in().mode == InputMode::Angle || in().mode == InputMode::Increment) &&
-                      in().angle_unit == AngleUnit::Second) ||
-                     (in().mode == InputMode::Rate && in().rate_unit == RateUnit::Unitless);
+  const bool clock =
+      ((in().mode == InputMode::Angle || in().mode == InputMode::Increment) && in().angle_unit == AngleUnit::Second) ||
+      (in().mode == InputMode::Rate && in().rate_unit == RateUnit::Unitless);
   const bool accel = ((in().mode == InputMode::Angle || in().mode == InputMode::Increment) &&
                       is_accelerometer_unit(in().angle_unit)) ||
                      (in().mode == InputMode::Rate && is_accelerometer_unit(in().rate_unit));

@@ -20,8 +20,8 @@ struct RateChoice {
 };
 
 constexpr double kGyroSi = std::numbers::pi / 180.0 / units::seconds_per_hour;  // °/h → rad/s
-constexpr double kAccelSi = 1.0 / units::seconds_per_hour;                        // m/s/h → m/s²
-constexpr double kMicroG = kAccelSi / units::standard_gravity * 1e6;              // m/s/h → µg
+constexpr double kAccelSi = 1.0 / units::seconds_per_hour;                      // m/s/h → m/s²
+constexpr double kMicroG = kAccelSi / units::standard_gravity * 1e6;            // m/s/h → µg
 
 constexpr RateChoice kRates[] = {{SensorKind::Gyro, "deg/s", "°/s", 1.0 / units::seconds_per_hour},
                                  {SensorKind::Gyro, "rad/s", "rad/s", kGyroSi},
@@ -36,7 +36,8 @@ UnitSet rate_based(SensorKind kind, std::string_view ascii, std::string_view lab
   u.kind = kind;
   u.deviation = {std::string(label), std::string(ascii), f};
   auto at = [&u](Term t) -> ShownUnit& { return u.term[static_cast<std::size_t>(t)]; };
-  at(Term::N) = {fmt::format("{}/√Hz", label), fmt::format("{}/sqrt(Hz)", ascii), f * std::sqrt(units::seconds_per_hour)};
+  at(Term::N) = {fmt::format("{}/√Hz", label), fmt::format("{}/sqrt(Hz)", ascii),
+                 f * std::sqrt(units::seconds_per_hour)};
   at(Term::B) = u.deviation;
   at(Term::K) = {fmt::format("{}/√s", label), fmt::format("{}/sqrt(s)", ascii), f / std::sqrt(units::seconds_per_hour)};
   at(Term::R) = {fmt::format("{}/s", label), fmt::format("{}/s", ascii), f / units::seconds_per_hour};
@@ -102,9 +103,10 @@ UnitSet output_units(SensorKind kind, std::string_view output_unit) {
                                      kind == SensorKind::Gyro ? "deg/h, deg/s or rad/s" : "m/s^2, g, mg or ug"));
       return rate_based(kind, r.name, r.label, r.factor);
     }
-  throw UsageError(fmt::format("unknown output unit '{}': expected deg/h, deg/s, rad/s (gyro) or m/s^2, g, mg, ug "
-                               "(accelerometer)",
-                               output_unit));
+  throw UsageError(
+      fmt::format("unknown output unit '{}': expected deg/h, deg/s, rad/s (gyro) or m/s^2, g, mg, ug "
+                  "(accelerometer)",
+                  output_unit));
 }
 
 UnitSet si_units(SensorKind kind) {

@@ -20,13 +20,18 @@ PlotResult plot_imu(const nlohmann::json& imu, const PlotOptions& options) {
       // The axis label in the unit's printed form; as a non-gyro unit it also keeps the class
       // limits (a ring-laser table) out of a figure of several axes.
       const std::string unit = c.at("allan").value("unit", "");
-      run["allan"]["unit"] = unit == "deg/h" ? "°/h" : unit == "deg/s" ? "°/s" : unit == "ug" ? "µg" : unit == "m/s^2" ? "m/s²" : unit;
+      run["allan"]["unit"] = unit == "deg/h"   ? "°/h"
+                             : unit == "deg/s" ? "°/s"
+                             : unit == "ug"    ? "µg"
+                             : unit == "m/s^2" ? "m/s²"
+                                               : unit;
       runs.push_back(std::move(run));
     }
     if (runs.empty()) continue;
     PlotOptions o = options;
-    if (o.title.empty()) o.title = fmt::format("{} axes of {}", kind == "gyro" ? "Gyro" : "Accelerometer",
-                                               std::filesystem::path(imu.value("source", "")).filename().string());
+    if (o.title.empty())
+      o.title = fmt::format("{} axes of {}", kind == "gyro" ? "Gyro" : "Accelerometer",
+                            std::filesystem::path(imu.value("source", "")).filename().string());
     Figure f = batch_allan_figure(runs, o);
     f.name = fmt::format("imu-{}", kind);
     figures.push_back(std::move(f));
