@@ -37,16 +37,17 @@ std::vector<std::vector<double>> load_si(const std::filesystem::path& path) {
 // √(S/2) with S the one-sided Welch PSD averaged over [1, 5] Hz.
 double welch_white_level(const std::vector<double>& x) {
   constexpr std::size_t kSeg = 4096;
+  constexpr double kSegD = kSeg;
   std::vector<double> w(kSeg);
   double u = 0;
-  for (std::size_t i = 0; i < kSeg; ++i) u += (w[i] = 0.5 - 0.5 * std::cos(2 * std::numbers::pi * i / kSeg)) * w[i];
+  for (std::size_t i = 0; i < kSeg; ++i) u += (w[i] = 0.5 - 0.5 * std::cos(2 * std::numbers::pi * static_cast<double>(i) / kSegD)) * w[i];
   Eigen::FFT<double> fft;
   std::vector<double> psd(kSeg / 2 + 1, 0.0), seg(kSeg);
   std::vector<std::complex<double>> spec;
   std::size_t segments = 0;
   for (std::size_t start = 0; start + kSeg <= x.size(); start += kSeg / 2, ++segments) {
     double mean = 0;
-    for (std::size_t i = 0; i < kSeg; ++i) mean += x[start + i] / kSeg;
+    for (std::size_t i = 0; i < kSeg; ++i) mean += x[start + i] / kSegD;
     for (std::size_t i = 0; i < kSeg; ++i) seg[i] = (x[start + i] - mean) * w[i];
     fft.fwd(spec, seg);
     for (std::size_t k = 0; k < psd.size(); ++k) psd[k] += std::norm(spec[k]);
@@ -54,9 +55,9 @@ double welch_white_level(const std::vector<double>& x) {
   double sum = 0;
   int n = 0;
   for (std::size_t k = 1; k + 1 < psd.size(); ++k) {
-    const double f = k * kRateHz / kSeg;
+    const double f = static_cast<double>(k) * kRateHz / kSegD;
     if (f < 1 || f > 5) continue;
-    sum += 2 * psd[k] / (segments * kRateHz * u);  // one-sided
+    sum += 2 * psd[k] / (static_cast<double>(segments) * kRateHz * u);  // one-sided
     ++n;
   }
   return std::sqrt(sum / n / 2);
