@@ -194,6 +194,10 @@ TEST(Imu, AColumnOfTheWrongKindIsAnError) {
   const auto u = run_cli({"imu", f.string(), "--rate", "100", "--accel", "4", "--accel-unit", "deg/s"});
   EXPECT_EQ(u.status, 2);
   EXPECT_TRUE(has(u.err, "--accel-unit deg/s is not an accelerometer unit")) << u.err;
+  // batch prints a gyro's units and classes: an accelerometer column is refused there.
+  const auto b = run_cli({"batch", f.string(), "--column", "acc_x_g", "--rate", "100"});
+  EXPECT_EQ(b.status, 2);
+  EXPECT_TRUE(has(b.err, "is an accelerometer channel; batch and report take gyro runs")) << b.err;
   // Without a suffix or --accel-unit an accelerometer column cannot be read as one.
   const auto plain = dir.write("plain.csv", "a\n0.001\n0.002\n-0.001\n0.003\n");
   const auto p = run_cli({"imu", plain.string(), "--rate", "100", "--accel", "a"});
