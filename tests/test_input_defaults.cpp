@@ -143,10 +143,10 @@ TEST(InputDefaults, DpsSuffixMeansDegreesPerSecondAndImpliesRateInput) {
   const auto t = run_cli({"analyze", f.string(), "--column", "gyro_x_dps", "--rate", "100"});
   ASSERT_EQ(t.status, 0) << t.err;
   EXPECT_TRUE(has(t.out, "input: rate samples in deg/s from column 'gyro_x_dps'; sample rate from option")) << t.out;
-  // An accelerometer channel is refused, not read as a gyro.
-  const auto acc = run_cli({"allan", f.string(), "--column", "acc_x_g", "--rate", "100"});
-  EXPECT_EQ(acc.status, 2);
-  EXPECT_TRUE(has(acc.err, "accelerometer channels are not supported")) << acc.err;
+  // An accelerometer channel is read in g as an accelerometer, not as a gyro.
+  const auto acc = allan_json(run_cli({"allan", f.string(), "--column", "acc_x_g", "--rate", "100", "--json"}));
+  EXPECT_EQ(acc["input"]["unit"], "g");
+  EXPECT_EQ(acc["unit"], "m/s/h");
 }
 
 TEST(InputDefaults, AUnitThatContradictsTheColumnNameIsUsedWithAWarning) {

@@ -12,6 +12,7 @@
 #include "rwcalc/methods.hpp"
 #include "rwcalc/outlier_screen.hpp"
 #include "rwcalc/reader.hpp"
+#include "rwcalc/sensor.hpp"
 #include "rwcalc/verdict.hpp"
 
 namespace rwcalc {
@@ -21,6 +22,11 @@ struct AnalysisOptions {
   FitOptions fit;
   MethodOptions methods;
   VerdictOptions verdict;
+  /// The Earth-rate removal and the class verdict: unset, on for pulse or counter input (a
+  /// ring-laser gyro on the test stand's vertical axis) and off for other input, a MEMS or other
+  /// gyro whose orientation and class table nobody gave; true asks for them (--vertical,
+  /// --earth-rate, --latitude; --limits). Never for an accelerometer.
+  std::optional<bool> earth_rate, verdict_wanted;
   double latitude_deg = 55.75;                          ///< for the vertical Earth rate Ω_E·sin(lat)
   std::optional<double> earth_rate_deg_per_h;           ///< overrides the latitude
   std::optional<double> temperature_c;                  ///< overrides the recording's temperature
@@ -67,6 +73,9 @@ struct FitRangeChoice {
 
 struct AnalysisResult {
   std::string source;
+  /// Gyro or accelerometer: the fit's coefficients are in the kind's fit-scale units (sensor.hpp);
+  /// accelerometers have no Earth rate and no class verdict.
+  SensorKind sensor = SensorKind::Gyro;
   std::size_t samples = 0;
   double rate_hz = 0;
   double duration_s = 0;
@@ -79,6 +88,11 @@ struct AnalysisResult {
   double earth_rate_deg_per_h = 0;
   double latitude_deg = 0;  ///< NaN-free: the latitude used (0 when the rate was given)
   bool earth_rate_given = false;
+  /// Whether the Earth rate was subtracted and the class verdict applies (AnalysisOptions), and why
+  /// not when they are off (one sentence; empty when both are on).
+  bool earth_rate_applied = true;
+  bool verdict_applies = true;
+  std::string not_applied_reason;
   double bias_deg_per_h = 0;  ///< mean − expected Earth rate
   /// Allan deviation; for the overlapping estimator its EDF, bounds and α come from the fitted
   /// model (EDF = 2σ⁴/Var(σ̂²) under the fit, α of the dominant term), not Stable32's noise id.
@@ -100,7 +114,8 @@ struct AnalysisResult {
   std::vector<AnalysisWarning> warnings;
 };
 
-/// Throws UsageError for clock data, AnalysisError for a record too short or without noise.
+/// Gyro or accelerometer data. Throws UsageError for clock data, AnalysisError for a record too short
+/// or without noise.
 AnalysisResult analyze(const Recording& rec, const AnalysisOptions& options = {});
 
 /// What was read and how (the `input` object of analyze and allan JSON): column, kind, unit, rate

@@ -50,6 +50,9 @@ PlotResult plot_batch(const nlohmann::json& batch, const PlotOptions& options);
 /// extended model.
 PlotResult plot_diagnosis(const nlohmann::json& diagnosis, const PlotOptions& options);
 
+/// An IMU (`rwcalc imu --json`): one panel per sensor kind with every axis' Allan deviation.
+PlotResult plot_imu(const nlohmann::json& imu, const PlotOptions& options);
+
 /// A figure as a gnuplot script body (no terminal or output lines).
 struct Figure {
   std::string name;     ///< e.g. "allan", "batch-allan", "batch-direct"

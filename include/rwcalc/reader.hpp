@@ -28,11 +28,15 @@ enum class InputMode {
   Counter,  ///< a cumulative counter reading that wraps at 2^counter_bits
   Angle,    ///< cumulative angle or phase samples, in angle_unit
   Rate,     ///< rate samples, in rate_unit (or dimensionless frequency for clocks)
+  /// per-sample increments of angle (Δθ) or velocity (Δv), in angle_unit: an IMU's integrated output
+  Increment,
 };
-/// Unit of Angle input. Second means clock phase (time error) in seconds.
-enum class AngleUnit { Arcsec, Deg, Rad, Second };
-/// Unit of Rate input. Unitless means dimensionless clock frequency (fractional frequency).
-enum class RateUnit { DegPerHour, DegPerSecond, RadPerSecond, Unitless };
+/// Unit of Angle input. Second means clock phase (time error) in seconds; MetrePerSecond is an
+/// accelerometer's cumulative velocity (integrated Δv).
+enum class AngleUnit { Arcsec, Deg, Rad, Second, MetrePerSecond };
+/// Unit of Rate input. Unitless means dimensionless clock frequency (fractional frequency); the
+/// last four are accelerometer units (g = 9.80665 m/s², the standard gravity).
+enum class RateUnit { DegPerHour, DegPerSecond, RadPerSecond, Unitless, MetrePerSecond2, G, MilliG, MicroG };
 
 /// Unset options mean "not given": the column's name may then choose (see docs/input-formats.md).
 struct ReadOptions {
@@ -120,12 +124,17 @@ Recording read_recording(const std::string& path, const ReadOptions& options = {
 Recording read_recording_text(std::string_view text, const std::string& name, const ReadOptions& options = {});
 
 /// The unit the samples were read in: "pulse" or "count" (of Recording::phase.arcsec_per_count),
-/// the angle unit ("arcsec", "deg", "rad", "s") or the rate unit ("deg/h", "deg/s", "rad/s", "1").
+/// the angle unit ("arcsec", "deg", "rad", "s", "m/s") or the rate unit ("deg/h", "deg/s", "rad/s",
+/// "1", "m/s^2", "g", "mg", "ug").
 std::string_view input_unit(const Recording& rec);
 /// One line for output headers: "column 'gyro_x_dps': rate samples in deg/s".
 std::string describe_input(const Recording& rec);
 
-/// Parse names used on the command line; throw UsageError on anything else.
+/// True for an accelerometer unit (m/s², g, mg, µg; m/s of cumulative velocity).
+bool is_accelerometer_unit(RateUnit u) noexcept;
+bool is_accelerometer_unit(AngleUnit u) noexcept;
+/// Parse names used on the command line; throw UsageError on anything else. Rate units also take
+/// "m/s2", "mps2" for m/s² and "µg" for ug.
 InputMode parse_input_mode(std::string_view s);
 AngleUnit parse_angle_unit(std::string_view s);
 RateUnit parse_rate_unit(std::string_view s);

@@ -12,6 +12,8 @@ namespace rwcalc {
 enum class PhaseKind {
   Gyro,   ///< phase in arcseconds; deviations in °/h
   Clock,  ///< phase in the input's unit (s for time error); deviations in input units per second
+  /// velocity in 1/3600 m/s (units::velocity_units_per_mps); deviations in m/s/h
+  Accelerometer,
 };
 
 struct PhaseSeries {
@@ -49,8 +51,11 @@ struct PhaseSeries {
   [[nodiscard]] double duration_s() const noexcept {
     return points() > 1 ? static_cast<double>(points() - 1) * tau0_s : 0.0;
   }
-  /// Unit of the Allan deviation: "deg/h" for gyro data, "1" (input units per second) for clock data.
-  [[nodiscard]] std::string deviation_unit() const { return kind == PhaseKind::Gyro ? "deg/h" : "1"; }
+  /// Unit of the Allan deviation: "deg/h" for gyro data, "m/s/h" for accelerometer data, "1" (input
+  /// units per second) for clock data.
+  [[nodiscard]] std::string deviation_unit() const {
+    return kind == PhaseKind::Gyro ? "deg/h" : kind == PhaseKind::Accelerometer ? "m/s/h" : "1";
+  }
   /// Rate sample i (0-based, i < points−1) in deviation units: (x_{i+1} − x_i)/τ0.
   [[nodiscard]] double rate(std::size_t i) const noexcept { return diff(i + 1, i) / tau0_s; }
 };

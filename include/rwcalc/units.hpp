@@ -14,6 +14,12 @@ inline constexpr double arcsec_per_deg = 3600.0;
 inline constexpr double seconds_per_hour = 3600.0;
 inline constexpr double arcsec_per_rad = 180.0 * 3600.0 / std::numbers::pi;
 inline constexpr double deg_per_h_per_arcsec_per_s = 1.0;
+/// Standard gravity, m/s² (the g of accelerometer units).
+inline constexpr double standard_gravity = 9.80665;
+/// Accelerometer records are carried as a velocity in units of 1/3600 m/s: the m/s takes the place
+/// of the degree and that unit the place of the arcsecond, so every gyro formula above holds as
+/// written, deviations come out in m/s/h and N, B, K, R in m/s/√h, m/s/h, m/s/h/√h, m/s/h².
+inline constexpr double velocity_units_per_mps = 3600.0;
 /// Earth's sidereal rotation rate, °/h (7.2921150e-5 rad/s).
 inline constexpr double earth_rate_deg_per_h = 7.2921150e-5 * arcsec_per_rad;
 /// Default GL-2D sampling: 400 Hz, 0.92″ per pulse; Moscow latitude.

@@ -254,9 +254,32 @@ Verdict verdict_of(const AnalysisResult& r, const AnalysisOptions& options) {
   return decide(b_in, from_fit(Term::N), rho, options.verdict);
 }
 
+/// The Earth rate and the class table are a ring-laser gyro's on its test stand: on for pulse or
+/// counter input, or when asked for; off (and said) for other gyros; never for accelerometers.
+void decide_applicability(const Recording& rec, const AnalysisOptions& options, AnalysisResult& r) {
+  const bool gyro = r.sensor == SensorKind::Gyro;
+  const bool pulses = rec.mode == InputMode::Pulses || rec.mode == InputMode::Counter;
+  r.earth_rate_applied = gyro && options.earth_rate.value_or(pulses);
+  r.verdict_applies = gyro && options.verdict_wanted.value_or(pulses);
+  if (!gyro)
+    r.not_applied_reason = "an accelerometer: no Earth rate and no gyro class table";
+  else if (!r.earth_rate_applied || !r.verdict_applies)
+    r.not_applied_reason =
+        fmt::format("{} input, not a ring-laser gyro's pulses: {}{}{} (--vertical asks for both{})",
+                    to_string(rec.mode), r.earth_rate_applied ? "" : "the Earth rate is not subtracted",
+                    !r.earth_rate_applied && !r.verdict_applies ? " and " : "",
+                    r.verdict_applies ? "" : "the GOST RV 52339 class verdict is not given",
+                    !r.verdict_applies ? "; --limits FILE for the verdict"
+                                       : "; --earth-rate or --latitude for the Earth rate");
+}
+
 /// Mean rate, expected Earth rate and the bias between them.
 void earth_rate_and_bias(const Recording& rec, const AnalysisOptions& options, AnalysisResult& r) {
   r.mean_rate_deg_per_h = rec.phase.diff(rec.phase.points() - 1, 0) / r.duration_s;
+  if (!r.earth_rate_applied) {  // the mean is the bias (for an accelerometer, with gravity's projection)
+    r.bias_deg_per_h = r.mean_rate_deg_per_h;
+    return;
+  }
   r.earth_rate_given = options.earth_rate_deg_per_h.has_value();
   r.latitude_deg = r.earth_rate_given ? 0.0 : options.latitude_deg;
   r.earth_rate_deg_per_h =
@@ -346,27 +369,32 @@ void cross_checks(const Recording& rec, const AnalysisOptions& options, Analysis
 }  // namespace
 
 AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
-  if (read.phase.kind != PhaseKind::Gyro)
+  const std::optional<SensorKind> sensor = sensor_kind(read.phase.kind);
+  if (!sensor)
     throw UsageError(
         trf("{}: analyze needs gyro data (pulses, counter, angle in arcsec/deg/rad, or rate in "
-            "deg/h, deg/s, rad/s); this input is clock data",
+            "deg/h, deg/s, rad/s) or accelerometer data (m/s^2, g, mg, ug); this input is clock data",
             read.source));
   AnalysisResult r;
+  r.sensor = *sensor;
   Recording edited;
   const Recording& rec = screen_outliers(read, options.outlier_action, options.outlier_threshold, r.outliers, edited);
   describe_record(rec, options, r);
   r.input = input_json(read);  // as read: the outlier screen's copy keeps no notes
+  decide_applicability(read, options, r);
   if (rec.phase.points() < 3)
     throw AnalysisError(trf("{}: the record holds {} sample(s); far too short to analyse", rec.source, rec.samples));
   earth_rate_and_bias(rec, options, r);
   allan_and_fit(rec, options, r);
   if (options.cross_checks) {
     cross_checks(rec, options, r);
-    r.verdict = verdict_of(r, options);
+    if (r.sensor == SensorKind::Gyro) r.verdict = verdict_of(r, options);  // made, shown only if it applies
   }
   if (options.fit_checks) r.warnings = fit_warnings(r);
   return r;
 }
+
+static nlohmann::json to_json_fields(const AnalysisResult& r);
 
 namespace {
 
@@ -518,6 +546,16 @@ json conventions_json() {
 }  // namespace
 
 nlohmann::json to_json(const AnalysisResult& r) {
+  json j = to_json_fields(r);
+  if (!r.not_applied_reason.empty()) {  // keys present only when something is off
+    j["earth_rate_subtracted"] = r.earth_rate_applied;
+    j["verdict"]["applies"] = r.verdict_applies;
+    j["not_applied_reason"] = r.not_applied_reason;
+  }
+  return j;
+}
+
+static nlohmann::json to_json_fields(const AnalysisResult& r) {
   return {{"source", r.source},
           {"input", r.input},
           {"samples", r.samples},
@@ -527,7 +565,7 @@ nlohmann::json to_json(const AnalysisResult& r) {
           {"temperature_source", r.temperature_source},
           {"mean_rate_deg_per_h", r.mean_rate_deg_per_h},
           {"earth_rate_deg_per_h", r.earth_rate_deg_per_h},
-          {"latitude_deg", r.earth_rate_given ? json(nullptr) : json(r.latitude_deg)},
+          {"latitude_deg", r.earth_rate_given || !r.earth_rate_applied ? json(nullptr) : json(r.latitude_deg)},
           {"bias_deg_per_h", r.bias_deg_per_h},
           {"warnings", warnings_json(r)},
           {"allan", allan_bounds_json(r)},
@@ -569,6 +607,8 @@ std::string input_line(const nlohmann::json& in) {
 
 }  // namespace
 
+static std::string format_verdict(const AnalysisResult& r);
+
 std::string format_report(const AnalysisResult& r) {
   std::string s;
   s += trf("rwcalc analyze: {}\n\n", printable(r.source));
@@ -581,9 +621,13 @@ std::string format_report(const AnalysisResult& r) {
   s += input_line(r.input);
   s += r.temperature_c ? trf("  temperature {:g} °C (from {})\n", *r.temperature_c, r.temperature_source)
                        : std::string(tr("  temperature unknown\n"));
-  s += trf("  mean rate {:.4f} °/h; expected vertical Earth rate {:.4f} °/h ({}); bias {:+.4f} °/h\n\n",
-           r.mean_rate_deg_per_h, r.earth_rate_deg_per_h,
-           r.earth_rate_given ? std::string(tr("given")) : trf("latitude {:g}°", r.latitude_deg), r.bias_deg_per_h);
+  if (r.earth_rate_applied)
+    s += trf("  mean rate {:.4f} °/h; expected vertical Earth rate {:.4f} °/h ({}); bias {:+.4f} °/h\n\n",
+             r.mean_rate_deg_per_h, r.earth_rate_deg_per_h,
+             r.earth_rate_given ? std::string(tr("given")) : trf("latitude {:g}°", r.latitude_deg), r.bias_deg_per_h);
+  else
+    s += trf("  mean rate {:.4f} °/h, the bias (no Earth rate subtracted)\n  {}\n\n", r.mean_rate_deg_per_h,
+             r.not_applied_reason);
   s += format_outliers(r.outliers);
 
   s += trf("Allan deviation ({}, bounds at {:g} %{}; * = used in the fit)\n", to_string(r.allan.estimator),
@@ -667,6 +711,16 @@ std::string format_report(const AnalysisResult& r) {
             num(r.avg100.expected, 3), num(r.avg100.expected_sigma, 2), r.B_100s_vs_model_sigma);
   s += "\n";
 
+  s += r.verdict_applies ? format_verdict(r) : trf("Verdict: not given ({})\n\n", r.not_applied_reason);
+  s +=
+      tr("Conventions: Q = rms white angle error, sigma² = 3Q²/tau² (IEEE 952; the paper's eq. (2) Q is √3·Q);\n"
+         "  N = sigma(1 h) of the −½ line; B from sigma² = (2 ln2/π)·B², floor 0.6643·B (the paper prints B for B²);\n"
+         "  K = sigma(3 h) of the +½ line; R from sigma² = R²tau²/2; 1 °/h = 1 arcsec/s.\n");
+  return s;
+}
+
+static std::string format_verdict(const AnalysisResult& r) {
+  std::string s;
   const auto& v = r.verdict;
   s += trf("Verdict ({}; B from {}{})\n", tr(v.table_name), v.b_estimate,
            v.tolerance_pct > 0 ? trf("; heading-gyro tolerance +{:g} % on B", v.tolerance_pct)
@@ -676,10 +730,6 @@ std::string format_report(const AnalysisResult& r) {
   s += trf("  overall: {}", v.statement());
   if (v.cls != v.cls_strict) s += trf("  [with the tolerance; strict: class {}]", class_label(v.cls_strict));
   s += "\n\n";
-  s +=
-      tr("Conventions: Q = rms white angle error, sigma² = 3Q²/tau² (IEEE 952; the paper's eq. (2) Q is √3·Q);\n"
-         "  N = sigma(1 h) of the −½ line; B from sigma² = (2 ln2/π)·B², floor 0.6643·B (the paper prints B for B²);\n"
-         "  K = sigma(3 h) of the +½ line; R from sigma² = R²tau²/2; 1 °/h = 1 arcsec/s.\n");
   return s;
 }
 

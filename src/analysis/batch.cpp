@@ -201,7 +201,15 @@ std::vector<json> analyze_files(const std::vector<std::string>& files, const Rea
   std::vector<std::exception_ptr> errors(files.size());
   parallel_for(files.size(), [&](std::size_t i) {
     try {
-      out[i] = to_json(analyze(read_recording(files[i], read), options));
+      const AnalysisResult r = analyze(read_recording(files[i], read), options);
+      // The batch tables and the report are in a gyro's units and classes: an accelerometer
+      // column would be printed under them.
+      if (r.sensor != SensorKind::Gyro)
+        throw UsageError(
+            fmt::format("{}: column '{}' is an accelerometer channel; batch and report take gyro runs "
+                        "(use rwcalc imu or analyze for accelerometers)",
+                        files[i], r.column));
+      out[i] = to_json(r);
     } catch (...) {
       errors[i] = std::current_exception();
     }

@@ -71,12 +71,20 @@ void AnalyzeArgs::add_to(CLI::App& app) {
                  "up to N/10), all, or a list of seconds; the fit always uses the octave points")
       ->capture_default_str()
       ->group("Fit");
-  app.add_option("--latitude", latitude_deg, "Latitude for the vertical Earth rate, degrees")
-      ->check(real_in(-90.0, 90.0, "deg"))
-      ->capture_default_str()
-      ->group("Earth rate");
-  app.add_option("--earth-rate", earth_rate, "Expected sensed Earth rate, deg/h (overrides --latitude)")
+  latitude_option = app.add_option("--latitude", latitude_deg,
+                                   "Latitude for the vertical Earth rate, degrees (given: the Earth rate is "
+                                   "subtracted whatever the input)")
+                        ->check(real_in(-90.0, 90.0, "deg"))
+                        ->capture_default_str()
+                        ->group("Earth rate");
+  app.add_option("--earth-rate", earth_rate,
+                 "Expected sensed Earth rate, deg/h (overrides --latitude; given: it is subtracted whatever the "
+                 "input)")
       ->check(real_in(-kMaxRateDegPerH, kMaxRateDegPerH, "deg/h"))
+      ->group("Earth rate");
+  app.add_flag("--vertical", vertical,
+               "The gyro's axis is vertical: subtract the vertical Earth rate and give the class verdict for any "
+               "input (default: only for pulse or counter input, a ring-laser gyro's)")
       ->group("Earth rate");
   app.add_option("--b-estimate", b_estimate, "B estimate the verdict uses: fit, sigma-min or avg100")
       ->capture_default_str()
@@ -86,7 +94,9 @@ void AnalyzeArgs::add_to(CLI::App& app) {
       ->check(real_in(0.0, 1000.0, "%"))
       ->capture_default_str()
       ->group("Verdict");
-  app.add_option("--limits", limits_file, "Class table as JSON (default: GOST RV 52339)")->group("Verdict");
+  app.add_option("--limits", limits_file,
+                 "Class table as JSON (default: GOST RV 52339); given, the verdict is made for any input")
+      ->group("Verdict");
   app.add_option("--block", block_s, "Block length of the averaging cross-check, s")
       ->check(real_in(0.0, 1e9, "s", Ends::OpenLow))
       ->capture_default_str()
@@ -120,6 +130,10 @@ AnalysisOptions AnalyzeArgs::options() const {
   o.fit.select_terms = !keep_all_terms;
   o.latitude_deg = latitude_deg;
   o.earth_rate_deg_per_h = earth_rate;
+  // Asked for: the Earth rate by --vertical, --earth-rate or --latitude; the verdict by --vertical or
+  // --limits. Otherwise analyze decides by the input (on for pulse or counter input).
+  if (vertical || earth_rate || (latitude_option && latitude_option->count() > 0)) o.earth_rate = true;
+  if (vertical || !limits_file.empty()) o.verdict_wanted = true;
   o.verdict.b_estimate = parse_b_estimate(b_estimate);
   o.verdict.tolerance_pct = tolerance_pct;
   if (!limits_file.empty()) o.verdict.table = ClassTable::load(limits_file);

@@ -23,6 +23,8 @@ struct AnalyzeArgs {
   bool keep_all_terms = false;
   double latitude_deg = 55.75;
   std::optional<double> earth_rate;
+  bool vertical = false;                         ///< --vertical: Earth rate and class verdict for any input
+  const CLI::Option* latitude_option = nullptr;  ///< to tell a --latitude given from its default
   std::string b_estimate = "fit";
   double tolerance_pct = 0;
   std::string limits_file;

@@ -30,9 +30,11 @@ struct Command {
   void (*add)(CLI::App&, Runner&);
 };
 constexpr Command kCommands[] = {
-    {"allan", register_allan},   {"analyze", register_analyze},   {"batch", register_batch},
-    {"merge", register_merge},   {"simulate", register_simulate}, {"diagnose", register_diagnose},
-    {"report", register_report}, {"man", register_man},           {"completion", register_completion},
+    {"allan", register_allan},       {"analyze", register_analyze},
+    {"batch", register_batch},       {"merge", register_merge},
+    {"simulate", register_simulate}, {"diagnose", register_diagnose},
+    {"imu", register_imu},           {"report", register_report},
+    {"man", register_man},           {"completion", register_completion},
 };
 
 /// --lang on every command that writes results or messages (not man and completion, which

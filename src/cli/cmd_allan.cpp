@@ -125,8 +125,9 @@ int run_allan(const AllanArgs& a, Io& io) {
   const Recording& rec = screen_outliers(read, outlier_action, a.outlier_threshold, outliers, edited);
   // Increment and rate samples are frequency data for the noise identification, as Stable32
   // treats a frequency file; cumulative counters and angles are phase data.
-  o.noise_id_domain =
-      (rec.mode == InputMode::Pulses || rec.mode == InputMode::Rate) ? NoiseIdDomain::Frequency : NoiseIdDomain::Phase;
+  o.noise_id_domain = (rec.mode == InputMode::Pulses || rec.mode == InputMode::Rate || rec.mode == InputMode::Increment)
+                          ? NoiseIdDomain::Frequency
+                          : NoiseIdDomain::Phase;
   const AllanResult res = compute_allan(rec.phase, o);
   require_finite(res, rec);
   // Where fewer than 10 averages of τ fit in the record, Stable32's noise identification (the B1 ratio,

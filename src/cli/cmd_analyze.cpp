@@ -13,6 +13,7 @@
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
+#include "rwcalc/imu.hpp"
 #include "rwcalc/output.hpp"
 
 namespace rwcalc::cli {
@@ -28,6 +29,7 @@ struct AnalyzeCmd {
   std::string output = "-";
   PlotArgs plot;
   bool force = false;
+  std::string output_unit;  ///< "" : the classic report (gyro), the usual units (accelerometer)
 };
 
 }  // namespace
@@ -43,6 +45,9 @@ void register_analyze(CLI::App& app, Runner& runner) {
   cmd->analysis.add_to(*sub);
   add_temperature_option(*sub, cmd->temperature, "Temperature of the run, °C (overrides the file)");
   sub->add_flag("--json", cmd->json, "Print the JSON object instead of the report");
+  sub->add_option("--output-unit", cmd->output_unit,
+                  "Show the results in this unit: deg/h, deg/s, rad/s (gyro); m/s^2, g, mg, ug (accelerometer). "
+                  "Given, or for an accelerometer column, the report is the channel's table in these units and SI");
   add_output_options(*sub, cmd->output, cmd->force);
   cmd->plot.add_to(*sub,
                    "the Allan deviation with its confidence bars, the fitted model, each term's line and the "
@@ -57,6 +62,17 @@ void register_analyze(CLI::App& app, Runner& runner) {
       const Recording rec = read_recording(cmd->file, cmd->input.options());
       print_input_notes(io.err, rec);
       const AnalysisResult res = analyze(rec, opt);
+      if (res.sensor != SensorKind::Gyro || !cmd->output_unit.empty()) {
+        const UnitSet shown = output_units(res.sensor, cmd->output_unit);
+        const nlohmann::json j = channel_json(res, shown);
+        require_finite(j, rec.source);
+        cmd->plot.draw_analysis(j, cmd->force, io);
+        emit(io,
+             cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"
+                       : format_channel(res, shown),
+             cmd->output, cmd->force);
+        return 0;
+      }
       const std::string text = [&] {
         const nlohmann::json j = to_json(res);
         require_finite(j, rec.source);

@@ -54,6 +54,7 @@ void register_batch(CLI::App& app, Runner& runner);
 void register_merge(CLI::App& app, Runner& runner);
 void register_simulate(CLI::App& app, Runner& runner);
 void register_diagnose(CLI::App& app, Runner& runner);
+void register_imu(CLI::App& app, Runner& runner);
 void register_report(CLI::App& app, Runner& runner);
 void register_man(CLI::App& app, Runner& runner);         // src/cli/cmd_docs.cpp
 void register_completion(CLI::App& app, Runner& runner);  // src/cli/cmd_docs.cpp

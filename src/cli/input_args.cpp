@@ -22,8 +22,9 @@ void InputArgs::add_to(CLI::App& app) {
   app.add_option("--input", input,
                  "What the column holds: pulses (per-sample pulse increments), counter (cumulative "
                  "counter, wraps at --counter-bits), angle (cumulative angle/phase in --angle-unit), "
-                 "rate (rate samples in --rate-unit). Default: implied by a unit suffix of the column's name "
-                 "(gyro_x_dps: rate), else pulses")
+                 "rate (rate samples in --rate-unit), increment (per-sample angle or velocity increments in "
+                 "--angle-unit: an IMU's delta theta or delta v). Default: implied by a unit suffix of the column's "
+                 "name (gyro_x_dps: rate), else pulses")
       ->group("Input");
   app.add_option("--column", column, "Column to read: a header name or a 1-based index")->group("Input");
   app.add_option("--rate", rate_hz,
@@ -39,12 +40,13 @@ void InputArgs::add_to(CLI::App& app) {
       ->capture_default_str()
       ->group("Input");
   app.add_option("--angle-unit", angle_unit,
-                 "Unit of angle input: arcsec, deg, rad, or s (clock phase). Default: the column name's suffix "
-                 "(_deg, _rad, _arcsec), else arcsec")
+                 "Unit of angle input: arcsec, deg, rad, s (clock phase), or m/s (an accelerometer's cumulative "
+                 "velocity). Default: the column name's suffix (_deg, _rad, _arcsec, _mps), else arcsec")
       ->group("Input");
   app.add_option("--rate-unit", rate_unit,
-                 "Unit of rate input: deg/h, deg/s, rad/s, or 1 (dimensionless clock frequency). Default: the "
-                 "column name's suffix (_dps, _dph, _rads, ...), else deg/h")
+                 "Unit of rate input: deg/h, deg/s, rad/s, 1 (dimensionless clock frequency), or an "
+                 "accelerometer's m/s^2, g, mg, ug. Default: the column name's suffix (_dps, _dph, _rads, _g, "
+                 "_mps2, ...), else deg/h")
       ->group("Input");
   app.add_option("--time-tolerance", time_tolerance,
                  "Time-column steps off the sample period by more than this fraction of it are reported as "

@@ -55,6 +55,8 @@ void PlotArgs::draw_batch(const nlohmann::json& batch, bool force, Io& io) const
   draw(*this, plot_batch, batch, force, io);
 }
 
+void PlotArgs::draw_imu(const nlohmann::json& imu, bool force, Io& io) const { draw(*this, plot_imu, imu, force, io); }
+
 void PlotArgs::draw_diagnosis(const nlohmann::json& diagnosis, bool force, Io& io) const {
   draw(*this, plot_diagnosis, diagnosis, force, io);
 }

@@ -28,6 +28,8 @@ struct PlotArgs {
   void draw_analysis(const nlohmann::json& analysis, bool force, Io& io) const;
   /// Draw Figs. 1 and 2 of a batch ({"runs": [...]}).
   void draw_batch(const nlohmann::json& batch, bool force, Io& io) const;
+  /// Draw one panel per sensor kind of a `rwcalc imu --json` object.
+  void draw_imu(const nlohmann::json& imu, bool force, Io& io) const;
   /// Draw the measurement against the base and extended bands of a `rwcalc diagnose --json` object.
   void draw_diagnosis(const nlohmann::json& diagnosis, bool force, Io& io) const;
 };

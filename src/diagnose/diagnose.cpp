@@ -36,6 +36,10 @@ struct Context {
 /// a bias step or inflate N.
 const Recording& screened(const Recording& read, const DiagnoseOptions& opt, OutlierReport& outliers,
                           Recording& edited) {
+  if (read.phase.kind == PhaseKind::Accelerometer)
+    throw UsageError(
+        "diagnose needs gyro data: an accelerometer column is analysed by analyze and imu, not yet "
+        "diagnosed");
   if (read.phase.kind != PhaseKind::Gyro)
     throw UsageError(tr("diagnose needs gyro data (clock phase/frequency cannot be simulated as a gyro)"));
   if (opt.runs < 10) throw UsageError(trf("--runs must be at least 10 (got {})", opt.runs));
@@ -53,6 +57,9 @@ const Recording& screened(const Recording& read, const DiagnoseOptions& opt, Out
 void fit_base(Context& c, DiagnoseResult& r, OutlierReport outliers) {
   c.aopt = c.opt.analysis;
   c.aopt.outlier_action = OutlierAction::Keep;
+  // The Earth-rate choice is the recording's (pulse input: on), kept for the cleaned and sliced
+  // floating series the stages analyse.
+  if (!c.aopt.earth_rate) c.aopt.earth_rate = c.rec.mode == InputMode::Pulses || c.rec.mode == InputMode::Counter;
   const PhaseSeries& x = c.rec.phase;
   if (x.exact() && c.aopt.fit.tau_min_s <= 0) c.aopt.fit.tau_min_s = kPulseFitTauMin;
   r.analysis = analyze_for_base(c.rec, c.aopt);

@@ -37,7 +37,8 @@ constexpr std::string_view kTemperatureNames[] = {"temperature_c", "temperature"
 const std::vector<std::string_view> kValueNames[] = {{"pulses", "pulse", "counts", "count"},
                                                      {"counter", "count", "counts", "pulses"},
                                                      {"angle", "phase"},
-                                                     {"rate", "gyro", "frequency", "freq"}};
+                                                     {"rate", "gyro", "frequency", "freq"},
+                                                     {"increment", "delta", "dtheta", "dv"}};
 
 const TimeName* time_name(std::string_view field) {
   for (const TimeName& t : kTimeNames)
@@ -337,10 +338,16 @@ constexpr UnitSuffix kUnitSuffixes[] = {{"_deg_s", InputMode::Rate, {}, RateUnit
                                         {"_rad_s", InputMode::Rate, {}, RateUnit::RadPerSecond},
                                         {"_radps", InputMode::Rate, {}, RateUnit::RadPerSecond},
                                         {"_rads", InputMode::Rate, {}, RateUnit::RadPerSecond},
+                                        {"_m_s2", InputMode::Rate, {}, RateUnit::MetrePerSecond2},
+                                        {"_mps2", InputMode::Rate, {}, RateUnit::MetrePerSecond2},
+                                        {"_ms2", InputMode::Rate, {}, RateUnit::MetrePerSecond2},
+                                        {"_mg", InputMode::Rate, {}, RateUnit::MilliG},
+                                        {"_ug", InputMode::Rate, {}, RateUnit::MicroG},
+                                        {"_g", InputMode::Rate, {}, RateUnit::G},
+                                        {"_mps", InputMode::Angle, AngleUnit::MetrePerSecond},
                                         {"_arcsec", InputMode::Angle, AngleUnit::Arcsec},
                                         {"_deg", InputMode::Angle, AngleUnit::Deg},
                                         {"_rad", InputMode::Angle, AngleUnit::Rad}};
-constexpr std::string_view kAccelSuffixes[] = {"_mps2", "_m_s2", "_ms2", "_g"};
 
 bool ends_with_nocase(std::string_view s, std::string_view suffix) {
   return s.size() > suffix.size() && iequals(s.substr(s.size() - suffix.size()), suffix);
@@ -372,13 +379,8 @@ Unit choose_unit(std::optional<Unit> given, std::optional<Unit> named, Unit fall
 
 }  // namespace
 
-InputChoice choose_input(const ReadOptions& o, std::string_view column, const std::string& file, std::size_t line) {
-  for (const std::string_view a : kAccelSuffixes)
-    if (ends_with_nocase(column, a))
-      throw InputError(file, line,
-                       trf("column '{}' is an accelerometer channel (unit '{}' in its name); accelerometer "
-                           "channels are not supported by this command: choose a gyro column with --column",
-                           column, a.substr(1)));
+InputChoice choose_input(const ReadOptions& o, std::string_view column, const std::string& /*file*/,
+                         std::size_t /*line*/) {
   InputChoice c;
   const UnitSuffix* u = unit_suffix(column);
   if (o.mode) {
@@ -390,7 +392,7 @@ InputChoice choose_input(const ReadOptions& o, std::string_view column, const st
     c.mode = u->mode;
     c.notes.push_back(fmt::format("input {} from the column name '{}' (no --input given)", to_string(c.mode), column));
   }
-  const bool angle = c.mode == InputMode::Angle, rate = c.mode == InputMode::Rate;
+  const bool angle = c.mode == InputMode::Angle || c.mode == InputMode::Increment, rate = c.mode == InputMode::Rate;
   const bool named_angle = u && u->mode == InputMode::Angle, named_rate = u && u->mode == InputMode::Rate;
   if (angle)
     c.angle_unit = choose_unit(o.angle_unit, named_angle ? std::optional(u->angle) : std::nullopt, AngleUnit::Arcsec,

@@ -66,8 +66,8 @@ struct InputChoice {
   RateUnit rate_unit = RateUnit::DegPerHour;
   std::vector<std::string> notes, warnings;
 };
-/// `column`: the selected column's header name ("" without a header). Throws InputError at `line`
-/// for an accelerometer column (`acc_x_g`, `_mps2`).
+/// `column`: the selected column's header name ("" without a header); accelerometer suffixes
+/// (`_g`, `_mg`, `_ug`, `_mps2`) choose rate input in that unit as gyro suffixes do.
 InputChoice choose_input(const ReadOptions& o, std::string_view column, const std::string& file, std::size_t line);
 
 struct Layout {

@@ -89,35 +89,43 @@ struct TimeTrack {
   }
 };
 
-template <class E>
-using NameTable = std::pair<E, std::string_view>[4];
-constexpr NameTable<InputMode> kModes{{InputMode::Pulses, "pulses"},
-                                      {InputMode::Counter, "counter"},
-                                      {InputMode::Angle, "angle"},
-                                      {InputMode::Rate, "rate"}};
-constexpr NameTable<AngleUnit> kAngleUnits{{AngleUnit::Arcsec, "arcsec"},
-                                           {AngleUnit::Deg, "deg"},
-                                           {AngleUnit::Rad, "rad"},
-                                           {AngleUnit::Second, "s"}};
-constexpr NameTable<RateUnit> kRateUnits{{RateUnit::DegPerHour, "deg/h"},
-                                         {RateUnit::DegPerSecond, "deg/s"},
-                                         {RateUnit::RadPerSecond, "rad/s"},
-                                         {RateUnit::Unitless, "1"}};
+template <class E, std::size_t Size = 4>
+using NameTable = std::pair<E, std::string_view>[Size];
+constexpr NameTable<InputMode, 5> kModes{{InputMode::Pulses, "pulses"},
+                                         {InputMode::Counter, "counter"},
+                                         {InputMode::Angle, "angle"},
+                                         {InputMode::Rate, "rate"},
+                                         {InputMode::Increment, "increment"}};
+constexpr NameTable<AngleUnit, 5> kAngleUnits{{AngleUnit::Arcsec, "arcsec"},
+                                              {AngleUnit::Deg, "deg"},
+                                              {AngleUnit::Rad, "rad"},
+                                              {AngleUnit::Second, "s"},
+                                              {AngleUnit::MetrePerSecond, "m/s"}};
+constexpr NameTable<RateUnit, 8> kRateUnits{{RateUnit::DegPerHour, "deg/h"},
+                                            {RateUnit::DegPerSecond, "deg/s"},
+                                            {RateUnit::RadPerSecond, "rad/s"},
+                                            {RateUnit::Unitless, "1"},
+                                            {RateUnit::MetrePerSecond2, "m/s^2"},
+                                            {RateUnit::G, "g"},
+                                            {RateUnit::MilliG, "mg"},
+                                            {RateUnit::MicroG, "ug"}};
 constexpr NameTable<RateSource> kRateSources{{RateSource::Option, "option"},
                                              {RateSource::Metadata, "metadata"},
                                              {RateSource::TimeColumn, "time column"},
                                              {RateSource::Default, "default"}};
 
-template <class E>
-E parse_name(const NameTable<E>& table, std::string_view s, std::string_view option) {
-  for (const auto& [value, name] : table)
+template <class E, std::size_t Size>
+E parse_name(const NameTable<E, Size>& table, std::string_view s, std::string_view option) {
+  std::string names;
+  for (const auto& [value, name] : table) {
     if (name == s) return value;
-  throw UsageError(trf("unknown {} '{}': expected {}, {}, {} or {}", option, s, table[0].second, table[1].second,
-                       table[2].second, table[3].second));
+    names += fmt::format("{}{}", names.empty() ? "" : &name == &table[Size - 1].second ? " or " : ", ", name);
+  }
+  throw UsageError(trf("unknown {} '{}': expected {}", option, s, names));
 }
 
-template <class E>
-std::string_view name_of(const NameTable<E>& table, E e) {
+template <class E, std::size_t Size>
+std::string_view name_of(const NameTable<E, Size>& table, E e) {
   for (const auto& [value, name] : table)
     if (value == e) return name;
   return "?";
@@ -269,7 +277,7 @@ std::size_t Reader::mac_limit(std::string& buf, std::size_t from, bool at_end) c
 // The first sample: the phase's starting point, and the time columns' units.
 void Reader::start_samples(const Sample& s) {
   if (in().mode == InputMode::Pulses) ints_.push_back(0);   // C_0
-  if (in().mode == InputMode::Rate) reals_.push_back(0.0);  // x_0
+  if (in().mode == InputMode::Rate || in().mode == InputMode::Increment) reals_.push_back(0.0);  // x_0
   if (layout_.time_col) tunit_ = time_unit_of(layout_.time_unit, s.time, detail::Role::Time);
   if (layout_.time2_col) tunit2_ = time_unit_of(layout_.time2_unit, s.time2, detail::Role::Time2);
 }
@@ -475,6 +483,35 @@ void Reader::build_counts(PhaseSeries& ph, std::size_t& wraps) {
   ph.counts = std::move(c);
 }
 
+// Phase units per unit of angle input: arcsec, clock seconds, or velocity in 1/3600 m/s (units.hpp).
+double phase_factor(AngleUnit u) {
+  switch (u) {
+    case AngleUnit::Deg: return units::arcsec_per_deg;
+    case AngleUnit::Rad: return units::arcsec_per_rad;
+    case AngleUnit::MetrePerSecond: return units::velocity_units_per_mps;
+    case AngleUnit::Arcsec:
+    case AngleUnit::Second: break;
+  }
+  return 1.0;
+}
+
+// Phase units per second per unit of rate input: ″/s = °/h for gyros, (1/3600 m/s)/s = m/s/h for
+// accelerometers.
+double phase_factor(RateUnit u) {
+  constexpr double g = units::standard_gravity * units::velocity_units_per_mps;
+  switch (u) {
+    case RateUnit::DegPerSecond: return units::arcsec_per_deg;
+    case RateUnit::RadPerSecond: return units::arcsec_per_rad;
+    case RateUnit::MetrePerSecond2: return units::velocity_units_per_mps;
+    case RateUnit::G: return g;
+    case RateUnit::MilliG: return g * 1e-3;
+    case RateUnit::MicroG: return g * 1e-6;
+    case RateUnit::DegPerHour:
+    case RateUnit::Unitless: break;
+  }
+  return 1.0;
+}
+
 // Angle samples in arcsec (or s); rate samples integrated to phase as in SP 1065.
 void Reader::build_values(PhaseSeries& ph) {
   // Floating phase beyond this (arcsec, or s for clocks) would overflow the squares of second
@@ -482,12 +519,8 @@ void Reader::build_values(PhaseSeries& ph) {
   constexpr double kMaxPhase = 1e150;
   std::vector<double>& x = reals_;
   const bool angle = in().mode == InputMode::Angle;
-  const double f = angle ? (in().angle_unit == AngleUnit::Deg   ? units::arcsec_per_deg
-                            : in().angle_unit == AngleUnit::Rad ? units::arcsec_per_rad
-                                                                : 1.0)
-                         : (in().rate_unit == RateUnit::DegPerSecond   ? units::arcsec_per_deg
-                            : in().rate_unit == RateUnit::RadPerSecond ? units::arcsec_per_rad
-                                                                       : 1.0);  // rate: to ″/s = °/h
+  const bool increments = in().mode == InputMode::Increment;  // summed like rates, without the τ0
+  const double f = angle || increments ? phase_factor(in().angle_unit) : phase_factor(in().rate_unit);
   for (std::size_t i = 0; angle && i < x.size(); ++i)
     if (!(std::abs(x[i] *= f) <= kMaxPhase)) [[unlikely]]
       fail(line_of_sample(i), fmt::format("angle out of range: {} is beyond ±{:g} arcsec, where the Allan "
@@ -497,7 +530,7 @@ void Reader::build_values(PhaseSeries& ph) {
     // x_0 = 0, x_j = τ0·Σ_{i<j} (y_i − ȳ), accumulated in long double. The mean rate ȳ goes into
     // rate_offset (series.hpp): a phase that kept it would grow to ȳ·T and round its noise away
     // once the offset is many orders above the noise.
-    const long double k = static_cast<long double>(ph.tau0_s) * f;
+    const long double k = increments ? static_cast<long double>(f) : static_cast<long double>(ph.tau0_s) * f;
     long double sum = 0, acc = 0;
     for (std::size_t i = 1; i < x.size(); ++i) sum += x[i];
     const double mean = x.size() > 1 ? static_cast<double>(sum / static_cast<long double>(x.size() - 1)) : 0.0;
@@ -512,7 +545,7 @@ void Reader::build_values(PhaseSeries& ph) {
                          "Allan variance would overflow) at this sample, {}",
                          static_cast<double>(whole), kMaxPhase, quoted(fmt::format("{:g}", y))));
     }
-    ph.rate_offset = mean * f;
+    ph.rate_offset = increments ? mean * f / ph.tau0_s : mean * f;
   }
   ph.values = std::move(x);
   check_data_magnitude(ph, angle ? "angle" : "rate");
@@ -534,9 +567,13 @@ Recording Reader::finish() {
   rec.samples = samples_;
   PhaseSeries& ph = rec.phase;
   ph.tau0_s = 1.0 / rate_hz_;
-  const bool clock = (in().mode == InputMode::Angle && in().angle_unit == AngleUnit::Second) ||
-                     (in().mode == InputMode::Rate && in().rate_unit == RateUnit::Unitless);
-  ph.kind = clock ? PhaseKind::Clock : PhaseKind::Gyro;
+  const bool clock =
+      ((in().mode == InputMode::Angle || in().mode == InputMode::Increment) && in().angle_unit == AngleUnit::Second) ||
+      (in().mode == InputMode::Rate && in().rate_unit == RateUnit::Unitless);
+  const bool accel = ((in().mode == InputMode::Angle || in().mode == InputMode::Increment) &&
+                      is_accelerometer_unit(in().angle_unit)) ||
+                     (in().mode == InputMode::Rate && is_accelerometer_unit(in().rate_unit));
+  ph.kind = clock ? PhaseKind::Clock : accel ? PhaseKind::Accelerometer : PhaseKind::Gyro;
   if (integer_mode())
     build_counts(ph, rec.counter_wraps);
   else
@@ -644,7 +681,8 @@ std::string_view input_unit(const Recording& rec) {
   switch (rec.mode) {
     case InputMode::Pulses: return "pulse";
     case InputMode::Counter: return "count";
-    case InputMode::Angle: return to_string(rec.angle_unit);
+    case InputMode::Angle:
+    case InputMode::Increment: return to_string(rec.angle_unit);
     case InputMode::Rate: return to_string(rec.rate_unit);
   }
   return "?";
@@ -660,7 +698,15 @@ std::string describe_input(const Recording& rec) {
 
 InputMode parse_input_mode(std::string_view s) { return parse_name(kModes, s, "--input"); }
 AngleUnit parse_angle_unit(std::string_view s) { return parse_name(kAngleUnits, s, "--angle-unit"); }
-RateUnit parse_rate_unit(std::string_view s) { return parse_name(kRateUnits, s, "--rate-unit"); }
+RateUnit parse_rate_unit(std::string_view s) {
+  if (s == "m/s2" || s == "mps2") return RateUnit::MetrePerSecond2;
+  if (s == "µg") return RateUnit::MicroG;
+  return parse_name(kRateUnits, s, "--rate-unit");
+}
+bool is_accelerometer_unit(RateUnit u) noexcept {
+  return u == RateUnit::MetrePerSecond2 || u == RateUnit::G || u == RateUnit::MilliG || u == RateUnit::MicroG;
+}
+bool is_accelerometer_unit(AngleUnit u) noexcept { return u == AngleUnit::MetrePerSecond; }
 std::string_view to_string(InputMode m) { return name_of(kModes, m); }
 std::string_view to_string(RateSource s) { return name_of(kRateSources, s); }
 std::string_view to_string(AngleUnit u) { return name_of(kAngleUnits, u); }

@@ -8,7 +8,9 @@
 
 namespace rwcalc {
 
-std::string unit_label(const AllanResult& r) { return tr(r.unit == "deg/h" ? units::label::rate : "input units/s"); }
+std::string unit_label(const AllanResult& r) {
+  return r.unit == "deg/h" ? tr(units::label::rate) : r.unit == "m/s/h" ? "m/s/h" : tr("input units/s");
+}
 
 std::string format_allan_table(const AllanResult& r, const AllanReportInfo& info) {
   const std::string u = unit_label(r);
@@ -21,6 +23,8 @@ std::string format_allan_table(const AllanResult& r, const AllanReportInfo& info
   if (r.unit == "deg/h")
     out += trf("# units: deviations in {0} (convention 1{1}/s = 1 {0} exactly); τ in s\n", tr(units::label::rate),
                tr(units::label::angle));
+  else if (r.unit == "m/s/h")  // accelerometer (units.hpp): 1 m/s/h = 1/3600 m/s² = 28.33 µg
+    out += tr("# units: deviations in m/s/h (accelerometer; 1 m/s/h = 1/3600 m/s^2); τ in s\n");
   else
     out += tr("# units: deviations in input units per second (dimensionless for phase in s); τ in s\n");
   out += trf("# samples: {}   phase points: {}   τ0: {:g} s", info.samples, r.points_in, r.tau0_s);
@@ -42,7 +46,7 @@ std::string format_allan_table(const AllanResult& r, const AllanReportInfo& info
 }
 
 std::string format_allan_csv(const AllanResult& r) {
-  const std::string u = r.unit == "deg/h" ? "deg_h" : "1";
+  const std::string u = r.unit == "deg/h" ? "deg_h" : r.unit == "m/s/h" ? "m_s_h" : "1";
   std::string out = fmt::format("af,tau_s,n,alpha,edf,dev_low_{0},dev_{0},dev_high_{0}\n", u);
   for (const AllanPoint& p : r.points)
     out += fmt::format("{},{:.17g},{},{},{:.10g},{:.10g},{:.10g},{:.10g}\n", p.m, p.tau_s, p.n, p.alpha, p.edf,

@@ -1,0 +1,412 @@
+// A whole IMU from one recording (imu.hpp): every channel's analysis, their tables and JSON.
+#include "rwcalc/imu.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <iterator>
+#include <sstream>
+
+#include "rwcalc/error.hpp"
+#include "rwcalc/parallel.hpp"
+#include "rwcalc/printable.hpp"
+
+namespace rwcalc {
+
+namespace imu_impl {
+
+std::string read_bytes(const std::string& path) {
+  if (path == "-") return {std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>()};
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, 0, fmt::format("cannot open: {}", std::strerror(errno)));
+  std::ostringstream s;
+  s << in.rdbuf();
+  return std::move(s).str();
+}
+
+struct ChannelSpec {
+  std::string column;
+  SensorKind kind;
+};
+
+// The channel's read options: its column, and rate input in the unit given for its kind (else the
+// column name's suffix decides, as for analyze).
+ReadOptions channel_read(const ImuOptions& o, const ChannelSpec& c) {
+  ReadOptions r = o.read;
+  r.column = c.column;
+  const bool gyro = c.kind == SensorKind::Gyro;
+  if (const std::optional<RateUnit> unit = gyro ? o.gyro_unit : o.accel_unit) {
+    r.mode = InputMode::Rate;
+    r.rate_unit = unit;
+  } else if (const std::optional<AngleUnit> inc = gyro ? o.gyro_increment_unit : o.accel_increment_unit) {
+    r.mode = InputMode::Increment;
+    r.angle_unit = inc;
+  }
+  return r;
+}
+
+void check_kind(const Recording& rec, const ChannelSpec& c) {
+  const std::optional<SensorKind> read = sensor_kind(rec.phase.kind);
+  if (read == c.kind) return;
+  const bool gyro = c.kind == SensorKind::Gyro;
+  throw UsageError(fmt::format("{}: column '{}' is given as {} but was read as {} ({}); give its unit with {}",
+                               rec.source, c.column, gyro ? "--gyro" : "--accel",
+                               read ? std::string(to_string(*read)) : std::string("clock data"), describe_input(rec),
+                               gyro ? "--gyro-unit (deg/h, deg/s, rad/s)" : "--accel-unit (m/s^2, g, mg, ug)"));
+}
+
+std::string imu_num(double v, int sig = 4) { return fmt::format("{:.{}g}", v, sig); }
+
+nlohmann::json shown_coef(const Coefficient& c, const ShownUnit& u) {
+  return {{"value", c.value * u.factor}, {"low95", c.low * u.factor},
+          {"high95", c.high * u.factor}, {"sigma", c.sigma * u.factor},
+          {"resolved", c.resolved},      {"in_model", c.in_model},
+          {"fitted", c.enabled},         {"unit", u.ascii}};
+}
+
+nlohmann::json allan_shown(const AllanResult& a, const ShownUnit& u) {
+  nlohmann::json pts = nlohmann::json::array();
+  for (const auto& p : a.points)
+    pts.push_back({{"m", p.m},
+                   {"tau_s", p.tau_s},
+                   {"edf", p.edf},
+                   {"dev", p.dev * u.factor},
+                   {"dev_low", p.dev_low * u.factor},
+                   {"dev_high", p.dev_high * u.factor}});
+  return {{"estimator", std::string(to_string(a.estimator))},
+          {"unit", u.ascii},
+          {"confidence", a.confidence},
+          {"points", pts}};
+}
+
+// "2.41 [2.39, 2.43]" or "< 0.031" (unresolved: the 95 % upper bound), "-" when not fitted.
+std::string cell(const Coefficient& c, double factor) {
+  if (!c.enabled) return "-";
+  if (!c.resolved) return fmt::format("< {}", imu_num(c.value * factor, 3));
+  return fmt::format("{} [{}, {}]", imu_num(c.value * factor, 4), imu_num(c.low * factor, 3),
+                     imu_num(c.high * factor, 3));
+}
+
+std::string units_line(const UnitSet& u) {
+  return fmt::format("Q {}, N {}, B {}, K {}, R {}; mean and Allan deviation in {}", u[Term::Q].label, u[Term::N].label,
+                     u[Term::B].label, u[Term::K].label, u[Term::R].label, u.deviation.label);
+}
+
+// Earth rate and class verdict: what was done for this channel, one phrase.
+std::string earth_and_verdict(const AnalysisResult& r) {
+  if (r.sensor != SensorKind::Gyro) return "no Earth rate, no class verdict (accelerometer)";
+  const std::string earth = r.earth_rate_applied
+                                ? fmt::format("Earth rate {} °/h subtracted", imu_num(r.earth_rate_deg_per_h, 4))
+                                : std::string("no Earth rate subtracted");
+  const std::string verdict =
+      r.verdict_applies ? fmt::format("class verdict: {}", r.verdict.statement()) : std::string("no class verdict");
+  return fmt::format("{}; {}{}", earth, verdict,
+                     r.not_applied_reason.empty()
+                         ? ""
+                         : " (ask with --vertical or imu --vertical-gyro COL, --limits, --earth-rate)");
+}
+
+}  // namespace imu_impl
+
+using namespace imu_impl;
+
+ImuResult analyze_imu(const std::string& path, const ImuOptions& options) {
+  std::vector<ChannelSpec> specs;
+  for (const auto& c : options.gyro_columns) specs.push_back({c, SensorKind::Gyro});
+  for (const auto& c : options.accel_columns) specs.push_back({c, SensorKind::Accelerometer});
+  if (specs.empty()) throw UsageError("imu needs at least one column: give --gyro COLS and/or --accel COLS");
+  if (!options.vertical_gyro.empty() && std::find(options.gyro_columns.begin(), options.gyro_columns.end(),
+                                                  options.vertical_gyro) == options.gyro_columns.end())
+    throw UsageError(fmt::format("--vertical-gyro {}: not one of the --gyro columns", options.vertical_gyro));
+  ImuResult out;
+  out.source = path;
+  out.gyro_units = output_units(SensorKind::Gyro, options.gyro_output_unit);
+  out.accel_units = output_units(SensorKind::Accelerometer, options.accel_output_unit);
+  const std::string bytes = read_bytes(path);
+  out.channels.resize(specs.size());
+  parallel_for(specs.size(), [&](std::size_t i) {
+    const Recording rec = read_recording_text(bytes, path, channel_read(options, specs[i]));
+    check_kind(rec, specs[i]);
+    AnalysisOptions a = options.analysis;
+    if (!options.vertical_gyro.empty() && specs[i].kind == SensorKind::Gyro &&
+        (specs[i].column == options.vertical_gyro || rec.column_name == options.vertical_gyro))
+      a.earth_rate = a.verdict_wanted = true;
+    out.channels[i] = {rec.column_name, specs[i].kind, analyze(rec, a)};
+  });
+  return out;
+}
+
+nlohmann::json channel_json(const AnalysisResult& r, const UnitSet& shown) {
+  const UnitSet si = si_units(r.sensor);
+  nlohmann::json fit = nlohmann::json::object();
+  for (const Term t : kAllTerms) {
+    nlohmann::json c = shown_coef(r.fit[t], shown[t]);
+    c["meaning"] = std::string(term_meaning(r.sensor, t));
+    c["si"] = shown_coef(r.fit[t], si[t]);
+    fit[std::string(term_name(t))] = std::move(c);
+  }
+  const auto& f = r.fit;
+  fit["chi2_per_dof"] = f.chi2_per_dof;
+  fit["p_value"] = f.p_value;
+  fit["dof"] = f.dof;
+  fit["tau_min_s"] = f.used.empty() ? 0.0 : f.used.front().tau_s;
+  fit["tau_max_s"] = f.used.empty() ? 0.0 : f.used.back().tau_s;
+  fit["range_reason"] = r.fit_range.reason();
+  fit["intervals_scaled"] = r.fit_range.intervals_scaled;
+  nlohmann::json warnings = nlohmann::json::array();
+  for (const auto& w : r.warnings) warnings.push_back({{"code", w.code}, {"message", w.message}});
+  return {{"source", r.column},
+          {"file", r.source},
+          {"column", r.column},
+          {"sensor", std::string(to_string(r.sensor))},
+          {"input", r.input},
+          {"samples", r.samples},
+          {"rate_hz", r.rate_hz},
+          {"duration_s", r.duration_s},
+          {"mean", {{"value", r.mean_rate_deg_per_h * shown.deviation.factor}, {"unit", shown.deviation.ascii}}},
+          {"earth_rate_subtracted",
+           r.earth_rate_applied ? nlohmann::json(r.earth_rate_deg_per_h * shown.deviation.factor) : nullptr},
+          {"verdict", r.verdict_applies ? to_json(r.verdict) : nlohmann::json(nullptr)},
+          {"not_applied_reason", r.not_applied_reason},
+          {"allan", allan_shown(r.allan, shown.deviation)},
+          {"fit", std::move(fit)},
+          {"warnings", std::move(warnings)}};
+}
+
+std::string format_channel(const AnalysisResult& r, const UnitSet& shown) {
+  std::string s = fmt::format("rwcalc {}: {}, column '{}'\n\n", to_string(r.sensor), printable(r.source), r.column);
+  s += format_warnings(r.warnings);
+  s += fmt::format("Data\n  {} samples at {:g} Hz, {:.1f} s ({:.2f} h); mean {} {}; {}\n", r.samples, r.rate_hz,
+                   r.duration_s, r.duration_s / 3600.0, imu_num(r.mean_rate_deg_per_h * shown.deviation.factor, 6),
+                   shown.deviation.label, earth_and_verdict(r));
+  s += fmt::format("\nAllan deviation ({}, {:g} % bounds)\n  {:>11} {:>12} {:>12} {:>12}\n",
+                   to_string(r.allan.estimator), 100 * r.allan.confidence, "tau (s)", "sigma", "low", "high");
+  const double k = shown.deviation.factor;
+  for (const auto& p : r.allan.points)
+    s += fmt::format("  {:>11.5g} {:>12.5g} {:>12.5g} {:>12.5g}\n", p.tau_s, p.dev * k, p.dev_low * k, p.dev_high * k);
+  s += fmt::format(
+      "  (in {})\n\nNoise coefficients (fit over tau {:g}..{:g} s; 95 % profile intervals; < : not "
+      "resolved, 95 % upper bound)\n",
+      shown.deviation.label, r.fit.used.front().tau_s, r.fit.used.back().tau_s);
+  const UnitSet si = si_units(r.sensor);
+  for (const Term t : kAllTerms)
+    s += fmt::format("  {} {:<26} {:<28} {:<12} = {} {}\n", term_name(t), term_meaning(r.sensor, t),
+                     cell(r.fit[t], shown[t].factor), shown[t].label, cell(r.fit[t], si[t].factor), si[t].label);
+  s += fmt::format("  chi2/dof = {:.2f} (dof {}, p = {:.3g}); fit range: {}\n", r.fit.chi2_per_dof, r.fit.dof,
+                   r.fit.p_value, r.fit_range.reason());
+  return s;
+}
+
+namespace imu_impl {
+
+std::vector<const ImuChannel*> of_kind(const ImuResult& r, SensorKind k) {
+  std::vector<const ImuChannel*> out;
+  for (const auto& c : r.channels)
+    if (c.kind == k) out.push_back(&c);
+  return out;
+}
+
+// One table per kind: a row per term, a column per axis.
+std::string kind_table(const std::vector<const ImuChannel*>& axes, const UnitSet& u) {
+  if (axes.empty()) return {};
+  const SensorKind kind = axes.front()->kind;
+  const UnitSet si = si_units(kind);
+  // Columns as wide as their widest cell (the SI N with its interval is the widest).
+  std::size_t width = 12;
+  for (const auto* a : axes)
+    for (const Term t : kAllTerms)
+      width = std::max({width, a->column.size(), cell(a->result.fit[t], u[t].factor).size(),
+                        cell(a->result.fit[t], si[t].factor).size()});
+  const int kWidth = static_cast<int>(width + 2);
+  std::string s = fmt::format("{} ({} axes; {};\n  95 % profile intervals; < : not resolved, 95 % upper bound)\n",
+                              kind == SensorKind::Gyro ? "Gyro" : "Accelerometer", axes.size(), units_line(u));
+  s += fmt::format("  {:<30}", "");
+  for (const auto* a : axes) s += fmt::format("{:<{}}", printable(a->column), kWidth);
+  s += "\n";
+  auto row = [&](std::string_view head, auto&& value) {
+    s += fmt::format("  {:<30}", head);
+    for (const auto* a : axes) s += fmt::format("{:<{}}", value(a->result), kWidth);
+    s += "\n";
+  };
+  row("mean", [&](const AnalysisResult& r) { return imu_num(r.mean_rate_deg_per_h * u.deviation.factor, 6); });
+  for (const Term t : kAllTerms)
+    row(fmt::format("{} {}", term_name(t), term_meaning(kind, t)),
+        [&](const AnalysisResult& r) { return cell(r.fit[t], u[t].factor); });
+  row(fmt::format("N in {}", si[Term::N].label),
+      [&](const AnalysisResult& r) { return cell(r.fit[Term::N], si[Term::N].factor); });
+  row(fmt::format("K in {}", si[Term::K].label),
+      [&](const AnalysisResult& r) { return cell(r.fit[Term::K], si[Term::K].factor); });
+  row("fit chi2/dof (p)",
+      [](const AnalysisResult& r) { return fmt::format("{:.2f} ({:.2g})", r.fit.chi2_per_dof, r.fit.p_value); });
+  row("fit tau (s)", [](const AnalysisResult& r) {
+    return fmt::format("{:g}..{:g}", r.fit.used.front().tau_s, r.fit.used.back().tau_s);
+  });
+  for (const auto* a : axes) s += fmt::format("  {}: {}\n", printable(a->column), earth_and_verdict(a->result));
+  return s + "\n";
+}
+
+// Each axis' noise density (N) and random walk (K) in SI, and the value the noise file uses.
+struct AxisNoise {
+  std::string column;
+  Coefficient N, K;          ///< in SI (factor applied)
+  double rejected_chi2 = 0;  ///< χ²/dof of a fit the goodness of fit rejected (its intervals scaled), else 0
+};
+
+Coefficient scaled(const Coefficient& c, double f) {
+  Coefficient o = c;
+  o.estimate *= f, o.value *= f, o.sigma *= f, o.low *= f, o.high *= f;
+  return o;
+}
+
+std::vector<AxisNoise> axis_noise(const ImuResult& r, SensorKind kind) {
+  const UnitSet si = si_units(kind);
+  std::vector<AxisNoise> out;
+  for (const auto* c : of_kind(r, kind))
+    out.push_back({c->column, scaled(c->result.fit[Term::N], si[Term::N].factor),
+                   scaled(c->result.fit[Term::K], si[Term::K].factor),
+                   c->result.fit_range.intervals_scaled ? c->result.fit.chi2_per_dof : 0.0});
+  return out;
+}
+
+// The combined value of one coefficient over the axes: the largest value (an unresolved axis
+// counts with its upper bound), or their mean; `bound` when any value used is an upper bound.
+struct Combined {
+  double value = 0;
+  bool bound = false;
+  std::string from;  ///< the worst axis' column
+};
+
+Combined combine(const std::vector<AxisNoise>& axes, Coefficient AxisNoise::*which, AxisCombination how) {
+  Combined c;
+  double sum = 0;
+  bool any_bound = false;
+  for (const auto& a : axes) {
+    const Coefficient& k = a.*which;
+    sum += k.value;
+    any_bound = any_bound || !k.resolved;
+    if (k.value >= c.value) c.value = k.value, c.from = a.column, c.bound = !k.resolved;
+  }
+  if (how == AxisCombination::Mean && !axes.empty()) {
+    c.value = sum / static_cast<double>(axes.size());
+    c.bound = any_bound;
+  }
+  return c;
+}
+
+nlohmann::json noise_json(const std::vector<AxisNoise>& axes, SensorKind kind) {
+  const UnitSet si = si_units(kind);
+  auto coef = [](const Coefficient& c, const ShownUnit& u) {
+    return nlohmann::json{
+        {"value", c.value}, {"low95", c.low}, {"high95", c.high}, {"resolved", c.resolved}, {"unit", u.ascii}};
+  };
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& a : axes)
+    list.push_back({{"column", a.column},
+                    {"noise_density", coef(a.N, si[Term::N])},
+                    {"random_walk", coef(a.K, si[Term::K])},
+                    {"fit_rejected", a.rejected_chi2 > 0}});
+  const Combined n = combine(axes, &AxisNoise::N, AxisCombination::Worst);
+  const Combined k = combine(axes, &AxisNoise::K, AxisCombination::Worst);
+  return {{"axes", std::move(list)},
+          {"worst",
+           {{"noise_density", n.value},
+            {"noise_density_axis", n.from},
+            {"random_walk", k.value},
+            {"random_walk_axis", k.from},
+            {"random_walk_is_upper_bound", k.bound}}}};
+}
+
+}  // namespace imu_impl
+
+nlohmann::json to_json(const ImuResult& r) {
+  nlohmann::json channels = nlohmann::json::array();
+  for (const auto& c : r.channels)
+    channels.push_back(channel_json(c.result, c.kind == SensorKind::Gyro ? r.gyro_units : r.accel_units));
+  nlohmann::json noise = nlohmann::json::object();
+  for (const SensorKind k : {SensorKind::Gyro, SensorKind::Accelerometer})
+    if (const auto axes = axis_noise(r, k); !axes.empty()) noise[std::string(to_string(k))] = noise_json(axes, k);
+  const auto& first = r.channels.front().result;
+  return {{"source", r.source},
+          {"input", first.input},
+          {"samples", first.samples},
+          {"rate_hz", first.rate_hz},
+          {"duration_s", first.duration_s},
+          {"channels", std::move(channels)},
+          {"noise", std::move(noise)},
+          {"conventions",
+           {{"noise_density", "N, the white-noise level: sigma^2 = N^2/tau (Kalibr's continuous-time noise density)"},
+            {"random_walk", "K, the bias random walk: sigma^2 = K^2 tau/3 (Kalibr's random walk)"},
+            {"intervals", "95 % profile likelihood; resolved=false: value is the 95 % upper bound"}}}};
+}
+
+std::string format_imu(const ImuResult& r) {
+  const auto& first = r.channels.front().result;
+  std::string s = fmt::format("rwcalc imu: {}\n\n", printable(r.source));
+  for (const auto& c : r.channels) {
+    if (c.result.warnings.empty()) continue;
+    s += fmt::format("[{}] ", printable(c.column)) + format_warnings(c.result.warnings);
+  }
+  s += fmt::format("Data\n  {} samples at {:g} Hz (tau0 = {:g} ms), {:.1f} s ({:.2f} h); {} channels\n\n",
+                   first.samples, first.rate_hz, 1000.0 / first.rate_hz, first.duration_s, first.duration_s / 3600.0,
+                   r.channels.size());
+  s += kind_table(of_kind(r, SensorKind::Gyro), r.gyro_units);
+  s += kind_table(of_kind(r, SensorKind::Accelerometer), r.accel_units);
+  s += "Conventions: IEEE 952 model sigma² = 3Q²/tau² + N²/tau + (2 ln2/π)B² + K²tau/3 + R²tau²/2 per axis;\n"
+       "  N is the noise density and K the bias random walk of Kalibr's IMU noise model.\n";
+  return s;
+}
+
+std::string kalibr_yaml(const ImuResult& r, const KalibrOptions& options) {
+  auto yaml_num = [](double v) { return fmt::format("{:.6e}", v); };  // always a YAML float
+  const auto& first = r.channels.front().result;
+  std::string s = fmt::format(
+      "# IMU noise parameters for Kalibr and OpenVINS, from the Allan variance of a static recording.\n"
+      "# file: {} (SHA-256 {}), {} samples at {:g} Hz\n"
+      "# noise_density = N (white noise, continuous time; sigma^2 = N^2/tau), random_walk = K (bias random\n"
+      "# walk; sigma^2 = K^2 tau/3), each axis fitted with 95 % intervals; the values used are the {}.\n",
+      printable(r.source), first.input.value("sha256", std::string()), first.samples, first.rate_hz,
+      options.combine == AxisCombination::Worst ? "worst axis' (the largest)" : "mean over the axes");
+  std::string keys =
+      fmt::format("rostopic: {}\nupdate_rate: {:.6f}  # Hz\n", nlohmann::json(options.rostopic).dump(), first.rate_hz);
+  for (const SensorKind kind : {SensorKind::Accelerometer, SensorKind::Gyro}) {
+    const auto axes = axis_noise(r, kind);
+    const bool gyro = kind == SensorKind::Gyro;
+    const std::string prefix = gyro ? "gyroscope" : "accelerometer";
+    const UnitSet si = si_units(kind);
+    if (axes.empty()) {
+      s += fmt::format("# no {} channel was analysed: its keys are left out\n", to_string(kind));
+      continue;
+    }
+    s += fmt::format("# {} axes: N [{}], K [{}]\n", to_string(kind), si[Term::N].ascii, si[Term::K].ascii);
+    for (const auto& a : axes) {
+      auto one = [&](const Coefficient& c) {
+        return c.resolved ? fmt::format("{} [{}, {}]", yaml_num(c.value), yaml_num(c.low), yaml_num(c.high))
+                          : fmt::format("< {} (not resolved: 95 % upper bound)", yaml_num(c.value));
+      };
+      s += fmt::format("#   {}: N {}; K {}\n", printable(a.column), one(a.N), one(a.K));
+      if (a.rejected_chi2 > 0)
+        s += fmt::format(
+            "#     the five-term model does not describe this axis (chi2/dof {:.3g}): its values are "
+            "doubtful; see rwcalc diagnose\n",
+            a.rejected_chi2);
+    }
+    const Combined n = combine(axes, &AxisNoise::N, options.combine);
+    const Combined k = combine(axes, &AxisNoise::K, options.combine);
+    const bool worst = options.combine == AxisCombination::Worst;
+    auto from = [&](const Combined& c) {
+      return worst ? fmt::format(" worst axis {}", printable(c.from)) : fmt::format(" mean of {} axes", axes.size());
+    };
+    keys += fmt::format("{}_noise_density: {}  # [{}]{}{}\n", prefix, yaml_num(n.value), si[Term::N].ascii, from(n),
+                        n.bound ? "; UPPER BOUND: N not resolved (its 95 % bound used)" : "");
+    keys += fmt::format("{}_random_walk: {}  # [{}]{}{}\n", prefix, yaml_num(k.value), si[Term::K].ascii, from(k),
+                        k.bound ? "; UPPER BOUND: K not resolved (its 95 % bound used)" : "");
+  }
+  return s + keys;
+}
+
+}  // namespace rwcalc

@@ -1,0 +1,55 @@
+// The figures of `rwcalc imu`: one panel per sensor kind, every axis' Allan deviation in it.
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "rwcalc/error.hpp"
+#include "rwcalc/output.hpp"
+#include "rwcalc/plot.hpp"
+
+namespace rwcalc {
+
+PlotResult plot_imu(const nlohmann::json& imu, const PlotOptions& options) {
+  std::vector<Figure> figures;
+  for (const std::string_view kind : {"gyro", "accelerometer"}) {
+    nlohmann::json runs = nlohmann::json::array();
+    for (const auto& c : imu.at("channels")) {
+      if (c.value("sensor", "") != kind) continue;
+      nlohmann::json run = c;
+      // The axis label in the unit's printed form; as a non-gyro unit it also keeps the class
+      // limits (a ring-laser table) out of a figure of several axes.
+      const std::string unit = c.at("allan").value("unit", "");
+      run["allan"]["unit"] = unit == "deg/h"   ? "°/h"
+                             : unit == "deg/s" ? "°/s"
+                             : unit == "ug"    ? "µg"
+                             : unit == "m/s^2" ? "m/s²"
+                                               : unit;
+      runs.push_back(std::move(run));
+    }
+    if (runs.empty()) continue;
+    PlotOptions o = options;
+    if (o.title.empty())
+      o.title = fmt::format("{} axes of {}", kind == "gyro" ? "Gyro" : "Accelerometer",
+                            std::filesystem::path(imu.value("source", "")).filename().string());
+    Figure f = batch_allan_figure(runs, o);
+    f.name = fmt::format("imu-{}", kind);
+    figures.push_back(std::move(f));
+  }
+  if (figures.empty()) throw AnalysisError("the imu result has no channels: nothing to plot");
+  PlotResult result;
+  for (const auto& f : figures) result.series += f.series;
+  check_output_targets({{"--plot", options.output}, {"--plot-script", options.script}}, options.force);
+  const PlotFormat format = options.output.empty() ? PlotFormat::Svg : plot_format_for(options.output);
+  if (!options.script.empty()) {
+    const std::string target = options.output.empty()
+                                   ? std::filesystem::path(options.script).replace_extension(".svg").string()
+                                   : options.output;
+    write_file_atomic(options.script, full_script(figures, format, options.width_px, target), options.force);
+  }
+  if (!options.output.empty())
+    write_file_atomic(options.output, render_figures(figures, format, options.width_px), options.force);
+  return result;
+}
+
+}  // namespace rwcalc

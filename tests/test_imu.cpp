@@ -1,0 +1,300 @@
+// Accelerometer channels and `rwcalc imu`: accelerometer units by option or column suffix, the
+// channel's results in the units asked for and in SI, every axis of a recording in one command,
+// and the Kalibr/OpenVINS noise file.
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <random>
+#include <string>
+
+#include "test_support.hpp"
+
+namespace rwcalc::test {
+namespace {
+
+bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+constexpr double kG = 9.80665;
+constexpr double kRateHz = 100;
+constexpr int kSamples = 60000;  // 600 s
+// Per-sample standard deviations of the white noise written: gyro °/s, accelerometer g.
+constexpr double kGyroSd = 0.05, kAccelSd = 0.002;
+
+// A static 6-axis IMU of white noise: gyro in °/s (mean 0.1 °/s), accelerometer in g (z at −1 g).
+std::string imu_csv(const std::string& header) {
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> z;
+  std::string s = header + "\n";
+  for (int k = 0; k < kSamples; ++k)
+    s += fmt::format("{:.6f},{:.6f},{:.6f},{:.7f},{:.7f},{:.7f}\n", 0.1 + kGyroSd * z(rng), 0.1 + kGyroSd * z(rng),
+                     0.1 + kGyroSd * z(rng), kAccelSd * z(rng), kAccelSd * z(rng), -1 + kAccelSd * z(rng));
+  return s;
+}
+
+const char* kHeader = "gyro_x_dps,gyro_y_dps,gyro_z_dps,acc_x_g,acc_y_g,acc_z_g";
+
+// The white level's N in SI: the per-sample deviation over √(sample rate).
+double gyro_n_si() { return kGyroSd * std::numbers::pi / 180 / std::sqrt(kRateHz); }
+double accel_n_si() { return kAccelSd * kG / std::sqrt(kRateHz); }
+
+nlohmann::json parse_ok(const CliResult& r) {
+  EXPECT_EQ(r.status, 0) << r.err;
+  return r.status == 0 ? nlohmann::json::parse(r.out) : nlohmann::json::object();
+}
+
+TEST(Imu, GSuffixMeansAnAccelerometerInG) {
+  TempDir dir;
+  const auto f = dir.write("imu.csv", imu_csv(kHeader));
+  const auto r = run_cli({"analyze", f.string(), "--column", "acc_z_g", "--rate", "100", "--json"});
+  const auto j = parse_ok(r);
+  EXPECT_EQ(j["sensor"], "accelerometer");
+  EXPECT_EQ(j["input"]["unit"], "g");
+  EXPECT_EQ(j["input"]["kind"], "rate");
+  EXPECT_NEAR(j["mean"]["value"].get<double>(), -1e6, 2e3);  // −1 g in µg; 1/3600 or 9.8× off if misread
+  EXPECT_EQ(j["mean"]["unit"], "ug");
+  EXPECT_TRUE(j["verdict"].is_null());
+  EXPECT_TRUE(has(r.err, "rate unit g from the column name 'acc_z_g'")) << r.err;
+  const auto& n = j["fit"]["N"];
+  EXPECT_EQ(n["meaning"], "velocity random walk");
+  EXPECT_EQ(n["si"]["unit"], "m/s^2/sqrt(Hz)");
+  EXPECT_NEAR(n["si"]["value"].get<double>() / accel_n_si(), 1.0, 0.05);
+  // The text names the kind, the column and the units.
+  const auto t = run_cli({"analyze", f.string(), "--column", "acc_z_g", "--rate", "100"});
+  ASSERT_EQ(t.status, 0) << t.err;
+  EXPECT_TRUE(has(t.out, "rwcalc accelerometer:")) << t.out;
+  EXPECT_TRUE(has(t.out, "velocity random walk")) << t.out;
+  EXPECT_TRUE(has(t.out, "m/s/√h")) << t.out;
+  EXPECT_TRUE(has(t.out, "no Earth rate, no class verdict (accelerometer)")) << t.out;
+}
+
+TEST(Imu, AccelerometerUnitsAgreeWithEachOther) {
+  // The same channel written in g, mg, ug and m/s²: one noise density in SI.
+  TempDir dir;
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> z;
+  std::string s = "a_g,a_mg,a_ug,a_mps2\n";
+  for (int k = 0; k < kSamples; ++k) {
+    const double g = kAccelSd * z(rng);
+    s += fmt::format("{:.9f},{:.6f},{:.3f},{:.8f}\n", g, g * 1e3, g * 1e6, g * kG);
+  }
+  const auto f = dir.write("acc.csv", s);
+  std::vector<double> n;
+  for (const char* c : {"a_g", "a_mg", "a_ug", "a_mps2"}) {
+    const auto j = parse_ok(run_cli({"analyze", f.string(), "--column", c, "--rate", "100", "--json"}));
+    n.push_back(j["fit"]["N"]["si"]["value"].get<double>());
+  }
+  for (double v : n) EXPECT_NEAR(v / n[0], 1.0, 1e-6);
+  EXPECT_NEAR(n[0] / accel_n_si(), 1.0, 0.05);
+}
+
+TEST(Imu, AnAccelerometerUnitOptionThatContradictsTheNameIsUsedWithAWarning) {
+  TempDir dir;
+  const auto f = dir.write("imu.csv", imu_csv(kHeader));
+  const auto r =
+      run_cli({"analyze", f.string(), "--column", "acc_x_g", "--rate-unit", "mg", "--rate", "100", "--json"});
+  const auto j = parse_ok(r);
+  EXPECT_EQ(j["input"]["unit"], "mg");
+  EXPECT_TRUE(has(r.err, "rwcalc: warning: ")) << r.err;
+  EXPECT_TRUE(has(r.err, "says rate in g, but --rate-unit mg is used as given")) << r.err;
+}
+
+TEST(Imu, OutputUnitChoosesTheShownUnitsOfEitherKind) {
+  TempDir dir;
+  const auto f = dir.write("imu.csv", imu_csv(kHeader));
+  const auto g = parse_ok(
+      run_cli({"analyze", f.string(), "--column", "gyro_x_dps", "--rate", "100", "--json", "--output-unit", "deg/s"}));
+  EXPECT_EQ(g["fit"]["N"]["unit"], "deg/s/sqrt(Hz)");
+  EXPECT_NEAR(g["fit"]["N"]["value"].get<double>() / (kGyroSd / std::sqrt(kRateHz)), 1.0, 0.05);
+  EXPECT_NEAR(g["mean"]["value"].get<double>(), 0.1, 1e-3);
+  const auto a = parse_ok(
+      run_cli({"analyze", f.string(), "--column", "acc_z_g", "--rate", "100", "--json", "--output-unit", "mg"}));
+  EXPECT_EQ(a["fit"]["B"]["unit"], "mg");
+  EXPECT_NEAR(a["mean"]["value"].get<double>(), -1000.0, 2.0);
+  // imu: one unit per kind, in either order.
+  const auto i = parse_ok(run_cli(
+      {"imu", f.string(), "--rate", "100", "--gyro", "1", "--accel", "6", "--json", "--output-unit", "mg,rad/s"}));
+  EXPECT_EQ(i["channels"][0]["fit"]["N"]["unit"], "rad/s/sqrt(Hz)");
+  EXPECT_NEAR(i["channels"][0]["fit"]["N"]["value"].get<double>() / gyro_n_si(), 1.0, 0.05);
+  EXPECT_EQ(i["channels"][1]["allan"]["unit"], "mg");
+  EXPECT_NEAR(i["channels"][1]["mean"]["value"].get<double>(), -1000.0, 2.0);
+  const auto bad = run_cli({"analyze", f.string(), "--column", "acc_z_g", "--rate", "100", "--output-unit", "deg/s"});
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_TRUE(has(bad.err, "output unit 'deg/s' is an gyro unit")) << bad.err;
+}
+
+TEST(Imu, EveryAxisInOneCommandWithTheNoiseFile) {
+  TempDir dir;
+  const auto f = dir.write("imu.csv", imu_csv(kHeader));
+  const auto yaml = dir.path() / "imu.yaml";
+  const auto r = run_cli({"imu", f.string(), "--rate", "100", "--gyro", "gyro_x_dps,gyro_y_dps,gyro_z_dps", "--accel",
+                          "acc_x_g,acc_y_g,acc_z_g", "--json", "--kalibr", yaml.string()});
+  const auto j = parse_ok(r);
+  ASSERT_EQ(j["channels"].size(), 6u);
+  for (std::size_t i = 0; i < 6; ++i) {
+    const auto& c = j["channels"][i];
+    EXPECT_EQ(c["sensor"], i < 3 ? "gyro" : "accelerometer");
+    const double want = i < 3 ? gyro_n_si() : accel_n_si();
+    EXPECT_NEAR(c["fit"]["N"]["si"]["value"].get<double>() / want, 1.0, 0.05) << c["column"];
+  }
+  EXPECT_EQ(j["channels"][3]["column"], "acc_x_g");
+  EXPECT_EQ(j["noise"]["gyro"]["axes"].size(), 3u);
+  EXPECT_EQ(j["noise"]["accelerometer"]["axes"][0]["noise_density"]["unit"], "m/s^2/sqrt(Hz)");
+  // The noise file: the keys, each with its unit; white noise only, so K is an upper bound.
+  const std::string y = slurp(yaml);
+  for (const char* key : {"rostopic: \"/imu0\"", "update_rate: 100.000000", "gyroscope_noise_density: ",
+                          "gyroscope_random_walk: ", "accelerometer_noise_density: ", "accelerometer_random_walk: "})
+    EXPECT_TRUE(has(y, key)) << key << "\n" << y;
+  EXPECT_TRUE(has(y, "[rad/s/sqrt(Hz)]")) << y;
+  EXPECT_TRUE(has(y, "[rad/s^2/sqrt(Hz)]")) << y;
+  EXPECT_TRUE(has(y, "[m/s^2/sqrt(Hz)]")) << y;
+  EXPECT_TRUE(has(y, "[m/s^3/sqrt(Hz)]")) << y;
+  EXPECT_TRUE(has(y, "UPPER BOUND")) << y;
+  EXPECT_TRUE(has(y, "#   acc_y_g: N ")) << y;
+  // A YAML parser reads it as numbers (PyYAML when python3 has it).
+  if (std::system("python3 -c 'import yaml' >/dev/null 2>&1") == 0) {
+    const auto py =
+        dir.write("check.py",
+                  "import sys, yaml\nd = yaml.safe_load(open(sys.argv[1]))\n"
+                  "keys = ['gyroscope_noise_density', 'gyroscope_random_walk', 'accelerometer_noise_density',\n"
+                  "        'accelerometer_random_walk', 'update_rate']\n"
+                  "assert all(isinstance(d[k], float) and d[k] > 0 for k in keys), d\n"
+                  "assert d['rostopic'] == '/imu0'\n"
+                  "print(d['gyroscope_noise_density'])\n");
+    EXPECT_EQ(std::system(fmt::format("python3 '{}' '{}' >/dev/null", py.string(), yaml.string()).c_str()), 0);
+  }
+  // The tables: one per kind.
+  const auto t = run_cli({"imu", f.string(), "--rate", "100", "--gyro", "1,2,3", "--accel", "4,5,6"});
+  ASSERT_EQ(t.status, 0) << t.err;
+  EXPECT_TRUE(has(t.out, "Gyro (3 axes;")) << t.out;
+  EXPECT_TRUE(has(t.out, "Accelerometer (3 axes;")) << t.out;
+}
+
+TEST(Imu, EitherKindMayBeAbsentButOneIsNeeded) {
+  TempDir dir;
+  const auto f = dir.write("imu.csv", imu_csv(kHeader));
+  const auto g = parse_ok(run_cli({"imu", f.string(), "--rate", "100", "--gyro", "gyro_z_dps", "--json"}));
+  EXPECT_EQ(g["channels"].size(), 1u);
+  const auto none = run_cli({"imu", f.string(), "--rate", "100"});
+  EXPECT_EQ(none.status, 2);
+  EXPECT_TRUE(has(none.err, "give --gyro COLS and/or --accel COLS")) << none.err;
+}
+
+TEST(Imu, AColumnOfTheWrongKindIsAnError) {
+  TempDir dir;
+  const auto f = dir.write("imu.csv", imu_csv(kHeader));
+  const auto r = run_cli({"imu", f.string(), "--rate", "100", "--gyro", "acc_x_g"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(has(r.err, "column 'acc_x_g' is given as --gyro but was read as accelerometer")) << r.err;
+  const auto u = run_cli({"imu", f.string(), "--rate", "100", "--accel", "4", "--accel-unit", "deg/s"});
+  EXPECT_EQ(u.status, 2);
+  EXPECT_TRUE(has(u.err, "--accel-unit deg/s is not an accelerometer unit")) << u.err;
+  // batch prints a gyro's units and classes: an accelerometer column is refused there.
+  const auto b = run_cli({"batch", f.string(), "--column", "acc_x_g", "--rate", "100"});
+  EXPECT_EQ(b.status, 2);
+  EXPECT_TRUE(has(b.err, "is an accelerometer channel; batch and report take gyro runs")) << b.err;
+  // Without a suffix or --accel-unit an accelerometer column cannot be read as one.
+  const auto plain = dir.write("plain.csv", "a\n0.001\n0.002\n-0.001\n0.003\n");
+  const auto p = run_cli({"imu", plain.string(), "--rate", "100", "--accel", "a"});
+  EXPECT_NE(p.status, 0);
+}
+
+TEST(Imu, EarthRateAndVerdictOnlyForPulsesOrWhenAsked) {
+  TempDir dir;
+  const auto f = dir.write("imu.csv", imu_csv(kHeader));
+  // A rate gyro: neither, and the output says so and how to ask.
+  const auto off = run_cli({"analyze", f.string(), "--column", "gyro_x_dps", "--rate", "100", "--json"});
+  const auto j = parse_ok(off);
+  EXPECT_EQ(j["earth_rate_subtracted"], false);
+  EXPECT_EQ(j["earth_rate_deg_per_h"].get<double>(), 0.0);
+  EXPECT_TRUE(j["latitude_deg"].is_null());
+  EXPECT_NEAR(j["bias_deg_per_h"].get<double>(), 360.0, 5.0);  // the mean, 0.1 °/s
+  EXPECT_EQ(j["verdict"]["applies"], false);
+  EXPECT_TRUE(has(j["not_applied_reason"].get<std::string>(), "--vertical")) << j["not_applied_reason"];
+  const auto t = run_cli({"analyze", f.string(), "--column", "gyro_x_dps", "--rate", "100"});
+  EXPECT_TRUE(has(t.out, "Verdict: not given (rate input")) << t.out;
+  EXPECT_FALSE(has(t.out, "P(meets class)")) << t.out;
+  EXPECT_TRUE(has(t.out, "(no Earth rate subtracted)")) << t.out;
+  // --vertical: both, as for pulse input (no not_applied keys at all).
+  const auto v =
+      parse_ok(run_cli({"analyze", f.string(), "--column", "gyro_x_dps", "--rate", "100", "--json", "--vertical"}));
+  EXPECT_FALSE(v.contains("not_applied_reason"));
+  EXPECT_NEAR(v["earth_rate_deg_per_h"].get<double>(), 12.43, 0.01);
+  // --earth-rate alone: the Earth rate, still no verdict.
+  const auto e = parse_ok(
+      run_cli({"analyze", f.string(), "--column", "gyro_x_dps", "--rate", "100", "--json", "--earth-rate", "10"}));
+  EXPECT_EQ(e["earth_rate_subtracted"], true);
+  EXPECT_EQ(e["verdict"]["applies"], false);
+  // Pulse input keeps both.
+  const auto p = parse_ok(run_cli({"analyze", source_path("data/gl2d/gl2d_p25C.csv.gz").string(), "--json"}));
+  EXPECT_FALSE(p.contains("not_applied_reason"));
+  EXPECT_TRUE(p["verdict"].contains("class"));
+  // imu: only the gyro said to be vertical.
+  const auto i = parse_ok(run_cli({"imu", f.string(), "--rate", "100", "--gyro", "gyro_x_dps,gyro_z_dps",
+                                   "--vertical-gyro", "gyro_z_dps", "--json"}));
+  EXPECT_TRUE(i["channels"][0]["verdict"].is_null());
+  EXPECT_TRUE(i["channels"][0]["earth_rate_subtracted"].is_null());
+  EXPECT_TRUE(i["channels"][1]["verdict"].is_object());
+  EXPECT_NEAR(i["channels"][1]["earth_rate_subtracted"].get<double>(), 12.43, 0.01);
+}
+
+TEST(Imu, IncrementsGiveWhatTheRatesGive) {
+  // The same axes as rates and as per-sample increments (Δθ = ω·τ0 in rad, Δv = a·τ0 in m/s).
+  TempDir dir;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> z;
+  std::string s = "w_rads,a_g,dtheta,dv\n";
+  for (int k = 0; k < kSamples; ++k) {
+    const double w = 0.001 + 0.0009 * z(rng), a = -1 + kAccelSd * z(rng);
+    s += fmt::format("{:.12g},{:.12g},{:.12g},{:.12g}\n", w, a, w / kRateHz, a * kG / kRateHz);
+  }
+  const auto f = dir.write("inc.csv", s);
+  const auto j =
+      parse_ok(run_cli({"imu", f.string(), "--rate", "100", "--gyro", "w_rads", "--accel", "a_g", "--json"}));
+  ASSERT_EQ(j["channels"].size(), 2u);
+  const auto g = parse_ok(run_cli({"imu", f.string(), "--rate", "100", "--gyro", "dtheta", "--gyro-unit", "rad",
+                                   "--accel", "dv", "--accel-unit", "m/s", "--json"}));
+  const auto& rate = j["channels"];
+  EXPECT_EQ(g["channels"][0]["input"]["kind"], "increment");
+  EXPECT_EQ(g["channels"][1]["input"]["unit"], "m/s");
+  EXPECT_EQ(g["channels"][1]["sensor"], "accelerometer");
+  for (const char* t : {"N", "B"}) {
+    EXPECT_NEAR(g["channels"][0]["fit"][t]["si"]["value"].get<double>() /
+                    rate[0]["fit"][t]["si"]["value"].get<double>(),
+                1.0, 1e-6)
+        << t;
+    EXPECT_NEAR(g["channels"][1]["fit"][t]["si"]["value"].get<double>() /
+                    rate[1]["fit"][t]["si"]["value"].get<double>(),
+                1.0, 1e-6)
+        << t;
+  }
+  EXPECT_NEAR(g["channels"][1]["mean"]["value"].get<double>(), -1e6, 2e3);  // µg
+  // analyze takes them too: --input increment --angle-unit m/s.
+  const auto a = parse_ok(run_cli({"analyze", f.string(), "--column", "dv", "--input", "increment", "--angle-unit",
+                                   "m/s", "--rate", "100", "--json"}));
+  EXPECT_EQ(a["sensor"], "accelerometer");
+}
+
+TEST(Imu, ReportDirectoryHoldsTheWholeResult) {
+  TempDir dir;
+  const auto f = dir.write("imu.csv", imu_csv(kHeader));
+  const auto out = dir.path() / "report";
+  const auto r = run_cli({"imu", f.string(), "--rate", "100", "--gyro", "1,2,3", "--accel", "4,5,6", "--report",
+                          out.string(), "-o", (dir.path() / "tables.txt").string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* name : {"index.html", "imu.txt", "imu.json", "imu.yaml"})
+    EXPECT_TRUE(std::filesystem::exists(out / name)) << name;
+  EXPECT_EQ(slurp(out / "imu.txt"), slurp(dir.path() / "tables.txt"));
+  const std::string html = slurp(out / "index.html");
+  EXPECT_TRUE(has(html, "Accelerometer (3 axes;")) << html;
+  EXPECT_TRUE(has(html, "<a href=\"imu.yaml\">")) << html;
+  EXPECT_EQ(nlohmann::json::parse(slurp(out / "imu.json"))["channels"].size(), 6u);
+}
+
+}  // namespace
+}  // namespace rwcalc::test
