@@ -146,6 +146,8 @@ class RecordDetector : public Detector {
   [[nodiscard]] virtual double statistic(const RecordView& r) const = 0;
   /// Whether shows_in reads the statistic on a block's own ensemble (which then scores it).
   [[nodiscard]] virtual bool block_statistic() const { return true; }
+  /// Whether the statistic reads the raw samples (its nulls are then simulated at full rate).
+  [[nodiscard]] virtual bool full_rate() const { return false; }
   [[nodiscard]] DetectorResult test(const Trial& t) const override;
   [[nodiscard]] DetectorResult calibrate(double statistic, const std::vector<RunStats>& runs, double alpha) const;
 };

@@ -63,7 +63,7 @@ class GaussMarkovDetector final : public Detector {
     if (!d.note.empty()) return d;
     const std::size_t runs = t.runs.size();
     const auto m1_runs =
-        run_ensemble(with_bump(s.base, gm), t.settings, runs, {s.octave_m, s.ref.grid, true, {}}, s.opt->progress);
+        run_ensemble(with_bump(s.base, gm), t.settings, runs, {s.octave_m, s.ref.grid, true, {}, false}, s.opt->progress);
     const auto m1_ref = make_reference(s.ref.grid, s.dec.tau_d, m1_runs, true);
     d.statistic = mid_deviance(v, s.clean_ref) - mid_deviance(v, m1_ref);
     std::vector<double> e_gm;

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 
 #include "diagnose/models.hpp"
 #include "rwcalc/error.hpp"
@@ -139,6 +140,27 @@ bool is_named(const std::vector<DetectorResult>& results, Effect e) {
   return std::any_of(results.begin(), results.end(), [e](const auto& d) { return d.effect == e && d.named; });
 }
 
+/// The base the mid-τ detectors test against. A base calibrated with a named line in the data
+/// takes the line's Allan variance into N or B, and beside it the data without the line shows a
+/// deficit that a bump fit mistakes for a Gauss–Markov term: with a named line, the base is
+/// re-calibrated (pilot seeds as before) on the data without it, and its ensemble taken.
+struct MidTauBase {
+  Stretch stretch;
+  std::optional<std::vector<RunStats>> runs;  ///< empty: the base ensemble's
+};
+MidTauBase mid_tau_base(const Context& c, const DiagnoseResult& r, const NoiseModel& det, const Decimated& dclean,
+                        const std::vector<RunStats>& runs) {
+  MidTauBase m{c.full, std::nullopt};
+  if (det.sinusoids.empty()) return m;
+  m.stretch.base = calibrated(c.rb.model, c.full.pilot, c.full.pilot_runs, c.plan, dclean, c.opt.progress);
+  EnsemblePlan plan = c.plan;
+  plan.scored.clear();
+  m.runs = run_ensemble(m.stretch.base, r.settings, runs.size(), plan, c.opt.progress);
+  m.stretch.ref = make_reference(c.plan.grid, c.full.dec.tau_d, *m.runs);
+  m.stretch.clean_ref = make_reference(c.plan.grid, c.full.dec.tau_d, *m.runs, true);
+  return m;
+}
+
 /// Every detector's verdict (r.detectors) and the named effects. The mid-τ detectors read the
 /// measurement without its candidate and without the named lines, so they run last.
 Named test_detectors(Context& c, const std::vector<RunStats>& runs, DiagnoseResult& r) {
@@ -167,7 +189,8 @@ Named test_detectors(Context& c, const std::vector<RunStats>& runs, DiagnoseResu
   Decimated dclean = c.full.dec;
   subtract_deterministic(dclean, det);
   const auto mid_var = decimated_avar(dclean, c.plan.grid);
-  const Trial mid_trial{c.view(), runs, c.full, r.settings, &mid_var};
+  const MidTauBase mid = mid_tau_base(c, r, det, dclean, runs);
+  const Trial mid_trial{c.view(), mid.runs ? *mid.runs : runs, mid.stretch, r.settings, &mid_var};
   for (std::size_t i = 0; i < c.detectors.size(); ++i)
     if (c.detectors[i]->mid_tau()) res[i] = c.detectors[i]->test(mid_trial);
   for (std::size_t e = 0; e < kEffectCount; ++e)
@@ -210,7 +233,7 @@ void extended_model(Context& c, const Named& named, DiagnoseResult& r) {
     return;
   }
   const auto ext_runs =
-      run_ensemble(r.extended, r.settings, c.opt.runs, {c.plan.octave_m, c.plan.grid, false, {}}, c.opt.progress);
+      run_ensemble(r.extended, r.settings, c.opt.runs, {c.plan.octave_m, {}, false, {}, false}, c.opt.progress);
   r.extended_band = make_band(r.analysis.allan.points, ext_runs, c.opt.band_level);
   refit_whole_band(r.extended, r.extended_band, r.analysis.allan.points, r.settings, c.opt.runs, c.plan, c.opt);
 }

@@ -62,6 +62,7 @@ struct EnsemblePlan {
   std::vector<std::size_t> grid;              ///< mid-τ grid (decimated periods)
   bool clean_mid = true;                      ///< also the mid-τ AV without the record's own candidate
   std::vector<const RecordDetector*> scored;  ///< detectors whose statistic each record gets
+  bool raw_mid = true;                        ///< the mid-τ AV of the record as simulated (mid_var)
 };
 
 struct RunStats {

@@ -22,7 +22,7 @@ struct Decimated {
   std::vector<double> theta;  ///< θ_0 = 0 … θ_L
   [[nodiscard]] double duration() const { return theta.size() > 1 ? tau_d * double(theta.size() - 1) : 0.0; }
 };
-std::size_t decimation(double rate_hz);  ///< D: rate/D ≈ 10 Hz; 1 below 20 Hz
+std::size_t decimation(double rate_hz);  ///< D: a power of two, 10 Hz ≤ rate/D < 20 Hz; 1 below 20 Hz
 Decimated decimate(const PhaseSeries& x);
 /// Mean rates over blocks of `per_block` decimated periods (about `seconds`: per_block_for), °/h.
 std::vector<double> block_rates(const Decimated& d, std::size_t per_block);
