@@ -74,7 +74,7 @@ class GaussMarkovDetector final : public Detector {
     d.ensemble_max = *std::max_element(e_gm.begin(), e_gm.end());
     d.ensemble_median = quantile(e_gm, 0.5);
     d.threshold = std::max(kGmMinLogLr, d.ensemble_max);
-    d.fired = d.named = d.statistic > d.threshold;
+    set_verdict(d, d.threshold);
     return d;
   }
 

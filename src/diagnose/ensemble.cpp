@@ -55,14 +55,20 @@ constexpr std::size_t kPieceSamples = 4096;
 
 /// The plan's reductions of one simulated record: its octave AV `v` (already set), mean rate,
 /// mid-τ AV and scored statistics, from `s` (full rate, or the decimated step itself).
-void reduce(const PhaseSeries& s, const EnsemblePlan& plan, RunStats& st) {
+/// Records from plan.stats_from on are reduced to the scored statistics.
+void reduce(const PhaseSeries& s, const EnsemblePlan& plan, std::size_t r, RunStats& st) {
   st.mean_rate = s.diff(s.points() - 1, 0) / s.duration_s();
+  const bool mid = r < plan.stats_from;
   const Decimated d = decimate(s);
-  if (plan.raw_mid) st.mid_var = decimated_avar(d, plan.grid);
+  if (plan.raw_mid && mid) st.mid_var = decimated_avar(d, plan.grid);
   if (!plan.clean_mid && plan.scored.empty()) return;
-  const Decimated dc = without_own_candidates(d);
-  st.mid_var_clean = decimated_avar(dc, plan.grid);
-  const RecordView view{s, d, dc, st.octave_var};
+  // The record's own candidate from its step and warm-up fits, which are also their statistics.
+  const StepEstimate step = step_detect(d);
+  const WarmupEstimate warm = warmup_detect(d);
+  Decimated dc = d;
+  subtract_deterministic(dc, own_candidates(step, warm));
+  if (plan.clean_mid && mid) st.mid_var_clean = decimated_avar(dc, plan.grid);
+  const RecordView view{s, d, dc, st.octave_var, &step, &warm};
   for (const RecordDetector* det : plan.scored) st.stat[static_cast<std::size_t>(det->effect())] = det->statistic(view);
 }
 
@@ -77,7 +83,7 @@ std::vector<RunStats> full_rate_ensemble(const NoiseModel& model, const Simulati
       model, settings, runs,
       [&](std::size_t r, const PhaseSeries& s) {
         out[r].octave_var = octave_avar(s, plan.octave_m);
-        reduce(s, plan, out[r]);
+        reduce(s, plan, r, out[r]);
       },
       eo);
   return out;
@@ -162,7 +168,7 @@ std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSett
         st.octave_var.assign(plan.octave_m.size(), 0.0);
         const std::vector<double> v = octave_avar(s, coarse_m);
         for (std::size_t k = 0; k < coarse_at.size(); ++k) st.octave_var[coarse_at[k]] = v[k];
-        reduce(s, plan, st);
+        reduce(s, plan, r, st);
       },
       eo);
   short_tau_octaves(model, settings, plan.octave_m, short_at, out);

@@ -186,21 +186,27 @@ double quantile(std::vector<double> v, double p) {
   return v[i] * (1 - f) + v[i + 1] * f;
 }
 
-double gumbel_threshold(const std::vector<double>& values, double alpha) {
-  if (values.empty()) return std::numeric_limits<double>::infinity();
+GumbelQuantile gumbel_quantile(const std::vector<double>& values, double alpha) {
+  if (values.empty()) return {std::numeric_limits<double>::infinity(), 0.0};
+  const double K = static_cast<double>(values.size());
   double mean = 0, mx = values.front();
   for (double x : values) {
     mean += x;
     mx = std::max(mx, x);
   }
-  mean /= static_cast<double>(values.size());
+  mean /= K;
   double var = 0;
   for (double x : values) var += (x - mean) * (x - mean);
-  var /= std::max<double>(1.0, static_cast<double>(values.size()) - 1.0);
-  const double beta = std::sqrt(var) * std::sqrt(6.0) / kPi;
-  const double u = mean - 0.5772156649 * beta;
-  const double q = u - beta * std::log(-std::log(1.0 - alpha));
-  return std::max(q, mx);
+  var /= std::max(1.0, K - 1.0);
+  constexpr double kEuler = 0.5772156649;
+  const double k = -std::sqrt(6.0) / kPi * (kEuler + std::log(-std::log(1.0 - alpha)));
+  const double q = mean + k * std::sqrt(var);
+  const double sigma = std::sqrt(var / K * (1.0 + 1.1396 * k + 1.1 * k * k));
+  return {K * alpha < 1.0 ? std::max(q, mx) : q, sigma};
+}
+
+double gumbel_threshold(const std::vector<double>& values, double alpha) {
+  return gumbel_quantile(values, alpha).value;
 }
 
 }  // namespace rwcalc::diag

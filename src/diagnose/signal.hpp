@@ -39,6 +39,13 @@ void subtract_deterministic(Decimated& d, const NoiseModel& m, double t0 = 0);
 /// (1 − α) quantile of a maximum-type statistic from ensemble values (Gumbel fit by moments),
 /// never below the largest ensemble value.
 double gumbel_threshold(const std::vector<double>& values, double alpha);
+/// The same quantile with its Monte-Carlo standard error (method-of-moments Gumbel quantile,
+/// Var = σ²/K·(1 + 1.1396k + 1.1k²), k its frequency factor); the ensemble maximum is a floor only
+/// when K < 1/α (beyond, the maximum lies above the quantile and would only add scatter).
+struct GumbelQuantile {
+  double value = 0, sigma = 0;
+};
+GumbelQuantile gumbel_quantile(const std::vector<double>& values, double alpha);
 double quantile(std::vector<double> v, double p);
 double median_of(std::vector<double>& v);  ///< the upper median; reorders v
 /// White-noise σ from first differences (block means of counts make most differences 0, so not
