@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 
 namespace rwcalc {
 
@@ -38,7 +39,8 @@ std::string_view detector_description(Effect e) { return kNames[static_cast<std:
 
 DetectorResult RecordDetector::calibrate(double statistic, const std::vector<RunStats>& runs, double alpha) const {
   std::vector<double> ens;
-  for (const auto& r : runs) ens.push_back(r.stat[static_cast<std::size_t>(effect())]);
+  for (const auto& r : runs)  // NaN: a record the statistic was not computed on
+    if (const double v = r.stat[static_cast<std::size_t>(effect())]; !std::isnan(v)) ens.push_back(v);
   DetectorResult d;
   d.effect = effect();
   d.statistic = statistic;

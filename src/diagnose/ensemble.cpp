@@ -89,12 +89,10 @@ std::vector<RunStats> full_rate_ensemble(const NoiseModel& model, const Simulati
   return out;
 }
 
-/// Whether the nulls can be simulated at the decimated step D·τ0: no scored statistic reads the
-/// raw samples, and every octave cluster size is a multiple of D or short enough for the pieces.
+/// Whether the nulls can be simulated at the decimated step D·τ0: every octave cluster size is a
+/// multiple of D or short enough for the pieces.
 bool decimated_nulls(const EnsemblePlan& plan, std::size_t D) {
   if (D < 2) return false;
-  if (std::any_of(plan.scored.begin(), plan.scored.end(), [](const RecordDetector* d) { return d->full_rate(); }))
-    return false;
   return std::all_of(plan.octave_m.begin(), plan.octave_m.end(), [D](std::int64_t m) {
     return m % static_cast<std::int64_t>(D) == 0 || m <= static_cast<std::int64_t>(kPieceSamples / 16);
   });
@@ -133,12 +131,38 @@ void short_tau_octaves(const NoiseModel& model, const SimulationSettings& settin
   }
 }
 
+std::vector<RunStats> decimated_ensemble(const NoiseModel& model, const SimulationSettings& settings, std::size_t runs,
+                                         const EnsemblePlan& plan, std::size_t D, Progress* progress);
+
 }  // namespace
 
 std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSettings& settings, std::size_t runs,
                                    const EnsemblePlan& plan, Progress* progress) {
   const std::size_t D = decimation(settings.rate_hz);
   if (!decimated_nulls(plan, D)) return full_rate_ensemble(model, settings, runs, plan, progress);
+  // A statistic that reads the raw samples gets its own full-rate records (the band's K at most,
+  // other seeds); the records beyond have no value for it (NaN, left out of its calibration).
+  EnsemblePlan rest = plan;
+  std::vector<const RecordDetector*> raw;
+  rest.scored.clear();
+  for (const RecordDetector* d : plan.scored) (d->full_rate() ? raw : rest.scored).push_back(d);
+  auto out = decimated_ensemble(model, settings, runs, rest, D, progress);
+  if (raw.empty()) return out;
+  SimulationSettings fs = settings;
+  fs.seed = ensemble_seed(settings.seed, 0x726177ULL);
+  const EnsemblePlan raw_plan{{}, {}, false, raw, false};
+  const auto full = full_rate_ensemble(model, fs, std::min(runs, plan.stats_from), raw_plan, nullptr);
+  for (std::size_t r = 0; r < runs; ++r)
+    for (const RecordDetector* d : raw)
+      out[r].stat[static_cast<std::size_t>(d->effect())] =
+          r < full.size() ? full[r].stat[static_cast<std::size_t>(d->effect())] : std::numeric_limits<double>::quiet_NaN();
+  return out;
+}
+
+namespace {
+
+std::vector<RunStats> decimated_ensemble(const NoiseModel& model, const SimulationSettings& settings, std::size_t runs,
+                                         const EnsemblePlan& plan, std::size_t D, Progress* progress) {
   // The detectors read the angle at D·τ0 only. The simulator's discrete model at that step gives
   // exactly that angle (every term is simulated as an exact step, the read-out quantizes the
   // angle at each sample, white angle noise is per sample); only an output-chain low-pass,
@@ -174,6 +198,8 @@ std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSett
   short_tau_octaves(model, settings, plan.octave_m, short_at, out);
   return out;
 }
+
+}  // namespace
 
 std::vector<BandPoint> make_band(const std::vector<AllanPoint>& measured, const std::vector<RunStats>& runs,
                                  double level) {
