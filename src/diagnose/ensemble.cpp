@@ -89,10 +89,11 @@ std::vector<RunStats> full_rate_ensemble(const NoiseModel& model, const Simulati
   return out;
 }
 
-/// Whether the nulls can be simulated at the decimated step D·τ0: every octave cluster size is a
-/// multiple of D or short enough for the pieces.
-bool decimated_nulls(const EnsemblePlan& plan, std::size_t D) {
-  if (D < 2) return false;
+/// Whether the nulls can be simulated at the decimated step D·τ0: no output-chain low-pass, and
+/// every octave cluster size a multiple of D or short enough for the pieces.
+bool decimated_nulls(const NoiseModel& model, const EnsemblePlan& plan, std::size_t D) {
+  // An output-chain low-pass filters the white angle noise up to a few τf, past the decimated step.
+  if (D < 2 || model.output_lowpass_tc_s > 0) return false;
   return std::all_of(plan.octave_m.begin(), plan.octave_m.end(), [D](std::int64_t m) {
     return m % static_cast<std::int64_t>(D) == 0 || m <= static_cast<std::int64_t>(kPieceSamples / 16);
   });
@@ -139,7 +140,7 @@ std::vector<RunStats> decimated_ensemble(const NoiseModel& model, const Simulati
 std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSettings& settings, std::size_t runs,
                                    const EnsemblePlan& plan, Progress* progress) {
   const std::size_t D = decimation(settings.rate_hz);
-  if (!decimated_nulls(plan, D)) return full_rate_ensemble(model, settings, runs, plan, progress);
+  if (!decimated_nulls(model, plan, D)) return full_rate_ensemble(model, settings, runs, plan, progress);
   // A statistic that reads the raw samples gets its own full-rate records (the band's K at most,
   // other seeds); the records beyond have no value for it (NaN, left out of its calibration).
   EnsemblePlan rest = plan;
@@ -165,12 +166,10 @@ std::vector<RunStats> decimated_ensemble(const NoiseModel& model, const Simulati
                                          const EnsemblePlan& plan, std::size_t D, Progress* progress) {
   // The detectors read the angle at D·τ0 only. The simulator's discrete model at that step gives
   // exactly that angle (every term is simulated as an exact step, the read-out quantizes the
-  // angle at each sample, white angle noise is per sample); only an output-chain low-pass,
-  // which acts at τ ≲ its time constant, is left to the short pieces.
+  // angle at each sample, white angle noise is per sample).
   SimulationSettings cs = settings;
   cs.rate_hz = settings.rate_hz / static_cast<double>(D);
-  NoiseModel cm = model;
-  cm.output_lowpass_tc_s = 0.0;
+  const NoiseModel& cm = model;
   std::vector<std::int64_t> coarse_m;
   std::vector<std::size_t> coarse_at, short_at;
   for (std::size_t i = 0; i < plan.octave_m.size(); ++i) {
