@@ -289,7 +289,7 @@ DiagnoseResult diagnose(const Recording& read, const DiagnoseOptions& opt) {
   Context c{screened(read, opt, outliers, edited), opt, {}, {}, {}, {}, {}, {}};
   DiagnoseResult r;
   r.runs = opt.runs;
-  r.holdout_runs = opt.holdout_runs ? opt.holdout_runs : opt.runs;
+  r.holdout_runs = opt.holdout_runs ? opt.holdout_runs : 2 * opt.runs;
   r.calibration_runs = std::max(opt.runs, opt.calibration_runs ? opt.calibration_runs : kCalibrationFactor * opt.runs);
   r.seed = opt.seed;
   r.band_level = opt.band_level;

@@ -113,7 +113,7 @@ void score_lines(const PhaseSeries& pred, const NoiseModel& e_pred, const std::v
 
 /// A block's pilot ensembles (of its base and of its extended model alike, same seeds), as the
 /// whole record's, have half the runs.
-std::size_t block_pilot_runs(const DiagnoseResult& r) { return std::max<std::size_t>(10, r.holdout_runs / 2); }
+std::size_t block_pilot_runs(const DiagnoseResult& r) { return r.holdout_runs; }
 
 /// The block's base is calibrated without the block's own step or transient already: a named
 /// mean shape changes the level the model predicts, and its re-calibrated N and B would only add
