@@ -36,8 +36,10 @@ Decimated from_rate(double seconds, double sd, std::uint64_t seed, const std::fu
 }
 
 TEST(DiagnoseBlocks, DecimationAndBlockRates) {
-  EXPECT_EQ(decimation(400), 40u);
-  EXPECT_EQ(decimation(100), 10u);
+  // A power of two (the octave cluster sizes from D on are whole decimated periods).
+  EXPECT_EQ(decimation(400), 32u);
+  EXPECT_EQ(decimation(100), 8u);
+  EXPECT_EQ(decimation(25), 2u);
   EXPECT_EQ(decimation(10), 1u);
   PhaseSeries x;
   x.tau0_s = 0.0025;
@@ -45,10 +47,10 @@ TEST(DiagnoseBlocks, DecimationAndBlockRates) {
   x.counts.resize(4001);
   for (std::size_t i = 0; i < x.counts.size(); ++i) x.counts[i] = static_cast<std::int64_t>(3 * i);  // 600 ″/s
   const auto d = decimate(x);
-  EXPECT_DOUBLE_EQ(d.tau_d, 0.1);
-  ASSERT_EQ(d.theta.size(), 101u);
+  EXPECT_DOUBLE_EQ(d.tau_d, 0.08);
+  ASSERT_EQ(d.theta.size(), 126u);
   const auto r = block_rates(d, 10);
-  ASSERT_EQ(r.size(), 10u);
+  ASSERT_EQ(r.size(), 12u);
   for (double v : r) EXPECT_NEAR(v, 600.0, 1e-9);
 }
 
@@ -199,12 +201,35 @@ TEST(DiagnoseBlocks, GumbelThresholdSitsInTheTail) {
   std::vector<double> v(2000);
   for (double& x : v) x = ev(g);
   const double q99 = 10.0 - 2.0 * std::log(-std::log(0.99));
-  // With 2000 values the threshold is the ensemble maximum or the fitted quantile, whichever is higher.
-  const double thr = gumbel_threshold(std::vector<double>(v.begin(), v.begin() + 50), 0.01);
+  // With 50 values (fewer than 1/α) the threshold is at least the ensemble maximum; with 2000 it is
+  // the fitted quantile.
+  const std::vector<double> v50(v.begin(), v.begin() + 50);
+  const double thr = gumbel_threshold(v50, 0.01);
   EXPECT_GT(thr, quantile(v, 0.9));
-  EXPECT_NEAR(gumbel_threshold(v, 0.01), std::max(q99, *std::max_element(v.begin(), v.end())), 1.5);
+  EXPECT_GE(thr, *std::max_element(v50.begin(), v50.end()));
+  EXPECT_NEAR(gumbel_threshold(v, 0.01), q99, 3 * gumbel_quantile(v, 0.01).sigma);
   EXPECT_NEAR(quantile({1, 2, 3, 4, 5}, 0.5), 3.0, 1e-12);
   EXPECT_NEAR(quantile({1, 2, 3, 4, 5}, 0.25), 2.0, 1e-12);
+}
+
+// The threshold's Monte-Carlo standard error is the scatter of the threshold over ensembles.
+TEST(DiagnoseBlocks, GumbelThresholdSigmaIsItsScatter) {
+  std::mt19937_64 g(5);
+  std::extreme_value_distribution<double> ev(10.0, 2.0);
+  const std::size_t ensembles = 400, K = 200;
+  double s = 0, s2 = 0, sig = 0;
+  for (std::size_t e = 0; e < ensembles; ++e) {
+    std::vector<double> v(K);
+    for (double& x : v) x = ev(g);
+    const GumbelQuantile q = gumbel_quantile(v, 0.01);
+    s += q.value;
+    s2 += q.value * q.value;
+    sig += q.sigma;
+  }
+  const double n = static_cast<double>(ensembles), mean = s / n;
+  const double sd = std::sqrt((s2 - n * mean * mean) / (n - 1));
+  EXPECT_NEAR(mean, 10.0 - 2.0 * std::log(-std::log(0.99)), 0.2);
+  EXPECT_NEAR(sig / n, sd, 0.15 * sd);
 }
 
 TEST(DiagnoseBlocks, MisfitAndCoverage) {

@@ -21,6 +21,9 @@ class Progress;
 struct DiagnoseOptions {
   AnalysisOptions analysis;      ///< the base fit (as `rwcalc analyze`)
   std::size_t runs = 50;         ///< ensemble size K of each simulated band
+  /// Records of the base model whose statistics set the detectors' thresholds (0: 4K); the band
+  /// and the mid-τ reference take the first K of them.
+  std::size_t calibration_runs = 0;
   std::size_t holdout_runs = 0;  ///< ensemble size of the out-of-sample check (0: K)
   std::uint64_t seed = 1;        ///< base seed of every ensemble
   double band_level = 0.95;      ///< central probability of the band (2.5–97.5 %)
@@ -51,11 +54,15 @@ struct BandPoint {
 struct DetectorResult {
   Effect effect = Effect::Sinusoid;
   double statistic = 0;  ///< on the measurement
-  double threshold = 0;  ///< the ensemble's (1 − α) quantile (never below the ensemble maximum)
+  double threshold = 0;  ///< the ensemble's (1 − α) quantile (never below the maximum of fewer than 1/α)
+  /// Monte-Carlo standard error of the threshold (the ensemble is finite) and its upper 95 %
+  /// confidence limit: an effect is named only above it, so that another seed names it too.
+  double threshold_sigma = 0, threshold_upper = 0;
   double ensemble_max = 0;
   double ensemble_median = 0;
-  bool fired = false;  ///< statistic > threshold
-  bool named = false;  ///< kept as a finding (a competing explanation may win)
+  bool fired = false;   ///< statistic > threshold
+  bool excess = false;  ///< fired, but not above the threshold's upper limit: "excess, not named"
+  bool named = false;   ///< kept as a finding (a competing explanation may win)
   std::string note;    ///< why it was not named although it fired, or not tested
 };
 
@@ -71,8 +78,9 @@ struct Finding {
 struct Gain {
   double misfit_base = 0, misfit_extended = 0;      ///< EDF-weighted AV misfit (≈ 1 when the model fits)
   double coverage_base = 0, coverage_extended = 0;  ///< share of measured τ inside the band
-  double holdout_misfit_base = 0,
-         holdout_misfit_extended = 0;  ///< out of sample (fit on one block, predict a neighbour)
+  /// Out of sample (fit on one block, predict a neighbour); NaN (JSON null) when nothing was
+  /// named, the extended model then being the base.
+  double holdout_misfit_base = 0, holdout_misfit_extended = 0;
 };
 
 struct DiagnoseResult {
@@ -84,9 +92,13 @@ struct DiagnoseResult {
   std::vector<BandPoint> extended_band;
   std::vector<DetectorResult> detectors;
   std::vector<Finding> findings;
+  /// Candidates that fired but whose extended model did not predict the held-out blocks better
+  /// than the base (their parameters and figures; not in the extended model).
+  std::vector<Finding> rejected;
   Gain gain;
   std::size_t runs = 0;
   std::size_t holdout_runs = 0;
+  std::size_t calibration_runs = 0;
   std::uint64_t seed = 0;
   double band_level = 0.95;
   double alpha = 0.01;

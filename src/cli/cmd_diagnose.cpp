@@ -70,7 +70,7 @@ void register_diagnose(CLI::App& app, Runner& runner) {
       const Recording rec = read_recording(cmd->file, cmd->input.options());
       print_input_notes(io.err, rec);
       const std::size_t hold = cmd->runs;  // the out-of-sample ensembles are as large as the main one
-      Progress progress("simulating", static_cast<std::uint64_t>(2 * cmd->runs + 7 * hold));
+      Progress progress("simulating", static_cast<std::uint64_t>(5 * cmd->runs + 7 * hold));
       opt.progress = &progress;
       const DiagnoseResult res = diagnose(rec, opt);
       progress.finish();

@@ -1,8 +1,11 @@
 // The detectors' shared calibration and the registry of a record's detectors.
 #include "diagnose/detector.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <array>
+#include <cmath>
 
 namespace rwcalc {
 
@@ -36,15 +39,30 @@ std::string_view detector_description(Effect e) { return kNames[static_cast<std:
 
 DetectorResult RecordDetector::calibrate(double statistic, const std::vector<RunStats>& runs, double alpha) const {
   std::vector<double> ens;
-  for (const auto& r : runs) ens.push_back(r.stat[static_cast<std::size_t>(effect())]);
+  for (const auto& r : runs)  // NaN: a record the statistic was not computed on
+    if (const double v = r.stat[static_cast<std::size_t>(effect())]; !std::isnan(v)) ens.push_back(v);
   DetectorResult d;
   d.effect = effect();
   d.statistic = statistic;
-  d.threshold = gumbel_threshold(ens, alpha);
+  const GumbelQuantile q = gumbel_quantile(ens, alpha);
+  d.threshold = q.value;
+  d.threshold_sigma = q.sigma;
   d.ensemble_max = ens.empty() ? 0.0 : *std::max_element(ens.begin(), ens.end());
   d.ensemble_median = quantile(ens, 0.5);
-  d.fired = d.named = statistic > d.threshold;
+  set_verdict(d, d.threshold + kThresholdUpperZ * q.sigma);
   return d;
+}
+
+void set_verdict(DetectorResult& d, double upper) {
+  d.threshold_upper = std::max(upper, d.threshold);
+  d.fired = d.statistic > d.threshold;
+  d.named = d.statistic > d.threshold_upper;
+  d.excess = d.fired && !d.named;
+  if (d.excess)
+    d.note = fmt::format(
+        "excess, not named: the statistic is above the threshold but within its Monte-Carlo uncertainty (upper 95 % "
+        "limit {:.4g}, threshold {:.4g} ± {:.2g})",
+        d.threshold_upper, d.threshold, d.threshold_sigma);
 }
 
 DetectorResult RecordDetector::test(const Trial& t) const {

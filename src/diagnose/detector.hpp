@@ -58,6 +58,8 @@ WarmupEstimate warmup_detect(const Decimated& d);
 /// A record's own mean-shape candidate: its best step or warm-up, whichever has the lower RSS.
 /// The measurement and every simulated record alike are compared without it.
 NoiseModel own_candidates(const Decimated& d);
+/// The same from the step and warm-up fits of the record.
+NoiseModel own_candidates(const StepEstimate& st, const WarmupEstimate& w);
 Decimated without_own_candidates(const Decimated& d);
 
 
@@ -112,6 +114,9 @@ struct RecordView {
   const Decimated& dec;
   const Decimated& clean;                 ///< dec without its own mean-shape candidate
   const std::vector<double>& octave_var;  ///< overlapping AV at the octave cluster sizes
+  /// The step and warm-up fits of dec when already made (for its own candidate), else null.
+  const StepEstimate* step = nullptr;
+  const WarmupEstimate* warmup = nullptr;
 };
 
 /// A record under test and its base model's ensemble.
@@ -146,9 +151,16 @@ class RecordDetector : public Detector {
   [[nodiscard]] virtual double statistic(const RecordView& r) const = 0;
   /// Whether shows_in reads the statistic on a block's own ensemble (which then scores it).
   [[nodiscard]] virtual bool block_statistic() const { return true; }
+  /// Whether the statistic reads the raw samples (its nulls are then simulated at full rate).
+  [[nodiscard]] virtual bool full_rate() const { return false; }
   [[nodiscard]] DetectorResult test(const Trial& t) const override;
   [[nodiscard]] DetectorResult calibrate(double statistic, const std::vector<RunStats>& runs, double alpha) const;
 };
+
+/// z of the threshold's one-sided upper 95 % confidence limit.
+inline constexpr double kThresholdUpperZ = 1.645;
+/// fired (statistic > threshold), named (> `upper`, at least the threshold) and the excess between.
+void set_verdict(DetectorResult& d, double upper);
 
 /// What a detector's statistic is, as the evidence of a finding says.
 std::string_view detector_description(Effect e);

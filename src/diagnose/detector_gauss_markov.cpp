@@ -63,7 +63,7 @@ class GaussMarkovDetector final : public Detector {
     if (!d.note.empty()) return d;
     const std::size_t runs = t.runs.size();
     const auto m1_runs =
-        run_ensemble(with_bump(s.base, gm), t.settings, runs, {s.octave_m, s.ref.grid, true, {}}, s.opt->progress);
+        run_ensemble(with_bump(s.base, gm), t.settings, runs, {s.octave_m, s.ref.grid, true, {}, false}, s.opt->progress);
     const auto m1_ref = make_reference(s.ref.grid, s.dec.tau_d, m1_runs, true);
     d.statistic = mid_deviance(v, s.clean_ref) - mid_deviance(v, m1_ref);
     std::vector<double> e_gm;
@@ -74,7 +74,7 @@ class GaussMarkovDetector final : public Detector {
     d.ensemble_max = *std::max_element(e_gm.begin(), e_gm.end());
     d.ensemble_median = quantile(e_gm, 0.5);
     d.threshold = std::max(kGmMinLogLr, d.ensemble_max);
-    d.fired = d.named = d.statistic > d.threshold;
+    set_verdict(d, d.threshold);
     return d;
   }
 

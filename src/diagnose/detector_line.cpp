@@ -207,6 +207,7 @@ void coherent_line(LineEstimate& e, const std::vector<double>& y, double t0, dou
 class LineDetector final : public RecordDetector {
  public:
   [[nodiscard]] Effect effect() const override { return Effect::Line; }
+  [[nodiscard]] bool full_rate() const override { return true; }
   [[nodiscard]] double statistic(const RecordView& r) const override {
     return line_detect(r.series, kHighLineMinHz, 0.0, false).statistic;
   }

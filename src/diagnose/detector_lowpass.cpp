@@ -75,7 +75,8 @@ class LowpassDetector final : public RecordDetector {
         boost::math::quantile(boost::math::chi_squared(1.0), 1.0 - alpha) * std::max(1.0, lp.chi2 / dof);
     if (d.threshold < floor) {
       d.threshold = floor;
-      d.fired = d.named = lp.statistic > floor;
+      d.note.clear();
+      set_verdict(d, floor);
     }
     return d;
   }

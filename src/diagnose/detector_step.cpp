@@ -115,7 +115,9 @@ class StepDetector final : public RecordDetector {
  public:
   [[nodiscard]] Effect effect() const override { return Effect::BiasStep; }
   [[nodiscard]] bool mean_shape() const override { return true; }
-  [[nodiscard]] double statistic(const RecordView& r) const override { return step_detect(r.dec).statistic; }
+  [[nodiscard]] double statistic(const RecordView& r) const override {
+    return r.step ? r.step->statistic : step_detect(r.dec).statistic;
+  }
   /// A block shows a step whose time, known from the whole record, lies inside it with data on
   /// both sides: its size is estimable there even where the block's own time search fails.
   [[nodiscard]] bool block_statistic() const override { return false; }

@@ -60,10 +60,10 @@ WarmupEstimate warmup_detect(const Decimated& d) {
   return e;
 }
 
-NoiseModel own_candidates(const Decimated& d) {
+NoiseModel own_candidates(const Decimated& d) { return own_candidates(step_detect(d), warmup_detect(d)); }
+
+NoiseModel own_candidates(const StepEstimate& st, const WarmupEstimate& w) {
   NoiseModel c;
-  const auto st = step_detect(d);
-  const auto w = warmup_detect(d);
   if (st.rss <= w.rss)
     c.bias_steps.push_back({st.t_s, st.size});
   else
@@ -83,7 +83,9 @@ class WarmupDetector final : public RecordDetector {
  public:
   [[nodiscard]] Effect effect() const override { return Effect::Warmup; }
   [[nodiscard]] bool mean_shape() const override { return true; }
-  [[nodiscard]] double statistic(const RecordView& r) const override { return warmup_detect(r.dec).statistic; }
+  [[nodiscard]] double statistic(const RecordView& r) const override {
+    return r.warmup ? r.warmup->statistic : warmup_detect(r.dec).statistic;
+  }
   void estimate(const Stretch& s, Extension& x) const override {
     const auto est = warmup_detect(s.dec);
     x.det.warmups.push_back({est.amp, est.tc});

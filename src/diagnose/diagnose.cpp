@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
+#include <optional>
 
 #include "diagnose/models.hpp"
 #include "rwcalc/error.hpp"
@@ -18,6 +20,7 @@ using namespace diag;
 namespace {
 
 constexpr double kPulseFitTauMin = 20.0;  ///< s, start of the base fit for pulse data
+constexpr std::size_t kCalibrationFactor = 4;  ///< default calibration ensemble: 4K records
 
 /// The measurement and what every stage reads of it.
 struct Context {
@@ -97,14 +100,18 @@ std::vector<const RecordDetector*> record_detectors(const Context& c, bool mean_
   return out;
 }
 
-/// The base model's ensemble: its band, mid-τ references and every record's detector statistics.
+/// The base model's ensemble: every record's detector statistics (calibration_runs records, the
+/// nulls being cheap: a threshold from a larger ensemble scatters less from seed to seed); its
+/// first K records give the band and the mid-τ references.
 std::vector<RunStats> base_ensemble(Context& c, DiagnoseResult& r) {
   EnsemblePlan plan = c.plan;
   plan.scored = record_detectors(c, false);
-  auto runs = run_ensemble(r.base, r.settings, c.opt.runs, plan, c.opt.progress);
-  r.base_band = make_band(r.analysis.allan.points, runs, c.opt.band_level);
-  c.full.ref = make_reference(c.plan.grid, c.full.dec.tau_d, runs);
-  c.full.clean_ref = make_reference(c.plan.grid, c.full.dec.tau_d, runs, true);
+  plan.stats_from = c.opt.runs;
+  auto runs = run_ensemble(r.base, r.settings, r.calibration_runs, plan, c.opt.progress);
+  const std::vector<RunStats> band_runs(runs.begin(), runs.begin() + static_cast<std::ptrdiff_t>(c.opt.runs));
+  r.base_band = make_band(r.analysis.allan.points, band_runs, c.opt.band_level);
+  c.full.ref = make_reference(c.plan.grid, c.full.dec.tau_d, band_runs);
+  c.full.clean_ref = make_reference(c.plan.grid, c.full.dec.tau_d, band_runs, true);
   return runs;
 }
 
@@ -116,9 +123,8 @@ void recalibrate_under_high_b(const Context& c, const DiagnoseResult& r, std::ve
   if (!(b.enabled && !b.resolved && b.high > r.base.bias_instability_deg_per_h)) return;
   NoiseModel hi = r.base;
   hi.bias_instability_deg_per_h = b.high;
-  EnsemblePlan plan = c.plan;
-  plan.scored = record_detectors(c, true);
-  const auto hi_runs = run_ensemble(hi, r.settings, c.opt.runs, plan, c.opt.progress);
+  EnsemblePlan plan{c.plan.octave_m, {}, false, record_detectors(c, true), false};
+  const auto hi_runs = run_ensemble(hi, r.settings, r.calibration_runs, plan, c.opt.progress);
   for (const RecordDetector* d : plan.scored)
     for (auto& res : results)
       if (res.effect == d->effect()) {
@@ -127,19 +133,28 @@ void recalibrate_under_high_b(const Context& c, const DiagnoseResult& r, std::ve
       }
 }
 
-/// A step and a transient that both fire are one change of the mean: the candidate is named.
+/// A step and a transient are two forms of one change of the mean: the detectors decide that
+/// there is one (either is named), the residual sum of squares of the block means decides its
+/// form (the record's own candidate). Left to the two thresholds, whose scatter from seed to seed
+/// is large when the base has rate random walk, the form changed with the seed.
 void one_mean_shape(const NoiseModel& candidate, std::vector<DetectorResult>& results) {
   auto of = [&](Effect e) {
     return std::find_if(results.begin(), results.end(), [e](auto& d) { return d.effect == e; });
   };
   const auto step = of(Effect::BiasStep), warm = of(Effect::Warmup);
-  if (step == results.end() || warm == results.end() || !step->fired || !warm->fired) return;
-  if (!candidate.warmups.empty()) {
-    step->named = false;
-    step->note = "the warm-up transient explains the block means better";
-  } else {
-    warm->named = false;
-    warm->note = "the bias step explains the block means better";
+  if (step == results.end() || warm == results.end() || !(step->named || warm->named)) return;
+  const bool warmup_form = !candidate.warmups.empty();
+  auto& keep = warmup_form ? *warm : *step;
+  auto& drop = warmup_form ? *step : *warm;
+  if (!keep.named) {
+    keep.named = true;
+    keep.note = fmt::format("named as the form of the change of the mean the {} detector found: it explains the "
+                            "block means better",
+                            detector_name(drop.effect));
+  }
+  if (drop.named) {
+    drop.named = false;
+    drop.note = fmt::format("the {} explains the block means better", warmup_form ? "warm-up transient" : "bias step");
   }
 }
 
@@ -147,11 +162,34 @@ bool is_named(const std::vector<DetectorResult>& results, Effect e) {
   return std::any_of(results.begin(), results.end(), [e](const auto& d) { return d.effect == e && d.named; });
 }
 
+/// The base the mid-τ detectors test against. A base calibrated with a named line in the data
+/// takes the line's Allan variance into N or B, and beside it the data without the line shows a
+/// deficit that a bump fit mistakes for a Gauss–Markov term: with a named line, the base is
+/// re-calibrated (pilot seeds as before) on the data without it, and its ensemble taken.
+struct MidTauBase {
+  Stretch stretch;
+  std::optional<std::vector<RunStats>> runs;  ///< empty: the base ensemble's
+};
+MidTauBase mid_tau_base(const Context& c, const DiagnoseResult& r, const NoiseModel& det, const Decimated& dclean,
+                        const std::vector<RunStats>& runs) {
+  MidTauBase m{c.full, std::nullopt};
+  if (det.sinusoids.empty()) return m;
+  m.stretch.base = calibrated(c.rb.model, c.full.pilot, c.full.pilot_runs, c.plan, dclean, c.opt.progress);
+  EnsemblePlan plan = c.plan;
+  plan.scored.clear();
+  m.runs = run_ensemble(m.stretch.base, r.settings, runs.size(), plan, c.opt.progress);
+  m.stretch.ref = make_reference(c.plan.grid, c.full.dec.tau_d, *m.runs);
+  m.stretch.clean_ref = make_reference(c.plan.grid, c.full.dec.tau_d, *m.runs, true);
+  return m;
+}
+
 /// Every detector's verdict (r.detectors) and the named effects. The mid-τ detectors read the
 /// measurement without its candidate and without the named lines, so they run last.
-Named test_detectors(Context& c, const std::vector<RunStats>& runs, DiagnoseResult& r) {
+Named test_detectors(Context& c, const std::vector<RunStats>& cal_runs, DiagnoseResult& r) {
   std::vector<DetectorResult> res(c.detectors.size());
-  const Trial trial{c.view(), runs, c.full, r.settings, nullptr};
+  const Trial trial{c.view(), cal_runs, c.full, r.settings, nullptr};
+  // The mid-τ detectors compare with the band's records (their references' own).
+  const std::vector<RunStats> runs(cal_runs.begin(), cal_runs.begin() + static_cast<std::ptrdiff_t>(c.opt.runs));
   for (std::size_t i = 0; i < c.detectors.size(); ++i) {
     res[i].effect = c.detectors[i]->effect();
     if (!c.detectors[i]->mid_tau()) res[i] = c.detectors[i]->test(trial);
@@ -175,7 +213,8 @@ Named test_detectors(Context& c, const std::vector<RunStats>& runs, DiagnoseResu
   Decimated dclean = c.full.dec;
   subtract_deterministic(dclean, det);
   const auto mid_var = decimated_avar(dclean, c.plan.grid);
-  const Trial mid_trial{c.view(), runs, c.full, r.settings, &mid_var};
+  const MidTauBase mid = mid_tau_base(c, r, det, dclean, runs);
+  const Trial mid_trial{c.view(), mid.runs ? *mid.runs : runs, mid.stretch, r.settings, &mid_var};
   for (std::size_t i = 0; i < c.detectors.size(); ++i)
     if (c.detectors[i]->mid_tau()) res[i] = c.detectors[i]->test(mid_trial);
   for (std::size_t e = 0; e < kEffectCount; ++e)
@@ -218,9 +257,35 @@ void extended_model(Context& c, const Named& named, DiagnoseResult& r) {
     return;
   }
   const auto ext_runs =
-      run_ensemble(r.extended, r.settings, c.opt.runs, {c.plan.octave_m, c.plan.grid, false, {}}, c.opt.progress);
+      run_ensemble(r.extended, r.settings, c.opt.runs, {c.plan.octave_m, {}, false, {}, false}, c.opt.progress);
   r.extended_band = make_band(r.analysis.allan.points, ext_runs, c.opt.band_level);
   refit_whole_band(r.extended, r.extended_band, r.analysis.allan.points, r.settings, c.opt.runs, c.plan, c.opt);
+}
+
+/// A finding must predict: when the extended model does not predict the held-out blocks better
+/// than the base, its terms are reported as failed candidates with their figures, the detectors'
+/// statistics as an excess, and the base stays the model.
+void reject_findings(DiagnoseResult& r) {
+  const std::string why = fmt::format(
+      "excess, not named: the model with it predicts the held-out blocks no better than the base (out-of-sample "
+      "misfit {:.4g} against {:.4g})",
+      r.gain.holdout_misfit_extended, r.gain.holdout_misfit_base);
+  for (auto& f : r.findings) {
+    f.evidence["holdout_misfit_base"] = r.gain.holdout_misfit_base;
+    f.evidence["holdout_misfit_extended"] = r.gain.holdout_misfit_extended;
+    for (auto& d : r.detectors)
+      if (d.effect == f.effect && d.named) {
+        d.named = false;
+        d.excess = true;
+        d.note = why;
+      }
+  }
+  r.rejected = std::move(r.findings);
+  r.findings.clear();
+  r.extended = r.base;
+  r.extended_band = r.base_band;
+  r.gain.misfit_extended = r.gain.misfit_base;
+  r.gain.coverage_extended = r.gain.coverage_base;
 }
 
 }  // namespace
@@ -232,7 +297,8 @@ DiagnoseResult diagnose(const Recording& read, const DiagnoseOptions& opt) {
   Context c{screened(read, opt, outliers, edited), opt, {}, {}, {}, {}, {}, {}};
   DiagnoseResult r;
   r.runs = opt.runs;
-  r.holdout_runs = opt.holdout_runs ? opt.holdout_runs : opt.runs;
+  r.holdout_runs = opt.holdout_runs ? opt.holdout_runs : 2 * opt.runs;
+  r.calibration_runs = std::max(opt.runs, opt.calibration_runs ? opt.calibration_runs : kCalibrationFactor * opt.runs);
   r.seed = opt.seed;
   r.band_level = opt.band_level;
   r.alpha = opt.alpha;
@@ -244,9 +310,14 @@ DiagnoseResult diagnose(const Recording& read, const DiagnoseOptions& opt) {
   r.gain.misfit_extended = band_misfit(r.extended_band, opt.runs);
   r.gain.coverage_base = band_coverage(r.base_band);
   r.gain.coverage_extended = band_coverage(r.extended_band);
-  const HoldoutScores h = out_of_sample(c.full, r, named);
-  r.gain.holdout_misfit_base = h.base;
-  r.gain.holdout_misfit_extended = h.extended;
+  if (r.findings.empty()) {  // nothing to predict: the base is the extended model
+    r.gain.holdout_misfit_base = r.gain.holdout_misfit_extended = std::numeric_limits<double>::quiet_NaN();
+  } else {
+    const HoldoutScores h = out_of_sample(c.full, r, named);
+    r.gain.holdout_misfit_base = h.base;
+    r.gain.holdout_misfit_extended = h.extended;
+    if (!(h.extended < h.base)) reject_findings(r);
+  }
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return r;
 }

@@ -12,6 +12,7 @@
 #include "rwcalc/allan.hpp"
 #include "rwcalc/ensemble.hpp"
 #include "rwcalc/fit.hpp"
+#include "rwcalc/noise_model.hpp"
 
 namespace rwcalc::diag {
 
@@ -47,31 +48,157 @@ bool band_point_valid(const BandPoint& b) { return b.mean_var > 0 && b.dev > 0 &
 
 }  // namespace
 
-std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSettings& settings, std::size_t runs,
-                                   const EnsemblePlan& plan, Progress* progress) {
+namespace {
+
+/// Full-rate samples of the short pieces that give the octave AV below the decimated step.
+constexpr std::size_t kPieceSamples = 4096;
+
+/// The plan's reductions of one simulated record: its octave AV `v` (already set), mean rate,
+/// mid-τ AV and scored statistics, from `s` (full rate, or the decimated step itself).
+/// Records from plan.stats_from on are reduced to the scored statistics.
+void reduce(const PhaseSeries& s, const EnsemblePlan& plan, std::size_t r, RunStats& st) {
+  st.mean_rate = s.diff(s.points() - 1, 0) / s.duration_s();
+  const bool mid = r < plan.stats_from;
+  const Decimated d = decimate(s);
+  if (plan.raw_mid && mid) st.mid_var = decimated_avar(d, plan.grid);
+  if (!plan.clean_mid && plan.scored.empty()) return;
+  // The record's own candidate from its step and warm-up fits, which are also their statistics.
+  const StepEstimate step = step_detect(d);
+  const WarmupEstimate warm = warmup_detect(d);
+  Decimated dc = d;
+  subtract_deterministic(dc, own_candidates(step, warm));
+  if (plan.clean_mid && mid) st.mid_var_clean = decimated_avar(dc, plan.grid);
+  const RecordView view{s, d, dc, st.octave_var, &step, &warm};
+  for (const RecordDetector* det : plan.scored) st.stat[static_cast<std::size_t>(det->effect())] = det->statistic(view);
+}
+
+/// The old way: every record at full rate (a statistic that reads the raw samples needs it).
+std::vector<RunStats> full_rate_ensemble(const NoiseModel& model, const SimulationSettings& settings,
+                                         std::size_t runs, const EnsemblePlan& plan, Progress* progress) {
   std::vector<RunStats> out(runs);
   EnsembleOptions eo;
   eo.path = SimulationPath::Ensemble;
   eo.progress = progress;
-  const bool clean = plan.clean_mid || !plan.scored.empty();
   simulate_ensemble(
       model, settings, runs,
       [&](std::size_t r, const PhaseSeries& s) {
-        RunStats& st = out[r];
-        st.octave_var = octave_avar(s, plan.octave_m);
-        st.mean_rate = s.diff(s.points() - 1, 0) / s.duration_s();
-        const Decimated d = decimate(s);
-        st.mid_var = decimated_avar(d, plan.grid);
-        if (!clean) return;
-        const Decimated dc = without_own_candidates(d);
-        st.mid_var_clean = decimated_avar(dc, plan.grid);
-        const RecordView view{s, d, dc, st.octave_var};
-        for (const RecordDetector* det : plan.scored)
-          st.stat[static_cast<std::size_t>(det->effect())] = det->statistic(view);
+        out[r].octave_var = octave_avar(s, plan.octave_m);
+        reduce(s, plan, r, out[r]);
       },
       eo);
   return out;
 }
+
+/// Whether the nulls can be simulated at the decimated step D·τ0: no output-chain low-pass, and
+/// every octave cluster size a multiple of D or short enough for the pieces.
+bool decimated_nulls(const NoiseModel& model, const EnsemblePlan& plan, std::size_t D) {
+  // An output-chain low-pass filters the white angle noise up to a few τf, past the decimated step.
+  if (D < 2 || model.output_lowpass_tc_s > 0) return false;
+  return std::all_of(plan.octave_m.begin(), plan.octave_m.end(), [D](std::int64_t m) {
+    return m % static_cast<std::int64_t>(D) == 0 || m <= static_cast<std::int64_t>(kPieceSamples / 16);
+  });
+}
+
+/// The octave AV below the decimated step, per record: the mean over the records of short
+/// full-rate pieces (exact read-out and all), each record's deviation from it shrunk to the full
+/// length (an overlapping AV's variance falls as 1/terms at τ ≪ T).
+void short_tau_octaves(const NoiseModel& model, const SimulationSettings& settings, const std::vector<std::int64_t>& m,
+                       const std::vector<std::size_t>& at, std::vector<RunStats>& out) {
+  if (at.empty()) return;
+  SimulationSettings ps = settings;
+  ps.duration_s = std::min(settings.duration_s, static_cast<double>(kPieceSamples) / settings.rate_hz);
+  ps.seed = ensemble_seed(settings.seed, 0x7069656365ULL);  // streams apart from the records'
+  std::vector<std::int64_t> ms;
+  for (const std::size_t i : at) ms.push_back(m[i]);
+  std::vector<std::vector<double>> piece(out.size());
+  std::size_t piece_points = 0;
+  simulate_ensemble(
+      model, ps, out.size(),
+      [&](std::size_t r, const PhaseSeries& s) {
+        piece[r] = octave_avar(s, ms);
+        if (r == 0) piece_points = s.points();
+      },
+      {SimulationPath::Exact, nullptr});
+  const std::size_t full_points = settings.samples() + 1;
+  for (std::size_t k = 0; k < at.size(); ++k) {
+    double mean = 0;
+    for (const auto& p : piece) mean += p[k];
+    mean /= static_cast<double>(out.size());
+    const double n_piece = static_cast<double>(term_count(Estimator::Overlapping, ms[k], piece_points));
+    const double n_full = static_cast<double>(term_count(Estimator::Overlapping, ms[k], full_points));
+    const double shrink = n_piece > 0 && n_full > 0 ? std::sqrt(n_piece / n_full) : 0.0;
+    for (std::size_t r = 0; r < out.size(); ++r)
+      out[r].octave_var[at[k]] = std::max(mean + (piece[r][k] - mean) * shrink, 1e-3 * mean);
+  }
+}
+
+std::vector<RunStats> decimated_ensemble(const NoiseModel& model, const SimulationSettings& settings, std::size_t runs,
+                                         const EnsemblePlan& plan, std::size_t D, Progress* progress);
+
+}  // namespace
+
+std::vector<RunStats> run_ensemble(const NoiseModel& model, const SimulationSettings& settings, std::size_t runs,
+                                   const EnsemblePlan& plan, Progress* progress) {
+  const std::size_t D = decimation(settings.rate_hz);
+  if (!decimated_nulls(model, plan, D)) return full_rate_ensemble(model, settings, runs, plan, progress);
+  // A statistic that reads the raw samples gets its own full-rate records (the band's K at most,
+  // other seeds); the records beyond have no value for it (NaN, left out of its calibration).
+  EnsemblePlan rest = plan;
+  std::vector<const RecordDetector*> raw;
+  rest.scored.clear();
+  for (const RecordDetector* d : plan.scored) (d->full_rate() ? raw : rest.scored).push_back(d);
+  auto out = decimated_ensemble(model, settings, runs, rest, D, progress);
+  if (raw.empty()) return out;
+  SimulationSettings fs = settings;
+  fs.seed = ensemble_seed(settings.seed, 0x726177ULL);
+  const EnsemblePlan raw_plan{{}, {}, false, raw, false};
+  const auto full = full_rate_ensemble(model, fs, std::min(runs, plan.stats_from), raw_plan, nullptr);
+  for (std::size_t r = 0; r < runs; ++r)
+    for (const RecordDetector* d : raw)
+      out[r].stat[static_cast<std::size_t>(d->effect())] =
+          r < full.size() ? full[r].stat[static_cast<std::size_t>(d->effect())] : std::numeric_limits<double>::quiet_NaN();
+  return out;
+}
+
+namespace {
+
+std::vector<RunStats> decimated_ensemble(const NoiseModel& model, const SimulationSettings& settings, std::size_t runs,
+                                         const EnsemblePlan& plan, std::size_t D, Progress* progress) {
+  // The detectors read the angle at D·τ0 only. The simulator's discrete model at that step gives
+  // exactly that angle (every term is simulated as an exact step, the read-out quantizes the
+  // angle at each sample, white angle noise is per sample).
+  SimulationSettings cs = settings;
+  cs.rate_hz = settings.rate_hz / static_cast<double>(D);
+  const NoiseModel& cm = model;
+  std::vector<std::int64_t> coarse_m;
+  std::vector<std::size_t> coarse_at, short_at;
+  for (std::size_t i = 0; i < plan.octave_m.size(); ++i) {
+    if (plan.octave_m[i] % static_cast<std::int64_t>(D) == 0) {
+      coarse_m.push_back(plan.octave_m[i] / static_cast<std::int64_t>(D));
+      coarse_at.push_back(i);
+    } else {
+      short_at.push_back(i);
+    }
+  }
+  std::vector<RunStats> out(runs);
+  EnsembleOptions eo;
+  eo.path = SimulationPath::Exact;
+  eo.progress = progress;
+  simulate_ensemble(
+      cm, cs, runs,
+      [&](std::size_t r, const PhaseSeries& s) {
+        RunStats& st = out[r];
+        st.octave_var.assign(plan.octave_m.size(), 0.0);
+        const std::vector<double> v = octave_avar(s, coarse_m);
+        for (std::size_t k = 0; k < coarse_at.size(); ++k) st.octave_var[coarse_at[k]] = v[k];
+        reduce(s, plan, r, st);
+      },
+      eo);
+  short_tau_octaves(model, settings, plan.octave_m, short_at, out);
+  return out;
+}
+
+}  // namespace
 
 std::vector<BandPoint> make_band(const std::vector<AllanPoint>& measured, const std::vector<RunStats>& runs,
                                  double level) {

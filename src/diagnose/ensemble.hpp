@@ -62,6 +62,10 @@ struct EnsemblePlan {
   std::vector<std::size_t> grid;              ///< mid-τ grid (decimated periods)
   bool clean_mid = true;                      ///< also the mid-τ AV without the record's own candidate
   std::vector<const RecordDetector*> scored;  ///< detectors whose statistic each record gets
+  bool raw_mid = true;                        ///< the mid-τ AV of the record as simulated (mid_var)
+  /// Records from this one on get only the scored statistics, mean rate and octave AV (a
+  /// detector calibration beyond the band's records).
+  std::size_t stats_from = static_cast<std::size_t>(-1);
 };
 
 struct RunStats {

@@ -8,6 +8,7 @@
 #include <complex>
 
 #include "diagnose/models.hpp"
+#include "rwcalc/parallel.hpp"
 #include "rwcalc/units.hpp"
 
 namespace rwcalc::diag {
@@ -110,6 +111,20 @@ void score_lines(const PhaseSeries& pred, const NoiseModel& e_pred, const std::v
   }
 }
 
+/// A block's pilot ensembles (of its base and of its extended model alike, same seeds), as the
+/// whole record's, have half the runs.
+std::size_t block_pilot_runs(const DiagnoseResult& r) { return r.holdout_runs; }
+
+/// The block's base is calibrated without the block's own step or transient already: a named
+/// mean shape changes the level the model predicts, and its re-calibrated N and B would only add
+/// the pilot's scatter to the comparison. Its extended model keeps the base's power laws.
+void keep_power_laws(const NoiseModel& base, NoiseModel& m) {
+  m.arw_deg_per_sqrt_h = base.arw_deg_per_sqrt_h;
+  m.bias_instability_deg_per_h = base.bias_instability_deg_per_h;
+  m.rrw_deg_per_h_per_sqrt_h = base.rrw_deg_per_h_per_sqrt_h;
+  m.ramp_deg_per_h2 = base.ramp_deg_per_h2;
+}
+
 /// The fitting block as a stretch with its base model, pilot settings and hints.
 Stretch fitting_stretch(const Stretch& full, const DiagnoseResult& r, const Named& named, const Recording& fit_rec,
                         const AnalysisResult& a_fit, const SimulationSettings& pilot, double t_fit) {
@@ -120,7 +135,7 @@ Stretch fitting_stretch(const Stretch& full, const DiagnoseResult& r, const Name
   st.opt = full.opt;
   st.dec = decimate(fit_rec.phase);
   st.pilot = pilot;
-  st.pilot_runs = r.holdout_runs;
+  st.pilot_runs = block_pilot_runs(r);
   st.sin_hint_hz = named.sin_hint_hz;
   st.line_hint_hz = named.line_hint_hz;
   // A named Gauss–Markov term keeps the whole record's correlation time (its structure).
@@ -151,11 +166,11 @@ std::pair<double, double> score_fold(const Stretch& full, const DiagnoseResult& 
   Stretch st = fitting_stretch(full, r, named, fit_rec, a_fit, sh, static_cast<double>(fa) * x.tau0_s);
   st.octave_m = octave_of(a_pred);
   EnsemblePlan plan{st.octave_m, mid_tau_grid(st.dec), true, {}};
-  st.base = robust_base(fit_rec, a_fit, *full.aopt, st.dec, sh, r.holdout_runs, plan, opt.progress).model;
+  st.base = robust_base(fit_rec, a_fit, *full.aopt, st.dec, sh, block_pilot_runs(r), plan, opt.progress).model;
   sh.seed += 50;
   const double pred_T = pred_rec.phase.duration_s();
   const double pred_mean = pred_rec.phase.diff(pred_rec.phase.points() - 1, 0) / pred_T;
-  const EnsemblePlan pred_plan{plan.octave_m, plan.grid, false, {}};
+  const EnsemblePlan pred_plan{plan.octave_m, {}, false, {}, false};
   const auto b_pred =
       run_ensemble(with_mean_rate(st.base, pred_T, pred_mean), sh, r.holdout_runs, pred_plan, opt.progress);
   const double v_base = std::max(mean_rate_variance(b_pred), 1e-30);
@@ -179,7 +194,9 @@ std::pair<double, double> score_fold(const Stretch& full, const DiagnoseResult& 
   for (const Detector* d : named.detectors)
     if (d->shows_in(trial)) shown.push_back(d);
   if (shown.empty()) return {sb.per_point(), sb.per_point()};
-  const Extension e = extend(st, shown);
+  Extension e = extend(st, shown);
+  if (std::all_of(shown.begin(), shown.end(), [](const Detector* d) { return d->mean_shape(); }))
+    keep_power_laws(st.base, e.model);
   const NoiseModel e_pred = shifted(e.model, (static_cast<double>(pa) - static_cast<double>(fa)) * x.tau0_s);
   const auto e_runs =
       run_ensemble(with_mean_rate(e_pred, pred_T, pred_mean), sh, r.holdout_runs, pred_plan, opt.progress);
@@ -193,13 +210,17 @@ std::pair<double, double> score_fold(const Stretch& full, const DiagnoseResult& 
 HoldoutScores out_of_sample(const Stretch& full, const DiagnoseResult& r, const Named& named) {
   const PhaseSeries& x = full.rec->phase;
   const auto folds = holdout_folds(x.points() - 1, x.tau0_s);
+  // The folds run side by side (each fold's ensembles then run on its thread): their fits and
+  // Allan variances of the measured blocks are otherwise serial. Summed in fold order.
+  std::vector<std::pair<double, double>> scores(folds.size());
+  parallel_for(folds.size(), [&](std::size_t i) { scores[i] = score_fold(full, r, named, folds[i], i); });
   HoldoutScores s;
   for (std::size_t i = 0; i < folds.size(); ++i) {
-    const auto [b, e] = score_fold(full, r, named, folds[i], i);
-    s.base += folds[i].weight * b;
-    s.extended += folds[i].weight * e;
+    s.base += folds[i].weight * scores[i].first;
+    s.extended += folds[i].weight * scores[i].second;
   }
   return s;
 }
 
 }  // namespace rwcalc::diag
+

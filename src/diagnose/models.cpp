@@ -152,7 +152,7 @@ PhaseSeries cleaned(const PhaseSeries& x, const NoiseModel& det) {
 /// pulled low makes a quiet model beside which the record's own wander looks like a step.
 NoiseModel calibrated(const NoiseModel& m0, const SimulationSettings& settings, std::size_t runs,
                       const EnsemblePlan& plan, const Decimated& dec, Progress* progress) {
-  const EnsemblePlan pilot_plan{plan.octave_m, plan.grid, true, {}};
+  const EnsemblePlan pilot_plan{plan.octave_m, plan.grid, true, {}, false};
   const auto pilot = run_ensemble(m0, settings, runs, pilot_plan, progress);
   const auto ref = make_reference(plan.grid, dec.tau_d, pilot, true);
   const auto dc = power_law_corrections(decimated_avar(dec, plan.grid), ref, c_of(m0), dec.duration() / 6.0, true);
@@ -191,7 +191,7 @@ void refit_whole_band(NoiseModel& m, std::vector<BandPoint>& band, const std::ve
   refit.arw_deg_per_sqrt_h = coefficient_from_c(Term::N, c[0] + dc[0]);
   refit.bias_instability_deg_per_h = coefficient_from_c(Term::B, c[1] + dc[1]);
   refit.rrw_deg_per_h_per_sqrt_h = coefficient_from_c(Term::K, c[2] + dc[2]);
-  const auto rr = run_ensemble(refit, settings, runs, {plan.octave_m, plan.grid, false, {}}, opt.progress);
+  const auto rr = run_ensemble(refit, settings, runs, {plan.octave_m, {}, false, {}, false}, opt.progress);
   auto b2 = make_band(measured, rr, opt.band_level);
   if (band_misfit(b2, runs) < band_misfit(band, runs)) {
     m = refit;

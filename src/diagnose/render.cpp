@@ -42,6 +42,9 @@ json clean_json(json j) {
   return j;
 }
 
+/// A figure not computed (NaN) is null in the JSON.
+json finite_or_null(double x) { return std::isnan(x) ? json(nullptr) : json(x); }
+
 /// N, B, K and R of a model, as the report prints them.
 std::string power_laws(const NoiseModel& m) {
   return trf("N = {:.4g} °/√h, B = {:.4g} °/h, K = {:.4g} °/h/√h, R = {:.4g} °/h²", m.arw_deg_per_sqrt_h,
@@ -56,6 +59,24 @@ std::string unit_of(const std::string& key) {
   return "";
 }
 
+/// One line per finding: its parameters with their standard errors and units.
+std::string format_findings(const std::vector<Finding>& fs) {
+  std::string s;
+  for (const auto& f : fs) {
+    s += fmt::format("  {}:", finding_name(f.effect));
+    for (const auto& [k, v] : f.params.items()) {
+      if (!v.is_number()) continue;
+      const double u = f.uncertainty.contains(k) ? f.uncertainty[k].get<double>() : -1;
+      s += fmt::format(" {} = {:.4g}", k, v.get<double>());
+      if (u >= 0) s += fmt::format(" ± {:.2g}", u);
+      s += fmt::format(" {};", unit_of(k));
+    }
+    s.pop_back();
+    s += "\n";
+  }
+  return s;
+}
+
 }  // namespace
 
 json to_json(const DiagnoseResult& r) {
@@ -67,10 +88,11 @@ json to_json(const DiagnoseResult& r) {
   j["scale_arcsec_per_pulse"] = r.settings.scale_arcsec;
   j["temperature_c"] = r.analysis.temperature_c ? json(*r.analysis.temperature_c) : json(nullptr);
   j["runs"] = r.runs;
+  j["calibration_runs"] = r.calibration_runs;
   j["holdout_runs"] = r.holdout_runs;
   j["seed"] = r.seed;
   j["false_alarm_level_per_detector"] = r.alpha;
-  j["simulation_path"] = "ensemble";
+  j["simulation_path"] = "decimated";
   j["outliers"] = to_json(r.analysis.outliers);
   json base = model_json(r.base, r.base_band, r.band_level, r.gain.misfit_base, r.gain.coverage_base);
   // Not under "fit": model_from_analysis_json would read those coefficients instead of this model.
@@ -86,31 +108,38 @@ json to_json(const DiagnoseResult& r) {
     json o = {{"effect", std::string(detector_name(d.effect))},
               {"statistic", d.statistic},
               {"threshold", d.threshold},
+              {"threshold_sigma", d.threshold_sigma},
+              {"threshold_upper", d.threshold_upper},
               {"ensemble_max", d.ensemble_max},
               {"ensemble_median", d.ensemble_median},
               {"fired", d.fired},
+              {"excess", d.excess},
               {"named", d.named}};
     if (!d.note.empty()) o["note"] = d.note;
     det.push_back(o);
   }
   j["detectors"] = det;
-  json fnd = json::array();
-  for (const auto& f : r.findings) {
-    json o = {{"effect", std::string(finding_name(f.effect))}};
-    for (const auto& [k, v] : f.params.items()) o[k] = v;
-    o["uncertainty"] = f.uncertainty;
-    o["evidence"] = f.evidence;
-    fnd.push_back(o);
-  }
-  j["findings"] = fnd;
+  const auto findings_json = [](const std::vector<Finding>& fs) {
+    json fnd = json::array();
+    for (const auto& f : fs) {
+      json o = {{"effect", std::string(finding_name(f.effect))}};
+      for (const auto& [k, v] : f.params.items()) o[k] = v;
+      o["uncertainty"] = f.uncertainty;
+      o["evidence"] = f.evidence;
+      fnd.push_back(o);
+    }
+    return fnd;
+  };
+  j["findings"] = findings_json(r.findings);
+  j["rejected_candidates"] = findings_json(r.rejected);
   j["extended_model"] =
       model_json(r.extended, r.extended_band, r.band_level, r.gain.misfit_extended, r.gain.coverage_extended);
   j["gain"] = {{"misfit_base", r.gain.misfit_base},
                {"misfit_extended", r.gain.misfit_extended},
                {"coverage_base", r.gain.coverage_base},
                {"coverage_extended", r.gain.coverage_extended},
-               {"holdout_misfit_base", r.gain.holdout_misfit_base},
-               {"holdout_misfit_extended", r.gain.holdout_misfit_extended}};
+               {"holdout_misfit_base", finite_or_null(r.gain.holdout_misfit_base)},
+               {"holdout_misfit_extended", finite_or_null(r.gain.holdout_misfit_extended)}};
   j["seconds"] = r.seconds;
   return clean_json(j);
 }
@@ -119,9 +148,10 @@ std::string format_report(const DiagnoseResult& r) {
   std::string s;
   s += trf("Diagnosis of {}\n", printable(r.analysis.source));
   s +=
-      trf("  record: {:.0f} s at {:g} Hz, pulse weight {:g}″; ensemble of {} simulated records per model "
-          "(seed {}), band {:g} % per τ\n\n",
-          r.settings.duration_s, r.settings.rate_hz, r.settings.scale_arcsec, r.runs, r.seed, r.band_level * 100);
+      trf("  record: {:.0f} s at {:g} Hz, pulse weight {:g}″; ensemble of {} simulated records per model, {} for the "
+          "detectors' thresholds (seed {}), band {:g} % per τ\n\n",
+          r.settings.duration_s, r.settings.rate_hz, r.settings.scale_arcsec, r.runs, r.calibration_runs, r.seed,
+          r.band_level * 100);
   s += format_outliers(r.analysis.outliers);
   const auto& m = r.base;
   s += tr("Base model (five-term fit): ") + power_laws(m) +
@@ -143,24 +173,21 @@ std::string format_report(const DiagnoseResult& r) {
   s += tr("\nDetectors (statistic on the measurement against the ensemble-calibrated threshold, ") +
        trf("false-alarm level {:g} % each):\n", r.alpha * 100);
   for (const auto& d : r.detectors)
-    s += trf("  {:<17} statistic {:>9.3f} (dimensionless), threshold {:>8.3f}, ensemble max {:>8.3f}: {}{}\n",
-             detector_name(d.effect), d.statistic, d.threshold, d.ensemble_max,
-             d.named ? tr("FOUND") : (d.fired ? tr("fired, not named") : tr("not found")),
-             d.note.empty() ? "" : " (" + d.note + ")");
+    s += trf(
+        "  {:<17} statistic {:>9.3f} (dimensionless), threshold {:>8.3f} ± {:.2g} (upper limit {:.3f}), ensemble max "
+        "{:>8.3f}: {}{}\n",
+        detector_name(d.effect), d.statistic, d.threshold, d.threshold_sigma, d.threshold_upper, d.ensemble_max,
+        d.named ? tr("FOUND")
+                : (d.excess ? tr("EXCESS, not named") : (d.fired ? tr("fired, not named") : tr("not found"))),
+        d.note.empty() ? "" : " (" + d.note + ")");
   s += tr("\nFindings:\n");
-  if (r.findings.empty()) s += tr("  none: the base model's simulations explain the measurement\n");
-  for (const auto& f : r.findings) {
-    s += fmt::format("  {}:", finding_name(f.effect));
-    for (const auto& [k, v] : f.params.items()) {
-      if (!v.is_number()) continue;
-      const double u = f.uncertainty.contains(k) ? f.uncertainty[k].get<double>() : -1;
-      s += fmt::format(" {} = {:.4g}", k, v.get<double>());
-      if (u >= 0) s += fmt::format(" ± {:.2g}", u);
-      s += fmt::format(" {};", unit_of(k));
-    }
-    s.pop_back();
-    s += "\n";
-  }
+  if (r.findings.empty() && r.rejected.empty())
+    s += tr("  none: the base model's simulations explain the measurement\n");
+  if (r.findings.empty() && !r.rejected.empty())
+    s += tr("  none named: the candidates below do not predict the held-out blocks better than the base\n");
+  s += format_findings(r.findings);
+  if (!r.rejected.empty())
+    s += tr("Candidates not named (no out-of-sample gain; excess only):\n") + format_findings(r.rejected);
   s += tr("\nExtended model: ") + power_laws(r.extended) + trf(", {} extra term(s)\n", r.findings.size());
   s += tr("\nGain (misfit: mean EDF-weighted Gamma deviance per τ, about 1 (dimensionless) when the model fits):\n");
   s += fmt::format("  {:<44} {:>10} {:>10}\n", "", tr("base"), tr("extended"));
@@ -168,8 +195,11 @@ std::string format_report(const DiagnoseResult& r) {
                    r.gain.misfit_extended);
   s += fmt::format("  {:<44} {:>9.1f}% {:>9.1f}%\n", tr("measured τ inside the simulated band"),
                    100 * r.gain.coverage_base, 100 * r.gain.coverage_extended);
-  s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", tr("out-of-sample misfit (dimensionless)"),
-                   r.gain.holdout_misfit_base, r.gain.holdout_misfit_extended);
+  if (std::isnan(r.gain.holdout_misfit_base))
+    s += fmt::format("  {:<44} {:>21}\n", tr("out-of-sample misfit (dimensionless)"), tr("not needed: none named"));
+  else
+    s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", tr("out-of-sample misfit (dimensionless)"),
+                     r.gain.holdout_misfit_base, r.gain.holdout_misfit_extended);
   s += fmt::format("\n  ({:.1f} s)\n", r.seconds);
   return s;
 }

@@ -22,7 +22,7 @@ struct Decimated {
   std::vector<double> theta;  ///< θ_0 = 0 … θ_L
   [[nodiscard]] double duration() const { return theta.size() > 1 ? tau_d * double(theta.size() - 1) : 0.0; }
 };
-std::size_t decimation(double rate_hz);  ///< D: rate/D ≈ 10 Hz; 1 below 20 Hz
+std::size_t decimation(double rate_hz);  ///< D: a power of two, 10 Hz ≤ rate/D < 20 Hz; 1 below 20 Hz
 Decimated decimate(const PhaseSeries& x);
 /// Mean rates over blocks of `per_block` decimated periods (about `seconds`: per_block_for), °/h.
 std::vector<double> block_rates(const Decimated& d, std::size_t per_block);
@@ -39,6 +39,13 @@ void subtract_deterministic(Decimated& d, const NoiseModel& m, double t0 = 0);
 /// (1 − α) quantile of a maximum-type statistic from ensemble values (Gumbel fit by moments),
 /// never below the largest ensemble value.
 double gumbel_threshold(const std::vector<double>& values, double alpha);
+/// The same quantile with its Monte-Carlo standard error (method-of-moments Gumbel quantile,
+/// Var = σ²/K·(1 + 1.1396k + 1.1k²), k its frequency factor); the ensemble maximum is a floor only
+/// when K < 1/α (beyond, the maximum lies above the quantile and would only add scatter).
+struct GumbelQuantile {
+  double value = 0, sigma = 0;
+};
+GumbelQuantile gumbel_quantile(const std::vector<double>& values, double alpha);
 double quantile(std::vector<double> v, double p);
 double median_of(std::vector<double>& v);  ///< the upper median; reorders v
 /// White-noise σ from first differences (block means of counts make most differences 0, so not
