@@ -3,16 +3,20 @@
 // checked by scripts/update-po.sh --check (the test i18n_catalogue_complete).
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <regex>
 #include <string>
 #include <vector>
 
 #include "rwcalc/i18n.hpp"
+#include "rwcalc/sensor.hpp"
 #include "test_support.hpp"
 
 using rwcalc::Language;
@@ -52,6 +56,28 @@ std::string field_problem(const std::string& english, const std::string& russian
 }
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+bool in_catalogue(const std::string& english) {
+  const auto& entries = rwcalc::i18n_detail::russian_entries();
+  return std::any_of(entries.begin(), entries.end(), [&](const auto& e) { return e.id == english; });
+}
+
+/// A static 6-axis IMU of white noise, 200 s at 100 Hz: gyro in °/s, accelerometer in g.
+std::string imu_csv() {
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> z;
+  std::string s = "gyro_x_dps,gyro_y_dps,gyro_z_dps,acc_x_g,acc_y_g,acc_z_g\n";
+  for (int k = 0; k < 20000; ++k)
+    s += fmt::format("{:.6f},{:.6f},{:.6f},{:.7f},{:.7f},{:.7f}\n", 0.1 + 0.05 * z(rng), 0.1 + 0.05 * z(rng),
+                     0.1 + 0.05 * z(rng), 0.002 * z(rng), 0.002 * z(rng), -1 + 0.002 * z(rng));
+  return s;
+}
+
+std::vector<std::string> imu_args(const std::filesystem::path& file, std::vector<std::string> more) {
+  return rwcalc::test::concat({"imu", file.string(), "--rate", "100", "--gyro", "gyro_x_dps,gyro_y_dps,gyro_z_dps",
+                               "--accel", "acc_x_g,acc_y_g,acc_z_g"},
+                              more);
+}
 
 }  // namespace
 
@@ -212,6 +238,68 @@ TEST(RussianCli, ReportIsInRussianWithoutEnglishHeadings) {
                               "with a probability",
                               "sigma^2",
                               "Page"})
+    EXPECT_FALSE(contains(html, english)) << english;
+}
+
+TEST(Catalogue, EveryUnitLabelAndTermNameOfEverySensorHasItsRussianEntry) {
+  using rwcalc::SensorKind;
+  std::vector<rwcalc::UnitSet> sets{rwcalc::si_units(SensorKind::Gyro), rwcalc::si_units(SensorKind::Accelerometer)};
+  for (const char* u : {"", "deg/h", "deg/s", "rad/s"}) sets.push_back(rwcalc::output_units(SensorKind::Gyro, u));
+  for (const char* u : {"", "m/s^2", "g", "mg", "ug"})
+    sets.push_back(rwcalc::output_units(SensorKind::Accelerometer, u));
+  for (const auto& set : sets) {
+    EXPECT_TRUE(in_catalogue(set.deviation.label)) << set.deviation.label;
+    for (const auto& u : set.term) EXPECT_TRUE(in_catalogue(u.label)) << u.label;
+  }
+  for (const SensorKind k : {SensorKind::Gyro, SensorKind::Accelerometer})
+    for (const rwcalc::Term t : rwcalc::kAllTerms) {
+      EXPECT_TRUE(in_catalogue(std::string(rwcalc::term_meaning(k, t)))) << rwcalc::term_meaning(k, t);
+      const LanguageScope ru(Language::Russian);
+      EXPECT_NE(rwcalc::localized_meaning(k, t), rwcalc::term_meaning(k, t));
+    }
+}
+
+TEST(RussianCli, ImuTablesInThePapersTermsAndRussianUnits) {
+  TempDir dir;
+  const auto file = dir.write("imu.csv", imu_csv());
+  const auto r = run_cli(imu_args(file, {"--lang", "ru"}));
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* part :
+       {"Данные", "Гироскопы (осей: 3", "Акселерометры (осей: 3", "случайное блуждание угла",
+        "нестабильность смещения нуля", "случайное блуждание скорости", "случайное блуждание линейной скорости",
+        "случайное блуждание ускорения", "N в °/√ч", "B в °/ч", "Q в угл. с", "N в м/с/√ч", "B в мкg",
+        "N в рад/с/√Гц", "N в м/с²/√Гц", "среднее", "τ аппроксимации (с)", "Обозначения"})
+    EXPECT_TRUE(contains(r.out, part)) << part << "\n" << r.out;
+  for (const char* english :
+       {"Data\n", "samples at", "Gyro", "Accelerometer", "axes;", "angle random walk", "bias instability",
+        "rate random walk", "velocity random walk", "quantisation", "mean", "N in", "fit chi2", "fit tau", "°/h",
+        "m/s/√h", "µg", "√Hz", "rad/s", "Earth rate", "class verdict", "Conventions", "profile intervals"})
+    EXPECT_FALSE(contains(r.out, english)) << english << "\n" << r.out;
+  EXPECT_FALSE(std::regex_search(r.out, std::regex(R"((^|[^\w.])\d+\.\d+\b)"))) << r.out;  // decimal comma
+}
+
+TEST(RussianCli, ImuJsonReportAndNoiseFile) {
+  TempDir dir;
+  const auto file = dir.write("imu.csv", imu_csv());
+  const auto en = run_cli(imu_args(file, {"--json", "--kalibr", (dir.path() / "en.yaml").string()}));
+  const auto ru = run_cli(imu_args(file, {"--json", "--lang", "ru", "--kalibr", (dir.path() / "ru.yaml").string()}));
+  ASSERT_EQ(ru.status, 0) << ru.err;
+  auto a = nlohmann::json::parse(en.out), b = nlohmann::json::parse(ru.out);
+  // Keys, numbers, units and the terms' names stay English; only the fit range's reason is free text.
+  for (auto* j : {&a, &b})
+    for (auto& c : (*j)["channels"]) c["fit"].erase("range_reason");
+  EXPECT_EQ(a["channels"], b["channels"]);
+  EXPECT_EQ(a["noise"], b["noise"]);
+  // The noise file is read by Kalibr and OpenVINS: the same bytes in every language.
+  EXPECT_EQ(slurp(dir.path() / "en.yaml"), slurp(dir.path() / "ru.yaml"));
+  EXPECT_TRUE(contains(ru.err, "файл шумов записан в")) << ru.err;
+  const auto report = dir.path() / "report";
+  ASSERT_EQ(run_cli(imu_args(file, {"--lang", "ru", "--report", report.string()})).status, 0);
+  const auto html = slurp(report / "index.html");
+  for (const char* part : {"<html lang=\"ru\">", "<h1>Шумы инерциального измерительного блока", "Гироскопы",
+                           "Файл шумов для Kalibr и OpenVINS", "°/√ч"})
+    EXPECT_TRUE(contains(html, part)) << part;
+  for (const char* english : {"IMU noise", "Noise file for", "all results", "Gyro", "angle random walk", "°/h"})
     EXPECT_FALSE(contains(html, english)) << english;
 }
 

@@ -69,7 +69,7 @@ void register_analyze(CLI::App& app, Runner& runner) {
         cmd->plot.draw_analysis(j, cmd->force, io);
         emit(io,
              cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"
-                       : format_channel(res, shown),
+                       : localize_numbers(format_channel(res, shown)),
              cmd->output, cmd->force);
         return 0;
       }

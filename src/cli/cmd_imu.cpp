@@ -12,6 +12,7 @@
 #include "cli/numeric_options.hpp"
 #include "cli/plot_args.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/imu.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/plot.hpp"
@@ -55,11 +56,11 @@ struct ImuCmd {
     else if (!accel_unit.empty())
       o.accel_unit = parse_rate_unit(accel_unit);
     if ((o.gyro_unit && (is_accelerometer_unit(*o.gyro_unit) || *o.gyro_unit == RateUnit::Unitless)))
-      throw UsageError(fmt::format(
+      throw UsageError(trf(
           "--gyro-unit {} is not a gyro unit: expected deg/h, deg/s, rad/s (rates) or arcsec, deg, rad (increments)",
           gyro_unit));
     if (o.accel_unit && !is_accelerometer_unit(*o.accel_unit))
-      throw UsageError(fmt::format(
+      throw UsageError(trf(
           "--accel-unit {} is not an accelerometer unit: expected m/s^2, g, mg, ug (rates) or m/s (increments)",
           accel_unit));
     // Each --output-unit belongs to the kind whose unit it is.
@@ -99,10 +100,10 @@ void write_report(const std::string& dir, const ImuResult& res, const nlohmann::
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec || !fs::is_directory(dir))
-    throw OutputError(fmt::format("{}: cannot create the report directory: {}", dir,
-                                  ec ? ec.message() : std::string("not a directory")));
+    throw OutputError(
+        trf("{}: cannot create the report directory: {}", dir, ec ? ec.message() : std::string(tr("not a directory"))));
   const auto at = [&dir](const char* name) { return (fs::path(dir) / name).string(); };
-  const std::string text = format_imu(res);
+  const std::string text = localize_numbers(format_imu(res));
   write_file_atomic(at("imu.txt"), text, force);
   write_file_atomic(at("imu.json"), j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n", force);
   write_file_atomic(at("imu.yaml"), kalibr_yaml(res, k), force);
@@ -112,19 +113,23 @@ void write_report(const std::string& dir, const ImuResult& res, const nlohmann::
     o.output = at("imu.svg");
     o.force = force;
     plot_imu(j, o);
-    figure = "<p><img src=\"imu.svg\" alt=\"Allan deviation of every axis\"></p>\n";
+    figure = fmt::format("<p><img src=\"imu.svg\" alt=\"{}\"></p>\n", html_escaped(tr("Allan deviation of every axis")));
   } catch (const OutputError& e) {  // no gnuplot: the page without the figure
-    print_message(io.err, fmt::format("note: --report without the figure: {}", e.what()));
+    print_message(io.err, trf("note: --report without the figure: {}", e.what()));
   }
+  // The page's words are translated; the text block is already localized (decimal comma).
+  const std::string source = html_escaped(printable(res.source));
   write_file_atomic(
       at("index.html"),
-      fmt::format("<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>rwcalc imu: {0}</title>"
-                  "</head>\n<body>\n<h1>IMU noise: {0}</h1>\n{1}<pre>{2}</pre>\n<p>Noise file for Kalibr and "
-                  "OpenVINS: <a href=\"imu.yaml\">imu.yaml</a>; all results: <a href=\"imu.json\">imu.json"
-                  "</a>.</p>\n<p>{3}</p>\n</body></html>\n",
-                  html_escaped(printable(res.source)), figure, html_escaped(text), html_escaped(version_line())),
+      fmt::format("<!DOCTYPE html>\n<html lang=\"{}\"><head><meta charset=\"utf-8\"><title>rwcalc imu: {}</title>"
+                  "</head>\n<body>\n<h1>{}</h1>\n{}<pre>{}</pre>\n<p>{}</p>\n<p>{}</p>\n</body></html>\n",
+                  language_code(), source, html_escaped(trf("IMU noise: {}", printable(res.source))), figure,
+                  html_escaped(text),
+                  trf("Noise file for Kalibr and OpenVINS: {}; all results: {}.",
+                      "<a href=\"imu.yaml\">imu.yaml</a>", "<a href=\"imu.json\">imu.json</a>"),
+                  html_escaped(version_line())),
       force);
-  print_message(io.err, fmt::format("report written to {}", at("index.html")));
+  print_message(io.err, trf("report written to {}", at("index.html")));
 }
 
 }  // namespace
@@ -201,10 +206,12 @@ void register_imu(CLI::App& app, Runner& runner) {
       k.combine = cmd->combine == "mean" ? AxisCombination::Mean : AxisCombination::Worst;
       if (!cmd->kalibr.empty()) {
         write_file_atomic(cmd->kalibr, kalibr_yaml(res, k), cmd->force);
-        print_message(io.err, fmt::format("noise file written to {}", cmd->kalibr));
+        print_message(io.err, trf("noise file written to {}", cmd->kalibr));
       }
       if (!cmd->report_dir.empty()) write_report(cmd->report_dir, res, j, k, cmd->force, io);
-      emit(io, cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n" : format_imu(res),
+      emit(io,
+           cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"
+                     : localize_numbers(format_imu(res)),
            cmd->output, cmd->force);
       return 0;
     };
