@@ -303,6 +303,38 @@ TEST(RussianCli, ImuJsonReportAndNoiseFile) {
     EXPECT_FALSE(contains(html, english)) << english;
 }
 
+TEST(RussianCli, HelpIsRussianUnderLangAndTheManualStaysEnglish) {
+  const auto imu = run_cli({"imu", "--help", "--lang", "ru"});
+  ASSERT_EQ(imu.status, 0) << imu.err;
+  for (const char* part : {"Использование: rwcalc imu [ПАРАМЕТРЫ] FILE", "Позиционные аргументы:", "Параметры:",
+                           "Вывести эту справку и выйти", "Вход:", "Вывод:", "Рисунки:", "Столбцы гироскопов",
+                           "Единица столбцов акселерометров", "Язык текста"})
+    EXPECT_TRUE(contains(imu.out, part)) << part << "\n" << imu.out;
+  for (const char* english : {"Usage:", "Options:", "Positionals:", "Print this help",
+                              "Input:", "Output:", "Figures:", "Gyro columns", "Recording", "REQUIRED"})
+    EXPECT_FALSE(contains(imu.out, english)) << english << "\n" << imu.out;
+  // No command's help keeps an English sentence (three English words in a row).
+  const std::regex english_words("[a-z]{3,} [a-z]{3,} [a-z]{3,}");
+  for (const char* cmd : {"allan", "analyze", "batch", "merge", "simulate", "diagnose", "imu", "report"}) {
+    const auto r = run_cli({cmd, "--help", "--lang", "ru"});
+    EXPECT_EQ(r.status, 0) << cmd;
+    std::smatch m;
+    EXPECT_FALSE(std::regex_search(r.out, m, english_words)) << cmd << ": " << m.str();
+  }
+  // RWCALC_LANG chooses the help's language too; the manual and the completion stay English.
+  const auto man = run_cli({"man"}), completion = run_cli({"completion"});
+  const auto english_help = run_cli({"--help"});
+  ::setenv("RWCALC_LANG", "ru", 1);
+  const auto help = run_cli({"--help"});
+  const auto man_ru = run_cli({"man"}), completion_ru = run_cli({"completion"});
+  ::unsetenv("RWCALC_LANG");
+  EXPECT_TRUE(contains(help.out, "Команды:")) << help.out;
+  EXPECT_TRUE(contains(english_help.out, "Subcommands:")) << english_help.out;
+  EXPECT_EQ(man_ru.out, man.out);
+  EXPECT_EQ(completion_ru.out, completion.out);
+  EXPECT_TRUE(contains(man.out, "Print the manual page"));
+}
+
 TEST(ReportPdf, WithoutChromiumTheHtmlIsWrittenAndTheMissingPdfSaid) {
   TempDir dir;
   const std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";

@@ -137,60 +137,61 @@ void write_report(const std::string& dir, const ImuResult& res, const nlohmann::
 void register_imu(CLI::App& app, Runner& runner) {
   auto cmd = std::make_shared<ImuCmd>();
   auto* sub = app.add_subcommand(
-      "imu",
-      "A whole IMU from one static recording: every gyro and accelerometer column's noise coefficients with "
-      "95 % intervals, one table per sensor kind, and the Kalibr/OpenVINS noise file");
-  sub->add_option("FILE", cmd->file, "Recording with one column per axis ('-' for standard input)")->required();
-  sub->add_option("--rate", cmd->rate_hz, "Sample rate, Hz (else metadata rate_hz or a time column)")
+      "imu", tr("A whole IMU from one static recording: every gyro and accelerometer column's noise coefficients with "
+                "95 % intervals, one table per sensor kind, and the Kalibr/OpenVINS noise file"));
+  sub->add_option("FILE", cmd->file, tr("Recording with one column per axis ('-' for standard input)"))->required();
+  sub->add_option("--rate", cmd->rate_hz, tr("Sample rate, Hz (else metadata rate_hz or a time column)"))
       ->check(real_in(kMinRateHz, kMaxRateHz, "Hz"))
-      ->group("Input");
+      ->group(tr("Input"));
   sub->add_option("--time-tolerance", cmd->time_tolerance,
-                  "Time-column steps off the sample period by more than this fraction of it are reported as jitter")
+                  tr("Time-column steps off the sample period by more than this fraction of it are reported as jitter"))
       ->check(real_in(0.0, 0.5, ""))
       ->capture_default_str()
-      ->group("Input");
-  sub->add_option("--gyro", cmd->gyro, "Gyro columns: header names or 1-based indices, comma-separated")
+      ->group(tr("Input"));
+  sub->add_option("--gyro", cmd->gyro, tr("Gyro columns: header names or 1-based indices, comma-separated"))
       ->delimiter(',')
-      ->group("Input");
+      ->group(tr("Input"));
   sub->add_option("--gyro-unit", cmd->gyro_unit,
-                  "Unit of the gyro columns: deg/h, deg/s, rad/s for rates; arcsec, deg, rad for per-sample angle "
-                  "increments (delta theta). Default: each name's suffix (_dps, _rads ...)")
-      ->group("Input");
+                  tr("Unit of the gyro columns: deg/h, deg/s, rad/s for rates; arcsec, deg, rad for per-sample angle "
+                     "increments (delta theta). Default: each name's suffix (_dps, _rads ...)"))
+      ->group(tr("Input"));
   sub->add_option("--vertical-gyro", cmd->vertical_gyro,
-                  "The gyro column whose axis is vertical: the vertical Earth rate is subtracted from it and the "
-                  "class verdict given (default: none, unless the input is pulses)")
-      ->group("Input");
-  sub->add_option("--accel", cmd->accel, "Accelerometer columns: header names or 1-based indices, comma-separated")
+                  tr("The gyro column whose axis is vertical: the vertical Earth rate is subtracted from it and the "
+                     "class verdict given (default: none, unless the input is pulses)"))
+      ->group(tr("Input"));
+  sub->add_option("--accel", cmd->accel, tr("Accelerometer columns: header names or 1-based indices, comma-separated"))
       ->delimiter(',')
-      ->group("Input");
-  sub->add_option("--accel-unit", cmd->accel_unit,
-                  "Unit of the accelerometer columns: m/s^2, g, mg, ug for accelerations; m/s for per-sample velocity "
-                  "increments (delta v). Default: each name's suffix (_g, _mps2 ...)")
-      ->group("Input");
-  sub->add_option("--output-unit", cmd->shown_units,
-                  "Units the results are shown in, one per sensor kind: deg/h, deg/s, rad/s (gyro); m/s^2, g, mg, ug "
-                  "(accelerometer). Default: °/h with N in °/√h; µg with N in m/s/√h")
+      ->group(tr("Input"));
+  sub->add_option(
+         "--accel-unit", cmd->accel_unit,
+         tr("Unit of the accelerometer columns: m/s^2, g, mg, ug for accelerations; m/s for per-sample velocity "
+            "increments (delta v). Default: each name's suffix (_g, _mps2 ...)"))
+      ->group(tr("Input"));
+  sub->add_option(
+         "--output-unit", cmd->shown_units,
+         tr("Units the results are shown in, one per sensor kind: deg/h, deg/s, rad/s (gyro); m/s^2, g, mg, ug "
+            "(accelerometer). Default: °/h with N in °/√h; µg with N in m/s/√h"))
       ->delimiter(',')
-      ->group("Output");
+      ->group(tr("Output"));
   cmd->analysis.add_to(*sub);
-  sub->add_flag("--json", cmd->json, "Print the JSON object instead of the tables")->group("Output");
+  sub->add_flag("--json", cmd->json, tr("Print the JSON object instead of the tables"))->group(tr("Output"));
   sub->add_option("--kalibr", cmd->kalibr,
-                  "Write the Kalibr/OpenVINS IMU noise file (imu.yaml: noise densities and random walks in SI)")
-      ->group("Output");
-  sub->add_option("--rostopic", cmd->rostopic, "rostopic written into the --kalibr file")
+                  tr("Write the Kalibr/OpenVINS IMU noise file (imu.yaml: noise densities and random walks in SI)"))
+      ->group(tr("Output"));
+  sub->add_option("--rostopic", cmd->rostopic, tr("rostopic written into the --kalibr file"))
       ->capture_default_str()
-      ->group("Output");
+      ->group(tr("Output"));
   sub->add_option("--combine", cmd->combine,
-                  "How the --kalibr file combines the axes of a kind: worst (the largest) or mean")
+                  tr("How the --kalibr file combines the axes of a kind: worst (the largest) or mean"))
       ->check(CLI::IsMember({"worst", "mean"}))
       ->capture_default_str()
-      ->group("Output");
+      ->group(tr("Output"));
   sub->add_option("--report", cmd->report_dir,
-                  "Write the whole result into DIR: index.html (tables and figure), imu.txt, imu.json, imu.yaml, "
-                  "imu.svg (created when missing)")
-      ->group("Output");
+                  tr("Write the whole result into DIR: index.html (tables and figure), imu.txt, imu.json, imu.yaml, "
+                     "imu.svg (created when missing)"))
+      ->group(tr("Output"));
   add_output_options(*sub, cmd->output, cmd->force);
-  cmd->plot.add_to(*sub, "one panel per sensor kind with every axis' Allan deviation and its confidence bars");
+  cmd->plot.add_to(*sub, N_("one panel per sensor kind with every axis' Allan deviation and its confidence bars"));
   sub->callback([cmd, &runner] {
     runner = [cmd](Io& io) -> int {
       const ImuOptions opt = cmd->options();

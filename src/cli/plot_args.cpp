@@ -6,6 +6,7 @@
 #include <ostream>
 
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/plot.hpp"
 
 namespace rwcalc::cli {
@@ -30,12 +31,11 @@ void draw(const PlotArgs& a, PlotResult (*plot)(const nlohmann::json&, const Plo
 
 void PlotArgs::add_to(CLI::App& app, const std::string& what) {
   app.add_option("--plot", plot,
-                 fmt::format("Draw {} into FILE with gnuplot; the format follows the extension: .svg, .png or .pdf",
-                             what))
-      ->group("Figures");
+                 trf("Draw {} into FILE with gnuplot; the format follows the extension: .svg, .png or .pdf", tr(what)))
+      ->group(tr("Figures"));
   app.add_option("--plot-script", script,
-                 "Write the gnuplot script of the figure (data inline) to FILE; alone it needs no gnuplot")
-      ->group("Figures");
+                 tr("Write the gnuplot script of the figure (data inline) to FILE; alone it needs no gnuplot"))
+      ->group(tr("Figures"));
 }
 
 void PlotArgs::check(bool force, const std::vector<OutputTarget>& others) const {
