@@ -285,9 +285,14 @@ TEST(RussianCli, ImuJsonReportAndNoiseFile) {
   const auto ru = run_cli(imu_args(file, {"--json", "--lang", "ru", "--kalibr", (dir.path() / "ru.yaml").string()}));
   ASSERT_EQ(ru.status, 0) << ru.err;
   auto a = nlohmann::json::parse(en.out), b = nlohmann::json::parse(ru.out);
-  // Keys, numbers, units and the terms' names stay English; only the fit range's reason is free text.
+  // Keys, numbers, units and the terms' names stay English; free text (the fit range's reason, why
+  // no verdict, the input notes) is in the chosen language.
   for (auto* j : {&a, &b})
-    for (auto& c : (*j)["channels"]) c["fit"].erase("range_reason");
+    for (auto& c : (*j)["channels"]) {
+      c["fit"].erase("range_reason");
+      c.erase("not_applied_reason");
+      c["input"].erase("notes");
+    }
   EXPECT_EQ(a["channels"], b["channels"]);
   EXPECT_EQ(a["noise"], b["noise"]);
   // The noise file is read by Kalibr and OpenVINS: the same bytes in every language.
@@ -333,6 +338,31 @@ TEST(RussianCli, HelpIsRussianUnderLangAndTheManualStaysEnglish) {
   EXPECT_EQ(man_ru.out, man.out);
   EXPECT_EQ(completion_ru.out, completion.out);
   EXPECT_TRUE(contains(man.out, "Print the manual page"));
+}
+
+TEST(RussianCli, AllanHeaderAndInputNotesInRussian) {
+  const auto r = run_cli({"allan", "--lang", "ru", "--tau", "decade", rwcalc::test::gl2d_runs().front()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* part : {"# вход: столбец 'pulses': счёт импульсов, 0,92 угл. с на импульс",
+                           "# оценка: перекрывающаяся девиация Аллана (oadev)", "(метаданные)"})
+    EXPECT_TRUE(contains(r.out, part)) << part << "\n" << r.out;
+  for (const char* english : {"# input:", "deviation", "arcsec per", "metadata"})
+    EXPECT_FALSE(contains(r.out, english)) << english << "\n" << r.out;
+  const auto mdev = run_cli({"allan", "--lang", "ru", "--estimator", "mdev", rwcalc::test::gl2d_runs().front()});
+  EXPECT_TRUE(contains(mdev.out, "# оценка: модифицированная девиация Аллана (mdev)")) << mdev.out;
+  // A rate column: the notes on how it was read and why no verdict is given.
+  TempDir dir;
+  const auto file = dir.write("imu.csv", imu_csv());
+  const auto a = run_cli({"analyze", "--lang", "ru", "--rate", "100", "--column", "gyro_x_dps", file.string()});
+  ASSERT_EQ(a.status, 0) << a.err;
+  EXPECT_TRUE(contains(a.err, "вход rate определён по имени столбца 'gyro_x_dps'")) << a.err;
+  EXPECT_TRUE(contains(a.err, "единица скорости deg/s взята из имени столбца")) << a.err;
+  EXPECT_FALSE(contains(a.err, "from the column name")) << a.err;
+  EXPECT_TRUE(contains(a.out, "а не импульсы лазерного гироскопа")) << a.out;
+  EXPECT_FALSE(contains(a.out, "ring-laser")) << a.out;
+  const auto bad = run_cli({"analyze", "--lang", "ru", "--rate", "-1", file.string()});
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_TRUE(contains(bad.err, "вне допустимого диапазона")) << bad.err;
 }
 
 TEST(ReportPdf, WithoutChromiumTheHtmlIsWrittenAndTheMissingPdfSaid) {

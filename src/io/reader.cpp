@@ -109,10 +109,11 @@ constexpr NameTable<RateUnit, 8> kRateUnits{{RateUnit::DegPerHour, "deg/h"},
                                             {RateUnit::G, "g"},
                                             {RateUnit::MilliG, "mg"},
                                             {RateUnit::MicroG, "ug"}};
-constexpr NameTable<RateSource> kRateSources{{RateSource::Option, "option"},
-                                             {RateSource::Metadata, "metadata"},
-                                             {RateSource::TimeColumn, "time column"},
-                                             {RateSource::Default, "default"}};
+// Marked for the catalogue: shown translated (tr) where text names the rate's source.
+constexpr NameTable<RateSource> kRateSources{{RateSource::Option, N_("option")},
+                                             {RateSource::Metadata, N_("metadata")},
+                                             {RateSource::TimeColumn, N_("time column")},
+                                             {RateSource::Default, N_("default")}};
 
 template <class E, std::size_t Size>
 E parse_name(const NameTable<E, Size>& table, std::string_view s, std::string_view option) {
@@ -690,10 +691,10 @@ std::string_view input_unit(const Recording& rec) {
 
 std::string describe_input(const Recording& rec) {
   if (rec.mode == InputMode::Pulses || rec.mode == InputMode::Counter)
-    return fmt::format("column '{}': {}, {:g} arcsec per {}", rec.column_name,
-                       rec.mode == InputMode::Pulses ? "pulse counts" : "counter readings", rec.phase.arcsec_per_count,
-                       input_unit(rec));
-  return fmt::format("column '{}': {} samples in {}", rec.column_name, to_string(rec.mode), input_unit(rec));
+    return trf(rec.mode == InputMode::Pulses ? N_("column '{}': pulse counts, {:g} arcsec per pulse")
+                                             : N_("column '{}': counter readings, {:g} arcsec per count"),
+               rec.column_name, rec.phase.arcsec_per_count);
+  return trf("column '{}': {} samples in {}", rec.column_name, to_string(rec.mode), input_unit(rec));
 }
 
 InputMode parse_input_mode(std::string_view s) { return parse_name(kModes, s, "--input"); }

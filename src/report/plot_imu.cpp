@@ -13,7 +13,8 @@ namespace rwcalc {
 
 PlotResult plot_imu(const nlohmann::json& imu, const PlotOptions& options) {
   std::vector<Figure> figures;
-  for (const std::string_view kind : {"gyro", "accelerometer"}) {
+  constexpr std::string_view kGyro = "gyro";
+  for (const std::string_view kind : {kGyro, std::string_view("accelerometer")}) {
     nlohmann::json runs = nlohmann::json::array();
     for (const auto& c : imu.at("channels")) {
       if (c.value("sensor", "") != kind) continue;
@@ -31,7 +32,7 @@ PlotResult plot_imu(const nlohmann::json& imu, const PlotOptions& options) {
     if (runs.empty()) continue;
     PlotOptions o = options;
     if (o.title.empty())
-      o.title = trf(kind == "gyro" ? N_("Gyro axes of {}") : N_("Accelerometer axes of {}"),
+      o.title = trf(kind == kGyro ? N_("Gyro axes of {}") : N_("Accelerometer axes of {}"),
                     std::filesystem::path(imu.value("source", "")).filename().string());
     Figure f = batch_allan_figure(runs, o);
     f.name = fmt::format("imu-{}", kind);
