@@ -267,13 +267,32 @@ TEST(RussianCli, ImuTablesInThePapersTermsAndRussianUnits) {
   for (const char* part :
        {"Данные", "Гироскопы (осей: 3", "Акселерометры (осей: 3", "случайное блуждание угла",
         "нестабильность смещения нуля", "случайное блуждание скорости", "случайное блуждание линейной скорости",
-        "случайное блуждание ускорения", "N в °/√ч", "B в °/ч", "Q в угл. с", "N в м/с/√ч", "B в мкg",
-        "N в рад/с/√Гц", "N в м/с²/√Гц", "среднее", "τ аппроксимации (с)", "Обозначения"})
+        "случайное блуждание ускорения", "N в °/√ч", "B в °/ч", "Q в угл. с", "N в м/с/√ч", "B в мкg", "N в рад/с/√Гц",
+        "N в м/с²/√Гц", "среднее", "τ аппроксимации (с)", "Обозначения"})
     EXPECT_TRUE(contains(r.out, part)) << part << "\n" << r.out;
-  for (const char* english :
-       {"Data\n", "samples at", "Gyro", "Accelerometer", "axes;", "angle random walk", "bias instability",
-        "rate random walk", "velocity random walk", "quantisation", "mean", "N in", "fit chi2", "fit tau", "°/h",
-        "m/s/√h", "µg", "√Hz", "rad/s", "Earth rate", "class verdict", "Conventions", "profile intervals"})
+  for (const char* english : {"Data\n",
+                              "samples at",
+                              "Gyro",
+                              "Accelerometer",
+                              "axes;",
+                              "angle random walk",
+                              "bias instability",
+                              "rate random walk",
+                              "velocity random walk",
+                              "quantisation",
+                              "mean",
+                              "N in",
+                              "fit chi2",
+                              "fit tau",
+                              "°/h",
+                              "m/s/√h",
+                              "µg",
+                              "√Hz",
+                              "rad/s",
+                              "Earth rate",
+                              "class verdict",
+                              "Conventions",
+                              "profile intervals"})
     EXPECT_FALSE(contains(r.out, english)) << english << "\n" << r.out;
   EXPECT_FALSE(std::regex_search(r.out, std::regex(R"((^|[^\w.])\d+\.\d+\b)"))) << r.out;  // decimal comma
 }

@@ -191,23 +191,23 @@ std::string format_channel(const AnalysisResult& r, const UnitSet& shown) {
                                                    : N_("rwcalc accelerometer: {}, column '{}'\n\n"),
                       printable(r.source), r.column);
   s += format_warnings(r.warnings);
-  s += trf("Data\n  {} samples at {:g} Hz, {:.1f} s ({:.2f} h); mean {} {}; {}\n", r.samples, r.rate_hz,
-           r.duration_s, r.duration_s / 3600.0, imu_num(r.mean_rate_deg_per_h * shown.deviation.factor, 6),
+  s += trf("Data\n  {} samples at {:g} Hz, {:.1f} s ({:.2f} h); mean {} {}; {}\n", r.samples, r.rate_hz, r.duration_s,
+           r.duration_s / 3600.0, imu_num(r.mean_rate_deg_per_h * shown.deviation.factor, 6),
            localized_label(shown.deviation), earth_and_verdict(r));
   s += trf("\nAllan deviation ({}, {:g} % bounds)\n  {:>11} {:>12} {:>12} {:>12}\n", to_string(r.allan.estimator),
            100 * r.allan.confidence, tr("tau (s)"), tr("sigma"), tr("low"), tr("high"));
   const double k = shown.deviation.factor;
   for (const auto& p : r.allan.points)
     s += fmt::format("  {:>11.5g} {:>12.5g} {:>12.5g} {:>12.5g}\n", p.tau_s, p.dev * k, p.dev_low * k, p.dev_high * k);
-  s += trf(
-      "  (in {})\n\nNoise coefficients (fit over tau {:g}..{:g} s; 95 % profile intervals; < : not "
-      "resolved, 95 % upper bound)\n",
-      localized_label(shown.deviation), r.fit.used.front().tau_s, r.fit.used.back().tau_s);
+  s +=
+      trf("  (in {})\n\nNoise coefficients (fit over tau {:g}..{:g} s; 95 % profile intervals; < : not "
+          "resolved, 95 % upper bound)\n",
+          localized_label(shown.deviation), r.fit.used.front().tau_s, r.fit.used.back().tau_s);
   const UnitSet si = si_units(r.sensor);
   for (const Term t : kAllTerms)
     s += fmt::format("  {} {:<26} {:<28} {:<12} = {} {}\n", term_name(t), localized_meaning(r.sensor, t),
-                     cell(r.fit[t], shown[t].factor), localized_label(shown[t]),
-                     cell(r.fit[t], si[t].factor), localized_label(si[t]));
+                     cell(r.fit[t], shown[t].factor), localized_label(shown[t]), cell(r.fit[t], si[t].factor),
+                     localized_label(si[t]));
   s += trf("  chi2/dof = {:.2f} (dof {}, p = {:.3g}); fit range: {}\n", r.fit.chi2_per_dof, r.fit.dof, r.fit.p_value,
            r.fit_range.reason());
   return s;
@@ -262,9 +262,7 @@ std::string kind_table(const std::vector<const ImuChannel*>& axes, const UnitSet
   row([&](const AnalysisResult& r) { return cell(r.fit[Term::N], si[Term::N].factor); });
   row([&](const AnalysisResult& r) { return cell(r.fit[Term::K], si[Term::K].factor); });
   row([](const AnalysisResult& r) { return fmt::format("{:.2f} ({:.2g})", r.fit.chi2_per_dof, r.fit.p_value); });
-  row([](const AnalysisResult& r) {
-    return trf("{:g}..{:g}", r.fit.used.front().tau_s, r.fit.used.back().tau_s);
-  });
+  row([](const AnalysisResult& r) { return trf("{:g}..{:g}", r.fit.used.front().tau_s, r.fit.used.back().tau_s); });
   for (const auto* a : axes) s += fmt::format("  {}: {}\n", printable(a->column), earth_and_verdict(a->result));
   return s + "\n";
 }
@@ -374,8 +372,9 @@ std::string format_imu(const ImuResult& r) {
            first.rate_hz, 1000.0 / first.rate_hz, first.duration_s, first.duration_s / 3600.0, r.channels.size());
   s += kind_table(of_kind(r, SensorKind::Gyro), r.gyro_units);
   s += kind_table(of_kind(r, SensorKind::Accelerometer), r.accel_units);
-  s += tr("Conventions: IEEE 952 model sigma² = 3Q²/tau² + N²/tau + (2 ln2/π)B² + K²tau/3 + R²tau²/2 per axis;\n"
-          "  N is the noise density and K the bias random walk of Kalibr's IMU noise model.\n");
+  s +=
+      tr("Conventions: IEEE 952 model sigma² = 3Q²/tau² + N²/tau + (2 ln2/π)B² + K²tau/3 + R²tau²/2 per axis;\n"
+         "  N is the noise density and K the bias random walk of Kalibr's IMU noise model.\n");
   return s;
 }
 

@@ -60,9 +60,9 @@ struct ImuCmd {
           "--gyro-unit {} is not a gyro unit: expected deg/h, deg/s, rad/s (rates) or arcsec, deg, rad (increments)",
           gyro_unit));
     if (o.accel_unit && !is_accelerometer_unit(*o.accel_unit))
-      throw UsageError(trf(
-          "--accel-unit {} is not an accelerometer unit: expected m/s^2, g, mg, ug (rates) or m/s (increments)",
-          accel_unit));
+      throw UsageError(
+          trf("--accel-unit {} is not an accelerometer unit: expected m/s^2, g, mg, ug (rates) or m/s (increments)",
+              accel_unit));
     // Each --output-unit belongs to the kind whose unit it is.
     for (const auto& u : shown_units) {
       try {
@@ -113,7 +113,8 @@ void write_report(const std::string& dir, const ImuResult& res, const nlohmann::
     o.output = at("imu.svg");
     o.force = force;
     plot_imu(j, o);
-    figure = fmt::format("<p><img src=\"imu.svg\" alt=\"{}\"></p>\n", html_escaped(tr("Allan deviation of every axis")));
+    figure =
+        fmt::format("<p><img src=\"imu.svg\" alt=\"{}\"></p>\n", html_escaped(tr("Allan deviation of every axis")));
   } catch (const OutputError& e) {  // no gnuplot: the page without the figure
     print_message(io.err, trf("note: --report without the figure: {}", e.what()));
   }
@@ -125,8 +126,8 @@ void write_report(const std::string& dir, const ImuResult& res, const nlohmann::
                   "</head>\n<body>\n<h1>{}</h1>\n{}<pre>{}</pre>\n<p>{}</p>\n<p>{}</p>\n</body></html>\n",
                   language_code(), source, html_escaped(trf("IMU noise: {}", printable(res.source))), figure,
                   html_escaped(text),
-                  trf("Noise file for Kalibr and OpenVINS: {}; all results: {}.",
-                      "<a href=\"imu.yaml\">imu.yaml</a>", "<a href=\"imu.json\">imu.json</a>"),
+                  trf("Noise file for Kalibr and OpenVINS: {}; all results: {}.", "<a href=\"imu.yaml\">imu.yaml</a>",
+                      "<a href=\"imu.json\">imu.json</a>"),
                   html_escaped(version_line())),
       force);
   print_message(io.err, trf("report written to {}", at("index.html")));

@@ -35,12 +35,11 @@ constexpr RateChoice kRates[] = {{SensorKind::Gyro, "deg/s", "°/s", 1.0 / units
 /// labels are kept in English and translated where shown (localized_label); a test checks that
 /// each label of every unit set has its entry.
 [[maybe_unused]] constexpr const char* kComposedLabels[] = {
-    N_("°/s"),        N_("°/s/√Hz"),   N_("°/s/√s"),    N_("°/s/s"),     N_("°"),          N_("rad/s"),
-    N_("rad/s/√Hz"),  N_("rad/s/√s"),  N_("rad/s/s"),   N_("rad"),       N_("m/s²"),       N_("m/s²/√Hz"),
-    N_("m/s²/√s"),    N_("m/s²/s"),    N_("m/s"),       N_("g"),         N_("g/√Hz"),      N_("g/√s"),
-    N_("g/s"),        N_("mg"),        N_("mg/√Hz"),    N_("mg/√s"),     N_("mg/s"),       N_("µg"),
-    N_("µg/√Hz"),     N_("µg/√s"),     N_("µg/s"),      N_("m/s/√h"),    N_("m/s/h/√h"),   N_("m/s/h²"),
-    N_("rad/s²/√Hz"), N_("rad/s²"),    N_("m/s³/√Hz"),  N_("m/s³")};
+    N_("°/s"),      N_("°/s/√Hz"), N_("°/s/√s"),     N_("°/s/s"),  N_("°"),        N_("rad/s"),   N_("rad/s/√Hz"),
+    N_("rad/s/√s"), N_("rad/s/s"), N_("rad"),        N_("m/s²"),   N_("m/s²/√Hz"), N_("m/s²/√s"), N_("m/s²/s"),
+    N_("m/s"),      N_("g"),       N_("g/√Hz"),      N_("g/√s"),   N_("g/s"),      N_("mg"),      N_("mg/√Hz"),
+    N_("mg/√s"),    N_("mg/s"),    N_("µg"),         N_("µg/√Hz"), N_("µg/√s"),    N_("µg/s"),    N_("m/s/√h"),
+    N_("m/s/h/√h"), N_("m/s/h²"),  N_("rad/s²/√Hz"), N_("rad/s²"), N_("m/s³/√Hz"), N_("m/s³")};
 
 // B and σ in U, N in U/√Hz, K in U/√s, R in U/s: the factors follow from 1 h = 3600 s.
 UnitSet rate_based(SensorKind kind, std::string_view ascii, std::string_view label, double f) {
@@ -94,12 +93,13 @@ std::optional<SensorKind> sensor_kind(PhaseKind k) {
 }
 
 std::string_view term_meaning(SensorKind k, Term t) {
-  static constexpr std::array<std::string_view, kTermCount> kGyro{
-      N_("angle quantisation"), N_("angle random walk"), N_("bias instability"), N_("rate random walk"),
-      N_("rate ramp")};
-  static constexpr std::array<std::string_view, kTermCount> kAccel{
-      N_("velocity quantisation"), N_("velocity random walk"), N_("bias instability"),
-      N_("acceleration random walk"), N_("acceleration ramp")};
+  static constexpr std::array<std::string_view, kTermCount> kGyro{N_("angle quantisation"), N_("angle random walk"),
+                                                                  N_("bias instability"), N_("rate random walk"),
+                                                                  N_("rate ramp")};
+  static constexpr std::array<std::string_view, kTermCount> kAccel{N_("velocity quantisation"),
+                                                                   N_("velocity random walk"), N_("bias instability"),
+                                                                   N_("acceleration random walk"),
+                                                                   N_("acceleration ramp")};
   return (k == SensorKind::Gyro ? kGyro : kAccel)[static_cast<std::size_t>(t)];
 }
 
