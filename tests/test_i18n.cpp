@@ -325,6 +325,15 @@ TEST(RussianCli, ImuJsonReportAndNoiseFile) {
     EXPECT_TRUE(contains(html, part)) << part;
   for (const char* english : {"IMU noise", "Noise file for", "all results", "Gyro", "angle random walk", "°/h"})
     EXPECT_FALSE(contains(html, english)) << english;
+  // The figures' titles and axes (the gnuplot script needs no gnuplot).
+  const auto script = dir.path() / "imu.gp";
+  ASSERT_EQ(run_cli(imu_args(file, {"--lang", "ru", "--plot-script", script.string(), "-o", "/dev/null"})).status, 0);
+  const auto gp = slurp(script);
+  for (const char* part : {"Оси гироскопов: imu.csv", "Оси акселерометров: imu.csv", "девиация Аллана σ(τ) (°/ч)",
+                           "девиация Аллана σ(τ) (мкg)", "τ (с)"})
+    EXPECT_TRUE(contains(gp, part)) << part;
+  for (const char* english : {"Gyro axes", "Accelerometer axes", "Allan deviation", "µg", "°/h"})
+    EXPECT_FALSE(contains(gp, english)) << english;
 }
 
 TEST(RussianCli, HelpIsRussianUnderLangAndTheManualStaysEnglish) {
