@@ -22,9 +22,9 @@ void draw(const PlotArgs& a, PlotResult (*plot)(const nlohmann::json&, const Plo
   o.script = a.script;
   o.force = force;
   const PlotResult r = plot(j, o);
-  for (const auto& note : r.notes) print_message(io.err, "note: " + note);
-  if (!a.plot.empty()) print_message(io.err, fmt::format("figure written to {} ({} data series)", a.plot, r.series));
-  if (!a.script.empty()) print_message(io.err, fmt::format("gnuplot script written to {}", a.script));
+  for (const auto& note : r.notes) print_message(io.err, trf("note: {}", note));
+  if (!a.plot.empty()) print_message(io.err, trf("figure written to {} ({} data series)", a.plot, r.series));
+  if (!a.script.empty()) print_message(io.err, trf("gnuplot script written to {}", a.script));
 }
 
 }  // namespace
