@@ -297,6 +297,18 @@ TEST(RussianCli, ImuTablesInThePapersTermsAndRussianUnits) {
   EXPECT_FALSE(std::regex_search(r.out, std::regex(R"((^|[^\w.])\d+\.\d+\b)"))) << r.out;  // decimal comma
 }
 
+TEST(RussianCli, AccelerometerChannelInRussianUnits) {
+  TempDir dir;
+  const auto file = dir.write("imu.csv", imu_csv());
+  const auto r = run_cli({"analyze", "--lang", "ru", "--rate", "100", "--column", "acc_x_g", file.string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* part : {"rwcalc, акселерометр:", "Данные", "случайное блуждание линейной скорости",
+                           "случайное блуждание ускорения", "м/с/√ч", "мкg", "м/с²/√Гц", "Коэффициенты шумов"})
+    EXPECT_TRUE(contains(r.out, part)) << part << "\n" << r.out;
+  for (const char* english : {"accelerometer", "Data", "velocity", "µg", "m/s", "Hz", "Noise coefficients", "tau"})
+    EXPECT_FALSE(contains(r.out, english)) << english << "\n" << r.out;
+}
+
 TEST(RussianCli, ImuJsonReportAndNoiseFile) {
   TempDir dir;
   const auto file = dir.write("imu.csv", imu_csv());

@@ -204,8 +204,10 @@ std::string format_channel(const AnalysisResult& r, const UnitSet& shown) {
           "resolved, 95 % upper bound)\n",
           localized_label(shown.deviation), r.fit.used.front().tau_s, r.fit.used.back().tau_s);
   const UnitSet si = si_units(r.sensor);
+  std::size_t name_width = 26;  // as wide as the longest term name (Russian ones are longer)
+  for (const Term t : kAllTerms) name_width = std::max(name_width, display_width(localized_meaning(r.sensor, t)));
   for (const Term t : kAllTerms)
-    s += fmt::format("  {} {:<26} {:<28} {:<12} = {} {}\n", term_name(t), localized_meaning(r.sensor, t),
+    s += fmt::format("  {} {:<{}} {:<28} {:<12} = {} {}\n", term_name(t), localized_meaning(r.sensor, t), name_width,
                      cell(r.fit[t], shown[t].factor), localized_label(shown[t]), cell(r.fit[t], si[t].factor),
                      localized_label(si[t]));
   s += trf("  chi2/dof = {:.2f} (dof {}, p = {:.3g}); fit range: {}\n", r.fit.chi2_per_dof, r.fit.dof, r.fit.p_value,
