@@ -297,6 +297,18 @@ TEST(RussianCli, ImuTablesInThePapersTermsAndRussianUnits) {
   EXPECT_FALSE(std::regex_search(r.out, std::regex(R"((^|[^\w.])\d+\.\d+\b)"))) << r.out;  // decimal comma
 }
 
+TEST(RussianCli, BadInputIsNamedInRussian) {
+  TempDir dir;
+  const auto bad = dir.write("bad.csv", "# rate_hz: 100\npulses,x\n1,2\n3\n");
+  const auto r = run_cli({"analyze", "--lang", "ru", "--column", "pulses", bad.string()});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "неверное число столбцов: ожидается 2")) << r.err;
+  const auto en = run_cli({"analyze", "--column", "pulses", bad.string()});
+  EXPECT_TRUE(contains(en.err, "wrong number of columns: expected 2")) << en.err;
+  const auto unit = run_cli({"imu", "--lang", "ru", bad.string(), "--gyro", "pulses", "--output-unit", "furlong"});
+  EXPECT_TRUE(contains(unit.err, "неизвестная единица вывода 'furlong'")) << unit.err;
+}
+
 TEST(RussianCli, AccelerometerChannelInRussianUnits) {
   TempDir dir;
   const auto file = dir.write("imu.csv", imu_csv());

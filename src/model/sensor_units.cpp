@@ -115,15 +115,15 @@ UnitSet output_units(SensorKind kind, std::string_view output_unit) {
   for (const RateChoice& r : kRates)
     if (r.name == output_unit) {
       if (r.kind != kind)
-        throw UsageError(fmt::format("output unit '{}' is an {} unit; the {} channels take {}", output_unit,
-                                     to_string(r.kind), to_string(kind),
-                                     kind == SensorKind::Gyro ? "deg/h, deg/s or rad/s" : "m/s^2, g, mg or ug"));
+        throw UsageError(trf("output unit '{}' is an {} unit; the {} channels take {}", output_unit, to_string(r.kind),
+                             to_string(kind),
+                             kind == SensorKind::Gyro ? "deg/h, deg/s or rad/s" : "m/s^2, g, mg or ug"));
       return rate_based(kind, r.name, r.label, r.factor);
     }
   throw UsageError(
-      fmt::format("unknown output unit '{}': expected deg/h, deg/s, rad/s (gyro) or m/s^2, g, mg, ug "
-                  "(accelerometer)",
-                  output_unit));
+      trf("unknown output unit '{}': expected deg/h, deg/s, rad/s (gyro) or m/s^2, g, mg, ug "
+          "(accelerometer)",
+          output_unit));
 }
 
 UnitSet si_units(SensorKind kind) {
