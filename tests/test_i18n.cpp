@@ -3,16 +3,20 @@
 // checked by scripts/update-po.sh --check (the test i18n_catalogue_complete).
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <regex>
 #include <string>
 #include <vector>
 
 #include "rwcalc/i18n.hpp"
+#include "rwcalc/sensor.hpp"
 #include "test_support.hpp"
 
 using rwcalc::Language;
@@ -52,6 +56,28 @@ std::string field_problem(const std::string& english, const std::string& russian
 }
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+bool in_catalogue(const std::string& english) {
+  const auto& entries = rwcalc::i18n_detail::russian_entries();
+  return std::any_of(entries.begin(), entries.end(), [&](const auto& e) { return e.id == english; });
+}
+
+/// A static 6-axis IMU of white noise, 200 s at 100 Hz: gyro in °/s, accelerometer in g.
+std::string imu_csv() {
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> z;
+  std::string s = "gyro_x_dps,gyro_y_dps,gyro_z_dps,acc_x_g,acc_y_g,acc_z_g\n";
+  for (int k = 0; k < 20000; ++k)
+    s += fmt::format("{:.6f},{:.6f},{:.6f},{:.7f},{:.7f},{:.7f}\n", 0.1 + 0.05 * z(rng), 0.1 + 0.05 * z(rng),
+                     0.1 + 0.05 * z(rng), 0.002 * z(rng), 0.002 * z(rng), -1 + 0.002 * z(rng));
+  return s;
+}
+
+std::vector<std::string> imu_args(const std::filesystem::path& file, std::vector<std::string> more) {
+  return rwcalc::test::concat({"imu", file.string(), "--rate", "100", "--gyro", "gyro_x_dps,gyro_y_dps,gyro_z_dps",
+                               "--accel", "acc_x_g,acc_y_g,acc_z_g"},
+                              more);
+}
 
 }  // namespace
 
@@ -213,6 +239,182 @@ TEST(RussianCli, ReportIsInRussianWithoutEnglishHeadings) {
                               "sigma^2",
                               "Page"})
     EXPECT_FALSE(contains(html, english)) << english;
+}
+
+TEST(Catalogue, EveryUnitLabelAndTermNameOfEverySensorHasItsRussianEntry) {
+  using rwcalc::SensorKind;
+  std::vector<rwcalc::UnitSet> sets{rwcalc::si_units(SensorKind::Gyro), rwcalc::si_units(SensorKind::Accelerometer)};
+  for (const char* u : {"", "deg/h", "deg/s", "rad/s"}) sets.push_back(rwcalc::output_units(SensorKind::Gyro, u));
+  for (const char* u : {"", "m/s^2", "g", "mg", "ug"})
+    sets.push_back(rwcalc::output_units(SensorKind::Accelerometer, u));
+  for (const auto& set : sets) {
+    EXPECT_TRUE(in_catalogue(set.deviation.label)) << set.deviation.label;
+    for (const auto& u : set.term) EXPECT_TRUE(in_catalogue(u.label)) << u.label;
+  }
+  for (const SensorKind k : {SensorKind::Gyro, SensorKind::Accelerometer})
+    for (const rwcalc::Term t : rwcalc::kAllTerms) {
+      EXPECT_TRUE(in_catalogue(std::string(rwcalc::term_meaning(k, t)))) << rwcalc::term_meaning(k, t);
+      const LanguageScope ru(Language::Russian);
+      EXPECT_NE(rwcalc::localized_meaning(k, t), rwcalc::term_meaning(k, t));
+    }
+}
+
+TEST(RussianCli, ImuTablesInThePapersTermsAndRussianUnits) {
+  TempDir dir;
+  const auto file = dir.write("imu.csv", imu_csv());
+  const auto r = run_cli(imu_args(file, {"--lang", "ru"}));
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* part :
+       {"Данные", "Гироскопы (осей: 3", "Акселерометры (осей: 3", "случайное блуждание угла",
+        "нестабильность смещения нуля", "случайное блуждание скорости", "случайное блуждание линейной скорости",
+        "случайное блуждание ускорения", "N в °/√ч", "B в °/ч", "Q в угл. с", "N в м/с/√ч", "B в мкg", "N в рад/с/√Гц",
+        "N в м/с²/√Гц", "среднее", "τ аппроксимации (с)", "Обозначения"})
+    EXPECT_TRUE(contains(r.out, part)) << part << "\n" << r.out;
+  for (const char* english : {"Data\n",
+                              "samples at",
+                              "Gyro",
+                              "Accelerometer",
+                              "axes;",
+                              "angle random walk",
+                              "bias instability",
+                              "rate random walk",
+                              "velocity random walk",
+                              "quantisation",
+                              "mean",
+                              "N in",
+                              "fit chi2",
+                              "fit tau",
+                              "°/h",
+                              "m/s/√h",
+                              "µg",
+                              "√Hz",
+                              "rad/s",
+                              "Earth rate",
+                              "class verdict",
+                              "Conventions",
+                              "profile intervals"})
+    EXPECT_FALSE(contains(r.out, english)) << english << "\n" << r.out;
+  EXPECT_FALSE(std::regex_search(r.out, std::regex(R"((^|[^\w.])\d+\.\d+\b)"))) << r.out;  // decimal comma
+}
+
+TEST(RussianCli, BadInputIsNamedInRussian) {
+  TempDir dir;
+  const auto bad = dir.write("bad.csv", "# rate_hz: 100\npulses,x\n1,2\n3\n");
+  const auto r = run_cli({"analyze", "--lang", "ru", "--column", "pulses", bad.string()});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "неверное число столбцов: ожидается 2")) << r.err;
+  const auto en = run_cli({"analyze", "--column", "pulses", bad.string()});
+  EXPECT_TRUE(contains(en.err, "wrong number of columns: expected 2")) << en.err;
+  const auto unit = run_cli({"imu", "--lang", "ru", bad.string(), "--gyro", "pulses", "--output-unit", "furlong"});
+  EXPECT_TRUE(contains(unit.err, "неизвестная единица вывода 'furlong'")) << unit.err;
+}
+
+TEST(RussianCli, AccelerometerChannelInRussianUnits) {
+  TempDir dir;
+  const auto file = dir.write("imu.csv", imu_csv());
+  const auto r = run_cli({"analyze", "--lang", "ru", "--rate", "100", "--column", "acc_x_g", file.string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* part : {"rwcalc, акселерометр:", "Данные", "случайное блуждание линейной скорости",
+                           "случайное блуждание ускорения", "м/с/√ч", "мкg", "м/с²/√Гц", "Коэффициенты шумов"})
+    EXPECT_TRUE(contains(r.out, part)) << part << "\n" << r.out;
+  for (const char* english : {"accelerometer", "Data", "velocity", "µg", "m/s", "Hz", "Noise coefficients", "tau"})
+    EXPECT_FALSE(contains(r.out, english)) << english << "\n" << r.out;
+}
+
+TEST(RussianCli, ImuJsonReportAndNoiseFile) {
+  TempDir dir;
+  const auto file = dir.write("imu.csv", imu_csv());
+  const auto en = run_cli(imu_args(file, {"--json", "--kalibr", (dir.path() / "en.yaml").string()}));
+  const auto ru = run_cli(imu_args(file, {"--json", "--lang", "ru", "--kalibr", (dir.path() / "ru.yaml").string()}));
+  ASSERT_EQ(ru.status, 0) << ru.err;
+  auto a = nlohmann::json::parse(en.out), b = nlohmann::json::parse(ru.out);
+  // Keys, numbers, units and the terms' names stay English; free text (the fit range's reason, why
+  // no verdict, the input notes) is in the chosen language.
+  for (auto* j : {&a, &b})
+    for (auto& c : (*j)["channels"]) {
+      c["fit"].erase("range_reason");
+      c.erase("not_applied_reason");
+      c["input"].erase("notes");
+    }
+  EXPECT_EQ(a["channels"], b["channels"]);
+  EXPECT_EQ(a["noise"], b["noise"]);
+  // The noise file is read by Kalibr and OpenVINS: the same bytes in every language.
+  EXPECT_EQ(slurp(dir.path() / "en.yaml"), slurp(dir.path() / "ru.yaml"));
+  EXPECT_TRUE(contains(ru.err, "файл шумов записан в")) << ru.err;
+  const auto report = dir.path() / "report";
+  ASSERT_EQ(run_cli(imu_args(file, {"--lang", "ru", "--report", report.string()})).status, 0);
+  const auto html = slurp(report / "index.html");
+  for (const char* part : {"<html lang=\"ru\">", "<h1>Шумы инерциального измерительного блока", "Гироскопы",
+                           "Файл шумов для Kalibr и OpenVINS", "°/√ч"})
+    EXPECT_TRUE(contains(html, part)) << part;
+  for (const char* english : {"IMU noise", "Noise file for", "all results", "Gyro", "angle random walk", "°/h"})
+    EXPECT_FALSE(contains(html, english)) << english;
+  // The figures' titles and axes (the gnuplot script needs no gnuplot).
+  const auto script = dir.path() / "imu.gp";
+  ASSERT_EQ(run_cli(imu_args(file, {"--lang", "ru", "--plot-script", script.string(), "-o", "/dev/null"})).status, 0);
+  const auto gp = slurp(script);
+  for (const char* part : {"Оси гироскопов: imu.csv", "Оси акселерометров: imu.csv", "девиация Аллана σ(τ) (°/ч)",
+                           "девиация Аллана σ(τ) (мкg)", "τ (с)"})
+    EXPECT_TRUE(contains(gp, part)) << part;
+  for (const char* english : {"Gyro axes", "Accelerometer axes", "Allan deviation", "µg", "°/h"})
+    EXPECT_FALSE(contains(gp, english)) << english;
+}
+
+TEST(RussianCli, HelpIsRussianUnderLangAndTheManualStaysEnglish) {
+  const auto imu = run_cli({"imu", "--help", "--lang", "ru"});
+  ASSERT_EQ(imu.status, 0) << imu.err;
+  for (const char* part : {"Использование: rwcalc imu [ПАРАМЕТРЫ] FILE", "Позиционные аргументы:", "Параметры:",
+                           "Вывести эту справку и выйти", "Вход:", "Вывод:", "Рисунки:", "Столбцы гироскопов",
+                           "Единица столбцов акселерометров", "Язык текста"})
+    EXPECT_TRUE(contains(imu.out, part)) << part << "\n" << imu.out;
+  for (const char* english : {"Usage:", "Options:", "Positionals:", "Print this help",
+                              "Input:", "Output:", "Figures:", "Gyro columns", "Recording", "REQUIRED"})
+    EXPECT_FALSE(contains(imu.out, english)) << english << "\n" << imu.out;
+  // No command's help keeps an English sentence (three English words in a row).
+  const std::regex english_words("[a-z]{3,} [a-z]{3,} [a-z]{3,}");
+  for (const char* cmd : {"allan", "analyze", "batch", "merge", "simulate", "diagnose", "imu", "report"}) {
+    const auto r = run_cli({cmd, "--help", "--lang", "ru"});
+    EXPECT_EQ(r.status, 0) << cmd;
+    std::smatch m;
+    EXPECT_FALSE(std::regex_search(r.out, m, english_words)) << cmd << ": " << m.str();
+  }
+  // RWCALC_LANG chooses the help's language too; the manual and the completion stay English.
+  const auto man = run_cli({"man"}), completion = run_cli({"completion"});
+  const auto english_help = run_cli({"--help"});
+  ::setenv("RWCALC_LANG", "ru", 1);
+  const auto help = run_cli({"--help"});
+  const auto man_ru = run_cli({"man"}), completion_ru = run_cli({"completion"});
+  ::unsetenv("RWCALC_LANG");
+  EXPECT_TRUE(contains(help.out, "Команды:")) << help.out;
+  EXPECT_TRUE(contains(english_help.out, "Subcommands:")) << english_help.out;
+  EXPECT_EQ(man_ru.out, man.out);
+  EXPECT_EQ(completion_ru.out, completion.out);
+  EXPECT_TRUE(contains(man.out, "Print the manual page"));
+}
+
+TEST(RussianCli, AllanHeaderAndInputNotesInRussian) {
+  const auto r = run_cli({"allan", "--lang", "ru", "--tau", "decade", rwcalc::test::gl2d_runs().front()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* part : {"# вход: столбец 'pulses': счёт импульсов, 0,92 угл. с на импульс",
+                           "# оценка: перекрывающаяся девиация Аллана (oadev)", "(метаданные)"})
+    EXPECT_TRUE(contains(r.out, part)) << part << "\n" << r.out;
+  for (const char* english : {"# input:", "deviation", "arcsec per", "metadata"})
+    EXPECT_FALSE(contains(r.out, english)) << english << "\n" << r.out;
+  const auto mdev = run_cli({"allan", "--lang", "ru", "--estimator", "mdev", rwcalc::test::gl2d_runs().front()});
+  EXPECT_TRUE(contains(mdev.out, "# оценка: модифицированная девиация Аллана (mdev)")) << mdev.out;
+  // A rate column: the notes on how it was read and why no verdict is given.
+  TempDir dir;
+  const auto file = dir.write("imu.csv", imu_csv());
+  const auto a = run_cli({"analyze", "--lang", "ru", "--rate", "100", "--column", "gyro_x_dps", file.string()});
+  ASSERT_EQ(a.status, 0) << a.err;
+  EXPECT_TRUE(contains(a.err, "вход rate определён по имени столбца 'gyro_x_dps'")) << a.err;
+  EXPECT_TRUE(contains(a.err, "единица скорости deg/s взята из имени столбца")) << a.err;
+  EXPECT_FALSE(contains(a.err, "from the column name")) << a.err;
+  EXPECT_TRUE(contains(a.out, "а не импульсы лазерного гироскопа")) << a.out;
+  EXPECT_FALSE(contains(a.out, "ring-laser")) << a.out;
+  const auto bad = run_cli({"analyze", "--lang", "ru", "--rate", "-1", file.string()});
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_TRUE(contains(bad.err, "вне допустимого диапазона")) << bad.err;
 }
 
 TEST(ReportPdf, WithoutChromiumTheHtmlIsWrittenAndTheMissingPdfSaid) {

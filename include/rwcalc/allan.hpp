@@ -118,7 +118,10 @@ std::string format_allan_csv(const AllanResult& r);
 std::string unit_label(const AllanResult& r);
 
 std::string_view to_string(Estimator e);  ///< "oadev", "adev", "mdev", "ohdev" or "hdev" (Stable32's names)
-std::string_view long_name(Estimator e);  ///< "overlapping Allan", …, "overlapping Hadamard", "Hadamard"
+/// The estimator's deviation and variance by name in the current language (i18n.hpp):
+/// "overlapping Allan deviation" («перекрывающаяся девиация Аллана»), "Hadamard variance", …
+[[nodiscard]] std::string deviation_name(Estimator e);
+[[nodiscard]] std::string variance_name(Estimator e);
 /// "oadev"|"overlapping", "adev"|"nonoverlapping", "mdev"|"modified", "ohdev", "hdev".
 Estimator parse_estimator(std::string_view s);
 

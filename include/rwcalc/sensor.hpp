@@ -21,15 +21,20 @@ std::string_view to_string(SensorKind k);
 /// The sensor of a phase series; nullopt for clock data.
 std::optional<SensorKind> sensor_kind(PhaseKind k);
 /// What a term is for the kind: "angle random walk" (gyro N), "velocity random walk" (accelerometer N), …
+/// English, as JSON carries it; localized_meaning gives it in the current language (i18n.hpp).
 std::string_view term_meaning(SensorKind k, Term t);
+[[nodiscard]] std::string localized_meaning(SensorKind k, Term t);
 
-/// One shown unit: its label for people ("°/√h"), its ASCII name for JSON ("deg/sqrt(h)") and the
-/// factor that takes a fit-scale value (fit.hpp) into it.
+/// One shown unit: its label for people ("°/√h", in English: localized_label gives it in the current
+/// language, "°/√ч"), its ASCII name for JSON ("deg/sqrt(h)") and the factor that takes a
+/// fit-scale value (fit.hpp) into it.
 struct ShownUnit {
   std::string label;
   std::string ascii;
   double factor = 1;
 };
+
+[[nodiscard]] std::string localized_label(const ShownUnit& u);
 
 /// The units a channel's results are shown in: the Allan deviation and the mean (a rate or an
 /// acceleration) and each of the five terms.

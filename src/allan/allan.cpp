@@ -275,8 +275,8 @@ void check_options(const PhaseSeries& x, const AllanOptions& options) {
   if (!options.noise_id && (options.alpha < -2 || options.alpha > 2))
     throw UsageError(trf("noise exponent alpha must lie in -2..2, got {}", options.alpha));
   if (max_cluster_size(options.estimator, x.points()) < 1)
-    throw AnalysisError(trf("the record has {} phase point(s); the {} variance needs at least {}", x.points(),
-                            long_name(options.estimator), 3));
+    throw AnalysisError(trf("the record has {} phase point(s); the {} needs at least {}", x.points(),
+                            variance_name(options.estimator), 3));
 }
 
 }  // namespace
@@ -355,13 +355,24 @@ std::string_view to_string(Estimator e) {
   return "?";
 }
 
-std::string_view long_name(Estimator e) {
+std::string deviation_name(Estimator e) {
   switch (e) {
-    case Estimator::Overlapping: return "overlapping Allan";
-    case Estimator::NonOverlapping: return "non-overlapping Allan";
-    case Estimator::Modified: return "modified Allan";
-    case Estimator::OverlappingHadamard: return "overlapping Hadamard";
-    case Estimator::NonOverlappingHadamard: return "Hadamard";
+    case Estimator::Overlapping: return tr("overlapping Allan deviation");
+    case Estimator::NonOverlapping: return tr("non-overlapping Allan deviation");
+    case Estimator::Modified: return tr("modified Allan deviation");
+    case Estimator::OverlappingHadamard: return tr("overlapping Hadamard deviation");
+    case Estimator::NonOverlappingHadamard: return tr("Hadamard deviation");
+  }
+  return "?";
+}
+
+std::string variance_name(Estimator e) {
+  switch (e) {
+    case Estimator::Overlapping: return tr("overlapping Allan variance");
+    case Estimator::NonOverlapping: return tr("non-overlapping Allan variance");
+    case Estimator::Modified: return tr("modified Allan variance");
+    case Estimator::OverlappingHadamard: return tr("overlapping Hadamard variance");
+    case Estimator::NonOverlappingHadamard: return tr("Hadamard variance");
   }
   return "?";
 }

@@ -180,13 +180,13 @@ void describe_record(const Recording& rec, const AnalysisOptions& options, Analy
   r.arcsec_per_count = rec.phase.exact() ? rec.phase.arcsec_per_count : 0.0;
   if (options.temperature_c) {
     r.temperature_c = options.temperature_c;
-    r.temperature_source = "option";
+    r.temperature_source = N_("option");  // the JSON's keyword, translated where shown
   } else if (rec.temperature_c) {
     r.temperature_c = rec.temperature_c;
-    r.temperature_source = rec.metadata.count("temperature_c") ? "metadata" : "column";
+    r.temperature_source = rec.metadata.count("temperature_c") ? N_("metadata") : N_("column");
   } else if (auto t = temperature_from_name(rec.source)) {
     r.temperature_c = t;
-    r.temperature_source = "file name";
+    r.temperature_source = N_("file name");
   }
 }
 
@@ -262,15 +262,14 @@ void decide_applicability(const Recording& rec, const AnalysisOptions& options, 
   r.earth_rate_applied = gyro && options.earth_rate.value_or(pulses);
   r.verdict_applies = gyro && options.verdict_wanted.value_or(pulses);
   if (!gyro)
-    r.not_applied_reason = "an accelerometer: no Earth rate and no gyro class table";
+    r.not_applied_reason = tr("an accelerometer: no Earth rate and no gyro class table");
   else if (!r.earth_rate_applied || !r.verdict_applies)
-    r.not_applied_reason =
-        fmt::format("{} input, not a ring-laser gyro's pulses: {}{}{} (--vertical asks for both{})",
-                    to_string(rec.mode), r.earth_rate_applied ? "" : "the Earth rate is not subtracted",
-                    !r.earth_rate_applied && !r.verdict_applies ? " and " : "",
-                    r.verdict_applies ? "" : "the GOST RV 52339 class verdict is not given",
-                    !r.verdict_applies ? "; --limits FILE for the verdict"
-                                       : "; --earth-rate or --latitude for the Earth rate");
+    r.not_applied_reason = trf("{} input, not a ring-laser gyro's pulses: {}{}{} (--vertical asks for both{})",
+                               to_string(rec.mode), r.earth_rate_applied ? "" : tr("the Earth rate is not subtracted"),
+                               !r.earth_rate_applied && !r.verdict_applies ? tr(" and ") : "",
+                               r.verdict_applies ? "" : tr("the GOST RV 52339 class verdict is not given"),
+                               !r.verdict_applies ? tr("; --limits FILE for the verdict")
+                                                  : tr("; --earth-rate or --latitude for the Earth rate"));
 }
 
 /// Mean rate, expected Earth rate and the bias between them.
@@ -587,7 +586,7 @@ std::string input_line(const nlohmann::json& in) {
   std::string s = tr("  input: ") + (kind == "pulses"    ? std::string(tr("pulse counts"))
                                      : kind == "counter" ? std::string(tr("counter readings"))
                                                          : trf("{} samples in {}", kind, unit));
-  s += trf(" from column '{}'; sample rate from {}", in.value("column", ""), in.value("rate_source", ""));
+  s += trf(" from column '{}'; sample rate from {}", in.value("column", ""), tr(in.value("rate_source", "")));
   if (in.contains("time_unit"))
     s += trf(" ('{}', in {} by {})", in["time_column"].get<std::string>(), in.value("time_unit", ""),
              in.value("time_unit_source", ""));
@@ -619,7 +618,7 @@ std::string format_report(const AnalysisResult& r) {
   if (r.arcsec_per_count > 0) s += trf(", pulse weight {:g} arcsec", r.arcsec_per_count);
   s += "\n";
   s += input_line(r.input);
-  s += r.temperature_c ? trf("  temperature {:g} °C (from {})\n", *r.temperature_c, r.temperature_source)
+  s += r.temperature_c ? trf("  temperature {:g} °C (from {})\n", *r.temperature_c, tr(r.temperature_source))
                        : std::string(tr("  temperature unknown\n"));
   if (r.earth_rate_applied)
     s += trf("  mean rate {:.4f} °/h; expected vertical Earth rate {:.4f} °/h ({}); bias {:+.4f} °/h\n\n",

@@ -334,8 +334,9 @@ std::string format_batch_markdown(const json& summary) {
   const auto& runs = summary.at("runs");
   const auto& ov = summary.at("overall");
   std::string s;
-  s += "| T, °C | N (AV), °/√h | N direct [95 %], °/√h | B (AV), °/h | B 100-s avg [95 %], °/h "
-       "| class by N | class by B | class |\n";
+  s +=
+      tr("| T, °C | N (AV), °/√h | N direct [95 %], °/√h | B (AV), °/h | B 100-s avg [95 %], °/h "
+         "| class by N | class by B | class |\n");
   s += "|---|---|---|---|---|---|---|---|\n";
   for (const auto& r : runs) {
     const auto& v = r.at("verdict");
@@ -344,9 +345,9 @@ std::string format_batch_markdown(const json& summary) {
                      interval_cell(r, {"methods", "B_100s_deg_per_h"}), v.value("statement_N", ""),
                      v.value("statement_B", ""), v.value("statement", ""));
   }
-  s += fmt::format("| overall | | | | | {} | {} | {} |\n", ov.at("N").at("statement").get<std::string>(),
+  s += fmt::format("| {} | | | | | {} | {} | {} |\n", tr("overall"), ov.at("N").at("statement").get<std::string>(),
                    ov.at("B").at("statement").get<std::string>(), ov.at("statement").get<std::string>());
-  s += "\nOutliers (--outliers keep|remove|replace):\n\n";
+  s += tr("\nOutliers (--outliers keep|remove|replace):\n\n");
   for (const auto& r : runs) {
     std::string item = outliers_line(r);  // "  file: …" → "- file: …", a Markdown list item
     item[0] = '-';
@@ -355,7 +356,7 @@ std::string format_batch_markdown(const json& summary) {
   std::string warnings;
   for (const auto& r : runs) warnings += warning_lines(r);
   if (!warnings.empty()) {
-    s += "\nWarnings:\n\n";
+    s += tr("\nWarnings:\n\n");
     for (std::size_t at = 0; at < warnings.size();) {  // "  file: …" → "- file: …" line by line
       const std::size_t end = warnings.find('\n', at);
       s += "- " + warnings.substr(at + 2, end - at - 1);

@@ -231,14 +231,14 @@ std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r) {
     w.push_back({fr.filter_tc_s > 0 ? "output_filter" : "short_tau_structure",
                  trf("The fit uses tau >= {:g} s only: {}. Give --fit-range to choose the range yourself.",
                      fr.tau_min_s, short_tau_findings(fr)),
-                 fmt::format("rwcalc analyze {} [input options] --fit-range 0:", src)});
+                 trf("rwcalc analyze {} [input options] --fit-range 0:", src)});
   if (r.fit.p_value < 0.001)
     w.push_back({"fit_rejected",
                  trf("The five-term model does not describe the Allan variance: chi2/dof = {:.3g} "
                      "(dof {}, p = {:.2g}). The coefficients' intervals are scaled by sqrt(chi2/dof) = "
                      "{:.3g}; look for what the model misses.",
                      r.fit.chi2_per_dof, r.fit.dof, r.fit.p_value, fr.interval_scale),
-                 fmt::format("rwcalc diagnose {} [input options]", src)});
+                 trf("rwcalc diagnose {} [input options]", src)});
   return w;
 }
 

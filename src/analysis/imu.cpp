@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/parallel.hpp"
 #include "rwcalc/printable.hpp"
 
@@ -23,7 +24,7 @@ namespace imu_impl {
 std::string read_bytes(const std::string& path) {
   if (path == "-") return {std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>()};
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, 0, fmt::format("cannot open: {}", std::strerror(errno)));
+  if (!in) throw InputError(path, 0, trf("cannot open: {}", std::strerror(errno)));
   std::ostringstream s;
   s << in.rdbuf();
   return std::move(s).str();
@@ -54,10 +55,16 @@ void check_kind(const Recording& rec, const ChannelSpec& c) {
   const std::optional<SensorKind> read = sensor_kind(rec.phase.kind);
   if (read == c.kind) return;
   const bool gyro = c.kind == SensorKind::Gyro;
-  throw UsageError(fmt::format("{}: column '{}' is given as {} but was read as {} ({}); give its unit with {}",
-                               rec.source, c.column, gyro ? "--gyro" : "--accel",
-                               read ? std::string(to_string(*read)) : std::string("clock data"), describe_input(rec),
-                               gyro ? "--gyro-unit (deg/h, deg/s, rad/s)" : "--accel-unit (m/s^2, g, mg, ug)"));
+  const char* read_as = !read ? N_("clock data") : *read == SensorKind::Gyro ? N_("gyro") : N_("accelerometer");
+  throw UsageError(trf("{}: column '{}' is given as {} but was read as {} ({}); give its unit with {}", rec.source,
+                       c.column, gyro ? "--gyro" : "--accel", tr(read_as), describe_input(rec),
+                       gyro ? "--gyro-unit (deg/h, deg/s, rad/s)" : "--accel-unit (m/s^2, g, mg, ug)"));
+}
+
+/// Columns on the screen, as fmt counts them when it pads: code points, not bytes (Cyrillic).
+std::size_t display_width(std::string_view s) {
+  return static_cast<std::size_t>(
+      std::count_if(s.begin(), s.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
 }
 
 std::string imu_num(double v, int sig = 4) { return fmt::format("{:.{}g}", v, sig); }
@@ -93,22 +100,23 @@ std::string cell(const Coefficient& c, double factor) {
 }
 
 std::string units_line(const UnitSet& u) {
-  return fmt::format("Q {}, N {}, B {}, K {}, R {}; mean and Allan deviation in {}", u[Term::Q].label, u[Term::N].label,
-                     u[Term::B].label, u[Term::K].label, u[Term::R].label, u.deviation.label);
+  return trf("Q {}, N {}, B {}, K {}, R {}; mean and Allan deviation in {}", localized_label(u[Term::Q]),
+             localized_label(u[Term::N]), localized_label(u[Term::B]), localized_label(u[Term::K]),
+             localized_label(u[Term::R]), localized_label(u.deviation));
 }
 
 // Earth rate and class verdict: what was done for this channel, one phrase.
 std::string earth_and_verdict(const AnalysisResult& r) {
-  if (r.sensor != SensorKind::Gyro) return "no Earth rate, no class verdict (accelerometer)";
+  if (r.sensor != SensorKind::Gyro) return tr("no Earth rate, no class verdict (accelerometer)");
   const std::string earth = r.earth_rate_applied
-                                ? fmt::format("Earth rate {} °/h subtracted", imu_num(r.earth_rate_deg_per_h, 4))
-                                : std::string("no Earth rate subtracted");
+                                ? trf("Earth rate {} °/h subtracted", imu_num(r.earth_rate_deg_per_h, 4))
+                                : std::string(tr("no Earth rate subtracted"));
   const std::string verdict =
-      r.verdict_applies ? fmt::format("class verdict: {}", r.verdict.statement()) : std::string("no class verdict");
+      r.verdict_applies ? trf("class verdict: {}", r.verdict.statement()) : std::string(tr("no class verdict"));
   return fmt::format("{}; {}{}", earth, verdict,
                      r.not_applied_reason.empty()
                          ? ""
-                         : " (ask with --vertical or imu --vertical-gyro COL, --limits, --earth-rate)");
+                         : tr(" (ask with --vertical or imu --vertical-gyro COL, --limits, --earth-rate)"));
 }
 
 }  // namespace imu_impl
@@ -119,10 +127,10 @@ ImuResult analyze_imu(const std::string& path, const ImuOptions& options) {
   std::vector<ChannelSpec> specs;
   for (const auto& c : options.gyro_columns) specs.push_back({c, SensorKind::Gyro});
   for (const auto& c : options.accel_columns) specs.push_back({c, SensorKind::Accelerometer});
-  if (specs.empty()) throw UsageError("imu needs at least one column: give --gyro COLS and/or --accel COLS");
+  if (specs.empty()) throw UsageError(tr("imu needs at least one column: give --gyro COLS and/or --accel COLS"));
   if (!options.vertical_gyro.empty() && std::find(options.gyro_columns.begin(), options.gyro_columns.end(),
                                                   options.vertical_gyro) == options.gyro_columns.end())
-    throw UsageError(fmt::format("--vertical-gyro {}: not one of the --gyro columns", options.vertical_gyro));
+    throw UsageError(trf("--vertical-gyro {}: not one of the --gyro columns", options.vertical_gyro));
   ImuResult out;
   out.source = path;
   out.gyro_units = output_units(SensorKind::Gyro, options.gyro_output_unit);
@@ -179,26 +187,31 @@ nlohmann::json channel_json(const AnalysisResult& r, const UnitSet& shown) {
 }
 
 std::string format_channel(const AnalysisResult& r, const UnitSet& shown) {
-  std::string s = fmt::format("rwcalc {}: {}, column '{}'\n\n", to_string(r.sensor), printable(r.source), r.column);
+  std::string s = trf(r.sensor == SensorKind::Gyro ? N_("rwcalc gyro: {}, column '{}'\n\n")
+                                                   : N_("rwcalc accelerometer: {}, column '{}'\n\n"),
+                      printable(r.source), r.column);
   s += format_warnings(r.warnings);
-  s += fmt::format("Data\n  {} samples at {:g} Hz, {:.1f} s ({:.2f} h); mean {} {}; {}\n", r.samples, r.rate_hz,
-                   r.duration_s, r.duration_s / 3600.0, imu_num(r.mean_rate_deg_per_h * shown.deviation.factor, 6),
-                   shown.deviation.label, earth_and_verdict(r));
-  s += fmt::format("\nAllan deviation ({}, {:g} % bounds)\n  {:>11} {:>12} {:>12} {:>12}\n",
-                   to_string(r.allan.estimator), 100 * r.allan.confidence, "tau (s)", "sigma", "low", "high");
+  s += trf("Data\n  {} samples at {:g} Hz, {:.1f} s ({:.2f} h); mean {} {}; {}\n", r.samples, r.rate_hz, r.duration_s,
+           r.duration_s / 3600.0, imu_num(r.mean_rate_deg_per_h * shown.deviation.factor, 6),
+           localized_label(shown.deviation), earth_and_verdict(r));
+  s += trf("\nAllan deviation ({}, {:g} % bounds)\n  {:>11} {:>12} {:>12} {:>12}\n", to_string(r.allan.estimator),
+           100 * r.allan.confidence, tr("tau (s)"), tr("sigma"), tr("low"), tr("high"));
   const double k = shown.deviation.factor;
   for (const auto& p : r.allan.points)
     s += fmt::format("  {:>11.5g} {:>12.5g} {:>12.5g} {:>12.5g}\n", p.tau_s, p.dev * k, p.dev_low * k, p.dev_high * k);
-  s += fmt::format(
-      "  (in {})\n\nNoise coefficients (fit over tau {:g}..{:g} s; 95 % profile intervals; < : not "
-      "resolved, 95 % upper bound)\n",
-      shown.deviation.label, r.fit.used.front().tau_s, r.fit.used.back().tau_s);
+  s +=
+      trf("  (in {})\n\nNoise coefficients (fit over tau {:g}..{:g} s; 95 % profile intervals; < : not "
+          "resolved, 95 % upper bound)\n",
+          localized_label(shown.deviation), r.fit.used.front().tau_s, r.fit.used.back().tau_s);
   const UnitSet si = si_units(r.sensor);
+  std::size_t name_width = 26;  // as wide as the longest term name (Russian ones are longer)
+  for (const Term t : kAllTerms) name_width = std::max(name_width, display_width(localized_meaning(r.sensor, t)));
   for (const Term t : kAllTerms)
-    s += fmt::format("  {} {:<26} {:<28} {:<12} = {} {}\n", term_name(t), term_meaning(r.sensor, t),
-                     cell(r.fit[t], shown[t].factor), shown[t].label, cell(r.fit[t], si[t].factor), si[t].label);
-  s += fmt::format("  chi2/dof = {:.2f} (dof {}, p = {:.3g}); fit range: {}\n", r.fit.chi2_per_dof, r.fit.dof,
-                   r.fit.p_value, r.fit_range.reason());
+    s += fmt::format("  {} {:<{}} {:<28} {:<12} = {} {}\n", term_name(t), localized_meaning(r.sensor, t), name_width,
+                     cell(r.fit[t], shown[t].factor), localized_label(shown[t]), cell(r.fit[t], si[t].factor),
+                     localized_label(si[t]));
+  s += trf("  chi2/dof = {:.2f} (dof {}, p = {:.3g}); fit range: {}\n", r.fit.chi2_per_dof, r.fit.dof, r.fit.p_value,
+           r.fit_range.reason());
   return s;
 }
 
@@ -223,29 +236,35 @@ std::string kind_table(const std::vector<const ImuChannel*>& axes, const UnitSet
       width = std::max({width, a->column.size(), cell(a->result.fit[t], u[t].factor).size(),
                         cell(a->result.fit[t], si[t].factor).size()});
   const int kWidth = static_cast<int>(width + 2);
-  std::string s = fmt::format("{} ({} axes; {};\n  95 % profile intervals; < : not resolved, 95 % upper bound)\n",
-                              kind == SensorKind::Gyro ? "Gyro" : "Accelerometer", axes.size(), units_line(u));
-  s += fmt::format("  {:<30}", "");
+  std::string s = trf(kind == SensorKind::Gyro
+                          ? N_("Gyro ({} axes; {};\n  95 % profile intervals; < : not resolved, 95 % upper bound)\n")
+                          : N_("Accelerometer ({} axes; {};\n  95 % profile intervals; < : not resolved, 95 % upper "
+                               "bound)\n"),
+                      axes.size(), units_line(u));
+  // The row heads' column fits the longest (the Russian term names are longer than the English).
+  std::vector<std::string> heads{tr("mean")};
+  for (const Term t : kAllTerms) heads.push_back(fmt::format("{} {}", term_name(t), localized_meaning(kind, t)));
+  heads.push_back(trf("N in {}", localized_label(si[Term::N])));
+  heads.push_back(trf("K in {}", localized_label(si[Term::K])));
+  heads.push_back(tr("fit chi2/dof (p)"));
+  heads.push_back(tr("fit tau (s)"));
+  std::size_t head_width = 30;
+  for (const auto& h : heads) head_width = std::max(head_width, display_width(h) + 2);
+  s += fmt::format("  {:<{}}", "", head_width);
   for (const auto* a : axes) s += fmt::format("{:<{}}", printable(a->column), kWidth);
   s += "\n";
-  auto row = [&](std::string_view head, auto&& value) {
-    s += fmt::format("  {:<30}", head);
+  std::size_t next_head = 0;
+  auto row = [&](auto&& value) {
+    s += fmt::format("  {:<{}}", heads.at(next_head++), head_width);
     for (const auto* a : axes) s += fmt::format("{:<{}}", value(a->result), kWidth);
     s += "\n";
   };
-  row("mean", [&](const AnalysisResult& r) { return imu_num(r.mean_rate_deg_per_h * u.deviation.factor, 6); });
-  for (const Term t : kAllTerms)
-    row(fmt::format("{} {}", term_name(t), term_meaning(kind, t)),
-        [&](const AnalysisResult& r) { return cell(r.fit[t], u[t].factor); });
-  row(fmt::format("N in {}", si[Term::N].label),
-      [&](const AnalysisResult& r) { return cell(r.fit[Term::N], si[Term::N].factor); });
-  row(fmt::format("K in {}", si[Term::K].label),
-      [&](const AnalysisResult& r) { return cell(r.fit[Term::K], si[Term::K].factor); });
-  row("fit chi2/dof (p)",
-      [](const AnalysisResult& r) { return fmt::format("{:.2f} ({:.2g})", r.fit.chi2_per_dof, r.fit.p_value); });
-  row("fit tau (s)", [](const AnalysisResult& r) {
-    return fmt::format("{:g}..{:g}", r.fit.used.front().tau_s, r.fit.used.back().tau_s);
-  });
+  row([&](const AnalysisResult& r) { return imu_num(r.mean_rate_deg_per_h * u.deviation.factor, 6); });
+  for (const Term t : kAllTerms) row([&](const AnalysisResult& r) { return cell(r.fit[t], u[t].factor); });
+  row([&](const AnalysisResult& r) { return cell(r.fit[Term::N], si[Term::N].factor); });
+  row([&](const AnalysisResult& r) { return cell(r.fit[Term::K], si[Term::K].factor); });
+  row([](const AnalysisResult& r) { return fmt::format("{:.2f} ({:.2g})", r.fit.chi2_per_dof, r.fit.p_value); });
+  row([](const AnalysisResult& r) { return trf("{:g}..{:g}", r.fit.used.front().tau_s, r.fit.used.back().tau_s); });
   for (const auto* a : axes) s += fmt::format("  {}: {}\n", printable(a->column), earth_and_verdict(a->result));
   return s + "\n";
 }
@@ -346,18 +365,18 @@ nlohmann::json to_json(const ImuResult& r) {
 
 std::string format_imu(const ImuResult& r) {
   const auto& first = r.channels.front().result;
-  std::string s = fmt::format("rwcalc imu: {}\n\n", printable(r.source));
+  std::string s = trf("rwcalc imu: {}\n\n", printable(r.source));
   for (const auto& c : r.channels) {
     if (c.result.warnings.empty()) continue;
     s += fmt::format("[{}] ", printable(c.column)) + format_warnings(c.result.warnings);
   }
-  s += fmt::format("Data\n  {} samples at {:g} Hz (tau0 = {:g} ms), {:.1f} s ({:.2f} h); {} channels\n\n",
-                   first.samples, first.rate_hz, 1000.0 / first.rate_hz, first.duration_s, first.duration_s / 3600.0,
-                   r.channels.size());
+  s += trf("Data\n  {} samples at {:g} Hz (tau0 = {:g} ms), {:.1f} s ({:.2f} h); {} channels\n\n", first.samples,
+           first.rate_hz, 1000.0 / first.rate_hz, first.duration_s, first.duration_s / 3600.0, r.channels.size());
   s += kind_table(of_kind(r, SensorKind::Gyro), r.gyro_units);
   s += kind_table(of_kind(r, SensorKind::Accelerometer), r.accel_units);
-  s += "Conventions: IEEE 952 model sigma² = 3Q²/tau² + N²/tau + (2 ln2/π)B² + K²tau/3 + R²tau²/2 per axis;\n"
-       "  N is the noise density and K the bias random walk of Kalibr's IMU noise model.\n";
+  s +=
+      tr("Conventions: IEEE 952 model sigma² = 3Q²/tau² + N²/tau + (2 ln2/π)B² + K²tau/3 + R²tau²/2 per axis;\n"
+         "  N is the noise density and K the bias random walk of Kalibr's IMU noise model.\n");
   return s;
 }
 

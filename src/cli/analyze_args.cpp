@@ -36,16 +36,16 @@ std::pair<double, double> parse_range(const std::string& spec, const char* what,
 
 void add_outlier_options(CLI::App& app, std::string& action, double& threshold) {
   app.add_option("--outliers", action,
-                 "Isolated outliers are always detected and reported (sample, time, line); then: keep "
-                 "(default: analyse the data as read), remove (drop them; later samples move one period "
-                 "earlier), or replace (by the median of the nearest good neighbours; keeps every sample)")
+                 tr("Isolated outliers are always detected and reported (sample, time, line); then: keep "
+                    "(default: analyse the data as read), remove (drop them; later samples move one period "
+                    "earlier), or replace (by the median of the nearest good neighbours; keeps every sample)"))
       ->capture_default_str()
-      ->group("Outliers");
+      ->group(tr("Outliers"));
   app.add_option("--outlier-threshold", threshold,
-                 "Detection threshold, robust sigma of the residual from the neighbour median")
+                 tr("Detection threshold, robust sigma of the residual from the neighbour median"))
       ->check(real_in(kMinOutlierThreshold, 1e6, "robust sigma"))
       ->capture_default_str()
-      ->group("Outliers");
+      ->group(tr("Outliers"));
 }
 
 CLI::Option* add_temperature_option(CLI::App& app, std::optional<double>& temperature, const std::string& help) {
@@ -54,56 +54,57 @@ CLI::Option* add_temperature_option(CLI::App& app, std::optional<double>& temper
 }
 
 void AnalyzeArgs::add_to(CLI::App& app) {
-  app.add_option("--fit-range", fit_range, "Tau range of the fit, TMIN:TMAX in s (either may be empty; default: all octave points, or "
-                 "tau >= 10 tau_f when the shortest tau shows an output filter of time constant tau_f)")
-      ->group("Fit");
-  app.add_option("--min-edf", min_edf, "Leave out AV points with fewer equivalent degrees of freedom")
+  app.add_option("--fit-range", fit_range,
+                 tr("Tau range of the fit, TMIN:TMAX in s (either may be empty; default: all octave points, or "
+                    "tau >= 10 tau_f when the shortest tau shows an output filter of time constant tau_f)"))
+      ->group(tr("Fit"));
+  app.add_option("--min-edf", min_edf, tr("Leave out AV points with fewer equivalent degrees of freedom"))
       ->check(real_in(0.0, 1e12, "", Ends::OpenLow))
       ->capture_default_str()
-      ->group("Fit");
-  app.add_option("--terms", terms, "Terms to fit, a subset of QNBKR")->capture_default_str()->group("Fit");
+      ->group(tr("Fit"));
+  app.add_option("--terms", terms, tr("Terms to fit, a subset of QNBKR"))->capture_default_str()->group(tr("Fit"));
   app.add_flag("--all-terms", keep_all_terms,
-               "Keep every fitted term in the model (default: K, R, Q not supported by the data are "
-               "left out and reported as upper bounds)")
-      ->group("Fit");
+               tr("Keep every fitted term in the model (default: K, R, Q not supported by the data are "
+                  "left out and reported as upper bounds)"))
+      ->group(tr("Fit"));
   app.add_option("--tau", tau,
-                 "Tau grid of the reported Allan deviation: octave, decade, dense[:P] (P per decade, default 20, "
-                 "up to N/10), all, or a list of seconds; the fit always uses the octave points")
+                 tr("Tau grid of the reported Allan deviation: octave, decade, dense[:P] (P per decade, default 20, "
+                    "up to N/10), all, or a list of seconds; the fit always uses the octave points"))
       ->capture_default_str()
-      ->group("Fit");
+      ->group(tr("Fit"));
   latitude_option = app.add_option("--latitude", latitude_deg,
-                                   "Latitude for the vertical Earth rate, degrees (given: the Earth rate is "
-                                   "subtracted whatever the input)")
+                                   tr("Latitude for the vertical Earth rate, degrees (given: the Earth rate is "
+                                      "subtracted whatever the input)"))
                         ->check(real_in(-90.0, 90.0, "deg"))
                         ->capture_default_str()
-                        ->group("Earth rate");
+                        ->group(tr("Earth rate"));
   app.add_option("--earth-rate", earth_rate,
-                 "Expected sensed Earth rate, deg/h (overrides --latitude; given: it is subtracted whatever the "
-                 "input)")
+                 tr("Expected sensed Earth rate, deg/h (overrides --latitude; given: it is subtracted whatever the "
+                    "input)"))
       ->check(real_in(-kMaxRateDegPerH, kMaxRateDegPerH, "deg/h"))
-      ->group("Earth rate");
+      ->group(tr("Earth rate"));
   app.add_flag("--vertical", vertical,
-               "The gyro's axis is vertical: subtract the vertical Earth rate and give the class verdict for any "
-               "input (default: only for pulse or counter input, a ring-laser gyro's)")
-      ->group("Earth rate");
-  app.add_option("--b-estimate", b_estimate, "B estimate the verdict uses: fit, sigma-min or avg100")
+               tr("The gyro's axis is vertical: subtract the vertical Earth rate and give the class verdict for any "
+                  "input (default: only for pulse or counter input, a ring-laser gyro's)"))
+      ->group(tr("Earth rate"));
+  app.add_option("--b-estimate", b_estimate, tr("B estimate the verdict uses: fit, sigma-min or avg100"))
       ->capture_default_str()
-      ->group("Verdict");
+      ->group(tr("Verdict"));
   app.add_option("--tolerance", tolerance_pct,
-                 "Accept a B up to PCT % above a class limit (the paper's heading-gyro rule, e.g. 50)")
+                 tr("Accept a B up to PCT % above a class limit (the paper's heading-gyro rule, e.g. 50)"))
       ->check(real_in(0.0, 1000.0, "%"))
       ->capture_default_str()
-      ->group("Verdict");
+      ->group(tr("Verdict"));
   app.add_option("--limits", limits_file,
-                 "Class table as JSON (default: GOST RV 52339); given, the verdict is made for any input")
-      ->group("Verdict");
-  app.add_option("--block", block_s, "Block length of the averaging cross-check, s")
+                 tr("Class table as JSON (default: GOST RV 52339); given, the verdict is made for any input"))
+      ->group(tr("Verdict"));
+  app.add_option("--block", block_s, tr("Block length of the averaging cross-check, s"))
       ->check(real_in(0.0, 1e9, "s", Ends::OpenLow))
       ->capture_default_str()
-      ->group("Cross-checks");
-  app.add_option("--direct-range", direct_range, "Interval lengths of the direct N method, TMIN:TMAX in s")
+      ->group(tr("Cross-checks"));
+  app.add_option("--direct-range", direct_range, tr("Interval lengths of the direct N method, TMIN:TMAX in s"))
       ->capture_default_str()
-      ->group("Cross-checks");
+      ->group(tr("Cross-checks"));
   add_outlier_options(app, outliers, outlier_threshold);
 }
 

@@ -20,11 +20,11 @@ inline constexpr auto kInvalidUtf8 = nlohmann::json::error_handler_t::replace;
 struct TableFormat {
   bool json = false, csv = false, markdown = false, jsonl = false;
   inline void add_to(CLI::App& app) {
-    auto* g = app.add_option_group("Output format", "default: the readable tables");
+    auto* g = app.add_option_group(tr("Output format"), tr("default: the readable tables"));
     g->add_flag("--json", json, "{\"runs\": [analyze objects], \"overall\": {...}, \"trends\": {...}}");
-    g->add_flag("--csv", csv, "One CSV row per run, then the overall row");
-    g->add_flag("--markdown", markdown, "The table in Markdown");
-    g->add_flag("--jsonl", jsonl, "One analyze JSON object per line (input of 'rwcalc merge')");
+    g->add_flag("--csv", csv, tr("One CSV row per run, then the overall row"));
+    g->add_flag("--markdown", markdown, tr("The table in Markdown"));
+    g->add_flag("--jsonl", jsonl, tr("One analyze JSON object per line (input of 'rwcalc merge')"));
     g->require_option(0, 1);
   }
   /// The runs are taken over (moved in): the summary holds them without a deep copy.
@@ -45,9 +45,9 @@ struct TableFormat {
 
 /// -o,--output FILE (default "-": standard output) and --force.
 inline void add_output_options(CLI::App& app, std::string& output, bool& force,
-                               const char* force_help = "Overwrite existing output, figure and script files") {
-  app.add_option("-o,--output", output, "Write to FILE instead of standard output")->capture_default_str();
-  app.add_flag("--force", force, force_help);
+                               const char* force_help = N_("Overwrite existing output, figure and script files")) {
+  app.add_option("-o,--output", output, tr("Write to FILE instead of standard output"))->capture_default_str();
+  app.add_flag("--force", force, tr(force_help));
 }
 
 /// The command's text to standard output ("-") or to the file, atomically.

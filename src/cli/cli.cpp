@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdlib>
 #include <exception>
+#include <memory>
 #include <optional>
 #include <ostream>
 #include <string_view>
@@ -21,9 +22,9 @@ namespace rwcalc::cli {
 
 namespace {
 constexpr const char* kDescription =
-    "rwcalc: Allan-variance noise analysis of gyro recordings (GL-2D ring laser gyro and others),\n"
-    "noise coefficients with uncertainties, navigation accuracy class verdicts (GOST RV 52339),\n"
-    "simulation of gyro records and diagnosis of what the noise model misses.";
+    N_("rwcalc: Allan-variance noise analysis of gyro recordings (GL-2D ring laser gyro and others),\n"
+       "noise coefficients with uncertainties, navigation accuracy class verdicts (GOST RV 52339),\n"
+       "simulation of gyro records and diagnosis of what the noise model misses.");
 
 struct Command {
   const char* name;
@@ -42,11 +43,58 @@ constexpr Command kCommands[] = {
 void add_language_option(CLI::App& sub) {
   const std::string name = sub.get_name();
   if (name == "man" || name == "completion") return;
-  sub.add_option("--lang",
-                 "Language of the text, tables, report and messages: en (default) or ru; "
-                 "default from RWCALC_LANG")
-      ->check(CLI::IsMember({"en", "ru"}))
-      ->option_text("en|ru");
+  const std::string help =
+      tr("Language of the text, tables, report and messages: en (default) or ru; default from RWCALC_LANG");
+  sub.add_option("--lang", help)->check(CLI::IsMember({"en", "ru"}))->option_text("en|ru");
+}
+
+/// The language of the command line before it is parsed (the options' help texts are translated
+/// when they are declared): the last "--lang X" or "--lang=X", else RWCALC_LANG, else English.
+/// An unknown name counts as none here; the parse then refuses it.
+Language prescanned_language(int argc, const char* const* argv) {
+  std::optional<Language> lang;
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view a = argv[i];
+    if (a == "--") break;
+    if (a == "--lang" && i + 1 < argc)
+      lang = parse_language(argv[++i]);
+    else if (a.starts_with("--lang="))
+      lang = parse_language(a.substr(7));
+  }
+  if (lang) return *lang;
+  if (const char* env = std::getenv("RWCALC_LANG")) return parse_language(env).value_or(Language::English);
+  return Language::English;
+}
+
+/// CLI11's help with the words it writes itself for an option group (its title, "at most one")
+/// translated.
+class HelpFormatter : public CLI::Formatter {
+ public:
+  std::string make_expanded(const CLI::App* sub) const override {
+    std::string e = CLI::Formatter::make_expanded(sub);
+    const std::string_view title = "[Option Group: ";
+    if (e.starts_with(title)) e.replace(0, title.size(), tr("[Option Group: "));
+    return e;
+  }
+  std::string make_description(const CLI::App* app) const override {
+    std::string d = CLI::Formatter::make_description(app);
+    const std::string_view at_most = "[At most 1 of the following options are allowed]";
+    if (const auto at = d.find(at_most); at != std::string::npos)
+      d.replace(at, at_most.size(), tr("[At most 1 of the following options are allowed]"));
+    return d;
+  }
+};
+
+/// CLI11's own words in the help (its labels, the default option group, the help flag), in the
+/// current language; set on the top-level app before the commands, which inherit them.
+void translate_help_words(CLI::App& app) {
+  app.option_defaults()->group(tr("Options"));  // before the flags, which take it when made
+  app.set_help_flag("-h,--help", tr("Print this help message and exit"));
+  auto f = std::make_shared<HelpFormatter>();
+  app.formatter(f);
+  for (const char* label : {N_("Usage"), N_("OPTIONS"), N_("SUBCOMMAND"), N_("SUBCOMMANDS"), N_("Positionals"),
+                            N_("REQUIRED"), N_("Env"), N_("Needs"), N_("Excludes")})
+    f->label(label, tr(label));
 }
 
 /// The language asked for: --lang, else RWCALC_LANG when it names one, else English.
@@ -62,17 +110,28 @@ Language chosen_language(const CLI::App& app) {
 /// is built (the parse is the same, without setting up the others' options); otherwise all, so
 /// that the overall help and the unknown-command message list every command.
 void build_app(CLI::App& app, Runner& runner, int argc, const char* const* argv) {
-  app.set_version_flag("-V,--version", version_line());
+  translate_help_words(app);
+  app.set_version_flag("-V,--version", version_line(), tr("Display program version information and exit"));
   app.require_subcommand(1);
   app.fallthrough(false);
+  const auto translate_groups = [&app] {
+    // A command takes its help flag before the parent's option defaults, and its group is
+    // CLI11's English "Subcommands": both named in the current language here.
+    for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
+      if (CLI::Option* help = sub->get_help_ptr()) help->group(app.option_defaults()->get_group());
+      if (sub->get_group() == "Subcommands") sub->group(tr("Subcommands"));
+    }
+  };
   if (argc > 1)
     for (const auto& c : kCommands)
       if (std::string_view(argv[1]) == c.name) {
         c.add(app, runner);
         add_language_option(*app.get_subcommand(c.name));
+        translate_groups();
         return;
       }
   add_all_commands(app, runner);
+  translate_groups();
 }
 
 /// Parse argv into `app`. Returns the exit status to stop with (help, version, a parse error),
@@ -100,9 +159,9 @@ std::optional<int> parse_args(CLI::App& app, int argc, const char* const* argv, 
     }
     print_message(err, e.what());
     if (app.get_subcommands().empty())
-      err << "Run 'rwcalc --help' for the list of commands.\n";
+      err << tr("Run 'rwcalc --help' for the list of commands.\n");
     else
-      err << "Run 'rwcalc " << app.get_subcommands().front()->get_name() << " --help' for its options.\n";
+      err << trf("Run 'rwcalc {} --help' for its options.\n", app.get_subcommands().front()->get_name());
     return static_cast<int>(ExitCode::BadInput);
   }
   return std::nullopt;
@@ -113,7 +172,8 @@ std::optional<int> parse_args(CLI::App& app, int argc, const char* const* argv, 
 int parse_and_run(int argc, const char* const* argv, std::ostream& out, std::ostream& err, bool execute) {
   const LanguageScope restore(language());  // the command sets its language; the caller's comes back after
   try {
-    CLI::App app{app_description(), "rwcalc"};
+    set_language(prescanned_language(argc, argv));
+    CLI::App app{tr(app_description()), "rwcalc"};
     Runner runner;
     build_app(app, runner, argc, argv);
     if (const auto status = parse_args(app, argc, argv, out, err)) return *status;

@@ -160,26 +160,25 @@ int run_allan(const AllanArgs& a, Io& io) {
 void register_allan(CLI::App& app, Runner& runner) {
   auto args = std::make_shared<AllanArgs>();
   auto* sub = app.add_subcommand(
-      "allan",
-      "Allan deviation of a recording per τ, with noise type α, equivalent degrees of freedom and\n"
-      "χ² confidence bounds (Stable32 conventions). Deviations in °/h for gyro input (1″/s = 1 °/h),\n"
-      "in input units per second for clock data.");
-  sub->add_option("FILE", args->file, "Recording to read ('-' for standard input; .gz accepted)")->required();
+      "allan", tr("Allan deviation of a recording per τ, with noise type α, equivalent degrees of freedom and\n"
+                  "χ² confidence bounds (Stable32 conventions). Deviations in °/h for gyro input (1″/s = 1 °/h),\n"
+                  "in input units per second for clock data."));
+  sub->add_option("FILE", args->file, tr("Recording to read ('-' for standard input; .gz accepted)"))->required();
   args->input.add_to(*sub);
   sub->add_option("--estimator", args->estimator,
-                  "oadev (fully overlapping Allan, default), adev (non-overlapping), mdev (modified), "
-                  "ohdev (overlapping Hadamard) or hdev (non-overlapping Hadamard)")
+                  tr("oadev (fully overlapping Allan, default), adev (non-overlapping), mdev (modified), "
+                     "ohdev (overlapping Hadamard) or hdev (non-overlapping Hadamard)"))
       ->capture_default_str();
   sub->add_option("--tau", args->tau,
-                  "τ grid: octave, decade (1,2,4 per decade), dense[:P] (P per decade), all, or a list of "
-                  "seconds such as 0.01,1,10 (each a whole number of samples)")
+                  tr("τ grid: octave, decade (1,2,4 per decade), dense[:P] (P per decade), all, or a list of "
+                     "seconds such as 0.01,1,10 (each a whole number of samples)"))
       ->capture_default_str();
-  sub->add_option("--confidence", args->confidence, "Two-sided confidence of the bounds (0..1)")
+  sub->add_option("--confidence", args->confidence, tr("Two-sided confidence of the bounds (0..1)"))
       ->check(real_in(0.0, 1.0, "", Ends::Open))
       ->capture_default_str();
   add_outlier_options(*sub, args->outliers, args->outlier_threshold);
-  auto* json = sub->add_flag("--json", args->json, "Print JSON instead of the table");
-  auto* csv = sub->add_flag("--csv", args->csv, "Print CSV instead of the table");
+  auto* json = sub->add_flag("--json", args->json, tr("Print JSON instead of the table"));
+  auto* csv = sub->add_flag("--csv", args->csv, tr("Print CSV instead of the table"));
   json->excludes(csv);
   sub->callback([&runner, args] { runner = [args](Io& io) { return run_allan(*args, io); }; });
 }

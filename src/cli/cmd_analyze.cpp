@@ -37,21 +37,19 @@ struct AnalyzeCmd {
 void register_analyze(CLI::App& app, Runner& runner) {
   auto cmd = std::make_shared<AnalyzeCmd>();
   auto* sub = app.add_subcommand(
-      "analyze",
-      "Noise coefficients (Q, N, B, K, R) with 95 % intervals, the paper's cross-checks (direct N, "
-      "100-s averages), Earth rate and bias, and the GOST RV 52339 class verdict with its probability");
-  sub->add_option("FILE", cmd->file, "Recording to analyse ('-' for standard input)")->required();
+      "analyze", tr("Noise coefficients (Q, N, B, K, R) with 95 % intervals, the paper's cross-checks (direct N, "
+                    "100-s averages), Earth rate and bias, and the GOST RV 52339 class verdict with its probability"));
+  sub->add_option("FILE", cmd->file, tr("Recording to analyse ('-' for standard input)"))->required();
   cmd->input.add_to(*sub);
   cmd->analysis.add_to(*sub);
-  add_temperature_option(*sub, cmd->temperature, "Temperature of the run, °C (overrides the file)");
-  sub->add_flag("--json", cmd->json, "Print the JSON object instead of the report");
+  add_temperature_option(*sub, cmd->temperature, tr("Temperature of the run, °C (overrides the file)"));
+  sub->add_flag("--json", cmd->json, tr("Print the JSON object instead of the report"));
   sub->add_option("--output-unit", cmd->output_unit,
-                  "Show the results in this unit: deg/h, deg/s, rad/s (gyro); m/s^2, g, mg, ug (accelerometer). "
-                  "Given, or for an accelerometer column, the report is the channel's table in these units and SI");
+                  tr("Show the results in this unit: deg/h, deg/s, rad/s (gyro); m/s^2, g, mg, ug (accelerometer). "
+                     "Given, or for an accelerometer column, the report is the channel's table in these units and SI"));
   add_output_options(*sub, cmd->output, cmd->force);
-  cmd->plot.add_to(*sub,
-                   "the Allan deviation with its confidence bars, the fitted model, each term's line and the "
-                   "class limits for B");
+  cmd->plot.add_to(*sub, N_("the Allan deviation with its confidence bars, the fitted model, each term's line and the "
+                            "class limits for B"));
   sub->callback([cmd, &runner] {
     runner = [cmd](Io& io) -> int {
       AnalysisOptions opt = cmd->analysis.options();
@@ -69,7 +67,7 @@ void register_analyze(CLI::App& app, Runner& runner) {
         cmd->plot.draw_analysis(j, cmd->force, io);
         emit(io,
              cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"
-                       : format_channel(res, shown),
+                       : localize_numbers(format_channel(res, shown)),
              cmd->output, cmd->force);
         return 0;
       }

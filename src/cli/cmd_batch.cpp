@@ -36,18 +36,17 @@ struct BatchCmd {
 
 void register_batch(CLI::App& app, Runner& runner) {
   auto cmd = std::make_shared<BatchCmd>();
-  auto* sub = app.add_subcommand("batch",
-                                 "Analyse many runs (in parallel): Table 1 (N and B by each method per "
-                                 "temperature), Table 2 (classes), overall verdict and temperature trends");
-  sub->add_option("FILES", cmd->files, "Recordings")->required();
+  auto* sub =
+      app.add_subcommand("batch", tr("Analyse many runs (in parallel): Table 1 (N and B by each method per "
+                                     "temperature), Table 2 (classes), overall verdict and temperature trends"));
+  sub->add_option("FILES", cmd->files, tr("Recordings"))->required();
   cmd->input.add_to(*sub);
   cmd->analysis.add_to(*sub);
-  add_temperature_option(*sub, cmd->temperature, "Temperature, °C (only with a single file)");
+  add_temperature_option(*sub, cmd->temperature, tr("Temperature, °C (only with a single file)"));
   cmd->format.add_to(*sub);
   add_output_options(*sub, cmd->output, cmd->force);
-  cmd->plot.add_to(*sub,
-                   "the paper's Fig. 1 (the Allan deviations of all runs overlaid) above Fig. 2 (the direct "
-                   "method's angle variance against t with its regression line per run)");
+  cmd->plot.add_to(*sub, N_("the paper's Fig. 1 (the Allan deviations of all runs overlaid) above Fig. 2 (the direct "
+                            "method's angle variance against t with its regression line per run)"));
   sub->callback([cmd, &runner] {
     runner = [cmd](Io& io) -> int {
       AnalysisOptions opt = cmd->analysis.options();

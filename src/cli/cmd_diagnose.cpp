@@ -37,26 +37,27 @@ void register_diagnose(CLI::App& app, Runner& runner) {
   auto cmd = std::make_shared<DiagnoseCmd>();
   auto* sub = app.add_subcommand(
       "diagnose",
-      "Where simulations of the fitted five-term model depart from the measurement, the named cause "
-      "(sinusoid, Gauss–Markov, bias step, warm-up transient, low-pass), the extended model and its gain");
-  sub->add_option("FILE", cmd->file, "Recording to diagnose ('-' for standard input)")->required();
+      tr("Where simulations of the fitted five-term model depart from the measurement, the named cause "
+         "(sinusoid, Gauss–Markov, bias step, warm-up transient, low-pass), the extended model and its gain"));
+  sub->add_option("FILE", cmd->file, tr("Recording to diagnose ('-' for standard input)"))->required();
   cmd->input.add_to(*sub);
   cmd->analysis.add_to(*sub);
-  sub->add_option("--temperature", cmd->temperature, "Temperature of the run, °C (overrides the file)")
+  sub->add_option("--temperature", cmd->temperature, tr("Temperature of the run, °C (overrides the file)"))
       ->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"));
-  sub->add_flag("--json", cmd->json, "Print the JSON object instead of the report");
-  sub->add_option("--runs", cmd->runs, "Simulated records per ensemble (at least 10)")
+  sub->add_flag("--json", cmd->json, tr("Print the JSON object instead of the report"));
+  sub->add_option("--runs", cmd->runs, tr("Simulated records per ensemble (at least 10)"))
       ->check(whole_in(10, 100000))
       ->capture_default_str();
-  sub->add_option("--seed", cmd->seed, "Base seed of the simulations")
+  sub->add_option("--seed", cmd->seed, tr("Base seed of the simulations"))
       ->check(whole_in(0, UINT64_MAX))
       ->capture_default_str();
-  sub->add_option("--false-alarm", cmd->alpha, "False-alarm probability of each of the five detectors")
+  sub->add_option("--false-alarm", cmd->alpha, tr("False-alarm probability of each of the five detectors"))
       ->check(real_in(1e-6, 0.2, ""))
       ->capture_default_str();
-  sub->add_option("-o,--output", cmd->output, "Write to FILE instead of standard output")->capture_default_str();
-  sub->add_flag("--force", cmd->force, "Overwrite existing output, figure and script files");
-  cmd->plot.add_to(*sub, "the measured Allan deviation against the simulated bands of the base and the extended model");
+  sub->add_option("-o,--output", cmd->output, tr("Write to FILE instead of standard output"))->capture_default_str();
+  sub->add_flag("--force", cmd->force, tr("Overwrite existing output, figure and script files"));
+  cmd->plot.add_to(*sub,
+                   N_("the measured Allan deviation against the simulated bands of the base and the extended model"));
   sub->callback([cmd, &runner] {
     runner = [cmd](Io& io) -> int {
       // Refuse bad figure names and existing outputs before the simulations rather than after them.

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "cli/commands.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/version.hpp"
 
 namespace rwcalc::cli {
@@ -110,9 +111,12 @@ void write_completion(std::ostream& out, const CLI::App& app) {
 void register_doc(CLI::App& app, Runner& runner, const char* name, const char* description,
                   void (*write)(std::ostream&, const CLI::App&)) {
   CLI::App* sub = app.add_subcommand(name, description);
-  sub->group("Documentation");
+  sub->group(tr("Documentation"));
   sub->callback([&runner, write] {
     runner = [write](Io& io) {
+      // The manual and the completion are English whatever the language: the options' texts are
+      // taken from definitions made now, in English.
+      const LanguageScope english(Language::English);
       CLI::App all{app_description(), "rwcalc"};
       Runner unused;
       add_all_commands(all, unused);
@@ -125,12 +129,12 @@ void register_doc(CLI::App& app, Runner& runner, const char* name, const char* d
 }  // namespace
 
 void register_man(CLI::App& app, Runner& runner) {
-  register_doc(app, runner, "man", "Print the manual page (roff; view with `rwcalc man | man -l -`)", write_man);
+  register_doc(app, runner, "man", tr("Print the manual page (roff; view with `rwcalc man | man -l -`)"), write_man);
 }
 
 void register_completion(CLI::App& app, Runner& runner) {
   register_doc(app, runner, "completion",
-               "Print the bash completion script (`source <(rwcalc completion)`; installed by cmake --install)",
+               tr("Print the bash completion script (`source <(rwcalc completion)`; installed by cmake --install)"),
                write_completion);
 }
 

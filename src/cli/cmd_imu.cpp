@@ -12,6 +12,7 @@
 #include "cli/numeric_options.hpp"
 #include "cli/plot_args.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/imu.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/plot.hpp"
@@ -55,13 +56,13 @@ struct ImuCmd {
     else if (!accel_unit.empty())
       o.accel_unit = parse_rate_unit(accel_unit);
     if ((o.gyro_unit && (is_accelerometer_unit(*o.gyro_unit) || *o.gyro_unit == RateUnit::Unitless)))
-      throw UsageError(fmt::format(
+      throw UsageError(trf(
           "--gyro-unit {} is not a gyro unit: expected deg/h, deg/s, rad/s (rates) or arcsec, deg, rad (increments)",
           gyro_unit));
     if (o.accel_unit && !is_accelerometer_unit(*o.accel_unit))
-      throw UsageError(fmt::format(
-          "--accel-unit {} is not an accelerometer unit: expected m/s^2, g, mg, ug (rates) or m/s (increments)",
-          accel_unit));
+      throw UsageError(
+          trf("--accel-unit {} is not an accelerometer unit: expected m/s^2, g, mg, ug (rates) or m/s (increments)",
+              accel_unit));
     // Each --output-unit belongs to the kind whose unit it is.
     for (const auto& u : shown_units) {
       try {
@@ -99,10 +100,10 @@ void write_report(const std::string& dir, const ImuResult& res, const nlohmann::
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec || !fs::is_directory(dir))
-    throw OutputError(fmt::format("{}: cannot create the report directory: {}", dir,
-                                  ec ? ec.message() : std::string("not a directory")));
+    throw OutputError(
+        trf("{}: cannot create the report directory: {}", dir, ec ? ec.message() : std::string(tr("not a directory"))));
   const auto at = [&dir](const char* name) { return (fs::path(dir) / name).string(); };
-  const std::string text = format_imu(res);
+  const std::string text = localize_numbers(format_imu(res));
   write_file_atomic(at("imu.txt"), text, force);
   write_file_atomic(at("imu.json"), j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n", force);
   write_file_atomic(at("imu.yaml"), kalibr_yaml(res, k), force);
@@ -112,19 +113,24 @@ void write_report(const std::string& dir, const ImuResult& res, const nlohmann::
     o.output = at("imu.svg");
     o.force = force;
     plot_imu(j, o);
-    figure = "<p><img src=\"imu.svg\" alt=\"Allan deviation of every axis\"></p>\n";
+    figure =
+        fmt::format("<p><img src=\"imu.svg\" alt=\"{}\"></p>\n", html_escaped(tr("Allan deviation of every axis")));
   } catch (const OutputError& e) {  // no gnuplot: the page without the figure
-    print_message(io.err, fmt::format("note: --report without the figure: {}", e.what()));
+    print_message(io.err, trf("note: --report without the figure: {}", e.what()));
   }
+  // The page's words are translated; the text block is already localized (decimal comma).
+  const std::string source = html_escaped(printable(res.source));
   write_file_atomic(
       at("index.html"),
-      fmt::format("<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>rwcalc imu: {0}</title>"
-                  "</head>\n<body>\n<h1>IMU noise: {0}</h1>\n{1}<pre>{2}</pre>\n<p>Noise file for Kalibr and "
-                  "OpenVINS: <a href=\"imu.yaml\">imu.yaml</a>; all results: <a href=\"imu.json\">imu.json"
-                  "</a>.</p>\n<p>{3}</p>\n</body></html>\n",
-                  html_escaped(printable(res.source)), figure, html_escaped(text), html_escaped(version_line())),
+      fmt::format("<!DOCTYPE html>\n<html lang=\"{}\"><head><meta charset=\"utf-8\"><title>rwcalc imu: {}</title>"
+                  "</head>\n<body>\n<h1>{}</h1>\n{}<pre>{}</pre>\n<p>{}</p>\n<p>{}</p>\n</body></html>\n",
+                  language_code(), source, html_escaped(trf("IMU noise: {}", printable(res.source))), figure,
+                  html_escaped(text),
+                  trf("Noise file for Kalibr and OpenVINS: {}; all results: {}.", "<a href=\"imu.yaml\">imu.yaml</a>",
+                      "<a href=\"imu.json\">imu.json</a>"),
+                  html_escaped(version_line())),
       force);
-  print_message(io.err, fmt::format("report written to {}", at("index.html")));
+  print_message(io.err, trf("report written to {}", at("index.html")));
 }
 
 }  // namespace
@@ -132,60 +138,61 @@ void write_report(const std::string& dir, const ImuResult& res, const nlohmann::
 void register_imu(CLI::App& app, Runner& runner) {
   auto cmd = std::make_shared<ImuCmd>();
   auto* sub = app.add_subcommand(
-      "imu",
-      "A whole IMU from one static recording: every gyro and accelerometer column's noise coefficients with "
-      "95 % intervals, one table per sensor kind, and the Kalibr/OpenVINS noise file");
-  sub->add_option("FILE", cmd->file, "Recording with one column per axis ('-' for standard input)")->required();
-  sub->add_option("--rate", cmd->rate_hz, "Sample rate, Hz (else metadata rate_hz or a time column)")
+      "imu", tr("A whole IMU from one static recording: every gyro and accelerometer column's noise coefficients with "
+                "95 % intervals, one table per sensor kind, and the Kalibr/OpenVINS noise file"));
+  sub->add_option("FILE", cmd->file, tr("Recording with one column per axis ('-' for standard input)"))->required();
+  sub->add_option("--rate", cmd->rate_hz, tr("Sample rate, Hz (else metadata rate_hz or a time column)"))
       ->check(real_in(kMinRateHz, kMaxRateHz, "Hz"))
-      ->group("Input");
+      ->group(tr("Input"));
   sub->add_option("--time-tolerance", cmd->time_tolerance,
-                  "Time-column steps off the sample period by more than this fraction of it are reported as jitter")
+                  tr("Time-column steps off the sample period by more than this fraction of it are reported as jitter"))
       ->check(real_in(0.0, 0.5, ""))
       ->capture_default_str()
-      ->group("Input");
-  sub->add_option("--gyro", cmd->gyro, "Gyro columns: header names or 1-based indices, comma-separated")
+      ->group(tr("Input"));
+  sub->add_option("--gyro", cmd->gyro, tr("Gyro columns: header names or 1-based indices, comma-separated"))
       ->delimiter(',')
-      ->group("Input");
+      ->group(tr("Input"));
   sub->add_option("--gyro-unit", cmd->gyro_unit,
-                  "Unit of the gyro columns: deg/h, deg/s, rad/s for rates; arcsec, deg, rad for per-sample angle "
-                  "increments (delta theta). Default: each name's suffix (_dps, _rads ...)")
-      ->group("Input");
+                  tr("Unit of the gyro columns: deg/h, deg/s, rad/s for rates; arcsec, deg, rad for per-sample angle "
+                     "increments (delta theta). Default: each name's suffix (_dps, _rads ...)"))
+      ->group(tr("Input"));
   sub->add_option("--vertical-gyro", cmd->vertical_gyro,
-                  "The gyro column whose axis is vertical: the vertical Earth rate is subtracted from it and the "
-                  "class verdict given (default: none, unless the input is pulses)")
-      ->group("Input");
-  sub->add_option("--accel", cmd->accel, "Accelerometer columns: header names or 1-based indices, comma-separated")
+                  tr("The gyro column whose axis is vertical: the vertical Earth rate is subtracted from it and the "
+                     "class verdict given (default: none, unless the input is pulses)"))
+      ->group(tr("Input"));
+  sub->add_option("--accel", cmd->accel, tr("Accelerometer columns: header names or 1-based indices, comma-separated"))
       ->delimiter(',')
-      ->group("Input");
-  sub->add_option("--accel-unit", cmd->accel_unit,
-                  "Unit of the accelerometer columns: m/s^2, g, mg, ug for accelerations; m/s for per-sample velocity "
-                  "increments (delta v). Default: each name's suffix (_g, _mps2 ...)")
-      ->group("Input");
-  sub->add_option("--output-unit", cmd->shown_units,
-                  "Units the results are shown in, one per sensor kind: deg/h, deg/s, rad/s (gyro); m/s^2, g, mg, ug "
-                  "(accelerometer). Default: °/h with N in °/√h; µg with N in m/s/√h")
+      ->group(tr("Input"));
+  sub->add_option(
+         "--accel-unit", cmd->accel_unit,
+         tr("Unit of the accelerometer columns: m/s^2, g, mg, ug for accelerations; m/s for per-sample velocity "
+            "increments (delta v). Default: each name's suffix (_g, _mps2 ...)"))
+      ->group(tr("Input"));
+  sub->add_option(
+         "--output-unit", cmd->shown_units,
+         tr("Units the results are shown in, one per sensor kind: deg/h, deg/s, rad/s (gyro); m/s^2, g, mg, ug "
+            "(accelerometer). Default: °/h with N in °/√h; µg with N in m/s/√h"))
       ->delimiter(',')
-      ->group("Output");
+      ->group(tr("Output"));
   cmd->analysis.add_to(*sub);
-  sub->add_flag("--json", cmd->json, "Print the JSON object instead of the tables")->group("Output");
+  sub->add_flag("--json", cmd->json, tr("Print the JSON object instead of the tables"))->group(tr("Output"));
   sub->add_option("--kalibr", cmd->kalibr,
-                  "Write the Kalibr/OpenVINS IMU noise file (imu.yaml: noise densities and random walks in SI)")
-      ->group("Output");
-  sub->add_option("--rostopic", cmd->rostopic, "rostopic written into the --kalibr file")
+                  tr("Write the Kalibr/OpenVINS IMU noise file (imu.yaml: noise densities and random walks in SI)"))
+      ->group(tr("Output"));
+  sub->add_option("--rostopic", cmd->rostopic, tr("rostopic written into the --kalibr file"))
       ->capture_default_str()
-      ->group("Output");
+      ->group(tr("Output"));
   sub->add_option("--combine", cmd->combine,
-                  "How the --kalibr file combines the axes of a kind: worst (the largest) or mean")
+                  tr("How the --kalibr file combines the axes of a kind: worst (the largest) or mean"))
       ->check(CLI::IsMember({"worst", "mean"}))
       ->capture_default_str()
-      ->group("Output");
+      ->group(tr("Output"));
   sub->add_option("--report", cmd->report_dir,
-                  "Write the whole result into DIR: index.html (tables and figure), imu.txt, imu.json, imu.yaml, "
-                  "imu.svg (created when missing)")
-      ->group("Output");
+                  tr("Write the whole result into DIR: index.html (tables and figure), imu.txt, imu.json, imu.yaml, "
+                     "imu.svg (created when missing)"))
+      ->group(tr("Output"));
   add_output_options(*sub, cmd->output, cmd->force);
-  cmd->plot.add_to(*sub, "one panel per sensor kind with every axis' Allan deviation and its confidence bars");
+  cmd->plot.add_to(*sub, N_("one panel per sensor kind with every axis' Allan deviation and its confidence bars"));
   sub->callback([cmd, &runner] {
     runner = [cmd](Io& io) -> int {
       const ImuOptions opt = cmd->options();
@@ -201,10 +208,12 @@ void register_imu(CLI::App& app, Runner& runner) {
       k.combine = cmd->combine == "mean" ? AxisCombination::Mean : AxisCombination::Worst;
       if (!cmd->kalibr.empty()) {
         write_file_atomic(cmd->kalibr, kalibr_yaml(res, k), cmd->force);
-        print_message(io.err, fmt::format("noise file written to {}", cmd->kalibr));
+        print_message(io.err, trf("noise file written to {}", cmd->kalibr));
       }
       if (!cmd->report_dir.empty()) write_report(cmd->report_dir, res, j, k, cmd->force, io);
-      emit(io, cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n" : format_imu(res),
+      emit(io,
+           cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"
+                     : localize_numbers(format_imu(res)),
            cmd->output, cmd->force);
       return 0;
     };

@@ -5,6 +5,7 @@
 
 #include "cli/batch_format.hpp"
 #include "cli/commands.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/saved_results.hpp"
 
 namespace rwcalc::cli {
@@ -23,15 +24,14 @@ struct MergeCmd {
 
 void register_merge(CLI::App& app, Runner& runner) {
   auto cmd = std::make_shared<MergeCmd>();
-  auto* sub = app.add_subcommand("merge",
-                                 "Build the batch tables and overall verdict from JSON lines written by "
-                                 "'rwcalc batch --jsonl' (runs analysed on many machines)");
-  sub->add_option("LINES", cmd->files, "JSON-lines files")->required();
+  auto* sub = app.add_subcommand("merge", tr("Build the batch tables and overall verdict from JSON lines written by "
+                                             "'rwcalc batch --jsonl' (runs analysed on many machines)"));
+  sub->add_option("LINES", cmd->files, tr("JSON-lines files"))->required();
   cmd->format.add_to(*sub);
-  add_output_options(*sub, cmd->output, cmd->force, "Overwrite an existing output file");
+  add_output_options(*sub, cmd->output, cmd->force, N_("Overwrite an existing output file"));
   sub->add_flag("--dedupe", cmd->dedupe,
-                "Keep one of repeated identical lines of a run (a re-queued job); lines of the same run "
-                "(same \"source\") that differ are refused all the same");
+                tr("Keep one of repeated identical lines of a run (a re-queued job); lines of the same run "
+                   "(same \"source\") that differ are refused all the same"));
   sub->callback([cmd, &runner] {
     runner = [cmd](Io& io) -> int {
       check_output_targets({{"-o", cmd->output}}, cmd->force);  // before the reading

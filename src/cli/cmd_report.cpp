@@ -237,29 +237,29 @@ void register_report(CLI::App& app, Runner& runner) {
   auto cmd = std::make_shared<ReportCmd>();
   auto* sub = app.add_subcommand(
       "report",
-      "A self-contained HTML test report (DIR/report.html): run summaries, Tables 1 and 2, the verdict with its "
-      "probability, figures inline, the settings and the version");
+      tr("A self-contained HTML test report (DIR/report.html): run summaries, Tables 1 and 2, the verdict with its "
+         "probability, figures inline, the settings and the version"));
   sub->add_option("FILES", cmd->files,
-                  "Recordings, and/or saved results: .json of 'analyze --json', 'batch --json' or 'diagnose "
-                  "--json', .jsonl of 'batch --jsonl'")
+                  tr("Recordings, and/or saved results: .json of 'analyze --json', 'batch --json' or 'diagnose "
+                     "--json', .jsonl of 'batch --jsonl'"))
       ->required();
-  sub->add_option("-o,--output", cmd->dir, "Directory for report.html (created when missing); required");
+  sub->add_option("-o,--output", cmd->dir, tr("Directory for report.html (created when missing); required"));
   cmd->input.add_to(*sub);
   cmd->analysis.add_to(*sub);
-  add_temperature_option(*sub, cmd->temperature, "Temperature, °C (only with a single recording)");
-  sub->add_option("--title", cmd->title, "Title of the report");
-  sub->add_option("--lab", cmd->lab, "The testing laboratory, for the title block");
-  sub->add_option("--gyro", cmd->gyro, "The gyro's type or name, for the title block (e.g. GL-2D)");
-  sub->add_flag("--pdf", cmd->pdf, "Also print DIR/report.pdf with a headless Chromium, when one is installed");
-  sub->add_flag("--diagnose", cmd->diagnose, "Also diagnose each recording (what the noise model misses)");
-  sub->add_option("--diagnose-runs", cmd->diagnose_runs, "Simulated records per diagnosis ensemble")
+  add_temperature_option(*sub, cmd->temperature, tr("Temperature, °C (only with a single recording)"));
+  sub->add_option("--title", cmd->title, tr("Title of the report"));
+  sub->add_option("--lab", cmd->lab, tr("The testing laboratory, for the title block"));
+  sub->add_option("--gyro", cmd->gyro, tr("The gyro's type or name, for the title block (e.g. GL-2D)"));
+  sub->add_flag("--pdf", cmd->pdf, tr("Also print DIR/report.pdf with a headless Chromium, when one is installed"));
+  sub->add_flag("--diagnose", cmd->diagnose, tr("Also diagnose each recording (what the noise model misses)"));
+  sub->add_option("--diagnose-runs", cmd->diagnose_runs, tr("Simulated records per diagnosis ensemble"))
       ->check(whole_in(10, 100000))
       ->capture_default_str();
-  sub->add_option("--diagnose-seed", cmd->diagnose_seed, "Seed of the diagnosis ensembles")
+  sub->add_option("--diagnose-seed", cmd->diagnose_seed, tr("Seed of the diagnosis ensembles"))
       ->check(whole_in(0, UINT64_MAX))
       ->capture_default_str();
-  sub->add_flag("--no-figures", cmd->no_figures, "Tables only (needs no gnuplot)");
-  sub->add_flag("--force", cmd->force, "Replace an existing report.html");
+  sub->add_flag("--no-figures", cmd->no_figures, tr("Tables only (needs no gnuplot)"));
+  sub->add_flag("--force", cmd->force, tr("Replace an existing report.html"));
   sub->callback([cmd, &runner] { runner = [cmd](Io& io) -> int { return run_report(*cmd, io); }; });
 }
 

@@ -358,95 +358,97 @@ void register_simulate(CLI::App& app, Runner& runner) {
   auto args = std::make_shared<SimulateArgs>();
   auto* sub = app.add_subcommand(
       "simulate",
-      "Simulate a gyro pulse record (exact discrete-time noise terms, counted in whole pulses) and write it as a "
-      "GL-2D pulse file (.gz compresses). Rates are in deg/h (= arcsec/s).");
+      tr("Simulate a gyro pulse record (exact discrete-time noise terms, counted in whole pulses) and write it as a "
+         "GL-2D pulse file (.gz compresses). Rates are in deg/h (= arcsec/s)."));
   auto& a = *args;
-  sub->add_option("-o,--output", a.output, "Output pulse file (FILE.csv or FILE.csv.gz; - for stdout)")->required();
-  sub->add_option("--truth", a.truth, "Also write the ground truth (model JSON, seed, settings) to this file");
+  sub->add_option("-o,--output", a.output, tr("Output pulse file (FILE.csv or FILE.csv.gz; - for stdout)"))->required();
+  sub->add_option("--truth", a.truth, tr("Also write the ground truth (model JSON, seed, settings) to this file"));
   sub->add_option("--from", a.from,
-                  "Take the model from 'rwcalc analyze --json' or 'rwcalc diagnose --json' output: the fitted model "
-                  "(terms at their estimates; terms the fit left out or did not resolve are left out)");
+                  tr("Take the model from 'rwcalc analyze --json' or 'rwcalc diagnose --json' output: the fitted model "
+                     "(terms at their estimates; terms the fit left out or did not resolve are left out)"));
   sub->add_flag("--upper-bounds", a.upper_bounds,
-                "With --from: put the terms the fit did not resolve in at their 95 % upper bounds (a pessimistic "
-                "model, not the fitted one)");
-  sub->add_option("--duration", a.duration_s, "Record length, s")
+                tr("With --from: put the terms the fit did not resolve in at their 95 % upper bounds (a pessimistic "
+                   "model, not the fitted one)"));
+  sub->add_option("--duration", a.duration_s, tr("Record length, s"))
       ->check(real_in(0.0, 1e9, "s", Ends::OpenLow))
       ->capture_default_str()
-      ->group("Record");
-  sub->add_option("--rate", a.rate_hz, "Sample rate, Hz")
+      ->group(tr("Record"));
+  sub->add_option("--rate", a.rate_hz, tr("Sample rate, Hz"))
       ->check(real_in(kMinRateHz, kMaxRateHz, "Hz"))
       ->capture_default_str()
-      ->group("Record");
-  sub->add_option("--scale", a.scale_arcsec, "Pulse weight q, arcsec per pulse")
+      ->group(tr("Record"));
+  sub->add_option("--scale", a.scale_arcsec, tr("Pulse weight q, arcsec per pulse"))
       ->check(real_in(kMinScaleArcsec, kMaxScaleArcsec, "arcsec"))
       ->capture_default_str()
-      ->group("Record");
-  sub->add_option("--seed", a.seed, "Seed of the random streams (same seed, same file)")
+      ->group(tr("Record"));
+  sub->add_option("--seed", a.seed, tr("Seed of the random streams (same seed, same file)"))
       ->check(whole_in(0, UINT64_MAX))
       ->capture_default_str()
-      ->group("Record");
-  sub->add_option("--temperature", a.temperature_c, "Nominal temperature written as metadata, deg C")
+      ->group(tr("Record"));
+  sub->add_option("--temperature", a.temperature_c, tr("Nominal temperature written as metadata, deg C"))
       ->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"))
-      ->group("Record");
-  sub->add_flag("--force", a.force, "Overwrite existing files")->group("Record");
-  sub->add_option("--runs", a.runs, "Write K realisations FILE_001… with seeds seed, seed+1, …")
+      ->group(tr("Record"));
+  sub->add_flag("--force", a.force, tr("Overwrite existing files"))->group(tr("Record"));
+  sub->add_option("--runs", a.runs, tr("Write K realisations FILE_001… with seeds seed, seed+1, …"))
       ->check(whole_in(1, 100000))
       ->capture_default_str()
-      ->group("Record");
-  sub->add_option("--arw", a.arw, "Angle random walk N, deg/sqrt(h)")
+      ->group(tr("Record"));
+  sub->add_option("--arw", a.arw, tr("Angle random walk N, deg/sqrt(h)"))
       ->check(real_in(0.0, kMaxRateDegPerH, "deg/sqrt(h)"))
-      ->group("Noise terms");
-  sub->add_option("--bias-instability", a.bi, "Bias instability B (flicker rate noise), deg/h")
+      ->group(tr("Noise terms"));
+  sub->add_option("--bias-instability", a.bi, tr("Bias instability B (flicker rate noise), deg/h"))
       ->check(real_in(0.0, kMaxRateDegPerH, "deg/h"))
-      ->group("Noise terms");
-  sub->add_option("--rrw", a.rrw, "Rate random walk K, deg/h/sqrt(h)")
+      ->group(tr("Noise terms"));
+  sub->add_option("--rrw", a.rrw, tr("Rate random walk K, deg/h/sqrt(h)"))
       ->check(real_in(0.0, kMaxRateDegPerH, "deg/h/sqrt(h)"))
-      ->group("Noise terms");
-  sub->add_option("--ramp", a.ramp, "Rate ramp R, deg/h^2")
+      ->group(tr("Noise terms"));
+  sub->add_option("--ramp", a.ramp, tr("Rate ramp R, deg/h^2"))
       ->check(real_in(-kMaxRateDegPerH, kMaxRateDegPerH, "deg/h^2"))
-      ->group("Noise terms");
-  sub->add_option("--bias", a.bias, "Constant bias, deg/h")
+      ->group(tr("Noise terms"));
+  sub->add_option("--bias", a.bias, tr("Constant bias, deg/h"))
       ->check(real_in(-kMaxRateDegPerH, kMaxRateDegPerH, "deg/h"))
-      ->group("Noise terms");
-  sub->add_option("--latitude", a.latitude, "Latitude for the vertical Earth rate 15.041*sin(lat) deg/h, deg")
+      ->group(tr("Noise terms"));
+  sub->add_option("--latitude", a.latitude, tr("Latitude for the vertical Earth rate 15.041*sin(lat) deg/h, deg"))
       ->check(real_in(-90.0, 90.0, "deg"))
       ->capture_default_str()
-      ->group("Noise terms");
-  sub->add_flag("--no-earth-rate", a.no_earth_rate, "Do not add the Earth rate")->group("Noise terms");
+      ->group(tr("Noise terms"));
+  sub->add_flag("--no-earth-rate", a.no_earth_rate, tr("Do not add the Earth rate"))->group(tr("Noise terms"));
   sub->add_flag("--white-readout", a.white_readout,
-                "Dither-like read-out: a fresh uniform phase per sample makes count errors white (Q = q/sqrt(6)); "
-                "default: counting with sawtooth errors")
-      ->group("Noise terms");
-  sub->add_option("--white-angle", a.white_angle, "Extra white angle noise before counting, rms arcsec")
+                tr("Dither-like read-out: a fresh uniform phase per sample makes count errors white (Q = q/sqrt(6)); "
+                   "default: counting with sawtooth errors"))
+      ->group(tr("Noise terms"));
+  sub->add_option("--white-angle", a.white_angle, tr("Extra white angle noise before counting, rms arcsec"))
       ->check(real_in(0.0, 1e12, "arcsec"))
-      ->group("Noise terms");
+      ->group(tr("Noise terms"));
   sub->add_option("--sinusoid", a.sinusoids,
-                  "Sinusoidal rate F_HZ:AMP_DEG_PER_H[:PHASE_RAD] (Hz, deg/h, rad); repeatable")
-      ->group("Extended terms");
-  sub->add_option("--gauss-markov", a.gauss_markov, "Gauss-Markov rate SIGMA_DEG_PER_H:TC_S (deg/h, s); repeatable")
-      ->group("Extended terms");
-  sub->add_option("--bias-step", a.bias_steps, "Bias step T_S:SIZE_DEG_PER_H (s from start, deg/h); repeatable")
-      ->group("Extended terms");
+                  tr("Sinusoidal rate F_HZ:AMP_DEG_PER_H[:PHASE_RAD] (Hz, deg/h, rad); repeatable"))
+      ->group(tr("Extended terms"));
+  sub->add_option("--gauss-markov", a.gauss_markov, tr("Gauss-Markov rate SIGMA_DEG_PER_H:TC_S (deg/h, s); repeatable"))
+      ->group(tr("Extended terms"));
+  sub->add_option("--bias-step", a.bias_steps, tr("Bias step T_S:SIZE_DEG_PER_H (s from start, deg/h); repeatable"))
+      ->group(tr("Extended terms"));
   sub->add_option("--warmup", a.warmups,
-                  "Warm-up transient AMP_DEG_PER_H:TC_S, rate amp*exp(-t/tc) (deg/h, s); repeatable")
-      ->group("Extended terms");
-  sub->add_option("--lowpass", a.lowpass, "First-order low-pass of the sensed rate inside the sensor, time constant s")
+                  tr("Warm-up transient AMP_DEG_PER_H:TC_S, rate amp*exp(-t/tc) (deg/h, s); repeatable"))
+      ->group(tr("Extended terms"));
+  sub->add_option("--lowpass", a.lowpass,
+                  tr("First-order low-pass of the sensed rate inside the sensor, time constant s"))
       ->check(real_in(0.0, 1e9, "s"))
-      ->group("Extended terms");
-  sub->add_option("--output-lowpass", a.output_lowpass,
-                  "First-order low-pass of the counted rate in the output chain, time constant s; the file then holds "
-                  "the filtered angle in arcsec (column 'angle', read with --input angle)")
+      ->group(tr("Extended terms"));
+  sub->add_option(
+         "--output-lowpass", a.output_lowpass,
+         tr("First-order low-pass of the counted rate in the output chain, time constant s; the file then holds "
+            "the filtered angle in arcsec (column 'angle', read with --input angle)"))
       ->check(real_in(0.0, 1e9, "s"))
-      ->group("Extended terms");
+      ->group(tr("Extended terms"));
   sub->add_option("--temp-bias", a.temp_bias,
-                  "Temperature-driven bias coefficient, deg/h per deg C (needs --temp-profile)")
+                  tr("Temperature-driven bias coefficient, deg/h per deg C (needs --temp-profile)"))
       ->check(real_in(-kMaxRateDegPerH, kMaxRateDegPerH, "deg/h per deg C"))
-      ->group("Extended terms");
+      ->group(tr("Extended terms"));
   sub->add_option(
          "--temp-profile", a.temp_profile,
-         "Temperature during the record: ramp:START_C:END_C (linear) or cycle:AMP_C:PERIOD_S (about --temperature); "
-         "bias = coef*(T(t) - T_nominal), T_nominal = --temperature (ramp: else START_C; cycle: else 0)")
-      ->group("Extended terms");
+         tr("Temperature during the record: ramp:START_C:END_C (linear) or cycle:AMP_C:PERIOD_S (about --temperature); "
+            "bias = coef*(T(t) - T_nominal), T_nominal = --temperature (ramp: else START_C; cycle: else 0)"))
+      ->group(tr("Extended terms"));
   sub->callback(
       [&runner, args, sub] { runner = [args, sub](Io& io) -> int { return run_simulate(*args, *sub, io); }; });
 }

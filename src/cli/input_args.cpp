@@ -11,49 +11,51 @@
 namespace rwcalc::cli {
 
 namespace {
-constexpr const char* kIdGroup = "Identification (else the file's # serial:, # operator:, # test_date:, # conditions:)";
+constexpr const char* kIdGroup =
+    N_("Identification (else the file's # serial:, # operator:, # test_date:, # conditions:)");
 }
 
 void InputArgs::add_to(CLI::App& app) {
-  app.add_option("--serial", serial, "Serial number of the gyro under test")->group(kIdGroup);
-  app.add_option("--operator", operator_name, "Who ran the test")->group(kIdGroup);
-  app.add_option("--test-date", test_date, "Date of the test, e.g. 2026-11-27")->group(kIdGroup);
-  app.add_option("--conditions", conditions, "Test conditions, e.g. 'static, +25 °C, vertical axis'")->group(kIdGroup);
+  app.add_option("--serial", serial, tr("Serial number of the gyro under test"))->group(tr(kIdGroup));
+  app.add_option("--operator", operator_name, tr("Who ran the test"))->group(tr(kIdGroup));
+  app.add_option("--test-date", test_date, tr("Date of the test, e.g. 2026-11-27"))->group(tr(kIdGroup));
+  app.add_option("--conditions", conditions, tr("Test conditions, e.g. 'static, +25 °C, vertical axis'"))
+      ->group(tr(kIdGroup));
   app.add_option("--input", input,
-                 "What the column holds: pulses (per-sample pulse increments), counter (cumulative "
-                 "counter, wraps at --counter-bits), angle (cumulative angle/phase in --angle-unit), "
-                 "rate (rate samples in --rate-unit), increment (per-sample angle or velocity increments in "
-                 "--angle-unit: an IMU's delta theta or delta v). Default: implied by a unit suffix of the column's "
-                 "name (gyro_x_dps: rate), else pulses")
-      ->group("Input");
-  app.add_option("--column", column, "Column to read: a header name or a 1-based index")->group("Input");
+                 tr("What the column holds: pulses (per-sample pulse increments), counter (cumulative "
+                    "counter, wraps at --counter-bits), angle (cumulative angle/phase in --angle-unit), "
+                    "rate (rate samples in --rate-unit), increment (per-sample angle or velocity increments in "
+                    "--angle-unit: an IMU's delta theta or delta v). Default: implied by a unit suffix of the column's "
+                    "name (gyro_x_dps: rate), else pulses"))
+      ->group(tr("Input"));
+  app.add_option("--column", column, tr("Column to read: a header name or a 1-based index"))->group(tr("Input"));
   app.add_option("--rate", rate_hz,
-                 "Sample rate, Hz (default: metadata rate_hz, else a time column, else 400 for pulse and counter "
-                 "input; rate and angle input need one of these)")
+                 tr("Sample rate, Hz (default: metadata rate_hz, else a time column, else 400 for pulse and counter "
+                    "input; rate and angle input need one of these)"))
       ->check(real_in(kMinRateHz, kMaxRateHz, "Hz"))
-      ->group("Input");
-  app.add_option("--scale", scale_arcsec, "Pulse weight, arcsec per pulse (default: metadata or 0.92)")
+      ->group(tr("Input"));
+  app.add_option("--scale", scale_arcsec, tr("Pulse weight, arcsec per pulse (default: metadata or 0.92)"))
       ->check(real_in(kMinScaleArcsec, kMaxScaleArcsec, "arcsec"))
-      ->group("Input");
-  app.add_option("--counter-bits", counter_bits, "Width of a wrapping counter, bits (counter input)")
+      ->group(tr("Input"));
+  app.add_option("--counter-bits", counter_bits, tr("Width of a wrapping counter, bits (counter input)"))
       ->check(whole_in(1, 64))
       ->capture_default_str()
-      ->group("Input");
+      ->group(tr("Input"));
   app.add_option("--angle-unit", angle_unit,
-                 "Unit of angle input: arcsec, deg, rad, s (clock phase), or m/s (an accelerometer's cumulative "
-                 "velocity). Default: the column name's suffix (_deg, _rad, _arcsec, _mps), else arcsec")
-      ->group("Input");
+                 tr("Unit of angle input: arcsec, deg, rad, s (clock phase), or m/s (an accelerometer's cumulative "
+                    "velocity). Default: the column name's suffix (_deg, _rad, _arcsec, _mps), else arcsec"))
+      ->group(tr("Input"));
   app.add_option("--rate-unit", rate_unit,
-                 "Unit of rate input: deg/h, deg/s, rad/s, 1 (dimensionless clock frequency), or an "
-                 "accelerometer's m/s^2, g, mg, ug. Default: the column name's suffix (_dps, _dph, _rads, _g, "
-                 "_mps2, ...), else deg/h")
-      ->group("Input");
+                 tr("Unit of rate input: deg/h, deg/s, rad/s, 1 (dimensionless clock frequency), or an "
+                    "accelerometer's m/s^2, g, mg, ug. Default: the column name's suffix (_dps, _dph, _rads, _g, "
+                    "_mps2, ...), else deg/h"))
+      ->group(tr("Input"));
   app.add_option("--time-tolerance", time_tolerance,
-                 "Time-column steps off the sample period by more than this fraction of it are reported as "
-                 "jitter (accepted up to half a period; 1.5 periods or more is a gap, an error)")
+                 tr("Time-column steps off the sample period by more than this fraction of it are reported as "
+                    "jitter (accepted up to half a period; 1.5 periods or more is a gap, an error)"))
       ->check(real_in(0.0, 0.5, ""))
       ->capture_default_str()
-      ->group("Input");
+      ->group(tr("Input"));
 }
 
 ReadOptions InputArgs::options() const {

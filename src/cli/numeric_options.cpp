@@ -30,13 +30,13 @@ CLI::Validator real_in(double lo, double hi, const std::string& unit, Ends ends)
     if (b != e && *b == '+') ++b;
     const auto [ptr, ec] = std::from_chars(b, e, v);
     if (ec == std::errc::result_out_of_range)
-      return fmt::format("'{}' is beyond the range of a double; allowed: a finite number in {}", text, range);
+      return trf("'{}' is beyond the range of a double; allowed: a finite number in {}", text, range);
     if (b == e || ec != std::errc() || ptr != e)
-      return fmt::format("'{}' is not a number; allowed: a finite number in {}", text, range);
+      return trf("'{}' is not a number; allowed: a finite number in {}", text, range);
     const bool low_ok = (ends == Ends::OpenLow || ends == Ends::Open) ? v > lo : v >= lo;
     const bool high_ok = (ends == Ends::OpenHigh || ends == Ends::Open) ? v < hi : v <= hi;
     if (!std::isfinite(v) || !low_ok || !high_ok)
-      return fmt::format("'{}' is out of range; allowed: a finite number in {}", text, range);
+      return trf("'{}' is out of range; allowed: a finite number in {}", text, range);
     return {};
   };
   return CLI::Validator(check, "NUMBER in " + range, kNumberCheck);
@@ -61,9 +61,9 @@ CLI::Validator whole_in(std::int64_t lo, std::uint64_t hi) {
     }
     const auto [ptr, ec] = r;
     if (b == e || (ec != std::errc() && ec != std::errc::result_out_of_range) || ptr != e)
-      return fmt::format("'{}' is not a whole number; allowed: a whole number in {}", text, range);
+      return trf("'{}' is not a whole number; allowed: a whole number in {}", text, range);
     if (ec == std::errc::result_out_of_range || !in_range)
-      return fmt::format("'{}' is out of range; allowed: a whole number in {}", text, range);
+      return trf("'{}' is out of range; allowed: a whole number in {}", text, range);
     return {};
   };
   return CLI::Validator(check, "INTEGER in " + range, kNumberCheck);

@@ -6,6 +6,7 @@
 #include <ostream>
 
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/plot.hpp"
 
 namespace rwcalc::cli {
@@ -21,21 +22,20 @@ void draw(const PlotArgs& a, PlotResult (*plot)(const nlohmann::json&, const Plo
   o.script = a.script;
   o.force = force;
   const PlotResult r = plot(j, o);
-  for (const auto& note : r.notes) print_message(io.err, "note: " + note);
-  if (!a.plot.empty()) print_message(io.err, fmt::format("figure written to {} ({} data series)", a.plot, r.series));
-  if (!a.script.empty()) print_message(io.err, fmt::format("gnuplot script written to {}", a.script));
+  for (const auto& note : r.notes) print_message(io.err, trf("note: {}", note));
+  if (!a.plot.empty()) print_message(io.err, trf("figure written to {} ({} data series)", a.plot, r.series));
+  if (!a.script.empty()) print_message(io.err, trf("gnuplot script written to {}", a.script));
 }
 
 }  // namespace
 
 void PlotArgs::add_to(CLI::App& app, const std::string& what) {
   app.add_option("--plot", plot,
-                 fmt::format("Draw {} into FILE with gnuplot; the format follows the extension: .svg, .png or .pdf",
-                             what))
-      ->group("Figures");
+                 trf("Draw {} into FILE with gnuplot; the format follows the extension: .svg, .png or .pdf", tr(what)))
+      ->group(tr("Figures"));
   app.add_option("--plot-script", script,
-                 "Write the gnuplot script of the figure (data inline) to FILE; alone it needs no gnuplot")
-      ->group("Figures");
+                 tr("Write the gnuplot script of the figure (data inline) to FILE; alone it needs no gnuplot"))
+      ->group(tr("Figures"));
 }
 
 void PlotArgs::check(bool force, const std::vector<OutputTarget>& others) const {

@@ -223,8 +223,8 @@ void Value::fail(std::string_view what) const {
 }
 
 void Value::wrong_type(std::string_view expected) const {
-  fail(fmt::format("must be {}, got {}", expected,
-                   value_->is_number() || value_->is_boolean() ? shown(*value_) : std::string(type_name(*value_))));
+  fail(trf("must be {}, got {}", expected,
+           value_->is_number() || value_->is_boolean() ? shown(*value_) : std::string(type_name(*value_))));
 }
 
 const Value& Value::object() const {
@@ -235,7 +235,7 @@ const Value& Value::object() const {
 Value Value::at(std::string_view key) const {
   object();
   const auto it = value_->find(key);
-  if (it == value_->end()) fail(fmt::format("lacks the key \"{}\"", key));
+  if (it == value_->end()) fail(trf("lacks the key \"{}\"", key));
   return Value(*doc_, *it, child_path(key));
 }
 
@@ -264,13 +264,13 @@ double Value::number() const {
 
 double Value::number_in(double lo, double hi, std::string_view domain) const {
   const double v = number();
-  if (!(v >= lo && v <= hi)) fail(fmt::format("must be {}, got {}", domain, shown(*value_)));
+  if (!(v >= lo && v <= hi)) fail(trf("must be {}, got {}", domain, shown(*value_)));
   return v;
 }
 
 double Value::positive() const {
   const double v = number();
-  if (!(v > 0)) fail(fmt::format("must be a positive number, got {}", shown(*value_)));
+  if (!(v > 0)) fail(trf("must be a positive number, got {}", shown(*value_)));
   return v;
 }
 
@@ -283,11 +283,11 @@ std::int64_t Value::integer(std::int64_t lo, std::int64_t hi) const {
   const double v = value_->get<double>();
   if (value_->is_number_float() &&
       (v != std::floor(v) || !(v >= static_cast<double>(lo) && v <= static_cast<double>(hi))))
-    fail(fmt::format("must be {}, got {}", domain, shown(*value_)));
+    fail(trf("must be {}, got {}", domain, shown(*value_)));
   if (value_->is_number_unsigned() && value_->get<std::uint64_t>() > static_cast<std::uint64_t>(hi))
-    fail(fmt::format("must be {}, got {}", domain, shown(*value_)));
+    fail(trf("must be {}, got {}", domain, shown(*value_)));
   const auto i = value_->is_number_float() ? static_cast<std::int64_t>(v) : value_->get<std::int64_t>();
-  if (i < lo || i > hi) fail(fmt::format("must be {}, got {}", domain, shown(*value_)));
+  if (i < lo || i > hi) fail(trf("must be {}, got {}", domain, shown(*value_)));
   return i;
 }
 

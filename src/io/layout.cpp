@@ -364,16 +364,22 @@ const UnitSuffix* unit_suffix(std::string_view column) {
 template <class Unit>
 Unit choose_unit(std::optional<Unit> given, std::optional<Unit> named, Unit fallback, std::string_view what,
                  std::string_view option, std::string_view column, InputChoice& c) {
+  const bool angle = what == "angle";  // a message per kind, so that each translates whole
   if (given && named && *given != *named)
-    c.warnings.push_back(fmt::format("the column name '{}' says {} in {}, but {} {} is used as given", column, what,
-                                     to_string(*named), option, to_string(*given)));
+    c.warnings.push_back(trf(angle ? N_("the column name '{}' says angle in {}, but {} {} is used as given")
+                                   : N_("the column name '{}' says rate in {}, but {} {} is used as given"),
+                             column, to_string(*named), option, to_string(*given)));
   if (given) return *given;
   if (named) {
-    c.notes.push_back(fmt::format("{} unit {} from the column name '{}'", what, to_string(*named), column));
+    c.notes.push_back(
+        trf(angle ? N_("angle unit {} from the column name '{}'") : N_("rate unit {} from the column name '{}'"),
+            to_string(*named), column));
     return *named;
   }
-  c.notes.push_back(fmt::format("{} unit {} (the default: no {} and no unit suffix such as _dps in the column name)",
-                                what, to_string(fallback), option));
+  c.notes.push_back(
+      trf(angle ? N_("angle unit {} (the default: no {} and no unit suffix such as _dps in the column name)")
+                : N_("rate unit {} (the default: no {} and no unit suffix such as _dps in the column name)"),
+          to_string(fallback), option));
   return fallback;
 }
 
@@ -386,11 +392,11 @@ InputChoice choose_input(const ReadOptions& o, std::string_view column, const st
   if (o.mode) {
     c.mode = *o.mode;
     if (u && u->mode != c.mode)
-      c.warnings.push_back(fmt::format("the column name '{}' says {} input, but --input {} is used as given", column,
-                                       to_string(u->mode), to_string(c.mode)));
+      c.warnings.push_back(trf("the column name '{}' says {} input, but --input {} is used as given", column,
+                               to_string(u->mode), to_string(c.mode)));
   } else if (u) {
     c.mode = u->mode;
-    c.notes.push_back(fmt::format("input {} from the column name '{}' (no --input given)", to_string(c.mode), column));
+    c.notes.push_back(trf("input {} from the column name '{}' (no --input given)", to_string(c.mode), column));
   }
   const bool angle = c.mode == InputMode::Angle || c.mode == InputMode::Increment, rate = c.mode == InputMode::Rate;
   const bool named_angle = u && u->mode == InputMode::Angle, named_rate = u && u->mode == InputMode::Rate;

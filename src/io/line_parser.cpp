@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 
 namespace rwcalc::detail {
 
@@ -49,7 +50,7 @@ LineKind LineParser::parse(std::string_view text, std::size_t line, Sample& s) {
   bool special = false;
   for (const char c : text) special |= c == '\r' || c == ';' || c == '\t';
   if (const auto cr = special ? text.find('\r') : std::string_view::npos; cr != std::string_view::npos)
-    fail(fmt::format("stray carriage return (CR) at column {} inside the line", cr + 1));
+    fail(trf("stray carriage return (CR) at column {} inside the line", cr + 1));
   const std::string_view t = trim(text);
   if (t.empty()) return LineKind::Blank;
   ++content_lines_;
@@ -74,9 +75,9 @@ LineKind LineParser::parse(std::string_view text, std::size_t line, Sample& s) {
     input_ = choose_input(opt_, layout_.header.empty() ? "" : layout_.header[layout_.value_col], file_, where);
   }
   if (fields_.size() != layout_.ncols)
-    fail(fmt::format("wrong number of columns: expected {} ({}-separated, as line {} has), found {}: {}", layout_.ncols,
-                     delim_name(layout_.delim), layout_.header_line ? layout_.header_line : first_data_line_,
-                     fields_.size(), quoted(t)));
+    fail(trf("wrong number of columns: expected {} ({}-separated, as line {} has), found {}: {}", layout_.ncols,
+             delim_name(layout_.delim), layout_.header_line ? layout_.header_line : first_data_line_, fields_.size(),
+             quoted(t)));
   read_fields(s, true);
   return LineKind::Data;
 }
@@ -103,9 +104,9 @@ void LineParser::check_foreign_delimiters(std::string_view line) const {
                                                                        : ";";
   const auto at = line.find_first_of(foreign);
   if (at == std::string_view::npos) return;
-  fail(fmt::format("mixed delimiters: the file is {}-separated (from line {}) but this line has a {} at column {}: {}",
-                   delim_name(layout_.delim), layout_.layout_line, line[at] == '\t' ? "tab" : "semicolon", at + 1,
-                   quoted(line)));
+  fail(trf("mixed delimiters: the file is {}-separated (from line {}) but this line has a {} at column {}: {}",
+           delim_name(layout_.delim), layout_.layout_line, line[at] == '\t' ? "tab" : "semicolon", at + 1,
+           quoted(line)));
 }
 
 void LineParser::split(std::string_view line) {
@@ -147,11 +148,10 @@ bool LineParser::header_row(std::string_view t) {
   };
   if (any_numeric || !any_text || (layout_known_ && fields_.size() < 2 && !repeats_header())) return false;
   if (layout_known_)
-    fail(fmt::format("a second header row inside the data: {} (the first is at line {}); were two files joined?",
-                     quoted(t), layout_.header_line ? layout_.header_line : first_data_line_));
+    fail(trf("a second header row inside the data: {} (the first is at line {}); were two files joined?", quoted(t),
+             layout_.header_line ? layout_.header_line : first_data_line_));
   if (!layout_.header.empty())
-    fail(fmt::format("a second header row {} (the first is at line {}); only one is allowed", quoted(t),
-                     layout_.header_line));
+    fail(trf("a second header row {} (the first is at line {}); only one is allowed", quoted(t), layout_.header_line));
   for (const auto f : fields_) layout_.header.emplace_back(unquote(f));
   layout_.header_line = line_;
   return true;
@@ -167,7 +167,7 @@ bool LineParser::read_fields(Sample& s, bool report) {
 
 bool LineParser::read_field(std::string_view f, Role role, Sample& s, bool report) {
   if (f.empty()) {
-    if (report) fail(fmt::format("empty field in {}", layout_.describe(role)));
+    if (report) fail(trf("empty field in {}", layout_.describe(role)));
     return false;
   }
   std::string_view t = f;
@@ -183,9 +183,9 @@ bool LineParser::read_field(std::string_view f, Role role, Sample& s, bool repor
   if (!report) return false;
   const std::string col = layout_.describe(role);
   if (r.ptr != n.data() + n.size() || r.ec == std::errc::invalid_argument)
-    fail(fmt::format("not a number in {}: {}", col, quoted(f)));
-  if (r.ec == std::errc::result_out_of_range) fail(fmt::format("number out of range in {}: {}", col, quoted(f)));
-  fail(fmt::format("non-finite value in {}: {}", col, quoted(f)));
+    fail(trf("not a number in {}: {}", col, quoted(f)));
+  if (r.ec == std::errc::result_out_of_range) fail(trf("number out of range in {}: {}", col, quoted(f)));
+  fail(trf("non-finite value in {}: {}", col, quoted(f)));
 }
 
 // A pulse count or counter reading: exact, as an int64 (a 64-bit counter's reading above 2^63-1
@@ -195,7 +195,7 @@ bool LineParser::read_integer(std::string_view f, std::string_view t, Sample& s,
   std::uint64_t u = 0;
   if (reads_whole(t, s.integer)) {
     if (!counter || (s.integer >= counter_lo_ && s.integer <= counter_max_)) return true;
-    if (report) fail(fmt::format("counter reading {} does not fit a {}-bit counter", quoted(f), opt_.counter_bits));
+    if (report) fail(trf("counter reading {} does not fit a {}-bit counter", quoted(f), opt_.counter_bits));
     return false;
   }
   if (counter && opt_.counter_bits == 64 && t.front() != '-' && reads_whole(t, u)) {
@@ -206,17 +206,17 @@ bool LineParser::read_integer(std::string_view f, std::string_view t, Sample& s,
   const std::string col = layout_.describe(Role::Value);
   double d = 0;
   if (reads_whole(normalise_decimal(t, layout_.delim != Delim::Comma, scratch_), d) && !std::isfinite(d))
-    fail(fmt::format("non-finite value in {}: {}", col, quoted(f)));
+    fail(trf("non-finite value in {}: {}", col, quoted(f)));
   const bool neg = t.front() == '-';
   if (t.size() > static_cast<std::size_t>(neg) &&
       std::all_of(t.begin() + neg, t.end(), [](char c) { return c >= '0' && c <= '9'; }))
-    fail(fmt::format("number out of range of a 64-bit integer in {}: {}", col, quoted(f)));
+    fail(trf("number out of range of a 64-bit integer in {}: {}", col, quoted(f)));
   if (looks_numeric(f, layout_.delim != Delim::Comma))
-    fail(fmt::format("{} counts must be integers: {} in {}{}", counter ? "counter" : "pulse", quoted(f), col,
-                     opt_.mode ? ""
-                               : " (pulses is the default input; for rate or angle samples give --input rate or "
-                                 "--input angle, or a column name with a unit such as gyro_x_dps)"));
-  fail(fmt::format("not a number in {}: {}", col, quoted(f)));
+    fail(trf("{} counts must be integers: {} in {}{}", counter ? "counter" : "pulse", quoted(f), col,
+             opt_.mode ? ""
+                       : " (pulses is the default input; for rate or angle samples give --input rate or "
+                         "--input angle, or a column name with a unit such as gyro_x_dps)"));
+  fail(trf("not a number in {}: {}", col, quoted(f)));
 }
 
 }  // namespace rwcalc::detail

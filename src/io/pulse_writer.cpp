@@ -51,7 +51,7 @@ void append_increments(std::string& text, std::span<const std::int64_t> counts, 
     ++at.line;
     std::int64_t d = 0;
     if (__builtin_sub_overflow(c, previous, &d))
-      throw_unwritable(at, fmt::format("the pulse count goes from {} to {}, an increment beyond 64 bits", previous, c));
+      throw_unwritable(at, trf("the pulse count goes from {} to {}, an increment beyond 64 bits", previous, c));
     append_line(text, d);
     previous = c;
     ++at.next_sample;
@@ -63,7 +63,7 @@ void append_angles(std::string& text, std::span<const double> angles, LinePositi
   char line[400];  // the widest finite double in fixed notation with 6 decimals is 317 characters
   for (const double v : angles) {
     ++at.line;
-    if (!std::isfinite(v)) throw_unwritable(at, fmt::format("the angle is {}, not a number of arcsec", v));
+    if (!std::isfinite(v)) throw_unwritable(at, trf("the angle is {}, not a number of arcsec", v));
     char* p = std::to_chars(line, line + sizeof line - 1, v, std::chars_format::fixed, 6).ptr;
     *p++ = '\n';
     text.append(line, p);

@@ -109,10 +109,11 @@ constexpr NameTable<RateUnit, 8> kRateUnits{{RateUnit::DegPerHour, "deg/h"},
                                             {RateUnit::G, "g"},
                                             {RateUnit::MilliG, "mg"},
                                             {RateUnit::MicroG, "ug"}};
-constexpr NameTable<RateSource> kRateSources{{RateSource::Option, "option"},
-                                             {RateSource::Metadata, "metadata"},
-                                             {RateSource::TimeColumn, "time column"},
-                                             {RateSource::Default, "default"}};
+// Marked for the catalogue: shown translated (tr) where text names the rate's source.
+constexpr NameTable<RateSource> kRateSources{{RateSource::Option, N_("option")},
+                                             {RateSource::Metadata, N_("metadata")},
+                                             {RateSource::TimeColumn, N_("time column")},
+                                             {RateSource::Default, N_("default")}};
 
 template <class E, std::size_t Size>
 E parse_name(const NameTable<E, Size>& table, std::string_view s, std::string_view option) {
@@ -140,7 +141,7 @@ constexpr double kMaxTimeTolerance = 0.5;
 // `fraction` of the period, the hint that says so; else nothing.
 std::string tolerance_hint(double fraction) {
   if (!(fraction < kMaxTimeTolerance)) return "";
-  return fmt::format(" (a --time-tolerance of {:.3g} or more would accept it)", fraction * 1.001);
+  return trf(" (a --time-tolerance of {:.3g} or more would accept it)", fraction * 1.001);
 }
 
 // The line of sample k in runs of consecutive data lines (Recording::line_runs); 0 if before them.
@@ -271,7 +272,7 @@ std::size_t Reader::mac_limit(std::string& buf, std::size_t from, bool at_end) c
   const auto lf = buf.find('\n', from);
   if (lf == std::string::npos) return buf.size();
   if (lf + 1 == buf.size()) return at_end ? (buf[lf] = '\r', buf.size()) : lf;  // else told by what follows
-  fail(1, fmt::format("stray carriage return (CR) at column {} inside the line", first_cr_column_));
+  fail(1, trf("stray carriage return (CR) at column {} inside the line", first_cr_column_));
 }
 
 // The first sample: the phase's starting point, and the time columns' units.
@@ -285,10 +286,10 @@ void Reader::start_samples(const Sample& s) {
 const detail::TimeName* Reader::time_unit_of(const detail::TimeName* named, double first, detail::Role role) const {
   if (named->per_second > 0) return named;
   if (const detail::TimeName* u = detail::time_unit_of_stamp(first)) return u;
-  fail(line_, fmt::format("cannot tell the unit of the {} from its stamps: the first, {}, is neither near 0 (seconds) "
-                          "nor like Unix time (~1.7e9 s, 1.7e12 ms, 1.7e15 us, 1.7e18 ns); name the column time_s, "
-                          "time_ms, time_us or time_ns",
-                          layout_.describe(role), first));
+  fail(line_, trf("cannot tell the unit of the {} from its stamps: the first, {}, is neither near 0 (seconds) "
+                  "nor like Unix time (~1.7e9 s, 1.7e12 ms, 1.7e15 us, 1.7e18 ns); name the column time_s, "
+                  "time_ms, time_us or time_ns",
+                  layout_.describe(role), first));
 }
 
 void Reader::push(const Sample& s) {
@@ -328,8 +329,8 @@ void Reader::rate_from_time_column() {
   const double candidate = times_.median;
   for (std::size_t i = 1; !(candidate > 0) && i < h.size(); ++i)
     if (!(h[i] > h[i - 1]))
-      fail(line_of_sample(i), fmt::format("the time column does not increase: {} at line {}, then {}", stamp(h[i - 1]),
-                                          line_of_sample(i - 1), stamp(h[i])));
+      fail(line_of_sample(i), trf("the time column does not increase: {} at line {}, then {}", stamp(h[i - 1]),
+                                  line_of_sample(i - 1), stamp(h[i])));
   const double span = (times_.last - times_.first) / static_cast<double>(times_.n - 1);
   const bool gapless = times_.min_dt > 0.5 * candidate && times_.max_dt < 1.5 * candidate;
   const double period = gapless && std::abs(span - candidate) <= opt_.time_tolerance * candidate ? span : candidate;
@@ -340,9 +341,9 @@ void Reader::rate_from_time_column() {
   rate_source_ = RateSource::TimeColumn;
   if (!(rate >= kMinRateHz && rate <= kMaxRateHz))
     fail(parser_.first_data_line(),
-         fmt::format("the time column's step of {:g} {} gives a sample rate of {:g} Hz, outside the usable range "
-                     "{:g}..{:g} Hz",
-                     period, tunit_->unit, rate, kMinRateHz, kMaxRateHz));
+         trf("the time column's step of {:g} {} gives a sample rate of {:g} Hz, outside the usable range "
+             "{:g}..{:g} Hz",
+             period, tunit_->unit, rate, kMinRateHz, kMaxRateHz));
 }
 
 // A key that looks like a sample rate (or a pulse weight) but is not the one rwcalc reads, when
@@ -351,22 +352,22 @@ void Reader::check_unread_keys() const {
   const detail::Metadata& meta = parser_.metadata();
   if (rate_source_ == RateSource::Default && meta.unread_rate_key)
     fail(meta.unread_rate_key->second,
-         fmt::format("metadata '{}' looks like the sample rate, but rwcalc reads the rate from rate_hz, a time "
-                     "column or --rate{}; write '# rate_hz: VALUE' or give --rate",
-                     meta.unread_rate_key->first,
-                     integer_mode() ? fmt::format(", and would otherwise use {:g} Hz", units::gl2d_rate_hz) : ""));
+         trf("metadata '{}' looks like the sample rate, but rwcalc reads the rate from rate_hz, a time "
+             "column or --rate{}; write '# rate_hz: VALUE' or give --rate",
+             meta.unread_rate_key->first,
+             integer_mode() ? trf(", and would otherwise use {:g} Hz", units::gl2d_rate_hz) : ""));
   // Rate and angle samples carry no GL-2D default: 400 Hz would put every τ off by the ratio.
   if (rate_source_ == RateSource::Default && !integer_mode())
-    fail(0, fmt::format("no sample rate: {} input takes it from --rate HZ, a '# rate_hz: HZ' metadata line or a time "
-                        "column (time_s, time_ms, time_us, time_ns, timestamp, %time, ...); the {:g}-Hz GL-2D default "
-                        "applies to pulse and counter input only",
-                        to_string(in().mode), units::gl2d_rate_hz));
+    fail(0, trf("no sample rate: {} input takes it from --rate HZ, a '# rate_hz: HZ' metadata line or a time "
+                "column (time_s, time_ms, time_us, time_ns, timestamp, %time, ...); the {:g}-Hz GL-2D default "
+                "applies to pulse and counter input only",
+                to_string(in().mode), units::gl2d_rate_hz));
   if (integer_mode() && !opt_.scale_arcsec && !meta.scale_arcsec && meta.unread_scale_key)
     fail(meta.unread_scale_key->second,
-         fmt::format("metadata '{}' looks like the pulse weight, but rwcalc reads it from scale_arcsec_per_pulse "
-                     "or --scale, and would otherwise use {:g} arcsec; write '# scale_arcsec_per_pulse: VALUE' or "
-                     "give --scale",
-                     meta.unread_scale_key->first, units::gl2d_arcsec_per_pulse));
+         trf("metadata '{}' looks like the pulse weight, but rwcalc reads it from scale_arcsec_per_pulse "
+             "or --scale, and would otherwise use {:g} arcsec; write '# scale_arcsec_per_pulse: VALUE' or "
+             "give --scale",
+             meta.unread_scale_key->first, units::gl2d_arcsec_per_pulse));
 }
 
 // Two time columns are used only when they agree, every line, within the time tolerance.
@@ -374,10 +375,10 @@ void Reader::check_time_columns_agree() const {
   const double period = 1.0 / rate_hz_;
   if (!layout_.time2_col || gap_max_ <= opt_.time_tolerance * period) return;
   fail(line_of_sample(gap_sample_),
-       fmt::format("the time columns '{}' and '{}' disagree: {} {} and {} {} differ by {:g} s here (their largest "
-                   "difference), more than the time tolerance ({} of the {:g}-s period); remove one of them{}",
-                   layout_.header[*layout_.time_col], layout_.header[*layout_.time2_col], gap_t_, tunit_->unit, gap_t2_,
-                   tunit2_->unit, gap_max_, opt_.time_tolerance, period, tolerance_hint(gap_max_ / period)));
+       trf("the time columns '{}' and '{}' disagree: {} {} and {} {} differ by {:g} s here (their largest "
+           "difference), more than the time tolerance ({} of the {:g}-s period); remove one of them{}",
+           layout_.header[*layout_.time_col], layout_.header[*layout_.time2_col], gap_t_, tunit_->unit, gap_t2_,
+           tunit2_->unit, gap_max_, opt_.time_tolerance, period, tolerance_hint(gap_max_ / period)));
 }
 
 // Every step must lie within half a period of the period: within the time tolerance it is exact,
@@ -401,31 +402,28 @@ void Reader::check_rate_against_time_column(const TimeTrack::Step& bad, double p
   if (std::abs(est - period) <= opt_.time_tolerance * period) return;
   const std::string tcol = layout_.header.empty() ? "column 1" : "'" + layout_.header[*layout_.time_col] + "'";
   fail(line_of_sample(bad.sample),
-       fmt::format("the sample rate {} Hz (from {}) is inconsistent with the time column {}, which steps by {} {} "
-                   "(~{:.6g} Hz), e.g. {} at line {} then {}{}",
-                   rate_hz_,
-                   rate_source_ == RateSource::Option
-                       ? "--rate"
-                       : fmt::format("metadata at line {}", parser_.metadata().rate_line),
-                   tcol, est, tunit_->unit, tunit_->per_second / est, stamp(bad.before), line_of_sample(bad.sample - 1),
-                   stamp(bad.after), tolerance_hint(std::abs(est - period) / period)));
+       trf("the sample rate {} Hz (from {}) is inconsistent with the time column {}, which steps by {} {} "
+           "(~{:.6g} Hz), e.g. {} at line {} then {}{}",
+           rate_hz_,
+           rate_source_ == RateSource::Option ? "--rate"
+                                              : fmt::format("metadata at line {}", parser_.metadata().rate_line),
+           tcol, est, tunit_->unit, tunit_->per_second / est, stamp(bad.before), line_of_sample(bad.sample - 1),
+           stamp(bad.after), tolerance_hint(std::abs(est - period) / period)));
 }
 
 [[noreturn]] void Reader::fail_step(const TimeTrack::Step& bad, double period) const {
   const double t0 = bad.before, t1 = bad.after, dt = t1 - t0;
   const std::size_t line = line_of_sample(bad.sample), prev = line_of_sample(bad.sample - 1);
-  if (dt == 0)
-    fail(line, fmt::format("repeated time stamp {} (also at line {}); no resampling is done", stamp(t1), prev));
-  if (dt < 0) fail(line, fmt::format("time goes backwards: {} at line {}, then {}", stamp(t0), prev, stamp(t1)));
+  if (dt == 0) fail(line, trf("repeated time stamp {} (also at line {}); no resampling is done", stamp(t1), prev));
+  if (dt < 0) fail(line, trf("time goes backwards: {} at line {}, then {}", stamp(t0), prev, stamp(t1)));
   const double p_s = period / tunit_->per_second;
   if (dt < period)
-    fail(line, fmt::format("time step too short: {} at line {}, then {} (a step of {:.6g} periods of {:g} s; steps "
-                           "within half a period of it are accepted as jitter); no resampling is done",
-                           stamp(t0), prev, stamp(t1), dt / period, p_s));
+    fail(line, trf("time step too short: {} at line {}, then {} (a step of {:.6g} periods of {:g} s; steps "
+                   "within half a period of it are accepted as jitter); no resampling is done",
+                   stamp(t0), prev, stamp(t1), dt / period, p_s));
   const double missing = std::round(dt / period - 1);
   fail(line,
-       fmt::format(
-           "gap in the time column: {} at line {}, then {}: {:.6g} s missing (~{:g} sample{}; a step "
+       trf("gap in the time column: {} at line {}, then {}: {:.6g} s missing (~{:g} sample{}; a step "
            "of {:.6g} periods of {:g} s); rwcalc neither resamples nor analyses a record with gaps: cut the record at "
            "this line and analyse the parts separately (--time-tolerance only sets which steps within half a "
            "period count as jitter)",
@@ -440,9 +438,9 @@ void Reader::check_data_magnitude(const PhaseSeries& ph, const char* what) const
   for (std::size_t i = 1; i < ph.values.size(); ++i)
     largest = std::max(largest, std::abs(ph.values[i] - ph.values[i - 1]));
   if (largest > 0 && largest < kMinDataStep)
-    fail(0, fmt::format("the {} data are too small to analyse: the largest step between samples is {:g} {}, below "
-                        "{:g}, where the squares in the Allan variance underflow; give the data in a larger unit",
-                        what, largest, ph.kind == PhaseKind::Clock ? "s" : "arcsec", kMinDataStep));
+    fail(0, trf("the {} data are too small to analyse: the largest step between samples is {:g} {}, below "
+                "{:g}, where the squares in the Allan variance underflow; give the data in a larger unit",
+                what, largest, ph.kind == PhaseKind::Clock ? "s" : "arcsec", kMinDataStep));
 }
 
 // C_0 = 0, C_k = Σ c_i modulo 2^64 for pulses (PhaseSeries differences are modular, so an offset
@@ -474,9 +472,9 @@ void Reader::build_counts(PhaseSeries& ph, std::size_t& wraps) {
       prev = r;
       c[i] = static_cast<std::int64_t>(acc += step);
       if (step > kLimit - total) [[unlikely]]
-        fail(line_of_sample(i), fmt::format("the unwrapped counter advances by more than 2^63-1 counts here (a "
-                                            "backwards step counts as a wrap of the {}-bit counter)",
-                                            b));
+        fail(line_of_sample(i), trf("the unwrapped counter advances by more than 2^63-1 counts here (a "
+                                    "backwards step counts as a wrap of the {}-bit counter)",
+                                    b));
       total += step;
     }
   }
@@ -523,9 +521,9 @@ void Reader::build_values(PhaseSeries& ph) {
   const double f = angle || increments ? phase_factor(in().angle_unit) : phase_factor(in().rate_unit);
   for (std::size_t i = 0; angle && i < x.size(); ++i)
     if (!(std::abs(x[i] *= f) <= kMaxPhase)) [[unlikely]]
-      fail(line_of_sample(i), fmt::format("angle out of range: {} is beyond ±{:g} arcsec, where the Allan "
-                                          "variance of the record would overflow",
-                                          quoted(fmt::format("{:g}", x[i] / f)), kMaxPhase));
+      fail(line_of_sample(i), trf("angle out of range: {} is beyond ±{:g} arcsec, where the Allan "
+                                  "variance of the record would overflow",
+                                  quoted(fmt::format("{:g}", x[i] / f)), kMaxPhase));
   if (!angle) {
     // x_0 = 0, x_j = τ0·Σ_{i<j} (y_i − ȳ), accumulated in long double. The mean rate ȳ goes into
     // rate_offset (series.hpp): a phase that kept it would grow to ȳ·T and round its noise away
@@ -541,9 +539,9 @@ void Reader::build_values(PhaseSeries& ph) {
       const long double whole = acc + static_cast<long double>(mean) * k * static_cast<long double>(i);
       if (!(std::abs(whole) <= kMaxPhase)) [[unlikely]]
         fail(line_of_sample(i - 1),
-             fmt::format("rate out of range: the accumulated phase reaches {:g} arcsec (beyond ±{:g}, where the "
-                         "Allan variance would overflow) at this sample, {}",
-                         static_cast<double>(whole), kMaxPhase, quoted(fmt::format("{:g}", y))));
+             trf("rate out of range: the accumulated phase reaches {:g} arcsec (beyond ±{:g}, where the "
+                 "Allan variance would overflow) at this sample, {}",
+                 static_cast<double>(whole), kMaxPhase, quoted(fmt::format("{:g}", y))));
     }
     ph.rate_offset = increments ? mean * f / ph.tau0_s : mean * f;
   }
@@ -598,7 +596,7 @@ Recording Reader::finish() {
   for (const auto& [key, value] : opt_.identification) {
     auto& slot = rec.metadata[key];
     if (!slot.empty() && slot != value)
-      rec.notes.push_back(fmt::format("{} '{}' from the command line, not the file's '{}'", key, value, slot));
+      rec.notes.push_back(trf("{} '{}' from the command line, not the file's '{}'", key, value, slot));
     slot = value;
   }
   note_time_column(rec);
@@ -615,17 +613,16 @@ void Reader::note_time_column(Recording& rec) const {
   rec.time_unit_source = by_name ? "name" : "magnitude";
   const double t0 = times_.first;
   if (!by_name)
-    rec.notes.push_back(fmt::format("time column '{}' in {} (by magnitude: {})", *rec.time_column, tunit_->unit,
-                                    std::abs(t0) >= 1e8
-                                        ? fmt::format("the first stamp {:.4g} is Unix time in {}", t0, tunit_->unit)
-                                        : std::string("the stamps start near 0")));
+    rec.notes.push_back(trf("time column '{}' in {} (by magnitude: {})", *rec.time_column, tunit_->unit,
+                            std::abs(t0) >= 1e8 ? trf("the first stamp {:.4g} is Unix time in {}", t0, tunit_->unit)
+                                                : std::string("the stamps start near 0")));
   if (times_.n >= 2 && times_.median > 0) rec.jitter = times_.jitter();
   if (rec.jitter.steps > 0)
     rec.notes.push_back(
-        fmt::format("jitter: {} time step{} off the period by more than the time tolerance ({:g} %), "
-                    "by up to {:.3g} % of the period (rms {:.2g} %)",
-                    rec.jitter.steps, rec.jitter.steps == 1 ? "" : "s", 100 * opt_.time_tolerance,
-                    100 * rec.jitter.max_fraction, 100 * rec.jitter.rms_fraction));
+        trf("jitter: {} time step{} off the period by more than the time tolerance ({:g} %), "
+            "by up to {:.3g} % of the period (rms {:.2g} %)",
+            rec.jitter.steps, rec.jitter.steps == 1 ? "" : "s", 100 * opt_.time_tolerance,
+            100 * rec.jitter.max_fraction, 100 * rec.jitter.rms_fraction));
 }
 
 void validate(const ReadOptions& o) {
@@ -690,10 +687,10 @@ std::string_view input_unit(const Recording& rec) {
 
 std::string describe_input(const Recording& rec) {
   if (rec.mode == InputMode::Pulses || rec.mode == InputMode::Counter)
-    return fmt::format("column '{}': {}, {:g} arcsec per {}", rec.column_name,
-                       rec.mode == InputMode::Pulses ? "pulse counts" : "counter readings", rec.phase.arcsec_per_count,
-                       input_unit(rec));
-  return fmt::format("column '{}': {} samples in {}", rec.column_name, to_string(rec.mode), input_unit(rec));
+    return trf(rec.mode == InputMode::Pulses ? N_("column '{}': pulse counts, {:g} arcsec per pulse")
+                                             : N_("column '{}': counter readings, {:g} arcsec per count"),
+               rec.column_name, rec.phase.arcsec_per_count);
+  return trf("column '{}': {} samples in {}", rec.column_name, to_string(rec.mode), input_unit(rec));
 }
 
 InputMode parse_input_mode(std::string_view s) { return parse_name(kModes, s, "--input"); }

@@ -77,7 +77,7 @@ void class_number(const std::optional<Value>& c, const std::vector<std::int64_t>
   if (!c) return;
   const auto n = c->integer(0, kMaxClassNumber);
   if (!classes.empty() && std::find(classes.begin(), classes.end(), n) == classes.end())
-    c->fail(fmt::format("is class {}, which is not among the verdict's \"classes\"", n));
+    c->fail(trf("is class {}, which is not among the verdict's \"classes\"", n));
 }
 
 /// Each element of the array `a` checked by `each`; `size`, when known, is how many it must hold.
@@ -85,7 +85,7 @@ template <class Each>
 void array_of(const Value& a, std::optional<std::size_t> size, std::string_view what, Each each) {
   const auto e = a.elements();
   if (size && e.size() != *size)
-    a.fail(fmt::format("must hold {} {} (one per {}), got {}", *size, *size == 1 ? "value" : "values", what, e.size()));
+    a.fail(trf("must hold {} {} (one per {}), got {}", *size, *size == 1 ? "value" : "values", what, e.size()));
   for (const auto& x : e) (void)each(x);
 }
 
@@ -159,7 +159,7 @@ void Checker::outliers(const Value& o) const {
   if (const auto action = o.find("action")) {
     const auto s = action->string();
     if (s != "keep" && s != "remove" && s != "replace")
-      action->fail(fmt::format("must be \"keep\", \"remove\" or \"replace\", got \"{}\"", s));
+      action->fail(trf("must be \"keep\", \"remove\" or \"replace\", got \"{}\"", s));
   }
   if (const auto positions = o.find("positions"))
     for (const auto& p : positions->elements()) {

@@ -50,7 +50,7 @@ std::size_t after_last(const char* b, const char* e, char c, std::size_t at, std
 }
 
 [[noreturn]] void fail_errno(const std::string& name, const char* what, int err) {
-  throw InputError(name, 0, std::string(what) + ": " + std::strerror(err));
+  throw InputError(name, 0, std::string(tr(what)) + ": " + std::strerror(err));
 }
 
 }  // namespace
@@ -94,10 +94,10 @@ TextSource::TextSource(const std::string& path) : name_(display_name(path)), che
   }
   if (path.empty()) throw InputError(tr("(empty path)"), 0, tr("no input file given"));
   in_.fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (in_.fd < 0) fail_errno(name_, "cannot open", errno);
+  if (in_.fd < 0) fail_errno(name_, N_("cannot open"), errno);
   in_.own = true;
   struct stat st {};
-  if (::fstat(in_.fd, &st) != 0) fail_errno(name_, "cannot stat", errno);
+  if (::fstat(in_.fd, &st) != 0) fail_errno(name_, N_("cannot stat"), errno);
   if (S_ISDIR(st.st_mode)) throw InputError(name_, 0, tr("is a directory, not a recording"));
   if (S_ISREG(st.st_mode)) bytes_ = static_cast<std::size_t>(st.st_size);
 }
@@ -122,7 +122,7 @@ std::size_t TextSource::read_raw(char* to, std::size_t max) {
   } else {
     ssize_t got = -1;
     while ((got = ::read(in_.fd, to, max)) < 0)
-      if (errno != EINTR) fail_errno(name_, "cannot read", errno);
+      if (errno != EINTR) fail_errno(name_, N_("cannot read"), errno);
     n = static_cast<std::size_t>(got);
   }
   hash_.update(std::string_view(to, n));

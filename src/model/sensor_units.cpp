@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/sensor.hpp"
 #include "rwcalc/units.hpp"
 
@@ -29,6 +30,16 @@ constexpr RateChoice kRates[] = {{SensorKind::Gyro, "deg/s", "°/s", 1.0 / units
                                  {SensorKind::Accelerometer, "g", "g", kMicroG * 1e-6},
                                  {SensorKind::Accelerometer, "mg", "mg", kMicroG * 1e-3},
                                  {SensorKind::Accelerometer, "ug", "µg", kMicroG}};
+
+/// Every label the unit sets below compose (rate_based, usual_units, si_units), for the catalogue:
+/// labels are kept in English and translated where shown (localized_label); a test checks that
+/// each label of every unit set has its entry.
+[[maybe_unused]] constexpr const char* kComposedLabels[] = {
+    N_("°/s"),      N_("°/s/√Hz"), N_("°/s/√s"),     N_("°/s/s"),  N_("°"),        N_("rad/s"),   N_("rad/s/√Hz"),
+    N_("rad/s/√s"), N_("rad/s/s"), N_("rad"),        N_("m/s²"),   N_("m/s²/√Hz"), N_("m/s²/√s"), N_("m/s²/s"),
+    N_("m/s"),      N_("g"),       N_("g/√Hz"),      N_("g/√s"),   N_("g/s"),      N_("mg"),      N_("mg/√Hz"),
+    N_("mg/√s"),    N_("mg/s"),    N_("µg"),         N_("µg/√Hz"), N_("µg/√s"),    N_("µg/s"),    N_("m/s/√h"),
+    N_("m/s/h/√h"), N_("m/s/h²"),  N_("rad/s²/√Hz"), N_("rad/s²"), N_("m/s³/√Hz"), N_("m/s³")};
 
 // B and σ in U, N in U/√Hz, K in U/√s, R in U/s: the factors follow from 1 h = 3600 s.
 UnitSet rate_based(SensorKind kind, std::string_view ascii, std::string_view label, double f) {
@@ -82,13 +93,19 @@ std::optional<SensorKind> sensor_kind(PhaseKind k) {
 }
 
 std::string_view term_meaning(SensorKind k, Term t) {
-  static constexpr std::array<std::string_view, kTermCount> kGyro{"angle quantisation", "angle random walk",
-                                                                  "bias instability", "rate random walk", "rate ramp"};
-  static constexpr std::array<std::string_view, kTermCount> kAccel{"velocity quantisation", "velocity random walk",
-                                                                   "bias instability", "acceleration random walk",
-                                                                   "acceleration ramp"};
+  static constexpr std::array<std::string_view, kTermCount> kGyro{N_("angle quantisation"), N_("angle random walk"),
+                                                                  N_("bias instability"), N_("rate random walk"),
+                                                                  N_("rate ramp")};
+  static constexpr std::array<std::string_view, kTermCount> kAccel{N_("velocity quantisation"),
+                                                                   N_("velocity random walk"), N_("bias instability"),
+                                                                   N_("acceleration random walk"),
+                                                                   N_("acceleration ramp")};
   return (k == SensorKind::Gyro ? kGyro : kAccel)[static_cast<std::size_t>(t)];
 }
+
+std::string localized_meaning(SensorKind k, Term t) { return tr(std::string(term_meaning(k, t))); }
+
+std::string localized_label(const ShownUnit& u) { return tr(u.label); }
 
 UnitSet output_units(SensorKind kind, std::string_view output_unit) {
   if (output_unit.empty()) return usual_units(kind);
@@ -98,15 +115,15 @@ UnitSet output_units(SensorKind kind, std::string_view output_unit) {
   for (const RateChoice& r : kRates)
     if (r.name == output_unit) {
       if (r.kind != kind)
-        throw UsageError(fmt::format("output unit '{}' is an {} unit; the {} channels take {}", output_unit,
-                                     to_string(r.kind), to_string(kind),
-                                     kind == SensorKind::Gyro ? "deg/h, deg/s or rad/s" : "m/s^2, g, mg or ug"));
+        throw UsageError(trf("output unit '{}' is an {} unit; the {} channels take {}", output_unit, to_string(r.kind),
+                             to_string(kind),
+                             kind == SensorKind::Gyro ? "deg/h, deg/s or rad/s" : "m/s^2, g, mg or ug"));
       return rate_based(kind, r.name, r.label, r.factor);
     }
   throw UsageError(
-      fmt::format("unknown output unit '{}': expected deg/h, deg/s, rad/s (gyro) or m/s^2, g, mg, ug "
-                  "(accelerometer)",
-                  output_unit));
+      trf("unknown output unit '{}': expected deg/h, deg/s, rad/s (gyro) or m/s^2, g, mg, ug "
+          "(accelerometer)",
+          output_unit));
 }
 
 UnitSet si_units(SensorKind kind) {

@@ -16,8 +16,8 @@ std::string format_allan_table(const AllanResult& r, const AllanReportInfo& info
   const std::string u = unit_label(r);
   std::string out;
   out += fmt::format("# rwcalc allan: {}\n", info.source.empty() ? "-" : printable(info.source));
-  if (!info.input.empty()) out += fmt::format("# input: {}\n", printable(info.input));
-  out += trf("# estimator: {} deviation ({})\n", long_name(r.estimator), to_string(r.estimator));
+  if (!info.input.empty()) out += trf("# input: {}\n", printable(info.input));
+  out += trf("# estimator: {} ({})\n", deviation_name(r.estimator), to_string(r.estimator));
   out +=
       trf("# confidence: {:g} (two-sided chi-square bounds, Greenhall-Riley EDF, lag-1 ACF noise id)\n", r.confidence);
   if (r.unit == "deg/h")
@@ -29,8 +29,8 @@ std::string format_allan_table(const AllanResult& r, const AllanReportInfo& info
     out += tr("# units: deviations in input units per second (dimensionless for phase in s); τ in s\n");
   out += trf("# samples: {}   phase points: {}   τ0: {:g} s", info.samples, r.points_in, r.tau0_s);
   if (info.rate_hz > 0)
-    out +=
-        trf("   rate: {:g} Hz{}", info.rate_hz, info.rate_source.empty() ? "" : fmt::format(" ({})", info.rate_source));
+    out += trf("   rate: {:g} Hz{}", info.rate_hz,
+               info.rate_source.empty() ? "" : fmt::format(" ({})", tr(info.rate_source)));
   out += "\n";
   out += tr(
       "# α: noise exponent of S(f) ∝ f^α: +2 white angle/PM, +1 flicker PM, 0 white rate/FM, −1 flicker FM, −2 random "

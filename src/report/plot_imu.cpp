@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/plot.hpp"
 
@@ -12,31 +13,32 @@ namespace rwcalc {
 
 PlotResult plot_imu(const nlohmann::json& imu, const PlotOptions& options) {
   std::vector<Figure> figures;
-  for (const std::string_view kind : {"gyro", "accelerometer"}) {
+  constexpr std::string_view kGyro = "gyro";
+  for (const std::string_view kind : {kGyro, std::string_view("accelerometer")}) {
     nlohmann::json runs = nlohmann::json::array();
     for (const auto& c : imu.at("channels")) {
       if (c.value("sensor", "") != kind) continue;
       nlohmann::json run = c;
-      // The axis label in the unit's printed form; as a non-gyro unit it also keeps the class
-      // limits (a ring-laser table) out of a figure of several axes.
+      // The axis label in the unit's printed form, in the current language; as a non-gyro unit it
+      // also keeps the class limits (a ring-laser table) out of a figure of several axes.
       const std::string unit = c.at("allan").value("unit", "");
-      run["allan"]["unit"] = unit == "deg/h"   ? "°/h"
-                             : unit == "deg/s" ? "°/s"
-                             : unit == "ug"    ? "µg"
-                             : unit == "m/s^2" ? "m/s²"
-                                               : unit;
+      run["allan"]["unit"] = tr(unit == "deg/h"   ? "°/h"
+                                : unit == "deg/s" ? "°/s"
+                                : unit == "ug"    ? "µg"
+                                : unit == "m/s^2" ? "m/s²"
+                                                  : unit);
       runs.push_back(std::move(run));
     }
     if (runs.empty()) continue;
     PlotOptions o = options;
     if (o.title.empty())
-      o.title = fmt::format("{} axes of {}", kind == "gyro" ? "Gyro" : "Accelerometer",
-                            std::filesystem::path(imu.value("source", "")).filename().string());
+      o.title = trf(kind == kGyro ? N_("Gyro axes of {}") : N_("Accelerometer axes of {}"),
+                    std::filesystem::path(imu.value("source", "")).filename().string());
     Figure f = batch_allan_figure(runs, o);
     f.name = fmt::format("imu-{}", kind);
     figures.push_back(std::move(f));
   }
-  if (figures.empty()) throw AnalysisError("the imu result has no channels: nothing to plot");
+  if (figures.empty()) throw AnalysisError(tr("the imu result has no channels: nothing to plot"));
   PlotResult result;
   for (const auto& f : figures) result.series += f.series;
   check_output_targets({{"--plot", options.output}, {"--plot-script", options.script}}, options.force);

@@ -10,6 +10,7 @@
 
 #include "core/json_input.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/i18n.hpp"
 #include "rwcalc/noise_model.hpp"
 
 namespace rwcalc {
@@ -51,13 +52,13 @@ double fitted(const Value& fit, const char* key, const CoefficientPolicy& policy
     if (policy.notes) policy.notes->push_back(std::move(line));
   };
   if (policy.upper_bounds && value > estimate) {
-    note(fmt::format("{} = {:g}: its 95 % upper bound (not resolved; --upper-bounds)", key, value));
+    note(trf("{} = {:g}: its 95 % upper bound (not resolved; --upper-bounds)", key, value));
     return value;
   }
   if (value > 0)
-    note(estimate > 0 ? fmt::format("{} = {:g}: its estimate (not resolved; 95 % upper bound {:g})", key, estimate, value)
-                      : fmt::format("{} left out ({}; 95 % upper bound {:g}; --upper-bounds takes it)", key,
-                                    in_model ? "not resolved" : "left out of the model by the fit", value));
+    note(estimate > 0 ? trf("{} = {:g}: its estimate (not resolved; 95 % upper bound {:g})", key, estimate, value)
+                      : trf("{} left out ({}; 95 % upper bound {:g}; --upper-bounds takes it)", key,
+                            in_model ? tr("not resolved") : tr("left out of the model by the fit"), value));
   return estimate;
 }
 
