@@ -7,6 +7,8 @@
 #include <array>
 #include <cmath>
 
+#include "rwcalc/i18n.hpp"
+
 namespace rwcalc {
 
 namespace {
@@ -73,11 +75,11 @@ std::vector<std::unique_ptr<Detector>> make_detectors(const AnalysisResult& anal
                                                       bool lattice) {
   std::string skip;
   if (x.exact())
-    skip = "whole pulse counts: no filter in the output chain";
+    skip = tr("whole pulse counts: no filter in the output chain");
   else if (lattice)
     skip =
-        "the samples are whole multiples of a step coarse against their scatter (pulse counts as numbers): no "
-        "filter in the output chain";
+        tr("the samples are whole multiples of a step coarse against their scatter (pulse counts as numbers): no "
+           "filter in the output chain");
   std::vector<std::unique_ptr<Detector>> d;
   d.push_back(sinusoid_detector());
   d.push_back(step_detector());

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "diagnose/models.hpp"
+#include "rwcalc/i18n.hpp"
 
 namespace rwcalc::diag {
 
@@ -32,15 +33,15 @@ NoiseModel with_bump(const NoiseModel& base, const ShapeEstimate& est) {
 /// Why a bump fit cannot be a Gauss–Markov term (empty: it can): a fit that only trades the white
 /// noise for a bump is a deficit; a bump far below the local AV re-arranges flicker or white noise.
 std::string implausible(const ShapeEstimate& gm) {
-  if (!(gm.scale > 0)) return "no bump improves the fit of the mid-τ Allan variance";
+  if (!(gm.scale > 0)) return tr("no bump improves the fit of the mid-τ Allan variance");
   if (gm.excess < kGmMinExcess && gm.white_rest < 2.0 * gm.white_rest_sigma)
-    return fmt::format(
+    return trf(
         "the fitted shape raises the mid-τ Allan variance by at most {:.2g} ensemble standard "
         "deviations and leaves no white rate noise ({:.3g} ± {:.2g} (°/h)²·s): a deficit, not a "
         "Gauss–Markov bump",
         gm.excess, gm.white_rest, gm.white_rest_sigma);
   if (gm.peak_ratio < kGmMinPeakRatio)
-    return fmt::format(
+    return trf(
         "the bump's Allan variance at its peak is {:.2g} of the base model's there (at least {:g} "
         "needed): not told apart from the flicker and white noise",
         gm.peak_ratio, kGmMinPeakRatio);
@@ -62,8 +63,8 @@ class GaussMarkovDetector final : public Detector {
     d.note = implausible(gm);
     if (!d.note.empty()) return d;
     const std::size_t runs = t.runs.size();
-    const auto m1_runs =
-        run_ensemble(with_bump(s.base, gm), t.settings, runs, {s.octave_m, s.ref.grid, true, {}, false}, s.opt->progress);
+    const auto m1_runs = run_ensemble(with_bump(s.base, gm), t.settings, runs,
+                                      {s.octave_m, s.ref.grid, true, {}, false}, s.opt->progress);
     const auto m1_ref = make_reference(s.ref.grid, s.dec.tau_d, m1_runs, true);
     d.statistic = mid_deviance(v, s.clean_ref) - mid_deviance(v, m1_ref);
     std::vector<double> e_gm;

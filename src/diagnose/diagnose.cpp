@@ -19,7 +19,7 @@ using namespace diag;
 
 namespace {
 
-constexpr double kPulseFitTauMin = 20.0;  ///< s, start of the base fit for pulse data
+constexpr double kPulseFitTauMin = 20.0;       ///< s, start of the base fit for pulse data
 constexpr std::size_t kCalibrationFactor = 4;  ///< default calibration ensemble: 4K records
 
 /// The measurement and what every stage reads of it.
@@ -41,8 +41,8 @@ const Recording& screened(const Recording& read, const DiagnoseOptions& opt, Out
                           Recording& edited) {
   if (read.phase.kind == PhaseKind::Accelerometer)
     throw UsageError(
-        "diagnose needs gyro data: an accelerometer column is analysed by analyze and imu, not yet "
-        "diagnosed");
+        tr("diagnose needs gyro data: an accelerometer column is analysed by analyze and imu, not yet "
+           "diagnosed"));
   if (read.phase.kind != PhaseKind::Gyro)
     throw UsageError(tr("diagnose needs gyro data (clock phase/frequency cannot be simulated as a gyro)"));
   if (opt.runs < 10) throw UsageError(trf("--runs must be at least 10 (got {})", opt.runs));
@@ -148,13 +148,14 @@ void one_mean_shape(const NoiseModel& candidate, std::vector<DetectorResult>& re
   auto& drop = warmup_form ? *step : *warm;
   if (!keep.named) {
     keep.named = true;
-    keep.note = fmt::format("named as the form of the change of the mean the {} detector found: it explains the "
-                            "block means better",
-                            detector_name(drop.effect));
+    keep.note =
+        trf("named as the form of the change of the mean the {} detector found: it explains the "
+            "block means better",
+            detector_name(drop.effect));
   }
   if (drop.named) {
     drop.named = false;
-    drop.note = fmt::format("the {} explains the block means better", warmup_form ? "warm-up transient" : "bias step");
+    drop.note = trf("the {} explains the block means better", warmup_form ? tr("warm-up transient") : tr("bias step"));
   }
 }
 

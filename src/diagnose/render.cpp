@@ -200,7 +200,7 @@ std::string format_report(const DiagnoseResult& r) {
   else
     s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", tr("out-of-sample misfit (dimensionless)"),
                      r.gain.holdout_misfit_base, r.gain.holdout_misfit_extended);
-  s += fmt::format("\n  ({:.1f} s)\n", r.seconds);
+  s += trf("\n  ({:.1f} s)\n", r.seconds);
   return s;
 }
 
