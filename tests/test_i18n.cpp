@@ -428,6 +428,18 @@ TEST(RussianCli, DiagnosisInRussian) {
     EXPECT_FALSE(contains(r.out, english)) << english << "\n" << r.out;
 }
 
+TEST(RussianCli, CommandLineErrorsInRussianAndUnchangedInEnglish) {
+  const auto extra = run_cli({"analyze", "--lang", "ru", rwcalc::test::gl2d_runs().front(), "surplus"});
+  EXPECT_EQ(extra.status, 2);
+  EXPECT_TRUE(contains(extra.err, "неожиданный аргумент: surplus")) << extra.err;
+  const auto missing = run_cli({"analyze", "--lang", "ru"});
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_TRUE(contains(missing.err, "требуется FILE")) << missing.err;
+  EXPECT_FALSE(contains(missing.err, "is required")) << missing.err;
+  const auto english = run_cli({"analyze"});
+  EXPECT_TRUE(contains(english.err, "FILE is required")) << english.err;
+}
+
 TEST(ReportPdf, WithoutChromiumTheHtmlIsWrittenAndTheMissingPdfSaid) {
   TempDir dir;
   const std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";

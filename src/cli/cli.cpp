@@ -1,5 +1,6 @@
 #include "rwcalc/cli.hpp"
 
+#include <fmt/args.h>
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -8,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <ostream>
+#include <regex>
 #include <string_view>
 #include <vector>
 
@@ -21,6 +23,37 @@
 namespace rwcalc::cli {
 
 namespace {
+
+/// CLI11's parse errors in the chosen language: its fixed English phrases, matched whole, with
+/// the option names and values they carry kept as written (English text is unchanged).
+std::string parse_error_text(const std::string& what) {
+  struct Phrase {
+    std::regex pattern;
+    const char* message;  // msgid with one {} per group
+  };
+  static const std::vector<Phrase> phrases{
+      {std::regex("The following arguments were not expected: (.*)"),
+       N_("The following arguments were not expected: {}")},
+      {std::regex("The following argument was not expected: (.*)"), N_("The following argument was not expected: {}")},
+      {std::regex("A subcommand is required"), N_("A subcommand is required")},
+      {std::regex("(.+) is required"), N_("{} is required")},
+      {std::regex("The value (.+) is not an allowed value for (.+)"),
+       N_("The value {} is not an allowed value for {}")},
+      {std::regex("Could not convert: (.+) = (.*)"), N_("Could not convert: {} = {}")},
+      {std::regex("(.+) requires (.+)"), N_("{} requires {}")},
+      {std::regex("(.+) excludes (.+)"), N_("{} excludes {}")},
+      {std::regex("Expected exactly (\\d+) arguments to (.+), got (\\d+)"),
+       N_("Expected exactly {} arguments to {}, got {}")},
+  };
+  std::smatch m;
+  for (const auto& p : phrases) {
+    if (!std::regex_match(what, m, p.pattern)) continue;
+    fmt::dynamic_format_arg_store<fmt::format_context> args;
+    for (std::size_t i = 1; i < m.size(); ++i) args.push_back(m[i].str());
+    return fmt::vformat(tr(p.message), args);
+  }
+  return what;
+}
 constexpr const char* kDescription =
     N_("rwcalc: Allan-variance noise analysis of gyro recordings (GL-2D ring laser gyro and others),\n"
        "noise coefficients with uncertainties, navigation accuracy class verdicts (GOST RV 52339),\n"
@@ -157,7 +190,7 @@ std::optional<int> parse_args(CLI::App& app, int argc, const char* const* argv, 
       if (app.get_subcommands().empty()) out << app.help();
       return 0;
     }
-    print_message(err, e.what());
+    print_message(err, parse_error_text(e.what()));
     if (app.get_subcommands().empty())
       err << tr("Run 'rwcalc --help' for the list of commands.\n");
     else
