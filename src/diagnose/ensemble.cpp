@@ -72,7 +72,7 @@ void reduce(const PhaseSeries& s, const EnsemblePlan& plan, std::size_t r, RunSt
   for (const RecordDetector* det : plan.scored) st.stat[static_cast<std::size_t>(det->effect())] = det->statistic(view);
 }
 
-/// The old way: every record at full rate (a statistic that reads the raw samples needs it).
+/// Every record at full rate: a statistic that reads the raw samples needs it.
 std::vector<RunStats> full_rate_ensemble(const NoiseModel& model, const SimulationSettings& settings,
                                          std::size_t runs, const EnsemblePlan& plan, Progress* progress) {
   std::vector<RunStats> out(runs);
