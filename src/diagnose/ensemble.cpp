@@ -76,16 +76,13 @@ void reduce(const PhaseSeries& s, const EnsemblePlan& plan, std::size_t r, RunSt
 std::vector<RunStats> full_rate_ensemble(const NoiseModel& model, const SimulationSettings& settings,
                                          std::size_t runs, const EnsemblePlan& plan, Progress* progress) {
   std::vector<RunStats> out(runs);
-  EnsembleOptions eo;
-  eo.path = SimulationPath::Ensemble;
-  eo.progress = progress;
   simulate_ensemble(
       model, settings, runs,
       [&](std::size_t r, const PhaseSeries& s) {
         out[r].octave_var = octave_avar(s, plan.octave_m);
         reduce(s, plan, r, out[r]);
       },
-      eo);
+      {SimulationPath::Ensemble, progress});
   return out;
 }
 
@@ -169,7 +166,6 @@ std::vector<RunStats> decimated_ensemble(const NoiseModel& model, const Simulati
   // angle at each sample, white angle noise is per sample).
   SimulationSettings cs = settings;
   cs.rate_hz = settings.rate_hz / static_cast<double>(D);
-  const NoiseModel& cm = model;
   std::vector<std::int64_t> coarse_m;
   std::vector<std::size_t> coarse_at, short_at;
   for (std::size_t i = 0; i < plan.octave_m.size(); ++i) {
@@ -181,11 +177,8 @@ std::vector<RunStats> decimated_ensemble(const NoiseModel& model, const Simulati
     }
   }
   std::vector<RunStats> out(runs);
-  EnsembleOptions eo;
-  eo.path = SimulationPath::Exact;
-  eo.progress = progress;
   simulate_ensemble(
-      cm, cs, runs,
+      model, cs, runs,
       [&](std::size_t r, const PhaseSeries& s) {
         RunStats& st = out[r];
         st.octave_var.assign(plan.octave_m.size(), 0.0);
@@ -193,7 +186,7 @@ std::vector<RunStats> decimated_ensemble(const NoiseModel& model, const Simulati
         for (std::size_t k = 0; k < coarse_at.size(); ++k) st.octave_var[coarse_at[k]] = v[k];
         reduce(s, plan, r, st);
       },
-      eo);
+      {SimulationPath::Exact, progress});
   short_tau_octaves(model, settings, plan.octave_m, short_at, out);
   return out;
 }
