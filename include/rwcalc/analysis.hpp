@@ -65,6 +65,20 @@ struct FitRangeChoice {
   double departure_tau_s = 0;
   double departure_ratio = 1;
   double reference_tau_s = 0;
+  /// Spectral lines of the rate (peaks 10× the local level of its Welch spectrum) whose Allan
+  /// variance, computed from the spectrum's excess, was taken off the octave points before the fit:
+  /// each with its frequency, rms (phase unit/s), peak over the local level, and the largest share
+  /// of an octave point's AV it carried (and that point's τ). Lines below 1 % everywhere are ignored.
+  struct Line {
+    double f_hz = 0;
+    double rms = 0;
+    double peak_ratio = 0;
+    double max_share = 0;
+    double tau_at_max_s = 0;
+  };
+  std::vector<Line> lines;
+  /// Octave points left out of the fit because the lines carry more than 90 % of their AV.
+  int line_points_left_out = 0;
   /// The fit was rejected (p < 0.001) and its intervals scaled by √(χ²/dof) (FitOptions::dispersion).
   bool intervals_scaled = false;
   double interval_scale = 1;  ///< √(χ²/dof) of the unscaled fit, when scaled

@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "analysis/fit_range.hpp"
+#include "analysis/spectral_lines.hpp"
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
@@ -169,6 +170,13 @@ nlohmann::json input_json(const Recording& rec) {
 
 namespace {
 
+/// A line that carries less than this share of every octave point's AV is ignored.
+constexpr double kLineShareIgnored = 0.01;
+/// The AV of a sinusoid of frequency f, ∝ sin⁴(πfτ)/(πfτ)², peaks at τ = this / f.
+constexpr double kLinePeakTau = 0.371;
+/// Points whose AV the lines carry more than this share of are left out of the fit.
+constexpr double kLineShareLeftOut = 0.9;
+
 /// What the result says of its record: source, size, column, pulse weight and temperature (from the
 /// option, the metadata or a column, or the file name, in that order).
 void describe_record(const Recording& rec, const AnalysisOptions& options, AnalysisResult& r) {
@@ -289,8 +297,41 @@ void earth_rate_and_bias(const Recording& rec, const AnalysisOptions& options, A
 /// The fit of the octave points: over the range the user gave, else from 10 τf when the shortest τ
 /// shows an output filter (check_output_filter), else over every point; a fit the goodness of fit
 /// rejects (p < 0.001) is refitted with its intervals scaled by √(χ²/dof) (FitOptions::dispersion).
-void fit_with_checks(const std::vector<FitPoint>& points, const AnalysisOptions& options, bool exact_counts,
+/// The octave points less the Allan variance of the rate's spectral lines (spectral_lines.hpp): a
+/// line the five-term model lacks would otherwise be read as white noise and bias-instability near
+/// τ ≈ 1/f. Only lines whose AV peaks (at τ = 0.371/f) at or beyond the short-τ check's reference τ
+/// are taken off: faster ones are short-τ structure, which the fit range leaves out
+/// (check_output_filter). Points the lines dominate (over 90 % of the AV) are left out: what
+/// remains there is the difference of two close numbers.
+std::vector<FitPoint> without_spectral_lines(const std::vector<FitPoint>& points, const PhaseSeries& x,
+                                             FitRangeChoice& range) {
+  std::vector<FitPoint> out = points;
+  for (const SpectralLineFound& found : find_spectral_lines(x)) {
+    if (kLinePeakTau / found.f_hz < short_tau_reference_s(x.tau0_s)) continue;
+    FitRangeChoice::Line line{found.f_hz, std::sqrt(found.power), found.peak_ratio, 0, 0};
+    for (const FitPoint& p : points) {
+      const double share = spectral_lines_avar({found}, p.tau_s) / p.var;
+      if (share > line.max_share) line.max_share = share, line.tau_at_max_s = p.tau_s;
+    }
+    if (line.max_share < kLineShareIgnored) continue;
+    range.lines.push_back(line);
+    for (FitPoint& p : out) p.var -= spectral_lines_avar({found}, p.tau_s);
+  }
+  const auto dominated = [&](const FitPoint& p) {
+    const auto it = std::find_if(points.begin(), points.end(), [&](const FitPoint& q) { return q.tau_s == p.tau_s; });
+    return !(p.var > (1 - kLineShareLeftOut) * it->var);
+  };
+  range.line_points_left_out = static_cast<int>(std::count_if(out.begin(), out.end(), dominated));
+  std::erase_if(out, dominated);
+  return out;
+}
+
+void fit_with_checks(const std::vector<FitPoint>& all_points, const PhaseSeries& x, const AnalysisOptions& options,
                      AnalysisResult& r) {
+  const bool exact_counts = x.exact();
+  // Pulse counts are a ring-laser read-out: no vibration line to take off.
+  const std::vector<FitPoint> points =
+      options.fit_checks && !exact_counts ? without_spectral_lines(all_points, x, r.fit_range) : all_points;
   FitOptions fopt = options.fit;
   FitRangeChoice& range = r.fit_range;
   const bool default_range = fopt.tau_min_s == 0 && std::isinf(fopt.tau_max_s);
@@ -335,7 +376,7 @@ void allan_and_fit(const Recording& rec, const AnalysisOptions& options, Analysi
   const AllanResult octave_points = octave ? AllanResult{} : octave_points_of(r.allan, aopt);
   const AllanResult& fitted = octave ? r.allan : octave_points;
   try {
-    fit_with_checks(fit_points(fitted), options, rec.phase.exact(), r);
+    fit_with_checks(fit_points(fitted), rec.phase, options, r);
   } catch (const AnalysisError& e) {
     throw AnalysisError(fmt::format("{}: {}", rec.source, e.what()));
   }
@@ -399,6 +440,18 @@ namespace {
 
 using nlohmann::json;
 
+/// The spectral lines taken off the fit's points; rms in the phase unit per second.
+json spectral_lines_json(const FitRangeChoice& range) {
+  json lines = json::array();
+  for (const auto& l : range.lines)
+    lines.push_back({{"frequency_hz", l.f_hz},
+                     {"rms", l.rms},
+                     {"peak_over_local_level", l.peak_ratio},
+                     {"max_share_of_av", l.max_share},
+                     {"tau_at_max_share_s", l.tau_at_max_s}});
+  return lines;
+}
+
 json fit_json(const AnalysisResult& r) {
   const auto& f = r.fit;
   return {{"Q_arcsec", coef_json(f[Term::Q])},
@@ -430,7 +483,9 @@ json fit_json(const AnalysisResult& r) {
             {"filter_time_constant_s", r.fit_range.filter_tc_s},
             {"departure_tau_s", r.fit_range.departure_tau_s},
             {"departure_ratio", r.fit_range.departure_ratio},
-            {"reference_tau_min_s", r.fit_range.reference_tau_s}}},
+            {"reference_tau_min_s", r.fit_range.reference_tau_s},
+            {"spectral_lines", spectral_lines_json(r.fit_range)},
+            {"line_points_left_out", r.fit_range.line_points_left_out}}},
           {"intervals_scaled", r.fit_range.intervals_scaled},
           {"interval_scale", r.fit_range.interval_scale}};
 }

@@ -166,6 +166,16 @@ nlohmann::json channel_json(const AnalysisResult& r, const UnitSet& shown) {
   fit["tau_max_s"] = f.used.empty() ? 0.0 : f.used.back().tau_s;
   fit["range_reason"] = r.fit_range.reason();
   fit["intervals_scaled"] = r.fit_range.intervals_scaled;
+  nlohmann::json lines = nlohmann::json::array();
+  for (const auto& l : r.fit_range.lines)
+    lines.push_back({{"frequency_hz", l.f_hz},
+                     {"rms", {{"value", l.rms * shown.deviation.factor}, {"unit", shown.deviation.ascii}}},
+                     {"rms_si", {{"value", l.rms * si.deviation.factor}, {"unit", si.deviation.ascii}}},
+                     {"peak_over_local_level", l.peak_ratio},
+                     {"max_share_of_av", l.max_share},
+                     {"tau_at_max_share_s", l.tau_at_max_s}});
+  fit["spectral_lines"] = std::move(lines);
+  fit["line_points_left_out"] = r.fit_range.line_points_left_out;
   nlohmann::json warnings = nlohmann::json::array();
   for (const auto& w : r.warnings) warnings.push_back({{"code", w.code}, {"message", w.message}});
   return {{"source", r.column},
