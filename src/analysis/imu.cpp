@@ -284,6 +284,7 @@ struct AxisNoise {
   std::string column;
   Coefficient N, K;          ///< in SI (factor applied)
   double rejected_chi2 = 0;  ///< χ²/dof of a fit the goodness of fit rejected (its intervals scaled), else 0
+  std::string lines;         ///< frequencies of the spectral lines taken off the fit's points, Hz ("" none)
 };
 
 Coefficient scaled(const Coefficient& c, double f) {
@@ -295,10 +296,13 @@ Coefficient scaled(const Coefficient& c, double f) {
 std::vector<AxisNoise> axis_noise(const ImuResult& r, SensorKind kind) {
   const UnitSet si = si_units(kind);
   std::vector<AxisNoise> out;
-  for (const auto* c : of_kind(r, kind))
+  for (const auto* c : of_kind(r, kind)) {
+    std::string lines;
+    for (const auto& l : c->result.fit_range.lines) lines += fmt::format("{}{:.4g}", lines.empty() ? "" : ", ", l.f_hz);
     out.push_back({c->column, scaled(c->result.fit[Term::N], si[Term::N].factor),
                    scaled(c->result.fit[Term::K], si[Term::K].factor),
-                   c->result.fit_range.intervals_scaled ? c->result.fit.chi2_per_dof : 0.0});
+                   c->result.fit_range.intervals_scaled ? c->result.fit.chi2_per_dof : 0.0, lines});
+  }
   return out;
 }
 
@@ -423,6 +427,8 @@ std::string kalibr_yaml(const ImuResult& r, const KalibrOptions& options) {
             "#     the five-term model does not describe this axis (chi2/dof {:.3g}): its values are "
             "doubtful; see rwcalc diagnose\n",
             a.rejected_chi2);
+      if (!a.lines.empty())
+        s += fmt::format("#     spectral line(s) at {} Hz: their Allan variance taken off before the fit\n", a.lines);
     }
     const Combined n = combine(axes, &AxisNoise::N, options.combine);
     const Combined k = combine(axes, &AxisNoise::K, options.combine);
