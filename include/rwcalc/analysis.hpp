@@ -126,6 +126,8 @@ struct AnalysisResult {
   OutlierReport outliers;
   Verdict verdict;
   std::vector<AnalysisWarning> warnings;
+  /// `--gaps segments`: the segments the record was split into at its gaps (empty: no gap).
+  std::vector<Recording::Segment> segments;
 };
 
 /// Gyro or accelerometer data. Throws UsageError for clock data, AnalysisError for a record too short
@@ -144,6 +146,11 @@ std::string format_report(const AnalysisResult& r);
 
 /// "WARNINGS" block of the readable report (empty when there are none).
 std::string format_warnings(const std::vector<AnalysisWarning>& warnings);
+
+/// "  segments: 2 (…)": how a record with gaps was split (`--gaps segments`), one line; "" without.
+std::string format_segments(const AnalysisResult& r);
+/// {count, samples, durations_s, gaps: [{line, missing_s}]}, or null without gaps.
+nlohmann::json segments_json(const AnalysisResult& r);
 
 /// Temperature from a file name: m50C → −50, p25C → 25, -50C, +25C, _0C (°C). Empty if none.
 std::optional<double> temperature_from_name(std::string_view path);

@@ -186,6 +186,7 @@ nlohmann::json channel_json(const AnalysisResult& r, const UnitSet& shown) {
           {"samples", r.samples},
           {"rate_hz", r.rate_hz},
           {"duration_s", r.duration_s},
+          {"segments", segments_json(r)},
           {"mean", {{"value", r.mean_rate_deg_per_h * shown.deviation.factor}, {"unit", shown.deviation.ascii}}},
           {"earth_rate_subtracted",
            r.earth_rate_applied ? nlohmann::json(r.earth_rate_deg_per_h * shown.deviation.factor) : nullptr},
@@ -204,6 +205,7 @@ std::string format_channel(const AnalysisResult& r, const UnitSet& shown) {
   s += trf("Data\n  {} samples at {:g} Hz, {:.1f} s ({:.2f} h); mean {} {}; {}\n", r.samples, r.rate_hz, r.duration_s,
            r.duration_s / 3600.0, imu_num(r.mean_rate_deg_per_h * shown.deviation.factor, 6),
            localized_label(shown.deviation), earth_and_verdict(r));
+  s += format_segments(r);
   s += trf("\nAllan deviation ({}, {:g} % bounds)\n  {:>11} {:>12} {:>12} {:>12}\n", to_string(r.allan.estimator),
            100 * r.allan.confidence, tr("tau (s)"), tr("sigma"), tr("low"), tr("high"));
   const double k = shown.deviation.factor;
@@ -384,8 +386,9 @@ std::string format_imu(const ImuResult& r) {
     if (c.result.warnings.empty()) continue;
     s += fmt::format("[{}] ", printable(c.column)) + format_warnings(c.result.warnings);
   }
-  s += trf("Data\n  {} samples at {:g} Hz (tau0 = {:g} ms), {:.1f} s ({:.2f} h); {} channels\n\n", first.samples,
+  s += trf("Data\n  {} samples at {:g} Hz (tau0 = {:g} ms), {:.1f} s ({:.2f} h); {} channels\n", first.samples,
            first.rate_hz, 1000.0 / first.rate_hz, first.duration_s, first.duration_s / 3600.0, r.channels.size());
+  s += format_segments(first) + "\n";
   s += kind_table(of_kind(r, SensorKind::Gyro), r.gyro_units);
   s += kind_table(of_kind(r, SensorKind::Accelerometer), r.accel_units);
   s +=
