@@ -199,6 +199,7 @@ TEST(InputDefaults, AGapIsAnErrorWithTheLineAndTheMissingDuration) {
   const auto a = run_cli({"allan", f.string(), "--input", "rate", "--gaps", "segments"});
   EXPECT_EQ(a.status, 0) << a.err;
   EXPECT_TRUE(has(a.err, "2 segments")) << a.err;
+  EXPECT_FALSE(has(a.err, "jitter")) << a.err;  // a gap is not jitter
   const auto j = run_cli({"analyze", f.string(), "--input", "rate", "--gaps", "segments", "--json"});
   ASSERT_EQ(j.status, 0) << j.err;
   const auto seg = nlohmann::json::parse(j.out)["segments"];

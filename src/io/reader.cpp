@@ -40,6 +40,7 @@ struct TimeTrack {
   std::size_t n = 0;
   std::vector<Step> lows, highs;
   std::vector<Step> long_steps;  // over 1.25 median steps: the candidate gaps of `--gaps segments`
+  double max_no_gap = -std::numeric_limits<double>::infinity();  // the longest step below 1.5 median
   double tolerance = 0.01;  // fraction of the median step
   double median = 0;        // of the first steps; 0 until known
   double shift = 0;         // the first step: Σ(dt − shift) and Σ(dt − shift)² keep their digits
@@ -63,6 +64,7 @@ struct TimeTrack {
     sum1 += d, sum2 += d * d;
     if (median > 0) count(dt);
     if (median_known && dt > 1.25 * median) long_steps.push_back({n, last, t});
+    if (!median_known || dt < 1.5 * median) max_no_gap = std::max(max_no_gap, dt);
   }
   void count(double dt) { off += std::abs(dt - median) > tolerance * median; }
   // The median of the first steps (robust to one bad step); the steps so far are counted against it.
@@ -75,13 +77,28 @@ struct TimeTrack {
     median = steps[k / 2];
     if (median > 0)
       for (std::size_t i = 0; i < k; ++i) count(head[i + 1] - head[i]);
-    for (std::size_t i = 0; i < k; ++i)
-      if (head[i + 1] - head[i] > 1.25 * median) long_steps.push_back({i + 1, head[i], head[i + 1]});
+    max_no_gap = -std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < k; ++i) {
+      const double dt = head[i + 1] - head[i];
+      if (dt > 1.25 * median) long_steps.push_back({i + 1, head[i], head[i + 1]});
+      if (dt < 1.5 * median) max_no_gap = std::max(max_no_gap, dt);
+    }
   }
+  // Over the steps that are not gaps (1.5 median steps or more: refused, or segment boundaries).
   [[nodiscard]] TimeJitter jitter() const {
-    const auto k = static_cast<long double>(n - 1), c = static_cast<long double>(median) - shift;
-    const long double ss = std::max(0.0L, sum2 - 2 * c * sum1 + k * c * c);
-    return {off, std::max(max_dt - median, median - min_dt) / median,
+    long double s1 = sum1, s2 = sum2;
+    std::size_t steps = n - 1, off_steps = off;
+    for (const Step& g : long_steps) {
+      const double dt = g.after - g.before;
+      if (!(dt >= 1.5 * median)) continue;
+      const long double d = static_cast<long double>(dt) - shift;
+      s1 -= d, s2 -= d * d, --steps, --off_steps;
+    }
+    if (steps == 0) return {};
+    const auto k = static_cast<long double>(steps), c = static_cast<long double>(median) - shift;
+    const long double ss = std::max(0.0L, s2 - 2 * c * s1 + k * c * c);
+    const double longest = std::isfinite(max_no_gap) ? max_no_gap : median;
+    return {off_steps, std::max(longest - median, median - min_dt) / median,
             static_cast<double>(std::sqrt(ss / k) / static_cast<long double>(median))};
   }
   [[nodiscard]] Step first_outside(double lo, double hi) const {
