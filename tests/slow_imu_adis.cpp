@@ -1,6 +1,7 @@
 // `rwcalc imu` on the shipped ADIS16405 runs (../shared/data/real/imudata_adis16405): six channels
 // each, and the noise densities beside an independent white level: Welch's one-sided PSD S
-// (Hann windows of 4096 samples, half overlap) averaged over 1–5 Hz, density √(S/2).
+// (Hann windows of 4096 samples, half overlap) averaged over 1–5 Hz, density √(S/2): within 5 % for
+// every gyro and accelerometer.
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
@@ -83,16 +84,18 @@ TEST(ImuAdis, SixChannelsWithNoiseDensitiesAtTheWelchWhiteLevel) {
                      fmt::format("N {:.4e}, Welch {:.4e}, ratio {:.3f}", n, welch, n / welch));
       std::cout << fmt::format("run {} {:<11} N {:.4e}  Welch {:.4e}  ratio {:.3f}\n", run,
                                ch["column"].get<std::string>(), n, welch, n / welch);
-      if (c < 3) {
-        EXPECT_NEAR(n / welch, 1.0, 0.05) << "run " << run << " " << ch["column"];
+      EXPECT_NEAR(n / welch, 1.0, 0.05) << "run " << run << " " << ch["column"];
+      if (c >= 3) {
+        // The accelerometers carry a line near 0.55 Hz (up to 55 % of the AV at 0.64 s): found,
+        // its AV taken off the fit's points, and said (without that, N read 12–30 % high).
+        const auto& lines = ch["fit"]["spectral_lines"];
+        ASSERT_FALSE(lines.empty()) << "run " << run << " " << ch["column"];
+        EXPECT_NEAR(lines[0]["frequency_hz"].get<double>(), 0.55, 0.03) << "run " << run << " " << ch["column"];
+        bool said = false;
+        for (const auto& w : ch["warnings"]) said = said || w["code"] == "spectral_line";
+        EXPECT_TRUE(said) << "run " << run << " " << ch["column"];
       } else {
-        // The accelerometers' spectrum is not white below 1 Hz (a line near 0.6 Hz, a rise below
-        // it): the five-term fit over τ ≥ 0.32 s reads that excess as N and is rejected. Checked:
-        // N is not below the white level, and the rejection is said.
-        EXPECT_GT(n / welch, 0.95) << "run " << run << " " << ch["column"];
-        bool rejected = false;
-        for (const auto& w : ch["warnings"]) rejected = rejected || w["code"] == "fit_rejected";
-        EXPECT_TRUE(rejected || std::abs(n / welch - 1) < 0.05) << "run " << run << " " << ch["column"];
+        EXPECT_TRUE(ch["fit"]["spectral_lines"].empty()) << "run " << run << " " << ch["column"];
       }
     }
     const std::string y = slurp(yaml);

@@ -126,6 +126,47 @@ TEST(FitWarnings, OutputFilterMovesTheRangeUnlessTheUserGivesOne) {
   EXPECT_NE(g["fit"]["range"]["reason"].get<std::string>().find("--fit-range"), std::string::npos);
 }
 
+/// A 1-h 100-Hz floating-angle record (N 0.002 °/√h, B 0.005 °/h), with a 0.5-Hz rate line of
+/// amplitude 0.15 °/h when `line`.
+std::string line_record(const TempDir& dir, bool line) {
+  const std::string path = (dir.path() / (line ? "line.csv" : "plain.csv")).string();
+  std::vector<std::string> args{"simulate", "-o", path, "--duration", "3600", "--rate", "100", "--scale", "0.2",
+                                "--arw", "0.002", "--bias-instability", "0.005", "--white-readout",
+                                "--output-lowpass", "0.001"};
+  if (line) args.insert(args.end(), {"--sinusoid", "0.5:0.15"});
+  const auto r = run_cli(args);
+  EXPECT_EQ(r.status, 0) << r.err;
+  return path;
+}
+
+TEST(FitWarnings, SpectralLineIsTakenOffTheFitAndSaid) {
+  TempDir dir;
+  const auto r = run_cli({"analyze", line_record(dir, true), "--input", "angle", "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  const json& lines = j["fit"]["range"]["spectral_lines"];
+  ASSERT_EQ(lines.size(), 1u) << lines.dump();
+  EXPECT_NEAR(lines[0]["frequency_hz"].get<double>(), 0.5, 0.005);
+  EXPECT_NEAR(lines[0]["rms"].get<double>(), 0.15 / std::sqrt(2.0), 0.015);  // °/h
+  EXPECT_NE(warning(j, "spectral_line"), nullptr);
+  EXPECT_NE(j["fit"]["range"]["reason"].get<std::string>().find("0.5005 Hz"), std::string::npos);
+  // The same record without the line: nothing found, nothing said; and the fit of the record with
+  // the line, its AV taken off, is that of the record without it (with the line left in the fit,
+  // N read 0.00216 [0.00203, 0.00230] °/√h and B 0.025 °/h, χ²/dof 5.4).
+  const auto plain = run_cli({"analyze", line_record(dir, false), "--input", "angle", "--json"});
+  ASSERT_EQ(plain.status, 0) << plain.err;
+  const json p = json::parse(plain.out);
+  EXPECT_TRUE(p["fit"]["range"]["spectral_lines"].empty());
+  EXPECT_EQ(warning(p, "spectral_line"), nullptr);
+  const json& n = j["fit"]["N_deg_per_sqrt_h"];
+  const json& n0 = p["fit"]["N_deg_per_sqrt_h"];
+  const double width = n0["high95"].get<double>() - n0["low95"].get<double>();
+  EXPECT_NEAR(n["value"].get<double>(), n0["value"].get<double>(), 0.25 * width);
+  EXPECT_NEAR(j["fit"]["B_deg_per_h"]["value"].get<double>(), p["fit"]["B_deg_per_h"]["value"].get<double>(),
+              0.1 * p["fit"]["B_deg_per_h"]["value"].get<double>());
+  EXPECT_LT(j["fit"]["chi2_per_dof"].get<double>(), 2.0);
+}
+
 TEST(FitWarnings, AllanBoundsOfAnalyzeComeFromTheModel) {
   const auto r = run_cli({"analyze", source_path("data/gl2d/gl2d_0C.csv.gz").string(), "--json"});
   ASSERT_EQ(r.status, 0) << r.err;

@@ -1,6 +1,6 @@
 // The reader makes no silent choices for IMU files: rate and angle input need a sample rate; time
 // columns are read in s, ms, us or ns (by name or by the stamps' magnitude); jitter is accepted and
-// reported, a gap refused; a unit suffix of the column name chooses the unit (and the input kind)
+// reported, a gap refused (or, with --gaps segments, the record split at it); a unit suffix of the column name chooses the unit (and the input kind)
 // that no option gave, and every such choice is said on standard error and in the JSON.
 #include <gtest/gtest.h>
 
@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 
 #include <fmt/format.h>
@@ -192,7 +193,64 @@ TEST(InputDefaults, AGapIsAnErrorWithTheLineAndTheMissingDuration) {
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(has(r.err, "gap.csv:102: gap in the time column: 0.99 s at line 101, then 1.03 s: 0.03 s missing"))
       << r.err;
+  EXPECT_TRUE(has(r.err, "give --gaps segments")) << r.err;
   EXPECT_TRUE(r.out.empty());
+  // --gaps segments: accepted, split in two, and said (allan on stderr, analyze in text and JSON).
+  const auto a = run_cli({"allan", f.string(), "--input", "rate", "--gaps", "segments"});
+  EXPECT_EQ(a.status, 0) << a.err;
+  EXPECT_TRUE(has(a.err, "2 segments")) << a.err;
+  EXPECT_FALSE(has(a.err, "jitter")) << a.err;  // a gap is not jitter
+  const auto j = run_cli({"analyze", f.string(), "--input", "rate", "--gaps", "segments", "--json"});
+  ASSERT_EQ(j.status, 0) << j.err;
+  const auto seg = nlohmann::json::parse(j.out)["segments"];
+  ASSERT_TRUE(seg.is_object()) << j.out.substr(0, 400);
+  EXPECT_EQ(seg["count"], 2);
+  EXPECT_EQ(seg["samples"], nlohmann::json::parse("[100, 200]"));
+  ASSERT_EQ(seg["gaps"].size(), 1u);
+  EXPECT_EQ(seg["gaps"][0]["line"], 102);
+  EXPECT_NEAR(seg["gaps"][0]["missing_s"].get<double>(), 0.03, 1e-9);
+  const auto t = run_cli({"analyze", f.string(), "--input", "rate", "--gaps", "segments"});
+  EXPECT_TRUE(has(t.out, "segments: 2 (split at the time column's gaps by --gaps segments: 0.03 s before line 102"))
+      << t.out;
+  // Only refuse and segments are ways to deal with a gap.
+  const auto g = run_cli({"analyze", f.string(), "--input", "rate", "--gaps", "bridge"});
+  EXPECT_NE(g.status, 0);
+}
+
+// Round trip: a simulated 4-h record (N 0.15 °/h/√h, B 3 °/h) with 10 minutes cut out of it, read
+// with its time column and --gaps segments, gives intervals that hold the truth; the differences
+// never span the gap (the angle runs on through it: a spanning difference would see 600 s of
+// Earth rate, 7460″).
+TEST(InputDefaults, GapsSegmentsRecoverTheCoefficientsOfARecordWithAChunkCutOut) {
+  TempDir dir;
+  const auto sim = dir.path() / "sim.csv";
+  ASSERT_EQ(run_cli({"simulate", "-o", sim.string(), "--duration", "14400", "--rate", "10", "--scale", "0.2",
+                     "--arw", "0.15", "--bias-instability", "3", "--white-readout", "--output-lowpass", "0.001",
+                     "--seed", "3"})
+                .status,
+            0);
+  std::istringstream in(slurp(sim));
+  std::string line, out = "# rate_hz: 10\ntime_s,angle\n";
+  int k = -1;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#' || line == "angle") continue;
+    ++k;
+    if (k >= 60000 && k < 66000) continue;  // 600 s cut out
+    out += fmt::format("{:.1f},{}\n", 0.1 * k, line);
+  }
+  const auto f = dir.write("cut.csv", out);
+  const auto r = run_cli({"analyze", f.string(), "--input", "angle", "--gaps", "segments", "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["segments"]["count"], 2);
+  EXPECT_NEAR(j["segments"]["gaps"][0]["missing_s"].get<double>(), 600.0, 1e-6);
+  for (const auto& [key, truth] : {std::pair{"N_deg_per_sqrt_h", 0.15}, std::pair{"B_deg_per_h", 3.0}}) {
+    const auto& c = j["fit"][key];
+    EXPECT_TRUE(c["resolved"].get<bool>()) << key;
+    EXPECT_LE(c["low95"].get<double>(), truth) << key << " " << c.dump();
+    EXPECT_GE(c["high95"].get<double>(), truth) << key << " " << c.dump();
+  }
+  EXPECT_LT(j["fit"]["chi2_per_dof"].get<double>(), 3.0);
 }
 
 TEST(InputDefaults, ARateThatDisagreesWithTheTimeColumnNamesTheToleranceThatWouldAcceptIt) {

@@ -65,6 +65,20 @@ struct FitRangeChoice {
   double departure_tau_s = 0;
   double departure_ratio = 1;
   double reference_tau_s = 0;
+  /// Spectral lines of the rate (peaks 10× the local level of its Welch spectrum) whose Allan
+  /// variance, computed from the spectrum's excess, was taken off the octave points before the fit:
+  /// each with its frequency, rms (phase unit/s), peak over the local level, and the largest share
+  /// of an octave point's AV it carried (and that point's τ). Lines below 1 % everywhere are ignored.
+  struct Line {
+    double f_hz = 0;
+    double rms = 0;
+    double peak_ratio = 0;
+    double max_share = 0;
+    double tau_at_max_s = 0;
+  };
+  std::vector<Line> lines;
+  /// Octave points left out of the fit because the lines carry more than 90 % of their AV.
+  int line_points_left_out = 0;
   /// The fit was rejected (p < 0.001) and its intervals scaled by √(χ²/dof) (FitOptions::dispersion).
   bool intervals_scaled = false;
   double interval_scale = 1;  ///< √(χ²/dof) of the unscaled fit, when scaled
@@ -112,6 +126,8 @@ struct AnalysisResult {
   OutlierReport outliers;
   Verdict verdict;
   std::vector<AnalysisWarning> warnings;
+  /// `--gaps segments`: the segments the record was split into at its gaps (empty: no gap).
+  std::vector<Recording::Segment> segments;
 };
 
 /// Gyro or accelerometer data. Throws UsageError for clock data, AnalysisError for a record too short
@@ -130,6 +146,11 @@ std::string format_report(const AnalysisResult& r);
 
 /// "WARNINGS" block of the readable report (empty when there are none).
 std::string format_warnings(const std::vector<AnalysisWarning>& warnings);
+
+/// "  segments: 2 (…)": how a record with gaps was split (`--gaps segments`), one line; "" without.
+std::string format_segments(const AnalysisResult& r);
+/// {count, samples, durations_s, gaps: [{line, missing_s}]}, or null without gaps.
+nlohmann::json segments_json(const AnalysisResult& r);
 
 /// Temperature from a file name: m50C → −50, p25C → 25, -50C, +25C, _0C (°C). Empty if none.
 std::optional<double> temperature_from_name(std::string_view path);

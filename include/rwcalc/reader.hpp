@@ -54,6 +54,9 @@ struct ReadOptions {
   /// A time-column step off the period by more than this fraction of it is jitter (accepted and
   /// reported) while it stays within half a period; 1.5 periods or more is a gap (an error).
   double time_tolerance = 0.01;
+  /// `--gaps segments`: a gap in the time column splits the record into segments (each analysed
+  /// without a difference spanning a gap) instead of being refused.
+  bool gaps_as_segments = false;
   /// What identifies the gyro and the test, given on the command line (--serial, --operator,
   /// --test-date, --conditions): keys "serial", "operator", "test_date", "conditions". They take
   /// the place of the file's metadata of the same name (a note says so when that differs).
@@ -99,6 +102,15 @@ struct Recording {
   std::vector<std::string> warnings;
   /// Counter input: how many times the counter wrapped (a backwards step counts as a wrap).
   std::size_t counter_wraps = 0;
+  /// `--gaps segments`: the stretches between gaps of the time column, in samples (empty: no gap).
+  /// Sample `first` is the first after a gap of `gap_s` seconds (0 for the first segment) at `line`.
+  struct Segment {
+    std::size_t first = 0;
+    std::size_t samples = 0;
+    double gap_s = 0;
+    std::size_t line = 0;
+  };
+  std::vector<Segment> segments;
   /// Where each run of consecutive data lines starts: (sample index, 1-based line number), sorted
   /// by sample index. A new run starts after a comment or blank line inside the data.
   std::vector<std::pair<std::size_t, std::size_t>> line_runs;

@@ -11,6 +11,8 @@
 #include <optional>
 
 #include "analysis/fit_range.hpp"
+#include "analysis/segments.hpp"
+#include "analysis/spectral_lines.hpp"
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
@@ -169,6 +171,13 @@ nlohmann::json input_json(const Recording& rec) {
 
 namespace {
 
+/// A line that carries less than this share of every octave point's AV is ignored.
+constexpr double kLineShareIgnored = 0.01;
+/// The AV of a sinusoid of frequency f, ∝ sin⁴(πfτ)/(πfτ)², peaks at τ = this / f.
+constexpr double kLinePeakTau = 0.371;
+/// Points whose AV the lines carry more than this share of are left out of the fit.
+constexpr double kLineShareLeftOut = 0.9;
+
 /// What the result says of its record: source, size, column, pulse weight and temperature (from the
 /// option, the metadata or a column, or the file name, in that order).
 void describe_record(const Recording& rec, const AnalysisOptions& options, AnalysisResult& r) {
@@ -176,6 +185,7 @@ void describe_record(const Recording& rec, const AnalysisOptions& options, Analy
   r.samples = rec.samples;
   r.rate_hz = rec.rate_hz;
   r.duration_s = rec.phase.duration_s();
+  r.segments = rec.segments;
   r.column = rec.column_name;
   r.arcsec_per_count = rec.phase.exact() ? rec.phase.arcsec_per_count : 0.0;
   if (options.temperature_c) {
@@ -274,7 +284,14 @@ void decide_applicability(const Recording& rec, const AnalysisOptions& options, 
 
 /// Mean rate, expected Earth rate and the bias between them.
 void earth_rate_and_bias(const Recording& rec, const AnalysisOptions& options, AnalysisResult& r) {
-  r.mean_rate_deg_per_h = rec.phase.diff(rec.phase.points() - 1, 0) / r.duration_s;
+  if (rec.segments.size() < 2) {
+    r.mean_rate_deg_per_h = rec.phase.diff(rec.phase.points() - 1, 0) / r.duration_s;
+  } else {  // over the segments only: the phase may run on through a gap (angle input)
+    double change = 0, duration = 0;
+    for (const PhaseSeries& x : segment_phases(rec))
+      if (x.points() > 1) change += x.diff(x.points() - 1, 0), duration += x.duration_s();
+    r.mean_rate_deg_per_h = change / duration;
+  }
   if (!r.earth_rate_applied) {  // the mean is the bias (for an accelerometer, with gravity's projection)
     r.bias_deg_per_h = r.mean_rate_deg_per_h;
     return;
@@ -289,8 +306,41 @@ void earth_rate_and_bias(const Recording& rec, const AnalysisOptions& options, A
 /// The fit of the octave points: over the range the user gave, else from 10 τf when the shortest τ
 /// shows an output filter (check_output_filter), else over every point; a fit the goodness of fit
 /// rejects (p < 0.001) is refitted with its intervals scaled by √(χ²/dof) (FitOptions::dispersion).
-void fit_with_checks(const std::vector<FitPoint>& points, const AnalysisOptions& options, bool exact_counts,
+/// The octave points less the Allan variance of the rate's spectral lines (spectral_lines.hpp): a
+/// line the five-term model lacks would otherwise be read as white noise and bias-instability near
+/// τ ≈ 1/f. Only lines whose AV peaks (at τ = 0.371/f) at or beyond the short-τ check's reference τ
+/// are taken off: faster ones are short-τ structure, which the fit range leaves out
+/// (check_output_filter). Points the lines dominate (over 90 % of the AV) are left out: what
+/// remains there is the difference of two close numbers.
+std::vector<FitPoint> without_spectral_lines(const std::vector<FitPoint>& points, const PhaseSeries& x,
+                                             FitRangeChoice& range) {
+  std::vector<FitPoint> out = points;
+  for (const SpectralLineFound& found : find_spectral_lines(x)) {
+    if (kLinePeakTau / found.f_hz < short_tau_reference_s(x.tau0_s)) continue;
+    FitRangeChoice::Line line{found.f_hz, std::sqrt(found.power), found.peak_ratio, 0, 0};
+    for (const FitPoint& p : points) {
+      const double share = spectral_lines_avar({found}, p.tau_s) / p.var;
+      if (share > line.max_share) line.max_share = share, line.tau_at_max_s = p.tau_s;
+    }
+    if (line.max_share < kLineShareIgnored) continue;
+    range.lines.push_back(line);
+    for (FitPoint& p : out) p.var -= spectral_lines_avar({found}, p.tau_s);
+  }
+  const auto dominated = [&](const FitPoint& p) {
+    const auto it = std::find_if(points.begin(), points.end(), [&](const FitPoint& q) { return q.tau_s == p.tau_s; });
+    return !(p.var > (1 - kLineShareLeftOut) * it->var);
+  };
+  range.line_points_left_out = static_cast<int>(std::count_if(out.begin(), out.end(), dominated));
+  std::erase_if(out, dominated);
+  return out;
+}
+
+void fit_with_checks(const std::vector<FitPoint>& all_points, const PhaseSeries& x, const AnalysisOptions& options,
                      AnalysisResult& r) {
+  const bool exact_counts = x.exact();
+  // Pulse counts are a ring-laser read-out: no vibration line to take off.
+  const std::vector<FitPoint> points =
+      options.fit_checks && !exact_counts ? without_spectral_lines(all_points, x, r.fit_range) : all_points;
   FitOptions fopt = options.fit;
   FitRangeChoice& range = r.fit_range;
   const bool default_range = fopt.tau_min_s == 0 && std::isinf(fopt.tau_max_s);
@@ -323,7 +373,8 @@ void fit_with_checks(const std::vector<FitPoint>& points, const AnalysisOptions&
 /// Allan variance, fit and classic readout. A finer grid (--tau) is reported in full, but the fit
 /// and the slope readout use its octave points, so the coefficients and the verdict do not depend
 /// on the grid. The reported bounds of the overlapping AV are the fitted model's (apply_model_bounds).
-void allan_and_fit(const Recording& rec, const AnalysisOptions& options, AnalysisResult& r) {
+void allan_and_fit(const Recording& rec, const PhaseSeries& longest, const AnalysisOptions& options,
+                   AnalysisResult& r) {
   AllanOptions aopt = options.allan;
   const bool octave = aopt.grid.kind == TauGrid::Kind::Octave;
   if (!octave) {
@@ -331,28 +382,28 @@ void allan_and_fit(const Recording& rec, const AnalysisOptions& options, Analysi
     if (aopt.grid.kind == TauGrid::Kind::Dense && aopt.grid.max_m == 0)  // dense to N/10
       aopt.grid.max_m = std::max<std::int64_t>(1, static_cast<std::int64_t>(rec.phase.points() / 10));
   }
-  r.allan = compute_allan(rec.phase, aopt);
+  r.allan = allan_of_record(rec, aopt);
   const AllanResult octave_points = octave ? AllanResult{} : octave_points_of(r.allan, aopt);
   const AllanResult& fitted = octave ? r.allan : octave_points;
   try {
-    fit_with_checks(fit_points(fitted), options, rec.phase.exact(), r);
+    fit_with_checks(fit_points(fitted), longest, options, r);
   } catch (const AnalysisError& e) {
     throw AnalysisError(fmt::format("{}: {}", rec.source, e.what()));
   }
   r.slope = slope_readout(fitted);
-  if (options.fit_checks) r.model_bounds = apply_model_bounds(r.allan, r.fit, &rec.phase);
+  if (options.fit_checks) r.model_bounds = apply_model_bounds(r.allan, r.fit, &longest);
 }
 
 /// The paper's methods as unbiased estimators (direct N, B from the 100-s averages, σ_min/0.6643
 /// with its bias factor) and their discrepancies from the fit; the raw spread of 100-s means
 /// beside its expectation under the fit.
-void cross_checks(const Recording& rec, const AnalysisOptions& options, AnalysisResult& r) {
-  r.direct = direct_n(rec.phase, options.methods);
-  attach_straight_line_bias(r.direct, r.fit, r.duration_s, rec.phase.tau0_s);
-  r.b100 = b_from_averages(rec.phase, r.fit, options.methods.block_s);
+void cross_checks(const PhaseSeries& x, const AnalysisOptions& options, AnalysisResult& r) {
+  r.direct = direct_n(x, options.methods);
+  attach_straight_line_bias(r.direct, r.fit, x.duration_s(), x.tau0_s);
+  r.b100 = b_from_averages(x, r.fit, options.methods.block_s);
   r.b_min = b_from_minimum(r.allan, r.slope, r.fit);
   if (r.b_min.B.valid) r.slope_B_sigma = r.b_min.B.sigma;
-  r.avg100 = block_spread(rec.phase, options.methods.block_s);
+  r.avg100 = block_spread(x, options.methods.block_s);
   attach_expectation(r.avg100, r.fit);
   const auto& fn = r.fit[Term::N];
   const auto& fb = r.fit[Term::B];
@@ -384,9 +435,14 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   if (rec.phase.points() < 3)
     throw AnalysisError(trf("{}: the record holds {} sample(s); far too short to analyse", rec.source, rec.samples));
   earth_rate_and_bias(rec, options, r);
-  allan_and_fit(rec, options, r);
+  // A record split at gaps: the spectral-line search, the per-τ bounds and the cross-checks use the
+  // longest segment (they need one contiguous stretch); the Allan variance pools every segment.
+  const bool segmented = rec.segments.size() > 1;
+  const PhaseSeries longest = segmented ? longest_segment(rec) : PhaseSeries{};
+  const PhaseSeries& contiguous = segmented ? longest : rec.phase;
+  allan_and_fit(rec, contiguous, options, r);
   if (options.cross_checks) {
-    cross_checks(rec, options, r);
+    cross_checks(contiguous, options, r);
     if (r.sensor == SensorKind::Gyro) r.verdict = verdict_of(r, options);  // made, shown only if it applies
   }
   if (options.fit_checks) r.warnings = fit_warnings(r);
@@ -398,6 +454,18 @@ static nlohmann::json to_json_fields(const AnalysisResult& r);
 namespace {
 
 using nlohmann::json;
+
+/// The spectral lines taken off the fit's points; rms in the phase unit per second.
+json spectral_lines_json(const FitRangeChoice& range) {
+  json lines = json::array();
+  for (const auto& l : range.lines)
+    lines.push_back({{"frequency_hz", l.f_hz},
+                     {"rms", l.rms},
+                     {"peak_over_local_level", l.peak_ratio},
+                     {"max_share_of_av", l.max_share},
+                     {"tau_at_max_share_s", l.tau_at_max_s}});
+  return lines;
+}
 
 json fit_json(const AnalysisResult& r) {
   const auto& f = r.fit;
@@ -430,7 +498,9 @@ json fit_json(const AnalysisResult& r) {
             {"filter_time_constant_s", r.fit_range.filter_tc_s},
             {"departure_tau_s", r.fit_range.departure_tau_s},
             {"departure_ratio", r.fit_range.departure_ratio},
-            {"reference_tau_min_s", r.fit_range.reference_tau_s}}},
+            {"reference_tau_min_s", r.fit_range.reference_tau_s},
+            {"spectral_lines", spectral_lines_json(r.fit_range)},
+            {"line_points_left_out", r.fit_range.line_points_left_out}}},
           {"intervals_scaled", r.fit_range.intervals_scaled},
           {"interval_scale", r.fit_range.interval_scale}};
 }
@@ -554,6 +624,32 @@ nlohmann::json to_json(const AnalysisResult& r) {
   return j;
 }
 
+std::string format_segments(const AnalysisResult& r) {
+  if (r.segments.size() < 2) return {};
+  std::string lengths, gaps;
+  for (const auto& g : r.segments) {
+    lengths += fmt::format("{}{:.1f}", lengths.empty() ? "" : ", ", static_cast<double>(g.samples) / r.rate_hz);
+    if (g.gap_s > 0) gaps += trf("{}{:.6g} s before line {}", gaps.empty() ? "" : ", ", g.gap_s, g.line);
+  }
+  return trf("  segments: {} (split at the time column's gaps by --gaps segments: {}; lengths {} s); the Allan "
+             "variance pools them (no difference spans a gap), the cross-checks use the longest\n",
+             r.segments.size(), gaps, lengths);
+}
+
+nlohmann::json segments_json(const AnalysisResult& r) {
+  if (r.segments.size() < 2) return nullptr;
+  nlohmann::json samples = nlohmann::json::array(), durations = nlohmann::json::array(),
+                 gaps = nlohmann::json::array();
+  for (const auto& g : r.segments) {
+    samples.push_back(g.samples);
+    durations.push_back(static_cast<double>(g.samples) / r.rate_hz);
+    if (g.gap_s > 0) gaps.push_back({{"line", g.line}, {"missing_s", g.gap_s}, {"before_sample", g.first}});
+  }
+  return {{"count", r.segments.size()}, {"samples", samples}, {"durations_s", durations}, {"gaps", gaps},
+          {"allan", "pooled over the segments: no difference spans a gap; EDF the sum of the segments'"},
+          {"cross_checks", "on the longest segment"}};
+}
+
 static nlohmann::json to_json_fields(const AnalysisResult& r) {
   return {{"source", r.source},
           {"input", r.input},
@@ -566,6 +662,7 @@ static nlohmann::json to_json_fields(const AnalysisResult& r) {
           {"earth_rate_deg_per_h", r.earth_rate_deg_per_h},
           {"latitude_deg", r.earth_rate_given || !r.earth_rate_applied ? json(nullptr) : json(r.latitude_deg)},
           {"bias_deg_per_h", r.bias_deg_per_h},
+          {"segments", segments_json(r)},
           {"warnings", warnings_json(r)},
           {"allan", allan_bounds_json(r)},
           {"fit", fit_json(r)},
@@ -618,6 +715,7 @@ std::string format_report(const AnalysisResult& r) {
   if (r.arcsec_per_count > 0) s += trf(", pulse weight {:g} arcsec", r.arcsec_per_count);
   s += "\n";
   s += input_line(r.input);
+  s += format_segments(r);
   s += r.temperature_c ? trf("  temperature {:g} °C (from {})\n", *r.temperature_c, tr(r.temperature_source))
                        : std::string(tr("  temperature unknown\n"));
   if (r.earth_rate_applied)

@@ -79,6 +79,8 @@ std::string shell_word(const std::string& path) {
 
 double filter_free_tau_s(double tc_s) { return kFilterTaus * tc_s; }
 
+double short_tau_reference_s(double tau0_s) { return kReferenceTaus * tau0_s; }
+
 namespace {
 
 /// The short-τ points against the model fitted from `reference_tau_s`.
@@ -121,13 +123,14 @@ OutputFilterCheck compare_short_tau(std::span<const FitPoint> octave, const FitO
 OutputFilterCheck check_output_filter(std::span<const FitPoint> octave, const FitOptions& fit) {
   if (octave.empty() || octave.front().m != 1 || !(octave.front().edf > 0) || !(octave.front().var > 0)) return {};
   // A filter slow enough to bend the reference range too is underestimated: the reference moves
-  // up an octave at a time until it starts beyond 30 τf.
+  // up an octave at a time until it starts beyond 30 τf. A reference so far up that its
+  // extrapolation no longer resolves the roll-off keeps the nearer one's finding.
   double reference = kReferenceTaus * octave.front().tau_s;
   OutputFilterCheck c = compare_short_tau(octave, fit, reference);
   for (int k = 0; k < 4 && c.found && c.tc_s * kReferenceFilterTaus > c.reference_tau_s; ++k) {
     reference = 2.0 * c.reference_tau_s;
     const OutputFilterCheck next = compare_short_tau(octave, fit, reference);
-    if (next.reference_tau_s == 0) break;  // no fit that far up
+    if (next.reference_tau_s == 0 || !next.found) break;  // no fit that far up, or one too loose
     c = next;
   }
   return c;
@@ -210,18 +213,33 @@ std::string short_tau_findings(const FitRangeChoice& c) {
 
 }  // namespace
 
-std::string FitRangeChoice::reason() const {
-  switch (source) {
-    case Source::Option: return tr("the range given by --fit-range");
-    case Source::ShortTau:
-      return trf("tau >= {:g} s ({}): {}", tau_min_s,
-                 filter_tc_s > 0 && 10.0 * filter_tc_s >= 2.0 * departure_tau_s ? tr("10 tau_f")
-                                                                                : tr("beyond the departing points"),
-                 short_tau_findings(*this));
-    case Source::All: break;
+namespace {
+
+/// The clause on the spectral lines taken off the points ("" when none).
+std::string lines_clause(const FitRangeChoice& c) {
+  if (c.lines.empty()) return {};
+  std::string freqs;
+  for (const auto& l : c.lines) freqs += fmt::format("{}{:.4g}", freqs.empty() ? "" : ", ", l.f_hz);
+  return trf("; the Allan variance of the spectral line(s) at {} Hz taken off the points", freqs);
+}
+
+std::string range_clause(const FitRangeChoice& c) {
+  switch (c.source) {
+    case FitRangeChoice::Source::Option: return tr("the range given by --fit-range");
+    case FitRangeChoice::Source::ShortTau:
+      return trf("tau >= {:g} s ({}): {}", c.tau_min_s,
+                 c.filter_tc_s > 0 && 10.0 * c.filter_tc_s >= 2.0 * c.departure_tau_s
+                     ? tr("10 tau_f")
+                     : tr("beyond the departing points"),
+                 short_tau_findings(c));
+    case FitRangeChoice::Source::All: break;
   }
   return tr("every octave point (the short-tau points agree with the model)");
 }
+
+}  // namespace
+
+std::string FitRangeChoice::reason() const { return range_clause(*this) + lines_clause(*this); }
 
 std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r) {
   std::vector<AnalysisWarning> w;
@@ -232,13 +250,30 @@ std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r) {
                  trf("The fit uses tau >= {:g} s only: {}. Give --fit-range to choose the range yourself.",
                      fr.tau_min_s, short_tau_findings(fr)),
                  trf("rwcalc analyze {} [input options] --fit-range 0:", src)});
+  for (const auto& line : fr.lines) {
+    const ShownUnit si = si_units(r.sensor).deviation;
+    w.push_back({"spectral_line",
+                 trf("A spectral line at {:.4g} Hz (rms {:.3g} {}, {:.0f} times the local level of the Welch "
+                     "spectrum) is not in the five-term model: its Allan variance, computed from the spectrum's "
+                     "excess over the local level, is taken off the octave points before the fit (it was "
+                     "{:.0f} % of the AV at {:g} s).",
+                     line.f_hz, line.rms * si.factor, localized_label(si), line.peak_ratio,
+                     100.0 * line.max_share, line.tau_at_max_s),
+                 ""});
+  }
+  if (fr.line_points_left_out > 0)
+    w.push_back({"spectral_line",
+                 trf("{} octave point(s) left out of the fit: spectral lines carry over 90 % of their AV.",
+                     fr.line_points_left_out),
+                 ""});
   if (r.fit.p_value < 0.001)
     w.push_back({"fit_rejected",
                  trf("The five-term model does not describe the Allan variance: chi2/dof = {:.3g} "
                      "(dof {}, p = {:.2g}). The coefficients' intervals are scaled by sqrt(chi2/dof) = "
                      "{:.3g}; look for what the model misses.",
                      r.fit.chi2_per_dof, r.fit.dof, r.fit.p_value, fr.interval_scale),
-                 trf("rwcalc diagnose {} [input options]", src)});
+                 // diagnose simulates gyros only: an accelerometer gets no command to try
+                 r.sensor == SensorKind::Gyro ? trf("rwcalc diagnose {} [input options]", src) : std::string()});
   return w;
 }
 

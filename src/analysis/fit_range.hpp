@@ -29,6 +29,10 @@ OutputFilterCheck check_output_filter(std::span<const FitPoint> octave, const Fi
 /// The fit's lower τ that leaves a filter of time constant tc_s out (10·τf).
 double filter_free_tau_s(double tc_s);
 
+/// The lower τ of the model fit against which check_output_filter compares the short-τ points
+/// (16 τ0): structure below it is left out of the fit by the range; above it, it is in the fit.
+double short_tau_reference_s(double tau0_s);
+
 /// Variance of the overlapping AV estimate at cluster size m measured from the data, relative to
 /// its Gaussian value, over the lags at which white phase noise makes two terms share samples (0, m,
 /// 2m; products taken against the disjoint lag 3m). A pulse read-out's count errors are far from

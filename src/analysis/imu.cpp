@@ -166,6 +166,16 @@ nlohmann::json channel_json(const AnalysisResult& r, const UnitSet& shown) {
   fit["tau_max_s"] = f.used.empty() ? 0.0 : f.used.back().tau_s;
   fit["range_reason"] = r.fit_range.reason();
   fit["intervals_scaled"] = r.fit_range.intervals_scaled;
+  nlohmann::json lines = nlohmann::json::array();
+  for (const auto& l : r.fit_range.lines)
+    lines.push_back({{"frequency_hz", l.f_hz},
+                     {"rms", {{"value", l.rms * shown.deviation.factor}, {"unit", shown.deviation.ascii}}},
+                     {"rms_si", {{"value", l.rms * si.deviation.factor}, {"unit", si.deviation.ascii}}},
+                     {"peak_over_local_level", l.peak_ratio},
+                     {"max_share_of_av", l.max_share},
+                     {"tau_at_max_share_s", l.tau_at_max_s}});
+  fit["spectral_lines"] = std::move(lines);
+  fit["line_points_left_out"] = r.fit_range.line_points_left_out;
   nlohmann::json warnings = nlohmann::json::array();
   for (const auto& w : r.warnings) warnings.push_back({{"code", w.code}, {"message", w.message}});
   return {{"source", r.column},
@@ -176,6 +186,7 @@ nlohmann::json channel_json(const AnalysisResult& r, const UnitSet& shown) {
           {"samples", r.samples},
           {"rate_hz", r.rate_hz},
           {"duration_s", r.duration_s},
+          {"segments", segments_json(r)},
           {"mean", {{"value", r.mean_rate_deg_per_h * shown.deviation.factor}, {"unit", shown.deviation.ascii}}},
           {"earth_rate_subtracted",
            r.earth_rate_applied ? nlohmann::json(r.earth_rate_deg_per_h * shown.deviation.factor) : nullptr},
@@ -194,6 +205,7 @@ std::string format_channel(const AnalysisResult& r, const UnitSet& shown) {
   s += trf("Data\n  {} samples at {:g} Hz, {:.1f} s ({:.2f} h); mean {} {}; {}\n", r.samples, r.rate_hz, r.duration_s,
            r.duration_s / 3600.0, imu_num(r.mean_rate_deg_per_h * shown.deviation.factor, 6),
            localized_label(shown.deviation), earth_and_verdict(r));
+  s += format_segments(r);
   s += trf("\nAllan deviation ({}, {:g} % bounds)\n  {:>11} {:>12} {:>12} {:>12}\n", to_string(r.allan.estimator),
            100 * r.allan.confidence, tr("tau (s)"), tr("sigma"), tr("low"), tr("high"));
   const double k = shown.deviation.factor;
@@ -274,6 +286,7 @@ struct AxisNoise {
   std::string column;
   Coefficient N, K;          ///< in SI (factor applied)
   double rejected_chi2 = 0;  ///< χ²/dof of a fit the goodness of fit rejected (its intervals scaled), else 0
+  std::string lines;         ///< frequencies of the spectral lines taken off the fit's points, Hz ("" none)
 };
 
 Coefficient scaled(const Coefficient& c, double f) {
@@ -285,10 +298,13 @@ Coefficient scaled(const Coefficient& c, double f) {
 std::vector<AxisNoise> axis_noise(const ImuResult& r, SensorKind kind) {
   const UnitSet si = si_units(kind);
   std::vector<AxisNoise> out;
-  for (const auto* c : of_kind(r, kind))
+  for (const auto* c : of_kind(r, kind)) {
+    std::string lines;
+    for (const auto& l : c->result.fit_range.lines) lines += fmt::format("{}{:.4g}", lines.empty() ? "" : ", ", l.f_hz);
     out.push_back({c->column, scaled(c->result.fit[Term::N], si[Term::N].factor),
                    scaled(c->result.fit[Term::K], si[Term::K].factor),
-                   c->result.fit_range.intervals_scaled ? c->result.fit.chi2_per_dof : 0.0});
+                   c->result.fit_range.intervals_scaled ? c->result.fit.chi2_per_dof : 0.0, lines});
+  }
   return out;
 }
 
@@ -370,8 +386,9 @@ std::string format_imu(const ImuResult& r) {
     if (c.result.warnings.empty()) continue;
     s += fmt::format("[{}] ", printable(c.column)) + format_warnings(c.result.warnings);
   }
-  s += trf("Data\n  {} samples at {:g} Hz (tau0 = {:g} ms), {:.1f} s ({:.2f} h); {} channels\n\n", first.samples,
+  s += trf("Data\n  {} samples at {:g} Hz (tau0 = {:g} ms), {:.1f} s ({:.2f} h); {} channels\n", first.samples,
            first.rate_hz, 1000.0 / first.rate_hz, first.duration_s, first.duration_s / 3600.0, r.channels.size());
+  s += format_segments(first) + "\n";
   s += kind_table(of_kind(r, SensorKind::Gyro), r.gyro_units);
   s += kind_table(of_kind(r, SensorKind::Accelerometer), r.accel_units);
   s +=
@@ -411,8 +428,10 @@ std::string kalibr_yaml(const ImuResult& r, const KalibrOptions& options) {
       if (a.rejected_chi2 > 0)
         s += fmt::format(
             "#     the five-term model does not describe this axis (chi2/dof {:.3g}): its values are "
-            "doubtful; see rwcalc diagnose\n",
-            a.rejected_chi2);
+            "doubtful{}\n",
+            a.rejected_chi2, kind == SensorKind::Gyro ? "; see rwcalc diagnose" : "");
+      if (!a.lines.empty())
+        s += fmt::format("#     spectral line(s) at {} Hz: their Allan variance taken off before the fit\n", a.lines);
     }
     const Combined n = combine(axes, &AxisNoise::N, options.combine);
     const Combined k = combine(axes, &AxisNoise::K, options.combine);

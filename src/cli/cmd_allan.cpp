@@ -8,7 +8,9 @@
 #include <nlohmann/json.hpp>
 #include <ostream>
 
+#include "analysis/segments.hpp"
 #include "cli/analyze_args.hpp"
+#include "rwcalc/printable.hpp"
 #include "cli/commands.hpp"
 #include "cli/numeric_options.hpp"
 #include "rwcalc/allan.hpp"
@@ -128,7 +130,12 @@ int run_allan(const AllanArgs& a, Io& io) {
   o.noise_id_domain = (rec.mode == InputMode::Pulses || rec.mode == InputMode::Rate || rec.mode == InputMode::Increment)
                           ? NoiseIdDomain::Frequency
                           : NoiseIdDomain::Phase;
-  const AllanResult res = compute_allan(rec.phase, o);
+  // A record split at its gaps (--gaps segments): every τ pools the segments' terms.
+  const AllanResult res = allan_of_record(rec, o);
+  if (rec.segments.size() > 1)
+    print_message(io.err, trf("{}: {} segments (split at the time column's gaps by --gaps segments); the Allan "
+                              "variance pools them: no difference spans a gap",
+                              printable(rec.source), rec.segments.size()));
   require_finite(res, rec);
   // Where fewer than 10 averages of τ fit in the record, Stable32's noise identification (the B1 ratio,
   // taken for the number of terms as Stable32 does) and the EDF that follows are weak: said on stderr,

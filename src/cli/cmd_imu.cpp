@@ -27,6 +27,7 @@ struct ImuCmd {
   std::string file;
   std::optional<double> rate_hz;
   double time_tolerance = 0.01;
+  std::string gaps = "refuse";
   std::vector<std::string> gyro, accel;
   std::string vertical_gyro;
   std::string gyro_unit, accel_unit;
@@ -43,6 +44,7 @@ struct ImuCmd {
     ImuOptions o;
     o.read.rate_hz = rate_hz;
     o.read.time_tolerance = time_tolerance;
+    o.read.gaps_as_segments = gaps == "segments";
     o.gyro_columns = gyro;
     o.accel_columns = accel;
     o.vertical_gyro = vertical_gyro;
@@ -149,6 +151,7 @@ void register_imu(CLI::App& app, Runner& runner) {
       ->check(real_in(0.0, 0.5, ""))
       ->capture_default_str()
       ->group(tr("Input"));
+  add_gaps_option(*sub, cmd->gaps);
   sub->add_option("--gyro", cmd->gyro, tr("Gyro columns: header names or 1-based indices, comma-separated"))
       ->delimiter(',')
       ->group(tr("Input"));

@@ -26,6 +26,9 @@ using Runner = std::function<int(Io&)>;
 /// \n, \x1b, \xff and cannot forge a line or drive the terminal. Every message goes through here.
 void print_message(std::ostream& err, std::string_view text);
 
+/// `--gaps refuse|segments` (ReadOptions::gaps_as_segments).
+void add_gaps_option(CLI::App& app, std::string& gaps);
+
 /// Input options shared by every command that reads a recording (allan, analyze, batch, diagnose).
 struct InputArgs {
   std::string input;  ///< empty: not given (the column name may imply it; else pulses)
@@ -36,6 +39,7 @@ struct InputArgs {
   std::string angle_unit;  ///< empty: not given (the column name's suffix, else arcsec)
   std::string rate_unit;   ///< empty: not given (the column name's suffix, else deg/h)
   double time_tolerance = 0.01;
+  std::string gaps = "refuse";  ///< --gaps refuse|segments
   std::string serial, operator_name, test_date, conditions;  ///< empty: the file's metadata, if any
   void add_to(CLI::App& app);
   [[nodiscard]] ReadOptions options() const;  ///< throws UsageError on bad names

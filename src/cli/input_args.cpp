@@ -56,6 +56,18 @@ void InputArgs::add_to(CLI::App& app) {
       ->check(real_in(0.0, 0.5, ""))
       ->capture_default_str()
       ->group(tr("Input"));
+  add_gaps_option(app, gaps);
+}
+
+void add_gaps_option(CLI::App& app, std::string& gaps) {
+  app.add_option("--gaps", gaps,
+                 tr("Gaps in the time column (steps of 1.5 periods or more): refuse (an error naming the gap), or "
+                    "segments (the record is split at the gaps and the Allan variance pooled over the segments; "
+                    "no difference spans a gap)"))
+      ->check(CLI::IsMember({"refuse", "segments"}))
+      ->option_text("refuse|segments")
+      ->capture_default_str()
+      ->group(tr("Input"));
 }
 
 ReadOptions InputArgs::options() const {
@@ -68,6 +80,7 @@ ReadOptions InputArgs::options() const {
   if (!angle_unit.empty()) o.angle_unit = parse_angle_unit(angle_unit);
   if (!rate_unit.empty()) o.rate_unit = parse_rate_unit(rate_unit);
   o.time_tolerance = time_tolerance;
+  o.gaps_as_segments = gaps == "segments";
   const std::string* given[] = {&serial, &operator_name, &test_date, &conditions};
   for (std::size_t i = 0; i < std::size(given); ++i)
     if (!given[i]->empty()) o.identification[std::string(kIdentificationKeys[i])] = *given[i];

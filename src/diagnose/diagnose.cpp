@@ -45,6 +45,8 @@ const Recording& screened(const Recording& read, const DiagnoseOptions& opt, Out
            "diagnosed"));
   if (read.phase.kind != PhaseKind::Gyro)
     throw UsageError(tr("diagnose needs gyro data (clock phase/frequency cannot be simulated as a gyro)"));
+  if (read.segments.size() > 1)
+    throw UsageError(tr("diagnose needs one contiguous record: --gaps segments is for analyze, allan and imu"));
   if (opt.runs < 10) throw UsageError(trf("--runs must be at least 10 (got {})", opt.runs));
   const Recording& rec =
       screen_outliers(read, opt.analysis.outlier_action, opt.analysis.outlier_threshold, outliers, edited);

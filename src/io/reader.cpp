@@ -39,6 +39,8 @@ struct TimeTrack {
   double min_dt = std::numeric_limits<double>::infinity(), max_dt = -std::numeric_limits<double>::infinity();
   std::size_t n = 0;
   std::vector<Step> lows, highs;
+  std::vector<Step> long_steps;  // over 1.25 median steps: the candidate gaps of `--gaps segments`
+  double max_no_gap = -std::numeric_limits<double>::infinity();  // the longest step below 1.5 median
   double tolerance = 0.01;  // fraction of the median step
   double median = 0;        // of the first steps; 0 until known
   double shift = 0;         // the first step: Σ(dt − shift) and Σ(dt − shift)² keep their digits
@@ -61,6 +63,8 @@ struct TimeTrack {
     const long double d = static_cast<long double>(dt) - shift;
     sum1 += d, sum2 += d * d;
     if (median > 0) count(dt);
+    if (median_known && dt > 1.25 * median) long_steps.push_back({n, last, t});
+    if (!median_known || dt < 1.5 * median) max_no_gap = std::max(max_no_gap, dt);
   }
   void count(double dt) { off += std::abs(dt - median) > tolerance * median; }
   // The median of the first steps (robust to one bad step); the steps so far are counted against it.
@@ -73,11 +77,28 @@ struct TimeTrack {
     median = steps[k / 2];
     if (median > 0)
       for (std::size_t i = 0; i < k; ++i) count(head[i + 1] - head[i]);
+    max_no_gap = -std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < k; ++i) {
+      const double dt = head[i + 1] - head[i];
+      if (dt > 1.25 * median) long_steps.push_back({i + 1, head[i], head[i + 1]});
+      if (dt < 1.5 * median) max_no_gap = std::max(max_no_gap, dt);
+    }
   }
+  // Over the steps that are not gaps (1.5 median steps or more: refused, or segment boundaries).
   [[nodiscard]] TimeJitter jitter() const {
-    const auto k = static_cast<long double>(n - 1), c = static_cast<long double>(median) - shift;
-    const long double ss = std::max(0.0L, sum2 - 2 * c * sum1 + k * c * c);
-    return {off, std::max(max_dt - median, median - min_dt) / median,
+    long double s1 = sum1, s2 = sum2;
+    std::size_t steps = n - 1, off_steps = off;
+    for (const Step& g : long_steps) {
+      const double dt = g.after - g.before;
+      if (!(dt >= 1.5 * median)) continue;
+      const long double d = static_cast<long double>(dt) - shift;
+      s1 -= d, s2 -= d * d, --steps, --off_steps;
+    }
+    if (steps == 0) return {};
+    const auto k = static_cast<long double>(steps), c = static_cast<long double>(median) - shift;
+    const long double ss = std::max(0.0L, s2 - 2 * c * s1 + k * c * c);
+    const double longest = std::isfinite(max_no_gap) ? max_no_gap : median;
+    return {off_steps, std::max(longest - median, median - min_dt) / median,
             static_cast<double>(std::sqrt(ss / k) / static_cast<long double>(median))};
   }
   [[nodiscard]] Step first_outside(double lo, double hi) const {
@@ -205,6 +226,7 @@ class Reader {
   void check_unread_keys() const;
   void check_time_columns_agree() const;
   void check_time_column() const;
+  void split_at_gaps(Recording& rec) const;
   void check_rate_against_time_column(const TimeTrack::Step& bad, double period) const;
   void build_counts(PhaseSeries& ph, std::size_t& wraps);
   void build_values(PhaseSeries& ph);
@@ -392,13 +414,37 @@ void Reader::check_time_column() const {
   check_rate_against_time_column(times_.first_outside(period - tol, period + tol), period);
   const double lo = std::nextafter(0.5 * period, period), hi = std::nextafter(1.5 * period, period);
   if (times_.min_dt >= lo && times_.max_dt <= hi) return;
+  if (opt_.gaps_as_segments) {  // gaps split the record; a step too short is still an error
+    if (times_.min_dt < lo) fail_step(times_.first_outside(lo, std::numeric_limits<double>::infinity()), period);
+    return;
+  }
   fail_step(times_.first_outside(lo, hi), period);
+}
+
+// `--gaps segments`: the segments between the time column's gaps (steps of 1.5 periods or more).
+void Reader::split_at_gaps(Recording& rec) const {
+  if (!opt_.gaps_as_segments || !layout_.time_col || times_.n < 2) return;
+  const double period = tunit_->per_second / rate_hz_;
+  std::vector<Recording::Segment> segs{{0, 0, 0, parser_.first_data_line()}};
+  for (const TimeTrack::Step& s : times_.long_steps) {
+    if (!(s.after - s.before >= 1.5 * period)) continue;
+    segs.back().samples = s.sample - segs.back().first;
+    segs.push_back({s.sample, 0, (s.after - s.before - period) / tunit_->per_second, line_of_sample(s.sample)});
+  }
+  if (segs.size() == 1) return;
+  segs.back().samples = samples_ - segs.back().first;
+  rec.segments = std::move(segs);
 }
 
 // --rate or rate_hz against the mean step of the time column.
 void Reader::check_rate_against_time_column(const TimeTrack::Step& bad, double period) const {
   if (rate_source_ != RateSource::Option && rate_source_ != RateSource::Metadata) return;
-  const double est = (times_.last - times_.first) / static_cast<double>(times_.n - 1);
+  // The mean step over the steps that are not gaps (1.5 median steps or more): a gap is said as such.
+  double gaps = 0;
+  std::size_t gap_steps = 0;
+  for (const TimeTrack::Step& s : times_.long_steps)
+    if (s.after - s.before >= 1.5 * times_.median) gaps += s.after - s.before, ++gap_steps;
+  const double est = (times_.last - times_.first - gaps) / static_cast<double>(times_.n - 1 - gap_steps);
   if (std::abs(est - period) <= opt_.time_tolerance * period) return;
   const std::string tcol = layout_.header.empty() ? "column 1" : "'" + layout_.header[*layout_.time_col] + "'";
   fail(line_of_sample(bad.sample),
@@ -424,9 +470,9 @@ void Reader::check_rate_against_time_column(const TimeTrack::Step& bad, double p
   const double missing = std::round(dt / period - 1);
   fail(line,
        trf("gap in the time column: {} at line {}, then {}: {:.6g} s missing (~{:g} sample{}; a step "
-           "of {:.6g} periods of {:g} s); rwcalc neither resamples nor analyses a record with gaps: cut the record at "
-           "this line and analyse the parts separately (--time-tolerance only sets which steps within half a "
-           "period count as jitter)",
+           "of {:.6g} periods of {:g} s); rwcalc does not resample: give --gaps segments to analyse the "
+           "stretches between gaps as segments (no difference spans a gap), or cut the record at this line "
+           "(--time-tolerance only sets which steps within half a period count as jitter)",
            stamp(t0), prev, stamp(t1), (dt - period) / tunit_->per_second, missing, missing == 1 ? "" : "s",
            dt / period, p_s));
 }
@@ -600,6 +646,7 @@ Recording Reader::finish() {
     slot = value;
   }
   note_time_column(rec);
+  split_at_gaps(rec);
   rec.line_runs = std::move(runs_);
   return rec;
 }
