@@ -137,7 +137,8 @@ struct Tally {
 /// `ok` checks the recovered parameters against it.
 Tally run_effect(const std::string& effect, std::size_t n, std::uint64_t seed0,
                  const std::function<json(std::mt19937_64&, NoiseModel&)>& make,
-                 const std::function<bool(const json& truth, const json& est)>& ok) {
+                 const std::function<bool(const json& truth, const json& est)>& ok,
+                 const std::function<void(const DiagnoseResult&)>& also = {}) {
   Tally t;
   std::mt19937_64 g(seed0);
   for (std::size_t i = 0; i < n; ++i) {
@@ -145,6 +146,7 @@ Tally run_effect(const std::string& effect, std::size_t n, std::uint64_t seed0,
     const json truth = make(g, m);
     if (only_case() >= 0 && static_cast<std::size_t>(only_case()) != i) continue;
     const auto r = run_case(m, seed0 + 101 * i);
+    if (also) also(r);
     const json* est = finding(r, effect);
     ++t.n;
     const bool named = est != nullptr;
@@ -203,6 +205,43 @@ TEST(DiagnoseAcceptance, Sinusoid) {
   expect_rates(t);
 }
 
+// Slow periodic terms: a period of 25–40 min (3–5 cycles in the 2-h record; log-uniform) at 2.5–3.5×
+// the flicker floor 0.6643·B = 0.0033 °/h in amplitude (0.0083–0.0116 °/h), random phase. The local
+// noise there (flicker and ARW, S ≈ 0.012 (°/h)²/Hz) gives σ_A ≈ √(S/T) ≈ 0.0013 °/h, 11–16 % of A,
+// so the tolerance is A ± 30 % and |Δf| ≤ 0.5/T as above. It must not be named Gauss–Markov, and
+// the extended model's B (without the line) must not exceed the base's (with it).
+// RWCALC_DIAGNOSE_RANGE=lo,hi: the amplitude range in units of the flicker floor.
+// NOT MET (disabled; docs/diagnosis.md, "Slow lines"). Measured (seeds 1500…, 10 cases, 20 runs):
+// named 1/10, within tolerance 1/10, gain in and out of sample 1/1; never named gauss_markov, B of
+// the extended model never above the base's. The misses' statistics 2–30 against thresholds 9–51:
+// at 3× the flicker floor a line of 3–5 cycles carries A²T/(2S) ≈ 18 (S ≈ 0.02 (°/h)²/Hz) of
+// explained power, and the flicker's own power in those bins varies ×4 between records.
+TEST(DiagnoseAcceptance, DISABLED_SlowSinusoid) {
+  std::size_t misnamed = 0, b_absorbed = 0;
+  const auto t = run_effect(
+      "sinusoid", cases(10), 1500,
+      [r = size_range(2.5, 3.5)](std::mt19937_64& g, NoiseModel& m) {
+        const double floor = 0.6643 * m.bias_instability_deg_per_h;
+        Sinusoid s{1.0 / log_uniform(g, 1500, 2400), uniform(g, r.first, r.second) * floor, uniform(g, 0, 6.283)};
+        m.sinusoids.push_back(s);
+        return json{{"frequency_hz", s.f_hz}, {"amplitude_deg_per_h", s.amp_deg_per_h}};
+      },
+      [](const json& tr, const json& e) {
+        return std::abs(e["frequency_hz"].get<double>() - tr["frequency_hz"].get<double>()) <= 0.5 / 7200.0 &&
+               within(e["amplitude_deg_per_h"], tr["amplitude_deg_per_h"], 0.3);
+      },
+      [&](const DiagnoseResult& r) {
+        misnamed += finding(r, "gauss_markov") != nullptr;
+        if (finding(r, "sinusoid"))
+          b_absorbed += r.extended.bias_instability_deg_per_h > r.base.bias_instability_deg_per_h;
+      });
+  std::cout << fmt::format("slow sinusoid: named gauss_markov {}, extended B above the base's {}\n", misnamed,
+                           b_absorbed);
+  expect_rates(t);
+  EXPECT_EQ(misnamed, 0u);
+  EXPECT_EQ(b_absorbed, 0u);
+}
+
 // Measured (seeds 2000…, 10 cases, 20 runs, calibration 80 runs, |δ| 0.04–0.1 °/h): named 10/10,
 // within tolerance 9/10 (one size −0.030 for −0.044 °/h, its time 80 s late), gain in sample
 // 10/10, out of sample 10/10 (holdout ensembles of 20; 1.02 -> 0.94 … 7.38 -> 6.24, the
@@ -242,6 +281,32 @@ TEST(DiagnoseAcceptance, WarmupTransient) {
       [](const json& tr, const json& e) {
         return within(e["amplitude_deg_per_h"], tr["amplitude_deg_per_h"], 0.3) &&
                within(e["time_constant_s"], tr["time_constant_s"], 0.35);
+      });
+  expect_rates(t);
+}
+
+// Drift of exponential plus linear form, A·(1 − e^{−t/τd}) + r·t: the warm-up detector's model
+// (level + trend + exponential, τ up to T) with the linear part reported as the rate ramp R.
+// A 0.05–0.15 °/h (random sign; A²τd ≥ 1.5 (°/h)²·s), τd 600–3600 s, r uniform in ±0.03 °/h².
+// Tolerances: A ± 35 %, τd ± 50 %, |Δr| ≤ 0.01 °/h² (the exponential's linear part trades with
+// r: σ_r ≈ 0.002–0.006 °/h² at τd ≈ T/2). RWCALC_DIAGNOSE_RANGE=lo,hi: the range of A.
+// NOT MET (disabled; docs/diagnosis.md). Measured (seeds 3500…, 10 cases, 20 runs): named 5/10,
+// within tolerance 3/10, gain in sample 4/5 (0.10 -> 0.11), out of sample 5/5; two candidates
+// that fired (statistics 35.5 and 97.3 against 10.5 and 42.7) lost out of sample and were
+// reported as rejected.
+TEST(DiagnoseAcceptance, DISABLED_ExponentialDrift) {
+  const auto t = run_effect(
+      "warmup_transient", cases(10), 3500,
+      [r = size_range(0.05, 0.15)](std::mt19937_64& g, NoiseModel& m) {
+        const double a = sign(g) * log_uniform(g, r.first, r.second), tc = log_uniform(g, 600, 3600);
+        m.warmups.push_back({-a, tc});  // A·(1 − e^{−t/τ}) = A − A·e^{−t/τ}: a warm-up of −A
+        m.ramp_deg_per_h2 = uniform(g, -0.03, 0.03);
+        return json{{"amplitude_deg_per_h", -a}, {"time_constant_s", tc}, {"ramp_deg_per_h2", m.ramp_deg_per_h2}};
+      },
+      [](const json& tr, const json& e) {
+        return within(e["amplitude_deg_per_h"], tr["amplitude_deg_per_h"], 0.35) &&
+               within(e["time_constant_s"], tr["time_constant_s"], 0.5) &&
+               std::abs(e["ramp_deg_per_h2"].get<double>() - tr["ramp_deg_per_h2"].get<double>()) <= 0.01;
       });
   expect_rates(t);
 }
