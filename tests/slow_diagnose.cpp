@@ -209,15 +209,18 @@ TEST(DiagnoseAcceptance, Sinusoid) {
 // the flicker floor 0.6643·B = 0.0033 °/h in amplitude (0.0083–0.0116 °/h), random phase. The local
 // noise there (flicker and ARW, S ≈ 0.012 (°/h)²/Hz) gives σ_A ≈ √(S/T) ≈ 0.0013 °/h, 11–16 % of A,
 // so the tolerance is A ± 30 % and |Δf| ≤ 0.5/T as above. It must not be named Gauss–Markov, and
-// the extended model's B (without the line) must not exceed the base's (with it).
+// the result gives B with the line (the base) and without it (the extended model).
 // RWCALC_DIAGNOSE_RANGE=lo,hi: the amplitude range in units of the flicker floor.
 // NOT MET (disabled; docs/diagnosis.md, "Slow lines"). Measured (seeds 1500…, 10 cases, 20 runs):
-// named 1/10, within tolerance 1/10, gain in and out of sample 1/1; never named gauss_markov, B of
-// the extended model never above the base's. The misses' statistics 2–30 against thresholds 9–51:
-// at 3× the flicker floor a line of 3–5 cycles carries A²T/(2S) ≈ 18 (S ≈ 0.02 (°/h)²/Hz) of
-// explained power, and the flicker's own power in those bins varies ×4 between records.
+// named 1/10, within tolerance 1/10, gain in and out of sample 1/1; never named gauss_markov. The
+// misses' statistics 2–30 against thresholds 9–51: at 3× the flicker floor a line of 3–5 cycles
+// carries A²T/(2S) ≈ 18 (S ≈ 0.02 (°/h)²/Hz) of explained power, and the flicker's own power in
+// those bins varies ×4 between records. At 6–9× the floor (RWCALC_DIAGNOSE_RANGE=6,9): 7/10, all
+// within tolerance, gain 7/7 in and out of sample; the misses' bases took the line into rate
+// random walk (K 0.05–0.07 °/h/√h, true 0), whose ensemble raises the threshold (57.6 against 50.6,
+// upper limit 57.8).
 TEST(DiagnoseAcceptance, DISABLED_SlowSinusoid) {
-  std::size_t misnamed = 0, b_absorbed = 0;
+  std::size_t misnamed = 0;
   const auto t = run_effect(
       "sinusoid", cases(10), 1500,
       [r = size_range(2.5, 3.5)](std::mt19937_64& g, NoiseModel& m) {
@@ -232,14 +235,15 @@ TEST(DiagnoseAcceptance, DISABLED_SlowSinusoid) {
       },
       [&](const DiagnoseResult& r) {
         misnamed += finding(r, "gauss_markov") != nullptr;
-        if (finding(r, "sinusoid"))
-          b_absorbed += r.extended.bias_instability_deg_per_h > r.base.bias_instability_deg_per_h;
+        if (finding(r, "sinusoid")) {  // B with and without the line, as the JSON gives them
+          const auto b = to_json(r)["bias_instability_named_terms"];
+          EXPECT_EQ(b["with_deg_per_h"].get<double>(), r.base.bias_instability_deg_per_h);
+          EXPECT_EQ(b["without_deg_per_h"].get<double>(), r.extended.bias_instability_deg_per_h);
+        }
       });
-  std::cout << fmt::format("slow sinusoid: named gauss_markov {}, extended B above the base's {}\n", misnamed,
-                           b_absorbed);
+  std::cout << fmt::format("slow sinusoid: named gauss_markov {}\n", misnamed);
   expect_rates(t);
   EXPECT_EQ(misnamed, 0u);
-  EXPECT_EQ(b_absorbed, 0u);
 }
 
 // Measured (seeds 2000…, 10 cases, 20 runs, calibration 80 runs, |δ| 0.04–0.1 °/h): named 10/10,
@@ -291,16 +295,23 @@ TEST(DiagnoseAcceptance, WarmupTransient) {
 // Tolerances: A ± 35 %, τd ± 50 %, |Δr| ≤ 0.01 °/h² (the exponential's linear part trades with
 // r: σ_r ≈ 0.002–0.006 °/h² at τd ≈ T/2). RWCALC_DIAGNOSE_RANGE=lo,hi: the range of A.
 // NOT MET (disabled; docs/diagnosis.md). Measured (seeds 3500…, 10 cases, 20 runs): named 5/10,
-// within tolerance 3/10, gain in sample 4/5 (0.10 -> 0.11), out of sample 5/5; two candidates
-// that fired (statistics 35.5 and 97.3 against 10.5 and 42.7) lost out of sample and were
-// reported as rejected.
+// within tolerance 2/10, gain in and out of sample 5/5. The drifts of τd 15–25 min were fitted
+// with τd 970–3130 s, A +50 … +96 % and the ramp of the other sign (over 2 h the exponential's
+// linear part trades with r); the misses: bases that took the drift into R with B unresolved
+// (thresholds 67.7 and 77.0), one rejected out of sample (19.1 -> 30.0), two ties.
+// A pure exponential drift (RWCALC_DIAGNOSE_DRIFT=300:3600:0, RWCALC_DIAGNOSE_RANGE=0.033,0.12):
+// named 1/10, at A²τd = 7.6 (°/h)²·s; not at 0.7–4.7.
+// RWCALC_DIAGNOSE_DRIFT=τlo:τhi:rmax measures other time constants and ramps (rmax 0: a pure
+// exponential drift).
 TEST(DiagnoseAcceptance, DISABLED_ExponentialDrift) {
+  double d[3] = {600, 3600, 0.03};
+  if (const char* e = std::getenv("RWCALC_DIAGNOSE_DRIFT")) std::sscanf(e, "%lf:%lf:%lf", &d[0], &d[1], &d[2]);
   const auto t = run_effect(
       "warmup_transient", cases(10), 3500,
-      [r = size_range(0.05, 0.15)](std::mt19937_64& g, NoiseModel& m) {
-        const double a = sign(g) * log_uniform(g, r.first, r.second), tc = log_uniform(g, 600, 3600);
+      [r = size_range(0.05, 0.15), &d](std::mt19937_64& g, NoiseModel& m) {
+        const double a = sign(g) * log_uniform(g, r.first, r.second), tc = log_uniform(g, d[0], d[1]);
         m.warmups.push_back({-a, tc});  // A·(1 − e^{−t/τ}) = A − A·e^{−t/τ}: a warm-up of −A
-        m.ramp_deg_per_h2 = uniform(g, -0.03, 0.03);
+        m.ramp_deg_per_h2 = uniform(g, -d[2], d[2]);
         return json{{"amplitude_deg_per_h", -a}, {"time_constant_s", tc}, {"ramp_deg_per_h2", m.ramp_deg_per_h2}};
       },
       [](const json& tr, const json& e) {

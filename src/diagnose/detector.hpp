@@ -114,6 +114,7 @@ struct Extension {
   std::vector<Sinusoid> broad;  ///< broadened lines: in the model, not subtracted
   std::optional<OutputLowpassEstimate> lowpass;
   std::optional<double> ramp;     ///< a named drift's linear part, °/h²: the model's R
+  double ramp_sigma = 0;          ///< its standard error, °/h²
   std::vector<double> mid_var;    ///< mid-τ AV of the data without the named terms
   NoiseModel model;               ///< extended model (time origin: the stretch start)
   std::vector<Finding> findings;  ///< parameters only (the caller adds the evidence)

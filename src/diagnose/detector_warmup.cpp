@@ -96,6 +96,7 @@ class WarmupDetector final : public RecordDetector {
     const auto est = warmup_detect(s.dec, s.warmup_tc_s);
     x.det.warmups.push_back({est.amp, est.tc});
     x.ramp = est.ramp;
+    x.ramp_sigma = est.ramp_sigma;
     x.findings.push_back(
         {Effect::Warmup,
          {{"amplitude_deg_per_h", est.amp}, {"time_constant_s", est.tc}, {"ramp_deg_per_h2", est.ramp}},
