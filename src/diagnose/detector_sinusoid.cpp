@@ -134,37 +134,65 @@ struct SlowPeak {
 };
 struct SlowFit {
   std::vector<double> y;
-  std::vector<std::vector<double>> cols;  ///< the candidate's, then cos and sin
-  double tb = 0, T = 0, rss0 = 0;
+  double tb = 0, T = 0;
+  Eigen::MatrixXd Q;   ///< orthonormal basis of level, trend and the candidate's columns
+  Eigen::VectorXd r0;  ///< y less its projection on them
+  Eigen::VectorXd c, s;
   SlowFit(const Decimated& raw, const NoiseModel* candidate) {
     const std::size_t pb = per_block_for(raw, 10.0);
     y = block_rates(raw, pb);
     tb = static_cast<double>(pb) * raw.tau_d;
     T = tb * static_cast<double>(y.size());
-    cols = candidate_columns(candidate, y.size(), tb);
-    rss0 = ls_rss(y, cols);
-    cols.resize(cols.size() + 2, std::vector<double>(y.size()));
-  }
-  /// Explained sum of squares at f; the line's coefficients a (cos) and b (sin).
-  double at(double f, double& a, double& b) {
-    const std::size_t n = y.size(), c = cols.size() - 2;
-    for (std::size_t i = 0; i < n; ++i) {
-      const double t = (static_cast<double>(i) + 0.5) * tb;
-      cols[c][i] = std::cos(2.0 * kPi * f * t);
-      cols[c + 1][i] = std::sin(2.0 * kPi * f * t);
+    const auto n = static_cast<Eigen::Index>(y.size());
+    const auto extra = candidate_columns(candidate, y.size(), tb);
+    Eigen::MatrixXd X(n, static_cast<Eigen::Index>(2 + extra.size()));
+    for (Eigen::Index i = 0; i < n; ++i) {
+      X(i, 0) = 1.0;
+      X(i, 1) = static_cast<double>(i) / static_cast<double>(n);
+      for (std::size_t k = 0; k < extra.size(); ++k)
+        X(i, static_cast<Eigen::Index>(2 + k)) = extra[k][static_cast<std::size_t>(i)];
     }
-    Eigen::VectorXd coef;
-    const double explained = rss0 - ls_rss(y, cols, &coef);
-    a = coef(static_cast<Eigen::Index>(c + 2));
-    b = coef(static_cast<Eigen::Index>(c + 3));
-    return explained;
+    Q = Eigen::HouseholderQR<Eigen::MatrixXd>(X).householderQ() * Eigen::MatrixXd::Identity(n, X.cols());
+    const Eigen::Map<const Eigen::VectorXd> Y(y.data(), n);
+    r0 = Y - Q * (Q.transpose() * Y);
+    c.resize(n);
+    s.resize(n);
+  }
+  /// Explained sum of squares at f beyond level, trend and candidate; the line's coefficients
+  /// a (cos) and b (sin) of the joint least squares (Frisch–Waugh: from the projected columns).
+  double at(double f, double& a, double& b) {
+    const Eigen::Index n = r0.size();
+    // cos and sin at (i + ½)·tb by rotation (the ensembles call this for every record; the
+    // rounding error grows as n·ε, 10⁻¹³ here).
+    const std::complex<double> step = std::polar(1.0, 2.0 * kPi * f * tb);
+    std::complex<double> z = std::polar(1.0, kPi * f * tb);
+    for (Eigen::Index i = 0; i < n; ++i, z *= step) {
+      c(i) = z.real();
+      s(i) = z.imag();
+    }
+    c -= Q * (Q.transpose() * c);
+    s -= Q * (Q.transpose() * s);
+    Eigen::Matrix2d G;
+    G << c.squaredNorm(), c.dot(s), c.dot(s), s.squaredNorm();
+    const Eigen::Vector2d g(c.dot(r0), s.dot(r0));
+    const Eigen::Vector2d ab = G.ldlt().solve(g);
+    a = ab(0);
+    b = ab(1);
+    return ab.dot(g);
   }
 };
 SlowPeak slow_line_search(SlowFit& fit, const std::vector<double>& P, double pad, double w2, double tb_hann) {
   SlowPeak best;
   if (fit.y.size() < 40) return best;
+  // The level fit depends on c only through the bins left out: one fit per set of them.
+  double left_out_lo = -1, left_out_hi = -1;
+  SlowLevel level;
   for (double c = kSlowCyclesLo; c <= kSlowCyclesHi; c += 0.25) {
-    const SlowLevel level = slow_level(P, pad, c);
+    if (std::ceil(c - 3.0) != left_out_lo || std::floor(c + 3.0) != left_out_hi) {
+      level = slow_level(P, pad, c);
+      left_out_lo = std::ceil(c - 3.0);
+      left_out_hi = std::floor(c + 3.0);
+    }
     const double f = c / fit.T;
     double a, b;
     const double E = fit.at(f, a, b);
