@@ -300,7 +300,7 @@ TEST(DiagnoseAcceptance, WarmupTransient) {
 // linear part trades with r); the misses: bases that took the drift into R with B unresolved
 // (thresholds 67.7 and 77.0), one rejected out of sample (19.1 -> 30.0), two ties.
 // A pure exponential drift (RWCALC_DIAGNOSE_DRIFT=300:3600:0, RWCALC_DIAGNOSE_RANGE=0.033,0.12):
-// named 1/10, at A²τd = 7.6 (°/h)²·s; not at 0.7–4.7.
+// named 2/10, both within tolerance, at A²τd = 1.6 and 7.6 (°/h)²·s; not at 0.7–4.7.
 // RWCALC_DIAGNOSE_DRIFT=τlo:τhi:rmax measures other time constants and ramps (rmax 0: a pure
 // exponential drift).
 TEST(DiagnoseAcceptance, DISABLED_ExponentialDrift) {
