@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Diagnose every run and gyro axis of the ADIS16405 recordings in ../shared/data/real/ and print one
 # Markdown table (docs/adis16405.md, "Diagnosis"): base model misfit and coverage, the named effects
-# with their parameters, the extended model's misfit and coverage, and the out-of-sample misfits.
+# with their parameters, the extended model's misfit and coverage, and the out-of-sample misfits;
+# then the table of which findings repeat across runs and axes (each detector's verdict, statistic
+# against the upper limit of its threshold).
 #
 # Usage: scripts/adis-diagnose.sh [RWCALC] [OUTDIR] [RUNS]
 #   RWCALC  the rwcalc binary (default build/rwcalc)
@@ -52,4 +54,22 @@ for run in (1, 2, 3, 4):
         print(f"| {run} | {axis.upper()} | {g['misfit_base']:.2f} | {100*g['coverage_base']:.0f} % | {names} | "
               f"{g['misfit_extended']:.2f} | {100*g['coverage_extended']:.0f} % | "
               f"{g['holdout_misfit_base']:.2f} → {g['holdout_misfit_extended']:.2f} |")
+# Which findings repeat across runs and axes: each detector's verdict per run, with its statistic
+# against the upper limit of its threshold (the figure that decides, docs/diagnosis.md).
+print()
+print("| effect | axis | run 1 | run 2 | run 3 | run 4 |")
+print("|---|---|---|---|---|---|")
+cells = {}
+for axis in "xyz":
+    for run in (1, 2, 3, 4):
+        j = json.load(open(out / f"run{run}_{axis}.json"))
+        for d in j["detectors"]:
+            if d["named"]: st = "**named**"
+            elif d["excess"]: st = "rejected" if "held-out" in d.get("note", "") else "excess"
+            else: st = "fired" if d["fired"] else "no"
+            cells.setdefault((d["effect"], axis), []).append(f"{st} {d['statistic']:.3g}/{d['threshold_upper']:.3g}")
+for e in ("sinusoid", "sinusoid_hf", "bias_step", "warmup_transient", "gauss_markov", "lowpass"):
+    for axis in "xyz":
+        if (e, axis) in cells:
+            print(f"| {e} | {axis.upper()} | " + " | ".join(cells[(e, axis)]) + " |")
 PY

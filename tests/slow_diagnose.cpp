@@ -137,7 +137,8 @@ struct Tally {
 /// `ok` checks the recovered parameters against it.
 Tally run_effect(const std::string& effect, std::size_t n, std::uint64_t seed0,
                  const std::function<json(std::mt19937_64&, NoiseModel&)>& make,
-                 const std::function<bool(const json& truth, const json& est)>& ok) {
+                 const std::function<bool(const json& truth, const json& est)>& ok,
+                 const std::function<void(const DiagnoseResult&)>& also = {}) {
   Tally t;
   std::mt19937_64 g(seed0);
   for (std::size_t i = 0; i < n; ++i) {
@@ -145,6 +146,7 @@ Tally run_effect(const std::string& effect, std::size_t n, std::uint64_t seed0,
     const json truth = make(g, m);
     if (only_case() >= 0 && static_cast<std::size_t>(only_case()) != i) continue;
     const auto r = run_case(m, seed0 + 101 * i);
+    if (also) also(r);
     const json* est = finding(r, effect);
     ++t.n;
     const bool named = est != nullptr;
@@ -203,6 +205,48 @@ TEST(DiagnoseAcceptance, Sinusoid) {
   expect_rates(t);
 }
 
+// Slow periodic terms: a period of 25–40 min (3–5 cycles in the 2-h record; log-uniform) at 2.5–3.5×
+// the flicker floor 0.6643·B = 0.0033 °/h in amplitude (0.0083–0.0116 °/h), random phase. The local
+// noise there (flicker and ARW, S ≈ 0.012 (°/h)²/Hz) gives σ_A ≈ √(S/T) ≈ 0.0013 °/h, 11–16 % of A,
+// so the tolerance is A ± 30 % and |Δf| ≤ 0.5/T as above. It must not be named Gauss–Markov, and
+// the result gives B with the line (the base) and without it (the extended model).
+// RWCALC_DIAGNOSE_RANGE=lo,hi: the amplitude range in units of the flicker floor.
+// NOT MET (disabled; docs/diagnosis.md, "Slow lines"). Measured (seeds 1500…, 10 cases, 20 runs):
+// named 1/10, within tolerance 1/10, gain in and out of sample 1/1; never named gauss_markov. The
+// misses' statistics 2–30 against thresholds 9–51: at 3× the flicker floor a line of 3–5 cycles
+// carries A²T/(2S) ≈ 18 (S ≈ 0.02 (°/h)²/Hz) of explained power, and the flicker's own power in
+// those bins varies ×4 between records. At 6–9× the floor (RWCALC_DIAGNOSE_RANGE=6,9): 7/10, all
+// within tolerance, gain 7/7 in and out of sample; the misses' bases took the line into rate
+// random walk (K 0.05–0.07 °/h/√h, true 0), whose ensemble raises the threshold (57.6 against 50.6,
+// upper limit 57.8). At 10–15× (0.033–0.050 °/h): 9/10, all within tolerance, gain 9/9 in and
+// out of sample: the 90 % limit.
+TEST(DiagnoseAcceptance, DISABLED_SlowSinusoid) {
+  std::size_t misnamed = 0;
+  const auto t = run_effect(
+      "sinusoid", cases(10), 1500,
+      [r = size_range(2.5, 3.5)](std::mt19937_64& g, NoiseModel& m) {
+        const double floor = 0.6643 * m.bias_instability_deg_per_h;
+        Sinusoid s{1.0 / log_uniform(g, 1500, 2400), uniform(g, r.first, r.second) * floor, uniform(g, 0, 6.283)};
+        m.sinusoids.push_back(s);
+        return json{{"frequency_hz", s.f_hz}, {"amplitude_deg_per_h", s.amp_deg_per_h}};
+      },
+      [](const json& tr, const json& e) {
+        return std::abs(e["frequency_hz"].get<double>() - tr["frequency_hz"].get<double>()) <= 0.5 / 7200.0 &&
+               within(e["amplitude_deg_per_h"], tr["amplitude_deg_per_h"], 0.3);
+      },
+      [&](const DiagnoseResult& r) {
+        misnamed += finding(r, "gauss_markov") != nullptr;
+        if (finding(r, "sinusoid")) {  // B with and without the line, as the JSON gives them
+          const auto b = to_json(r)["bias_instability_named_terms"];
+          EXPECT_EQ(b["with_deg_per_h"].get<double>(), r.base.bias_instability_deg_per_h);
+          EXPECT_EQ(b["without_deg_per_h"].get<double>(), r.extended.bias_instability_deg_per_h);
+        }
+      });
+  std::cout << fmt::format("slow sinusoid: named gauss_markov {}\n", misnamed);
+  expect_rates(t);
+  EXPECT_EQ(misnamed, 0u);
+}
+
 // Measured (seeds 2000…, 10 cases, 20 runs, calibration 80 runs, |δ| 0.04–0.1 °/h): named 10/10,
 // within tolerance 9/10 (one size −0.030 for −0.044 °/h, its time 80 s late), gain in sample
 // 10/10, out of sample 10/10 (holdout ensembles of 20; 1.02 -> 0.94 … 7.38 -> 6.24, the
@@ -242,6 +286,39 @@ TEST(DiagnoseAcceptance, WarmupTransient) {
       [](const json& tr, const json& e) {
         return within(e["amplitude_deg_per_h"], tr["amplitude_deg_per_h"], 0.3) &&
                within(e["time_constant_s"], tr["time_constant_s"], 0.35);
+      });
+  expect_rates(t);
+}
+
+// Drift of exponential plus linear form, A·(1 − e^{−t/τd}) + r·t: the warm-up detector's model
+// (level + trend + exponential, τ up to T) with the linear part reported as the rate ramp R.
+// A 0.05–0.15 °/h (random sign; A²τd ≥ 1.5 (°/h)²·s), τd 600–3600 s, r uniform in ±0.03 °/h².
+// Tolerances: A ± 35 %, τd ± 50 %, |Δr| ≤ 0.01 °/h² (the exponential's linear part trades with
+// r: σ_r ≈ 0.002–0.006 °/h² at τd ≈ T/2). RWCALC_DIAGNOSE_RANGE=lo,hi: the range of A.
+// NOT MET (disabled; docs/diagnosis.md). Measured (seeds 3500…, 10 cases, 20 runs): named 5/10,
+// within tolerance 2/10, gain in and out of sample 5/5. The drifts of τd 15–25 min were fitted
+// with τd 970–3130 s, A +50 … +96 % and the ramp of the other sign (over 2 h the exponential's
+// linear part trades with r); the misses: bases that took the drift into R with B unresolved
+// (thresholds 67.7 and 77.0), one rejected out of sample (19.1 -> 30.0), two ties.
+// A pure exponential drift (RWCALC_DIAGNOSE_DRIFT=300:3600:0, RWCALC_DIAGNOSE_RANGE=0.033,0.12):
+// named 2/10, both within tolerance, at A²τd = 1.6 and 7.6 (°/h)²·s; not at 0.7–4.7.
+// RWCALC_DIAGNOSE_DRIFT=τlo:τhi:rmax measures other time constants and ramps (rmax 0: a pure
+// exponential drift).
+TEST(DiagnoseAcceptance, DISABLED_ExponentialDrift) {
+  double d[3] = {600, 3600, 0.03};
+  if (const char* e = std::getenv("RWCALC_DIAGNOSE_DRIFT")) std::sscanf(e, "%lf:%lf:%lf", &d[0], &d[1], &d[2]);
+  const auto t = run_effect(
+      "warmup_transient", cases(10), 3500,
+      [r = size_range(0.05, 0.15), &d](std::mt19937_64& g, NoiseModel& m) {
+        const double a = sign(g) * log_uniform(g, r.first, r.second), tc = log_uniform(g, d[0], d[1]);
+        m.warmups.push_back({-a, tc});  // A·(1 − e^{−t/τ}) = A − A·e^{−t/τ}: a warm-up of −A
+        m.ramp_deg_per_h2 = uniform(g, -d[2], d[2]);
+        return json{{"amplitude_deg_per_h", -a}, {"time_constant_s", tc}, {"ramp_deg_per_h2", m.ramp_deg_per_h2}};
+      },
+      [](const json& tr, const json& e) {
+        return within(e["amplitude_deg_per_h"], tr["amplitude_deg_per_h"], 0.35) &&
+               within(e["time_constant_s"], tr["time_constant_s"], 0.5) &&
+               std::abs(e["ramp_deg_per_h2"].get<double>() - tr["ramp_deg_per_h2"].get<double>()) <= 0.01;
       });
   expect_rates(t);
 }

@@ -67,6 +67,19 @@ TEST(DiagnoseBlocks, SinusoidLineSearchRecoversFrequencyAndAmplitude) {
   EXPECT_LT(e0.statistic, 20.0);
 }
 
+// A line of 3.3 cycles per record lies below the periodogram search's 4 cycles: the slow band's
+// least-squares search finds it, with level and trend fitted together.
+TEST(DiagnoseBlocks, SlowLineOfThreeCyclesRecoversFrequencyAndAmplitude) {
+  const double f = 3.3 / 7200.0, a = 0.05;
+  const auto d = from_rate(7200, 0.3, 15, [&](double t) { return a * std::cos(2 * std::numbers::pi * f * t + 1.1); });
+  const auto e = sinusoid_detect(d);
+  EXPECT_LT(e.f_hz * 7200.0, 4.0);
+  EXPECT_NEAR(e.f_hz, f, 3 * e.f_sigma + 1e-7);
+  EXPECT_NEAR(e.amp, a, 3 * e.amp_sigma);
+  EXPECT_GT(e.amp_sigma, 0.0);
+  EXPECT_GT(e.statistic, 30.0);
+}
+
 TEST(DiagnoseBlocks, StepTimeAndSize) {
   const auto d = from_rate(7200, 0.3, 7, [](double t) { return t > 3100 ? 0.03 : 0.0; });
   const auto e = step_detect(d);
@@ -80,6 +93,18 @@ TEST(DiagnoseBlocks, WarmupAmplitudeAndTimeConstant) {
   const auto e = warmup_detect(d);
   EXPECT_NEAR(e.amp, -0.08, 4 * e.amp_sigma);
   EXPECT_NEAR(e.tc, 500, 150);
+  EXPECT_GT(e.statistic, 20);
+}
+
+// A drift A'·(1 − e^{−t/τd}) + r·t is the warm-up model with A = −A'; its trend is the ramp r.
+TEST(DiagnoseBlocks, DriftReportsItsLinearPartAsTheRamp) {
+  const double ap = 0.1, td = 900, r = 0.02;  // °/h, s, °/h²
+  const auto d = from_rate(7200, 0.3, 9, [&](double t) { return ap * -std::expm1(-t / td) + r * t / 3600.0; });
+  const auto e = warmup_detect(d);
+  EXPECT_NEAR(e.amp, -ap, 4 * e.amp_sigma);
+  EXPECT_NEAR(e.tc, td, 0.35 * td);
+  EXPECT_GT(e.ramp_sigma, 0.0);
+  EXPECT_NEAR(e.ramp, r, 4 * e.ramp_sigma);
   EXPECT_GT(e.statistic, 20);
 }
 

@@ -74,6 +74,13 @@ TEST_F(DiagnoseCli, JsonHasTheDocumentedKeysAndFindsTheSinusoid) {
   ASSERT_EQ(j["extended_model"]["sinusoids"].size(), 1u);
   EXPECT_LT(j["gain"]["misfit_extended"].get<double>(), j["gain"]["misfit_base"].get<double>());
   EXPECT_GE(j["gain"]["coverage_extended"].get<double>(), j["gain"]["coverage_base"].get<double>());
+  // B with the named terms in the data (the base) and without them (the extended model).
+  const auto& b = j["bias_instability_named_terms"];
+  EXPECT_DOUBLE_EQ(b["with_deg_per_h"].get<double>(), j["base_model"]["bias_instability_deg_per_h"].get<double>());
+  EXPECT_DOUBLE_EQ(b["without_deg_per_h"].get<double>(),
+                   j["extended_model"]["bias_instability_deg_per_h"].get<double>());
+  ASSERT_TRUE(b["with_over_without_percent"].is_number() || b["without_deg_per_h"].get<double>() == 0.0);
+  EXPECT_EQ(b["named_terms"], json::array({"sinusoid"}));
 }
 
 TEST_F(DiagnoseCli, ResultDoesNotDependOnTheThreadCount) {

@@ -19,8 +19,12 @@ struct SinusoidEstimate {
   double f_hz = 0, amp = 0, phase = 0;
   double f_sigma = 0, amp_sigma = 0;
 };
-/// Periodogram line search on 0.5-s block rates. `f_hint` > 0 restricts the search to ±3 bins.
-SinusoidEstimate sinusoid_detect(const Decimated& d, double f_hint = 0, bool estimate = true);
+/// Periodogram line search on the 0.5-s block rates of `d` (the record without its mean-shape
+/// candidate), and from 2.8 to 12 cycles per record a least-squares search on the 10-s block
+/// rates of `raw` (default d) with `candidate` fitted jointly. `f_hint` > 0 restricts the search
+/// to ±3 bins (in the slow band: the frequency is the hint).
+SinusoidEstimate sinusoid_detect(const Decimated& d, double f_hint = 0, bool estimate = true,
+                                 const Decimated* raw = nullptr, const NoiseModel* candidate = nullptr);
 
 /// Least-squares a·cos(2πft) + b·sin(2πft) on block rates `y` (`tb` s each) and its standard
 /// error (0: too few blocks). A line A·cos(2πft + φ) gives a = A·s·cos φ, b = −A·s·sin φ,
@@ -48,12 +52,17 @@ struct StepEstimate {
 };
 StepEstimate step_detect(const Decimated& d);
 
+/// A change of the mean of exponential form on a linear trend, A·e^{−t/τ} + r·t (+ level): a
+/// warm-up transient, or a drift A'·(1 − e^{−t/τ}) + r·t (A' = −A), τ from 20 s to T. The linear
+/// part r is the rate ramp R of the five-term model, estimated with the exponential.
 struct WarmupEstimate {
   double statistic = 0;  ///< RSS drop on 10-s block means when an exponential joins
   double amp = 0, tc = 0, amp_sigma = 0, tc_sigma = 0;
+  double ramp = 0, ramp_sigma = 0;  ///< r, °/h² (signed)
   double rss = 0;
 };
-WarmupEstimate warmup_detect(const Decimated& d);
+/// `tc_hint` > 0: the time constant is that one (a block of the record keeps the record's).
+WarmupEstimate warmup_detect(const Decimated& d, double tc_hint = 0);
 
 /// A record's own mean-shape candidate: its best step or warm-up, whichever has the lower RSS.
 /// The measurement and every simulated record alike are compared without it.
@@ -96,6 +105,7 @@ struct Stretch {
   double line_hint_hz = 0;  ///< a named coherent high-frequency line's frequency (0: search)
   double step_time_s = -1;  ///< a named step's time in stretch time (< 0: estimate it)
   double gm_tc_s = 0;       ///< a named Gauss–Markov term's correlation time (0: fit it)
+  double warmup_tc_s = 0;   ///< a named transient's or drift's time constant (0: fit it)
 };
 
 /// The extended model under construction: the named terms, the findings in naming order.
@@ -103,6 +113,8 @@ struct Extension {
   NoiseModel det;               ///< deterministic terms subtracted from the data
   std::vector<Sinusoid> broad;  ///< broadened lines: in the model, not subtracted
   std::optional<OutputLowpassEstimate> lowpass;
+  std::optional<double> ramp;     ///< a named drift's linear part, °/h²: the model's R
+  double ramp_sigma = 0;          ///< its standard error, °/h²
   std::vector<double> mid_var;    ///< mid-τ AV of the data without the named terms
   NoiseModel model;               ///< extended model (time origin: the stretch start)
   std::vector<Finding> findings;  ///< parameters only (the caller adds the evidence)

@@ -7,7 +7,7 @@
 
 namespace rwcalc::diag {
 
-WarmupEstimate warmup_detect(const Decimated& d) {
+WarmupEstimate warmup_detect(const Decimated& d, double tc_hint) {
   WarmupEstimate e;
   const std::size_t pb = per_block_for(d, 10.0);
   const std::vector<double> y = block_rates(d, pb);
@@ -24,7 +24,9 @@ WarmupEstimate warmup_detect(const Decimated& d) {
     return c;
   };
   auto rss_at = [&](double tc) { return ls_rss(y, {column(tc)}); };
-  const double lt_lo = std::log(2.0 * tb), lt_hi = std::log(T / 3.0);
+  // Up to τ = T: a drift whose exponential outlasts the record still bends the block means
+  // away from the straight line (its curvature over the record falls as (T/τ)²).
+  const double lt_lo = std::log(2.0 * tb), lt_hi = std::log(T);
   const int G = 40;
   double best = std::numeric_limits<double>::infinity(), lbest = lt_lo;
   for (int g = 0; g <= G; ++g) {
@@ -37,12 +39,16 @@ WarmupEstimate warmup_detect(const Decimated& d) {
   }
   const double step = (lt_hi - lt_lo) / G;
   lbest = golden_min([&](double lt) { return rss_at(std::exp(lt)); }, lbest - step, lbest + step, 25);
+  if (tc_hint > 0) lbest = std::log(tc_hint);
   Eigen::VectorXd coef;
   Eigen::MatrixXd inv;
   e.tc = std::exp(lbest);
   e.rss = ls_rss(y, {column(e.tc)}, &coef, &inv);
   e.amp = coef(2);
   e.amp_sigma = sig * std::sqrt(inv(2, 2));
+  // ls_rss's trend column runs over (i − (n − 1)/2)/n: its coefficient is the change over T.
+  e.ramp = coef(1) / T * 3600.0;
+  e.ramp_sigma = sig * std::sqrt(inv(1, 1)) / T * 3600.0;
   // F-type statistic: the residual variance, not the white level, normalises the drop, so that
   // wander the base fit took up into K or R does not hide the transient.
   e.statistic = std::max(0.0, (rss0 - e.rss) / (e.rss / static_cast<double>(n - 4)));
@@ -87,12 +93,15 @@ class WarmupDetector final : public RecordDetector {
     return r.warmup ? r.warmup->statistic : warmup_detect(r.dec).statistic;
   }
   void estimate(const Stretch& s, Extension& x) const override {
-    const auto est = warmup_detect(s.dec);
+    const auto est = warmup_detect(s.dec, s.warmup_tc_s);
     x.det.warmups.push_back({est.amp, est.tc});
-    x.findings.push_back({Effect::Warmup,
-                          {{"amplitude_deg_per_h", est.amp}, {"time_constant_s", est.tc}},
-                          {{"amplitude_deg_per_h", est.amp_sigma}, {"time_constant_s", est.tc_sigma}},
-                          {}});
+    x.ramp = est.ramp;
+    x.ramp_sigma = est.ramp_sigma;
+    x.findings.push_back(
+        {Effect::Warmup,
+         {{"amplitude_deg_per_h", est.amp}, {"time_constant_s", est.tc}, {"ramp_deg_per_h2", est.ramp}},
+         {{"amplitude_deg_per_h", est.amp_sigma}, {"time_constant_s", est.tc_sigma}, {"ramp_deg_per_h2", est.ramp_sigma}},
+         {}});
   }
 };
 

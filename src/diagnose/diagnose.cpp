@@ -202,7 +202,7 @@ Named test_detectors(Context& c, const std::vector<RunStats>& cal_runs, Diagnose
   Named named;
   NoiseModel det = c.rb.candidate;
   if (is_named(res, Effect::Sinusoid)) {
-    const auto sin = sinusoid_detect(c.full.clean);
+    const auto sin = sinusoid_detect(c.full.clean, 0, true, &c.full.dec, &c.rb.candidate);
     det.sinusoids.push_back({sin.f_hz, sin.amp, sin.phase});
     named.sin_hint_hz = sin.f_hz;
   }

@@ -118,6 +118,13 @@ Extension extend(const Stretch& s, const std::vector<const Detector*>& named) {
     correct_nbk(x.model, power_law_corrections(x.mid_var, s.clean_ref, c_of(s.base)));
   }
   if (deterministic && !x.lowpass && (self_pilot || !x.det.sinusoids.empty())) refit_without_named(s, x, self_pilot);
+  if (x.ramp) {
+    // A named drift's linear part is the rate ramp R, estimated with the exponential (signed, as
+    // the simulator's deterministic ramp); the mean rate over the record is kept (the bias, like
+    // the base's, is the mean rate without any ramp: the ramp adds r·T/2 to it).
+    x.model.bias_deg_per_h -= *x.ramp * s.rec->phase.duration_s() / 3600.0 / 2.0;
+    x.model.ramp_deg_per_h2 = *x.ramp;
+  }
   for (const Detector* d : named)
     if (d->mid_tau()) d->estimate(s, x);
   return x;

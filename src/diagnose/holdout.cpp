@@ -95,6 +95,7 @@ void score_lines(const PhaseSeries& pred, const NoiseModel& e_pred, const std::v
       y.resize(pred.points() - 1);
       for (std::size_t i = 0; i + 1 < pred.points(); ++i) y[i] = pred.diff(i + 1, i) / tb;
     }
+    const std::size_t ny = y.size();
     const LineCoefficients c = line_coefficients(std::move(y), tb, l.f_hz);
     if (!(c.sigma > 0)) continue;
     const double att = block_attenuation(l.f_hz, tb);
@@ -102,7 +103,17 @@ void score_lines(const PhaseSeries& pred, const NoiseModel& e_pred, const std::v
     const std::complex<double> hf =
         e_pred.output_lowpass_tc_s > 0 ? lowpass_response(l.f_hz, pred.tau0_s, e_pred.output_lowpass_tc_s) : 1.0;
     const double am = l.amp_deg_per_h * std::abs(hf) * att, ph = l.phase_rad + std::arg(hf);
-    const double ap = am * std::cos(ph), bp = -am * std::sin(ph);
+    double ap = am * std::cos(ph), bp = -am * std::sin(ph);
+    if (l.f_hz < kHighLineMinHz) {
+      // The block's coefficients are fitted after its level and trend are taken out, which takes
+      // a share of a line of a few cycles: the model's line is put through the same fit.
+      std::vector<double> ym(ny);
+      for (std::size_t i = 0; i < ym.size(); ++i)
+        ym[i] = am * std::cos(2.0 * kPi * l.f_hz * (static_cast<double>(i) + 0.5) * tb + ph);
+      const LineCoefficients cm = line_coefficients(std::move(ym), tb, l.f_hz);
+      ap = cm.a;
+      bp = cm.b;
+    }
     const double s2 = c.sigma * c.sigma;
     sb.sum += (c.a * c.a + c.b * c.b) / s2;
     se.sum += ((c.a - ap) * (c.a - ap) + (c.b - bp) * (c.b - bp)) / s2;
@@ -140,6 +151,8 @@ Stretch fitting_stretch(const Stretch& full, const DiagnoseResult& r, const Name
   st.line_hint_hz = named.line_hint_hz;
   // A named Gauss–Markov term keeps the whole record's correlation time (its structure).
   st.gm_tc_s = r.extended.gauss_markov.empty() ? 0.0 : r.extended.gauss_markov.front().tc_s;
+  // So does a transient or drift: half the record cannot place a time constant of up to T.
+  st.warmup_tc_s = r.extended.warmups.empty() ? 0.0 : r.extended.warmups.front().tc_s;
   // A step whose time lies inside the fitting block, with data on each side, keeps that time.
   if (!r.extended.bias_steps.empty()) {
     const double t_local = r.extended.bias_steps.front().t_s - t_fit;
@@ -174,9 +187,9 @@ std::pair<double, double> score_fold(const Stretch& full, const DiagnoseResult& 
   const auto b_pred =
       run_ensemble(with_mean_rate(st.base, pred_T, pred_mean), sh, r.holdout_runs, pred_plan, opt.progress);
   const double v_base = std::max(mean_rate_variance(b_pred), 1e-30);
-  auto prediction_score = [&](const std::vector<RunStats>& runs, const NoiseModel& m) {
+  auto prediction_score = [&](const std::vector<RunStats>& runs, const NoiseModel& m, double ramp_level = 0) {
     const auto dev = band_deviance(make_band(a_pred.points, runs, opt.band_level), r.holdout_runs);
-    const double d = pred_mean - model_level(m, pred_T);
+    const double d = pred_mean - model_level(m, pred_T) - ramp_level;
     return BandDeviance{dev.sum + d * d / v_base, dev.points + 1};
   };
   BandDeviance sb = prediction_score(b_pred, st.base);
@@ -197,10 +210,24 @@ std::pair<double, double> score_fold(const Stretch& full, const DiagnoseResult& 
   Extension e = extend(st, shown);
   if (std::all_of(shown.begin(), shown.end(), [](const Detector* d) { return d->mean_shape(); }))
     keep_power_laws(st.base, e.model);
-  const NoiseModel e_pred = shifted(e.model, (static_cast<double>(pa) - static_cast<double>(fa)) * x.tau0_s);
+  const double dt = (static_cast<double>(pa) - static_cast<double>(fa)) * x.tau0_s;
+  NoiseModel e_pred = shifted(e.model, dt);
+  double ramp_level = 0;
+  if (e.ramp) {
+    // A named drift's signed ramp carries the level to the predicted block, shrunk by how well
+    // the block determines it, r²/(r² + σ_r²): beside an exponential whose time constant is near
+    // the block's length the trend is loose, and its extrapolation over a block missed the level
+    // by far more than the rate's wander (out of sample 63.6 → 2237 on one drift).
+    const double ramp = *e.ramp, s2 = e.ramp_sigma * e.ramp_sigma;
+    const double r_eff = ramp * ramp * ramp / std::max(ramp * ramp + s2, 1e-300);
+    e_pred.bias_deg_per_h += ramp * fit_rec.phase.duration_s() / 3600.0 / 2.0;  // the ramp's own share
+    e_pred.ramp_deg_per_h2 = r_eff;
+    e_pred.bias_deg_per_h += r_eff * (dt - fit_rec.phase.duration_s() / 2.0) / 3600.0;
+    ramp_level = r_eff * pred_T / 3600.0 / 2.0;
+  }
   const auto e_runs =
       run_ensemble(with_mean_rate(e_pred, pred_T, pred_mean), sh, r.holdout_runs, pred_plan, opt.progress);
-  BandDeviance se = prediction_score(e_runs, e_pred);
+  BandDeviance se = prediction_score(e_runs, e_pred, ramp_level);
   score_lines(pred_rec.phase, e_pred, e.broad, sb, se);
   return {sb.per_point(), se.per_point()};
 }

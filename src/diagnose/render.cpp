@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <limits>
 
 #include "rwcalc/diagnose.hpp"
 #include "rwcalc/fit.hpp"
@@ -53,6 +54,7 @@ std::string power_laws(const NoiseModel& m) {
 
 std::string unit_of(const std::string& key) {
   if (key.ends_with("_hz")) return tr("Hz");
+  if (key.ends_with("_deg_per_h2")) return tr("°/h²");
   if (key.ends_with("_deg_per_h")) return tr("°/h");
   if (key.ends_with("_s")) return tr("s");
   if (key.ends_with("_rad")) return tr("rad");
@@ -75,6 +77,22 @@ std::string format_findings(const std::vector<Finding>& fs) {
     s += "\n";
   }
   return s;
+}
+
+/// The named findings' names, comma-separated.
+std::string named_terms(const std::vector<Finding>& fs) {
+  std::string s;
+  for (const auto& f : fs) s += (s.empty() ? "" : ", ") + std::string(finding_name(f.effect));
+  return s;
+}
+
+/// How much B the base (the five-term model of the data with the named terms in them) has over B
+/// without them (the extended model), %: a term the five-term fit cannot represent is taken up
+/// into the flicker floor and moves the class verdict. NaN when nothing is named.
+double b_excess_percent(const DiagnoseResult& r) {
+  const double with = r.base.bias_instability_deg_per_h, without = r.extended.bias_instability_deg_per_h;
+  if (r.findings.empty() || !(without > 0)) return std::numeric_limits<double>::quiet_NaN();
+  return 100.0 * (with / without - 1.0);
 }
 
 }  // namespace
@@ -134,6 +152,13 @@ json to_json(const DiagnoseResult& r) {
   j["rejected_candidates"] = findings_json(r.rejected);
   j["extended_model"] =
       model_json(r.extended, r.extended_band, r.band_level, r.gain.misfit_extended, r.gain.coverage_extended);
+  j["bias_instability_named_terms"] = {
+      {"with_deg_per_h", r.base.bias_instability_deg_per_h},
+      {"without_deg_per_h", r.extended.bias_instability_deg_per_h},
+      {"with_over_without_percent", finite_or_null(b_excess_percent(r))},
+      {"named_terms", json::array()}};
+  for (const auto& f : r.findings)
+    j["bias_instability_named_terms"]["named_terms"].push_back(std::string(finding_name(f.effect)));
   j["gain"] = {{"misfit_base", r.gain.misfit_base},
                {"misfit_extended", r.gain.misfit_extended},
                {"coverage_base", r.gain.coverage_base},
@@ -189,6 +214,11 @@ std::string format_report(const DiagnoseResult& r) {
   if (!r.rejected.empty())
     s += tr("Candidates not named (no out-of-sample gain; excess only):\n") + format_findings(r.rejected);
   s += tr("\nExtended model: ") + power_laws(r.extended) + trf(", {} extra term(s)\n", r.findings.size());
+  if (!r.findings.empty())
+    s += trf("  B with the named terms in the data (base model) {:.4g} °/h, without them (extended model) {:.4g} °/h: "
+             "{:+.1f} % with them ({})\n",
+             r.base.bias_instability_deg_per_h, r.extended.bias_instability_deg_per_h, b_excess_percent(r),
+             named_terms(r.findings));
   s += tr("\nGain (misfit: mean EDF-weighted Gamma deviance per τ, about 1 (dimensionless) when the model fits):\n");
   s += fmt::format("  {:<44} {:>10} {:>10}\n", "", tr("base"), tr("extended"));
   s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", tr("Allan-variance misfit (dimensionless)"), r.gain.misfit_base,
