@@ -24,9 +24,9 @@ WarmupEstimate warmup_detect(const Decimated& d, double tc_hint) {
     return c;
   };
   auto rss_at = [&](double tc) { return ls_rss(y, {column(tc)}); };
-  // Up to τ = T: a drift whose exponential outlasts the record still bends the block means
-  // away from the straight line (its curvature over the record falls as (T/τ)²).
-  const double lt_lo = std::log(2.0 * tb), lt_hi = std::log(T);
+  // Up to τ = T/3: a longer exponential is nearly the trend over the record, and searched up to T
+  // it took part of a Gauss–Markov wander in every record's own candidate (docs/diagnosis.md).
+  const double lt_lo = std::log(2.0 * tb), lt_hi = std::log(T / 3.0);
   const int G = 40;
   double best = std::numeric_limits<double>::infinity(), lbest = lt_lo;
   for (int g = 0; g <= G; ++g) {

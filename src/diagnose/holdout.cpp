@@ -151,7 +151,7 @@ Stretch fitting_stretch(const Stretch& full, const DiagnoseResult& r, const Name
   st.line_hint_hz = named.line_hint_hz;
   // A named Gauss–Markov term keeps the whole record's correlation time (its structure).
   st.gm_tc_s = r.extended.gauss_markov.empty() ? 0.0 : r.extended.gauss_markov.front().tc_s;
-  // So does a transient or drift: half the record cannot place a time constant of up to T.
+  // So does a transient or drift: half the record cannot place a time constant of up to T/3.
   st.warmup_tc_s = r.extended.warmups.empty() ? 0.0 : r.extended.warmups.front().tc_s;
   // A step whose time lies inside the fitting block, with data on each side, keeps that time.
   if (!r.extended.bias_steps.empty()) {
