@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <boost/math/distributions/fisher_f.hpp>
+#include <boost/math/distributions/normal.hpp>
 #include <cmath>
 #include <cstdio>
 #include <utility>
@@ -204,19 +205,21 @@ double model_log_variance(const json& fit, double tau) {
 }
 
 /// analyze → simulate --from → analyze: the simulated record's AV and the measured one agree within
-/// the 95 % band at every τ: two independent estimates (F distribution with the model's EDFs) of an
-/// estimated model (its coefficients' standard errors, added in quadrature in ln σ²).
-int points_outside_band(const json& measured, const json& simulated) {
+/// a band at every τ: two independent estimates (F distribution with the model's EDFs) of an
+/// estimated model (its coefficients' standard errors, added in quadrature in ln σ²). `alpha` is the
+/// two-sided level of each point's band.
+int points_outside_band(const json& measured, const json& simulated, double alpha = 0.05) {
   int outside = 0;
   const auto& a = measured["allan"]["points"];
   const auto& b = simulated["allan"]["points"];
   EXPECT_EQ(a.size(), b.size());
+  const double z = boost::math::quantile(boost::math::complement(boost::math::normal(), alpha / 2));
   for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) {
     const double ea = a[i]["edf"], eb = b[i]["edf"];
     const boost::math::fisher_f f(eb, ea);
-    const double model = 1.96 * std::sqrt(model_log_variance(measured["fit"], a[i]["tau_s"].get<double>()));
-    const double lo = -std::hypot(std::log(boost::math::quantile(f, 0.025)), model);
-    const double hi = std::hypot(std::log(boost::math::quantile(f, 0.975)), model);
+    const double model = z * std::sqrt(model_log_variance(measured["fit"], a[i]["tau_s"].get<double>()));
+    const double lo = -std::hypot(std::log(boost::math::quantile(f, alpha / 2)), model);
+    const double hi = std::hypot(std::log(boost::math::quantile(f, 1 - alpha / 2)), model);
     const double ratio = std::log(b[i]["var"].get<double>() / a[i]["var"].get<double>());
     if (ratio < lo || ratio > hi) {
       ++outside;
@@ -245,7 +248,14 @@ TEST(SimulateFrom, FittedModelReproducesTheMeasuredAllanDeviation) {
     EXPECT_EQ(r.status, 0) << r.err;
     return json::parse(r.out);
   };
-  EXPECT_EQ(points_outside_band(a, round_trip(false)), 0);
+  // "At every τ" is a statement about all the points at once: each point's band is at the Šidák level
+  // 1 − 0.95^(1/n) (3.0σ-wide for 21 points), so that the fitted model's record lies inside all of
+  // them with 95 % probability. With the pointwise 95 % bands a correct model fails whenever one of
+  // its ~21 points falls in a 5 % tail: the shipped p25C record's point at τ = 0.32 s is itself 2.4
+  // sampling standard deviations below its model (ln ratio −0.0024), and seed 3 misses the
+  // pointwise band there by 0.00333 against 0.00317.
+  const auto n = static_cast<double>(a["allan"]["points"].size());
+  EXPECT_EQ(points_outside_band(a, round_trip(false), 1.0 - std::pow(0.95, 1.0 / n)), 0);
   // With the unresolved K and R at their upper bounds the long-τ AV is far above the measured one.
   const json u = round_trip(true);
   EXPECT_GT(u["allan"]["points"].back()["dev"].get<double>(), 5.0 * a["allan"]["points"].back()["dev"].get<double>());
