@@ -214,11 +214,15 @@ std::string format_report(const DiagnoseResult& r) {
   if (!r.rejected.empty())
     s += tr("Candidates not named (no out-of-sample gain; excess only):\n") + format_findings(r.rejected);
   s += tr("\nExtended model: ") + power_laws(r.extended) + trf(", {} extra term(s)\n", r.findings.size());
-  if (!r.findings.empty())
+  // Without B in the extended model the ratio has no value (JSON: null), so none is printed.
+  if (!r.findings.empty() && std::isfinite(b_excess_percent(r)))
     s += trf("  B with the named terms in the data (base model) {:.4g} °/h, without them (extended model) {:.4g} °/h: "
              "{:+.1f} % with them ({})\n",
              r.base.bias_instability_deg_per_h, r.extended.bias_instability_deg_per_h, b_excess_percent(r),
              named_terms(r.findings));
+  else if (!r.findings.empty())
+    s += trf("  B with the named terms in the data (base model) {:.4g} °/h, without them (extended model) {:.4g} °/h ({})\n",
+             r.base.bias_instability_deg_per_h, r.extended.bias_instability_deg_per_h, named_terms(r.findings));
   s += tr("\nGain (misfit: mean EDF-weighted Gamma deviance per τ, about 1 (dimensionless) when the model fits):\n");
   s += fmt::format("  {:<44} {:>10} {:>10}\n", "", tr("base"), tr("extended"));
   s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", tr("Allan-variance misfit (dimensionless)"), r.gain.misfit_base,
