@@ -38,8 +38,10 @@ inline constexpr std::size_t kMaxOutlierPositions = 1000;
 const Recording& screen_outliers(const Recording& read, OutlierAction action, double threshold, OutlierReport& report,
                                  Recording& edited);
 
-/// The "Outliers" section of the readable reports, and the JSON "outliers" object.
-std::string format_outliers(const OutlierReport& report);
+/// The "Outliers" section of the readable reports, and the JSON "outliers" object. The scale and
+/// the rates are in °/h, or, given a unit label (an accelerometer's "µg"), in it: the report's
+/// values (phase unit per second) times `factor`.
+std::string format_outliers(const OutlierReport& report, std::string_view unit = {}, double factor = 1);
 nlohmann::json to_json(const OutlierReport& report);
 
 /// Parse "keep", "remove" or "replace" (UsageError otherwise).

@@ -272,8 +272,7 @@ std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r) {
                      "(dof {}, p = {:.2g}). The coefficients' intervals are scaled by sqrt(chi2/dof) = "
                      "{:.3g}; look for what the model misses.",
                      r.fit.chi2_per_dof, r.fit.dof, r.fit.p_value, fr.interval_scale),
-                 // diagnose simulates gyros only: an accelerometer gets no command to try
-                 r.sensor == SensorKind::Gyro ? trf("rwcalc diagnose {} [input options]", src) : std::string()});
+                 trf("rwcalc diagnose {} [input options]", src)});
   return w;
 }
 

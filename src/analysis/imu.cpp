@@ -428,8 +428,8 @@ std::string kalibr_yaml(const ImuResult& r, const KalibrOptions& options) {
       if (a.rejected_chi2 > 0)
         s += fmt::format(
             "#     the five-term model does not describe this axis (chi2/dof {:.3g}): its values are "
-            "doubtful{}\n",
-            a.rejected_chi2, kind == SensorKind::Gyro ? "; see rwcalc diagnose" : "");
+            "doubtful; see rwcalc diagnose\n",
+            a.rejected_chi2);
       if (!a.lines.empty())
         s += fmt::format("#     spectral line(s) at {} Hz: their Allan variance taken off before the fit\n", a.lines);
     }

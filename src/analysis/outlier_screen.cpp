@@ -117,10 +117,14 @@ namespace {
 constexpr std::size_t kReportOutliers = 20;  // rows of the readable list; the JSON has up to kMaxOutlierPositions
 }  // namespace
 
-std::string format_outliers(const OutlierReport& o) {
+std::string format_outliers(const OutlierReport& o, std::string_view unit, double factor) {
   std::string s =
-      trf("Outliers (rate samples more than {:g} robust sigma from the median of their 6 neighbours; scale {} °/h)\n",
-          o.threshold, fmt::format("{:.3g}", o.scale_deg_per_h));
+      unit.empty()
+          ? trf("Outliers (rate samples more than {:g} robust sigma from the median of their 6 neighbours; scale {} "
+                "°/h)\n",
+                o.threshold, fmt::format("{:.3g}", o.scale_deg_per_h))
+          : trf("Outliers (samples more than {:g} robust sigma from the median of their 6 neighbours; scale {} {})\n",
+                o.threshold, fmt::format("{:.3g}", o.scale_deg_per_h * factor), unit);
   if (o.count == 0) return s + tr("  none found\n\n");
   switch (o.action) {
     case OutlierAction::Keep:
@@ -134,11 +138,12 @@ std::string format_outliers(const OutlierReport& o) {
       s += trf("  {} found; {} REPLACED by the median of their four nearest good neighbours\n", o.count, o.replaced);
       break;
   }
-  s += fmt::format("  {:>10} {:>12} {:>10} {:>14} {:>9}\n", tr("sample"), tr("time (s)"), tr("line"), tr("rate (°/h)"),
-                   "z");
+  const std::string value = unit.empty() ? tr("rate (°/h)") : trf("value ({})", unit);
+  s += fmt::format("  {:>10} {:>12} {:>10} {:>14} {:>9}\n", tr("sample"), tr("time (s)"), tr("line"), value, "z");
   for (std::size_t k = 0; k < o.positions.size() && k < kReportOutliers; ++k) {
     const auto& p = o.positions[k];
-    s += fmt::format("  {:>10} {:>12.6g} {:>10} {:>14.6g} {:>+9.1f}\n", p.index, p.time_s, p.line, p.value, p.robust_z);
+    s += fmt::format("  {:>10} {:>12.6g} {:>10} {:>14.6g} {:>+9.1f}\n", p.index, p.time_s, p.line, p.value * factor,
+                     p.robust_z);
   }
   if (o.count > kReportOutliers)
     s += trf("  … and {} more (the first {} are listed in --json)\n", o.count - kReportOutliers, o.positions.size());

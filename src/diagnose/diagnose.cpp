@@ -39,12 +39,11 @@ struct Context {
 /// a bias step or inflate N.
 const Recording& screened(const Recording& read, const DiagnoseOptions& opt, OutlierReport& outliers,
                           Recording& edited) {
-  if (read.phase.kind == PhaseKind::Accelerometer)
+  // An accelerometer's velocity (1/3600 m/s, units.hpp) takes the angle's place: the fit, the
+  // simulator and the detectors read it as they read a gyro's angle; only the output's units differ.
+  if (!sensor_kind(read.phase.kind))
     throw UsageError(
-        tr("diagnose needs gyro data: an accelerometer column is analysed by analyze and imu, not yet "
-           "diagnosed"));
-  if (read.phase.kind != PhaseKind::Gyro)
-    throw UsageError(tr("diagnose needs gyro data (clock phase/frequency cannot be simulated as a gyro)"));
+        tr("diagnose needs gyro or accelerometer data (clock phase/frequency cannot be simulated as a sensor)"));
   if (read.segments.size() > 1)
     throw UsageError(tr("diagnose needs one contiguous record: --gaps segments is for analyze, allan and imu"));
   if (opt.runs < 10) throw UsageError(trf("--runs must be at least 10 (got {})", opt.runs));

@@ -9,6 +9,8 @@
 #include "rwcalc/fit.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/printable.hpp"
+#include "rwcalc/sensor.hpp"
+#include "rwcalc/units.hpp"
 
 namespace rwcalc {
 
@@ -16,18 +18,64 @@ using nlohmann::json;
 
 namespace {
 
+/// The units a diagnosis is shown in. A gyro's numbers are the fit's own (°/h, ″), as they always
+/// were; an accelerometer's are the fit's twins (m/s in place of °, units.hpp), shown in its usual
+/// units (sensor.hpp): levels, amplitudes, steps and σ in µg, ramps in m/s/h².
+struct Shown {
+  bool accel = false;
+  UnitSet units;
+  explicit Shown(const DiagnoseResult& r)
+      : accel(r.analysis.sensor == SensorKind::Accelerometer), units(output_units(r.analysis.sensor)) {}
+  [[nodiscard]] double level(double v) const { return accel ? v * units.deviation.factor : v; }
+};
+
+/// A JSON key's unit part from a unit's ASCII name: "m/s/h^2" → "m_per_s_per_h2", "ug" → "ug".
+std::string key_suffix(std::string a) {
+  std::string out;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a.compare(i, 5, "sqrt(") == 0) {
+      out += "sqrt_";
+      i += 4;
+    } else if (a[i] == '/') {
+      out += "_per_";
+    } else if (a[i] != '^' && a[i] != ')') {
+      out += a[i];
+    }
+  }
+  return out;
+}
+
+/// A finding's parameters as shown: for an accelerometer, every °/h figure (amplitude, step, σ)
+/// becomes the level unit and every °/h² figure (ramp) the ramp unit, key and value.
+json shown_params(const json& p, const Shown& sh) {
+  if (!sh.accel || !p.is_object()) return p;
+  json out = json::object();
+  for (const auto& [k, v] : p.items()) {
+    const ShownUnit* u = k.ends_with("_deg_per_h2") ? &sh.units[Term::R]
+                         : k.ends_with("_deg_per_h") ? &sh.units.deviation
+                                                     : nullptr;
+    if (!u || !v.is_number()) {
+      out[k] = v;
+      continue;
+    }
+    const std::string stem = k.substr(0, k.rfind(k.ends_with("_deg_per_h2") ? "_deg_per_h2" : "_deg_per_h"));
+    out[stem + "_" + key_suffix(u->ascii)] = v.get<double>() * u->factor;
+  }
+  return out;
+}
+
 /// A simulated model with its band and how well the measurement sits in it.
 json model_json(const NoiseModel& model, const std::vector<BandPoint>& band, double level, double misfit,
-                double coverage) {
+                double coverage, const Shown& sh) {
   json m;
   to_json(m, model);
   m["band"] = json::array();
   for (const auto& b : band)
     m["band"].push_back({{"tau_s", b.tau_s},
-                         {"dev", b.dev},
-                         {"band_low", b.low},
-                         {"band_high", b.high},
-                         {"median", b.median},
+                         {"dev", sh.level(b.dev)},
+                         {"band_low", sh.level(b.low)},
+                         {"band_high", sh.level(b.high)},
+                         {"median", sh.level(b.median)},
                          {"edf", b.edf}});
   m["band_level"] = level;
   m["misfit"] = misfit;
@@ -47,12 +95,34 @@ json clean_json(json j) {
 json finite_or_null(double x) { return std::isnan(x) ? json(nullptr) : json(x); }
 
 /// N, B, K and R of a model, as the report prints them.
-std::string power_laws(const NoiseModel& m) {
-  return trf("N = {:.4g} °/√h, B = {:.4g} °/h, K = {:.4g} °/h/√h, R = {:.4g} °/h²", m.arw_deg_per_sqrt_h,
-             m.bias_instability_deg_per_h, m.rrw_deg_per_h_per_sqrt_h, m.ramp_deg_per_h2);
+std::string power_laws(const NoiseModel& m, const Shown& sh) {
+  if (!sh.accel)
+    return trf("N = {:.4g} °/√h, B = {:.4g} °/h, K = {:.4g} °/h/√h, R = {:.4g} °/h²", m.arw_deg_per_sqrt_h,
+               m.bias_instability_deg_per_h, m.rrw_deg_per_h_per_sqrt_h, m.ramp_deg_per_h2);
+  const UnitSet& u = sh.units;
+  return fmt::format("N = {:.4g} {}, B = {:.4g} {}, K = {:.4g} {}, R = {:.4g} {}",
+                     m.arw_deg_per_sqrt_h * u[Term::N].factor, localized_label(u[Term::N]),
+                     m.bias_instability_deg_per_h * u[Term::B].factor, localized_label(u[Term::B]),
+                     m.rrw_deg_per_h_per_sqrt_h * u[Term::K].factor, localized_label(u[Term::K]),
+                     m.ramp_deg_per_h2 * u[Term::R].factor, localized_label(u[Term::R]));
 }
 
-std::string unit_of(const std::string& key) {
+/// The N, B, K and R of a model under keys named with the accelerometer's units.
+json coefficients_json(const NoiseModel& m, const Shown& sh) {
+  const UnitSet& u = sh.units;
+  return {{"N_" + key_suffix(u[Term::N].ascii), m.arw_deg_per_sqrt_h * u[Term::N].factor},
+          {"B_" + key_suffix(u[Term::B].ascii), m.bias_instability_deg_per_h * u[Term::B].factor},
+          {"K_" + key_suffix(u[Term::K].ascii), m.rrw_deg_per_h_per_sqrt_h * u[Term::K].factor},
+          {"R_" + key_suffix(u[Term::R].ascii), m.ramp_deg_per_h2 * u[Term::R].factor}};
+}
+
+std::string unit_of(const std::string& key, const Shown& sh) {
+  if (sh.accel)
+    for (const ShownUnit* u : {&sh.units[Term::R], &sh.units.deviation}) {
+      const std::string suffix = key_suffix(u->ascii);
+      if (key.size() > suffix.size() && key.ends_with(suffix) && key[key.size() - suffix.size() - 1] == '_')
+        return localized_label(*u);
+    }
   if (key.ends_with("_hz")) return tr("Hz");
   if (key.ends_with("_deg_per_h2")) return tr("°/h²");
   if (key.ends_with("_deg_per_h")) return tr("°/h");
@@ -62,16 +132,17 @@ std::string unit_of(const std::string& key) {
 }
 
 /// One line per finding: its parameters with their standard errors and units.
-std::string format_findings(const std::vector<Finding>& fs) {
+std::string format_findings(const std::vector<Finding>& fs, const Shown& sh) {
   std::string s;
   for (const auto& f : fs) {
     s += fmt::format("  {}:", finding_name(f.effect));
-    for (const auto& [k, v] : f.params.items()) {
+    const json params = shown_params(f.params, sh), uncertainty = shown_params(f.uncertainty, sh);
+    for (const auto& [k, v] : params.items()) {
       if (!v.is_number()) continue;
-      const double u = f.uncertainty.contains(k) ? f.uncertainty[k].get<double>() : -1;
+      const double u = uncertainty.contains(k) ? uncertainty[k].get<double>() : -1;
       s += fmt::format(" {} = {:.4g}", k, v.get<double>());
       if (u >= 0) s += fmt::format(" ± {:.2g}", u);
-      s += fmt::format(" {};", unit_of(k));
+      s += fmt::format(" {};", unit_of(k, sh));
     }
     s.pop_back();
     s += "\n";
@@ -97,7 +168,45 @@ double b_excess_percent(const DiagnoseResult& r) {
 
 }  // namespace
 
+namespace {
+
+/// What an accelerometer's diagnosis states beside the gyro's keys: the column, the sensor kind,
+/// the input's unit and the units of its numbers. The models keep the simulator's keys (`rwcalc
+/// simulate --from` reads them), whose ° stands for m/s; their N, B, K, R are also given in the
+/// accelerometer's units ("coefficients").
+void accelerometer_json(const DiagnoseResult& r, const Shown& sh, json& j) {
+  const UnitSet& u = sh.units;
+  j["sensor"] = std::string(to_string(r.analysis.sensor));
+  j["column"] = r.analysis.input.value("column", r.analysis.column);
+  j["input_unit"] = r.analysis.input.value("unit", "");
+  j["units"] = {{"level", u.deviation.ascii},
+                {"ramp", u[Term::R].ascii},
+                {"band", u.deviation.ascii},
+                {"models", "simulator keys in fit-scale units: m/s in place of deg (deg/h = m/s/h, arcsec = m/s/3600)"}};
+  j["outliers"] = shown_params(j["outliers"], sh);
+  for (auto& p : j["outliers"]["positions"]) p = shown_params(p, sh);
+  j.erase("scale_arcsec_per_pulse");
+  j["simulation_quantum_m_per_s"] = r.settings.scale_arcsec / units::velocity_units_per_mps;
+  const auto& f = r.analysis.fit;
+  json fc = {{"Q_" + key_suffix(u[Term::Q].ascii), f[Term::Q].estimate * u[Term::Q].factor},
+             {"chi2_per_dof", f.chi2_per_dof}};
+  for (Term t : {Term::N, Term::B, Term::K, Term::R})
+    fc[std::string(term_name(t)) + "_" + key_suffix(u[t].ascii)] = f[t].estimate * u[t].factor;
+  j["base_model"]["fitted_coefficients"] = fc;
+  j["base_model"]["coefficients"] = coefficients_json(r.base, sh);
+  j["extended_model"]["coefficients"] = coefficients_json(r.extended, sh);
+  const std::string b = "_" + key_suffix(u[Term::B].ascii);
+  auto& named = j["bias_instability_named_terms"];
+  named["with" + b] = r.base.bias_instability_deg_per_h * u[Term::B].factor;
+  named["without" + b] = r.extended.bias_instability_deg_per_h * u[Term::B].factor;
+  named.erase("with_deg_per_h");
+  named.erase("without_deg_per_h");
+}
+
+}  // namespace
+
 json to_json(const DiagnoseResult& r) {
+  const Shown sh(r);
   json j;
   j["source"] = r.analysis.source;
   j["samples"] = r.analysis.samples;
@@ -112,7 +221,7 @@ json to_json(const DiagnoseResult& r) {
   j["false_alarm_level_per_detector"] = r.alpha;
   j["simulation_path"] = "decimated";
   j["outliers"] = to_json(r.analysis.outliers);
-  json base = model_json(r.base, r.base_band, r.band_level, r.gain.misfit_base, r.gain.coverage_base);
+  json base = model_json(r.base, r.base_band, r.band_level, r.gain.misfit_base, r.gain.coverage_base, sh);
   // Not under "fit": model_from_analysis_json would read those coefficients instead of this model.
   base["fitted_coefficients"] = {{"Q_arcsec", r.analysis.fit[Term::Q].estimate},
                                  {"N_deg_per_sqrt_h", r.analysis.fit[Term::N].estimate},
@@ -137,13 +246,14 @@ json to_json(const DiagnoseResult& r) {
     det.push_back(o);
   }
   j["detectors"] = det;
-  const auto findings_json = [](const std::vector<Finding>& fs) {
+  const auto findings_json = [&sh](const std::vector<Finding>& fs) {
     json fnd = json::array();
     for (const auto& f : fs) {
       json o = {{"effect", std::string(finding_name(f.effect))}};
-      for (const auto& [k, v] : f.params.items()) o[k] = v;
-      o["uncertainty"] = f.uncertainty;
-      o["evidence"] = f.evidence;
+      const json params = shown_params(f.params, sh);
+      for (const auto& [k, v] : params.items()) o[k] = v;
+      o["uncertainty"] = shown_params(f.uncertainty, sh);
+      o["evidence"] = shown_params(f.evidence, sh);
       fnd.push_back(o);
     }
     return fnd;
@@ -151,7 +261,7 @@ json to_json(const DiagnoseResult& r) {
   j["findings"] = findings_json(r.findings);
   j["rejected_candidates"] = findings_json(r.rejected);
   j["extended_model"] =
-      model_json(r.extended, r.extended_band, r.band_level, r.gain.misfit_extended, r.gain.coverage_extended);
+      model_json(r.extended, r.extended_band, r.band_level, r.gain.misfit_extended, r.gain.coverage_extended, sh);
   j["bias_instability_named_terms"] = {
       {"with_deg_per_h", r.base.bias_instability_deg_per_h},
       {"without_deg_per_h", r.extended.bias_instability_deg_per_h},
@@ -166,31 +276,68 @@ json to_json(const DiagnoseResult& r) {
                {"holdout_misfit_base", finite_or_null(r.gain.holdout_misfit_base)},
                {"holdout_misfit_extended", finite_or_null(r.gain.holdout_misfit_extended)}};
   j["seconds"] = r.seconds;
+  if (sh.accel) accelerometer_json(r, sh, j);
   return clean_json(j);
 }
 
+namespace {
+
+/// The record's line and the base model's: a gyro's with its pulse weight and Earth rate, an
+/// accelerometer's with its column and units (no Earth rate).
+std::string record_and_base(const DiagnoseResult& r, const Shown& sh) {
+  std::string s;
+  const auto& m = r.base;
+  const std::string readout = m.readout == ReadoutMode::Counting ? tr("counting") : tr("white");
+  if (!sh.accel) {
+    s += trf(
+        "  record: {:.0f} s at {:g} Hz, pulse weight {:g}″; ensemble of {} simulated records per model, {} for the "
+        "detectors' thresholds (seed {}), band {:g} % per τ\n\n",
+        r.settings.duration_s, r.settings.rate_hz, r.settings.scale_arcsec, r.runs, r.calibration_runs, r.seed,
+        r.band_level * 100);
+    s += format_outliers(r.analysis.outliers);
+    return s + tr("Base model (five-term fit): ") + power_laws(m, sh) +
+           trf(", white angle {:.4g}″, {} read-out, Earth rate {:.4g} °/h, bias {:.4g} °/h\n", m.white_angle_arcsec,
+               readout, m.earth_rate_deg_per_h, m.bias_deg_per_h);
+  }
+  const std::string level = localized_label(sh.units.deviation);
+  s += trf(
+      "  record: {:.0f} s at {:g} Hz, column '{}' of an accelerometer read in {} (levels in {}, no Earth rate, no "
+      "class verdict); ensemble of {} simulated records per model, {} for the detectors' thresholds (seed {}), band "
+      "{:g} % per τ\n\n",
+      r.settings.duration_s, r.settings.rate_hz, printable(r.analysis.input.value("column", r.analysis.column)),
+      r.analysis.input.value("unit", ""), level, r.runs, r.calibration_runs, r.seed, r.band_level * 100);
+  s += format_outliers(r.analysis.outliers, level, sh.units.deviation.factor);
+  return s + tr("Base model (five-term fit): ") + power_laws(m, sh) +
+         trf(", white velocity {:.4g} m/s, {} read-out, bias (with gravity's projection) {:.4g} {}\n",
+             m.white_angle_arcsec / units::velocity_units_per_mps, readout, sh.level(m.bias_deg_per_h), level);
+}
+
+/// A τ whose measured σ lies outside the band, one line.
+std::string outside_row(const BandPoint& b, const Shown& sh) {
+  const bool above = b.dev > b.high;
+  const double share = 100 * (above ? b.dev / b.high - 1 : 1 - b.dev / b.low);
+  if (!sh.accel)
+    return trf("    τ = {:>9.4g} s: σ = {:.4g} °/h, {:.1f} % {} the band's {} edge {:.4g} °/h\n", b.tau_s, b.dev, share,
+               above ? tr("above") : tr("below"), above ? tr("upper") : tr("lower"), above ? b.high : b.low);
+  const std::string u = localized_label(sh.units.deviation);
+  return trf("    τ = {:>9.4g} s: σ = {:.4g} {}, {:.1f} % {} the band's {} edge {:.4g} {}\n", b.tau_s, sh.level(b.dev), u,
+             share, above ? tr("above") : tr("below"), above ? tr("upper") : tr("lower"),
+             sh.level(above ? b.high : b.low), u);
+}
+
+}  // namespace
+
 std::string format_report(const DiagnoseResult& r) {
+  const Shown sh(r);
   std::string s;
   s += trf("Diagnosis of {}\n", printable(r.analysis.source));
-  s +=
-      trf("  record: {:.0f} s at {:g} Hz, pulse weight {:g}″; ensemble of {} simulated records per model, {} for the "
-          "detectors' thresholds (seed {}), band {:g} % per τ\n\n",
-          r.settings.duration_s, r.settings.rate_hz, r.settings.scale_arcsec, r.runs, r.calibration_runs, r.seed,
-          r.band_level * 100);
-  s += format_outliers(r.analysis.outliers);
-  const auto& m = r.base;
-  s += tr("Base model (five-term fit): ") + power_laws(m) +
-       trf(", white angle {:.4g}″, {} read-out, Earth rate {:.4g} °/h, bias {:.4g} °/h\n", m.white_angle_arcsec,
-           m.readout == ReadoutMode::Counting ? tr("counting") : tr("white"), m.earth_rate_deg_per_h, m.bias_deg_per_h);
+  s += record_and_base(r, sh);
   std::size_t outside = 0;
   std::string rows;
   for (const auto& b : r.base_band) {
     if (b.dev >= b.low && b.dev <= b.high) continue;
     ++outside;
-    const bool above = b.dev > b.high;
-    rows += trf("    τ = {:>9.4g} s: σ = {:.4g} °/h, {:.1f} % {} the band's {} edge {:.4g} °/h\n", b.tau_s, b.dev,
-                100 * (above ? b.dev / b.high - 1 : 1 - b.dev / b.low), above ? tr("above") : tr("below"),
-                above ? tr("upper") : tr("lower"), above ? b.high : b.low);
+    rows += outside_row(b, sh);
   }
   s += trf("  measured Allan deviation inside the base band at {} of {} τ\n", r.base_band.size() - outside,
            r.base_band.size());
@@ -210,19 +357,30 @@ std::string format_report(const DiagnoseResult& r) {
     s += tr("  none: the base model's simulations explain the measurement\n");
   if (r.findings.empty() && !r.rejected.empty())
     s += tr("  none named: the candidates below do not predict the held-out blocks better than the base\n");
-  s += format_findings(r.findings);
+  s += format_findings(r.findings, sh);
   if (!r.rejected.empty())
-    s += tr("Candidates not named (no out-of-sample gain; excess only):\n") + format_findings(r.rejected);
-  s += tr("\nExtended model: ") + power_laws(r.extended) + trf(", {} extra term(s)\n", r.findings.size());
+    s += tr("Candidates not named (no out-of-sample gain; excess only):\n") + format_findings(r.rejected, sh);
+  s += tr("\nExtended model: ") + power_laws(r.extended, sh) + trf(", {} extra term(s)\n", r.findings.size());
   // Without B in the extended model the ratio has no value (JSON: null), so none is printed.
-  if (!r.findings.empty() && std::isfinite(b_excess_percent(r)))
+  const bool b_ratio = std::isfinite(b_excess_percent(r));
+  if (!r.findings.empty() && !sh.accel && b_ratio)
     s += trf("  B with the named terms in the data (base model) {:.4g} °/h, without them (extended model) {:.4g} °/h: "
              "{:+.1f} % with them ({})\n",
              r.base.bias_instability_deg_per_h, r.extended.bias_instability_deg_per_h, b_excess_percent(r),
              named_terms(r.findings));
-  else if (!r.findings.empty())
+  else if (!r.findings.empty() && !sh.accel)
     s += trf("  B with the named terms in the data (base model) {:.4g} °/h, without them (extended model) {:.4g} °/h ({})\n",
              r.base.bias_instability_deg_per_h, r.extended.bias_instability_deg_per_h, named_terms(r.findings));
+  if (!r.findings.empty() && sh.accel) {
+    const std::string u = localized_label(sh.units[Term::B]);
+    s += b_ratio ? trf("  B with the named terms in the data (base model) {:.4g} {}, without them (extended model) {:.4g} {}: "
+                       "{:+.1f} % with them ({})\n",
+                       sh.level(r.base.bias_instability_deg_per_h), u, sh.level(r.extended.bias_instability_deg_per_h), u,
+                       b_excess_percent(r), named_terms(r.findings))
+                 : trf("  B with the named terms in the data (base model) {:.4g} {}, without them (extended model) {:.4g} {} ({})\n",
+                       sh.level(r.base.bias_instability_deg_per_h), u, sh.level(r.extended.bias_instability_deg_per_h), u,
+                       named_terms(r.findings));
+  }
   s += tr("\nGain (misfit: mean EDF-weighted Gamma deviance per τ, about 1 (dimensionless) when the model fits):\n");
   s += fmt::format("  {:<44} {:>10} {:>10}\n", "", tr("base"), tr("extended"));
   s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", tr("Allan-variance misfit (dimensionless)"), r.gain.misfit_base,

@@ -449,6 +449,15 @@ std::vector<BandRow> band_rows(const json& band) {
   return rows;
 }
 
+/// °/h, or the unit the diagnosis names for its band (an accelerometer's: "units": {"band": "ug"}).
+std::string diagnosis_ylabel(const json& diagnosis) {
+  const auto u = diagnosis.find("units");
+  if (u == diagnosis.end() || !u->is_object() || !u->contains("band") || !(*u)["band"].is_string())
+    return fmt::format("Allan deviation σ(τ) ({})", lbl::rate);
+  const std::string band = (*u)["band"].get<std::string>();
+  return trf("Allan deviation σ(τ) ({})", band == "ug" ? std::string("µg") : band);
+}
+
 std::string band_label(const char* what, const json& model, const std::vector<BandRow>& rows) {
   int inside = 0, measured = 0;
   for (const auto& r : rows) {
@@ -518,7 +527,7 @@ Figure diagnosis_figure(const json& diagnosis, const PlotOptions& options) {
              label_text(tr("measured, outside the base band")));
   }
   return loglog_figure("diagnosis", options, options.title.empty() ? diagnosis_title(diagnosis) : options.title,
-                       fmt::format("Allan deviation σ(τ) ({})", lbl::rate), bounds, blocks, plot);
+                       diagnosis_ylabel(diagnosis), bounds, blocks, plot);
 }
 
 PlotResult plot_analysis(const json& analysis, const PlotOptions& options) {
