@@ -606,62 +606,6 @@ Coefficient coefficient_interval(int i, const Stage& sel, const Stage& full, boo
   return co;
 }
 
-/// The selection's allowance on the terms it kept. A term the data cannot tell from zero may still
-/// be present (a rate random walk below its detection limit), and then the kept terms take up its
-/// variance: B takes K's, N takes Q's. The selected model's intervals do not see that bias, so each
-/// kept term's interval is stretched towards its estimate in the selected model with the dropped
-/// term put back — by the shift of that estimate, not by the wider interval of the larger model:
-/// a dropped term that the data put at 0 moves nothing.
-void allow_for_dropped(const std::vector<FitPoint>& used, const Stage& sel, const Stage& full,
-                       const std::array<bool, P>& dropped, double z, FitResult& res) {
-  std::array<double, P> down{}, up{};
-  bool any = false;
-  auto kept = [&](int i) { return i >= 0 && i < P && res.options.enabled[static_cast<std::size_t>(i)]; };
-  for (int d = 0; d < P; ++d) {
-    // Only a dropped term that borders the kept ones in τ (Q, N, B, K, R): one beyond another
-    // dropped term (R beyond K) would only stand in for it.
-    if (!dropped[static_cast<std::size_t>(d)] || !(kept(d - 1) || kept(d + 1))) continue;
-    FitOptions with = res.options;
-    with.enabled[static_cast<std::size_t>(d)] = true;
-    const Problem pr = make_problem(used, with);
-    Vec5 start = sel.fit.d;  // column scales do not depend on the enabled terms
-    start[d] = full.fit.d[d];
-    const IrlsResult r = irls(pr, pr.enabled_mask, start, false);
-    if (!std::isfinite(r.dev) || !r.d.allFinite()) continue;
-    // The larger model's Akaike weight against the selected one (model averaging, Buckland et al.
-    // 1997): the shift counts as much as the data favour the dropped term.
-    const double drop = std::max(0.0, sel.fit.dev - r.dev) / res.phi[static_cast<std::size_t>(d)];
-    const double weight = 1.0 / (1.0 + std::exp(1.0 - drop / 2.0));
-    for (int i = 0; i < P; ++i) {
-      const auto ui = static_cast<std::size_t>(i);
-      if (!kept(i)) continue;
-      const double shift =
-          weight * (kCoefScale[ui] * std::sqrt(pr.scale[i]) * std::sqrt(r.d[i]) - res.coef[ui].estimate);
-      down[ui] = std::min(down[ui], shift);
-      up[ui] = std::max(up[ui], shift);
-      any = true;
-    }
-  }
-  if (!any) return;
-  for (std::size_t i = 0; i < P; ++i) {
-    Coefficient& co = res.coef[i];
-    if (!co.enabled || !res.options.enabled[i]) continue;
-    co.high += up[i];
-    if (!co.resolved) {
-      co.value = co.high;
-      co.sigma = co.high / (2.0 * z);
-      continue;
-    }
-    co.low += down[i];
-    if (co.low <= 0) {  // the allowance reaches 0: the term is no longer resolved
-      co.low = 0;
-      co.resolved = false;
-      co.value = co.high;
-      co.sigma = co.high / (2.0 * z);
-    }
-  }
-}
-
 }  // namespace
 
 std::string_view term_name(Term t) {
@@ -794,13 +738,8 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
       continue;
     }
     co = coefficient_interval(i, sel, full, dropped[ui], res, z, chi2_1);
-  }
-  allow_for_dropped(res.used, sel, full, dropped, z, res);
-  for (std::size_t i = 0; i < P; ++i) {
-    const auto& co = res.coef[i];
-    if (co.enabled && (!std::isfinite(co.value) || !std::isfinite(co.sigma) || !std::isfinite(co.low) ||
-                       !std::isfinite(co.high)))
-      throw AnalysisError(trf("the data do not bound the {} coefficient", term_name(kAllTerms[i])));
+    if (!std::isfinite(co.value) || !std::isfinite(co.sigma) || !std::isfinite(co.low) || !std::isfinite(co.high))
+      throw AnalysisError(trf("the data do not bound the {} coefficient", term_name(kAllTerms[ui])));
   }
   return res;
 }
