@@ -88,9 +88,13 @@ TEST(DiagnoseBlocks, StepTimeAndSize) {
   EXPECT_GT(e.statistic, 6);
 }
 
+// The estimate's noise: white only (from_rate's), no flicker or rate random walk.
+const DriftNoise kWhite{};
+
 TEST(DiagnoseBlocks, WarmupAmplitudeAndTimeConstant) {
   const auto d = from_rate(7200, 0.3, 8, [](double t) { return -0.08 * std::exp(-t / 500.0); });
-  const auto e = warmup_detect(d);
+  const auto e = warmup_detect(d, 0, &kWhite);
+  EXPECT_TRUE(e.separable);
   EXPECT_NEAR(e.amp, -0.08, 4 * e.amp_sigma);
   EXPECT_NEAR(e.tc, 500, 150);
   EXPECT_GT(e.statistic, 20);
@@ -100,12 +104,44 @@ TEST(DiagnoseBlocks, WarmupAmplitudeAndTimeConstant) {
 TEST(DiagnoseBlocks, DriftReportsItsLinearPartAsTheRamp) {
   const double ap = 0.1, td = 900, r = 0.02;  // °/h, s, °/h²
   const auto d = from_rate(7200, 0.3, 9, [&](double t) { return ap * -std::expm1(-t / td) + r * t / 3600.0; });
-  const auto e = warmup_detect(d);
+  const auto e = warmup_detect(d, 0, &kWhite);
+  EXPECT_TRUE(e.separable);
   EXPECT_NEAR(e.amp, -ap, 4 * e.amp_sigma);
   EXPECT_NEAR(e.tc, td, 0.35 * td);
   EXPECT_GT(e.ramp_sigma, 0.0);
   EXPECT_NEAR(e.ramp, r, 4 * e.ramp_sigma);
   EXPECT_GT(e.statistic, 20);
+  // The detection statistic alone leaves the standard errors unset (the estimate sets them).
+  EXPECT_EQ(warmup_detect(d).ramp_sigma, 0.0);
+}
+
+// A drift whose time constant is half the record: the estimate searches τ beyond the statistic's
+// T/3 (where it was clipped, and A and r came out far off), and its joint standard errors (τ
+// free) cover the truth.
+TEST(DiagnoseBlocks, DriftOfHalfTheRecordIsNotClippedAtAThird) {
+  const double ap = 0.6, td = 3600, r = -0.02;  // °/h, s, °/h²
+  const auto d = from_rate(7200, 0.3, 11, [&](double t) { return ap * -std::expm1(-t / td) + r * t / 3600.0; });
+  const auto e = warmup_detect(d, 0, &kWhite);
+  EXPECT_TRUE(e.separable);
+  EXPECT_GT(e.tc, 7200.0 / 3.0 * 1.05);
+  EXPECT_NEAR(e.tc, td, 3 * e.tc_sigma);
+  EXPECT_NEAR(e.amp, -ap, 3 * e.amp_sigma);
+  EXPECT_NEAR(e.ramp, r, 3 * e.ramp_sigma);
+  EXPECT_LT(e.tc_sigma, kDriftSeparableSigma * e.tc);
+}
+
+// A drift of τ ≫ T is a parabola over the record: A, τ and r trade along a ridge, the estimate
+// says so, and the mid-record slope and curvature it reports instead are within their errors.
+TEST(DiagnoseBlocks, LongDriftReportsSlopeAndCurvatureNotAPair) {
+  const double ap = 0.3, td = 20000;  // °/h, s
+  const auto d = from_rate(7200, 0.3, 12, [&](double t) { return ap * -std::expm1(-t / td); });
+  const auto e = warmup_detect(d, 0, &kWhite);
+  EXPECT_FALSE(e.separable);
+  const double x = 3600.0 / td, E = std::exp(-x);  // at mid-record, τ in hours = 1/x
+  EXPECT_NEAR(e.slope_mid, ap * x * E, 3 * e.slope_mid_sigma);
+  EXPECT_NEAR(e.curvature_mid, -ap * x * x * E, 3 * e.curvature_mid_sigma);
+  EXPECT_GT(e.slope_mid_sigma, 0.0);
+  EXPECT_LT(e.slope_mid_sigma, 0.2 * ap * x * E);  // the slope is determined (5σ and more)
 }
 
 TEST(DiagnoseBlocks, DeterministicAngleMatchesTheSimulator) {

@@ -53,16 +53,32 @@ struct StepEstimate {
 StepEstimate step_detect(const Decimated& d);
 
 /// A change of the mean of exponential form on a linear trend, A·e^{−t/τ} + r·t (+ level): a
-/// warm-up transient, or a drift A'·(1 − e^{−t/τ}) + r·t (A' = −A), τ from 20 s to T. The linear
+/// warm-up transient, or a drift A'·(1 − e^{−t/τ}) + r·t (A' = −A), τ from 20 s to 2T. The linear
 /// part r is the rate ramp R of the five-term model, estimated with the exponential.
 struct WarmupEstimate {
   double statistic = 0;  ///< RSS drop on 10-s block means when an exponential joins
   double amp = 0, tc = 0, amp_sigma = 0, tc_sigma = 0;
   double ramp = 0, ramp_sigma = 0;  ///< r, °/h² (signed)
   double rss = 0;
+  /// The drift's rate slope and curvature at mid-record, °/h² and °/h³ (what a record shorter than
+  /// a few τ determines), with their standard errors.
+  double slope_mid = 0, slope_mid_sigma = 0, curvature_mid = 0, curvature_mid_sigma = 0;
+  /// Whether A, τ and r are separately determined (σ_τ/τ ≤ kDriftSeparableSigma); if not, only
+  /// the mid-record slope and curvature are.
+  bool separable = true;
+};
+/// Relative standard error of τ above which A, τ and r are reported as not separately determined.
+inline constexpr double kDriftSeparableSigma = 0.3;
+/// The estimate's noise beyond the 10-s blocks' white scatter: the base model's flicker floor and
+/// rate random walk (their Allan deviation at T/4 enlarges the standard errors).
+struct DriftNoise {
+  double b_deg_per_h = 0, k_deg_per_h_per_sqrt_h = 0;
 };
 /// `tc_hint` > 0: the time constant is that one (a block of the record keeps the record's).
-WarmupEstimate warmup_detect(const Decimated& d, double tc_hint = 0);
+/// Without `noise` the detection statistic (τ searched from 2 blocks to T/3); with it the estimate:
+/// τ searched up to 2T, standard errors over all four parameters jointly (τ included, the noise's
+/// flicker and random walk counted) and the mid-record slope and curvature.
+WarmupEstimate warmup_detect(const Decimated& d, double tc_hint = 0, const DriftNoise* noise = nullptr);
 
 /// A record's own mean-shape candidate: its best step or warm-up, whichever has the lower RSS.
 /// The measurement and every simulated record alike are compared without it.

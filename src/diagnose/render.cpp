@@ -51,6 +51,11 @@ json shown_params(const json& p, const Shown& sh) {
   if (!sh.accel || !p.is_object()) return p;
   json out = json::object();
   for (const auto& [k, v] : p.items()) {
+    // The drift's curvature (°/h³) scales as the ramp does: m/s/h³ beside m/s/h².
+    if (k.ends_with("_deg_per_h3") && v.is_number()) {
+      out[k.substr(0, k.rfind("_deg_per_h3")) + "_m_per_s_per_h3"] = v.get<double>() * sh.units[Term::R].factor;
+      continue;
+    }
     const ShownUnit* u = k.ends_with("_deg_per_h2") ? &sh.units[Term::R]
                          : k.ends_with("_deg_per_h") ? &sh.units.deviation
                                                      : nullptr;
@@ -125,6 +130,8 @@ std::string unit_of(const std::string& key, const Shown& sh) {
     }
   if (key.ends_with("_hz")) return tr("Hz");
   if (key.ends_with("_deg_per_h2")) return tr("°/h²");
+  if (key.ends_with("_deg_per_h3")) return tr("°/h³");
+  if (key.ends_with("_m_per_s_per_h3")) return "m/s/h³";
   if (key.ends_with("_deg_per_h")) return tr("°/h");
   if (key.ends_with("_s")) return tr("s");
   if (key.ends_with("_rad")) return tr("rad");
@@ -138,6 +145,7 @@ std::string format_findings(const std::vector<Finding>& fs, const Shown& sh) {
     s += fmt::format("  {}:", finding_name(f.effect));
     const json params = shown_params(f.params, sh), uncertainty = shown_params(f.uncertainty, sh);
     for (const auto& [k, v] : params.items()) {
+      if (v.is_boolean()) s += fmt::format(" {} = {};", k, v.get<bool>());
       if (!v.is_number()) continue;
       const double u = uncertainty.contains(k) ? uncertainty[k].get<double>() : -1;
       s += fmt::format(" {} = {:.4g}", k, v.get<double>());
