@@ -69,10 +69,12 @@ struct WarmupEstimate {
 };
 /// Relative standard error of τ above which A, τ and r are reported as not separately determined.
 inline constexpr double kDriftSeparableSigma = 0.3;
-/// The estimate's noise beyond the 10-s blocks' white scatter: the base model's flicker floor and
-/// rate random walk (their Allan deviation at T/4 enlarges the standard errors).
+/// The estimate's noise beyond the 10-s blocks' white scatter: the base model's flicker floor (its
+/// Allan variance at T/4 enlarges the standard errors). Not its rate random walk: beside a drift
+/// the base takes part of the drift into K (K 0.015 °/h/√h on a warm-up record without any made
+/// the errors ×2.3).
 struct DriftNoise {
-  double b_deg_per_h = 0, k_deg_per_h_per_sqrt_h = 0;
+  double b_deg_per_h = 0;
 };
 /// `tc_hint` > 0: the time constant is that one (a block of the record keeps the record's).
 /// Without `noise` the detection statistic (τ searched from 2 blocks to T/3); with it the estimate:

@@ -71,13 +71,11 @@ void drift_uncertainty(std::size_t n, double tb, double s, bool tc_free, const E
 }
 
 /// The white scatter `sig` of a 10-s block mean enlarged so that its Allan variance at T/4 also
-/// carries the base's flicker floor ((2 ln 2/π)·B²) and rate random walk (K²τ/3): the drift's
-/// parameters are set by the record's slowest scales, where the flicker matters most.
+/// carries the base's flicker floor (2 ln 2/π)·B²: the drift's parameters are set by the record's
+/// slowest scales, where the flicker matters most.
 double block_noise(double sig, double tb, double T, const DriftNoise& m) {
-  const double tau_h = T / 4 / 3600.0;
-  const double slow = 2 * std::log(2.0) / kPi * m.b_deg_per_h * m.b_deg_per_h +
-                      m.k_deg_per_h_per_sqrt_h * m.k_deg_per_h_per_sqrt_h * tau_h / 3.0;
-  return sig * std::sqrt(1.0 + slow * (T / 4) / (sig * sig * tb));
+  const double floor2 = 2 * std::log(2.0) / kPi * m.b_deg_per_h * m.b_deg_per_h;
+  return sig * std::sqrt(1.0 + floor2 * (T / 4) / (sig * sig * tb));
 }
 
 }  // namespace
@@ -143,7 +141,7 @@ class WarmupDetector final : public RecordDetector {
     return r.warmup ? r.warmup->statistic : warmup_detect(r.dec).statistic;
   }
   void estimate(const Stretch& s, Extension& x) const override {
-    const DriftNoise noise{s.base.bias_instability_deg_per_h, s.base.rrw_deg_per_h_per_sqrt_h};
+    const DriftNoise noise{s.base.bias_instability_deg_per_h};
     const auto est = warmup_detect(s.dec, s.warmup_tc_s, &noise);
     x.det.warmups.push_back({est.amp, est.tc});
     x.ramp = est.ramp;
