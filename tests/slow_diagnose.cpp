@@ -302,7 +302,7 @@ TEST(DiagnoseAcceptance, WarmupTransient) {
 // warm-up detector's model with A = −A', its trend reported as the rate ramp R. The estimate
 // searches τd up to 2T and states the errors of A, τd, r from all four parameters jointly, the
 // block noise enlarged by the base's flicker (docs/diagnosis.md, "Drift of exponential plus linear
-// form"); where σ_τ/τ > 0.3 it reports only the mid-record slope and curvature (`separable` false).
+// form"); where σ_τ/τ > 0.5 it reports only the mid-record slope and curvature (`separable` false).
 // Over 2 h σ_r does not shrink with A' (r trades with the exponential's linear part A'/τd): stated
 // σ_r ≈ 0.007–0.013 °/h² at τd 10–20 min, ≈ 0.02–0.03 at 30 min, ≈ 0.09 at 60 min.
 // Range (the measured 90 % limit): A' 0.15–0.4 °/h (random sign), τd 10–20 min, r uniform in

@@ -68,7 +68,7 @@ struct WarmupEstimate {
   bool separable = true;
 };
 /// Relative standard error of τ above which A, τ and r are reported as not separately determined.
-inline constexpr double kDriftSeparableSigma = 0.3;
+inline constexpr double kDriftSeparableSigma = 0.5;  // τ within a factor e^{0.5} ≈ 1.65 at 1σ
 /// The estimate's noise beyond the 10-s blocks' white scatter: the base model's flicker floor (its
 /// Allan variance at T/4 enlarges the standard errors). Not its rate random walk: beside a drift
 /// the base takes part of the drift into K (K 0.015 °/h/√h on a warm-up record without any made
