@@ -101,10 +101,7 @@ json finite_or_null(double x) { return std::isnan(x) ? json(nullptr) : json(x); 
 
 /// N, B, K and R of a model, as the report prints them.
 std::string power_laws(const NoiseModel& m, const Shown& sh) {
-  if (!sh.accel)
-    return trf("N = {:.4g} °/√h, B = {:.4g} °/h, K = {:.4g} °/h/√h, R = {:.4g} °/h²", m.arw_deg_per_sqrt_h,
-               m.bias_instability_deg_per_h, m.rrw_deg_per_h_per_sqrt_h, m.ramp_deg_per_h2);
-  const UnitSet& u = sh.units;
+  const UnitSet& u = sh.units;  // gyro: °/√h, °/h, °/h/√h, °/h² at factor 1
   return fmt::format("N = {:.4g} {}, B = {:.4g} {}, K = {:.4g} {}, R = {:.4g} {}",
                      m.arw_deg_per_sqrt_h * u[Term::N].factor, localized_label(u[Term::N]),
                      m.bias_instability_deg_per_h * u[Term::B].factor, localized_label(u[Term::B]),
@@ -370,24 +367,17 @@ std::string format_report(const DiagnoseResult& r) {
     s += tr("Candidates not named (no out-of-sample gain; excess only):\n") + format_findings(r.rejected, sh);
   s += tr("\nExtended model: ") + power_laws(r.extended, sh) + trf(", {} extra term(s)\n", r.findings.size());
   // Without B in the extended model the ratio has no value (JSON: null), so none is printed.
-  const bool b_ratio = std::isfinite(b_excess_percent(r));
-  if (!r.findings.empty() && !sh.accel && b_ratio)
-    s += trf("  B with the named terms in the data (base model) {:.4g} °/h, without them (extended model) {:.4g} °/h: "
-             "{:+.1f} % with them ({})\n",
-             r.base.bias_instability_deg_per_h, r.extended.bias_instability_deg_per_h, b_excess_percent(r),
-             named_terms(r.findings));
-  else if (!r.findings.empty() && !sh.accel)
-    s += trf("  B with the named terms in the data (base model) {:.4g} °/h, without them (extended model) {:.4g} °/h ({})\n",
-             r.base.bias_instability_deg_per_h, r.extended.bias_instability_deg_per_h, named_terms(r.findings));
-  if (!r.findings.empty() && sh.accel) {
+  if (!r.findings.empty()) {
     const std::string u = localized_label(sh.units[Term::B]);
-    s += b_ratio ? trf("  B with the named terms in the data (base model) {:.4g} {}, without them (extended model) {:.4g} {}: "
-                       "{:+.1f} % with them ({})\n",
-                       sh.level(r.base.bias_instability_deg_per_h), u, sh.level(r.extended.bias_instability_deg_per_h), u,
-                       b_excess_percent(r), named_terms(r.findings))
-                 : trf("  B with the named terms in the data (base model) {:.4g} {}, without them (extended model) {:.4g} {} ({})\n",
-                       sh.level(r.base.bias_instability_deg_per_h), u, sh.level(r.extended.bias_instability_deg_per_h), u,
-                       named_terms(r.findings));
+    const double with = sh.level(r.base.bias_instability_deg_per_h),
+                 without = sh.level(r.extended.bias_instability_deg_per_h), pct = b_excess_percent(r);
+    s += std::isfinite(pct)
+             ? trf("  B with the named terms in the data (base model) {:.4g} {}, without them (extended model) {:.4g} "
+                   "{}: {:+.1f} % with them ({})\n",
+                   with, u, without, u, pct, named_terms(r.findings))
+             : trf("  B with the named terms in the data (base model) {:.4g} {}, without them (extended model) {:.4g} "
+                   "{} ({})\n",
+                   with, u, without, u, named_terms(r.findings));
   }
   s += tr("\nGain (misfit: mean EDF-weighted Gamma deviance per τ, about 1 (dimensionless) when the model fits):\n");
   s += fmt::format("  {:<44} {:>10} {:>10}\n", "", tr("base"), tr("extended"));
