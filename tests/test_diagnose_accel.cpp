@@ -42,7 +42,7 @@ std::string accel_csv(bool with_sinusoid, std::uint64_t seed) {
   std::string out = "time_s,acc_x_mps2\n";
   for (std::size_t k = 0; k + 1 < x.points(); ++k)
     fmt::format_to(std::back_inserter(out), "{:.2f},{:.10g}\n", static_cast<double>(k) / s.rate_hz,
-                   9.80665 + x.rate(k) / 3600.0);  // + 1 g of gravity's projection
+                   rwcalc::units::standard_gravity + x.rate(k) / 3600.0);  // + 1 g of gravity's projection
   return out;
 }
 
