@@ -53,7 +53,7 @@ struct FitOptions {
   double dispersion = 1.0;  ///< constant variance inflation on top of the model-based one
   /// Profile deviance scaled by 1 + a/ν_i (ν_i the term's own EDF); calibrated by
   /// tests/slow_coverage_fit.cpp.
-  double edf_inflation = 3.0;
+  double edf_inflation = 1.0;
   bool model_covariance = true;  ///< when the points carry cluster sizes and terms
   /// Backward elimination (R, K, Q) of terms that lower the scaled deviance by less than the χ²₁
   /// quantile; a dropped term is reported as the full model's upper bound. N, B: never dropped.

@@ -176,6 +176,7 @@ struct Simulator::Impl {
   Eigen::FFT<double> fft;
   std::vector<std::complex<double>> filter_spectrum, spectrum;
   std::vector<double> flicker;
+  double level_sd = 0.0;  // standard deviation of the first flicker rate per B
   std::vector<GmStep> gm_steps;
   // Sinusoids: cos and sin of (j + 1)·ωτ0 for j < kBlock, per line (deterministic_block).
   struct LineSteps {
@@ -223,22 +224,38 @@ struct Simulator::Impl {
   }
 
   void prepare_flicker() {
-    // Circular convolution of length L ≥ 2n, filter of L − n + 1 taps: no wrap-around on the
-    // first n outputs.
+    // The rate's increments d_k = y_k − y_{k−1} of the infinite Kasdin filter are stationary with
+    // PSD 2B²·sin(πfτd) and autocovariance γ(0) = 4B²/π, γ(h) = −4B²/(π(4h² − 1)). Their
+    // circulant embedding of length L ≥ 2n has eigenvalues λ ≥ 0 (all γ(h ≠ 0) < 0, Craigmile
+    // 2003), so filtering white noise by √λ gives increments with exactly that covariance
+    // (Davies–Harte). A filter cut at the record length instead adds a spurious rate random walk
+    // (AV +7 % at τ = T/4, +18 % at T/2).
     fft_size = good_fft_size(2 * flicker_n);
-    const std::size_t taps = fft_size - flicker_n + 1;
-    std::vector<double> h(fft_size, 0.0);
-    h[0] = 1.0;
-    for (std::size_t k = 1; k < taps; ++k)
-      h[k] = h[k - 1] * (0.5 + static_cast<double>(k) - 1.0) / static_cast<double>(k);
-    fft.fwd(filter_spectrum, h);
+    const std::size_t half = fft_size / 2;
+    std::vector<double> acf(fft_size, 0.0);
+    for (std::size_t h = 0; h <= half; ++h) {
+      const double hd = static_cast<double>(h);
+      acf[h] = 4.0 / (std::numbers::pi * (1.0 - 4.0 * hd * hd));
+      if (h > 0 && h < half) acf[fft_size - h] = acf[h];
+    }
+    fft.fwd(filter_spectrum, acf);
+    for (auto& l : filter_spectrum) l = std::sqrt(std::max(l.real(), 0.0));
+    // Level of the first rate value: the spread a Kasdin filter of n taps gives it (Σ h_k²).
+    double hk = 1.0;
+    level_sd = 1.0;
+    for (std::size_t k = 1; k < flicker_n; ++k) {
+      hk *= (static_cast<double>(k) - 0.5) / static_cast<double>(k);
+      level_sd += hk * hk;
+    }
+    level_sd = std::sqrt(level_sd);
     spectrum.resize(filter_spectrum.size());
     flicker.resize(fft_size);
   }
 
   // Flicker rate samples, ″/s, by filtering white noise whose DFT is drawn directly (independent
-  // complex normal bins). On the Ensemble path the Kasdin sequence is at τd = D·τ0 (Q_d = B² keeps
-  // the low-frequency PSD B²/(πf)), each value held over D samples.
+  // complex normal bins) into the rate's increments, summed. On the Ensemble path the Kasdin
+  // sequence is at τd = D·τ0 (Q_d = B² keeps the low-frequency PSD B²/(πf)), each value held over
+  // D samples.
   void make_flicker(std::uint64_t seed) {
     Rng rng(seed, kFlickerStream);
     const double b = model.bias_instability_deg_per_h;  // Q_d = B²
@@ -253,6 +270,9 @@ struct Simulator::Impl {
     }
     spectrum[half] = filter_spectrum[half] * s_edge * rng.normal();
     fft.inv(flicker.data(), spectrum.data(), static_cast<Eigen::Index>(fft_size));
+    // Rates from the increments (flicker[0]'s increment is not used).
+    flicker[0] = b * level_sd * rng.normal();
+    for (std::size_t k = 1; k < flicker_n; ++k) flicker[k] += flicker[k - 1];
   }
 
   // A realisation is generated in blocks of kBlock samples: each term adds its angle increments
