@@ -73,6 +73,25 @@ TEST(Verdict, ProbabilitiesFromTheLogNormalSamplingDistribution) {
   EXPECT_EQ(d.statement(), fmt::format("class 1 (P={:.2f})", d.p_class));
 }
 
+TEST(Verdict, AnUnresolvedEstimateIsTakenAsPositive) {
+  // A fit whose B estimate is 0: half the confidence distribution sits at 0, the rest a half-normal
+  // whose 97.5 % point (the reported upper bound) is 0.0062 °/h.
+  const double s = 0.0062 / 1.959964;
+  EstimateInput b;
+  b.value = 0.0062;
+  b.high = 0.0062;
+  b.resolved = false;
+  b.cdf = [s](double x) { return x > 0 ? 0.5 + 0.5 * std::erf(x / s / std::numbers::sqrt2) : 0.0; };
+  const Verdict v = decide(b, exact(0.0005), 0, VerdictOptions{});
+  // Given B > 0: P(B ≤ x) = 2·cdf(x) − 1, not cdf(x) (which put P(class 1) at 0.94, now 0.89).
+  EXPECT_NEAR(v.B.p_meets[0], 2 * b.cdf(0.005) - 1, 1e-12);
+  EXPECT_NEAR(v.B.p_meets[1], 2 * b.cdf(0.008) - 1, 1e-12);
+  EXPECT_LT(v.B.p_meets[0], b.cdf(0.005) - 0.05);
+  // A resolved estimate has no mass at 0 and keeps its distribution.
+  const auto r = lognormal_estimate(0.006, 0.001);
+  EXPECT_NEAR(decide(r, exact(0.0005), 0, VerdictOptions{}).B.p_meets[0], r.cdf(0.005), 1e-15);
+}
+
 TEST(Verdict, OverallProbabilityCombinesBothParameters) {
   const VerdictOptions o;
   const auto b = lognormal_estimate(0.005, 0.001);   // P(B ≤ class 1) = 0.5

@@ -392,6 +392,7 @@ double AvBEstimate::cdf(double b) const {
   if (!(edf > 0) || !(var > 0)) return b >= B.value ? 1.0 : 0.0;
   // P(σ²_true ≤ s) = P(χ²_ν ≥ ν·σ̂²/s), s = white + (2 ln2/π)·b²: the χ² interval's distribution.
   const double s = white + kFlicker * b * b;
+  if (!(s > 0)) return 0.0;  // b² underflows and no white part: no variance can be that small
   const boost::math::chi_squared dist(edf);
   return boost::math::cdf(boost::math::complement(dist, edf * var / s));
 }
