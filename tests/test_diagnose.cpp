@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 
@@ -361,6 +362,41 @@ TEST(DiagnoseBlocks, BandRefitRecoversKnownCoefficientChanges) {
   EXPECT_EQ(d0[0], 0.0);
   EXPECT_EQ(d0[1], 0.0);
   EXPECT_EQ(d0[2], 0.0);
+}
+
+TEST(DiagnoseBlocks, CalibrationCorrectsOnlyTheTermsTheModelCarries) {
+  // The pilot calibration's corrections are applied to N, B (and K): Q², which no model carries,
+  // is not fitted (left free, its 3/τ² traded with N²'s 1/τ).
+  const std::array<double, 4> c{-std::numeric_limits<double>::infinity(), c_from_coefficient(Term::N, 0.001),
+                                c_from_coefficient(Term::B, 0.005), 0.0};
+  auto avar = [&](double tau, double cn, double cb) {
+    return 0.2 / (tau * tau) + cn * term_basis(Term::N, tau) + cb * term_basis(Term::B, tau);
+  };
+  MidTauReference ref;
+  for (double tau = 1.0; tau < 2400.0; tau *= std::pow(10.0, 0.1)) {
+    ref.tau.push_back(tau);
+    ref.mean.push_back(avar(tau, c[1], c[2]));
+    ref.var.push_back(std::pow(0.05 * ref.mean.back(), 2));
+    ref.grid.push_back(ref.grid.size() + 1);
+  }
+  std::vector<double> v;
+  for (double tau : ref.tau) v.push_back(avar(tau, 0.5 * c[1], 1.3 * c[2]));
+  const auto dc = power_law_corrections(v, ref, c, 1200.0, true);
+  EXPECT_EQ(dc[0], 0.0);
+  EXPECT_NEAR(dc[1], -0.5 * c[1], 1e-6 * c[1]);
+  EXPECT_NEAR(dc[2], 0.3 * c[2], 1e-6 * c[2]);
+  EXPECT_EQ(dc[3], 0.0);
+
+  // An excess of the white angle noise's shape 3/τ² is not a correction: no model would carry it.
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] += 3.0 * 0.02 / (ref.tau[i] * ref.tau[i]);
+  EXPECT_EQ(power_law_corrections(v, ref, c, 1200.0, true)[0], 0.0);
+
+  // Both N² and B² asked below zero with K held: every term at its bound, nothing left to fit.
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = 0.2 / (ref.tau[i] * ref.tau[i]) * 0.999;
+  const auto d0 = power_law_corrections(v, ref, c, 1200.0, true);
+  EXPECT_EQ(d0[0], 0.0);
+  EXPECT_DOUBLE_EQ(d0[1], -c[1]);
+  EXPECT_DOUBLE_EQ(d0[2], -c[2]);
 }
 
 }  // namespace

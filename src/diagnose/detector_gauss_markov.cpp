@@ -3,6 +3,7 @@
 // plus bump), simulated with the same seeds; the statistic is the drop of the mid-τ Gamma deviance
 // from the base ensemble to M1's, which must beat every base record's drop and a likelihood ratio
 // of 100 (docs/diagnosis.md, "Naming a Gauss–Markov term").
+#include <boost/math/distributions/chi_squared.hpp>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -19,6 +20,17 @@ constexpr double kGmMinPeakRatio = 0.6;  ///< bump AV at its peak / base AV ther
 constexpr double kGmMinExcess = 2.0;     ///< ensemble SDs the bump must raise the mid-τ AV by
 /// The deviance drop (2 ln of the likelihood ratio) M1 must reach at least.
 const double kGmMinLogLr = 2.0 * std::log(100.0);
+/// Parameters of M1 fitted to the data beyond the base: the bump's σ² and Tc, and the N², B², K²
+/// corrections beside it.
+constexpr double kGmFittedParameters = 5.0;
+
+/// The floor of the data's deviance drop. M1 is fitted to the data and the base records are
+/// scored against that M1 without a fit of their own, so their drops do not carry the fit's gain:
+/// under the base the data's drop is about χ² with M1's fitted parameters as degrees of freedom
+/// (Wilks), whose (1 − α) quantile is the floor (15.1 at α = 1 %), and never below 2 ln 100.
+double min_log_lr(double alpha) {
+  return std::max(kGmMinLogLr, boost::math::quantile(boost::math::chi_squared(kGmFittedParameters), 1.0 - alpha));
+}
 
 /// A model plus a fitted bump, its B² and K² corrections and the white rate noise left beside it.
 NoiseModel with_bump(const NoiseModel& base, const ShapeEstimate& est) {
@@ -59,7 +71,7 @@ class GaussMarkovDetector final : public Detector {
     const auto gm = shape_detect(v, s.ref, c_of(s.base));
     DetectorResult d;
     d.effect = Effect::GaussMarkov;
-    d.threshold = kGmMinLogLr;
+    d.threshold = min_log_lr(s.opt->alpha);
     d.note = implausible(gm);
     if (!d.note.empty()) return d;
     const std::size_t runs = t.runs.size();
@@ -74,7 +86,7 @@ class GaussMarkovDetector final : public Detector {
     }
     d.ensemble_max = *std::max_element(e_gm.begin(), e_gm.end());
     d.ensemble_median = quantile(e_gm, 0.5);
-    d.threshold = std::max(kGmMinLogLr, d.ensemble_max);
+    d.threshold = std::max(min_log_lr(s.opt->alpha), d.ensemble_max);
     set_verdict(d, d.threshold);
     return d;
   }

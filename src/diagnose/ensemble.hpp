@@ -27,7 +27,7 @@ struct MidTauReference {
 };
 
 struct ShapeEstimate {
-  double statistic = 0;               ///< χ² drop when a Gauss–Markov bump joins the Q, N, B, K corrections
+  double statistic = 0;               ///< χ² drop when a Gauss–Markov bump joins the N, B, K corrections
   double scale = 0, scale_sigma = 0;  ///< its variance σ², (°/h)², and standard error
   double time = 0, time_low = 0, time_high = 0;  ///< its correlation time and Δχ² = 1 range, s
   std::array<double, 4> dc{0, 0, 0, 0};          ///< corrections of the fit-scale Q², N², B², K²
@@ -41,12 +41,13 @@ struct ShapeEstimate {
 };
 /// AV of a unit-variance Gauss–Markov process of correlation time tc.
 double gauss_markov_avar(double tau, double tc);
-/// Fit `v` against the reference plus Q, N, B, K corrections (corrected N², B², K² of `c_base`
+/// Fit `v` against the reference plus N, B, K corrections (corrected N², B², K² of `c_base`
 /// kept ≥ 0) plus a Gauss–Markov bump; `fixed_time` > 0: its correlation time, else a grid search.
 ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& ref,
                            const std::array<double, 4>& c_base, double fixed_time = 0.0);
 /// Corrections of the fit-scale Q², N², B², K² that bring the reference to `v` on τ ≤ tau_max
-/// (corrected N², B², K² kept ≥ 0); `hold_k`: K keeps the reference model's value.
+/// (corrected N², B², K² kept ≥ 0; Q² held, its correction 0); `hold_k`: K keeps the reference
+/// model's value.
 std::array<double, 4> power_law_corrections(const std::vector<double>& v, const MidTauReference& ref,
                                             const std::array<double, 4>& c_base,
                                             double tau_max = std::numeric_limits<double>::infinity(),

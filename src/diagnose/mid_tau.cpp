@@ -1,4 +1,4 @@
-// Fits of the mid-τ Allan variance against an ensemble reference: Q, N, B, K corrections kept
+// Fits of the mid-τ Allan variance against an ensemble reference: N, B, K corrections kept
 // ≥ 0, the Gauss–Markov bump beside them, and the reference without one run.
 #include "diagnose/ensemble.hpp"
 
@@ -85,7 +85,10 @@ Whitener whiten(MidTauProblem& p, const MidTauReference& ref) {
 }
 
 /// Weighted least squares with c_base + Δc ≥ 0 for N², B², K² (active set: the most negative is
-/// held at −c_base and the rest re-fitted); `shape`: a further, free column. Q² is free.
+/// held at −c_base and the rest re-fitted); `shape`: a further, free column. Q² is held: the
+/// read-out and the white angle noise are simulated as the five-term fit gave them and no model
+/// carries a Q² correction; left free, its 3/τ² traded with N²'s 1/τ over 1–10 s, where a record's
+/// evidence of N lies, and the simulated model then had neither (docs/diagnosis.md, Method).
 struct ConstrainedFit {
   double chi2 = 0;
   std::array<double, 4> dc{0, 0, 0, 0};
@@ -94,7 +97,7 @@ struct ConstrainedFit {
 };
 
 ConstrainedFit constrained_fit(const MidTauProblem& p, const std::array<double, 4>& c_base,
-                               const std::vector<double>* shape, std::array<bool, 4> free = {true, true, true, true}) {
+                               const std::vector<double>* shape, std::array<bool, 4> free = {false, true, true, true}) {
   ConstrainedFit f;
   std::array<bool, 4> fixed{false, false, false, false};
   for (int iter = 0; iter < 4; ++iter) {
@@ -158,7 +161,7 @@ std::array<double, 4> power_law_corrections(const std::vector<double>& v, const 
     if (ref.tau[i] > tau_max) w[i] = 0.0;  // left out of the problem
   const MidTauProblem p = mid_tau_problem(w, ref);
   if (p.y.size() < 6) return {0, 0, 0, 0};
-  return constrained_fit(p, c_base, nullptr, {true, true, true, !hold_k}).dc;
+  return constrained_fit(p, c_base, nullptr, {false, true, true, !hold_k}).dc;
 }
 
 ShapeEstimate shape_detect(const std::vector<double>& v, const MidTauReference& ref,

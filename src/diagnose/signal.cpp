@@ -148,9 +148,13 @@ WlsOut wls(const std::vector<double>& y, const std::vector<double>& w, const std
     Y(i) = y[static_cast<std::size_t>(i)];
     W(i) = w[static_cast<std::size_t>(i)];
   }
+  WlsOut o;
+  if (p == 0) {  // nothing free (every term at its bound): the residuals are the data
+    o.chi2 = (Y.array().square() * W.array()).sum();
+    return o;
+  }
   const Eigen::MatrixXd XtW = X.transpose() * W.asDiagonal();
   const Eigen::MatrixXd A = XtW * X;
-  WlsOut o;
   o.inv = A.completeOrthogonalDecomposition().pseudoInverse();
   o.coef = o.inv * (XtW * Y);
   const Eigen::VectorXd r = Y - X * o.coef;
