@@ -48,7 +48,8 @@ std::vector<std::int64_t> octave_of(const AllanResult& a);
 /// The series with the deterministic terms of `det` removed: floating phase.
 PhaseSeries cleaned(const PhaseSeries& x, const NoiseModel& det);
 
-/// Fit-scale squared coefficients Q², N², B², K² of a model (Q² is not corrected: −∞).
+/// Fit-scale squared coefficients Q², N², B², K² of a model; Q²'s entry is −∞ (no bound: Q² is held in
+/// the mid-τ fits, never corrected).
 std::array<double, 4> c_of(const NoiseModel& m);
 /// Add a fit-scale correction to a coefficient, the corrected square kept ≥ 0.
 void correct(double& coef, Term t, double dc);
