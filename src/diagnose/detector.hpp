@@ -79,7 +79,7 @@ struct DriftNoise {
 /// `tc_hint` > 0: the time constant is that one (a block of the record keeps the record's).
 /// Without `noise` the detection statistic (τ searched from 2 blocks to T/3); with it the estimate:
 /// τ searched up to 2T, standard errors over all four parameters jointly (τ included, the noise's
-/// flicker and random walk counted) and the mid-record slope and curvature.
+/// flicker counted) and the mid-record slope and curvature.
 WarmupEstimate warmup_detect(const Decimated& d, double tc_hint = 0, const DriftNoise* noise = nullptr);
 
 /// A record's own mean-shape candidate: its best step or warm-up, whichever has the lower RSS.

@@ -317,13 +317,11 @@ std::string record_and_base(const DiagnoseResult& r, const Shown& sh) {
              m.white_angle_arcsec / units::velocity_units_per_mps, readout, sh.level(m.bias_deg_per_h), level);
 }
 
-/// A τ whose measured σ lies outside the band, one line.
+/// A τ whose measured σ lies outside the band, one line, in the sensor's level unit (a gyro's °/h
+/// at factor 1).
 std::string outside_row(const BandPoint& b, const Shown& sh) {
   const bool above = b.dev > b.high;
   const double share = 100 * (above ? b.dev / b.high - 1 : 1 - b.dev / b.low);
-  if (!sh.accel)
-    return trf("    τ = {:>9.4g} s: σ = {:.4g} °/h, {:.1f} % {} the band's {} edge {:.4g} °/h\n", b.tau_s, b.dev, share,
-               above ? tr("above") : tr("below"), above ? tr("upper") : tr("lower"), above ? b.high : b.low);
   const std::string u = localized_label(sh.units.deviation);
   return trf("    τ = {:>9.4g} s: σ = {:.4g} {}, {:.1f} % {} the band's {} edge {:.4g} {}\n", b.tau_s, sh.level(b.dev), u,
              share, above ? tr("above") : tr("below"), above ? tr("upper") : tr("lower"),
