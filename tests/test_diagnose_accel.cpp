@@ -46,10 +46,11 @@ std::string accel_csv(bool with_sinusoid, std::uint64_t seed) {
   return out;
 }
 
-json diagnose_json(const std::string& file, std::vector<std::string> extra = {}) {
-  std::vector<std::string> args{"diagnose", file, "--json", "--runs", "12", "--seed", "3"};
-  args.insert(args.end(), extra.begin(), extra.end());
-  const auto r = run_cli(args);
+/// `rwcalc diagnose --json` of a simulated accelerometer record (the file in a temporary folder).
+json diagnose_record(bool with_sinusoid, std::uint64_t seed) {
+  TempDir dir;
+  const auto f = dir.write("acc.csv", accel_csv(with_sinusoid, seed)).string();
+  const auto r = run_cli({"diagnose", f, "--json", "--runs", "12", "--seed", "3"});
   EXPECT_EQ(r.status, 0) << r.err;
   return r.status == 0 ? json::parse(r.out) : json();
 }
@@ -57,9 +58,7 @@ json diagnose_json(const std::string& file, std::vector<std::string> extra = {})
 }  // namespace
 
 TEST(DiagnoseAccelerometer, NamesTheSinusoidInAccelerometerUnits) {
-  TempDir dir;
-  const auto f = dir.write("acc.csv", accel_csv(true, 21)).string();
-  const json j = diagnose_json(f);
+  const json j = diagnose_record(true, 21);
   ASSERT_FALSE(j.is_null());
   EXPECT_EQ(j["sensor"], "accelerometer");
   EXPECT_EQ(j["column"], "acc_x_mps2");
@@ -86,9 +85,7 @@ TEST(DiagnoseAccelerometer, NamesTheSinusoidInAccelerometerUnits) {
 }
 
 TEST(DiagnoseAccelerometer, CleanRecordHasNoFinding) {
-  TempDir dir;
-  const auto f = dir.write("acc.csv", accel_csv(false, 22)).string();
-  const json j = diagnose_json(f);
+  const json j = diagnose_record(false, 22);
   ASSERT_FALSE(j.is_null());
   EXPECT_EQ(j["sensor"], "accelerometer");
   EXPECT_TRUE(j["findings"].empty()) << j["findings"].dump();
