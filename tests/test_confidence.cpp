@@ -2,6 +2,7 @@
 // synthetic power-law noises whose exponent is known.
 #include <gtest/gtest.h>
 
+#include <boost/multiprecision/cpp_bin_float.hpp>
 #include <cmath>
 #include <random>
 
@@ -43,6 +44,41 @@ TEST(Edf, AsymptotesAndTheWhitePmClosedFormAreContinuous) {
     }
   EXPECT_THROW(edf_greenhall(-3, 1, 4, 100, true, false), AnalysisError);  // α + 2d ≤ 1
   EXPECT_EQ(edf_greenhall(0, 2, 600, 1001, true, false), 0.0);             // no term left
+}
+
+// Greenhall's basic sum for α = +1 (flicker PM), d = 2, evaluated directly in 50 decimal digits, where
+// the second difference of sw at step 1/F that cancels ~2·log10(F·t) digits still leaves 30.
+double edf_flicker_pm_reference(std::int64_t m, std::int64_t n_phase, bool overlapping) {
+  using Big = boost::multiprecision::cpp_bin_float_50;
+  const Big f = m, s = overlapping ? m : 1, mr = m, d = 2;
+  auto sw = [](const Big& t) { return t == 0 ? Big(0) : Big(t * t * log(abs(t))); };
+  auto sx = [&](const Big& t) { return f * f * (2 * sw(t) - sw(t - 1 / f) - sw(t + 1 / f)); };
+  auto sz = [&](const Big& t) { return 6 * sx(t) - 4 * sx(t - 1) - 4 * sx(t + 1) + sx(t - 2) + sx(t + 2); };
+  const Big m_terms = 1 + floor(s * (Big(n_phase) - (mr / f + mr * d)) / mr);
+  const Big j_terms = std::min(m_terms, Big((d + 1) * s));
+  const Big z0 = sz(0), zj = sz(j_terms / s);
+  Big sum = z0 * z0 + (1 - j_terms / m_terms) * zj * zj;
+  for (std::int64_t j = 1; j < static_cast<std::int64_t>(j_terms); ++j) {
+    const Big z = sz(Big(j) / s);
+    sum += 2 * (1 - Big(j) / m_terms) * z * z;
+  }
+  return static_cast<double>(z0 * z0 * m_terms / sum);
+}
+
+TEST(Edf, FlickerPmAtLargeClusterSizesKeepsFullPrecision) {
+  // Non-overlapping ADEV at m = 524288 (τ = 1311 s of a 400-Hz record) with a few intervals left: the
+  // direct second difference lost 11 digits in long double, and its x87 logarithm differs between
+  // processors, so the EDF differed in the 8th digit from one machine to another.
+  for (std::int64_t m : {1000, 524288, 2000000}) {
+    for (std::int64_t intervals : {4, 9, 40}) {
+      const std::int64_t n = m * intervals + 1;
+      const double nonoverlapping = edf_greenhall(1, 2, m, static_cast<std::size_t>(n), false, false);
+      EXPECT_NEAR(nonoverlapping / edf_flicker_pm_reference(m, n, false), 1.0, 1e-13) << m << " " << intervals;
+    }
+    const std::int64_t n = 2 * m + 41;  // overlapping: 41 terms (the direct sum needs J ≤ 100)
+    const double overlapping = edf_greenhall(1, 2, m, static_cast<std::size_t>(n), true, false);
+    EXPECT_NEAR(overlapping / edf_flicker_pm_reference(m, n, true), 1.0, 1e-13) << m;
+  }
 }
 
 TEST(Chi2, IntervalBracketsTheEstimateAndNarrowsWithEdf) {
