@@ -297,7 +297,6 @@ TEST(Imu, ReportDirectoryHoldsTheWholeResult) {
   EXPECT_EQ(nlohmann::json::parse(slurp(out / "imu.json"))["channels"].size(), 6u);
 }
 
-
 // A 6-axis recording of 3000 samples: enough for the checks below, quick to analyse.
 std::string short_imu_csv() {
   std::string s = imu_csv(kHeader);

@@ -44,8 +44,8 @@ std::string imu_text(const std::vector<std::string>& names, int samples = 3000) 
 
 /// `rwcalc imu` of those columns with the noise file: gyro columns 2 and 3, accelerometer 4.
 std::vector<std::string> imu_kalibr_args(const fs::path& file, const fs::path& yaml, const std::string& rostopic) {
-  return {"imu",         file.string(), "--gyro",   "2,3",         "--gyro-unit", "deg/s",    "--accel",
-          "4",           "--accel-unit", "g",       "--kalibr",    yaml.string(), "--rostopic", rostopic};
+  return {"imu", file.string(),  "--gyro", "2,3",      "--gyro-unit", "deg/s",      "--accel",
+          "4",   "--accel-unit", "g",      "--kalibr", yaml.string(), "--rostopic", rostopic};
 }
 
 bool python_yaml() { return std::system("python3 -c 'import yaml' >/dev/null 2>&1") == 0; }
@@ -81,19 +81,59 @@ class HostileText {
   explicit HostileText(std::uint64_t seed) : rng_(seed) {}
 
   std::string next(bool invalid_ok, bool controls_ok, std::size_t max_pieces = 12) {
-    static const std::vector<std::string> kPieces = {
-        "\"", "\\", "'", "#", ": ", "- ", "? ", "&a", "*b", "!!str ", "%", "@", "`", "{", "}", "[", "]", ",", "|",
-        ">", " ", "  ", "~", "null", "yes", "1.5", "0x1F", ".inf", "=", "/imu0",
-        "\xC2\x85",                                          // NEL
-        "\xE2\x80\xA8", "\xE2\x80\xA9",                      // line and paragraph separators
-        "\xEF\xBF\xBE", "\xEF\xBF\xBF", "\xEF\xB7\x90",      // U+FFFE, U+FFFF, U+FDD0
-        "\xF0\x9F\xBF\xBE", "\xF4\x8F\xBF\xBF",              // U+1FFFE, U+10FFFF
-        "\xEF\xBB\xBF", "\xE2\x80\xAE", "\xE2\x81\xA6",      // BOM, RLO, LRI
-        "\xC2\x80", "\xC2\x9B", "\xC2\x9F", "\xC2\xA0",      // C1 controls, no-break space
-        "Ж", "τ", "°/√h", "中文", "\xF0\x9F\x98\x80"};        // letters, an emoji
+    static const std::vector<std::string> kPieces = {"\"",
+                                                     "\\",
+                                                     "'",
+                                                     "#",
+                                                     ": ",
+                                                     "- ",
+                                                     "? ",
+                                                     "&a",
+                                                     "*b",
+                                                     "!!str ",
+                                                     "%",
+                                                     "@",
+                                                     "`",
+                                                     "{",
+                                                     "}",
+                                                     "[",
+                                                     "]",
+                                                     ",",
+                                                     "|",
+                                                     ">",
+                                                     " ",
+                                                     "  ",
+                                                     "~",
+                                                     "null",
+                                                     "yes",
+                                                     "1.5",
+                                                     "0x1F",
+                                                     ".inf",
+                                                     "=",
+                                                     "/imu0",
+                                                     "\xC2\x85",  // NEL
+                                                     "\xE2\x80\xA8",
+                                                     "\xE2\x80\xA9",  // line and paragraph separators
+                                                     "\xEF\xBF\xBE",
+                                                     "\xEF\xBF\xBF",
+                                                     "\xEF\xB7\x90",  // U+FFFE, U+FFFF, U+FDD0
+                                                     "\xF0\x9F\xBF\xBE",
+                                                     "\xF4\x8F\xBF\xBF",  // U+1FFFE, U+10FFFF
+                                                     "\xEF\xBB\xBF",
+                                                     "\xE2\x80\xAE",
+                                                     "\xE2\x81\xA6",  // BOM, RLO, LRI
+                                                     "\xC2\x80",
+                                                     "\xC2\x9B",
+                                                     "\xC2\x9F",
+                                                     "\xC2\xA0",  // C1 controls, no-break space
+                                                     "Ж",
+                                                     "τ",
+                                                     "°/√h",
+                                                     "中文",
+                                                     "\xF0\x9F\x98\x80"};  // letters, an emoji
     static const std::vector<std::string> kControls = {"\t", "\x01", "\x1b[31m", "\x7f", "\n", "\r"};
-    static const std::vector<std::string> kInvalid = {"\xED\xA0\x80", "\xED\xBF\xBF", "\xC0\xAF", "\x80", "\xFF",
-                                                      "\xFE", "\xE2\x82", "\xF4\x90\x80\x80"};
+    static const std::vector<std::string> kInvalid = {"\xED\xA0\x80", "\xED\xBF\xBF", "\xC0\xAF", "\x80",
+                                                      "\xFF",         "\xFE",         "\xE2\x82", "\xF4\x90\x80\x80"};
     std::string s;
     const std::size_t n = std::uniform_int_distribution<std::size_t>(1, max_pieces)(rng_);
     for (std::size_t i = 0; i < n; ++i) {
@@ -147,15 +187,15 @@ TEST(ReportPdf, AnOutputDirectoryWithUrlCharactersPrintsThatReport) {
   // Before the URL was encoded, Chromium opened the directory before '#' (its listing went into
   // the PDF), a file named before '?', or nothing for '%41'.
   const std::vector<std::string> names = {"a#b", "c?d", "e%41f", "g h\xff;j&k=1%"};
-  fs::create_directory(dir.path() / "a");                              // what "a#b/…" reached
-  std::ofstream(dir.path() / "c") << "what \"c?d/…\" reached\n";       // what "c?d/…" reached
+  fs::create_directory(dir.path() / "a");                         // what "a#b/…" reached
+  std::ofstream(dir.path() / "c") << "what \"c?d/…\" reached\n";  // what "c?d/…" reached
   for (std::size_t i = 0; i < names.size(); ++i) {
     const fs::path parent = dir.path() / names[i];
     fs::create_directories(parent);
     const auto out = parent / "sub";
     const std::string title = fmt::format("rwcalc url check {}", i);
-    const auto r = run_cli({"report", "--pdf", "--no-figures", "--title", title, "-o", out.string(),
-                            rwcalc::test::gl2d_runs().front()});
+    const auto r = run_cli(
+        {"report", "--pdf", "--no-figures", "--title", title, "-o", out.string(), rwcalc::test::gl2d_runs().front()});
     ASSERT_EQ(r.status, 0) << names[i] << ": " << r.err;
     const std::string pdf = slurp(out / "report.pdf");
     ASSERT_TRUE(pdf.starts_with("%PDF-")) << names[i];
@@ -171,11 +211,11 @@ TEST(YamlQuoted, EscapesWhatYamlForbidsOrFoldsAndRefusesBytesThatAreNotUtf8) {
   EXPECT_EQ(yaml_quoted("/imu0"), "\"/imu0\"");
   EXPECT_EQ(yaml_quoted("a\"b\\c#d: e"), "\"a\\\"b\\\\c#d: e\"");
   EXPECT_EQ(yaml_quoted("\t\n\r\x01\x7f"), "\"\\t\\n\\r\\x01\\x7f\"");
-  EXPECT_EQ(yaml_quoted("\xC2\x85\xC2\x9B"), "\"\\x85\\x9b\"");                         // NEL, CSI
+  EXPECT_EQ(yaml_quoted("\xC2\x85\xC2\x9B"), "\"\\x85\\x9b\"");  // NEL, CSI
   EXPECT_EQ(yaml_quoted("\xE2\x80\xA8\xEF\xBB\xBF\xE2\x80\xAE"), "\"\\u2028\\ufeff\\u202e\"");
   EXPECT_EQ(yaml_quoted("\xEF\xBF\xBE\xEF\xB7\x90\xF4\x8F\xBF\xBF"), "\"\\ufffe\\ufdd0\\U0010ffff\"");
   EXPECT_EQ(yaml_quoted("Ж τ \xF0\x9F\x98\x80"), "\"Ж τ \xF0\x9F\x98\x80\"");  // text is kept
-  EXPECT_EQ(yaml_quoted("\xED\xA0\x80"), std::nullopt);                         // a surrogate
+  EXPECT_EQ(yaml_quoted("\xED\xA0\x80"), std::nullopt);                        // a surrogate
   EXPECT_EQ(yaml_quoted("a\xFF"), std::nullopt);
 }
 
@@ -244,10 +284,10 @@ TEST(RussianText, NamesIdentificationAndLaboratoryKeepTheirDecimalPoints) {
   ASSERT_EQ(batch.status, 0) << batch.err;
   EXPECT_TRUE(has(batch.out, "run 1.5 (v2.5).csv.gz")) << batch.out;
   const auto out = dir.path() / "report 3.5";
-  const auto report = run_cli(rwcalc::test::concat(
-      {"report", "--lang", "ru", "--no-figures", "--lab", "Lab 2.5", "--gyro", "G 4.5", "--title", "Title 6.5", "-o",
-       out.string(), run.string()},
-      id));
+  const auto report =
+      run_cli(rwcalc::test::concat({"report", "--lang", "ru", "--no-figures", "--lab", "Lab 2.5", "--gyro", "G 4.5",
+                                    "--title", "Title 6.5", "-o", out.string(), run.string()},
+                                   id));
   ASSERT_EQ(report.status, 0) << report.err;
   EXPECT_TRUE(has(report.out, "report 3.5")) << report.out;
   const std::string html = slurp(out / "report.html");
@@ -268,8 +308,8 @@ TEST(RussianText, ImuTablesReportAndFigureKeepColumnAndFileNames) {
   const auto file = dir.write("imu 2.5.csv", imu_text({"(1.5)", "gy", "ax"}));
   const auto report = dir.path() / "rep";
   const auto script = dir.path() / "imu.gp";
-  const auto r = run_cli({"imu", "--lang", "ru", file.string(), "--gyro", "2,3", "--gyro-unit", "deg/s", "--accel",
-                          "4", "--accel-unit", "g", "--report", report.string(), "--plot-script", script.string()});
+  const auto r = run_cli({"imu", "--lang", "ru", file.string(), "--gyro", "2,3", "--gyro-unit", "deg/s", "--accel", "4",
+                          "--accel-unit", "g", "--report", report.string(), "--plot-script", script.string()});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(has(r.out, "imu 2.5.csv")) << r.out;
   EXPECT_TRUE(has(r.out, "(1.5)")) << r.out;
@@ -285,8 +325,8 @@ TEST(ImuFigure, KeysAndTitlesKeepTheWholeColumnName) {
   TempDir dir;
   const auto file = dir.write("imu.csv", imu_text({"gyro/x", "gyro/y", "accel/z"}));
   const auto script = dir.path() / "imu.gp";
-  const auto r = run_cli({"imu", file.string(), "--gyro", "2,3", "--gyro-unit", "deg/s", "--accel", "4",
-                          "--accel-unit", "g", "--plot-script", script.string()});
+  const auto r = run_cli({"imu", file.string(), "--gyro", "2,3", "--gyro-unit", "deg/s", "--accel", "4", "--accel-unit",
+                          "g", "--plot-script", script.string()});
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string gp = slurp(script);
   for (const char* key : {"t 'gyro/x", "t 'gyro/y", "t 'accel/z"}) EXPECT_TRUE(has(gp, key)) << key << "\n" << gp;

@@ -364,7 +364,8 @@ void require_noise(const Recording& rec) {
   for (std::size_t i = 2; i < x.points(); ++i)
     if (x.diff(i, i - 1) != x.diff(1, 0)) return;
   throw AnalysisError(
-      trf("{}: every sample has the same value, so there is no noise to analyse (a dead or stuck channel?)", rec.source));
+      trf("{}: every sample has the same value, so there is no noise to analyse (a dead or stuck channel?)",
+          rec.source));
 }
 
 /// The paper's methods as unbiased estimators (direct N, B from the 100-s averages, σ_min/0.6643

@@ -246,9 +246,7 @@ void add_all_commands(CLI::App& app, Runner& runner) {
   }
 }
 
-void print_message(std::ostream& err, std::string_view text) {
-  err << "rwcalc: " << localize_message(text) << "\n";
-}
+void print_message(std::ostream& err, std::string_view text) { err << "rwcalc: " << localize_message(text) << "\n"; }
 
 int parse_only(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   return parse_and_run(argc, argv, out, err, false);

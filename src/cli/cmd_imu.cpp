@@ -106,11 +106,12 @@ std::vector<OutputTarget> report_targets(const std::string& dir) {
     fs::path parent = fs::absolute(dir).parent_path();
     while (!fs::exists(parent, ec) && parent.has_relative_path()) parent = parent.parent_path();
     if (!fs::is_directory(parent, ec) || ::access(parent.c_str(), W_OK | X_OK) != 0)
-      throw OutputError(trf("{}: cannot create the report directory: {} is not a writable directory", dir,
-                            parent.string()));
+      throw OutputError(
+          trf("{}: cannot create the report directory: {} is not a writable directory", dir, parent.string()));
     return {};
   }
-  if (!fs::is_directory(dir, ec)) throw OutputError(trf("{}: cannot create the report directory: {}", dir, tr("not a directory")));
+  if (!fs::is_directory(dir, ec))
+    throw OutputError(trf("{}: cannot create the report directory: {}", dir, tr("not a directory")));
   std::vector<OutputTarget> files;
   for (const char* name : {"imu.txt", "imu.json", "imu.yaml", "imu.svg", "index.html"})
     files.push_back({fmt::format("--report ({})", name), (fs::path(dir) / name).string()});

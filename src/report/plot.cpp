@@ -319,7 +319,8 @@ Figure analysis_figure(const json& analysis, const PlotOptions& options) {
     if (const auto& fit = at(analysis, "fit"); fit.is_object()) add_model(fit, body, plot);
     add_class_floors(analysis, body, plot, bounds);
   }
-  return loglog_figure("allan", options, options.title.empty() ? default_analysis_title(analysis) : as_typed(options.title),
+  return loglog_figure("allan", options,
+                       options.title.empty() ? default_analysis_title(analysis) : as_typed(options.title),
                        allan_ylabel(allan), bounds, body, plot);
 }
 
@@ -350,8 +351,8 @@ Figure batch_allan_figure(const json& runs, const PlotOptions& options) {
     add_class_floors(runs[order.front()], blocks, plot, bounds);
   }
   return loglog_figure("batch-allan", options,
-                       options.title.empty() ? tr("Allan deviation at each test temperature") : as_typed(options.title), ylabel,
-                       bounds, blocks, plot);
+                       options.title.empty() ? tr("Allan deviation at each test temperature") : as_typed(options.title),
+                       ylabel, bounds, blocks, plot);
 }
 
 Figure batch_direct_figure(const json& runs, const PlotOptions& options) {
@@ -529,7 +530,8 @@ Figure diagnosis_figure(const json& diagnosis, const PlotOptions& options) {
     plot.add("$outside u 1:2 w p pt 6 ps 1.6 lw 1.6 lc rgb '#d62728' t " +
              label_text(tr("measured, outside the base band")));
   }
-  return loglog_figure("diagnosis", options, options.title.empty() ? diagnosis_title(diagnosis) : as_typed(options.title),
+  return loglog_figure("diagnosis", options,
+                       options.title.empty() ? diagnosis_title(diagnosis) : as_typed(options.title),
                        diagnosis_ylabel(diagnosis), bounds, blocks, plot);
 }
 

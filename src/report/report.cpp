@@ -240,7 +240,8 @@ json worst_class(const std::vector<json>& analyses, const char* key) {
 
 /// A table row: the run and its temperature, then the cells (class="num"; bold when asked).
 std::string run_row(const json& run, const std::vector<std::string>& cells, std::string_view tail = "") {
-  std::string s = fmt::format("<tr><td>{}</td><td class=\"num\">{}</td>", typed(source_name(run)), temperature_text(run));
+  std::string s =
+      fmt::format("<tr><td>{}</td><td class=\"num\">{}</td>", typed(source_name(run)), temperature_text(run));
   for (const auto& c : cells) s += fmt::format("<td class=\"num\">{}</td>", c);
   return s + std::string(tail) + "</tr>\n";
 }
