@@ -1,6 +1,10 @@
 // End-to-end behaviour of the command-line front end that every command shares.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
 #include "test_support.hpp"
 
 using rwcalc::test::run_cli;
@@ -33,6 +37,30 @@ TEST(Cli, ManualPageAndCompletionDescribeEveryCommandAndOption) {
     }
   }
   EXPECT_NE(completion.out.find("complete -o filenames -F _rwcalc rwcalc"), std::string::npos);
+}
+
+// The completion run by bash: each candidate is a whole file name, never split at a blank nor
+// expanded as a pattern.
+TEST(Cli, CompletionOffersFileNamesWithBlanksAndPatternCharactersWhole) {
+  if (std::system("command -v bash >/dev/null 2>&1") != 0) GTEST_SKIP() << "no bash";
+  const rwcalc::test::TempDir dir;
+  const auto script = dir.write("rwcalc.bash", run_cli({"completion"}).out);
+  const auto files = dir.path() / "files";
+  std::filesystem::create_directory(files);
+  for (const char* name : {"run 1.csv", "run*2.csv", "run$3 [x].csv", "other.csv"})
+    (void)dir.write(std::string("files/") + name, "1\n");
+  const auto out = dir.path() / "candidates";
+  const std::string cmd = "cd '" + files.string() + "' && bash -c '. \"$0\"; COMP_WORDS=(rwcalc analyze run); " +
+                          "COMP_CWORD=2; _rwcalc; printf \"%s\\n\" \"${COMPREPLY[@]}\"' '" + script.string() +
+                          "' | LC_ALL=C sort > '" + out.string() + "'";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  EXPECT_EQ(rwcalc::test::slurp(out), "run 1.csv\nrun$3 [x].csv\nrun*2.csv\n");
+  // Options complete as before.
+  const std::string opts = "bash -c '. \"$0\"; COMP_WORDS=(rwcalc imu --kal); COMP_CWORD=2; _rwcalc; " +
+                           std::string("printf \"%s\\n\" \"${COMPREPLY[@]}\"' '") + script.string() + "' > '" +
+                           out.string() + "'";
+  ASSERT_EQ(std::system(opts.c_str()), 0) << opts;
+  EXPECT_EQ(rwcalc::test::slurp(out), "--kalibr\n");
 }
 
 TEST(Cli, HelpListsEveryCommand) {

@@ -216,6 +216,7 @@ TEST(Printable, ControlCharactersAndInvalidBytesAreEscapedTextKept) {
   EXPECT_EQ(printable("sur\xed\xa0\x80"), "sur\\xed\\xa0\\x80");  // a UTF-16 surrogate
   EXPECT_EQ(printable("c1\xc2\x9b"), "c1\\u009b");                // C1 control (CSI)
   EXPECT_EQ(printable("bidi\xe2\x80\xae"), "bidi\\u202e");        // right-to-left override
+  EXPECT_EQ(printable("nc\xef\xbf\xbe\xef\xb7\x90\xf4\x8f\xbf\xbf"), "nc\\ufffe\\ufdd0\\U0010ffff");  // noncharacters
   EXPECT_EQ(printable("quote ' \" \\ kept"), "quote ' \" \\ kept");
 }
 

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <numbers>
@@ -294,6 +295,104 @@ TEST(Imu, ReportDirectoryHoldsTheWholeResult) {
   EXPECT_TRUE(has(html, "Accelerometer (3 axes;")) << html;
   EXPECT_TRUE(has(html, "<a href=\"imu.yaml\">")) << html;
   EXPECT_EQ(nlohmann::json::parse(slurp(out / "imu.json"))["channels"].size(), 6u);
+}
+
+// A 6-axis recording of 3000 samples: enough for the checks below, quick to analyse.
+std::string short_imu_csv() {
+  std::string s = imu_csv(kHeader);
+  std::size_t end = 0;
+  for (int lines = 0; lines <= 3000; ++lines) end = s.find('\n', end) + 1;
+  return s.substr(0, end);
+}
+
+TEST(Imu, EveryOutputIsCheckedBeforeAnyIsWritten) {
+  TempDir dir;
+  const auto f = dir.write("imu.csv", short_imu_csv());
+  const auto report = dir.path() / "report";
+  const std::vector<std::string> base{"imu", f.string(), "--rate", "100", "--gyro", "1,2", "--accel", "4"};
+  // An existing imu.yaml in the report directory stops every output: no imu.txt, no imu.json, no
+  // --kalibr file (before, imu.txt and imu.json were written and the command ended with status 3).
+  std::filesystem::create_directory(report);
+  std::ofstream(report / "imu.yaml") << "old\n";
+  const auto kalibr = dir.path() / "k.yaml";
+  auto r = run_cli(concat(base, {"--report", report.string(), "--kalibr", kalibr.string()}));
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_TRUE(has(r.err, "imu.yaml: exists")) << r.err;
+  for (const char* name : {"imu.txt", "imu.json", "index.html", "imu.svg"})
+    EXPECT_FALSE(std::filesystem::exists(report / name)) << name;
+  EXPECT_FALSE(std::filesystem::exists(kalibr));
+  EXPECT_EQ(slurp(report / "imu.yaml"), "old\n");
+  // -o naming a file of the report is a usage error; so is a rostopic no YAML file can carry.
+  r = run_cli(concat(base, {"--report", report.string(), "-o", (report / "imu.txt").string(), "--force"}));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(has(r.err, "the same file")) << r.err;
+  const auto fresh = dir.path() / "fresh";
+  r = run_cli(concat(base, {"--report", fresh.string(), "--rostopic", "/imu\xff"}));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(has(r.err, "--rostopic")) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(fresh));
+  // A report directory under a file cannot be made: said before the analysis.
+  r = run_cli(concat(base, {"--report", (f / "sub").string()}));
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_TRUE(has(r.err, "cannot create the report directory")) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  // With --force the whole set is written.
+  r = run_cli(concat(base, {"--report", report.string(), "--force"}));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(slurp(report / "imu.yaml"), "old\n");
+}
+
+TEST(Imu, AColumnGivenTwiceOrTheTimeColumnIsRefusedNamingIt) {
+  TempDir dir;
+  // The short recording with a time column first.
+  const std::string plain = short_imu_csv();
+  std::string timed = "time_s,";
+  for (std::size_t at = 0, k = 0; at < plain.size(); ++k) {
+    const auto eol = plain.find('\n', at);
+    timed += (k == 0 ? "" : fmt::format("{:.2f},", static_cast<double>(k - 1) / 100)) + plain.substr(at, eol - at + 1);
+    at = eol + 1;
+  }
+  const auto f = dir.write("imu.csv", timed);
+  const std::vector<std::string> base{"imu", f.string()};
+  // Once by name and once by index; as gyro and as accelerometer: the noise would count twice.
+  auto r = run_cli(concat(base, {"--gyro", "gyro_x_dps,2"}));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(has(r.err, "column 'gyro_x_dps' is given twice (--gyro gyro_x_dps and --gyro 2)")) << r.err;
+  r = run_cli(concat(base, {"--gyro", "gyro_x_dps", "--accel", "acc_x_g,gyro_x_dps", "--accel-unit", "g"}));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(has(r.err, "column 'gyro_x_dps' is given twice (--gyro gyro_x_dps and --accel gyro_x_dps)")) << r.err;
+  // The time column is no sensor's output, whatever unit is claimed for it.
+  for (const char* time : {"time_s", "1"}) {
+    r = run_cli(concat(base, {"--gyro", std::string("gyro_x_dps,") + time, "--gyro-unit", "deg/s"}));
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_TRUE(has(r.err, "imu.csv:1: column 'time_s' (1) is the time column")) << r.err;
+  }
+}
+
+TEST(Imu, AConstantChannelIsRefusedNamingItsColumn) {
+  TempDir dir;
+  std::string text = imu_csv("gyro_x_dps,gyro_y_dps,gyro_z_dps,acc_x_g,acc_y_g,acc_z_g");
+  // gyro_y_dps stuck at one value: the second field of every data line.
+  std::string stuck;
+  for (std::size_t at = 0, line = 0; at < text.size() && line < 3001; ++line) {
+    const auto eol = text.find('\n', at);
+    std::string l = text.substr(at, eol - at);
+    if (line > 0) {
+      const auto a = l.find(','), b = l.find(',', a + 1);
+      l = l.substr(0, a + 1) + "0.25" + l.substr(b);
+    }
+    stuck += l + "\n";
+    at = eol + 1;
+  }
+  const auto f = dir.write("imu.csv", stuck);
+  const auto r = run_cli({"imu", f.string(), "--rate", "100", "--gyro", "1,2,3"});
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_TRUE(has(r.err, "column 'gyro_y_dps': ")) << r.err;
+  EXPECT_TRUE(has(r.err, "every sample has the same value")) << r.err;
+  EXPECT_TRUE(has(r.err, "leave it out of --gyro")) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  // Left out, the other axes are analysed.
+  EXPECT_EQ(run_cli({"imu", f.string(), "--rate", "100", "--gyro", "1,3"}).status, 0);
 }
 
 }  // namespace

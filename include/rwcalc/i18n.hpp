@@ -44,12 +44,27 @@ template <typename... Args>
   return fmt::format(fmt::runtime(tr(english)), std::forward<Args>(args)...);
 }
 
+/// Outside text inside human-readable text (a file or column name, a serial number, an operator,
+/// a laboratory), to be shown as typed: printable(outside) between two marks (the noncharacters
+/// U+FDD0 and U+FDD1, which printable() never outputs) that localize_numbers, localize_html and
+/// localize_message skip and remove. Text holding marks is shown only through one of them, so that
+/// a "1.5" in a serial number stays "1.5" in Russian while the numbers rwcalc prints get their
+/// decimal comma.
+[[nodiscard]] std::string as_typed(std::string_view outside);
+/// The marks alone, around text already encoded for its place by an encoder built on printable()
+/// (the HTML escape of the report).
+[[nodiscard]] std::string marked_as_typed(std::string_view encoded);
+
 /// Human-readable text with the decimal comma when the language asks for it: every decimal
-/// number standing alone (not part of a name, a path or a version such as 0.1.0) is rewritten
-/// "3.14" → "3,14". Unchanged in English.
+/// number standing alone (not part of a name, a path or a version such as 0.1.0, nor inside the
+/// marks of as_typed) is rewritten "3.14" → "3,14"; the marks are removed in every language.
 [[nodiscard]] std::string localize_numbers(std::string text);
 /// The same for an HTML page: only text between tags, and never inside <style> or <script>.
 [[nodiscard]] std::string localize_html(std::string html);
+/// A message for standard error: printable(text) outside the marks of as_typed (the text inside
+/// is printable already), then localize_numbers. Text from an exception is raw: U+FDD0 and U+FDD1
+/// in it are taken for marks, so they can change only where a decimal comma goes.
+[[nodiscard]] std::string localize_message(std::string_view text);
 
 /// The language while it lives, the previous one restored after (a command run in-process).
 class LanguageScope {

@@ -61,9 +61,14 @@ struct KalibrOptions {
   AxisCombination combine = AxisCombination::Worst;
 };
 
+/// The rostopic as the noise file writes it (one YAML double-quoted scalar, encode.hpp); UsageError
+/// naming --rostopic when it is not UTF-8, which no YAML file can carry. The command calls it before
+/// it writes anything.
+std::string rostopic_scalar(const std::string& rostopic);
+
 /// Kalibr's imu.yaml (OpenVINS reads the same keys): noise densities = N and random walks = K of
 /// each kind in SI, the axes combined as asked; each axis' values and any unresolved K (its 95 %
-/// upper bound) in comments. Throws AnalysisError when a kind has no channel.
+/// upper bound) in comments, every outside name in them made a safe comment (yaml_comment).
 std::string kalibr_yaml(const ImuResult& r, const KalibrOptions& options = {});
 
 }  // namespace rwcalc

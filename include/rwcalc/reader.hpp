@@ -46,6 +46,9 @@ struct ReadOptions {
   /// column named "pulses" (or counter/angle/phase/rate/gyro by mode), else the only non-time
   /// column, else an error asking for --column (also when two columns have such names).
   std::string column;
+  /// A `column` that names a time column (time_s, timestamp …) is an error rather than samples
+  /// (imu: a sensor's channel is never the time).
+  bool column_not_time = false;
   std::optional<double> rate_hz;        ///< --rate, Hz; overrides metadata; checked against a time column
   std::optional<double> scale_arcsec;   ///< --scale: pulse weight, ″ per pulse; overrides metadata
   int counter_bits = 32;                ///< wrap width of Counter mode (1..64)
@@ -87,6 +90,7 @@ struct Recording {
   std::map<std::string, std::string> metadata;
   std::optional<double> temperature_c;  ///< mean of a temperature_c column, else metadata, °C
   std::string column_name;              ///< the column that was read (header name or "column N")
+  std::size_t column_index = 0;         ///< its 1-based position in the line
   /// the time column that was checked, if any (the first of two, which were found to agree)
   std::optional<std::string> time_column;
   InputMode mode = InputMode::Pulses;

@@ -357,6 +357,17 @@ void allan_and_fit(const Recording& rec, const PhaseSeries& longest, const Analy
   if (options.fit_checks) r.model_bounds = apply_model_bounds(r.allan, r.fit, &longest);
 }
 
+/// A record whose samples are all the same value (a dead or stuck channel) has no noise: its Allan
+/// deviation is zero at every τ and nothing can be fitted. Said as such, not as a fit without points.
+void require_noise(const Recording& rec) {
+  const PhaseSeries& x = rec.phase;
+  for (std::size_t i = 2; i < x.points(); ++i)
+    if (x.diff(i, i - 1) != x.diff(1, 0)) return;
+  throw AnalysisError(
+      trf("{}: every sample has the same value, so there is no noise to analyse (a dead or stuck channel?)",
+          rec.source));
+}
+
 /// The paper's methods as unbiased estimators (direct N, B from the 100-s averages, σ_min/0.6643
 /// with its bias factor) and their discrepancies from the fit; the raw spread of 100-s means
 /// beside its expectation under the fit.
@@ -397,6 +408,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   decide_applicability(read, options, r);
   if (rec.phase.points() < 3)
     throw AnalysisError(trf("{}: the record holds {} sample(s); far too short to analyse", rec.source, rec.samples));
+  require_noise(rec);
   earth_rate_and_bias(rec, options, r);
   // A record split at gaps: the spectral-line search, the per-τ bounds and the cross-checks use the
   // longest segment (they need one contiguous stretch); the Allan variance pools every segment.

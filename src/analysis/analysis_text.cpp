@@ -8,7 +8,6 @@
 
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/i18n.hpp"
-#include "rwcalc/printable.hpp"
 
 namespace rwcalc {
 
@@ -47,7 +46,7 @@ std::string format_warnings(const std::vector<AnalysisWarning>& warnings) {
   std::string s = tr("WARNINGS\n");
   for (const auto& w : warnings) {
     s += fmt::format("  [{}] {}\n", w.code, w.message);
-    if (!w.command.empty()) s += trf("    try: {}\n", w.command);
+    if (!w.command.empty()) s += trf("    try: {}\n", as_typed(w.command));  // a command line: never localized
   }
   return s + "\n";
 }
@@ -73,9 +72,9 @@ std::string input_line(const nlohmann::json& in) {
   std::string s = tr("  input: ") + (kind == "pulses"    ? std::string(tr("pulse counts"))
                                      : kind == "counter" ? std::string(tr("counter readings"))
                                                          : trf("{} samples in {}", kind, unit));
-  s += trf(" from column '{}'; sample rate from {}", in.value("column", ""), tr(in.value("rate_source", "")));
+  s += trf(" from column '{}'; sample rate from {}", as_typed(in.value("column", "")), tr(in.value("rate_source", "")));
   if (in.contains("time_unit"))
-    s += trf(" ('{}', in {} by {})", in["time_column"].get<std::string>(), in.value("time_unit", ""),
+    s += trf(" ('{}', in {} by {})", as_typed(in["time_column"].get<std::string>()), in.value("time_unit", ""),
              in.value("time_unit_source", ""));
   if (const auto id = in.find("identification"); id != in.end() && id->is_object()) {
     std::string who;
@@ -83,7 +82,7 @@ std::string input_line(const nlohmann::json& in) {
          {std::pair{"serial", N_("serial")}, std::pair{"operator", N_("operator")},
           std::pair{"test_date", N_("test date")}, std::pair{"conditions", N_("conditions")}})
       if (id->contains(key) && (*id)[key].is_string())
-        who += fmt::format("{}{} {}", who.empty() ? "" : "; ", tr(label), printable((*id)[key].get<std::string>()));
+        who += fmt::format("{}{} {}", who.empty() ? "" : "; ", tr(label), as_typed((*id)[key].get<std::string>()));
     if (!who.empty()) s += tr("\n  gyro and test: ") + who;
   }
   if (in.contains("sha256"))
@@ -97,11 +96,11 @@ static std::string format_verdict(const AnalysisResult& r);
 
 std::string format_report(const AnalysisResult& r) {
   std::string s;
-  s += trf("rwcalc analyze: {}\n\n", printable(r.source));
+  s += trf("rwcalc analyze: {}\n\n", as_typed(r.source));
   s += format_warnings(r.warnings);
   s += tr("Data\n");
   s += trf("  {} samples at {:g} Hz (tau0 = {:g} ms), {:.1f} s ({:.2f} h), column '{}'", r.samples, r.rate_hz,
-           1000.0 / r.rate_hz, r.duration_s, r.duration_s / 3600.0, r.column);
+           1000.0 / r.rate_hz, r.duration_s, r.duration_s / 3600.0, as_typed(r.column));
   if (r.arcsec_per_count > 0) s += trf(", pulse weight {:g} arcsec", r.arcsec_per_count);
   s += "\n";
   s += input_line(r.input);

@@ -165,13 +165,13 @@ std::string warning_lines(const json& run) {
   const auto w = run.find("warnings");
   if (w == run.end() || !w->is_array()) return s;
   for (const auto& x : *w)
-    s += fmt::format("  {}: [{}] {}\n", printable(run.at("source").get<std::string>()), x.value("code", ""),
+    s += fmt::format("  {}: [{}] {}\n", as_typed(run.at("source").get<std::string>()), x.value("code", ""),
                      printable(x.value("message", "")));
   return s;
 }
 
 std::string outliers_line(const json& run) {
-  const std::string source = printable(run.at("source").get<std::string>());
+  const std::string source = as_typed(run.at("source").get<std::string>());
   if (!run.contains("outliers") || !run.at("outliers").is_object())
     return trf("  {}: not in the results (no outlier summary)\n", source);
   const auto& o = run.at("outliers");
@@ -286,7 +286,7 @@ std::string format_batch_text(const json& summary) {
   for (const auto& r : runs)
     s += fmt::format("  {:>6}  {:<22} {:<30} {:<22} {:<30} {}\n", temp_cell(r), cell(r, {"fit", "N_deg_per_sqrt_h"}),
                      interval_cell(r, {"methods", "N_direct_deg_per_sqrt_h"}), cell(r, {"fit", "B_deg_per_h"}),
-                     interval_cell(r, {"methods", "B_100s_deg_per_h"}), printable(r.at("source").get<std::string>()));
+                     interval_cell(r, {"methods", "B_100s_deg_per_h"}), as_typed(r.at("source").get<std::string>()));
   s += tr("\nTable 2: class per parameter (probability of the stated class)\n");
   s += fmt::format("  {:>6}  {:<30} {:<30} {}\n", tr("T, °C"), tr("by N"), tr("by B"), tr("overall"));
   for (const auto& r : runs) {

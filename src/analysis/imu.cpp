@@ -12,6 +12,7 @@
 #include <iterator>
 #include <sstream>
 
+#include "rwcalc/encode.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/parallel.hpp"
@@ -40,6 +41,7 @@ struct ChannelSpec {
 ReadOptions channel_read(const ImuOptions& o, const ChannelSpec& c) {
   ReadOptions r = o.read;
   r.column = c.column;
+  r.column_not_time = true;
   const bool gyro = c.kind == SensorKind::Gyro;
   if (const std::optional<RateUnit> unit = gyro ? o.gyro_unit : o.accel_unit) {
     r.mode = InputMode::Rate;
@@ -59,6 +61,21 @@ void check_kind(const Recording& rec, const ChannelSpec& c) {
   throw UsageError(trf("{}: column '{}' is given as {} but was read as {} ({}); give its unit with {}", rec.source,
                        c.column, gyro ? "--gyro" : "--accel", tr(read_as), describe_input(rec),
                        gyro ? "--gyro-unit (deg/h, deg/s, rad/s)" : "--accel-unit (m/s^2, g, mg, ug)"));
+}
+
+/// Each channel of its kind and each column once (the reader refuses the time column): a column
+/// given twice (by name and by index, or as gyro and accelerometer) would count one sensor's noise
+/// twice in the noise file.
+void check_channels(const std::vector<Recording>& recs, const std::vector<ChannelSpec>& specs) {
+  for (std::size_t i = 0; i < recs.size(); ++i) {
+    const ChannelSpec& c = specs[i];
+    const auto option = [](const ChannelSpec& s) { return s.kind == SensorKind::Gyro ? "--gyro" : "--accel"; };
+    for (std::size_t k = 0; k < i; ++k)
+      if (recs[k].column_index == recs[i].column_index)
+        throw UsageError(trf("{}: column '{}' is given twice ({} {} and {} {}); give each column once", recs[i].source,
+                             recs[i].column_name, option(specs[k]), specs[k].column, option(c), c.column));
+    check_kind(recs[i], c);
+  }
 }
 
 /// Columns on the screen, as fmt counts them when it pads: code points, not bytes (Cyrillic).
@@ -136,15 +153,27 @@ ImuResult analyze_imu(const std::string& path, const ImuOptions& options) {
   out.gyro_units = output_units(SensorKind::Gyro, options.gyro_output_unit);
   out.accel_units = output_units(SensorKind::Accelerometer, options.accel_output_unit);
   const std::string bytes = read_bytes(path);
+  // Every channel is read and checked before any is analysed: a column given twice is refused
+  // before the work, and always the same pair is named. (The recordings are held together for
+  // that: 8 bytes a sample each, less than the text they come from, which is held anyway.)
+  std::vector<Recording> recs(specs.size());
+  parallel_for(specs.size(),
+               [&](std::size_t i) { recs[i] = read_recording_text(bytes, path, channel_read(options, specs[i])); });
+  check_channels(recs, specs);
   out.channels.resize(specs.size());
   parallel_for(specs.size(), [&](std::size_t i) {
-    const Recording rec = read_recording_text(bytes, path, channel_read(options, specs[i]));
-    check_kind(rec, specs[i]);
+    const Recording rec = std::move(recs[i]);
     AnalysisOptions a = options.analysis;
     if (!options.vertical_gyro.empty() && specs[i].kind == SensorKind::Gyro &&
         (specs[i].column == options.vertical_gyro || rec.column_name == options.vertical_gyro))
       a.earth_rate = a.verdict_wanted = true;
-    out.channels[i] = {rec.column_name, specs[i].kind, analyze(rec, a)};
+    try {
+      out.channels[i] = {rec.column_name, specs[i].kind, analyze(rec, a)};
+    } catch (const Error& e) {  // one channel cannot be analysed: the whole IMU's file would be wrong
+      throw Error(trf("column '{}': {}; leave it out of {} to analyse the other columns", rec.column_name, e.what(),
+                      specs[i].kind == SensorKind::Gyro ? "--gyro" : "--accel"),
+                  e.code());
+    }
   });
   return out;
 }
@@ -200,7 +229,7 @@ nlohmann::json channel_json(const AnalysisResult& r, const UnitSet& shown) {
 std::string format_channel(const AnalysisResult& r, const UnitSet& shown) {
   std::string s = trf(r.sensor == SensorKind::Gyro ? N_("rwcalc gyro: {}, column '{}'\n\n")
                                                    : N_("rwcalc accelerometer: {}, column '{}'\n\n"),
-                      printable(r.source), r.column);
+                      as_typed(r.source), as_typed(r.column));
   s += format_warnings(r.warnings);
   s += trf("Data\n  {} samples at {:g} Hz, {:.1f} s ({:.2f} h); mean {} {}; {}\n", r.samples, r.rate_hz, r.duration_s,
            r.duration_s / 3600.0, imu_num(r.mean_rate_deg_per_h * shown.deviation.factor, 6),
@@ -263,7 +292,7 @@ std::string kind_table(const std::vector<const ImuChannel*>& axes, const UnitSet
   std::size_t head_width = 30;
   for (const auto& h : heads) head_width = std::max(head_width, display_width(h) + 2);
   s += fmt::format("  {:<{}}", "", head_width);
-  for (const auto* a : axes) s += fmt::format("{:<{}}", printable(a->column), kWidth);
+  for (const auto* a : axes) s += marked_as_typed(fmt::format("{:<{}}", printable(a->column), kWidth));
   s += "\n";
   std::size_t next_head = 0;
   auto row = [&](auto&& value) {
@@ -277,7 +306,7 @@ std::string kind_table(const std::vector<const ImuChannel*>& axes, const UnitSet
   row([&](const AnalysisResult& r) { return cell(r.fit[Term::K], si[Term::K].factor); });
   row([](const AnalysisResult& r) { return fmt::format("{:.2f} ({:.2g})", r.fit.chi2_per_dof, r.fit.p_value); });
   row([](const AnalysisResult& r) { return trf("{:g}..{:g}", r.fit.used.front().tau_s, r.fit.used.back().tau_s); });
-  for (const auto* a : axes) s += fmt::format("  {}: {}\n", printable(a->column), earth_and_verdict(a->result));
+  for (const auto* a : axes) s += fmt::format("  {}: {}\n", as_typed(a->column), earth_and_verdict(a->result));
   return s + "\n";
 }
 
@@ -381,10 +410,10 @@ nlohmann::json to_json(const ImuResult& r) {
 
 std::string format_imu(const ImuResult& r) {
   const auto& first = r.channels.front().result;
-  std::string s = trf("rwcalc imu: {}\n\n", printable(r.source));
+  std::string s = trf("rwcalc imu: {}\n\n", as_typed(r.source));
   for (const auto& c : r.channels) {
     if (c.result.warnings.empty()) continue;
-    s += fmt::format("[{}] ", printable(c.column)) + format_warnings(c.result.warnings);
+    s += fmt::format("[{}] ", as_typed(c.column)) + format_warnings(c.result.warnings);
   }
   s += trf("Data\n  {} samples at {:g} Hz (tau0 = {:g} ms), {:.1f} s ({:.2f} h); {} channels\n", first.samples,
            first.rate_hz, 1000.0 / first.rate_hz, first.duration_s, first.duration_s / 3600.0, r.channels.size());
@@ -397,6 +426,13 @@ std::string format_imu(const ImuResult& r) {
   return s;
 }
 
+std::string rostopic_scalar(const std::string& rostopic) {
+  const auto quoted = yaml_quoted(rostopic);
+  if (!quoted)
+    throw UsageError(trf("--rostopic '{}': not UTF-8 text; a YAML file cannot carry these bytes", printable(rostopic)));
+  return *quoted;
+}
+
 std::string kalibr_yaml(const ImuResult& r, const KalibrOptions& options) {
   auto yaml_num = [](double v) { return fmt::format("{:.6e}", v); };  // always a YAML float
   const auto& first = r.channels.front().result;
@@ -405,10 +441,10 @@ std::string kalibr_yaml(const ImuResult& r, const KalibrOptions& options) {
       "# file: {} (SHA-256 {}), {} samples at {:g} Hz\n"
       "# noise_density = N (white noise, continuous time; sigma^2 = N^2/tau), random_walk = K (bias random\n"
       "# walk; sigma^2 = K^2 tau/3), each axis fitted with 95 % intervals; the values used are the {}.\n",
-      printable(r.source), first.input.value("sha256", std::string()), first.samples, first.rate_hz,
+      yaml_comment(r.source), first.input.value("sha256", std::string()), first.samples, first.rate_hz,
       options.combine == AxisCombination::Worst ? "worst axis' (the largest)" : "mean over the axes");
   std::string keys =
-      fmt::format("rostopic: {}\nupdate_rate: {:.6f}  # Hz\n", nlohmann::json(options.rostopic).dump(), first.rate_hz);
+      fmt::format("rostopic: {}\nupdate_rate: {:.6f}  # Hz\n", rostopic_scalar(options.rostopic), first.rate_hz);
   for (const SensorKind kind : {SensorKind::Accelerometer, SensorKind::Gyro}) {
     const auto axes = axis_noise(r, kind);
     const bool gyro = kind == SensorKind::Gyro;
@@ -424,7 +460,7 @@ std::string kalibr_yaml(const ImuResult& r, const KalibrOptions& options) {
         return c.resolved ? fmt::format("{} [{}, {}]", yaml_num(c.value), yaml_num(c.low), yaml_num(c.high))
                           : fmt::format("< {} (not resolved: 95 % upper bound)", yaml_num(c.value));
       };
-      s += fmt::format("#   {}: N {}; K {}\n", printable(a.column), one(a.N), one(a.K));
+      s += fmt::format("#   {}: N {}; K {}\n", yaml_comment(a.column), one(a.N), one(a.K));
       if (a.rejected_chi2 > 0)
         s += fmt::format(
             "#     the five-term model does not describe this axis (chi2/dof {:.3g}): its values are "
@@ -437,7 +473,7 @@ std::string kalibr_yaml(const ImuResult& r, const KalibrOptions& options) {
     const Combined k = combine(axes, &AxisNoise::K, options.combine);
     const bool worst = options.combine == AxisCombination::Worst;
     auto from = [&](const Combined& c) {
-      return worst ? fmt::format(" worst axis {}", printable(c.from)) : fmt::format(" mean of {} axes", axes.size());
+      return worst ? fmt::format(" worst axis {}", yaml_comment(c.from)) : fmt::format(" mean of {} axes", axes.size());
     };
     keys += fmt::format("{}_noise_density: {}  # [{}]{}{}\n", prefix, yaml_num(n.value), si[Term::N].ascii, from(n),
                         n.bound ? "; UPPER BOUND: N not resolved (its 95 % bound used)" : "");

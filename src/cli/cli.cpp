@@ -217,6 +217,10 @@ int parse_and_run(int argc, const char* const* argv, std::ostream& out, std::ost
     }
     Io io{out, err};
     return execute ? runner(io) : 0;
+  } catch (const InputError& e) {  // the file named as typed, the message in the language asked for
+    const std::string where = as_typed(e.file()) + (e.line() > 0 ? fmt::format(":{}", e.line()) : "");
+    print_message(err, trf("error: {}", fmt::format("{}: {}", where, e.message())));
+    return static_cast<int>(e.code());
   } catch (const Error& e) {
     print_message(err, trf("error: {}", e.what()));
     return static_cast<int>(e.code());
@@ -242,9 +246,7 @@ void add_all_commands(CLI::App& app, Runner& runner) {
   }
 }
 
-void print_message(std::ostream& err, std::string_view text) {
-  err << "rwcalc: " << localize_numbers(printable(text)) << "\n";
-}
+void print_message(std::ostream& err, std::string_view text) { err << "rwcalc: " << localize_message(text) << "\n"; }
 
 int parse_only(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   return parse_and_run(argc, argv, out, err, false);

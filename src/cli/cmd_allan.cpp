@@ -135,7 +135,7 @@ int run_allan(const AllanArgs& a, Io& io) {
   if (rec.segments.size() > 1)
     print_message(io.err, trf("{}: {} segments (split at the time column's gaps by --gaps segments); the Allan "
                               "variance pools them: no difference spans a gap",
-                              printable(rec.source), rec.segments.size()));
+                              as_typed(rec.source), rec.segments.size()));
   require_finite(res, rec);
   // Where fewer than 10 averages of τ fit in the record, Stable32's noise identification (the B1 ratio,
   // taken for the number of terms as Stable32 does) and the EDF that follows are weak: said on stderr,
@@ -144,7 +144,7 @@ int run_allan(const AllanArgs& a, Io& io) {
     if ((rec.phase.points() - 1) / static_cast<std::size_t>(p.m) < 10) {
       print_message(io.err, trf("note: {}: from tau = {:g} s on fewer than 10 averages remain; the noise type and "
                                 "the bounds there rest on few data ('rwcalc analyze' takes them from the fitted model)",
-                                rec.source, p.tau_s));
+                                as_typed(rec.source), p.tau_s));
       break;
     }
   if (a.json) {
@@ -152,7 +152,7 @@ int run_allan(const AllanArgs& a, Io& io) {
   } else if (a.csv) {
     io.out << format_allan_csv(res);
     // The CSV holds the table only; the outliers found are said on standard error.
-    if (outliers.count > 0) print_message(io.err, trf("note: {}: {}", rec.source, format_outliers(outliers)));
+    if (outliers.count > 0) print_message(io.err, trf("note: {}: {}", as_typed(rec.source), format_outliers(outliers)));
   } else {
     io.out << localize_numbers(
         format_allan_table(res, {rec.source, rec.samples, rec.rate_hz, std::string(to_string(rec.rate_source)),

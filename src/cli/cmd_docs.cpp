@@ -81,6 +81,9 @@ void write_man(std::ostream& out, const CLI::App& app) {
          "(methods), docs/input-formats.md, docs/diagnosis.md.\n";
 }
 
+/// The bash completion. Each candidate is one line of compgen's output taken whole (mapfile), never
+/// split at blanks or expanded as a pattern, so that file names with blanks, '*' or '$' complete as
+/// they are named.
 void write_completion(std::ostream& out, const CLI::App& app) {
   std::string names;
   for (const CLI::App* cmd : commands_of(app)) names += (names.empty() ? "" : " ") + cmd->get_name();
@@ -88,7 +91,7 @@ void write_completion(std::ostream& out, const CLI::App& app) {
       << "_rwcalc() {\n"
       << "  local cur=\"${COMP_WORDS[COMP_CWORD]}\" opts=\"\"\n"
       << "  if [[ $COMP_CWORD -eq 1 ]]; then\n"
-      << "    COMPREPLY=($(compgen -W \"" << names << " --help --version\" -- \"$cur\"))\n"
+      << "    mapfile -t COMPREPLY < <(compgen -W \"" << names << " --help --version\" -- \"$cur\")\n"
       << "    return\n  fi\n"
       << "  case \"${COMP_WORDS[1]}\" in\n";
   for (const CLI::App* cmd : commands_of(app)) {
@@ -99,9 +102,9 @@ void write_completion(std::ostream& out, const CLI::App& app) {
   }
   out << "  esac\n"
       << "  if [[ $cur == -* ]]; then\n"
-      << "    COMPREPLY=($(compgen -W \"$opts\" -- \"$cur\"))\n"
+      << "    mapfile -t COMPREPLY < <(compgen -W \"$opts\" -- \"$cur\")\n"
       << "  else\n"
-      << "    COMPREPLY=($(compgen -f -- \"$cur\"))\n"
+      << "    mapfile -t COMPREPLY < <(compgen -f -- \"$cur\")\n"
       << "  fi\n"
       << "}\n"
       << "complete -o filenames -F _rwcalc rwcalc\n";

@@ -2,6 +2,8 @@
 // table per sensor kind, the JSON `channels` list and the Kalibr/OpenVINS noise file.
 #include <fmt/format.h>
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <memory>
 #include <ostream>
@@ -94,6 +96,28 @@ std::string html_escaped(std::string_view text) {
   return out;
 }
 
+/// The files of --report DIR, for the check of every output before the first is written. A
+/// directory still to be made holds none of them yet: only that it can be made is checked.
+std::vector<OutputTarget> report_targets(const std::string& dir) {
+  namespace fs = std::filesystem;
+  if (dir.empty()) return {};
+  std::error_code ec;
+  if (!fs::exists(dir, ec)) {
+    fs::path parent = fs::absolute(dir).parent_path();
+    while (!fs::exists(parent, ec) && parent.has_relative_path()) parent = parent.parent_path();
+    if (!fs::is_directory(parent, ec) || ::access(parent.c_str(), W_OK | X_OK) != 0)
+      throw OutputError(
+          trf("{}: cannot create the report directory: {} is not a writable directory", dir, parent.string()));
+    return {};
+  }
+  if (!fs::is_directory(dir, ec))
+    throw OutputError(trf("{}: cannot create the report directory: {}", dir, tr("not a directory")));
+  std::vector<OutputTarget> files;
+  for (const char* name : {"imu.txt", "imu.json", "imu.yaml", "imu.svg", "index.html"})
+    files.push_back({fmt::format("--report ({})", name), (fs::path(dir) / name).string()});
+  return files;
+}
+
 // --report DIR: the tables as a page (index.html, with the figure when gnuplot is there), the
 // JSON, the noise file and the figure beside it, so that one directory holds the whole result.
 void write_report(const std::string& dir, const ImuResult& res, const nlohmann::json& j, const KalibrOptions& k,
@@ -132,7 +156,7 @@ void write_report(const std::string& dir, const ImuResult& res, const nlohmann::
                       "<a href=\"imu.json\">imu.json</a>"),
                   html_escaped(version_line())),
       force);
-  print_message(io.err, trf("report written to {}", at("index.html")));
+  print_message(io.err, trf("report written to {}", as_typed(at("index.html"))));
 }
 
 }  // namespace
@@ -199,7 +223,11 @@ void register_imu(CLI::App& app, Runner& runner) {
   sub->callback([cmd, &runner] {
     runner = [cmd](Io& io) -> int {
       const ImuOptions opt = cmd->options();
-      cmd->plot.check(cmd->force, {{"-o", cmd->output}, {"--kalibr", cmd->kalibr}});
+      // Every output is checked before the work and before the first is written.
+      if (!cmd->kalibr.empty() || !cmd->report_dir.empty()) (void)rostopic_scalar(cmd->rostopic);
+      std::vector<OutputTarget> targets = report_targets(cmd->report_dir);
+      targets.insert(targets.begin(), {{"-o", cmd->output}, {"--kalibr", cmd->kalibr}});
+      cmd->plot.check(cmd->force, targets);
       const ImuResult res = analyze_imu(cmd->file, opt);
       for (const auto& c : res.channels)
         print_input_notes(io.err, nlohmann::json{{"source", c.result.source}, {"input", c.result.input}});
@@ -211,7 +239,7 @@ void register_imu(CLI::App& app, Runner& runner) {
       k.combine = cmd->combine == "mean" ? AxisCombination::Mean : AxisCombination::Worst;
       if (!cmd->kalibr.empty()) {
         write_file_atomic(cmd->kalibr, kalibr_yaml(res, k), cmd->force);
-        print_message(io.err, trf("noise file written to {}", cmd->kalibr));
+        print_message(io.err, trf("noise file written to {}", as_typed(cmd->kalibr)));
       }
       if (!cmd->report_dir.empty()) write_report(cmd->report_dir, res, j, k, cmd->force, io);
       emit(io,

@@ -218,7 +218,7 @@ int run_report(const ReportCmd& c, Io& io) {
   ro.figures = !c.no_figures;
   ro.generated = utc_now();
   const auto path = write_report(c.dir, in, ro, c.force);
-  io.out << localize_numbers(trf("report written to {} ({} run(s){})\n", printable(path), in.analyses.size(),
+  io.out << localize_numbers(trf("report written to {} ({} run(s){})\n", as_typed(path), in.analyses.size(),
                                  c.no_figures ? tr(", no figures") : ""));
   if (c.pdf) {
     const std::string pdf = (fs::path(c.dir) / "report.pdf").string();

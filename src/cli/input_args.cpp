@@ -88,14 +88,14 @@ ReadOptions InputArgs::options() const {
 }
 
 void print_input_notes(std::ostream& err, const Recording& rec) {
-  for (const std::string& w : rec.warnings) print_message(err, trf("warning: {}: {}", rec.source, w));
-  for (const std::string& n : rec.notes) print_message(err, trf("note: {}: {}", rec.source, n));
+  for (const std::string& w : rec.warnings) print_message(err, trf("warning: {}: {}", as_typed(rec.source), w));
+  for (const std::string& n : rec.notes) print_message(err, trf("note: {}: {}", as_typed(rec.source), n));
 }
 
 void print_input_notes(std::ostream& err, const nlohmann::json& analysis) {
   const auto in = analysis.find("input");
   if (in == analysis.end() || !in->is_object()) return;
-  const std::string source = analysis.value("source", std::string());
+  const std::string source = as_typed(analysis.value("source", std::string()));
   for (const char* kind : {"warnings", "notes"})
     for (const auto& line : in->value(kind, nlohmann::json::array()))
       if (line.is_string())

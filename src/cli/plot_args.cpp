@@ -23,8 +23,8 @@ void draw(const PlotArgs& a, PlotResult (*plot)(const nlohmann::json&, const Plo
   o.force = force;
   const PlotResult r = plot(j, o);
   for (const auto& note : r.notes) print_message(io.err, trf("note: {}", note));
-  if (!a.plot.empty()) print_message(io.err, trf("figure written to {} ({} data series)", a.plot, r.series));
-  if (!a.script.empty()) print_message(io.err, trf("gnuplot script written to {}", a.script));
+  if (!a.plot.empty()) print_message(io.err, trf("figure written to {} ({} data series)", as_typed(a.plot), r.series));
+  if (!a.script.empty()) print_message(io.err, trf("gnuplot script written to {}", as_typed(a.script)));
 }
 
 }  // namespace

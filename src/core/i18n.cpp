@@ -6,6 +6,8 @@
 #include <unordered_map>
 #include <utility>
 
+#include "rwcalc/printable.hpp"
+
 namespace rwcalc {
 
 std::string_view embedded_russian_po();  // generated from po/ru.po by cmake/catalog.cmake
@@ -49,6 +51,28 @@ struct Catalogue {
 const Catalogue& catalogue() {
   static const Catalogue c;  // thread-safe initialisation
   return c;
+}
+
+/// The marks of as_typed(): U+FDD0 and U+FDD1 in UTF-8.
+constexpr std::string_view kTypedOpen = "\xEF\xB7\x90", kTypedClose = "\xEF\xB7\x91";
+
+/// Where the text marked as typed that starts at `open` ends (after its closing mark), at most `to`.
+std::size_t typed_end(const std::string& t, std::size_t open, std::size_t to) {
+  const std::size_t close = t.find(kTypedClose, open + kTypedOpen.size());
+  return close == std::string::npos || close >= to ? to : close + kTypedClose.size();
+}
+
+/// `t` without the marks of as_typed().
+void remove_typed_marks(std::string& t) {
+  std::size_t out = 0;
+  for (std::size_t i = 0; i < t.size();) {
+    if (t.compare(i, kTypedOpen.size(), kTypedOpen) == 0 || t.compare(i, kTypedClose.size(), kTypedClose) == 0) {
+      i += kTypedOpen.size();
+      continue;
+    }
+    t[out++] = t[i++];
+  }
+  t.resize(out);
 }
 
 bool word_byte(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
@@ -95,6 +119,11 @@ void localize_span(std::string& t, std::size_t from, std::size_t to) {
   bool last_had_point = false;
   std::size_t last_end = std::string::npos;
   for (std::size_t i = from; i < to;) {
+    if (t.compare(i, kTypedOpen.size(), kTypedOpen) == 0) {  // outside text: as typed
+      i = typed_end(t, i, to);
+      last_end = std::string::npos;
+      continue;
+    }
     if (!number_starts(t, i)) {
       ++i;
       continue;
@@ -142,13 +171,39 @@ const char* tr(const char* english) {
 
 std::string tr(const std::string& english) { return tr(english.c_str()); }
 
+std::string marked_as_typed(std::string_view encoded) {
+  std::string s;
+  s.reserve(encoded.size() + kTypedOpen.size() + kTypedClose.size());
+  return s.append(kTypedOpen).append(encoded).append(kTypedClose);
+}
+
+std::string as_typed(std::string_view outside) { return marked_as_typed(printable(outside)); }
+
 std::string localize_numbers(std::string text) {
   if (language() == Language::Russian) localize_span(text, 0, text.size());
+  remove_typed_marks(text);
   return text;
 }
 
+std::string localize_message(std::string_view text) {
+  std::string shown;
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t open = std::min(text.find(kTypedOpen, at), text.size());
+    shown += printable(text.substr(at, open - at));
+    if (open == text.size()) break;
+    const std::size_t inside = open + kTypedOpen.size();
+    const std::size_t close = std::min(text.find(kTypedClose, inside), text.size());
+    shown += as_typed(text.substr(inside, close - inside));
+    at = std::min(close + kTypedClose.size(), text.size());
+  }
+  return localize_numbers(std::move(shown));
+}
+
 std::string localize_html(std::string html) {
-  if (language() != Language::Russian) return html;
+  if (language() != Language::Russian) {
+    remove_typed_marks(html);
+    return html;
+  }
   std::size_t i = 0;
   while (i < html.size()) {
     const std::size_t tag = html.find('<', i);
@@ -164,6 +219,7 @@ std::string localize_html(std::string html) {
       }
     i = after + 1;
   }
+  remove_typed_marks(html);
   return html;
 }
 

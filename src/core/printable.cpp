@@ -5,13 +5,12 @@
 
 #include <cstdint>
 
+#include "core/utf8.hpp"
+
 namespace rwcalc {
 
-namespace {
+namespace detail {
 
-/// Length of the valid UTF-8 sequence at `s[i]` and its code point, or 0 when the bytes there
-/// are not valid UTF-8 (a stray continuation byte, a truncated or overlong sequence, a UTF-16
-/// surrogate, a code point beyond U+10FFFF).
 std::size_t utf8_sequence(std::string_view s, std::size_t i, char32_t& code) {
   const auto lead = static_cast<unsigned char>(s[i]);
   std::size_t n = 0;
@@ -38,28 +37,21 @@ std::size_t utf8_sequence(std::string_view s, std::size_t i, char32_t& code) {
   return n;
 }
 
-/// Code points that act on a terminal or on the layout of text rather than show: the C1
-/// controls, the line and paragraph separators, and the bidirectional embeddings, overrides and
-/// isolates (which can make a name read differently from its bytes).
-bool acting_code_point(char32_t c) {
-  return (c >= 0x80 && c <= 0x9F) || c == 0x2028 || c == 0x2029 || (c >= 0x202A && c <= 0x202E) ||
-         (c >= 0x2066 && c <= 0x2069);
-}
-
-}  // namespace
+}  // namespace detail
 
 std::string printable(std::string_view text) {
   std::string out;
   out.reserve(text.size());
   for (std::size_t i = 0; i < text.size();) {
     char32_t code = 0;
-    const std::size_t n = utf8_sequence(text, i, code);
+    const std::size_t n = detail::utf8_sequence(text, i, code);
     if (n == 0 || code == 0x7F || (code < 0x20 && code != '\n' && code != '\r' && code != '\t'))
       out += fmt::format("\\x{:02x}", static_cast<unsigned char>(text[i]));  // invalid byte or C0 control
     else if (code < 0x20)
       out += code == '\n' ? "\\n" : code == '\r' ? "\\r" : "\\t";
-    else if (acting_code_point(code))
-      out += fmt::format("\\u{:04x}", static_cast<std::uint32_t>(code));
+    else if (detail::acting_code_point(code) || detail::noncharacter(code))
+      out += code > 0xFFFF ? fmt::format("\\U{:08x}", static_cast<std::uint32_t>(code))
+                           : fmt::format("\\u{:04x}", static_cast<std::uint32_t>(code));
     else
       out.append(text.substr(i, n));
     i += n == 0 ? 1 : n;

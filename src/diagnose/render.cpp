@@ -309,7 +309,7 @@ std::string record_and_base(const DiagnoseResult& r, const Shown& sh) {
       "  record: {:.0f} s at {:g} Hz, column '{}' of an accelerometer read in {} (levels in {}, no Earth rate, no "
       "class verdict); ensemble of {} simulated records per model, {} for the detectors' thresholds (seed {}), band "
       "{:g} % per τ\n\n",
-      r.settings.duration_s, r.settings.rate_hz, printable(r.analysis.input.value("column", r.analysis.column)),
+      r.settings.duration_s, r.settings.rate_hz, as_typed(r.analysis.input.value("column", r.analysis.column)),
       r.analysis.input.value("unit", ""), level, r.runs, r.calibration_runs, r.seed, r.band_level * 100);
   s += format_outliers(r.analysis.outliers, level, sh.units.deviation.factor);
   return s + tr("Base model (five-term fit): ") + power_laws(m, sh) +
@@ -333,7 +333,7 @@ std::string outside_row(const BandPoint& b, const Shown& sh) {
 std::string format_report(const DiagnoseResult& r) {
   const Shown sh(r);
   std::string s;
-  s += trf("Diagnosis of {}\n", printable(r.analysis.source));
+  s += trf("Diagnosis of {}\n", as_typed(r.analysis.source));
   s += record_and_base(r, sh);
   std::size_t outside = 0;
   std::string rows;

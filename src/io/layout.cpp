@@ -260,6 +260,10 @@ void Layout::choose_by_name(const ReadOptions& o, bool value_given, const std::s
   auto temps = columns_where(header, [](std::string_view h) { return any_named(h, kTemperatureNames); });
   if (!value_given && ncols == 1) times.clear();  // a lone column named "time" holds the samples
   if (value_given) {
+    if (o.column_not_time && time_name(header[value_col]))
+      throw InputError(file, header_line,
+                       trf("column '{}' ({}) is the time column, not a sensor's samples", header[value_col],
+                           value_col + 1));
     std::erase(times, value_col);
     std::erase(temps, value_col);
   } else {

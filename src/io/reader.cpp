@@ -633,6 +633,7 @@ Recording Reader::finish() {
                                   : meta.temperature_c;
   const auto& h = layout_.header;
   rec.column_name = h.empty() ? fmt::format("column {}", layout_.value_col + 1) : h[layout_.value_col];
+  rec.column_index = layout_.value_col + 1;
   if (layout_.time_col) rec.time_column = h.empty() ? std::string("column 1") : h[*layout_.time_col];
   rec.mode = in().mode;
   rec.angle_unit = in().angle_unit;

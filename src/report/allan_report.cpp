@@ -15,7 +15,7 @@ std::string unit_label(const AllanResult& r) {
 std::string format_allan_table(const AllanResult& r, const AllanReportInfo& info) {
   const std::string u = unit_label(r);
   std::string out;
-  out += fmt::format("# rwcalc allan: {}\n", info.source.empty() ? "-" : printable(info.source));
+  out += fmt::format("# rwcalc allan: {}\n", info.source.empty() ? "-" : as_typed(info.source));
   if (!info.input.empty()) out += trf("# input: {}\n", printable(info.input));
   out += trf("# estimator: {} ({})\n", deviation_name(r.estimator), to_string(r.estimator));
   out +=

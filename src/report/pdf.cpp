@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "report/process.hpp"
+#include "rwcalc/encode.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"
@@ -54,7 +55,7 @@ bool print_to_pdf(const std::string& html_path, const std::string& pdf_path, boo
   const auto r = detail::run_process(chromium,
                                      {"--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
                                       "--no-pdf-header-footer", "--user-data-dir=" + (scratch / "profile").string(),
-                                      "--print-to-pdf=" + pdf.string(), "file://" + fs::absolute(html_path).string()},
+                                      "--print-to-pdf=" + pdf.string(), file_url(fs::absolute(html_path).string())},
                                      scratch / "log");
   std::error_code ec;
   if (!r.started || r.status != 0 || !fs::exists(pdf)) {

@@ -226,22 +226,25 @@ void add_class_floors(const json& analysis, std::string& vars, PlotCommand& plot
   }
 }
 
-std::string file_name(const json& a) {
+/// What names a run in a title or a key, as typed: an IMU channel by its column as named (a column
+/// name is no path: "accel/x" keeps its '/'), any other run by the file name of its source.
+std::string run_name(const json& a) {
+  if (std::string column = view::str(a, "column"); !column.empty()) return as_typed(column);
   std::string src = view::str(a, "source");
   if (src.empty()) src = view::str(a, "file");
-  return src.empty() ? src : std::filesystem::path(src).filename().string();
+  return src.empty() ? src : as_typed(std::filesystem::path(src).filename().string());
 }
 
 std::string default_analysis_title(const json& a) {
   std::string t = tr("Allan deviation");
-  if (const auto src = file_name(a); !src.empty()) t += trf(" of {}", src);
+  if (const auto src = run_name(a); !src.empty()) t += trf(" of {}", src);
   if (const auto temp = view::temperature_label(at(a, "temperature_c")); !temp.empty()) t += trf(" at {}", temp);
   return t;
 }
 
 std::string run_label(const json& run, std::size_t index) {
   const auto t = view::temperature_label(at(run, "temperature_c"));
-  const auto src = file_name(run);
+  const auto src = run_name(run);
   if (!t.empty()) return src.empty() ? t : fmt::format("{} ({})", t, src);
   return src.empty() ? trf("run {}", index + 1) : src;
 }
@@ -316,7 +319,8 @@ Figure analysis_figure(const json& analysis, const PlotOptions& options) {
     if (const auto& fit = at(analysis, "fit"); fit.is_object()) add_model(fit, body, plot);
     add_class_floors(analysis, body, plot, bounds);
   }
-  return loglog_figure("allan", options, options.title.empty() ? default_analysis_title(analysis) : options.title,
+  return loglog_figure("allan", options,
+                       options.title.empty() ? default_analysis_title(analysis) : as_typed(options.title),
                        allan_ylabel(allan), bounds, body, plot);
 }
 
@@ -347,8 +351,8 @@ Figure batch_allan_figure(const json& runs, const PlotOptions& options) {
     add_class_floors(runs[order.front()], blocks, plot, bounds);
   }
   return loglog_figure("batch-allan", options,
-                       options.title.empty() ? tr("Allan deviation at each test temperature") : options.title, ylabel,
-                       bounds, blocks, plot);
+                       options.title.empty() ? tr("Allan deviation at each test temperature") : as_typed(options.title),
+                       ylabel, bounds, blocks, plot);
 }
 
 Figure batch_direct_figure(const json& runs, const PlotOptions& options) {
@@ -405,7 +409,7 @@ Figure batch_direct_figure(const json& runs, const PlotOptions& options) {
   const std::string title =
       options.title.empty()
           ? tr("Direct method: variance of the angle over t (Earth rate removed), with regression lines")
-          : options.title + tr(" — direct method");
+          : as_typed(options.title) + tr(" — direct method");
   // The variance grows with t, so the upper-left corner is empty: the key goes there.
   f.script = fmt::format(
       "set encoding utf8\nset title {} noenhanced\n"
@@ -526,7 +530,8 @@ Figure diagnosis_figure(const json& diagnosis, const PlotOptions& options) {
     plot.add("$outside u 1:2 w p pt 6 ps 1.6 lw 1.6 lc rgb '#d62728' t " +
              label_text(tr("measured, outside the base band")));
   }
-  return loglog_figure("diagnosis", options, options.title.empty() ? diagnosis_title(diagnosis) : options.title,
+  return loglog_figure("diagnosis", options,
+                       options.title.empty() ? diagnosis_title(diagnosis) : as_typed(options.title),
                        diagnosis_ylabel(diagnosis), bounds, blocks, plot);
 }
 

@@ -69,6 +69,10 @@ std::string esc(std::string_view text) {
   return r;
 }
 
+/// Outside text (a file name, a serial, the laboratory, a command line) escaped for HTML and shown
+/// as typed: no decimal comma is put into it (as_typed, i18n.hpp).
+std::string typed(std::string_view text) { return marked_as_typed(esc(text)); }
+
 std::string g(double v, int digits = 3) { return fmt::format("{:.{}g}", v, digits); }
 
 /// A unit label of units.hpp in the report's language (°/h → °/ч).
@@ -236,7 +240,8 @@ json worst_class(const std::vector<json>& analyses, const char* key) {
 
 /// A table row: the run and its temperature, then the cells (class="num"; bold when asked).
 std::string run_row(const json& run, const std::vector<std::string>& cells, std::string_view tail = "") {
-  std::string s = fmt::format("<tr><td>{}</td><td class=\"num\">{}</td>", esc(source_name(run)), temperature_text(run));
+  std::string s =
+      fmt::format("<tr><td>{}</td><td class=\"num\">{}</td>", typed(source_name(run)), temperature_text(run));
   for (const auto& c : cells) s += fmt::format("<td class=\"num\">{}</td>", c);
   return s + std::string(tail) + "</tr>\n";
 }
@@ -361,12 +366,12 @@ constexpr std::array<std::pair<const char*, const char*>, 4> kIdentification{{{"
 
 std::string data_table(const json& run, std::size_t index, Numbering& numbering) {
   std::string s = numbering.table(fmt::format("run{}-data", index + 1),
-                                  trf("Data and identification: {}", esc(source_name(run))), "run");
-  s += kv_row(tr("file"), esc(str(run, "source")));
+                                  trf("Data and identification: {}", typed(source_name(run))), "run");
+  s += kv_row(tr("file"), typed(str(run, "source")));
   const json& input = at(run, "input");
   if (const json& id = at(input, "identification"); id.is_object())
     for (const auto& [key, label] : kIdentification)
-      if (const auto v = str(id, key); !v.empty()) s += kv_row(tr(label), esc(v));
+      if (const auto v = str(id, key); !v.empty()) s += kv_row(tr(label), typed(v));
   if (const auto sha = str(input, "sha256"); !sha.empty())
     s += kv_row(tr("file size, SHA-256"),
                 trf("{:.0f} bytes, <code>{}</code>", num(input, "file_bytes").value_or(0), esc(sha)));
@@ -425,7 +430,7 @@ std::string warnings_html(const json& run) {
   std::string s = fmt::format("<div class=\"warning\"><b>{}</b><ul>\n", tr("Warnings"));
   for (const auto& x : w) {
     s += fmt::format("<li><b>{}</b>: {}", esc(str(x, "code")), esc(str(x, "message")));
-    if (const std::string c = str(x, "command"); !c.empty()) s += fmt::format(" <code>{}</code>", esc(c));
+    if (const std::string c = str(x, "command"); !c.empty()) s += fmt::format(" <code>{}</code>", typed(c));
     s += "</li>\n";
   }
   return s + "</ul></div>\n";
@@ -531,7 +536,7 @@ std::string verdict_html(const std::vector<json>& a, const std::vector<std::size
                      by_parameter(str(at(overall, "B"), "statement"), str(at(overall, "N"), "statement")));
   h += "<ul>\n";
   for (auto i : order)
-    h += fmt::format("<li>{} ({}): {}</li>\n", esc(source_name(a[i])), temperature_text(a[i]),
+    h += fmt::format("<li>{} ({}): {}</li>\n", typed(source_name(a[i])), temperature_text(a[i]),
                      esc(statement_text(at(a[i], "verdict"))));
   h += "</ul>\n";
   if (const auto t = num(v0, "tolerance_pct"); t && *t > 0)
@@ -542,7 +547,7 @@ std::string verdict_html(const std::vector<json>& a, const std::vector<std::size
   h += "<p class=\"meta\">" +
        std::string(tr("P is the probability, from the estimates' uncertainty, that the true class is the one stated; "
                       "where it is low the runner-up class is named."));
-  if (auto table = str(v0, "table"); !table.empty()) h += " " + trf("Class table: {}.", esc(tr(table)));
+  if (auto table = str(v0, "table"); !table.empty()) h += " " + trf("Class table: {}.", typed(tr(table)));
   return h + "</p>\n";
 }
 
@@ -606,18 +611,18 @@ std::string identification_values(const std::vector<json>& a, const char* key) {
     if (const auto v = str(at(at(run, "input"), "identification"), key); !v.empty())
       if (std::find(seen.begin(), seen.end(), v) == seen.end()) seen.push_back(v);
   std::string s;
-  for (const auto& v : seen) s += (s.empty() ? "" : "; ") + esc(v);
+  for (const auto& v : seen) s += (s.empty() ? "" : "; ") + typed(v);
   return s;
 }
 
 /// The title block: what a filed report names first (laboratory, gyro, serial, test, date).
 std::string title_block(const std::vector<json>& a, const ReportOptions& options, const std::string& title) {
-  std::string h = fmt::format("<header class=\"title\">\n<h1>{}</h1>\n<table id=\"title-block\">\n", esc(title));
+  std::string h = fmt::format("<header class=\"title\">\n<h1>{}</h1>\n<table id=\"title-block\">\n", typed(title));
   auto row = [&](const char* name, const std::string& html) {
     h += kv_row(tr(name), html.empty() ? std::string(kNotAvailable) : html);
   };
-  row(N_("laboratory"), esc(options.lab));
-  row(N_("gyro"), options.gyro.empty() ? std::string() : esc(options.gyro));
+  row(N_("laboratory"), options.lab.empty() ? std::string() : typed(options.lab));
+  row(N_("gyro"), options.gyro.empty() ? std::string() : typed(options.gyro));
   row(N_("gyro serial"), identification_values(a, "serial"));
   row(N_("test date"), identification_values(a, "test_date"));
   row(N_("operator"), identification_values(a, "operator"));
@@ -646,7 +651,7 @@ std::string report_html(const ReportInput& input, const ReportOptions& options) 
       "<!DOCTYPE html>\n<html lang=\"{0}\">\n<head>\n<meta charset=\"utf-8\"/>\n"
       "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"/>\n"
       "<meta name=\"generator\" content=\"rwcalc {1}\"/>\n<title>{2}</title>\n<style>{3}</style>\n</head>\n<body>\n",
-      language_code(), RWCALC_VERSION, esc(title), fmt::format(fmt::runtime(kStyle), tr("Page"), tr("of")));
+      language_code(), RWCALC_VERSION, typed(title), fmt::format(fmt::runtime(kStyle), tr("Page"), tr("of")));
   h += title_block(a, options, title) + verdict_html(a, order, overall, numbering);
   // One statement each: the tables are numbered in the order they are made.
   h += numbering.section("tables", tr("Tables 1 and 2"));
@@ -660,7 +665,7 @@ std::string report_html(const ReportInput& input, const ReportOptions& options) 
     const auto& run = a[i];
     // "4&#46;1." : the entity keeps the decimal comma of Russian text out of the heading number.
     h += fmt::format("<h3 id=\"run{}\">{}&#46;{}. {}</h3>\n", i + 1, runs_section, ++k,
-                     trf("{} at {}", esc(source_name(run)), temperature_text(run)));
+                     trf("{} at {}", typed(source_name(run)), temperature_text(run)));
     h += run_summary(run, i, numbering);
     if (options.figures)
       h += numbering.figure(fmt::format("fig-run{}-allan", i + 1), {analysis_figure(run, PlotOptions{})},
