@@ -11,6 +11,7 @@
 #include <sys/wait.h>
 #include <zlib.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "rwcalc/error.hpp"
@@ -202,7 +204,7 @@ TEST(MemoryCeiling, AGzipOfGoodLinesStopsAtTheCeilingNamingTheFileAndTheMemoryNe
   auto r = run_limited("", {"analyze", path, "--max-memory", "64M"});
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_EQ(r.err.rfind("rwcalc: error: " + path + ":", 0), 0u) << r.err;
-  EXPECT_NEAR(needed_mib(r.err), 4096, 64) << r.err;
+  EXPECT_NEAR(needed_mib(r.err), 4096, 200) << r.err;  // judged from a part of the file
   EXPECT_NE(r.err.find("memory ceiling of 64 MiB (--max-memory)"), std::string::npos) << r.err;
   EXPECT_TRUE(r.out.empty());
   // From a pipe the size is unknown: the record needs more than the ceiling.
@@ -216,7 +218,7 @@ TEST(MemoryCeiling, AGzipOfGoodLinesStopsAtTheCeilingNamingTheFileAndTheMemoryNe
     r = run_limited("", {"analyze", path});
     EXPECT_EQ(r.status, 2) << r.err;
     EXPECT_EQ(r.err.rfind("rwcalc: error: " + path + ":", 0), 0u) << r.err;
-    EXPECT_NEAR(needed_mib(r.err), 4096, 64) << r.err;
+    EXPECT_NEAR(needed_mib(r.err), 4096, 200) << r.err;  // judged from a part of the file
     EXPECT_NE(r.err.find("memory ceiling of 256 MiB (half the address-space limit"), std::string::npos) << r.err;
   }
   // A record within the ceiling is read whole: 2^20 samples (8 MiB of counts) under 16 MiB.
@@ -234,18 +236,18 @@ TEST(MemoryCeiling, SimulateEstimatesTheFlickerMemoryAndRefusesWhatCannotFit) {
   // 24 h at 1 kHz with bias instability: its flicker term is one FFT over twice the record, about
   // 100 bytes per sample, some 8 GiB. Under ulimit -v 4000000 (or a ceiling of 1 GiB) it is refused
   // before anything is written, naming the option and the memory.
-  const std::vector<std::string> day{"simulate",         "-o",   out, "--duration", "86400", "--rate", "1000",
+  const std::vector<std::string> day{"simulate",           "-o",  out, "--duration", "86400", "--rate", "1000",
                                      "--bias-instability", "0.01"};
-  auto r = kSanitized ? run_limited("", rwcalc::test::concat(day, {"--max-memory", "1G"}))
-                      : run_limited("", day, 4000000);
+  auto r =
+      kSanitized ? run_limited("", rwcalc::test::concat(day, {"--max-memory", "1G"})) : run_limited("", day, 4000000);
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("--bias-instability"), std::string::npos) << r.err;
   EXPECT_GT(needed_mib(r.err), 7 * 1024) << r.err;
   EXPECT_LT(needed_mib(r.err), 10 * 1024) << r.err;
   EXPECT_FALSE(std::filesystem::exists(out));
   // The estimate is what the record takes: 2·10^6 samples run within an address-space limit of
-  // the estimate plus 64 MiB for the program itself.
-  const std::vector<std::string> small{"simulate", "-o", out, "--duration", "20000", "--rate", "100",
+  // the estimate plus 64 MiB for the program itself (with the ceiling raised to the estimate).
+  const std::vector<std::string> small{"simulate",           "-o",  out, "--duration", "20000", "--rate", "100",
                                        "--bias-instability", "0.01"};
   r = run_limited("", rwcalc::test::concat(small, {"--max-memory", "1M"}));
   EXPECT_EQ(r.status, 2) << r.err;
@@ -253,7 +255,8 @@ TEST(MemoryCeiling, SimulateEstimatesTheFlickerMemoryAndRefusesWhatCannotFit) {
   EXPECT_GT(mib, 150) << r.err;
   EXPECT_LT(mib, 300) << r.err;
   if (!kSanitized) {
-    r = run_limited("", small, static_cast<long>((mib + 64) * 1024));
+    const std::string ceiling = fmt::format("{:.0f}M", std::ceil(mib) + 1);
+    r = run_limited("", rwcalc::test::concat(small, {"--max-memory", ceiling}), static_cast<long>((mib + 64) * 1024));
     EXPECT_EQ(r.status, 0) << r.err;
     EXPECT_TRUE(std::filesystem::exists(out));
   }

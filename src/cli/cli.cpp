@@ -242,6 +242,12 @@ void add_all_commands(CLI::App& app, Runner& runner) {
   }
 }
 
+CLI::Validator output_name() {
+  return CLI::Validator(
+      [](std::string& name) { return name.empty() ? std::string(tr("an empty name names no file")) : std::string(); },
+      "");
+}
+
 void print_message(std::ostream& err, std::string_view text) {
   err << "rwcalc: " << localize_numbers(printable(text)) << "\n";
 }
