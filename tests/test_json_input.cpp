@@ -421,18 +421,20 @@ TEST_F(JsonInput, SimulateFromRefusesDocumentsThatHoldNoGyroModel) {
   };
   // Nothing of a model: an empty object, a class table, the output of imu, a simulation's truth.
   const auto empty = dir_->write("empty.json", "{}\n").string();
-  refused(empty, empty + ": ", {"holds no model", "\"fit\"", "\"extended_model\"", "arw_deg_per_sqrt_h"});
-  const auto table = rwcalc::test::source_path("fuzz/corpus/result_json/class_table.json").string();
-  refused(table, table + ": ", {"holds no model", "\"classes\""});
+  refused(empty, empty + ":1: ", {"holds no model", "\"fit\"", "\"extended_model\"", "arw_deg_per_sqrt_h"});
+  const auto table = dir_->write("classes.json", R"({"name": "lab", "classes": [{"class": 1, "B_deg_per_h": 0.005,
+                                                 "N_deg_per_sqrt_h": 0.001}]})")
+                         .string();
+  refused(table, table + ":1: ", {"holds no model", "\"classes\""});
   const auto rec = records_[0];
   const auto imu = produce("imu.json", {"imu", rec, "--gyro", "pulses", "--json"});
-  refused(imu, imu + ": ", {"holds no model", "\"channels\""});
+  refused(imu, imu + ":1: ", {"holds no model", "\"channels\""});
   const auto truth = dir_->path() / "truth.json";
-  ASSERT_EQ(run_exe({"simulate", "-o", (dir_->path() / "t.csv").string(), "--duration", "60", "--truth",
-                     truth.string(), "--force"})
+  ASSERT_EQ(run_exe({"simulate", "-o", (dir_->path() / "t.csv").string(), "--duration", "60", "--truth", truth.string(),
+                     "--force"})
                 .status,
             0);
-  refused(truth.string(), truth.string() + ": ", {"holds no model", "\"model\""});
+  refused(truth.string(), truth.string() + ":1: ", {"holds no model", "\"model\""});
   // An analysis whose fit lacks a coefficient, and one of an accelerometer.
   json a = read_json(analysis_);
   a["fit"].erase("N_deg_per_sqrt_h");
