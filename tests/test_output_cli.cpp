@@ -17,8 +17,8 @@
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <filesystem>
+#include <fstream>
 #include <optional>
 #include <string>
 #include <thread>
@@ -223,7 +223,8 @@ rwcalc::test::CliResult run_shell(const TempDir& tmp, const std::string& setup, 
   for (const auto& e : env) cmd += " " + shell_quote(e);
   cmd += " " + shell_quote(RWCALC_EXE);
   for (const auto& a : args) cmd += " " + shell_quote(a);
-  cmd += " </dev/null >" + shell_quote((tmp.path() / "out").string()) + " 2>" + shell_quote((tmp.path() / "err").string());
+  cmd +=
+      " </dev/null >" + shell_quote((tmp.path() / "out").string()) + " 2>" + shell_quote((tmp.path() / "err").string());
   const int rc = std::system(("sh -c " + shell_quote(cmd)).c_str());
   rwcalc::test::CliResult r;
   r.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : 128 + WTERMSIG(rc);
@@ -234,15 +235,15 @@ rwcalc::test::CliResult run_shell(const TempDir& tmp, const std::string& setup, 
 
 TEST(InterruptedWrite, AFileSizeLimitIsAnOutputErrorAndLeavesNoTemporaryFile) {
   TempDir tmp;
-  fs::create_directory(tmp.path() / "out");
-  const auto out = (tmp.path() / "out" / "rec.csv").string();
+  fs::create_directory(tmp.path() / "records");
+  const auto out = (tmp.path() / "records" / "rec.csv").string();
   // A 1-h record at 400 Hz is megabytes; the limit is 64 blocks.
   const auto r = run_shell(tmp, "ulimit -f 64", {},
                            {"simulate", "-o", out, "--duration", "3600", "--rate", "400", "--arw", "0.01"});
   EXPECT_EQ(r.status, 3) << r.err;
   EXPECT_NE(r.err.find("rwcalc: error: " + out), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("File too large"), std::string::npos) << r.err;
-  EXPECT_TRUE(entries(tmp.path() / "out").empty()) << "left: " << entries(tmp.path() / "out").front();
+  EXPECT_TRUE(entries(tmp.path() / "records").empty()) << "left: " << entries(tmp.path() / "records").front();
 }
 
 /// True while process `pid` exists and is not a zombie.
@@ -274,15 +275,19 @@ bool both_gone(pid_t a, pid_t b) {
 /// its own, writes both pids into `pids`, and then hangs.
 fs::path hanging_chromium(const TempDir& tmp, const fs::path& pids) {
   fs::create_directory(pids);
-  const auto script = tmp.write(
-      "hanging-chromium",
-      "#!/bin/sh\n"
-      "for a in \"$@\"; do case \"$a\" in --user-data-dir=*) d=\"${a#--user-data-dir=}\";; esac; done\n"
-      "mkdir -p \"$d/Default/Cache\" && echo cached >\"$d/Default/Cache/data_0\"\n"
-      "sleep 30 &\n"
-      "echo $! >" + shell_quote((pids / "child").string()) + "\n"
-      "echo $$ >" + shell_quote((pids / "helper").string()) + "\n"
-      "wait\n");
+  const auto script =
+      tmp.write("hanging-chromium",
+                "#!/bin/sh\n"
+                "for a in \"$@\"; do case \"$a\" in --user-data-dir=*) d=\"${a#--user-data-dir=}\";; esac; done\n"
+                "mkdir -p \"$d/Default/Cache\" && echo cached >\"$d/Default/Cache/data_0\"\n"
+                "sleep 30 &\n"
+                "echo $! >" +
+                    shell_quote((pids / "child").string()) +
+                    "\n"
+                    "echo $$ >" +
+                    shell_quote((pids / "helper").string()) +
+                    "\n"
+                    "wait\n");
   fs::permissions(script, fs::perms::owner_all);
   return script;
 }
@@ -316,9 +321,9 @@ TEST(HelperProcesses, ASignalEndsTheHelpersProcessGroupAndRemovesItsScratchDirec
     const auto chromium = hanging_chromium(tmp, pids);
     const auto scratch = tmp.path() / (whole_group ? "tmp-int" : "tmp-term");
     fs::create_directory(scratch);
-    const auto child = spawn_rwcalc(
-        {"report", rec.string(), "-o", (tmp.path() / "report").string(), "--no-figures", "--pdf", "--force"},
-        {"TMPDIR=" + scratch.string(), "RWCALC_CHROMIUM=" + chromium.string()});
+    const auto child = spawn_rwcalc({"report", rec.string(), "-o", (tmp.path() / "report").string(), "--no-figures",
+                                     "--pdf", "--force"},
+                                    {"TMPDIR=" + scratch.string(), "RWCALC_CHROMIUM=" + chromium.string()});
     const bool seen = wait_until(child.pid, [&] { return fs::exists(pids / "helper"); });
     if (seen) ::kill(whole_group ? -child.pid : child.pid, sig);
     const int status = wait_for(child.pid);
