@@ -173,9 +173,9 @@ TEST_F(JsonInput, ReportRefusesCraftedValuesNamingFileLineAndKey) {
   expect_input_error(report({file}), file, line, {"\"runs[1].fit.B_deg_per_h.value\" must be a number"});
 }
 
-TEST_F(JsonInput, ReportRefusesInputAndIdentificationValuesOfTheWrongType) {
-  // The report shows the input's identification and file: a value of another type used to be shown
-  // as "—", as if the key were absent.
+TEST_F(JsonInput, ReportRefusesInputIdentificationAndSegmentsOfTheWrongType) {
+  // The report shows the input's identification and file, and the segments of a record read with
+  // --gaps segments: a value of another type used to be shown as "—", as if the key were absent.
   struct Case {
     const char* pointer;
     const char* text;
@@ -190,6 +190,9 @@ TEST_F(JsonInput, ReportRefusesInputAndIdentificationValuesOfTheWrongType) {
       {"/input/sha256", "7", "\"input.sha256\" must be a string, got 7"},
       {"/input/file_bytes", "-1", "\"input.file_bytes\" must be an integer"},
       {"/input", "[]", "\"input\" must be an object, got array"},
+      {"/segments/count", "\"two\"", "\"segments.count\" must be an integer"},
+      {"/segments/durations_s", "[1, -1]", "\"segments.durations_s[1]\" must be a number >= 0"},
+      {"/segments/gaps", "{}", "\"segments.gaps\" must be an array, got object"},
   };
   for (const auto& c : cases) {
     std::size_t line = 0;

@@ -67,6 +67,7 @@ void optional(const Value& object, std::string_view key, Check check) {
 }
 constexpr auto as_number = [](const Value& v) { return v.number(); };
 constexpr auto as_non_negative = [](const Value& v) { return v.non_negative(); };
+constexpr auto as_positive = [](const Value& v) { return v.positive(); };
 constexpr auto as_string = [](const Value& v) { return v.string(); };
 constexpr auto as_boolean = [](const Value& v) { return v.boolean(); };
 constexpr auto as_probability = [](const Value& v) { return v.probability(); };
@@ -184,7 +185,7 @@ void Checker::input(const Value& in) const {
   for (const char* key : {"sha256", "column", "unit", "kind", "rate_source", "time_column", "time_unit"})
     optional(in, key, as_string);
   optional(in, "file_bytes", as_count);
-  optional(in, "rate_hz", [](const Value& v) { return v.positive(); });
+  optional(in, "rate_hz", as_positive);
   for (const char* key : {"notes", "warnings"})
     if (const auto lines = in.find(key)) array_of(*lines, std::nullopt, "line", as_string);
 }
@@ -266,7 +267,7 @@ void Checker::run(const Value& r) const {
   if (const auto t = r.find("temperature_c")) temperature(*t);
   optional(r, "temperature_source", as_string);
   optional(r, "samples", as_count);
-  optional(r, "rate_hz", [](const Value& v) { return v.positive(); });
+  optional(r, "rate_hz", as_positive);
   optional(r, "duration_s", as_non_negative);
   for (const char* key : {"mean_rate_deg_per_h", "earth_rate_deg_per_h", "bias_deg_per_h"}) optional(r, key, as_number);
   if (const auto l = r.find("latitude_deg")) (void)l->number_in(-90, 90, "a latitude in [-90, 90]");
