@@ -2,6 +2,7 @@
 // `rwcalc analyze FILE OPTIONS` exits with the documented status and prints one error naming the
 // file and the line; accepted inputs are either analysed or refused by the analysis with its own
 // message (these records are a few samples long) — never a crash, a hang or silence.
+// An output option given an empty name is a usage error naming the option, for every command.
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -64,5 +65,40 @@ TEST_P(CliBadInput, AnalyzeExitsWithTheDocumentedStatusNamingFileAndLine) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Corpus, CliBadInput, ::testing::ValuesIn(load_bad_input_manifest()), bad_input_case_name);
+
+TEST(CliErrors, AnEmptyOutputNameIsAUsageErrorNamingTheOption) {
+  // "-o ''" used to end in ": cannot move the finished file into place" (status 3), or in nothing.
+  const rwcalc::test::TempDir tmp;
+  const auto rec = (tmp.path() / "rec.csv").string();
+  ASSERT_EQ(rwcalc::test::run_cli({"simulate", "-o", rec, "--duration", "600", "--rate", "10", "--arw", "0.1"}).status,
+            0);
+  const auto saved = rwcalc::test::run_cli({"analyze", rec, "--json"});
+  ASSERT_EQ(saved.status, 0) << saved.err;
+  const auto json = tmp.write("a.json", saved.out).string();
+  const auto lines = tmp.write("a.jsonl", rwcalc::test::run_cli({"batch", rec, "--jsonl"}).out).string();
+  struct Case {
+    std::vector<std::string> args;  ///< the option with its empty value last
+    std::string option;
+  };
+  const std::vector<Case> cases{
+      {{"analyze", rec, "-o", ""}, "--output"},          {{"analyze", rec, "--plot", ""}, "--plot"},
+      {{"analyze", rec, "--plot-script", ""}, "--plot-script"}, {{"batch", rec, "-o", ""}, "--output"},
+      {{"batch", rec, "--plot", ""}, "--plot"},           {{"merge", lines, "-o", ""}, "--output"},
+      {{"simulate", "-o", ""}, "--output"},               {{"simulate", "-o", rec, "--truth", ""}, "--truth"},
+      {{"diagnose", rec, "-o", ""}, "--output"},          {{"diagnose", rec, "--plot-script", ""}, "--plot-script"},
+      {{"imu", rec, "--gyro", "pulses", "-o", ""}, "--output"},
+      {{"imu", rec, "--gyro", "pulses", "--kalibr", ""}, "--kalibr"},
+      {{"imu", rec, "--gyro", "pulses", "--report", ""}, "--report"},
+      {{"report", json, "-o", ""}, "--output"},
+  };
+  for (const auto& c : cases) {
+    const auto r = rwcalc::test::run_cli(c.args);
+    const std::string shown = c.args[0] + " " + c.option;
+    EXPECT_EQ(r.status, 2) << shown << ": " << r.err;
+    EXPECT_NE(r.err.find(c.option), std::string::npos) << shown << ": " << r.err;
+    EXPECT_NE(r.err.find("empty"), std::string::npos) << shown << ": " << r.err;
+    EXPECT_TRUE(r.out.empty()) << shown;
+  }
+}
 
 }  // namespace

@@ -173,6 +173,43 @@ TEST_F(JsonInput, ReportRefusesCraftedValuesNamingFileLineAndKey) {
   expect_input_error(report({file}), file, line, {"\"runs[1].fit.B_deg_per_h.value\" must be a number"});
 }
 
+TEST_F(JsonInput, ReportRefusesInputIdentificationAndSegmentsOfTheWrongType) {
+  // The report shows the input's identification and file, and the segments of a record read with
+  // --gaps segments: a value of another type used to be shown as "—", as if the key were absent.
+  struct Case {
+    const char* pointer;
+    const char* text;
+    const char* what;
+  };
+  const std::vector<Case> cases{
+      {"/input/identification/serial", "12345", "\"input.identification.serial\" must be a string, got 12345"},
+      {"/input/identification/operator", "[\"A\"]", "\"input.identification.operator\" must be a string, got array"},
+      {"/input/identification/test_date", "{}", "\"input.identification.test_date\" must be a string, got object"},
+      {"/input/identification/conditions", "true", "\"input.identification.conditions\" must be a string"},
+      {"/input/identification", "\"SN 7\"", "\"input.identification\" must be an object, got string"},
+      {"/input/sha256", "7", "\"input.sha256\" must be a string, got 7"},
+      {"/input/file_bytes", "-1", "\"input.file_bytes\" must be an integer"},
+      {"/input", "[]", "\"input\" must be an object, got array"},
+      {"/segments/count", "\"two\"", "\"segments.count\" must be an integer"},
+      {"/segments/durations_s", "[1, -1]", "\"segments.durations_s[1]\" must be a number >= 0"},
+      {"/segments/gaps", "{}", "\"segments.gaps\" must be an array, got object"},
+  };
+  for (const auto& c : cases) {
+    std::size_t line = 0;
+    const auto file = dir_->write("id.json", with_value(read_json(analysis_), c.pointer, c.text, line)).string();
+    SCOPED_TRACE(std::string(c.pointer) + " = " + c.text);
+    expect_input_error(report({file}), file, line, {c.what});
+  }
+  // A string, or null for "not given", is shown or left out as before.
+  json a = read_json(analysis_);
+  a["input"]["identification"]["serial"] = "SN 0042";
+  a["input"]["identification"]["operator"] = nullptr;
+  const auto file = dir_->write("id.json", a.dump(2)).string();
+  const auto r = report({file});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(slurp(dir_->path() / "report" / "report.html").find("SN 0042"), std::string::npos);
+}
+
 TEST_F(JsonInput, ReportRefusesMissingKeysTruncatedAndNonObjectDocuments) {
   json a = read_json(analysis_);
   a.erase("allan");
@@ -371,6 +408,49 @@ TEST_F(JsonInput, SimulateFromChecksEveryValueNamingTheLine) {
     const auto file = dir_->write("model.json", with_value(model, c.pointer, c.text, line)).string();
     SCOPED_TRACE(std::string(c.pointer) + " = " + c.text);
     expect_input_error(run_exe({"simulate", "--from", file, "-o", sim, "--force"}), file, line, {c.what});
+  }
+}
+
+TEST_F(JsonInput, SimulateFromRefusesDocumentsThatHoldNoGyroModel) {
+  // Any JSON object used to pass and give a noise-free record with exit status 0. Now a document
+  // must be an analysis of a gyro with its fitted coefficients, a diagnosis, or a noise model.
+  const auto sim = dir_->path() / "never.csv";
+  const auto refused = [&](const std::string& file, const std::string& where, const std::vector<std::string>& what) {
+    const auto r = run_exe({"simulate", "--from", file, "-o", sim.string()});
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_NE(r.err.find("rwcalc: error: " + where), std::string::npos) << "expected " << where << " in: " << r.err;
+    for (const auto& w : what) EXPECT_NE(r.err.find(w), std::string::npos) << "expected '" << w << "' in: " << r.err;
+    EXPECT_FALSE(fs::exists(sim)) << file;
+  };
+  // Nothing of a model: an empty object, a class table, the output of imu, a simulation's truth.
+  const auto empty = dir_->write("empty.json", "{}\n").string();
+  refused(empty, empty + ":1: ", {"holds no model", "\"fit\"", "\"extended_model\"", "arw_deg_per_sqrt_h"});
+  const auto table = dir_->write("classes.json", R"({"name": "lab", "classes": [{"class": 1, "B_deg_per_h": 0.005,
+                                                 "N_deg_per_sqrt_h": 0.001}]})")
+                         .string();
+  refused(table, table + ":1: ", {"holds no model", "\"classes\""});
+  const auto rec = records_[0];
+  const auto imu = produce("imu.json", {"imu", rec, "--gyro", "pulses", "--json"});
+  refused(imu, imu + ":1: ", {"holds no model", "\"channels\""});
+  const auto truth = dir_->path() / "truth.json";
+  ASSERT_EQ(run_exe({"simulate", "-o", (dir_->path() / "t.csv").string(), "--duration", "60", "--truth", truth.string(),
+                     "--force"})
+                .status,
+            0);
+  refused(truth.string(), truth.string() + ":1: ", {"holds no model", "\"model\""});
+  // An analysis whose fit lacks a coefficient, and one of an accelerometer.
+  json a = read_json(analysis_);
+  a["fit"].erase("N_deg_per_sqrt_h");
+  const auto no_n = dir_->write("no-n.json", a.dump(2)).string();
+  refused(no_n, no_n + ":", {"\"fit\" lacks the key \"N_deg_per_sqrt_h\""});
+  std::size_t line = 0;
+  const auto accel =
+      dir_->write("accel.json", with_value(read_json(analysis_), "/sensor", "\"accelerometer\"", line)).string();
+  refused(accel, fmt::format("{}:{}: ", accel, line), {"\"sensor\" is \"accelerometer\"", "gyro"});
+  // What simulate --from is for still works: an analysis, a diagnosis.
+  for (const auto& from : {analysis_, diagnosis_}) {
+    const auto r = run_exe({"simulate", "--from", from, "-o", sim.string(), "--duration", "60", "--force"});
+    EXPECT_EQ(r.status, 0) << from << ": " << r.err;
   }
 }
 

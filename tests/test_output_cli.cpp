@@ -4,6 +4,10 @@
 //   status 3 and a message naming standard output.
 // - SIGINT or SIGTERM during a write removes the output's temporary file (.NAME.tmpXXXX) and
 //   gnuplot's scratch directory (rwcalc-plot-*), and the process still ends by that signal.
+// - A file-size limit (ulimit -f) is an output error (status 3), not SIGXFSZ with the temporary
+//   file left behind.
+// - A helper program (the headless Chromium of report --pdf) that hangs is stopped at its timeout;
+//   a signal to rwcalc ends the helper's whole process group; neither leaves a scratch directory.
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
@@ -11,8 +15,10 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <optional>
 #include <string>
 #include <thread>
@@ -29,6 +35,7 @@ namespace {
 namespace fs = std::filesystem;
 using rwcalc::test::run_cli;
 using rwcalc::test::run_exe_stdout;
+using rwcalc::test::slurp;
 using rwcalc::test::TempDir;
 
 // A short simulated record to feed the commands (10 min at 100 Hz).
@@ -198,6 +205,136 @@ TEST(InterruptedWrite, NoGnuplotScratchDirectoryIsLeftBehind) {
     EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == sig) << "status " << status << ", signal " << sig;
     EXPECT_TRUE(entries(scratch).empty()) << "left: " << entries(scratch).front();
     EXPECT_FALSE(fs::exists(tmp.path() / "fig.svg"));
+  }
+}
+
+// ---- Limits and helper programs ------------------------------------------------------------------
+
+std::string shell_quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+/// `sh -c 'SETUP; exec env ENV… rwcalc ARGS…'`, standard error kept in `tmp`/err.
+rwcalc::test::CliResult run_shell(const TempDir& tmp, const std::string& setup, const std::vector<std::string>& env,
+                                  const std::vector<std::string>& args) {
+  std::string cmd = setup + "; exec env";
+  for (const auto& e : env) cmd += " " + shell_quote(e);
+  cmd += " " + shell_quote(RWCALC_EXE);
+  for (const auto& a : args) cmd += " " + shell_quote(a);
+  cmd +=
+      " </dev/null >" + shell_quote((tmp.path() / "out").string()) + " 2>" + shell_quote((tmp.path() / "err").string());
+  const int rc = std::system(("sh -c " + shell_quote(cmd)).c_str());
+  rwcalc::test::CliResult r;
+  r.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : 128 + WTERMSIG(rc);
+  r.out = slurp(tmp.path() / "out");
+  r.err = slurp(tmp.path() / "err");
+  return r;
+}
+
+TEST(InterruptedWrite, AFileSizeLimitIsAnOutputErrorAndLeavesNoTemporaryFile) {
+  TempDir tmp;
+  fs::create_directory(tmp.path() / "records");
+  const auto out = (tmp.path() / "records" / "rec.csv").string();
+  // A 1-h record at 400 Hz is megabytes; the limit is 64 blocks.
+  const auto r = run_shell(tmp, "ulimit -f 64", {},
+                           {"simulate", "-o", out, "--duration", "3600", "--rate", "400", "--arw", "0.01"});
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_NE(r.err.find("rwcalc: error: " + out), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("File too large"), std::string::npos) << r.err;
+  EXPECT_TRUE(entries(tmp.path() / "records").empty()) << "left: " << entries(tmp.path() / "records").front();
+}
+
+/// True while process `pid` exists and is not a zombie.
+bool alive(pid_t pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string text;
+  if (!std::getline(stat, text)) return false;
+  const auto paren = text.rfind(')');
+  return paren != std::string::npos && paren + 2 < text.size() && text[paren + 2] != 'Z';
+}
+
+/// The pid written in `file`, or -1.
+pid_t pid_in(const fs::path& file) {
+  std::ifstream in(file);
+  long pid = -1;
+  return in >> pid ? static_cast<pid_t>(pid) : -1;
+}
+
+/// True once neither process is alive (within 10 s).
+bool both_gone(pid_t a, pid_t b) {
+  for (int i = 0; i < 1000; ++i) {
+    if (!alive(a) && !alive(b)) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return false;
+}
+
+/// A stand-in for Chromium that fills its profile directory like the real one, starts a child of
+/// its own, writes both pids into `pids`, and then hangs.
+fs::path hanging_chromium(const TempDir& tmp, const fs::path& pids) {
+  fs::create_directory(pids);
+  const auto script =
+      tmp.write("hanging-chromium",
+                "#!/bin/sh\n"
+                "for a in \"$@\"; do case \"$a\" in --user-data-dir=*) d=\"${a#--user-data-dir=}\";; esac; done\n"
+                "mkdir -p \"$d/Default/Cache\" && echo cached >\"$d/Default/Cache/data_0\"\n"
+                "sleep 30 &\n"
+                "echo $! >" +
+                    shell_quote((pids / "child").string()) +
+                    "\n"
+                    "echo $$ >" +
+                    shell_quote((pids / "helper").string()) +
+                    "\n"
+                    "wait\n");
+  fs::permissions(script, fs::perms::owner_all);
+  return script;
+}
+
+TEST(HelperProcesses, AHangingChromiumIsStoppedAtItsTimeoutWithItsChildren) {
+  TempDir tmp;
+  const auto rec = make_record(tmp);
+  const auto pids = tmp.path() / "pids";
+  const auto chromium = hanging_chromium(tmp, pids);
+  fs::create_directory(tmp.path() / "tmp");
+  const auto start = std::chrono::steady_clock::now();
+  const auto r = run_shell(tmp, "true",
+                           {"RWCALC_CHROMIUM=" + chromium.string(), "RWCALC_HELPER_TIMEOUT=2",
+                            "TMPDIR=" + (tmp.path() / "tmp").string()},
+                           {"report", rec.string(), "-o", (tmp.path() / "report").string(), "--no-figures", "--pdf"});
+  const auto seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_NE(r.err.find("did not finish within 2 s"), std::string::npos) << r.err;
+  EXPECT_LT(seconds, 20) << "the helper was not stopped at its timeout";
+  EXPECT_TRUE(both_gone(pid_in(pids / "helper"), pid_in(pids / "child"))) << "the helper's processes still run";
+  EXPECT_TRUE(entries(tmp.path() / "tmp").empty()) << "left: " << entries(tmp.path() / "tmp").front();
+  EXPECT_FALSE(fs::exists(tmp.path() / "report" / "report.pdf"));
+}
+
+TEST(HelperProcesses, ASignalEndsTheHelpersProcessGroupAndRemovesItsScratchDirectory) {
+  TempDir tmp;
+  const auto rec = make_record(tmp);
+  for (const bool whole_group : {true, false}) {  // Ctrl-C reaches rwcalc's group; kill reaches rwcalc
+    const int sig = whole_group ? SIGINT : SIGTERM;
+    const auto pids = tmp.path() / (whole_group ? "pids-int" : "pids-term");
+    const auto chromium = hanging_chromium(tmp, pids);
+    const auto scratch = tmp.path() / (whole_group ? "tmp-int" : "tmp-term");
+    fs::create_directory(scratch);
+    const auto child = spawn_rwcalc({"report", rec.string(), "-o", (tmp.path() / "report").string(), "--no-figures",
+                                     "--pdf", "--force"},
+                                    {"TMPDIR=" + scratch.string(), "RWCALC_CHROMIUM=" + chromium.string()});
+    const bool seen = wait_until(child.pid, [&] { return fs::exists(pids / "helper"); });
+    if (seen) ::kill(whole_group ? -child.pid : child.pid, sig);
+    const int status = wait_for(child.pid);
+    ASSERT_TRUE(seen) << "rwcalc ended before the helper started";
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == sig) << "status " << status << ", signal " << sig;
+    const pid_t helper = pid_in(pids / "helper"), grandchild = pid_in(pids / "child");
+    EXPECT_TRUE(both_gone(helper, grandchild)) << "the helper's processes still run";
+    for (const pid_t p : {helper, grandchild})
+      if (p > 0 && alive(p)) ::kill(p, SIGKILL);
+    EXPECT_TRUE(entries(scratch).empty()) << "left: " << entries(scratch).front();
+    EXPECT_FALSE(fs::exists(tmp.path() / "report" / "report.pdf"));
   }
 }
 

@@ -5,14 +5,21 @@
 // suite. A good record of long lines is read within a limit below the size of its text: memory
 // follows the samples kept, not the text. Under AddressSanitizer (which reserves terabytes of
 // address space) the limit is left out and only the messages are checked.
+// The memory ceiling: a record whose samples would take more than it (half the address space
+// rwcalc may use, or --max-memory) is refused naming the file and the memory it needs; simulate
+// estimates the memory of a record before it starts and refuses one that cannot fit.
 #include <sys/wait.h>
 #include <zlib.h>
 
+#include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <regex>
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "rwcalc/error.hpp"
@@ -167,6 +174,92 @@ TEST(HostileInput, MemoryFollowsTheSamplesNotTheText) {
   const auto r = run_limited("", {"allan", path}, 128L * 1024);
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("200000"), std::string::npos) << r.out.substr(0, 400);
+}
+
+// ---- The memory ceiling -------------------------------------------------------------------------
+
+// A gzip file of good lines, "0\n1\n" over and over: 1 MB that inflates to 1 GiB of text, 2^29
+// samples, 4 GiB to keep as 64-bit pulse counts.
+std::string good_lines_bomb() {
+  std::string unit;
+  for (int i = 0; i < (1 << 20); ++i) unit += "0\n1\n";
+  return gzip_repeated(unit, 256);
+}
+
+// The memory a refusal names ("needs about 4.01 GiB"), in MiB; 0 when there is none.
+double needed_mib(const std::string& message) {
+  std::smatch m;
+  if (!std::regex_search(message, m, std::regex("needs about ([0-9.]+) (KiB|MiB|GiB|TiB)"))) return 0;
+  const double unit = m[2] == "KiB" ? 1.0 / 1024 : m[2] == "MiB" ? 1 : m[2] == "GiB" ? 1024 : 1024 * 1024;
+  return std::stod(m[1]) * unit;
+}
+
+TEST(MemoryCeiling, AGzipOfGoodLinesStopsAtTheCeilingNamingTheFileAndTheMemoryNeeded) {
+  const rwcalc::test::TempDir tmp;
+  const std::string bomb = good_lines_bomb();
+  ASSERT_LT(bomb.size(), std::size_t{2} << 20);
+  const auto path = tmp.write("lines.csv.gz", bomb).string();
+  // --max-memory sets the ceiling: the samples stop at it, and the memory the whole record needs
+  // is judged from the file's size.
+  auto r = run_limited("", {"analyze", path, "--max-memory", "64M"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err.rfind("rwcalc: error: " + path + ":", 0), 0u) << r.err;
+  EXPECT_NEAR(needed_mib(r.err), 4096, 200) << r.err;  // judged from a part of the file
+  EXPECT_NE(r.err.find("memory ceiling of 64 MiB (--max-memory)"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty());
+  // From a pipe the size is unknown: the record needs more than the ceiling.
+  r = run_limited("cat " + quote(path), {"analyze", "-", "--max-memory", "64M"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err.rfind("rwcalc: error: <stdin>:", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find("needs more than 64 MiB"), std::string::npos) << r.err;
+  // Without the option the ceiling is half the address space rwcalc may use: under ulimit -v of
+  // 512 MiB, 256 MiB; the file ends with status 2, not "out of memory".
+  if (!kSanitized) {
+    r = run_limited("", {"analyze", path});
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(r.err.rfind("rwcalc: error: " + path + ":", 0), 0u) << r.err;
+    EXPECT_NEAR(needed_mib(r.err), 4096, 200) << r.err;  // judged from a part of the file
+    EXPECT_NE(r.err.find("memory ceiling of 256 MiB (half the address-space limit"), std::string::npos) << r.err;
+  }
+  // A record within the ceiling is read whole: 2^20 samples (8 MiB of counts) under 16 MiB.
+  std::string unit;
+  for (int i = 0; i < (1 << 19); ++i) unit += "0\n1\n";
+  const auto fits = tmp.write("fits.csv", unit).string();
+  r = run_limited("", {"allan", fits, "--max-memory", "16M"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("1048576"), std::string::npos) << r.out.substr(0, 400);
+}
+
+TEST(MemoryCeiling, SimulateEstimatesTheFlickerMemoryAndRefusesWhatCannotFit) {
+  const rwcalc::test::TempDir tmp;
+  const auto out = (tmp.path() / "day.csv").string();
+  // 24 h at 1 kHz with bias instability: its flicker term is one FFT over twice the record, about
+  // 100 bytes per sample, some 8 GiB. Under ulimit -v 4000000 (or a ceiling of 1 GiB) it is refused
+  // before anything is written, naming the option and the memory.
+  const std::vector<std::string> day{"simulate",           "-o",  out, "--duration", "86400", "--rate", "1000",
+                                     "--bias-instability", "0.01"};
+  auto r =
+      kSanitized ? run_limited("", rwcalc::test::concat(day, {"--max-memory", "1G"})) : run_limited("", day, 4000000);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("--bias-instability"), std::string::npos) << r.err;
+  EXPECT_GT(needed_mib(r.err), 7 * 1024) << r.err;
+  EXPECT_LT(needed_mib(r.err), 10 * 1024) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  // The estimate is what the record takes: 2·10^6 samples run within an address-space limit of
+  // the estimate plus 64 MiB for the program itself (with the ceiling raised to the estimate).
+  const std::vector<std::string> small{"simulate",           "-o",  out, "--duration", "20000", "--rate", "100",
+                                       "--bias-instability", "0.01"};
+  r = run_limited("", rwcalc::test::concat(small, {"--max-memory", "1M"}));
+  EXPECT_EQ(r.status, 2) << r.err;
+  const double mib = needed_mib(r.err);
+  EXPECT_GT(mib, 150) << r.err;
+  EXPECT_LT(mib, 300) << r.err;
+  if (!kSanitized) {
+    const std::string ceiling = fmt::format("{:.0f}M", std::ceil(mib) + 1);
+    r = run_limited("", rwcalc::test::concat(small, {"--max-memory", ceiling}), static_cast<long>((mib + 64) * 1024));
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_TRUE(std::filesystem::exists(out));
+  }
 }
 
 }  // namespace

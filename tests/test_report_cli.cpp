@@ -334,3 +334,37 @@ TEST(ReportCli, BadSavedResultsNameTheFileAndLine) {
   EXPECT_NE(r.err.find("no run to report"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out / "report.html"));
 }
+
+TEST(ReportCli, GapsSegmentsAreNamedInTheReport) {
+  // A record in two stretches of 2000 s at 10 Hz with 10 s missing between them, read with
+  // --gaps segments: the report names the segments, the gap and its line, as analyze does.
+  TempDir dir;
+  std::string text = "time_s,gyro_dph\n";
+  std::uint64_t state = 12345;
+  for (int k = 0; k < 40000; ++k) {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    const double white = static_cast<double>(state >> 11) / 9007199254740992.0 - 0.5;
+    const double t = 0.1 * k + (k >= 20000 ? 10.0 : 0.0);
+    text += fmt::format("{:.1f},{:.6f}\n", t, 15.0 + white);
+  }
+  const auto rec = dir.write("gap.csv", text).string();
+  const auto out = dir.path() / "out";
+  auto r = run_cli({"report", rec, "-o", out.string(), "--no-figures", "--gaps", "segments"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  // Sample 20000, the first after the gap, is on line 20002 (the header is line 1).
+  const auto segments = [](const std::string& html) {
+    const auto at = html.find("<th>segments</th>");
+    return at == std::string::npos ? std::string() : html.substr(at, html.find("</tr>", at) - at);
+  };
+  const std::string row = segments(slurp(out / "report.html"));
+  EXPECT_NE(row.find("2 segments"), std::string::npos) << row;
+  EXPECT_NE(row.find("10 s missing before line 20002"), std::string::npos) << row;
+  EXPECT_NE(row.find("2000"), std::string::npos) << row;
+  // The same from the saved analysis.
+  const auto saved = run_cli({"analyze", rec, "--gaps", "segments", "--json"});
+  ASSERT_EQ(saved.status, 0) << saved.err;
+  const auto a = dir.write("a.json", saved.out).string();
+  r = run_cli({"report", a, "-o", out.string(), "--no-figures", "--force"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(segments(slurp(out / "report.html")), row);
+}

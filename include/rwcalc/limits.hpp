@@ -13,8 +13,13 @@ inline constexpr double kMaxScaleArcsec = 1e9;
 inline constexpr double kMaxRateDegPerH = 1e9;
 inline constexpr double kMinTemperatureC = -273.15;
 inline constexpr double kMaxTemperatureC = 1000.0;
-/// Smallest floating data step the Allan variance carries: its square over τ² (up to
-/// (1e9 s·2^40)²) stays above the smallest normal double.
-inline constexpr double kMinDataStep = 1e-100;
+/// The range of the rates a record may hold, in its deviation unit (°/h for a gyro, m/s/h for an
+/// accelerometer, 1 for a clock's frequency): any rate sample, or rate between two angle samples,
+/// beyond ±kMaxDataRate, or a record whose largest rate is below kMinDataRate, is refused. Within
+/// them the Allan variances, the noise fit (whose weights are squared variances) and the bootstrap
+/// of the cross-checks stay far inside a double; beyond them the fit overflows or underflows
+/// (from about 1e76 and 1e-72).
+inline constexpr double kMaxDataRate = 1e50;
+inline constexpr double kMinDataRate = 1e-50;
 
 }  // namespace rwcalc

@@ -18,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "rwcalc/memory.hpp"
 #include "rwcalc/series.hpp"
 
 namespace rwcalc {
@@ -64,6 +65,9 @@ struct ReadOptions {
   /// --test-date, --conditions): keys "serial", "operator", "test_date", "conditions". They take
   /// the place of the file's metadata of the same name (a note says so when that differs).
   std::map<std::string, std::string> identification;
+  /// The most memory the samples kept may take (--max-memory); unset: default_memory_ceiling().
+  /// A record beyond it is an InputError naming the line where it was reached and the memory needed.
+  std::optional<MemoryCeiling> memory;
 };
 
 /// Where the sample rate came from (reported in outputs).

@@ -62,6 +62,13 @@ class Simulator {
 
   [[nodiscard]] const NoiseModel& model() const noexcept;
 
+  /// Peak bytes a simulator of this model and length holds beyond a few MiB: the flicker
+  /// (bias-instability) term's FFT over twice the record, about 104 bytes per sample (176 for
+  /// lengths whose FFT size is not a multiple of 4); 0 without that term. simulate compares it with
+  /// the memory ceiling before it starts.
+  [[nodiscard]] static std::size_t memory_bytes(const NoiseModel& model, const SimulationSettings& settings,
+                                                SimulationPath path = SimulationPath::Exact);
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

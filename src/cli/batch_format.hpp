@@ -46,7 +46,9 @@ struct TableFormat {
 /// -o,--output FILE (default "-": standard output) and --force.
 inline void add_output_options(CLI::App& app, std::string& output, bool& force,
                                const char* force_help = N_("Overwrite existing output, figure and script files")) {
-  app.add_option("-o,--output", output, tr("Write to FILE instead of standard output"))->capture_default_str();
+  app.add_option("-o,--output", output, tr("Write to FILE instead of standard output"))
+      ->check(output_name())
+      ->capture_default_str();
   app.add_flag("--force", force, tr(force_help));
 }
 

@@ -246,6 +246,12 @@ void add_all_commands(CLI::App& app, Runner& runner) {
   }
 }
 
+CLI::Validator output_name() {
+  return CLI::Validator(
+      [](std::string& name) { return name.empty() ? std::string(tr("an empty name names no file")) : std::string(); },
+      "");
+}
+
 void print_message(std::ostream& err, std::string_view text) { err << "rwcalc: " << localize_message(text) << "\n"; }
 
 int parse_only(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {

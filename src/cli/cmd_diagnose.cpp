@@ -54,7 +54,9 @@ void register_diagnose(CLI::App& app, Runner& runner) {
   sub->add_option("--false-alarm", cmd->alpha, tr("False-alarm probability of each of the five detectors"))
       ->check(real_in(1e-6, 0.2, ""))
       ->capture_default_str();
-  sub->add_option("-o,--output", cmd->output, tr("Write to FILE instead of standard output"))->capture_default_str();
+  sub->add_option("-o,--output", cmd->output, tr("Write to FILE instead of standard output"))
+      ->check(output_name())
+      ->capture_default_str();
   sub->add_flag("--force", cmd->force, tr("Overwrite existing output, figure and script files"));
   cmd->plot.add_to(*sub,
                    N_("the measured Allan deviation against the simulated bands of the base and the extended model"));

@@ -30,6 +30,7 @@ struct ImuCmd {
   std::optional<double> rate_hz;
   double time_tolerance = 0.01;
   std::string gaps = "refuse";
+  std::string max_memory;
   std::vector<std::string> gyro, accel;
   std::string vertical_gyro;
   std::string gyro_unit, accel_unit;
@@ -47,6 +48,7 @@ struct ImuCmd {
     o.read.rate_hz = rate_hz;
     o.read.time_tolerance = time_tolerance;
     o.read.gaps_as_segments = gaps == "segments";
+    o.read.memory = memory_ceiling_of(max_memory);
     o.gyro_columns = gyro;
     o.accel_columns = accel;
     o.vertical_gyro = vertical_gyro;
@@ -176,6 +178,7 @@ void register_imu(CLI::App& app, Runner& runner) {
       ->capture_default_str()
       ->group(tr("Input"));
   add_gaps_option(*sub, cmd->gaps);
+  add_memory_option(*sub, cmd->max_memory);
   sub->add_option("--gyro", cmd->gyro, tr("Gyro columns: header names or 1-based indices, comma-separated"))
       ->delimiter(',')
       ->group(tr("Input"));
@@ -205,6 +208,7 @@ void register_imu(CLI::App& app, Runner& runner) {
   sub->add_flag("--json", cmd->json, tr("Print the JSON object instead of the tables"))->group(tr("Output"));
   sub->add_option("--kalibr", cmd->kalibr,
                   tr("Write the Kalibr/OpenVINS IMU noise file (imu.yaml: noise densities and random walks in SI)"))
+      ->check(output_name())
       ->group(tr("Output"));
   sub->add_option("--rostopic", cmd->rostopic, tr("rostopic written into the --kalibr file"))
       ->capture_default_str()
@@ -217,6 +221,7 @@ void register_imu(CLI::App& app, Runner& runner) {
   sub->add_option("--report", cmd->report_dir,
                   tr("Write the whole result into DIR: index.html (tables and figure), imu.txt, imu.json, imu.yaml, "
                      "imu.svg (created when missing)"))
+      ->check(output_name())
       ->group(tr("Output"));
   add_output_options(*sub, cmd->output, cmd->force);
   cmd->plot.add_to(*sub, N_("one panel per sensor kind with every axis' Allan deviation and its confidence bars"));

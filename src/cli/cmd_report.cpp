@@ -243,7 +243,8 @@ void register_report(CLI::App& app, Runner& runner) {
                   tr("Recordings, and/or saved results: .json of 'analyze --json', 'batch --json' or 'diagnose "
                      "--json', .jsonl of 'batch --jsonl'"))
       ->required();
-  sub->add_option("-o,--output", cmd->dir, tr("Directory for report.html (created when missing); required"));
+  sub->add_option("-o,--output", cmd->dir, tr("Directory for report.html (created when missing); required"))
+      ->check(output_name());
   cmd->input.add_to(*sub);
   cmd->analysis.add_to(*sub);
   add_temperature_option(*sub, cmd->temperature, tr("Temperature, °C (only with a single recording)"));

@@ -47,6 +47,7 @@ struct SimulateArgs {
   double white_angle = 0.0;
   std::optional<double> temp_bias;
   std::string temp_profile;
+  std::string max_memory;
 };
 
 // "a:b[:c]" as numbers, `min_n`..`max_n` of them; errors name the option and the form.
@@ -310,6 +311,21 @@ void write_truth(const std::string& path, const NoiseModel& m, const SimulationS
   write_file_atomic(path, t.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n", force);
 }
 
+/// The flicker term holds an FFT over twice the record: a record whose memory would pass the
+/// ceiling is refused before anything is written.
+void check_memory(const NoiseModel& m, const SimulationSettings& s, const std::string& max_memory) {
+  const auto need = static_cast<double>(Simulator::memory_bytes(m, s));
+  const MemoryCeiling ceiling = memory_ceiling_of(max_memory);
+  if (need <= static_cast<double>(ceiling.bytes)) return;
+  throw UsageError(
+      trf("--bias-instability: a record of {} samples with bias instability needs about {} of memory "
+          "(its flicker rate is one FFT over twice the record, {:.0f} bytes per sample), more than the "
+          "memory ceiling of {} ({}); shorten --duration, lower --rate, or give {} SIZE if the machine "
+          "has the memory",
+          s.samples(), format_memory(need), need / static_cast<double>(s.samples()),
+          format_memory(static_cast<double>(ceiling.bytes)), ceiling.origin, kMaxMemoryOption));
+}
+
 int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
   // Without --from every option counts (its default included); with it, only those given.
   const Take take = [&](const char* name) { return a.from.empty() || sub.count(name) > 0; };
@@ -327,6 +343,7 @@ int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
   apply_model(a, take, m);
   if (a.runs < 1) throw UsageError(trf("--runs must be >= 1, got {}", a.runs));
   check_record_range(m, s);
+  check_memory(m, s, a.max_memory);
   if (a.output == "-" && a.runs > 1) throw UsageError(tr("--runs > 1 needs a file name for -o"));
 
   auto path_of = [&](const std::string& p, int r) { return a.runs > 1 ? numbered(p, r, a.runs) : p; };
@@ -361,8 +378,11 @@ void register_simulate(CLI::App& app, Runner& runner) {
       tr("Simulate a gyro pulse record (exact discrete-time noise terms, counted in whole pulses) and write it as a "
          "GL-2D pulse file (.gz compresses). Rates are in deg/h (= arcsec/s)."));
   auto& a = *args;
-  sub->add_option("-o,--output", a.output, tr("Output pulse file (FILE.csv or FILE.csv.gz; - for stdout)"))->required();
-  sub->add_option("--truth", a.truth, tr("Also write the ground truth (model JSON, seed, settings) to this file"));
+  sub->add_option("-o,--output", a.output, tr("Output pulse file (FILE.csv or FILE.csv.gz; - for stdout)"))
+      ->check(output_name())
+      ->required();
+  sub->add_option("--truth", a.truth, tr("Also write the ground truth (model JSON, seed, settings) to this file"))
+      ->check(output_name());
   sub->add_option("--from", a.from,
                   tr("Take the model from 'rwcalc analyze --json' or 'rwcalc diagnose --json' output: the fitted model "
                      "(terms at their estimates; terms the fit left out or did not resolve are left out)"));
@@ -389,6 +409,7 @@ void register_simulate(CLI::App& app, Runner& runner) {
       ->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"))
       ->group(tr("Record"));
   sub->add_flag("--force", a.force, tr("Overwrite existing files"))->group(tr("Record"));
+  add_memory_option(*sub, a.max_memory)->group(tr("Record"));
   sub->add_option("--runs", a.runs, tr("Write K realisations FILE_001… with seeds seed, seed+1, …"))
       ->check(whole_in(1, 100000))
       ->capture_default_str()

@@ -9,6 +9,7 @@
 #include <string>
 #include <string_view>
 
+#include "rwcalc/memory.hpp"
 #include "rwcalc/reader.hpp"
 
 namespace rwcalc::cli {
@@ -29,6 +30,15 @@ void print_message(std::ostream& err, std::string_view text);
 /// `--gaps refuse|segments` (ReadOptions::gaps_as_segments).
 void add_gaps_option(CLI::App& app, std::string& gaps);
 
+/// `--max-memory SIZE` (rwcalc/memory.hpp), checked as it is parsed; `size` stays empty when not given.
+CLI::Option* add_memory_option(CLI::App& app, std::string& size);
+/// The ceiling `--max-memory` names, or the default when it was not given.
+MemoryCeiling memory_ceiling_of(const std::string& size);
+
+/// The check every option naming an output file or directory carries: an empty name names none
+/// (it would otherwise fail only when the finished file is moved into place).
+CLI::Validator output_name();
+
 /// Input options shared by every command that reads a recording (allan, analyze, batch, diagnose).
 struct InputArgs {
   std::string input;  ///< empty: not given (the column name may imply it; else pulses)
@@ -39,7 +49,8 @@ struct InputArgs {
   std::string angle_unit;  ///< empty: not given (the column name's suffix, else arcsec)
   std::string rate_unit;   ///< empty: not given (the column name's suffix, else deg/h)
   double time_tolerance = 0.01;
-  std::string gaps = "refuse";  ///< --gaps refuse|segments
+  std::string gaps = "refuse";                               ///< --gaps refuse|segments
+  std::string max_memory;                                    ///< --max-memory; empty: the default ceiling
   std::string serial, operator_name, test_date, conditions;  ///< empty: the file's metadata, if any
   void add_to(CLI::App& app);
   [[nodiscard]] ReadOptions options() const;  ///< throws UsageError on bad names

@@ -57,6 +57,31 @@ void InputArgs::add_to(CLI::App& app) {
       ->capture_default_str()
       ->group(tr("Input"));
   add_gaps_option(app, gaps);
+  add_memory_option(app, max_memory);
+}
+
+CLI::Option* add_memory_option(CLI::App& app, std::string& size) {
+  const auto check = [](std::string& s) {
+    try {
+      (void)memory_ceiling_option(s);
+      return std::string();
+    } catch (const UsageError& e) {
+      return std::string(e.what());
+    }
+  };
+  return app
+      .add_option(
+          kMaxMemoryOption, size,
+          tr("The most memory one record may take, e.g. 8G (K, M, G, T: binary units). Default: half the memory "
+             "rwcalc may use (the least of the physical memory, ulimit -v, ulimit -d and the cgroup's limit). A "
+             "record beyond it is refused with the memory it needs"))
+      ->check(CLI::Validator(check, "SIZE"))
+      ->option_text("SIZE")
+      ->group(tr("Input"));
+}
+
+MemoryCeiling memory_ceiling_of(const std::string& size) {
+  return size.empty() ? default_memory_ceiling() : memory_ceiling_option(size);
 }
 
 void add_gaps_option(CLI::App& app, std::string& gaps) {
@@ -81,6 +106,7 @@ ReadOptions InputArgs::options() const {
   if (!rate_unit.empty()) o.rate_unit = parse_rate_unit(rate_unit);
   o.time_tolerance = time_tolerance;
   o.gaps_as_segments = gaps == "segments";
+  if (!max_memory.empty()) o.memory = memory_ceiling_option(max_memory);
   const std::string* given[] = {&serial, &operator_name, &test_date, &conditions};
   for (std::size_t i = 0; i < std::size(given); ++i)
     if (!given[i]->empty()) o.identification[std::string(kIdentificationKeys[i])] = *given[i];

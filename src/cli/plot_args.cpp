@@ -32,9 +32,11 @@ void draw(const PlotArgs& a, PlotResult (*plot)(const nlohmann::json&, const Plo
 void PlotArgs::add_to(CLI::App& app, const std::string& what) {
   app.add_option("--plot", plot,
                  trf("Draw {} into FILE with gnuplot; the format follows the extension: .svg, .png or .pdf", tr(what)))
+      ->check(output_name())
       ->group(tr("Figures"));
   app.add_option("--plot-script", script,
                  tr("Write the gnuplot script of the figure (data inline) to FILE; alone it needs no gnuplot"))
+      ->check(output_name())
       ->group(tr("Figures"));
 }
 

@@ -1,7 +1,10 @@
 #include "core/cleanup.hpp"
 
+#include <fcntl.h>
 #include <limits.h>
 #include <signal.h>
+#include <sys/syscall.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -29,12 +32,61 @@ static_assert(std::atomic<int>::is_always_lock_free, "the signal handler needs l
 Slot g_slots[kSlots];
 constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP};
 
+// Process groups of running helpers (0: free slot).
+constexpr int kGroups = 16;
+std::atomic<pid_t> g_groups[kGroups];
+static_assert(std::atomic<pid_t>::is_always_lock_free, "the signal handler needs lock-free atomics");
+
+void end_groups() {
+  for (auto& g : g_groups) {
+    const pid_t group = g.exchange(0);
+    if (group <= 0) continue;
+    (void)kill(-group, SIGKILL);
+    while (waitpid(group, nullptr, 0) < 0 && errno == EINTR) {
+    }
+  }
+}
+
+// The record getdents64 fills (linux_dirent64; glibc has no declaration of it).
+struct DirEntry {
+  ino64_t ino;
+  off64_t off;
+  unsigned short reclen;
+  unsigned char type;
+  char name[1];
+};
+
+// Remove the directory `name` in `parent` and everything in it, links not followed, with system
+// calls only (openat, getdents64, unlinkat, lseek, close). Entries are unlinked as they are read;
+// the directory is read again until it is empty (a filesystem may skip entries read while others
+// go).
+void remove_tree(int parent, const char* name, int depth) {
+  const int fd = openat(parent, name, O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) return;
+  alignas(8) char buf[2048];
+  for (int pass = 0; pass < 4; ++pass) {
+    long n = 0;
+    while ((n = syscall(SYS_getdents64, fd, buf, sizeof buf)) > 0)
+      for (long at = 0; at < n;) {
+        const auto* e = reinterpret_cast<const DirEntry*>(buf + at);
+        at += e->reclen;
+        const bool dot = e->name[0] == '.' && (e->name[1] == 0 || (e->name[1] == '.' && e->name[2] == 0));
+        if (!dot && unlinkat(fd, e->name, 0) != 0 && errno == EISDIR && depth < 32) remove_tree(fd, e->name, depth + 1);
+      }
+    if (unlinkat(parent, name, AT_REMOVEDIR) == 0 || errno != ENOTEMPTY) break;
+    (void)lseek(fd, 0, SEEK_SET);
+  }
+  (void)close(fd);
+}
+
 void remove_kind(RemoveOnSignal::Kind kind) {
   for (auto& s : g_slots) {
     int expected = kReady;
     if (s.kind != kind || !s.state.compare_exchange_strong(expected, kBusy)) continue;
     if (kind == RemoveOnSignal::Kind::File)
       (void)unlink(s.path);
+    else if (kind == RemoveOnSignal::Kind::Tree)
+      remove_tree(AT_FDCWD, s.path, 0);
     else
       (void)rmdir(s.path);
   }
@@ -42,7 +94,9 @@ void remove_kind(RemoveOnSignal::Kind kind) {
 
 extern "C" void remove_registered_and_reraise(int sig) {
   const int saved = errno;
+  end_groups();                             // nothing writes into the paths any more
   remove_kind(RemoveOnSignal::Kind::File);  // a directory can only go once it is empty
+  remove_kind(RemoveOnSignal::Kind::Tree);
   remove_kind(RemoveOnSignal::Kind::Directory);
   errno = saved;
   // SA_RESETHAND has restored the default action; the signal is blocked until the handler
@@ -63,13 +117,19 @@ void install_handler() {
     sa.sa_flags = SA_RESETHAND;
     (void)sigaction(sig, &sa, nullptr);
   }
+  // A write beyond the file-size limit then fails (EFBIG) and is reported, instead of ending rwcalc
+  // with its temporary file left behind.
+  struct sigaction xfsz {};
+  if (sigaction(SIGXFSZ, nullptr, &xfsz) == 0 && (xfsz.sa_flags & SA_SIGINFO) == 0 && xfsz.sa_handler == SIG_DFL)
+    (void)signal(SIGXFSZ, SIG_IGN);
 }
+
+std::once_flag g_installed;
 
 }  // namespace
 
 RemoveOnSignal::RemoveOnSignal(const std::string& path, Kind kind) {
-  static std::once_flag installed;
-  std::call_once(installed, install_handler);
+  std::call_once(g_installed, install_handler);
   if (path.empty() || path.size() >= PATH_MAX) return;
   for (int i = 0; i < kSlots; ++i) {
     int expected = kFree;
@@ -87,6 +147,24 @@ RemoveOnSignal::~RemoveOnSignal() {
   // Fails only when the handler has claimed the slot: the process is ending then.
   int expected = kReady;
   (void)g_slots[slot_].state.compare_exchange_strong(expected, kFree);
+}
+
+EndOnSignal::EndOnSignal(pid_t group) : group_(group) {
+  std::call_once(g_installed, install_handler);
+  for (int i = 0; i < kGroups && group > 0; ++i) {
+    pid_t expected = 0;
+    if (g_groups[i].compare_exchange_strong(expected, group)) {
+      slot_ = i;
+      return;
+    }
+  }
+}
+
+EndOnSignal::~EndOnSignal() {
+  if (slot_ < 0) return;
+  // Fails only when the handler has taken the group: the process is ending then.
+  pid_t expected = group_;
+  (void)g_groups[slot_].compare_exchange_strong(expected, 0);
 }
 
 }  // namespace rwcalc::detail

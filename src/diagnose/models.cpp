@@ -46,7 +46,12 @@ NoiseModel base_model(const AnalysisResult& a, const PhaseSeries& x) {
 
 double sim_scale(const PhaseSeries& x, const AnalysisResult& a) {
   if (x.exact()) return x.arcsec_per_count;
-  return std::max(1e-6, 1e-3 * term_value(a.fit, Term::Q));
+  // Coarse enough that a record of the data's extent stays within 2^50 pulses (data of huge rates;
+  // the simulator counts up to 2^61).
+  double extent = 0;
+  for (const double v : x.values) extent = std::max(extent, std::abs(v - x.values.front()));
+  extent += std::abs(x.rate_offset) * x.duration_s();
+  return std::max({1e-6, 1e-3 * term_value(a.fit, Term::Q), std::ldexp(extent, -50)});
 }
 
 AnalysisResult analyze_for_base(const Recording& rec, const AnalysisOptions& options) {

@@ -1,6 +1,7 @@
 // The recording reader: text arrives in pieces (TextSource), is cut into lines, and each line goes
 // through the one LineParser; the reader keeps only the selected column's values (8 bytes per
 // sample) and running statistics of the time column, then checks the rate and builds the phase.
+// What it keeps grows within the memory ceiling (SampleMemory); a record beyond it is refused.
 #include "rwcalc/reader.hpp"
 #include "rwcalc/i18n.hpp"
 
@@ -12,9 +13,11 @@
 #include <fmt/format.h>
 
 #include "io/line_parser.hpp"
+#include "io/sample_memory.hpp"
 #include "io/text_source.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/limits.hpp"
+#include "rwcalc/memory.hpp"
 #include "rwcalc/units.hpp"
 
 namespace rwcalc {
@@ -47,6 +50,7 @@ struct TimeTrack {
   long double sum1 = 0, sum2 = 0;
   std::size_t off = 0;  // steps off the median by more than the tolerance
   bool median_known = false;
+  detail::SampleMemory* memory = nullptr;  // where the lists of steps grow
 
   void add(double t) {
     if (n == 0) first = t;
@@ -58,12 +62,12 @@ struct TimeTrack {
   }
   void step(double dt, double t) {
     if (n == 1) shift = dt;
-    if (dt < min_dt) min_dt = dt, lows.push_back({n, last, t});
-    if (dt > max_dt) max_dt = dt, highs.push_back({n, last, t});
+    if (dt < min_dt) min_dt = dt, memory->keep(lows, {n, last, t});
+    if (dt > max_dt) max_dt = dt, memory->keep(highs, {n, last, t});
     const long double d = static_cast<long double>(dt) - shift;
     sum1 += d, sum2 += d * d;
     if (median > 0) count(dt);
-    if (median_known && dt > 1.25 * median) long_steps.push_back({n, last, t});
+    if (median_known && dt > 1.25 * median) memory->keep(long_steps, {n, last, t});
     if (!median_known || dt < 1.5 * median) max_no_gap = std::max(max_no_gap, dt);
   }
   void count(double dt) { off += std::abs(dt - median) > tolerance * median; }
@@ -173,21 +177,17 @@ std::size_t line_in_runs(const Runs& runs, std::size_t k) {
 
 class Reader {
  public:
-  Reader(const std::string& file, const ReadOptions& o) : parser_(file, o), opt_(o) {
+  Reader(const std::string& file, const ReadOptions& o)
+      : parser_(file, o), opt_(o), ceiling_(o.memory ? *o.memory : default_memory_ceiling()), memory_(ceiling_.bytes) {
     times_.tolerance = o.time_tolerance;
+    times_.memory = &memory_;
   }
   void read(detail::TextSource& src) {
-    std::string buf;
-    for (bool more = true, first = true; more;) {
-      more = src.read(buf);
-      const std::size_t taken = take_lines(buf, !more);
-      const auto lines = static_cast<double>(line_);
-      if (first && parser_.layout_known())
-        reserve(static_cast<double>(src.size_estimate()) / static_cast<double>(taken) * lines);
-      first = first && !parser_.layout_known();
-      buf.erase(0, taken);
+    try {
+      read_lines(src);
+    } catch (const detail::CeilingReached&) {
+      refuse_memory(src);
     }
-    if (!buf.empty()) line(buf);  // the last line, without a line end
   }
   Recording finish();
 
@@ -198,6 +198,8 @@ class Reader {
   [[nodiscard]] const detail::InputChoice& in() const { return parser_.input(); }
   [[nodiscard]] bool integer_mode() const { return in().mode == InputMode::Pulses || in().mode == InputMode::Counter; }
   [[nodiscard]] std::size_t line_of_sample(std::size_t k) const { return line_in_runs(runs_, k); }
+  void read_lines(detail::TextSource& src);
+  [[noreturn]] void refuse_memory(const detail::TextSource& src) const;
   std::size_t take_lines(std::string& buf, bool at_end);
   bool decide_line_end(std::string_view s, bool at_end);
   std::size_t mac_limit(std::string& buf, std::size_t from, bool at_end) const;
@@ -210,10 +212,10 @@ class Reader {
   }
   void push(const Sample& s);
   // Room for the samples the text likely holds, judged from its first lines, so that a long record
-  // is not copied as it grows (capped: only an estimate).
+  // is not copied as it grows (within the ceiling: only an estimate).
   void reserve(double lines) {
-    const auto n = static_cast<std::size_t>(std::min(lines * 1.05 + 2, 0x1p26));
-    integer_mode() ? ints_.reserve(n) : reals_.reserve(n);
+    const auto n = static_cast<std::size_t>(std::min(lines * 1.05 + 2, 0x1p60));
+    integer_mode() ? memory_.reserve(ints_, n) : memory_.reserve(reals_, n);
   }
   void start_samples(const Sample& s);
   [[nodiscard]] const detail::TimeName* time_unit_of(const detail::TimeName* named, double first,
@@ -231,9 +233,14 @@ class Reader {
   void build_counts(PhaseSeries& ph, std::size_t& wraps);
   void build_values(PhaseSeries& ph);
   void check_data_magnitude(const PhaseSeries& ph, const char* what) const;
+  void check_angle_steps(const PhaseSeries& ph, const std::vector<double>& x, double f) const;
+  void check_rates(const PhaseSeries& ph, const std::vector<double>& x, double f) const;
 
   detail::LineParser parser_;
   const ReadOptions& opt_;
+  const MemoryCeiling ceiling_;
+  detail::SampleMemory memory_;
+  std::size_t text_taken_ = 0;  // bytes of text cut into lines so far
   const detail::Layout& layout_ = parser_.layout();
   bool started_ = false;
   char eol_ = 0;  // the line end: LF, or CR for classic Mac text (no LF but maybe a last one); 0 undecided
@@ -253,6 +260,39 @@ class Reader {
   double rate_hz_ = units::gl2d_rate_hz;
   RateSource rate_source_ = RateSource::Default;
 };
+
+void Reader::read_lines(detail::TextSource& src) {
+  std::string buf;
+  for (bool more = true, first = true; more;) {
+    more = src.read(buf);
+    const std::size_t taken = take_lines(buf, !more);
+    text_taken_ += taken;
+    const auto lines = static_cast<double>(line_);
+    if (first && parser_.layout_known())
+      reserve(static_cast<double>(src.size_estimate()) / static_cast<double>(taken) * lines);
+    first = first && !parser_.layout_known();
+    buf.erase(0, taken);
+  }
+  if (!buf.empty()) line(buf);  // the last line, without a line end
+}
+
+// The samples kept have reached the ceiling: the memory the whole record needs, judged from the
+// input's size (the text read so far held `held` bytes of samples), else only "more than".
+void Reader::refuse_memory(const detail::TextSource& src) const {
+  const double part =
+      static_cast<double>(src.size_estimate()) / static_cast<double>(std::max<std::size_t>(text_taken_, 1));
+  const double needed = static_cast<double>(memory_.held()) * part;
+  const std::string ceiling =
+      trf("the memory ceiling of {} ({})", format_memory(static_cast<double>(ceiling_.bytes)), ceiling_.origin);
+  const std::string remedy = trf("give {} SIZE if the machine has the memory, or cut the record", kMaxMemoryOption);
+  if (needed > static_cast<double>(ceiling_.bytes))
+    fail(line_, trf("the record needs about {} of memory for its samples (about {:.0f} samples, judged from the "
+                    "file's size), more than {}; {}",
+                    format_memory(needed), static_cast<double>(samples_) * part, ceiling, remedy));
+  fail(line_, trf("the record needs more than {} of memory for its samples: {} is reached at this line, sample "
+                  "{}; {}",
+                  format_memory(static_cast<double>(ceiling_.bytes)), ceiling, samples_, remedy));
+}
 
 // Take the complete lines of buf; returns the bytes taken.
 std::size_t Reader::take_lines(std::string& buf, bool at_end) {
@@ -299,8 +339,8 @@ std::size_t Reader::mac_limit(std::string& buf, std::size_t from, bool at_end) c
 
 // The first sample: the phase's starting point, and the time columns' units.
 void Reader::start_samples(const Sample& s) {
-  if (in().mode == InputMode::Pulses) ints_.push_back(0);   // C_0
-  if (in().mode == InputMode::Rate || in().mode == InputMode::Increment) reals_.push_back(0.0);  // x_0
+  if (in().mode == InputMode::Pulses) memory_.keep(ints_, std::int64_t{0});                          // C_0
+  if (in().mode == InputMode::Rate || in().mode == InputMode::Increment) memory_.keep(reals_, 0.0);  // x_0
   if (layout_.time_col) tunit_ = time_unit_of(layout_.time_unit, s.time, detail::Role::Time);
   if (layout_.time2_col) tunit2_ = time_unit_of(layout_.time2_unit, s.time2, detail::Role::Time2);
 }
@@ -317,10 +357,10 @@ const detail::TimeName* Reader::time_unit_of(const detail::TimeName* named, doub
 void Reader::push(const Sample& s) {
   if (samples_ == 0) start_samples(s);
   if (new_run_) {
-    runs_.emplace_back(samples_, line_);
+    memory_.keep(runs_, {samples_, line_});
     new_run_ = false;
   }
-  integer_mode() ? ints_.push_back(s.integer) : reals_.push_back(s.real);
+  integer_mode() ? memory_.keep(ints_, s.integer) : memory_.keep(reals_, s.real);
   if (layout_.time_col) times_.add(s.time);
   if (layout_.time2_col) {
     const double d = std::abs(s.time / tunit_->per_second - s.time2 / tunit2_->per_second);
@@ -468,25 +508,58 @@ void Reader::check_rate_against_time_column(const TimeTrack::Step& bad, double p
                    "within half a period of it are accepted as jitter); no resampling is done",
                    stamp(t0), prev, stamp(t1), dt / period, p_s));
   const double missing = std::round(dt / period - 1);
-  fail(line,
-       trf("gap in the time column: {} at line {}, then {}: {:.6g} s missing (~{:g} sample{}; a step "
-           "of {:.6g} periods of {:g} s); rwcalc does not resample: give --gaps segments to analyse the "
-           "stretches between gaps as segments (no difference spans a gap), or cut the record at this line "
-           "(--time-tolerance only sets which steps within half a period count as jitter)",
-           stamp(t0), prev, stamp(t1), (dt - period) / tunit_->per_second, missing, missing == 1 ? "" : "s",
-           dt / period, p_s));
+  fail(line, trf("gap in the time column: {} at line {}, then {}: {:.6g} s missing (~{:g} sample{}; a step "
+                 "of {:.6g} periods of {:g} s); rwcalc does not resample: give --gaps segments to analyse the "
+                 "stretches between gaps as segments (no difference spans a gap), or cut the record at this line "
+                 "(--time-tolerance only sets which steps within half a period count as jitter)",
+                 stamp(t0), prev, stamp(t1), (dt - period) / tunit_->per_second, missing, missing == 1 ? "" : "s",
+                 dt / period, p_s));
 }
 
-/// Floating data whose phase steps are all below kMinDataStep (limits.hpp) but not all zero:
-/// the Allan variance would square them to zero and call the record noiseless.
+/// Floating data whose rates between samples are all below kMinDataRate (limits.hpp) but not all
+/// zero: the noise fit would square their variances to nothing and call the record noiseless.
 void Reader::check_data_magnitude(const PhaseSeries& ph, const char* what) const {
   double largest = 0;
   for (std::size_t i = 1; i < ph.values.size(); ++i)
     largest = std::max(largest, std::abs(ph.values[i] - ph.values[i - 1]));
-  if (largest > 0 && largest < kMinDataStep)
-    fail(0, trf("the {} data are too small to analyse: the largest step between samples is {:g} {}, below "
-                "{:g}, where the squares in the Allan variance underflow; give the data in a larger unit",
-                what, largest, ph.kind == PhaseKind::Clock ? "s" : "arcsec", kMinDataStep));
+  largest /= ph.tau0_s;
+  if (largest > 0 && largest < kMinDataRate)
+    fail(0, trf("the {} data are too small to analyse: the largest rate between samples is {:g} {}, below "
+                "{:g} {}, where the squares of the variances in the noise fit underflow; give the data in a larger "
+                "unit",
+                what, largest, ph.deviation_unit(), kMinDataRate, ph.deviation_unit()));
+}
+
+/// Angle samples (already in phase units) whose step, as a rate, passes ±kMaxDataRate.
+void Reader::check_angle_steps(const PhaseSeries& ph, const std::vector<double>& x, double f) const {
+  for (std::size_t i = 1; i < x.size(); ++i) {
+    const double rate = (x[i] - x[i - 1]) / ph.tau0_s;
+    if (!(std::abs(rate) <= kMaxDataRate)) [[unlikely]]
+      fail(line_of_sample(i),
+           trf("angle step out of range: from {} to {} {} in one sample is a rate of {:g} {}, beyond ±{:g} {}, "
+               "where the variances the noise fit squares would overflow",
+               quoted(fmt::format("{:g}", x[i - 1] / f)), quoted(fmt::format("{:g}", x[i] / f)),
+               to_string(in().angle_unit), rate, ph.deviation_unit(), kMaxDataRate, ph.deviation_unit()));
+  }
+}
+
+/// Rate samples x[1..] (x[0] is x_0), or increments, whose rate passes ±kMaxDataRate: `f` turns a
+/// sample into its rate in phase units per second.
+void Reader::check_rates(const PhaseSeries& ph, const std::vector<double>& x, double f) const {
+  const bool increments = in().mode == InputMode::Increment;
+  for (std::size_t i = 1; i < x.size(); ++i) {
+    const double rate = x[i] * f;
+    if (std::abs(rate) <= kMaxDataRate) [[likely]]
+      continue;
+    const std::string as_rate = f == 1 ? "" : fmt::format(" ({:g} {})", rate, ph.deviation_unit());
+    fail(line_of_sample(i - 1),
+         trf(increments ? N_("increment out of range: {} {}{} is beyond ±{:g} {}, where the variances the noise fit "
+                             "squares would overflow")
+                        : N_("rate out of range: {} {}{} is beyond ±{:g} {}, where the variances the noise fit squares "
+                             "would overflow"),
+             quoted(fmt::format("{:g}", x[i])), increments ? to_string(in().angle_unit) : to_string(in().rate_unit),
+             as_rate, kMaxDataRate, ph.deviation_unit()));
+  }
 }
 
 // C_0 = 0, C_k = Σ c_i modulo 2^64 for pulses (PhaseSeries differences are modular, so an offset
@@ -556,7 +629,8 @@ double phase_factor(RateUnit u) {
   return 1.0;
 }
 
-// Angle samples in arcsec (or s); rate samples integrated to phase as in SP 1065.
+// Angle samples in arcsec (or s); rate samples integrated to phase as in SP 1065. Every rate, given
+// or between two angle samples, lies within ±kMaxDataRate (limits.hpp).
 void Reader::build_values(PhaseSeries& ph) {
   // Floating phase beyond this (arcsec, or s for clocks) would overflow the squares of second
   // differences (|Δ²x| ≤ 4·max|x|) in the Allan variance; no instrument comes near it.
@@ -570,7 +644,10 @@ void Reader::build_values(PhaseSeries& ph) {
       fail(line_of_sample(i), trf("angle out of range: {} is beyond ±{:g} arcsec, where the Allan "
                                   "variance of the record would overflow",
                                   quoted(fmt::format("{:g}", x[i] / f)), kMaxPhase));
-  if (!angle) {
+  if (angle) {
+    check_angle_steps(ph, x, f);
+  } else {
+    check_rates(ph, x, increments ? f / ph.tau0_s : f);
     // x_0 = 0, x_j = τ0·Σ_{i<j} (y_i − ȳ), accumulated in long double. The mean rate ȳ goes into
     // rate_offset (series.hpp): a phase that kept it would grow to ȳ·T and round its noise away
     // once the offset is many orders above the noise.
@@ -579,15 +656,8 @@ void Reader::build_values(PhaseSeries& ph) {
     for (std::size_t i = 1; i < x.size(); ++i) sum += x[i];
     const double mean = x.size() > 1 ? static_cast<double>(sum / static_cast<long double>(x.size() - 1)) : 0.0;
     for (std::size_t i = 1; i < x.size(); ++i) {
-      const double y = x[i];
-      acc += (static_cast<long double>(y) - mean) * k;
+      acc += (static_cast<long double>(x[i]) - mean) * k;
       x[i] = static_cast<double>(acc);
-      const long double whole = acc + static_cast<long double>(mean) * k * static_cast<long double>(i);
-      if (!(std::abs(whole) <= kMaxPhase)) [[unlikely]]
-        fail(line_of_sample(i - 1),
-             trf("rate out of range: the accumulated phase reaches {:g} arcsec (beyond ±{:g}, where the "
-                 "Allan variance would overflow) at this sample, {}",
-                 static_cast<double>(whole), kMaxPhase, quoted(fmt::format("{:g}", y))));
     }
     ph.rate_offset = increments ? mean * f / ph.tau0_s : mean * f;
   }

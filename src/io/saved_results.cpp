@@ -13,6 +13,7 @@
 
 #include "core/json_input.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/reader.hpp"
 
 namespace rwcalc {
 
@@ -51,6 +52,8 @@ class Checker {
   void methods(const Value& m) const;
   void allan(const Value& a) const;
   void outliers(const Value& o) const;
+  void input(const Value& in) const;
+  void segments(const Value& s) const;
   void verdict(const Value& v) const;
   void parameter_verdict(const Value& p, std::optional<std::size_t> classes) const;
 
@@ -64,6 +67,7 @@ void optional(const Value& object, std::string_view key, Check check) {
 }
 constexpr auto as_number = [](const Value& v) { return v.number(); };
 constexpr auto as_non_negative = [](const Value& v) { return v.non_negative(); };
+constexpr auto as_positive = [](const Value& v) { return v.positive(); };
 constexpr auto as_string = [](const Value& v) { return v.string(); };
 constexpr auto as_boolean = [](const Value& v) { return v.boolean(); };
 constexpr auto as_probability = [](const Value& v) { return v.probability(); };
@@ -170,6 +174,37 @@ void Checker::outliers(const Value& o) const {
     }
 }
 
+/// What a run was read from, as far as the report shows it: the identification (a string each, or
+/// null when not given), the file's size and digest, the column and the reader's notes.
+void Checker::input(const Value& in) const {
+  in.object();
+  if (const auto id = in.find("identification")) {
+    id->object();
+    for (const std::string_view key : kIdentificationKeys) optional(*id, key, as_string);
+  }
+  for (const char* key : {"sha256", "column", "unit", "kind", "rate_source", "time_column", "time_unit"})
+    optional(in, key, as_string);
+  optional(in, "file_bytes", as_count);
+  optional(in, "rate_hz", as_positive);
+  for (const char* key : {"notes", "warnings"})
+    if (const auto lines = in.find(key)) array_of(*lines, std::nullopt, "line", as_string);
+}
+
+/// The segments of a record read with --gaps segments: their count, lengths and gaps.
+void Checker::segments(const Value& s) const {
+  s.object();
+  optional(s, "count", as_count);
+  if (const auto v = s.find("samples")) array_of(*v, std::nullopt, "segment", as_count);
+  if (const auto v = s.find("durations_s")) array_of(*v, std::nullopt, "segment", as_non_negative);
+  if (const auto gaps = s.find("gaps"))
+    for (const auto& g : gaps->elements()) {
+      g.object();
+      (void)g.at("line").integer(1, kMaxCount);
+      (void)g.at("missing_s").positive();
+      optional(g, "before_sample", as_count);
+    }
+}
+
 /// The verdict of one parameter (B or N); its arrays hold one value per class when `classes` is
 /// known (the verdict's "classes" is given).
 void Checker::parameter_verdict(const Value& p, std::optional<std::size_t> classes) const {
@@ -232,7 +267,7 @@ void Checker::run(const Value& r) const {
   if (const auto t = r.find("temperature_c")) temperature(*t);
   optional(r, "temperature_source", as_string);
   optional(r, "samples", as_count);
-  optional(r, "rate_hz", [](const Value& v) { return v.positive(); });
+  optional(r, "rate_hz", as_positive);
   optional(r, "duration_s", as_non_negative);
   for (const char* key : {"mean_rate_deg_per_h", "earth_rate_deg_per_h", "bias_deg_per_h"}) optional(r, key, as_number);
   if (const auto l = r.find("latitude_deg")) (void)l->number_in(-90, 90, "a latitude in [-90, 90]");
@@ -240,6 +275,8 @@ void Checker::run(const Value& r) const {
   if (const auto f = member(r, "fit")) fit(*f);
   if (const auto m = member(r, "methods")) methods(*m);
   if (const auto o = r.find("outliers")) outliers(*o);
+  if (const auto in = r.find("input")) input(*in);
+  if (const auto s = r.find("segments")) segments(*s);
   verdict(r.at("verdict"));
   if (const auto c = r.find("conventions")) c->object();
 }

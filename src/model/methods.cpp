@@ -273,7 +273,11 @@ BootstrapSd bootstrap_n2_sd(const DirectNResult& r, const std::vector<std::size_
   SimulationSettings settings;
   settings.rate_hz = 1.0 / step;
   settings.duration_s = static_cast<double>(nb) * step;
-  settings.scale_arcsec = 1e-6;  // counting error 1e-6″: negligible
+  // A counting error of 1e-6″ is negligible; a model whose angle would pass 2^40 such pulses (data
+  // of huge rates) is counted in pulses of 2^-40 of its extent (6σ of the random walk and the
+  // flicker's drift over the record), still negligible and far inside the simulator's range.
+  const double extent = 6.0 * (std::sqrt(n2 * settings.duration_s) + std::sqrt(b2) * settings.duration_s);
+  settings.scale_arcsec = std::max(1e-6, std::ldexp(extent, -40));
   std::vector<Vec3> xb(ts.size());
   std::vector<std::size_t> coarse(ts.size());
   for (std::size_t i = 0; i < ts.size(); ++i) coarse[i] = ts[i] / base;

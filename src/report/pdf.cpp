@@ -46,20 +46,22 @@ bool print_to_pdf(const std::string& html_path, const std::string& pdf_path, boo
   if (chromium.empty()) return false;
   check_output_targets({{"--pdf", pdf_path}}, force);
   // A private profile and output: Chromium writes into its profile, and the PDF is moved into
-  // place only when complete.
-  std::string scratch_template = (fs::temp_directory_path() / "rwcalc-pdf-XXXXXX").string();
-  if (mkdtemp(scratch_template.data()) == nullptr)
-    throw OutputError(trf("cannot create a temporary directory for the PDF: {}", std::strerror(errno)));
-  const fs::path scratch = scratch_template;
+  // place only when complete. The directory goes with everything in it, on a signal too.
+  const detail::ScratchDir dir("rwcalc-pdf-", N_("cannot create a temporary directory for the PDF: {}"));
+  const fs::path& scratch = dir.path();
   const fs::path pdf = scratch / "report.pdf";
   const auto r = detail::run_process(chromium,
                                      {"--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
                                       "--no-pdf-header-footer", "--user-data-dir=" + (scratch / "profile").string(),
                                       "--print-to-pdf=" + pdf.string(), file_url(fs::absolute(html_path).string())},
                                      scratch / "log");
+  if (r.timed_out)
+    throw OutputError(
+        trf("{}: printing the report to PDF did not finish within {:g} s and was stopped "
+            "(RWCALC_HELPER_TIMEOUT sets the limit)",
+            printable(chromium), detail::helper_timeout_s()));
   std::error_code ec;
-  if (!r.started || r.status != 0 || !fs::exists(pdf)) {
-    fs::remove_all(scratch, ec);
+  if (!r.started || r.status != 0 || !fs::exists(pdf, ec)) {
     throw OutputError(trf("{}: printing the report to PDF failed (exit status {}): {}", printable(chromium), r.status,
                           printable(r.err.substr(0, 300))));
   }
@@ -68,7 +70,6 @@ bool print_to_pdf(const std::string& html_path, const std::string& pdf_path, boo
     bytes.resize(std::fread(bytes.data(), 1, bytes.size(), f));
     std::fclose(f);
   }
-  fs::remove_all(scratch, ec);
   write_file_atomic(pdf_path, bytes, force);
   return true;
 }

@@ -1,80 +1,33 @@
 // Running gnuplot: the terminal preamble of a script, the subprocess, and the output file.
-#include <fcntl.h>
 #include <fmt/format.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
-#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <vector>
 
-#include "core/cleanup.hpp"
 #include "report/process.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/plot.hpp"
 #include "rwcalc/printable.hpp"
 
-extern char** environ;
-
 namespace rwcalc {
 
 namespace fs = std::filesystem;
-
-namespace detail {
-ProcessResult run_process(const std::string& command, const std::vector<std::string>& args, const fs::path& log,
-                          const fs::path& cwd) {
-  ProcessResult r;
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  if (!cwd.empty()) posix_spawn_file_actions_addchdir_np(&actions, cwd.c_str());
-  // A relative command path names a file from our directory, not from `cwd`.
-  std::error_code ec;
-  const auto absolute = fs::absolute(command, ec);
-  std::vector<std::string> storage{!cwd.empty() && command.find('/') != std::string::npos && !ec ? absolute.string()
-                                                                                                 : command};
-  storage.insert(storage.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& s : storage) argv.push_back(s.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  const int rc = posix_spawnp(&pid, storage.front().c_str(), &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0) {
-    r.spawn_errno = rc;
-    return r;
-  }
-  r.started = true;
-  int wstatus = 0;
-  pid_t waited = 0;
-  while ((waited = waitpid(pid, &wstatus, 0)) < 0 && errno == EINTR) {
-  }
-  if (waited < 0) return r;  // status -1
-  r.status = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : 128 + WTERMSIG(wstatus);
-  std::ifstream in(log, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  r.err = ss.str();
-  return r;
-}
-
-}  // namespace detail
 
 namespace {
 
 using detail::ProcessResult;
 using detail::run_process;
+using detail::ScratchDir;
+
+constexpr const char* kScratchFailure = N_("cannot create a temporary directory for gnuplot: {}");
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -83,34 +36,14 @@ std::string slurp(const fs::path& p) {
   return ss.str();
 }
 
-/// A private temporary directory, removed with everything in it, also when a signal ends rwcalc
-/// while gnuplot runs: the signal handler cannot list a directory, so each file is registered.
-class ScratchDir {
- public:
-  ScratchDir() {
-    std::string templ = (fs::temp_directory_path() / "rwcalc-plot-XXXXXX").string();
-    if (mkdtemp(templ.data()) == nullptr)
-      throw OutputError(trf("cannot create a temporary directory for gnuplot: {}", std::strerror(errno)));
-    path_ = templ;
-    on_signal_.emplace_back(path_.string(), detail::RemoveOnSignal::Kind::Directory);
-    for (const char* name : {"log", "gnuplot.log", "figure.gp", "figure.svg", "figure.png", "figure.pdf"})
-      on_signal_.emplace_back((path_ / name).string(), detail::RemoveOnSignal::Kind::File);
-  }
-  ~ScratchDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  ScratchDir(const ScratchDir&) = delete;
-  ScratchDir& operator=(const ScratchDir&) = delete;
-  [[nodiscard]] const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-  std::deque<detail::RemoveOnSignal> on_signal_;  ///< unregistered after the removal above
-};
-
-/// Throws when gnuplot could not be started (a shell wrapper reports a missing binary as 127).
+/// Throws when gnuplot could not be started (a shell wrapper reports a missing binary as 127) or
+/// was stopped at the time limit.
 void require_started(const ProcessResult& r, const std::string& command) {
+  if (r.timed_out)
+    throw OutputError(
+        trf("gnuplot ('{}') did not finish within {:g} s and was stopped (RWCALC_HELPER_TIMEOUT sets "
+            "the limit)",
+            command, detail::helper_timeout_s()));
   if (r.started && r.status != 127) return;
   throw OutputError(
       trf("cannot run gnuplot ('{}': {}): plots need gnuplot; install it (Debian: apt-get install "
@@ -174,7 +107,7 @@ bool gnuplot_available() {
 }
 
 void require_gnuplot() {
-  ScratchDir dir;
+  ScratchDir dir("rwcalc-plot-", kScratchFailure);
   const auto command = gnuplot_command();
   const auto r = run_process(command, {"--version"}, dir.path() / "log");
   require_started(r, command);
@@ -239,7 +172,7 @@ std::string full_script(const std::vector<Figure>& figures, PlotFormat format, i
 }
 
 std::string render_figures(const std::vector<Figure>& figures, PlotFormat format, int width_px) {
-  ScratchDir dir;
+  ScratchDir dir("rwcalc-plot-", kScratchFailure);
   // gnuplot runs inside the scratch directory and names its files relative to it, so no path
   // (the temporary directory's comes from TMPDIR) is ever written into the script.
   const std::string out_name = std::string("figure") + (format == PlotFormat::Svg   ? ".svg"

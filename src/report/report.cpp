@@ -364,6 +364,23 @@ constexpr std::array<std::pair<const char*, const char*>, 4> kIdentification{{{"
                                                                               {"test_date", N_("test date")},
                                                                               {"conditions", N_("test conditions")}}};
 
+/// A record read with --gaps segments: how many segments, the gaps between them and their lengths
+/// (the text report's line); empty for a record in one piece.
+std::string segments_text(const json& segments) {
+  const auto n = num(segments, "count");
+  if (!n || *n < 2) return {};
+  std::string gaps, lengths;
+  for (const auto& gap : at(segments, "gaps"))
+    if (const auto line = num(gap, "line"), missing = num(gap, "missing_s"); line && missing)
+      gaps += trf("{}{:.6g} s missing before line {:.0f}", gaps.empty() ? "" : ", ", *missing, *line);
+  for (const auto& d : at(segments, "durations_s"))
+    if (const auto v = num(d)) lengths += fmt::format("{}{:.1f}", lengths.empty() ? "" : ", ", *v);
+  return trf(
+      "{:.0f} segments, split at the time column's gaps by --gaps segments ({}); lengths {} s. The Allan "
+      "variance pools them (no difference spans a gap); the cross-checks use the longest",
+      *n, gaps, lengths);
+}
+
 std::string data_table(const json& run, std::size_t index, Numbering& numbering) {
   std::string s = numbering.table(fmt::format("run{}-data", index + 1),
                                   trf("Data and identification: {}", typed(source_name(run))), "run");
@@ -378,6 +395,7 @@ std::string data_table(const json& run, std::size_t index, Numbering& numbering)
   if (const auto n = num(run, "samples")) s += kv_row(tr("samples"), fmt::format("{:.0f}", *n));
   if (const auto r = num(run, "rate_hz")) s += kv_row(tr("sample rate"), trf("{:g} Hz", *r));
   if (const auto d = num(run, "duration_s")) s += kv_row(tr("duration"), trf("{:.1f} s ({:.2f} h)", *d, *d / 3600));
+  if (const auto text = segments_text(at(run, "segments")); !text.empty()) s += kv_row(tr("segments"), esc(text));
   s += kv_row(tr("temperature"), temperature_text(run));
   auto rate = [&](const char* key, const char* name, int digits) {
     if (const auto v = num(run, key)) s += kv_row(tr(name), fmt::format("{} {}", g(*v, digits), unit(lbl::rate)));

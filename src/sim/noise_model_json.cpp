@@ -1,10 +1,13 @@
 // JSON form of the simulator's noise model (noise_model.hpp), shared by simulate, analyze and diagnose.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -202,6 +205,57 @@ void to_json(json& j, const SimulationSettings& s) {
 
 namespace {
 
+/// The fitted coefficients of a gyro's analysis, in the order the model takes them.
+constexpr const char* kCoefficientKeys[] = {"Q_arcsec", "N_deg_per_sqrt_h", "B_deg_per_h", "K_deg_per_h_per_sqrt_h",
+                                            "R_deg_per_h2"};
+
+/// A key of a noise model object's terms.
+bool term_key(std::string_view key) {
+  for (const auto& [name, member] : kScalars)
+    if (key == name) return true;
+  for (const char* name :
+       {"readout", "sinusoids", "gauss_markov", "bias_steps", "warmups", "terms", "temperature_bias"})
+    if (key == name) return true;
+  return false;
+}
+
+/// A key of the record's settings, which a model object may hold beside its terms.
+bool setting_key(std::string_view key) {
+  for (const char* name : {"rate_hz", "duration_s", "temperature_c", "scale_arcsec_per_pulse"})
+    if (key == name) return true;
+  return false;
+}
+
+/// What --from takes: the analysis of a gyro with its five coefficients, a diagnosis (its models),
+/// or a noise model of model keys only. Anything else, which used to give a noise-free record, is
+/// an error naming what it lacks.
+void require_model(const Value& j) {
+  if (const auto fit = j.find("fit")) {
+    if (const auto sensor = j.find("sensor"); sensor && sensor->string() != "gyro")
+      sensor->fail(
+          trf("is \"{}\": --from takes the analysis of a gyro (simulate writes gyro pulse records)", sensor->string()));
+    for (const char* key : kCoefficientKeys) (void)fit->at(key);
+    return;
+  }
+  const auto& items = j.json().items();
+  if (std::any_of(items.begin(), items.end(), [](const auto& item) { return term_key(item.key()); })) {
+    for (const auto& item : items)
+      if (!term_key(item.key()) && !setting_key(item.key()))
+        j.at(item.key())
+            .fail(tr("is not a key of a noise model (arw_deg_per_sqrt_h, bias_instability_deg_per_h, "
+                     "readout, sinusoids, …)"));
+    return;
+  }
+  std::vector<std::string> keys;
+  for (const auto& item : items) keys.push_back(fmt::format("\"{}\"", item.key()));
+  if (keys.size() > 6) keys.resize(6), keys.back() = "…";
+  j.fail(
+      trf("holds no model for --from: neither the \"fit\" of 'rwcalc analyze --json' (of a gyro), the "
+          "\"extended_model\" of 'rwcalc diagnose --json', nor the keys of a noise model "
+          "(arw_deg_per_sqrt_h, bias_instability_deg_per_h, …){}",
+          keys.empty() ? std::string(tr("; it is an empty object")) : trf("; its keys: {}", fmt::join(keys, ", "))));
+}
+
 NoiseModel model_from_analysis(const Value& j, SimulationSettings& settings, const CoefficientPolicy& policy) {
   j.object();
   // Diagnose output: take its extended model (else the base model).
@@ -211,6 +265,7 @@ NoiseModel model_from_analysis(const Value& j, SimulationSettings& settings, con
   };
   const Value root = model("extended_model").value_or(model("base_model").value_or(j));
   const bool nested = &root.json() != &j.json();
+  if (!nested) require_model(j);
   // The record's settings, from the model or else the top level.
   auto setting = [&](const char* key) {
     auto v = root.find(key);

@@ -540,6 +540,21 @@ void Simulator::stream(std::uint64_t seed, const std::function<void(const Record
 }
 const NoiseModel& Simulator::model() const noexcept { return impl_->model; }
 
+std::size_t Simulator::memory_bytes(const NoiseModel& model, const SimulationSettings& settings, SimulationPath path) {
+  if (!(model.bias_instability_deg_per_h > 0)) return 0;
+  std::size_t n = settings.samples();
+  if (path == SimulationPath::Ensemble) {
+    const std::size_t hold = std::min(flicker_decimation(settings.rate_hz), n);
+    n = (n + hold - 1) / hold;
+  }
+  const std::size_t size = good_fft_size(2 * n);
+  // Bytes per FFT point: the filter's spectrum, the drawn spectrum (each L/2 + 1 complex values)
+  // and the flicker (L doubles) held for the record, 24; Eigen's kissfft for a real transform of L
+  // points, when 4 divides L: a plan of L/2 twiddles each way, L/4 real twiddles and an L/2 buffer,
+  // 28; else a complex transform of L points each way and two L-point buffers, 64.
+  return size * (24 + (size % 4 == 0 ? 28 : 64));
+}
+
 PhaseSeries simulate(const NoiseModel& model, const SimulationSettings& settings) {
   Simulator sim(model, settings);
   PhaseSeries out;
