@@ -11,6 +11,7 @@
 /// malformed line is an InputError naming the file and the line. See docs/input-formats.md.
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <map>
 #include <optional>
 #include <string>
@@ -61,6 +62,9 @@ struct ReadOptions {
   /// --test-date, --conditions): keys "serial", "operator", "test_date", "conditions". They take
   /// the place of the file's metadata of the same name (a note says so when that differs).
   std::map<std::string, std::string> identification;
+  /// Where the reading's progress line goes (progress.hpp: the bytes read of the input's size);
+  /// nullptr: none.
+  std::FILE* progress = nullptr;
 };
 
 /// Where the sample rate came from (reported in outputs).

@@ -16,6 +16,7 @@
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/parallel.hpp"
 #include "rwcalc/printable.hpp"
+#include "rwcalc/progress.hpp"
 
 namespace rwcalc {
 
@@ -137,6 +138,7 @@ ImuResult analyze_imu(const std::string& path, const ImuOptions& options) {
   out.accel_units = output_units(SensorKind::Accelerometer, options.accel_output_unit);
   const std::string bytes = read_bytes(path);
   out.channels.resize(specs.size());
+  Progress progress(trf("analysing the channels of {}", printable(path)), specs.size(), options.analysis.progress);
   parallel_for(specs.size(), [&](std::size_t i) {
     const Recording rec = read_recording_text(bytes, path, channel_read(options, specs[i]));
     check_kind(rec, specs[i]);
@@ -145,6 +147,7 @@ ImuResult analyze_imu(const std::string& path, const ImuOptions& options) {
         (specs[i].column == options.vertical_gyro || rec.column_name == options.vertical_gyro))
       a.earth_rate = a.verdict_wanted = true;
     out.channels[i] = {rec.column_name, specs[i].kind, analyze(rec, a)};
+    progress.advance();
   });
   return out;
 }

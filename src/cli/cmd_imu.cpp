@@ -198,7 +198,8 @@ void register_imu(CLI::App& app, Runner& runner) {
   cmd->plot.add_to(*sub, N_("one panel per sensor kind with every axis' Allan deviation and its confidence bars"));
   sub->callback([cmd, &runner] {
     runner = [cmd](Io& io) -> int {
-      const ImuOptions opt = cmd->options();
+      ImuOptions opt = cmd->options();
+      opt.read.progress = opt.analysis.progress = io.progress;
       cmd->plot.check(cmd->force, {{"-o", cmd->output}, {"--kalibr", cmd->kalibr}});
       const ImuResult res = analyze_imu(cmd->file, opt);
       for (const auto& c : res.channels)

@@ -15,6 +15,8 @@
 #include "io/text_source.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/limits.hpp"
+#include "rwcalc/printable.hpp"
+#include "rwcalc/progress.hpp"
 #include "rwcalc/units.hpp"
 
 namespace rwcalc {
@@ -177,9 +179,12 @@ class Reader {
     times_.tolerance = o.time_tolerance;
   }
   void read(detail::TextSource& src) {
+    Progress progress(trf("reading {}", printable(src.name())), src.stored_size(), opt_.progress,
+                      Progress::Measure::Bytes);
     std::string buf;
     for (bool more = true, first = true; more;) {
       more = src.read(buf);
+      progress.advance(src.taken_bytes() - progress.done());
       const std::size_t taken = take_lines(buf, !more);
       const auto lines = static_cast<double>(line_);
       if (first && parser_.layout_known())
