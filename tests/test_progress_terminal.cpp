@@ -91,7 +91,8 @@ TEST_F(ProgressOnTerminal, Simulate) {
 
 TEST_F(ProgressOnTerminal, AnalyzeAndAllanShowReadingAndAnalysis) {
   expect_progress({"analyze", record()}, {"reading " + record() + ": ", "analysing " + record() + ": "});
-  expect_progress({"allan", record()}, {"reading " + record() + ": "});
+  expect_progress({"allan", record(), "--tau", "dense"},
+                  {"reading " + record() + ": ", "computing the deviation at each τ: "});
 }
 
 TEST_F(ProgressOnTerminal, BatchCountsTheRuns) {

@@ -118,6 +118,7 @@ int run_allan(const AllanArgs& a, Io& io) {
   o.estimator = parse_estimator(a.estimator);
   o.grid = TauGrid::parse(a.tau);
   o.confidence = a.confidence;
+  o.progress = io.progress;
   const OutlierAction outlier_action = parse_outlier_action(a.outliers);
   ReadOptions read_options = a.input.options();
   read_options.progress = io.progress;
