@@ -33,7 +33,8 @@ int main(int argc, char** argv) {
   // is not written by rwcalc.
   rwcalc::DescriptorBuffer standard_output(STDOUT_FILENO);
   std::streambuf* const previous = std::cout.rdbuf(&standard_output);
-  const int status = rwcalc::cli::run(argc, argv, std::cout, std::cerr);
+  const int status =
+      rwcalc::cli::run(argc, argv, std::cout, std::cerr, rwcalc::stderr_is_terminal() ? stderr : nullptr);
   std::cout.rdbuf(previous);
   return status;
 }

@@ -8,6 +8,7 @@
 /// squares summed exactly, the pulse weight applied at the end: any counter offset gives the same
 /// bits. Units: τ in seconds; σ in deviation units (PhaseSeries::deviation_unit()).
 #include <cstdint>
+#include <cstdio>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -65,6 +66,9 @@ struct AllanOptions {
   bool noise_id = true;       ///< identify α per τ (else use `alpha` for all)
   int alpha = 0;              ///< noise exponent used when noise_id is false (−2 … +2)
   NoiseIdDomain noise_id_domain = NoiseIdDomain::Phase;
+  /// Where the progress line of the per-τ noise identification and bounds goes (progress.hpp; long
+  /// on the `all` grid); nullptr: none.
+  std::FILE* progress = nullptr;
 };
 
 struct AllanPoint {

@@ -1,6 +1,7 @@
 #pragma once
 /// @file analysis.hpp
 /// The `rwcalc analyze` pipeline (Allan variance, fit, cross-checks, bias, verdict) and its outputs.
+#include <cstdio>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -42,6 +43,9 @@ struct AnalysisOptions {
   /// The paper's cross-checks and the class verdict; off for a fit that only feeds a model (the
   /// diagnosis's base fits), where the direct-N bootstrap would be spent for nothing.
   bool cross_checks = true;
+  /// Where progress lines go (progress.hpp): analyze() shows how far the analysis is, analyze_files
+  /// and analyze_imu how many runs or channels are done; nullptr: none.
+  std::FILE* progress = nullptr;
 };
 
 /// Something the reader must know about a result: a stable code, a sentence, and a command that

@@ -31,6 +31,12 @@ struct DiagnoseOptions {
   Progress* progress = nullptr;  ///< advanced once per simulated record (may be null)
 };
 
+/// The records diagnose() simulates with `opt` when it names nothing: the pilot and the calibration
+/// ensembles, the total its progress counts to. What it finds decides how many more it simulates
+/// (recalibration, the extended model, the out-of-sample check; often several times as many), so
+/// its progress line shows the count alone beyond this total.
+[[nodiscard]] std::uint64_t simulated_records(const DiagnoseOptions& opt);
+
 /// The effects the diagnosis can name, in the order they are named and estimated.
 enum class Effect { Sinusoid, Line, BiasStep, Warmup, GaussMarkov, Lowpass };
 inline constexpr std::size_t kEffectCount = 6;

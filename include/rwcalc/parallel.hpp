@@ -18,4 +18,8 @@ void parallel_for(std::size_t n, const std::function<void(std::size_t)>& fn);
 /// from 1 to 4096 (tests use it to show that results do not depend on it), else the hardware's.
 unsigned worker_count();
 
+/// True on a thread while it runs items of a parallel_for that uses several threads (a Progress
+/// made there shows nothing: the items' lines would overwrite each other).
+[[nodiscard]] bool inside_parallel_items() noexcept;
+
 }  // namespace rwcalc

@@ -11,6 +11,7 @@
 /// malformed line is an InputError naming the file and the line. See docs/input-formats.md.
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <map>
 #include <optional>
 #include <string>
@@ -68,6 +69,9 @@ struct ReadOptions {
   /// The most memory the samples kept may take (--max-memory); unset: default_memory_ceiling().
   /// A record beyond it is an InputError naming the line where it was reached and the memory needed.
   std::optional<MemoryCeiling> memory;
+  /// Where the reading's progress line goes (progress.hpp: the bytes read of the input's size);
+  /// nullptr: none.
+  std::FILE* progress = nullptr;
 };
 
 /// Where the sample rate came from (reported in outputs).

@@ -15,6 +15,7 @@
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/parallel.hpp"
+#include "rwcalc/progress.hpp"
 
 namespace rwcalc {
 
@@ -299,6 +300,9 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
   result.points_in = points;
   result.confidence = options.confidence;
   result.points.resize(ms.size());
+  // Two steps per τ: the noise identification, then the EDF and the bounds.
+  Progress progress(tr("computing the deviation at each τ"), 2 * ms.size(), options.progress,
+                    Progress::Measure::Percent);
   const std::vector<double> var = grid_variances(x, CountData(x, est), ms, options.grid, est, result.fft_from_m);
   parallel_for(ms.size(), [&](std::size_t i) {
     AllanPoint& p = result.points[i];
@@ -308,6 +312,7 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
     p.var = var[i];
     p.dev = std::sqrt(p.var);
     p.alpha = options.noise_id ? identify_noise(x, p.m, est, options.noise_id_domain) : options.alpha;
+    progress.advance();
   });
   // EDF and bounds once every α is known: Stable32 does not identify the noise at the longest τ of
   // a run (too few points) but carries the previous τ's α over.
@@ -319,6 +324,7 @@ AllanResult compute_allan(const PhaseSeries& x, const AllanOptions& options) {
     const DevInterval ci = chi2_interval(p.var, p.edf, options.confidence);
     p.dev_low = ci.low;
     p.dev_high = ci.high;
+    progress.advance();
   });
   return result;
 }

@@ -12,6 +12,7 @@
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/parallel.hpp"
 #include "rwcalc/printable.hpp"
+#include "rwcalc/progress.hpp"
 
 namespace rwcalc {
 
@@ -199,9 +200,11 @@ std::vector<json> analyze_files(const std::vector<std::string>& files, const Rea
   // then run serially, parallel_for being nested). Results and errors are kept per file.
   std::vector<json> out(files.size());
   std::vector<std::exception_ptr> errors(files.size());
+  Progress progress(tr("analysing the runs"), files.size(), options.progress);
   parallel_for(files.size(), [&](std::size_t i) {
     try {
       const AnalysisResult r = analyze(read_recording(files[i], read), options);
+      progress.advance();
       // The batch tables and the report are in a gyro's units and classes: an accelerometer
       // column would be printed under them.
       if (r.sensor != SensorKind::Gyro)

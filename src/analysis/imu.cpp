@@ -17,6 +17,7 @@
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/parallel.hpp"
 #include "rwcalc/printable.hpp"
+#include "rwcalc/progress.hpp"
 
 namespace rwcalc {
 
@@ -176,6 +177,7 @@ ImuResult analyze_imu(const std::string& path, const ImuOptions& options) {
                [&](std::size_t i) { recs[i] = read_recording_text(bytes, path, channel_read(options, specs[i])); });
   check_channels(recs, specs);
   out.channels.resize(specs.size());
+  Progress progress(trf("analysing the channels of {}", printable(path)), specs.size(), options.analysis.progress);
   parallel_for(specs.size(), [&](std::size_t i) {
     const Recording rec = std::move(recs[i]);
     AnalysisOptions a = options.analysis;
@@ -189,6 +191,7 @@ ImuResult analyze_imu(const std::string& path, const ImuOptions& options) {
                       specs[i].kind == SensorKind::Gyro ? "--gyro" : "--accel"),
                   e.code());
     }
+    progress.advance();
   });
   return out;
 }

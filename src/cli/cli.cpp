@@ -71,14 +71,23 @@ constexpr Command kCommands[] = {
     {"man", register_man},           {"completion", register_completion},
 };
 
-/// --lang on every command that writes results or messages (not man and completion, which
-/// describe the options themselves).
-void add_language_option(CLI::App& sub) {
+/// --lang and --quiet on every command that writes results or messages (not man and completion,
+/// which describe the options themselves).
+void add_common_options(CLI::App& sub) {
   const std::string name = sub.get_name();
   if (name == "man" || name == "completion") return;
   const std::string help =
       tr("Language of the text, tables, report and messages: en (default) or ru; default from RWCALC_LANG");
   sub.add_option("--lang", help)->check(CLI::IsMember({"en", "ru"}))->option_text("en|ru");
+  sub.add_flag("-q,--quiet")->description(tr("No progress lines (shown on standard error only when it is a terminal)"));
+}
+
+/// Where the command's progress lines go: `terminal` (standard error when it is one), unless the
+/// command was given --quiet.
+std::FILE* progress_sink(const CLI::App& app, std::FILE* terminal) {
+  for (const auto* sub : app.get_subcommands())
+    if (const auto* opt = sub->get_option_no_throw("--quiet"); opt && opt->count() > 0) return nullptr;
+  return terminal;
 }
 
 /// The language of the command line before it is parsed (the options' help texts are translated
@@ -159,7 +168,7 @@ void build_app(CLI::App& app, Runner& runner, int argc, const char* const* argv)
     for (const auto& c : kCommands)
       if (std::string_view(argv[1]) == c.name) {
         c.add(app, runner);
-        add_language_option(*app.get_subcommand(c.name));
+        add_common_options(*app.get_subcommand(c.name));
         translate_groups();
         return;
       }
@@ -202,7 +211,8 @@ std::optional<int> parse_args(CLI::App& app, int argc, const char* const* argv, 
 
 /// Parse argv and, when `execute`, run the command; the exit status. Without `execute`, anything
 /// but an rwcalc error escapes: the argument-parsing fuzzer treats it as a finding.
-int parse_and_run(int argc, const char* const* argv, std::ostream& out, std::ostream& err, bool execute) {
+int parse_and_run(int argc, const char* const* argv, std::ostream& out, std::ostream& err, bool execute,
+                  std::FILE* progress) {
   const LanguageScope restore(language());  // the command sets its language; the caller's comes back after
   try {
     set_language(prescanned_language(argc, argv));
@@ -215,7 +225,7 @@ int parse_and_run(int argc, const char* const* argv, std::ostream& out, std::ost
       print_message(err, tr("no command given; run 'rwcalc --help'"));
       return static_cast<int>(ExitCode::BadInput);
     }
-    Io io{out, err};
+    Io io{out, err, progress_sink(app, progress)};
     return execute ? runner(io) : 0;
   } catch (const InputError& e) {  // the file named as typed, the message in the language asked for
     const std::string where = as_typed(e.file()) + (e.line() > 0 ? fmt::format(":{}", e.line()) : "");
@@ -242,7 +252,7 @@ const char* app_description() { return kDescription; }
 void add_all_commands(CLI::App& app, Runner& runner) {
   for (const auto& c : kCommands) {
     c.add(app, runner);
-    add_language_option(*app.get_subcommand(c.name));
+    add_common_options(*app.get_subcommand(c.name));
   }
 }
 
@@ -255,11 +265,11 @@ CLI::Validator output_name() {
 void print_message(std::ostream& err, std::string_view text) { err << "rwcalc: " << localize_message(text) << "\n"; }
 
 int parse_only(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
-  return parse_and_run(argc, argv, out, err, false);
+  return parse_and_run(argc, argv, out, err, false, nullptr);
 }
 
-int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
-  const int status = parse_and_run(argc, argv, out, err, true);
+int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err, std::FILE* progress) {
+  const int status = parse_and_run(argc, argv, out, err, true, progress);
   // The one place where every command's standard output (reports, tables, help) is flushed and
   // checked: a full disk or a closed descriptor must not end in status 0.
   try {

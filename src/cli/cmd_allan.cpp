@@ -118,8 +118,11 @@ int run_allan(const AllanArgs& a, Io& io) {
   o.estimator = parse_estimator(a.estimator);
   o.grid = TauGrid::parse(a.tau);
   o.confidence = a.confidence;
+  o.progress = io.progress;
   const OutlierAction outlier_action = parse_outlier_action(a.outliers);
-  const Recording read = read_recording(a.file, a.input.options());
+  ReadOptions read_options = a.input.options();
+  read_options.progress = io.progress;
+  const Recording read = read_recording(a.file, read_options);
   print_input_notes(io.err, read);
   // Outliers are looked for, reported and dealt with as by analyze (--outliers).
   OutlierReport outliers;

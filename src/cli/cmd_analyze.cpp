@@ -54,10 +54,13 @@ void register_analyze(CLI::App& app, Runner& runner) {
     runner = [cmd](Io& io) -> int {
       AnalysisOptions opt = cmd->analysis.options();
       opt.temperature_c = cmd->temperature;
+      opt.progress = io.progress;
       // Output problems (figure format, existing files, two outputs naming one file, no gnuplot)
       // are reported before the analysis, and before anything is written.
       cmd->plot.check(cmd->force, {{"-o", cmd->output}});
-      const Recording rec = read_recording(cmd->file, cmd->input.options());
+      ReadOptions read = cmd->input.options();
+      read.progress = io.progress;
+      const Recording rec = read_recording(cmd->file, read);
       print_input_notes(io.err, rec);
       const AnalysisResult res = analyze(rec, opt);
       if (res.sensor != SensorKind::Gyro || !cmd->output_unit.empty()) {

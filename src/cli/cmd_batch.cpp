@@ -50,13 +50,16 @@ void register_batch(CLI::App& app, Runner& runner) {
   sub->callback([cmd, &runner] {
     runner = [cmd](Io& io) -> int {
       AnalysisOptions opt = cmd->analysis.options();
+      opt.progress = io.progress;
       if (cmd->temperature) {
         if (cmd->files.size() != 1)
           throw UsageError(tr("--temperature applies to a single file; name the temperature in each file instead"));
         opt.temperature_c = cmd->temperature;
       }
       cmd->plot.check(cmd->force, {{"-o", cmd->output}});
-      auto runs = analyze_files(cmd->files, cmd->input.options(), opt);
+      ReadOptions read = cmd->input.options();
+      read.progress = io.progress;
+      auto runs = analyze_files(cmd->files, read, opt);
       for (const auto& run : runs) require_finite(run, run.value("source", std::string("batch")));
       for (const auto& run : runs) print_input_notes(io.err, run);
       if (cmd->plot.any()) cmd->plot.draw_batch(nlohmann::json{{"runs", runs}}, cmd->force, io);

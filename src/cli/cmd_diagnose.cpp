@@ -1,5 +1,6 @@
 // 'rwcalc diagnose FILE': compare the measurement with simulations of its fitted five-term model,
 // name what the model misses, extend the model and measure the gain (docs/diagnosis.md).
+#include <cstdio>
 #include <memory>
 #include <ostream>
 
@@ -11,6 +12,7 @@
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"
+#include "rwcalc/printable.hpp"
 #include "rwcalc/progress.hpp"
 
 namespace rwcalc::cli {
@@ -32,6 +34,12 @@ struct DiagnoseCmd {
 };
 
 }  // namespace
+
+DiagnoseResult diagnose_showing_progress(const Recording& rec, DiagnoseOptions opt, std::FILE* sink) {
+  Progress progress(trf("diagnosing {} (simulated records)", printable(rec.source)), simulated_records(opt), sink);
+  opt.progress = &progress;
+  return diagnose(rec, opt);
+}
 
 void register_diagnose(CLI::App& app, Runner& runner) {
   auto cmd = std::make_shared<DiagnoseCmd>();
@@ -70,13 +78,11 @@ void register_diagnose(CLI::App& app, Runner& runner) {
       opt.runs = cmd->runs;
       opt.seed = cmd->seed;
       opt.alpha = cmd->alpha;
-      const Recording rec = read_recording(cmd->file, cmd->input.options());
+      ReadOptions read = cmd->input.options();
+      read.progress = io.progress;
+      const Recording rec = read_recording(cmd->file, read);
       print_input_notes(io.err, rec);
-      const std::size_t hold = cmd->runs;  // the out-of-sample ensembles are as large as the main one
-      Progress progress("simulating", static_cast<std::uint64_t>(5 * cmd->runs + 7 * hold));
-      opt.progress = &progress;
-      const DiagnoseResult res = diagnose(rec, opt);
-      progress.finish();
+      const DiagnoseResult res = diagnose_showing_progress(rec, opt, io.progress);
       const nlohmann::json j = to_json(res);
       // A file name that is not UTF-8 is written with U+FFFD for its invalid bytes, not refused.
       const std::string text = cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"

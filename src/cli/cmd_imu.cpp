@@ -227,7 +227,8 @@ void register_imu(CLI::App& app, Runner& runner) {
   cmd->plot.add_to(*sub, N_("one panel per sensor kind with every axis' Allan deviation and its confidence bars"));
   sub->callback([cmd, &runner] {
     runner = [cmd](Io& io) -> int {
-      const ImuOptions opt = cmd->options();
+      ImuOptions opt = cmd->options();
+      opt.read.progress = opt.analysis.progress = io.progress;
       // Every output is checked before the work and before the first is written.
       if (!cmd->kalibr.empty() || !cmd->report_dir.empty()) (void)rostopic_scalar(cmd->rostopic);
       std::vector<OutputTarget> targets = report_targets(cmd->report_dir);

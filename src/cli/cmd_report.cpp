@@ -23,6 +23,7 @@
 #include "rwcalc/output.hpp"
 #include "rwcalc/plot.hpp"
 #include "rwcalc/printable.hpp"
+#include "rwcalc/progress.hpp"
 #include "rwcalc/reader.hpp"
 #include "rwcalc/report.hpp"
 #include "rwcalc/saved_results.hpp"
@@ -54,7 +55,8 @@ struct ReportCmd {
 /// The diagnoses of the recordings, one per file in file order: each recording is read again and
 /// diagnosed as by `rwcalc diagnose FILE --runs K --seed N` with the report's analysis options.
 std::vector<json> diagnose_recordings(const std::vector<std::string>& recordings, const ReadOptions& read,
-                                      const AnalysisOptions& options, std::size_t runs, std::uint64_t seed) {
+                                      const AnalysisOptions& options, std::size_t runs, std::uint64_t seed,
+                                      std::FILE* progress) {
   std::vector<json> out;
   out.reserve(recordings.size());
   for (const auto& f : recordings) {
@@ -62,7 +64,7 @@ std::vector<json> diagnose_recordings(const std::vector<std::string>& recordings
     d.analysis = options;
     d.runs = runs;
     d.seed = seed;
-    out.push_back(to_json(diagnose(read_recording(f, read), d)));
+    out.push_back(to_json(diagnose_showing_progress(read_recording(f, read), d, progress)));
   }
   return out;
 }
@@ -156,7 +158,8 @@ ReportInput report_input(const ReportCmd& c, const std::vector<std::string>& rec
   SavedResults saved;
   for (const auto& f : saved_files) load_saved_result(f, saved);
   std::vector<json> diagnoses;
-  if (c.diagnose) diagnoses = diagnose_recordings(recordings, read, opt, c.diagnose_runs, c.diagnose_seed);
+  if (c.diagnose)
+    diagnoses = diagnose_recordings(recordings, read, opt, c.diagnose_runs, c.diagnose_seed, io.progress);
   ReportInput in;
   if (!recordings.empty()) in.analyses = analyze_files(recordings, read, opt);
   for (auto& a : saved.analyses) in.analyses.push_back(std::move(a.run));
@@ -189,6 +192,7 @@ int run_report(const ReportCmd& c, Io& io) {
   std::vector<std::string> recordings, saved_files;
   for (const auto& f : c.files) (is_json_path(f) ? saved_files : recordings).push_back(f);
   AnalysisOptions opt = c.analysis.options();
+  opt.progress = io.progress;
   if (c.temperature) {
     if (recordings.size() != 1)
       throw UsageError(tr("--temperature applies to a single recording; name the temperature in each file instead"));
@@ -196,7 +200,8 @@ int run_report(const ReportCmd& c, Io& io) {
   }
   if (c.diagnose && recordings.empty())
     throw UsageError(tr("--diagnose needs recordings; saved diagnoses are given as 'rwcalc diagnose --json' files"));
-  const ReadOptions read = c.input.options();
+  ReadOptions read = c.input.options();
+  read.progress = io.progress;
   if (c.diagnose && c.diagnose_runs < 10)
     throw UsageError(tr("--diagnose-runs: at least 10 simulated records are needed"));
   // Fail before the analysis: a report.html that cannot be written (existing without --force, a
@@ -222,7 +227,11 @@ int run_report(const ReportCmd& c, Io& io) {
                                  c.no_figures ? tr(", no figures") : ""));
   if (c.pdf) {
     const std::string pdf = (fs::path(c.dir) / "report.pdf").string();
-    if (print_to_pdf(path, pdf, c.force))
+    const bool printed = [&] {
+      const Progress progress(trf("printing {}", printable(pdf)), 0, io.progress);  // erased before the message
+      return print_to_pdf(path, pdf, c.force);
+    }();
+    if (printed)
       io.out << trf("PDF written to {}\n", printable(pdf));
     else
       print_message(io.err, tr("note: --pdf: no headless Chromium found (chromium, chromium-browser or google-chrome "

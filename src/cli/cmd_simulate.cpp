@@ -17,6 +17,7 @@
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/printable.hpp"
+#include "rwcalc/progress.hpp"
 #include "rwcalc/pulse_writer.hpp"
 #include "rwcalc/simulate.hpp"
 #include "rwcalc/units.hpp"
@@ -128,15 +129,18 @@ Metadata metadata_of(const NoiseModel& m, const SimulationSettings& s) {
 
 // Generate one record and write it block by block as it is generated, so that memory does not
 // grow with its length; the file appears only when it is complete (PulseFileWriter).
-void write_record(Simulator& sim, const SimulationSettings& sr, const std::string& path, bool force) {
+void write_record(Simulator& sim, const SimulationSettings& sr, const std::string& path, bool force, Io& io) {
   const bool angle = sim.model().output_lowpass_tc_s > 0;
   PulseFileWriter out(path, metadata_of(sim.model(), sr),
                       angle ? PulseFileWriter::Column::Angle : PulseFileWriter::Column::Pulses, force);
+  Progress progress(trf("simulating {}", printable(path == "-" ? "<stdout>" : path)), sr.samples(), io.progress,
+                    Progress::Measure::Percent);
   sim.stream(sr.seed, [&](const RecordBlock& block) {
     if (angle)
       out.add_angles(block.angles);
     else
       out.add_counts(block.counts);
+    progress.advance(angle ? block.angles.size() : block.counts.size());
   });
   out.commit();
 }
@@ -360,7 +364,7 @@ int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
     SimulationSettings sr = s;
     sr.seed = s.seed + static_cast<std::uint64_t>(r - 1);
     const std::string path = path_of(a.output, r);
-    write_record(sim, sr, path, a.force);
+    write_record(sim, sr, path, a.force, io);
     if (!a.truth.empty()) write_truth(path_of(a.truth, r), m, sr, path, a.force);
     if (path != "-")
       io.out << trf("wrote {} ({} samples, {} s at {} Hz, seed {})\n", printable(path), sr.samples(), sr.duration_s,

@@ -2,6 +2,7 @@
 // Internal to the command-line layer: each sub-command registers itself on the CLI11 app and
 // returns a callable that runs it once parsing succeeded.
 #include <CLI/CLI.hpp>
+#include <cstdio>
 #include <functional>
 #include <iosfwd>
 #include <nlohmann/json.hpp>
@@ -12,15 +13,26 @@
 #include "rwcalc/memory.hpp"
 #include "rwcalc/reader.hpp"
 
+namespace rwcalc {
+struct DiagnoseOptions;
+struct DiagnoseResult;
+}  // namespace rwcalc
+
 namespace rwcalc::cli {
 
 /// Streams a command writes to.
 struct Io {
   std::ostream& out;
   std::ostream& err;
+  /// Where progress lines go (progress.hpp): standard error when it is a terminal and --quiet was
+  /// not given; nullptr (none) otherwise.
+  std::FILE* progress = nullptr;
 };
 
 using Runner = std::function<int(Io&)>;
+
+/// diagnose() with its progress line on `sink` (Io::progress): the simulated records done.
+DiagnoseResult diagnose_showing_progress(const Recording& rec, DiagnoseOptions opt, std::FILE* sink);
 
 /// Print one message line, "rwcalc: TEXT", to `err`. TEXT goes through printable(): a newline,
 /// an escape sequence or an invalid byte in a file name (or anywhere else in the text) shows as

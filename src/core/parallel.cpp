@@ -38,6 +38,8 @@ unsigned worker_count() {
   return std::max(1u, std::thread::hardware_concurrency());
 }
 
+bool inside_parallel_items() noexcept { return inside_parallel_for; }
+
 void parallel_for(std::size_t n, const std::function<void(std::size_t)>& fn) {
   const std::size_t threads = inside_parallel_for ? 1 : std::min<std::size_t>(n, worker_count());
   if (threads <= 1) {

@@ -22,6 +22,13 @@ namespace {
 constexpr double kPulseFitTauMin = 20.0;       ///< s, start of the base fit for pulse data
 constexpr std::size_t kCalibrationFactor = 4;  ///< default calibration ensemble: 4K records
 
+/// Records of the pilot ensemble the base model is calibrated with: K/2, at least 10.
+std::size_t pilot_records(const DiagnoseOptions& opt) { return std::max<std::size_t>(10, opt.runs / 2); }
+/// Records of the base model's calibration ensemble (DiagnoseOptions::calibration_runs).
+std::size_t calibration_records(const DiagnoseOptions& opt) {
+  return std::max(opt.runs, opt.calibration_runs ? opt.calibration_runs : kCalibrationFactor * opt.runs);
+}
+
 /// The measurement and what every stage reads of it.
 struct Context {
   const Recording& rec;
@@ -83,7 +90,7 @@ void fit_base(Context& c, DiagnoseResult& r, OutlierReport outliers) {
   s.octave_m = octave_of(r.analysis.allan);
   s.pilot = r.settings;
   s.pilot.seed = c.opt.seed + 1000;
-  s.pilot_runs = std::max<std::size_t>(10, c.opt.runs / 2);
+  s.pilot_runs = pilot_records(c.opt);
   c.plan = {s.octave_m, mid_tau_grid(s.dec), true, {}};
   c.rb = robust_base(c.rec, r.analysis, c.aopt, s.dec, s.pilot, s.pilot_runs, c.plan, c.opt.progress);
   r.base = s.base = c.rb.model;
@@ -292,6 +299,8 @@ void reject_findings(DiagnoseResult& r) {
 
 }  // namespace
 
+std::uint64_t simulated_records(const DiagnoseOptions& opt) { return pilot_records(opt) + calibration_records(opt); }
+
 DiagnoseResult diagnose(const Recording& read, const DiagnoseOptions& opt) {
   const auto t_start = std::chrono::steady_clock::now();
   OutlierReport outliers;
@@ -300,7 +309,7 @@ DiagnoseResult diagnose(const Recording& read, const DiagnoseOptions& opt) {
   DiagnoseResult r;
   r.runs = opt.runs;
   r.holdout_runs = opt.holdout_runs ? opt.holdout_runs : 2 * opt.runs;
-  r.calibration_runs = std::max(opt.runs, opt.calibration_runs ? opt.calibration_runs : kCalibrationFactor * opt.runs);
+  r.calibration_runs = calibration_records(opt);
   r.seed = opt.seed;
   r.band_level = opt.band_level;
   r.alpha = opt.alpha;

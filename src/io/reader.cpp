@@ -18,6 +18,8 @@
 #include "rwcalc/error.hpp"
 #include "rwcalc/limits.hpp"
 #include "rwcalc/memory.hpp"
+#include "rwcalc/printable.hpp"
+#include "rwcalc/progress.hpp"
 #include "rwcalc/units.hpp"
 
 namespace rwcalc {
@@ -262,9 +264,12 @@ class Reader {
 };
 
 void Reader::read_lines(detail::TextSource& src) {
+  Progress progress(trf("reading {}", printable(src.name())), src.stored_size(), opt_.progress,
+                    Progress::Measure::Bytes);
   std::string buf;
   for (bool more = true, first = true; more;) {
     more = src.read(buf);
+    progress.advance(src.taken_bytes() - progress.done());
     const std::size_t taken = take_lines(buf, !more);
     text_taken_ += taken;
     const auto lines = static_cast<double>(line_);

@@ -53,6 +53,11 @@ class TextSource {
   /// The input's bytes as stored (compressed, for gzip) read so far, and their SHA-256: once read()
   /// has returned false, the file's size and the digest `sha256sum` prints.
   [[nodiscard]] std::size_t raw_bytes() const noexcept { return raw_total_; }
+  /// The input's size as stored (compressed, for gzip); 0 when unknown (a pipe).
+  [[nodiscard]] std::size_t stored_size() const noexcept { return bytes_; }
+  /// The stored bytes taken so far (for gzip, inflated; raw_bytes() runs ahead by what zlib has
+  /// not taken yet): how far the reading is.
+  [[nodiscard]] std::size_t taken_bytes() const noexcept { return gzip_ ? raw_total_ - zs_.avail_in : raw_total_; }
   [[nodiscard]] std::string sha256() const { return hash_.hex(); }
   /// The text's likely length in bytes: the input's size, for gzip times the ratio inflated so far;
   /// 0 when unknown (a pipe). An estimate only.

@@ -121,6 +121,22 @@ CliResult run_exe_stdout(const std::vector<std::string>& args, const std::string
   return run_exe_as(args, {}, redirection);
 }
 
+CliResult run_exe_on_terminal(const std::vector<std::string>& args) {
+  TempDir tmp;
+  std::string inner = shell_quote(RWCALC_EXE);
+  for (const auto& a : args) inner += " " + shell_quote(a);
+  inner += " >" + shell_quote((tmp.path() / "out").string());
+  // -e: script exits with the command's status; /dev/null: no typescript file.
+  const std::string cmd = "script -qec " + shell_quote(inner) + " /dev/null </dev/null >" +
+                          shell_quote((tmp.path() / "terminal").string()) + " 2>&1";
+  const int rc = std::system(cmd.c_str());
+  CliResult r;
+  r.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : 128 + WTERMSIG(rc);
+  r.out = slurp(tmp.path() / "out");
+  r.err = slurp(tmp.path() / "terminal");
+  return r;
+}
+
 TempDir::TempDir() {
   std::random_device rd;
   const auto base = std::filesystem::temp_directory_path();

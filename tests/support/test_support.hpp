@@ -46,6 +46,11 @@ CliResult run_exe(const std::vector<std::string>& args, const std::string& stdin
 /// e.g. ">/dev/full" or ">&-" (closed); `out` is then empty.
 CliResult run_exe_stdout(const std::vector<std::string>& args, const std::string& redirection);
 
+/// Run the built executable with its standard error (and input) on a pseudo-terminal, as in an
+/// interactive shell, through util-linux `script`: `err` is what the terminal received (progress
+/// lines and messages, line ends as CR LF), `out` the standard output, which goes to a file.
+CliResult run_exe_on_terminal(const std::vector<std::string>& args);
+
 /// A fresh temporary directory removed when the object goes out of scope.
 class TempDir {
  public:
