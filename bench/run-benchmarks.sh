@@ -14,18 +14,25 @@
 # given for both wall and CPU time.
 #
 # Usage: bench/run-benchmarks.sh [--repeat N] [--build-dir DIR] [--no-build] [--skip-24h]
-#                                [--skip-tau-all] [--kernels]
-#   --repeat N      runs per measurement (default 5; the median is reported)
-#   --build-dir D   build directory of the bench preset (default build-bench)
-#   --no-build      use the existing build as it is
-#   --skip-24h      skip the 24-h 1 kHz record (its text file takes ~1 min to generate once)
-#   --skip-tau-all  skip `allan --tau all` and its growth with N
-#   --kernels       also run the Google Benchmark kernels (bench_*) after the table
+#                                [--skip-tau-all] [--kernels] [--allantools DIR] [--gate]
+#   --repeat N        runs per measurement (default 5; the median is reported)
+#   --build-dir D     build directory of the bench preset (default build-bench)
+#   --no-build        use the existing build as it is
+#   --skip-24h        skip the 24-h 1 kHz record (its text file takes ~1 min to generate once)
+#   --skip-tau-all    skip `allan --tau all` and its growth with N
+#   --kernels         also run the Google Benchmark kernels (bench_*) after the table
+#   --allantools DIR  also time AllanTools' own oadev (bench/allantools_oadev.py, whole process)
+#                     side by side with target 1, from a checkout of AllanTools in DIR (not part of
+#                     rwcalc; needs python3-scipy); skipped when DIR holds no allantools package
+#   --gate            the regression gate CI runs: target 1 alone on an existing build (never
+#                     builds; give the release build with --build-dir build), both figures printed;
+#                     exits 1 when analyze is less than a third of the 25x target (8.33x) faster
+#                     than the NumPy baseline in wall time
 # Needs: cmake, g++, GNU time (/usr/bin/time; Debian package `time`), python3 with numpy
 # (Debian python3-numpy) for the baseline rows. Commands this build lacks show "not available".
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-repeat=5 build="$here/build-bench" do_build=1 skip24=0 skipall=0 kernels=0
+repeat=5 build="$here/build-bench" do_build=1 skip24=0 skipall=0 kernels=0 allantools="" gate=0
 while (($#)); do
   case "$1" in
     --repeat) repeat="$2"; shift 2 ;;
@@ -34,6 +41,8 @@ while (($#)); do
     --skip-24h) skip24=1; shift ;;
     --skip-tau-all) skipall=1; shift ;;
     --kernels) kernels=1; shift ;;
+    --allantools) allantools="$2"; shift 2 ;;
+    --gate) gate=1 do_build=0 skip24=1 skipall=1; shift ;;
     -h|--help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;;
     *) echo "run-benchmarks.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
@@ -157,6 +166,28 @@ side_by_side() {
   rss_mb=$rss status=$st
 }
 
+# The gate: target 1 alone, both figures, and the verdict in the exit status. A ratio of two
+# processes measured together, never an absolute time: a loaded machine slows both.
+gate_floor=$(calc "25 / 3")
+if ((gate)); then
+  available analyze || { echo "run-benchmarks.sh: $rw has no analyze command" >&2; exit 2; }
+  [[ -n "$py" ]] || { echo "run-benchmarks.sh: --gate needs python3 with numpy (python3-numpy)" >&2; exit 2; }
+  side_by_side "$repeat" "$rw" analyze "$run2h" --json -- "$py" "$here/bench/numpy_oavar.py" "$run2h" --grid octave
+  ((status)) && { echo "run-benchmarks.sh: a run failed (exit $status): $(head -c 300 "$tmp/err.txt")" >&2; exit 2; }
+  sw=$(calc "$b_s / $a_s") sc=$(calc "$b_c / $a_c")
+  printf 'analyze of the 2-h 400-Hz file vs the NumPy baseline (read + octave OADEV), median of %s alternating runs:\n' "$repeat"
+  printf '  rwcalc analyze: %s wall, %s CPU;  NumPy baseline: %s wall, %s CPU\n' \
+    "$(fmt_t "$a_s")" "$(fmt_t "$a_c")" "$(fmt_t "$b_s")" "$(fmt_t "$b_c")"
+  printf '  ratio: %.1fx wall (%.1fx CPU); floor %.2fx (a third of the 25x target); load %s\n' "$sw" "$sc" \
+    "$gate_floor" "$(loadavg)"
+  if awk "BEGIN { exit !($sw < $gate_floor) }"; then
+    echo "benchmark gate: FAILED: analyze is ${sw}x the baseline's speed, below ${gate_floor}x" >&2
+    exit 1
+  fi
+  echo "benchmark gate: passed"
+  exit 0
+fi
+
 speed_name="analyze 2-h 400 Hz vs NumPy read + octave OADEV (whole processes)"
 if ! available analyze; then
   row "$speed_name" "≥ 25× faster" "not available" "" "" "" ""
@@ -172,6 +203,25 @@ else
       "$(printf '%.1f× (%s vs %s)' "$sw" "$(fmt_t "$a_s")" "$(fmt_t "$b_s")")" \
       "$(printf '%.1f× (%s vs %s)' "$sc" "$(fmt_t "$a_c")" "$(fmt_t "$b_c")")" \
       "$(fmt_mb "$rss_mb")" "$(verdict "$sw >= 25")" "$l"
+  fi
+fi
+at_name="analyze 2-h 400 Hz vs AllanTools' own oadev (read + octave OADEV, whole processes)"
+if [[ -n "$allantools" ]]; then
+  if [[ ! -f "$allantools/allantools/__init__.py" ]]; then
+    row "$at_name" "≥ 25× faster" "skipped (no allantools package in $allantools)" "" "" "" ""
+  elif [[ -z "$py" ]] || ! "$py" -c 'import scipy' 2>/dev/null; then
+    row "$at_name" "≥ 25× faster" "skipped (AllanTools needs python3 with numpy and scipy)" "" "" "" ""
+  elif available analyze; then
+    l=$(loadavg)
+    side_by_side "$repeat" "$rw" analyze "$run2h" --json -- "$py" "$here/bench/allantools_oadev.py" "$allantools" "$run2h"
+    if ((status)); then row "$at_name" "≥ 25× faster" "$(failed)" "" "" "" "$l"
+    else
+      aw=$(calc "$b_s / $a_s") ac=$(calc "$b_c / $a_c")
+      row "$at_name" "≥ 25× faster" \
+        "$(printf '%.1f× (%s vs %s)' "$aw" "$(fmt_t "$a_s")" "$(fmt_t "$b_s")")" \
+        "$(printf '%.1f× (%s vs %s)' "$ac" "$(fmt_t "$a_c")" "$(fmt_t "$b_c")")" \
+        "$(fmt_mb "$rss_mb")" "$(verdict "$aw >= 25")" "$l"
+    fi
   fi
 fi
 if available analyze; then
