@@ -3,6 +3,7 @@
 #include "allan/allan_kernels.hpp"
 
 #include <algorithm>
+#include <optional>
 
 #include "allan/narrow_counts.hpp"
 #include "rwcalc/parallel.hpp"
@@ -73,7 +74,9 @@ std::vector<u128> second_diff_sumsq_sweep(const std::int64_t* c, std::size_t poi
   const auto parts = static_cast<std::size_t>((longest + kStretch - 1) / kStretch);
   std::vector<u128> part_sums(parts * count, 0);
   static_assert(kBlock <= static_cast<std::int64_t>(NarrowCounts::kMaxTerms));
-  const NarrowCounts narrow(c, points);
+  // Narrow sums pay for their pass over the record when several m share it.
+  const std::optional<NarrowCounts> narrow = count > 1 ? std::optional<NarrowCounts>(std::in_place, c, points)
+                                                       : std::nullopt;
   parallel_for(parts, [&](std::size_t part) {
     const std::int64_t from = static_cast<std::int64_t>(part) * kStretch;
     const std::int64_t to = std::min(longest, from + kStretch);
@@ -83,8 +86,10 @@ std::vector<u128> second_diff_sumsq_sweep(const std::int64_t* c, std::size_t poi
         const std::int64_t n = np - 2 * ms[i];
         if (k0 >= n) continue;
         const std::int64_t len = std::min(kBlock, n - k0);
-        const auto small = narrow.second_diff_sumsq(static_cast<std::size_t>(k0), static_cast<std::size_t>(len),
-                                                    static_cast<std::size_t>(ms[i]));
+        const auto small = narrow ? narrow->second_diff_sumsq(static_cast<std::size_t>(k0),
+                                                              static_cast<std::size_t>(len),
+                                                              static_cast<std::size_t>(ms[i]))
+                                  : std::nullopt;
         out[i] += small ? u128{*small} : block_sumsq<2>(c + k0, len, ms[i], 1);
       }
     }

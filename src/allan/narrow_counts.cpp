@@ -48,7 +48,7 @@ void narrow_increment_sums(const std::uint16_t* __restrict a, const std::uint16_
 }  // namespace
 
 NarrowCounts::NarrowCounts(const std::int64_t* c, std::size_t points)
-    : low_(points), min_((points + kGroup - 1) / kGroup), max_(min_.size()) {
+    : low_(std::make_unique_for_overwrite<std::uint16_t[]>(points)), min_((points + kGroup - 1) / kGroup), max_(min_.size()) {
   if (points == 0) return;
   const auto c0 = static_cast<std::uint64_t>(c[0]);
   if (points > 1) {  // the mean step, whole: a trend of many counts per point would widen every bound
@@ -58,12 +58,15 @@ NarrowCounts::NarrowCounts(const std::int64_t* c, std::size_t points)
   }
   const auto a = static_cast<std::uint64_t>(slope_);
   const std::size_t groups = min_.size(), items = (groups + kGroupsPerItem - 1) / kGroupsPerItem;
+  std::uint16_t* low = low_.get();
   parallel_for(items, [&](std::size_t item) {
     for (std::size_t g = item * kGroupsPerItem; g < std::min(groups, (item + 1) * kGroupsPerItem); ++g) {
+      const std::size_t begin = g * kGroup, end = std::min(points, begin + kGroup);
+      std::uint64_t trend = c0 + a * begin;  // C_0 + a·k, modulo 2^64
       std::int64_t lo = std::numeric_limits<std::int64_t>::max(), hi = std::numeric_limits<std::int64_t>::min();
-      for (std::size_t k = g * kGroup; k < std::min(points, (g + 1) * kGroup); ++k) {
-        const auto v = static_cast<std::int64_t>(static_cast<std::uint64_t>(c[k]) - c0 - a * k);
-        low_[k] = static_cast<std::uint16_t>(v);
+      for (std::size_t k = begin; k < end; ++k, trend += a) {
+        const auto v = static_cast<std::int64_t>(static_cast<std::uint64_t>(c[k]) - trend);
+        low[k] = static_cast<std::uint16_t>(v);
         lo = std::min(lo, v);
         hi = std::max(hi, v);
       }
@@ -86,7 +89,7 @@ std::optional<std::uint64_t> NarrowCounts::second_diff_sumsq(std::size_t k0, std
   const Range r0 = range(k0, len), r1 = range(k0 + m, len), r2 = range(k0 + 2 * m, len);
   const i128 lo = r2.lo - 2 * r1.hi + r0.lo, hi = r2.hi - 2 * r1.lo + r0.hi;
   if (len > kMaxTerms || !narrow_enough(std::max(-lo, hi), len)) return std::nullopt;
-  const std::uint16_t* p = low_.data() + k0;
+  const std::uint16_t* p = low_.get() + k0;
   return narrow_second_diff_sumsq(p, p + m, p + 2 * m, len);
 }
 
@@ -103,7 +106,7 @@ bool NarrowCounts::increment_sums(std::size_t k0, std::size_t len, std::size_t t
   if (len > kMaxTerms || !narrow_enough(std::max(-lo, hi), len)) return false;
   std::int32_t n1 = 0;
   std::uint32_t n2 = 0;
-  const std::uint16_t* p = low_.data() + k0;
+  const std::uint16_t* p = low_.get() + k0;
   narrow_increment_sums(p, p + t, static_cast<std::uint16_t>(static_cast<std::uint64_t>(off)), len, n1, n2);
   s1 = n1, s2 = n2;
   return true;

@@ -10,6 +10,7 @@
 // left to the caller's 64-bit sums. The result is the exact integer either way.
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -41,7 +42,7 @@ class NarrowCounts {
   [[nodiscard]] Range range(std::size_t from, std::size_t len) const;
 
   std::int64_t slope_ = 0;           // a: x'_k = C_k − C_0 − a·k (modulo 2^64)
-  std::vector<std::uint16_t> low_;   // x'_k modulo 2^16
+  std::unique_ptr<std::uint16_t[]> low_;  // x'_k modulo 2^16 (written once: not zeroed first)
   std::vector<std::int64_t> min_, max_;  // of x' over each group of kGroup points
 };
 

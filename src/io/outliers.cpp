@@ -107,23 +107,20 @@ struct Window {
   }
 };
 
-// What one stretch [from, to) of the record contributes to the scale: the smallest non-zero step
-// |y_i − y_{i−1}| and the |residuals| of the strided subset (every i divisible by `stride`).
-struct ScalePart {
-  double resolution = std::numeric_limits<double>::infinity();
-  std::vector<double> residuals;
-};
+// The strided subset's samples (every i divisible by `stride`) in [0, to).
+std::size_t strided_below(std::size_t to, std::size_t stride) { return (to + stride - 1) / stride; }
 
-ScalePart scale_part(const RateSource& src, std::size_t from, std::size_t to, std::size_t stride) {
+// What one stretch [from, to) of the record contributes to the scale: the smallest non-zero step
+// |y_i − y_{i−1}| (returned) and the |residuals| of the strided subset, written from `out` on.
+double scale_part(const RateSource& src, std::size_t from, std::size_t to, std::size_t stride, double* out) {
   const Window w(src, from, to);
-  ScalePart part;
+  double resolution = std::numeric_limits<double>::infinity();
   for (std::size_t i = std::max<std::size_t>(from, 1); i < to; ++i) {
     const double d = std::abs(w.at(i) - w.at(i - 1));
-    if (d > 0) part.resolution = std::min(part.resolution, d);
+    resolution = std::min(resolution, d > 0 ? d : std::numeric_limits<double>::infinity());
   }
-  for (std::size_t i = (from + stride - 1) / stride * stride; i < to; i += stride)
-    part.residuals.push_back(std::abs(w.residual(i)));
-  return part;
+  for (std::size_t i = strided_below(from, stride) * stride; i < to; i += stride) *out++ = std::abs(w.residual(i));
+  return resolution;
 }
 
 std::size_t chunks_of(std::size_t n) { return (n + kChunk - 1) / kChunk; }
@@ -132,16 +129,14 @@ OutlierScale scale_of(const RateSource& src) {
   OutlierScale s;
   if (src.n < kMinSamples) return s;
   const std::size_t stride = (src.n + kScaleSamples - 1) / kScaleSamples;
-  std::vector<ScalePart> parts(chunks_of(src.n));
-  parallel_for(parts.size(), [&](std::size_t c) {
-    parts[c] = scale_part(src, c * kChunk, std::min(src.n, (c + 1) * kChunk), stride);
+  std::vector<double> part_resolution(chunks_of(src.n));
+  std::vector<double> residuals(strided_below(src.n, stride));  // in record order, each chunk its own stretch
+  parallel_for(part_resolution.size(), [&](std::size_t c) {
+    const std::size_t from = c * kChunk;
+    part_resolution[c] = scale_part(src, from, std::min(src.n, from + kChunk), stride,
+                                    residuals.data() + strided_below(from, stride));
   });
-  double resolution = std::numeric_limits<double>::infinity();
-  std::vector<double> residuals;
-  for (const auto& p : parts) {
-    resolution = std::min(resolution, p.resolution);
-    residuals.insert(residuals.end(), p.residuals.begin(), p.residuals.end());
-  }
+  const double resolution = *std::min_element(part_resolution.begin(), part_resolution.end());
   // The median |residual|: the value of rank size/2, whatever the order the parts came in.
   const auto mid = residuals.begin() + static_cast<std::ptrdiff_t>(residuals.size() / 2);
   std::nth_element(residuals.begin(), mid, residuals.end());
@@ -189,6 +184,7 @@ std::vector<Outlier> outliers_of(const RateSource& src, double threshold, const 
   parallel_for(parts.size(), [&](std::size_t c) {
     const std::size_t from = c * kChunk, to = std::min(src.n, from + kChunk);
     const std::optional<std::vector<char>> maybe = count_candidates(src, from, to, limit);
+    if (maybe && std::find(maybe->begin(), maybe->end(), 1) == maybe->end()) return;
     const Window w(src, from, to);
     for (std::size_t i = from; i < to; ++i) {
       if (maybe && !(*maybe)[i - from]) continue;
