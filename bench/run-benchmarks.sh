@@ -202,21 +202,26 @@ if ((gate)); then
 fi
 
 speed_name="analyze 2-h 400 Hz vs NumPy read + octave OADEV (whole processes)"
+# analyze_vs NAME PEER_CMD...: analyze of the 2-h file side by side with a peer process; its row,
+# the target met when analyze is at least 25 times as fast in wall time.
+analyze_vs() {
+  local name="$1" l; shift
+  l=$(loadavg)
+  side_by_side "$repeat" "$rw" analyze "$run2h" --json -- "$@"
+  if ((status)); then row "$name" "≥ 25× faster" "$(failed)" "" "" "" "$l"; return; fi
+  local sw sc
+  sw=$(calc "$b_s / $a_s") sc=$(calc "$b_c / $a_c")
+  row "$name" "≥ 25× faster" \
+    "$(printf '%.1f× (%s vs %s)' "$sw" "$(fmt_t "$a_s")" "$(fmt_t "$b_s")")" \
+    "$(printf '%.1f× (%s vs %s)' "$sc" "$(fmt_t "$a_c")" "$(fmt_t "$b_c")")" \
+    "$(fmt_mb "$rss_mb")" "$(verdict "$sw >= 25")" "$l"
+}
 if ! available analyze; then
   row "$speed_name" "≥ 25× faster" "not available" "" "" "" ""
 elif [[ -z "$py" ]]; then
   row "$speed_name" "≥ 25× faster" "not measured (no python3 with numpy)" "" "" "" ""
 else
-  l=$(loadavg)
-  side_by_side "$repeat" "$rw" analyze "$run2h" --json -- "$py" "$here/bench/numpy_oavar.py" "$run2h" --grid octave
-  if ((status)); then row "$speed_name" "≥ 25× faster" "$(failed)" "" "" "" "$l"
-  else
-    sw=$(calc "$b_s / $a_s") sc=$(calc "$b_c / $a_c")
-    row "$speed_name" "≥ 25× faster" \
-      "$(printf '%.1f× (%s vs %s)' "$sw" "$(fmt_t "$a_s")" "$(fmt_t "$b_s")")" \
-      "$(printf '%.1f× (%s vs %s)' "$sc" "$(fmt_t "$a_c")" "$(fmt_t "$b_c")")" \
-      "$(fmt_mb "$rss_mb")" "$(verdict "$sw >= 25")" "$l"
-  fi
+  analyze_vs "$speed_name" "$py" "$here/bench/numpy_oavar.py" "$run2h" --grid octave
 fi
 at_name="analyze 2-h 400 Hz vs AllanTools' own oadev (read + octave OADEV, whole processes)"
 if [[ -n "$allantools" ]]; then
@@ -225,16 +230,7 @@ if [[ -n "$allantools" ]]; then
   elif [[ -z "$py" ]] || ! "$py" -c 'import scipy' 2>/dev/null; then
     row "$at_name" "≥ 25× faster" "skipped (AllanTools needs python3 with numpy and scipy)" "" "" "" ""
   elif available analyze; then
-    l=$(loadavg)
-    side_by_side "$repeat" "$rw" analyze "$run2h" --json -- "$py" "$here/bench/allantools_oadev.py" "$allantools" "$run2h"
-    if ((status)); then row "$at_name" "≥ 25× faster" "$(failed)" "" "" "" "$l"
-    else
-      aw=$(calc "$b_s / $a_s") ac=$(calc "$b_c / $a_c")
-      row "$at_name" "≥ 25× faster" \
-        "$(printf '%.1f× (%s vs %s)' "$aw" "$(fmt_t "$a_s")" "$(fmt_t "$b_s")")" \
-        "$(printf '%.1f× (%s vs %s)' "$ac" "$(fmt_t "$a_c")" "$(fmt_t "$b_c")")" \
-        "$(fmt_mb "$rss_mb")" "$(verdict "$aw >= 25")" "$l"
-    fi
+    analyze_vs "$at_name" "$py" "$here/bench/allantools_oadev.py" "$allantools" "$run2h"
   fi
 fi
 if available analyze; then

@@ -85,15 +85,17 @@ LineKind LineParser::parse(std::string_view text, std::size_t line, Sample& s) {
 namespace {
 
 // An optional minus and 1–18 digits (no overflow) from p on, as far as they go; p is left after them.
+// Bounded: without checking `end` while at least 20 bytes remain (a sign and 19 digits).
+template <bool Bounded = true>
 bool plain_value(const char*& p, const char* end, std::int64_t& v) {
-  const bool neg = p < end && *p == '-';
+  const bool neg = (!Bounded || p < end) && *p == '-';
   const char* digits = p + neg;
   std::uint64_t u = 0;
   const char* q = digits;
-  for (; q < end; ++q) {
+  for (; (!Bounded || q < end) && q - digits < 19; ++q) {
     const auto d = static_cast<unsigned char>(*q - '0');
     if (d > 9) break;
-    u = u * 10 + d;  // modulo 2^64 past 19 digits, and then refused below
+    u = u * 10 + d;  // 19 digits may wrap modulo 2^64: refused below
   }
   if (q == digits || q - digits > 18) return false;
   v = neg ? -static_cast<std::int64_t>(u) : static_cast<std::int64_t>(u);
@@ -121,16 +123,19 @@ const char* LineParser::plain_integer_lines(const char* p, const char* end, std:
                                             std::vector<std::int64_t>& out) {
   if (!plain_layout()) return p;
   const bool counter = input_.mode == InputMode::Counter;
+  const std::size_t before = out.size();
+  // Lines with 22 bytes to spare (sign, 19 digits, CR, LF) need no look at `end`.
+  const char* roomy = end - p > 22 ? end - 22 : p;
   for (const char* q = p; q < end; p = q) {
     std::int64_t v = 0;
-    if (!plain_value(q, end, v) || q == end) break;
+    if (!(q < roomy ? plain_value<false>(q, end, v) : plain_value(q, end, v)) || q == end) break;
     if (*q == '\r' && q + 1 < end) ++q;  // CR LF
     if (*q != '\n' || (counter && (v < counter_lo_ || v > counter_max_))) break;
     ++q;
     out.push_back(v);
-    ++line;
-    ++content_lines_;
   }
+  line += out.size() - before;
+  content_lines_ += out.size() - before;
   return p;
 }
 
