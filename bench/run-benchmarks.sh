@@ -98,8 +98,9 @@ imu_day="$inputs/imu_day_200Hz.csv"
 adis="$here/../shared/data/real/imudata_adis16405/adis_16405_imu1.csv.gz"
 if ((!skip24)) && [[ ! -s "$imu_day" && -s "$adis" ]]; then
   echo "generating the 24-h 6-channel IMU record (once) ..." >&2
-  { gzip -dc "$adis" | sed -n 3p
-    for _ in $(seq 18); do gzip -dc "$adis" | tail -n +4; done | head -n 17280000; } >"$imu_day.part" && mv "$imu_day.part" "$imu_day"
+  { gzip -dc "$adis" | sed -n 3p  # the header row; then 17.28 copies of the 1 M data lines
+    for _ in $(seq 17); do gzip -dc "$adis" | sed -n '4,$p'; done
+    gzip -dc "$adis" | sed -n '4,280003p'; } >"$imu_day.part" && mv "$imu_day.part" "$imu_day"
 fi
 
 # ---- measurement helpers ----------------------------------------------------------------------
