@@ -142,7 +142,7 @@ namespace {
 
 /// The fourth-moment ratio reads at most kRatioTerms terms, in kRatioRuns runs spread evenly over
 /// the record (long runs: each is read at the speed of memory, not of its latency), a run's terms
-/// consecutive at short τ and m/4 apart at long τ. Where the ratio is used white phase noise leads,
+/// consecutive at short τ and m/4 apart at long τ (term_spacing). Where the ratio is used white phase noise leads,
 /// whose terms share no sample beyond the lags 0, m and 2m: the sample's relative standard error is
 /// about 3 % (within 4 % of the whole-record ratio on the records of data/gl2d at every octave up to
 /// 2^15), against the clamp's range of a factor 16.
@@ -158,6 +158,35 @@ double second_difference(const PhaseSeries& x, std::size_t i, std::size_t m) {
   return static_cast<double>(static_cast<std::int64_t>(at(i + 2 * m) - 2 * at(i + m) + at(i)));
 }
 
+/// The spacing of a run's terms: m/4 at long τ (neighbours there share most of their samples
+/// through the other noises), halved while the runs would overlap; a divisor of m, so that the
+/// terms and their partners l·m on lie on one lattice. 1 when m has no such divisor.
+std::size_t term_spacing(std::size_t m, std::size_t most) {
+  std::size_t s = m % 4 == 0 ? m / 4 : 1;
+  while (s > most && s % 2 == 0) s /= 2;
+  return s <= most ? s : 1;
+}
+
+/// The second differences of the terms i = from + j·step (j < len) and of their partners l·m on
+/// (l = 1, 2, 3) into d[l·len + j]. For counts, each lattice point's count is read once when the
+/// partners are few steps on (the three samples of the 4·len differences lie on the lattice).
+void lattice_differences(const PhaseSeries& x, std::size_t from, std::size_t step, std::size_t m, std::size_t len,
+                         std::vector<std::uint64_t>& g, double* d) {
+  const std::size_t r = m / step;  // m in lattice steps
+  if (!x.exact() || m % step != 0 || 5 * r > len) {
+    for (std::size_t l = 0; l < 4; ++l)
+      for (std::size_t j = 0, i = from + l * m; j < len; ++j, i += step) d[l * len + j] = second_difference(x, i, m);
+    return;
+  }
+  g.resize(len + 5 * r);
+  for (std::size_t t = 0; t < g.size(); ++t) g[t] = static_cast<std::uint64_t>(x.count(from + t * step));
+  for (std::size_t l = 0; l < 4; ++l)
+    for (std::size_t j = 0; j < len; ++j) {
+      const std::size_t k = j + l * r;
+      d[l * len + j] = static_cast<double>(static_cast<std::int64_t>(g[k + 2 * r] - 2 * g[k + r] + g[k]));
+    }
+}
+
 }  // namespace
 
 double measured_variance_ratio(const PhaseSeries& x, std::int64_t m) {
@@ -169,18 +198,15 @@ double measured_variance_ratio(const PhaseSeries& x, std::int64_t m) {
   double c[4][kLanes] = {}, p[4][kLanes] = {};  // kLanes accumulators each, so the loop vectorises
   const bool sampled = n > kRatioTerms;
   const std::size_t runs = sampled ? kRatioRuns : 1, run = sampled ? kRatioTerms / kRatioRuns : n;
-  // A run's terms m/4 apart at long τ (neighbours there share most of their samples through the
-  // other noises), never so far apart that the runs would overlap.
-  const std::size_t step = sampled ? std::clamp<std::size_t>(um / 4, 1, (n - 1) / kRatioTerms) : 1;
+  const std::size_t step = sampled ? term_spacing(um, (n - 1) / kRatioTerms) : 1;
   const std::size_t span = (run - 1) * step + 1;
   std::vector<double> d(4 * std::min(run, kRatioChunk));
+  std::vector<std::uint64_t> lattice;
   for (std::size_t r = 0; r < runs; ++r) {
     const std::size_t from = sampled ? r * (n - span) / (runs - 1) : 0;
     for (std::size_t i0 = 0; i0 < run; i0 += d.size() / 4) {
       const std::size_t len = std::min(d.size() / 4, run - i0);
-      for (std::size_t l = 0; l < 4; ++l)  // d at the terms i and their partners l·m on
-        for (std::size_t j = 0, i = from + i0 * step + l * um; j < len; ++j, i += step)
-          d[l * len + j] = second_difference(x, i, um);
+      lattice_differences(x, from + i0 * step, step, um, len, lattice, d.data());
       for (std::size_t l = 0; l < 4; ++l)
         for (std::size_t j = 0; j < len; ++j) {
           const double a = d[j], b = d[l * len + j];
