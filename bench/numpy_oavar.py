@@ -34,6 +34,24 @@ def oadev(phase, tau0, ms):
     return out
 
 
+def load_pulses(path):
+    """The pulse counts of a pulse file: its '# key: value' lines and 'pulses' header row skipped."""
+    with open(path, "rb") as f:
+        header_lines = 0
+        for line in f:
+            s = line.strip()
+            if s.startswith(b"#") or s == b"pulses":
+                header_lines += 1
+                continue
+            break
+    return np.loadtxt(path, dtype=np.int64, skiprows=header_lines, ndmin=1)
+
+
+def phase_of(pulses, scale):
+    """The phase in arcsec from the pulse counts (C_0 = 0)."""
+    return np.concatenate(([0.0], np.cumsum(pulses, dtype=np.float64))) * scale
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("file")
@@ -43,18 +61,9 @@ def main():
     ap.add_argument("--print", action="store_true")
     a = ap.parse_args()
     t0 = time.perf_counter()
-    # The pulse file has '# key: value' lines and a 'pulses' header row: skip both.
-    with open(a.file, "rb") as f:
-        header_lines = 0
-        for line in f:
-            s = line.strip()
-            if s.startswith(b"#") or s == b"pulses":
-                header_lines += 1
-                continue
-            break
-    pulses = np.loadtxt(a.file, dtype=np.int64, skiprows=header_lines, ndmin=1)
+    pulses = load_pulses(a.file)
     t1 = time.perf_counter()
-    phase = np.concatenate(([0.0], np.cumsum(pulses, dtype=np.float64))) * a.scale
+    phase = phase_of(pulses, a.scale)
     ms = cluster_sizes(len(phase), a.grid)
     dev = oadev(phase, 1.0 / a.rate, ms)
     t2 = time.perf_counter()

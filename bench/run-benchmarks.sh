@@ -4,7 +4,8 @@
 #      the NumPy baseline (bench/numpy_oavar.py: numpy.loadtxt + AllanTools' overlapping-ADEV
 #      algorithm on the octave grid), also as a whole process; the two alternate run by run so that
 #      both see the same load;
-#   2. `rwcalc analyze` of 24 h at 1 kHz (86.4 M samples) takes at most 3 s and 1.5 GB peak RSS.
+#   2. `rwcalc analyze` of 24 h at 1 kHz (86.4 M samples) takes at most 3 s and 1.5 GB peak RSS, and
+#      `rwcalc imu` of 6 channels × 24 h × 200 Hz at most 6 s (inputs from ../shared when present).
 #   3. the default 50-run `rwcalc diagnose` of the 2-h record takes at most 1.5× the NumPy
 #      baseline, side by side as in 1.
 # Other rows (dense grid, `allan`, `--tau all`, the `cat` floor) are figures without a target. It builds the `bench` preset if needed, generates the inputs with `rwcalc simulate`
@@ -14,18 +15,26 @@
 # given for both wall and CPU time.
 #
 # Usage: bench/run-benchmarks.sh [--repeat N] [--build-dir DIR] [--no-build] [--skip-24h]
-#                                [--skip-tau-all] [--kernels]
-#   --repeat N      runs per measurement (default 5; the median is reported)
-#   --build-dir D   build directory of the bench preset (default build-bench)
-#   --no-build      use the existing build as it is
-#   --skip-24h      skip the 24-h 1 kHz record (its text file takes ~1 min to generate once)
-#   --skip-tau-all  skip `allan --tau all` and its growth with N
-#   --kernels       also run the Google Benchmark kernels (bench_*) after the table
+#                                [--skip-tau-all] [--kernels] [--allantools DIR] [--gate] [--floor X]
+#   --repeat N        runs per measurement (default 5; the median is reported)
+#   --build-dir D     build directory of the bench preset (default build-bench)
+#   --no-build        use the existing build as it is
+#   --skip-24h        skip the 24-h records (1-kHz pulses and the IMU; ~1 min each to generate once)
+#   --skip-tau-all    skip `allan --tau all` and its growth with N
+#   --kernels         also run the Google Benchmark kernels (bench_*) after the table
+#   --allantools DIR  also time AllanTools' own oadev (bench/allantools_oadev.py, whole process)
+#                     side by side with target 1, from a checkout of AllanTools in DIR (not part of
+#                     rwcalc; needs python3-scipy); skipped when DIR holds no allantools package
+#   --gate            the regression gate CI runs: target 1 alone on an existing build (never
+#                     builds; give the release build with --build-dir build), both figures printed;
+#                     exits 1 when analyze is less than --floor times as fast as the NumPy baseline
+#                     in wall time
+#   --floor X         the gate's floor (default 8.33: a third of the 25x target)
 # Needs: cmake, g++, GNU time (/usr/bin/time; Debian package `time`), python3 with numpy
 # (Debian python3-numpy) for the baseline rows. Commands this build lacks show "not available".
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-repeat=5 build="$here/build-bench" do_build=1 skip24=0 skipall=0 kernels=0
+repeat=5 build="$here/build-bench" do_build=1 skip24=0 skipall=0 kernels=0 allantools="" gate=0 gate_floor=8.33
 while (($#)); do
   case "$1" in
     --repeat) repeat="$2"; shift 2 ;;
@@ -34,11 +43,15 @@ while (($#)); do
     --skip-24h) skip24=1; shift ;;
     --skip-tau-all) skipall=1; shift ;;
     --kernels) kernels=1; shift ;;
+    --allantools) allantools="$2"; shift 2 ;;
+    --gate) gate=1 do_build=0 skip24=1 skipall=1; shift ;;
+    --floor) gate_floor="$2"; shift 2 ;;
     -h|--help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;;
     *) echo "run-benchmarks.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
 [[ "$repeat" =~ ^[1-9][0-9]*$ ]] || { echo "run-benchmarks.sh: --repeat needs a positive integer" >&2; exit 2; }
+[[ "$gate_floor" =~ ^[0-9]+(\.[0-9]+)?$ ]] || { echo "run-benchmarks.sh: --floor needs a positive number" >&2; exit 2; }
 [[ -x /usr/bin/time ]] || { echo "run-benchmarks.sh: GNU time is missing: apt-get install -y time" >&2; exit 2; }
 
 # ---- build ------------------------------------------------------------------------------------
@@ -76,6 +89,18 @@ if ((!skip24)) && [[ ! -s "$day" ]]; then
   echo "generating the 24-h 1 kHz record (once) ..." >&2
   "$rw" simulate -o "$day" --force --duration 86400 --rate 1000 --scale 0.92 --latitude 55.75 \
     --white-readout --arw 0.001 --rrw 0.0005 --seed 86400 >/dev/null
+fi
+
+# A 6-channel 24-h 200-Hz IMU record (17.28 M lines, ~660 MB): the ADIS16405 static run of
+# ../shared/data/real repeated to a day (its own 100 Hz read as 200 Hz; the time does not depend on
+# what the samples hold). Skipped without the shared data.
+imu_day="$inputs/imu_day_200Hz.csv"
+adis="$here/../shared/data/real/imudata_adis16405/adis_16405_imu1.csv.gz"
+if ((!skip24)) && [[ ! -s "$imu_day" && -s "$adis" ]]; then
+  echo "generating the 24-h 6-channel IMU record (once) ..." >&2
+  { gzip -dc "$adis" | sed -n 3p  # the header row; then 17.28 copies of the 1 M data lines
+    for _ in $(seq 17); do gzip -dc "$adis" | sed -n '4,$p'; done
+    gzip -dc "$adis" | sed -n '4,280003p'; } >"$imu_day.part" && mv "$imu_day.part" "$imu_day"
 fi
 
 # ---- measurement helpers ----------------------------------------------------------------------
@@ -157,27 +182,66 @@ side_by_side() {
   rss_mb=$rss status=$st
 }
 
+# The gate: target 1 alone, both figures, and the verdict in the exit status. A ratio of two
+# processes measured together, never an absolute time: a loaded machine slows both.
+if ((gate)); then
+  available analyze || { echo "run-benchmarks.sh: $rw has no analyze command" >&2; exit 2; }
+  [[ -n "$py" ]] || { echo "run-benchmarks.sh: --gate needs python3 with numpy (python3-numpy)" >&2; exit 2; }
+  side_by_side "$repeat" "$rw" analyze "$run2h" --json -- "$py" "$here/bench/numpy_oavar.py" "$run2h" --grid octave
+  ((status)) && { echo "run-benchmarks.sh: a run failed (exit $status): $(head -c 300 "$tmp/err.txt")" >&2; exit 2; }
+  sw=$(calc "$b_s / $a_s") sc=$(calc "$b_c / $a_c")
+  printf 'analyze of the 2-h 400-Hz file vs the NumPy baseline (read + octave OADEV), median of %s alternating runs:\n' "$repeat"
+  printf '  rwcalc analyze: %s wall, %s CPU;  NumPy baseline: %s wall, %s CPU\n' \
+    "$(fmt_t "$a_s")" "$(fmt_t "$a_c")" "$(fmt_t "$b_s")" "$(fmt_t "$b_c")"
+  printf '  ratio: %.1fx wall (%.1fx CPU); floor %sx (target 25x); load %s\n' "$sw" "$sc" "$gate_floor" "$(loadavg)"
+  if awk "BEGIN { exit !($sw < $gate_floor) }"; then
+    printf 'benchmark gate: FAILED: analyze is %.2fx as fast as the baseline, below the floor of %sx\n' "$sw" "$gate_floor" >&2
+    exit 1
+  fi
+  echo "benchmark gate: passed"
+  exit 0
+fi
+
 speed_name="analyze 2-h 400 Hz vs NumPy read + octave OADEV (whole processes)"
+# analyze_vs NAME PEER_CMD...: analyze of the 2-h file side by side with a peer process; its row,
+# the target met when analyze is at least 25 times as fast in wall time.
+analyze_vs() {
+  local name="$1" l; shift
+  l=$(loadavg)
+  side_by_side "$repeat" "$rw" analyze "$run2h" --json -- "$@"
+  if ((status)); then row "$name" "≥ 25× faster" "$(failed)" "" "" "" "$l"; return; fi
+  local sw sc
+  sw=$(calc "$b_s / $a_s") sc=$(calc "$b_c / $a_c")
+  row "$name" "≥ 25× faster" \
+    "$(printf '%.1f× (%s vs %s)' "$sw" "$(fmt_t "$a_s")" "$(fmt_t "$b_s")")" \
+    "$(printf '%.1f× (%s vs %s)' "$sc" "$(fmt_t "$a_c")" "$(fmt_t "$b_c")")" \
+    "$(fmt_mb "$rss_mb")" "$(verdict "$sw >= 25")" "$l"
+}
 if ! available analyze; then
   row "$speed_name" "≥ 25× faster" "not available" "" "" "" ""
 elif [[ -z "$py" ]]; then
   row "$speed_name" "≥ 25× faster" "not measured (no python3 with numpy)" "" "" "" ""
 else
-  l=$(loadavg)
-  side_by_side "$repeat" "$rw" analyze "$run2h" --json -- "$py" "$here/bench/numpy_oavar.py" "$run2h" --grid octave
-  if ((status)); then row "$speed_name" "≥ 25× faster" "$(failed)" "" "" "" "$l"
-  else
-    sw=$(calc "$b_s / $a_s") sc=$(calc "$b_c / $a_c")
-    row "$speed_name" "≥ 25× faster" \
-      "$(printf '%.1f× (%s vs %s)' "$sw" "$(fmt_t "$a_s")" "$(fmt_t "$b_s")")" \
-      "$(printf '%.1f× (%s vs %s)' "$sc" "$(fmt_t "$a_c")" "$(fmt_t "$b_c")")" \
-      "$(fmt_mb "$rss_mb")" "$(verdict "$sw >= 25")" "$l"
+  analyze_vs "$speed_name" "$py" "$here/bench/numpy_oavar.py" "$run2h" --grid octave
+fi
+at_name="analyze 2-h 400 Hz vs AllanTools' own oadev (read + octave OADEV, whole processes)"
+if [[ -n "$allantools" ]]; then
+  if [[ ! -f "$allantools/allantools/__init__.py" ]]; then
+    row "$at_name" "≥ 25× faster" "skipped (no allantools package in $allantools)" "" "" "" ""
+  elif [[ -z "$py" ]] || ! "$py" -c 'import scipy' 2>/dev/null; then
+    row "$at_name" "≥ 25× faster" "skipped (AllanTools needs python3 with numpy and scipy)" "" "" "" ""
+  elif available analyze; then
+    analyze_vs "$at_name" "$py" "$here/bench/allantools_oadev.py" "$allantools" "$run2h"
   fi
 fi
 if available analyze; then
   if ((!skip24)); then
     timed "analyze 24-h 1 kHz (86.4 M samples)" "≤ 3 s, ≤ 1.5 GB" "w <= 3 && r <= 1536" \
       "$rw" analyze "$day" --json || true
+  fi
+  if [[ -s "$imu_day" ]] && available imu; then
+    timed "imu 6 channels × 24 h × 200 Hz (17.28 M lines)" "≤ 6 s" "w <= 6" "$rw" imu "$imu_day" --rate 200 --json \
+      --gyro gyro_x_dps,gyro_y_dps,gyro_z_dps --accel acc_x_g,acc_y_g,acc_z_g || true
   fi
   if has_option analyze --tau; then
     timed "analyze 2-h, dense grid (20/decade to N/10)" "—" "" "$rw" analyze "$run2h" --json --tau dense || true

@@ -2,7 +2,7 @@
 // non-overlapping second-difference sums at every length around the block size, for small and huge
 // steps (blocks inside and beyond the 64-bit fast path), with any counter offset and across the
 // counter's wrap-around; the sweep of a whole grid against the per-τ sums on one and two threads;
-// the modified variance's numerator from prefix sums.
+// the modified variance's numerator from prefix sums; the 16-bit sums against the exact ones.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "allan/allan_kernels.hpp"
+#include "allan/narrow_counts.hpp"
 #include "rwcalc/allan.hpp"
 #include "test_support.hpp"
 
@@ -126,6 +127,61 @@ TEST(ExactKernels, SweepEqualsThePerTauSumsOnOneAndTwoThreads) {
   const std::int64_t n1 = static_cast<std::int64_t>(c.size()) - 2;
   EXPECT_TRUE(second_diff_sumsq(c.data(), n1, 1, 1) == brute_sumsq(c, n1, 1, 1));
   EXPECT_TRUE(second_diff_sumsq(c.data(), n1, 1, 1) > (static_cast<u128>(1) << 52) * 40u) << "no wide block";
+}
+
+/// Counts with small steps about a steady rate of `slope` counts per point (a trend the narrow
+/// sums must take out), from an offset near the counter's wrap.
+std::vector<std::int64_t> drifting(std::size_t n, std::int64_t step, std::int64_t slope, std::uint64_t seed) {
+  std::vector<std::int64_t> c = walk(n, step, seed);
+  for (std::size_t k = 0; k < n; ++k) c[k] += slope * static_cast<std::int64_t>(k);
+  return shifted(c, kWrapping);
+}
+
+// The 16-bit sums equal the exact ones wherever the counts' bounds let them run, and they run on
+// small steps under any whole trend; beyond the bound they decline (the caller sums in 64 bits).
+TEST(ExactKernels, NarrowSumsAreExactWhereTheirBoundHolds) {
+  for (const std::int64_t slope : {std::int64_t{0}, std::int64_t{3}, std::int64_t{-1000}}) {
+    const auto c = drifting(40'000, 1, slope, 11 + static_cast<std::uint64_t>(slope < 0));
+    const NarrowCounts narrow(c.data(), c.size());
+    std::size_t taken = 0;
+    for (std::size_t m : {std::size_t{1}, std::size_t{2}, std::size_t{64}, std::size_t{1000}, std::size_t{9000}})
+      for (std::size_t k0 = 0; k0 + 2 * m < c.size(); k0 += 4567) {
+        const std::size_t len = std::min<std::size_t>(NarrowCounts::kMaxTerms, c.size() - 2 * m - k0);
+        const auto s = narrow.second_diff_sumsq(k0, len, m);
+        if (!s) continue;
+        ++taken;
+        u128 want = 0;
+        for (std::size_t k = k0; k < k0 + len; ++k) {
+          const i128 d = brute_diff(c, static_cast<std::int64_t>(k), static_cast<std::int64_t>(m));
+          want += static_cast<u128>(d * d);
+        }
+        EXPECT_TRUE(u128{*s} == want) << "slope " << slope << " m " << m << " k0 " << k0;
+      }
+    EXPECT_GT(taken, 30u) << "slope " << slope;
+    for (std::size_t t : {std::size_t{1}, std::size_t{400}, std::size_t{7000}})
+      for (const std::int64_t shift : {slope * static_cast<std::int64_t>(t), slope * static_cast<std::int64_t>(t) + 5})
+        for (std::size_t k0 = 0; k0 + t < c.size(); k0 += 9001) {
+          const std::size_t len = std::min<std::size_t>(NarrowCounts::kMaxTerms, c.size() - t - k0);
+          std::int64_t s1 = 0;
+          std::uint64_t s2 = 0;
+          ASSERT_TRUE(narrow.increment_sums(k0, len, t, shift, s1, s2)) << "t " << t << " k0 " << k0;
+          i128 w1 = 0, w2 = 0;
+          for (std::size_t k = k0; k < k0 + len; ++k) {
+            const auto e = static_cast<std::int64_t>(static_cast<std::uint64_t>(c[k + t]) -
+                                                     static_cast<std::uint64_t>(c[k]) - static_cast<std::uint64_t>(shift));
+            w1 += e;
+            w2 += static_cast<i128>(e) * e;
+          }
+          EXPECT_TRUE(i128{s1} == w1 && i128{s2} == w2) << "slope " << slope << " t " << t << " k0 " << k0;
+        }
+  }
+  // Steps of 2^12 (second differences far beyond 2^11) and an increment shift far off the mean.
+  const auto wide = drifting(5000, std::int64_t{1} << 12, 0, 2);
+  const NarrowCounts narrow(wide.data(), wide.size());
+  EXPECT_FALSE(narrow.second_diff_sumsq(0, NarrowCounts::kMaxTerms, 100));
+  std::int64_t s1 = 0;
+  std::uint64_t s2 = 0;
+  EXPECT_FALSE(narrow.increment_sums(0, 1000, 1000, std::int64_t{1} << 40, s1, s2));
 }
 
 TEST(ExactKernels, SweepOfNothing) {

@@ -227,8 +227,9 @@ TEST(Outliers, LongRecordFindsEverySpikeOnceInOrder) {
 namespace {
 
 // The scan of a phase series (rates computed stretch by stretch) is the scan of its rates as a
-// vector, bit for bit: scale, indices, values and z, on exact counts and on a floating phase, with
-// RWCALC_THREADS=1 and =2.
+// vector, bit for bit: scale, indices, values and z, on exact counts (whose candidates are screened
+// on the counts, in a stretch with a count beyond 13 bits through the rates) and on a floating
+// phase, with RWCALC_THREADS=1 and =2.
 TEST(Outliers, PhaseSeriesScanEqualsVectorScan) {
   std::mt19937_64 rng(21);
   std::poisson_distribution<int> pulses(2.5);
@@ -240,6 +241,7 @@ TEST(Outliers, PhaseSeriesScanEqualsVectorScan) {
   for (std::size_t i = 0; i < n; ++i) {
     std::int64_t c = pulses(rng);
     if (i % 99991 == 17 || i == 1 || i == n - 1) c += 60;  // glitches, two at the very ends
+    if (i == 500000) c += 20000;  // beyond the 13 bits of the counts' candidate screen
     counts.counts.push_back(counts.counts.back() + c);
   }
   rwcalc::PhaseSeries floating;

@@ -211,6 +211,11 @@ double variance_at(const PhaseSeries& x, const CountData& data, std::int64_t m, 
                                    : detail::third_diff_sumsq(x.values.data(), n, m, stride);
     return sumsq * sum_scale(x) / (6.0 * tau * tau * static_cast<double>(n));
   }
+  if (x.exact() && overlapping) {  // a pass over the whole record: the sweep's stretches run in parallel
+    const std::int64_t one[] = {m};
+    return avar_from_sum(static_cast<double>(detail::second_diff_sumsq_sweep(data.c, x.points(), one)[0]), sum_scale(x),
+                         tau, n);
+  }
   const double sumsq = x.exact() ? static_cast<double>(detail::second_diff_sumsq(data.c, n, m, stride))
                                  : detail::second_diff_sumsq(x.values.data(), n, m, stride);
   return avar_from_sum(sumsq, sum_scale(x), tau, n);

@@ -3,7 +3,9 @@
 #include "allan/allan_kernels.hpp"
 
 #include <algorithm>
+#include <optional>
 
+#include "allan/narrow_counts.hpp"
 #include "rwcalc/parallel.hpp"
 
 namespace rwcalc::detail {
@@ -66,10 +68,15 @@ u128 third_diff_sumsq(const std::int64_t* c, std::int64_t n, std::int64_t m, std
 std::vector<u128> second_diff_sumsq_sweep(const std::int64_t* c, std::size_t points, std::span<const std::int64_t> ms) {
   const auto np = static_cast<std::int64_t>(points);
   const std::size_t count = ms.size();
+  if (count == 0) return {};
   std::int64_t longest = 0;
   for (std::int64_t m : ms) longest = std::max(longest, np - 2 * m);
   const auto parts = static_cast<std::size_t>((longest + kStretch - 1) / kStretch);
   std::vector<u128> part_sums(parts * count, 0);
+  static_assert(kBlock <= static_cast<std::int64_t>(NarrowCounts::kMaxTerms));
+  // Narrow sums pay for their pass over the record when several m share it.
+  const std::optional<NarrowCounts> narrow = count > 1 ? std::optional<NarrowCounts>(std::in_place, c, points)
+                                                       : std::nullopt;
   parallel_for(parts, [&](std::size_t part) {
     const std::int64_t from = static_cast<std::int64_t>(part) * kStretch;
     const std::int64_t to = std::min(longest, from + kStretch);
@@ -77,7 +84,13 @@ std::vector<u128> second_diff_sumsq_sweep(const std::int64_t* c, std::size_t poi
     for (std::int64_t k0 = from; k0 < to; k0 += kBlock) {
       for (std::size_t i = 0; i < count; ++i) {
         const std::int64_t n = np - 2 * ms[i];
-        if (k0 < n) out[i] += block_sumsq<2>(c + k0, std::min(kBlock, n - k0), ms[i], 1);
+        if (k0 >= n) continue;
+        const std::int64_t len = std::min(kBlock, n - k0);
+        const auto small = narrow ? narrow->second_diff_sumsq(static_cast<std::size_t>(k0),
+                                                              static_cast<std::size_t>(len),
+                                                              static_cast<std::size_t>(ms[i]))
+                                  : std::nullopt;
+        out[i] += small ? u128{*small} : block_sumsq<2>(c + k0, len, ms[i], 1);
       }
     }
   });

@@ -27,7 +27,8 @@ double third_diff_sumsq(const double* x, std::int64_t n, std::int64_t m, std::in
 
 /// The overlapping sums second_diff_sumsq(c, points − 2m, m, 1) of every m of ms in one blocked
 /// sweep: each block of terms is taken for every m while it is in the core's cache, and stretches
-/// of the record run in parallel. Exact, so bit for bit the per-m sums.
+/// of the record run in parallel; a block whose terms are small is summed in 16-bit lanes
+/// (narrow_counts.hpp). Exact, so bit for bit the per-m sums.
 std::vector<u128> second_diff_sumsq_sweep(const std::int64_t* c, std::size_t points, std::span<const std::int64_t> ms);
 
 /// Modular prefix sums of the counts: P[0] = 0, P[k+1] = P[k] + C[k] (points + 1 entries).

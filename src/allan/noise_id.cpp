@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "rwcalc/confidence.hpp"
@@ -143,59 +144,115 @@ double r1_from_exact(const ExactLag1& s, std::size_t len, std::int64_t z_first, 
 /// Terms per block: while every |z| ≤ 2^26 a block's Σz² and Σz·z' stay below 2^62, so it is summed
 /// in 64 bits and flushed into the 128-bit totals; a block with a larger z is summed in 128 bits.
 constexpr std::size_t kBlock = 1024;
+/// Difference levels whose sums one gather of the decimated phase feeds at most.
+constexpr int kLevelsAtOnce = 2;
 
-template <class Acc, class Wide>
-void add_block(const std::int64_t* z, std::size_t n, std::size_t pairs, u128 (&s)[3]) {
-  Acc a = 0, b = 0, c = 0;
+/// The exact sums of one level over a block: z (n values, and z[n] the next one, 0 at the record's
+/// end, where `pairs` = n − 1). False when some |z| ≥ kZLimit (the 128-bit sums could then overflow).
+bool add_block(const std::int64_t* z, std::size_t n, std::size_t pairs, u128 (&s)[3]) {
+  std::int64_t a = 0, b = 0, c = 0;
+  std::uint64_t small = 0;  // below 2^27 iff every −2^26 ≤ z < 2^26: then no int64 sum overflows
   for (std::size_t i = 0; i < n; ++i) {
-    a += static_cast<Acc>(static_cast<Wide>(z[i]));
-    b += static_cast<Acc>(static_cast<Wide>(z[i]) * z[i]);
+    small |= static_cast<std::uint64_t>(z[i]) + (kZLimit >> 8);
+    a += z[i];  // modulo 2^64 (unsigned arithmetic would say the same), used only when small
+    b += static_cast<std::int64_t>(static_cast<std::uint64_t>(z[i]) * static_cast<std::uint64_t>(z[i]));
+    c += static_cast<std::int64_t>(static_cast<std::uint64_t>(z[i]) * static_cast<std::uint64_t>(z[i + 1]));
   }
-  for (std::size_t i = 0; i < pairs; ++i) c += static_cast<Acc>(static_cast<Wide>(z[i]) * z[i + 1]);
-  s[0] += static_cast<u128>(static_cast<i128>(a));
-  s[1] += static_cast<u128>(static_cast<i128>(b));
-  s[2] += static_cast<u128>(static_cast<i128>(c));
+  if (small < (kZLimit >> 7)) {
+    s[0] += static_cast<u128>(static_cast<i128>(a));
+    s[1] += static_cast<u128>(static_cast<i128>(b));
+    s[2] += static_cast<u128>(static_cast<i128>(c));
+    return true;
+  }
+  std::uint64_t range = 0;
+  for (std::size_t i = 0; i < n; ++i) range |= static_cast<std::uint64_t>(z[i]) + kZLimit;
+  if (range >= 2 * kZLimit) return false;
+  for (std::size_t i = 0; i < n; ++i) {
+    s[0] += static_cast<u128>(static_cast<i128>(z[i]));
+    s[1] += static_cast<u128>(static_cast<i128>(z[i]) * z[i]);
+    if (i < pairs) s[2] += static_cast<u128>(static_cast<i128>(z[i]) * z[i + 1]);
+  }
+  return true;
 }
 
-/// r1 of the level-th difference z of p(0) … p(count − 1) from exact sums; nothing when they could
-/// leave 128 bits (the sums run modulo 2^128 and are used only when every |z| < kZLimit). The
-/// differences of a block are taken in place, modulo 2^64: exact while |z| < 2^63.
+/// r1 of the difference levels first … first + r1.size() − 1 (at most kLevelsAtOnce) of p(0) …
+/// p(count − 1) from exact sums, the decimated phase gathered once for all of them; nothing for a
+/// level whose sums could leave 128 bits (they run modulo 2^128 and are used only when every
+/// |z| < kZLimit). The differences of a block are taken modulo 2^64: exact while |z| < 2^63.
 template <class P>
-std::optional<double> lag1_exact(const P& p, std::size_t count, int level) {
-  if (count <= static_cast<std::size_t>(level) + 1) return 0.0;
-  if (count >= kExactMaxPoints) return std::nullopt;
-  const auto lv = static_cast<std::size_t>(level);
-  const std::size_t len = count - lv;
-  u128 s[3] = {};
-  std::int64_t z[kBlock + 4], z_first = 0, z_last = 0;
-  for (std::size_t k0 = 0; k0 < len; k0 += kBlock) {
-    const std::size_t n = std::min(kBlock, len - k0), pairs = k0 + n < len ? n : n - 1;
-    for (std::size_t i = 0; i < pairs + 1 + lv; ++i) z[i] = static_cast<std::int64_t>(p(k0 + i));
-    for (std::size_t d = 0; d < lv; ++d)
-      for (std::size_t i = 0; i < pairs + lv - d; ++i)
-        z[i] = static_cast<std::int64_t>(static_cast<std::uint64_t>(z[i + 1]) - static_cast<std::uint64_t>(z[i]));
-    std::uint64_t small = 0, range = 0;  // below 2^27 (2^35) iff every −2^26 ≤ z < 2^26 (2^34)
-    for (std::size_t i = 0; i < n; ++i) small |= static_cast<std::uint64_t>(z[i]) + (kZLimit >> 8);
-    if (small < (kZLimit >> 7)) {
-      add_block<std::int64_t, std::int64_t>(z, n, pairs, s);
-    } else {
-      for (std::size_t i = 0; i < n; ++i) range |= static_cast<std::uint64_t>(z[i]) + kZLimit;
-      if (range >= 2 * kZLimit) return std::nullopt;
-      add_block<u128, i128>(z, n, pairs, s);
+void lag1_exact(const P& p, std::size_t count, int first, std::span<std::optional<double>> r1) {
+  const auto levels = static_cast<std::size_t>(std::min<std::ptrdiff_t>(std::ssize(r1), kLevelsAtOnce));
+  const auto lv0 = static_cast<std::size_t>(first);
+  struct Level {
+    u128 s[3] = {};
+    std::int64_t z_first = 0, z_last = 0;
+    bool exact = true;
+  } lev[kLevelsAtOnce];
+  std::int64_t g[kBlock + 1 + 3 + kLevelsAtOnce], z[kBlock + 1 + 3 + kLevelsAtOnce];
+  const std::size_t longest = count > lv0 ? count - lv0 : 0;
+  for (std::size_t k0 = 0; k0 < longest; k0 += kBlock) {
+    const std::size_t have = std::min(kBlock + 1 + lv0 + levels - 1, count - k0);
+    for (std::size_t i = 0; i < have; ++i) g[i] = static_cast<std::int64_t>(p(k0 + i));
+    for (std::size_t l = 0; l < levels; ++l) {
+      const std::size_t lv = lv0 + l, len = count > lv ? count - lv : 0;
+      if (k0 >= len || !lev[l].exact) continue;
+      const std::size_t n = std::min(kBlock, len - k0), pairs = k0 + n < len ? n : n - 1;
+      const std::size_t width = std::min(n + 1, len - k0);  // z values used: with the successor if any
+      for (std::size_t i = 0; i < width + lv; ++i) z[i] = g[i];
+      for (std::size_t d = 0; d < lv; ++d)
+        for (std::size_t i = 0; i < width + lv - d - 1; ++i)
+          z[i] = static_cast<std::int64_t>(static_cast<std::uint64_t>(z[i + 1]) - static_cast<std::uint64_t>(z[i]));
+      if (width == n) z[n] = 0;  // the record's last block: no successor
+      lev[l].exact = add_block(z, n, pairs, lev[l].s);
+      if (k0 == 0) lev[l].z_first = z[0];
+      lev[l].z_last = z[n - 1];
     }
-    if (k0 == 0) z_first = z[0];
-    z_last = z[n - 1];
   }
-  const ExactLag1 e{static_cast<i128>(s[0]), static_cast<i128>(s[1]), static_cast<i128>(s[2])};
-  return r1_from_exact(e, len, z_first, z_last);
+  for (std::size_t l = 0; l < levels; ++l) {
+    const std::size_t lv = lv0 + l;
+    if (count <= lv + 1) {
+      r1[l] = 0.0;
+    } else if (count >= kExactMaxPoints || !lev[l].exact) {
+      r1[l] = std::nullopt;
+    } else {
+      const ExactLag1 e{static_cast<i128>(lev[l].s[0]), static_cast<i128>(lev[l].s[1]), static_cast<i128>(lev[l].s[2])};
+      r1[l] = r1_from_exact(e, count - lv, lev[l].z_first, lev[l].z_last);
+    }
+  }
+}
+
+/// r1 of the levels first … first + r1.size() − 1 (at most kLevelsAtOnce) of the phase decimated by m.
+void lag1_autocorrelations(const PhaseSeries& x, std::int64_t m, std::size_t count, int first, std::span<double> r1) {
+  const auto um = static_cast<std::size_t>(m);
+  if (x.exact()) {
+    const auto c0 = static_cast<std::uint64_t>(x.count(0));
+    auto p = [&x, c0, um](std::size_t k) { return static_cast<std::uint64_t>(x.count(k * um)) - c0; };
+    std::optional<double> exact[kLevelsAtOnce];
+    const std::size_t levels = std::min<std::size_t>(r1.size(), kLevelsAtOnce);
+    lag1_exact(p, count, first, std::span(exact, levels));
+    for (std::size_t l = 0; l < levels; ++l)
+      r1[l] = exact[l] ? *exact[l]
+                       : lag1_floating([&p](std::size_t k) { return static_cast<double>(static_cast<std::int64_t>(p(k))); },
+                                       count, first + static_cast<int>(l));
+    return;
+  }
+  const double* v = x.values.data();
+  for (std::size_t l = 0; l < r1.size(); ++l)
+    r1[l] = lag1_floating([v, um](std::size_t k) { return v[k * um] - v[0]; }, count, first + static_cast<int>(l));
 }
 
 /// Lag-1 ACF method on the phase decimated by m, starting at difference level `base` (0: phase
 /// data, 1: frequency data): difference until δ = r1/(1 + r1) < 0.25 or d = d_max;
 /// p = −round(2δ) − 2d. Returns p, the exponent of the analysed series' own spectrum.
 int acf_exponent(const PhaseSeries& x, std::int64_t m, std::size_t count, int base) {
-  for (int d = 0;; ++d) {
-    const double r1 = detail::lag1_autocorrelation(x, m, count, base + d);
+  double r1s[kMaxDifferences + 1] = {};
+  for (int d = 0, known = 0;; ++d) {
+    if (d == known) {  // this level and the next from one pass: the phase itself seldom ends it
+      const int levels = std::min(kLevelsAtOnce, kMaxDifferences + 1 - d);
+      lag1_autocorrelations(x, m, count, base + d, std::span(r1s + d, static_cast<std::size_t>(levels)));
+      known += levels;
+    }
+    const double r1 = r1s[d];
     const double delta = r1 / (1.0 + r1);
     if (delta < 0.25 || d >= kMaxDifferences) return -static_cast<int>(std::lround(2.0 * delta)) - 2 * d;
   }
@@ -271,16 +328,9 @@ int noise_id_b1(const PhaseSeries& x, std::int64_t m, Estimator est) {
 namespace detail {
 
 double lag1_autocorrelation(const PhaseSeries& x, std::int64_t m, std::size_t count, int level) {
-  const auto um = static_cast<std::size_t>(m);
-  if (x.exact()) {
-    const auto c0 = static_cast<std::uint64_t>(x.count(0));
-    auto p = [&x, c0, um](std::size_t k) { return static_cast<std::uint64_t>(x.count(k * um)) - c0; };
-    if (const std::optional<double> r1 = lag1_exact(p, count, level)) return *r1;
-    return lag1_floating([&p](std::size_t k) { return static_cast<double>(static_cast<std::int64_t>(p(k))); }, count,
-                         level);
-  }
-  const double* v = x.values.data();
-  return lag1_floating([v, um](std::size_t k) { return v[k * um] - v[0]; }, count, level);
+  double r1 = 0;
+  lag1_autocorrelations(x, m, count, level, std::span(&r1, 1));
+  return r1;
 }
 
 }  // namespace detail

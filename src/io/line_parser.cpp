@@ -82,20 +82,61 @@ LineKind LineParser::parse(std::string_view text, std::size_t line, Sample& s) {
   return LineKind::Data;
 }
 
+namespace {
+
+// An optional minus and 1–18 digits (no overflow) from p on, as far as they go; p is left after them.
+// Bounded: without checking `end` while at least 20 bytes remain (a sign and 19 digits).
+template <bool Bounded = true>
+bool plain_value(const char*& p, const char* end, std::int64_t& v) {
+  const bool neg = (!Bounded || p < end) && *p == '-';
+  const char* digits = p + neg;
+  std::uint64_t u = 0;
+  const char* q = digits;
+  for (; (!Bounded || q < end) && q - digits < 19; ++q) {
+    const auto d = static_cast<unsigned char>(*q - '0');
+    if (d > 9) break;
+    u = u * 10 + d;  // 19 digits may wrap modulo 2^64: refused below
+  }
+  if (q == digits || q - digits > 18) return false;
+  v = neg ? -static_cast<std::int64_t>(u) : static_cast<std::int64_t>(u);
+  p = q;
+  return true;
+}
+
+}  // namespace
+
+// The one integer column of pulses or a counter, which plain_integer and plain_integer_lines read.
+bool LineParser::plain_layout() const noexcept {
+  return layout_known_ && layout_.ncols == 1 && layout_.roles[0] == Role::Value && integer_mode();
+}
+
 // The common data line, read without splitting: one integer column and the line just an optional
 // minus and up to 18 digits (no overflow). Anything else goes the general way, which reports.
 bool LineParser::plain_integer(std::string_view t, Sample& s) const {
-  if (!layout_known_ || layout_.ncols != 1 || layout_.roles[0] != Role::Value || !integer_mode()) return false;
-  const bool neg = !t.empty() && t.front() == '-';
-  if (t.size() == static_cast<std::size_t>(neg) || t.size() > 18 + static_cast<std::size_t>(neg)) return false;
-  std::int64_t v = 0;
-  for (std::size_t i = neg; i < t.size(); ++i) {
-    const auto d = static_cast<unsigned char>(t[i] - '0');
-    if (d > 9) return false;
-    v = v * 10 + d;
-  }
-  s.integer = neg ? -v : v;
+  if (!plain_layout()) return false;
+  const char* p = t.data();
+  if (!plain_value(p, t.data() + t.size(), s.integer) || p != t.data() + t.size()) return false;
   return input_.mode != InputMode::Counter || (s.integer >= counter_lo_ && s.integer <= counter_max_);
+}
+
+const char* LineParser::plain_integer_lines(const char* p, const char* end, std::size_t& line,
+                                            std::vector<std::int64_t>& out) {
+  if (!plain_layout()) return p;
+  const bool counter = input_.mode == InputMode::Counter;
+  const std::size_t before = out.size();
+  // Lines with 22 bytes to spare (sign, 19 digits, CR, LF) need no look at `end`.
+  const char* roomy = end - p > 22 ? end - 22 : p;
+  for (const char* q = p; q < end; p = q) {
+    std::int64_t v = 0;
+    if (!(q < roomy ? plain_value<false>(q, end, v) : plain_value(q, end, v)) || q == end) break;
+    if (*q == '\r' && q + 1 < end) ++q;  // CR LF
+    if (*q != '\n' || (counter && (v < counter_lo_ || v > counter_max_))) break;
+    ++q;
+    out.push_back(v);
+  }
+  line += out.size() - before;
+  content_lines_ += out.size() - before;
+  return p;
 }
 
 void LineParser::check_foreign_delimiters(std::string_view line) const {

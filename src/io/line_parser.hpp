@@ -40,6 +40,12 @@ class LineParser {
   [[nodiscard]] const InputChoice& input() const noexcept { return input_; }
   [[nodiscard]] bool layout_known() const noexcept { return layout_known_; }
 
+  /// The common data lines read on from `p` in one loop: while the layout is one integer column,
+  /// each line that is an optional minus and 1–18 digits ended by LF (or CR LF) is appended to `out`
+  /// and counted in `line` and content_lines(). Returns where the first other line starts (or the
+  /// last one without its line end before `end`): parse() takes that one, and reports it if need be.
+  const char* plain_integer_lines(const char* p, const char* end, std::size_t& line, std::vector<std::int64_t>& out);
+
  private:
   [[noreturn]] void fail(const std::string& message) const;
   void split(std::string_view line);
@@ -47,6 +53,7 @@ class LineParser {
   bool header_row(std::string_view line);
   bool read_fields(Sample& s, bool report);
   bool read_field(std::string_view f, Role role, Sample& s, bool report);
+  [[nodiscard]] bool plain_layout() const noexcept;
   bool plain_integer(std::string_view t, Sample& s) const;
   bool read_integer(std::string_view f, std::string_view t, Sample& s, bool report);
   [[nodiscard]] bool integer_mode() const noexcept {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <type_traits>
 
 #include "rwcalc/parallel.hpp"
@@ -21,36 +22,50 @@ constexpr double kMadToSigma = 1.482602218505602;  // 1/Φ⁻¹(3/4)
 // and thus every result, do not depend on the number of threads.
 constexpr std::size_t kChunk = std::size_t{1} << 16;
 
-inline void sort2(double& a, double& b) {
-  const double lo = std::min(a, b);
+template <class T>
+inline void sort2(T& a, T& b) {
+  const T lo = std::min(a, b);
   b = std::max(a, b);
   a = lo;
 }
 
-// Median of six values: a 12-comparator sorting network (branch-free, so the compiler can
-// vectorise the screen), then the mean of the middle two.
-inline double median6(double a, double b, double c, double d, double e, double f) {
+// The middle pair of six values, left in c and d: a 12-comparator sorting network (branch-free, so
+// the compiler can vectorise the screen).
+template <class T>
+inline void middle_pair6(T& a, T& b, T& c, T& d, T& e, T& f) {
   sort2(a, f), sort2(b, d), sort2(c, e);
   sort2(b, c), sort2(d, e);
   sort2(a, d), sort2(c, f);
   sort2(a, b), sort2(c, d), sort2(e, f);
   sort2(b, c), sort2(d, e);
+}
+
+// Median of six values: the mean of the middle two.
+inline double median6(double a, double b, double c, double d, double e, double f) {
+  middle_pair6(a, b, c, d, e, f);
   return 0.5 * (c + d);
 }
 
 // The rates of a record, read through windows: from a vector, or computed from a phase series
 // as Recording::rates() computes them (no copy of the whole record). Both give the same doubles.
+// Pulse counts take few values: their rates come from a table of the small ones (the same doubles).
 struct RateSource {
+  static constexpr std::int64_t kTabled = 64;  // counts per sample tabled either side of 0
   const std::vector<double>* vector = nullptr;
   const PhaseSeries* phase = nullptr;
   std::size_t n = 0;
+  std::vector<double> count_rate;  // PhaseSeries::rate of an increment of c counts, |c| ≤ kTabled
 
   void fill(std::size_t from, std::size_t to, double* out) const {
     if (vector) {
       std::copy(vector->begin() + static_cast<std::ptrdiff_t>(from), vector->begin() + static_cast<std::ptrdiff_t>(to),
                 out);
     } else if (phase->exact()) {
-      for (std::size_t i = from; i < to; ++i) out[i - from] = phase->rate(i);
+      const std::int64_t* c = phase->counts.data();
+      for (std::size_t i = from; i < to; ++i) {
+        const auto d = static_cast<std::int64_t>(static_cast<std::uint64_t>(c[i + 1]) - static_cast<std::uint64_t>(c[i]));
+        out[i - from] = d >= -kTabled && d <= kTabled ? count_rate[static_cast<std::size_t>(d + kTabled)] : phase->rate(i);
+      }
     } else {
       const double* x = phase->values.data();
       for (std::size_t i = from; i < to; ++i) out[i - from] = (x[i + 1] - x[i]) / phase->tau0_s + phase->rate_offset;
@@ -58,9 +73,13 @@ struct RateSource {
   }
 };
 
-RateSource source_of(const std::vector<double>& rates) { return {&rates, nullptr, rates.size()}; }
+RateSource source_of(const std::vector<double>& rates) { return {&rates, nullptr, rates.size(), {}}; }
 RateSource source_of(const PhaseSeries& phase) {
-  return {nullptr, &phase, phase.points() > 0 ? phase.points() - 1 : 0};
+  RateSource src{nullptr, &phase, phase.points() > 0 ? phase.points() - 1 : 0, {}};
+  if (phase.exact())
+    for (std::int64_t d = -RateSource::kTabled; d <= RateSource::kTabled; ++d)  // as PhaseSeries::diff and rate
+      src.count_rate.push_back(static_cast<double>(d) * phase.arcsec_per_count / phase.tau0_s);
+  return src;
 }
 
 // The rates of samples [lo, hi), enough to compute the residual of every sample of [from, to):
@@ -88,23 +107,20 @@ struct Window {
   }
 };
 
-// What one stretch [from, to) of the record contributes to the scale: the smallest non-zero step
-// |y_i − y_{i−1}| and the |residuals| of the strided subset (every i divisible by `stride`).
-struct ScalePart {
-  double resolution = std::numeric_limits<double>::infinity();
-  std::vector<double> residuals;
-};
+// The strided subset's samples (every i divisible by `stride`) in [0, to).
+std::size_t strided_below(std::size_t to, std::size_t stride) { return (to + stride - 1) / stride; }
 
-ScalePart scale_part(const RateSource& src, std::size_t from, std::size_t to, std::size_t stride) {
+// What one stretch [from, to) of the record contributes to the scale: the smallest non-zero step
+// |y_i − y_{i−1}| (returned) and the |residuals| of the strided subset, written from `out` on.
+double scale_part(const RateSource& src, std::size_t from, std::size_t to, std::size_t stride, double* out) {
   const Window w(src, from, to);
-  ScalePart part;
+  double resolution = std::numeric_limits<double>::infinity();
   for (std::size_t i = std::max<std::size_t>(from, 1); i < to; ++i) {
     const double d = std::abs(w.at(i) - w.at(i - 1));
-    if (d > 0) part.resolution = std::min(part.resolution, d);
+    resolution = std::min(resolution, d > 0 ? d : std::numeric_limits<double>::infinity());
   }
-  for (std::size_t i = (from + stride - 1) / stride * stride; i < to; i += stride)
-    part.residuals.push_back(std::abs(w.residual(i)));
-  return part;
+  for (std::size_t i = strided_below(from, stride) * stride; i < to; i += stride) *out++ = std::abs(w.residual(i));
+  return resolution;
 }
 
 std::size_t chunks_of(std::size_t n) { return (n + kChunk - 1) / kChunk; }
@@ -113,16 +129,14 @@ OutlierScale scale_of(const RateSource& src) {
   OutlierScale s;
   if (src.n < kMinSamples) return s;
   const std::size_t stride = (src.n + kScaleSamples - 1) / kScaleSamples;
-  std::vector<ScalePart> parts(chunks_of(src.n));
-  parallel_for(parts.size(), [&](std::size_t c) {
-    parts[c] = scale_part(src, c * kChunk, std::min(src.n, (c + 1) * kChunk), stride);
+  std::vector<double> part_resolution(chunks_of(src.n));
+  std::vector<double> residuals(strided_below(src.n, stride));  // in record order, each chunk its own stretch
+  parallel_for(part_resolution.size(), [&](std::size_t c) {
+    const std::size_t from = c * kChunk;
+    part_resolution[c] = scale_part(src, from, std::min(src.n, from + kChunk), stride,
+                                    residuals.data() + strided_below(from, stride));
   });
-  double resolution = std::numeric_limits<double>::infinity();
-  std::vector<double> residuals;
-  for (const auto& p : parts) {
-    resolution = std::min(resolution, p.resolution);
-    residuals.insert(residuals.end(), p.residuals.begin(), p.residuals.end());
-  }
+  const double resolution = *std::min_element(part_resolution.begin(), part_resolution.end());
   // The median |residual|: the value of rank size/2, whatever the order the parts came in.
   const auto mid = residuals.begin() + static_cast<std::ptrdiff_t>(residuals.size() / 2);
   std::nth_element(residuals.begin(), mid, residuals.end());
@@ -132,14 +146,48 @@ OutlierScale scale_of(const RateSource& src) {
   return s;
 }
 
+/// Pulse counts: the samples of [from, to) that may lie beyond `limit`, found on the counts. A rate
+/// is an increasing function of its count, so the six neighbours' middle pair is that of their counts,
+/// found in 16-bit lanes; a sample whose count residual stays a quarter count inside the limit (far
+/// more than the rates' rounding) cannot be an outlier. Nothing when the counts do not fit 13 bits:
+/// then every sample is a candidate.
+std::optional<std::vector<char>> count_candidates(const RateSource& src, std::size_t from, std::size_t to,
+                                                  double limit) {
+  constexpr std::int64_t kFits = std::int64_t{1} << 13;  // |2c − a − b| then fits int16
+  const std::size_t lo = std::max<std::size_t>(from, 3), hi = std::min(to, src.n - 3);  // interior samples
+  if (!src.phase || !src.phase->exact() || lo >= hi) return std::nullopt;
+  const std::int64_t* x = src.phase->counts.data();
+  std::vector<std::int16_t> c(hi - lo + 6);
+  for (std::size_t j = 0; j < c.size(); ++j) {
+    const std::size_t i = lo - 3 + j;
+    const auto d = static_cast<std::int64_t>(static_cast<std::uint64_t>(x[i + 1]) - static_cast<std::uint64_t>(x[i]));
+    if (d <= -kFits || d >= kFits) return std::nullopt;
+    c[j] = static_cast<std::int16_t>(d);
+  }
+  const double step = src.phase->arcsec_per_count / src.phase->tau0_s;  // rate of one count
+  const double edge = std::floor(std::min(2.0 * limit / step - 0.5, 30000.0));
+  const auto limit2 = static_cast<std::int16_t>(std::max(-1.0, edge));  // |2c − a − b| above it: a candidate
+  std::vector<char> maybe(to - from, 1);
+  for (std::size_t j = 3; j + 3 < c.size(); ++j) {
+    std::int16_t a = c[j - 3], b = c[j - 2], m3 = c[j - 1], m4 = c[j + 1], e = c[j + 2], f = c[j + 3];
+    middle_pair6(a, b, m3, m4, e, f);
+    const int u = 2 * c[j] - m3 - m4;
+    maybe[lo - 3 + j - from] = static_cast<char>((u < 0 ? -u : u) > limit2);
+  }
+  return maybe;
+}
+
 std::vector<Outlier> outliers_of(const RateSource& src, double threshold, const OutlierScale& s) {
   if (src.n < kMinSamples || !(s.scale > 0)) return {};  // a constant record has no outliers
   const double limit = threshold * s.scale;
   std::vector<std::vector<Outlier>> parts(chunks_of(src.n));
   parallel_for(parts.size(), [&](std::size_t c) {
     const std::size_t from = c * kChunk, to = std::min(src.n, from + kChunk);
+    const std::optional<std::vector<char>> maybe = count_candidates(src, from, to, limit);
+    if (maybe && std::find(maybe->begin(), maybe->end(), 1) == maybe->end()) return;
     const Window w(src, from, to);
     for (std::size_t i = from; i < to; ++i) {
+      if (maybe && !(*maybe)[i - from]) continue;
       const double r = w.residual(i);
       if (std::abs(r) > limit) parts[c].push_back({i, 0, w.at(i), r / s.scale});
     }

@@ -310,6 +310,13 @@ std::size_t Reader::take_lines(std::string& buf, bool at_end) {
   if (!eol_ && !decide_line_end(std::string_view(buf).substr(p), at_end)) return p;
   const std::size_t end = eol_ == '\r' ? mac_limit(buf, p, at_end) : buf.size();
   while (p < end) {
+    if (eol_ == '\n' && samples_ > 0 && !new_run_) {  // the common lines of one integer column, in bulk
+      const std::size_t before = ints_.size();
+      p = static_cast<std::size_t>(parser_.plain_integer_lines(buf.data() + p, buf.data() + end, line_, ints_) -
+                                   buf.data());
+      samples_ += ints_.size() - before;
+      if (p == end) break;
+    }
     const auto* e = static_cast<const char*>(std::memchr(buf.data() + p, eol_, end - p));
     if (!e) break;
     const auto n = static_cast<std::size_t>(e - buf.data()) - p;

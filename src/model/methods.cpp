@@ -10,6 +10,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "allan/narrow_counts.hpp"
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/noise_model.hpp"
 #include "rwcalc/parallel.hpp"
@@ -44,15 +45,28 @@ double sample_variance(const std::vector<double>& v) {
   return ss / static_cast<double>(v.size() - 1);
 }
 
-/// Σd and Σd² of the increments d_k = C_{k+t} − C_k, k in [k0, k1): int64 sums while every
-/// |d| < 2^24 (blocks of 2^14 cannot overflow then), 128-bit ones for a block with a larger one.
-void add_increment_sums(const std::int64_t* c, std::size_t t, std::size_t k0, std::size_t k1, i128& s1, i128& s2) {
-  std::uint64_t b1 = 0, b2 = 0, big = 0;  // modular: exact whenever no |d| reaches 2^24
+/// Σe and Σe² of e_k = C_{k+t} − C_k − shift, k in [k0, k1): in 16-bit lanes where the counts'
+/// bounds allow (narrow_counts.hpp), else int64 sums while every |e| < 2^24 (blocks of 2^14 cannot
+/// overflow then), 128-bit ones for a block with a larger one.
+void add_increment_sums(const std::int64_t* c, const detail::NarrowCounts& narrow, std::size_t t, std::int64_t shift,
+                        std::size_t k0, std::size_t k1, i128& s1, i128& s2) {
+  for (std::size_t from = k0; from < k1; from += detail::NarrowCounts::kMaxTerms) {
+    const std::size_t to = std::min(k1, from + detail::NarrowCounts::kMaxTerms);
+    std::int64_t n1 = 0;
+    std::uint64_t n2 = 0;
+    if (!narrow.increment_sums(from, to - from, t, shift, n1, n2)) break;
+    s1 += n1;
+    s2 += n2;
+    k0 = to;
+  }
+  if (k0 == k1) return;
+  std::uint64_t b1 = 0, b2 = 0, big = 0;  // modular: exact whenever no |e| reaches 2^24
   for (std::size_t k = k0; k < k1; ++k) {
-    const std::uint64_t d = static_cast<std::uint64_t>(c[k + t]) - static_cast<std::uint64_t>(c[k]);
-    big |= d + (std::uint64_t{1} << 24);
-    b1 += d;
-    b2 += d * d;
+    const std::uint64_t e =
+        static_cast<std::uint64_t>(c[k + t]) - static_cast<std::uint64_t>(c[k]) - static_cast<std::uint64_t>(shift);
+    big |= e + (std::uint64_t{1} << 24);
+    b1 += e;
+    b2 += e * e;
   }
   if (big < (std::uint64_t{1} << 25)) {
     s1 += static_cast<std::int64_t>(b1);
@@ -60,16 +74,19 @@ void add_increment_sums(const std::int64_t* c, std::size_t t, std::size_t k0, st
     return;
   }
   for (std::size_t k = k0; k < k1; ++k) {
-    const auto d = static_cast<std::int64_t>(static_cast<std::uint64_t>(c[k + t]) - static_cast<std::uint64_t>(c[k]));
-    s1 += d;
-    s2 += static_cast<i128>(d) * d;
+    const auto e = static_cast<std::int64_t>(static_cast<std::uint64_t>(c[k + t]) - static_cast<std::uint64_t>(c[k]) -
+                                             static_cast<std::uint64_t>(shift));
+    s1 += e;
+    s2 += static_cast<i128>(e) * e;
   }
 }
 
 /// Sample variances of the M = n − t + 1 overlapping increments x_{k+t} − x_k for every t in ts,
-/// ″². Pulse counts: exact integer sums, all lengths in one sweep over the record in short blocks
-/// (the longest interval's window stays in cache); integer sums make the result independent of
-/// the split between threads. Floating phases: the mean rate taken out first.
+/// ″². Pulse counts: exact integer sums of the increments less the mean rate's whole counts (the
+/// variance does not see the shift, and the small values fit narrow sums), all lengths in one sweep
+/// over the record in short blocks (the longest interval's window stays in cache); integer sums
+/// make the result independent of the split between threads. Floating phases: the mean rate taken
+/// out first.
 std::vector<double> overlapping_variances(const PhaseSeries& x, const std::vector<std::size_t>& ts) {
   const std::size_t n = x.points() - 1;
   std::vector<double> out(ts.size());
@@ -89,12 +106,21 @@ std::vector<double> overlapping_variances(const PhaseSeries& x, const std::vecto
   }
   constexpr std::size_t kBlock = std::size_t{1} << 14, kChunk = kBlock * 32;
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  const detail::NarrowCounts narrow(x.counts.data(), x.points());
+  const auto total = static_cast<double>(
+      static_cast<std::int64_t>(static_cast<std::uint64_t>(x.count(n)) - static_cast<std::uint64_t>(x.count(0))));
+  std::vector<std::int64_t> shift(ts.size());
+  for (std::size_t i = 0; i < ts.size(); ++i) {
+    const double s = std::round(total * static_cast<double>(ts[i]) / static_cast<double>(n));
+    shift[i] = std::abs(s) < 0x1p62 ? static_cast<std::int64_t>(s) : 0;
+  }
   std::vector<std::vector<std::array<i128, 2>>> part(chunks, std::vector<std::array<i128, 2>>(ts.size()));
   parallel_for(chunks, [&](std::size_t ci) {
     for (std::size_t k0 = ci * kChunk; k0 < std::min(n, (ci + 1) * kChunk); k0 += kBlock)
       for (std::size_t i = 0; i < ts.size(); ++i) {
         const std::size_t k1 = std::min({k0 + kBlock, (ci + 1) * kChunk, n - ts[i] + 1});
-        if (k1 > k0) add_increment_sums(x.counts.data(), ts[i], k0, k1, part[ci][i][0], part[ci][i][1]);
+        if (k1 > k0)
+          add_increment_sums(x.counts.data(), narrow, ts[i], shift[i], k0, k1, part[ci][i][0], part[ci][i][1]);
       }
   });
   const double q2 = x.arcsec_per_count * x.arcsec_per_count;
@@ -348,11 +374,10 @@ DirectNResult direct_n(const PhaseSeries& x, const MethodOptions& o) {
 
   if (ts.size() < 4) return r;
   r.points = overlapping_points(x, ts);
+  r.basis.resize(ts.size());  // each an O(t) sum: in parallel
+  parallel_for(ts.size(), [&](std::size_t i) { r.basis[i] = increment_basis(ts[i], n + 1, x.tau0_s); });
   std::vector<Vec3> xs;
-  for (std::size_t t : ts) {
-    r.basis.push_back(increment_basis(t, n + 1, x.tau0_s));
-    xs.push_back(as_vec(r.basis.back()));
-  }
+  for (const IncrementBasis& g : r.basis) xs.push_back(as_vec(g));
   Vec3 beta;
   if (!regress(r.points, xs, beta)) return r;
   r.q2_arcsec2 = beta[0];
