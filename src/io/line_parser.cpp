@@ -120,13 +120,13 @@ bool LineParser::plain_integer(std::string_view t, Sample& s) const {
 }
 
 const char* LineParser::plain_integer_lines(const char* p, const char* end, std::size_t& line,
-                                            std::vector<std::int64_t>& out) {
+                                            std::vector<std::int64_t>& out, std::size_t max_lines) {
   if (!plain_layout()) return p;
   const bool counter = input_.mode == InputMode::Counter;
   const std::size_t before = out.size();
   // Lines with 22 bytes to spare (sign, 19 digits, CR, LF) need no look at `end`.
   const char* roomy = end - p > 22 ? end - 22 : p;
-  for (const char* q = p; q < end; p = q) {
+  for (const char* q = p; q < end && out.size() - before < max_lines; p = q) {
     std::int64_t v = 0;
     if (!(q < roomy ? plain_value<false>(q, end, v) : plain_value(q, end, v)) || q == end) break;
     if (*q == '\r' && q + 1 < end) ++q;  // CR LF

@@ -42,9 +42,10 @@ class LineParser {
 
   /// The common data lines read on from `p` in one loop: while the layout is one integer column,
   /// each line that is an optional minus and 1–18 digits ended by LF (or CR LF) is appended to `out`
-  /// and counted in `line` and content_lines(). Returns where the first other line starts (or the
+  /// and counted in `line` and content_lines(), `max_lines` at most. Returns where the first other line starts (or the
   /// last one without its line end before `end`): parse() takes that one, and reports it if need be.
-  const char* plain_integer_lines(const char* p, const char* end, std::size_t& line, std::vector<std::int64_t>& out);
+  const char* plain_integer_lines(const char* p, const char* end, std::size_t& line, std::vector<std::int64_t>& out,
+                                  std::size_t max_lines);
 
  private:
   [[noreturn]] void fail(const std::string& message) const;

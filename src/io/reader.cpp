@@ -310,9 +310,13 @@ std::size_t Reader::take_lines(std::string& buf, bool at_end) {
   if (!eol_ && !decide_line_end(std::string_view(buf).substr(p), at_end)) return p;
   const std::size_t end = eol_ == '\r' ? mac_limit(buf, p, at_end) : buf.size();
   while (p < end) {
-    if (eol_ == '\n' && samples_ > 0 && !new_run_) {  // the common lines of one integer column, in bulk
+    if (eol_ == '\n' && samples_ > 0 && !new_run_ && integer_mode()) {  // one integer column's lines, in bulk
+      // Room first, within the memory ceiling: a line takes at least 2 bytes; the bulk read stops
+      // where the room does, and the next pass asks for more (CeilingReached when none is left).
+      memory_.make_room(ints_, (end - p) / 2 + 1);
       const std::size_t before = ints_.size();
-      p = static_cast<std::size_t>(parser_.plain_integer_lines(buf.data() + p, buf.data() + end, line_, ints_) -
+      p = static_cast<std::size_t>(parser_.plain_integer_lines(buf.data() + p, buf.data() + end, line_, ints_,
+                                                               ints_.capacity() - before) -
                                    buf.data());
       samples_ += ints_.size() - before;
       if (p == end) break;

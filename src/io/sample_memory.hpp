@@ -25,6 +25,12 @@ class SampleMemory {
     v.push_back(x);
   }
 
+  /// Room for `n` more elements in `v`, or for as many as fit; CeilingReached when none is left.
+  template <class T>
+  void make_room(std::vector<T>& v, std::size_t n) {
+    if (v.capacity() - v.size() < n) grow(v, std::max(v.size() + n, 2 * v.capacity()));
+  }
+
   /// Room for `n` elements in `v` at once (an estimate of the record: up to what fits, and never
   /// an error).
   template <class T>
