@@ -602,9 +602,11 @@ std::string conventions_rows(const json& conventions) {
   std::string h;
   for (const auto& [key, name, text] : kConventions) h += kv_row(tr(name), esc(tr(text)));
   if (conventions.is_object())
-    for (const auto& [k, v] : conventions.items())
+    for (const auto& item : conventions.items()) {
+      const std::string& k = item.key();  // a structured binding, clang 14 (the fuzz build) cannot capture
       if (std::none_of(kConventions.begin(), kConventions.end(), [&](const auto& c) { return k == c[0]; }))
-        h += kv_row(k, json_value_html(v));
+        h += kv_row(k, json_value_html(item.value()));
+    }
   return h;
 }
 
