@@ -150,18 +150,21 @@ constexpr int kLevelsAtOnce = 2;
 /// The exact sums of one level over a block: z (n values, and z[n] the next one, 0 at the record's
 /// end, where `pairs` = n − 1). False when some |z| ≥ kZLimit (the 128-bit sums could then overflow).
 bool add_block(const std::int64_t* z, std::size_t n, std::size_t pairs, u128 (&s)[3]) {
-  std::int64_t a = 0, b = 0, c = 0;
+  // Sums modulo 2^64 in unsigned arithmetic (no signed overflow on any input), used only when small:
+  // then they are the true int64 sums.
+  std::uint64_t a = 0, b = 0, c = 0;
   std::uint64_t small = 0;  // below 2^27 iff every −2^26 ≤ z < 2^26: then no int64 sum overflows
   for (std::size_t i = 0; i < n; ++i) {
-    small |= static_cast<std::uint64_t>(z[i]) + (kZLimit >> 8);
-    a += z[i];  // modulo 2^64 (unsigned arithmetic would say the same), used only when small
-    b += static_cast<std::int64_t>(static_cast<std::uint64_t>(z[i]) * static_cast<std::uint64_t>(z[i]));
-    c += static_cast<std::int64_t>(static_cast<std::uint64_t>(z[i]) * static_cast<std::uint64_t>(z[i + 1]));
+    const auto zi = static_cast<std::uint64_t>(z[i]);
+    small |= zi + (kZLimit >> 8);
+    a += zi;
+    b += zi * zi;
+    c += zi * static_cast<std::uint64_t>(z[i + 1]);
   }
   if (small < (kZLimit >> 7)) {
-    s[0] += static_cast<u128>(static_cast<i128>(a));
-    s[1] += static_cast<u128>(static_cast<i128>(b));
-    s[2] += static_cast<u128>(static_cast<i128>(c));
+    s[0] += static_cast<u128>(static_cast<i128>(static_cast<std::int64_t>(a)));
+    s[1] += static_cast<u128>(static_cast<i128>(static_cast<std::int64_t>(b)));
+    s[2] += static_cast<u128>(static_cast<i128>(static_cast<std::int64_t>(c)));
     return true;
   }
   std::uint64_t range = 0;
