@@ -184,4 +184,100 @@ TEST(ReaderCli, UpperCaseRateKeyGivesTheAnalysisItsRate) {
   EXPECT_NE(r.out.find("40000 samples at 100 Hz (tau0 = 10 ms)"), std::string::npos) << r.out.substr(0, 800);
 }
 
+// imu reads its columns in one pass over the text (several passes, one per thread, for a regular
+// file). Each recording must be exactly the one read_recording gives for that column alone, and an
+// error the one a pass over the columns in order meets first, whatever the number of threads.
+const char* kMixedColumns =
+    "# rate_hz: 50\r\n"
+    "# serial: A-7\r\n"
+    "time_s,pulses,gyro_x_dps,acc_y_g,temperature_c\r\n"
+    "0.00,12,0.5,-1.01,20.5\r\n"
+    "0.02,-3, 0.25 ,-1.02,20.5\r\n"
+    "\r\n"
+    "0.04,7,1e-3,-0.99,20.6\r\n"
+    "# a note inside the data\r\n"
+    "0.06,0,-0.75,-1.00,20.6\r\n"
+    "0.08,5,+0.5,-1.03,20.7\r\n";
+
+ReadOptions column(const std::string& name) {
+  ReadOptions o;
+  o.column = name;
+  o.column_not_time = true;
+  return o;
+}
+
+void expect_same_recording(const rwcalc::Recording& a, const rwcalc::Recording& b) {
+  EXPECT_EQ(a.column_name, b.column_name);
+  EXPECT_EQ(a.column_index, b.column_index);
+  EXPECT_EQ(a.samples, b.samples);
+  EXPECT_EQ(a.phase.counts, b.phase.counts);
+  EXPECT_EQ(a.phase.values, b.phase.values);
+  EXPECT_EQ(a.phase.rate_offset, b.phase.rate_offset);
+  EXPECT_EQ(a.phase.kind, b.phase.kind);
+  EXPECT_EQ(a.rate_hz, b.rate_hz);
+  EXPECT_EQ(a.rate_source, b.rate_source);
+  EXPECT_EQ(a.metadata, b.metadata);
+  EXPECT_EQ(a.temperature_c, b.temperature_c);
+  EXPECT_EQ(a.time_column, b.time_column);
+  EXPECT_EQ(a.mode, b.mode);
+  EXPECT_EQ(a.notes, b.notes);
+  EXPECT_EQ(a.warnings, b.warnings);
+  EXPECT_EQ(a.line_runs, b.line_runs);
+  EXPECT_EQ(a.sha256, b.sha256);
+  EXPECT_EQ(a.file_bytes, b.file_bytes);
+}
+
+TEST(ReaderOnePass, EveryColumnIsTheRecordingReadAlone) {
+  const rwcalc::test::TempDir tmp;
+  const std::string path = tmp.write("imu.csv", kMixedColumns).string();
+  const std::vector<ReadOptions> columns = {column("gyro_x_dps"), column("pulses"), column("acc_y_g")};
+  for (const char* threads : {"1", "2", "3"}) {
+    const rwcalc::test::ScopedEnv env("RWCALC_THREADS", threads);
+    const std::vector<rwcalc::Recording> all = rwcalc::read_recordings(path, columns);
+    ASSERT_EQ(all.size(), columns.size());
+    for (std::size_t i = 0; i < columns.size(); ++i) {
+      SCOPED_TRACE(fmt::format("{} threads, column {}", threads, columns[i].column));
+      expect_same_recording(all[i], rwcalc::read_recording(path, columns[i]));
+    }
+    EXPECT_EQ(all[1].phase.counts, (std::vector<std::int64_t>{0, 12, 9, 16, 16, 21}));
+    EXPECT_EQ(all[1].line_runs.size(), 3u);  // the blank line and the comment start new runs
+  }
+}
+
+TEST(ReaderOnePass, TheEarliestLinesErrorWhateverTheThreads) {
+  const rwcalc::test::TempDir tmp;
+  // acc_y_g is bad at line 5, gyro_x_dps at line 7; on line 8 both are.
+  const std::string path =
+      tmp.write("bad.csv",
+                "time_s,gyro_x_dps,acc_y_g\n0,1,2\n0.01,1,2\n0.02,1,2\n0.03,1,x\n0.04,1,2\n0.05,y,2\n0.06,z,w\n")
+          .string();
+  const auto first_error = [&](const std::vector<ReadOptions>& columns) -> std::pair<std::size_t, std::string> {
+    try {
+      (void)rwcalc::read_recordings(path, columns);
+    } catch (const InputError& e) {
+      return {e.line(), e.message()};
+    }
+    return {0, ""};
+  };
+  for (const char* threads : {"1", "2"}) {
+    const rwcalc::test::ScopedEnv env("RWCALC_THREADS", threads);
+    const auto e = first_error({column("gyro_x_dps"), column("acc_y_g")});
+    EXPECT_EQ(e.first, 5u) << threads;
+    EXPECT_NE(e.second.find("acc_y_g"), std::string::npos) << e.second;
+    EXPECT_EQ(e.second, error_of(fmt::format("time_s,gyro_x_dps,acc_y_g\n0,1,2\n0.01,1,2\n0.02,1,2\n0.03,1,x\n"),
+                                 column("acc_y_g")).first);
+  }
+  const std::string same_line = tmp.write("both.csv", "a,b,c\n1,2,3\n1,2,3\nx,y,3\n").string();
+  for (const char* threads : {"1", "2"}) {
+    const rwcalc::test::ScopedEnv env("RWCALC_THREADS", threads);
+    try {
+      (void)rwcalc::read_recordings(same_line, std::vector{column("b"), column("a")});
+      ADD_FAILURE() << "accepted";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.line(), 4u);
+      EXPECT_NE(e.message().find("'b'"), std::string::npos) << e.message();  // the first column given
+    }
+  }
+}
+
 }  // namespace

@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -142,6 +143,11 @@ inline constexpr std::string_view kIdentificationKeys[] = {"serial", "operator",
 
 /// Read a file (or "-" for stdin). Throws InputError (file, line, message) on any malformed input.
 Recording read_recording(const std::string& path, const ReadOptions& options = {});
+
+/// Several columns of one file (or "-") in one pass over its text: a recording for each of
+/// `columns`' options, in their order, each as read_recording would give it. The first column's
+/// errors on a line come before the second's.
+std::vector<Recording> read_recordings(const std::string& path, std::span<const ReadOptions> columns);
 
 /// Read from text already in memory (used by tests and fuzzers); `name` labels errors.
 /// The text may be gzip-compressed (detected by its magic bytes).

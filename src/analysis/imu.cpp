@@ -4,10 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstring>
-#include <fstream>
 #include <iostream>
 #include <iterator>
 #include <sstream>
@@ -22,30 +19,6 @@
 namespace rwcalc {
 
 namespace imu_impl {
-
-// The file's bytes as stored (compressed, for gzip), kept once for every channel's reading: they
-// count against the memory ceiling like samples, so that a stream without end cannot fill the memory.
-std::string read_bytes(const std::string& path, const MemoryCeiling& ceiling) {
-  const std::string name = path == "-" ? "<stdin>" : path;
-  std::ifstream file;
-  if (path != "-") {
-    file.open(path, std::ios::binary);
-    if (!file) throw InputError(name, 0, trf("cannot open: {}", std::strerror(errno)));
-  }
-  std::istream& in = path == "-" ? std::cin : file;
-  std::string bytes;
-  std::vector<char> piece(std::size_t{1} << 16);
-  while (in.read(piece.data(), static_cast<std::streamsize>(piece.size())) || in.gcount() > 0) {
-    bytes.append(piece.data(), static_cast<std::size_t>(in.gcount()));
-    if (bytes.size() > ceiling.bytes / 2)  // the string doubles as it grows
-      throw InputError(name, 0,
-                       trf("the file holds more than {}, which imu keeps in memory to read each column from it: more "
-                           "than half the memory ceiling of {} ({}); give {} SIZE if the machine has the memory",
-                           format_memory(static_cast<double>(bytes.size())),
-                           format_memory(static_cast<double>(ceiling.bytes)), ceiling.origin, kMaxMemoryOption));
-  }
-  return bytes;
-}
 
 struct ChannelSpec {
   std::string column;
@@ -168,13 +141,11 @@ ImuResult analyze_imu(const std::string& path, const ImuOptions& options) {
   out.source = path;
   out.gyro_units = output_units(SensorKind::Gyro, options.gyro_output_unit);
   out.accel_units = output_units(SensorKind::Accelerometer, options.accel_output_unit);
-  const std::string bytes = read_bytes(path, options.read.memory ? *options.read.memory : default_memory_ceiling());
-  // Every channel is read and checked before any is analysed: a column given twice is refused
-  // before the work, and always the same pair is named. (The recordings are held together for
-  // that: 8 bytes a sample each, less than the text they come from, which is held anyway.)
-  std::vector<Recording> recs(specs.size());
-  parallel_for(specs.size(),
-               [&](std::size_t i) { recs[i] = read_recording_text(bytes, path, channel_read(options, specs[i])); });
+  // Every channel is read in one pass over the text and checked before any is analysed: a column
+  // given twice is refused before the work, and always the same pair is named.
+  std::vector<ReadOptions> reads;
+  for (const ChannelSpec& c : specs) reads.push_back(channel_read(options, c));
+  std::vector<Recording> recs = read_recordings(path, reads);
   check_channels(recs, specs);
   out.channels.resize(specs.size());
   Progress progress(trf("analysing the channels of {}", printable(path)), specs.size(), options.analysis.progress);

@@ -41,7 +41,7 @@ void LineParser::fail(const std::string& message) const { throw InputError(file_
 
 LineKind LineParser::parse(std::string_view text, std::size_t line, Sample& s) {
   line_ = line;
-  if (plain_integer(text, s)) {
+  if (plain_integer(text, s) || delimited_data_line(text, s)) {
     ++content_lines_;
     return LineKind::Data;
   }
@@ -64,7 +64,7 @@ LineKind LineParser::parse(std::string_view text, std::size_t line, Sample& s) {
   }
   if (special) check_foreign_delimiters(t);
   split(t);
-  if (layout_known_ && fields_.size() == layout_.ncols && read_fields(s, false)) return LineKind::Data;
+  if (layout_known_ && fields_.size() == layout_.ncols && read_fields(fields_, s, false)) return LineKind::Data;
   if (header_row(t)) return LineKind::Header;
   if (!layout_known_) {  // the first data line fixes the columns
     layout_.ncols = layout_.header.empty() ? fields_.size() : layout_.header.size();
@@ -78,7 +78,7 @@ LineKind LineParser::parse(std::string_view text, std::size_t line, Sample& s) {
     fail(trf("wrong number of columns: expected {} ({}-separated, as line {} has), found {}: {}", layout_.ncols,
              delim_name(layout_.delim), layout_.header_line ? layout_.header_line : first_data_line_, fields_.size(),
              quoted(t)));
-  read_fields(s, true);
+  read_fields(fields_, s, true);
   return LineKind::Data;
 }
 
@@ -137,6 +137,35 @@ const char* LineParser::plain_integer_lines(const char* p, const char* end, std:
   line += out.size() - before;
   content_lines_ += out.size() - before;
   return p;
+}
+
+// The common line of a delimited file whose columns are known, with one look at each byte: split at
+// the delimiter and taken when nothing in it needs the general way (a CR inside, another delimiter,
+// blanks around the line, a comment) and its selected fields read. Any other line goes the general
+// way, which decides and reports it exactly as if this path did not exist. A parser that follows a
+// lead reads its fields from the lead's split of the same line.
+bool LineParser::delimited_data_line(std::string_view text, Sample& s) {
+  if (!layout_known_ || layout_.delim == Delim::Blanks) return false;
+  if (lead_ && lead_->split_line_ == line_)
+    return lead_->fields_.size() == layout_.ncols && read_fields(lead_->fields_, s, false);
+  if (!text.empty() && text.back() == '\r') text.remove_suffix(1);
+  const auto edge = [](char c) { return c == ' ' || c == '\t'; };
+  if (text.empty() || edge(text.front()) || edge(text.back()) || text.front() == '#') return false;
+  const char d = layout_.delim == Delim::Comma ? ',' : layout_.delim == Delim::Semicolon ? ';' : '\t';
+  fields_.clear();
+  std::size_t start = 0;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == d) {
+      fields_.push_back(trim(text.substr(start, i - start), false));
+      start = i + 1;
+    } else if (c == '\r' || c == ';' || c == '\t') {
+      return false;
+    }
+  }
+  fields_.push_back(trim(text.substr(start), false));
+  split_line_ = line_;
+  return fields_.size() == layout_.ncols && read_fields(fields_, s, false);
 }
 
 void LineParser::check_foreign_delimiters(std::string_view line) const {
@@ -200,9 +229,9 @@ bool LineParser::header_row(std::string_view t) {
 
 // The selected fields, in column order: false at the first that does not read (with `report`,
 // its InputError instead).
-bool LineParser::read_fields(Sample& s, bool report) {
+bool LineParser::read_fields(const std::vector<std::string_view>& fields, Sample& s, bool report) {
   for (std::size_t c = 0; c < layout_.ncols; ++c)
-    if (layout_.roles[c] != Role::Skip && !read_field(fields_[c], layout_.roles[c], s, report)) return false;
+    if (layout_.roles[c] != Role::Skip && !read_field(fields[c], layout_.roles[c], s, report)) return false;
   return true;
 }
 

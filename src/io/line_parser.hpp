@@ -40,6 +40,10 @@ class LineParser {
   [[nodiscard]] const InputChoice& input() const noexcept { return input_; }
   [[nodiscard]] bool layout_known() const noexcept { return layout_known_; }
 
+  /// Read the same lines as `lead`, each after it, taking the lead's split of a common data line
+  /// rather than splitting it again (several columns of one file in one pass).
+  void follow(const LineParser& lead) noexcept { lead_ = &lead; }
+
   /// The common data lines read on from `p` in one loop: while the layout is one integer column,
   /// each line that is an optional minus and 1–18 digits ended by LF (or CR LF) is appended to `out`
   /// and counted in `line` and content_lines(), `max_lines` at most. Returns where the first other line starts (or the
@@ -52,10 +56,11 @@ class LineParser {
   void split(std::string_view line);
   void check_foreign_delimiters(std::string_view line) const;
   bool header_row(std::string_view line);
-  bool read_fields(Sample& s, bool report);
+  bool read_fields(const std::vector<std::string_view>& fields, Sample& s, bool report);
   bool read_field(std::string_view f, Role role, Sample& s, bool report);
   [[nodiscard]] bool plain_layout() const noexcept;
   bool plain_integer(std::string_view t, Sample& s) const;
+  bool delimited_data_line(std::string_view text, Sample& s);
   bool read_integer(std::string_view f, std::string_view t, Sample& s, bool report);
   [[nodiscard]] bool integer_mode() const noexcept {
     return input_.mode == InputMode::Pulses || input_.mode == InputMode::Counter;
@@ -72,6 +77,8 @@ class LineParser {
   Metadata meta_;
   std::int64_t counter_lo_ = 0, counter_max_ = 0;  // the readings a counter can give
   std::vector<std::string_view> fields_;
+  const LineParser* lead_ = nullptr;
+  std::size_t split_line_ = 0;  // the line fields_ holds, when the common path split it
   std::string scratch_;
 };
 

@@ -8,9 +8,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <limits>
+#include <memory>
+#include <span>
 
 #include <fmt/format.h>
+#include <sys/stat.h>
 
 #include "io/line_parser.hpp"
 #include "io/sample_memory.hpp"
@@ -18,6 +22,7 @@
 #include "rwcalc/error.hpp"
 #include "rwcalc/limits.hpp"
 #include "rwcalc/memory.hpp"
+#include "rwcalc/parallel.hpp"
 #include "rwcalc/printable.hpp"
 #include "rwcalc/progress.hpp"
 #include "rwcalc/units.hpp"
@@ -188,8 +193,15 @@ class Reader {
     try {
       read_lines(src);
     } catch (const detail::CeilingReached&) {
-      refuse_memory(src);
+      Reader& full = reached_ ? *reached_ : *this;
+      full.text_taken_ = text_taken_;
+      full.refuse_memory(src);
     }
+  }
+  /// Read another column of the same text in the same pass: `f` gets every line after this reader.
+  void lead(Reader& f) {
+    f.parser_.follow(parser_);
+    followers_.push_back(&f);
   }
   Recording finish();
 
@@ -211,6 +223,11 @@ class Reader {
       push(s);
     else
       new_run_ = true;
+    for (Reader* f : followers_) {
+      reached_ = f;  // a ceiling reached in here is the follower's
+      f->line(text);
+    }
+    reached_ = nullptr;
   }
   void push(const Sample& s);
   // Room for the samples the text likely holds, judged from its first lines, so that a long record
@@ -218,6 +235,7 @@ class Reader {
   void reserve(double lines) {
     const auto n = static_cast<std::size_t>(std::min(lines * 1.05 + 2, 0x1p60));
     integer_mode() ? memory_.reserve(ints_, n) : memory_.reserve(reals_, n);
+    for (Reader* f : followers_) f->reserve(lines);
   }
   void start_samples(const Sample& s);
   [[nodiscard]] const detail::TimeName* time_unit_of(const detail::TimeName* named, double first,
@@ -261,6 +279,8 @@ class Reader {
   std::size_t temp_n_ = 0;
   double rate_hz_ = units::gl2d_rate_hz;
   RateSource rate_source_ = RateSource::Default;
+  std::vector<Reader*> followers_;  // other columns read in the same pass
+  Reader* reached_ = nullptr;       // the follower being given a line
 };
 
 void Reader::read_lines(detail::TextSource& src) {
@@ -310,7 +330,7 @@ std::size_t Reader::take_lines(std::string& buf, bool at_end) {
   if (!eol_ && !decide_line_end(std::string_view(buf).substr(p), at_end)) return p;
   const std::size_t end = eol_ == '\r' ? mac_limit(buf, p, at_end) : buf.size();
   while (p < end) {
-    if (eol_ == '\n' && samples_ > 0 && !new_run_ && integer_mode()) {  // one integer column's lines, in bulk
+    if (eol_ == '\n' && samples_ > 0 && !new_run_ && integer_mode() && followers_.empty()) {  // one integer column's lines, in bulk
       // Room first, within the memory ceiling: a line takes at least 2 bytes; the bulk read stops
       // where the room does, and the next pass asks for more (CeilingReached when none is left).
       memory_.make_room(ints_, (end - p) / 2 + 1);
@@ -770,26 +790,95 @@ void validate(const ReadOptions& o) {
     throw UsageError(trf("--time-tolerance must be in [0, 1), got {}", o.time_tolerance));
 }
 
-Recording read_source(detail::TextSource&& src, const std::string& source, const ReadOptions& options) {
-  Reader reader(src.name(), options);
-  reader.read(src);
-  Recording rec = reader.finish();
-  rec.source = source;
-  rec.file_bytes = src.raw_bytes();
-  rec.sha256 = src.sha256();
-  return rec;
+// One pass over a text for some columns: the first reader leads, the others follow it line by line.
+struct Pass {
+  std::unique_ptr<detail::TextSource> src;
+  std::vector<std::unique_ptr<Reader>> readers;
+
+  Pass(std::unique_ptr<detail::TextSource> text, std::span<const ReadOptions> columns) : src(std::move(text)) {
+    for (const ReadOptions& o : columns) {
+      validate(o);
+      readers.push_back(std::make_unique<Reader>(src->name(), o));
+      if (readers.size() > 1) readers.front()->lead(*readers.back());
+    }
+  }
+  void read() { readers.front()->read(*src); }
+  Recording finish(std::size_t i, const std::string& source) {
+    Recording rec = readers[i]->finish();
+    rec.source = source;
+    rec.file_bytes = src->raw_bytes();
+    rec.sha256 = src->sha256();
+    return rec;
+  }
+};
+
+// The error a single pass over all columns would have raised: the earliest line's, and of those
+// the first column's (passes hold columns in order). Nothing when every pass read.
+void rethrow_first(const std::vector<std::exception_ptr>& errors, const std::vector<std::size_t>& lines) {
+  std::size_t first = errors.size();
+  for (std::size_t g = 0; g < errors.size(); ++g)
+    if (errors[g] && (first == errors.size() || lines[g] < lines[first])) first = g;
+  if (first < errors.size()) std::rethrow_exception(errors[first]);
+}
+
+// Each pass reads its columns (in parallel: several passes over one file cost less wall time than one
+// pass that reads every column alone), then every column is finished.
+std::vector<Recording> read_passes(std::vector<Pass>& passes, const std::string& source) {
+  std::vector<std::exception_ptr> errors(passes.size());
+  std::vector<std::size_t> lines(passes.size(), 0);
+  parallel_for(passes.size(), [&](std::size_t g) {
+    try {
+      passes[g].read();
+    } catch (const InputError& e) {
+      errors[g] = std::current_exception();
+      lines[g] = e.line();
+    } catch (...) {
+      errors[g] = std::current_exception();
+    }
+  });
+  rethrow_first(errors, lines);
+  std::vector<std::pair<std::size_t, std::size_t>> items;  // (pass, reader)
+  for (std::size_t g = 0; g < passes.size(); ++g)
+    for (std::size_t i = 0; i < passes[g].readers.size(); ++i) items.emplace_back(g, i);
+  std::vector<Recording> recs(items.size());
+  std::vector<std::exception_ptr> failed(items.size());
+  parallel_for(items.size(), [&](std::size_t k) {
+    try {
+      recs[k] = passes[items[k].first].finish(items[k].second, source);
+    } catch (...) {
+      failed[k] = std::current_exception();
+    }
+  });
+  rethrow_first(failed, std::vector<std::size_t>(items.size(), 0));
+  return recs;
 }
 
 }  // namespace
 
 Recording read_recording(const std::string& path, const ReadOptions& options) {
-  validate(options);
-  return read_source(detail::TextSource(path), path, options);
+  std::vector<Pass> pass;
+  pass.emplace_back(std::make_unique<detail::TextSource>(path), std::span(&options, 1));
+  return std::move(read_passes(pass, path).front());
+}
+
+std::vector<Recording> read_recordings(const std::string& path, std::span<const ReadOptions> columns) {
+  if (columns.empty()) throw UsageError("no column to read");
+  // A pipe or standard input can be read once only.
+  struct stat st {};
+  const bool again = path != "-" && ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+  const std::size_t n = again ? std::min<std::size_t>(worker_count(), columns.size()) : 1;
+  std::vector<Pass> passes;
+  for (std::size_t g = 0; g < n; ++g) {
+    const std::size_t from = columns.size() * g / n, to = columns.size() * (g + 1) / n;
+    passes.emplace_back(std::make_unique<detail::TextSource>(path), columns.subspan(from, to - from));
+  }
+  return read_passes(passes, path);
 }
 
 Recording read_recording_text(std::string_view text, const std::string& name, const ReadOptions& options) {
-  validate(options);
-  return read_source(detail::TextSource(text, detail::display_name(name)), name, options);
+  std::vector<Pass> pass;
+  pass.emplace_back(std::make_unique<detail::TextSource>(text, detail::display_name(name)), std::span(&options, 1));
+  return std::move(read_passes(pass, name).front());
 }
 
 std::vector<double> Recording::rates() const {
