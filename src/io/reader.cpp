@@ -574,7 +574,7 @@ void Reader::check_angle_steps(const PhaseSeries& ph, const std::vector<double>&
       fail(line_of_sample(i),
            trf("angle step out of range: from {} to {} {} in one sample is a rate of {:g} {}, beyond ±{:g} {}, "
                "where the variances the noise fit squares would overflow",
-               quoted(fmt::format("{:g}", x[i - 1] / f)), quoted(fmt::format("{:g}", x[i] / f)),
+               detail::quoted(fmt::format("{:g}", x[i - 1] / f)), detail::quoted(fmt::format("{:g}", x[i] / f)),
                to_string(in().angle_unit), rate, ph.deviation_unit(), kMaxDataRate, ph.deviation_unit()));
   }
 }
@@ -593,7 +593,7 @@ void Reader::check_rates(const PhaseSeries& ph, const std::vector<double>& x, do
                              "squares would overflow")
                         : N_("rate out of range: {} {}{} is beyond ±{:g} {}, where the variances the noise fit squares "
                              "would overflow"),
-             quoted(fmt::format("{:g}", x[i])), increments ? to_string(in().angle_unit) : to_string(in().rate_unit),
+             detail::quoted(fmt::format("{:g}", x[i])), increments ? to_string(in().angle_unit) : to_string(in().rate_unit),
              as_rate, kMaxDataRate, ph.deviation_unit()));
   }
 }
@@ -679,7 +679,7 @@ void Reader::build_values(PhaseSeries& ph) {
     if (!(std::abs(x[i] *= f) <= kMaxPhase)) [[unlikely]]
       fail(line_of_sample(i), trf("angle out of range: {} is beyond ±{:g} arcsec, where the Allan "
                                   "variance of the record would overflow",
-                                  quoted(fmt::format("{:g}", x[i] / f)), kMaxPhase));
+                                  detail::quoted(fmt::format("{:g}", x[i] / f)), kMaxPhase));
   if (angle) {
     check_angle_steps(ph, x, f);
   } else {
