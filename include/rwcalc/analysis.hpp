@@ -85,9 +85,13 @@ struct FitRangeChoice {
   int line_points_left_out = 0;
   /// The fit was rejected (p < 0.001) and its intervals scaled by √(χ²/dof) (FitOptions::dispersion).
   bool intervals_scaled = false;
-  double interval_scale = 1;  ///< √(χ²/dof) of the unscaled fit, when scaled
+  double interval_scale = 1;                 ///< √(χ²/dof) of the unscaled fit, when scaled
   [[nodiscard]] std::string reason() const;  ///< why the range is what it is, one sentence
 };
+
+/// A fit whose goodness-of-fit p-value is below this is rejected: its intervals are scaled by
+/// √(χ²/dof) and the class verdict is withheld (docs/analysis.md, "When the fit fails").
+inline constexpr double kFitRejectedP = 0.001;
 
 struct AnalysisResult {
   std::string source;
@@ -132,6 +136,8 @@ struct AnalysisResult {
   std::vector<AnalysisWarning> warnings;
   /// `--gaps segments`: the segments the record was split into at its gaps (empty: no gap).
   std::vector<Recording::Segment> segments;
+  /// The goodness of fit rejects the fit (p < kFitRejectedP).
+  [[nodiscard]] bool fit_rejected() const { return fit.p_value < kFitRejectedP; }
 };
 
 /// Gyro or accelerometer data. Throws UsageError for clock data, AnalysisError for a record too short

@@ -324,7 +324,7 @@ void fit_with_checks(const std::vector<FitPoint>& all_points, const PhaseSeries&
     }
   }
   r.fit = fit_noise(points, fopt);
-  if (options.fit_checks && r.fit.p_value < 0.001 && r.fit.chi2_per_dof > 1) {
+  if (options.fit_checks && r.fit_rejected() && r.fit.chi2_per_dof > 1) {
     range.intervals_scaled = true;
     range.interval_scale = std::sqrt(r.fit.chi2_per_dof);
     fopt.dispersion *= r.fit.chi2_per_dof;
@@ -426,6 +426,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   if (options.cross_checks) {
     cross_checks(contiguous, options, r);
     if (r.sensor == SensorKind::Gyro) r.verdict = verdict_of(r, options);  // made, shown only if it applies
+    if (r.sensor == SensorKind::Gyro && r.fit_rejected()) withhold_verdict(r);
   }
   if (options.fit_checks) r.warnings = fit_warnings(r);
   return r;
@@ -608,14 +609,16 @@ nlohmann::json to_json(const AnalysisResult& r) {
 
 nlohmann::json segments_json(const AnalysisResult& r) {
   if (r.segments.size() < 2) return nullptr;
-  nlohmann::json samples = nlohmann::json::array(), durations = nlohmann::json::array(),
-                 gaps = nlohmann::json::array();
+  nlohmann::json samples = nlohmann::json::array(), durations = nlohmann::json::array(), gaps = nlohmann::json::array();
   for (const auto& g : r.segments) {
     samples.push_back(g.samples);
     durations.push_back(static_cast<double>(g.samples) / r.rate_hz);
     if (g.gap_s > 0) gaps.push_back({{"line", g.line}, {"missing_s", g.gap_s}, {"before_sample", g.first}});
   }
-  return {{"count", r.segments.size()}, {"samples", samples}, {"durations_s", durations}, {"gaps", gaps},
+  return {{"count", r.segments.size()},
+          {"samples", samples},
+          {"durations_s", durations},
+          {"gaps", gaps},
           {"allan", "pooled over the segments: no difference spans a gap; EDF the sum of the segments'"},
           {"cross_checks", "on the longest segment"}};
 }

@@ -7,9 +7,9 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cmath>
 #include <map>
 #include <numeric>
-#include <cmath>
 
 #include "model/output_filter.hpp"
 #include "rwcalc/confidence.hpp"
@@ -69,8 +69,9 @@ double filter_time_constant(const FitResult& f, double tau0, double measured) {
 /// The file name as a shell word (quoted when it holds anything beyond [A-Za-z0-9/._+,-]).
 std::string shell_word(const std::string& path) {
   const std::string p = printable(path);
-  const bool plain = !p.empty() && p.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
-                                                       "0123456789/._+,-") == std::string::npos;
+  const bool plain = !p.empty() && p.find_first_not_of(
+                                       "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
+                                       "0123456789/._+,-") == std::string::npos;
   if (plain) return p;
   std::string q = "'";
   for (const char ch : p) q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
@@ -239,7 +240,8 @@ bool white_phase_leads(const FitResult& fit, double tau_s) {
 
 /// measured_variance_ratio of each octave that holds a point where white phase noise leads, the
 /// octaves in parallel.
-std::map<std::int64_t, double> white_phase_ratios(const AllanResult& allan, const FitResult& fit, const PhaseSeries& x) {
+std::map<std::int64_t, double> white_phase_ratios(const AllanResult& allan, const FitResult& fit,
+                                                  const PhaseSeries& x) {
   std::vector<std::int64_t> octaves;
   for (const AllanPoint& p : allan.points)
     if (white_phase_leads(fit, p.tau_s) && (octaves.empty() || octaves.back() != octave_of(p.m)))
@@ -256,7 +258,8 @@ std::map<std::int64_t, double> white_phase_ratios(const AllanResult& allan, cons
 bool apply_model_bounds(AllanResult& allan, const FitResult& fit, const PhaseSeries* x) {
   if (allan.estimator != Estimator::Overlapping || allan.points.empty()) return false;
   const std::vector<FitPoint> pts = fit_points(allan);
-  const std::map<std::int64_t, double> ratio = x ? white_phase_ratios(allan, fit, *x) : std::map<std::int64_t, double>{};
+  const std::map<std::int64_t, double> ratio =
+      x ? white_phase_ratios(allan, fit, *x) : std::map<std::int64_t, double>{};
   for (std::size_t i = 0; i < allan.points.size(); ++i) {
     AllanPoint& p = allan.points[i];
     const double model = fit.model_var(p.tau_s);
@@ -328,10 +331,29 @@ std::string range_clause(const FitRangeChoice& c) {
 
 std::string FitRangeChoice::reason() const { return range_clause(*this) + lines_clause(*this); }
 
+void withhold_verdict(AnalysisResult& r) {
+  const FitRangeChoice& fr = r.fit_range;
+  const std::string tried =
+      fr.source == FitRangeChoice::Source::Option ? std::string(tr("over the range given by --fit-range"))
+      : r.arcsec_per_count > 0
+          ? std::string(tr("over every octave point, the pulse read-out taken as white angle noise (Q)"))
+          : std::string(tr("after the short-tau check (output filter, short-tau structure) and the spectral-line "
+                           "search"));
+  r.verdict.withhold(trf("the fit is rejected: chi2/dof = {:.3g} on {} degrees of freedom (p = {:.2g} < {:g}), {}",
+                         r.fit.chi2_per_dof, r.fit.dof, r.fit.p_value, kFitRejectedP, tried),
+                     trf("rwcalc diagnose {} [input options]", shell_word(r.source)));
+}
+
 std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r) {
   std::vector<AnalysisWarning> w;
   const std::string src = shell_word(r.source);
   const FitRangeChoice& fr = r.fit_range;
+  if (r.verdict.withheld && r.verdict_applies)
+    w.push_back({"no_verdict",
+                 trf("No class verdict: {}. A rejected fit gives no class and no probability; find what the "
+                     "model misses (diagnose) or choose the fit range (--fit-range).",
+                     r.verdict.withheld_reason),
+                 r.verdict.next_command});
   if (fr.source == FitRangeChoice::Source::ShortTau)
     w.push_back({fr.filter_tc_s > 0 ? "output_filter" : "short_tau_structure",
                  trf("The fit uses tau >= {:g} s only: {}. Give --fit-range to choose the range yourself.",
@@ -344,8 +366,8 @@ std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r) {
                      "spectrum) is not in the five-term model: its Allan variance, computed from the spectrum's "
                      "excess over the local level, is taken off the octave points before the fit (it was "
                      "{:.0f} % of the AV at {:g} s).",
-                     line.f_hz, line.rms * si.factor, localized_label(si), line.peak_ratio,
-                     100.0 * line.max_share, line.tau_at_max_s),
+                     line.f_hz, line.rms * si.factor, localized_label(si), line.peak_ratio, 100.0 * line.max_share,
+                     line.tau_at_max_s),
                  ""});
   }
   if (fr.line_points_left_out > 0)
@@ -353,7 +375,7 @@ std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r) {
                  trf("{} octave point(s) left out of the fit: spectral lines carry over 90 % of their AV.",
                      fr.line_points_left_out),
                  ""});
-  if (r.fit.p_value < 0.001)
+  if (r.fit_rejected())
     w.push_back({"fit_rejected",
                  trf("The five-term model does not describe the Allan variance: chi2/dof = {:.3g} "
                      "(dof {}, p = {:.2g}). The coefficients' intervals are scaled by sqrt(chi2/dof) = "

@@ -46,7 +46,11 @@ double measured_variance_ratio(const PhaseSeries& x, std::int64_t m);
 /// σ²_model. Other estimators are left as computed (Stable32's noise id). Returns whether it applied.
 bool apply_model_bounds(AllanResult& allan, const FitResult& fit, const PhaseSeries* x);
 
-/// The warnings of a result's fit range and goodness of fit.
+/// A rejected fit gives no class: the verdict is withheld with the reason (the goodness of fit, the
+/// range and what the short-τ check and the line search took off) and the command to run next.
+void withhold_verdict(AnalysisResult& r);
+
+/// The warnings of a result's fit range and goodness of fit (a withheld verdict's first).
 std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r);
 
 }  // namespace rwcalc
