@@ -35,6 +35,13 @@ constexpr double kFilterTaus = 10;
 /// The extrapolating fit must start beyond this many τf for the filter's estimate to hold.
 constexpr double kReferenceFilterTaus = 30;
 
+/// A rejected fit's lower τ moves up at most to this many τ0: a line at a tenth of the sample rate
+/// or above (and a filter) bends the AV up to a few times 1/f; beyond, the points carry the white
+/// noise that N is read from.
+constexpr double kMisfitSearchTaus = 32;
+/// A point departs from the fit by this many of its standard errors to be named with its neighbours.
+constexpr double kMisfitSigmas = 2;
+
 /// α of S_y(f) ∝ f^α for each term (R, a drift, shown as −2 like K).
 constexpr int kTermAlpha[kTermCount] = {2, 0, -1, -2, -2};
 
@@ -283,6 +290,82 @@ bool apply_model_bounds(AllanResult& allan, const FitResult& fit, const PhaseSer
   return true;
 }
 
+void move_past_short_tau_misfit(const std::vector<FitPoint>& points, double tau0_s, FitOptions& fopt,
+                                AnalysisResult& r) {
+  if (r.fit.used.empty()) return;
+  const double rejected_chi2 = r.fit.chi2_per_dof, from = r.fit.used.front().tau_s;
+  for (double next = 2.0 * from; next <= kMisfitSearchTaus * tau0_s * (1 + 1e-9); next *= 2.0) {
+    FitOptions o = fopt;
+    o.tau_min_s = next * (1 - 1e-9);
+    FitResult f;
+    try {
+      f = fit_noise(points, o);
+    } catch (const AnalysisError&) {
+      return;  // too few points left
+    }
+    if (f.p_value < kFitRejectedP) continue;
+    fopt = o;
+    r.fit = std::move(f);
+    r.fit_range.source = FitRangeChoice::Source::ShortTau;
+    r.fit_range.rejected_chi2 = rejected_chi2;
+    r.fit_range.rejected_from_tau_s = from;
+    return;
+  }
+}
+
+namespace {
+
+/// What a run of departing points is, from where it lies and the lines taken off.
+std::string misfit_structure(const AnalysisResult& r, const FitMisfit& m) {
+  for (const auto& l : r.fit_range.lines) {
+    const double peak = kLinePeakTau / l.f_hz;
+    if (peak >= 0.5 * m.tau_from_s && peak <= 2.0 * m.tau_to_s)
+      return trf(
+          "the spectral line at {:.4g} Hz: its Allan variance from the spectrum does not match the points "
+          "(a line broader or less steady than one sinusoid)",
+          l.f_hz);
+  }
+  const bool first = m.tau_from_s <= r.fit.used.front().tau_s;
+  if (first && m.ratio < 1)
+    return tr("a roll-off at the shortest tau fitted: an output filter the short-tau check did not resolve");
+  if (first) return tr("short-tau structure: a line or a resonance near 1/(2 tau) Hz, or a filter");
+  if (m.ratio > 1) return tr("a bump the five terms cannot follow: a Gauss-Markov process or a low-frequency line");
+  return tr("a dip below the model: a step, a drift or a bump elsewhere pulls the fitted terms up");
+}
+
+}  // namespace
+
+FitMisfit fit_misfit(const AnalysisResult& r) {
+  FitMisfit m;
+  const auto& pts = r.fit.used;
+  if (!r.fit_rejected() || pts.empty()) return m;
+  std::vector<double> z(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const double model = r.fit.model_var(pts[i].tau_s);
+    z[i] = model > 0 && pts[i].edf > 0 ? (pts[i].var / model - 1.0) * std::sqrt(pts[i].edf / 2.0) : 0.0;
+  }
+  const auto worst = static_cast<std::size_t>(
+      std::max_element(z.begin(), z.end(), [](double a, double b) { return std::abs(a) < std::abs(b); }) - z.begin());
+  auto departs = [&](std::size_t i) { return std::abs(z[i]) >= kMisfitSigmas && (z[i] > 0) == (z[worst] > 0); };
+  std::size_t lo = worst, hi = worst;
+  while (lo > 0 && departs(lo - 1)) --lo;
+  while (hi + 1 < pts.size() && departs(hi + 1)) ++hi;
+  m.tau_from_s = pts[lo].tau_s;
+  m.tau_to_s = pts[hi].tau_s;
+  m.worst_tau_s = pts[worst].tau_s;
+  m.ratio = pts[worst].var / r.fit.model_var(pts[worst].tau_s);
+  m.sigmas = z[worst];
+  m.structure = misfit_structure(r, m);
+  return m;
+}
+
+nlohmann::json misfit_json(const AnalysisResult& r) {
+  if (!r.fit_rejected()) return nullptr;
+  const FitMisfit m = fit_misfit(r);
+  return {{"tau_from_s", m.tau_from_s}, {"tau_to_s", m.tau_to_s}, {"worst_tau_s", m.worst_tau_s},
+          {"ratio", m.ratio},           {"sigmas", m.sigmas},     {"structure", m.structure}};
+}
+
 namespace {
 
 /// What the short-τ check saw, one clause per finding.
@@ -298,6 +381,11 @@ std::string short_tau_findings(const FitRangeChoice& c) {
         trf("{}the AV at {:g} s is {:.0f} % of the extrapolation of the model fitted from {:g} s (short-tau "
             "structure the five-term model lacks: a spectral line, a bump or a filter)",
             s.empty() ? "" : "; ", c.departure_tau_s, 100.0 * c.departure_ratio, c.reference_tau_s);
+  if (c.rejected_chi2 > 0)
+    s +=
+        trf("{}the fit from {:g} s was rejected (chi2/dof = {:.3g}) and is accepted from {:g} s: short-tau "
+            "structure (a line or a filter) that bends the longer tau too",
+            s.empty() ? "" : "; ", c.rejected_from_tau_s, c.rejected_chi2, c.tau_min_s);
   return s;
 }
 
@@ -318,7 +406,8 @@ std::string range_clause(const FitRangeChoice& c) {
     case FitRangeChoice::Source::Option: return tr("the range given by --fit-range");
     case FitRangeChoice::Source::ShortTau:
       return trf("tau >= {:g} s ({}): {}", c.tau_min_s,
-                 c.filter_tc_s > 0 && 10.0 * c.filter_tc_s >= 2.0 * c.departure_tau_s
+                 c.rejected_chi2 > 0 ? tr("from where the fit is accepted")
+                 : c.filter_tc_s > 0 && 10.0 * c.filter_tc_s >= 2.0 * c.departure_tau_s
                      ? tr("10 tau_f")
                      : tr("beyond the departing points"),
                  short_tau_findings(c));
@@ -375,13 +464,17 @@ std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r) {
                  trf("{} octave point(s) left out of the fit: spectral lines carry over 90 % of their AV.",
                      fr.line_points_left_out),
                  ""});
-  if (r.fit_rejected())
+  if (r.fit_rejected()) {
+    const FitMisfit m = fit_misfit(r);
     w.push_back({"fit_rejected",
                  trf("The five-term model does not describe the Allan variance: chi2/dof = {:.3g} "
-                     "(dof {}, p = {:.2g}). The coefficients' intervals are scaled by sqrt(chi2/dof) = "
-                     "{:.3g}; look for what the model misses.",
-                     r.fit.chi2_per_dof, r.fit.dof, r.fit.p_value, fr.interval_scale),
+                     "(dof {}, p = {:.2g}). The points at tau = {:g}..{:g} s depart most (at {:g} s the AV is "
+                     "{:.0f} % of the model's, {:+.1f} sigma): {}. The coefficients' intervals are scaled by "
+                     "sqrt(chi2/dof) = {:.3g}.",
+                     r.fit.chi2_per_dof, r.fit.dof, r.fit.p_value, m.tau_from_s, m.tau_to_s, m.worst_tau_s,
+                     100.0 * m.ratio, m.sigmas, m.structure, fr.interval_scale),
                  trf("rwcalc diagnose {} [input options]", src)});
+  }
   return w;
 }
 
