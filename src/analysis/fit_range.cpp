@@ -330,7 +330,9 @@ std::string misfit_structure(const AnalysisResult& r, const FitMisfit& m) {
     return tr("a roll-off at the shortest tau fitted: an output filter the short-tau check did not resolve");
   if (first) return tr("short-tau structure: a line or a resonance near 1/(2 tau) Hz, or a filter");
   if (m.ratio > 1) return tr("a bump the five terms cannot follow: a Gauss-Markov process or a low-frequency line");
-  return tr("a dip below the model: a step, a drift or a bump elsewhere pulls the fitted terms up");
+  return tr(
+      "a dip below the model: the fitted terms rise to follow a bump or a step at other tau (a Gauss-Markov "
+      "process, a bias step)");
 }
 
 }  // namespace
@@ -339,22 +341,33 @@ FitMisfit fit_misfit(const AnalysisResult& r) {
   FitMisfit m;
   const auto& pts = r.fit.used;
   if (!r.fit_rejected() || pts.empty()) return m;
+  // Each point's signed share of the fit's Gamma deviance, ν(x/m − 1 − ln(x/m)), in standard errors.
   std::vector<double> z(pts.size());
   for (std::size_t i = 0; i < pts.size(); ++i) {
-    const double model = r.fit.model_var(pts[i].tau_s);
-    z[i] = model > 0 && pts[i].edf > 0 ? (pts[i].var / model - 1.0) * std::sqrt(pts[i].edf / 2.0) : 0.0;
+    const double q = pts[i].var / r.fit.model_var(pts[i].tau_s);
+    z[i] = q > 0 && pts[i].edf > 0 ? std::copysign(std::sqrt(pts[i].edf * std::max(0.0, q - 1 - std::log(q))), q - 1)
+                                   : 0.0;
   }
-  const auto worst = static_cast<std::size_t>(
-      std::max_element(z.begin(), z.end(), [](double a, double b) { return std::abs(a) < std::abs(b); }) - z.begin());
-  auto departs = [&](std::size_t i) { return std::abs(z[i]) >= kMisfitSigmas && (z[i] > 0) == (z[worst] > 0); };
-  std::size_t lo = worst, hi = worst;
-  while (lo > 0 && departs(lo - 1)) --lo;
-  while (hi + 1 < pts.size() && departs(hi + 1)) ++hi;
-  m.tau_from_s = pts[lo].tau_s;
-  m.tau_to_s = pts[hi].tau_s;
-  m.worst_tau_s = pts[worst].tau_s;
-  m.ratio = pts[worst].var / r.fit.model_var(pts[worst].tau_s);
-  m.sigmas = z[worst];
+  // The run of neighbouring points departing on one side with the largest deviance.
+  double best = -1;
+  for (std::size_t lo = 0; lo < pts.size();) {
+    std::size_t hi = lo;
+    double sum = z[lo] * z[lo];
+    std::size_t worst = lo;
+    while (hi + 1 < pts.size() && std::abs(z[hi + 1]) >= kMisfitSigmas && std::abs(z[lo]) >= kMisfitSigmas &&
+           (z[hi + 1] > 0) == (z[lo] > 0)) {
+      ++hi;
+      sum += z[hi] * z[hi];
+      if (std::abs(z[hi]) > std::abs(z[worst])) worst = hi;
+    }
+    if (sum > best) {
+      best = sum;
+      m.tau_from_s = pts[lo].tau_s, m.tau_to_s = pts[hi].tau_s, m.worst_tau_s = pts[worst].tau_s;
+      m.ratio = pts[worst].var / r.fit.model_var(pts[worst].tau_s);
+      m.sigmas = z[worst];
+    }
+    lo = hi + 1;
+  }
   m.structure = misfit_structure(r, m);
   return m;
 }
