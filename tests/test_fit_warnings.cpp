@@ -283,15 +283,6 @@ TEST(SimulateFrom, UpperBoundsNeedFrom) {
   EXPECT_NE(r.err.find("--from"), std::string::npos);
 }
 
-}  // namespace
-}  // namespace rwcalc
-
-namespace rwcalc {
-namespace {
-
-using nlohmann::json;
-using namespace rwcalc::test;
-
 /// An hour at 100 Hz of a MEMS-like gyro (N 2.4 °/√h, B 30 °/h) through a 5.5-ms output filter, with
 /// a broadened line near 14 Hz (five sinusoids 0.3 Hz apart): its Allan variance's tail reaches the
 /// short-τ check's reference points, so the check alone leaves the line in the fit.

@@ -426,8 +426,8 @@ TEST(ImuNoiseFile, KeysTakeAcceptedResolvedAxesAndNameTheOthers) {
   TempDir dir;
   const auto f = dir.write("g.csv", gyros_one_misfit());
   const auto yaml = dir.path() / "imu.yaml";
-  const auto j = parse_ok(
-      run_cli({"imu", f.string(), "--rate", "100", "--gyro", "1,2,3", "--json", "--kalibr", yaml.string()}));
+  const auto j =
+      parse_ok(run_cli({"imu", f.string(), "--rate", "100", "--gyro", "1,2,3", "--json", "--kalibr", yaml.string()}));
   const auto& axes = j["noise"]["gyro"]["axes"];
   ASSERT_EQ(axes.size(), 3u);
   ASSERT_FALSE(axes[0]["fit_rejected"].get<bool>());
@@ -450,13 +450,13 @@ TEST(ImuNoiseFile, KeysTakeAcceptedResolvedAxesAndNameTheOthers) {
   // Asked for, every axis goes into the keys: then z is the worst.
   const auto all = dir.path() / "all.yaml";
   ASSERT_EQ(run_cli({"imu", f.string(), "--rate", "100", "--gyro", "1,2,3", "-o", (dir.path() / "t.txt").string(),
-                     "--kalibr", all.string(), "--kalibr-all-axes"})
+                     "--kalibr", all.string(), "--keys-from-all-axes"})
                 .status,
             0);
   const std::string ya = slurp(all);
   EXPECT_GT(yaml_key(ya, "gyroscope_noise_density"), yaml_key(y, "gyroscope_noise_density"));
   EXPECT_TRUE(has(ya, "worst axis gyro_z_dps")) << ya;
-  EXPECT_TRUE(has(ya, "in the keys (--kalibr-all-axes) although its fit is rejected")) << ya;
+  EXPECT_TRUE(has(ya, "in the keys (--keys-from-all-axes) although its fit is rejected")) << ya;
 }
 
 }  // namespace

@@ -90,12 +90,12 @@ struct FitRangeChoice {
   double rejected_from_tau_s = 0;  ///< the lower τ of that rejected fit, s
   /// The fit was rejected (p < 0.001) and its intervals scaled by √(χ²/dof) (FitOptions::dispersion).
   bool intervals_scaled = false;
-  double interval_scale = 1;                 ///< √(χ²/dof) of the unscaled fit, when scaled
+  double interval_scale = 1;  ///< √(χ²/dof) of the unscaled fit, when scaled
   [[nodiscard]] std::string reason() const;  ///< why the range is what it is, one sentence
 };
 
-/// Where a rejected fit departs most from its points: the run of neighbouring points on the same
-/// side of the model around the largest standardised departure, and what structure that is.
+/// Where a rejected fit departs most from its points: the run of neighbouring points on one side of
+/// the model (each beyond 2 standard errors) with the largest Gamma deviance, and what structure that is.
 struct FitMisfit {
   double tau_from_s = 0, tau_to_s = 0;  ///< the departing points' range, s
   double worst_tau_s = 0;               ///< the point of the largest departure, s

@@ -612,16 +612,14 @@ nlohmann::json to_json(const AnalysisResult& r) {
 
 nlohmann::json segments_json(const AnalysisResult& r) {
   if (r.segments.size() < 2) return nullptr;
-  nlohmann::json samples = nlohmann::json::array(), durations = nlohmann::json::array(), gaps = nlohmann::json::array();
+  nlohmann::json samples = nlohmann::json::array(), durations = nlohmann::json::array(),
+                 gaps = nlohmann::json::array();
   for (const auto& g : r.segments) {
     samples.push_back(g.samples);
     durations.push_back(static_cast<double>(g.samples) / r.rate_hz);
     if (g.gap_s > 0) gaps.push_back({{"line", g.line}, {"missing_s", g.gap_s}, {"before_sample", g.first}});
   }
-  return {{"count", r.segments.size()},
-          {"samples", samples},
-          {"durations_s", durations},
-          {"gaps", gaps},
+  return {{"count", r.segments.size()}, {"samples", samples}, {"durations_s", durations}, {"gaps", gaps},
           {"allan", "pooled over the segments: no difference spans a gap; EDF the sum of the segments'"},
           {"cross_checks", "on the longest segment"}};
 }

@@ -7,9 +7,10 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <cmath>
 #include <map>
 #include <numeric>
+#include <optional>
+#include <cmath>
 
 #include "model/output_filter.hpp"
 #include "rwcalc/confidence.hpp"
@@ -76,9 +77,8 @@ double filter_time_constant(const FitResult& f, double tau0, double measured) {
 /// The file name as a shell word (quoted when it holds anything beyond [A-Za-z0-9/._+,-]).
 std::string shell_word(const std::string& path) {
   const std::string p = printable(path);
-  const bool plain = !p.empty() && p.find_first_not_of(
-                                       "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
-                                       "0123456789/._+,-") == std::string::npos;
+  const bool plain = !p.empty() && p.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
+                                                       "0123456789/._+,-") == std::string::npos;
   if (plain) return p;
   std::string q = "'";
   for (const char ch : p) q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
@@ -93,18 +93,24 @@ double short_tau_reference_s(double tau0_s) { return kReferenceTaus * tau0_s; }
 
 namespace {
 
+/// The fit of the points from `tau_min_s` on, the options otherwise as given; none when it fails (too
+/// few points left, or no convergence).
+std::optional<FitResult> fit_from(std::span<const FitPoint> points, FitOptions options, double tau_min_s) {
+  options.tau_min_s = tau_min_s * (1 - 1e-9);
+  try {
+    return fit_noise(points, options);
+  } catch (const AnalysisError&) {
+    return std::nullopt;
+  }
+}
+
 /// The short-τ points against the model fitted from `reference_tau_s`.
 OutputFilterCheck compare_short_tau(std::span<const FitPoint> octave, const FitOptions& fit, double reference_tau_s) {
   OutputFilterCheck c;
   const FitPoint& first = octave.front();
-  FitOptions ref = fit;
-  ref.tau_min_s = reference_tau_s * (1 - 1e-9);
-  FitResult f;
-  try {
-    f = fit_noise(octave, ref);
-  } catch (const AnalysisError&) {
-    return c;  // too few points beyond the reference τ: no test
-  }
+  const std::optional<FitResult> reference = fit_from(octave, fit, reference_tau_s);
+  if (!reference) return c;  // too few points beyond the reference τ: no test
+  const FitResult& f = *reference;
   c.reference_tau_s = f.used.front().tau_s;
   for (const FitPoint& p : octave) {
     if (p.tau_s >= c.reference_tau_s) break;
@@ -247,8 +253,7 @@ bool white_phase_leads(const FitResult& fit, double tau_s) {
 
 /// measured_variance_ratio of each octave that holds a point where white phase noise leads, the
 /// octaves in parallel.
-std::map<std::int64_t, double> white_phase_ratios(const AllanResult& allan, const FitResult& fit,
-                                                  const PhaseSeries& x) {
+std::map<std::int64_t, double> white_phase_ratios(const AllanResult& allan, const FitResult& fit, const PhaseSeries& x) {
   std::vector<std::int64_t> octaves;
   for (const AllanPoint& p : allan.points)
     if (white_phase_leads(fit, p.tau_s) && (octaves.empty() || octaves.back() != octave_of(p.m)))
@@ -265,8 +270,7 @@ std::map<std::int64_t, double> white_phase_ratios(const AllanResult& allan, cons
 bool apply_model_bounds(AllanResult& allan, const FitResult& fit, const PhaseSeries* x) {
   if (allan.estimator != Estimator::Overlapping || allan.points.empty()) return false;
   const std::vector<FitPoint> pts = fit_points(allan);
-  const std::map<std::int64_t, double> ratio =
-      x ? white_phase_ratios(allan, fit, *x) : std::map<std::int64_t, double>{};
+  const std::map<std::int64_t, double> ratio = x ? white_phase_ratios(allan, fit, *x) : std::map<std::int64_t, double>{};
   for (std::size_t i = 0; i < allan.points.size(); ++i) {
     AllanPoint& p = allan.points[i];
     const double model = fit.model_var(p.tau_s);
@@ -295,17 +299,11 @@ void move_past_short_tau_misfit(const std::vector<FitPoint>& points, double tau0
   if (r.fit.used.empty()) return;
   const double rejected_chi2 = r.fit.chi2_per_dof, from = r.fit.used.front().tau_s;
   for (double next = 2.0 * from; next <= kMisfitSearchTaus * tau0_s * (1 + 1e-9); next *= 2.0) {
-    FitOptions o = fopt;
-    o.tau_min_s = next * (1 - 1e-9);
-    FitResult f;
-    try {
-      f = fit_noise(points, o);
-    } catch (const AnalysisError&) {
-      return;  // too few points left
-    }
-    if (f.p_value < kFitRejectedP) continue;
-    fopt = o;
-    r.fit = std::move(f);
+    std::optional<FitResult> f = fit_from(points, fopt, next);
+    if (!f) return;  // too few points left
+    if (f->p_value < kFitRejectedP) continue;
+    fopt.tau_min_s = f->options.tau_min_s;  // the rest as given: the fit's own options carry its term choice
+    r.fit = std::move(*f);
     r.fit_range.source = FitRangeChoice::Source::ShortTau;
     r.fit_range.rejected_chi2 = rejected_chi2;
     r.fit_range.rejected_from_tau_s = from;
@@ -468,8 +466,8 @@ std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r) {
                      "spectrum) is not in the five-term model: its Allan variance, computed from the spectrum's "
                      "excess over the local level, is taken off the octave points before the fit (it was "
                      "{:.0f} % of the AV at {:g} s).",
-                     line.f_hz, line.rms * si.factor, localized_label(si), line.peak_ratio, 100.0 * line.max_share,
-                     line.tau_at_max_s),
+                     line.f_hz, line.rms * si.factor, localized_label(si), line.peak_ratio,
+                     100.0 * line.max_share, line.tau_at_max_s),
                  ""});
   }
   if (fr.line_points_left_out > 0)

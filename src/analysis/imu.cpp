@@ -495,7 +495,7 @@ std::string axes_comments(const std::vector<AxisNoise>& axes, SensorKind kind, b
     s += fmt::format("#   {}: N {}; K {}\n", yaml_comment(a.column), one(a.N), one(a.K));
     for (const auto& [name, c] : {std::pair{"N", &a.N}, std::pair{"K", &a.K}})
       if (const std::string why = left_out_because(a, *c); !why.empty())
-        s += all ? fmt::format("#     {} in the keys (--kalibr-all-axes) although {}\n", name, why)
+        s += all ? fmt::format("#     {} in the keys (--keys-from-all-axes) although {}\n", name, why)
                  : fmt::format("#     {} left out of the keys: {}\n", name, why);
     if (a.rejected_chi2 > 0) s += "#     the five-term model does not describe this axis; see rwcalc diagnose\n";
     if (!a.lines.empty())
@@ -525,7 +525,7 @@ std::string kalibr_yaml(const ImuResult& r, const KalibrOptions& options) {
       "# walk; sigma^2 = K^2 tau/3), each axis fitted with 95 % intervals; the values used are the {} of {}.\n",
       yaml_comment(r.source), first.input.value("sha256", std::string()), first.samples, first.rate_hz,
       worst ? "worst axis' (the largest)" : "mean",
-      options.all_axes ? "every axis (--kalibr-all-axes)" : "the axes with an accepted fit and a resolved value");
+      options.all_axes ? "every axis (--keys-from-all-axes)" : "the axes with an accepted fit and a resolved value");
   std::string body,
       keys = fmt::format("rostopic: {}\nupdate_rate: {:.6f}  # Hz\n", rostopic_scalar(options.rostopic), first.rate_hz);
   for (const SensorKind kind : {SensorKind::Accelerometer, SensorKind::Gyro}) {
