@@ -7,10 +7,10 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cmath>
 #include <map>
 #include <numeric>
 #include <optional>
-#include <cmath>
 
 #include "model/output_filter.hpp"
 #include "rwcalc/confidence.hpp"
@@ -77,8 +77,9 @@ double filter_time_constant(const FitResult& f, double tau0, double measured) {
 /// The file name as a shell word (quoted when it holds anything beyond [A-Za-z0-9/._+,-]).
 std::string shell_word(const std::string& path) {
   const std::string p = printable(path);
-  const bool plain = !p.empty() && p.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
-                                                       "0123456789/._+,-") == std::string::npos;
+  const bool plain = !p.empty() && p.find_first_not_of(
+                                       "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
+                                       "0123456789/._+,-") == std::string::npos;
   if (plain) return p;
   std::string q = "'";
   for (const char ch : p) q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
@@ -253,7 +254,8 @@ bool white_phase_leads(const FitResult& fit, double tau_s) {
 
 /// measured_variance_ratio of each octave that holds a point where white phase noise leads, the
 /// octaves in parallel.
-std::map<std::int64_t, double> white_phase_ratios(const AllanResult& allan, const FitResult& fit, const PhaseSeries& x) {
+std::map<std::int64_t, double> white_phase_ratios(const AllanResult& allan, const FitResult& fit,
+                                                  const PhaseSeries& x) {
   std::vector<std::int64_t> octaves;
   for (const AllanPoint& p : allan.points)
     if (white_phase_leads(fit, p.tau_s) && (octaves.empty() || octaves.back() != octave_of(p.m)))
@@ -270,7 +272,8 @@ std::map<std::int64_t, double> white_phase_ratios(const AllanResult& allan, cons
 bool apply_model_bounds(AllanResult& allan, const FitResult& fit, const PhaseSeries* x) {
   if (allan.estimator != Estimator::Overlapping || allan.points.empty()) return false;
   const std::vector<FitPoint> pts = fit_points(allan);
-  const std::map<std::int64_t, double> ratio = x ? white_phase_ratios(allan, fit, *x) : std::map<std::int64_t, double>{};
+  const std::map<std::int64_t, double> ratio =
+      x ? white_phase_ratios(allan, fit, *x) : std::map<std::int64_t, double>{};
   for (std::size_t i = 0; i < allan.points.size(); ++i) {
     AllanPoint& p = allan.points[i];
     const double model = fit.model_var(p.tau_s);
@@ -325,7 +328,7 @@ std::string misfit_structure(const AnalysisResult& r, const FitMisfit& m) {
   }
   const bool first = m.tau_from_s <= r.fit.used.front().tau_s;
   if (first && m.ratio < 1)
-    return tr("a roll-off at the shortest tau fitted: an output filter the short-tau check did not resolve");
+    return tr("a roll-off at the shortest tau fitted: an output filter whose roll-off reaches into the fit's range");
   if (first) return tr("short-tau structure: a line or a resonance near 1/(2 tau) Hz, or a filter");
   if (m.ratio > 1) return tr("a bump the five terms cannot follow: a Gauss-Markov process or a low-frequency line");
   return tr(
@@ -466,8 +469,8 @@ std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r) {
                      "spectrum) is not in the five-term model: its Allan variance, computed from the spectrum's "
                      "excess over the local level, is taken off the octave points before the fit (it was "
                      "{:.0f} % of the AV at {:g} s).",
-                     line.f_hz, line.rms * si.factor, localized_label(si), line.peak_ratio,
-                     100.0 * line.max_share, line.tau_at_max_s),
+                     line.f_hz, line.rms * si.factor, localized_label(si), line.peak_ratio, 100.0 * line.max_share,
+                     line.tau_at_max_s),
                  ""});
   }
   if (fr.line_points_left_out > 0)
