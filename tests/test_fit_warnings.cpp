@@ -128,30 +128,22 @@ TEST(FitWarnings, OutputFilterMovesTheRangeUnlessTheUserGivesOne) {
   EXPECT_NE(g["fit"]["range"]["reason"].get<std::string>().find("--fit-range"), std::string::npos);
 }
 
-/// A 1-h 100-Hz floating-angle record (N 0.002 °/√h, B 0.005 °/h), with a 0.5-Hz rate line of
-/// amplitude 0.15 °/h when `line`.
-std::string line_record(const TempDir& dir, bool line) {
-  const std::string path = (dir.path() / (line ? "line.csv" : "plain.csv")).string();
-  std::vector<std::string> args{"simulate",
-                                "-o",
-                                path,
-                                "--duration",
-                                "3600",
-                                "--rate",
-                                "100",
-                                "--scale",
-                                "0.2",
-                                "--arw",
-                                "0.002",
-                                "--bias-instability",
-                                "0.005",
-                                "--white-readout",
-                                "--output-lowpass",
-                                "0.001"};
-  if (line) args.insert(args.end(), {"--sinusoid", "0.5:0.15"});
+/// A 1-h 100-Hz record from `simulate` (a dithered read-out: floating angle) of the model `terms`.
+std::string hour_at_100_hz(const TempDir& dir, const std::string& name, const std::vector<std::string>& terms) {
+  const std::string path = (dir.path() / name).string();
+  std::vector<std::string> args{"simulate", "-o", path, "--duration", "3600", "--rate", "100", "--white-readout"};
+  args.insert(args.end(), terms.begin(), terms.end());
   const auto r = run_cli(args);
   EXPECT_EQ(r.status, 0) << r.err;
   return path;
+}
+
+/// N 0.002 °/√h, B 0.005 °/h, with a 0.5-Hz rate line of amplitude 0.15 °/h when `line`.
+std::string line_record(const TempDir& dir, bool line) {
+  std::vector<std::string> terms{"--scale",          "0.2",  "--arw", "0.002", "--bias-instability", "0.005",
+                                 "--output-lowpass", "0.001"};
+  if (line) terms.insert(terms.end(), {"--sinusoid", "0.5:0.15"});
+  return hour_at_100_hz(dir, line ? "line.csv" : "plain.csv", terms);
 }
 
 TEST(FitWarnings, SpectralLineIsTakenOffTheFitAndSaid) {
@@ -283,35 +275,16 @@ TEST(SimulateFrom, UpperBoundsNeedFrom) {
   EXPECT_NE(r.err.find("--from"), std::string::npos);
 }
 
-/// An hour at 100 Hz of a MEMS-like gyro (N 2.4 °/√h, B 30 °/h) through a 5.5-ms output filter, with
-/// a broadened line near 14 Hz (five sinusoids 0.3 Hz apart): its Allan variance's tail reaches the
-/// short-τ check's reference points, so the check alone leaves the line in the fit.
+/// A MEMS-like gyro (N 2.4 °/√h, B 30 °/h) through a 5.5-ms output filter, with a broadened line near
+/// 14 Hz (five sinusoids 0.3 Hz apart): its Allan variance's tail reaches the short-τ check's reference
+/// points, so the check alone leaves the line in the fit.
 std::string broad_line_record(const TempDir& dir) {
-  const std::string path = (dir.path() / "line14.csv").string();
-  std::vector<std::string> args = {"simulate",
-                                   "-o",
-                                   path,
-                                   "--duration",
-                                   "3600",
-                                   "--rate",
-                                   "100",
-                                   "--scale",
-                                   "0.01",
-                                   "--arw",
-                                   "2.4",
-                                   "--bias-instability",
-                                   "30",
-                                   "--output-lowpass",
-                                   "0.0055",
-                                   "--white-readout",
-                                   "--no-earth-rate",
-                                   "--seed",
-                                   "5"};
+  std::vector<std::string> terms{
+      "--scale",         "0.01",   "--arw", "2.4", "--bias-instability", "30", "--output-lowpass", "0.0055",
+      "--no-earth-rate", "--seed", "5"};
   for (int k = 0; k < 5; ++k)
-    args.insert(args.end(), {std::string("--sinusoid"), fmt::format("{}:600:{}", 13.4 + 0.3 * k, k + 1)});
-  const auto r = run_cli(args);
-  EXPECT_EQ(r.status, 0) << r.err;
-  return path;
+    terms.insert(terms.end(), {std::string("--sinusoid"), fmt::format("{}:600:{}", 13.4 + 0.3 * k, k + 1)});
+  return hour_at_100_hz(dir, "line14.csv", terms);
 }
 
 TEST(FitWarnings, AShortTauLineTheCheckMissesMovesTheRangeUntilTheFitIsAccepted) {
