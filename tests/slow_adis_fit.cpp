@@ -2,7 +2,7 @@
 // and gyro axis, analyze's fit (its range chosen by the short-τ check) gives N within 3 % of an
 // independent white level, a Welch estimate of the one-sided rate PSD between 1 and 5 Hz computed here
 // (N = √(S/2), S in (°/h)²/Hz: 2.417, 2.546, 2.275 °/√h for run 1 X, Y, Z, as numpy gives), with
-// χ²/dof ≤ 5 and the range and its reason stated.
+// χ²/dof ≤ 3 and the range and its reason stated.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -95,7 +95,7 @@ TEST(SlowAdis, FitMatchesTheWelchWhiteLevelOnEveryRunAndAxis) {
                   column.c_str(), n, welch, 100.0 * (n / welch - 1.0), chi2, j["fit"]["tau_min_s"].get<double>(),
                   j["fit"]["range"]["chosen_by"].get<std::string>().c_str());
       EXPECT_NEAR(n / welch, 1.0, 0.03) << run << column;
-      EXPECT_LE(chi2, 5.0) << run << column;
+      EXPECT_LE(chi2, 3.0) << run << column;
       EXPECT_EQ(j["fit"]["range"]["chosen_by"], "short_tau_check") << run << column;
       EXPECT_FALSE(j["warnings"].empty()) << run << column;
       if (run == 1 && axis == 0) {

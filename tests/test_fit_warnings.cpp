@@ -1,15 +1,16 @@
 // analyze's fit checks end to end: the warning of a rejected fit (text and JSON), the range an
 // output filter moves and the --fit-range that overrides it, the model-based per-τ bounds, and
 // `simulate --from` of an analysis reproducing the measured Allan deviation.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <boost/math/distributions/fisher_f.hpp>
 #include <boost/math/distributions/normal.hpp>
 #include <cmath>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 #include <utility>
 #include <vector>
-#include <nlohmann/json.hpp>
 
 #include "rwcalc/fit.hpp"
 #include "test_support.hpp"
@@ -127,17 +128,22 @@ TEST(FitWarnings, OutputFilterMovesTheRangeUnlessTheUserGivesOne) {
   EXPECT_NE(g["fit"]["range"]["reason"].get<std::string>().find("--fit-range"), std::string::npos);
 }
 
-/// A 1-h 100-Hz floating-angle record (N 0.002 °/√h, B 0.005 °/h), with a 0.5-Hz rate line of
-/// amplitude 0.15 °/h when `line`.
-std::string line_record(const TempDir& dir, bool line) {
-  const std::string path = (dir.path() / (line ? "line.csv" : "plain.csv")).string();
-  std::vector<std::string> args{"simulate", "-o", path, "--duration", "3600", "--rate", "100", "--scale", "0.2",
-                                "--arw", "0.002", "--bias-instability", "0.005", "--white-readout",
-                                "--output-lowpass", "0.001"};
-  if (line) args.insert(args.end(), {"--sinusoid", "0.5:0.15"});
+/// A 1-h 100-Hz record from `simulate` (a dithered read-out: floating angle) of the model `terms`.
+std::string hour_at_100_hz(const TempDir& dir, const std::string& name, const std::vector<std::string>& terms) {
+  const std::string path = (dir.path() / name).string();
+  std::vector<std::string> args{"simulate", "-o", path, "--duration", "3600", "--rate", "100", "--white-readout"};
+  args.insert(args.end(), terms.begin(), terms.end());
   const auto r = run_cli(args);
   EXPECT_EQ(r.status, 0) << r.err;
   return path;
+}
+
+/// N 0.002 °/√h, B 0.005 °/h, with a 0.5-Hz rate line of amplitude 0.15 °/h when `line`.
+std::string line_record(const TempDir& dir, bool line) {
+  std::vector<std::string> terms{"--scale",          "0.2",  "--arw", "0.002", "--bias-instability", "0.005",
+                                 "--output-lowpass", "0.001"};
+  if (line) terms.insert(terms.end(), {"--sinusoid", "0.5:0.15"});
+  return hour_at_100_hz(dir, line ? "line.csv" : "plain.csv", terms);
 }
 
 TEST(FitWarnings, SpectralLineIsTakenOffTheFitAndSaid) {
@@ -267,6 +273,57 @@ TEST(SimulateFrom, UpperBoundsNeedFrom) {
   const auto r = run_cli({"simulate", "-o", (dir.path() / "x.csv").string(), "--upper-bounds"});
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("--from"), std::string::npos);
+}
+
+/// A MEMS-like gyro (N 2.4 °/√h, B 30 °/h) through a 5.5-ms output filter, with a broadened line near
+/// 14 Hz (five sinusoids 0.3 Hz apart): its Allan variance's tail reaches the short-τ check's reference
+/// points, so the check alone leaves the line in the fit.
+std::string broad_line_record(const TempDir& dir) {
+  std::vector<std::string> terms{
+      "--scale",         "0.01",   "--arw", "2.4", "--bias-instability", "30", "--output-lowpass", "0.0055",
+      "--no-earth-rate", "--seed", "5"};
+  for (int k = 0; k < 5; ++k)
+    terms.insert(terms.end(), {std::string("--sinusoid"), fmt::format("{}:600:{}", 13.4 + 0.3 * k, k + 1)});
+  return hour_at_100_hz(dir, "line14.csv", terms);
+}
+
+TEST(FitWarnings, AShortTauLineTheCheckMissesMovesTheRangeUntilTheFitIsAccepted) {
+  TempDir dir;
+  const std::string rec = broad_line_record(dir);
+  const auto given = run_cli({"analyze", rec, "--input", "angle", "--json", "--fit-range", "0.08:"});
+  ASSERT_EQ(given.status, 0) << given.err;
+  const json g = json::parse(given.out);
+  ASSERT_LT(g["fit"]["p_value"].get<double>(), 0.001);  // from where the short-tau check starts: rejected
+  EXPECT_FALSE(g["fit"]["misfit"]["structure"].get<std::string>().empty());
+  const auto r = run_cli({"analyze", rec, "--input", "angle", "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_GE(j["fit"]["p_value"].get<double>(), 0.001);
+  EXPECT_TRUE(j["fit"]["misfit"].is_null());
+  const auto& range = j["fit"]["range"];
+  EXPECT_EQ(range["chosen_by"], "short_tau_check");
+  EXPECT_NEAR(range["rejected_chi2_per_dof"].get<double>(), g["fit"]["chi2_per_dof"].get<double>(), 1e-9);
+  EXPECT_EQ(range["rejected_from_tau_s"].get<double>(), 0.08);
+  EXPECT_GT(range["tau_min_s"].get<double>(), 0.08);
+  EXPECT_NE(range["reason"].get<std::string>().find("the fit from 0.08 s was rejected"), std::string::npos);
+  EXPECT_NEAR(j["fit"]["N_deg_per_sqrt_h"]["value"].get<double>() / 2.4, 1.0, 0.03);
+}
+
+TEST(FitWarnings, ARejectedFitNamesWhereItDeparts) {
+  TempDir dir;
+  const std::string rec = bump_record(dir);
+  const json j = json::parse(run_cli({"analyze", rec, "--json"}).out);
+  const auto& m = j["fit"]["misfit"];
+  ASSERT_TRUE(m.is_object()) << j["fit"].dump();
+  const double from = m["tau_from_s"].get<double>(), to = m["tau_to_s"].get<double>(),
+               at = m["worst_tau_s"].get<double>();
+  EXPECT_LE(from, at);
+  EXPECT_LE(at, to);
+  EXPECT_GT(std::abs(m["sigmas"].get<double>()), 2.0);
+  EXPECT_EQ(m["sigmas"].get<double>() > 0, m["ratio"].get<double>() > 1);
+  const json* w = warning(j, "fit_rejected");
+  ASSERT_NE(w, nullptr);
+  EXPECT_NE(w->at("message").get<std::string>().find(m["structure"].get<std::string>()), std::string::npos);
 }
 
 }  // namespace

@@ -397,3 +397,67 @@ TEST(Imu, AConstantChannelIsRefusedNamingItsColumn) {
 
 }  // namespace
 }  // namespace rwcalc::test
+
+namespace rwcalc::test {
+namespace {
+
+// Three gyro axes of white noise (°/s), the last with a ±0.05 °/s square wave of period 60 s
+// (a rejected fit): 40 min at 100 Hz.
+std::string gyros_one_misfit() {
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> z;
+  std::string s = "gyro_x_dps,gyro_y_dps,gyro_z_dps\n";
+  for (int k = 0; k < 240000; ++k) {
+    const double square = (k / 3000) % 2 == 0 ? 0.05 : -0.05;
+    s += fmt::format("{:.6f},{:.6f},{:.6f}\n", kGyroSd * z(rng), 1.2 * kGyroSd * z(rng),
+                     square + 1.5 * kGyroSd * z(rng));
+  }
+  return s;
+}
+
+// The value of a key of the noise file.
+double yaml_key(const std::string& y, const std::string& key) {
+  const auto at = y.find("\n" + key + ": ");
+  EXPECT_NE(at, std::string::npos) << key;
+  return at == std::string::npos ? 0.0 : std::stod(y.substr(at + key.size() + 3));
+}
+
+TEST(ImuNoiseFile, KeysTakeAcceptedResolvedAxesAndNameTheOthers) {
+  TempDir dir;
+  const auto f = dir.write("g.csv", gyros_one_misfit());
+  const auto yaml = dir.path() / "imu.yaml";
+  const auto j =
+      parse_ok(run_cli({"imu", f.string(), "--rate", "100", "--gyro", "1,2,3", "--json", "--kalibr", yaml.string()}));
+  const auto& axes = j["noise"]["gyro"]["axes"];
+  ASSERT_EQ(axes.size(), 3u);
+  ASSERT_FALSE(axes[0]["fit_rejected"].get<bool>());
+  ASSERT_FALSE(axes[1]["fit_rejected"].get<bool>());
+  ASSERT_TRUE(axes[2]["fit_rejected"].get<bool>());  // the square wave
+  // N: the worst accepted axis (y), not z's larger value from a rejected fit.
+  const double ny = axes[1]["noise_density"]["value"].get<double>();
+  EXPECT_GT(axes[2]["noise_density"]["value"].get<double>(), ny);
+  const std::string y = slurp(yaml);
+  EXPECT_DOUBLE_EQ(yaml_key(y, "gyroscope_noise_density"), std::stod(fmt::format("{:.6e}", ny))) << y;
+  EXPECT_EQ(j["noise"]["gyro"]["worst"]["noise_density_axis"], "gyro_y_dps");
+  EXPECT_FALSE(axes[2]["noise_density"]["in_keys"].get<bool>());
+  EXPECT_TRUE(has(y, "#     N left out of the keys: its fit is rejected")) << y;
+  // K: white noise only, so no axis resolves it: the key is the largest bound, said in the first lines.
+  const auto first_lines = y.substr(0, y.find("# gyro axes"));
+  EXPECT_TRUE(has(first_lines, "# WARNING: no gyro axis has an accepted fit and a resolved K")) << y;
+  EXPECT_TRUE(has(y, "gyroscope_random_walk: ")) << y;
+  EXPECT_TRUE(j["noise"]["gyro"]["worst"]["random_walk_no_axis_qualifies"].get<bool>());
+  EXPECT_FALSE(has(first_lines, "resolved N")) << y;
+  // Asked for, every axis goes into the keys: then z is the worst.
+  const auto all = dir.path() / "all.yaml";
+  ASSERT_EQ(run_cli({"imu", f.string(), "--rate", "100", "--gyro", "1,2,3", "-o", (dir.path() / "t.txt").string(),
+                     "--kalibr", all.string(), "--keys-from-all-axes"})
+                .status,
+            0);
+  const std::string ya = slurp(all);
+  EXPECT_GT(yaml_key(ya, "gyroscope_noise_density"), yaml_key(y, "gyroscope_noise_density"));
+  EXPECT_TRUE(has(ya, "worst axis gyro_z_dps")) << ya;
+  EXPECT_TRUE(has(ya, "in the keys (--keys-from-all-axes) although its fit is rejected")) << ya;
+}
+
+}  // namespace
+}  // namespace rwcalc::test

@@ -83,11 +83,30 @@ struct FitRangeChoice {
   std::vector<Line> lines;
   /// Octave points left out of the fit because the lines carry more than 90 % of their AV.
   int line_points_left_out = 0;
+  /// The fit from the short-τ check's range was rejected (χ²/dof rejected_chi2) and the lower τ moved
+  /// up an octave at a time (to at most 32 τ0) until it was accepted: short-τ structure (a line or
+  /// a filter) whose tail also bends the check's reference points. 0: no such move.
+  double rejected_chi2 = 0;
+  double rejected_from_tau_s = 0;  ///< the lower τ of that rejected fit, s
   /// The fit was rejected (p < 0.001) and its intervals scaled by √(χ²/dof) (FitOptions::dispersion).
   bool intervals_scaled = false;
   double interval_scale = 1;  ///< √(χ²/dof) of the unscaled fit, when scaled
   [[nodiscard]] std::string reason() const;  ///< why the range is what it is, one sentence
 };
+
+/// Where a rejected fit departs most from its points: the run of neighbouring points on one side of
+/// the model (each beyond 2 standard errors) with the largest Gamma deviance, and what structure that is.
+struct FitMisfit {
+  double tau_from_s = 0, tau_to_s = 0;  ///< the departing points' range, s
+  double worst_tau_s = 0;               ///< the point of the largest departure, s
+  double ratio = 1;                     ///< measured / model AV there
+  double sigmas = 0;                    ///< the departure there in standard errors of the point
+  std::string structure;                ///< what it is, one phrase ("" when the fit is accepted)
+};
+
+/// A fit whose goodness-of-fit p-value is below this is rejected: its intervals are scaled by
+/// √(χ²/dof) and the class verdict is withheld (docs/analysis.md, "When the fit fails").
+inline constexpr double kFitRejectedP = 0.001;
 
 struct AnalysisResult {
   std::string source;
@@ -132,6 +151,8 @@ struct AnalysisResult {
   std::vector<AnalysisWarning> warnings;
   /// `--gaps segments`: the segments the record was split into at its gaps (empty: no gap).
   std::vector<Recording::Segment> segments;
+  /// The goodness of fit rejects the fit (p < kFitRejectedP).
+  [[nodiscard]] bool fit_rejected() const { return fit.p_value < kFitRejectedP; }
 };
 
 /// Gyro or accelerometer data. Throws UsageError for clock data, AnalysisError for a record too short

@@ -59,6 +59,9 @@ enum class AxisCombination { Worst, Mean };
 struct KalibrOptions {
   std::string rostopic = "/imu0";
   AxisCombination combine = AxisCombination::Worst;
+  /// The keys take every axis; by default only the axes with an accepted fit and a resolved value
+  /// (the others named in the comments, with why; when none qualifies, every axis, said in the first lines).
+  bool all_axes = false;
 };
 
 /// The rostopic as the noise file writes it (one YAML double-quoted scalar, encode.hpp); UsageError
@@ -67,8 +70,8 @@ struct KalibrOptions {
 std::string rostopic_scalar(const std::string& rostopic);
 
 /// Kalibr's imu.yaml (OpenVINS reads the same keys): noise densities = N and random walks = K of
-/// each kind in SI, the axes combined as asked; each axis' values and any unresolved K (its 95 %
-/// upper bound) in comments, every outside name in them made a safe comment (yaml_comment).
+/// each kind in SI, the qualifying axes (KalibrOptions::all_axes) combined as asked; each axis' values,
+/// and why one is left out, in comments, every outside name in them made a safe comment (yaml_comment).
 std::string kalibr_yaml(const ImuResult& r, const KalibrOptions& options = {});
 
 }  // namespace rwcalc

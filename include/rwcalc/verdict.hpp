@@ -9,6 +9,8 @@
 #include <string_view>
 #include <vector>
 
+#include "rwcalc/i18n.hpp"
+
 namespace rwcalc {
 
 struct ClassLimit {
@@ -70,6 +72,9 @@ struct ParameterVerdict {
   double p_class = 0;              ///< probability of the stated class
 };
 
+/// The statement of a withheld verdict (Verdict::withhold), untranslated.
+inline constexpr const char* kNoVerdict = N_("no verdict: the noise model does not describe this record");
+
 struct Verdict {
   ParameterVerdict B, N;
   std::optional<int> cls;  ///< the worse of the two
@@ -85,7 +90,13 @@ struct Verdict {
   double tolerance_pct = 0;
   std::string table_name;
   std::vector<int> class_numbers;
-  [[nodiscard]] std::string statement() const;  ///< see describe_class
+  /// No verdict: the fit the estimates come from is rejected, so no class and no probability is
+  /// stated; `withheld_reason` says why and `next_command` what to run next.
+  bool withheld = false;
+  std::string withheld_reason, next_command;
+  /// Withholds the verdict (the class and the probabilities stay computed but are not stated).
+  void withhold(std::string reason, std::string command);
+  [[nodiscard]] std::string statement() const;  ///< see describe_class; "no verdict: …" when withheld
   [[nodiscard]] std::string statement(const ParameterVerdict& p) const;
 };
 

@@ -137,8 +137,6 @@ namespace {
 
 /// A line that carries less than this share of every octave point's AV is ignored.
 constexpr double kLineShareIgnored = 0.01;
-/// The AV of a sinusoid of frequency f, ∝ sin⁴(πfτ)/(πfτ)², peaks at τ = this / f.
-constexpr double kLinePeakTau = 0.371;
 /// Points whose AV the lines carry more than this share of are left out of the fit.
 constexpr double kLineShareLeftOut = 0.9;
 
@@ -324,7 +322,9 @@ void fit_with_checks(const std::vector<FitPoint>& all_points, const PhaseSeries&
     }
   }
   r.fit = fit_noise(points, fopt);
-  if (options.fit_checks && r.fit.p_value < 0.001 && r.fit.chi2_per_dof > 1) {
+  if (options.fit_checks && !exact_counts && range.source != FitRangeChoice::Source::Option && r.fit_rejected())
+    move_past_short_tau_misfit(points, x.tau0_s, fopt, r);
+  if (options.fit_checks && r.fit_rejected() && r.fit.chi2_per_dof > 1) {
     range.intervals_scaled = true;
     range.interval_scale = std::sqrt(r.fit.chi2_per_dof);
     fopt.dispersion *= r.fit.chi2_per_dof;
@@ -426,6 +426,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   if (options.cross_checks) {
     cross_checks(contiguous, options, r);
     if (r.sensor == SensorKind::Gyro) r.verdict = verdict_of(r, options);  // made, shown only if it applies
+    if (r.sensor == SensorKind::Gyro && r.fit_rejected()) withhold_verdict(r);
   }
   if (options.fit_checks) r.warnings = fit_warnings(r);
   return r;
@@ -482,7 +483,10 @@ json fit_json(const AnalysisResult& r) {
             {"departure_ratio", r.fit_range.departure_ratio},
             {"reference_tau_min_s", r.fit_range.reference_tau_s},
             {"spectral_lines", spectral_lines_json(r.fit_range)},
-            {"line_points_left_out", r.fit_range.line_points_left_out}}},
+            {"line_points_left_out", r.fit_range.line_points_left_out},
+            {"rejected_chi2_per_dof", r.fit_range.rejected_chi2},
+            {"rejected_from_tau_s", r.fit_range.rejected_from_tau_s}}},
+          {"misfit", misfit_json(r)},
           {"intervals_scaled", r.fit_range.intervals_scaled},
           {"interval_scale", r.fit_range.interval_scale}};
 }

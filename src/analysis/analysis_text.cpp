@@ -58,9 +58,10 @@ std::string format_segments(const AnalysisResult& r) {
     lengths += fmt::format("{}{:.1f}", lengths.empty() ? "" : ", ", static_cast<double>(g.samples) / r.rate_hz);
     if (g.gap_s > 0) gaps += trf("{}{:.6g} s before line {}", gaps.empty() ? "" : ", ", g.gap_s, g.line);
   }
-  return trf("  segments: {} (split at the time column's gaps by --gaps segments: {}; lengths {} s); the Allan "
-             "variance pools them (no difference spans a gap), the cross-checks use the longest\n",
-             r.segments.size(), gaps, lengths);
+  return trf(
+      "  segments: {} (split at the time column's gaps by --gaps segments: {}; lengths {} s); the Allan "
+      "variance pools them (no difference spans a gap), the cross-checks use the longest\n",
+      r.segments.size(), gaps, lengths);
 }
 namespace {
 
@@ -211,6 +212,8 @@ static std::string format_verdict(const AnalysisResult& r) {
   s += trf("Verdict ({}; B from {}{})\n", tr(v.table_name), v.b_estimate,
            v.tolerance_pct > 0 ? trf("; heading-gyro tolerance +{:g} % on B", v.tolerance_pct)
                                : std::string(tr("; strict limits")));
+  if (v.withheld)  // no class and no probability from a rejected fit
+    return s + trf("  {}\n  why: {}\n  next: {}\n\n", v.statement(), v.withheld_reason, as_typed(v.next_command));
   s += verdict_param_line(v, v.B);
   s += verdict_param_line(v, v.N);
   s += trf("  overall: {}", v.statement());

@@ -65,6 +65,29 @@ json combine(const std::vector<json>& runs, const std::vector<int>& classes, con
           {"p_class", p_is[s]},     {"statement", describe_class(p_is, cls, classes)}};
 }
 
+bool withheld(const json& run) { return run.at("verdict").value("withheld", false); }
+
+/// The overall verdict when a run's verdict is withheld (its fit rejected): none over the runs, naming
+/// them; null when every run has a verdict.
+json withheld_overall(const std::vector<json>& runs) {
+  std::vector<std::string> sources;
+  for (const auto& r : runs)
+    if (withheld(r)) sources.push_back(r.at("source").get<std::string>());
+  if (sources.empty()) return nullptr;
+  std::string names;
+  for (const auto& n : sources) names += (names.empty() ? "" : ", ") + printable(n);
+  const std::string st =
+      trf("no verdict: the fit of {} of {} run(s) is rejected ({})", sources.size(), runs.size(), names);
+  const json none = {{"class", nullptr}, {"class_strict", nullptr}, {"p_meets", nullptr},
+                     {"p_is", nullptr},  {"p_class", nullptr},      {"statement", st}};
+  json o = none;
+  o["withheld"] = true;
+  o["runs_withheld"] = sources;
+  o["class_B"] = o["class_N"] = nullptr;
+  o["B"] = o["N"] = none;
+  return o;
+}
+
 struct Series {
   const char* key;
   const char* label;
@@ -249,11 +272,14 @@ json summarize_runs(std::vector<json> runs, const std::string& source) {
     for (const auto& r : runs)
       if (r.at("verdict").at("classes").get<std::vector<int>>() != classes)
         throw InputError(source, 0, tr("runs were judged against different class tables"));
-    json overall = combine(runs, classes, nullptr);
-    overall["class_B"] = combine(runs, classes, "B").at("class");
-    overall["class_N"] = combine(runs, classes, "N").at("class");
-    overall["B"] = combine(runs, classes, "B");
-    overall["N"] = combine(runs, classes, "N");
+    json overall = withheld_overall(runs);
+    if (overall.is_null()) {
+      overall = combine(runs, classes, nullptr);
+      overall["class_B"] = combine(runs, classes, "B").at("class");
+      overall["class_N"] = combine(runs, classes, "N").at("class");
+      overall["B"] = combine(runs, classes, "B");
+      overall["N"] = combine(runs, classes, "N");
+    }
     overall["tolerance_pct"] = runs.front().at("verdict").value("tolerance_pct", 0.0);
     overall["tolerance_changed"] = overall.at("class") != overall.at("class_strict") ||
                                    overall["B"].at("class") != overall["B"].at("class_strict");
@@ -309,8 +335,11 @@ std::string format_batch_text(const json& summary) {
   if (ov.value("tolerance_changed", false))
     s += trf("  [with the +{:g} % tolerance on B; strict: class {}]", ov.value("tolerance_pct", 0.0),
              class_cell(ov.at("class_strict")));
-  s += trf("\n  by N: {}; by B: {}\n", ov.at("N").at("statement").get<std::string>(),
-           ov.at("B").at("statement").get<std::string>());
+  if (ov.value("withheld", false))  // the runs' rows above say why and what to run
+    s += "\n";
+  else
+    s += trf("\n  by N: {}; by B: {}\n", ov.at("N").at("statement").get<std::string>(),
+             ov.at("B").at("statement").get<std::string>());
   s += tr("\nTrend with temperature (weighted linear fit) and worst case\n");
   for (const auto& [key, t] : summary.at("trends").items()) {
     const std::string unit = tr(t.at("unit").get<std::string>());
@@ -387,6 +416,10 @@ std::string format_batch_csv(const json& summary) {
     for (char ch : x) o += ch == '"' ? std::string("\"\"") : std::string(1, ch);
     return o + "\"";
   };
+  // A withheld verdict (a rejected fit) has no probability: its cell is empty, like its class.
+  auto probability = [](const json& v) {
+    return v.at("p_class").is_null() ? std::string() : fmt::format("{:.4f}", v.at("p_class").get<double>());
+  };
   for (const auto& r : summary.at("runs")) {
     const auto& v = r.at("verdict");
     const json* o = lookup(r, {"outliers"});
@@ -394,17 +427,16 @@ std::string format_batch_csv(const json& summary) {
     for (const auto& se : series_list())
       for (const char* k : {"value", "sigma", "resolved"})
         if (std::string_view(k) != "resolved" || se.path[0] == "fit") values += val(r, se.path, k) + ",";
-    s += fmt::format("{},{},{}{},{},{},{:.4f},{},{}\n", csv_escape(r.at("source").get<std::string>()),
+    s += fmt::format("{},{},{}{},{},{},{},{},{}\n", csv_escape(r.at("source").get<std::string>()),
                      r.at("temperature_c").is_null() ? std::string("")
                                                      : fmt::format("{:g}", r.at("temperature_c").get<double>()),
-                     values, cls(v.at("class_N")), cls(v.at("class_B")), cls(v.at("class")),
-                     v.at("p_class").get<double>(),
+                     values, cls(v.at("class_N")), cls(v.at("class_B")), cls(v.at("class")), probability(v),
                      o ? fmt::format("{}", o->value("count", std::size_t{0})) : std::string(),
                      o ? csv_escape(o->value("action", std::string())) : std::string());
   }
   const auto& ov = summary.at("overall");
-  s += fmt::format("overall,,,,,,,,,,,,{},{},{},{:.4f},,\n", cls(ov.at("class_N")), cls(ov.at("class_B")),
-                   cls(ov.at("class")), ov.at("p_class").get<double>());
+  s += fmt::format("overall,,,,,,,,,,,,{},{},{},{},,\n", cls(ov.at("class_N")), cls(ov.at("class_B")),
+                   cls(ov.at("class")), probability(ov));
   return s;
 }
 

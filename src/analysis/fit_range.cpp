@@ -7,9 +7,10 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cmath>
 #include <map>
 #include <numeric>
-#include <cmath>
+#include <optional>
 
 #include "model/output_filter.hpp"
 #include "rwcalc/confidence.hpp"
@@ -34,6 +35,13 @@ constexpr double kRollOffSigmas = 5;
 constexpr double kFilterTaus = 10;
 /// The extrapolating fit must start beyond this many τf for the filter's estimate to hold.
 constexpr double kReferenceFilterTaus = 30;
+
+/// A rejected fit's lower τ moves up at most to this many τ0: a line at a tenth of the sample rate
+/// or above (and a filter) bends the AV up to a few times 1/f; beyond, the points carry the white
+/// noise that N is read from.
+constexpr double kMisfitSearchTaus = 32;
+/// A point departs from the fit by this many of its standard errors to be named with its neighbours.
+constexpr double kMisfitSigmas = 2;
 
 /// α of S_y(f) ∝ f^α for each term (R, a drift, shown as −2 like K).
 constexpr int kTermAlpha[kTermCount] = {2, 0, -1, -2, -2};
@@ -69,8 +77,9 @@ double filter_time_constant(const FitResult& f, double tau0, double measured) {
 /// The file name as a shell word (quoted when it holds anything beyond [A-Za-z0-9/._+,-]).
 std::string shell_word(const std::string& path) {
   const std::string p = printable(path);
-  const bool plain = !p.empty() && p.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
-                                                       "0123456789/._+,-") == std::string::npos;
+  const bool plain = !p.empty() && p.find_first_not_of(
+                                       "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
+                                       "0123456789/._+,-") == std::string::npos;
   if (plain) return p;
   std::string q = "'";
   for (const char ch : p) q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
@@ -85,18 +94,24 @@ double short_tau_reference_s(double tau0_s) { return kReferenceTaus * tau0_s; }
 
 namespace {
 
+/// The fit of the points from `tau_min_s` on, the options otherwise as given; none when it fails (too
+/// few points left, or no convergence).
+std::optional<FitResult> fit_from(std::span<const FitPoint> points, FitOptions options, double tau_min_s) {
+  options.tau_min_s = tau_min_s * (1 - 1e-9);
+  try {
+    return fit_noise(points, options);
+  } catch (const AnalysisError&) {
+    return std::nullopt;
+  }
+}
+
 /// The short-τ points against the model fitted from `reference_tau_s`.
 OutputFilterCheck compare_short_tau(std::span<const FitPoint> octave, const FitOptions& fit, double reference_tau_s) {
   OutputFilterCheck c;
   const FitPoint& first = octave.front();
-  FitOptions ref = fit;
-  ref.tau_min_s = reference_tau_s * (1 - 1e-9);
-  FitResult f;
-  try {
-    f = fit_noise(octave, ref);
-  } catch (const AnalysisError&) {
-    return c;  // too few points beyond the reference τ: no test
-  }
+  const std::optional<FitResult> reference = fit_from(octave, fit, reference_tau_s);
+  if (!reference) return c;  // too few points beyond the reference τ: no test
+  const FitResult& f = *reference;
   c.reference_tau_s = f.used.front().tau_s;
   for (const FitPoint& p : octave) {
     if (p.tau_s >= c.reference_tau_s) break;
@@ -239,7 +254,8 @@ bool white_phase_leads(const FitResult& fit, double tau_s) {
 
 /// measured_variance_ratio of each octave that holds a point where white phase noise leads, the
 /// octaves in parallel.
-std::map<std::int64_t, double> white_phase_ratios(const AllanResult& allan, const FitResult& fit, const PhaseSeries& x) {
+std::map<std::int64_t, double> white_phase_ratios(const AllanResult& allan, const FitResult& fit,
+                                                  const PhaseSeries& x) {
   std::vector<std::int64_t> octaves;
   for (const AllanPoint& p : allan.points)
     if (white_phase_leads(fit, p.tau_s) && (octaves.empty() || octaves.back() != octave_of(p.m)))
@@ -256,7 +272,8 @@ std::map<std::int64_t, double> white_phase_ratios(const AllanResult& allan, cons
 bool apply_model_bounds(AllanResult& allan, const FitResult& fit, const PhaseSeries* x) {
   if (allan.estimator != Estimator::Overlapping || allan.points.empty()) return false;
   const std::vector<FitPoint> pts = fit_points(allan);
-  const std::map<std::int64_t, double> ratio = x ? white_phase_ratios(allan, fit, *x) : std::map<std::int64_t, double>{};
+  const std::map<std::int64_t, double> ratio =
+      x ? white_phase_ratios(allan, fit, *x) : std::map<std::int64_t, double>{};
   for (std::size_t i = 0; i < allan.points.size(); ++i) {
     AllanPoint& p = allan.points[i];
     const double model = fit.model_var(p.tau_s);
@@ -280,6 +297,89 @@ bool apply_model_bounds(AllanResult& allan, const FitResult& fit, const PhaseSer
   return true;
 }
 
+void move_past_short_tau_misfit(const std::vector<FitPoint>& points, double tau0_s, FitOptions& fopt,
+                                AnalysisResult& r) {
+  if (r.fit.used.empty()) return;
+  const double rejected_chi2 = r.fit.chi2_per_dof, from = r.fit.used.front().tau_s;
+  for (double next = 2.0 * from; next <= kMisfitSearchTaus * tau0_s * (1 + 1e-9); next *= 2.0) {
+    std::optional<FitResult> f = fit_from(points, fopt, next);
+    if (!f) return;  // too few points left
+    if (f->p_value < kFitRejectedP) continue;
+    fopt.tau_min_s = f->options.tau_min_s;  // the rest as given: the fit's own options carry its term choice
+    r.fit = std::move(*f);
+    r.fit_range.source = FitRangeChoice::Source::ShortTau;
+    r.fit_range.rejected_chi2 = rejected_chi2;
+    r.fit_range.rejected_from_tau_s = from;
+    return;
+  }
+}
+
+namespace {
+
+/// What a run of departing points is, from where it lies and the lines taken off.
+std::string misfit_structure(const AnalysisResult& r, const FitMisfit& m) {
+  for (const auto& l : r.fit_range.lines) {
+    const double peak = kLinePeakTau / l.f_hz;
+    if (peak >= 0.5 * m.tau_from_s && peak <= 2.0 * m.tau_to_s)
+      return trf(
+          "the spectral line at {:.4g} Hz: its Allan variance from the spectrum does not match the points "
+          "(a line broader or less steady than one sinusoid)",
+          l.f_hz);
+  }
+  const bool first = m.tau_from_s <= r.fit.used.front().tau_s;
+  if (first && m.ratio < 1)
+    return tr("a roll-off at the shortest tau fitted: an output filter whose roll-off reaches into the fit's range");
+  if (first) return tr("short-tau structure: a line or a resonance near 1/(2 tau) Hz, or a filter");
+  if (m.ratio > 1) return tr("a bump the five terms cannot follow: a Gauss-Markov process or a low-frequency line");
+  return tr(
+      "a dip below the model: the fitted terms rise to follow a bump or a step at other tau (a Gauss-Markov "
+      "process, a bias step)");
+}
+
+}  // namespace
+
+FitMisfit fit_misfit(const AnalysisResult& r) {
+  FitMisfit m;
+  const auto& pts = r.fit.used;
+  if (!r.fit_rejected() || pts.empty()) return m;
+  // Each point's signed share of the fit's Gamma deviance, ν(x/m − 1 − ln(x/m)), in standard errors.
+  std::vector<double> z(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const double q = pts[i].var / r.fit.model_var(pts[i].tau_s);
+    z[i] = q > 0 && pts[i].edf > 0 ? std::copysign(std::sqrt(pts[i].edf * std::max(0.0, q - 1 - std::log(q))), q - 1)
+                                   : 0.0;
+  }
+  // The run of neighbouring points departing on one side with the largest deviance.
+  double best = -1;
+  for (std::size_t lo = 0; lo < pts.size();) {
+    std::size_t hi = lo;
+    double sum = z[lo] * z[lo];
+    std::size_t worst = lo;
+    while (hi + 1 < pts.size() && std::abs(z[hi + 1]) >= kMisfitSigmas && std::abs(z[lo]) >= kMisfitSigmas &&
+           (z[hi + 1] > 0) == (z[lo] > 0)) {
+      ++hi;
+      sum += z[hi] * z[hi];
+      if (std::abs(z[hi]) > std::abs(z[worst])) worst = hi;
+    }
+    if (sum > best) {
+      best = sum;
+      m.tau_from_s = pts[lo].tau_s, m.tau_to_s = pts[hi].tau_s, m.worst_tau_s = pts[worst].tau_s;
+      m.ratio = pts[worst].var / r.fit.model_var(pts[worst].tau_s);
+      m.sigmas = z[worst];
+    }
+    lo = hi + 1;
+  }
+  m.structure = misfit_structure(r, m);
+  return m;
+}
+
+nlohmann::json misfit_json(const AnalysisResult& r) {
+  if (!r.fit_rejected()) return nullptr;
+  const FitMisfit m = fit_misfit(r);
+  return {{"tau_from_s", m.tau_from_s}, {"tau_to_s", m.tau_to_s}, {"worst_tau_s", m.worst_tau_s},
+          {"ratio", m.ratio},           {"sigmas", m.sigmas},     {"structure", m.structure}};
+}
+
 namespace {
 
 /// What the short-τ check saw, one clause per finding.
@@ -295,6 +395,11 @@ std::string short_tau_findings(const FitRangeChoice& c) {
         trf("{}the AV at {:g} s is {:.0f} % of the extrapolation of the model fitted from {:g} s (short-tau "
             "structure the five-term model lacks: a spectral line, a bump or a filter)",
             s.empty() ? "" : "; ", c.departure_tau_s, 100.0 * c.departure_ratio, c.reference_tau_s);
+  if (c.rejected_chi2 > 0)
+    s +=
+        trf("{}the fit from {:g} s was rejected (chi2/dof = {:.3g}) and is accepted from {:g} s: short-tau "
+            "structure (a line or a filter) that bends the longer tau too",
+            s.empty() ? "" : "; ", c.rejected_from_tau_s, c.rejected_chi2, c.tau_min_s);
   return s;
 }
 
@@ -315,7 +420,8 @@ std::string range_clause(const FitRangeChoice& c) {
     case FitRangeChoice::Source::Option: return tr("the range given by --fit-range");
     case FitRangeChoice::Source::ShortTau:
       return trf("tau >= {:g} s ({}): {}", c.tau_min_s,
-                 c.filter_tc_s > 0 && 10.0 * c.filter_tc_s >= 2.0 * c.departure_tau_s
+                 c.rejected_chi2 > 0 ? tr("from where the fit is accepted")
+                 : c.filter_tc_s > 0 && 10.0 * c.filter_tc_s >= 2.0 * c.departure_tau_s
                      ? tr("10 tau_f")
                      : tr("beyond the departing points"),
                  short_tau_findings(c));
@@ -328,10 +434,29 @@ std::string range_clause(const FitRangeChoice& c) {
 
 std::string FitRangeChoice::reason() const { return range_clause(*this) + lines_clause(*this); }
 
+void withhold_verdict(AnalysisResult& r) {
+  const FitRangeChoice& fr = r.fit_range;
+  const std::string tried =
+      fr.source == FitRangeChoice::Source::Option ? std::string(tr("over the range given by --fit-range"))
+      : r.arcsec_per_count > 0
+          ? std::string(tr("over every octave point, the pulse read-out taken as white angle noise (Q)"))
+          : std::string(tr("after the short-tau check (output filter, short-tau structure) and the spectral-line "
+                           "search"));
+  r.verdict.withhold(trf("the fit is rejected: chi2/dof = {:.3g} on {} degrees of freedom (p = {:.2g} < {:g}), {}",
+                         r.fit.chi2_per_dof, r.fit.dof, r.fit.p_value, kFitRejectedP, tried),
+                     trf("rwcalc diagnose {} [input options]", shell_word(r.source)));
+}
+
 std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r) {
   std::vector<AnalysisWarning> w;
   const std::string src = shell_word(r.source);
   const FitRangeChoice& fr = r.fit_range;
+  if (r.verdict.withheld && r.verdict_applies)
+    w.push_back({"no_verdict",
+                 trf("No class verdict: {}. A rejected fit gives no class and no probability; find what the "
+                     "model misses (diagnose) or choose the fit range (--fit-range).",
+                     r.verdict.withheld_reason),
+                 r.verdict.next_command});
   if (fr.source == FitRangeChoice::Source::ShortTau)
     w.push_back({fr.filter_tc_s > 0 ? "output_filter" : "short_tau_structure",
                  trf("The fit uses tau >= {:g} s only: {}. Give --fit-range to choose the range yourself.",
@@ -344,8 +469,8 @@ std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r) {
                      "spectrum) is not in the five-term model: its Allan variance, computed from the spectrum's "
                      "excess over the local level, is taken off the octave points before the fit (it was "
                      "{:.0f} % of the AV at {:g} s).",
-                     line.f_hz, line.rms * si.factor, localized_label(si), line.peak_ratio,
-                     100.0 * line.max_share, line.tau_at_max_s),
+                     line.f_hz, line.rms * si.factor, localized_label(si), line.peak_ratio, 100.0 * line.max_share,
+                     line.tau_at_max_s),
                  ""});
   }
   if (fr.line_points_left_out > 0)
@@ -353,13 +478,17 @@ std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r) {
                  trf("{} octave point(s) left out of the fit: spectral lines carry over 90 % of their AV.",
                      fr.line_points_left_out),
                  ""});
-  if (r.fit.p_value < 0.001)
+  if (r.fit_rejected()) {
+    const FitMisfit m = fit_misfit(r);
     w.push_back({"fit_rejected",
                  trf("The five-term model does not describe the Allan variance: chi2/dof = {:.3g} "
-                     "(dof {}, p = {:.2g}). The coefficients' intervals are scaled by sqrt(chi2/dof) = "
-                     "{:.3g}; look for what the model misses.",
-                     r.fit.chi2_per_dof, r.fit.dof, r.fit.p_value, fr.interval_scale),
+                     "(dof {}, p = {:.2g}). The points at tau = {:g}..{:g} s depart most (at {:g} s the AV is "
+                     "{:.0f} % of the model's, {:+.1f} sigma): {}. The coefficients' intervals are scaled by "
+                     "sqrt(chi2/dof) = {:.3g}.",
+                     r.fit.chi2_per_dof, r.fit.dof, r.fit.p_value, m.tau_from_s, m.tau_to_s, m.worst_tau_s,
+                     100.0 * m.ratio, m.sigmas, m.structure, fr.interval_scale),
                  trf("rwcalc diagnose {} [input options]", src)});
+  }
   return w;
 }
 

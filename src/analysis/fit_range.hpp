@@ -8,6 +8,9 @@
 
 namespace rwcalc {
 
+/// The AV of a sinusoid of frequency f, ∝ sin⁴(πfτ)/(πfτ)², peaks at τ = this / f.
+inline constexpr double kLinePeakTau = 0.371;
+
 /// The short-τ octave points against the extrapolation of the model fitted from τ ≥ 16 τ0: a
 /// roll-off of the shortest τ (an output filter) and other departures (a line, a resonance), each
 /// more than 10 % of the AV and 5 standard errors (the point's EDF and the extrapolation's variance).
@@ -46,7 +49,22 @@ double measured_variance_ratio(const PhaseSeries& x, std::int64_t m);
 /// σ²_model. Other estimators are left as computed (Stable32's noise id). Returns whether it applied.
 bool apply_model_bounds(AllanResult& allan, const FitResult& fit, const PhaseSeries* x);
 
-/// The warnings of a result's fit range and goodness of fit.
+/// A fit the goodness of fit rejects, whose range the short-τ check chose: the lower τ moves up an
+/// octave at a time, to at most 32 τ0, until the fit of `points` is accepted (FitRangeChoice::
+/// rejected_chi2); `fit` and `fopt` then hold that fit and its options. Unchanged when none is.
+void move_past_short_tau_misfit(const std::vector<FitPoint>& points, double tau0_s, FitOptions& fopt,
+                                AnalysisResult& r);
+
+/// Where and how a rejected fit departs from its points (empty structure for an accepted fit).
+FitMisfit fit_misfit(const AnalysisResult& r);
+/// fit_misfit as the JSON of the fit's "misfit" (null for an accepted fit).
+nlohmann::json misfit_json(const AnalysisResult& r);
+
+/// A rejected fit gives no class: the verdict is withheld with the reason (the goodness of fit, the
+/// range and what the short-τ check and the line search took off) and the command to run next.
+void withhold_verdict(AnalysisResult& r);
+
+/// The warnings of a result's fit range and goodness of fit (a withheld verdict's first).
 std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r);
 
 }  // namespace rwcalc

@@ -9,6 +9,7 @@
 #include <iterator>
 #include <sstream>
 
+#include "analysis/fit_range.hpp"
 #include "rwcalc/encode.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
@@ -194,6 +195,7 @@ nlohmann::json channel_json(const AnalysisResult& r, const UnitSet& shown) {
                      {"tau_at_max_share_s", l.tau_at_max_s}});
   fit["spectral_lines"] = std::move(lines);
   fit["line_points_left_out"] = r.fit_range.line_points_left_out;
+  fit["misfit"] = misfit_json(r);
   nlohmann::json warnings = nlohmann::json::array();
   for (const auto& w : r.warnings) warnings.push_back({{"code", w.code}, {"message", w.message}});
   return {{"source", r.column},
@@ -321,31 +323,47 @@ std::vector<AxisNoise> axis_noise(const ImuResult& r, SensorKind kind) {
     for (const auto& l : c->result.fit_range.lines) lines += fmt::format("{}{:.4g}", lines.empty() ? "" : ", ", l.f_hz);
     out.push_back({c->column, scaled(c->result.fit[Term::N], si[Term::N].factor),
                    scaled(c->result.fit[Term::K], si[Term::K].factor),
-                   c->result.fit_range.intervals_scaled ? c->result.fit.chi2_per_dof : 0.0, lines});
+                   c->result.fit_rejected() ? c->result.fit.chi2_per_dof : 0.0, lines});
   }
   return out;
 }
 
-// The combined value of one coefficient over the axes: the largest value (an unresolved axis
-// counts with its upper bound), or their mean; `bound` when any value used is an upper bound.
+// Why an axis' coefficient is left out of the noise file's key ("" when it qualifies): a fit the
+// goodness of fit rejects, or a value that is only an upper bound.
+std::string left_out_because(const AxisNoise& a, const Coefficient& c) {
+  if (a.rejected_chi2 > 0) return fmt::format("its fit is rejected (chi2/dof {:.3g})", a.rejected_chi2);
+  if (!c.resolved) return "not resolved (only its 95 % upper bound is known)";
+  return {};
+}
+
+// The combined value of one coefficient over the axes that qualify (an accepted fit and a resolved
+// value; every axis when `all`): the largest, or their mean. When none qualifies, the largest value
+// or bound of every axis, marked `fallback`; `bound` when a value used is an upper bound.
 struct Combined {
   double value = 0;
   bool bound = false;
-  std::string from;  ///< the worst axis' column
+  bool fallback = false;  ///< no axis qualified: the largest of all (a bound or a rejected fit's value)
+  std::string from;       ///< the worst axis' column
+  std::size_t axes = 0;   ///< how many axes the value is taken from
 };
 
-Combined combine(const std::vector<AxisNoise>& axes, Coefficient AxisNoise::*which, AxisCombination how) {
+Combined combine(const std::vector<AxisNoise>& axes, Coefficient AxisNoise::*which, AxisCombination how,
+                 bool all = false) {
+  auto qualifies = [&](const AxisNoise& a) { return all || left_out_because(a, a.*which).empty(); };
   Combined c;
+  c.fallback = std::none_of(axes.begin(), axes.end(), qualifies);
   double sum = 0;
   bool any_bound = false;
   for (const auto& a : axes) {
+    if (!c.fallback && !qualifies(a)) continue;
     const Coefficient& k = a.*which;
     sum += k.value;
+    ++c.axes;
     any_bound = any_bound || !k.resolved;
     if (k.value >= c.value) c.value = k.value, c.from = a.column, c.bound = !k.resolved;
   }
-  if (how == AxisCombination::Mean && !axes.empty()) {
-    c.value = sum / static_cast<double>(axes.size());
+  if (how == AxisCombination::Mean && c.axes > 0) {
+    c.value = sum / static_cast<double>(c.axes);
     c.bound = any_bound;
   }
   return c;
@@ -353,15 +371,20 @@ Combined combine(const std::vector<AxisNoise>& axes, Coefficient AxisNoise::*whi
 
 nlohmann::json noise_json(const std::vector<AxisNoise>& axes, SensorKind kind) {
   const UnitSet si = si_units(kind);
-  auto coef = [](const Coefficient& c, const ShownUnit& u) {
-    return nlohmann::json{
-        {"value", c.value}, {"low95", c.low}, {"high95", c.high}, {"resolved", c.resolved}, {"unit", u.ascii}};
+  auto coef = [](const Coefficient& c, const ShownUnit& u, const std::string& left_out) {
+    return nlohmann::json{{"value", c.value},
+                          {"low95", c.low},
+                          {"high95", c.high},
+                          {"resolved", c.resolved},
+                          {"unit", u.ascii},
+                          {"in_keys", left_out.empty()},
+                          {"left_out_because", left_out.empty() ? nlohmann::json(nullptr) : nlohmann::json(left_out)}};
   };
   nlohmann::json list = nlohmann::json::array();
   for (const auto& a : axes)
     list.push_back({{"column", a.column},
-                    {"noise_density", coef(a.N, si[Term::N])},
-                    {"random_walk", coef(a.K, si[Term::K])},
+                    {"noise_density", coef(a.N, si[Term::N], left_out_because(a, a.N))},
+                    {"random_walk", coef(a.K, si[Term::K], left_out_because(a, a.K))},
                     {"fit_rejected", a.rejected_chi2 > 0}});
   const Combined n = combine(axes, &AxisNoise::N, AxisCombination::Worst);
   const Combined k = combine(axes, &AxisNoise::K, AxisCombination::Worst);
@@ -369,9 +392,14 @@ nlohmann::json noise_json(const std::vector<AxisNoise>& axes, SensorKind kind) {
           {"worst",
            {{"noise_density", n.value},
             {"noise_density_axis", n.from},
+            {"noise_density_no_axis_qualifies", n.fallback},
             {"random_walk", k.value},
             {"random_walk_axis", k.from},
-            {"random_walk_is_upper_bound", k.bound}}}};
+            {"random_walk_is_upper_bound", k.bound},
+            {"random_walk_no_axis_qualifies", k.fallback},
+            {"rule",
+             "the worst axis with an accepted fit and a resolved value; when none qualifies, the largest "
+             "value or 95 % upper bound of every axis"}}}};
 }
 
 }  // namespace imu_impl
@@ -422,54 +450,77 @@ std::string rostopic_scalar(const std::string& rostopic) {
   return *quoted;
 }
 
+namespace imu_impl {
+
+std::string yaml_num(double v) { return fmt::format("{:.6e}", v); }  // always a YAML float
+
+// One kind's axes in the comments: each axis' N and K with intervals, and why one is left out of the keys.
+std::string axes_comments(const std::vector<AxisNoise>& axes, SensorKind kind, bool all) {
+  const UnitSet si = si_units(kind);
+  std::string s = fmt::format("# {} axes: N [{}], K [{}]\n", to_string(kind), si[Term::N].ascii, si[Term::K].ascii);
+  for (const auto& a : axes) {
+    auto one = [&](const Coefficient& c) {
+      return c.resolved ? fmt::format("{} [{}, {}]", yaml_num(c.value), yaml_num(c.low), yaml_num(c.high))
+                        : fmt::format("< {} (not resolved: 95 % upper bound)", yaml_num(c.value));
+    };
+    s += fmt::format("#   {}: N {}; K {}\n", yaml_comment(a.column), one(a.N), one(a.K));
+    for (const auto& [name, c] : {std::pair{"N", &a.N}, std::pair{"K", &a.K}})
+      if (const std::string why = left_out_because(a, *c); !why.empty())
+        s += all ? fmt::format("#     {} in the keys (--keys-from-all-axes) although {}\n", name, why)
+                 : fmt::format("#     {} left out of the keys: {}\n", name, why);
+    if (a.rejected_chi2 > 0) s += "#     the five-term model does not describe this axis; see rwcalc diagnose\n";
+    if (!a.lines.empty())
+      s += fmt::format("#     spectral line(s) at {} Hz: their Allan variance taken off before the fit\n", a.lines);
+  }
+  return s;
+}
+
+// A key's line: the value, its unit and where it comes from.
+std::string key_line(const std::string& key, const Combined& c, const ShownUnit& unit, const char* term, bool worst) {
+  std::string from =
+      worst ? fmt::format(" worst axis {}", yaml_comment(c.from)) : fmt::format(" mean of {} axes", c.axes);
+  if (c.fallback) from += "; NO AXIS QUALIFIES (see the first lines)";
+  if (c.bound) from += fmt::format("; UPPER BOUND: {} not resolved (its 95 % bound used)", term);
+  return fmt::format("{}: {}  # [{}]{}\n", key, yaml_num(c.value), unit.ascii, from);
+}
+
+}  // namespace imu_impl
+
 std::string kalibr_yaml(const ImuResult& r, const KalibrOptions& options) {
-  auto yaml_num = [](double v) { return fmt::format("{:.6e}", v); };  // always a YAML float
   const auto& first = r.channels.front().result;
-  std::string s = fmt::format(
+  const bool worst = options.combine == AxisCombination::Worst;
+  std::string head = fmt::format(
       "# IMU noise parameters for Kalibr and OpenVINS, from the Allan variance of a static recording.\n"
       "# file: {} (SHA-256 {}), {} samples at {:g} Hz\n"
       "# noise_density = N (white noise, continuous time; sigma^2 = N^2/tau), random_walk = K (bias random\n"
-      "# walk; sigma^2 = K^2 tau/3), each axis fitted with 95 % intervals; the values used are the {}.\n",
+      "# walk; sigma^2 = K^2 tau/3), each axis fitted with 95 % intervals; the values used are the {} of {}.\n",
       yaml_comment(r.source), first.input.value("sha256", std::string()), first.samples, first.rate_hz,
-      options.combine == AxisCombination::Worst ? "worst axis' (the largest)" : "mean over the axes");
-  std::string keys =
-      fmt::format("rostopic: {}\nupdate_rate: {:.6f}  # Hz\n", rostopic_scalar(options.rostopic), first.rate_hz);
+      worst ? "worst axis' (the largest)" : "mean",
+      options.all_axes ? "every axis (--keys-from-all-axes)" : "the axes with an accepted fit and a resolved value");
+  std::string body,
+      keys = fmt::format("rostopic: {}\nupdate_rate: {:.6f}  # Hz\n", rostopic_scalar(options.rostopic), first.rate_hz);
   for (const SensorKind kind : {SensorKind::Accelerometer, SensorKind::Gyro}) {
     const auto axes = axis_noise(r, kind);
-    const bool gyro = kind == SensorKind::Gyro;
-    const std::string prefix = gyro ? "gyroscope" : "accelerometer";
+    const std::string prefix = kind == SensorKind::Gyro ? "gyroscope" : "accelerometer";
     const UnitSet si = si_units(kind);
     if (axes.empty()) {
-      s += fmt::format("# no {} channel was analysed: its keys are left out\n", to_string(kind));
+      body += fmt::format("# no {} channel was analysed: its keys are left out\n", to_string(kind));
       continue;
     }
-    s += fmt::format("# {} axes: N [{}], K [{}]\n", to_string(kind), si[Term::N].ascii, si[Term::K].ascii);
-    for (const auto& a : axes) {
-      auto one = [&](const Coefficient& c) {
-        return c.resolved ? fmt::format("{} [{}, {}]", yaml_num(c.value), yaml_num(c.low), yaml_num(c.high))
-                          : fmt::format("< {} (not resolved: 95 % upper bound)", yaml_num(c.value));
-      };
-      s += fmt::format("#   {}: N {}; K {}\n", yaml_comment(a.column), one(a.N), one(a.K));
-      if (a.rejected_chi2 > 0)
-        s += fmt::format(
-            "#     the five-term model does not describe this axis (chi2/dof {:.3g}): its values are "
-            "doubtful; see rwcalc diagnose\n",
-            a.rejected_chi2);
-      if (!a.lines.empty())
-        s += fmt::format("#     spectral line(s) at {} Hz: their Allan variance taken off before the fit\n", a.lines);
+    body += axes_comments(axes, kind, options.all_axes);
+    for (const auto& [suffix, which, term] :
+         {std::tuple{"_noise_density", &AxisNoise::N, Term::N}, std::tuple{"_random_walk", &AxisNoise::K, Term::K}}) {
+      const Combined c = combine(axes, which, options.combine, options.all_axes);
+      const char* name = term == Term::N ? "N" : "K";
+      if (c.fallback)
+        head += fmt::format(
+            "# WARNING: no {} axis has an accepted fit and a resolved {}: {}{} is the {} of every axis, {}.\n",
+            to_string(kind), name, prefix, suffix, worst ? "largest" : "mean",
+            c.bound ? "an upper bound, not a measured value" : "from a fit the goodness of fit rejects");
+      keys += key_line(prefix + suffix, c, si[term], name, worst);
     }
-    const Combined n = combine(axes, &AxisNoise::N, options.combine);
-    const Combined k = combine(axes, &AxisNoise::K, options.combine);
-    const bool worst = options.combine == AxisCombination::Worst;
-    auto from = [&](const Combined& c) {
-      return worst ? fmt::format(" worst axis {}", yaml_comment(c.from)) : fmt::format(" mean of {} axes", axes.size());
-    };
-    keys += fmt::format("{}_noise_density: {}  # [{}]{}{}\n", prefix, yaml_num(n.value), si[Term::N].ascii, from(n),
-                        n.bound ? "; UPPER BOUND: N not resolved (its 95 % bound used)" : "");
-    keys += fmt::format("{}_random_walk: {}  # [{}]{}{}\n", prefix, yaml_num(k.value), si[Term::K].ascii, from(k),
-                        k.bound ? "; UPPER BOUND: K not resolved (its 95 % bound used)" : "");
   }
-  return s + keys;
+  return head + body + keys;
 }
 
 }  // namespace rwcalc

@@ -39,6 +39,7 @@ struct ImuCmd {
   bool json = false;
   std::string output = "-";
   std::string kalibr, rostopic = "/imu0", combine = "worst";
+  bool keys_from_all_axes = false;
   std::string report_dir;
   PlotArgs plot;
   bool force = false;
@@ -218,6 +219,10 @@ void register_imu(CLI::App& app, Runner& runner) {
       ->check(CLI::IsMember({"worst", "mean"}))
       ->capture_default_str()
       ->group(tr("Output"));
+  sub->add_flag("--keys-from-all-axes", cmd->keys_from_all_axes,
+                tr("Let every axis into the --kalibr keys (default: only axes with an accepted fit and a resolved "
+                   "value; the others are named in the file's comments)"))
+      ->group(tr("Output"));
   sub->add_option("--report", cmd->report_dir,
                   tr("Write the whole result into DIR: index.html (tables and figure), imu.txt, imu.json, imu.yaml, "
                      "imu.svg (created when missing)"))
@@ -243,6 +248,7 @@ void register_imu(CLI::App& app, Runner& runner) {
       KalibrOptions k;
       k.rostopic = cmd->rostopic;
       k.combine = cmd->combine == "mean" ? AxisCombination::Mean : AxisCombination::Worst;
+      k.all_axes = cmd->keys_from_all_axes;
       if (!cmd->kalibr.empty()) {
         write_file_atomic(cmd->kalibr, kalibr_yaml(res, k), cmd->force);
         print_message(io.err, trf("noise file written to {}", as_typed(cmd->kalibr)));

@@ -269,13 +269,63 @@ std::string describe_class(const std::vector<double>& p_is, const std::optional<
   return trf("class {} or {} (P={:.2f}/{:.2f})", label(a), label(b), p_is[a], p_is[b]);
 }
 
-std::string Verdict::statement() const { return describe_class(p_is, cls, class_numbers, decisive_threshold); }
+void Verdict::withhold(std::string reason, std::string command) {
+  withheld = true;
+  withheld_reason = std::move(reason);
+  next_command = std::move(command);
+}
+
+std::string Verdict::statement() const {
+  if (withheld) return std::string(tr(kNoVerdict));
+  return describe_class(p_is, cls, class_numbers, decisive_threshold);
+}
 
 std::string Verdict::statement(const ParameterVerdict& p) const {
+  if (withheld) return std::string(tr("no verdict"));
   return describe_class(p.p_is, p.cls, class_numbers, decisive_threshold);
 }
 
+namespace {
+
+/// A withheld verdict: what was judged against (table, limits, the estimates) but no class and no
+/// probability; "withheld", the reason and the command to run next.
+nlohmann::json withheld_json(const Verdict& v) {
+  auto param = [](const ParameterVerdict& p) {
+    return nlohmann::json{{"value", p.value},   {"unit", p.unit},          {"resolved", p.resolved},
+                          {"class", nullptr},   {"class_strict", nullptr}, {"limits", p.limit},
+                          {"p_meets", nullptr}, {"p_is", nullptr},         {"p_class", nullptr}};
+  };
+  const std::string st = v.statement(), by = v.statement(v.B);
+  return {{"withheld", true},
+          {"reason", v.withheld_reason},
+          {"command", v.next_command},
+          {"class_B", nullptr},
+          {"class_N", nullptr},
+          {"class", nullptr},
+          {"class_strict", nullptr},
+          {"p_class", nullptr},
+          {"p_class_B", nullptr},
+          {"p_class_N", nullptr},
+          {"statement", st},
+          {"statement_B", by},
+          {"statement_N", by},
+          {"decisive", false},
+          {"b_estimate", v.b_estimate},
+          {"tolerance_pct", v.tolerance_pct},
+          {"tolerance_changed", false},
+          {"table", v.table_name},
+          {"classes", v.class_numbers},
+          {"p_meets", nullptr},
+          {"p_is", nullptr},
+          {"rho_BN", v.rho_BN},
+          {"B", param(v.B)},
+          {"N", param(v.N)}};
+}
+
+}  // namespace
+
 nlohmann::json to_json(const Verdict& v) {
+  if (v.withheld) return withheld_json(v);
   return {{"class_B", opt_class(v.B.cls)},
           {"class_N", opt_class(v.N.cls)},
           {"class", opt_class(v.cls)},

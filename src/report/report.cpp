@@ -105,6 +105,17 @@ std::string class_text(const json& c) {
   return kNotAvailable;
 }
 
+/// Whether a verdict (a run's or the overall one) is withheld: its fit rejected, no class stated.
+bool is_withheld(const json& v) {
+  const auto& w = at(v, "withheld");
+  return w.is_boolean() && w.get<bool>();
+}
+
+/// A verdict's class cell: "no verdict" when it is withheld, else the class under `key`.
+std::string verdict_class(const json& v, std::string_view key) {
+  return is_withheld(v) ? std::string(tr("no verdict")) : class_text(at(v, key));
+}
+
 /// The verdict's statement, else its class (plain text).
 std::string statement_text(const json& v) {
   const auto st = str(v, "statement");
@@ -283,16 +294,19 @@ std::string table2(const std::vector<json>& a, const std::vector<std::size_t>& o
       statement += fmt::format(" <span class=\"note\">{}</span>",
                                trf("changed by the +{:g} % B tolerance", num(v, "tolerance_pct").value_or(0.0)));
     s += run_row(run,
-                 {class_text(at(v, "class_N")), class_by_value(at(methods, "N_direct_deg_per_sqrt_h"), run, "N"),
-                  class_text(at(v, "class_B")), class_by_value(at(methods, "B_100s_deg_per_h"), run, "B"),
-                  "<b>" + class_text(at(v, "class")) + "</b>"},
+                 // The cross-checks' classes too depend on the rejected fit (the terms they take off).
+                 {verdict_class(v, "class_N"),
+                  is_withheld(v) ? tr("no verdict") : class_by_value(at(methods, "N_direct_deg_per_sqrt_h"), run, "N"),
+                  verdict_class(v, "class_B"),
+                  is_withheld(v) ? tr("no verdict") : class_by_value(at(methods, "B_100s_deg_per_h"), run, "B"),
+                  "<b>" + verdict_class(v, "class") + "</b>"},
                  "<td>" + statement + "</td>");
   }
   s += fmt::format(
       "<tr><th colspan=\"2\">{}</th><td class=\"num\"><b>{}</b></td><td></td><td class=\"num\"><b>{}</b></td><td></td>"
       "<td class=\"num\"><b>{}</b></td><td>{}</td></tr>\n",
-      tr("over the temperature range"), class_text(at(overall, "class_N")), class_text(at(overall, "class_B")),
-      class_text(at(overall, "class")), tr("worst case over the runs"));
+      tr("over the temperature range"), verdict_class(overall, "class_N"), verdict_class(overall, "class_B"),
+      verdict_class(overall, "class"), tr("worst case over the runs"));
   return s + "</table>\n<p class=\"meta\">" +
          tr("Classes by N direct and by B 100-s compare the reported value with the class limits only (no "
             "probability); the verdict uses the estimates named in the settings.") +
@@ -454,11 +468,22 @@ std::string warnings_html(const json& run) {
   return s + "</ul></div>\n";
 }
 
+/// A withheld verdict: the statement, why, and the command to run next.
+std::string withheld_html(const json& v) {
+  std::string s = fmt::format("<p>{} <b>{}</b>.</p>\n", tr("Verdict:"), esc(statement_text(v)));
+  if (const auto why = str(v, "reason"); !why.empty()) s += fmt::format("<p>{}</p>\n", esc(trf("Why: {}.", why)));
+  if (const auto c = str(v, "command"); !c.empty())
+    s += fmt::format("<p>{} <code>{}</code></p>\n", tr("Run next:"), typed(c));
+  return s;
+}
+
 std::string run_summary(const json& run, std::size_t index, Numbering& numbering) {
   std::string s = warnings_html(run);
   s += data_table(run, index, numbering);  // one statement each: the tables are numbered in order
   s += fit_table(at(run, "fit"), index, numbering);
-  if (const auto& v = at(run, "verdict"); v.is_object()) {
+  if (const auto& v = at(run, "verdict"); is_withheld(v)) {
+    s += withheld_html(v);
+  } else if (v.is_object()) {
     s += fmt::format("<p>{} <b>{}</b>{}.</p>\n", tr("Verdict:"), esc(statement_text(v)),
                      by_parameter(str(v, "statement_B"), str(v, "statement_N")));
     if (const auto words = verdict_in_words(v, at(v, "classes")); !words.empty())
@@ -535,10 +560,40 @@ std::string diagnosis_html(const json& d, std::size_t index, const json& run, Nu
   return s;
 }
 
+/// No verdict over the runs (a run's fit is rejected): said first, with each run's reason and command.
+std::string withheld_verdict_html(const std::vector<json>& a, const std::vector<std::size_t>& order,
+                                  const json& overall) {
+  std::string h =
+      fmt::format("<p class=\"verdict\">{}</p>\n",
+                  a.size() == 1
+                      ? std::string(tr("<b>No verdict</b>: the noise model does not describe this record, so no "
+                                       "class and no probability is stated."))
+                      : trf("<b>No verdict</b> over the temperature range: the noise model does not describe {} of "
+                            "the {} records, so no class and no probability is stated.",
+                            std::count_if(a.begin(), a.end(),
+                                          [](const json& r) { return is_withheld(at(r, "verdict")); }),
+                            a.size()));
+  if (const auto st = str(overall, "statement"); !st.empty() && a.size() > 1)
+    h += fmt::format("<p id=\"verdict-probability\">{} <b>{}</b>.</p>\n", tr("Over all runs:"), esc(st));
+  h += "<ul>\n";
+  for (auto i : order) {
+    const auto& v = at(a[i], "verdict");
+    h += fmt::format("<li>{} ({}): {}", typed(source_name(a[i])), temperature_text(a[i]), esc(statement_text(v)));
+    if (is_withheld(v)) {
+      h += esc(fmt::format(" ({})", str(v, "reason")));
+      if (const auto c = str(v, "command"); !c.empty())
+        h += fmt::format("; {} <code>{}</code>", tr("run next:"), typed(c));
+    }
+    h += "</li>\n";
+  }
+  return h + "</ul>\n";
+}
+
 /// The verdict first: it is what the report is for.
 std::string verdict_html(const std::vector<json>& a, const std::vector<std::size_t>& order, const json& overall,
                          Numbering& numbering) {
   std::string h = numbering.section("verdict", tr("Verdict"));
+  if (is_withheld(overall)) return h + withheld_verdict_html(a, order, overall);
   h += fmt::format("<p class=\"verdict\">{}</p>\n",
                    trf("Overall class over {}: <b>{}</b> (by B: {}, by N: {}).",
                        a.size() == 1 ? tr("the run") : tr("the temperature range"), class_text(at(overall, "class")),
@@ -662,7 +717,9 @@ std::string report_html(const ReportInput& input, const ReportOptions& options) 
   if (!overall.is_object())
     overall = {{"class_B", worst_class(a, "class_B")},
                {"class_N", worst_class(a, "class_N")},
-               {"class", worst_class(a, "class")}};
+               {"class", worst_class(a, "class")},
+               {"withheld",
+                std::any_of(a.begin(), a.end(), [](const json& r) { return is_withheld(at(r, "verdict")); })}};
   Numbering numbering{options.figures};
   // The default title is the program's text, translated; a title given is the user's own.
   const std::string title = options.title == ReportOptions{}.title ? tr(options.title) : options.title;
