@@ -220,11 +220,9 @@ json to_json(const DiagnoseResult& r) {
   j["scale_arcsec_per_pulse"] = r.settings.scale_arcsec;
   j["temperature_c"] = r.analysis.temperature_c ? json(*r.analysis.temperature_c) : json(nullptr);
   j["runs"] = r.runs;
-  j["calibration_runs"] = r.calibration_runs;
-  j["holdout_runs"] = r.holdout_runs;
   j["seed"] = r.seed;
   j["false_alarm_level_per_detector"] = r.alpha;
-  j["simulation_path"] = "decimated";
+  j["method"] = "likelihood";
   j["outliers"] = to_json(r.analysis.outliers);
   json base = model_json(r.base, r.base_band, r.band_level, r.gain.misfit_base, r.gain.coverage_base, sh);
   // Not under "fit": model_from_analysis_json would read those coefficients instead of this model.
@@ -240,13 +238,12 @@ json to_json(const DiagnoseResult& r) {
     json o = {{"effect", std::string(detector_name(d.effect))},
               {"statistic", d.statistic},
               {"threshold", d.threshold},
-              {"threshold_sigma", d.threshold_sigma},
               {"threshold_upper", d.threshold_upper},
-              {"ensemble_max", d.ensemble_max},
-              {"ensemble_median", d.ensemble_median},
+              {"p_value", d.p_value},
               {"fired", d.fired},
               {"excess", d.excess},
               {"named", d.named}};
+    if (!d.test.empty()) o["test"] = d.test;
     if (!d.note.empty()) o["note"] = d.note;
     det.push_back(o);
   }
@@ -264,7 +261,6 @@ json to_json(const DiagnoseResult& r) {
     return fnd;
   };
   j["findings"] = findings_json(r.findings);
-  j["rejected_candidates"] = findings_json(r.rejected);
   j["extended_model"] =
       model_json(r.extended, r.extended_band, r.band_level, r.gain.misfit_extended, r.gain.coverage_extended, sh);
   j["bias_instability_named_terms"] = {
@@ -295,10 +291,9 @@ std::string record_and_base(const DiagnoseResult& r, const Shown& sh) {
   const std::string readout = m.readout == ReadoutMode::Counting ? tr("counting") : tr("white");
   if (!sh.accel) {
     s += trf(
-        "  record: {:.0f} s at {:g} Hz, pulse weight {:g}″; ensemble of {} simulated records per model, {} for the "
-        "detectors' thresholds (seed {}), band {:g} % per τ\n\n",
-        r.settings.duration_s, r.settings.rate_hz, r.settings.scale_arcsec, r.runs, r.calibration_runs, r.seed,
-        r.band_level * 100);
+        "  record: {:.0f} s at {:g} Hz, pulse weight {:g}″; band {:g} % per τ (the model's AV and the points' χ² "
+        "EDF)\n\n",
+        r.settings.duration_s, r.settings.rate_hz, r.settings.scale_arcsec, r.band_level * 100);
     s += format_outliers(r.analysis.outliers);
     return s + tr("Base model (five-term fit): ") + power_laws(m, sh) +
            trf(", white angle {:.4g}″, {} read-out, Earth rate {:.4g} °/h, bias {:.4g} °/h\n", m.white_angle_arcsec,
@@ -307,10 +302,9 @@ std::string record_and_base(const DiagnoseResult& r, const Shown& sh) {
   const std::string level = localized_label(sh.units.deviation);
   s += trf(
       "  record: {:.0f} s at {:g} Hz, column '{}' of an accelerometer read in {} (levels in {}, no Earth rate, no "
-      "class verdict); ensemble of {} simulated records per model, {} for the detectors' thresholds (seed {}), band "
-      "{:g} % per τ\n\n",
+      "class verdict); band {:g} % per τ (the model's AV and the points' χ² EDF)\n\n",
       r.settings.duration_s, r.settings.rate_hz, as_typed(r.analysis.input.value("column", r.analysis.column)),
-      r.analysis.input.value("unit", ""), level, r.runs, r.calibration_runs, r.seed, r.band_level * 100);
+      r.analysis.input.value("unit", ""), level, r.band_level * 100);
   s += format_outliers(r.analysis.outliers, level, sh.units.deviation.factor);
   return s + tr("Base model (five-term fit): ") + power_laws(m, sh) +
          trf(", white velocity {:.4g} m/s, {} read-out, bias (with gravity's projection) {:.4g} {}\n",
@@ -345,24 +339,18 @@ std::string format_report(const DiagnoseResult& r) {
   s += trf("  measured Allan deviation inside the base band at {} of {} τ\n", r.base_band.size() - outside,
            r.base_band.size());
   s += rows;
-  s += tr("\nDetectors (statistic on the measurement against the ensemble-calibrated threshold, ") +
-       trf("false-alarm level {:g} % each):\n", r.alpha * 100);
+  s += tr("\nDetectors (likelihood ratio of the block means, noise levels profiled, against the threshold of ") +
+       trf("its null law, false-alarm level {:g} % each):\n", r.alpha * 100);
   for (const auto& d : r.detectors)
-    s += trf(
-        "  {:<17} statistic {:>9.3f} (dimensionless), threshold {:>8.3f} ± {:.2g} (upper limit {:.3f}), ensemble max "
-        "{:>8.3f}: {}{}\n",
-        detector_name(d.effect), d.statistic, d.threshold, d.threshold_sigma, d.threshold_upper, d.ensemble_max,
-        d.named ? tr("FOUND")
-                : (d.excess ? tr("EXCESS, not named") : (d.fired ? tr("fired, not named") : tr("not found"))),
-        d.note.empty() ? "" : " (" + d.note + ")");
+    s += d.test.empty()
+             ? trf("  {:<17} {}\n", detector_name(d.effect), d.note)
+             : trf("  {:<17} statistic {:>9.3f} (dimensionless), threshold {:>8.3f}, p ≤ {:.3g}: {}{}\n",
+                   detector_name(d.effect), d.statistic, d.threshold, d.p_value,
+                   d.named ? tr("FOUND") : (d.fired ? tr("fired, not named") : tr("not found")),
+                   d.note.empty() ? "" : " (" + d.note + ")");
   s += tr("\nFindings:\n");
-  if (r.findings.empty() && r.rejected.empty())
-    s += tr("  none: the base model's simulations explain the measurement\n");
-  if (r.findings.empty() && !r.rejected.empty())
-    s += tr("  none named: the candidates below do not predict the held-out blocks better than the base\n");
+  if (r.findings.empty()) s += tr("  none: the base model explains the measurement\n");
   s += format_findings(r.findings, sh);
-  if (!r.rejected.empty())
-    s += tr("Candidates not named (no out-of-sample gain; excess only):\n") + format_findings(r.rejected, sh);
   s += tr("\nExtended model: ") + power_laws(r.extended, sh) + trf(", {} extra term(s)\n", r.findings.size());
   // Without B in the extended model the ratio has no value (JSON: null), so none is printed.
   if (!r.findings.empty()) {
@@ -381,12 +369,12 @@ std::string format_report(const DiagnoseResult& r) {
   s += fmt::format("  {:<44} {:>10} {:>10}\n", "", tr("base"), tr("extended"));
   s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", tr("Allan-variance misfit (dimensionless)"), r.gain.misfit_base,
                    r.gain.misfit_extended);
-  s += fmt::format("  {:<44} {:>9.1f}% {:>9.1f}%\n", tr("measured τ inside the simulated band"),
+  s += fmt::format("  {:<44} {:>9.1f}% {:>9.1f}%\n", tr("measured τ inside the model's band"),
                    100 * r.gain.coverage_base, 100 * r.gain.coverage_extended);
   if (std::isnan(r.gain.holdout_misfit_base))
-    s += fmt::format("  {:<44} {:>21}\n", tr("out-of-sample misfit (dimensionless)"), tr("not needed: none named"));
+    s += fmt::format("  {:<44} {:>21}\n", tr("out-of-sample −2 ln L per block (dimensionless)"), tr("not needed: none named"));
   else
-    s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", tr("out-of-sample misfit (dimensionless)"),
+    s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", tr("out-of-sample −2 ln L per block (dimensionless)"),
                      r.gain.holdout_misfit_base, r.gain.holdout_misfit_extended);
   s += trf("\n  ({:.1f} s)\n", r.seconds);
   return s;
