@@ -194,12 +194,18 @@ Candidate with_det(const Blocks& b, const GlsModel& cur, const DetTerm& t) {
 Candidate scan_det(const Blocks& b, const GlsModel& cur, Effect e, const std::vector<double>& grid, double& length,
                    bool log_refine) {
   const ScanBase s = scan_base(b, cur);
+  const Eigen::Index q = det_columns(b, {e, grid.front()}).cols();
+  // Every grid point's columns whitened in one product.
+  Eigen::MatrixXd all(static_cast<Eigen::Index>(b.n()), q * static_cast<Eigen::Index>(grid.size()));
+  for (std::size_t k = 0; k < grid.size(); ++k) all.middleCols(q * static_cast<Eigen::Index>(k), q) = det_columns(b, {e, grid[k]});
+  all = (s.w.triangularView<Eigen::Lower>() * all).eval();
+  if (s.q.cols()) all -= s.q * (s.q.transpose() * all);
   double best = -1;
   std::size_t kbest = 0;
   Eigen::MatrixXd prev;
   length = 0;
   for (std::size_t k = 0; k < grid.size(); ++k) {
-    const Eigen::MatrixXd cp = projected(s, det_columns(b, {e, grid[k]}));
+    const Eigen::MatrixXd cp = all.middleCols(q * static_cast<Eigen::Index>(k), q);
     const double lr = lr_of(s, cp);
     if (lr > best) best = lr, kbest = k;
     Eigen::MatrixXd u = orthonormal(cp);
@@ -208,7 +214,7 @@ Candidate scan_det(const Blocks& b, const GlsModel& cur, Effect e, const std::ve
   }
   const double lo = grid[kbest ? kbest - 1 : 0], hi = grid[std::min(kbest + 1, grid.size() - 1)];
   const auto f = [&](double x) { return lr_of(s, projected(s, det_columns(b, {e, log_refine ? std::exp(x) : x}))); };
-  double x = log_refine ? std::exp(golden_max(f, std::log(lo), std::log(hi), 30)) : golden_max(f, lo, hi, 30);
+  double x = log_refine ? std::exp(golden_max(f, std::log(lo), std::log(hi), 25)) : golden_max(f, lo, hi, 25);
   if (f(log_refine ? std::log(x) : x) < best) x = grid[kbest];
   return with_det(b, cur, {e, x});
 }
@@ -217,7 +223,8 @@ Candidate scan_det(const Blocks& b, const GlsModel& cur, Effect e, const std::ve
 
 Candidate search_slow_line(const Blocks& b, const GlsModel& cur, double alpha, double f_lo, double f_hi,
                            Effect effect) {
-  const double T = b.duration(), df = 1.0 / (8.0 * T);
+  // Eight points per 1/T in the slow band, four above (the curve's length needs its bends resolved).
+  const double T = b.duration(), df = 1.0 / ((f_hi * T <= 20 ? 8.0 : 4.0) * T);
   std::vector<double> grid;
   for (double f = f_lo; f <= f_hi; f += df) grid.push_back(f);
   double length = 0;
@@ -285,7 +292,7 @@ Candidate search_gauss_markov(const Blocks& b, const GlsModel& cur, double alpha
       lv.back() = std::exp(lg);
       return -evaluate(b, h, lv).m2ll;
     };
-    const double lg = golden_max(f, std::log(v0 * 1e-3), std::log(v0 * 1e3), 25);
+    const double lg = golden_max(f, std::log(v0 * 1e-3), std::log(v0 * 1e3), 16);
     const double lr = cur.fit.m2ll + f(lg);
     if (lr > best) best = lr, best_tc = tc, best_level = std::exp(lg);
   }
