@@ -10,9 +10,13 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <string>
 
 #include "diagnose/band.hpp"
 #include "diagnose/effects.hpp"
+#include "diagnose/fast_line.hpp"
+#include "diagnose/lowpass.hpp"
 #include "diagnose/models.hpp"
 #include "diagnose/signal.hpp"
 #include "rwcalc/error.hpp"
@@ -98,12 +102,57 @@ std::vector<double> start_levels(const NoiseModel& m, double q_arcsec, const Blo
   return lv;
 }
 
+/// The tests outside the block means: lines above their band on the periodogram, the output
+/// low-pass on the short-τ AV. Pulse counts (whole, or as numbers on a lattice) get the periodogram
+/// of the decimated angle up to 0.25 Hz only (the counting read-out's beat of the pulse rate against
+/// the sampling makes lines above) and no low-pass test.
+struct Outside {
+  std::optional<FastLine> fast;
+  std::optional<OutputLowpassEstimate> lowpass;
+  std::string lowpass_skip;
+};
+
+Outside outside_tests(const PhaseSeries& x, const Blocks& b, const AnalysisResult& a, double alpha) {
+  Outside o;
+  const bool pulses = x.exact() || on_lattice(x);
+  const double f_min = 0.4 / b.tb;
+  std::vector<double> y;
+  double dt = x.tau0_s, f_max = 0.49 / x.tau0_s;
+  if (pulses) {
+    const Decimated d = decimate(x);
+    dt = d.tau_d;
+    f_max = std::min(0.25, 0.49 / dt);
+    for (std::size_t j = 0; j + 1 < d.theta.size(); ++j) y.push_back((d.theta[j + 1] - d.theta[j]) / dt);
+  } else {
+    y.resize(x.points() - 1);
+    for (std::size_t k = 0; k + 1 < x.points(); ++k) y[k] = x.rate(k);
+  }
+  if (f_max > 2 * f_min) o.fast = fast_line_search(std::move(y), dt, f_min, f_max, 0.5 * alpha);
+  if (pulses) {
+    o.lowpass_skip = tr("not tested: pulse counts cannot have passed through an output-chain filter");
+    return o;
+  }
+  std::vector<std::int64_t> m;
+  std::vector<double> v, edf;
+  for (const auto& p : a.allan.points) {
+    m.push_back(p.m);
+    v.push_back(p.var);
+    edf.push_back(p.edf);
+  }
+  o.lowpass = output_lowpass_detect(m, v, edf, x.tau0_s, x.duration_s(), alpha);
+  if (o.lowpass->points < 5) {
+    o.lowpass.reset();
+    o.lowpass_skip = tr("not tested: fewer than 5 Allan points below 20 s");
+  }
+  return o;
+}
+
 /// The families and their searches against the current model.
 Candidate search(Effect e, const Blocks& b, const GlsModel& cur, double alpha) {
   const double T = b.duration();
   switch (e) {
     case Effect::Sinusoid: return search_slow_line(b, cur, alpha, 2.5 / T, kSlowCycles / T, e);
-    case Effect::Line: return search_slow_line(b, cur, alpha, kSlowCycles / T, 0.4 / b.tb, e);
+    case Effect::Line: return search_slow_line(b, cur, 0.5 * alpha, kSlowCycles / T, 0.4 / b.tb, e);
     case Effect::BiasStep: return search_step(b, cur, alpha);
     case Effect::Warmup: return search_transient(b, cur, alpha);
     default: return search_gauss_markov(b, cur, alpha);
@@ -122,27 +171,50 @@ DetectorResult verdict(const Candidate& c, bool named, double alpha) {
   return d;
 }
 
+/// The line family above the slow band has two parts (block means, periodogram), each at α/2:
+/// its p-value is twice the smaller one's.
+void merge_fast(DetectorResult& d, const Candidate& c, const std::optional<FastLine>& fast, bool& fast_wins) {
+  fast_wins = fast && fast->p < c.p;
+  d.p_value = std::min(1.0, 2.0 * (fast_wins ? fast->p : c.p));
+  if (fast_wins) {
+    d.statistic = fast->statistic;
+    d.threshold = d.threshold_upper = fast->threshold;
+    d.test = fast->test;
+  }
+}
+
 /// Forward selection: every family searched against the current model, the one with the smallest
 /// p-value bound named when that bound is within its false-alarm level, and the search repeated
-/// against the model that includes it; the families' verdicts are their last ones.
-GlsModel select_effects(const Blocks& b, GlsModel cur, double alpha, DiagnoseResult& r) {
+/// against the model that includes it; the families' verdicts are their last ones. Returns the
+/// final model; `fast_named` tells whether the line family was named from the periodogram.
+GlsModel select_effects(const Blocks& b, GlsModel cur, const Outside& out, double alpha, DiagnoseResult& r,
+                        bool& fast_named) {
   const std::vector<Effect> families = {Effect::Sinusoid, Effect::Line, Effect::BiasStep, Effect::Warmup,
                                         Effect::GaussMarkov};
   std::vector<DetectorResult> verdicts(families.size());
-  std::vector<bool> named(families.size(), false);
+  std::vector<bool> named(families.size(), false), fast(families.size(), false);
+  std::vector<Candidate> cands(families.size());
   for (;;) {
     std::size_t best = families.size();
-    std::vector<Candidate> cands(families.size());
     for (std::size_t i = 0; i < families.size(); ++i) {
       if (named[i]) continue;
       cands[i] = search(families[i], b, cur, alpha);
       verdicts[i] = verdict(cands[i], false, alpha);
-      if (cands[i].p <= alpha && (best == families.size() || cands[i].p < cands[best].p)) best = i;
+      if (families[i] == Effect::Line) {
+        bool wins = false;
+        merge_fast(verdicts[i], cands[i], out.fast, wins);
+        fast[i] = wins;
+      }
+      verdicts[i].fired = verdicts[i].p_value <= alpha;
+      if (verdicts[i].fired && (best == families.size() || verdicts[i].p_value < verdicts[best].p_value)) best = i;
     }
     if (best == families.size()) break;
     named[best] = true;
-    verdicts[best] = verdict(cands[best], true, alpha);
-    cur = cands[best].model;
+    verdicts[best].named = true;
+    if (fast[best])
+      fast_named = true;
+    else
+      cur = cands[best].model;
     for (std::size_t i = 0; i < families.size(); ++i)
       if (!named[i] && verdicts[i].fired)
         verdicts[i].note = trf("explained by the {} named before it", detector_name(families[best]));
@@ -150,14 +222,43 @@ GlsModel select_effects(const Blocks& b, GlsModel cur, double alpha, DiagnoseRes
   r.detectors = verdicts;
   DetectorResult lp;
   lp.effect = Effect::Lowpass;
-  lp.note = tr("not tested: the output low-pass is not part of the block-mean likelihood");
+  if (out.lowpass) {
+    lp.statistic = out.lowpass->statistic;
+    lp.threshold = lp.threshold_upper = out.lowpass->threshold;
+    lp.p_value = out.lowpass->p;
+    lp.test =
+        "χ² drop of the short-τ Allan variance (τ ≤ min(20 s, T/100)) when white angle and rate noise pass through "
+        "a first-order low-pass, scaled by the fit's χ²/dof; null law: χ²₁, Bonferroni over the octave points";
+    lp.fired = lp.named = lp.p_value <= alpha;
+  } else {
+    lp.note = out.lowpass_skip;
+  }
   r.detectors.push_back(lp);
   return cur;
 }
 
 /// The named terms as findings and as the extended model (N, B and K of the final profile).
-void extend(const Blocks& b, const GlsModel& m, DiagnoseResult& r) {
+void extend(const Blocks& b, const GlsModel& m, const Outside& out, bool fast_named, DiagnoseResult& r) {
   r.extended = r.base;
+  if (fast_named) {
+    const FastLine& l = *out.fast;
+    Finding f{Effect::Line,
+              {{"frequency_hz", l.f_hz}, {"amplitude_deg_per_h", l.amp}, {"phase_rad", l.phase}},
+              {{"frequency_hz", l.f_sigma}, {"amplitude_deg_per_h", l.amp_sigma}},
+              {}};
+    f.evidence["interval95"] = {
+        {"frequency_hz", {l.f_hz - 1.96 * l.f_sigma, l.f_hz + 1.96 * l.f_sigma}},
+        {"amplitude_deg_per_h", {l.amp - 1.96 * l.amp_sigma, l.amp + 1.96 * l.amp_sigma}}};
+    r.extended.sinusoids.push_back({l.f_hz, l.amp, l.phase});
+    r.findings.push_back(std::move(f));
+  }
+  if (out.lowpass && out.lowpass->p <= r.alpha) {
+    const OutputLowpassEstimate& lp = *out.lowpass;
+    Finding f{Effect::Lowpass, {{"time_constant_s", lp.tf}}, {{"time_constant_s", (lp.tf_high - lp.tf_low) / 3.92}}, {}};
+    f.evidence["interval95"] = {{"time_constant_s", {lp.tf_low, lp.tf_high}}};
+    r.extended.output_lowpass_tc_s = lp.tf;
+    r.findings.push_back(std::move(f));
+  }
   for (std::size_t j = 0; j < m.det.size(); ++j) {
     const TermEstimate e = estimate_det(b, m, j);
     Finding f{m.det[j].effect, e.params, e.uncertainty, {}};
@@ -190,6 +291,10 @@ void extend(const Blocks& b, const GlsModel& m, DiagnoseResult& r) {
       default: break;
     }
   }
+  if (r.findings.empty()) {  // nothing named: the base is the extended model
+    r.extended = r.base;
+    return;
+  }
   std::stable_sort(r.findings.begin(), r.findings.end(),
                    [](const Finding& a, const Finding& c) { return a.effect < c.effect; });
   for (auto& f : r.findings)
@@ -221,11 +326,10 @@ DiagnoseResult diagnose(const Recording& read, const DiagnoseOptions& opt) {
   h0.cov = {{CovKind::Q}, {CovKind::N}, {CovKind::B}, {CovKind::K}};
   const double q = rec.phase.exact() ? rec.phase.arcsec_per_count : 0.0;
   h0.fit = profile(b, hypothesis_of(b, {}, h0.cov), start_levels(r.base, q, b, h0.cov));
-  const GlsModel final_model = select_effects(b, h0, opt.alpha, r);
-  if (final_model.det.empty() && final_model.cov.size() == h0.cov.size())
-    r.extended = r.base;
-  else
-    extend(b, final_model, r);
+  const Outside out = outside_tests(rec.phase, b, r.analysis, opt.alpha);
+  bool fast_named = false;
+  const GlsModel final_model = select_effects(b, h0, out, opt.alpha, r, fast_named);
+  extend(b, final_model, out, fast_named, r);
   bands_and_gain(rec.phase, b, h0, final_model, r);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return r;

@@ -70,6 +70,26 @@ AnalysisResult analyze_for_base(const Recording& rec, const AnalysisOptions& opt
   }
 }
 
+bool on_lattice(const PhaseSeries& x) {
+  const std::size_t n = std::min<std::size_t>(x.points() - 1, 100000);
+  if (n < 2) return false;
+  double step = 0, sum = 0, sum2 = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double d = x.diff(i + 1, i);
+    sum += d;
+    sum2 += d * d;
+    if (std::abs(d) > 1e-9 && (step == 0 || std::abs(d) < step)) step = std::abs(d);
+  }
+  if (!(step > 0)) return false;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double r = std::abs(x.diff(i + 1, i)) / step;
+    if (std::abs(r - std::round(r)) > 1e-3) return false;
+  }
+  const double mean = sum / static_cast<double>(n);
+  const double sd = std::sqrt(std::max(0.0, sum2 / static_cast<double>(n) - mean * mean));
+  return step >= 0.5 * sd;
+}
+
 PhaseSeries cleaned(const PhaseSeries& x, const NoiseModel& det) {
   PhaseSeries s;
   s.tau0_s = x.tau0_s;

@@ -17,6 +17,10 @@ double sim_scale(const PhaseSeries& x, const AnalysisResult& a);
 /// The five-term analysis, its fit range widened (to τ ≥ 1 s, then all τ) when it leaves too few
 /// Allan points.
 AnalysisResult analyze_for_base(const Recording& rec, const AnalysisOptions& aopt);
+/// Whether a floating series is pulse counts given as numbers: its first 10⁵ increments are
+/// integer multiples of the smallest one, a step coarse against their scatter (a finely
+/// quantized ADC read-out is not counting).
+bool on_lattice(const PhaseSeries& x);
 /// The series with the deterministic terms of `det` removed: floating phase.
 PhaseSeries cleaned(const PhaseSeries& x, const NoiseModel& det);
 
