@@ -7,7 +7,9 @@
 
 #include "diagnose/models.hpp"
 #include "rwcalc/allan.hpp"
+#include "model/output_filter.hpp"
 #include "rwcalc/confidence.hpp"
+#include "rwcalc/units.hpp"
 
 namespace rwcalc::diag {
 
@@ -15,6 +17,17 @@ namespace {
 
 /// A band point's weight in the misfit: its EDF with a 1000-EDF model floor.
 double band_nu(double edf) { return 1.0 / (1.0 / edf + 1.0 / 1000.0); }
+
+/// The model's AV at cluster size m; with an output-chain low-pass its white angle and rate noise
+/// pass through the filter.
+double model_avar(const NoiseModel& model, double tau0, double scale, std::size_t m) {
+  if (!(model.output_lowpass_tc_s > 0)) return theoretical_avar(model, tau0, scale, m);
+  NoiseModel rest = model;
+  rest.arw_deg_per_sqrt_h = rest.white_angle_arcsec = 0;
+  const double n = model.arw_deg_per_sqrt_h * units::sqrt_s_per_sqrt_h, tf = model.output_lowpass_tc_s;
+  return theoretical_avar(rest, tau0, scale, m) + n * n * output_lowpass_rate_avar(m, tau0, tf) +
+         model.white_angle_arcsec * model.white_angle_arcsec * output_lowpass_angle_avar(m, tau0, tf);
+}
 
 /// The band of `model` at the measured points (σ per τ in `dev`): the model's σ times the χ²
 /// quantiles of a variance with the point's EDF.
@@ -24,7 +37,7 @@ std::vector<BandPoint> model_band(const std::vector<AllanPoint>& pts, const std:
   for (std::size_t i = 0; i < pts.size(); ++i) {
     const auto& p = pts[i];
     if (!(dev[i] > 0) || !(p.edf > 0)) continue;
-    const double var = theoretical_avar(model, x.tau0_s, scale, static_cast<std::size_t>(p.m));
+    const double var = model_avar(model, x.tau0_s, scale, static_cast<std::size_t>(p.m));
     const DevInterval ci = chi2_interval(1.0, p.edf, level);
     BandPoint b;
     b.tau_s = p.tau_s;
