@@ -1,6 +1,7 @@
 // The effects' scans, their null laws and estimates (effects.hpp): every statistic is a
 // likelihood ratio of the block means with the noise levels profiled (gls.hpp).
 #include "diagnose/effects.hpp"
+#include "diagnose/signal.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,7 +13,7 @@ namespace rwcalc::diag {
 
 namespace {
 
-constexpr double kTwoPi = 6.283185307179586;
+constexpr double kTwoPi = 2.0 * kPi;
 
 /// Block i spans [i·tb, (i + 1)·tb] from the record's start.
 double edge(const Blocks& b, std::size_t i) { return b.t0 + static_cast<double>(i) * b.tb; }
@@ -164,17 +165,7 @@ double subspace_angle(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
 /// Golden-section maximum of f on [lo, hi].
 template <class F>
 double golden_max(const F& f, double lo, double hi, int iters) {
-  double a = lo, bb = hi;
-  const double g = 0.3819660112501051;
-  double x1 = a + g * (bb - a), x2 = bb - g * (bb - a), f1 = f(x1), f2 = f(x2);
-  for (int i = 0; i < iters; ++i) {
-    if (f1 > f2) {
-      bb = x2, x2 = x1, f2 = f1, x1 = a + g * (bb - a), f1 = f(x1);
-    } else {
-      a = x1, x1 = x2, f1 = f2, x2 = bb - g * (bb - a), f2 = f(x2);
-    }
-  }
-  return f1 > f2 ? x1 : x2;
+  return golden_min([&f](double x) { return -f(x); }, lo, hi, iters);
 }
 
 /// The candidate model: the current one with a deterministic term, profiled.

@@ -93,25 +93,44 @@ double term_avar(const CovTerm& t, double tau) {
   return 0.0;
 }
 
+namespace {
+
+/// Σ a[i]·b[i] in four partial sums (the loop vectorises; the order is fixed, so the result too).
+double dot4(const double* a, const double* b, std::size_t n) {
+  double acc[4] = {0, 0, 0, 0};
+  std::size_t i = 0;
+  for (; i + 4 <= n; i += 4)
+    for (std::size_t u = 0; u < 4; ++u) acc[u] += a[i + u] * b[i + u];
+  for (; i < n; ++i) acc[0] += a[i] * b[i];
+  return (acc[0] + acc[1]) + (acc[2] + acc[3]);
+}
+
+}  // namespace
+
 Whitened whiten(const std::vector<double>& r, const Eigen::MatrixXd& v, Eigen::MatrixXd* w_out) {
   const std::size_t n = r.size();
   const auto q = v.cols();
   Whitened out;
   out.v.resize(static_cast<Eigen::Index>(n), q);
-  if (w_out) w_out->setZero(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
-  std::vector<double> phi, prev;  // prediction coefficients φ_{k,1…k}
-  phi.reserve(n);
-  prev.reserve(n);
+  RowMatrix w;
+  if (w_out) w.setZero(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
+  // The order-k predictor reversed, ψ[i] = φ_{k−i}, kept at the end of `buf` (it grows at its
+  // front): both the recursion's sums and the prediction of sample k are then ascending dot
+  // products.
+  std::vector<double> buf(n + 1, 0.0);
+  double* psi = buf.data() + n;  // order 0: empty
   double var = r[0];
   for (std::size_t k = 0; k < n; ++k) {
     if (k > 0) {
-      double acc = r[k];
-      for (std::size_t j = 1; j < k; ++j) acc -= phi[j - 1] * r[k - j];
-      const double kappa = acc / var;
-      prev = phi;
-      phi.resize(k);
-      for (std::size_t j = 1; j < k; ++j) phi[j - 1] = prev[j - 1] - kappa * prev[k - j - 1];
-      phi[k - 1] = kappa;
+      const double kappa = (r[k] - dot4(psi, r.data() + 1, k - 1)) / var;
+      // φ_j ← φ_j − κ φ_{k−j}: in ψ, ψ[m] ← ψ[m] − κ ψ[k−2−m], pairwise; then κ in front.
+      for (std::size_t m = 0, e = k - 1; m < e / 2 + (e % 2); ++m) {
+        const std::size_t o = k - 2 - m;
+        const double a = psi[m], b = psi[o];
+        psi[m] = a - kappa * b;
+        if (o != m) psi[o] = b - kappa * a;
+      }
+      *--psi = kappa;
       var *= 1.0 - kappa * kappa;
     }
     if (!(var > 0) || !std::isfinite(var)) {
@@ -121,16 +140,13 @@ Whitened whiten(const std::vector<double>& r, const Eigen::MatrixXd& v, Eigen::M
     out.logdet += std::log(var);
     const double s = 1.0 / std::sqrt(var);
     const auto K = static_cast<Eigen::Index>(k);
-    for (Eigen::Index c = 0; c < q; ++c) {
-      double e = v(K, c);
-      for (std::size_t j = 1; j <= k; ++j) e -= phi[j - 1] * v(K - static_cast<Eigen::Index>(j), c);
-      out.v(K, c) = e * s;
-    }
+    for (Eigen::Index c = 0; c < q; ++c) out.v(K, c) = (v(K, c) - dot4(psi, &v(0, c), k)) * s;
     if (w_out) {
-      (*w_out)(K, K) = s;
-      for (std::size_t j = 1; j <= k; ++j) (*w_out)(K, K - static_cast<Eigen::Index>(j)) = -phi[j - 1] * s;
+      for (std::size_t i = 0; i < k; ++i) w(K, static_cast<Eigen::Index>(i)) = -psi[i] * s;
+      w(K, K) = s;
     }
   }
+  if (w_out) *w_out = std::move(w);
   return out;
 }
 

@@ -13,6 +13,8 @@
 
 namespace rwcalc::diag {
 
+using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
 /// A covariance term of the block means: its kind, and its correlation time for a Gauss–Markov one.
 enum class CovKind { Q, N, B, K, GM };
 struct CovTerm {
