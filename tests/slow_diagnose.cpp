@@ -81,9 +81,10 @@ TEST(DiagnoseAcceptance, SlowLinesAtThreeAndAHalfFloors) {
     gain += r.gain.holdout_misfit_extended < r.gain.holdout_misfit_base;
     cover_f += covers(*s, "frequency_hz", f);
   }
-  std::cout << fmt::format("slow lines at 3.5x: {}/{} named in tolerance, {} Gauss-Markov, {} with out-of-sample "
-                           "gain, frequency interval covers {}\n",
-                           named, n, gauss_markov, gain, cover_f);
+  std::cout << fmt::format(
+      "slow lines at 3.5x: {}/{} named in tolerance, {} Gauss-Markov, {} with out-of-sample "
+      "gain, frequency interval covers {}\n",
+      named, n, gauss_markov, gain, cover_f);
   EXPECT_GE(named, 27);
   EXPECT_EQ(gauss_markov, 0);
 }
@@ -125,11 +126,11 @@ TEST(DiagnoseAcceptance, StepIntervalsCover) {
     const Finding* s = finding(r, Effect::BiasStep);
     if (!s) continue;
     ++named;
-    cover_t += covers(*s, "t_s", t);
+    cover_t += covers(*s, "time_s", t);
     cover_s += covers(*s, "size_deg_per_h", size);
   }
-  std::cout << fmt::format("steps: {}/{} named, time interval covers {}, size interval covers {}\n", named, n,
-                           cover_t, cover_s);
+  std::cout << fmt::format("steps: {}/{} named, time interval covers {}, size interval covers {}\n", named, n, cover_t,
+                           cover_s);
   EXPECT_GE(named, 36);
   EXPECT_GE(cover_t, 0.85 * named);
   EXPECT_GE(cover_s, 0.85 * named);

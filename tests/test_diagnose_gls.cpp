@@ -112,8 +112,7 @@ TEST(DiagnoseGls, FlickerSeriesJoinsTheDirectSum) {
   // The series is −δ⁶ of u² ln u, ≈ 12/u⁴ (×h/2): smooth through lag 31 → 32.
   EXPECT_NEAR(r[32] / r[31], std::pow(31.0 / 32.0, 4), 2e-3);
   EXPECT_NEAR(r[33] / r[32], std::pow(32.0 / 33.0, 4), 2e-3);
-  for (const CovKind k : {CovKind::N, CovKind::B, CovKind::K})
-    EXPECT_GT(term_autocov({k}, 3, 10)[0], 0.0);
+  for (const CovKind k : {CovKind::N, CovKind::B, CovKind::K}) EXPECT_GT(term_autocov({k}, 3, 10)[0], 0.0);
 }
 
 // W Σ Wᵀ = I for a Toeplitz covariance, and log det Σ from the recursion equals the dense one.
@@ -183,11 +182,11 @@ TEST(DiagnoseGls, StepFoundAndEstimated) {
   const Candidate c = search_step(b, null_model(b), 0.01);
   EXPECT_LT(c.p, 1e-3);
   const TermEstimate e = estimate_det(b, c.model, 0);
-  EXPECT_NEAR(e.params["t_s"].get<double>(), 3000, 100);
+  EXPECT_NEAR(e.params["time_s"].get<double>(), 3000, 100);
   EXPECT_NEAR(e.params["size_deg_per_h"].get<double>(), 0.05, 0.015);
-  const auto& ti = e.interval95["t_s"];
-  EXPECT_LE(ti[0].get<double>(), e.params["t_s"].get<double>());
-  EXPECT_GE(ti[1].get<double>(), e.params["t_s"].get<double>());
+  const auto& ti = e.interval95["time_s"];
+  EXPECT_LE(ti[0].get<double>(), e.params["time_s"].get<double>());
+  EXPECT_GE(ti[1].get<double>(), e.params["time_s"].get<double>());
 }
 
 // A warm-up transient: found, its time constant near the truth.

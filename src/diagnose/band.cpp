@@ -6,8 +6,8 @@
 #include <limits>
 
 #include "diagnose/models.hpp"
-#include "rwcalc/allan.hpp"
 #include "model/output_filter.hpp"
+#include "rwcalc/allan.hpp"
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/units.hpp"
 
@@ -80,8 +80,7 @@ double predicted(const Blocks& fit, const Blocks& test, const GlsModel& m) {
   for (const auto& d : m.det)
     if (det_columns(fit, d).squaredNorm() > 1e-12 * static_cast<double>(fit.n())) f.det.push_back(d);
   refit(fit, f, m, 1e-12);
-  return m2ll_fixed(test, hypothesis_of(test, f.det, f.cov), f.fit.level, f.fit.beta) /
-         static_cast<double>(test.n());
+  return m2ll_fixed(test, hypothesis_of(test, f.det, f.cov), f.fit.level, f.fit.beta) / static_cast<double>(test.n());
 }
 
 }  // namespace

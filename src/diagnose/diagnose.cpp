@@ -93,7 +93,8 @@ std::vector<double> start_levels(const NoiseModel& m, double q_arcsec, const Blo
   const double n = m.arw_deg_per_sqrt_h * units::sqrt_s_per_sqrt_h;
   const double k = m.rrw_deg_per_h_per_sqrt_h / units::sqrt_s_per_sqrt_h;
   std::vector<double> lv = {m.white_angle_arcsec * m.white_angle_arcsec + q_arcsec * q_arcsec / 12.0, n * n,
-                            kFlickerFloorPerB2 * m.bias_instability_deg_per_h * m.bias_instability_deg_per_h, k * k / 3.0};
+                            kFlickerFloorPerB2 * m.bias_instability_deg_per_h * m.bias_instability_deg_per_h,
+                            k * k / 3.0};
   double top = 0;
   std::vector<double> share(lv.size());
   for (std::size_t t = 0; t < lv.size(); ++t) {
@@ -194,9 +195,9 @@ void test_lowpass(const PhaseSeries& x, const Outside& out, DiagnoseResult& r) {
   r.detectors.push_back(d);
   if (!d.named) return;
   Finding f{Effect::Lowpass, {{"time_constant_s", lp.tf}}, {{"time_constant_s", (lp.tf_high - lp.tf_low) / 3.92}}, {}};
-  f.evidence = {{"statistic", d.statistic}, {"threshold", d.threshold}, {"p_value", d.p_value},
-                {"false_alarm_level", r.alpha}, {"detector", d.test},
-                {"interval95", {{"time_constant_s", {lp.tf_low, lp.tf_high}}}}};
+  f.evidence = {{"statistic", d.statistic}, {"threshold", d.threshold},
+                {"p_value", d.p_value},     {"false_alarm_level", r.alpha},
+                {"detector", d.test},       {"interval95", {{"time_constant_s", {lp.tf_low, lp.tf_high}}}}};
   if (r.findings.empty()) r.extended = r.base;
   r.extended.output_lowpass_tc_s = lp.tf;
   r.extended.arw_deg_per_sqrt_h = std::sqrt(lp.white_rate) / units::sqrt_s_per_sqrt_h;
@@ -266,9 +267,8 @@ void extend(const Blocks& b, const GlsModel& m, const Outside& out, bool fast_na
               {{"frequency_hz", l.f_hz}, {"amplitude_deg_per_h", l.amp}, {"phase_rad", l.phase}},
               {{"frequency_hz", l.f_sigma}, {"amplitude_deg_per_h", l.amp_sigma}},
               {}};
-    f.evidence["interval95"] = {
-        {"frequency_hz", {l.f_hz - 1.96 * l.f_sigma, l.f_hz + 1.96 * l.f_sigma}},
-        {"amplitude_deg_per_h", {l.amp - 1.96 * l.amp_sigma, l.amp + 1.96 * l.amp_sigma}}};
+    f.evidence["interval95"] = {{"frequency_hz", {l.f_hz - 1.96 * l.f_sigma, l.f_hz + 1.96 * l.f_sigma}},
+                                {"amplitude_deg_per_h", {l.amp - 1.96 * l.amp_sigma, l.amp + 1.96 * l.amp_sigma}}};
     r.extended.sinusoids.push_back({l.f_hz, l.amp, l.phase});
     r.findings.push_back(std::move(f));
   }
@@ -278,21 +278,19 @@ void extend(const Blocks& b, const GlsModel& m, const Outside& out, bool fast_na
     f.evidence["interval95"] = e.interval95;
     const auto& p = e.params;
     if (f.effect == Effect::BiasStep)
-      r.extended.bias_steps.push_back({p["t_s"].get<double>(), p["size_deg_per_h"].get<double>()});
+      r.extended.bias_steps.push_back({p["time_s"].get<double>(), p["size_deg_per_h"].get<double>()});
     else if (f.effect == Effect::Warmup)
-      r.extended.warmups.push_back({p["amp_deg_per_h"].get<double>(), p["tc_s"].get<double>()});
+      r.extended.warmups.push_back({p["amplitude_deg_per_h"].get<double>(), p["time_constant_s"].get<double>()});
     else
-      r.extended.sinusoids.push_back({p["frequency_hz"].get<double>(), p["amplitude_deg_per_h"].get<double>(),
-                                      p["phase_rad"].get<double>()});
+      r.extended.sinusoids.push_back(
+          {p["frequency_hz"].get<double>(), p["amplitude_deg_per_h"].get<double>(), p["phase_rad"].get<double>()});
     r.findings.push_back(std::move(f));
   }
   for (std::size_t c = 0; c < m.cov.size(); ++c) {
     const double lv = m.fit.level[c];
     switch (m.cov[c].kind) {
       case CovKind::B: r.extended.bias_instability_deg_per_h = std::sqrt(lv / kFlickerFloorPerB2); break;
-      case CovKind::K:
-        r.extended.rrw_deg_per_h_per_sqrt_h = std::sqrt(3.0 * lv) * units::sqrt_s_per_sqrt_h;
-        break;
+      case CovKind::K: r.extended.rrw_deg_per_h_per_sqrt_h = std::sqrt(3.0 * lv) * units::sqrt_s_per_sqrt_h; break;
       case CovKind::GM: {
         const TermEstimate e = estimate_gm(b, m, c);
         Finding f{Effect::GaussMarkov, e.params, e.uncertainty, {}};

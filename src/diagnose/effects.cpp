@@ -3,9 +3,9 @@
 #include "diagnose/effects.hpp"
 #include "diagnose/signal.hpp"
 
+#include <fmt/format.h>
 #include <algorithm>
 #include <cmath>
-#include <fmt/format.h>
 #include <functional>
 #include <limits>
 
@@ -188,7 +188,8 @@ Candidate scan_det(const Blocks& b, const GlsModel& cur, Effect e, const std::ve
   const Eigen::Index q = det_columns(b, {e, grid.front()}).cols();
   // Every grid point's columns whitened in one product.
   Eigen::MatrixXd all(static_cast<Eigen::Index>(b.n()), q * static_cast<Eigen::Index>(grid.size()));
-  for (std::size_t k = 0; k < grid.size(); ++k) all.middleCols(q * static_cast<Eigen::Index>(k), q) = det_columns(b, {e, grid[k]});
+  for (std::size_t k = 0; k < grid.size(); ++k)
+    all.middleCols(q * static_cast<Eigen::Index>(k), q) = det_columns(b, {e, grid[k]});
   all = (s.w.triangularView<Eigen::Lower>() * all).eval();
   if (s.q.cols()) all -= s.q * (s.q.transpose() * all);
   double best = -1;
@@ -361,16 +362,17 @@ TermEstimate estimate_det(const Blocks& b, const GlsModel& m, std::size_t index)
   } else if (t.effect == Effect::BiasStep) {
     const double size = beta(off), ss = std::sqrt(cov(off, off));
     const auto [tlo, thi] = profile_interval(g, t.nl, 0.05 * b.tb, b.t0, b.t0 + T);
-    e.params = {{"t_s", t.nl}, {"size_deg_per_h", size}};
-    e.uncertainty = {{"t_s", (thi - tlo) / 3.92}, {"size_deg_per_h", ss}};
-    e.interval95 = {{"t_s", {tlo, thi}}, {"size_deg_per_h", {size - 1.96 * ss, size + 1.96 * ss}}};
+    e.params = {{"time_s", t.nl}, {"size_deg_per_h", size}};
+    e.uncertainty = {{"time_s", (thi - tlo) / 3.92}, {"size_deg_per_h", ss}};
+    e.interval95 = {{"time_s", {tlo, thi}}, {"size_deg_per_h", {size - 1.96 * ss, size + 1.96 * ss}}};
   } else {
     const double amp = beta(off), as = std::sqrt(cov(off, off));
     const auto gl = [&](double lx) { return g(std::exp(lx)); };
     const auto [llo, lhi] = profile_interval(gl, std::log(t.nl), 0.02, std::log(0.5 * b.tb), std::log(20 * T));
-    e.params = {{"amp_deg_per_h", amp}, {"tc_s", t.nl}};
-    e.uncertainty = {{"amp_deg_per_h", as}, {"tc_s", (std::exp(lhi) - std::exp(llo)) / 3.92}};
-    e.interval95 = {{"amp_deg_per_h", {amp - 1.96 * as, amp + 1.96 * as}}, {"tc_s", {std::exp(llo), std::exp(lhi)}}};
+    e.params = {{"amplitude_deg_per_h", amp}, {"time_constant_s", t.nl}};
+    e.uncertainty = {{"amplitude_deg_per_h", as}, {"time_constant_s", (std::exp(lhi) - std::exp(llo)) / 3.92}};
+    e.interval95 = {{"amplitude_deg_per_h", {amp - 1.96 * as, amp + 1.96 * as}},
+                    {"time_constant_s", {std::exp(llo), std::exp(lhi)}}};
   }
   return e;
 }
@@ -399,9 +401,10 @@ TermEstimate estimate_gm(const Blocks& b, const GlsModel& m, std::size_t ci) {
   const auto [tlo, thi] = profile_interval(g_tc, std::log(tc), 0.05, std::log(0.5 * b.tb), std::log(10 * b.duration()));
   const double s = std::sqrt(var), slo = std::exp(0.5 * vlo), shi = std::exp(0.5 * vhi);
   TermEstimate e;
-  e.params = {{"sigma_deg_per_h", s}, {"tc_s", tc}};
-  e.uncertainty = {{"sigma_deg_per_h", (shi - slo) / 3.92}, {"tc_s", (std::exp(thi) - std::exp(tlo)) / 3.92}};
-  e.interval95 = {{"sigma_deg_per_h", {slo, shi}}, {"tc_s", {std::exp(tlo), std::exp(thi)}}};
+  e.params = {{"sigma_deg_per_h", s}, {"correlation_time_s", tc}};
+  e.uncertainty = {{"sigma_deg_per_h", (shi - slo) / 3.92},
+                   {"correlation_time_s", (std::exp(thi) - std::exp(tlo)) / 3.92}};
+  e.interval95 = {{"sigma_deg_per_h", {slo, shi}}, {"correlation_time_s", {std::exp(tlo), std::exp(thi)}}};
   return e;
 }
 

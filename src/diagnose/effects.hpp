@@ -52,8 +52,7 @@ struct Candidate {
 };
 
 /// The searches. `alpha` is the family's false-alarm level.
-Candidate search_slow_line(const Blocks& b, const GlsModel& cur, double alpha, double f_lo, double f_hi,
-                           Effect effect);
+Candidate search_slow_line(const Blocks& b, const GlsModel& cur, double alpha, double f_lo, double f_hi, Effect effect);
 Candidate search_step(const Blocks& b, const GlsModel& cur, double alpha);
 Candidate search_transient(const Blocks& b, const GlsModel& cur, double alpha);
 Candidate search_gauss_markov(const Blocks& b, const GlsModel& cur, double alpha);

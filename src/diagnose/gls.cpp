@@ -57,16 +57,17 @@ std::vector<double> term_autocov(const CovTerm& t, std::size_t n, double tb) {
     }
     case CovKind::K:  // AV τ: G(τ) = τ³/4; exact in integers, 0 from lag 3 on
       for (std::size_t m = 0; m < std::min<std::size_t>(n, 3); ++m)
-        r[m] = static_cast<double>(lag_sum(m, [](std::size_t u) { return static_cast<long double>(u * u * u); })) *
-               tb / 4.0;
+        r[m] = static_cast<double>(lag_sum(m, [](std::size_t u) { return static_cast<long double>(u * u * u); })) * tb /
+               4.0;
       break;
     case CovKind::GM: {  // variance 1, G(τ) = −Tc²(τ/Tc − 1 + e^{−τ/Tc})
       const long double tc = t.tc_s, a = tb / tc;
       for (std::size_t m = 0; m < std::min<std::size_t>(n, 3); ++m)
-        r[m] = static_cast<double>(lag_sum(m, [&](std::size_t u) {
-                 const long double x = u * a;
-                 return -tc * tc * (x - 1.0L + std::exp(-x));
-               })) /
+        r[m] = static_cast<double>(lag_sum(m,
+                                           [&](std::size_t u) {
+                                             const long double x = u * a;
+                                             return -tc * tc * (x - 1.0L + std::exp(-x));
+                                           })) /
                tb2;
       // From lag 3 on only the exponential is left: Tc²(2 sinh(a/2))⁶ e^{−ma}/tb².
       const double s6 = std::pow(2.0 * std::sinh(0.5 * static_cast<double>(a)), 6.0);
@@ -157,7 +158,8 @@ Eigen::VectorXd second_differences(const std::vector<double>& y) {
   return z;
 }
 
-std::vector<double> total_autocov(const Blocks& b, const std::vector<CovTerm>& terms, const std::vector<double>& level) {
+std::vector<double> total_autocov(const Blocks& b, const std::vector<CovTerm>& terms,
+                                  const std::vector<double>& level) {
   std::vector<double> r(b.n(), 0.0);
   for (std::size_t t = 0; t < terms.size(); ++t) {
     const auto rt = term_autocov(terms[t], b.n(), b.tb);
@@ -253,8 +255,10 @@ std::vector<double> nelder_mead(const F& f, std::vector<double> x0, double step,
       auto xe = along(-2.0);
       const double fe = f(xe);
       ++evals;
-      if (fe < fr) s[worst] = xe, fv[worst] = fe;
-      else s[worst] = xr, fv[worst] = fr;
+      if (fe < fr)
+        s[worst] = xe, fv[worst] = fe;
+      else
+        s[worst] = xr, fv[worst] = fr;
     } else if (fr < fv[second]) {
       s[worst] = xr, fv[worst] = fr;
     } else {
@@ -292,8 +296,7 @@ Profile profile(const Blocks& b, const Hypothesis& h, const std::vector<double>&
     if (start[t] * unit[t][0] > start[ref] * unit[ref][0]) ref = t;
   auto levels_of = [&](const std::vector<double>& u) {
     std::vector<double> lv(nt);
-    for (std::size_t t = 0, j = 0; t < nt; ++t)
-      lv[t] = t == ref ? 1.0 : std::exp(std::clamp(u[j++], kLogFloor, 40.0));
+    for (std::size_t t = 0, j = 0; t < nt; ++t) lv[t] = t == ref ? 1.0 : std::exp(std::clamp(u[j++], kLogFloor, 40.0));
     return lv;
   };
   auto fit_at = [&](const std::vector<double>& u) {
@@ -313,8 +316,8 @@ Profile profile(const Blocks& b, const Hypothesis& h, const std::vector<double>&
   if (u0.empty()) return fit_at(u0);
   const auto f = [&](const std::vector<double>& u) { return fit_at(u).m2ll; };
   // Two rounds: a restart from the first optimum escapes a collapsed simplex.
-  auto u = nelder_mead(f, u0, 1.0, 400, 1e-6);
-  u = nelder_mead(f, u, 0.3, 200, 1e-7);
+  auto u = nelder_mead(f, u0, 1.0, 300, 1e-4);
+  u = nelder_mead(f, u, 0.3, 150, 1e-5);
   return fit_at(u);
 }
 

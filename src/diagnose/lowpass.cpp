@@ -13,8 +13,8 @@ namespace rwcalc::diag {
 namespace {
 
 /// Non-negative weighted least squares of y on up to three columns (all subsets; small p).
-double nn_fit3(const std::vector<double>& y, const std::vector<double>& w, const std::array<std::vector<double>, 3>& cols,
-               std::array<double, 3>& coef) {
+double nn_fit3(const std::vector<double>& y, const std::vector<double>& w,
+               const std::array<std::vector<double>, 3>& cols, std::array<double, 3>& coef) {
   double best = std::numeric_limits<double>::infinity();
   coef = {0, 0, 0};
   for (int mask = 1; mask < 8; ++mask) {

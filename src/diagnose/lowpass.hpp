@@ -22,7 +22,6 @@ struct OutputLowpassEstimate {
 /// of freedom when above 1, is χ²₁ at each time constant; the bound is Bonferroni over the octave
 /// points (time constants an octave apart are the distinct alternatives).
 OutputLowpassEstimate output_lowpass_detect(const std::vector<std::int64_t>& m, const std::vector<double>& v,
-                                            const std::vector<double>& edf, double tau0, double duration,
-                                            double alpha);
+                                            const std::vector<double>& edf, double tau0, double duration, double alpha);
 
 }  // namespace rwcalc::diag

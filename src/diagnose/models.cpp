@@ -8,7 +8,6 @@
 #include "diagnose/signal.hpp"
 #include "rwcalc/error.hpp"
 
-
 namespace rwcalc::diag {
 
 namespace {

@@ -56,7 +56,7 @@ json shown_params(const json& p, const Shown& sh) {
       out[k.substr(0, k.rfind("_deg_per_h3")) + "_m_per_s_per_h3"] = v.get<double>() * sh.units[Term::R].factor;
       continue;
     }
-    const ShownUnit* u = k.ends_with("_deg_per_h2") ? &sh.units[Term::R]
+    const ShownUnit* u = k.ends_with("_deg_per_h2")  ? &sh.units[Term::R]
                          : k.ends_with("_deg_per_h") ? &sh.units.deviation
                                                      : nullptr;
     if (!u || !v.is_number()) {
@@ -187,7 +187,8 @@ void accelerometer_json(const DiagnoseResult& r, const Shown& sh, json& j) {
   j["units"] = {{"level", u.deviation.ascii},
                 {"ramp", u[Term::R].ascii},
                 {"band", u.deviation.ascii},
-                {"models", "simulator keys in fit-scale units: m/s in place of deg (deg/h = m/s/h, arcsec = m/s/3600)"}};
+                {"models",
+                 "simulator keys in fit-scale units: m/s in place of deg (deg/h = m/s/h, arcsec = m/s/3600)"}};
   j["outliers"] = shown_params(j["outliers"], sh);
   for (auto& p : j["outliers"]["positions"]) p = shown_params(p, sh);
   j.erase("scale_arcsec_per_pulse");
@@ -263,11 +264,10 @@ json to_json(const DiagnoseResult& r) {
   j["findings"] = findings_json(r.findings);
   j["extended_model"] =
       model_json(r.extended, r.extended_band, r.band_level, r.gain.misfit_extended, r.gain.coverage_extended, sh);
-  j["bias_instability_named_terms"] = {
-      {"with_deg_per_h", r.base.bias_instability_deg_per_h},
-      {"without_deg_per_h", r.extended.bias_instability_deg_per_h},
-      {"with_over_without_percent", finite_or_null(b_excess_percent(r))},
-      {"named_terms", json::array()}};
+  j["bias_instability_named_terms"] = {{"with_deg_per_h", r.base.bias_instability_deg_per_h},
+                                       {"without_deg_per_h", r.extended.bias_instability_deg_per_h},
+                                       {"with_over_without_percent", finite_or_null(b_excess_percent(r))},
+                                       {"named_terms", json::array()}};
   for (const auto& f : r.findings)
     j["bias_instability_named_terms"]["named_terms"].push_back(std::string(finding_name(f.effect)));
   j["gain"] = {{"misfit_base", r.gain.misfit_base},
@@ -290,21 +290,21 @@ std::string record_and_base(const DiagnoseResult& r, const Shown& sh) {
   const auto& m = r.base;
   const std::string readout = m.readout == ReadoutMode::Counting ? tr("counting") : tr("white");
   if (!sh.accel) {
-    s += trf(
-        "  record: {:.0f} s at {:g} Hz, pulse weight {:g}″; band {:g} % per τ (the model's AV and the points' χ² "
-        "EDF)\n\n",
-        r.settings.duration_s, r.settings.rate_hz, r.settings.scale_arcsec, r.band_level * 100);
+    s +=
+        trf("  record: {:.0f} s at {:g} Hz, pulse weight {:g}″; band {:g} % per τ (the model's AV and the points' χ² "
+            "EDF)\n\n",
+            r.settings.duration_s, r.settings.rate_hz, r.settings.scale_arcsec, r.band_level * 100);
     s += format_outliers(r.analysis.outliers);
     return s + tr("Base model (five-term fit): ") + power_laws(m, sh) +
            trf(", white angle {:.4g}″, {} read-out, Earth rate {:.4g} °/h, bias {:.4g} °/h\n", m.white_angle_arcsec,
                readout, m.earth_rate_deg_per_h, m.bias_deg_per_h);
   }
   const std::string level = localized_label(sh.units.deviation);
-  s += trf(
-      "  record: {:.0f} s at {:g} Hz, column '{}' of an accelerometer read in {} (levels in {}, no Earth rate, no "
-      "class verdict); band {:g} % per τ (the model's AV and the points' χ² EDF)\n\n",
-      r.settings.duration_s, r.settings.rate_hz, as_typed(r.analysis.input.value("column", r.analysis.column)),
-      r.analysis.input.value("unit", ""), level, r.band_level * 100);
+  s +=
+      trf("  record: {:.0f} s at {:g} Hz, column '{}' of an accelerometer read in {} (levels in {}, no Earth rate, no "
+          "class verdict); band {:g} % per τ (the model's AV and the points' χ² EDF)\n\n",
+          r.settings.duration_s, r.settings.rate_hz, as_typed(r.analysis.input.value("column", r.analysis.column)),
+          r.analysis.input.value("unit", ""), level, r.band_level * 100);
   s += format_outliers(r.analysis.outliers, level, sh.units.deviation.factor);
   return s + tr("Base model (five-term fit): ") + power_laws(m, sh) +
          trf(", white velocity {:.4g} m/s, {} read-out, bias (with gravity's projection) {:.4g} {}\n",
@@ -317,8 +317,8 @@ std::string outside_row(const BandPoint& b, const Shown& sh) {
   const bool above = b.dev > b.high;
   const double share = 100 * (above ? b.dev / b.high - 1 : 1 - b.dev / b.low);
   const std::string u = localized_label(sh.units.deviation);
-  return trf("    τ = {:>9.4g} s: σ = {:.4g} {}, {:.1f} % {} the band's {} edge {:.4g} {}\n", b.tau_s, sh.level(b.dev), u,
-             share, above ? tr("above") : tr("below"), above ? tr("upper") : tr("lower"),
+  return trf("    τ = {:>9.4g} s: σ = {:.4g} {}, {:.1f} % {} the band's {} edge {:.4g} {}\n", b.tau_s, sh.level(b.dev),
+             u, share, above ? tr("above") : tr("below"), above ? tr("upper") : tr("lower"),
              sh.level(above ? b.high : b.low), u);
 }
 
@@ -342,12 +342,11 @@ std::string format_report(const DiagnoseResult& r) {
   s += tr("\nDetectors (likelihood ratio of the block means, noise levels profiled, against the threshold of ") +
        trf("its null law, false-alarm level {:g} % each):\n", r.alpha * 100);
   for (const auto& d : r.detectors)
-    s += d.test.empty()
-             ? trf("  {:<17} {}\n", detector_name(d.effect), d.note)
-             : trf("  {:<17} statistic {:>9.3f} (dimensionless), threshold {:>8.3f}, p ≤ {:.3g}: {}{}\n",
-                   detector_name(d.effect), d.statistic, d.threshold, d.p_value,
-                   d.named ? tr("FOUND") : (d.fired ? tr("fired, not named") : tr("not found")),
-                   d.note.empty() ? "" : " (" + d.note + ")");
+    s += d.test.empty() ? trf("  {:<17} {}\n", detector_name(d.effect), d.note)
+                        : trf("  {:<17} statistic {:>9.3f} (dimensionless), threshold {:>8.3f}, p ≤ {:.3g}: {}{}\n",
+                              detector_name(d.effect), d.statistic, d.threshold, d.p_value,
+                              d.named ? tr("FOUND") : (d.fired ? tr("fired, not named") : tr("not found")),
+                              d.note.empty() ? "" : " (" + d.note + ")");
   s += tr("\nFindings:\n");
   if (r.findings.empty()) s += tr("  none: the base model explains the measurement\n");
   s += format_findings(r.findings, sh);
@@ -372,7 +371,8 @@ std::string format_report(const DiagnoseResult& r) {
   s += fmt::format("  {:<44} {:>9.1f}% {:>9.1f}%\n", tr("measured τ inside the model's band"),
                    100 * r.gain.coverage_base, 100 * r.gain.coverage_extended);
   if (std::isnan(r.gain.holdout_misfit_base))
-    s += fmt::format("  {:<44} {:>21}\n", tr("out-of-sample −2 ln L per block (dimensionless)"), tr("not needed: none named"));
+    s += fmt::format("  {:<44} {:>21}\n", tr("out-of-sample −2 ln L per block (dimensionless)"),
+                     tr("not needed: none named"));
   else
     s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", tr("out-of-sample −2 ln L per block (dimensionless)"),
                      r.gain.holdout_misfit_base, r.gain.holdout_misfit_extended);

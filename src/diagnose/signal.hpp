@@ -44,7 +44,6 @@ inline double block_attenuation(double f, double tb) {
   return x > 1e-9 ? std::sin(x) / x : 1.0;
 }
 
-
 /// `iters` golden-section steps towards a minimum of f in [lo, hi] (one evaluation each); the
 /// better of the last two points.
 template <class F>
