@@ -168,6 +168,17 @@ double golden_max(const F& f, double lo, double hi, int iters) {
   return golden_min([&f](double x) { return -f(x); }, lo, hi, iters);
 }
 
+/// −2 ln L of the current model at its best: its own profile, or the profile restarted from the
+/// candidate's levels when that one is lower (the levels' likelihood can have more than one
+/// maximum, and a candidate must not win only because its fit found the better one).
+double best_null(const Blocks& b, const GlsModel& cur, const GlsModel& cand) {
+  GlsModel again;
+  again.det = cur.det;
+  again.cov = cur.cov;
+  refit(b, again, cand, 0);
+  return std::min(cur.fit.m2ll, again.fit.m2ll);
+}
+
 /// The candidate model: the current one with a deterministic term, profiled.
 Candidate with_det(const Blocks& b, const GlsModel& cur, const DetTerm& t) {
   Candidate c;
@@ -176,7 +187,7 @@ Candidate with_det(const Blocks& b, const GlsModel& cur, const DetTerm& t) {
   c.model.det.push_back(t);
   c.model.cov = cur.cov;
   refit(b, c.model, cur, 0);
-  c.lr = std::max(0.0, cur.fit.m2ll - c.model.fit.m2ll);
+  c.lr = std::max(0.0, best_null(b, cur, c.model) - c.model.fit.m2ll);
   return c;
 }
 
@@ -294,7 +305,7 @@ Candidate search_gauss_markov(const Blocks& b, const GlsModel& cur, double alpha
   c.model.cov = cur.cov;
   c.model.cov.push_back({CovKind::GM, best_tc});
   refit(b, c.model, cur, best_level);
-  c.lr = std::max(0.0, cur.fit.m2ll - c.model.fit.m2ll);
+  c.lr = std::max(0.0, best_null(b, cur, c.model) - c.model.fit.m2ll);
   const double m = static_cast<double>(grid.size());
   c.p = std::min(1.0, m * 0.5 * chi2_sf(c.lr, 1));
   double lo = 0, hi = 400;
