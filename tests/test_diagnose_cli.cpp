@@ -106,7 +106,7 @@ TEST_F(DiagnoseCli, ReportCarriesUnitsAndTheFinding) {
   EXPECT_NE(r.out.find("frequency_hz = 0.05"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find(" Hz"), std::string::npos);
   EXPECT_NE(r.out.find("°/h"), std::string::npos);
-  EXPECT_NE(r.out.find("out-of-sample misfit"), std::string::npos);
+  EXPECT_NE(r.out.find("out-of-sample −2 ln L per block"), std::string::npos);
   EXPECT_EQ(r.out.find("nan"), std::string::npos);
 }
 

@@ -115,7 +115,7 @@ TEST_F(ProgressOnTerminal, Report) {
 }
 
 TEST_F(ProgressOnTerminal, DiagnoseCountsSimulatedRecords) {
-  expect_progress({"diagnose", record(), "--runs", "10"}, {"diagnosing " + record() + " (simulated records): 0/"});
+  expect_progress({"diagnose", record(), "--runs", "10"}, {"diagnosing " + record() + " (likelihood tests): 0/"});
 }
 
 TEST_F(ProgressOnTerminal, InTheOutputLanguage) {

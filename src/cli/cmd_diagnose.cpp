@@ -36,7 +36,7 @@ struct DiagnoseCmd {
 }  // namespace
 
 DiagnoseResult diagnose_showing_progress(const Recording& rec, DiagnoseOptions opt, std::FILE* sink) {
-  Progress progress(trf("diagnosing {} (simulated records)", printable(rec.source)), simulated_records(opt), sink);
+  Progress progress(trf("diagnosing {} (likelihood tests)", printable(rec.source)), 5, sink);
   opt.progress = &progress;
   return diagnose(rec, opt);
 }

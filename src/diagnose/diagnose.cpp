@@ -1,5 +1,6 @@
-// The diagnosis pipeline: base fit → ensemble band and detector calibration → findings →
-// extended model → its band and the gain in and out of sample (render.cpp writes the results).
+// The diagnosis pipeline: base fit → block means → forward selection of effects by likelihood
+// ratios (effects.cpp) → estimates with profile intervals → extended model, its band and gain
+// (band.cpp); render.cpp writes the results. No decision reads a random number.
 #include "rwcalc/diagnose.hpp"
 #include "rwcalc/i18n.hpp"
 
@@ -7,11 +8,21 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <limits>
 #include <optional>
+#include <string>
 
+#include "diagnose/band.hpp"
+#include "diagnose/effects.hpp"
+#include "diagnose/fast_line.hpp"
+#include "diagnose/lowpass.hpp"
 #include "diagnose/models.hpp"
+#include "diagnose/signal.hpp"
+#include "rwcalc/allan.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/progress.hpp"
+#include "rwcalc/units.hpp"
 
 namespace rwcalc {
 
@@ -19,35 +30,17 @@ using namespace diag;
 
 namespace {
 
-constexpr double kPulseFitTauMin = 20.0;       ///< s, start of the base fit for pulse data
-constexpr std::size_t kCalibrationFactor = 4;  ///< default calibration ensemble: 4K records
-
-/// Records of the pilot ensemble the base model is calibrated with: K/2, at least 10.
-std::size_t pilot_records(const DiagnoseOptions& opt) { return std::max<std::size_t>(10, opt.runs / 2); }
-/// Records of the base model's calibration ensemble (DiagnoseOptions::calibration_runs).
-std::size_t calibration_records(const DiagnoseOptions& opt) {
-  return std::max(opt.runs, opt.calibration_runs ? opt.calibration_runs : kCalibrationFactor * opt.runs);
-}
-
-/// The measurement and what every stage reads of it.
-struct Context {
-  const Recording& rec;
-  const DiagnoseOptions& opt;
-  AnalysisOptions aopt;            ///< the five-term fit's
-  EnsemblePlan plan;               ///< octave sizes and mid-τ grid of the record
-  Stretch full;                    ///< the whole record as a stretch
-  std::vector<double> octave_var;  ///< measured octave AV
-  RobustBase rb;                   ///< base model, own candidate, B of the fit without it
-  std::vector<std::unique_ptr<Detector>> detectors;
-  [[nodiscard]] RecordView view() const { return {rec.phase, full.dec, full.clean, octave_var}; }
-};
+constexpr double kPulseFitTauMin = 20.0;  ///< s, start of the base fit for pulse data
+constexpr double kBlockSeconds = 10.0;    ///< block length of the likelihood, s (longer for long records)
+constexpr std::size_t kMaxBlocks = 1000;  ///< the likelihood's cost grows as blocks²
+constexpr double kSlowCycles = 12.0;      ///< the slow-line band ends at 12 cycles per record
 
 /// Outliers are screened once, first: every stage sees the same data, and a spike cannot pass for
 /// a bias step or inflate N.
 const Recording& screened(const Recording& read, const DiagnoseOptions& opt, OutlierReport& outliers,
                           Recording& edited) {
-  // An accelerometer's velocity (1/3600 m/s, units.hpp) takes the angle's place: the fit, the
-  // simulator and the detectors read it as they read a gyro's angle; only the output's units differ.
+  // An accelerometer's velocity (1/3600 m/s, units.hpp) takes the angle's place: the fit and the
+  // likelihood read it as they read a gyro's angle; only the output's units differ.
   if (!sensor_kind(read.phase.kind))
     throw UsageError(
         tr("diagnose needs gyro or accelerometer data (clock phase/frequency cannot be simulated as a sensor)"));
@@ -64,271 +57,292 @@ const Recording& screened(const Recording& read, const DiagnoseOptions& opt, Out
 }
 
 /// The five-term fit of the record and its base model. Pulse data: the counting read-out's
-/// structured short-τ AV (simulated exactly) would distort the fit, which starts at 20 s.
-void fit_base(Context& c, DiagnoseResult& r, OutlierReport outliers) {
-  c.aopt = c.opt.analysis;
-  c.aopt.outlier_action = OutlierAction::Keep;
-  // The Earth-rate choice is the recording's (pulse input: on), kept for the cleaned and sliced
-  // floating series the stages analyse.
-  if (!c.aopt.earth_rate) c.aopt.earth_rate = c.rec.mode == InputMode::Pulses || c.rec.mode == InputMode::Counter;
-  const PhaseSeries& x = c.rec.phase;
-  if (x.exact() && c.aopt.fit.tau_min_s <= 0) c.aopt.fit.tau_min_s = kPulseFitTauMin;
-  r.analysis = analyze_for_base(c.rec, c.aopt);
+/// structured short-τ AV would distort the fit, which starts at 20 s.
+void fit_base(const Recording& rec, const DiagnoseOptions& opt, DiagnoseResult& r, OutlierReport outliers) {
+  AnalysisOptions aopt = opt.analysis;
+  aopt.outlier_action = OutlierAction::Keep;
+  if (!aopt.earth_rate) aopt.earth_rate = rec.mode == InputMode::Pulses || rec.mode == InputMode::Counter;
+  const PhaseSeries& x = rec.phase;
+  if (x.exact() && aopt.fit.tau_min_s <= 0) aopt.fit.tau_min_s = kPulseFitTauMin;
+  r.analysis = analyze_for_base(rec, aopt);
   r.analysis.outliers = std::move(outliers);
   r.settings.rate_hz = 1.0 / x.tau0_s;
   r.settings.duration_s = static_cast<double>(x.points() - 1) * x.tau0_s;
   r.settings.scale_arcsec = sim_scale(x, r.analysis);
-  r.settings.seed = c.opt.seed;
+  r.settings.seed = opt.seed;
   r.settings.temperature_c = r.analysis.temperature_c;
-  for (const auto& p : r.analysis.allan.points) c.octave_var.push_back(p.var);
-  Stretch& s = c.full;
-  s.rec = &c.rec;
-  s.analysis = &r.analysis;
-  s.aopt = &c.aopt;
-  s.opt = &c.opt;
-  s.dec = decimate(x);
-  s.octave_m = octave_of(r.analysis.allan);
-  s.pilot = r.settings;
-  s.pilot.seed = c.opt.seed + 1000;
-  s.pilot_runs = pilot_records(c.opt);
-  c.plan = {s.octave_m, mid_tau_grid(s.dec), true, {}};
-  c.rb = robust_base(c.rec, r.analysis, c.aopt, s.dec, s.pilot, s.pilot_runs, c.plan, c.opt.progress);
-  r.base = s.base = c.rb.model;
-  s.clean = s.dec;
-  subtract_deterministic(s.clean, c.rb.candidate);
-  c.detectors = make_detectors(r.analysis, x, !x.exact() && on_lattice(x));
+  r.base = base_model(r.analysis, x);
 }
 
-/// The record detectors, or those of them that change the mean.
-std::vector<const RecordDetector*> record_detectors(const Context& c, bool mean_shape_only) {
-  std::vector<const RecordDetector*> out;
-  for (const auto& d : c.detectors)
-    if (const auto* rd = dynamic_cast<const RecordDetector*>(d.get()); rd && (!mean_shape_only || rd->mean_shape()))
-      out.push_back(rd);
-  return out;
+/// The block means the likelihood reads: 10-s blocks, longer when the record has more than 1000.
+Blocks make_blocks(const PhaseSeries& x) {
+  const Decimated d = decimate(x);
+  const double seconds = std::max(kBlockSeconds, d.duration() / static_cast<double>(kMaxBlocks));
+  const std::size_t per = per_block_for(d, seconds);
+  Blocks b;
+  b.tb = static_cast<double>(per) * d.tau_d;
+  b.y = block_rates(d, per);
+  b.z = second_differences(b.y);
+  return b;
 }
 
-/// The base model's ensemble: every record's detector statistics (calibration_runs records, the
-/// nulls being cheap: a threshold from a larger ensemble scatters less from seed to seed); its
-/// first K records give the band and the mid-τ references.
-std::vector<RunStats> base_ensemble(Context& c, DiagnoseResult& r) {
-  EnsemblePlan plan = c.plan;
-  plan.scored = record_detectors(c, false);
-  plan.stats_from = c.opt.runs;
-  auto runs = run_ensemble(r.base, r.settings, r.calibration_runs, plan, c.opt.progress);
-  const std::vector<RunStats> band_runs(runs.begin(), runs.begin() + static_cast<std::ptrdiff_t>(c.opt.runs));
-  r.base_band = make_band(r.analysis.allan.points, band_runs, c.opt.band_level);
-  c.full.ref = make_reference(c.plan.grid, c.full.dec.tau_d, band_runs);
-  c.full.clean_ref = make_reference(c.plan.grid, c.full.dec.tau_d, band_runs, true);
-  return runs;
-}
-
-/// When the fit does not resolve B, the calibrated B may be far below the record's, and beside
-/// such a quiet model the record's flicker wander looks like a step or a transient: the
-/// mean-shape thresholds are also taken under B at its upper bound (same seeds), the larger kept.
-void recalibrate_under_high_b(const Context& c, const DiagnoseResult& r, std::vector<DetectorResult>& results) {
-  const Coefficient& b = c.rb.b_fit;
-  if (!(b.enabled && !b.resolved && b.high > r.base.bias_instability_deg_per_h)) return;
-  NoiseModel hi = r.base;
-  hi.bias_instability_deg_per_h = b.high;
-  EnsemblePlan plan{c.plan.octave_m, {}, false, record_detectors(c, true), false};
-  const auto hi_runs = run_ensemble(hi, r.settings, r.calibration_runs, plan, c.opt.progress);
-  for (const RecordDetector* d : plan.scored)
-    for (auto& res : results)
-      if (res.effect == d->effect()) {
-        const DetectorResult h = d->calibrate(res.statistic, hi_runs, c.opt.alpha);
-        if (h.threshold > res.threshold) res = h;
-      }
-}
-
-/// A step and a transient are two forms of one change of the mean: the detectors decide that
-/// there is one (either is named), the residual sum of squares of the block means decides its
-/// form (the record's own candidate). Left to the two thresholds, whose scatter from seed to seed
-/// is large when the base has rate random walk, the form changed with the seed.
-void one_mean_shape(const NoiseModel& candidate, std::vector<DetectorResult>& results) {
-  auto of = [&](Effect e) {
-    return std::find_if(results.begin(), results.end(), [e](auto& d) { return d.effect == e; });
-  };
-  const auto step = of(Effect::BiasStep), warm = of(Effect::Warmup);
-  if (step == results.end() || warm == results.end() || !(step->named || warm->named)) return;
-  const bool warmup_form = !candidate.warmups.empty();
-  auto& keep = warmup_form ? *warm : *step;
-  auto& drop = warmup_form ? *step : *warm;
-  if (!keep.named) {
-    keep.named = true;
-    keep.note =
-        trf("named as the form of the change of the mean the {} detector found: it explains the "
-            "block means better",
-            detector_name(drop.effect));
+/// The base model's levels in the likelihood's units (gls.hpp), each at least a small share of the
+/// largest so that its logarithm can start.
+std::vector<double> start_levels(const NoiseModel& m, double q_arcsec, const Blocks& b,
+                                 const std::vector<CovTerm>& terms) {
+  const double n = m.arw_deg_per_sqrt_h * units::sqrt_s_per_sqrt_h;
+  const double k = m.rrw_deg_per_h_per_sqrt_h / units::sqrt_s_per_sqrt_h;
+  std::vector<double> lv = {m.white_angle_arcsec * m.white_angle_arcsec + q_arcsec * q_arcsec / 12.0, n * n,
+                            kFlickerFloorPerB2 * m.bias_instability_deg_per_h * m.bias_instability_deg_per_h,
+                            k * k / 3.0};
+  double top = 0;
+  std::vector<double> share(lv.size());
+  for (std::size_t t = 0; t < lv.size(); ++t) {
+    share[t] = term_autocov(terms[t], 1, b.tb)[0];
+    top = std::max(top, lv[t] * share[t]);
   }
-  if (drop.named) {
-    drop.named = false;
-    drop.note = trf("the {} explains the block means better", warmup_form ? tr("warm-up transient") : tr("bias step"));
-  }
+  for (std::size_t t = 0; t < lv.size(); ++t) lv[t] = std::max(lv[t], 1e-3 * top / share[t]);
+  return lv;
 }
 
-bool is_named(const std::vector<DetectorResult>& results, Effect e) {
-  return std::any_of(results.begin(), results.end(), [e](const auto& d) { return d.effect == e && d.named; });
-}
-
-/// The base the mid-τ detectors test against. A base calibrated with a named line in the data
-/// takes the line's Allan variance into N or B, and beside it the data without the line shows a
-/// deficit that a bump fit mistakes for a Gauss–Markov term: with a named line, the base is
-/// re-calibrated (pilot seeds as before) on the data without it, and its ensemble taken.
-struct MidTauBase {
-  Stretch stretch;
-  std::optional<std::vector<RunStats>> runs;  ///< empty: the base ensemble's
+/// The tests outside the block means: lines above their band on the periodogram, the output
+/// low-pass on the short-τ AV. Pulse counts (whole, or as numbers on a lattice) get the periodogram
+/// of the decimated angle up to 0.25 Hz only (the counting read-out's beat of the pulse rate against
+/// the sampling makes lines above) and no low-pass test.
+struct Outside {
+  std::optional<FastLine> fast;
+  std::string lowpass_skip;  ///< why the low-pass is not tested (empty: it is)
 };
-MidTauBase mid_tau_base(const Context& c, const DiagnoseResult& r, const NoiseModel& det, const Decimated& dclean,
-                        const std::vector<RunStats>& runs) {
-  MidTauBase m{c.full, std::nullopt};
-  if (det.sinusoids.empty()) return m;
-  m.stretch.base = calibrated(c.rb.model, c.full.pilot, c.full.pilot_runs, c.plan, dclean, c.opt.progress);
-  EnsemblePlan plan = c.plan;
-  plan.scored.clear();
-  m.runs = run_ensemble(m.stretch.base, r.settings, runs.size(), plan, c.opt.progress);
-  m.stretch.ref = make_reference(c.plan.grid, c.full.dec.tau_d, *m.runs);
-  m.stretch.clean_ref = make_reference(c.plan.grid, c.full.dec.tau_d, *m.runs, true);
-  return m;
+
+Outside outside_tests(const PhaseSeries& x, const Blocks& b, double alpha) {
+  Outside o;
+  const bool pulses = x.exact() || on_lattice(x);
+  const double f_min = 0.4 / b.tb;
+  std::vector<double> y;
+  double dt = x.tau0_s, f_max = 0.49 / x.tau0_s;
+  if (pulses) {
+    const Decimated d = decimate(x);
+    dt = d.tau_d;
+    f_max = std::min(0.25, 0.49 / dt);
+    for (std::size_t j = 0; j + 1 < d.theta.size(); ++j) y.push_back((d.theta[j + 1] - d.theta[j]) / dt);
+  } else {
+    y.resize(x.points() - 1);
+    for (std::size_t k = 0; k + 1 < x.points(); ++k) y[k] = x.rate(k);
+  }
+  if (f_max > 2 * f_min) o.fast = fast_line_search(std::move(y), dt, f_min, f_max, 0.5 * alpha);
+  if (pulses) o.lowpass_skip = tr("not tested: pulse counts cannot have passed through an output-chain filter");
+  return o;
 }
 
-/// Every detector's verdict (r.detectors) and the named effects. The mid-τ detectors read the
-/// measurement without its candidate and without the named lines, so they run last.
-Named test_detectors(Context& c, const std::vector<RunStats>& cal_runs, DiagnoseResult& r) {
-  std::vector<DetectorResult> res(c.detectors.size());
-  const Trial trial{c.view(), cal_runs, c.full, r.settings, nullptr};
-  // The mid-τ detectors compare with the band's records (their references' own).
-  const std::vector<RunStats> runs(cal_runs.begin(), cal_runs.begin() + static_cast<std::ptrdiff_t>(c.opt.runs));
-  for (std::size_t i = 0; i < c.detectors.size(); ++i) {
-    res[i].effect = c.detectors[i]->effect();
-    if (!c.detectors[i]->mid_tau()) res[i] = c.detectors[i]->test(trial);
-  }
-  recalibrate_under_high_b(c, r, res);
-  one_mean_shape(c.rb.candidate, res);
-  Named named;
-  NoiseModel det = c.rb.candidate;
-  if (is_named(res, Effect::Sinusoid)) {
-    const auto sin = sinusoid_detect(c.full.clean, 0, true, &c.full.dec, &c.rb.candidate);
-    det.sinusoids.push_back({sin.f_hz, sin.amp, sin.phase});
-    named.sin_hint_hz = sin.f_hz;
-  }
-  if (is_named(res, Effect::Line)) {
-    const auto line = line_detect(c.rec.phase);
-    if (line.coherent) {
-      named.line_hint_hz = line.f_hz;
-      det.sinusoids.push_back({line.f_hz, line.amp, line.phase});
-    }
-  }
-  Decimated dclean = c.full.dec;
-  subtract_deterministic(dclean, det);
-  const auto mid_var = decimated_avar(dclean, c.plan.grid);
-  const MidTauBase mid = mid_tau_base(c, r, det, dclean, runs);
-  const Trial mid_trial{c.view(), mid.runs ? *mid.runs : runs, mid.stretch, r.settings, &mid_var};
-  for (std::size_t i = 0; i < c.detectors.size(); ++i)
-    if (c.detectors[i]->mid_tau()) res[i] = c.detectors[i]->test(mid_trial);
-  for (std::size_t e = 0; e < kEffectCount; ++e)
-    for (std::size_t i = 0; i < c.detectors.size(); ++i)
-      if (static_cast<std::size_t>(res[i].effect) == e && res[i].named) named.detectors.push_back(c.detectors[i].get());
-  r.detectors = std::move(res);
-  return named;
-}
-
-/// A finding's evidence: its detector's verdict, and what the estimate added.
-void add_evidence(Finding& f, const DiagnoseResult& r) {
-  const auto& d = *std::find_if(r.detectors.begin(), r.detectors.end(),
-                                [&](const DetectorResult& dd) { return dd.effect == f.effect; });
-  const nlohmann::json extra = f.evidence;
-  f.evidence = {{"statistic", d.statistic},
-                {"threshold", d.threshold},
-                {"ensemble_max", d.ensemble_max},
-                {"ensemble_median", d.ensemble_median},
-                {"false_alarm_level", r.alpha}};
-  f.evidence["detector"] = std::string(detector_description(f.effect));
-  if (f.effect == Effect::Line) {
-    f.evidence["search_band_hz"] = {kHighLineMinHz, 0.5 * r.settings.rate_hz};
-    for (const auto& [k, v] : extra.items()) f.evidence[k] = v;
+/// The families and their searches against the current model.
+Candidate search(Effect e, const Blocks& b, const GlsModel& cur, double alpha) {
+  const double T = b.duration();
+  switch (e) {
+    case Effect::Sinusoid: return search_slow_line(b, cur, alpha, 2.5 / T, kSlowCycles / T, e);
+    case Effect::Line: return search_slow_line(b, cur, 0.5 * alpha, kSlowCycles / T, 0.4 / b.tb, e);
+    case Effect::BiasStep: return search_step(b, cur, alpha);
+    case Effect::Warmup: return search_transient(b, cur, alpha);
+    default: return search_gauss_markov(b, cur, alpha);
   }
 }
 
-/// The extended model of the whole record, its findings and its band. Its ensemble reuses the
-/// base's seeds, so the bands differ by the model, not by sampling noise; N and B are then
-/// re-fitted to the whole band (the extension was calibrated at mid τ only).
-void extended_model(Context& c, const Named& named, DiagnoseResult& r) {
-  c.full.sin_hint_hz = named.sin_hint_hz;
-  Extension ext = extend(c.full, named.detectors);
-  r.extended = ext.model;
-  for (auto& f : ext.findings) {
-    add_evidence(f, r);
-    r.findings.push_back(std::move(f));
-  }
-  if (r.findings.empty()) {
-    r.extended_band = r.base_band;
+DetectorResult verdict(const Candidate& c, bool named, double alpha) {
+  DetectorResult d;
+  d.effect = c.effect;
+  d.statistic = c.lr;
+  d.threshold = d.threshold_upper = c.threshold;
+  d.p_value = c.p;
+  d.test = c.test;
+  d.fired = c.p <= alpha;
+  d.named = named;
+  return d;
+}
+
+/// The output low-pass, tested on the short-τ AV of the record less the named lines (a line's AV
+/// bump would otherwise pass for a filter); named, its white noises before the filter replace the
+/// extended model's N and white angle noise.
+void test_lowpass(const PhaseSeries& x, const Outside& out, DiagnoseResult& r) {
+  DetectorResult d;
+  d.effect = Effect::Lowpass;
+  if (!out.lowpass_skip.empty()) {
+    d.note = out.lowpass_skip;
+    r.detectors.push_back(d);
     return;
   }
-  const auto ext_runs =
-      run_ensemble(r.extended, r.settings, c.opt.runs, {c.plan.octave_m, {}, false, {}, false}, c.opt.progress);
-  r.extended_band = make_band(r.analysis.allan.points, ext_runs, c.opt.band_level);
-  refit_whole_band(r.extended, r.extended_band, r.analysis.allan.points, r.settings, c.opt.runs, c.plan, c.opt);
+  const PhaseSeries c = cleaned(x, r.extended);
+  const bool clean = r.extended.sinusoids.empty() && r.extended.bias_steps.empty() && r.extended.warmups.empty();
+  std::vector<std::int64_t> m;
+  std::vector<double> v, edf;
+  for (const auto& p : r.analysis.allan.points) {
+    m.push_back(p.m);
+    v.push_back(clean ? p.var : allan_variance(c, p.m, Estimator::Overlapping));
+    edf.push_back(p.edf);
+  }
+  const OutputLowpassEstimate lp = output_lowpass_detect(m, v, edf, x.tau0_s, x.duration_s(), r.alpha);
+  if (lp.points < 5) {
+    d.note = tr("not tested: fewer than 5 Allan points below 20 s");
+    r.detectors.push_back(d);
+    return;
+  }
+  d.statistic = lp.statistic;
+  d.threshold = d.threshold_upper = lp.threshold;
+  d.p_value = lp.p;
+  d.test =
+      "χ² drop of the short-τ Allan variance (τ ≤ min(20 s, T/100)) of the record less its named lines when white "
+      "angle and rate noise pass through a first-order low-pass, scaled by the fit's χ²/dof; null law: χ²₁, "
+      "Bonferroni over the octave points";
+  d.fired = d.named = lp.p <= r.alpha;
+  r.detectors.push_back(d);
+  if (!d.named) return;
+  Finding f{Effect::Lowpass, {{"time_constant_s", lp.tf}}, {{"time_constant_s", (lp.tf_high - lp.tf_low) / 3.92}}, {}};
+  f.evidence = {{"statistic", d.statistic}, {"threshold", d.threshold},
+                {"p_value", d.p_value},     {"false_alarm_level", r.alpha},
+                {"detector", d.test},       {"interval95", {{"time_constant_s", {lp.tf_low, lp.tf_high}}}}};
+  if (r.findings.empty()) r.extended = r.base;
+  r.extended.output_lowpass_tc_s = lp.tf;
+  r.extended.arw_deg_per_sqrt_h = std::sqrt(lp.white_rate) / units::sqrt_s_per_sqrt_h;
+  r.extended.white_angle_arcsec = std::sqrt(lp.white_angle2);
+  r.findings.push_back(std::move(f));
 }
 
-/// A finding must predict: when the extended model does not predict the held-out blocks better
-/// than the base, its terms are reported as failed candidates with their figures, the detectors'
-/// statistics as an excess, and the base stays the model.
-void reject_findings(DiagnoseResult& r) {
-  const std::string why = fmt::format(
-      "excess, not named: the model with it predicts the held-out blocks no better than the base (out-of-sample "
-      "misfit {:.4g} against {:.4g})",
-      r.gain.holdout_misfit_extended, r.gain.holdout_misfit_base);
-  for (auto& f : r.findings) {
-    f.evidence["holdout_misfit_base"] = r.gain.holdout_misfit_base;
-    f.evidence["holdout_misfit_extended"] = r.gain.holdout_misfit_extended;
-    for (auto& d : r.detectors)
-      if (d.effect == f.effect && d.named) {
-        d.named = false;
-        d.excess = true;
-        d.note = why;
-      }
+/// The line family above the slow band has two parts (block means, periodogram), each at α/2:
+/// its p-value is twice the smaller one's.
+void merge_fast(DetectorResult& d, const Candidate& c, const std::optional<FastLine>& fast, bool& fast_wins) {
+  fast_wins = fast && fast->p < c.p;
+  d.p_value = std::min(1.0, 2.0 * (fast_wins ? fast->p : c.p));
+  if (fast_wins) {
+    d.statistic = fast->statistic;
+    d.threshold = d.threshold_upper = fast->threshold;
+    d.test = fast->test;
   }
-  r.rejected = std::move(r.findings);
-  r.findings.clear();
+}
+
+/// Forward selection: every family searched against the current model, the one with the smallest
+/// p-value bound named when that bound is within its false-alarm level, and the search repeated
+/// against the model that includes it; the families' verdicts are their last ones. Returns the
+/// final model; `fast_named` tells whether the line family was named from the periodogram.
+GlsModel select_effects(const Blocks& b, GlsModel cur, const Outside& out, double alpha, DiagnoseResult& r,
+                        bool& fast_named, Progress* progress) {
+  const std::vector<Effect> families = {Effect::Sinusoid, Effect::Line, Effect::BiasStep, Effect::Warmup,
+                                        Effect::GaussMarkov};
+  std::vector<DetectorResult> verdicts(families.size());
+  std::vector<bool> named(families.size(), false), fast(families.size(), false);
+  std::vector<Candidate> cands(families.size());
+  for (;;) {
+    std::size_t best = families.size();
+    for (std::size_t i = 0; i < families.size(); ++i) {
+      if (named[i]) continue;
+      cands[i] = search(families[i], b, cur, alpha);
+      verdicts[i] = verdict(cands[i], false, alpha);
+      if (families[i] == Effect::Line) {
+        bool wins = false;
+        merge_fast(verdicts[i], cands[i], out.fast, wins);
+        fast[i] = wins;
+      }
+      verdicts[i].fired = verdicts[i].p_value <= alpha;
+      if (verdicts[i].fired && (best == families.size() || verdicts[i].p_value < verdicts[best].p_value)) best = i;
+    }
+    if (progress) progress->advance();
+    if (best == families.size()) break;
+    named[best] = true;
+    verdicts[best].named = true;
+    if (fast[best])
+      fast_named = true;
+    else
+      cur = cands[best].model;
+    for (std::size_t i = 0; i < families.size(); ++i)
+      if (!named[i] && verdicts[i].fired)
+        verdicts[i].note = trf("explained by the {} named before it", detector_name(families[best]));
+  }
+  r.detectors = verdicts;
+  return cur;
+}
+
+/// The named terms as findings and as the extended model (N, B and K of the final profile).
+void extend(const Blocks& b, const GlsModel& m, const Outside& out, bool fast_named, DiagnoseResult& r) {
   r.extended = r.base;
-  r.extended_band = r.base_band;
-  r.gain.misfit_extended = r.gain.misfit_base;
-  r.gain.coverage_extended = r.gain.coverage_base;
+  if (fast_named) {
+    const FastLine& l = *out.fast;
+    Finding f{Effect::Line,
+              {{"frequency_hz", l.f_hz}, {"amplitude_deg_per_h", l.amp}, {"phase_rad", l.phase}},
+              {{"frequency_hz", l.f_sigma}, {"amplitude_deg_per_h", l.amp_sigma}},
+              {}};
+    f.evidence["interval95"] = {{"frequency_hz", {l.f_hz - 1.96 * l.f_sigma, l.f_hz + 1.96 * l.f_sigma}},
+                                {"amplitude_deg_per_h", {l.amp - 1.96 * l.amp_sigma, l.amp + 1.96 * l.amp_sigma}}};
+    r.extended.sinusoids.push_back({l.f_hz, l.amp, l.phase});
+    r.findings.push_back(std::move(f));
+  }
+  for (std::size_t j = 0; j < m.det.size(); ++j) {
+    const TermEstimate e = estimate_det(b, m, j);
+    Finding f{m.det[j].effect, e.params, e.uncertainty, {}};
+    f.evidence["interval95"] = e.interval95;
+    const auto& p = e.params;
+    if (f.effect == Effect::BiasStep)
+      r.extended.bias_steps.push_back({p["time_s"].get<double>(), p["size_deg_per_h"].get<double>()});
+    else if (f.effect == Effect::Warmup)
+      r.extended.warmups.push_back({p["amplitude_deg_per_h"].get<double>(), p["time_constant_s"].get<double>()});
+    else
+      r.extended.sinusoids.push_back(
+          {p["frequency_hz"].get<double>(), p["amplitude_deg_per_h"].get<double>(), p["phase_rad"].get<double>()});
+    r.findings.push_back(std::move(f));
+  }
+  for (std::size_t c = 0; c < m.cov.size(); ++c) {
+    const double lv = m.fit.level[c];
+    switch (m.cov[c].kind) {
+      case CovKind::B: r.extended.bias_instability_deg_per_h = std::sqrt(lv / kFlickerFloorPerB2); break;
+      case CovKind::K: r.extended.rrw_deg_per_h_per_sqrt_h = std::sqrt(3.0 * lv) * units::sqrt_s_per_sqrt_h; break;
+      case CovKind::GM: {
+        const TermEstimate e = estimate_gm(b, m, c);
+        Finding f{Effect::GaussMarkov, e.params, e.uncertainty, {}};
+        f.evidence["interval95"] = e.interval95;
+        r.extended.gauss_markov.push_back({e.params["sigma_deg_per_h"].get<double>(), m.cov[c].tc_s});
+        r.findings.push_back(std::move(f));
+        break;
+      }
+      default: break;
+    }
+  }
+  if (r.findings.empty()) {  // nothing named: the base is the extended model
+    r.extended = r.base;
+    return;
+  }
+  std::stable_sort(r.findings.begin(), r.findings.end(),
+                   [](const Finding& a, const Finding& c) { return a.effect < c.effect; });
+  for (auto& f : r.findings)
+    for (const auto& d : r.detectors)
+      if (d.effect == f.effect) {
+        f.evidence["statistic"] = d.statistic;
+        f.evidence["threshold"] = d.threshold;
+        f.evidence["p_value"] = d.p_value;
+        f.evidence["false_alarm_level"] = r.alpha;
+        f.evidence["detector"] = d.test;
+      }
 }
 
 }  // namespace
-
-std::uint64_t simulated_records(const DiagnoseOptions& opt) { return pilot_records(opt) + calibration_records(opt); }
 
 DiagnoseResult diagnose(const Recording& read, const DiagnoseOptions& opt) {
   const auto t_start = std::chrono::steady_clock::now();
   OutlierReport outliers;
   Recording edited;
-  Context c{screened(read, opt, outliers, edited), opt, {}, {}, {}, {}, {}, {}};
+  const Recording& rec = screened(read, opt, outliers, edited);
   DiagnoseResult r;
   r.runs = opt.runs;
-  r.holdout_runs = opt.holdout_runs ? opt.holdout_runs : 2 * opt.runs;
-  r.calibration_runs = calibration_records(opt);
   r.seed = opt.seed;
   r.band_level = opt.band_level;
   r.alpha = opt.alpha;
-  fit_base(c, r, std::move(outliers));
-  const auto base_runs = base_ensemble(c, r);
-  const Named named = test_detectors(c, base_runs, r);
-  extended_model(c, named, r);
-  r.gain.misfit_base = band_misfit(r.base_band, opt.runs);
-  r.gain.misfit_extended = band_misfit(r.extended_band, opt.runs);
-  r.gain.coverage_base = band_coverage(r.base_band);
-  r.gain.coverage_extended = band_coverage(r.extended_band);
-  if (r.findings.empty()) {  // nothing to predict: the base is the extended model
-    r.gain.holdout_misfit_base = r.gain.holdout_misfit_extended = std::numeric_limits<double>::quiet_NaN();
-  } else {
-    const HoldoutScores h = out_of_sample(c.full, r, named);
-    r.gain.holdout_misfit_base = h.base;
-    r.gain.holdout_misfit_extended = h.extended;
-    if (!(h.extended < h.base)) reject_findings(r);
-  }
+  fit_base(rec, opt, r, std::move(outliers));
+  const Blocks b = make_blocks(rec.phase);
+  GlsModel h0;
+  h0.cov = {{CovKind::Q}, {CovKind::N}, {CovKind::B}, {CovKind::K}};
+  const double q = rec.phase.exact() ? rec.phase.arcsec_per_count : 0.0;
+  h0.fit = profile(b, hypothesis_of(b, {}, h0.cov), start_levels(r.base, q, b, h0.cov));
+  const Outside out = outside_tests(rec.phase, b, opt.alpha);
+  bool fast_named = false;
+  const GlsModel final_model = select_effects(b, h0, out, opt.alpha, r, fast_named, opt.progress);
+  extend(b, final_model, out, fast_named, r);
+  test_lowpass(rec.phase, out, r);
+  bands_and_gain(rec.phase, b, h0, final_model, r);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return r;
 }

@@ -56,7 +56,7 @@ json shown_params(const json& p, const Shown& sh) {
       out[k.substr(0, k.rfind("_deg_per_h3")) + "_m_per_s_per_h3"] = v.get<double>() * sh.units[Term::R].factor;
       continue;
     }
-    const ShownUnit* u = k.ends_with("_deg_per_h2") ? &sh.units[Term::R]
+    const ShownUnit* u = k.ends_with("_deg_per_h2")  ? &sh.units[Term::R]
                          : k.ends_with("_deg_per_h") ? &sh.units.deviation
                                                      : nullptr;
     if (!u || !v.is_number()) {
@@ -187,7 +187,8 @@ void accelerometer_json(const DiagnoseResult& r, const Shown& sh, json& j) {
   j["units"] = {{"level", u.deviation.ascii},
                 {"ramp", u[Term::R].ascii},
                 {"band", u.deviation.ascii},
-                {"models", "simulator keys in fit-scale units: m/s in place of deg (deg/h = m/s/h, arcsec = m/s/3600)"}};
+                {"models",
+                 "simulator keys in fit-scale units: m/s in place of deg (deg/h = m/s/h, arcsec = m/s/3600)"}};
   j["outliers"] = shown_params(j["outliers"], sh);
   for (auto& p : j["outliers"]["positions"]) p = shown_params(p, sh);
   j.erase("scale_arcsec_per_pulse");
@@ -220,11 +221,9 @@ json to_json(const DiagnoseResult& r) {
   j["scale_arcsec_per_pulse"] = r.settings.scale_arcsec;
   j["temperature_c"] = r.analysis.temperature_c ? json(*r.analysis.temperature_c) : json(nullptr);
   j["runs"] = r.runs;
-  j["calibration_runs"] = r.calibration_runs;
-  j["holdout_runs"] = r.holdout_runs;
   j["seed"] = r.seed;
   j["false_alarm_level_per_detector"] = r.alpha;
-  j["simulation_path"] = "decimated";
+  j["method"] = "likelihood";
   j["outliers"] = to_json(r.analysis.outliers);
   json base = model_json(r.base, r.base_band, r.band_level, r.gain.misfit_base, r.gain.coverage_base, sh);
   // Not under "fit": model_from_analysis_json would read those coefficients instead of this model.
@@ -240,13 +239,12 @@ json to_json(const DiagnoseResult& r) {
     json o = {{"effect", std::string(detector_name(d.effect))},
               {"statistic", d.statistic},
               {"threshold", d.threshold},
-              {"threshold_sigma", d.threshold_sigma},
               {"threshold_upper", d.threshold_upper},
-              {"ensemble_max", d.ensemble_max},
-              {"ensemble_median", d.ensemble_median},
+              {"p_value", d.p_value},
               {"fired", d.fired},
               {"excess", d.excess},
               {"named", d.named}};
+    if (!d.test.empty()) o["test"] = d.test;
     if (!d.note.empty()) o["note"] = d.note;
     det.push_back(o);
   }
@@ -264,14 +262,12 @@ json to_json(const DiagnoseResult& r) {
     return fnd;
   };
   j["findings"] = findings_json(r.findings);
-  j["rejected_candidates"] = findings_json(r.rejected);
   j["extended_model"] =
       model_json(r.extended, r.extended_band, r.band_level, r.gain.misfit_extended, r.gain.coverage_extended, sh);
-  j["bias_instability_named_terms"] = {
-      {"with_deg_per_h", r.base.bias_instability_deg_per_h},
-      {"without_deg_per_h", r.extended.bias_instability_deg_per_h},
-      {"with_over_without_percent", finite_or_null(b_excess_percent(r))},
-      {"named_terms", json::array()}};
+  j["bias_instability_named_terms"] = {{"with_deg_per_h", r.base.bias_instability_deg_per_h},
+                                       {"without_deg_per_h", r.extended.bias_instability_deg_per_h},
+                                       {"with_over_without_percent", finite_or_null(b_excess_percent(r))},
+                                       {"named_terms", json::array()}};
   for (const auto& f : r.findings)
     j["bias_instability_named_terms"]["named_terms"].push_back(std::string(finding_name(f.effect)));
   j["gain"] = {{"misfit_base", r.gain.misfit_base},
@@ -294,23 +290,21 @@ std::string record_and_base(const DiagnoseResult& r, const Shown& sh) {
   const auto& m = r.base;
   const std::string readout = m.readout == ReadoutMode::Counting ? tr("counting") : tr("white");
   if (!sh.accel) {
-    s += trf(
-        "  record: {:.0f} s at {:g} Hz, pulse weight {:g}″; ensemble of {} simulated records per model, {} for the "
-        "detectors' thresholds (seed {}), band {:g} % per τ\n\n",
-        r.settings.duration_s, r.settings.rate_hz, r.settings.scale_arcsec, r.runs, r.calibration_runs, r.seed,
-        r.band_level * 100);
+    s +=
+        trf("  record: {:.0f} s at {:g} Hz, pulse weight {:g}″; band {:g} % per τ (the model's AV and the points' χ² "
+            "EDF)\n\n",
+            r.settings.duration_s, r.settings.rate_hz, r.settings.scale_arcsec, r.band_level * 100);
     s += format_outliers(r.analysis.outliers);
     return s + tr("Base model (five-term fit): ") + power_laws(m, sh) +
            trf(", white angle {:.4g}″, {} read-out, Earth rate {:.4g} °/h, bias {:.4g} °/h\n", m.white_angle_arcsec,
                readout, m.earth_rate_deg_per_h, m.bias_deg_per_h);
   }
   const std::string level = localized_label(sh.units.deviation);
-  s += trf(
-      "  record: {:.0f} s at {:g} Hz, column '{}' of an accelerometer read in {} (levels in {}, no Earth rate, no "
-      "class verdict); ensemble of {} simulated records per model, {} for the detectors' thresholds (seed {}), band "
-      "{:g} % per τ\n\n",
-      r.settings.duration_s, r.settings.rate_hz, as_typed(r.analysis.input.value("column", r.analysis.column)),
-      r.analysis.input.value("unit", ""), level, r.runs, r.calibration_runs, r.seed, r.band_level * 100);
+  s +=
+      trf("  record: {:.0f} s at {:g} Hz, column '{}' of an accelerometer read in {} (levels in {}, no Earth rate, no "
+          "class verdict); band {:g} % per τ (the model's AV and the points' χ² EDF)\n\n",
+          r.settings.duration_s, r.settings.rate_hz, as_typed(r.analysis.input.value("column", r.analysis.column)),
+          r.analysis.input.value("unit", ""), level, r.band_level * 100);
   s += format_outliers(r.analysis.outliers, level, sh.units.deviation.factor);
   return s + tr("Base model (five-term fit): ") + power_laws(m, sh) +
          trf(", white velocity {:.4g} m/s, {} read-out, bias (with gravity's projection) {:.4g} {}\n",
@@ -323,8 +317,8 @@ std::string outside_row(const BandPoint& b, const Shown& sh) {
   const bool above = b.dev > b.high;
   const double share = 100 * (above ? b.dev / b.high - 1 : 1 - b.dev / b.low);
   const std::string u = localized_label(sh.units.deviation);
-  return trf("    τ = {:>9.4g} s: σ = {:.4g} {}, {:.1f} % {} the band's {} edge {:.4g} {}\n", b.tau_s, sh.level(b.dev), u,
-             share, above ? tr("above") : tr("below"), above ? tr("upper") : tr("lower"),
+  return trf("    τ = {:>9.4g} s: σ = {:.4g} {}, {:.1f} % {} the band's {} edge {:.4g} {}\n", b.tau_s, sh.level(b.dev),
+             u, share, above ? tr("above") : tr("below"), above ? tr("upper") : tr("lower"),
              sh.level(above ? b.high : b.low), u);
 }
 
@@ -345,24 +339,17 @@ std::string format_report(const DiagnoseResult& r) {
   s += trf("  measured Allan deviation inside the base band at {} of {} τ\n", r.base_band.size() - outside,
            r.base_band.size());
   s += rows;
-  s += tr("\nDetectors (statistic on the measurement against the ensemble-calibrated threshold, ") +
-       trf("false-alarm level {:g} % each):\n", r.alpha * 100);
+  s += tr("\nDetectors (likelihood ratio of the block means, noise levels profiled, against the threshold of ") +
+       trf("its null law, false-alarm level {:g} % each):\n", r.alpha * 100);
   for (const auto& d : r.detectors)
-    s += trf(
-        "  {:<17} statistic {:>9.3f} (dimensionless), threshold {:>8.3f} ± {:.2g} (upper limit {:.3f}), ensemble max "
-        "{:>8.3f}: {}{}\n",
-        detector_name(d.effect), d.statistic, d.threshold, d.threshold_sigma, d.threshold_upper, d.ensemble_max,
-        d.named ? tr("FOUND")
-                : (d.excess ? tr("EXCESS, not named") : (d.fired ? tr("fired, not named") : tr("not found"))),
-        d.note.empty() ? "" : " (" + d.note + ")");
+    s += d.test.empty() ? trf("  {:<17} {}\n", detector_name(d.effect), d.note)
+                        : trf("  {:<17} statistic {:>9.3f} (dimensionless), threshold {:>8.3f}, p ≤ {:.3g}: {}{}\n",
+                              detector_name(d.effect), d.statistic, d.threshold, d.p_value,
+                              d.named ? tr("FOUND") : (d.fired ? tr("fired, not named") : tr("not found")),
+                              d.note.empty() ? "" : " (" + d.note + ")");
   s += tr("\nFindings:\n");
-  if (r.findings.empty() && r.rejected.empty())
-    s += tr("  none: the base model's simulations explain the measurement\n");
-  if (r.findings.empty() && !r.rejected.empty())
-    s += tr("  none named: the candidates below do not predict the held-out blocks better than the base\n");
+  if (r.findings.empty()) s += tr("  none: the base model explains the measurement\n");
   s += format_findings(r.findings, sh);
-  if (!r.rejected.empty())
-    s += tr("Candidates not named (no out-of-sample gain; excess only):\n") + format_findings(r.rejected, sh);
   s += tr("\nExtended model: ") + power_laws(r.extended, sh) + trf(", {} extra term(s)\n", r.findings.size());
   // Without B in the extended model the ratio has no value (JSON: null), so none is printed.
   if (!r.findings.empty()) {
@@ -381,12 +368,13 @@ std::string format_report(const DiagnoseResult& r) {
   s += fmt::format("  {:<44} {:>10} {:>10}\n", "", tr("base"), tr("extended"));
   s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", tr("Allan-variance misfit (dimensionless)"), r.gain.misfit_base,
                    r.gain.misfit_extended);
-  s += fmt::format("  {:<44} {:>9.1f}% {:>9.1f}%\n", tr("measured τ inside the simulated band"),
+  s += fmt::format("  {:<44} {:>9.1f}% {:>9.1f}%\n", tr("measured τ inside the model's band"),
                    100 * r.gain.coverage_base, 100 * r.gain.coverage_extended);
   if (std::isnan(r.gain.holdout_misfit_base))
-    s += fmt::format("  {:<44} {:>21}\n", tr("out-of-sample misfit (dimensionless)"), tr("not needed: none named"));
+    s += fmt::format("  {:<44} {:>21}\n", tr("out-of-sample −2 ln L per block (dimensionless)"),
+                     tr("not needed: none named"));
   else
-    s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", tr("out-of-sample misfit (dimensionless)"),
+    s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", tr("out-of-sample −2 ln L per block (dimensionless)"),
                      r.gain.holdout_misfit_base, r.gain.holdout_misfit_extended);
   s += trf("\n  ({:.1f} s)\n", r.seconds);
   return s;

@@ -1,0 +1,137 @@
+// The bands of σ per τ from the models' theoretical AV, and the gain in and out of sample
+// (band.hpp).
+#include "diagnose/band.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "diagnose/models.hpp"
+#include "model/output_filter.hpp"
+#include "rwcalc/allan.hpp"
+#include "rwcalc/confidence.hpp"
+#include "rwcalc/units.hpp"
+
+namespace rwcalc::diag {
+
+namespace {
+
+/// A band point's weight in the misfit: its EDF with a 1000-EDF model floor.
+double band_nu(double edf) { return 1.0 / (1.0 / edf + 1.0 / 1000.0); }
+
+/// The model's AV at cluster size m; with an output-chain low-pass its white angle and rate noise
+/// pass through the filter.
+double model_avar(const NoiseModel& model, double tau0, double scale, std::size_t m) {
+  if (!(model.output_lowpass_tc_s > 0)) return theoretical_avar(model, tau0, scale, m);
+  NoiseModel rest = model;
+  rest.arw_deg_per_sqrt_h = rest.white_angle_arcsec = 0;
+  const double n = model.arw_deg_per_sqrt_h * units::sqrt_s_per_sqrt_h, tf = model.output_lowpass_tc_s;
+  return theoretical_avar(rest, tau0, scale, m) + n * n * output_lowpass_rate_avar(m, tau0, tf) +
+         model.white_angle_arcsec * model.white_angle_arcsec * output_lowpass_angle_avar(m, tau0, tf);
+}
+
+/// The band of `model` at the measured points (σ per τ in `dev`): the model's σ times the χ²
+/// quantiles of a variance with the point's EDF.
+std::vector<BandPoint> model_band(const std::vector<AllanPoint>& pts, const std::vector<double>& dev,
+                                  const NoiseModel& model, const PhaseSeries& x, double scale, double level) {
+  std::vector<BandPoint> band;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const auto& p = pts[i];
+    if (!(dev[i] > 0) || !(p.edf > 0)) continue;
+    const double var = model_avar(model, x.tau0_s, scale, static_cast<std::size_t>(p.m));
+    const DevInterval ci = chi2_interval(1.0, p.edf, level);
+    BandPoint b;
+    b.tau_s = p.tau_s;
+    b.dev = dev[i];
+    b.edf = p.edf;
+    b.mean_var = var;
+    b.median = std::sqrt(var);
+    b.low = b.median / ci.high;
+    b.high = b.median / ci.low;
+    band.push_back(b);
+  }
+  return band;
+}
+
+/// The model's noise only: its deterministic terms are taken from the data instead.
+NoiseModel noise_only(NoiseModel m) {
+  m.sinusoids.clear();
+  m.bias_steps.clear();
+  m.warmups.clear();
+  return m;
+}
+
+/// Half `h` (0, 1) of the block means.
+Blocks half(const Blocks& b, int h) {
+  const std::size_t n = b.y.size() / 2;
+  Blocks out;
+  out.tb = b.tb;
+  out.t0 = b.t0 + (h ? static_cast<double>(n) * b.tb : 0.0);
+  out.y.assign(b.y.begin() + (h ? static_cast<std::ptrdiff_t>(n) : 0),
+               h ? b.y.end() : b.y.begin() + static_cast<std::ptrdiff_t>(n));
+  out.z = second_differences(out.y);
+  return out;
+}
+
+/// −2 ln L per block of `test` under `m` fitted on `fit` (terms whose columns vanish on `fit`,
+/// such as a step outside it, are left out of both).
+double predicted(const Blocks& fit, const Blocks& test, const GlsModel& m) {
+  GlsModel f;
+  f.cov = m.cov;
+  for (const auto& d : m.det)
+    if (det_columns(fit, d).squaredNorm() > 1e-12 * static_cast<double>(fit.n())) f.det.push_back(d);
+  refit(fit, f, m, 1e-12);
+  return m2ll_fixed(test, hypothesis_of(test, f.det, f.cov), f.fit.level, f.fit.beta) / static_cast<double>(test.n());
+}
+
+}  // namespace
+
+void bands_and_gain(const PhaseSeries& x, const Blocks& b, const GlsModel& base, const GlsModel& extended,
+                    DiagnoseResult& r) {
+  const auto& pts = r.analysis.allan.points;
+  std::vector<double> dev, dev_clean;
+  for (const auto& p : pts) dev.push_back(p.dev);
+  r.base_band = model_band(pts, dev, r.base, x, r.settings.scale_arcsec, r.band_level);
+  if (r.findings.empty()) {
+    r.extended_band = r.base_band;
+  } else {
+    const PhaseSeries c = cleaned(x, r.extended);
+    for (const auto& p : pts) dev_clean.push_back(std::sqrt(allan_variance(c, p.m, Estimator::Overlapping)));
+    r.extended_band = model_band(pts, dev_clean, noise_only(r.extended), x, r.settings.scale_arcsec, r.band_level);
+  }
+  r.gain.misfit_base = band_misfit(r.base_band);
+  r.gain.misfit_extended = band_misfit(r.extended_band);
+  r.gain.coverage_base = band_coverage(r.base_band);
+  r.gain.coverage_extended = band_coverage(r.extended_band);
+  if (r.findings.empty()) {
+    r.gain.holdout_misfit_base = r.gain.holdout_misfit_extended = std::numeric_limits<double>::quiet_NaN();
+    return;
+  }
+  const Blocks h0 = half(b, 0), h1 = half(b, 1);
+  r.gain.holdout_misfit_base = 0.5 * (predicted(h0, h1, base) + predicted(h1, h0, base));
+  r.gain.holdout_misfit_extended = 0.5 * (predicted(h0, h1, extended) + predicted(h1, h0, extended));
+}
+
+}  // namespace rwcalc::diag
+
+namespace rwcalc {
+
+double band_misfit(const std::vector<BandPoint>& band) {
+  double sum = 0;
+  std::size_t n = 0;
+  for (const auto& b : band) {
+    if (!(b.mean_var > 0 && b.dev > 0 && b.edf > 0)) continue;
+    const double ratio = b.dev * b.dev / b.mean_var;
+    sum += diag::band_nu(b.edf) * (ratio - 1.0 - std::log(ratio));
+    ++n;
+  }
+  return n ? sum / static_cast<double>(n) : 0.0;
+}
+
+double band_coverage(const std::vector<BandPoint>& band) {
+  if (band.empty()) return 0.0;
+  std::size_t in = 0;
+  for (const auto& b : band) in += (b.dev >= b.low && b.dev <= b.high) ? 1 : 0;
+  return static_cast<double>(in) / static_cast<double>(band.size());
+}
+
+}  // namespace rwcalc

@@ -1,0 +1,422 @@
+// The effects' scans, their null laws and estimates (effects.hpp): every statistic is a
+// likelihood ratio of the block means with the noise levels profiled (gls.hpp).
+#include "diagnose/effects.hpp"
+#include "diagnose/signal.hpp"
+
+#include <fmt/format.h>
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+
+namespace rwcalc::diag {
+
+namespace {
+
+constexpr double kTwoPi = 2.0 * kPi;
+
+/// Block i spans [i·tb, (i + 1)·tb] from the record's start.
+double edge(const Blocks& b, std::size_t i) { return b.t0 + static_cast<double>(i) * b.tb; }
+
+Eigen::MatrixXd differenced(const std::vector<std::vector<double>>& cols) {
+  Eigen::MatrixXd x;
+  for (std::size_t c = 0; c < cols.size(); ++c) {
+    const Eigen::VectorXd z = second_differences(cols[c]);
+    if (c == 0) x.resize(z.size(), static_cast<Eigen::Index>(cols.size()));
+    x.col(static_cast<Eigen::Index>(c)) = z;
+  }
+  return x;
+}
+
+}  // namespace
+
+Eigen::MatrixXd det_columns(const Blocks& b, const DetTerm& t) {
+  const std::size_t nb = b.y.size();
+  std::vector<std::vector<double>> cols(t.effect == Effect::Sinusoid || t.effect == Effect::Line ? 2 : 1,
+                                        std::vector<double>(nb));
+  for (std::size_t i = 0; i < nb; ++i) {
+    const double t0 = edge(b, i), t1 = edge(b, i + 1);
+    switch (t.effect) {
+      case Effect::Sinusoid:
+      case Effect::Line: {  // block means of cos ωt and sin ωt
+        const double w = kTwoPi * t.nl;
+        cols[0][i] = (std::sin(w * t1) - std::sin(w * t0)) / (w * b.tb);
+        cols[1][i] = (std::cos(w * t0) - std::cos(w * t1)) / (w * b.tb);
+        break;
+      }
+      case Effect::BiasStep: cols[0][i] = std::clamp((t1 - t.nl) / b.tb, 0.0, 1.0); break;
+      default: cols[0][i] = t.nl * (std::exp(-t0 / t.nl) - std::exp(-t1 / t.nl)) / b.tb; break;
+    }
+  }
+  return differenced(cols);
+}
+
+Hypothesis hypothesis_of(const Blocks& b, const std::vector<DetTerm>& det, const std::vector<CovTerm>& cov) {
+  Hypothesis h;
+  h.terms = cov;
+  Eigen::Index p = 0;
+  std::vector<Eigen::MatrixXd> parts;
+  for (const auto& d : det) {
+    parts.push_back(det_columns(b, d));
+    p += parts.back().cols();
+  }
+  h.x.resize(static_cast<Eigen::Index>(b.n()), p);
+  Eigen::Index c = 0;
+  for (const auto& m : parts) {
+    h.x.middleCols(c, m.cols()) = m;
+    c += m.cols();
+  }
+  return h;
+}
+
+void refit(const Blocks& b, GlsModel& m, const GlsModel& from, double new_level) {
+  std::vector<double> start;
+  for (const auto& t : m.cov) {
+    double l = new_level;
+    for (std::size_t j = 0; j < from.cov.size(); ++j)
+      if (from.cov[j].kind == t.kind && from.cov[j].tc_s == t.tc_s) l = from.fit.level[j];
+    start.push_back(std::max(l, 1e-30));
+  }
+  m.fit = profile(b, hypothesis_of(b, m.det, m.cov), start);
+}
+
+double chi2_sf(double u, int s) {
+  if (u <= 0) return 1.0;
+  if (s == 1) return std::erfc(std::sqrt(0.5 * u));
+  return std::exp(-0.5 * u);  // s = 2
+}
+
+double scan_p(double u, int s, double length) {
+  if (u <= 0) return 1.0;
+  // Rice's up-crossing rate of a χ²_s process: L u^{(s−1)/2} e^{−u/2} / (2^{(s−2)/2} Γ(s/2) √(2π)).
+  const double gamma_half = s == 1 ? std::sqrt(3.141592653589793) : 1.0;
+  const double up = length * std::pow(u, 0.5 * (s - 1)) * std::exp(-0.5 * u) /
+                    (std::pow(2.0, 0.5 * (s - 2)) * gamma_half * std::sqrt(kTwoPi));
+  return std::min(1.0, chi2_sf(u, s) + up);
+}
+
+double scan_threshold(double alpha, int s, double length) {
+  double lo = 0, hi = 400;
+  for (int it = 0; it < 100; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (scan_p(mid, s, length) > alpha ? lo : hi) = mid;
+  }
+  return hi;
+}
+
+namespace {
+
+/// The current model whitened: W, an orthonormal basis of its whitened regressors and the
+/// whitened residual. A candidate's LR at the current levels is read from these.
+struct ScanBase {
+  Eigen::MatrixXd w, q;
+  Eigen::VectorXd res;
+  double rss = 0, n = 0;
+};
+
+ScanBase scan_base(const Blocks& b, const GlsModel& cur) {
+  ScanBase s;
+  const Hypothesis h = hypothesis_of(b, cur.det, cur.cov);
+  Eigen::MatrixXd v(b.z.size(), 1);
+  v.col(0) = b.z;
+  whiten(cur.fit.r, v, &s.w);
+  const Eigen::VectorXd zw = s.w.triangularView<Eigen::Lower>() * b.z;
+  s.res = zw;
+  if (h.x.cols()) {
+    const Eigen::MatrixXd xw = s.w.triangularView<Eigen::Lower>() * h.x;
+    Eigen::HouseholderQR<Eigen::MatrixXd> qr(xw);
+    s.q = qr.householderQ() * Eigen::MatrixXd::Identity(xw.rows(), xw.cols());
+    s.res -= s.q * (s.q.transpose() * zw);
+  }
+  s.rss = s.res.squaredNorm();
+  s.n = static_cast<double>(b.n());
+  return s;
+}
+
+/// Whitened candidate columns less their part in the current regressors.
+Eigen::MatrixXd projected(const ScanBase& s, const Eigen::MatrixXd& cols) {
+  Eigen::MatrixXd cw = s.w.triangularView<Eigen::Lower>() * cols;
+  if (s.q.cols()) cw -= s.q * (s.q.transpose() * cw);
+  return cw;
+}
+
+/// LR of adding projected whitened columns `cp` at the current levels (the scale profiled).
+double lr_of(const ScanBase& s, const Eigen::MatrixXd& cp) {
+  const Eigen::MatrixXd g = cp.transpose() * cp;
+  const Eigen::VectorXd u = cp.transpose() * s.res;
+  const double drop = u.dot(g.ldlt().solve(u));
+  return s.n * std::log(s.rss / std::max(s.rss - drop, 1e-300 * s.rss));
+}
+
+/// Orthonormal basis of a block's columns.
+Eigen::MatrixXd orthonormal(const Eigen::MatrixXd& c) {
+  Eigen::HouseholderQR<Eigen::MatrixXd> qr(c);
+  return qr.householderQ() * Eigen::MatrixXd::Identity(c.rows(), c.cols());
+}
+
+/// Principal angle (mean over the dimensions) between two subspaces given by orthonormal bases.
+double subspace_angle(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(a.transpose() * b).singularValues();
+  double s = 0;
+  for (Eigen::Index i = 0; i < sv.size(); ++i) s += std::acos(std::clamp(sv(i), -1.0, 1.0));
+  return s / static_cast<double>(sv.size());
+}
+
+/// Golden-section maximum of f on [lo, hi].
+template <class F>
+double golden_max(const F& f, double lo, double hi, int iters) {
+  return golden_min([&f](double x) { return -f(x); }, lo, hi, iters);
+}
+
+/// −2 ln L of the current model at its best: its own profile, or the profile restarted from the
+/// candidate's levels when that one is lower (the levels' likelihood can have more than one
+/// maximum, and a candidate must not win only because its fit found the better one).
+double best_null(const Blocks& b, const GlsModel& cur, const GlsModel& cand) {
+  GlsModel again;
+  again.det = cur.det;
+  again.cov = cur.cov;
+  refit(b, again, cand, 0);
+  return std::min(cur.fit.m2ll, again.fit.m2ll);
+}
+
+/// The candidate model: the current one with a deterministic term, profiled.
+Candidate with_det(const Blocks& b, const GlsModel& cur, const DetTerm& t) {
+  Candidate c;
+  c.effect = t.effect;
+  c.model.det = cur.det;
+  c.model.det.push_back(t);
+  c.model.cov = cur.cov;
+  refit(b, c.model, cur, 0);
+  c.lr = std::max(0.0, best_null(b, cur, c.model) - c.model.fit.m2ll);
+  return c;
+}
+
+/// Scan a one-parameter family of deterministic terms over `grid` at the current levels; the best
+/// refined by golden section between its neighbours, then profiled. `length`: the curve's length.
+Candidate scan_det(const Blocks& b, const GlsModel& cur, Effect e, const std::vector<double>& grid, double& length,
+                   bool log_refine) {
+  const ScanBase s = scan_base(b, cur);
+  const Eigen::Index q = det_columns(b, {e, grid.front()}).cols();
+  // Every grid point's columns whitened in one product.
+  Eigen::MatrixXd all(static_cast<Eigen::Index>(b.n()), q * static_cast<Eigen::Index>(grid.size()));
+  for (std::size_t k = 0; k < grid.size(); ++k)
+    all.middleCols(q * static_cast<Eigen::Index>(k), q) = det_columns(b, {e, grid[k]});
+  all = (s.w.triangularView<Eigen::Lower>() * all).eval();
+  if (s.q.cols()) all -= s.q * (s.q.transpose() * all);
+  double best = -1;
+  std::size_t kbest = 0;
+  Eigen::MatrixXd prev;
+  length = 0;
+  for (std::size_t k = 0; k < grid.size(); ++k) {
+    const Eigen::MatrixXd cp = all.middleCols(q * static_cast<Eigen::Index>(k), q);
+    const double lr = lr_of(s, cp);
+    if (lr > best) best = lr, kbest = k;
+    Eigen::MatrixXd u = orthonormal(cp);
+    if (k) length += subspace_angle(prev, u);
+    prev = std::move(u);
+  }
+  const double lo = grid[kbest ? kbest - 1 : 0], hi = grid[std::min(kbest + 1, grid.size() - 1)];
+  const auto f = [&](double x) { return lr_of(s, projected(s, det_columns(b, {e, log_refine ? std::exp(x) : x}))); };
+  double x = log_refine ? std::exp(golden_max(f, std::log(lo), std::log(hi), 25)) : golden_max(f, lo, hi, 25);
+  if (f(log_refine ? std::log(x) : x) < best) x = grid[kbest];
+  return with_det(b, cur, {e, x});
+}
+
+}  // namespace
+
+Candidate search_slow_line(const Blocks& b, const GlsModel& cur, double alpha, double f_lo, double f_hi,
+                           Effect effect) {
+  // Eight points per 1/T in the slow band, four above (the curve's length needs its bends resolved).
+  const double T = b.duration(), df = 1.0 / ((f_hi * T <= 20 ? 8.0 : 4.0) * T);
+  std::vector<double> grid;
+  for (double f = f_lo; f <= f_hi; f += df) grid.push_back(f);
+  double length = 0;
+  Candidate c = scan_det(b, cur, effect, grid, length, false);
+  c.p = scan_p(c.lr, 2, length);
+  c.threshold = scan_threshold(alpha, 2, length);
+  c.test = fmt::format(
+      "likelihood ratio of a line (2 coefficients, frequency searched {:.4g}–{:.4g} Hz) on the {:g}-s block means, "
+      "noise levels profiled; null law: χ²₂ scan over a curve of length {:.3g} (Davies bound)",
+      f_lo, f_hi, b.tb, length);
+  return c;
+}
+
+Candidate search_step(const Blocks& b, const GlsModel& cur, double alpha) {
+  const std::size_t nb = b.y.size();
+  std::vector<double> grid;
+  for (std::size_t i = 3; i + 3 < nb; ++i) grid.push_back(edge(b, i));
+  if (grid.empty()) return {};
+  double length = 0;
+  Candidate c = scan_det(b, cur, Effect::BiasStep, grid, length, false);
+  const double m = static_cast<double>(grid.size());
+  c.p = std::min(1.0, m * chi2_sf(c.lr, 1));
+  double lo = 0, hi = 400;
+  for (int it = 0; it < 100; ++it) (m * chi2_sf(0.5 * (lo + hi), 1) > alpha ? lo : hi) = 0.5 * (lo + hi);
+  c.threshold = hi;
+  c.test = fmt::format(
+      "likelihood ratio of a change of the mean rate on the {:g}-s block means, noise levels profiled; null law: "
+      "χ²₁ with Bonferroni over {} block edges",
+      b.tb, grid.size());
+  return c;
+}
+
+Candidate search_transient(const Blocks& b, const GlsModel& cur, double alpha) {
+  const double T = b.duration();
+  std::vector<double> grid;
+  for (double tau = 2 * b.tb; tau <= 2 * T; tau *= 1.25) grid.push_back(tau);
+  double length = 0;
+  Candidate c = scan_det(b, cur, Effect::Warmup, grid, length, true);
+  c.p = scan_p(c.lr, 1, length);
+  c.threshold = scan_threshold(alpha, 1, length);
+  c.test = fmt::format(
+      "likelihood ratio of an exponential A·e^(−t/τ) of the rate beside its level and ramp on the {:g}-s block "
+      "means (τ searched {:.3g}–{:.3g} s), noise levels profiled; null law: χ²₁ scan over a curve of length {:.3g} "
+      "(Davies bound)",
+      b.tb, grid.front(), grid.back(), length);
+  return c;
+}
+
+Candidate search_gauss_markov(const Blocks& b, const GlsModel& cur, double alpha) {
+  const double T = b.duration();
+  std::vector<double> grid;
+  for (double tc = 2 * b.tb; tc <= T / 3; tc *= 1.6) grid.push_back(tc);
+  // The flicker level is the scale of a Gauss–Markov variance that shows against the noise.
+  double v0 = 1e-12;
+  for (std::size_t j = 0; j < cur.cov.size(); ++j)
+    if (cur.cov[j].kind == CovKind::B) v0 = std::max(v0, cur.fit.level[j]);
+  const Hypothesis h0 = hypothesis_of(b, cur.det, cur.cov);
+  double best = -1, best_tc = grid.front(), best_level = v0;
+  for (const double tc : grid) {
+    Hypothesis h = h0;
+    h.terms.push_back({CovKind::GM, tc});
+    auto lv = cur.fit.level;
+    lv.push_back(0);
+    const auto f = [&](double lg) {
+      lv.back() = std::exp(lg);
+      return -evaluate(b, h, lv).m2ll;
+    };
+    const double lg = golden_max(f, std::log(v0 * 1e-3), std::log(v0 * 1e3), 16);
+    const double lr = cur.fit.m2ll + f(lg);
+    if (lr > best) best = lr, best_tc = tc, best_level = std::exp(lg);
+  }
+  Candidate c;
+  c.effect = Effect::GaussMarkov;
+  c.model.det = cur.det;
+  c.model.cov = cur.cov;
+  c.model.cov.push_back({CovKind::GM, best_tc});
+  refit(b, c.model, cur, best_level);
+  c.lr = std::max(0.0, best_null(b, cur, c.model) - c.model.fit.m2ll);
+  const double m = static_cast<double>(grid.size());
+  c.p = std::min(1.0, m * 0.5 * chi2_sf(c.lr, 1));
+  double lo = 0, hi = 400;
+  for (int it = 0; it < 100; ++it) (m * 0.5 * chi2_sf(0.5 * (lo + hi), 1) > alpha ? lo : hi) = 0.5 * (lo + hi);
+  c.threshold = hi;
+  c.test = fmt::format(
+      "likelihood ratio of a Gauss–Markov rate term (variance ≥ 0, Tc searched {:.3g}–{:.3g} s) in the covariance "
+      "of the {:g}-s block means, noise levels profiled; null law: ½χ²₀ + ½χ²₁ with Bonferroni over {} Tc",
+      grid.front(), grid.back(), b.tb, grid.size());
+  return c;
+}
+
+namespace {
+
+/// The 95 % profile interval of a parameter x whose −2 ln L is g(x) (minimum at x0): where g rises
+/// by 3.84, found by steps of `step` outwards and bisection; clipped to [lo, hi].
+std::pair<double, double> profile_interval(const std::function<double(double)>& g, double x0, double step, double lo,
+                                           double hi) {
+  const double g0 = g(x0), target = g0 + 3.841458820694124;
+  auto side = [&](double dir) {
+    double inside = x0, x = x0;
+    for (int i = 0; i < 60; ++i) {
+      x = std::clamp(inside + dir * step * std::pow(1.5, i), lo, hi);
+      if (g(x) > target) break;
+      inside = x;
+      if (x == lo || x == hi) return x;
+    }
+    double out = x;
+    for (int i = 0; i < 40; ++i) {
+      const double mid = 0.5 * (inside + out);
+      (g(mid) > target ? out : inside) = mid;
+    }
+    return 0.5 * (inside + out);
+  };
+  return {side(-1.0), side(1.0)};
+}
+
+/// −2 ln L of the model with det term `index`'s parameter at x (levels held, coefficients fitted).
+double det_m2ll(const Blocks& b, const GlsModel& m, std::size_t index, double x) {
+  auto det = m.det;
+  det[index].nl = x;
+  return evaluate(b, hypothesis_of(b, det, m.cov), m.fit.level).m2ll;
+}
+
+}  // namespace
+
+TermEstimate estimate_det(const Blocks& b, const GlsModel& m, std::size_t index) {
+  Eigen::Index off = 0;
+  for (std::size_t j = 0; j < index; ++j) off += det_columns(b, m.det[j]).cols();
+  const DetTerm& t = m.det[index];
+  const auto& beta = m.fit.beta;
+  const auto& cov = m.fit.beta_cov;
+  const auto g = [&](double x) { return det_m2ll(b, m, index, x); };
+  const double T = b.duration();
+  TermEstimate e;
+  if (t.effect == Effect::Sinusoid || t.effect == Effect::Line) {
+    const double a = beta(off), bb = beta(off + 1), amp = std::hypot(a, bb);
+    const Eigen::Vector2d grad(a / amp, bb / amp);
+    const double amp_sigma = std::sqrt(grad.dot(cov.block(off, off, 2, 2) * grad));
+    const auto [flo, fhi] = profile_interval(g, t.nl, 0.02 / T, 0.5 * t.nl, 2.0 * t.nl);
+    e.params = {{"frequency_hz", t.nl}, {"amplitude_deg_per_h", amp}, {"phase_rad", std::atan2(-bb, a)}};
+    e.uncertainty = {{"frequency_hz", (fhi - flo) / 3.92}, {"amplitude_deg_per_h", amp_sigma}};
+    e.interval95 = {{"frequency_hz", {flo, fhi}},
+                    {"amplitude_deg_per_h", {amp - 1.96 * amp_sigma, amp + 1.96 * amp_sigma}}};
+  } else if (t.effect == Effect::BiasStep) {
+    const double size = beta(off), ss = std::sqrt(cov(off, off));
+    const auto [tlo, thi] = profile_interval(g, t.nl, 0.05 * b.tb, b.t0, b.t0 + T);
+    e.params = {{"time_s", t.nl}, {"size_deg_per_h", size}};
+    e.uncertainty = {{"time_s", (thi - tlo) / 3.92}, {"size_deg_per_h", ss}};
+    e.interval95 = {{"time_s", {tlo, thi}}, {"size_deg_per_h", {size - 1.96 * ss, size + 1.96 * ss}}};
+  } else {
+    const double amp = beta(off), as = std::sqrt(cov(off, off));
+    const auto gl = [&](double lx) { return g(std::exp(lx)); };
+    const auto [llo, lhi] = profile_interval(gl, std::log(t.nl), 0.02, std::log(0.5 * b.tb), std::log(20 * T));
+    e.params = {{"amplitude_deg_per_h", amp}, {"time_constant_s", t.nl}};
+    e.uncertainty = {{"amplitude_deg_per_h", as}, {"time_constant_s", (std::exp(lhi) - std::exp(llo)) / 3.92}};
+    e.interval95 = {{"amplitude_deg_per_h", {amp - 1.96 * as, amp + 1.96 * as}},
+                    {"time_constant_s", {std::exp(llo), std::exp(lhi)}}};
+  }
+  return e;
+}
+
+TermEstimate estimate_gm(const Blocks& b, const GlsModel& m, std::size_t ci) {
+  const Hypothesis h = hypothesis_of(b, m.det, m.cov);
+  const double var = m.fit.level[ci], tc = m.cov[ci].tc_s;
+  // σ²: its own profile with the other levels held; Tc: with the variance re-fitted at each Tc.
+  const auto g_var = [&](double lv) {
+    auto l = m.fit.level;
+    l[ci] = std::exp(lv);
+    return evaluate(b, h, l).m2ll;
+  };
+  const auto g_tc = [&](double lt) {
+    Hypothesis ht = h;
+    ht.terms[ci].tc_s = std::exp(lt);
+    auto l = m.fit.level;
+    const auto f = [&](double lv) {
+      l[ci] = std::exp(lv);
+      return -evaluate(b, ht, l).m2ll;
+    };
+    l[ci] = std::exp(golden_max(f, std::log(var) - 5, std::log(var) + 5, 25));
+    return evaluate(b, ht, l).m2ll;
+  };
+  const auto [vlo, vhi] = profile_interval(g_var, std::log(var), 0.05, std::log(var) - 30, std::log(var) + 10);
+  const auto [tlo, thi] = profile_interval(g_tc, std::log(tc), 0.05, std::log(0.5 * b.tb), std::log(10 * b.duration()));
+  const double s = std::sqrt(var), slo = std::exp(0.5 * vlo), shi = std::exp(0.5 * vhi);
+  TermEstimate e;
+  e.params = {{"sigma_deg_per_h", s}, {"correlation_time_s", tc}};
+  e.uncertainty = {{"sigma_deg_per_h", (shi - slo) / 3.92},
+                   {"correlation_time_s", (std::exp(thi) - std::exp(tlo)) / 3.92}};
+  e.interval95 = {{"sigma_deg_per_h", {slo, shi}}, {"correlation_time_s", {std::exp(tlo), std::exp(thi)}}};
+  return e;
+}
+
+}  // namespace rwcalc::diag

@@ -1,0 +1,121 @@
+// The periodogram line search (fast_line.hpp).
+#include "diagnose/fast_line.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+
+#include <boost/math/special_functions/beta.hpp>
+
+#include "allan/fft.hpp"
+#include "diagnose/signal.hpp"
+
+namespace rwcalc::diag {
+
+namespace {
+
+/// P(ratio > u) for one bin: a mean of K exponentials over a level that is a mean of K·W, an
+/// F(2K, 2KW) ratio; (1 + u/W)^{−W} for K = 1.
+double bin_tail(double u, double K) {
+  const double W = kLevelBins;
+  return boost::math::ibeta(K * W, K, W / (W + u));
+}
+
+/// The least-squares line a·cos 2πft + b·sin 2πft in y (mean removed) and its explained sum of
+/// squares (the 2×2 normal equations, the phase stepped by rotation).
+double line_fit(const std::vector<double>& y, double dt, double f, double& a, double& b) {
+  const std::complex<double> step = std::polar(1.0, 2.0 * kPi * f * dt);
+  std::complex<double> e = std::polar(1.0, 2.0 * kPi * f * 0.5 * dt);  // sample k: the mean over [k, k+1)·dt
+  double cc = 0, ss = 0, cs = 0, yc = 0, ys = 0;
+  for (const double v : y) {
+    const double c = e.real(), s = e.imag();
+    cc += c * c, ss += s * s, cs += c * s, yc += v * c, ys += v * s;
+    e *= step;
+  }
+  const double det = cc * ss - cs * cs;
+  if (!(det > 0)) return a = b = 0, 0.0;
+  a = (ss * yc - cs * ys) / det;
+  b = (cc * ys - cs * yc) / det;
+  return a * yc + b * ys;
+}
+
+}  // namespace
+
+FastLine fast_line_search(std::vector<double> y, double dt, double f_min, double f_max, double alpha) {
+  FastLine r;
+  const std::size_t n = y.size();
+  double mean = 0;
+  for (const double v : y) mean += v / static_cast<double>(n);
+  for (double& v : y) v -= mean;
+  // Segments of at most kSegment samples (the memory stays bounded), their periodograms averaged.
+  const std::size_t len = std::min(n, kSegment), segs = n / len;
+  std::size_t nfft = 4;
+  while (nfft < 2 * len) nfft <<= 1;
+  const double pad = static_cast<double>(nfft) / static_cast<double>(len), df = 1.0 / (static_cast<double>(nfft) * dt);
+  const auto stride = static_cast<std::size_t>(std::lround(2 * pad));  // every second true bin
+  const std::size_t reach = (kLevelBins / 2 + 1) * stride, half = nfft / 2;
+  std::size_t k_lo = std::max<std::size_t>(static_cast<std::size_t>(std::ceil(f_min / df)), 2 * stride);
+  const std::size_t k_hi = std::min(static_cast<std::size_t>(f_max / df), half - 2 * stride);
+  if (k_lo >= k_hi || (2 * static_cast<std::size_t>(kLevelBins) + 2) * stride >= half) return r;
+  std::vector<double> P(half + 1, 0.0), buf(len);
+  double w2 = 0;
+  for (std::size_t i = 0; i < len; ++i) {
+    const double w = 0.5 - 0.5 * std::cos(2.0 * kPi * (static_cast<double>(i) + 0.5) / static_cast<double>(len));
+    w2 += w * w;
+  }
+  detail::RealPowerSpectrum spectrum(nfft);
+  for (std::size_t sg = 0; sg < segs; ++sg) {
+    for (std::size_t i = 0; i < len; ++i)
+      buf[i] = (0.5 - 0.5 * std::cos(2.0 * kPi * (static_cast<double>(i) + 0.5) / static_cast<double>(len))) *
+               y[sg * len + i];
+    spectrum.add(buf.data(), len, P.data());
+  }
+  // E P = σ² for white noise of variance σ²
+  for (double& p : P) p /= w2 * static_cast<double>(segs);
+  // C[k] = P[k] + C[k − stride]: the sum of P[a], P[a + stride], …, P[b] in O(1).
+  std::vector<double> C(P);
+  for (std::size_t k = stride; k < C.size(); ++k) C[k] += C[k - stride];
+  const auto run = [&](std::size_t a, std::size_t b) { return C[b] - (a >= stride ? C[a - stride] : 0.0); };
+  const std::size_t W = kLevelBins / 2;
+  double best = 0, best_level = 0;
+  std::size_t kbest = k_lo;
+  for (std::size_t k = k_lo; k <= k_hi; ++k) {
+    // W values on each side, 2 … W + 1 strides away; near an end, 2W on the other side.
+    double s;
+    if (k < reach)
+      s = run(k + 2 * stride, k + (2 * W + 1) * stride);
+    else if (k + reach > half)
+      s = run(k - (2 * W + 1) * stride, k - 2 * stride);
+    else
+      s = run(k - (W + 1) * stride, k - 2 * stride) + run(k + 2 * stride, k + (W + 1) * stride);
+    const double level = s / static_cast<double>(kLevelBins);
+    if (level > 0 && P[k] / level > best) best = P[k] / level, best_level = level, kbest = k;
+  }
+  const double bins = static_cast<double>(k_hi - k_lo + 1);
+  r.statistic = best;
+  const double K = static_cast<double>(segs);
+  r.p = std::min(1.0, bins * bin_tail(best, K));
+  double lo = 0, hi = 1e4;
+  for (int it = 0; it < 100; ++it) (bins * bin_tail(0.5 * (lo + hi), K) > alpha ? lo : hi) = 0.5 * (lo + hi);
+  r.threshold = hi;
+  r.test = fmt::format(
+      "largest Hann periodogram ordinate of the rate samples ({:.4g}–{:.4g} Hz, mean of {} segments) over the "
+      "mean of {} others 4–{} bins away; null law: F(2K, 2KW) per bin, Bonferroni over {:.0f} bins",
+      f_min, f_max, segs, kLevelBins, kLevelBins + 2, bins);
+  // The frequency refined by least squares between the neighbouring bins.
+  double a = 0, b = 0;
+  const auto fit = [&](double f, double& ca, double& cb) { return line_fit(y, dt, f, ca, cb); };
+  r.f_hz = refine_frequency(fit, static_cast<double>(kbest) * df, df, 1, 30, 0.5 / dt);
+  fit(r.f_hz, a, b);
+  r.amp = std::hypot(a, b) / block_attenuation(r.f_hz, dt);  // a sample is the mean over dt
+  r.phase = std::atan2(-b, a);
+  // Standard errors of a line in noise of the local level (per-sample variance σ² at f).
+  const double nn = static_cast<double>(n);
+  r.amp_sigma = std::sqrt(2.0 * best_level / nn);
+  r.f_sigma = r.amp > 0 ? std::sqrt(24.0 * best_level / (r.amp * r.amp * nn * nn * nn)) / (2.0 * kPi * dt) : 0.0;
+  return r;
+}
+
+}  // namespace rwcalc::diag

@@ -1,0 +1,324 @@
+// The exact likelihood of the block means' second differences (gls.hpp): the terms' Toeplitz
+// autocovariances, Durbin–Levinson whitening and the levels' profile.
+#include "diagnose/gls.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace rwcalc::diag {
+
+namespace {
+
+/// Autocorrelation of the third difference (−1, 3, −3, 1) at lags 0 … 3: z_i is the third
+/// difference of the angle at the block edges over tb.
+constexpr long double kR[4] = {20, -15, 6, -1};
+
+/// Σ_d kR[|d|]·g(|m + d|), d = −3 … 3: the covariance of z at lag m for a term whose generalised
+/// covariance of the angle at lag u blocks is g(u) (an intrinsic covariance: its polynomial part of
+/// degree ≤ 2 cancels).
+template <class G>
+long double lag_sum(std::size_t m, const G& g) {
+  long double s = 0;
+  for (int d = -3; d <= 3; ++d) s += kR[std::abs(d)] * g(static_cast<std::size_t>(std::abs(static_cast<long>(m) + d)));
+  return s;
+}
+
+/// Flicker: g(u) = u² ln u (the generalised covariance of a 1/f rate, the τ² ln tb part cancels).
+/// Beyond 32 lags the difference is taken from its series (the direct sum loses every digit):
+/// −δ⁶f = −(f⁽⁶⁾ + f⁽⁸⁾/4 + 7f⁽¹⁰⁾/240), f⁽⁶⁾ = −12/u⁴, f⁽⁸⁾ = −240/u⁶, f⁽¹⁰⁾ = −10080/u⁸.
+double flicker_lag(std::size_t m) {
+  if (m < 32)
+    return static_cast<double>(lag_sum(m, [](std::size_t u) {
+      const long double x = static_cast<long double>(u);
+      return u ? x * x * std::log(x) : 0.0L;
+    }));
+  const double u2 = 1.0 / (static_cast<double>(m) * static_cast<double>(m));
+  return 12.0 * u2 * u2 + 60.0 * u2 * u2 * u2 + 294.0 * u2 * u2 * u2 * u2;
+}
+
+}  // namespace
+
+std::vector<double> term_autocov(const CovTerm& t, std::size_t n, double tb) {
+  std::vector<double> r(n, 0.0);
+  const double tb2 = tb * tb;
+  switch (t.kind) {
+    case CovKind::Q:  // G(0) = 1 ″², 0 beyond
+      for (std::size_t m = 0; m < std::min<std::size_t>(n, 4); ++m) r[m] = static_cast<double>(kR[m]) / tb2;
+      break;
+    case CovKind::N:  // AV 1/τ: G(τ) = −τ/2
+      for (std::size_t m = 0; m < std::min<std::size_t>(n, 4); ++m)
+        r[m] = static_cast<double>(lag_sum(m, [&](std::size_t u) { return -0.5L * u * tb; })) / tb2;
+      break;
+    case CovKind::B: {  // AV 1 = 2 ln2·h: G(τ) = (h/2)τ² ln τ
+      const double h = 1.0 / (2.0 * std::log(2.0));
+      for (std::size_t m = 0; m < n; ++m) r[m] = 0.5 * h * flicker_lag(m);
+      break;
+    }
+    case CovKind::K:  // AV τ: G(τ) = τ³/4; exact in integers, 0 from lag 3 on
+      for (std::size_t m = 0; m < std::min<std::size_t>(n, 3); ++m)
+        r[m] = static_cast<double>(lag_sum(m, [](std::size_t u) { return static_cast<long double>(u * u * u); })) * tb /
+               4.0;
+      break;
+    case CovKind::GM: {  // variance 1, G(τ) = −Tc²(τ/Tc − 1 + e^{−τ/Tc})
+      const long double tc = t.tc_s, a = tb / tc;
+      for (std::size_t m = 0; m < std::min<std::size_t>(n, 3); ++m)
+        r[m] = static_cast<double>(lag_sum(m,
+                                           [&](std::size_t u) {
+                                             const long double x = u * a;
+                                             return -tc * tc * (x - 1.0L + std::exp(-x));
+                                           })) /
+               tb2;
+      // From lag 3 on only the exponential is left: Tc²(2 sinh(a/2))⁶ e^{−ma}/tb².
+      const double s6 = std::pow(2.0 * std::sinh(0.5 * static_cast<double>(a)), 6.0);
+      for (std::size_t m = 3; m < n; ++m)
+        r[m] = static_cast<double>(tc * tc) * s6 * std::exp(-static_cast<double>(a) * static_cast<double>(m)) / tb2;
+      break;
+    }
+  }
+  return r;
+}
+
+double term_avar(const CovTerm& t, double tau) {
+  switch (t.kind) {
+    case CovKind::Q: return 3.0 / (tau * tau);
+    case CovKind::N: return 1.0 / tau;
+    case CovKind::B: return 1.0;
+    case CovKind::K: return tau;
+    case CovKind::GM: {
+      const double x = tau / t.tc_s;
+      const double h = x < 1e-3 ? 1.0 - x * x / 3.0 : (3.0 - 4.0 * std::exp(-x) + std::exp(-2.0 * x)) / (2.0 * x);
+      return 2.0 / x * (1.0 - h);
+    }
+  }
+  return 0.0;
+}
+
+namespace {
+
+/// Σ a[i]·b[i] in four partial sums (the loop vectorises; the order is fixed, so the result too).
+double dot4(const double* a, const double* b, std::size_t n) {
+  double acc[4] = {0, 0, 0, 0};
+  std::size_t i = 0;
+  for (; i + 4 <= n; i += 4)
+    for (std::size_t u = 0; u < 4; ++u) acc[u] += a[i + u] * b[i + u];
+  for (; i < n; ++i) acc[0] += a[i] * b[i];
+  return (acc[0] + acc[1]) + (acc[2] + acc[3]);
+}
+
+}  // namespace
+
+Whitened whiten(const std::vector<double>& r, const Eigen::MatrixXd& v, Eigen::MatrixXd* w_out) {
+  const std::size_t n = r.size();
+  const auto q = v.cols();
+  Whitened out;
+  out.v.resize(static_cast<Eigen::Index>(n), q);
+  RowMatrix w;
+  if (w_out) w.setZero(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
+  // The order-k predictor reversed, ψ[i] = φ_{k−i}, kept at the end of `buf` (it grows at its
+  // front): both the recursion's sums and the prediction of sample k are then ascending dot
+  // products.
+  std::vector<double> buf(n + 1, 0.0);
+  double* psi = buf.data() + n;  // order 0: empty
+  double var = r[0];
+  for (std::size_t k = 0; k < n; ++k) {
+    if (k > 0) {
+      const double kappa = (r[k] - dot4(psi, r.data() + 1, k - 1)) / var;
+      // φ_j ← φ_j − κ φ_{k−j}: in ψ, ψ[m] ← ψ[m] − κ ψ[k−2−m], pairwise; then κ in front.
+      for (std::size_t m = 0, e = k - 1; m < e / 2 + (e % 2); ++m) {
+        const std::size_t o = k - 2 - m;
+        const double a = psi[m], b = psi[o];
+        psi[m] = a - kappa * b;
+        if (o != m) psi[o] = b - kappa * a;
+      }
+      *--psi = kappa;
+      var *= 1.0 - kappa * kappa;
+    }
+    if (!(var > 0) || !std::isfinite(var)) {
+      out.ok = false;
+      return out;
+    }
+    out.logdet += std::log(var);
+    const double s = 1.0 / std::sqrt(var);
+    const auto K = static_cast<Eigen::Index>(k);
+    for (Eigen::Index c = 0; c < q; ++c) out.v(K, c) = (v(K, c) - dot4(psi, &v(0, c), k)) * s;
+    if (w_out) {
+      for (std::size_t i = 0; i < k; ++i) w(K, static_cast<Eigen::Index>(i)) = -psi[i] * s;
+      w(K, K) = s;
+    }
+  }
+  if (w_out) *w_out = std::move(w);
+  return out;
+}
+
+Eigen::VectorXd second_differences(const std::vector<double>& y) {
+  const std::size_t n = y.size() < 3 ? 0 : y.size() - 2;
+  Eigen::VectorXd z(static_cast<Eigen::Index>(n));
+  for (std::size_t i = 0; i < n; ++i) z(static_cast<Eigen::Index>(i)) = y[i + 2] - 2.0 * y[i + 1] + y[i];
+  return z;
+}
+
+std::vector<double> total_autocov(const Blocks& b, const std::vector<CovTerm>& terms,
+                                  const std::vector<double>& level) {
+  std::vector<double> r(b.n(), 0.0);
+  for (std::size_t t = 0; t < terms.size(); ++t) {
+    const auto rt = term_autocov(terms[t], b.n(), b.tb);
+    for (std::size_t m = 0; m < r.size(); ++m) r[m] += level[t] * rt[m];
+  }
+  return r;
+}
+
+double m2ll_fixed(const Blocks& b, const Hypothesis& h, const std::vector<double>& level, const Eigen::VectorXd& beta) {
+  Eigen::MatrixXd v(b.z.size(), 1);
+  v.col(0) = b.z;
+  if (h.x.cols()) v.col(0) -= h.x * beta;
+  const Whitened w = whiten(total_autocov(b, h.terms, level), v);
+  if (!w.ok) return std::numeric_limits<double>::infinity();
+  return w.v.col(0).squaredNorm() + w.logdet;
+}
+
+namespace {
+
+/// −2 ln L of z with the overall scale s of `r` profiled: n ln(RSS/n) + ln det Σ(r) + n ln… The
+/// returned profile's levels are s times the given ones.
+Profile scaled_fit(const Blocks& b, const Hypothesis& h, const std::vector<double>& r) {
+  Profile p;
+  const Eigen::Index n = static_cast<Eigen::Index>(b.n()), k = h.x.cols();
+  Eigen::MatrixXd v(n, 1 + k);
+  v.col(0) = b.z;
+  if (k) v.rightCols(k) = h.x;
+  const Whitened w = whiten(r, v);
+  if (!w.ok) {
+    p.m2ll = std::numeric_limits<double>::infinity();
+    return p;
+  }
+  Eigen::VectorXd res = w.v.col(0);
+  if (k) {
+    const Eigen::MatrixXd xw = w.v.rightCols(k);
+    const Eigen::MatrixXd xtx = xw.transpose() * xw;
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(xtx);
+    p.beta = ldlt.solve(xw.transpose() * res);
+    res -= xw * p.beta;
+    p.beta_cov = ldlt.solve(Eigen::MatrixXd::Identity(k, k));
+  }
+  const double rss = res.squaredNorm(), nn = static_cast<double>(n);
+  const double s = rss / nn;
+  p.m2ll = nn * std::log(s) + w.logdet + nn;
+  if (k) p.beta_cov *= s;
+  p.r = r;
+  for (double& x : p.r) x *= s;
+  p.level.assign(1, s);  // the caller scales its levels by this
+  return p;
+}
+
+}  // namespace
+
+Profile evaluate(const Blocks& b, const Hypothesis& h, const std::vector<double>& level) {
+  const auto r = total_autocov(b, h.terms, level);
+  Profile p = scaled_fit(b, h, r);
+  const double s = p.level.empty() ? 1.0 : p.level[0];
+  p.level = level;
+  for (double& l : p.level) l *= s;
+  return p;
+}
+
+namespace {
+
+/// Nelder–Mead minimisation of f over R^d from x0 with initial steps `step`.
+template <class F>
+std::vector<double> nelder_mead(const F& f, std::vector<double> x0, double step, int max_evals, double ftol) {
+  const std::size_t d = x0.size();
+  std::vector<std::vector<double>> s(d + 1, x0);
+  std::vector<double> fv(d + 1);
+  for (std::size_t i = 0; i < d; ++i) s[i + 1][i] += step;
+  for (std::size_t i = 0; i <= d; ++i) fv[i] = f(s[i]);
+  int evals = static_cast<int>(d + 1);
+  std::vector<std::size_t> idx(d + 1);
+  while (evals < max_evals) {
+    for (std::size_t i = 0; i <= d; ++i) idx[i] = i;
+    std::sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) { return fv[a] < fv[b]; });
+    const std::size_t best = idx[0], worst = idx[d], second = idx[d - 1];
+    if (std::abs(fv[worst] - fv[best]) < ftol) break;
+    std::vector<double> c(d, 0.0);
+    for (std::size_t i = 0; i <= d; ++i)
+      if (i != worst)
+        for (std::size_t j = 0; j < d; ++j) c[j] += s[i][j] / static_cast<double>(d);
+    auto along = [&](double t) {
+      std::vector<double> x(d);
+      for (std::size_t j = 0; j < d; ++j) x[j] = c[j] + t * (s[worst][j] - c[j]);
+      return x;
+    };
+    auto xr = along(-1.0);
+    const double fr = f(xr);
+    ++evals;
+    if (fr < fv[best]) {
+      auto xe = along(-2.0);
+      const double fe = f(xe);
+      ++evals;
+      if (fe < fr)
+        s[worst] = xe, fv[worst] = fe;
+      else
+        s[worst] = xr, fv[worst] = fr;
+    } else if (fr < fv[second]) {
+      s[worst] = xr, fv[worst] = fr;
+    } else {
+      auto xc = along(fr < fv[worst] ? -0.5 : 0.5);
+      const double fc = f(xc);
+      ++evals;
+      if (fc < std::min(fr, fv[worst])) {
+        s[worst] = xc, fv[worst] = fc;
+      } else {  // shrink towards the best
+        for (std::size_t i = 0; i <= d; ++i) {
+          if (i == best) continue;
+          for (std::size_t j = 0; j < d; ++j) s[i][j] = s[best][j] + 0.5 * (s[i][j] - s[best][j]);
+          fv[i] = f(s[i]);
+          ++evals;
+        }
+      }
+    }
+  }
+  const auto it = std::min_element(fv.begin(), fv.end());
+  return s[static_cast<std::size_t>(it - fv.begin())];
+}
+
+/// Log-levels below the reference's by more than this are a term switched off (e^{−40}).
+constexpr double kLogFloor = -40.0;
+
+}  // namespace
+
+Profile profile(const Blocks& b, const Hypothesis& h, const std::vector<double>& start) {
+  const std::size_t nt = h.terms.size();
+  std::vector<std::vector<double>> unit(nt);
+  for (std::size_t t = 0; t < nt; ++t) unit[t] = term_autocov(h.terms[t], b.n(), b.tb);
+  // The reference term (level 1, the scale profiled) is the one with the largest share of Var z.
+  std::size_t ref = 0;
+  for (std::size_t t = 1; t < nt; ++t)
+    if (start[t] * unit[t][0] > start[ref] * unit[ref][0]) ref = t;
+  auto levels_of = [&](const std::vector<double>& u) {
+    std::vector<double> lv(nt);
+    for (std::size_t t = 0, j = 0; t < nt; ++t) lv[t] = t == ref ? 1.0 : std::exp(std::clamp(u[j++], kLogFloor, 40.0));
+    return lv;
+  };
+  auto fit_at = [&](const std::vector<double>& u) {
+    const auto lv = levels_of(u);
+    std::vector<double> r(b.n(), 0.0);
+    for (std::size_t t = 0; t < nt; ++t)
+      for (std::size_t m = 0; m < r.size(); ++m) r[m] += lv[t] * unit[t][m];
+    Profile p = scaled_fit(b, h, r);
+    const double s = p.level.empty() ? 1.0 : p.level[0];
+    p.level = lv;
+    for (double& l : p.level) l *= s;
+    return p;
+  };
+  std::vector<double> u0;
+  for (std::size_t t = 0; t < nt; ++t)
+    if (t != ref) u0.push_back(std::log(std::max(start[t], 1e-300) / start[ref]));
+  if (u0.empty()) return fit_at(u0);
+  const auto f = [&](const std::vector<double>& u) { return fit_at(u).m2ll; };
+  // Two rounds: a restart from the first optimum escapes a collapsed simplex.
+  auto u = nelder_mead(f, u0, 1.0, 300, 1e-4);
+  u = nelder_mead(f, u, 0.3, 150, 1e-5);
+  return fit_at(u);
+}
+
+}  // namespace rwcalc::diag

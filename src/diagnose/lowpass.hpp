@@ -1,0 +1,27 @@
+#pragma once
+/// @file lowpass.hpp
+/// The output-chain low-pass: the χ² drop of the short-τ octave AV when white angle and rate noise
+/// (and a floor) pass through a first-order filter, and its null law.
+#include <cstdint>
+#include <vector>
+
+namespace rwcalc::diag {
+
+struct OutputLowpassEstimate {
+  double statistic = 0;                    ///< χ² drop of the short-τ octave AV with the filter
+  double tf = 0, tf_low = 0, tf_high = 0;  ///< time constant, s, and its 95 % profile interval
+  double white_angle2 = 0;                 ///< white angle variance before the filter, ″²
+  double white_rate = 0;                   ///< white rate N² before the filter, (°/h)²·s
+  double points = 0;                       ///< octave points used
+  double chi2 = 0;                         ///< χ² of the best fit (with the filter)
+  double p = 1;                            ///< bound on the statistic's false-alarm probability
+  double threshold = 0;                    ///< the statistic whose bound is α
+};
+/// Fit the octave AV `v` (τ ≤ min(20 s, T/100)) by white angle and rate noise and a floor through
+/// a low-pass, against the same without it. The statistic, scaled by the best fit's χ² per degree
+/// of freedom when above 1, is χ²₁ at each time constant; the bound is Bonferroni over the octave
+/// points (time constants an octave apart are the distinct alternatives).
+OutputLowpassEstimate output_lowpass_detect(const std::vector<std::int64_t>& m, const std::vector<double>& v,
+                                            const std::vector<double>& edf, double tau0, double duration, double alpha);
+
+}  // namespace rwcalc::diag

@@ -1,0 +1,200 @@
+// The likelihood of the block means (src/diagnose/gls.cpp) and the effects' scans
+// (src/diagnose/effects.cpp): known covariances, the whitening, the levels' profile, the null laws'
+// bounds and known effects recovered.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "diagnose/effects.hpp"
+#include "diagnose/gls.hpp"
+#include "diagnose/signal.hpp"
+#include "rwcalc/simulate.hpp"
+
+using namespace rwcalc;
+using namespace rwcalc::diag;
+
+namespace {
+
+/// Block means of a simulated record (20 Hz: the tests stay quick).
+Blocks blocks_of(const NoiseModel& m, double duration, std::uint64_t seed) {
+  SimulationSettings s;
+  s.duration_s = duration;
+  s.rate_hz = 20;
+  s.scale_arcsec = 1e-4;
+  NoiseModel mm = m;
+  mm.readout = ReadoutMode::White;
+  Simulator sim(mm, s);
+  PhaseSeries x;
+  sim.run(seed, x);
+  const Decimated d = decimate(x);
+  Blocks b;
+  b.tb = 10;
+  b.y = block_rates(d, per_block_for(d, 10));
+  b.z = second_differences(b.y);
+  return b;
+}
+
+GlsModel null_model(const Blocks& b) {
+  GlsModel h;
+  h.cov = {{CovKind::Q}, {CovKind::N}, {CovKind::B}, {CovKind::K}};
+  h.fit = profile(b, hypothesis_of(b, {}, h.cov), {1e-6, 0.0036, 1.1e-5, 1e-9});
+  return h;
+}
+
+NoiseModel gl2d_like() {
+  NoiseModel m;
+  m.arw_deg_per_sqrt_h = 0.001;
+  m.bias_instability_deg_per_h = 0.005;
+  return m;
+}
+
+}  // namespace
+
+// White rate noise of AV 1/τ: block means of variance 1/tb, so z = Δ²y has variance 6/tb and
+// lag-1 covariance −4/tb; white angle noise of variance 1 ″²: z = Δ³θ/tb, variance 20/tb².
+TEST(DiagnoseGls, WhiteTermsHaveTheirKnownCovariances) {
+  const double tb = 10;
+  const auto n = term_autocov({CovKind::N}, 5, tb);
+  EXPECT_NEAR(n[0], 6 / tb, 1e-12);
+  EXPECT_NEAR(n[1], -4 / tb, 1e-12);
+  EXPECT_NEAR(n[2], 1 / tb, 1e-12);
+  EXPECT_NEAR(n[3], 0, 1e-12);
+  const auto q = term_autocov({CovKind::Q}, 5, tb);
+  EXPECT_NEAR(q[0], 20 / (tb * tb), 1e-12);
+  EXPECT_NEAR(q[3], -1 / (tb * tb), 1e-12);
+  EXPECT_EQ(q[4], 0.0);
+}
+
+// Every term's z covariance against the sample covariance of block means the simulator makes
+// (the flicker's far lags by their series; the Gauss–Markov term's by its closed form).
+TEST(DiagnoseGls, CovariancesMatchTheSimulator) {
+  struct Case {
+    NoiseModel m;
+    CovTerm t;
+    double level;
+  };
+  NoiseModel fl;
+  fl.bias_instability_deg_per_h = 0.01;
+  NoiseModel gm;
+  gm.gauss_markov.push_back({0.01, 60});
+  NoiseModel rrw;
+  rrw.rrw_deg_per_h_per_sqrt_h = 0.05;
+  const double k = 0.05 / 60.0;
+  const std::vector<Case> cases = {{fl, {CovKind::B}, kFlickerFloorPerB2 * 1e-4},
+                                   {gm, {CovKind::GM, 60}, 1e-4},
+                                   {rrw, {CovKind::K}, k * k / 3}};
+  for (const auto& c : cases) {
+    double s0 = 0, s1 = 0, s4 = 0;
+    std::size_t cnt = 0;
+    for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+      const Blocks b = blocks_of(c.m, 7200, seed);
+      for (Eigen::Index i = 0; i + 4 < b.z.size(); ++i) {
+        s0 += b.z(i) * b.z(i);
+        s1 += b.z(i) * b.z(i + 1);
+        s4 += b.z(i) * b.z(i + 4);
+        ++cnt;
+      }
+    }
+    const auto r = term_autocov(c.t, 8, 10);
+    const double v = s0 / static_cast<double>(cnt);
+    EXPECT_NEAR(v / (c.level * r[0]), 1.0, 0.05) << static_cast<int>(c.t.kind);
+    EXPECT_NEAR(s1 / static_cast<double>(cnt) / v, r[1] / r[0], 0.03) << static_cast<int>(c.t.kind);
+    EXPECT_NEAR(s4 / static_cast<double>(cnt) / v, r[4] / r[0], 0.03) << static_cast<int>(c.t.kind);
+  }
+}
+
+// The flicker's far lags switch from the direct sum to its series at lag 32: the two agree there,
+// and the AV of a term read from its generalised covariance is the unit AV it promises.
+TEST(DiagnoseGls, FlickerSeriesJoinsTheDirectSum) {
+  const auto r = term_autocov({CovKind::B}, 40, 10);
+  // The series is −δ⁶ of u² ln u, ≈ 12/u⁴ (×h/2): smooth through lag 31 → 32.
+  EXPECT_NEAR(r[32] / r[31], std::pow(31.0 / 32.0, 4), 2e-3);
+  EXPECT_NEAR(r[33] / r[32], std::pow(32.0 / 33.0, 4), 2e-3);
+  for (const CovKind k : {CovKind::N, CovKind::B, CovKind::K}) EXPECT_GT(term_autocov({k}, 3, 10)[0], 0.0);
+}
+
+// W Σ Wᵀ = I for a Toeplitz covariance, and log det Σ from the recursion equals the dense one.
+TEST(DiagnoseGls, WhiteningInvertsTheCovariance) {
+  const std::size_t n = 30;
+  std::vector<double> r = term_autocov({CovKind::B}, n, 10);
+  const auto w = term_autocov({CovKind::N}, n, 10);
+  for (std::size_t i = 0; i < n; ++i) r[i] += 1e-3 * w[i];
+  Eigen::MatrixXd sigma(n, n);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < n; ++j) sigma(i, j) = r[i > j ? i - j : j - i];
+  Eigen::MatrixXd W;
+  const Whitened out = whiten(r, Eigen::MatrixXd::Identity(n, n), &W);
+  ASSERT_TRUE(out.ok);
+  EXPECT_LT((W * sigma * W.transpose() - Eigen::MatrixXd::Identity(n, n)).cwiseAbs().maxCoeff(), 1e-8);
+  EXPECT_NEAR(out.logdet, std::log(sigma.determinant()), 1e-6 * std::abs(out.logdet));
+  EXPECT_LT((out.v - W).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+// The profile recovers the flicker level of simulated records (mean of 6: one 2-h record
+// determines it to about ±50 %).
+TEST(DiagnoseGls, ProfileRecoversTheFlickerLevel) {
+  NoiseModel m;
+  m.arw_deg_per_sqrt_h = 0.0005;
+  m.bias_instability_deg_per_h = 0.01;
+  const double b2 = kFlickerFloorPerB2 * 1e-4;
+  double sum = 0;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    const Blocks b = blocks_of(m, 7200, seed);
+    sum += null_model(b).fit.level[2] / b2;
+  }
+  EXPECT_NEAR(sum / 6, 1.0, 0.3);
+}
+
+// The bounds: no searched curve leaves the single test's χ² law; a longer curve needs a larger
+// statistic; the threshold is where the bound equals α.
+TEST(DiagnoseGls, ScanBoundsReduceToTheSingleTest) {
+  EXPECT_NEAR(scan_p(9.21034, 2, 0), 0.01, 1e-6);
+  EXPECT_NEAR(scan_p(6.634897, 1, 0), 0.01, 1e-6);
+  EXPECT_GT(scan_threshold(0.01, 2, 100), scan_threshold(0.01, 2, 10));
+  EXPECT_NEAR(scan_p(scan_threshold(0.01, 1, 30), 1, 30), 0.01, 1e-9);
+}
+
+// A slow line of 4 cycles at 6× the flicker floor: named at its frequency and amplitude, its
+// intervals holding the truth; nothing in a clean record of the same noise.
+TEST(DiagnoseGls, SlowLineFoundAndEstimated) {
+  NoiseModel m = gl2d_like();
+  const double f = 4.0 / 7200, amp = 6 * 0.6643 * 0.005;
+  m.sinusoids.push_back({f, amp, 0.3});
+  const Blocks b = blocks_of(m, 7200, 5);
+  const GlsModel h = null_model(b);
+  const Candidate c = search_slow_line(b, h, 0.01, 2.5 / 7200, 12.0 / 7200, Effect::Sinusoid);
+  EXPECT_LT(c.p, 1e-3);
+  EXPECT_GT(c.lr, c.threshold);
+  const TermEstimate e = estimate_det(b, c.model, 0);
+  EXPECT_NEAR(e.params["frequency_hz"].get<double>(), f, 0.5 / 7200);
+  EXPECT_NEAR(e.params["amplitude_deg_per_h"].get<double>(), amp, 0.3 * amp);
+  const Blocks clean = blocks_of(gl2d_like(), 7200, 5);
+  EXPECT_GT(search_slow_line(clean, null_model(clean), 0.01, 2.5 / 7200, 12.0 / 7200, Effect::Sinusoid).p, 0.01);
+}
+
+// A bias step: its time and size, the 95 % intervals around the truth.
+TEST(DiagnoseGls, StepFoundAndEstimated) {
+  NoiseModel m = gl2d_like();
+  m.bias_steps.push_back({3000, 0.05});
+  const Blocks b = blocks_of(m, 7200, 7);
+  const Candidate c = search_step(b, null_model(b), 0.01);
+  EXPECT_LT(c.p, 1e-3);
+  const TermEstimate e = estimate_det(b, c.model, 0);
+  EXPECT_NEAR(e.params["time_s"].get<double>(), 3000, 100);
+  EXPECT_NEAR(e.params["size_deg_per_h"].get<double>(), 0.05, 0.015);
+  const auto& ti = e.interval95["time_s"];
+  EXPECT_LE(ti[0].get<double>(), e.params["time_s"].get<double>());
+  EXPECT_GE(ti[1].get<double>(), e.params["time_s"].get<double>());
+}
+
+// A warm-up transient: found, its time constant near the truth.
+TEST(DiagnoseGls, TransientFound) {
+  NoiseModel w = gl2d_like();
+  w.warmups.push_back({0.1, 600});
+  const Blocks bw = blocks_of(w, 7200, 9);
+  const Candidate cw = search_transient(bw, null_model(bw), 0.01);
+  EXPECT_LT(cw.p, 1e-3);
+  EXPECT_NEAR(cw.model.det.back().nl, 600, 300);
+}
