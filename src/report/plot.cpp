@@ -471,8 +471,8 @@ std::string band_label(const char* what, const json& model, const std::vector<Ba
   }
   const auto level = num(model, "band_level");
   const std::string percent = level ? fmt::format("{:g} % ", *level * 100) : std::string();
-  std::string s = std::string_view(what) == "base" ? trf("base model: simulated {}band", percent)
-                                                   : trf("extended model: simulated {}band", percent);
+  std::string s = std::string_view(what) == "base" ? trf("base model: {}band", percent)
+                                                   : trf("extended model: {}band", percent);
   if (measured > 0) s += trf(", {} of {} τ inside", inside, measured);
   return s;
 }
@@ -483,7 +483,7 @@ std::string diagnosis_title(const json& diagnosis) {
   if (findings.is_array())
     for (const auto& f : findings)
       if (auto e = view::str(f, "effect"); !e.empty()) effects.push_back(e);
-  return tr("Measurement against simulations of the noise model") +
+  return tr("Measurement against the noise model's band") +
          (effects.empty() ? std::string(tr(" (no finding)")) : trf(" (findings: {})", fmt::join(effects, ", ")));
 }
 
@@ -494,7 +494,7 @@ Figure diagnosis_figure(const json& diagnosis, const PlotOptions& options) {
   const auto ext = band_rows(band_of(diagnosis, true));
   if (base.empty())
     throw AnalysisError(
-        "the diagnosis has no simulated band (band or base_model.band, with tau_s, band_low, "
+        "the diagnosis has no band (band or base_model.band, with tau_s, band_low, "
         "band_high): nothing to plot");
   std::string blocks;
   PlotCommand plot;
@@ -512,7 +512,7 @@ Figure diagnosis_figure(const json& diagnosis, const PlotOptions& options) {
   plot.add(fmt::format("$base u 1:3:4 w filledcurves fs transparent solid 0.30 noborder lc rgb '#1f77b4' t {}",
                        label_text(band_label("base", at(diagnosis, "base_model"), base))));
   if (std::all_of(base.begin(), base.end(), [](const BandRow& r) { return r.median > 0; }))
-    plot.add("$base u 1:5 w l lw 1.2 dt 2 lc rgb '#1f77b4' t " + label_text(tr("base model: simulated median")));
+    plot.add("$base u 1:5 w l lw 1.2 dt 2 lc rgb '#1f77b4' t " + label_text(tr("base model: median")));
   if (!ext.empty()) {
     add_band("extended", ext);
     plot.add(fmt::format(
