@@ -306,6 +306,10 @@ void fit_with_checks(const std::vector<FitPoint>& all_points, const PhaseSeries&
   const std::vector<FitPoint> points =
       options.fit_checks && !exact_counts ? without_spectral_lines(all_points, x, r.fit_range) : all_points;
   FitOptions fopt = options.fit;
+  if (exact_counts && x.points() > 1)  // the counter's read-out, from the record's mean rate
+    fopt.counter = CounterReadout{static_cast<double>(x.count(x.points() - 1) - x.count(0)) /
+                                      static_cast<double>(x.points() - 1),
+                                  x.arcsec_per_count, x.tau0_s, x.points()};
   FitRangeChoice& range = r.fit_range;
   const bool default_range = fopt.tau_min_s == 0 && std::isinf(fopt.tau_max_s);
   if (options.fit_range_given || !default_range) {

@@ -38,6 +38,7 @@ struct Problem {
   Eigen::MatrixXd g;   // J×P: basis_i(τ_j)·scale_i
   Eigen::VectorXd y;   // observed σ²
   Eigen::VectorXd nu;  // effective EDF
+  Eigen::VectorXd offset;  // known AV not fitted (FitPoint::fixed_var)
   Vec5 scale = Vec5::Ones();
   unsigned enabled_mask = 0;
 };
@@ -48,9 +49,11 @@ Problem make_problem(std::span<const FitPoint> pts, const FitOptions& o) {
   pr.g.resize(j, P);
   pr.y.resize(j);
   pr.nu.resize(j);
+  pr.offset.resize(j);
   for (Eigen::Index r = 0; r < j; ++r) {
     const auto& p = pts[static_cast<std::size_t>(r)];
     pr.y[r] = p.var;
+    pr.offset[r] = p.fixed_var;
     pr.nu[r] = o.edf_cap > 0 ? 1.0 / (1.0 / p.edf + 1.0 / o.edf_cap) : p.edf;
     for (int i = 0; i < P; ++i) pr.g(r, i) = term_basis(kAllTerms[static_cast<std::size_t>(i)], p.tau_s);
   }
@@ -63,6 +66,9 @@ Problem make_problem(std::span<const FitPoint> pts, const FitOptions& o) {
   }
   return pr;
 }
+
+/// Model σ² at the points: the fitted terms plus the known part.
+Eigen::VectorXd mean_of(const Problem& pr, const Vec5& d) { return pr.g * d + pr.offset; }
 
 double deviance(const Problem& pr, const Eigen::VectorXd& mu) {
   double d = 0;
@@ -115,7 +121,7 @@ Vec5 nnls(const Problem& pr, const Eigen::VectorXd& w, unsigned free_mask, const
   Vec5 fixed = base;
   for (int i = 0; i < P; ++i)
     if (free_mask & (1u << i)) fixed[i] = 0;
-  const Eigen::VectorXd target = pr.y - pr.g * fixed;
+  const Eigen::VectorXd target = pr.y - pr.offset - pr.g * fixed;
   const Eigen::MatrixXd gw = pr.g.array().colwise() * w.array();
   const Mat5 a = pr.g.transpose() * gw;
   const Vec5 b = gw.transpose() * target;
@@ -145,18 +151,18 @@ struct IrlsResult {
 IrlsResult irls(const Problem& pr, unsigned free_mask, const Vec5& start, bool from_data) {
   IrlsResult res;
   Vec5 d = start;
-  Eigen::VectorXd mu = pr.g * d;
+  Eigen::VectorXd mu = mean_of(pr, d);
   double dev = from_data ? kInf : deviance(pr, mu);
   if (!std::isfinite(dev)) {
     const Eigen::VectorXd w = pr.nu.array() / pr.y.array().square();
     d = nnls(pr, w, free_mask, start);
-    mu = pr.g * d;
+    mu = mean_of(pr, d);
     dev = deviance(pr, mu);
     if (!std::isfinite(dev)) {
       // Positive start on the free terms, so that every model point is positive.
       for (int i = 0; i < P; ++i)
         if (free_mask & (1u << i)) d[i] = std::max(d[i], 1e-3);
-      mu = pr.g * d;
+      mu = mean_of(pr, d);
       dev = deviance(pr, mu);
     }
   }
@@ -166,12 +172,12 @@ IrlsResult irls(const Problem& pr, unsigned free_mask, const Vec5& start, bool f
     const Vec5 d_new = nnls(pr, w, free_mask, d);
     double step = 1.0;
     Vec5 d_try = d_new;
-    Eigen::VectorXd mu_try = pr.g * d_try;
+    Eigen::VectorXd mu_try = mean_of(pr, d_try);
     double dev_try = deviance(pr, mu_try);
     for (int h = 0; h < 50 && !(dev_try <= dev); ++h) {
       step *= 0.5;
       d_try = d + step * (d_new - d);
-      mu_try = pr.g * d_try;
+      mu_try = mean_of(pr, d_try);
       dev_try = deviance(pr, mu_try);
     }
     if (!(dev_try <= dev)) break;
@@ -270,7 +276,7 @@ Sandwich sandwich(const Problem& pr, const Vec5& d, const std::vector<int>& set,
   Sandwich sw;
   const auto k = static_cast<Eigen::Index>(set.size());
   if (k == 0) return sw;
-  const Eigen::VectorXd mu = pr.g * d;
+  const Eigen::VectorXd mu = mean_of(pr, d);
   Eigen::MatrixXd g(pr.g.rows(), k);
   for (Eigen::Index q = 0; q < k; ++q) g.col(q) = pr.g.col(set[static_cast<std::size_t>(q)]);
   const Eigen::VectorXd w = pr.nu.array() / (2.0 * mu.array().square());
@@ -428,12 +434,24 @@ double point_pair_covariance(const FitPoint& a, const FitPoint& b, const Structu
   return 2.0 * total / (4.0 * a.tau_s * a.tau_s * b.tau_s * b.tau_s * pp.na * pp.nb);
 }
 
+/// The terms that jitter the angle about its mean-rate line (counter_readout.hpp).
+AngleJitter jitter_of(const Vec5& c) { return {c[idx(Term::Q)], c[idx(Term::N)], c[idx(Term::B)]}; }
+
+/// The coefficients whose Gaussian covariance stands for the points' sampling variance: a counter's
+/// read-out error counts as white angle noise of its mean level q²/12 (its sawtooth varies less,
+/// its blurred part as much).
+Vec5 covariance_terms(Vec5 c, std::span<const FitPoint> pts, const FitOptions& o) {
+  const bool counter = o.counter && std::any_of(pts.begin(), pts.end(), [](const FitPoint& p) { return p.fixed_var > 0; });
+  if (counter) c[idx(Term::Q)] += o.counter->q_arcsec * o.counter->q_arcsec / 12.0;
+  return c;
+}
+
 /// One fitted problem: its design and the IRLS optimum.
 struct Stage {
   Problem pr;
   IrlsResult fit;
   [[nodiscard]] Vec5 coefficients() const { return fit.d.cwiseProduct(pr.scale); }
-  [[nodiscard]] Eigen::VectorXd model() const { return pr.g * fit.d; }
+  [[nodiscard]] Eigen::VectorXd model() const { return mean_of(pr, fit.d); }
 };
 
 void require_converged(const IrlsResult& r) {
@@ -480,7 +498,7 @@ Stage fit_full_model(std::vector<FitPoint>& used, const FitOptions& options, boo
   if (use_cov) {
     const Vec5 c0 = full.coefficients();
     const Eigen::VectorXd mu0 = full.model();
-    const Eigen::MatrixXd cov0 = av_covariance(used, c0, true);  // only its diagonal is used
+    const Eigen::MatrixXd cov0 = av_covariance(used, covariance_terms(c0, used, options), true);  // its diagonal
     for (std::size_t r = 0; r < used.size(); ++r) {
       const double v = cov0(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(r));
       if (v > 0 && std::isfinite(v))
@@ -647,9 +665,23 @@ std::vector<FitPoint> fit_points(const AllanResult& allan) {
 }
 
 double FitResult::model_var(double tau_s) const {
-  double v = 0;
+  double v = counter_var(tau_s);
   for (int i = 0; i < P; ++i) v += c[i] * term_basis(kAllTerms[static_cast<std::size_t>(i)], tau_s);
   return v;
+}
+
+double FitResult::counter_var(double tau_s) const {
+  if (!counter_readout || !options.counter) return 0.0;
+  const CounterReadout& ctr = *options.counter;
+  return counter_avar(ctr, std::llround(tau_s / ctr.tau0_s), jitter_of(c));
+}
+
+double FitResult::readout_var(double tau_s) const {
+  return c[idx(Term::Q)] * term_basis(Term::Q, tau_s) + counter_var(tau_s);
+}
+
+Eigen::Matrix<double, kTermCount, 1> FitResult::covariance_c() const {
+  return counter_readout ? covariance_terms(c, used, options) : c;
 }
 
 double FitResult::log_correlation(Term a, Term b) const {
@@ -692,7 +724,10 @@ Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix
   return cov;
 }
 
-FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options) {
+namespace {
+
+/// The fit with the points' known parts (FitPoint::fixed_var) as given.
+FitResult fit_given(std::span<const FitPoint> points, const FitOptions& options) {
   FitResult res;
   res.used = points_in_range(points, options);
   const double z = boost::math::quantile(boost::math::normal_distribution<double>(), 0.5 + options.confidence / 2.0);
@@ -702,7 +737,9 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
   FitOptions opt;  // edf_cap: the one in force (estimated when options.edf_cap is 0)
   const Stage full = fit_full_model(res.used, options, res.model_covariance, opt);
   Eigen::MatrixXd sigma_y;
-  if (res.model_covariance) sigma_y = point_covariance(res.used, full.coefficients(), full.model(), opt.edf_cap);
+  if (res.model_covariance)
+    sigma_y = point_covariance(res.used, covariance_terms(full.coefficients(), res.used, options), full.model(),
+                               opt.edf_cap);
 
   // Inflation of every enabled term in the full model (at the boundary too).
   std::vector<int> full_set;
@@ -742,6 +779,46 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
       throw AnalysisError(trf("the data do not bound the {} coefficient", term_name(kAllTerms[ui])));
   }
   return res;
+}
+
+/// The counter model: its read-out AV depends on the angle's jitter, i.e. on the fitted Q, N and B,
+/// so the fit is repeated with the read-out computed from the previous fit. The map from the jitter's
+/// terms to their refit alternates about its fixed point (slope ≈ −0.6 on GL-2D-like records), so
+/// each pass moves half way: the error then shrinks ≈ 5× per pass.
+FitResult fit_counter(std::span<const FitPoint> points, const FitOptions& options, const Vec5& start) {
+  std::vector<FitPoint> pts(points.begin(), points.end());
+  const CounterReadout& ctr = *options.counter;
+  Vec5 c = start;
+  FitResult res;
+  for (int pass = 0; pass < 16; ++pass) {
+    for (FitPoint& p : pts) {
+      const std::int64_t m = p.m > 0 ? p.m : std::llround(p.tau_s / ctr.tau0_s);
+      p.fixed_var = counter_avar(ctr, m, jitter_of(c));
+    }
+    res = fit_given(pts, options);
+    const Vec5 next = pass == 0 ? res.c : Vec5(0.5 * (c + res.c));
+    const bool settled = ((next - c).cwiseAbs().array() <= 1e-4 * c.cwiseAbs().array() + 1e-300).all();
+    c = next;
+    if (settled) break;
+  }
+  res.counter_readout = true;
+  return res;
+}
+
+}  // namespace
+
+FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options) {
+  if (!options.counter || options.readout == Readout::White) return fit_given(points, options);
+  if (options.readout == Readout::Counter) return fit_counter(points, options, Vec5::Zero());
+  // Auto: a counter with or without dither. The better fit (Bartlett-corrected deviance, the same
+  // points and terms) says which read-out the record has.
+  FitResult white = fit_given(points, options);
+  try {
+    FitResult counter = fit_counter(points, options, white.c);
+    if (counter.chi2 < white.chi2) return counter;
+  } catch (const AnalysisError&) {  // the white model stands
+  }
+  return white;
 }
 
 SlopeReadout slope_readout(const AllanResult& allan) {

@@ -455,7 +455,7 @@ double model_edf(const FitPoint& p, const FitResult& fit, double extra_var) {
   const double mu = fit.model_var(p.tau_s);
   if (p.m <= 0 || p.terms <= 0 || !(mu > 0)) return p.edf;
   const std::vector<FitPoint> one{p};
-  const double v = av_covariance(one, fit.c, true)(0, 0) + extra_var;
+  const double v = av_covariance(one, fit.covariance_c(), true)(0, 0) + extra_var;
   return v > 0 && std::isfinite(v) ? 2.0 * mu * mu / v : p.edf;
 }
 
