@@ -32,4 +32,8 @@ struct AngleJitter {
 /// 0 where the mean rate advances a whole number of pulses per m samples and the angle is still.
 [[nodiscard]] double counter_avar(const CounterReadout& counter, std::int64_t m, const AngleJitter& jitter);
 
+/// Mean square of the read-out error's increments over h samples, 2q²·[R(0) − R(h)], ″²: its part
+/// of the variance of the angle increments (the direct N method).
+[[nodiscard]] double counter_increment_var(const CounterReadout& counter, std::int64_t h, const AngleJitter& jitter);
+
 }  // namespace rwcalc

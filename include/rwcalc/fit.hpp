@@ -111,6 +111,9 @@ struct FitResult {
   [[nodiscard]] double model_var(double tau_s) const;
   /// The counter read-out's part of model_var at τ (s), (°/h)² (0 unless counter_readout).
   [[nodiscard]] double counter_var(double tau_s) const;
+  /// The counter read-out's part of the variance of angle increments over h samples, ″² (0 unless
+  /// counter_readout; counter_increment_var).
+  [[nodiscard]] double counter_increment_var(std::int64_t h) const;
   /// The read-out's part of model_var at τ (s): the white angle term Q and the counter's, (°/h)².
   [[nodiscard]] double readout_var(double tau_s) const;
   /// `c` with a counter read-out counted as white angle noise of its mean level q²/12: the

@@ -377,7 +377,7 @@ void require_noise(const Recording& rec) {
 /// with its bias factor) and their discrepancies from the fit; the raw spread of 100-s means
 /// beside its expectation under the fit.
 void cross_checks(const PhaseSeries& x, const AnalysisOptions& options, AnalysisResult& r) {
-  r.direct = direct_n(x, options.methods);
+  r.direct = direct_n(x, options.methods, &r.fit);
   attach_straight_line_bias(r.direct, r.fit, x.duration_s(), x.tau0_s);
   r.b100 = b_from_averages(x, r.fit, options.methods.block_s);
   r.b_min = b_from_minimum(r.allan, r.slope, r.fit);
@@ -475,6 +475,7 @@ json fit_json(const AnalysisResult& r) {
           {"phi_N", f.phi[static_cast<std::size_t>(Term::N)]},
           {"phi_B", f.phi[static_cast<std::size_t>(Term::B)]},
           {"confidence", f.options.confidence},
+          {"readout", !f.options.counter ? "floating" : f.counter_readout ? "counter" : "white"},
           {"range",
            {{"tau_min_s", r.fit_range.tau_min_s},
             {"tau_max_s", std::isinf(r.fit_range.tau_max_s) ? json(nullptr) : json(r.fit_range.tau_max_s)},

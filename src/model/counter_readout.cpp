@@ -51,19 +51,29 @@ double sawtooth_covariance(double fraction, double s) {
   return r;
 }
 
+namespace {
+
+/// R(h) of the record: the mean-rate advance and the jitter over h samples about the record's
+/// mean-rate line (sample variance of the increments, mean removed; Gaussian terms), in pulses.
+double error_covariance(const CounterReadout& c, std::int64_t h, const AngleJitter& j) {
+  if (c.points / static_cast<std::size_t>(h) < 3) return 0.0;  // no two increments: taken as white
+  const IncrementBasis g = increment_basis(static_cast<std::size_t>(h), c.points, c.tau0_s, false);
+  const double var = (g.q * j.q2 + g.n * j.n2 + g.b * j.b2) / (c.q_arcsec * c.q_arcsec);
+  const double advance = c.pulses_per_sample * static_cast<double>(h);
+  return sawtooth_covariance(advance - std::floor(advance), std::sqrt(std::max(var, 0.0)));
+}
+
+}  // namespace
+
+double counter_increment_var(const CounterReadout& c, std::int64_t h, const AngleJitter& j) {
+  if (h <= 0 || !(c.q_arcsec > 0)) return 0.0;
+  return 2.0 * c.q_arcsec * c.q_arcsec * (1.0 / 12.0 - error_covariance(c, h, j));
+}
+
 double counter_avar(const CounterReadout& c, std::int64_t m, const AngleJitter& j) {
   if (m <= 0 || !(c.q_arcsec > 0)) return 0.0;
-  auto cov = [&](std::int64_t h) {
-    if (c.points / static_cast<std::size_t>(h) < 3) return 0.0;  // no two increments: taken as white
-    // The jitter over h samples about the record's mean-rate line (sample variance of the
-    // increments, mean removed; Gaussian terms), in pulses.
-    const IncrementBasis g = increment_basis(static_cast<std::size_t>(h), c.points, c.tau0_s, false);
-    const double var = (g.q * j.q2 + g.n * j.n2 + g.b * j.b2) / (c.q_arcsec * c.q_arcsec);
-    const double advance = c.pulses_per_sample * static_cast<double>(h);
-    return sawtooth_covariance(advance - std::floor(advance), std::sqrt(std::max(var, 0.0)));
-  };
   const double tau = static_cast<double>(m) * c.tau0_s;
-  const double e = 6.0 / 12.0 - 8.0 * cov(m) + 2.0 * cov(2 * m);
+  const double e = 6.0 / 12.0 - 8.0 * error_covariance(c, m, j) + 2.0 * error_covariance(c, 2 * m, j);
   return c.q_arcsec * c.q_arcsec / (2.0 * tau * tau) * std::max(e, 0.0);
 }
 

@@ -676,6 +676,10 @@ double FitResult::counter_var(double tau_s) const {
   return counter_avar(ctr, std::llround(tau_s / ctr.tau0_s), jitter_of(c));
 }
 
+double FitResult::counter_increment_var(std::int64_t h) const {
+  return counter_readout && options.counter ? rwcalc::counter_increment_var(*options.counter, h, jitter_of(c)) : 0.0;
+}
+
 double FitResult::readout_var(double tau_s) const {
   return c[idx(Term::Q)] * term_basis(Term::Q, tau_s) + counter_var(tau_s);
 }

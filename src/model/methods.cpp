@@ -350,7 +350,7 @@ BootstrapSd bootstrap_n2_sd(const DirectNResult& r, const std::vector<std::size_
 
 }  // namespace
 
-DirectNResult direct_n(const PhaseSeries& x, const MethodOptions& o) {
+DirectNResult direct_n(const PhaseSeries& x, const MethodOptions& o, const FitResult* fit) {
   DirectNResult r;
   const std::size_t n = x.points() > 0 ? x.points() - 1 : 0;
   const double t_total = static_cast<double>(n) * x.tau0_s;
@@ -374,6 +374,9 @@ DirectNResult direct_n(const PhaseSeries& x, const MethodOptions& o) {
 
   if (ts.size() < 4) return r;
   r.points = overlapping_points(x, ts);
+  // A counter's read-out error is not white angle noise: its known part of each variance is taken off.
+  if (fit)
+    for (DirectPoint& p : r.points) p.var_arcsec2 -= fit->counter_increment_var(std::llround(p.t_s / x.tau0_s));
   r.basis.resize(ts.size());  // each an O(t) sum: in parallel
   parallel_for(ts.size(), [&](std::size_t i) { r.basis[i] = increment_basis(ts[i], n + 1, x.tau0_s); });
   std::vector<Vec3> xs;
@@ -417,7 +420,7 @@ void attach_straight_line_bias(DirectNResult& r, const FitResult& fit, double du
   for (auto& p : expected) {
     const auto t = static_cast<std::size_t>(std::llround(p.t_s / tau0_s));
     const IncrementBasis g = increment_basis(t, points, tau0_s, false);
-    p.var_arcsec2 = g.q * fit.c[0] + g.n * fit.c[1] + g.b * fit.c[2];
+    p.var_arcsec2 = g.q * fit.c[0] + g.n * fit.c[1] + g.b * fit.c[2] + fit.counter_increment_var(static_cast<std::int64_t>(t));
   }
   double a = 0, b = 0;
   if (fit_straight(expected, a, b) && b > 0) sl.bias_factor = std::sqrt(b / n2);
@@ -475,7 +478,7 @@ AvBEstimate b_from_averages(const PhaseSeries& x, const FitResult& fit, double b
   // variance of that estimate from the fit covariance.
   Eigen::Matrix<double, kTermCount, 1> h;
   for (const Term t : kAllTerms) h[static_cast<int>(t)] = t == Term::B ? 0.0 : term_basis(t, e.tau_s);
-  e.white = h.dot(fit.c);
+  e.white = h.dot(fit.c) + fit.counter_var(e.tau_s);
   const double white_var = std::max(0.0, h.dot(fit.cov_c * h));
   e.edf = model_edf({e.tau_s, e.var, 0.0, m, terms}, fit, white_var);
   if (!(e.edf > 0)) return e;
