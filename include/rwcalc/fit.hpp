@@ -41,7 +41,6 @@ struct FitPoint {
   double edf = 0;
   std::int64_t m = 0;      ///< cluster size (0: unknown, no model covariance)
   std::int64_t terms = 0;  ///< second differences in the overlapping estimator (0: unknown)
-  double fixed_var = 0;    ///< known part of σ² not fitted (the counter read-out's AV), (°/h)²
 };
 
 /// How the pulses of a record were counted (FitOptions::readout).
@@ -102,8 +101,8 @@ struct FitResult {
   FitOptions options;
   std::vector<FitPoint> used;  ///< the points fitted (τ ascending; edf = the EDF the fit used)
   std::vector<double> model;   ///< model σ² at those points, (°/h)²
-  /// The counter read-out's AV is part of the model (FitPoint::fixed_var of `used`; Q is then
-  /// the white angle noise beyond it); false: the read-out is the white term Q.
+  /// The counter read-out's AV is part of the model (Q is then the white angle noise beyond it);
+  /// false: the read-out is the white term Q.
   bool counter_readout = false;
 
   [[nodiscard]] const Coefficient& operator[](Term t) const { return coef[static_cast<int>(t)]; }
