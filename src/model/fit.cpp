@@ -793,6 +793,9 @@ Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix
 
 namespace {
 
+/// χ²₁ at 0.999: how much better the counter's fit must be to be chosen over the white one.
+constexpr double kCounterMargin = 10.83;
+
 /// The fit with the read-out model of options.readout (Auto taken as White).
 FitResult fit_given(std::span<const FitPoint> points, const FitOptions& options) {
   FitResult res;
@@ -853,15 +856,17 @@ FitResult fit_given(std::span<const FitPoint> points, const FitOptions& options)
 
 FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options) {
   if (!options.counter || options.readout != Readout::Auto) return fit_given(points, options);
-  // A counter with or without dither: the better fit (Bartlett-corrected deviance, the same points
-  // and terms) says which read-out the record has.
+  // A counter with or without dither. The white model (the simpler, and a dithered counter's) stands
+  // unless the counter's fits better by more than χ²₁ at 0.001 (10.83, the level at which a fit is
+  // rejected): on dithered records the two differ by chance by a few units, on a plain counter's
+  // by 10³–10⁴ per point.
   FitOptions white = options, counter = options;
   white.readout = Readout::White;
   counter.readout = Readout::Counter;
   FitResult w = fit_given(points, white);
   try {
     FitResult c = fit_given(points, counter);
-    if (c.chi2 < w.chi2) return c;
+    if (c.chi2 + kCounterMargin < w.chi2) return c;
   } catch (const AnalysisError&) {  // the white model stands
   }
   return w;

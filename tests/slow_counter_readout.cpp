@@ -1,0 +1,178 @@
+// The counter read-out in the fit (docs/analysis.md, "The counter read-out"), on two generators:
+// rwcalc's simulator with its default read-out (a plain counter) and a second one written here in the
+// frequency domain (FFT-shaped flicker, white rate, its own counter with or without dither), which
+// shares no code with the simulator or the fit. Each record: fit accepted (p ≥ 0.001), the read-out
+// the fit chose, N and B inside their 95 % intervals, and a verdict that is right or stated below
+// P = 0.9. RWCALC_COUNTER_RECORDS scales every set (the docs' table comes from larger counts).
+#include <gtest/gtest.h>
+
+#include <unsupported/Eigen/FFT>
+
+#include <cmath>
+#include <complex>
+#include <cstdint>
+#include <cstdlib>
+#include <random>
+#include <vector>
+
+#include "rwcalc/analysis.hpp"
+#include "rwcalc/noise_model.hpp"
+#include "rwcalc/parallel.hpp"
+#include "rwcalc/simulate.hpp"
+#include "test_fit_sim.hpp"
+#include "test_support.hpp"
+
+namespace rwcalc {
+namespace {
+
+constexpr double kQ = 0.92;  // GL-2D pulse weight, ″
+
+struct Outcome {
+  bool accepted = false, counter = false, n_in = false, b_in = false, verdict_ok = false;
+};
+
+/// Rate noise per sample (″/s) of two-sided PSD psd(f) ((″/s)²/Hz): Gaussian Fourier coefficients of
+/// variance L·psd(f)/τ0 on a circle of L ≥ 4n points, the first n kept (the lowest frequency is then
+/// below 1/(4T): the flicker's AV at τ = T/4 is within 1.3 % of its floor).
+std::vector<double> shaped_noise(std::size_t n, double tau0, double b, test::Normal& g) {
+  std::size_t len = 1;
+  while (len < 4 * n) len <<= 1;
+  std::vector<std::complex<double>> spec(len, 0.0);
+  const double ld = static_cast<double>(len);
+  for (std::size_t j = 1; j <= len / 2; ++j) {
+    const double f = static_cast<double>(j) / (ld * tau0);
+    const double psd = b * b / (2.0 * M_PI * f);  // IEEE 952 two-sided flicker rate
+    if (j == len / 2) {
+      spec[j] = std::sqrt(ld * psd / tau0) * g();
+    } else {
+      const double sd = std::sqrt(ld * psd / tau0 / 2.0);
+      spec[j] = {sd * g(), sd * g()};
+      spec[len - j] = std::conj(spec[j]);
+    }
+  }
+  Eigen::FFT<double> fft;
+  std::vector<double> x;
+  fft.inv(x, spec);
+  x.resize(n);
+  return x;
+}
+
+/// A pulse record from the frequency-domain generator: Earth rate, white rate N (°/√h), flicker B
+/// (°/h), counted by ⌊θ/q + φ⌋ with one random phase (plain counter) or a fresh one per sample
+/// (dither of up to a pulse).
+Recording independent_record(double n, double b, double seconds, double rate_hz, bool dither, std::uint64_t seed) {
+  test::Normal g(seed);
+  std::mt19937_64 u(seed ^ 0x9e3779b97f4a7c15ULL);
+  auto uniform = [&] { return (static_cast<double>(u() >> 11) + 0.5) * 0x1.0p-53; };
+  const double tau0 = 1.0 / rate_hz;
+  const auto count = static_cast<std::size_t>(std::llround(seconds * rate_hz));
+  const std::vector<double> flicker = shaped_noise(count, tau0, b, g);
+  const double arw = 60.0 * n * std::sqrt(tau0);  // ″ per sample
+  const double earth = earth_rate_at(55.75);
+  const double phase = uniform();
+  Recording rec;
+  rec.source = "independent";
+  rec.rate_hz = rate_hz;
+  rec.phase.tau0_s = tau0;
+  rec.phase.arcsec_per_count = kQ;
+  rec.phase.counts.resize(count + 1);
+  double theta = 0;  // ″
+  auto counted = [&](double angle) {
+    return static_cast<std::int64_t>(std::floor(angle / kQ + (dither ? uniform() : phase)));
+  };
+  const std::int64_t c0 = counted(0.0);
+  rec.phase.counts[0] = 0;
+  for (std::size_t k = 0; k < count; ++k) {
+    theta += (earth + flicker[k]) * tau0 + arw * g();
+    rec.phase.counts[k + 1] = counted(theta) - c0;
+  }
+  rec.samples = count;
+  return rec;
+}
+
+/// A record of rwcalc's simulator with its default read-out (the plain counter).
+Recording simulator_record(double n, double b, double seconds, std::uint64_t seed) {
+  NoiseModel m;
+  m.arw_deg_per_sqrt_h = n;
+  m.bias_instability_deg_per_h = b;
+  m.earth_rate_deg_per_h = earth_rate_at(55.75);
+  SimulationSettings s;
+  s.duration_s = seconds;
+  s.seed = seed;
+  Recording rec;
+  rec.source = "sim";
+  rec.phase = simulate(m, s);
+  rec.rate_hz = s.rate_hz;
+  rec.samples = rec.phase.points() - 1;
+  return rec;
+}
+
+Outcome judge(const Recording& rec, double n, double b) {
+  const AnalysisOptions o;
+  const AnalysisResult r = analyze(rec, o);
+  Outcome out;
+  out.accepted = r.fit.p_value >= 0.001;
+  out.counter = r.fit.counter_readout;
+  out.n_in = r.fit[Term::N].low <= n && n <= r.fit[Term::N].high;
+  out.b_in = r.fit[Term::B].low <= b && b <= r.fit[Term::B].high;
+  out.verdict_ok = test::true_class(b, n, o.verdict.table) == r.verdict.cls || r.verdict.p_class < 0.9;
+  return out;
+}
+
+int records(int fallback) {
+  const char* e = std::getenv("RWCALC_COUNTER_RECORDS");
+  return e ? std::max(4, std::atoi(e)) : fallback;
+}
+
+/// Runs `count` records (N in 0.0005–0.001 °/√h, B in 0.005–0.01 °/h, drawn per record) in parallel
+/// and checks the set.
+template <class Make>
+void check_set(const char* name, int count, bool counter_expected, Make make) {
+  std::vector<Outcome> out(static_cast<std::size_t>(count));
+  parallel_for(out.size(), [&](std::size_t i) {
+    std::mt19937_64 g(7000 + i);
+    std::uniform_real_distribution<double> un(0.0005, 0.001), ub(0.005, 0.01);
+    const double n = un(g), b = ub(g);
+    out[i] = judge(make(n, b, 7100 + i), n, b);
+  });
+  int accepted = 0, readout = 0, n_in = 0, b_in = 0, verdict_ok = 0;
+  for (const Outcome& o : out) {
+    accepted += o.accepted;
+    readout += o.counter == counter_expected;
+    n_in += o.n_in;
+    b_in += o.b_in;
+    verdict_ok += o.verdict_ok;
+  }
+  const double c = count;
+  std::printf("%s, %d records: fit accepted %d, read-out %s %d, N covered %.3f, B covered %.3f, verdict right or "
+              "P < 0.9 %d\n",
+              name, count, accepted, counter_expected ? "counter" : "white", readout, n_in / c, b_in / c, verdict_ok);
+  const double tol = 2.5 * std::sqrt(0.95 * 0.05 / c);
+  EXPECT_GE(accepted, std::floor(0.95 * c)) << name;
+  EXPECT_EQ(readout, count) << name;
+  EXPECT_NEAR(n_in / c, 0.95, tol) << name;
+  EXPECT_NEAR(b_in / c, 0.95, tol) << name;
+  EXPECT_EQ(verdict_ok, count) << name;
+}
+
+TEST(CounterReadout, SimulatorDefaultReadoutTwoHourRecords) {
+  check_set("simulate's default read-out, 2 h at 400 Hz", records(24), true,
+            [](double n, double b, std::uint64_t seed) { return simulator_record(n, b, 7200.0, seed); });
+}
+
+TEST(CounterReadout, IndependentGeneratorPlainCounter) {
+  check_set("frequency-domain generator, plain counter, 30 min at 400 Hz", records(40), true,
+            [](double n, double b, std::uint64_t seed) {
+              return independent_record(n, b, 1800.0, 400.0, false, seed);
+            });
+}
+
+TEST(CounterReadout, IndependentGeneratorDitheredCounter) {
+  check_set("frequency-domain generator, dithered counter, 30 min at 400 Hz", records(24), false,
+            [](double n, double b, std::uint64_t seed) {
+              return independent_record(n, b, 1800.0, 400.0, true, seed);
+            });
+}
+
+}  // namespace
+}  // namespace rwcalc
