@@ -28,7 +28,7 @@ namespace {
 constexpr double kQ = 0.92;  // GL-2D pulse weight, ″
 
 struct Outcome {
-  bool accepted = false, counter = false, n_in = false, b_in = false, verdict_ok = false;
+  bool accepted = false, counter = false, n_in = false, b_in = false, verdict_ok = false, k_resolved = false;
 };
 
 /// Rate noise per sample (″/s) of two-sided PSD psd(f) ((″/s)²/Hz): Gaussian Fourier coefficients of
@@ -90,23 +90,6 @@ Recording independent_record(double n, double b, double seconds, double rate_hz,
   return rec;
 }
 
-/// A record of rwcalc's simulator with its default read-out (the plain counter).
-Recording simulator_record(double n, double b, double seconds, std::uint64_t seed) {
-  NoiseModel m;
-  m.arw_deg_per_sqrt_h = n;
-  m.bias_instability_deg_per_h = b;
-  m.earth_rate_deg_per_h = earth_rate_at(55.75);
-  SimulationSettings s;
-  s.duration_s = seconds;
-  s.seed = seed;
-  Recording rec;
-  rec.source = "sim";
-  rec.phase = simulate(m, s);
-  rec.rate_hz = s.rate_hz;
-  rec.samples = rec.phase.points() - 1;
-  return rec;
-}
-
 Outcome judge(const Recording& rec, double n, double b) {
   const AnalysisOptions o;
   const AnalysisResult r = analyze(rec, o);
@@ -115,6 +98,7 @@ Outcome judge(const Recording& rec, double n, double b) {
   out.counter = r.fit.counter_readout;
   out.n_in = r.fit[Term::N].low <= n && n <= r.fit[Term::N].high;
   out.b_in = r.fit[Term::B].low <= b && b <= r.fit[Term::B].high;
+  out.k_resolved = r.fit[Term::K].resolved;  // the records have no rate random walk
   out.verdict_ok = test::true_class(b, n, o.verdict.table) == r.verdict.cls || r.verdict.p_class < 0.9;
   return out;
 }
@@ -135,29 +119,36 @@ void check_set(const char* name, int count, bool counter_expected, Make make) {
     const double n = un(g), b = ub(g);
     out[i] = judge(make(n, b, 7100 + i), n, b);
   });
-  int accepted = 0, readout = 0, n_in = 0, b_in = 0, verdict_ok = 0;
+  int accepted = 0, readout = 0, n_in = 0, b_in = 0, verdict_ok = 0, k_resolved = 0;
   for (const Outcome& o : out) {
     accepted += o.accepted;
     readout += o.counter == counter_expected;
     n_in += o.n_in;
     b_in += o.b_in;
     verdict_ok += o.verdict_ok;
+    k_resolved += o.k_resolved;
   }
   const double c = count;
   std::printf("%s, %d records: fit accepted %d, read-out %s %d, N covered %.3f, B covered %.3f, verdict right or "
-              "P < 0.9 %d\n",
-              name, count, accepted, counter_expected ? "counter" : "white", readout, n_in / c, b_in / c, verdict_ok);
+              "P < 0.9 %d, K resolved (none in the truth) %d\n",
+              name, count, accepted, counter_expected ? "counter" : "white", readout, n_in / c, b_in / c, verdict_ok,
+              k_resolved);
   const double tol = 2.5 * std::sqrt(0.95 * 0.05 / c);
   EXPECT_GE(accepted, std::floor(0.95 * c)) << name;
   EXPECT_EQ(readout, count) << name;
   EXPECT_NEAR(n_in / c, 0.95, tol) << name;
   EXPECT_NEAR(b_in / c, 0.95, tol) << name;
   EXPECT_EQ(verdict_ok, count) << name;
+  EXPECT_LE(k_resolved, std::max(1.0, 0.05 * c)) << name;
 }
 
 TEST(CounterReadout, SimulatorDefaultReadoutTwoHourRecords) {
   check_set("simulate's default read-out, 2 h at 400 Hz", records(24), true,
-            [](double n, double b, std::uint64_t seed) { return simulator_record(n, b, 7200.0, seed); });
+            [](double n, double b, std::uint64_t seed) {
+              SimulationSettings s;
+              s.seed = seed;
+              return test::simulated_gyro(n, b, s, ReadoutMode::Counting);
+            });
 }
 
 TEST(CounterReadout, IndependentGeneratorPlainCounter) {

@@ -263,6 +263,9 @@ std::vector<DirectPoint> block_points(const PhaseSeries& x, const std::vector<st
 /// A bootstrap standard deviation and the replicates it rests on.
 struct BootstrapSd {
   double sd = 0.0;
+  /// Semi-deviations below and above the replicates' mean, √(2·Σ(x − x̄)²/(count − 1)) over each
+  /// side: equal to sd for a symmetric spread.
+  double sd_below = 0.0, sd_above = 0.0;
   std::size_t count = 0;
 };
 
@@ -345,7 +348,11 @@ BootstrapSd bootstrap_n2_sd(const DirectNResult& r, const std::vector<std::size_
   for (std::size_t i = 0; i < n2s.size(); ++i)
     if (ok[i]) good.push_back(n2s[i]);
   if (good.size() < 8) return {};
-  return {std::sqrt(sample_variance(good)), good.size()};
+  double mean = 0, below = 0, above = 0;
+  for (double v : good) mean += v / static_cast<double>(good.size());
+  for (double v : good) (v < mean ? below : above) += 2.0 * (v - mean) * (v - mean);
+  const double dof = static_cast<double>(good.size() - 1);
+  return {std::sqrt(sample_variance(good)), std::sqrt(below / dof), std::sqrt(above / dof), good.size()};
 }
 
 }  // namespace
@@ -396,7 +403,11 @@ DirectNResult direct_n(const PhaseSeries& x, const MethodOptions& o, const FitRe
   e.valid = sd > 0;
   if (!e.valid) return r;
   const double t95 = boost::math::quantile(boost::math::students_t(static_cast<double>(bs.count - 1)), 0.975);
-  const double lo = beta[1] - t95 * sd, hi = beta[1] + t95 * sd;
+  // The basic bootstrap's orientation: a right-skewed estimate (N″² traded against B² on short
+  // records) puts the truth further below it than above, so the low end takes the upper
+  // semi-deviation and the high end the lower one. Symmetric ends (N″² ± t·sd) missed the truth on
+  // the high side only: 5 of 64 records at N = 0.00045 °/√h (docs/analysis.md).
+  const double lo = beta[1] - t95 * bs.sd_above, hi = beta[1] + t95 * bs.sd_below;
   e.high = hi > 0 ? std::sqrt(hi) / 60.0 : 0.0;
   e.resolved = lo > 0;
   e.low = e.resolved ? std::sqrt(lo) / 60.0 : 0.0;
