@@ -129,10 +129,11 @@ void check_set(const char* name, int count, bool counter_expected, Make make) {
     k_resolved += o.k_resolved;
   }
   const double c = count;
-  std::printf("%s, %d records: fit accepted %d, read-out %s %d, N covered %.3f, B covered %.3f, verdict right or "
-              "P < 0.9 %d, K resolved (none in the truth) %d\n",
-              name, count, accepted, counter_expected ? "counter" : "white", readout, n_in / c, b_in / c, verdict_ok,
-              k_resolved);
+  std::printf(
+      "%s, %d records: fit accepted %d, read-out %s %d, N covered %.3f, B covered %.3f, verdict right or "
+      "P < 0.9 %d, K resolved (none in the truth) %d\n",
+      name, count, accepted, counter_expected ? "counter" : "white", readout, n_in / c, b_in / c, verdict_ok,
+      k_resolved);
   const double tol = 2.5 * std::sqrt(0.95 * 0.05 / c);
   EXPECT_GE(accepted, std::floor(0.95 * c)) << name;
   EXPECT_EQ(readout, count) << name;
@@ -160,9 +161,7 @@ TEST(CounterReadout, IndependentGeneratorPlainCounter) {
 
 TEST(CounterReadout, IndependentGeneratorDitheredCounter) {
   check_set("frequency-domain generator, dithered counter, 30 min at 400 Hz", records(24), false,
-            [](double n, double b, std::uint64_t seed) {
-              return independent_record(n, b, 1800.0, 400.0, true, seed);
-            });
+            [](double n, double b, std::uint64_t seed) { return independent_record(n, b, 1800.0, 400.0, true, seed); });
 }
 
 }  // namespace

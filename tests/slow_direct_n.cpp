@@ -37,9 +37,10 @@ TEST(DirectN, CoverageAtTheSmallestNWithTheGl2dReadout) {
   int hits = 0, low_misses = 0;
   for (std::size_t i = 0; i < in.size(); ++i) hits += in[i], low_misses += below[i];
   const double c = count, cover = hits / c;
-  std::printf("direct N at %g deg/sqrt(h), %d records: interval holds the truth in %.3f (%d of the %d misses "
-              "with the truth below the interval)\n",
-              kN, count, cover, low_misses, count - hits);
+  std::printf(
+      "direct N at %g deg/sqrt(h), %d records: interval holds the truth in %.3f (%d of the %d misses "
+      "with the truth below the interval)\n",
+      kN, count, cover, low_misses, count - hits);
   EXPECT_NEAR(cover, 0.95, std::max(0.02, 2.5 * std::sqrt(0.95 * 0.05 / c)));
 }
 

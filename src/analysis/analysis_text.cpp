@@ -58,9 +58,10 @@ std::string format_segments(const AnalysisResult& r) {
     lengths += fmt::format("{}{:.1f}", lengths.empty() ? "" : ", ", static_cast<double>(g.samples) / r.rate_hz);
     if (g.gap_s > 0) gaps += trf("{}{:.6g} s before line {}", gaps.empty() ? "" : ", ", g.gap_s, g.line);
   }
-  return trf("  segments: {} (split at the time column's gaps by --gaps segments: {}; lengths {} s); the Allan "
-             "variance pools them (no difference spans a gap), the cross-checks use the longest\n",
-             r.segments.size(), gaps, lengths);
+  return trf(
+      "  segments: {} (split at the time column's gaps by --gaps segments: {}; lengths {} s); the Allan "
+      "variance pools them (no difference spans a gap), the cross-checks use the longest\n",
+      r.segments.size(), gaps, lengths);
 }
 namespace {
 

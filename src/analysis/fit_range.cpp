@@ -7,9 +7,9 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cmath>
 #include <map>
 #include <numeric>
-#include <cmath>
 
 #include "model/output_filter.hpp"
 #include "rwcalc/confidence.hpp"
@@ -69,8 +69,9 @@ double filter_time_constant(const FitResult& f, double tau0, double measured) {
 /// The file name as a shell word (quoted when it holds anything beyond [A-Za-z0-9/._+,-]).
 std::string shell_word(const std::string& path) {
   const std::string p = printable(path);
-  const bool plain = !p.empty() && p.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
-                                                       "0123456789/._+,-") == std::string::npos;
+  const bool plain = !p.empty() && p.find_first_not_of(
+                                       "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
+                                       "0123456789/._+,-") == std::string::npos;
   if (plain) return p;
   std::string q = "'";
   for (const char ch : p) q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
@@ -239,7 +240,8 @@ bool white_phase_leads(const FitResult& fit, double tau_s) {
 
 /// measured_variance_ratio of each octave that holds a point where white phase noise leads, the
 /// octaves in parallel.
-std::map<std::int64_t, double> white_phase_ratios(const AllanResult& allan, const FitResult& fit, const PhaseSeries& x) {
+std::map<std::int64_t, double> white_phase_ratios(const AllanResult& allan, const FitResult& fit,
+                                                  const PhaseSeries& x) {
   std::vector<std::int64_t> octaves;
   for (const AllanPoint& p : allan.points)
     if (white_phase_leads(fit, p.tau_s) && (octaves.empty() || octaves.back() != octave_of(p.m)))
@@ -256,7 +258,8 @@ std::map<std::int64_t, double> white_phase_ratios(const AllanResult& allan, cons
 bool apply_model_bounds(AllanResult& allan, const FitResult& fit, const PhaseSeries* x) {
   if (allan.estimator != Estimator::Overlapping || allan.points.empty()) return false;
   const std::vector<FitPoint> pts = fit_points(allan);
-  const std::map<std::int64_t, double> ratio = x ? white_phase_ratios(allan, fit, *x) : std::map<std::int64_t, double>{};
+  const std::map<std::int64_t, double> ratio =
+      x ? white_phase_ratios(allan, fit, *x) : std::map<std::int64_t, double>{};
   for (std::size_t i = 0; i < allan.points.size(); ++i) {
     AllanPoint& p = allan.points[i];
     const double model = fit.model_var(p.tau_s);
@@ -269,8 +272,9 @@ bool apply_model_bounds(AllanResult& allan, const FitResult& fit, const PhaseSer
     int leading = 0;
     double largest = -1;
     for (int t = 0; t < kTermCount; ++t) {
-      const double part = t == static_cast<int>(Term::Q) ? fit.readout_var(p.tau_s)
-                                                         : fit.c[t] * term_basis(kAllTerms[static_cast<std::size_t>(t)], p.tau_s);
+      const double part = t == static_cast<int>(Term::Q)
+                              ? fit.readout_var(p.tau_s)
+                              : fit.c[t] * term_basis(kAllTerms[static_cast<std::size_t>(t)], p.tau_s);
       if (part > largest) largest = part, leading = t;
     }
     p.alpha = kTermAlpha[leading];
@@ -345,8 +349,8 @@ std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r) {
                      "spectrum) is not in the five-term model: its Allan variance, computed from the spectrum's "
                      "excess over the local level, is taken off the octave points before the fit (it was "
                      "{:.0f} % of the AV at {:g} s).",
-                     line.f_hz, line.rms * si.factor, localized_label(si), line.peak_ratio,
-                     100.0 * line.max_share, line.tau_at_max_s),
+                     line.f_hz, line.rms * si.factor, localized_label(si), line.peak_ratio, 100.0 * line.max_share,
+                     line.tau_at_max_s),
                  ""});
   }
   if (fr.line_points_left_out > 0)

@@ -44,16 +44,17 @@ struct CounterPart {
   std::vector<std::int64_t> m;  // cluster sizes of the points
   [[nodiscard]] Eigen::VectorXd at(const Vec5& c) const {
     Eigen::VectorXd v(static_cast<Eigen::Index>(m.size()));
-    for (std::size_t r = 0; r < m.size(); ++r) v[static_cast<Eigen::Index>(r)] = counter_avar(counter, m[r], jitter_of(c));
+    for (std::size_t r = 0; r < m.size(); ++r)
+      v[static_cast<Eigen::Index>(r)] = counter_avar(counter, m[r], jitter_of(c));
     return v;
   }
 };
 
 /// The problem in scaled parameters d = c / scale (columns of comparable size).
 struct Problem {
-  Eigen::MatrixXd g;   // J×P: basis_i(τ_j)·scale_i
-  Eigen::VectorXd y;   // observed σ²
-  Eigen::VectorXd nu;  // effective EDF
+  Eigen::MatrixXd g;       // J×P: basis_i(τ_j)·scale_i
+  Eigen::VectorXd y;       // observed σ²
+  Eigen::VectorXd nu;      // effective EDF
   Eigen::VectorXd offset;  // the part of the model linearised away (see linearised); 0 for the five terms
   std::shared_ptr<const CounterPart> counter;  // the counter read-out (FitOptions::readout), or none
   Vec5 scale = Vec5::Ones();
@@ -747,9 +748,7 @@ double FitResult::readout_var(double tau_s) const {
   return c[idx(Term::Q)] * term_basis(Term::Q, tau_s) + counter_var(tau_s);
 }
 
-Eigen::Matrix<double, kTermCount, 1> FitResult::covariance_c() const {
-  return covariance_terms(c, options);
-}
+Eigen::Matrix<double, kTermCount, 1> FitResult::covariance_c() const { return covariance_terms(c, options); }
 
 double FitResult::log_correlation(Term a, Term b) const {
   const double va = cov_c(idx(a), idx(a));
@@ -809,8 +808,7 @@ FitResult fit_given(std::span<const FitPoint> points, const FitOptions& options)
   const Stage full = fit_full_model(res.used, options, res.model_covariance, opt);
   Eigen::MatrixXd sigma_y;
   if (res.model_covariance)
-    sigma_y = point_covariance(res.used, covariance_terms(full.coefficients(), options), full.model(),
-                               opt.edf_cap);
+    sigma_y = point_covariance(res.used, covariance_terms(full.coefficients(), options), full.model(), opt.edf_cap);
 
   // Inflation of every enabled term in the full model (at the boundary too).
   std::vector<int> full_set;

@@ -291,7 +291,7 @@ std::uint64_t bootstrap_seed(const std::vector<DirectPoint>& pts) {
 /// overlapping variances computed there; the white-angle part, whose sampling noise at the data's
 /// stride is tiny, enters per point as its expectation plus a normal with its exact variance.
 BootstrapSd bootstrap_n2_sd(const DirectNResult& r, const std::vector<std::size_t>& ts, std::size_t base, double tau0,
-                           std::size_t n, int replicates) {
+                            std::size_t n, int replicates) {
   const double step = static_cast<double>(base) * tau0;
   const std::size_t nb = n / base;
   const double q2 = std::max(0.0, r.q2_arcsec2), n2 = std::max(0.0, r.n2_arcsec2_per_s);
@@ -431,7 +431,8 @@ void attach_straight_line_bias(DirectNResult& r, const FitResult& fit, double du
   for (auto& p : expected) {
     const auto t = static_cast<std::size_t>(std::llround(p.t_s / tau0_s));
     const IncrementBasis g = increment_basis(t, points, tau0_s, false);
-    p.var_arcsec2 = g.q * fit.c[0] + g.n * fit.c[1] + g.b * fit.c[2] + fit.counter_increment_var(static_cast<std::int64_t>(t));
+    p.var_arcsec2 =
+        g.q * fit.c[0] + g.n * fit.c[1] + g.b * fit.c[2] + fit.counter_increment_var(static_cast<std::int64_t>(t));
   }
   double a = 0, b = 0;
   if (fit_straight(expected, a, b) && b > 0) sl.bias_factor = std::sqrt(b / n2);
