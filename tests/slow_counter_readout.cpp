@@ -8,6 +8,7 @@
 
 #include <unsupported/Eigen/FFT>
 
+#include <array>
 #include <cmath>
 #include <complex>
 #include <cstdint>
@@ -29,6 +30,8 @@ constexpr double kQ = 0.92;  // GL-2D pulse weight, ″
 
 struct Outcome {
   bool accepted = false, counter = false, n_in = false, b_in = false, verdict_ok = false, k_resolved = false;
+  double p_class = 0;  // stated probability of the overall class
+  bool class_right = false;
 };
 
 /// Rate noise per sample (″/s) of two-sided PSD psd(f) ((″/s)²/Hz): Gaussian Fourier coefficients of
@@ -99,7 +102,9 @@ Outcome judge(const Recording& rec, double n, double b) {
   out.n_in = r.fit[Term::N].low <= n && n <= r.fit[Term::N].high;
   out.b_in = r.fit[Term::B].low <= b && b <= r.fit[Term::B].high;
   out.k_resolved = r.fit[Term::K].resolved;  // the records have no rate random walk
-  out.verdict_ok = test::true_class(b, n, o.verdict.table) == r.verdict.cls || r.verdict.p_class < 0.9;
+  out.class_right = test::true_class(b, n, o.verdict.table) == r.verdict.cls;
+  out.p_class = r.verdict.p_class;
+  out.verdict_ok = out.class_right || r.verdict.p_class < 0.9;
   return out;
 }
 
@@ -162,6 +167,34 @@ TEST(CounterReadout, IndependentGeneratorPlainCounter) {
 TEST(CounterReadout, IndependentGeneratorDitheredCounter) {
   check_set("frequency-domain generator, dithered counter, 30 min at 400 Hz", records(24), false,
             [](double n, double b, std::uint64_t seed) { return independent_record(n, b, 1800.0, 400.0, true, seed); });
+}
+
+// Class probabilities over gyros spread across the class range (N log-uniform in 0.0003–0.004 °/√h,
+// B in 0.003–0.02 °/h), plain counter: in every bin of stated probability with at least 30
+// statements the share right is within 0.07 of the mean stated probability.
+// RWCALC_COUNTER_CALIBRATION_RECORDS sets the count (default 60).
+TEST(CounterReadout, ClassProbabilitiesAcrossTheClassRange) {
+  const char* e = std::getenv("RWCALC_COUNTER_CALIBRATION_RECORDS");
+  const int count = e ? std::max(8, std::atoi(e)) : 60;
+  std::vector<Outcome> out(static_cast<std::size_t>(count));
+  parallel_for(out.size(), [&](std::size_t i) {
+    std::mt19937_64 g(9000 + i);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const double n = 0.0003 * std::pow(0.004 / 0.0003, u(g)), b = 0.003 * std::pow(0.02 / 0.003, u(g));
+    out[i] = judge(independent_record(n, b, 1800.0, 400.0, false, 9100 + i), n, b);
+  });
+  const std::array<double, 5> edges{0.0, 0.5, 0.7, 0.9, 1.0001};
+  for (std::size_t k = 0; k + 1 < edges.size(); ++k) {
+    int cnt = 0, hit = 0;
+    double ps = 0;
+    for (const Outcome& o : out)
+      if (o.p_class >= edges[k] && o.p_class < edges[k + 1]) ++cnt, ps += o.p_class, hit += o.class_right;
+    if (cnt == 0) continue;
+    const double pm = ps / cnt, share = static_cast<double>(hit) / cnt;
+    std::printf("class probabilities, %d records: stated %.2f..%.2f: %d statements, mean P %.3f, share right %.3f\n",
+                count, edges[k], std::min(edges[k + 1], 1.0), cnt, pm, share);
+    if (cnt >= 30) EXPECT_NEAR(share, pm, 0.07) << "bin " << k;
+  }
 }
 
 }  // namespace
