@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "rwcalc/allan.hpp"
+#include "rwcalc/counter_readout.hpp"
 
 namespace rwcalc {
 
@@ -42,6 +43,13 @@ struct FitPoint {
   std::int64_t terms = 0;  ///< second differences in the overlapping estimator (0: unknown)
 };
 
+/// How the pulses of a record were counted (FitOptions::readout).
+enum class Readout {
+  Auto,     ///< pulse counts: the counter model and the white one both fitted, the better kept
+  Counter,  ///< a plain counter: its read-out AV (counter_readout.hpp) plus a white angle term Q
+  White,    ///< white angle noise only (dithered or randomised read-out, floating data): Q alone
+};
+
 struct FitOptions {
   double tau_min_s = 0;                                        ///< fit range, s (inclusive)
   double tau_max_s = std::numeric_limits<double>::infinity();  ///< fit range, s (inclusive)
@@ -59,6 +67,9 @@ struct FitOptions {
   /// quantile; a dropped term is reported as the full model's upper bound. N, B: never dropped.
   bool select_terms = true;
   std::array<bool, kTermCount> droppable{true, false, false, true, true};
+  /// The record's counter (pulse counts only); without it the read-out is white (Q).
+  std::optional<CounterReadout> counter;
+  Readout readout = Readout::Auto;  ///< with `counter`: which read-out model
 };
 
 /// One fitted coefficient in its IEEE unit (see term_unit).
@@ -90,10 +101,23 @@ struct FitResult {
   FitOptions options;
   std::vector<FitPoint> used;  ///< the points fitted (τ ascending; edf = the EDF the fit used)
   std::vector<double> model;   ///< model σ² at those points, (°/h)²
+  /// The counter read-out's AV is part of the model (Q is then the white angle noise beyond it);
+  /// false: the read-out is the white term Q.
+  bool counter_readout = false;
 
   [[nodiscard]] const Coefficient& operator[](Term t) const { return coef[static_cast<int>(t)]; }
   /// Model σ² at τ (s), (°/h)².
   [[nodiscard]] double model_var(double tau_s) const;
+  /// The counter read-out's part of model_var at τ (s), (°/h)² (0 unless counter_readout).
+  [[nodiscard]] double counter_var(double tau_s) const;
+  /// The counter read-out's part of the variance of angle increments over h samples, ″² (0 unless
+  /// counter_readout; counter_increment_var).
+  [[nodiscard]] double counter_increment_var(std::int64_t h) const;
+  /// The read-out's part of model_var at τ (s): the white angle term Q and the counter's, (°/h)².
+  [[nodiscard]] double readout_var(double tau_s) const;
+  /// `c` with a counter read-out counted as white angle noise of its mean level q²/12: the
+  /// coefficients whose Gaussian AV covariance (av_covariance) stands for the points' variance.
+  [[nodiscard]] Eigen::Matrix<double, kTermCount, 1> covariance_c() const;
   /// Confidence distribution of a coefficient: P(true value ≤ `value`, IEEE unit) = Φ(sign·√(ΔD/φ))
   /// from the scaled profile deviance; cdf(low) = (1−conf)/2 and cdf(high) = (1+conf)/2.
   [[nodiscard]] double cdf(Term t, double value) const;

@@ -69,7 +69,9 @@ struct DirectNResult {
 };
 
 /// Direct N of a phase series in ″. Invalid (not thrown) when fewer than four lengths fit.
-DirectNResult direct_n(const PhaseSeries& x, const MethodOptions& options = {});
+/// `fit` (optional): the AV fit, whose counter read-out (FitResult::counter_readout) is taken off
+/// the increment variances.
+DirectNResult direct_n(const PhaseSeries& x, const MethodOptions& options = {}, const FitResult* fit = nullptr);
 
 /// Fills the straight line's bias factor from the fitted Q, N, B.
 void attach_straight_line_bias(DirectNResult& r, const FitResult& fit, double duration_s, double tau0_s);

@@ -304,6 +304,10 @@ void fit_with_checks(const std::vector<FitPoint>& all_points, const PhaseSeries&
   const std::vector<FitPoint> points =
       options.fit_checks && !exact_counts ? without_spectral_lines(all_points, x, r.fit_range) : all_points;
   FitOptions fopt = options.fit;
+  if (exact_counts && x.points() > 1)  // the counter's read-out, from the record's mean rate
+    fopt.counter =
+        CounterReadout{static_cast<double>(x.count(x.points() - 1) - x.count(0)) / static_cast<double>(x.points() - 1),
+                       x.arcsec_per_count, x.tau0_s, x.points()};
   FitRangeChoice& range = r.fit_range;
   const bool default_range = fopt.tau_min_s == 0 && std::isinf(fopt.tau_max_s);
   if (options.fit_range_given || !default_range) {
@@ -373,7 +377,7 @@ void require_noise(const Recording& rec) {
 /// with its bias factor) and their discrepancies from the fit; the raw spread of 100-s means
 /// beside its expectation under the fit.
 void cross_checks(const PhaseSeries& x, const AnalysisOptions& options, AnalysisResult& r) {
-  r.direct = direct_n(x, options.methods);
+  r.direct = direct_n(x, options.methods, &r.fit);
   attach_straight_line_bias(r.direct, r.fit, x.duration_s(), x.tau0_s);
   r.b100 = b_from_averages(x, r.fit, options.methods.block_s);
   r.b_min = b_from_minimum(r.allan, r.slope, r.fit);
@@ -472,6 +476,9 @@ json fit_json(const AnalysisResult& r) {
           {"phi_N", f.phi[static_cast<std::size_t>(Term::N)]},
           {"phi_B", f.phi[static_cast<std::size_t>(Term::B)]},
           {"confidence", f.options.confidence},
+          {"readout", !f.options.counter  ? "floating"
+                      : f.counter_readout ? "counter"
+                                          : "white"},
           {"range",
            {{"tau_min_s", r.fit_range.tau_min_s},
             {"tau_max_s", std::isinf(r.fit_range.tau_max_s) ? json(nullptr) : json(r.fit_range.tau_max_s)},
@@ -612,14 +619,16 @@ nlohmann::json to_json(const AnalysisResult& r) {
 
 nlohmann::json segments_json(const AnalysisResult& r) {
   if (r.segments.size() < 2) return nullptr;
-  nlohmann::json samples = nlohmann::json::array(), durations = nlohmann::json::array(),
-                 gaps = nlohmann::json::array();
+  nlohmann::json samples = nlohmann::json::array(), durations = nlohmann::json::array(), gaps = nlohmann::json::array();
   for (const auto& g : r.segments) {
     samples.push_back(g.samples);
     durations.push_back(static_cast<double>(g.samples) / r.rate_hz);
     if (g.gap_s > 0) gaps.push_back({{"line", g.line}, {"missing_s", g.gap_s}, {"before_sample", g.first}});
   }
-  return {{"count", r.segments.size()}, {"samples", samples}, {"durations_s", durations}, {"gaps", gaps},
+  return {{"count", r.segments.size()},
+          {"samples", samples},
+          {"durations_s", durations},
+          {"gaps", gaps},
           {"allan", "pooled over the segments: no difference spans a gap; EDF the sum of the segments'"},
           {"cross_checks", "on the longest segment"}};
 }

@@ -137,6 +137,12 @@ std::string format_report(const AnalysisResult& r) {
           r.fit_range.intervals_scaled ? trf(", scaled by sqrt(chi2/dof) = {:.3g}", r.fit_range.interval_scale)
                                        : std::string());
   s += trf("  fit range: {}\n", r.fit_range.reason());
+  if (f.options.counter)
+    s += f.counter_readout
+             ? trf("  read-out: a plain counter (its Allan variance from the mean rate, {:.6g} pulses per sample, "
+                   "and the pulse weight; Q is white angle noise beyond it)\n",
+                   f.options.counter->pulses_per_sample)
+             : tr("  read-out: white angle noise Q (a dithered or randomised counter)\n");
   for (const Term t : kAllTerms)
     s += coef_line(f[t], term_name(t),
                    tr(std::array{N_("arcsec"), N_("°/√h"), N_("°/h"), N_("°/h/√h"),

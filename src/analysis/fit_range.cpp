@@ -249,7 +249,7 @@ std::int64_t octave_of(std::int64_t m) {
 
 /// Whether white phase noise carries at least half of σ²_model at τ.
 bool white_phase_leads(const FitResult& fit, double tau_s) {
-  return fit.c[static_cast<int>(Term::Q)] * term_basis(Term::Q, tau_s) >= 0.5 * fit.model_var(tau_s);
+  return fit.readout_var(tau_s) >= 0.5 * fit.model_var(tau_s);
 }
 
 /// measured_variance_ratio of each octave that holds a point where white phase noise leads, the
@@ -278,7 +278,7 @@ bool apply_model_bounds(AllanResult& allan, const FitResult& fit, const PhaseSer
     AllanPoint& p = allan.points[i];
     const double model = fit.model_var(p.tau_s);
     // One point at a time: a dense grid would not fit a full covariance matrix in memory.
-    double var = av_covariance(std::span(&pts[i], 1), fit.c, true)(0, 0);
+    double var = av_covariance(std::span(&pts[i], 1), fit.covariance_c(), true)(0, 0);
     // Where white phase noise leads, its read-out's non-Gaussian errors set the variance.
     if (x && white_phase_leads(fit, p.tau_s)) var *= ratio.at(octave_of(p.m));
     if (!(model > 0) || !(var > 0)) continue;
@@ -286,7 +286,9 @@ bool apply_model_bounds(AllanResult& allan, const FitResult& fit, const PhaseSer
     int leading = 0;
     double largest = -1;
     for (int t = 0; t < kTermCount; ++t) {
-      const double part = fit.c[t] * term_basis(kAllTerms[static_cast<std::size_t>(t)], p.tau_s);
+      const double part = t == static_cast<int>(Term::Q)
+                              ? fit.readout_var(p.tau_s)
+                              : fit.c[t] * term_basis(kAllTerms[static_cast<std::size_t>(t)], p.tau_s);
       if (part > largest) largest = part, leading = t;
     }
     p.alpha = kTermAlpha[leading];

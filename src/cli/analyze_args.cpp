@@ -67,6 +67,11 @@ void AnalyzeArgs::add_to(CLI::App& app) {
                tr("Keep every fitted term in the model (default: K, R, Q not supported by the data are "
                   "left out and reported as upper bounds)"))
       ->group(tr("Fit"));
+  app.add_option("--readout", readout,
+                 tr("Read-out model of pulse counts: auto (the better of the two), counter (a plain counter's "
+                    "sawtooth plus white angle noise Q) or white (Q alone: a dithered counter)"))
+      ->capture_default_str()
+      ->group(tr("Fit"));
   app.add_option("--tau", tau,
                  tr("Tau grid of the reported Allan deviation: octave, decade, dense[:P] (P per decade, default 20, "
                     "up to N/10), all, or a list of seconds; the fit always uses the octave points"))
@@ -129,6 +134,14 @@ AnalysisOptions AnalyzeArgs::options() const {
   if (!o.fit.enabled[1] || !o.fit.enabled[2])
     throw UsageError(tr("--terms must include N and B (the verdict needs both)"));
   o.fit.select_terms = !keep_all_terms;
+  if (readout == "auto")
+    o.fit.readout = Readout::Auto;
+  else if (readout == "counter")
+    o.fit.readout = Readout::Counter;
+  else if (readout == "white")
+    o.fit.readout = Readout::White;
+  else
+    throw UsageError(trf("--readout: unknown read-out '{}' (use auto, counter or white)", readout));
   o.latitude_deg = latitude_deg;
   o.earth_rate_deg_per_h = earth_rate;
   // Asked for: the Earth rate by --vertical, --earth-rate or --latitude; the verdict by --vertical or

@@ -21,6 +21,7 @@ struct AnalyzeArgs {
   double min_edf = 1.0;
   std::string terms = "QNBKR";
   bool keep_all_terms = false;
+  std::string readout = "auto";  ///< --readout: auto, counter or white (FitOptions::readout)
   double latitude_deg = 55.75;
   std::optional<double> earth_rate;
   bool vertical = false;                         ///< --vertical: Earth rate and class verdict for any input

@@ -11,6 +11,7 @@
 #include <boost/math/distributions/normal.hpp>
 #include <boost/math/special_functions/digamma.hpp>
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <tuple>
 #include <utility>
@@ -33,11 +34,29 @@ constexpr std::array<double, P> kCoefScale{1.0, 1.0 / 60.0, 1.0, 60.0, 3600.0};
 
 int idx(Term t) { return static_cast<int>(t); }
 
+/// The terms that jitter the angle about its mean-rate line (counter_readout.hpp).
+AngleJitter jitter_of(const Vec5& c) { return {c[idx(Term::Q)], c[idx(Term::N)], c[idx(Term::B)]}; }
+
+/// A counter's read-out AV at the points: not a linear term, as the angle's jitter (from Q, N, B)
+/// smooths its sawtooth.
+struct CounterPart {
+  CounterReadout counter;
+  std::vector<std::int64_t> m;  // cluster sizes of the points
+  [[nodiscard]] Eigen::VectorXd at(const Vec5& c) const {
+    Eigen::VectorXd v(static_cast<Eigen::Index>(m.size()));
+    for (std::size_t r = 0; r < m.size(); ++r)
+      v[static_cast<Eigen::Index>(r)] = counter_avar(counter, m[r], jitter_of(c));
+    return v;
+  }
+};
+
 /// The problem in scaled parameters d = c / scale (columns of comparable size).
 struct Problem {
-  Eigen::MatrixXd g;   // J×P: basis_i(τ_j)·scale_i
-  Eigen::VectorXd y;   // observed σ²
-  Eigen::VectorXd nu;  // effective EDF
+  Eigen::MatrixXd g;       // J×P: basis_i(τ_j)·scale_i
+  Eigen::VectorXd y;       // observed σ²
+  Eigen::VectorXd nu;      // effective EDF
+  Eigen::VectorXd offset;  // the part of the model linearised away (see linearised); 0 for the five terms
+  std::shared_ptr<const CounterPart> counter;  // the counter read-out (FitOptions::readout), or none
   Vec5 scale = Vec5::Ones();
   unsigned enabled_mask = 0;
 };
@@ -48,6 +67,13 @@ Problem make_problem(std::span<const FitPoint> pts, const FitOptions& o) {
   pr.g.resize(j, P);
   pr.y.resize(j);
   pr.nu.resize(j);
+  pr.offset = Eigen::VectorXd::Zero(j);
+  if (o.counter && o.readout == Readout::Counter) {
+    auto part = std::make_shared<CounterPart>();
+    part->counter = *o.counter;
+    for (const FitPoint& p : pts) part->m.push_back(p.m > 0 ? p.m : std::llround(p.tau_s / o.counter->tau0_s));
+    pr.counter = std::move(part);
+  }
   for (Eigen::Index r = 0; r < j; ++r) {
     const auto& p = pts[static_cast<std::size_t>(r)];
     pr.y[r] = p.var;
@@ -62,6 +88,51 @@ Problem make_problem(std::span<const FitPoint> pts, const FitOptions& o) {
     pr.g.col(i) *= pr.scale[i];
   }
   return pr;
+}
+
+/// Model σ² at the points: the linear terms plus the counter's read-out.
+Eigen::VectorXd mean_of(const Problem& pr, const Vec5& d) {
+  Eigen::VectorXd mu = pr.g * d + pr.offset;
+  if (pr.counter) mu += pr.counter->at(d.cwiseProduct(pr.scale));
+  return mu;
+}
+
+/// The design at d: the basis plus the counter read-out's derivatives (forward differences in the
+/// jitter's terms Q, N, B; its AV is smooth in them).
+Eigen::MatrixXd design_at(const Problem& pr, const Vec5& d) {
+  if (!pr.counter) return pr.g;
+  Eigen::MatrixXd g = pr.g;
+  const Eigen::VectorXd k0 = pr.counter->at(d.cwiseProduct(pr.scale));
+  for (const Term t : {Term::Q, Term::N, Term::B}) {
+    const int i = idx(t);
+    Vec5 dh = d;
+    const double h = 1e-5 * std::max(d[i], 1e-3);
+    dh[i] += h;
+    g.col(i) += (pr.counter->at(dh.cwiseProduct(pr.scale)) - k0) / h;
+  }
+  return g;
+}
+
+/// The counter's AV is computed for the flicker's mean jitter, but a record holds one realisation
+/// of its slow wander, which leaves a partly smoothed sawtooth (τ ≈ 1–60 s on a GL-2D-like record)
+/// higher or lower: half the change of the counter's AV between no flicker jitter and twice it is
+/// taken as that model error's standard deviation, (°/h)².
+Eigen::VectorXd wander_error(const Problem& pr, const Vec5& d) {
+  if (!pr.counter) return Eigen::VectorXd::Zero(pr.y.size());
+  Vec5 none = d.cwiseProduct(pr.scale), twice = none;
+  none[idx(Term::B)] = 0;
+  twice[idx(Term::B)] *= 2;
+  return 0.5 * (pr.counter->at(twice) - pr.counter->at(none)).cwiseAbs();
+}
+
+/// The problem linearised at d (a Gauss–Newton step of the counter's part): μ ≈ G'·d' + offset'.
+Problem linearised(const Problem& pr, const Vec5& d) {
+  if (!pr.counter) return pr;
+  Problem lin = pr;
+  lin.g = design_at(pr, d);
+  lin.offset = mean_of(pr, d) - lin.g * d;
+  lin.counter.reset();
+  return lin;
 }
 
 double deviance(const Problem& pr, const Eigen::VectorXd& mu) {
@@ -115,7 +186,7 @@ Vec5 nnls(const Problem& pr, const Eigen::VectorXd& w, unsigned free_mask, const
   Vec5 fixed = base;
   for (int i = 0; i < P; ++i)
     if (free_mask & (1u << i)) fixed[i] = 0;
-  const Eigen::VectorXd target = pr.y - pr.g * fixed;
+  const Eigen::VectorXd target = pr.y - pr.offset - pr.g * fixed;
   const Eigen::MatrixXd gw = pr.g.array().colwise() * w.array();
   const Mat5 a = pr.g.transpose() * gw;
   const Vec5 b = gw.transpose() * target;
@@ -145,33 +216,33 @@ struct IrlsResult {
 IrlsResult irls(const Problem& pr, unsigned free_mask, const Vec5& start, bool from_data) {
   IrlsResult res;
   Vec5 d = start;
-  Eigen::VectorXd mu = pr.g * d;
+  Eigen::VectorXd mu = mean_of(pr, d);
   double dev = from_data ? kInf : deviance(pr, mu);
   if (!std::isfinite(dev)) {
     const Eigen::VectorXd w = pr.nu.array() / pr.y.array().square();
-    d = nnls(pr, w, free_mask, start);
-    mu = pr.g * d;
+    d = nnls(linearised(pr, start), w, free_mask, start);
+    mu = mean_of(pr, d);
     dev = deviance(pr, mu);
     if (!std::isfinite(dev)) {
       // Positive start on the free terms, so that every model point is positive.
       for (int i = 0; i < P; ++i)
         if (free_mask & (1u << i)) d[i] = std::max(d[i], 1e-3);
-      mu = pr.g * d;
+      mu = mean_of(pr, d);
       dev = deviance(pr, mu);
     }
   }
   int it = 0;
   for (; it < 300 && std::isfinite(dev); ++it) {
     const Eigen::VectorXd w = pr.nu.array() / mu.array().square();
-    const Vec5 d_new = nnls(pr, w, free_mask, d);
+    const Vec5 d_new = nnls(linearised(pr, d), w, free_mask, d);
     double step = 1.0;
     Vec5 d_try = d_new;
-    Eigen::VectorXd mu_try = pr.g * d_try;
+    Eigen::VectorXd mu_try = mean_of(pr, d_try);
     double dev_try = deviance(pr, mu_try);
     for (int h = 0; h < 50 && !(dev_try <= dev); ++h) {
       step *= 0.5;
       d_try = d + step * (d_new - d);
-      mu_try = pr.g * d_try;
+      mu_try = mean_of(pr, d_try);
       dev_try = deviance(pr, mu_try);
     }
     if (!(dev_try <= dev)) break;
@@ -270,9 +341,10 @@ Sandwich sandwich(const Problem& pr, const Vec5& d, const std::vector<int>& set,
   Sandwich sw;
   const auto k = static_cast<Eigen::Index>(set.size());
   if (k == 0) return sw;
-  const Eigen::VectorXd mu = pr.g * d;
+  const Eigen::VectorXd mu = mean_of(pr, d);
+  const Eigen::MatrixXd design = design_at(pr, d);
   Eigen::MatrixXd g(pr.g.rows(), k);
-  for (Eigen::Index q = 0; q < k; ++q) g.col(q) = pr.g.col(set[static_cast<std::size_t>(q)]);
+  for (Eigen::Index q = 0; q < k; ++q) g.col(q) = design.col(set[static_cast<std::size_t>(q)]);
   const Eigen::VectorXd w = pr.nu.array() / (2.0 * mu.array().square());
   const Eigen::MatrixXd gw = g.array().colwise() * w.array();
   const Eigen::MatrixXd info = g.transpose() * gw;
@@ -428,12 +500,20 @@ double point_pair_covariance(const FitPoint& a, const FitPoint& b, const Structu
   return 2.0 * total / (4.0 * a.tau_s * a.tau_s * b.tau_s * b.tau_s * pp.na * pp.nb);
 }
 
+/// The coefficients whose Gaussian covariance stands for the points' sampling variance: a counter's
+/// read-out error counts as white angle noise of its mean level q²/12 (its sawtooth varies less,
+/// its blurred part as much).
+Vec5 covariance_terms(Vec5 c, const FitOptions& o) {
+  if (o.counter && o.readout == Readout::Counter) c[idx(Term::Q)] += o.counter->q_arcsec * o.counter->q_arcsec / 12.0;
+  return c;
+}
+
 /// One fitted problem: its design and the IRLS optimum.
 struct Stage {
   Problem pr;
   IrlsResult fit;
   [[nodiscard]] Vec5 coefficients() const { return fit.d.cwiseProduct(pr.scale); }
-  [[nodiscard]] Eigen::VectorXd model() const { return pr.g * fit.d; }
+  [[nodiscard]] Eigen::VectorXd model() const { return mean_of(pr, fit.d); }
 };
 
 void require_converged(const IrlsResult& r) {
@@ -480,9 +560,11 @@ Stage fit_full_model(std::vector<FitPoint>& used, const FitOptions& options, boo
   if (use_cov) {
     const Vec5 c0 = full.coefficients();
     const Eigen::VectorXd mu0 = full.model();
-    const Eigen::MatrixXd cov0 = av_covariance(used, c0, true);  // only its diagonal is used
+    const Eigen::MatrixXd cov0 = av_covariance(used, covariance_terms(c0, options), true);  // its diagonal
+    const Eigen::VectorXd wander = wander_error(full.pr, full.fit.d);
     for (std::size_t r = 0; r < used.size(); ++r) {
-      const double v = cov0(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(r));
+      const auto er = static_cast<Eigen::Index>(r);
+      const double v = cov0(er, er) + wander[er] * wander[er];
       if (v > 0 && std::isfinite(v))
         used[r].edf = 2.0 * mu0[static_cast<Eigen::Index>(r)] * mu0[static_cast<Eigen::Index>(r)] / v;
     }
@@ -647,10 +729,26 @@ std::vector<FitPoint> fit_points(const AllanResult& allan) {
 }
 
 double FitResult::model_var(double tau_s) const {
-  double v = 0;
+  double v = counter_var(tau_s);
   for (int i = 0; i < P; ++i) v += c[i] * term_basis(kAllTerms[static_cast<std::size_t>(i)], tau_s);
   return v;
 }
+
+double FitResult::counter_var(double tau_s) const {
+  if (!counter_readout || !options.counter) return 0.0;
+  const CounterReadout& ctr = *options.counter;
+  return counter_avar(ctr, std::llround(tau_s / ctr.tau0_s), jitter_of(c));
+}
+
+double FitResult::counter_increment_var(std::int64_t h) const {
+  return counter_readout && options.counter ? rwcalc::counter_increment_var(*options.counter, h, jitter_of(c)) : 0.0;
+}
+
+double FitResult::readout_var(double tau_s) const {
+  return c[idx(Term::Q)] * term_basis(Term::Q, tau_s) + counter_var(tau_s);
+}
+
+Eigen::Matrix<double, kTermCount, 1> FitResult::covariance_c() const { return covariance_terms(c, options); }
 
 double FitResult::log_correlation(Term a, Term b) const {
   const double va = cov_c(idx(a), idx(a));
@@ -692,8 +790,15 @@ Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix
   return cov;
 }
 
-FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options) {
+namespace {
+
+/// χ²₁ at 0.999: how much better the counter's fit must be to be chosen over the white one.
+constexpr double kCounterMargin = 10.83;
+
+/// The fit with the read-out model of options.readout (Auto taken as White).
+FitResult fit_given(std::span<const FitPoint> points, const FitOptions& options) {
   FitResult res;
+  res.counter_readout = options.counter && options.readout == Readout::Counter;
   res.used = points_in_range(points, options);
   const double z = boost::math::quantile(boost::math::normal_distribution<double>(), 0.5 + options.confidence / 2.0);
   const double chi2_1 = boost::math::quantile(boost::math::chi_squared_distribution<double>(1.0), options.confidence);
@@ -702,7 +807,8 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
   FitOptions opt;  // edf_cap: the one in force (estimated when options.edf_cap is 0)
   const Stage full = fit_full_model(res.used, options, res.model_covariance, opt);
   Eigen::MatrixXd sigma_y;
-  if (res.model_covariance) sigma_y = point_covariance(res.used, full.coefficients(), full.model(), opt.edf_cap);
+  if (res.model_covariance)
+    sigma_y = point_covariance(res.used, covariance_terms(full.coefficients(), options), full.model(), opt.edf_cap);
 
   // Inflation of every enabled term in the full model (at the boundary too).
   std::vector<int> full_set;
@@ -742,6 +848,26 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
       throw AnalysisError(trf("the data do not bound the {} coefficient", term_name(kAllTerms[ui])));
   }
   return res;
+}
+
+}  // namespace
+
+FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options) {
+  if (!options.counter || options.readout != Readout::Auto) return fit_given(points, options);
+  // A counter with or without dither. The white model (the simpler, and a dithered counter's) stands
+  // unless the counter's fits better by more than χ²₁ at 0.001 (10.83, the level at which a fit is
+  // rejected): on dithered records the two differ by chance by a few units, on a plain counter's
+  // by 10³–10⁴ per point.
+  FitOptions white = options, counter = options;
+  white.readout = Readout::White;
+  counter.readout = Readout::Counter;
+  FitResult w = fit_given(points, white);
+  try {
+    FitResult c = fit_given(points, counter);
+    if (c.chi2 + kCounterMargin < w.chi2) return c;
+  } catch (const AnalysisError&) {  // the white model stands
+  }
+  return w;
 }
 
 SlopeReadout slope_readout(const AllanResult& allan) {

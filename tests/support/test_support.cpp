@@ -171,11 +171,11 @@ NoiseModel gl2d_model() {
   return m;
 }
 
-Recording simulated_gyro(double n, double b, const SimulationSettings& settings) {
+Recording simulated_gyro(double n, double b, const SimulationSettings& settings, ReadoutMode readout) {
   NoiseModel m;
   m.arw_deg_per_sqrt_h = n;
   m.bias_instability_deg_per_h = b;
-  m.readout = ReadoutMode::White;
+  m.readout = readout;
   m.earth_rate_deg_per_h = earth_rate_at(55.75);
   Recording rec;
   rec.source = "sim";

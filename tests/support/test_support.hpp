@@ -82,9 +82,11 @@ std::vector<std::string> concat(std::vector<std::string> a, const std::vector<st
 /// a record that is already floating is returned as it is.
 PhaseSeries floating_angle(const PhaseSeries& x);
 
-/// A GL-2D-like record of the coverage tests: ARW n (°/√h), flicker b (°/h), white read-out, the
-/// vertical Earth rate at 55.75°, simulated with `settings` (its seed, length, rate, pulse weight).
-Recording simulated_gyro(double n, double b, const SimulationSettings& settings);
+/// A GL-2D-like record of the coverage tests: ARW n (°/√h), flicker b (°/h), the white read-out
+/// unless another is given, the vertical Earth rate at 55.75°, simulated with `settings` (its seed,
+/// length, rate, pulse weight).
+Recording simulated_gyro(double n, double b, const SimulationSettings& settings,
+                         ReadoutMode readout = ReadoutMode::White);
 
 /// The class a gyro with these true B and N belongs to (none: beyond the table).
 std::optional<int> true_class(double b, double n, const ClassTable& table);
