@@ -52,6 +52,9 @@ struct ReadOptions {
   /// A `column` that names a time column (time_s, timestamp …) is an error rather than samples
   /// (imu: a sensor's channel is never the time).
   bool column_not_time = false;
+  /// What the error for a column that reads as no unit suggests (imu: its unit options); empty:
+  /// --input and a unit suffix.
+  std::string unit_advice;
   /// --time-column: the header name of the time column to use (the other time columns are then
   /// left unread); empty: the time columns by name (field.header.stamp before %time).
   std::string time_column;

@@ -32,6 +32,10 @@ ReadOptions channel_read(const ImuOptions& o, const ChannelSpec& c) {
   r.column = c.column;
   r.column_not_time = true;
   const bool gyro = c.kind == SensorKind::Gyro;
+  r.unit_advice = gyro ? tr(" (a gyro column needs its unit: give --gyro-unit deg/h, deg/s, rad/s (or arcsec, deg, rad "
+                            "for increments), or name the column with a unit suffix such as gyro_x_dps)")
+                       : tr(" (an accelerometer column needs its unit: give --accel-unit m/s^2, g, mg, ug (or m/s for "
+                            "increments), or name the column with a unit suffix such as acc_x_g)");
   if (const std::optional<RateUnit> unit = gyro ? o.gyro_unit : o.accel_unit) {
     r.mode = InputMode::Rate;
     r.rate_unit = unit;

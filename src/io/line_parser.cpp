@@ -289,9 +289,11 @@ bool LineParser::read_integer(std::string_view f, std::string_view t, Sample& s,
     fail(trf("number out of range of a 64-bit integer in {}: {}", col, quoted(f)));
   if (looks_numeric(f, layout_.delim != Delim::Comma))
     fail(trf("{} counts must be integers: {} in {}{}", counter ? "counter" : "pulse", quoted(f), col,
-             opt_.mode ? ""
-                       : " (pulses is the default input; for rate or angle samples give --input rate or "
-                         "--input angle, or a column name with a unit such as gyro_x_dps)"));
+             opt_.mode                   ? std::string()
+             : !opt_.unit_advice.empty() ? std::string(opt_.unit_advice)
+                                         : std::string(" (pulses is the default input; for rate or angle samples give "
+                                                       "--input rate or --input angle, or a column name with a unit "
+                                                       "such as gyro_x_dps)")));
   fail(trf("not a number in {}: {}", col, quoted(f)));
 }
 
