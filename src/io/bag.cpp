@@ -214,7 +214,7 @@ std::string Place::str() const {
 }
 
 void ByteCursor::fail(std::string_view what) const {
-  throw InputError(file_, 0, trf("{} at {}: ends before its {} ({} bytes left)", record_, where(), what, left()));
+  throw InputError(file_, 0, trf("{} at {}: ends before its {} ({} bytes left)", tr(std::string(record_)), where(), what, left()));
 }
 
 std::string decompress_chunk(std::string_view compression, std::string_view data, std::uint64_t size,
