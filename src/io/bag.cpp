@@ -113,7 +113,7 @@ ImuMessage decode_cdr_imu(std::string_view b, const std::string& file, const Pla
   return m;
 }
 
-MappedFile::MappedFile(const std::string& path) {
+MappedFile::MappedFile(const std::string& path) : path_(path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   struct stat st {};
   if (fd < 0 || ::fstat(fd, &st) != 0) {
@@ -136,6 +136,32 @@ MappedFile::MappedFile(const std::string& path) {
 
 MappedFile::~MappedFile() {
   if (data_) ::munmap(const_cast<char*>(data_), size_);
+}
+
+void MappedFile::release(std::size_t upto) noexcept {
+  const auto page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
+  upto = std::min(upto, size_) / page * page;
+  if (!data_ || upto <= released_) return;
+  ::madvise(const_cast<char*>(data_) + released_, upto - released_, MADV_DONTNEED);
+  released_ = upto;
+}
+
+std::string MappedFile::sha256() const {
+  Sha256 h;
+  const int fd = ::open(path_.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw InputError(path_, 0, trf("cannot read: {}", std::strerror(errno)));
+  std::string buf(std::size_t{1} << 20, '\0');
+  for (ssize_t n; (n = ::read(fd, buf.data(), buf.size())) != 0;) {
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const int err = errno;
+      ::close(fd);
+      throw InputError(path_, 0, trf("cannot read: {}", std::strerror(err)));
+    }
+    h.update(std::string_view(buf.data(), static_cast<std::size_t>(n)));
+  }
+  ::close(fd);
+  return h.hex();
 }
 
 std::unique_ptr<BagStream> BagStream::open(const std::string& path) {
@@ -177,11 +203,7 @@ void BagStream::select(const std::string& wanted) {
   start(topic_);
 }
 
-std::string BagStream::sha256() const {
-  Sha256 h;
-  h.update(file_.bytes());
-  return h.hex();
-}
+std::string BagStream::sha256() const { return file_.sha256(); }
 
 void BagStream::fail(std::uint64_t offset, const std::string& what) const {
   throw InputError(name_, 0, trf("byte {}: {}", offset, what));

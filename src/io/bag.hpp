@@ -59,10 +59,15 @@ class MappedFile {
   MappedFile(const MappedFile&) = delete;
   MappedFile& operator=(const MappedFile&) = delete;
   [[nodiscard]] std::string_view bytes() const noexcept { return {data_, size_}; }
+  /// The bytes before `upto` are read: their pages leave the process' memory (the file keeps them).
+  void release(std::size_t upto) noexcept;
+  /// The SHA-256 of the file, read again through read(2) (no mapped page stays in memory).
+  [[nodiscard]] std::string sha256() const;
 
  private:
+  std::string path_;
   const char* data_ = nullptr;
-  std::size_t size_ = 0;
+  std::size_t size_ = 0, released_ = 0;
 };
 
 /// A bag of one of the three formats, its Imu topic chosen. Reading goes message batch by batch.
@@ -94,6 +99,7 @@ class BagStream {
   virtual void start(const BagTopic& topic) = 0;
   [[noreturn]] void fail(std::uint64_t offset, const std::string& what) const;
   [[nodiscard]] std::string_view bytes() const noexcept { return file_.bytes(); }
+  void release(std::size_t upto) noexcept { file_.release(upto); }
 
  private:
   std::string name_;

@@ -188,6 +188,7 @@ bool McapFile::next(std::vector<ImuMessage>& batch) {
     read_records(bytes().substr(pos_, c.offset() - pos_), pos_, ~std::uint64_t{0}, &batch);
     pos_ = c.offset();
   }
+  release(pos_);
   return !batch.empty();
 }
 

@@ -158,6 +158,7 @@ bool Ros1Bag::next(std::vector<ImuMessage>& batch) {
     if (r.op == kChunk) read_chunk(recs, r, batch);
     else if (r.op == kMessage) take_message(recs, r, batch);
   }
+  release(pos_);
   return !batch.empty();
 }
 
