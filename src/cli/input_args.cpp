@@ -33,7 +33,7 @@ void SourceArgs::add_to(CLI::App& app) {
 void SourceArgs::apply(ReadOptions& o) const {
   if (!time.empty() && !time_column.empty())
     throw UsageError(tr("give --time or --time-column, not both"));
-  o.time_column = time == "receive" ? "%time" : time == "stamp" ? "field.header.stamp" : time_column;
+  o.time_column = time == "receive" ? "%time" : time_column;  // stamp: the default choice
   o.topic = topic;
 }
 

@@ -123,9 +123,9 @@ std::vector<BagTopic> Ros1Bag::topics() {
       const auto conn = recs.number<std::uint32_t>(r, "conn");
       const std::string topic(recs.field(r, "topic"));
       std::string type;
-      ByteCursor c(r.data, 0, name(), "");
+      ByteCursor c(r.data, recs.cursor().offset() - r.data.size(), name(), N_("ROS 1 connection record"));
       while (c.left() > 0) {
-        const std::string_view f = c.left() >= 4 ? c.string32("") : std::string_view{};
+        const std::string_view f = c.string32(tr("connection header field"));
         if (f.starts_with("type=")) type = f.substr(5);
       }
       connections_[topic].insert(conn);

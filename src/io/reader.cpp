@@ -330,6 +330,8 @@ void Reader::read_bag(detail::BagStream& bag) {
       }
       progress.advance(bag.taken() - std::min(bag.taken(), progress.done()));
     }
+    if (samples_ == 0)
+      fail(0, trf("topic '{}' of this {} has no messages", bag.topic().name, bag.format()));
   } catch (const detail::CeilingReached&) {
     Reader& full = reached_ ? *reached_ : *this;
     full.refuse_memory_bag(bag);
