@@ -197,6 +197,21 @@ TEST(Bag, TheTopicIsTheOnlyImuTopicOrTheOneNamed) {
   EXPECT_TRUE(has(r.err, "no sensor_msgs/Imu topic in this MCAP file; its topics: /status")) << r.err;
 }
 
+TEST(Bag, ARos2BagDirectoryReadsAsItsStorageFile) {
+  TempDir dir;
+  const auto bag = dir.path() / "rosbag2_2026_12_02";
+  std::filesystem::create_directory(bag);
+  dir.write("rosbag2_2026_12_02/metadata.yaml", "rosbag2_bagfile_information:\n  version: 5\n");
+  write_mcap(bag / "rosbag2_2026_12_02_0.mcap", one_imu_and_text(), "zstd");
+  auto r = run_cli({"imu", bag.string(), "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["channels"].size(), 6U);
+  write_mcap(bag / "rosbag2_2026_12_02_1.mcap", one_imu_and_text(), "zstd");
+  r = run_cli({"imu", bag.string()});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(has(r.err, "a ROS 2 bag split into 2 files")) << r.err;
+}
+
 TEST(Bag, AnalyzeReadsOneChannelOfABag) {
   TempDir dir;
   const auto bag = dir.path() / "imu.bag";

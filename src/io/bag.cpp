@@ -3,6 +3,7 @@
 #include "io/bag.hpp"
 
 #include <bzlib.h>
+#include <dirent.h>
 #include <fcntl.h>
 #include <lz4frame.h>
 #include <sys/mman.h>
@@ -164,9 +165,41 @@ std::string MappedFile::sha256() const {
   return h.hex();
 }
 
-std::unique_ptr<BagStream> BagStream::open(const std::string& path) {
-  if (path == "-") return nullptr;
+namespace {
+
+// A ROS 2 bag as `ros2 bag record` leaves it: a directory with metadata.yaml and its storage file.
+// Its one .db3 or .mcap file; an error for a bag split into several; "" for any other directory.
+// (POSIX directory calls: <filesystem> brings std::quoted into the io layer's unity build, where
+// it would take the reader's quoted() calls by argument-dependent lookup.)
+std::string storage_of_bag_directory(const std::string& dir) {
   struct stat st {};
+  if (::stat((dir + "/metadata.yaml").c_str(), &st) != 0) return "";
+  std::vector<std::string> files;
+  if (DIR* d = ::opendir(dir.c_str())) {
+    while (const dirent* e = ::readdir(d)) {
+      const std::string_view n = e->d_name;
+      if (n.ends_with(".db3") || n.ends_with(".mcap")) files.push_back(dir + "/" + std::string(n));
+    }
+    ::closedir(d);
+  }
+  std::sort(files.begin(), files.end());
+  if (files.size() == 1) return files.front();
+  std::string list;
+  for (const auto& f : files) list += (list.empty() ? "" : ", ") + f;
+  throw InputError(dir, 0, files.empty() ? std::string(tr("a ROS 2 bag directory without a .db3 or .mcap file"))
+                                         : trf("a ROS 2 bag split into {} files ({}): give one of them", files.size(), list));
+}
+
+}  // namespace
+
+std::unique_ptr<BagStream> BagStream::open(const std::string& given) {
+  if (given == "-") return nullptr;
+  struct stat st {};
+  std::string path = given;
+  if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
+    path = storage_of_bag_directory(given);
+    if (path.empty() || ::stat(path.c_str(), &st) != 0) return nullptr;
+  }
   if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return nullptr;
   char head[16] = {};
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
@@ -174,9 +207,9 @@ std::unique_ptr<BagStream> BagStream::open(const std::string& path) {
   const ssize_t got = ::read(fd, head, sizeof head);
   ::close(fd);
   const std::string_view h(head, got > 0 ? static_cast<std::size_t>(got) : 0);
-  if (h.starts_with(kRos1Magic)) return open_ros1_bag(path, path);
-  if (h.starts_with(kMcapMagic)) return open_mcap(path, path);
-  if (h.starts_with(kSqliteMagic)) return open_ros2_sqlite(path, path);
+  if (h.starts_with(kRos1Magic)) return open_ros1_bag(path, given);
+  if (h.starts_with(kMcapMagic)) return open_mcap(path, given);
+  if (h.starts_with(kSqliteMagic)) return open_ros2_sqlite(path, given);
   return nullptr;
 }
 

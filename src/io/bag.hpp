@@ -74,8 +74,9 @@ class MappedFile {
 class BagStream {
  public:
   virtual ~BagStream() = default;
-  /// A bag, told by its first bytes; null for a file that is none (text, gzip) or cannot be opened
-  /// (the text reader then says why).
+  /// A bag, told by its first bytes, or a ROS 2 bag's directory (metadata.yaml and one .db3 or
+  /// .mcap file); null for a file that is none (text, gzip) or cannot be opened (the text reader
+  /// then says why).
   static std::unique_ptr<BagStream> open(const std::string& path);
   /// The topic to read: the one named, else the only sensor_msgs/Imu topic. InputError listing the
   /// Imu topics (or all topics when there is none) when that does not decide.
