@@ -5,7 +5,8 @@
 #      algorithm on the octave grid), also as a whole process; the two alternate run by run so that
 #      both see the same load;
 #   2. `rwcalc analyze` of 24 h at 1 kHz (86.4 M samples) takes at most 3 s and 1.5 GB peak RSS, and
-#      `rwcalc imu` of 6 channels × 24 h × 200 Hz at most 6 s (inputs from ../shared when present).
+#      `rwcalc imu` of 6 channels × 24 h × 200 Hz at most 6 s (inputs from ../shared when present);
+#      `rwcalc imu` of a 24-h 200-Hz ROS 1 bag in at most 2× the time of its rostopic CSV.
 #   3. the default 50-run `rwcalc diagnose` of the 2-h record takes at most 1.5× the NumPy
 #      baseline, side by side as in 1.
 # Other rows (dense grid, `allan`, `--tau all`, the `cat` floor) are figures without a target. It builds the `bench` preset if needed, generates the inputs with `rwcalc simulate`
@@ -101,6 +102,15 @@ if ((!skip24)) && [[ ! -s "$imu_day" && -s "$adis" ]]; then
   { gzip -dc "$adis" | sed -n 3p  # the header row; then 17.28 copies of the 1 M data lines
     for _ in $(seq 17); do gzip -dc "$adis" | sed -n '4,$p'; done
     gzip -dc "$adis" | sed -n '4,280003p'; } >"$imu_day.part" && mv "$imu_day.part" "$imu_day"
+fi
+
+# A 24-h 200-Hz static IMU as a ROS 1 bag and as its `rostopic echo -p` CSV (bench/make_ros_imu.py;
+# about 6.3 GB and 3.5 GB, ~8 min to write once, mostly the disk's time). Skipped without numpy.
+ros_bag="$inputs/imu_day_200Hz.bag" ros_csv="$inputs/imu_day_200Hz_rostopic.csv"
+if ((!skip24)) && [[ -n "${py:-}" && ( ! -s "$ros_bag" || ! -s "$ros_csv" ) ]]; then
+  echo "generating the 24-h 200-Hz ROS 1 bag and its rostopic CSV (once) ..." >&2
+  "$py" "$here/bench/make_ros_imu.py" "$ros_bag.part" "$ros_csv.part" && mv "$ros_bag.part" "$ros_bag" &&
+    mv "$ros_csv.part" "$ros_csv"
 fi
 
 # ---- measurement helpers ----------------------------------------------------------------------
@@ -242,6 +252,18 @@ if available analyze; then
   if [[ -s "$imu_day" ]] && available imu; then
     timed "imu 6 channels × 24 h × 200 Hz (17.28 M lines)" "≤ 6 s" "w <= 6" "$rw" imu "$imu_day" --rate 200 --json \
       --gyro gyro_x_dps,gyro_y_dps,gyro_z_dps --accel acc_x_g,acc_y_g,acc_z_g || true
+  fi
+  if ((!skip24)) && [[ -s "$ros_bag" ]] && has_option imu --topic; then
+    bag_name="imu 24-h 200-Hz ROS 1 bag vs its rostopic CSV (side by side)" l=$(loadavg)
+    side_by_side "$repeat" "$rw" imu "$ros_bag" --json -- "$rw" imu "$ros_csv" --json
+    if ((status)); then
+      row "$bag_name" "≤ 2× the CSV's time" "$(failed)" "" "" "" "$l"
+    else
+      bw=$(calc "$a_s / $b_s") bc=$(calc "$a_c / $b_c")
+      row "$bag_name" "≤ 2× the CSV's time" "$(printf '%.2f× (%s vs %s)' "$bw" "$(fmt_t "$a_s")" "$(fmt_t "$b_s")")" \
+        "$(printf '%.2f× (%s vs %s)' "$bc" "$(fmt_t "$a_c")" "$(fmt_t "$b_c")")" "$(fmt_mb "$rss_mb")" \
+        "$(verdict "$bw <= 2")" "$l"
+    fi
   fi
   if has_option analyze --tau; then
     timed "analyze 2-h, dense grid (20/decade to N/10)" "—" "" "$rw" analyze "$run2h" --json --tau dense || true

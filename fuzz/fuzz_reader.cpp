@@ -9,7 +9,9 @@
 //           7: "gyro"), bit 3 give --scale, bits 4-7 --rate choice
 //   byte 3: time tolerance (byte / 512, within the CLI's 0..0.5)
 // A body that starts with the gzip magic bytes is also inflated by the reader itself, so corrupt
-// and truncated gzip reach it both ways.
+// and truncated gzip reach it both ways. A body that starts as a ROS bag does (ROS 1, MCAP, SQLite)
+// is written to a file and read as one (bags are read from files only), its column one of the Imu
+// channels or times by bits 0-2 of byte 2, the unit from the channel's name.
 //
 // The contract checked: the reader either returns a recording or throws rwcalc::InputError /
 // UsageError; a returned recording has at least two samples, a positive finite rate, and finite
@@ -23,6 +25,7 @@
 #include <cstdlib>
 #include <string>
 #include <string_view>
+#include <unistd.h>
 
 #include "rwcalc/allan.hpp"
 #include "rwcalc/error.hpp"
@@ -50,6 +53,37 @@ void check(bool ok, const char* what) {
     std::fprintf(stderr, "fuzz_reader: contract broken: %s\n", what);
     std::abort();
   }
+}
+
+bool is_bag(std::string_view body) {
+  return body.starts_with("#ROSBAG V2.0\n") || body.starts_with("\x89MCAP0\r\n") ||
+         body.starts_with(std::string_view("SQLite format 3\0", 16));
+}
+
+// A bag's bytes read from a temporary file: a recording, or nothing after an InputError or UsageError.
+bool read_bag(std::string_view body, std::uint8_t b2, rwcalc::Recording& rec) {
+  char path[] = "/tmp/fuzz_reader_bag.XXXXXX";
+  const int fd = ::mkstemp(path);
+  if (fd < 0) std::abort();
+  if (::write(fd, body.data(), body.size()) != static_cast<ssize_t>(body.size())) std::abort();
+  ::close(fd);
+  rwcalc::ReadOptions o;
+  static const char* const kBagColumns[] = {"field.angular_velocity.x",    "field.angular_velocity.y",
+                                            "field.angular_velocity.z",    "field.linear_acceleration.x",
+                                            "field.linear_acceleration.y", "field.linear_acceleration.z",
+                                            "%time",                       "1"};
+  o.column = kBagColumns[b2 & 7];
+  if (b2 & 8) o.time_column = "%time";
+  bool ok = true;
+  try {
+    rec = rwcalc::read_recording(path, o);
+  } catch (const rwcalc::InputError&) {
+    ok = false;
+  } catch (const rwcalc::UsageError&) {
+    ok = false;
+  }
+  ::unlink(path);
+  return ok;
 }
 
 }  // namespace
@@ -80,8 +114,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
 
   rwcalc::Recording rec;
+  if (is_bag(body) && !read_bag(body, b2, rec)) return 0;
   try {
-    rec = rwcalc::read_recording_text(body, "fuzz.txt", o);
+    if (!is_bag(body)) rec = rwcalc::read_recording_text(body, "fuzz.txt", o);
   } catch (const rwcalc::InputError&) {
     return 0;
   } catch (const rwcalc::UsageError&) {

@@ -48,6 +48,10 @@ rwcalc::ReadOptions parse_options(const std::string& text) {
       o.rate_unit = rwcalc::parse_rate_unit(value);
     else if (key == "--time-tolerance")
       o.time_tolerance = std::stod(value);
+    else if (key == "--time-column")
+      o.time_column = value;
+    else if (key == "--topic")
+      o.topic = value;
     else
       throw std::runtime_error("MANIFEST.tsv: unknown option " + key);
   }

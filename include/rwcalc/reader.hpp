@@ -52,6 +52,14 @@ struct ReadOptions {
   /// A `column` that names a time column (time_s, timestamp …) is an error rather than samples
   /// (imu: a sensor's channel is never the time).
   bool column_not_time = false;
+  /// What the error for a column that reads as no unit suggests (imu: its unit options); empty:
+  /// --input and a unit suffix.
+  std::string unit_advice;
+  /// --time-column: the header name of the time column to use (the other time columns are then
+  /// left unread); empty: the time columns by name (field.header.stamp before %time).
+  std::string time_column;
+  /// --topic: the sensor_msgs/Imu topic of a ROS bag; empty: the bag's only Imu topic.
+  std::string topic;
   std::optional<double> rate_hz;        ///< --rate, Hz; overrides metadata; checked against a time column
   std::optional<double> scale_arcsec;   ///< --scale: pulse weight, ″ per pulse; overrides metadata
   int counter_bits = 32;                ///< wrap width of Counter mode (1..64)
@@ -152,6 +160,14 @@ std::vector<Recording> read_recordings(const std::string& path, std::span<const 
 /// Read from text already in memory (used by tests and fuzzers); `name` labels errors.
 /// The text may be gzip-compressed (detected by its magic bytes).
 Recording read_recording_text(std::string_view text, const std::string& name, const ReadOptions& options = {});
+
+/// The columns of a file whose names tell an IMU channel (a unit suffix such as `_dps` or `_g`, or
+/// a ROS field such as `angular_velocity.x`, `linear_acceleration.x`), gyros and accelerometers in
+/// file order; a ROS bag's six channels. Reads the header row only; standard input has none to spare.
+struct ImuColumnNames {
+  std::vector<std::string> gyro, accel;
+};
+ImuColumnNames imu_column_names(const std::string& path, const ReadOptions& options);
 
 /// The unit the samples were read in: "pulse" or "count" (of Recording::phase.arcsec_per_count),
 /// the angle unit ("arcsec", "deg", "rad", "s", "m/s") or the rate unit ("deg/h", "deg/s", "rad/s",

@@ -33,6 +33,10 @@ ReadOptions channel_read(const ImuOptions& o, const ChannelSpec& c) {
   r.column = c.column;
   r.column_not_time = true;
   const bool gyro = c.kind == SensorKind::Gyro;
+  r.unit_advice = gyro ? tr(" (a gyro column needs its unit: give --gyro-unit deg/h, deg/s, rad/s (or arcsec, deg, rad "
+                            "for increments), or name the column with a unit suffix such as gyro_x_dps)")
+                       : tr(" (an accelerometer column needs its unit: give --accel-unit m/s^2, g, mg, ug (or m/s for "
+                            "increments), or name the column with a unit suffix such as acc_x_g)");
   if (const std::optional<RateUnit> unit = gyro ? o.gyro_unit : o.accel_unit) {
     r.mode = InputMode::Rate;
     r.rate_unit = unit;
@@ -41,6 +45,26 @@ ReadOptions channel_read(const ImuOptions& o, const ChannelSpec& c) {
     r.angle_unit = inc;
   }
   return r;
+}
+
+// No --gyro or --accel: every column whose name tells a gyro or accelerometer unit (or a ROS Imu
+// field), said in `note`.
+std::vector<ChannelSpec> channels_by_name(const std::string& path, const ReadOptions& read, std::string& note) {
+  const ImuColumnNames names = imu_column_names(path, read);
+  std::vector<ChannelSpec> specs;
+  for (const auto& c : names.gyro) specs.push_back({c, SensorKind::Gyro});
+  for (const auto& c : names.accel) specs.push_back({c, SensorKind::Accelerometer});
+  if (specs.empty())
+    throw UsageError(tr("imu needs at least one column: give --gyro COLS and/or --accel COLS (no column name has a "
+                        "unit suffix such as _dps or _g, nor is a ROS field such as angular_velocity.x)"));
+  const auto list = [](const std::vector<std::string>& v) {
+    std::string s;
+    for (const auto& c : v) s += (s.empty() ? "" : ", ") + c;
+    return s.empty() ? std::string("-") : s;
+  };
+  note = trf("channels from the column names: gyro {}; accelerometer {} (--gyro and --accel choose others)",
+             list(names.gyro), list(names.accel));
+  return specs;
 }
 
 void check_kind(const Recording& rec, const ChannelSpec& c) {
@@ -134,7 +158,8 @@ ImuResult analyze_imu(const std::string& path, const ImuOptions& options) {
   std::vector<ChannelSpec> specs;
   for (const auto& c : options.gyro_columns) specs.push_back({c, SensorKind::Gyro});
   for (const auto& c : options.accel_columns) specs.push_back({c, SensorKind::Accelerometer});
-  if (specs.empty()) throw UsageError(tr("imu needs at least one column: give --gyro COLS and/or --accel COLS"));
+  std::string found;  // the channels the column names gave, when none was given
+  if (specs.empty()) specs = channels_by_name(path, options.read, found);
   if (!options.vertical_gyro.empty() && std::find(options.gyro_columns.begin(), options.gyro_columns.end(),
                                                   options.vertical_gyro) == options.gyro_columns.end())
     throw UsageError(trf("--vertical-gyro {}: not one of the --gyro columns", options.vertical_gyro));
@@ -148,6 +173,7 @@ ImuResult analyze_imu(const std::string& path, const ImuOptions& options) {
   for (const ChannelSpec& c : specs) reads.push_back(channel_read(options, c));
   std::vector<Recording> recs = read_recordings(path, reads);
   check_channels(recs, specs);
+  if (!found.empty()) recs.front().notes.push_back(found);
   out.channels.resize(specs.size());
   Progress progress(trf("analysing the channels of {}", printable(path)), specs.size(), options.analysis.progress);
   parallel_for(specs.size(), [&](std::size_t i) {

@@ -27,6 +27,7 @@ namespace {
 
 struct ImuCmd {
   std::string file;
+  SourceArgs source;
   std::optional<double> rate_hz;
   double time_tolerance = 0.01;
   std::string gaps = "refuse";
@@ -49,6 +50,7 @@ struct ImuCmd {
     o.read.rate_hz = rate_hz;
     o.read.time_tolerance = time_tolerance;
     o.read.gaps_as_segments = gaps == "segments";
+    source.apply(o.read);
     o.read.memory = memory_ceiling_of(max_memory);
     o.gyro_columns = gyro;
     o.accel_columns = accel;
@@ -180,6 +182,7 @@ void register_imu(CLI::App& app, Runner& runner) {
       ->group(tr("Input"));
   add_gaps_option(*sub, cmd->gaps);
   add_memory_option(*sub, cmd->max_memory);
+  cmd->source.add_to(*sub);
   sub->add_option("--gyro", cmd->gyro, tr("Gyro columns: header names or 1-based indices, comma-separated"))
       ->delimiter(',')
       ->group(tr("Input"));

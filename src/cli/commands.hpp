@@ -52,7 +52,16 @@ MemoryCeiling memory_ceiling_of(const std::string& size);
 CLI::Validator output_name();
 
 /// Input options shared by every command that reads a recording (allan, analyze, batch, diagnose).
+/// --time-column NAME, --time stamp|receive and --topic TOPIC: which stamps of a ROS export or bag
+/// and which Imu topic of a bag are read.
+struct SourceArgs {
+  std::string time_column, time, topic;
+  void add_to(CLI::App& app);
+  void apply(ReadOptions& o) const;  ///< throws UsageError for --time with --time-column
+};
+
 struct InputArgs {
+  SourceArgs source;
   std::string input;  ///< empty: not given (the column name may imply it; else pulses)
   std::string column;
   std::optional<double> rate_hz;

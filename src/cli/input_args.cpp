@@ -15,7 +15,30 @@ constexpr const char* kIdGroup =
     N_("Identification (else the file's # serial:, # operator:, # test_date:, # conditions:)");
 }
 
+void SourceArgs::add_to(CLI::App& app) {
+  app.add_option("--time-column", time_column,
+                 tr("The time column to read, by its header name (the other time columns are then not read). "
+                    "Default: the time columns by name; of a ROS export field.header.stamp, not %time"))
+      ->group(tr("Input"));
+  app.add_option("--time", time,
+                 tr("Which time of a ROS bag or export: stamp (header.stamp, the sensor's) or receive (when the "
+                    "bag recorded the message, %time)"))
+      ->check(CLI::IsMember({"stamp", "receive"}))
+      ->option_text("stamp|receive")
+      ->group(tr("Input"));
+  app.add_option("--topic", topic, tr("The sensor_msgs/Imu topic of a ROS bag (default: its only Imu topic)"))
+      ->group(tr("Input"));
+}
+
+void SourceArgs::apply(ReadOptions& o) const {
+  if (!time.empty() && !time_column.empty())
+    throw UsageError(tr("give --time or --time-column, not both"));
+  o.time_column = time == "receive" ? "%time" : time_column;  // stamp: the default choice
+  o.topic = topic;
+}
+
 void InputArgs::add_to(CLI::App& app) {
+  source.add_to(app);
   app.add_option("--serial", serial, tr("Serial number of the gyro under test"))->group(tr(kIdGroup));
   app.add_option("--operator", operator_name, tr("Who ran the test"))->group(tr(kIdGroup));
   app.add_option("--test-date", test_date, tr("Date of the test, e.g. 2026-11-27"))->group(tr(kIdGroup));
@@ -106,6 +129,7 @@ ReadOptions InputArgs::options() const {
   if (!rate_unit.empty()) o.rate_unit = parse_rate_unit(rate_unit);
   o.time_tolerance = time_tolerance;
   o.gaps_as_segments = gaps == "segments";
+  source.apply(o);
   if (!max_memory.empty()) o.memory = memory_ceiling_option(max_memory);
   const std::string* given[] = {&serial, &operator_name, &test_date, &conditions};
   for (std::size_t i = 0; i < std::size(given); ++i)

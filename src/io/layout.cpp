@@ -20,7 +20,8 @@ namespace {
 constexpr std::size_t kQuoteLimit = 40;
 
 // The first four are the units a stamp's magnitude can tell; "%time" is ROS's receive time (ns
-// since the epoch) in CSV exports of ROS bags.
+// since the epoch) in CSV exports of ROS bags (`rostopic echo -p`), "field.header.stamp" the
+// message's own stamp there, "__time" PlotJuggler's time in seconds.
 constexpr TimeName kTimeNames[] = {{"time_s", "s", 1},     {"time_ms", "ms", 1e3},
                                    {"time_us", "us", 1e6}, {"time_ns", "ns", 1e9},
                                    {"time", "", 0},        {"t", "", 0},
@@ -29,8 +30,11 @@ constexpr TimeName kTimeNames[] = {{"time_s", "s", 1},     {"time_ms", "ms", 1e3
                                    {"t_ms", "ms", 1e3},    {"timestamp_ms", "ms", 1e3},
                                    {"t_us", "us", 1e6},    {"timestamp_us", "us", 1e6},
                                    {"t_ns", "ns", 1e9},    {"timestamp_ns", "ns", 1e9},
-                                   {"%time", "ns", 1e9}};
+                                   {"%time", "ns", 1e9},   {"field.header.stamp", "ns", 1e9},
+                                   {"__time", "s", 1}};
 constexpr const TimeName* kByMagnitude = &kTimeNames[4];  // "time": the headerless time column
+constexpr const TimeName* kNanoseconds = &kTimeNames[3];
+constexpr std::string_view kReceiveTime = "%time", kHeaderStamp = "field.header.stamp";
 constexpr std::string_view kTemperatureNames[] = {"temperature_c", "temperature", "temp_c", "temp", "t_c"};
 
 // The names of a column that holds the samples, by InputMode.
@@ -223,6 +227,7 @@ void Layout::choose(const ReadOptions& o, std::size_t where, const std::string& 
   if (time_col) roles[*time_col] = Role::Time;
   if (time2_col) roles[*time2_col] = Role::Time2;
   if (temp_col) roles[*temp_col] = Role::Temperature;
+  if (nanosec_col) roles[*nanosec_col] = Role::Nanosec;
 }
 
 // --column: a 1-based index, or a header name.
@@ -242,15 +247,54 @@ void Layout::choose_given(const std::string& want, std::size_t where, const std:
                      trf("--column '{}' names a column but the file has no header row; give a "
                          "1-based index instead",
                          want));
+  value_col = named_column(want, "--column", file);
+}
+
+std::size_t Layout::named_column(const std::string& want, std::string_view option, const std::string& file) const {
   const auto named = columns_where(header, [&](std::string_view h) { return iequals(h, want); });
   if (named.empty())
     throw InputError(file, header_line,
-                     trf("no column named '{}'; the columns are {}", want, column_list(all_columns(ncols))));
+                     trf("no column named '{}' ({}); the columns are {}", want, option, column_list(all_columns(ncols))));
   if (named.size() > 1)
     throw InputError(file, header_line,
                      trf("{} columns are named '{}' (columns {}); choose one by its index with --column", named.size(),
                          want, column_list(named)));
-  value_col = named.front();
+  return named.front();
+}
+
+// The time columns kept: the one --time-column names; of a ROS export's field.header.stamp and
+// %time the stamp (said in a note); a ROS 2 stamp split into `…sec` and `…nanosec` as one time.
+void Layout::choose_times(const ReadOptions& o, std::vector<std::size_t>& times, const std::string& file) {
+  if (!o.time_column.empty()) {
+    if (header.empty())
+      throw InputError(file, layout_line, trf("--time-column '{}' names a column but the file has no header row",
+                                              o.time_column));
+    const std::size_t t = named_column(o.time_column, "--time-column", file);
+    if (t == value_col)
+      throw InputError(file, header_line, trf("--time-column '{}' is the column of the samples", o.time_column));
+    times = {t};
+    return;
+  }
+  const auto is = [&](std::size_t c, std::string_view name) { return iequals(header[c], name); };
+  const auto stamp = std::find_if(times.begin(), times.end(), [&](std::size_t c) { return is(c, kHeaderStamp); });
+  const auto receive = std::find_if(times.begin(), times.end(), [&](std::size_t c) { return is(c, kReceiveTime); });
+  if (stamp != times.end() && receive != times.end()) {
+    notes.push_back(trf("time from '{}' (the sensor's stamp), not '{}' (the receive time; --time receive takes it)",
+                        kHeaderStamp, kReceiveTime));
+    times.erase(receive);
+  }
+  if (!times.empty()) return;
+  for (std::size_t c = 0; c < header.size(); ++c) {
+    const std::string& h = header[c];
+    if (h.size() < 7 || !iequals(std::string_view(h).substr(h.size() - 7), "nanosec")) continue;
+    const std::string sec = h.substr(0, h.size() - 7) + "sec";
+    const auto s = columns_where(header, [&](std::string_view n) { return iequals(n, sec); });
+    if (s.size() != 1 || s.front() == value_col || c == value_col) continue;
+    times = {s.front()};
+    nanosec_col = c;
+    notes.push_back(trf("time from '{}' and '{}' (seconds and nanoseconds of one stamp)", sec, h));
+    return;
+  }
 }
 
 // The samples (unless --column chose them), the time column(s) and the temperature column of a
@@ -284,6 +328,7 @@ void Layout::choose_by_name(const ReadOptions& o, bool value_given, const std::s
                            to_string(mode), column_list(all_columns(ncols))));
     value_col = named.empty() ? rest.front() : named.front();
   }
+  choose_times(o, times, file);
   if (times.size() > 2)
     throw InputError(file, header_line,
                      trf("{} time columns ({}); rwcalc reads one, or two that agree: remove the others", times.size(),
@@ -293,7 +338,11 @@ void Layout::choose_by_name(const ReadOptions& o, bool value_given, const std::s
                      trf("{} temperature columns ({}); rwcalc reports one temperature: remove or rename "
                          "the others",
                          temps.size(), column_list(temps)));
-  if (!times.empty()) time_col = times[0], time_unit = time_name(header[times[0]]);
+  if (!times.empty()) {
+    time_col = times[0];
+    time_unit = nanosec_col ? kNanoseconds : time_name(header[times[0]]);
+    if (!time_unit) time_unit = kByMagnitude;  // --time-column with a name that says no unit
+  }
   if (times.size() == 2) time2_col = times[1], time2_unit = time_name(header[times[1]]);
   if (!temps.empty()) temp_col = temps[0];
 }
@@ -357,7 +406,28 @@ bool ends_with_nocase(std::string_view s, std::string_view suffix) {
   return s.size() > suffix.size() && iequals(s.substr(s.size() - suffix.size()), suffix);
 }
 
+// sensor_msgs/Imu's fields carry their units by definition: angular_velocity in rad/s,
+// linear_acceleration in m/s² ("field.angular_velocity.x" of rostopic, "angular_velocity.x" of ROS 2,
+// "/imu/angular_velocity/x" of PlotJuggler).
+constexpr UnitSuffix kRosGyro{"angular_velocity", InputMode::Rate, {}, RateUnit::RadPerSecond};
+constexpr UnitSuffix kRosAccel{"linear_acceleration", InputMode::Rate, {}, RateUnit::MetrePerSecond2};
+
+const UnitSuffix* ros_field_unit(std::string_view column) {
+  const std::size_t n = column.size();
+  if (n < 3 || (column[n - 2] != '.' && column[n - 2] != '/')) return nullptr;
+  const char axis = static_cast<char>(column[n - 1] | 0x20);
+  if (axis != 'x' && axis != 'y' && axis != 'z') return nullptr;
+  const std::string_view stem = column.substr(0, n - 2);
+  for (const UnitSuffix* u : {&kRosGyro, &kRosAccel})
+    if (stem.size() >= u->suffix.size() && iequals(stem.substr(stem.size() - u->suffix.size()), u->suffix) &&
+        (stem.size() == u->suffix.size() || std::string_view("./_").find(stem[stem.size() - u->suffix.size() - 1]) !=
+                                                std::string_view::npos))
+      return u;
+  return nullptr;
+}
+
 const UnitSuffix* unit_suffix(std::string_view column) {
+  if (const UnitSuffix* ros = ros_field_unit(column)) return ros;
   for (const UnitSuffix& u : kUnitSuffixes)
     if (ends_with_nocase(column, u.suffix)) return &u;
   return nullptr;

@@ -43,7 +43,8 @@ struct Metadata {
 
 enum class Delim { Comma, Semicolon, Tab, Blanks };
 /// What a column is read for. Time2: a second time column, which must agree with the first.
-enum class Role : unsigned char { Skip, Value, Time, Time2, Temperature };
+/// Nanosec: the nanoseconds of a ROS 2 stamp split as `sec`, `nanosec` (the Time column holds the seconds).
+enum class Role : unsigned char { Skip, Value, Time, Time2, Temperature, Nanosec };
 
 /// A time column's name and the unit it is in.
 struct TimeName {
@@ -78,7 +79,9 @@ struct Layout {
   std::size_t ncols = 0;
   std::vector<Role> roles;
   std::size_t value_col = 0;
-  std::optional<std::size_t> time_col, time2_col, temp_col;
+  std::optional<std::size_t> time_col, time2_col, temp_col, nanosec_col;
+  /// The choices of time column that no option made, one sentence each (Recording::notes).
+  std::vector<std::string> notes;
   const TimeName* time_unit = nullptr;
   const TimeName* time2_unit = nullptr;
 
@@ -94,6 +97,8 @@ struct Layout {
  private:
   void choose_by_name(const ReadOptions& o, bool value_given, const std::string& file);
   void choose_given(const std::string& want, std::size_t where, const std::string& file);
+  void choose_times(const ReadOptions& o, std::vector<std::size_t>& times, const std::string& file);
+  [[nodiscard]] std::size_t named_column(const std::string& want, std::string_view option, const std::string& file) const;
 };
 
 std::string_view delim_name(Delim d);

@@ -66,6 +66,7 @@ LineKind LineParser::parse(std::string_view text, std::size_t line, Sample& s) {
   split(t);
   if (layout_known_ && fields_.size() == layout_.ncols && read_fields(fields_, s, false)) return LineKind::Data;
   if (header_row(t)) return LineKind::Header;
+  if (stop_at_data_) return LineKind::Data;
   if (!layout_known_) {  // the first data line fixes the columns
     layout_.ncols = layout_.header.empty() ? fields_.size() : layout_.header.size();
     layout_known_ = true;
@@ -232,6 +233,7 @@ bool LineParser::header_row(std::string_view t) {
 bool LineParser::read_fields(const std::vector<std::string_view>& fields, Sample& s, bool report) {
   for (std::size_t c = 0; c < layout_.ncols; ++c)
     if (layout_.roles[c] != Role::Skip && !read_field(fields[c], layout_.roles[c], s, report)) return false;
+  if (layout_.nanosec_col) s.time = s.time * 1e9 + s.nanosec;  // one stamp in ns
   return true;
 }
 
@@ -247,7 +249,11 @@ bool LineParser::read_field(std::string_view f, Role role, Sample& s, bool repor
   double v = 0;
   const auto r = std::from_chars(n.data(), n.data() + n.size(), v);
   if (r.ptr == n.data() + n.size() && r.ec == std::errc() && std::isfinite(v)) {
-    (role == Role::Value ? s.real : role == Role::Time ? s.time : role == Role::Time2 ? s.time2 : s.temperature) = v;
+    (role == Role::Value   ? s.real
+     : role == Role::Time  ? s.time
+     : role == Role::Time2 ? s.time2
+     : role == Role::Nanosec ? s.nanosec
+                           : s.temperature) = v;
     return true;
   }
   if (!report) return false;
@@ -283,9 +289,11 @@ bool LineParser::read_integer(std::string_view f, std::string_view t, Sample& s,
     fail(trf("number out of range of a 64-bit integer in {}: {}", col, quoted(f)));
   if (looks_numeric(f, layout_.delim != Delim::Comma))
     fail(trf("{} counts must be integers: {} in {}{}", counter ? "counter" : "pulse", quoted(f), col,
-             opt_.mode ? ""
-                       : " (pulses is the default input; for rate or angle samples give --input rate or "
-                         "--input angle, or a column name with a unit such as gyro_x_dps)"));
+             opt_.mode                   ? std::string()
+             : !opt_.unit_advice.empty() ? std::string(opt_.unit_advice)
+                                         : std::string(" (pulses is the default input; for rate or angle samples give "
+                                                       "--input rate or --input angle, or a column name with a unit "
+                                                       "such as gyro_x_dps)")));
   fail(trf("not a number in {}: {}", col, quoted(f)));
 }
 

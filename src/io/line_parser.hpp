@@ -21,6 +21,7 @@ struct Sample {
   double time = 0.0;         ///< in the time column's own unit
   double time2 = 0.0;        ///< the second time column's
   double temperature = 0.0;
+  double nanosec = 0.0;  ///< a split ROS 2 stamp's nanoseconds (the time column holds its seconds)
 };
 
 class LineParser {
@@ -43,6 +44,9 @@ class LineParser {
   /// Read the same lines as `lead`, each after it, taking the lead's split of a common data line
   /// rather than splitting it again (several columns of one file in one pass).
   void follow(const LineParser& lead) noexcept { lead_ = &lead; }
+  /// Stop at the first data line: parse() then says Data without choosing the columns or reading
+  /// the line (the header row alone is wanted).
+  void stop_at_first_data() noexcept { stop_at_data_ = true; }
 
   /// The common data lines read on from `p` in one loop: while the layout is one integer column,
   /// each line that is an optional minus and 1–18 digits ended by LF (or CR LF) is appended to `out`
@@ -80,6 +84,7 @@ class LineParser {
   const LineParser* lead_ = nullptr;
   std::size_t split_line_ = 0;  // the line fields_ holds, when the common path split it
   std::string scratch_;
+  bool stop_at_data_ = false;
 };
 
 }  // namespace rwcalc::detail

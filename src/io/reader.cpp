@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 #include <sys/stat.h>
 
+#include "io/bag.hpp"
 #include "io/line_parser.hpp"
 #include "io/sample_memory.hpp"
 #include "io/text_source.hpp"
@@ -198,6 +199,7 @@ class Reader {
       full.refuse_memory(src);
     }
   }
+  void read_bag(detail::BagStream& bag);
   /// Read another column of the same text in the same pass: `f` gets every line after this reader.
   void lead(Reader& f) {
     f.parser_.follow(parser_);
@@ -214,6 +216,7 @@ class Reader {
   [[nodiscard]] std::size_t line_of_sample(std::size_t k) const { return line_in_runs(runs_, k); }
   void read_lines(detail::TextSource& src);
   [[noreturn]] void refuse_memory(const detail::TextSource& src) const;
+  [[noreturn]] void refuse_memory_bag(const detail::BagStream& bag) const;
   std::size_t take_lines(std::string& buf, bool at_end);
   bool decide_line_end(std::string_view s, bool at_end);
   std::size_t mac_limit(std::string& buf, std::size_t from, bool at_end) const;
@@ -230,6 +233,7 @@ class Reader {
     reached_ = nullptr;
   }
   void push(const Sample& s);
+  void bag_message(const detail::ImuMessage& m);
   // Room for the samples the text likely holds, judged from its first lines, so that a long record
   // is not copied as it grows (within the ceiling: only an estimate).
   void reserve(double lines) {
@@ -301,6 +305,56 @@ void Reader::read_lines(detail::TextSource& src) {
   if (!buf.empty()) line(buf);  // the last line, without a line end
 }
 
+// A bag reads as the `rostopic echo -p` CSV of its Imu topic: the header row and the first message
+// go through the one parser as text (which fixes the columns, units and notes as for the CSV), every
+// later message goes in as the Sample that parsing its line would give (numbers printed shortest
+// round-trip read back exactly), each message one line.
+void Reader::read_bag(detail::BagStream& bag) {
+  try {
+    Progress progress(trf("reading {}", printable(bag.name())), bag.size(), opt_.progress, Progress::Measure::Bytes);
+    std::string header(detail::kBagStampColumn);
+    header += fmt::format(",{}", detail::kBagReceiveColumn);
+    for (const std::string_view f : detail::kImuFieldColumns) header += fmt::format(",{}", f);
+    line(header);
+    std::vector<detail::ImuMessage> batch;
+    while (bag.next(batch)) {
+      for (const detail::ImuMessage& m : batch) {
+        if (samples_ > 0) {
+          bag_message(m);
+          continue;
+        }
+        const double* v = m.values;
+        line(fmt::format("{},{},{},{},{},{},{},{}", m.stamp_ns, m.receive_ns, v[0], v[1], v[2], v[3], v[4], v[5]));
+        if (integer_mode()) fail(line_, tr("a bag's channels are rates (rad/s, m/s^2), not pulse counts"));
+        reserve(static_cast<double>(bag.topic().messages));
+      }
+      progress.advance(bag.taken() - std::min(bag.taken(), progress.done()));
+    }
+    if (samples_ == 0)
+      fail(0, trf("topic '{}' of this {} has no messages", bag.topic().name, bag.format()));
+  } catch (const detail::CeilingReached&) {
+    Reader& full = reached_ ? *reached_ : *this;
+    full.refuse_memory_bag(bag);
+  }
+}
+
+void Reader::bag_message(const detail::ImuMessage& m) {
+  ++line_;
+  const auto field = [&m](std::size_t col) {
+    return col == 0 ? static_cast<double>(m.stamp_ns) : col == 1 ? static_cast<double>(m.receive_ns) : m.values[col - 2];
+  };
+  Sample s;
+  s.real = field(layout_.value_col);
+  if (layout_.time_col) s.time = field(*layout_.time_col);
+  if (layout_.time2_col) s.time2 = field(*layout_.time2_col);
+  push(s);
+  for (Reader* f : followers_) {
+    reached_ = f;
+    f->bag_message(m);
+  }
+  reached_ = nullptr;
+}
+
 // The samples kept have reached the ceiling: the memory the whole record needs, judged from the
 // input's size (the text read so far held `held` bytes of samples), else only "more than".
 void Reader::refuse_memory(const detail::TextSource& src) const {
@@ -317,6 +371,14 @@ void Reader::refuse_memory(const detail::TextSource& src) const {
   fail(line_, trf("the record needs more than {} of memory for its samples: {} is reached at this line, sample "
                   "{}; {}",
                   format_memory(static_cast<double>(ceiling_.bytes)), ceiling, samples_, remedy));
+}
+
+void Reader::refuse_memory_bag(const detail::BagStream& bag) const {
+  const double messages = static_cast<double>(bag.topic().messages);
+  const std::string remedy = trf("give {} SIZE if the machine has the memory, or cut the record", kMaxMemoryOption);
+  fail(line_, trf("the record needs more than {} of memory for its samples ({}): reached at message {} of {}; {}",
+                  format_memory(static_cast<double>(ceiling_.bytes)), ceiling_.origin, samples_,
+                  messages > 0 ? fmt::format("{:.0f}", messages) : std::string("?"), remedy));
 }
 
 // Take the complete lines of buf; returns the bytes taken.
@@ -745,6 +807,7 @@ Recording Reader::finish() {
   rec.angle_unit = in().angle_unit;
   rec.rate_unit = in().rate_unit;
   rec.notes = in().notes;
+  rec.notes.insert(rec.notes.end(), layout_.notes.begin(), layout_.notes.end());
   rec.warnings = in().warnings;
   for (const auto& [key, value] : opt_.identification) {
     auto& slot = rec.metadata[key];
@@ -791,23 +854,36 @@ void validate(const ReadOptions& o) {
 }
 
 // One pass over a text for some columns: the first reader leads, the others follow it line by line.
+// A bag is read in one pass over its messages for all columns, its digest taken beside it.
 struct Pass {
   std::unique_ptr<detail::TextSource> src;
+  std::unique_ptr<detail::BagStream> bag;
+  std::string bag_sha256;
   std::vector<std::unique_ptr<Reader>> readers;
 
   Pass(std::unique_ptr<detail::TextSource> text, std::span<const ReadOptions> columns) : src(std::move(text)) {
+    add(src->name(), columns);
+  }
+  Pass(std::unique_ptr<detail::BagStream> b, std::span<const ReadOptions> columns) : bag(std::move(b)) {
+    add(bag->name(), columns);
+  }
+  void add(const std::string& name, std::span<const ReadOptions> columns) {
     for (const ReadOptions& o : columns) {
       validate(o);
-      readers.push_back(std::make_unique<Reader>(src->name(), o));
+      readers.push_back(std::make_unique<Reader>(name, o));
       if (readers.size() > 1) readers.front()->lead(*readers.back());
     }
   }
-  void read() { readers.front()->read(*src); }
+  void read() {
+    if (!bag) return readers.front()->read(*src);
+    parallel_for(2, [&](std::size_t i) { i == 0 ? readers.front()->read_bag(*bag) : void(bag_sha256 = bag->sha256()); });
+  }
   Recording finish(std::size_t i, const std::string& source) {
     Recording rec = readers[i]->finish();
     rec.source = source;
-    rec.file_bytes = src->raw_bytes();
-    rec.sha256 = src->sha256();
+    rec.file_bytes = bag ? bag->size() : src->raw_bytes();
+    rec.sha256 = bag ? bag_sha256 : src->sha256();
+    if (bag) rec.notes.insert(rec.notes.begin(), trf("{} topic '{}' ({})", bag->format(), bag->topic().name, bag->topic().type));
     return rec;
   }
 };
@@ -857,12 +933,23 @@ std::vector<Recording> read_passes(std::vector<Pass>& passes, const std::string&
 
 Recording read_recording(const std::string& path, const ReadOptions& options) {
   std::vector<Pass> pass;
-  pass.emplace_back(std::make_unique<detail::TextSource>(path), std::span(&options, 1));
+  if (auto bag = detail::BagStream::open(path)) {
+    bag->select(options.topic);
+    pass.emplace_back(std::move(bag), std::span(&options, 1));
+  } else {
+    pass.emplace_back(std::make_unique<detail::TextSource>(path), std::span(&options, 1));
+  }
   return std::move(read_passes(pass, path).front());
 }
 
 std::vector<Recording> read_recordings(const std::string& path, std::span<const ReadOptions> columns) {
   if (columns.empty()) throw UsageError("no column to read");
+  if (auto bag = detail::BagStream::open(path)) {
+    bag->select(columns.front().topic);
+    std::vector<Pass> pass;
+    pass.emplace_back(std::move(bag), columns);
+    return read_passes(pass, path);
+  }
   // A pipe or standard input can be read once only.
   struct stat st {};
   const bool again = path != "-" && ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
@@ -879,6 +966,48 @@ Recording read_recording_text(std::string_view text, const std::string& name, co
   std::vector<Pass> pass;
   pass.emplace_back(std::make_unique<detail::TextSource>(text, detail::display_name(name)), std::span(&options, 1));
   return std::move(read_passes(pass, name).front());
+}
+
+namespace {
+
+// The header row of a text file, read up to its first data line.
+std::vector<std::string> header_row(const std::string& path, const ReadOptions& options) {
+  detail::TextSource src(path);
+  detail::LineParser parser(src.name(), options);
+  parser.stop_at_first_data();
+  std::string buf;
+  std::size_t line = 0;
+  Sample s;
+  for (bool more = true; more;) {
+    more = src.read(buf);
+    std::size_t p = 0;
+    for (std::size_t e; (e = buf.find('\n', p)) != std::string::npos; p = e + 1)
+      if (parser.parse(std::string_view(buf).substr(p, e - p), ++line, s) == detail::LineKind::Data)
+        return parser.layout().header;
+    buf.erase(0, p);
+  }
+  return parser.layout().header;
+}
+
+}  // namespace
+
+ImuColumnNames imu_column_names(const std::string& path, const ReadOptions& options) {
+  std::vector<std::string> names;
+  if (detail::BagStream::open(path)) {
+    for (const std::string_view f : detail::kImuFieldColumns) names.emplace_back(f);
+  } else if (path != "-") {
+    names = header_row(path, options);
+  }
+  ImuColumnNames out;
+  for (const std::string& n : names) {
+    const detail::InputChoice c = detail::choose_input(ReadOptions{}, n, path, 0);
+    const bool rate = c.mode == InputMode::Rate, angle = c.mode == InputMode::Angle;
+    if ((rate && is_accelerometer_unit(c.rate_unit)) || (angle && is_accelerometer_unit(c.angle_unit)))
+      out.accel.push_back(n);
+    else if ((rate && c.rate_unit != RateUnit::Unitless) || angle)
+      out.gyro.push_back(n);
+  }
+  return out;
 }
 
 std::vector<double> Recording::rates() const {
