@@ -1,5 +1,5 @@
 // 'rwcalc imu FILE': every gyro and accelerometer column of one static IMU recording analysed, one
-// table per sensor kind, the JSON `channels` list and the Kalibr/OpenVINS noise file.
+// table per sensor kind, the JSON `channels` list and the noise file (Kalibr, OpenVINS, VINS-Fusion, ORB-SLAM3).
 #include <fmt/format.h>
 
 #include <unistd.h>
@@ -177,7 +177,7 @@ void write_report(const std::string& dir, const ImuResult& res, const nlohmann::
                   "</head>\n<body>\n<h1>{}</h1>\n{}<pre>{}</pre>\n<p>{}</p>\n<p>{}</p>\n</body></html>\n",
                   language_code(), source, html_escaped(trf("IMU noise: {}", printable(res.source))), figure,
                   html_escaped(text),
-                  trf("Noise file for Kalibr and OpenVINS: {}; all results: {}.", "<a href=\"imu.yaml\">imu.yaml</a>",
+                  trf("Noise file for Kalibr: {}; all results: {}.", "<a href=\"imu.yaml\">imu.yaml</a>",
                       "<a href=\"imu.json\">imu.json</a>"),
                   html_escaped(version_line())),
       force);
@@ -231,7 +231,8 @@ void register_imu(CLI::App& app, Runner& runner) {
   cmd->analysis.add_to(*sub);
   sub->add_flag("--json", cmd->json, tr("Print the JSON object instead of the tables"))->group(tr("Output"));
   sub->add_option("--kalibr", cmd->kalibr,
-                  tr("Write the Kalibr/OpenVINS IMU noise file (imu.yaml: noise densities and random walks in SI)"))
+                  tr("Write the Kalibr IMU noise file (imu.yaml: noise densities and random walks in SI); the same as "
+                     "--noise-file PATH --noise-format kalibr"))
       ->check(output_name())
       ->group(tr("Output"));
   sub->add_option("--noise-file", cmd->noise_file,
@@ -255,16 +256,16 @@ void register_imu(CLI::App& app, Runner& runner) {
                 tr("Discrete-time values in the --noise-file: N*sqrt(rate) and K/sqrt(rate) (vins-fusion only; the "
                    "other programs convert continuous values themselves)"))
       ->group(tr("Output"));
-  sub->add_option("--rostopic", cmd->rostopic, tr("rostopic written into the --kalibr file"))
+  sub->add_option("--rostopic", cmd->rostopic, tr("rostopic written into the noise files"))
       ->capture_default_str()
       ->group(tr("Output"));
   sub->add_option("--combine", cmd->combine,
-                  tr("How the --kalibr file combines the axes of a kind: worst (the largest) or mean"))
+                  tr("How the noise files combine the axes of a kind: worst (the largest) or mean"))
       ->check(CLI::IsMember({"worst", "mean"}))
       ->capture_default_str()
       ->group(tr("Output"));
   sub->add_flag("--keys-from-all-axes", cmd->keys_from_all_axes,
-                tr("Let every axis into the --kalibr keys (default: only axes with an accepted fit and a resolved "
+                tr("Let every axis into the noise files' keys (default: only axes with an accepted fit and a resolved "
                    "value; the others are named in the file's comments)"))
       ->group(tr("Output"));
   sub->add_option("--report", cmd->report_dir,
