@@ -461,7 +461,6 @@ TEST(ImuNoiseFile, KeysTakeAcceptedResolvedAxesAndNameTheOthers) {
   EXPECT_TRUE(has(ya, "in the keys (--keys-from-all-axes) although its fit is rejected")) << ya;
 }
 
-
 // Loads a noise file as its consumer does (PyYAML; for OpenCV's %YAML:1.0 form, the directive line
 // taken off as OpenCV's reader does) and checks its header, its keys and their values against the
 // JSON's worst axes: factor_n and factor_k times them, within 1e-9 relative.
@@ -499,8 +498,8 @@ TEST(ImuNoiseFile, EveryFormatLoadsAsItsConsumerReadsIt) {
   TempDir dir;
   const auto f = dir.write("imu.csv", imu_csv(kHeader));
   const auto py = dir.write("load.py", kLoadNoiseFile);
-  const std::vector<std::string> base{"imu",   f.string(), "--rate", "100", "--gyro", "1,2,3", "--accel", "4,5,6",
-                                      "--json"};
+  const std::vector<std::string> base{"imu",   f.string(), "--rate", "100",   "--gyro",
+                                      "1,2,3", "--accel",  "4,5,6",  "--json"};
   const std::string topic = "/imu \"0\" \xc3\xa9";  // a quote and a non-ASCII letter, encoded for YAML
   auto check = [&](const std::string& format, const std::vector<std::string>& extra, double fn,
                    double fk) -> std::string {
@@ -550,8 +549,8 @@ TEST(ImuNoiseFile, BadFormatInflateOrDiscreteIsAUsageErrorBeforeAnyOutput) {
   TempDir dir;
   const auto f = dir.write("imu.csv", imu_csv(kHeader));
   const auto yaml = dir.path() / "n.yaml";
-  const std::vector<std::string> base{"imu", f.string(), "--rate", "100", "--gyro", "1,2,3", "--noise-file",
-                                      yaml.string()};
+  const std::vector<std::string> base{"imu",    f.string(), "--rate",       "100",
+                                      "--gyro", "1,2,3",    "--noise-file", yaml.string()};
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
       {{"--noise-format", "rovio"}, "--noise-format"},
       {{"--noise-format", "vins-fusion", "--inflate", "0.5"}, "--inflate"},

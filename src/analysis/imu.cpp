@@ -58,8 +58,9 @@ std::vector<ChannelSpec> channels_by_name(const std::string& path, const ReadOpt
   for (const auto& c : names.gyro) specs.push_back({c, SensorKind::Gyro});
   for (const auto& c : names.accel) specs.push_back({c, SensorKind::Accelerometer});
   if (specs.empty())
-    throw UsageError(tr("imu needs at least one column: give --gyro COLS and/or --accel COLS (no column name has a "
-                        "unit suffix such as _dps or _g, nor is a ROS field such as angular_velocity.x)"));
+    throw UsageError(
+        tr("imu needs at least one column: give --gyro COLS and/or --accel COLS (no column name has a "
+           "unit suffix such as _dps or _g, nor is a ROS field such as angular_velocity.x)"));
   const auto list = [](const std::vector<std::string>& v) {
     std::string s;
     for (const auto& c : v) s += (s.empty() ? "" : ", ") + c;
@@ -530,11 +531,13 @@ struct FormatSpec {
 const FormatSpec& spec_of(NoiseFormat f) {
   static const FormatSpec specs[] = {
       {"Kalibr",
-       {{"accelerometer_noise_density", "accelerometer_random_walk"}, {"gyroscope_noise_density", "gyroscope_random_walk"}},
+       {{"accelerometer_noise_density", "accelerometer_random_walk"},
+        {"gyroscope_noise_density", "gyroscope_random_walk"}},
        "",
        false},
       {"OpenVINS (kalibr_imu_chain.yaml)",
-       {{"accelerometer_noise_density", "accelerometer_random_walk"}, {"gyroscope_noise_density", "gyroscope_random_walk"}},
+       {{"accelerometer_noise_density", "accelerometer_random_walk"},
+        {"gyroscope_noise_density", "gyroscope_random_walk"}},
        "  ",
        true},
       {"VINS-Fusion", {{"acc_n", "acc_w"}, {"gyr_n", "gyr_w"}}, "", true},
@@ -562,15 +565,16 @@ std::string key_line(const std::string& key, const Combined& c, double factor, c
 // What the values are: continuous or discrete time, inflated or as measured.
 std::string values_comment(const NoiseFileOptions& o, double rate_hz) {
   std::string s =
-      o.discrete
-          ? fmt::format("# values: DISCRETE time at {:g} Hz (--discrete): white noise sigma_d = N*sqrt(rate) [rad/s, "
-                        "m/s^2],\n#   bias random walk sigma_bd = K/sqrt(rate) [rad/s, m/s^2 per sample]\n",
-                        rate_hz)
-          : std::string("# values: continuous time (noise density N, random walk K)\n");
+      o.discrete ? fmt::format(
+                       "# values: DISCRETE time at {:g} Hz (--discrete): white noise sigma_d = N*sqrt(rate) [rad/s, "
+                       "m/s^2],\n#   bias random walk sigma_bd = K/sqrt(rate) [rad/s, m/s^2 per sample]\n",
+                       rate_hz)
+                 : std::string("# values: continuous time (noise density N, random walk K)\n");
   s += "# the axes' values below are as measured (continuous time, not inflated); the keys' values are written\n";
-  s += o.inflate == 1.0 ? std::string("# not inflated: the keys hold the measured values (--inflate F multiplies them)\n")
-                        : fmt::format("# INFLATED: every key's noise value is {:g} x the measured one (--inflate {:g})\n",
-                                      o.inflate, o.inflate);
+  s += o.inflate == 1.0
+           ? std::string("# not inflated: the keys hold the measured values (--inflate F multiplies them)\n")
+           : fmt::format("# INFLATED: every key's noise value is {:g} x the measured one (--inflate {:g})\n", o.inflate,
+                         o.inflate);
   return s;
 }
 
@@ -629,8 +633,9 @@ std::string noise_file(const ImuResult& r, const NoiseFileOptions& options) {
       "# file: {} (SHA-256 {}), {} samples at {:g} Hz\n"
       "# noise_density = N (white noise, continuous time; sigma^2 = N^2/tau), random_walk = K (bias random\n"
       "# walk; sigma^2 = K^2 tau/3), each axis fitted with 95 % intervals; the values used are the {} of {}.\n",
-      spec.opencv ? "%YAML:1.0\n" : "", spec.consumer, yaml_comment(r.source), first.input.value("sha256", std::string()),
-      first.samples, first.rate_hz, worst ? "worst axis' (the largest)" : "mean",
+      spec.opencv ? "%YAML:1.0\n" : "", spec.consumer, yaml_comment(r.source),
+      first.input.value("sha256", std::string()), first.samples, first.rate_hz,
+      worst ? "worst axis' (the largest)" : "mean",
       options.all_axes ? "every axis (--keys-from-all-axes)" : "the axes with an accepted fit and a resolved value");
   head += values_comment(options, first.rate_hz);
   std::string body, keys = format_keys(r, options);
@@ -642,13 +647,15 @@ std::string noise_file(const ImuResult& r, const NoiseFileOptions& options) {
       continue;
     }
     body += axes_comments(axes, kind, options.all_axes);
-    for (const auto& [t, which, term] : {std::tuple{0, &AxisNoise::N, Term::N}, std::tuple{1, &AxisNoise::K, Term::K}}) {
+    for (const auto& [t, which, term] :
+         {std::tuple{0, &AxisNoise::N, Term::N}, std::tuple{1, &AxisNoise::K, Term::K}}) {
       const Combined c = combine(axes, which, options.combine, options.all_axes);
       const char* name = term == Term::N ? "N" : "K";
       if (c.fallback)
-        head += fmt::format("# WARNING: no {} axis has an accepted fit and a resolved {}: {} is the {} of every axis, {}.\n",
-                            to_string(kind), name, spec.keys[k][t], worst ? "largest" : "mean",
-                            c.bound ? "an upper bound, not a measured value" : "from a fit the goodness of fit rejects");
+        head += fmt::format(
+            "# WARNING: no {} axis has an accepted fit and a resolved {}: {} is the {} of every axis, {}.\n",
+            to_string(kind), name, spec.keys[k][t], worst ? "largest" : "mean",
+            c.bound ? "an upper bound, not a measured value" : "from a fit the goodness of fit rejects");
       keys += spec.indent + key_line(spec.keys[k][t], c, written_factor(options, term, first.rate_hz),
                                      written_unit(kind, term, options.discrete), name, worst);
     }

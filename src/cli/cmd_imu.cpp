@@ -100,9 +100,10 @@ struct ImuCmd {
     k.inflate = inflate;
     k.discrete = discrete_wanted;
     if (discrete_wanted && !takes_discrete(format))
-      throw UsageError(trf("--discrete: --noise-format {} takes continuous-time values only (its reader converts "
-                           "them); --discrete is for vins-fusion",
-                           noise_format));
+      throw UsageError(
+          trf("--discrete: --noise-format {} takes continuous-time values only (its reader converts "
+              "them); --discrete is for vins-fusion",
+              noise_format));
     return k;
   }
 };
@@ -190,7 +191,8 @@ void register_imu(CLI::App& app, Runner& runner) {
   auto cmd = std::make_shared<ImuCmd>();
   auto* sub = app.add_subcommand(
       "imu", tr("A whole IMU from one static recording: every gyro and accelerometer column's noise coefficients with "
-                "95 % intervals, one table per sensor kind, and the noise file for Kalibr, OpenVINS, VINS-Fusion or ORB-SLAM3"));
+                "95 % intervals, one table per sensor kind, and the noise file for Kalibr, OpenVINS, VINS-Fusion or "
+                "ORB-SLAM3"));
   sub->add_option("FILE", cmd->file, tr("Recording with one column per axis ('-' for standard input)"))->required();
   sub->add_option("--rate", cmd->rate_hz, tr("Sample rate, Hz (else metadata rate_hz or a time column)"))
       ->check(real_in(kMinRateHz, kMaxRateHz, "Hz"))
