@@ -58,9 +58,8 @@ std::vector<ChannelSpec> channels_by_name(const std::string& path, const ReadOpt
   for (const auto& c : names.gyro) specs.push_back({c, SensorKind::Gyro});
   for (const auto& c : names.accel) specs.push_back({c, SensorKind::Accelerometer});
   if (specs.empty())
-    throw UsageError(
-        tr("imu needs at least one column: give --gyro COLS and/or --accel COLS (no column name has a "
-           "unit suffix such as _dps or _g, nor is a ROS field such as angular_velocity.x)"));
+    throw UsageError(tr("imu needs at least one column: give --gyro COLS and/or --accel COLS (no column name has a "
+                        "unit suffix such as _dps or _g, nor is a ROS field such as angular_velocity.x)"));
   const auto list = [](const std::vector<std::string>& v) {
     std::string s;
     for (const auto& c : v) s += (s.empty() ? "" : ", ") + c;
@@ -570,7 +569,7 @@ std::string values_comment(const NoiseFileOptions& o, double rate_hz) {
                        "m/s^2],\n#   bias random walk sigma_bd = K/sqrt(rate) [rad/s, m/s^2 per sample]\n",
                        rate_hz)
                  : std::string("# values: continuous time (noise density N, random walk K)\n");
-  s += "# the axes' values below are as measured (continuous time, not inflated); the keys' values are written\n";
+  s += "# the axes' values in the comments below are as measured (continuous time, not inflated)\n";
   s += o.inflate == 1.0
            ? std::string("# not inflated: the keys hold the measured values (--inflate F multiplies them)\n")
            : fmt::format("# INFLATED: every key's noise value is {:g} x the measured one (--inflate {:g})\n", o.inflate,
