@@ -439,7 +439,7 @@ TEST(ImuNoiseFile, KeysTakeAcceptedResolvedAxesAndNameTheOthers) {
   const double ny = axes[1]["noise_density"]["value"].get<double>();
   EXPECT_GT(axes[2]["noise_density"]["value"].get<double>(), ny);
   const std::string y = slurp(yaml);
-  EXPECT_DOUBLE_EQ(yaml_key(y, "gyroscope_noise_density"), std::stod(fmt::format("{:.6e}", ny))) << y;
+  EXPECT_DOUBLE_EQ(yaml_key(y, "gyroscope_noise_density"), ny) << y;  // every digit written
   EXPECT_EQ(j["noise"]["gyro"]["worst"]["noise_density_axis"], "gyro_y_dps");
   EXPECT_FALSE(axes[2]["noise_density"]["in_keys"].get<bool>());
   EXPECT_TRUE(has(y, "#     N left out of the keys: its fit is rejected")) << y;
@@ -459,6 +459,115 @@ TEST(ImuNoiseFile, KeysTakeAcceptedResolvedAxesAndNameTheOthers) {
   EXPECT_GT(yaml_key(ya, "gyroscope_noise_density"), yaml_key(y, "gyroscope_noise_density"));
   EXPECT_TRUE(has(ya, "worst axis gyro_z_dps")) << ya;
   EXPECT_TRUE(has(ya, "in the keys (--keys-from-all-axes) although its fit is rejected")) << ya;
+}
+
+// Loads a noise file as its consumer does (PyYAML; for OpenCV's %YAML:1.0 form, the directive line
+// taken off as OpenCV's reader does) and checks its header, its keys and their values against the
+// JSON's worst axes: factor_n and factor_k times them, within 1e-9 relative.
+const char* kLoadNoiseFile = R"(import sys, json, math, yaml
+path, fmt, jpath, fn, fk, topic = sys.argv[1:7]
+fn, fk = float(fn), float(fk)
+text = open(path, encoding='utf-8').read()
+opencv = fmt != 'kalibr'
+first, rest = text.split('\n', 1)
+assert (first == '%YAML:1.0') == opencv, first
+d = yaml.safe_load(rest if opencv else text)
+j = json.load(open(jpath))['noise']
+keys = {'kalibr': ('accelerometer_noise_density', 'accelerometer_random_walk', 'gyroscope_noise_density', 'gyroscope_random_walk'),
+        'vins-fusion': ('acc_n', 'acc_w', 'gyr_n', 'gyr_w'),
+        'orb-slam3': ('IMU.NoiseAcc', 'IMU.AccWalk', 'IMU.NoiseGyro', 'IMU.GyroWalk')}
+keys['openvins'] = keys['kalibr']
+if fmt == 'openvins':
+    d = d['imu0']
+    assert d['model'] == 'kalibr' and len(d['T_i_b']) == 4 and d['T_i_b'][3] == [0.0, 0.0, 0.0, 1.0], d
+want = [j['accelerometer']['worst']['noise_density'] * fn, j['accelerometer']['worst']['random_walk'] * fk,
+        j['gyro']['worst']['noise_density'] * fn, j['gyro']['worst']['random_walk'] * fk]
+for k, w in zip(keys[fmt], want):
+    assert isinstance(d[k], float) and abs(d[k] / w - 1) < 1e-9, (k, d[k], w)
+rate = {'kalibr': 'update_rate', 'openvins': 'update_rate', 'orb-slam3': 'IMU.Frequency'}
+if fmt in rate: assert d[rate[fmt]] == 100.0, d
+if fmt in ('kalibr', 'openvins'): assert d['rostopic'] == topic, d['rostopic']
+if fmt == 'vins-fusion':
+    assert d['imu_topic'] == topic and abs(d['g_norm'] / 9.80665 - 1) < 1e-3, d
+)";
+
+bool have_pyyaml() { return std::system("python3 -c 'import yaml' >/dev/null 2>&1") == 0; }
+
+TEST(ImuNoiseFile, EveryFormatLoadsAsItsConsumerReadsIt) {
+  if (!have_pyyaml()) GTEST_SKIP() << "python3-yaml is not installed";
+  TempDir dir;
+  const auto f = dir.write("imu.csv", imu_csv(kHeader));
+  const auto py = dir.write("load.py", kLoadNoiseFile);
+  const std::vector<std::string> base{"imu",   f.string(), "--rate", "100",   "--gyro",
+                                      "1,2,3", "--accel",  "4,5,6",  "--json"};
+  const std::string topic = "/imu \"0\" \xc3\xa9";  // a quote and a non-ASCII letter, encoded for YAML
+  auto check = [&](const std::string& format, const std::vector<std::string>& extra, double fn,
+                   double fk) -> std::string {
+    const auto yaml = dir.path() / (format + ".yaml");
+    const auto json = dir.path() / (format + ".json");
+    std::vector<std::string> args = base;
+    for (const auto& a : {std::string("--noise-file"), yaml.string(), std::string("--noise-format"), format,
+                          std::string("--rostopic"), topic, std::string("-o"), json.string(), std::string("--force")})
+      args.push_back(a);
+    args.insert(args.end(), extra.begin(), extra.end());
+    const auto r = run_cli(args);
+    if (r.status != 0) {
+      ADD_FAILURE() << format << ": " << r.err;
+      return {};
+    }
+    const std::string cmd = fmt::format("python3 '{}' '{}' '{}' '{}' {:.17g} {:.17g} '{}'", py.string(), yaml.string(),
+                                        format, json.string(), fn, fk, topic);
+    EXPECT_EQ(std::system(cmd.c_str()), 0) << format << "\n" << slurp(yaml);
+    return slurp(yaml);
+  };
+  for (const char* format : {"kalibr", "openvins", "vins-fusion", "orb-slam3"}) {
+    const std::string y = check(format, {}, 1, 1);
+    EXPECT_TRUE(has(y, "# values: continuous time")) << y;
+    EXPECT_TRUE(has(y, "# not inflated")) << y;
+    const std::string inflated = check(format, {"--inflate", "3.5"}, 3.5, 3.5);
+    EXPECT_TRUE(has(inflated, "# INFLATED: every key's noise value is 3.5 x the measured one (--inflate 3.5)"))
+        << inflated;
+  }
+  // Discrete time at 100 Hz: sigma_d = N*sqrt(100), sigma_bd = K/sqrt(100), inflated on top.
+  const std::string d = check("vins-fusion", {"--discrete", "--inflate", "2"}, 2 * 10.0, 2 / 10.0);
+  EXPECT_TRUE(has(d, "# values: DISCRETE time at 100 Hz (--discrete)")) << d;
+  EXPECT_TRUE(has(d, "acc_n: ") && has(d, "  # [m/s^2] worst axis")) << d;
+  // --kalibr stays the Kalibr shorthand beside a --noise-file of another format.
+  const auto k = dir.path() / "k.yaml";
+  const auto o = dir.path() / "o.yaml";
+  ASSERT_EQ(run_cli({"imu", f.string(), "--rate", "100", "--gyro", "1,2,3", "--kalibr", k.string(), "--noise-file",
+                     o.string(), "--noise-format", "orb-slam3", "-o", (dir.path() / "t.txt").string()})
+                .status,
+            0);
+  EXPECT_TRUE(has(slurp(k), "\ngyroscope_noise_density: "));
+  EXPECT_TRUE(has(slurp(o), "\nIMU.NoiseGyro: "));
+  EXPECT_FALSE(has(slurp(o), "IMU.NoiseAcc"));  // no accelerometer channel: its keys left out, said
+  EXPECT_TRUE(has(slurp(o), "# no accelerometer channel was analysed"));
+}
+
+TEST(ImuNoiseFile, BadFormatInflateOrDiscreteIsAUsageErrorBeforeAnyOutput) {
+  TempDir dir;
+  const auto f = dir.write("imu.csv", imu_csv(kHeader));
+  const auto yaml = dir.path() / "n.yaml";
+  const std::vector<std::string> base{"imu",    f.string(), "--rate",       "100",
+                                      "--gyro", "1,2,3",    "--noise-file", yaml.string()};
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
+      {{"--noise-format", "rovio"}, "--noise-format"},
+      {{"--noise-format", "vins-fusion", "--inflate", "0.5"}, "--inflate"},
+      {{"--inflate", "nan"}, "--inflate"},
+      {{"--inflate", "inf"}, "--inflate"},
+      {{"--inflate", "-2"}, "--inflate"},
+      {{"--noise-format", "orb-slam3", "--discrete"}, "--discrete"},
+      {{"--noise-format", "openvins", "--discrete"}, "--discrete"},
+      {{"--discrete"}, "--discrete"}};  // kalibr by default
+  for (const auto& [extra, option] : cases) {
+    std::vector<std::string> args = base;
+    args.insert(args.end(), extra.begin(), extra.end());
+    const auto r = run_cli(args);
+    EXPECT_EQ(r.status, 2) << extra.front() << " " << extra.back();
+    EXPECT_TRUE(has(r.err, option)) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(yaml)) << extra.back();
+  }
 }
 
 }  // namespace

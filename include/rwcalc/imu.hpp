@@ -1,7 +1,7 @@
 #pragma once
 /// @file imu.hpp
 /// A whole IMU from one recording: every gyro and accelerometer column analysed (in parallel), one
-/// table per sensor kind, the JSON `channels` list, and the Kalibr/OpenVINS noise file.
+/// table per sensor kind, the JSON `channels` list, and the noise file (Kalibr, OpenVINS, VINS-Fusion, ORB-SLAM3).
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -56,12 +56,24 @@ std::string format_channel(const AnalysisResult& r, const UnitSet& shown);
 /// How the noise file combines the axes of one kind.
 enum class AxisCombination { Worst, Mean };
 
-struct KalibrOptions {
+/// The program a noise file is written for, each with its own keys and layout.
+enum class NoiseFormat { Kalibr, OpenVins, VinsFusion, OrbSlam3 };
+
+/// Parses kalibr, openvins, vins-fusion, orb-slam3; UsageError naming --noise-format otherwise.
+NoiseFormat parse_noise_format(std::string_view name);
+/// Whether the format's consumer can be given discrete-time values (VINS-Fusion: its acc_n ...
+/// are used as per-sample deviations by some users); the others convert continuous values themselves.
+bool takes_discrete(NoiseFormat format);
+
+struct NoiseFileOptions {
+  NoiseFormat format = NoiseFormat::Kalibr;
   std::string rostopic = "/imu0";
   AxisCombination combine = AxisCombination::Worst;
   /// The keys take every axis; by default only the axes with an accepted fit and a resolved value
   /// (the others named in the comments, with why; when none qualifies, every axis, said in the first lines).
   bool all_axes = false;
+  double inflate = 1;     ///< every value written is this many times the measured one (≥ 1), said in the file
+  bool discrete = false;  ///< discrete-time values: N·√rate, K/√rate (takes_discrete formats only)
 };
 
 /// The rostopic as the noise file writes it (one YAML double-quoted scalar, encode.hpp); UsageError
@@ -69,9 +81,12 @@ struct KalibrOptions {
 /// it writes anything.
 std::string rostopic_scalar(const std::string& rostopic);
 
-/// Kalibr's imu.yaml (OpenVINS reads the same keys): noise densities = N and random walks = K of
-/// each kind in SI, the qualifying axes (KalibrOptions::all_axes) combined as asked; each axis' values,
-/// and why one is left out, in comments, every outside name in them made a safe comment (yaml_comment).
-std::string kalibr_yaml(const ImuResult& r, const KalibrOptions& options = {});
+/// The noise file for the format's consumer: noise densities = N and random walks = K of each kind
+/// in SI (Kalibr: imu.yaml; OpenVINS: the imu0 block of kalibr_imu_chain.yaml; VINS-Fusion: acc_n,
+/// gyr_n, acc_w, gyr_w, g_norm; ORB-SLAM3: IMU.Noise*, IMU.*Walk, IMU.Frequency; OpenCV's %YAML:1.0
+/// header for the three that read it with OpenCV), the qualifying axes (all_axes) combined as asked;
+/// each axis' values, and why one is left out, in comments, every outside name in them made a safe
+/// comment (yaml_comment).
+std::string noise_file(const ImuResult& r, const NoiseFileOptions& options = {});
 
 }  // namespace rwcalc

@@ -8,6 +8,8 @@
 #include <iostream>
 #include <iterator>
 #include <sstream>
+#include <tuple>
+#include <utility>
 
 #include "analysis/fit_range.hpp"
 #include "rwcalc/encode.hpp"
@@ -16,6 +18,7 @@
 #include "rwcalc/parallel.hpp"
 #include "rwcalc/printable.hpp"
 #include "rwcalc/progress.hpp"
+#include "rwcalc/units.hpp"
 
 namespace rwcalc {
 
@@ -476,9 +479,24 @@ std::string rostopic_scalar(const std::string& rostopic) {
   return *quoted;
 }
 
+NoiseFormat parse_noise_format(std::string_view name) {
+  constexpr std::pair<std::string_view, NoiseFormat> names[] = {{"kalibr", NoiseFormat::Kalibr},
+                                                                {"openvins", NoiseFormat::OpenVins},
+                                                                {"vins-fusion", NoiseFormat::VinsFusion},
+                                                                {"orb-slam3", NoiseFormat::OrbSlam3}};
+  for (const auto& [n, f] : names)
+    if (n == name) return f;
+  throw UsageError(
+      trf("--noise-format '{}': unknown; expected kalibr, openvins, vins-fusion or orb-slam3", printable(name)));
+}
+
+bool takes_discrete(NoiseFormat format) { return format == NoiseFormat::VinsFusion; }
+
 namespace imu_impl {
 
 std::string yaml_num(double v) { return fmt::format("{:.6e}", v); }  // always a YAML float
+// A key's value: every digit a double carries, so the file reads back as the JSON's value.
+std::string yaml_key_num(double v) { return fmt::format("{:.16e}", v); }
 
 // One kind's axes in the comments: each axis' N and K with intervals, and why one is left out of the keys.
 std::string axes_comments(const std::vector<AxisNoise>& axes, SensorKind kind, bool all) {
@@ -501,49 +519,144 @@ std::string axes_comments(const std::vector<AxisNoise>& axes, SensorKind kind, b
   return s;
 }
 
-// A key's line: the value, its unit and where it comes from.
-std::string key_line(const std::string& key, const Combined& c, const ShownUnit& unit, const char* term, bool worst) {
+// How one consumer names the four noise keys and lays out its file.
+struct FormatSpec {
+  const char* consumer;
+  const char* keys[2][2];  ///< [accelerometer, gyro][N, K]
+  const char* indent;      ///< of the keys (OpenVINS nests them under imu0:)
+  bool opencv;             ///< read by OpenCV's FileStorage: the %YAML:1.0 header
+};
+
+const FormatSpec& spec_of(NoiseFormat f) {
+  static const FormatSpec specs[] = {
+      {"Kalibr",
+       {{"accelerometer_noise_density", "accelerometer_random_walk"},
+        {"gyroscope_noise_density", "gyroscope_random_walk"}},
+       "",
+       false},
+      {"OpenVINS (kalibr_imu_chain.yaml)",
+       {{"accelerometer_noise_density", "accelerometer_random_walk"},
+        {"gyroscope_noise_density", "gyroscope_random_walk"}},
+       "  ",
+       true},
+      {"VINS-Fusion", {{"acc_n", "acc_w"}, {"gyr_n", "gyr_w"}}, "", true},
+      {"ORB-SLAM3", {{"IMU.NoiseAcc", "IMU.AccWalk"}, {"IMU.NoiseGyro", "IMU.GyroWalk"}}, "", true}};
+  return specs[static_cast<std::size_t>(f)];
+}
+
+// The factor from a measured N or K to the value written: --inflate, and for discrete-time values
+// σ_d = N·√rate (white noise) and σ_bd = K/√rate (the bias random walk's step).
+double written_factor(const NoiseFileOptions& o, Term term, double rate_hz) {
+  if (!o.discrete) return o.inflate;
+  return o.inflate * (term == Term::N ? std::sqrt(rate_hz) : 1.0 / std::sqrt(rate_hz));
+}
+
+// A key's line: the value written, its unit and where it comes from.
+std::string key_line(const std::string& key, const Combined& c, double factor, const std::string& unit,
+                     const char* term, bool worst) {
   std::string from =
       worst ? fmt::format(" worst axis {}", yaml_comment(c.from)) : fmt::format(" mean of {} axes", c.axes);
   if (c.fallback) from += "; NO AXIS QUALIFIES (see the first lines)";
   if (c.bound) from += fmt::format("; UPPER BOUND: {} not resolved (its 95 % bound used)", term);
-  return fmt::format("{}: {}  # [{}]{}\n", key, yaml_num(c.value), unit.ascii, from);
+  return fmt::format("{}: {}  # [{}]{}\n", key, yaml_key_num(c.value * factor), unit, from);
+}
+
+// What the values are: continuous or discrete time, inflated or as measured.
+std::string values_comment(const NoiseFileOptions& o, double rate_hz) {
+  std::string s =
+      o.discrete ? fmt::format(
+                       "# values: DISCRETE time at {:g} Hz (--discrete): white noise sigma_d = N*sqrt(rate) [rad/s, "
+                       "m/s^2],\n#   bias random walk sigma_bd = K/sqrt(rate) [rad/s, m/s^2 per sample]\n",
+                       rate_hz)
+                 : std::string("# values: continuous time (noise density N, random walk K)\n");
+  s += "# the axes' values in the comments below are as measured (continuous time, not inflated)\n";
+  s += o.inflate == 1.0
+           ? std::string("# not inflated: the keys hold the measured values (--inflate F multiplies them)\n")
+           : fmt::format("# INFLATED: every key's noise value is {:g} x the measured one (--inflate {:g})\n", o.inflate,
+                         o.inflate);
+  return s;
+}
+
+// g_norm: the magnitude of the mean of three accelerometer axes (their biases included), else
+// standard gravity.
+std::string g_norm_line(const ImuResult& r) {
+  const auto accel = of_kind(r, SensorKind::Accelerometer);
+  if (accel.size() != 3)
+    return fmt::format("g_norm: {}  # [m/s^2] standard gravity (not three accelerometer axes)\n",
+                       yaml_key_num(units::standard_gravity));
+  const double to_si = output_units(SensorKind::Accelerometer, "m/s^2").deviation.factor;
+  double sum = 0;
+  for (const auto* c : accel) sum += std::pow(c->result.mean_rate_deg_per_h * to_si, 2);
+  return fmt::format("g_norm: {}  # [m/s^2] magnitude of the mean of the three accelerometer axes\n",
+                     yaml_key_num(std::sqrt(sum)));
+}
+
+// The consumer's keys other than the noise values, before them.
+std::string format_keys(const ImuResult& r, const NoiseFileOptions& o) {
+  const double rate = r.channels.front().result.rate_hz;
+  switch (o.format) {
+    case NoiseFormat::Kalibr:
+      return fmt::format("rostopic: {}\nupdate_rate: {:.6f}  # Hz\n", rostopic_scalar(o.rostopic), rate);
+    case NoiseFormat::OpenVins:
+      return fmt::format(
+          "imu0:\n  # not measured here: identity extrinsic and intrinsics (model kalibr), no time offset\n"
+          "  T_i_b:\n    - [1.0, 0.0, 0.0, 0.0]\n    - [0.0, 1.0, 0.0, 0.0]\n    - [0.0, 0.0, 1.0, 0.0]\n"
+          "    - [0.0, 0.0, 0.0, 1.0]\n  model: \"kalibr\"\n"
+          "  Tw:\n    - [1.0, 0.0, 0.0]\n    - [0.0, 1.0, 0.0]\n    - [0.0, 0.0, 1.0]\n"
+          "  R_IMUtoGYRO:\n    - [1.0, 0.0, 0.0]\n    - [0.0, 1.0, 0.0]\n    - [0.0, 0.0, 1.0]\n"
+          "  Ta:\n    - [1.0, 0.0, 0.0]\n    - [0.0, 1.0, 0.0]\n    - [0.0, 0.0, 1.0]\n"
+          "  R_IMUtoACC:\n    - [1.0, 0.0, 0.0]\n    - [0.0, 1.0, 0.0]\n    - [0.0, 0.0, 1.0]\n"
+          "  Tg:\n    - [0.0, 0.0, 0.0]\n    - [0.0, 0.0, 0.0]\n    - [0.0, 0.0, 0.0]\n"
+          "  rostopic: {}\n  time_offset: 0.0\n  update_rate: {:.6f}  # Hz\n",
+          rostopic_scalar(o.rostopic), rate);
+    case NoiseFormat::VinsFusion: return fmt::format("imu_topic: {}\n", rostopic_scalar(o.rostopic)) + g_norm_line(r);
+    case NoiseFormat::OrbSlam3: return fmt::format("IMU.Frequency: {:.6f}  # Hz\n", rate);
+  }
+  return {};
+}
+
+// The unit of a value written: SI densities, or per-sample deviations for discrete values.
+std::string written_unit(SensorKind kind, Term term, bool discrete) {
+  if (discrete) return kind == SensorKind::Gyro ? "rad/s" : "m/s^2";
+  return si_units(kind)[term].ascii;
 }
 
 }  // namespace imu_impl
 
-std::string kalibr_yaml(const ImuResult& r, const KalibrOptions& options) {
+std::string noise_file(const ImuResult& r, const NoiseFileOptions& options) {
   const auto& first = r.channels.front().result;
+  const FormatSpec& spec = spec_of(options.format);
   const bool worst = options.combine == AxisCombination::Worst;
   std::string head = fmt::format(
-      "# IMU noise parameters for Kalibr and OpenVINS, from the Allan variance of a static recording.\n"
+      "{}# IMU noise parameters for {}, from the Allan variance of a static recording.\n"
       "# file: {} (SHA-256 {}), {} samples at {:g} Hz\n"
       "# noise_density = N (white noise, continuous time; sigma^2 = N^2/tau), random_walk = K (bias random\n"
       "# walk; sigma^2 = K^2 tau/3), each axis fitted with 95 % intervals; the values used are the {} of {}.\n",
-      yaml_comment(r.source), first.input.value("sha256", std::string()), first.samples, first.rate_hz,
+      spec.opencv ? "%YAML:1.0\n" : "", spec.consumer, yaml_comment(r.source),
+      first.input.value("sha256", std::string()), first.samples, first.rate_hz,
       worst ? "worst axis' (the largest)" : "mean",
       options.all_axes ? "every axis (--keys-from-all-axes)" : "the axes with an accepted fit and a resolved value");
-  std::string body,
-      keys = fmt::format("rostopic: {}\nupdate_rate: {:.6f}  # Hz\n", rostopic_scalar(options.rostopic), first.rate_hz);
+  head += values_comment(options, first.rate_hz);
+  std::string body, keys = format_keys(r, options);
   for (const SensorKind kind : {SensorKind::Accelerometer, SensorKind::Gyro}) {
     const auto axes = axis_noise(r, kind);
-    const std::string prefix = kind == SensorKind::Gyro ? "gyroscope" : "accelerometer";
-    const UnitSet si = si_units(kind);
+    const int k = kind == SensorKind::Gyro ? 1 : 0;
     if (axes.empty()) {
       body += fmt::format("# no {} channel was analysed: its keys are left out\n", to_string(kind));
       continue;
     }
     body += axes_comments(axes, kind, options.all_axes);
-    for (const auto& [suffix, which, term] :
-         {std::tuple{"_noise_density", &AxisNoise::N, Term::N}, std::tuple{"_random_walk", &AxisNoise::K, Term::K}}) {
+    for (const auto& [t, which, term] :
+         {std::tuple{0, &AxisNoise::N, Term::N}, std::tuple{1, &AxisNoise::K, Term::K}}) {
       const Combined c = combine(axes, which, options.combine, options.all_axes);
       const char* name = term == Term::N ? "N" : "K";
       if (c.fallback)
         head += fmt::format(
-            "# WARNING: no {} axis has an accepted fit and a resolved {}: {}{} is the {} of every axis, {}.\n",
-            to_string(kind), name, prefix, suffix, worst ? "largest" : "mean",
+            "# WARNING: no {} axis has an accepted fit and a resolved {}: {} is the {} of every axis, {}.\n",
+            to_string(kind), name, spec.keys[k][t], worst ? "largest" : "mean",
             c.bound ? "an upper bound, not a measured value" : "from a fit the goodness of fit rejects");
-      keys += key_line(prefix + suffix, c, si[term], name, worst);
+      keys += spec.indent + key_line(spec.keys[k][t], c, written_factor(options, term, first.rate_hz),
+                                     written_unit(kind, term, options.discrete), name, worst);
     }
   }
   return head + body + keys;

@@ -1,5 +1,5 @@
 // 'rwcalc imu FILE': every gyro and accelerometer column of one static IMU recording analysed, one
-// table per sensor kind, the JSON `channels` list and the Kalibr/OpenVINS noise file.
+// table per sensor kind, the JSON `channels` list and the noise file (Kalibr, OpenVINS, VINS-Fusion, ORB-SLAM3).
 #include <fmt/format.h>
 
 #include <unistd.h>
@@ -40,7 +40,9 @@ struct ImuCmd {
   bool json = false;
   std::string output = "-";
   std::string kalibr, rostopic = "/imu0", combine = "worst";
-  bool keys_from_all_axes = false;
+  std::string noise_file, noise_format = "kalibr";
+  double inflate = 1;
+  bool keys_from_all_axes = false, discrete = false;
   std::string report_dir;
   PlotArgs plot;
   bool force = false;
@@ -85,6 +87,25 @@ struct ImuCmd {
     o.analysis = analysis.options();
     return o;
   }
+
+  /// The noise files' options; `discrete_wanted` for --noise-file (--kalibr and --report's imu.yaml
+  /// are continuous). UsageError for --discrete with a format whose consumer takes continuous-time
+  /// values only.
+  [[nodiscard]] NoiseFileOptions noise_options(NoiseFormat format, bool discrete_wanted) const {
+    NoiseFileOptions k;
+    k.format = format;
+    k.rostopic = rostopic;
+    k.combine = combine == "mean" ? AxisCombination::Mean : AxisCombination::Worst;
+    k.all_axes = keys_from_all_axes;
+    k.inflate = inflate;
+    k.discrete = discrete_wanted;
+    if (discrete_wanted && !takes_discrete(format))
+      throw UsageError(
+          trf("--discrete: --noise-format {} takes continuous-time values only (its reader converts "
+              "them); --discrete is for vins-fusion",
+              noise_format));
+    return k;
+  }
 };
 
 std::string html_escaped(std::string_view text) {
@@ -125,7 +146,7 @@ std::vector<OutputTarget> report_targets(const std::string& dir) {
 
 // --report DIR: the tables as a page (index.html, with the figure when gnuplot is there), the
 // JSON, the noise file and the figure beside it, so that one directory holds the whole result.
-void write_report(const std::string& dir, const ImuResult& res, const nlohmann::json& j, const KalibrOptions& k,
+void write_report(const std::string& dir, const ImuResult& res, const nlohmann::json& j, const NoiseFileOptions& k,
                   bool force, Io& io) {
   namespace fs = std::filesystem;
   std::error_code ec;
@@ -137,7 +158,7 @@ void write_report(const std::string& dir, const ImuResult& res, const nlohmann::
   const std::string text = localize_numbers(format_imu(res));
   write_file_atomic(at("imu.txt"), text, force);
   write_file_atomic(at("imu.json"), j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n", force);
-  write_file_atomic(at("imu.yaml"), kalibr_yaml(res, k), force);
+  write_file_atomic(at("imu.yaml"), noise_file(res, k), force);
   std::string figure;
   try {
     PlotOptions o;
@@ -157,7 +178,7 @@ void write_report(const std::string& dir, const ImuResult& res, const nlohmann::
                   "</head>\n<body>\n<h1>{}</h1>\n{}<pre>{}</pre>\n<p>{}</p>\n<p>{}</p>\n</body></html>\n",
                   language_code(), source, html_escaped(trf("IMU noise: {}", printable(res.source))), figure,
                   html_escaped(text),
-                  trf("Noise file for Kalibr and OpenVINS: {}; all results: {}.", "<a href=\"imu.yaml\">imu.yaml</a>",
+                  trf("Noise file for Kalibr: {}; all results: {}.", "<a href=\"imu.yaml\">imu.yaml</a>",
                       "<a href=\"imu.json\">imu.json</a>"),
                   html_escaped(version_line())),
       force);
@@ -170,7 +191,8 @@ void register_imu(CLI::App& app, Runner& runner) {
   auto cmd = std::make_shared<ImuCmd>();
   auto* sub = app.add_subcommand(
       "imu", tr("A whole IMU from one static recording: every gyro and accelerometer column's noise coefficients with "
-                "95 % intervals, one table per sensor kind, and the Kalibr/OpenVINS noise file"));
+                "95 % intervals, one table per sensor kind, and the noise file for Kalibr, OpenVINS, VINS-Fusion or "
+                "ORB-SLAM3"));
   sub->add_option("FILE", cmd->file, tr("Recording with one column per axis ('-' for standard input)"))->required();
   sub->add_option("--rate", cmd->rate_hz, tr("Sample rate, Hz (else metadata rate_hz or a time column)"))
       ->check(real_in(kMinRateHz, kMaxRateHz, "Hz"))
@@ -211,19 +233,41 @@ void register_imu(CLI::App& app, Runner& runner) {
   cmd->analysis.add_to(*sub);
   sub->add_flag("--json", cmd->json, tr("Print the JSON object instead of the tables"))->group(tr("Output"));
   sub->add_option("--kalibr", cmd->kalibr,
-                  tr("Write the Kalibr/OpenVINS IMU noise file (imu.yaml: noise densities and random walks in SI)"))
+                  tr("Write the Kalibr IMU noise file (imu.yaml: noise densities and random walks in SI); the same as "
+                     "--noise-file PATH --noise-format kalibr"))
       ->check(output_name())
       ->group(tr("Output"));
-  sub->add_option("--rostopic", cmd->rostopic, tr("rostopic written into the --kalibr file"))
+  sub->add_option("--noise-file", cmd->noise_file,
+                  tr("Write the IMU noise file for the program --noise-format names (noise densities and random "
+                     "walks in SI)"))
+      ->check(output_name())
+      ->group(tr("Output"));
+  sub->add_option("--noise-format", cmd->noise_format,
+                  tr("The program the --noise-file is for: kalibr (imu.yaml), openvins (the imu0 block of "
+                     "kalibr_imu_chain.yaml), vins-fusion (acc_n, gyr_n, acc_w, gyr_w, g_norm), orb-slam3 "
+                     "(IMU.NoiseGyro ...); the last three in OpenCV's %YAML:1.0 form"))
+      ->capture_default_str()
+      ->group(tr("Output"));
+  sub->add_option("--inflate", cmd->inflate,
+                  tr("Multiply every value of the noise files by F (≥ 1) for effects the static recording does not "
+                     "show; said in the file"))
+      ->check(real_in(1.0, 1e6, ""))
+      ->capture_default_str()
+      ->group(tr("Output"));
+  sub->add_flag("--discrete", cmd->discrete,
+                tr("Discrete-time values in the --noise-file: N*sqrt(rate) and K/sqrt(rate) (vins-fusion only; the "
+                   "other programs convert continuous values themselves)"))
+      ->group(tr("Output"));
+  sub->add_option("--rostopic", cmd->rostopic, tr("rostopic written into the noise files"))
       ->capture_default_str()
       ->group(tr("Output"));
   sub->add_option("--combine", cmd->combine,
-                  tr("How the --kalibr file combines the axes of a kind: worst (the largest) or mean"))
+                  tr("How the noise files combine the axes of a kind: worst (the largest) or mean"))
       ->check(CLI::IsMember({"worst", "mean"}))
       ->capture_default_str()
       ->group(tr("Output"));
   sub->add_flag("--keys-from-all-axes", cmd->keys_from_all_axes,
-                tr("Let every axis into the --kalibr keys (default: only axes with an accepted fit and a resolved "
+                tr("Let every axis into the noise files' keys (default: only axes with an accepted fit and a resolved "
                    "value; the others are named in the file's comments)"))
       ->group(tr("Output"));
   sub->add_option("--report", cmd->report_dir,
@@ -238,9 +282,13 @@ void register_imu(CLI::App& app, Runner& runner) {
       ImuOptions opt = cmd->options();
       opt.read.progress = opt.analysis.progress = io.progress;
       // Every output is checked before the work and before the first is written.
-      if (!cmd->kalibr.empty() || !cmd->report_dir.empty()) (void)rostopic_scalar(cmd->rostopic);
+      if (!cmd->kalibr.empty() || !cmd->report_dir.empty() || !cmd->noise_file.empty())
+        (void)rostopic_scalar(cmd->rostopic);
+      const NoiseFileOptions chosen = cmd->noise_options(parse_noise_format(cmd->noise_format), cmd->discrete);
+      const NoiseFileOptions k = cmd->noise_options(NoiseFormat::Kalibr, false);
       std::vector<OutputTarget> targets = report_targets(cmd->report_dir);
-      targets.insert(targets.begin(), {{"-o", cmd->output}, {"--kalibr", cmd->kalibr}});
+      targets.insert(targets.begin(),
+                     {{"-o", cmd->output}, {"--kalibr", cmd->kalibr}, {"--noise-file", cmd->noise_file}});
       cmd->plot.check(cmd->force, targets);
       const ImuResult res = analyze_imu(cmd->file, opt);
       for (const auto& c : res.channels)
@@ -248,13 +296,10 @@ void register_imu(CLI::App& app, Runner& runner) {
       const nlohmann::json j = to_json(res);
       require_finite(j, res.source);
       cmd->plot.draw_imu(j, cmd->force, io);
-      KalibrOptions k;
-      k.rostopic = cmd->rostopic;
-      k.combine = cmd->combine == "mean" ? AxisCombination::Mean : AxisCombination::Worst;
-      k.all_axes = cmd->keys_from_all_axes;
-      if (!cmd->kalibr.empty()) {
-        write_file_atomic(cmd->kalibr, kalibr_yaml(res, k), cmd->force);
-        print_message(io.err, trf("noise file written to {}", as_typed(cmd->kalibr)));
+      for (const auto& [path, o] : {std::pair{cmd->kalibr, k}, std::pair{cmd->noise_file, chosen}}) {
+        if (path.empty()) continue;
+        write_file_atomic(path, noise_file(res, o), cmd->force);
+        print_message(io.err, trf("noise file written to {}", as_typed(path)));
       }
       if (!cmd->report_dir.empty()) write_report(cmd->report_dir, res, j, k, cmd->force, io);
       emit(io,
