@@ -114,8 +114,8 @@ TEST_F(ProgressOnTerminal, Report) {
                   {"analysing the runs: ", "reading " + record()});
 }
 
-TEST_F(ProgressOnTerminal, DiagnoseCountsSimulatedRecords) {
-  expect_progress({"diagnose", record(), "--runs", "10"}, {"diagnosing " + record() + " (likelihood tests): 0/"});
+TEST_F(ProgressOnTerminal, DiagnoseCountsItsLikelihoodTests) {
+  expect_progress({"diagnose", record()}, {"diagnosing " + record() + " (likelihood tests): 0/"});
 }
 
 TEST_F(ProgressOnTerminal, InTheOutputLanguage) {
