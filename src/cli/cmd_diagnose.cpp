@@ -53,10 +53,10 @@ void register_diagnose(CLI::App& app, Runner& runner) {
   sub->add_option("--temperature", cmd->temperature, tr("Temperature of the run, °C (overrides the file)"))
       ->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"));
   sub->add_flag("--json", cmd->json, tr("Print the JSON object instead of the report"));
-  sub->add_option("--runs", cmd->runs, tr("Simulated records per ensemble (at least 10)"))
+  sub->add_option("--runs", cmd->runs, tr("Accepted for earlier scripts (at least 10); the diagnosis simulates no records"))
       ->check(whole_in(10, 100000))
       ->capture_default_str();
-  sub->add_option("--seed", cmd->seed, tr("Base seed of the simulations"))
+  sub->add_option("--seed", cmd->seed, tr("Recorded in the output only: no finding depends on a seed"))
       ->check(whole_in(0, UINT64_MAX))
       ->capture_default_str();
   sub->add_option("--false-alarm", cmd->alpha, tr("False-alarm probability of each of the five detectors"))

@@ -262,10 +262,10 @@ void register_report(CLI::App& app, Runner& runner) {
   sub->add_option("--gyro", cmd->gyro, tr("The gyro's type or name, for the title block (e.g. GL-2D)"));
   sub->add_flag("--pdf", cmd->pdf, tr("Also print DIR/report.pdf with a headless Chromium, when one is installed"));
   sub->add_flag("--diagnose", cmd->diagnose, tr("Also diagnose each recording (what the noise model misses)"));
-  sub->add_option("--diagnose-runs", cmd->diagnose_runs, tr("Simulated records per diagnosis ensemble"))
+  sub->add_option("--diagnose-runs", cmd->diagnose_runs, tr("Accepted for earlier scripts; the diagnosis simulates no records"))
       ->check(whole_in(10, 100000))
       ->capture_default_str();
-  sub->add_option("--diagnose-seed", cmd->diagnose_seed, tr("Seed of the diagnosis ensembles"))
+  sub->add_option("--diagnose-seed", cmd->diagnose_seed, tr("Recorded only: no finding of the diagnosis depends on a seed"))
       ->check(whole_in(0, UINT64_MAX))
       ->capture_default_str();
   sub->add_flag("--no-figures", cmd->no_figures, tr("Tables only (needs no gnuplot)"));
