@@ -90,7 +90,7 @@ struct FitRangeChoice {
   double rejected_from_tau_s = 0;  ///< the lower τ of that rejected fit, s
   /// The fit was rejected (p < 0.001) and its intervals scaled by √(χ²/dof) (FitOptions::dispersion).
   bool intervals_scaled = false;
-  double interval_scale = 1;  ///< √(χ²/dof) of the unscaled fit, when scaled
+  double interval_scale = 1;                 ///< √(χ²/dof) of the unscaled fit, when scaled
   [[nodiscard]] std::string reason() const;  ///< why the range is what it is, one sentence
 };
 

@@ -95,7 +95,7 @@ struct TimeJitter {
 };
 
 struct Recording {
-  std::string source;      ///< the path as given ("-" for stdin)
+  std::string source;  ///< the path as given ("-" for stdin)
   /// The input as stored (compressed bytes, for gzip): its size and SHA-256, as `sha256sum` prints it.
   std::uint64_t file_bytes = 0;
   std::string sha256;

@@ -234,9 +234,10 @@ void lag1_autocorrelations(const PhaseSeries& x, std::int64_t m, std::size_t cou
     const std::size_t levels = std::min<std::size_t>(r1.size(), kLevelsAtOnce);
     lag1_exact(p, count, first, std::span(exact, levels));
     for (std::size_t l = 0; l < levels; ++l)
-      r1[l] = exact[l] ? *exact[l]
-                       : lag1_floating([&p](std::size_t k) { return static_cast<double>(static_cast<std::int64_t>(p(k))); },
-                                       count, first + static_cast<int>(l));
+      r1[l] = exact[l]
+                  ? *exact[l]
+                  : lag1_floating([&p](std::size_t k) { return static_cast<double>(static_cast<std::int64_t>(p(k))); },
+                                  count, first + static_cast<int>(l));
     return;
   }
   const double* v = x.values.data();

@@ -58,8 +58,9 @@ std::vector<ChannelSpec> channels_by_name(const std::string& path, const ReadOpt
   for (const auto& c : names.gyro) specs.push_back({c, SensorKind::Gyro});
   for (const auto& c : names.accel) specs.push_back({c, SensorKind::Accelerometer});
   if (specs.empty())
-    throw UsageError(tr("imu needs at least one column: give --gyro COLS and/or --accel COLS (no column name has a "
-                        "unit suffix such as _dps or _g, nor is a ROS field such as angular_velocity.x)"));
+    throw UsageError(
+        tr("imu needs at least one column: give --gyro COLS and/or --accel COLS (no column name has a "
+           "unit suffix such as _dps or _g, nor is a ROS field such as angular_velocity.x)"));
   const auto list = [](const std::vector<std::string>& v) {
     std::string s;
     for (const auto& c : v) s += (s.empty() ? "" : ", ") + c;

@@ -53,7 +53,8 @@ void register_diagnose(CLI::App& app, Runner& runner) {
   sub->add_option("--temperature", cmd->temperature, tr("Temperature of the run, °C (overrides the file)"))
       ->check(real_in(kMinTemperatureC, kMaxTemperatureC, "deg C"));
   sub->add_flag("--json", cmd->json, tr("Print the JSON object instead of the report"));
-  sub->add_option("--runs", cmd->runs, tr("Accepted for earlier scripts (at least 10); the diagnosis simulates no records"))
+  sub->add_option("--runs", cmd->runs,
+                  tr("Accepted for earlier scripts (at least 10); the diagnosis simulates no records"))
       ->check(whole_in(10, 100000))
       ->capture_default_str();
   sub->add_option("--seed", cmd->seed, tr("Recorded in the output only: no finding depends on a seed"))
