@@ -185,6 +185,77 @@ void write_report(const std::string& dir, const ImuResult& res, const nlohmann::
   print_message(io.err, trf("report written to {}", as_typed(at("index.html"))));
 }
 
+// The noise files' options: where, for which program, and how the values are written.
+void add_noise_file_options(CLI::App& sub, ImuCmd& cmd) {
+  sub.add_option("--kalibr", cmd.kalibr,
+                 tr("Write the Kalibr IMU noise file (imu.yaml: noise densities and random walks in SI); the same as "
+                    "--noise-file PATH --noise-format kalibr"))
+      ->check(output_name())
+      ->group(tr("Output"));
+  sub.add_option("--noise-file", cmd.noise_file,
+                 tr("Write the IMU noise file for the program --noise-format names (noise densities and random "
+                    "walks in SI)"))
+      ->check(output_name())
+      ->group(tr("Output"));
+  sub.add_option("--noise-format", cmd.noise_format,
+                 tr("The program the --noise-file is for: kalibr (imu.yaml), openvins (the imu0 block of "
+                    "kalibr_imu_chain.yaml), vins-fusion (acc_n, gyr_n, acc_w, gyr_w, g_norm), orb-slam3 "
+                    "(IMU.NoiseGyro ...); the last three in OpenCV's %YAML:1.0 form"))
+      ->capture_default_str()
+      ->group(tr("Output"));
+  sub.add_option("--inflate", cmd.inflate,
+                 tr("Multiply every value of the noise files by F (≥ 1) for effects the static recording does not "
+                    "show; said in the file"))
+      ->check(real_in(1.0, 1e6, ""))
+      ->capture_default_str()
+      ->group(tr("Output"));
+  sub.add_flag("--discrete", cmd.discrete,
+               tr("Discrete-time values in the --noise-file: N*sqrt(rate) and K/sqrt(rate) (vins-fusion only; the "
+                  "other programs convert continuous values themselves)"))
+      ->group(tr("Output"));
+  sub.add_option("--rostopic", cmd.rostopic, tr("rostopic written into the noise files"))
+      ->capture_default_str()
+      ->group(tr("Output"));
+  sub.add_option("--combine", cmd.combine,
+                 tr("How the noise files combine the axes of a kind: worst (the largest) or mean"))
+      ->check(CLI::IsMember({"worst", "mean"}))
+      ->capture_default_str()
+      ->group(tr("Output"));
+  sub.add_flag("--keys-from-all-axes", cmd.keys_from_all_axes,
+               tr("Let every axis into the noise files' keys (default: only axes with an accepted fit and a resolved "
+                  "value; the others are named in the file's comments)"))
+      ->group(tr("Output"));
+}
+
+int run_imu(ImuCmd& cmd, Io& io) {
+  ImuOptions opt = cmd.options();
+  opt.read.progress = opt.analysis.progress = io.progress;
+  // Every output is checked before the work and before the first is written.
+  if (!cmd.kalibr.empty() || !cmd.report_dir.empty() || !cmd.noise_file.empty()) (void)rostopic_scalar(cmd.rostopic);
+  const NoiseFileOptions chosen = cmd.noise_options(parse_noise_format(cmd.noise_format), cmd.discrete);
+  const NoiseFileOptions k = cmd.noise_options(NoiseFormat::Kalibr, false);
+  std::vector<OutputTarget> targets = report_targets(cmd.report_dir);
+  targets.insert(targets.begin(), {{"-o", cmd.output}, {"--kalibr", cmd.kalibr}, {"--noise-file", cmd.noise_file}});
+  cmd.plot.check(cmd.force, targets);
+  const ImuResult res = analyze_imu(cmd.file, opt);
+  for (const auto& c : res.channels)
+    print_input_notes(io.err, nlohmann::json{{"source", c.result.source}, {"input", c.result.input}});
+  const nlohmann::json j = to_json(res);
+  cli::require_finite(j, res.source);  // not another command's of the same name (unity build)
+  cmd.plot.draw_imu(j, cmd.force, io);
+  for (const auto& [path, o] : {std::pair{cmd.kalibr, k}, std::pair{cmd.noise_file, chosen}}) {
+    if (path.empty()) continue;
+    write_file_atomic(path, noise_file(res, o), cmd.force);
+    print_message(io.err, trf("noise file written to {}", as_typed(path)));
+  }
+  if (!cmd.report_dir.empty()) write_report(cmd.report_dir, res, j, k, cmd.force, io);
+  emit(io,
+       cmd.json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"
+                : localize_numbers(format_imu(res)),
+       cmd.output, cmd.force);
+  return 0;
+}
+
 }  // namespace
 
 void register_imu(CLI::App& app, Runner& runner) {
@@ -232,44 +303,7 @@ void register_imu(CLI::App& app, Runner& runner) {
       ->group(tr("Output"));
   cmd->analysis.add_to(*sub);
   sub->add_flag("--json", cmd->json, tr("Print the JSON object instead of the tables"))->group(tr("Output"));
-  sub->add_option("--kalibr", cmd->kalibr,
-                  tr("Write the Kalibr IMU noise file (imu.yaml: noise densities and random walks in SI); the same as "
-                     "--noise-file PATH --noise-format kalibr"))
-      ->check(output_name())
-      ->group(tr("Output"));
-  sub->add_option("--noise-file", cmd->noise_file,
-                  tr("Write the IMU noise file for the program --noise-format names (noise densities and random "
-                     "walks in SI)"))
-      ->check(output_name())
-      ->group(tr("Output"));
-  sub->add_option("--noise-format", cmd->noise_format,
-                  tr("The program the --noise-file is for: kalibr (imu.yaml), openvins (the imu0 block of "
-                     "kalibr_imu_chain.yaml), vins-fusion (acc_n, gyr_n, acc_w, gyr_w, g_norm), orb-slam3 "
-                     "(IMU.NoiseGyro ...); the last three in OpenCV's %YAML:1.0 form"))
-      ->capture_default_str()
-      ->group(tr("Output"));
-  sub->add_option("--inflate", cmd->inflate,
-                  tr("Multiply every value of the noise files by F (≥ 1) for effects the static recording does not "
-                     "show; said in the file"))
-      ->check(real_in(1.0, 1e6, ""))
-      ->capture_default_str()
-      ->group(tr("Output"));
-  sub->add_flag("--discrete", cmd->discrete,
-                tr("Discrete-time values in the --noise-file: N*sqrt(rate) and K/sqrt(rate) (vins-fusion only; the "
-                   "other programs convert continuous values themselves)"))
-      ->group(tr("Output"));
-  sub->add_option("--rostopic", cmd->rostopic, tr("rostopic written into the noise files"))
-      ->capture_default_str()
-      ->group(tr("Output"));
-  sub->add_option("--combine", cmd->combine,
-                  tr("How the noise files combine the axes of a kind: worst (the largest) or mean"))
-      ->check(CLI::IsMember({"worst", "mean"}))
-      ->capture_default_str()
-      ->group(tr("Output"));
-  sub->add_flag("--keys-from-all-axes", cmd->keys_from_all_axes,
-                tr("Let every axis into the noise files' keys (default: only axes with an accepted fit and a resolved "
-                   "value; the others are named in the file's comments)"))
-      ->group(tr("Output"));
+  add_noise_file_options(*sub, *cmd);
   sub->add_option("--report", cmd->report_dir,
                   tr("Write the whole result into DIR: index.html (tables and figure), imu.txt, imu.json, imu.yaml, "
                      "imu.svg (created when missing)"))
@@ -277,38 +311,7 @@ void register_imu(CLI::App& app, Runner& runner) {
       ->group(tr("Output"));
   add_output_options(*sub, cmd->output, cmd->force);
   cmd->plot.add_to(*sub, N_("one panel per sensor kind with every axis' Allan deviation and its confidence bars"));
-  sub->callback([cmd, &runner] {
-    runner = [cmd](Io& io) -> int {
-      ImuOptions opt = cmd->options();
-      opt.read.progress = opt.analysis.progress = io.progress;
-      // Every output is checked before the work and before the first is written.
-      if (!cmd->kalibr.empty() || !cmd->report_dir.empty() || !cmd->noise_file.empty())
-        (void)rostopic_scalar(cmd->rostopic);
-      const NoiseFileOptions chosen = cmd->noise_options(parse_noise_format(cmd->noise_format), cmd->discrete);
-      const NoiseFileOptions k = cmd->noise_options(NoiseFormat::Kalibr, false);
-      std::vector<OutputTarget> targets = report_targets(cmd->report_dir);
-      targets.insert(targets.begin(),
-                     {{"-o", cmd->output}, {"--kalibr", cmd->kalibr}, {"--noise-file", cmd->noise_file}});
-      cmd->plot.check(cmd->force, targets);
-      const ImuResult res = analyze_imu(cmd->file, opt);
-      for (const auto& c : res.channels)
-        print_input_notes(io.err, nlohmann::json{{"source", c.result.source}, {"input", c.result.input}});
-      const nlohmann::json j = to_json(res);
-      require_finite(j, res.source);
-      cmd->plot.draw_imu(j, cmd->force, io);
-      for (const auto& [path, o] : {std::pair{cmd->kalibr, k}, std::pair{cmd->noise_file, chosen}}) {
-        if (path.empty()) continue;
-        write_file_atomic(path, noise_file(res, o), cmd->force);
-        print_message(io.err, trf("noise file written to {}", as_typed(path)));
-      }
-      if (!cmd->report_dir.empty()) write_report(cmd->report_dir, res, j, k, cmd->force, io);
-      emit(io,
-           cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"
-                     : localize_numbers(format_imu(res)),
-           cmd->output, cmd->force);
-      return 0;
-    };
-  });
+  sub->callback([cmd, &runner] { runner = [cmd](Io& io) { return run_imu(*cmd, io); }; });
 }
 
 }  // namespace rwcalc::cli
