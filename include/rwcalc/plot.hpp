@@ -67,6 +67,10 @@ Figure batch_allan_figure(const nlohmann::json& runs, const PlotOptions& options
 /// Empty script and series == 0 when no run carries a direct-method curve.
 Figure batch_direct_figure(const nlohmann::json& runs, const PlotOptions& options);
 Figure diagnosis_figure(const nlohmann::json& diagnosis, const PlotOptions& options);
+/// One sensor kind of an IMU: every axis' Allan deviation (`channels`, each an `imu --json` channel)
+/// with its confidence bars and, in the same colour, its fitted model (from the fit's SI
+/// coefficients and allan.unit_per_si).
+Figure imu_axes_figure(const nlohmann::json& channels, const PlotOptions& options);
 
 /// Render figures (stacked panels) to bytes in `format`. Throws OutputError when gnuplot is
 /// missing or fails.

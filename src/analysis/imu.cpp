@@ -228,6 +228,9 @@ nlohmann::json channel_json(const AnalysisResult& r, const UnitSet& shown) {
   fit["misfit"] = misfit_json(r);
   nlohmann::json warnings = nlohmann::json::array();
   for (const auto& w : r.warnings) warnings.push_back({{"code", w.code}, {"message", w.message}});
+  nlohmann::json allan = allan_shown(r.allan, shown.deviation);
+  // The deviation's unit per SI unit: what the figure scales the fit's SI model by.
+  allan["unit_per_si"] = shown.deviation.factor / si_units(r.sensor).deviation.factor;
   return {{"source", r.column},
           {"file", r.source},
           {"column", r.column},
@@ -242,7 +245,7 @@ nlohmann::json channel_json(const AnalysisResult& r, const UnitSet& shown) {
            r.earth_rate_applied ? nlohmann::json(r.earth_rate_deg_per_h * shown.deviation.factor) : nullptr},
           {"verdict", r.verdict_applies ? to_json(r.verdict) : nlohmann::json(nullptr)},
           {"not_applied_reason", r.not_applied_reason},
-          {"allan", allan_shown(r.allan, shown.deviation)},
+          {"allan", std::move(allan)},
           {"fit", std::move(fit)},
           {"warnings", std::move(warnings)}};
 }

@@ -16,6 +16,7 @@
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/imu.hpp"
+#include "rwcalc/imu_report.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/plot.hpp"
 #include "rwcalc/printable.hpp"
@@ -108,20 +109,6 @@ struct ImuCmd {
   }
 };
 
-std::string html_escaped(std::string_view text) {
-  std::string out;
-  for (const char c : text) {
-    switch (c) {
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '&': out += "&amp;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
 /// The files of --report DIR, for the check of every output before the first is written. A
 /// directory still to be made holds none of them yet: only that it can be made is checked.
 std::vector<OutputTarget> report_targets(const std::string& dir) {
@@ -144,8 +131,9 @@ std::vector<OutputTarget> report_targets(const std::string& dir) {
   return files;
 }
 
-// --report DIR: the tables as a page (index.html, with the figure when gnuplot is there), the
-// JSON, the noise file and the figure beside it, so that one directory holds the whole result.
+// --report DIR: the tables as a page (index.html, in the test report's look, with the figure when
+// gnuplot is there), the JSON, the noise file and the figure beside it, so that one directory holds
+// the whole result.
 void write_report(const std::string& dir, const ImuResult& res, const nlohmann::json& j, const NoiseFileOptions& k,
                   bool force, Io& io) {
   namespace fs = std::filesystem;
@@ -159,29 +147,17 @@ void write_report(const std::string& dir, const ImuResult& res, const nlohmann::
   write_file_atomic(at("imu.txt"), text, force);
   write_file_atomic(at("imu.json"), j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n", force);
   write_file_atomic(at("imu.yaml"), noise_file(res, k), force);
-  std::string figure;
+  ImuPageOptions page;
   try {
     PlotOptions o;
     o.output = at("imu.svg");
     o.force = force;
     plot_imu(j, o);
-    figure =
-        fmt::format("<p><img src=\"imu.svg\" alt=\"{}\"></p>\n", html_escaped(tr("Allan deviation of every axis")));
+    page.figure = "imu.svg";
   } catch (const OutputError& e) {  // no gnuplot: the page without the figure
     print_message(io.err, trf("note: --report without the figure: {}", e.what()));
   }
-  // The page's words are translated; the text block is already localized (decimal comma).
-  const std::string source = html_escaped(printable(res.source));
-  write_file_atomic(
-      at("index.html"),
-      fmt::format("<!DOCTYPE html>\n<html lang=\"{}\"><head><meta charset=\"utf-8\"><title>rwcalc imu: {}</title>"
-                  "</head>\n<body>\n<h1>{}</h1>\n{}<pre>{}</pre>\n<p>{}</p>\n<p>{}</p>\n</body></html>\n",
-                  language_code(), source, html_escaped(trf("IMU noise: {}", printable(res.source))), figure,
-                  html_escaped(text),
-                  trf("Noise file for Kalibr: {}; all results: {}.", "<a href=\"imu.yaml\">imu.yaml</a>",
-                      "<a href=\"imu.json\">imu.json</a>"),
-                  html_escaped(version_line())),
-      force);
+  write_file_atomic(at("index.html"), imu_report_html(j, page), force);
   print_message(io.err, trf("report written to {}", as_typed(at("index.html"))));
 }
 

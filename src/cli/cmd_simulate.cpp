@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -15,6 +16,7 @@
 #include "cli/numeric_options.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
+#include "rwcalc/imu_simulate.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/printable.hpp"
 #include "rwcalc/progress.hpp"
@@ -49,6 +51,10 @@ struct SimulateArgs {
   std::optional<double> temp_bias;
   std::string temp_profile;
   std::string max_memory;
+  std::string layout = "pulses";
+  std::vector<std::string> gyro_noise, accel_noise;
+  double gyro_lsb = 0.05, accel_lsb_mg = 3.33;
+  std::string accel_unit = "m/s^2";
 };
 
 // "a:b[:c]" as numbers, `min_n`..`max_n` of them; errors name the option and the form.
@@ -330,7 +336,77 @@ void check_memory(const NoiseModel& m, const SimulationSettings& s, const std::s
           format_memory(static_cast<double>(ceiling.bytes)), ceiling.origin, kMaxMemoryOption));
 }
 
+/// The options of a single gyro's record, which the IMU layout does not take.
+constexpr std::array<const char*, 22> kPulseOnlyOptions{
+    "--temp-profile",   "--from",         "--upper-bounds",     "--truth",         "--scale",
+    "--temperature",    "--arw",          "--bias-instability", "--rrw",           "--ramp",
+    "--bias",           "--latitude",     "--no-earth-rate",    "--white-readout", "--white-angle",
+    "--sinusoid",       "--gauss-markov", "--bias-step",        "--warmup",        "--lowpass",
+    "--output-lowpass", "--temp-bias"};
+
+/// One kind's three axes from "N:B:K" given once (every axis) or three times (x, y, z).
+std::array<AxisNoise, 3> axis_noise(const char* option, const std::vector<std::string>& given,
+                                    const std::array<AxisNoise, 3>& preset) {
+  if (given.empty()) return preset;
+  if (given.size() != 1 && given.size() != 3)
+    throw UsageError(trf("{}: give N:B:K once (every axis) or three times, comma-separated (x, y, z); got {}", option,
+                         given.size()));
+  std::array<AxisNoise, 3> noise{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    const auto v = fields(option, given[given.size() == 1 ? 0 : i], 3, 3, "N:B:K");
+    for (const double x : v)
+      if (x < 0) throw UsageError(trf("{}: every term must be >= 0 in '{}'", option, given[i]));
+    noise[i] = {v[0], v[1], v[2]};
+  }
+  return noise;
+}
+
+/// `simulate --layout imu`: one six-axis record (or --runs of them) from the layout's options.
+int run_simulate_imu(const SimulateArgs& a, const CLI::App& sub, Io& io) {
+  for (const char* name : kPulseOnlyOptions)
+    if (sub.count(name) > 0)
+      throw UsageError(
+          trf("{} is an option of the pulse layout; --layout imu takes --gyro-noise, --accel-noise, "
+              "--gyro-step, --accel-step and --accel-unit",
+              name));
+  ImuLayout layout = adis16405_like_layout();
+  layout.gyro = axis_noise("--gyro-noise", a.gyro_noise, layout.gyro);
+  layout.accel = axis_noise("--accel-noise", a.accel_noise, layout.accel);
+  layout.gyro_lsb_dps = a.gyro_lsb;
+  layout.accel_lsb_mg = a.accel_lsb_mg;
+  layout.accel_unit = a.accel_unit == "g" ? AccelColumnUnit::G : AccelColumnUnit::MetrePerSecond2;
+  SimulationSettings s;
+  apply_settings(
+      a, [](const char*) { return true; }, s);
+  if (a.output == "-" && a.runs > 1) throw UsageError(tr("--runs > 1 needs a file name for -o"));
+  const MemoryCeiling ceiling = memory_ceiling_of(a.max_memory);
+  if (const auto need = static_cast<double>(imu_memory_bytes(layout, s)); need > static_cast<double>(ceiling.bytes))
+    throw UsageError(
+        trf("--layout imu: a record of {} samples needs about {} of memory, more than the memory ceiling "
+            "of {} ({}); shorten --duration, lower --rate, or give {} SIZE if the machine has the memory",
+            s.samples(), format_memory(need), format_memory(static_cast<double>(ceiling.bytes)), ceiling.origin,
+            kMaxMemoryOption));
+  auto path_of = [&](int r) { return a.runs > 1 ? numbered(a.output, r, a.runs) : a.output; };
+  std::vector<OutputTarget> targets;
+  for (int r = 1; r <= a.runs; ++r) targets.push_back({"-o", path_of(r)});
+  check_output_targets(targets, a.force);
+  for (int r = 1; r <= a.runs; ++r) {
+    SimulationSettings sr = s;
+    sr.seed = s.seed + static_cast<std::uint64_t>(r - 1);
+    const std::string path = path_of(r);
+    write_imu_record(layout, sr, imu_metadata(layout, sr), path, a.force, io.progress);
+    if (path != "-")
+      io.out << trf("wrote {} (six IMU axes, {} samples, {} s at {} Hz, seed {})\n", printable(path), sr.samples(),
+                    sr.duration_s, sr.rate_hz, sr.seed);
+  }
+  return 0;
+}
+
 int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
+  if (a.layout == "imu") return run_simulate_imu(a, sub, io);
+  if (!a.gyro_noise.empty() || !a.accel_noise.empty() || sub.count("--gyro-step") || sub.count("--accel-step") ||
+      sub.count("--accel-unit"))
+    throw UsageError(tr("--gyro-noise, --accel-noise, --gyro-step, --accel-step and --accel-unit need --layout imu"));
   // Without --from every option counts (its default included); with it, only those given.
   const Take take = [&](const char* name) { return a.from.empty() || sub.count(name) > 0; };
   SimulationSettings s;
@@ -418,6 +494,36 @@ void register_simulate(CLI::App& app, Runner& runner) {
       ->check(whole_in(1, 100000))
       ->capture_default_str()
       ->group(tr("Record"));
+  sub->add_option("--layout", a.layout,
+                  tr("What the file holds: pulses (one gyro's pulse counts) or imu (a six-axis MEMS-like IMU: "
+                     "gyro_x_dps ... and acc_x_mps2 ... or acc_x_g ... columns, ADIS16405-like levels unless "
+                     "--gyro-noise and --accel-noise say otherwise; docs/simulation.md)"))
+      ->check(CLI::IsMember({"pulses", "imu"}))
+      ->capture_default_str()
+      ->group(tr("Record"));
+  sub->add_option("--gyro-noise", a.gyro_noise,
+                  tr("--layout imu: the gyros' N:B:K (deg/sqrt(h), deg/h, deg/h/sqrt(h)), once for every axis or "
+                     "three times for x,y,z"))
+      ->delimiter(',')
+      ->group(tr("IMU layout"));
+  sub->add_option("--accel-noise", a.accel_noise,
+                  tr("--layout imu: the accelerometers' N:B:K (m/s/sqrt(h), ug, m/s/h/sqrt(h)), once for every axis "
+                     "or three times for x,y,z"))
+      ->delimiter(',')
+      ->group(tr("IMU layout"));
+  sub->add_option("--gyro-step", a.gyro_lsb, tr("--layout imu: the gyro output step (LSB), deg/s"))
+      ->check(real_in(1e-9, 1e6, "deg/s"))
+      ->capture_default_str()
+      ->group(tr("IMU layout"));
+  sub->add_option("--accel-step", a.accel_lsb_mg, tr("--layout imu: the accelerometer output step (LSB), mg"))
+      ->check(real_in(1e-9, 1e6, "mg"))
+      ->capture_default_str()
+      ->group(tr("IMU layout"));
+  sub->add_option("--accel-unit", a.accel_unit,
+                  tr("--layout imu: the accelerometer columns' unit, m/s^2 (acc_x_mps2 ...) or g (acc_x_g ...)"))
+      ->check(CLI::IsMember({"m/s^2", "g"}))
+      ->capture_default_str()
+      ->group(tr("IMU layout"));
   sub->add_option("--arw", a.arw, tr("Angle random walk N, deg/sqrt(h)"))
       ->check(real_in(0.0, kMaxRateDegPerH, "deg/sqrt(h)"))
       ->group(tr("Noise terms"));

@@ -567,4 +567,57 @@ PlotResult plot_diagnosis(const json& diagnosis, const PlotOptions& options) {
   return r;
 }
 
+namespace {
+
+/// The fitted model of an IMU axis as a gnuplot function `fn(t)` of τ (s) giving σ in the axis'
+/// shown unit: the IEEE 952 sum over the SI coefficients (fit.X.si; a term left out is 0) times
+/// allan.unit_per_si (the axis' unit per SI unit). Empty without SI coefficients or the factor.
+std::string imu_model_function(const json& channel, const std::string& fn) {
+  const auto factor = num(at(channel, "allan"), "unit_per_si");
+  const auto& fit = at(channel, "fit");
+  if (!factor || !fit.is_object()) return {};
+  std::array<double, 5> c{};
+  constexpr std::array<const char*, 5> kKeys{"Q", "N", "B", "K", "R"};
+  for (std::size_t k = 0; k < kKeys.size(); ++k) {
+    if (!at(at(fit, kKeys[k]), "si").is_object()) return {};
+    c[k] = coefficient(at(fit, kKeys[k]), "si").model;
+  }
+  return fmt::format(
+      "{0}(t) = {1:.10g} * sqrt(3 * {2:.10g}**2 / t**2 + {3:.10g}**2 / t + 2 * log(2) / pi * {4:.10g}**2"
+      " + {5:.10g}**2 * t / 3 + {6:.10g}**2 * t**2 / 2)\n",
+      fn, *factor, c[0], c[1], c[2], c[3], c[4]);
+}
+
+}  // namespace
+
+Figure imu_axes_figure(const json& channels, const PlotOptions& options) {
+  std::string body = "# Each axis' fitted model: sigma in the axis' unit from its SI coefficients (Q, N, B, K, R)\n";
+  PlotCommand plot;
+  Bounds bounds;
+  std::string ylabel;
+  std::size_t i = 0;
+  for (const auto& c : channels) {
+    const auto rows = allan_rows(at(c, "allan"));
+    if (rows.empty()) continue;
+    ylabel = allan_ylabel(at(c, "allan"));
+    const std::string colour = temperature_colour(nullptr, i);
+    const auto name = fmt::format("axis{}", i + 1);
+    append_allan_block(body, name, rows);
+    for (const auto& r : rows) bounds.x(r.tau), bounds.y(r.low, r.high);
+    plot.add(fmt::format("${} u 1:2:3:4 w yerrorbars pt {} ps 0.6 lw 1.2 lc rgb '{}' t {}", name,
+                         kPointTypes[i % kPointTypes.size()], colour, label_text(run_name(c))));
+    if (const auto fn = std::string("model_") + name, model = imu_model_function(c, fn); !model.empty()) {
+      body += model;
+      const auto chi2 = num(at(c, "fit"), "chi2_per_dof");
+      plot.add(fmt::format("{}(x) w l lw 1.6 lc rgb '{}' t {}", fn, colour,
+                           label_text(chi2 ? trf("{}: fitted model (χ²/dof = {:.3g})", run_name(c), *chi2)
+                                           : trf("{}: fitted model", run_name(c)))));
+    }
+    ++i;
+  }
+  if (plot.elements.empty())
+    throw AnalysisError(tr("no axis of the IMU has Allan deviation points (channels[].allan.points): nothing to plot"));
+  return loglog_figure("imu", options, as_typed(options.title), ylabel, bounds, body, plot);
+}
+
 }  // namespace rwcalc

@@ -1,4 +1,4 @@
-// The figures of `rwcalc imu`: one panel per sensor kind, every axis' Allan deviation in it.
+// The figures of `rwcalc imu`: one panel per sensor kind, every axis' Allan deviation and fitted model in it.
 #include <fmt/format.h>
 
 #include <filesystem>
@@ -34,7 +34,7 @@ PlotResult plot_imu(const nlohmann::json& imu, const PlotOptions& options) {
     if (o.title.empty())
       o.title = trf(kind == kGyro ? N_("Gyro axes of {}") : N_("Accelerometer axes of {}"),
                     std::filesystem::path(imu.value("source", "")).filename().string());
-    Figure f = batch_allan_figure(runs, o);
+    Figure f = imu_axes_figure(runs, o);
     f.name = fmt::format("imu-{}", kind);
     figures.push_back(std::move(f));
   }

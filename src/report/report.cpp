@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <optional>
 
+#include "report/html.hpp"
 #include "report/json_view.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
@@ -709,6 +710,11 @@ std::string title_block(const std::vector<json>& a, const ReportOptions& options
 
 }  // namespace
 
+std::string html::stylesheet() { return fmt::format(fmt::runtime(kStyle), tr("Page"), tr("of")); }
+std::string html::text(std::string_view s) { return esc(s); }
+std::string html::typed(std::string_view s) { return rwcalc::typed(s); }
+std::string html::coefficient_cell(const json& c) { return coef_cell(c); }
+
 std::string report_html(const ReportInput& input, const ReportOptions& options) {
   const auto& a = input.analyses;
   if (a.empty()) throw AnalysisError(tr(tr("a report needs at least one analysed run")));
@@ -728,7 +734,7 @@ std::string report_html(const ReportInput& input, const ReportOptions& options) 
       "<!DOCTYPE html>\n<html lang=\"{0}\">\n<head>\n<meta charset=\"utf-8\"/>\n"
       "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"/>\n"
       "<meta name=\"generator\" content=\"rwcalc {1}\"/>\n<title>{2}</title>\n<style>{3}</style>\n</head>\n<body>\n",
-      language_code(), RWCALC_VERSION, typed(title), fmt::format(fmt::runtime(kStyle), tr("Page"), tr("of")));
+      language_code(), RWCALC_VERSION, typed(title), html::stylesheet());
   h += title_block(a, options, title) + verdict_html(a, order, overall, numbering);
   // One statement each: the tables are numbered in the order they are made.
   h += numbering.section("tables", tr("Tables 1 and 2"));

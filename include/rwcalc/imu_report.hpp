@@ -1,0 +1,21 @@
+#pragma once
+/// @file imu_report.hpp
+/// The page of `rwcalc imu --report DIR` (index.html), in the look of the HTML test report
+/// (report.hpp): title block, the noise file's keys, one table per sensor kind (a row per term, a
+/// column per axis), each axis' warnings, the figure and the files beside the page.
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace rwcalc {
+
+struct ImuPageOptions {
+  std::string figure;                   ///< the figure's file beside the page; empty: none
+  std::string noise_file = "imu.yaml";  ///< the Kalibr noise file beside the page
+  std::string json_file = "imu.json";   ///< the whole result beside the page
+  std::string text_file = "imu.txt";    ///< the text tables beside the page
+};
+
+/// The page from `rwcalc imu --json`'s object (channels, noise, conventions).
+std::string imu_report_html(const nlohmann::json& imu, const ImuPageOptions& options);
+
+}  // namespace rwcalc
