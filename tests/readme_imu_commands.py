@@ -50,7 +50,9 @@ def main():
             if words[0] != "./build/rwcalc":
                 failures.append(f"{command}: does not start with ./build/rwcalc")
                 continue
-            outside = [w for w in words if w.startswith("../") or w.startswith("/")]
+            # A path out of the clone: up from it, or an absolute path that exists here (a ROS
+            # topic such as /imu/data is no path).
+            outside = [w for w in words if w.startswith(("../", "~")) or (w.startswith("/") and os.path.exists(w))]
             missing = [w for w in words if w.startswith("data/") and not (
                 (source / w).exists() and tracked(source, w))]
             if outside or missing:

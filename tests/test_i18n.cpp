@@ -344,10 +344,10 @@ TEST(RussianCli, ImuJsonReportAndNoiseFile) {
   const auto report = dir.path() / "report";
   ASSERT_EQ(run_cli(imu_args(file, {"--lang", "ru", "--report", report.string()})).status, 0);
   const auto html = slurp(report / "index.html");
-  for (const char* part : {"<html lang=\"ru\">", "<h1>Шумы инерциального измерительного блока", "Гироскопы",
-                           "Файл шумов для Kalibr:", "°/√ч"})
+  for (const char* part : {"<html lang=\"ru\">", "<h1>Шумы инерциального измерительного блока", "Оси гироскопов",
+                           "Файл шумов", "Таблица 2", "°/√ч", "Страница"})
     EXPECT_TRUE(contains(html, part)) << part;
-  for (const char* english : {"IMU noise", "Noise file for", "all results", "Gyro", "angle random walk", "°/h"})
+  for (const char* english : {"IMU noise", "Noise file", "All results", "Gyro", "angle random walk", "°/h", "Page"})
     EXPECT_FALSE(contains(html, english)) << english;
   // The figures' titles and axes (the gnuplot script needs no gnuplot).
   const auto script = dir.path() / "imu.gp";

@@ -293,9 +293,20 @@ TEST(Imu, ReportDirectoryHoldsTheWholeResult) {
   for (const char* name : {"index.html", "imu.txt", "imu.json", "imu.yaml"})
     EXPECT_TRUE(std::filesystem::exists(out / name)) << name;
   EXPECT_EQ(slurp(out / "imu.txt"), slurp(dir.path() / "tables.txt"));
+  // The page is in the test report's look (its stylesheet, A4 with page numbers) and holds the
+  // tables as HTML tables, a column per axis, not preformatted text that runs off the page.
   const std::string html = slurp(out / "index.html");
-  EXPECT_TRUE(has(html, "Accelerometer (3 axes;")) << html;
+  EXPECT_TRUE(has(html, "@page")) << html;
+  EXPECT_TRUE(has(html, "<header class=\"title\">")) << html;
+  EXPECT_FALSE(has(html, "<pre>")) << html;
+  EXPECT_TRUE(has(html, "<b>Table 2.</b> Accelerometer axes")) << html;
+  for (const char* column : {"gyro_x_dps", "gyro_z_dps", "acc_x_g", "acc_z_g"})
+    EXPECT_TRUE(has(html, fmt::format("<th class=\"axis\">{}</th>", column))) << column;
+  EXPECT_TRUE(has(html, "N velocity random walk <span class=\"unit\">(m/s/√h)</span>")) << html;
   EXPECT_TRUE(has(html, "<a href=\"imu.yaml\">")) << html;
+  EXPECT_TRUE(has(html, "<a href=\"imu.json\">")) << html;
+  // The figure is on the page when gnuplot drew it, and absent (no broken image) when not.
+  EXPECT_EQ(has(html, "<img alt=\"Allan deviation of every axis"), std::filesystem::exists(out / "imu.svg")) << html;
   EXPECT_EQ(nlohmann::json::parse(slurp(out / "imu.json"))["channels"].size(), 6u);
 }
 
