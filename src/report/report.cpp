@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <optional>
 
-#include "report/json_view.hpp"
+#include "json_view.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"
