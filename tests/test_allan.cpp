@@ -9,6 +9,7 @@
 #include <random>
 
 #include "rwcalc/allan.hpp"
+#include "rwcalc/allan_report.hpp"
 #include "rwcalc/error.hpp"
 #include "test_support.hpp"
 

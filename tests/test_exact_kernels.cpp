@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "allan/allan_kernels.hpp"
-#include "allan/narrow_counts.hpp"
+#include "rwcalc/narrow_counts.hpp"
 #include "rwcalc/allan.hpp"
 #include "test_support.hpp"
 

@@ -11,7 +11,7 @@
 #include <unsupported/Eigen/FFT>
 #include <vector>
 
-#include "allan/fft.hpp"
+#include "rwcalc/fft.hpp"
 
 namespace {
 

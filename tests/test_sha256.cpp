@@ -9,7 +9,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "core/sha256.hpp"
+#include "rwcalc/sha256.hpp"
 #include "io/text_source.hpp"
 #include "rwcalc/reader.hpp"
 #include "test_support.hpp"

@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_ALLAN
+#error "rwcalc/allan.hpp belongs to the allan layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file allan.hpp
 /// Allan-type variances of a PhaseSeries: fully overlapping AVAR (the workhorse), non-overlapping
 /// AVAR, modified AVAR and the Hadamard variance (overlapping and not), on a chosen τ grid, with noise identification, equivalent degrees of
@@ -103,23 +106,6 @@ double allan_variance(const PhaseSeries& x, std::int64_t m, Estimator est, std::
 
 /// JSON form: {"unit", "estimator", "confidence", "tau0_s", "points": [{"af", "tau_s", "n", …}]}.
 nlohmann::json to_json(const AllanResult& r);
-
-/// What the report header says about the record.
-struct AllanReportInfo {
-  std::string source;       ///< file name as given
-  std::size_t samples = 0;  ///< samples read
-  double rate_hz = 0;       ///< sample rate, Hz
-  std::string rate_source;  ///< where the rate came from ("option", "metadata", …); may be empty
-  std::string input;        ///< what was read (describe_input in reader.hpp); may be empty
-};
-
-/// Human-readable table: a header block (source, estimator, confidence, unit convention, samples,
-/// rate) and columns AF, τ (s), terms, α, EDF, σ_min, σ, σ_max with the deviation unit.
-std::string format_allan_table(const AllanResult& r, const AllanReportInfo& info);
-/// CSV with a header row naming each column and its unit.
-std::string format_allan_csv(const AllanResult& r);
-/// Unit label of the deviations for people: "°/h" for gyro data, "input units/s" otherwise.
-std::string unit_label(const AllanResult& r);
 
 std::string_view to_string(Estimator e);  ///< "oadev", "adev", "mdev", "ohdev" or "hdev" (Stable32's names)
 /// The estimator's deviation and variance by name in the current language (i18n.hpp):

@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_ANALYSIS
+#error "rwcalc/analysis.hpp belongs to the analysis layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file analysis.hpp
 /// The `rwcalc analyze` pipeline (Allan variance, fit, cross-checks, bias, verdict) and its outputs.
 #include <cstdio>

@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_ANALYSIS
+#error "rwcalc/batch.hpp belongs to the analysis layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file batch.hpp
 /// Many runs at once (analysed here or merged from JSON lines) in the seed paper's Table 1/Table 2
 /// layout, with the overall verdict and trends with temperature; built from analyze JSON objects.

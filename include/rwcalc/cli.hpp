@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_CLI
+#error "rwcalc/cli.hpp belongs to the cli layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file cli.hpp
 /// The command-line front end as a library call, so that the executable is a thin main and tests
 /// can run every command in-process.

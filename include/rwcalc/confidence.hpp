@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_ALLAN
+#error "rwcalc/confidence.hpp belongs to the allan layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file confidence.hpp
 /// Noise identification and equivalent degrees of freedom for Allan-type variances, and the χ²
 /// confidence interval that follows (NIST SP 1065 §5; Greenhall & Riley, PTTI 2003; Riley &

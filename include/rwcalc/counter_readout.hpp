@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_MODEL
+#error "rwcalc/counter_readout.hpp belongs to the model layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file counter_readout.hpp
 /// The Allan variance of a plain pulse counter's read-out error (docs/analysis.md, "The counter
 /// read-out"): the angle's fractional pulse, a sawtooth driven by the mean rate, smoothed by the

@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_DIAGNOSE
+#error "rwcalc/diagnose.hpp belongs to the diagnose layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file diagnose.hpp
 /// `rwcalc diagnose`: fit the five-term model, test each candidate effect by a likelihood ratio of
 /// the record's block means under the noise model (levels profiled, thresholds from the test's

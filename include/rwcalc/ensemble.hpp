@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_SIM
+#error "rwcalc/ensemble.hpp belongs to the sim layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file ensemble.hpp
 /// Many realisations of one simulated record, run side by side (parallel.hpp).
 #include <cstddef>

@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_MODEL
+#error "rwcalc/fit.hpp belongs to the model layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file fit.hpp
 /// Fit of the IEEE 952 five-term model σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)·B² + K²τ/3 + R²τ²/2
 /// (AV in (°/h)², τ in s) by Gamma deviance with c ≥ 0, and profile-likelihood intervals

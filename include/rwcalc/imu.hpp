@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_ANALYSIS
+#error "rwcalc/imu.hpp belongs to the analysis layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file imu.hpp
 /// A whole IMU from one recording: every gyro and accelerometer column analysed (in parallel), one
 /// table per sensor kind, the JSON `channels` list, and the noise file (Kalibr, OpenVINS, VINS-Fusion, ORB-SLAM3).

@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_REPORT
+#error "rwcalc/imu_report.hpp belongs to the report layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file imu_report.hpp
 /// The page of `rwcalc imu --report DIR` (index.html), in the look of the HTML test report
 /// (report.hpp): title block, the noise file's keys, one table per sensor kind (a row per term, a

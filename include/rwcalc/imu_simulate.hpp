@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_SIM
+#error "rwcalc/imu_simulate.hpp belongs to the sim layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file imu_simulate.hpp
 /// A simulated six-axis IMU record (`rwcalc simulate --layout imu`; docs/simulation.md, "IMU
 /// layout"): three gyros and three accelerometers, each axis an exact simulator record of its own

@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_MODEL
+#error "rwcalc/methods.hpp belongs to the model layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file methods.hpp
 /// The seed paper's cross-checks of the AV results as unbiased estimators with intervals
 /// (docs/analysis.md, "Cross-checks"): N from the angle variance against interval, B from the

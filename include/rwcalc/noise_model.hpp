@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_SIM
+#error "rwcalc/noise_model.hpp belongs to the sim layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file noise_model.hpp
 /// What a simulated gyro senses and how it is read out (docs/simulation.md), its theoretical
 /// Allan variance and its JSON form. Rates in °/h (= ″/s), angles in ″, times in s.

@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_ANALYSIS
+#error "rwcalc/outlier_screen.hpp belongs to the analysis layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file outlier_screen.hpp
 /// Outlier screening as every command that analyses a record does it: detection, report of
 /// where in the input, and the action chosen (--outliers keep|remove|replace).

@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_IO
+#error "rwcalc/outliers.hpp belongs to the io layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file outliers.hpp
 /// Isolated outliers in a rate record (loose connectors, bus glitches): detection, removal and
 /// replacement by the local median. A sample is an outlier when its residual from the median of

@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_REPORT
+#error "rwcalc/plot.hpp belongs to the report layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file plot.hpp
 /// Figures of an analysis, a temperature batch and a diagnosis, drawn by gnuplot.
 ///

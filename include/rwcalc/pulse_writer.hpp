@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_IO
+#error "rwcalc/pulse_writer.hpp belongs to the io layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file pulse_writer.hpp
 /// GL-2D pulse files: `# key: value` metadata, the header `pulses` and one increment per line, or
 /// the header `angle` and the cumulative angle in ″.

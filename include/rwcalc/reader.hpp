@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_IO
+#error "rwcalc/reader.hpp belongs to the io layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file reader.hpp
 /// Reading gyro and clock recordings into a PhaseSeries without losing or bending a sample.
 ///

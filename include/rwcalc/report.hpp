@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_REPORT
+#error "rwcalc/report.hpp belongs to the report layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file report.hpp
 /// A test report a lab can file: one self-contained HTML page (figures inline) with the run
 /// summaries, the seed paper's Tables 1 and 2, the verdict with its probability, the diagnoses,

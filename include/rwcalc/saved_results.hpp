@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_IO
+#error "rwcalc/saved_results.hpp belongs to the io layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file saved_results.hpp
 /// Reading back rwcalc's JSON (`analyze`, `batch`, `diagnose --json`, `batch --jsonl`) for
 /// `report` and `merge`: every value read is checked (InputError naming file, line and key path).

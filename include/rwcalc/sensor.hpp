@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_MODEL
+#error "rwcalc/sensor.hpp belongs to the model layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file sensor.hpp
 /// The kind of sensor a channel holds (gyro or accelerometer) and the units its results are shown
 /// in. The numerics have one path: the phase series is an angle in ″ or a velocity in 1/3600 m/s

@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_SIM
+#error "rwcalc/simulate.hpp belongs to the sim layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file simulate.hpp
 /// Exact discrete-time simulation of gyro pulse records from a NoiseModel (docs/simulation.md).
 #include <cstddef>

@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_MODEL
+#error "rwcalc/verdict.hpp belongs to the model layer, which this layer may not use (docs/architecture.md)"
+#endif
 /// @file verdict.hpp
 /// Accuracy class of a gyro from B and N (the best class whose limits the estimates meet; null
 /// beyond the last), with the probability that the true values meet each class.

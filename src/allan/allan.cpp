@@ -10,8 +10,8 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
-#include "allan/allan_all.hpp"
-#include "allan/allan_kernels.hpp"
+#include "allan_all.hpp"
+#include "allan_kernels.hpp"
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/parallel.hpp"

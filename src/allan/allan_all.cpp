@@ -1,6 +1,6 @@
 // Overlapping AVAR sums for every cluster size at once (the `--tau all` grid) through FFT
 // autocorrelations: O(N log² N) instead of O(N²). See allan_all.hpp.
-#include "allan/allan_all.hpp"
+#include "allan_all.hpp"
 
 #include <algorithm>
 #include <complex>

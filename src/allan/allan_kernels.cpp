@@ -1,11 +1,11 @@
 // Inner loops of the Allan-variance estimators: plain loops over contiguous arrays, with several
 // independent accumulators where the sum is floating, so that the compiler may vectorise them.
-#include "allan/allan_kernels.hpp"
+#include "allan_kernels.hpp"
 
 #include <algorithm>
 #include <optional>
 
-#include "allan/narrow_counts.hpp"
+#include "rwcalc/narrow_counts.hpp"
 #include "rwcalc/parallel.hpp"
 
 namespace rwcalc::detail {

@@ -1,5 +1,5 @@
 // Power spectra of real sequences: kissfft for small transforms, four steps for long ones.
-#include "allan/fft.hpp"
+#include "rwcalc/fft.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 // Exact sums of small differences of counts in 16-bit lanes (narrow_counts.hpp).
-#include "allan/narrow_counts.hpp"
+#include "rwcalc/narrow_counts.hpp"
 
 #include <algorithm>
 #include <cmath>

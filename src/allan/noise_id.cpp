@@ -1,6 +1,6 @@
 // Noise identification as Stable32 does it: the lag-1 autocorrelation of the decimated phase or
 // frequency, the B1 ratio where too few points remain, and R(n) for the modified variance.
-#include "allan/noise_id.hpp"
+#include "noise_id.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -10,9 +10,9 @@
 #include <numbers>
 #include <optional>
 
-#include "analysis/fit_range.hpp"
-#include "analysis/segments.hpp"
-#include "analysis/spectral_lines.hpp"
+#include "fit_range.hpp"
+#include "rwcalc/segments.hpp"
+#include "spectral_lines.hpp"
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"

@@ -1,6 +1,6 @@
 // The output-filter test that chooses the fit's lower τ, the per-τ bounds from the fitted model,
 // and the warnings of a fit that fails (docs/analysis.md, "Per-τ bounds", "When the fit fails").
-#include "analysis/fit_range.hpp"
+#include "fit_range.hpp"
 
 #include <fmt/format.h>
 
@@ -12,7 +12,7 @@
 #include <numeric>
 #include <optional>
 
-#include "model/output_filter.hpp"
+#include "rwcalc/output_filter.hpp"
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"

@@ -11,7 +11,7 @@
 #include <tuple>
 #include <utility>
 
-#include "analysis/fit_range.hpp"
+#include "fit_range.hpp"
 #include "rwcalc/encode.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"

@@ -1,5 +1,5 @@
 // The Allan variance of a record split at its gaps (segments.hpp).
-#include "analysis/segments.hpp"
+#include "rwcalc/segments.hpp"
 
 #include <algorithm>
 #include <map>

@@ -1,11 +1,11 @@
 // Spectral lines of a rate record and their Allan variance (spectral_lines.hpp).
-#include "analysis/spectral_lines.hpp"
+#include "spectral_lines.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 
-#include "allan/fft.hpp"
+#include "rwcalc/fft.hpp"
 
 namespace rwcalc {
 

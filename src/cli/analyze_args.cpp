@@ -1,4 +1,4 @@
-#include "cli/analyze_args.hpp"
+#include "analyze_args.hpp"
 
 #include <fmt/format.h>
 
@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-#include "cli/numeric_options.hpp"
+#include "numeric_options.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 

@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "cli/commands.hpp"
+#include "commands.hpp"
 #include "rwcalc/batch.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"

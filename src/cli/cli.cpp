@@ -13,7 +13,7 @@
 #include <string_view>
 #include <vector>
 
-#include "cli/commands.hpp"
+#include "commands.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"

@@ -8,12 +8,13 @@
 #include <nlohmann/json.hpp>
 #include <ostream>
 
-#include "analysis/segments.hpp"
-#include "cli/analyze_args.hpp"
+#include "rwcalc/segments.hpp"
+#include "analyze_args.hpp"
 #include "rwcalc/printable.hpp"
-#include "cli/commands.hpp"
-#include "cli/numeric_options.hpp"
+#include "commands.hpp"
+#include "numeric_options.hpp"
 #include "rwcalc/allan.hpp"
+#include "rwcalc/allan_report.hpp"
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"

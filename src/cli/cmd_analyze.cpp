@@ -5,11 +5,11 @@
 #include <memory>
 #include <ostream>
 
-#include "cli/analyze_args.hpp"
-#include "cli/batch_format.hpp"
-#include "cli/commands.hpp"
-#include "cli/numeric_options.hpp"
-#include "cli/plot_args.hpp"
+#include "analyze_args.hpp"
+#include "batch_format.hpp"
+#include "commands.hpp"
+#include "numeric_options.hpp"
+#include "plot_args.hpp"
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"

@@ -7,11 +7,11 @@
 #include <ostream>
 #include <utility>
 
-#include "cli/analyze_args.hpp"
-#include "cli/batch_format.hpp"
-#include "cli/commands.hpp"
-#include "cli/numeric_options.hpp"
-#include "cli/plot_args.hpp"
+#include "analyze_args.hpp"
+#include "batch_format.hpp"
+#include "commands.hpp"
+#include "numeric_options.hpp"
+#include "plot_args.hpp"
 #include "rwcalc/batch.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"

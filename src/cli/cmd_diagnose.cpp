@@ -4,10 +4,10 @@
 #include <memory>
 #include <ostream>
 
-#include "cli/analyze_args.hpp"
-#include "cli/commands.hpp"
-#include "cli/numeric_options.hpp"
-#include "cli/plot_args.hpp"
+#include "analyze_args.hpp"
+#include "commands.hpp"
+#include "numeric_options.hpp"
+#include "plot_args.hpp"
 #include "rwcalc/diagnose.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"

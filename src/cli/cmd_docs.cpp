@@ -5,7 +5,7 @@
 #include <ostream>
 #include <string>
 
-#include "cli/commands.hpp"
+#include "commands.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/version.hpp"
 

@@ -3,8 +3,8 @@
 #include <memory>
 #include <utility>
 
-#include "cli/batch_format.hpp"
-#include "cli/commands.hpp"
+#include "batch_format.hpp"
+#include "commands.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/saved_results.hpp"
 

@@ -13,9 +13,9 @@
 #include <optional>
 #include <ostream>
 
-#include "cli/analyze_args.hpp"
-#include "cli/commands.hpp"
-#include "cli/numeric_options.hpp"
+#include "analyze_args.hpp"
+#include "commands.hpp"
+#include "numeric_options.hpp"
 #include "rwcalc/batch.hpp"
 #include "rwcalc/diagnose.hpp"
 #include "rwcalc/error.hpp"

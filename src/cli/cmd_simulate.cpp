@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "cli/commands.hpp"
-#include "cli/numeric_options.hpp"
+#include "commands.hpp"
+#include "numeric_options.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/imu_simulate.hpp"

@@ -3,8 +3,8 @@
 #include <nlohmann/json.hpp>
 #include <ostream>
 
-#include "cli/commands.hpp"
-#include "cli/numeric_options.hpp"
+#include "commands.hpp"
+#include "numeric_options.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 

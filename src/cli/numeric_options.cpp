@@ -1,4 +1,4 @@
-#include "cli/numeric_options.hpp"
+#include "numeric_options.hpp"
 
 #include <fmt/format.h>
 

@@ -1,4 +1,4 @@
-#include "cli/plot_args.hpp"
+#include "plot_args.hpp"
 
 #include <fmt/format.h>
 

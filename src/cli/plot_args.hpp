@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "cli/commands.hpp"
+#include "commands.hpp"
 #include "rwcalc/output.hpp"
 
 namespace rwcalc::cli {

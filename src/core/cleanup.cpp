@@ -1,4 +1,4 @@
-#include "core/cleanup.hpp"
+#include "rwcalc/cleanup.hpp"
 
 #include <fcntl.h>
 #include <limits.h>

@@ -5,7 +5,7 @@
 
 #include <cstdint>
 
-#include "core/utf8.hpp"
+#include "utf8.hpp"
 #include "rwcalc/printable.hpp"
 
 namespace rwcalc {

@@ -1,5 +1,5 @@
 // Typed, located reading of JSON input (json_input.hpp).
-#include "core/json_input.hpp"
+#include "rwcalc/json_input.hpp"
 
 #include <fmt/format.h>
 

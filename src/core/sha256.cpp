@@ -1,4 +1,4 @@
-#include "core/sha256.hpp"
+#include "rwcalc/sha256.hpp"
 #include "rwcalc/i18n.hpp"
 
 #include <fmt/format.h>

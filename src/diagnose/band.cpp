@@ -1,12 +1,12 @@
 // The bands of σ per τ from the models' theoretical AV, and the gain in and out of sample
 // (band.hpp).
-#include "diagnose/band.hpp"
+#include "band.hpp"
 
 #include <cmath>
 #include <limits>
 
-#include "diagnose/models.hpp"
-#include "model/output_filter.hpp"
+#include "models.hpp"
+#include "rwcalc/output_filter.hpp"
 #include "rwcalc/allan.hpp"
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/units.hpp"

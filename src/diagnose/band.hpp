@@ -3,7 +3,7 @@
 /// What the models predict of the Allan variance and of held-out data: the band of σ per τ from a
 /// model's theoretical AV and the measured points' χ² EDF (no simulation), and the gain of the
 /// extended model in and out of sample (docs/diagnosis.md).
-#include "diagnose/effects.hpp"
+#include "effects.hpp"
 #include "rwcalc/diagnose.hpp"
 
 namespace rwcalc::diag {

@@ -13,12 +13,12 @@
 #include <optional>
 #include <string>
 
-#include "diagnose/band.hpp"
-#include "diagnose/effects.hpp"
-#include "diagnose/fast_line.hpp"
-#include "diagnose/lowpass.hpp"
-#include "diagnose/models.hpp"
-#include "diagnose/signal.hpp"
+#include "band.hpp"
+#include "effects.hpp"
+#include "fast_line.hpp"
+#include "lowpass.hpp"
+#include "models.hpp"
+#include "signal.hpp"
 #include "rwcalc/allan.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/progress.hpp"

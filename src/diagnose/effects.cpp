@@ -1,7 +1,7 @@
 // The effects' scans, their null laws and estimates (effects.hpp): every statistic is a
 // likelihood ratio of the block means with the noise levels profiled (gls.hpp).
-#include "diagnose/effects.hpp"
-#include "diagnose/signal.hpp"
+#include "effects.hpp"
+#include "signal.hpp"
 
 #include <fmt/format.h>
 #include <algorithm>

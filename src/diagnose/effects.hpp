@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "diagnose/gls.hpp"
+#include "gls.hpp"
 #include "rwcalc/diagnose.hpp"
 
 namespace rwcalc::diag {

@@ -1,5 +1,5 @@
 // The periodogram line search (fast_line.hpp).
-#include "diagnose/fast_line.hpp"
+#include "fast_line.hpp"
 
 #include <fmt/format.h>
 
@@ -9,8 +9,8 @@
 
 #include <boost/math/special_functions/beta.hpp>
 
-#include "allan/fft.hpp"
-#include "diagnose/signal.hpp"
+#include "rwcalc/fft.hpp"
+#include "signal.hpp"
 
 namespace rwcalc::diag {
 

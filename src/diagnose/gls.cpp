@@ -1,6 +1,6 @@
 // The exact likelihood of the block means' second differences (gls.hpp): the terms' Toeplitz
 // autocovariances, Durbin–Levinson whitening and the levels' profile.
-#include "diagnose/gls.hpp"
+#include "gls.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,12 +1,12 @@
 // The output-chain low-pass family (lowpass.hpp).
-#include "diagnose/lowpass.hpp"
+#include "lowpass.hpp"
 
 #include <array>
 #include <cmath>
 #include <limits>
 
-#include "diagnose/signal.hpp"
-#include "model/output_filter.hpp"
+#include "signal.hpp"
+#include "rwcalc/output_filter.hpp"
 
 namespace rwcalc::diag {
 

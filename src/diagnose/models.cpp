@@ -1,11 +1,11 @@
 // The base model of a record and the helpers of the extended one.
-#include "diagnose/models.hpp"
+#include "models.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "diagnose/signal.hpp"
+#include "signal.hpp"
 #include "rwcalc/error.hpp"
 
 namespace rwcalc::diag {

@@ -1,5 +1,5 @@
 // The decimated angle, its block rates, deterministic terms and weighted least squares.
-#include "diagnose/signal.hpp"
+#include "signal.hpp"
 
 #include <cmath>
 #include <limits>

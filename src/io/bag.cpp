@@ -1,6 +1,6 @@
 // What the three bag readers share: telling a bag by its first bytes, choosing the Imu topic,
 // decoding sensor_msgs/Imu (ROS 1 and CDR), bounds-checked bytes and the chunk decompressors.
-#include "io/bag.hpp"
+#include "bag.hpp"
 
 #include <bzlib.h>
 #include <dirent.h>
@@ -18,7 +18,7 @@
 
 #include <fmt/format.h>
 
-#include "core/sha256.hpp"
+#include "rwcalc/sha256.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 

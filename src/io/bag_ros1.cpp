@@ -7,7 +7,7 @@
 
 #include <fmt/format.h>
 
-#include "io/bag.hpp"
+#include "bag.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 

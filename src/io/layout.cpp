@@ -1,6 +1,6 @@
 // Layout detection: metadata keys, the delimiter, and the choice of the sample, time and
 // temperature columns. Two columns that could both be the one wanted are an error, never a choice.
-#include "io/layout.hpp"
+#include "layout.hpp"
 
 #include <algorithm>
 #include <charconv>

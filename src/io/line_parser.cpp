@@ -1,7 +1,7 @@
 // Each line is split at the delimiter and its selected fields read with std::from_chars (exact int64
 // for pulses and counters, correctly rounded doubles otherwise). A data line of the known layout is
 // taken as soon as its fields read; any other is looked at in the order that decides its error.
-#include "io/line_parser.hpp"
+#include "line_parser.hpp"
 
 #include <algorithm>
 #include <charconv>

@@ -7,7 +7,7 @@
 #include <string_view>
 #include <vector>
 
-#include "io/layout.hpp"
+#include "layout.hpp"
 #include "rwcalc/reader.hpp"
 
 namespace rwcalc::detail {

@@ -16,10 +16,10 @@
 #include <fmt/format.h>
 #include <sys/stat.h>
 
-#include "io/bag.hpp"
-#include "io/line_parser.hpp"
-#include "io/sample_memory.hpp"
-#include "io/text_source.hpp"
+#include "bag.hpp"
+#include "line_parser.hpp"
+#include "sample_memory.hpp"
+#include "text_source.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/limits.hpp"
 #include "rwcalc/memory.hpp"

@@ -11,7 +11,7 @@
 #include <optional>
 #include <unordered_map>
 
-#include "core/json_input.hpp"
+#include "rwcalc/json_input.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/reader.hpp"
 

@@ -1,7 +1,7 @@
 // A recording's bytes in pieces: read(2) on a descriptor (file, standard input, pipe, device) or
 // slices of text in memory, gzip inflated piece by piece. Each piece is checked before the next is
 // read: binary data or an endless line is refused before more of it is read.
-#include "io/text_source.hpp"
+#include "text_source.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>

@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-#include "core/sha256.hpp"
+#include "rwcalc/sha256.hpp"
 
 namespace rwcalc::detail {
 

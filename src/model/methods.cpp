@@ -10,7 +10,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "allan/narrow_counts.hpp"
+#include "rwcalc/narrow_counts.hpp"
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/noise_model.hpp"
 #include "rwcalc/parallel.hpp"

@@ -1,7 +1,7 @@
 // Allan variances of white angle and white rate noise seen through a first-order output filter
 // (the sensor's own low-pass): the analysis finds the filter's roll-off with them, the diagnosis
 // names it.
-#include "model/output_filter.hpp"
+#include "rwcalc/output_filter.hpp"
 
 #include <cmath>
 

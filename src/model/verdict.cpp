@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "core/json_input.hpp"
+#include "rwcalc/json_input.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 

@@ -1,7 +1,7 @@
 // Text and CSV renderings of an Allan-variance result (the JSON form is to_json in allan.cpp).
 #include <fmt/format.h>
 
-#include "rwcalc/allan.hpp"
+#include "rwcalc/allan_report.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/printable.hpp"
 #include "rwcalc/units.hpp"

@@ -10,8 +10,8 @@
 #include <string_view>
 #include <vector>
 
-#include "report/html.hpp"
-#include "report/json_view.hpp"
+#include "html.hpp"
+#include "json_view.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/version.hpp"
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "report/process.hpp"
+#include "process.hpp"
 #include "rwcalc/encode.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"

@@ -10,7 +10,7 @@
 #include <limits>
 #include <optional>
 
-#include "report/json_view.hpp"
+#include "json_view.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"

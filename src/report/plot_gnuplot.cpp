@@ -11,7 +11,7 @@
 #include <sstream>
 #include <vector>
 
-#include "report/process.hpp"
+#include "process.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/plot.hpp"

@@ -1,6 +1,6 @@
 // Helper programs: spawned in their own process group, waited for within a time limit, their
 // group ended afterwards; their scratch directories.
-#include "report/process.hpp"
+#include "process.hpp"
 
 #include <fcntl.h>
 #include <signal.h>

@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/cleanup.hpp"
+#include "rwcalc/cleanup.hpp"
 
 namespace rwcalc::detail {
 

@@ -9,8 +9,8 @@
 #include <filesystem>
 #include <optional>
 
-#include "report/html.hpp"
-#include "report/json_view.hpp"
+#include "html.hpp"
+#include "json_view.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"

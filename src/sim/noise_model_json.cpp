@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/json_input.hpp"
+#include "rwcalc/json_input.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/noise_model.hpp"

@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_ALLAN
+#error "rwcalc/narrow_counts.hpp belongs to the allan layer, which this layer may not use (docs/architecture.md)"
+#endif
 // Exact sums of small differences of counts in 16-bit lanes (internal to the library).
 //
 // A difference of counts Σ w_j·C[k + j·lag] is exact modulo 2^16 from the counts' low 16 bits, so it

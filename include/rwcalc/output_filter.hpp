@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_MODEL
+#error "rwcalc/output_filter.hpp belongs to the model layer, which this layer may not use (docs/architecture.md)"
+#endif
 // The first-order output filter (time constant tf) of a sensor's read-out chain, as the Allan
 // variance sees it.
 #include <cstddef>

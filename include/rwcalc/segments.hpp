@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_ANALYSIS
+#error "rwcalc/segments.hpp belongs to the analysis layer, which this layer may not use (docs/architecture.md)"
+#endif
 // A record split at the gaps of its time column (`--gaps segments`): each segment's phase, and the
 // Allan variance pooled over the segments so that no difference spans a gap.
 #include <vector>

@@ -1,4 +1,7 @@
 #pragma once
+#ifndef RWCALC_USES_ALLAN
+#error "rwcalc/fft.hpp belongs to the allan layer, which this layer may not use (docs/architecture.md)"
+#endif
 // Power spectra of real sequences (internal): |X_k|² of the zero-padded DFT, for the periodograms
 // of the line search. Small transforms go to Eigen's kissfft as they are; a long one (the whole
 // record's, 2^23 points for a 2-h record at 400 Hz) is taken in four steps over sub-transforms that
