@@ -2,7 +2,8 @@
 // non-overlapping second-difference sums at every length around the block size, for small and huge
 // steps (blocks inside and beyond the 64-bit fast path), with any counter offset and across the
 // counter's wrap-around; the sweep of a whole grid against the per-τ sums on one and two threads;
-// the modified variance's numerator from prefix sums; the 16-bit sums against the exact ones.
+// the modified variance's numerator from prefix sums; the 16-bit sums against the exact ones; the
+// floating sweep against the floating per-τ sums, bit for bit.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -129,6 +130,35 @@ TEST(ExactKernels, SweepEqualsThePerTauSumsOnOneAndTwoThreads) {
   EXPECT_TRUE(second_diff_sumsq(c.data(), n1, 1, 1) > (static_cast<u128>(1) << 52) * 40u) << "no wide block";
 }
 
+// The floating sweep takes each block for every τ in the per-τ kernel's lanes and order: its sums
+// are the per-τ ones bit for bit, on one thread and on two, for term counts that do and do not fill
+// the last group of lanes; and both are the plain sum to rounding.
+TEST(FloatingKernels, SweepEqualsThePerTauSumsBitForBit) {
+  std::mt19937_64 gen(7);
+  std::normal_distribution<double> normal;
+  std::vector<double> x(100'003);
+  double walk = 1e3;
+  for (double& v : x) v = (walk += normal(gen)) + 0.1 * normal(gen);
+  std::vector<std::int64_t> ms;
+  for (std::int64_t m = 1; 2 * m < static_cast<std::int64_t>(x.size()); m = m * 2 + (m % 3 == 0)) ms.push_back(m);
+  for (const char* threads : {"1", "2"}) {
+    const ScopedEnv env("RWCALC_THREADS", threads);
+    const std::vector<double> swept = second_diff_sumsq_sweep(x.data(), x.size(), ms);
+    ASSERT_EQ(swept.size(), ms.size());
+    for (std::size_t i = 0; i < ms.size(); ++i) {
+      const std::int64_t m = ms[i], n = static_cast<std::int64_t>(x.size()) - 2 * m;
+      EXPECT_EQ(swept[i], second_diff_sumsq(x.data(), n, m, 1)) << "threads " << threads << " m " << m;
+      long double plain = 0;
+      for (std::int64_t k = 0; k < n; ++k) {
+        const long double d = static_cast<long double>(x[static_cast<std::size_t>(k + 2 * m)]) -
+                              2.0L * x[static_cast<std::size_t>(k + m)] + x[static_cast<std::size_t>(k)];
+        plain += d * d;
+      }
+      EXPECT_NEAR(swept[i] / static_cast<double>(plain), 1.0, 1e-11) << "m " << m;
+    }
+  }
+}
+
 /// Counts with small steps about a steady rate of `slope` counts per point (a trend the narrow
 /// sums must take out), from an offset near the counter's wrap.
 std::vector<std::int64_t> drifting(std::size_t n, std::int64_t step, std::int64_t slope, std::uint64_t seed) {
@@ -167,8 +197,9 @@ TEST(ExactKernels, NarrowSumsAreExactWhereTheirBoundHolds) {
           ASSERT_TRUE(narrow.increment_sums(k0, len, t, shift, s1, s2)) << "t " << t << " k0 " << k0;
           i128 w1 = 0, w2 = 0;
           for (std::size_t k = k0; k < k0 + len; ++k) {
-            const auto e = static_cast<std::int64_t>(static_cast<std::uint64_t>(c[k + t]) -
-                                                     static_cast<std::uint64_t>(c[k]) - static_cast<std::uint64_t>(shift));
+            const auto e =
+                static_cast<std::int64_t>(static_cast<std::uint64_t>(c[k + t]) - static_cast<std::uint64_t>(c[k]) -
+                                          static_cast<std::uint64_t>(shift));
             w1 += e;
             w2 += static_cast<i128>(e) * e;
           }

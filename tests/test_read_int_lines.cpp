@@ -1,7 +1,8 @@
 // Pulse files of many lines that mix plain counts with every other accepted spelling (comments,
 // blank lines, CRLF, blanks around the value, '+', leading zeros, up to 18 digits): the exact
 // cumulative counts, the runs of lines that map samples to line numbers, and the line named
-// when the sum of |counts| passes 2^63 - 1.
+// when the sum of |counts| passes 2^63 - 1; the same on one thread and on two (long stretches of
+// plain lines are read in two halves at once).
 #include <cstdint>
 #include <random>
 #include <string>
@@ -13,6 +14,7 @@
 
 #include "rwcalc/error.hpp"
 #include "rwcalc/reader.hpp"
+#include "test_support.hpp"
 
 namespace {
 
@@ -110,6 +112,25 @@ TEST(ReadIntLines, LinesOfEveryFormAcrossPieces) {
   const Recording r = read_recording_text(text, "pieces.csv");
   EXPECT_EQ(r.phase.counts, want);
   EXPECT_EQ(r.line_runs, expected_runs(text));
+}
+
+// Plain stretches are read in two halves on two cores; a line the plain way does not take (here
+// every 3000th or so, anywhere in a half) stops the first half and the second half's lines are read
+// again: the counts, the runs of lines and an error's line are those of one thread.
+TEST(ReadIntLines, TwoHalvesReadAsOneThread) {
+  std::vector<std::int64_t> counts;
+  std::string text = mixed_text(600000, 11, counts);
+  for (std::size_t at = 1000; at < text.size(); at += 2999 + at % 7)
+    if (text[at] == '\n') text.insert(at + 1, "# note\n");
+  std::vector<rwcalc::Recording> read;
+  for (const char* threads : {"1", "2"}) {
+    const rwcalc::test::ScopedEnv env("RWCALC_THREADS", threads);
+    read.push_back(read_recording_text(text, "halves.csv"));
+  }
+  EXPECT_EQ(read[0].phase.counts, read[1].phase.counts);
+  EXPECT_EQ(read[0].line_runs, read[1].line_runs);
+  EXPECT_EQ(read[1].line_runs, expected_runs(text));
+  EXPECT_EQ(read[1].samples, counts.size());
 }
 
 std::size_t error_line(const std::string& text) {

@@ -240,8 +240,17 @@ std::vector<double> all_grid_fft_sums(const PhaseSeries& x, const CountData& dat
   return detail::all_oavar_sumsq_fft(std::move(phase), max_m);
 }
 
+/// The overlapping sums of every m of ms in one blocked sweep: exact over counts, in lanes over
+/// floating phase (allan_kernels.hpp).
+std::vector<double> overlapping_sweep(const PhaseSeries& x, const CountData& data,
+                                      const std::vector<std::int64_t>& ms) {
+  if (!x.exact()) return detail::second_diff_sumsq_sweep(x.values.data(), x.points(), ms);
+  const std::vector<detail::u128> exact = detail::second_diff_sumsq_sweep(data.c, x.points(), ms);
+  return {exact.begin(), exact.end()};
+}
+
 /// σ² of every τ of ms: from the FFT sums where `all` takes them (analyze's fitted octave points
-/// stay exact), from one blocked sweep for the other overlapping sums of counts, else per τ.
+/// stay exact), from one blocked sweep for the other overlapping sums, else per τ.
 std::vector<double> grid_variances(const PhaseSeries& x, const CountData& data, const std::vector<std::int64_t>& ms,
                                    const TauGrid& grid, Estimator est, std::int64_t& fft_from_m) {
   const std::vector<double> fft_sums = all_grid_fft_sums(x, data, grid, est, ms.back());
@@ -251,10 +260,10 @@ std::vector<double> grid_variances(const PhaseSeries& x, const CountData& data, 
     return !fft_sums.empty() && m >= kAllExactBelow && !octave_kept;
   };
   std::vector<std::int64_t> swept_ms;
-  if (x.exact() && est == Estimator::Overlapping)
+  if (est == Estimator::Overlapping)
     for (std::int64_t m : ms)
       if (!from_fft(m)) swept_ms.push_back(m);
-  const std::vector<detail::u128> swept = detail::second_diff_sumsq_sweep(data.c, x.points(), swept_ms);
+  const std::vector<double> swept = overlapping_sweep(x, data, swept_ms);
   std::vector<double> var(ms.size(), 0.0);
   std::size_t next_swept = 0;
   std::vector<std::size_t> per_tau;  // the τ left to compute one by one
@@ -264,7 +273,7 @@ std::vector<double> grid_variances(const PhaseSeries& x, const CountData& data, 
     if (from_fft(m))
       var[i] = n > 0 ? avar_from_sum(fft_sums[static_cast<std::size_t>(m)], sum_scale(x), tau, n) : 0.0;
     else if (!swept_ms.empty())
-      var[i] = n > 0 ? avar_from_sum(static_cast<double>(swept[next_swept++]), sum_scale(x), tau, n) : 0.0;
+      var[i] = n > 0 ? avar_from_sum(swept[next_swept++], sum_scale(x), tau, n) : 0.0;
     else
       per_tau.push_back(i);
   }

@@ -3,6 +3,7 @@
 #include "allan_kernels.hpp"
 
 #include <algorithm>
+#include <array>
 #include <optional>
 
 #include "rwcalc/narrow_counts.hpp"
@@ -19,14 +20,20 @@ constexpr std::int64_t kBlock = 1024;
 constexpr std::uint64_t kHalfRange = std::uint64_t{1} << 26;
 // Terms per stretch of the sweep that one parallel_for item takes (a multiple of kBlock).
 constexpr std::int64_t kStretch = std::int64_t{1} << 16;
+// Terms per block of the floating sweep: a block's three streams of every m stay in the core's
+// cache while it is taken for each m (octave lags share their streams: k + 2m is k + m of 2m).
+constexpr std::int64_t kFloatBlock = 2048;
+static_assert(kFloatBlock % kLanes == 0);
 
 /// The d-th difference of the counts at lag m from k (2: Allan, 3: Hadamard), modulo 2^64: the
 /// signed difference whenever it fits in int64, whatever the counter's offset.
 template <int Order>
 inline std::uint64_t difference(const std::int64_t* c, std::int64_t k, std::int64_t m) {
   auto at = [c, k, m](std::int64_t j) { return static_cast<std::uint64_t>(c[k + j * m]); };
-  if constexpr (Order == 2) return at(2) - 2 * at(1) + at(0);
-  else return at(3) - 3 * at(2) + 3 * at(1) - at(0);
+  if constexpr (Order == 2)
+    return at(2) - 2 * at(1) + at(0);
+  else
+    return at(3) - 3 * at(2) + 3 * at(1) - at(0);
 }
 
 /// Σ (d-th difference at k = i·stride)², i < len (len ≤ kBlock), exactly.
@@ -55,6 +62,23 @@ u128 difference_sumsq(const std::int64_t* c, std::int64_t n, std::int64_t m, std
   return total;
 }
 
+/// Adds the squared second differences of x at lag m, terms 0 … len − 1 (len a multiple of
+/// kLanes), term i to lane i mod kLanes: the one inner loop of the floating overlapping sums.
+void add_second_diff_lanes(const double* x, std::int64_t len, std::int64_t m, double* lanes) {
+  double acc[kLanes];
+  std::copy(lanes, lanes + kLanes, acc);  // in registers: the lanes cannot alias x
+  const double* __restrict a = x;
+  const double* __restrict b = x + m;
+  const double* __restrict e = x + 2 * m;
+  for (std::int64_t i = 0; i < len; i += kLanes) {
+    for (int j = 0; j < kLanes; ++j) {
+      const double d = e[i + j] - 2.0 * b[i + j] + a[i + j];
+      acc[j] += d * d;
+    }
+  }
+  std::copy(acc, acc + kLanes, lanes);
+}
+
 }  // namespace
 
 u128 second_diff_sumsq(const std::int64_t* c, std::int64_t n, std::int64_t m, std::int64_t stride) {
@@ -75,8 +99,8 @@ std::vector<u128> second_diff_sumsq_sweep(const std::int64_t* c, std::size_t poi
   std::vector<u128> part_sums(parts * count, 0);
   static_assert(kBlock <= static_cast<std::int64_t>(NarrowCounts::kMaxTerms));
   // Narrow sums pay for their pass over the record when several m share it.
-  const std::optional<NarrowCounts> narrow = count > 1 ? std::optional<NarrowCounts>(std::in_place, c, points)
-                                                       : std::nullopt;
+  const std::optional<NarrowCounts> narrow =
+      count > 1 ? std::optional<NarrowCounts>(std::in_place, c, points) : std::nullopt;
   parallel_for(parts, [&](std::size_t part) {
     const std::int64_t from = static_cast<std::int64_t>(part) * kStretch;
     const std::int64_t to = std::min(longest, from + kStretch);
@@ -86,10 +110,10 @@ std::vector<u128> second_diff_sumsq_sweep(const std::int64_t* c, std::size_t poi
         const std::int64_t n = np - 2 * ms[i];
         if (k0 >= n) continue;
         const std::int64_t len = std::min(kBlock, n - k0);
-        const auto small = narrow ? narrow->second_diff_sumsq(static_cast<std::size_t>(k0),
-                                                              static_cast<std::size_t>(len),
-                                                              static_cast<std::size_t>(ms[i]))
-                                  : std::nullopt;
+        const auto small = narrow
+                               ? narrow->second_diff_sumsq(static_cast<std::size_t>(k0), static_cast<std::size_t>(len),
+                                                           static_cast<std::size_t>(ms[i]))
+                               : std::nullopt;
         out[i] += small ? u128{*small} : block_sumsq<2>(c + k0, len, ms[i], 1);
       }
     }
@@ -103,18 +127,10 @@ std::vector<u128> second_diff_sumsq_sweep(const std::int64_t* c, std::size_t poi
 double second_diff_sumsq(const double* x, std::int64_t n, std::int64_t m, std::int64_t stride) {
   double acc[kLanes] = {};
   if (stride == 1) {
-    const double* __restrict a = x;
-    const double* __restrict b = x + m;
-    const double* __restrict e = x + 2 * m;
-    std::int64_t i = 0;
-    for (; i + kLanes <= n; i += kLanes) {
-      for (int j = 0; j < kLanes; ++j) {
-        const double d = e[i + j] - 2.0 * b[i + j] + a[i + j];
-        acc[j] += d * d;
-      }
-    }
-    for (; i < n; ++i) {
-      const double d = e[i] - 2.0 * b[i] + a[i];
+    const std::int64_t whole = n - n % kLanes;
+    add_second_diff_lanes(x, whole, m, acc);
+    for (std::int64_t i = whole; i < n; ++i) {
+      const double d = x[i + 2 * m] - 2.0 * x[i + m] + x[i];
       acc[0] += d * d;
     }
   } else {
@@ -127,6 +143,43 @@ double second_diff_sumsq(const double* x, std::int64_t n, std::int64_t m, std::i
   double s = 0;
   for (double v : acc) s += v;
   return s;
+}
+
+std::vector<double> second_diff_sumsq_sweep(const double* x, std::size_t points, std::span<const std::int64_t> ms) {
+  const auto np = static_cast<std::int64_t>(points);
+  const std::size_t count = ms.size();
+  std::vector<double> sums(count, 0.0);
+  if (count == 0) return sums;
+  // Each part sweeps the whole record for its share of the m (every parts-th): a part's sums are
+  // those of the per-m kernel, whichever part takes them.
+  const std::size_t parts = std::min<std::size_t>(count, worker_count());
+  parallel_for(parts, [&](std::size_t part) {
+    std::vector<std::size_t> mine;
+    std::int64_t longest = 0;
+    for (std::size_t i = part; i < count; i += parts) {
+      mine.push_back(i);
+      longest = std::max(longest, np - 2 * ms[i]);
+    }
+    std::vector<std::array<double, kLanes>> acc(mine.size(), std::array<double, kLanes>{});
+    for (std::int64_t k0 = 0; k0 < longest; k0 += kFloatBlock)
+      for (std::size_t j = 0; j < mine.size(); ++j) {
+        const std::int64_t n = np - 2 * ms[mine[j]], whole = n - n % kLanes;
+        const std::int64_t end = std::min(k0 + kFloatBlock, whole);
+        if (k0 < end) add_second_diff_lanes(x + k0, end - k0, ms[mine[j]], acc[j].data());
+      }
+    for (std::size_t j = 0; j < mine.size(); ++j) {  // the terms beyond the last whole group of lanes
+      const std::int64_t m = ms[mine[j]], n = np - 2 * m;
+      double* a = acc[j].data();
+      for (std::int64_t i = n - n % kLanes; i < n; ++i) {
+        const double d = x[i + 2 * m] - 2.0 * x[i + m] + x[i];
+        a[0] += d * d;
+      }
+      double s = 0;
+      for (double v : acc[j]) s += v;
+      sums[mine[j]] = s;
+    }
+  });
+  return sums;
 }
 
 double third_diff_sumsq(const double* x, std::int64_t n, std::int64_t m, std::int64_t stride) {

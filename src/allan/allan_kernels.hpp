@@ -31,6 +31,11 @@ double third_diff_sumsq(const double* x, std::int64_t n, std::int64_t m, std::in
 /// (narrow_counts.hpp). Exact, so bit for bit the per-m sums.
 std::vector<u128> second_diff_sumsq_sweep(const std::int64_t* c, std::size_t points, std::span<const std::int64_t> ms);
 
+/// The floating overlapping sums second_diff_sumsq(x, points − 2m, m, 1) of every m of ms in one
+/// blocked sweep (each block of the record taken for every m while it is in cache, the m shared out
+/// among the cores): the same terms in the same lanes and order, so bit for bit the per-m sums.
+std::vector<double> second_diff_sumsq_sweep(const double* x, std::size_t points, std::span<const std::int64_t> ms);
+
 /// Modular prefix sums of the counts: P[0] = 0, P[k+1] = P[k] + C[k] (points + 1 entries).
 std::vector<std::uint64_t> count_prefix_sums(const std::int64_t* c, std::size_t points);
 

@@ -24,15 +24,22 @@ constexpr std::size_t kFirstBin = 16;
 /// Bins each side of a line kept with it: the Hann window's main lobe.
 constexpr std::size_t kLobeBins = 2;
 
+/// Records that hold this many whole windows step a whole window at a time: Hann windows without
+/// overlap give ν = 2 per window (half-overlapping ones about 1.9 per window, at twice the
+/// transforms), so ν ≥ 128 here, far above the ν ≥ 25 the threshold is set for.
+constexpr std::size_t kWholeStepWindows = 64;
+
 std::size_t window_length(std::size_t n) {
   std::size_t w = kMaxWindow;
   while (w >= kMinWindow && (n < w || (n - w) / (w / 2) + 1 < kMinWindows)) w /= 2;
   return w;
 }
 
-/// One-sided Welch PSD of the rate, Hann windows of `w` samples, half overlap, each less its mean.
+/// One-sided Welch PSD of the rate, Hann windows of `w` samples, each less its mean, half
+/// overlapping (whole windows apart on a record of kWholeStepWindows or more).
 std::vector<double> welch_rate_psd(const PhaseSeries& x, std::size_t w) {
   const std::size_t n = x.points() - 1;
+  const std::size_t step = n / w >= kWholeStepWindows ? w : w / 2;
   std::vector<double> hann(w), seg(w), psd(w / 2 + 1, 0.0);
   double u = 0;
   for (std::size_t i = 0; i < w; ++i) {
@@ -41,7 +48,7 @@ std::vector<double> welch_rate_psd(const PhaseSeries& x, std::size_t w) {
   }
   detail::RealPowerSpectrum fft(w);
   std::size_t windows = 0;
-  for (std::size_t start = 0; start + w <= n; start += w / 2, ++windows) {
+  for (std::size_t start = 0; start + w <= n; start += step, ++windows) {
     double mean = 0;
     for (std::size_t i = 0; i < w; ++i) mean += (seg[i] = x.rate(start + i));
     mean /= static_cast<double>(w);

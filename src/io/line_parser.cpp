@@ -6,12 +6,14 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include <fmt/format.h>
 
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
+#include "rwcalc/parallel.hpp"
 
 namespace rwcalc::detail {
 
@@ -120,9 +122,10 @@ bool LineParser::plain_integer(std::string_view t, Sample& s) const {
   return input_.mode != InputMode::Counter || (s.integer >= counter_lo_ && s.integer <= counter_max_);
 }
 
-const char* LineParser::plain_integer_lines(const char* p, const char* end, std::size_t& line,
-                                            std::vector<std::int64_t>& out, std::size_t max_lines) {
-  if (!plain_layout()) return p;
+// The lines of [p, end) while they are plain integers (a counter's within its readings), onto
+// `out`, `max_lines` at most; returns where the first other line starts.
+const char* LineParser::plain_run(const char* p, const char* end, std::vector<std::int64_t>& out,
+                                  std::size_t max_lines) const {
   const bool counter = input_.mode == InputMode::Counter;
   const std::size_t before = out.size();
   // Lines with 22 bytes to spare (sign, 19 digits, CR, LF) need no look at `end`.
@@ -134,6 +137,34 @@ const char* LineParser::plain_integer_lines(const char* p, const char* end, std:
     if (*q != '\n' || (counter && (v < counter_lo_ || v > counter_max_))) break;
     ++q;
     out.push_back(v);
+  }
+  return p;
+}
+
+const char* LineParser::plain_integer_lines(const char* p, const char* end, std::size_t& line,
+                                            std::vector<std::int64_t>& out, std::size_t max_lines) {
+  if (!plain_layout()) return p;
+  const std::size_t before = out.size();
+  // A long stretch with room for every line it can hold (each takes 2 bytes or more) is read in two
+  // halves on two cores, cut after a line end: the second half's lines count only if the first half
+  // reached them, so the lines taken and where the reading stops are those of one pass.
+  const char* cut =
+      end - p >= kSplitBytes && max_lines > static_cast<std::size_t>(end - p) / 2
+          ? static_cast<const char*>(std::memchr(p + (end - p) / 2, '\n', static_cast<std::size_t>(end - p) / 2))
+          : nullptr;
+  if (!cut) {
+    p = plain_run(p, end, out, max_lines);
+  } else {
+    const char* stop[2] = {};
+    second_half_.clear();
+    parallel_for(2, [&](std::size_t half) {
+      stop[half] = half == 0 ? plain_run(p, cut + 1, out, max_lines) : plain_run(cut + 1, end, second_half_, max_lines);
+    });
+    p = stop[0];
+    if (stop[0] == cut + 1) {
+      out.insert(out.end(), second_half_.begin(), second_half_.end());
+      p = stop[1];
+    }
   }
   line += out.size() - before;
   content_lines_ += out.size() - before;
@@ -249,11 +280,11 @@ bool LineParser::read_field(std::string_view f, Role role, Sample& s, bool repor
   double v = 0;
   const auto r = std::from_chars(n.data(), n.data() + n.size(), v);
   if (r.ptr == n.data() + n.size() && r.ec == std::errc() && std::isfinite(v)) {
-    (role == Role::Value   ? s.real
-     : role == Role::Time  ? s.time
-     : role == Role::Time2 ? s.time2
+    (role == Role::Value     ? s.real
+     : role == Role::Time    ? s.time
+     : role == Role::Time2   ? s.time2
      : role == Role::Nanosec ? s.nanosec
-                           : s.temperature) = v;
+                             : s.temperature) = v;
     return true;
   }
   if (!report) return false;

@@ -64,6 +64,7 @@ class LineParser {
   bool read_field(std::string_view f, Role role, Sample& s, bool report);
   [[nodiscard]] bool plain_layout() const noexcept;
   bool plain_integer(std::string_view t, Sample& s) const;
+  const char* plain_run(const char* p, const char* end, std::vector<std::int64_t>& out, std::size_t max_lines) const;
   bool delimited_data_line(std::string_view text, Sample& s);
   bool read_integer(std::string_view f, std::string_view t, Sample& s, bool report);
   [[nodiscard]] bool integer_mode() const noexcept {
@@ -84,6 +85,9 @@ class LineParser {
   const LineParser* lead_ = nullptr;
   std::size_t split_line_ = 0;  // the line fields_ holds, when the common path split it
   std::string scratch_;
+  /// plain_integer_lines reads stretches of this many bytes or more in two halves, in parallel.
+  static constexpr std::ptrdiff_t kSplitBytes = std::ptrdiff_t{1} << 16;
+  std::vector<std::int64_t> second_half_;  // the second half's lines, until the first half reaches them
   bool stop_at_data_ = false;
 };
 
