@@ -92,20 +92,26 @@ TEST(DiagnoseAcceptance, SlowLinesAtThreeAndAHalfFloors) {
   EXPECT_GE(gain, named - 1);
 }
 
-// Clean records: no family names anything in more than 2 % of them (its bound is α = 1 %); 50
-// records here, the 200 of the acceptance measured in docs/diagnosis.md.
-TEST(DiagnoseAcceptance, CleanRecordsNameNothing) {
-  const int n = 50;
+// Clean records: no family names anything in more than 2 % of them (its bound is α = 1 %). 100
+// records with the counting read-out and 100 with the white one, each at most 2 per family: at
+// least 98 % of the 200 clean records without a finding per family.
+void expect_clean(ReadoutMode readout, std::uint64_t first_seed) {
+  const int n = 100;
   std::array<int, kEffectCount> fired{};
   for (int i = 0; i < n; ++i) {
-    const DiagnoseResult r = run_case(gl2d(), 5000 + static_cast<std::uint64_t>(i));
+    NoiseModel m = gl2d();
+    m.readout = readout;
+    const DiagnoseResult r = run_case(m, first_seed + static_cast<std::uint64_t>(i));
     for (const auto& f : r.findings) ++fired[static_cast<std::size_t>(f.effect)];
   }
   for (std::size_t e = 0; e < kEffectCount; ++e) {
     std::cout << fmt::format("{}: named in {}/{} clean records\n", detector_name(static_cast<Effect>(e)), fired[e], n);
-    EXPECT_LE(fired[e], 1) << detector_name(static_cast<Effect>(e));
+    EXPECT_LE(fired[e], 2) << detector_name(static_cast<Effect>(e));
   }
 }
+
+TEST(DiagnoseAcceptance, CleanRecordsNameNothingCountingReadout) { expect_clean(ReadoutMode::Counting, 5000); }
+TEST(DiagnoseAcceptance, CleanRecordsNameNothingWhiteReadout) { expect_clean(ReadoutMode::White, 6000); }
 
 // The same record gives the same findings, parameters and intervals for every --seed.
 TEST(DiagnoseAcceptance, SameFindingsForEverySeed) {

@@ -104,6 +104,28 @@ double scan_threshold(double alpha, int s, double length) {
   return hi;
 }
 
+double level_boundary_p(const std::function<double(double)>& p_chi2, double u) {
+  // E p(u − Y), Y ~ χ²₁, by the substitution Y = x² (density √(2/π)e^{−x²/2} on x > 0), trapezoid
+  // to x = 9 (P(Y > 81) ≈ 1e−19).
+  constexpr int kPoints = 900;
+  double sum = 0, wsum = 0;
+  for (int i = 0; i <= kPoints; ++i) {
+    const double x = 9.0 * i / kPoints, w = std::exp(-0.5 * x * x) * (i == 0 || i == kPoints ? 0.5 : 1.0);
+    sum += w * std::min(1.0, p_chi2(u - x * x));
+    wsum += w;
+  }
+  return std::min(1.0, 0.5 * std::min(1.0, p_chi2(u)) + 0.5 * sum / wsum);
+}
+
+double threshold_of(const std::function<double(double)>& p, double alpha) {
+  double lo = 0, hi = 400;
+  for (int it = 0; it < 60; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (p(mid) > alpha ? lo : hi) = mid;
+  }
+  return hi;
+}
+
 namespace {
 
 /// The current model whitened: W, an orthonormal basis of its whitened regressors and the
@@ -232,12 +254,17 @@ Candidate search_slow_line(const Blocks& b, const GlsModel& cur, double alpha, d
   for (double f = f_lo; f <= f_hi; f += df) grid.push_back(f);
   double length = 0;
   Candidate c = scan_det(b, cur, effect, grid, length, false);
-  c.p = scan_p(c.lr, 2, length);
-  c.threshold = scan_threshold(alpha, 2, length);
+  const auto chi2 = [&](double v) { return scan_p(v, 2, length); };
+  // In the slow band the flicker level competes with the line (it is read mostly from those few
+  // frequencies): the law has the level's one-sided move beside the line's χ²₂ scan.
+  const bool slow = f_hi * T <= 20;
+  const auto p = [&](double u) { return slow ? level_boundary_p(chi2, u) : chi2(u); };
+  c.p = p(c.lr);
+  c.threshold = threshold_of(p, alpha);
   c.test = fmt::format(
       "likelihood ratio of a line (2 coefficients, frequency searched {:.4g}–{:.4g} Hz) on the {:g}-s block means, "
-      "noise levels profiled; null law: χ²₂ scan over a curve of length {:.3g} (Davies bound)",
-      f_lo, f_hi, b.tb, length);
+      "noise levels profiled; null law: χ²₂ scan over a curve of length {:.3g} (Davies bound){}",
+      f_lo, f_hi, b.tb, length, slow ? ", plus ½χ²₀ + ½χ²₁ for the flicker level's move" : "");
   return c;
 }
 
@@ -249,13 +276,12 @@ Candidate search_step(const Blocks& b, const GlsModel& cur, double alpha) {
   double length = 0;
   Candidate c = scan_det(b, cur, Effect::BiasStep, grid, length, false);
   const double m = static_cast<double>(grid.size());
-  c.p = std::min(1.0, m * chi2_sf(c.lr, 1));
-  double lo = 0, hi = 400;
-  for (int it = 0; it < 100; ++it) (m * chi2_sf(0.5 * (lo + hi), 1) > alpha ? lo : hi) = 0.5 * (lo + hi);
-  c.threshold = hi;
+  const auto p = [&](double u) { return level_boundary_p([&](double v) { return m * chi2_sf(v, 1); }, u); };
+  c.p = p(c.lr);
+  c.threshold = threshold_of(p, alpha);
   c.test = fmt::format(
       "likelihood ratio of a change of the mean rate on the {:g}-s block means, noise levels profiled; null law: "
-      "χ²₁ with Bonferroni over {} block edges",
+      "χ²₁ with Bonferroni over {} block edges, plus ½χ²₀ + ½χ²₁ for the flicker level's move",
       b.tb, grid.size());
   return c;
 }
@@ -266,12 +292,13 @@ Candidate search_transient(const Blocks& b, const GlsModel& cur, double alpha) {
   for (double tau = 2 * b.tb; tau <= 2 * T; tau *= 1.25) grid.push_back(tau);
   double length = 0;
   Candidate c = scan_det(b, cur, Effect::Warmup, grid, length, true);
-  c.p = scan_p(c.lr, 1, length);
-  c.threshold = scan_threshold(alpha, 1, length);
+  const auto p = [&](double u) { return level_boundary_p([&](double v) { return scan_p(v, 1, length); }, u); };
+  c.p = p(c.lr);
+  c.threshold = threshold_of(p, alpha);
   c.test = fmt::format(
       "likelihood ratio of an exponential A·e^(−t/τ) of the rate beside its level and ramp on the {:g}-s block "
       "means (τ searched {:.3g}–{:.3g} s), noise levels profiled; null law: χ²₁ scan over a curve of length {:.3g} "
-      "(Davies bound)",
+      "(Davies bound), plus ½χ²₀ + ½χ²₁ for the flicker level's move",
       b.tb, grid.front(), grid.back(), length);
   return c;
 }

@@ -3,6 +3,7 @@
 /// The effects the likelihood of the block means tests (gls.hpp): slow lines, bias steps, warm-up
 /// transients and drifts as regressors, Gauss–Markov terms as covariance terms; each family's scan,
 /// its p-value bound, and the forward selection that names them (docs/diagnosis.md).
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -40,6 +41,13 @@ double scan_p(double u, int s, double length);
 double scan_threshold(double alpha, int s, double length);
 /// P(χ²_s > u).
 double chi2_sf(double u, int s);
+
+/// A χ² bound `p_chi2(u)` of a statistic whose alternative also moves one noise level towards its
+/// boundary (the flicker level giving up power to a slow effect): the law of the sum with an
+/// independent ½χ²₀ + ½χ²₁, ½p(u) + ½E p(u − Y), Y ~ χ²₁.
+double level_boundary_p(const std::function<double(double)>& p_chi2, double u);
+/// The u at which a decreasing p(u) falls to alpha.
+double threshold_of(const std::function<double(double)>& p, double alpha);
 
 /// One family's best candidate against the current model.
 struct Candidate {
