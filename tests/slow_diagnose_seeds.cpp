@@ -1,6 +1,7 @@
 // No decision of the diagnosis reads a random number: every ADIS16405 run and gyro axis in
-// ../shared gives exactly the same findings, detectors and extended model for 10 different --seed
-// values (one test per run, so that each stays short).
+// ../shared gives exactly the same findings, detectors and extended model for three far-apart
+// --seed values (one test per run, so that each stays short); three far-apart seeds show any
+// dependence at a third of the time ten would take.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -28,7 +29,7 @@ void same_for_every_seed(int run) {
   const auto recs = read_recordings(path.string(), columns);
   for (const auto& rec : recs) {
     std::string first;
-    for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    for (const std::uint64_t seed : {1ULL, 7ULL, 0x9e3779b97f4a7c15ULL}) {
       DiagnoseOptions o;
       o.seed = seed;
       o.analysis.earth_rate = false;
