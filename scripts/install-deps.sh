@@ -3,10 +3,11 @@
 # installed yet: as root directly, otherwise through sudo. The one list of them (CI uses it too).
 # libsqlite3-dev, libbz2-dev, liblz4-dev, libzstd-dev: ROS bags; g++-11: CI's build with the oldest
 # compiler supported (Ubuntu 22.04's).
+# clang-format, clang-tidy: the style checks (scripts/lint.sh).
 set -euo pipefail
 PACKAGES=(cmake g++ make libeigen3-dev libcli11-dev libfmt-dev nlohmann-json3-dev zlib1g-dev libssl-dev libboost-dev
           libgtest-dev libbenchmark-dev gnuplot-nox python3-numpy time dpkg-dev man-db gettext python3-yaml
-          libsqlite3-dev libbz2-dev liblz4-dev libzstd-dev g++-11)
+          libsqlite3-dev libbz2-dev liblz4-dev libzstd-dev g++-11 clang-format clang-tidy)
 missing=()
 for p in "${PACKAGES[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done
 ((${#missing[@]})) || exit 0

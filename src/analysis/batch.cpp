@@ -402,7 +402,7 @@ std::string format_batch_csv(const json& summary) {
   std::string s =
       "source,temperature_c,N_fit,N_fit_sigma,N_fit_resolved,N_direct,N_direct_sigma,B_fit,B_fit_sigma,B_fit_resolved,"
       "B_100s,B_100s_sigma,class_N,class_B,class,p_class,outliers,outlier_action\n";
-  auto val = [](const json& r, std::vector<std::string> path, const char* k) -> std::string {
+  auto val = [](const json& r, const std::vector<std::string>& path, const char* k) -> std::string {
     const json* e = lookup(r, path);
     if (!e) return "";
     const json& x = e->at(k);

@@ -174,6 +174,7 @@ ImuResult analyze_imu(const std::string& path, const ImuOptions& options) {
   // Every channel is read in one pass over the text and checked before any is analysed: a column
   // given twice is refused before the work, and always the same pair is named.
   std::vector<ReadOptions> reads;
+  reads.reserve(specs.size());
   for (const ChannelSpec& c : specs) reads.push_back(channel_read(options, c));
   std::vector<Recording> recs = read_recordings(path, reads);
   check_channels(recs, specs);

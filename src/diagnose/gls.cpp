@@ -147,7 +147,7 @@ Whitened whiten(const std::vector<double>& r, const Eigen::MatrixXd& v, Eigen::M
       w(K, K) = s;
     }
   }
-  if (w_out) *w_out = std::move(w);
+  if (w_out) *w_out = w;
   return out;
 }
 
@@ -226,7 +226,7 @@ namespace {
 
 /// Nelder–Mead minimisation of f over R^d from x0 with initial steps `step`.
 template <class F>
-std::vector<double> nelder_mead(const F& f, std::vector<double> x0, double step, int max_evals, double ftol) {
+std::vector<double> nelder_mead(const F& f, const std::vector<double>& x0, double step, int max_evals, double ftol) {
   const std::size_t d = x0.size();
   std::vector<std::vector<double>> s(d + 1, x0);
   std::vector<double> fv(d + 1);

@@ -126,6 +126,7 @@ std::vector<BagTopic> McapFile::topics() {
     t.messages += counts[id];
   }
   std::vector<BagTopic> out;
+  out.reserve(by_topic.size());
   for (auto& [topic, t] : by_topic) out.push_back(std::move(t));
   return out;
 }

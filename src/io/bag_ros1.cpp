@@ -144,6 +144,7 @@ std::vector<BagTopic> Ros1Bag::topics() {
   for (const auto& [conn, n] : counts)
     if (topic_of.count(conn)) by_topic[topic_of[conn]].messages += n;
   std::vector<BagTopic> out;
+  out.reserve(by_topic.size());
   for (auto& [topic, t] : by_topic) out.push_back(std::move(t));
   return out;
 }

@@ -32,7 +32,6 @@ namespace rwcalc {
 
 namespace {
 
-using detail::quoted;
 using detail::Sample;
 
 // The time column, checked without keeping every stamp (all in the column's own unit): its first

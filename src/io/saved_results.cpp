@@ -363,6 +363,7 @@ void parse_saved_result(std::string_view text, const std::string& file, SavedRes
       overall = o->json();
     }
     std::vector<std::size_t> lines;
+    lines.reserve(runs.size());
     for (const auto& r : runs) lines.push_back(r.line());
     json all = doc.take();
     for (std::size_t i = 0; i < lines.size(); ++i) into.analyses.push_back({std::move(all["runs"][i]), file, lines[i]});

@@ -108,6 +108,7 @@ ProcessResult run_process(const std::string& command, const std::vector<std::str
                                                                                                  : command};
   storage.insert(storage.end(), args.begin(), args.end());
   std::vector<char*> argv;
+  argv.reserve(storage.size() + 1);
   for (auto& s : storage) argv.push_back(s.data());
   argv.push_back(nullptr);
   pid_t pid = 0;

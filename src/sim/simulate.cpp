@@ -186,7 +186,7 @@ struct Simulator::Impl {
   std::vector<std::vector<double>> warmup_steps;  // e^{−jτ0/Tc} for j < kBlock, per warm-up
   GmStep lowpass_arw;
 
-  Impl(NoiseModel m, SimulationSettings s, SimulationPath p) : model(std::move(m)), settings(std::move(s)), path(p) {
+  Impl(NoiseModel m, SimulationSettings s, SimulationPath p) : model(std::move(m)), settings(s), path(p) {
     validate(model, settings);
     n = settings.samples();
     flicker_n = n;
@@ -529,7 +529,7 @@ struct Simulator::Impl {
 };
 
 Simulator::Simulator(NoiseModel model, SimulationSettings settings, SimulationPath path)
-    : impl_(std::make_unique<Impl>(std::move(model), std::move(settings), path)) {}
+    : impl_(std::make_unique<Impl>(std::move(model), settings, path)) {}
 Simulator::~Simulator() = default;
 Simulator::Simulator(Simulator&&) noexcept = default;
 Simulator& Simulator::operator=(Simulator&&) noexcept = default;
