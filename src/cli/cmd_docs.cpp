@@ -105,7 +105,7 @@ constexpr std::pair<const char*, const char*> kEnvironment[] = {
 /// Commands a user starts from, with what each does.
 constexpr std::pair<const char*, const char*> kExamples[] = {
     {"Noise coefficients, cross-checks and the class verdict of one recording:",
-     "rwcalc analyze data/gl2d/run1.csv.gz"},
+     "rwcalc analyze data/gl2d/gl2d_p50C.csv.gz"},
     {"The paper's Tables 1 and 2 over the temperature runs, with its figures:",
      "rwcalc batch data/gl2d/*.csv.gz --plot figs.svg"},
     {"The Allan deviation with the modified estimator on a dense grid, as CSV:",
@@ -132,7 +132,7 @@ void write_man(std::ostream& out, const CLI::App& app) {
   for (const auto& [name, text] : kEnvironment) out << ".TP\n.B " << name << "\n" << roff(text) << "\n";
   out << ".SH EXAMPLES\n";
   for (const auto& [text, command] : kExamples)
-    out << roff(text) << "\n.PP\n.RS\n.nf\n" << roff(command) << "\n.fi\n.RE\n";
+    out << ".PP\n" << roff(text) << "\n.RS\n.nf\n" << roff(command) << "\n.fi\n.RE\n";
   out << ".SH EXIT STATUS\n0 success; 1 the analysis is impossible (e.g. a record too short); 2 bad input or usage; "
          "3 an output could not be written.\n"
       << ".SH SEE ALSO\n.BR gnuplot (1).\nThe documents under docs/ of the source tree: docs/analysis.md "
@@ -165,8 +165,9 @@ void write_completion(std::ostream& out, const CLI::App& app) {
         if (!words.empty()) values += "        --" + n + ") values=\"" + words + "\" ;;\n";
       }
     }
-    std::string label = cmd->get_name();
-    for (const auto& alias : cmd->get_aliases()) label += "|" + alias;
+    std::string label;  // the aliases, then the name: "analyse|analyze"
+    for (const auto& alias : cmd->get_aliases()) label += alias + "|";
+    label += cmd->get_name();
     out << "    " << label << ") opts=\"" << opts << "\"\n";
     if (!values.empty())
       out << "      case \"$prev\" in\n" << values << "      esac ;;\n";

@@ -153,6 +153,7 @@ json settings_of(const ReportCmd& c, const std::vector<std::string>& recordings,
 std::string local_now(CalendarDate& date) {
   const auto now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
   std::tm tm{};
+  tzset();  // localtime_r need not read TZ itself
   localtime_r(&now, &tm);
   date = {tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday};
   const long offset_min = tm.tm_gmtoff / 60;

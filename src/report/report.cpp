@@ -795,17 +795,17 @@ std::string protocol_results(const std::vector<json>& a, const std::vector<std::
 /// The conclusion of a protocol: the verdict in words, or why there is none.
 std::string protocol_conclusion(const std::vector<json>& a, const std::vector<std::size_t>& order,
                                 const json& overall) {
-  std::string words;
-  if (is_withheld(overall))
-    words = tr("no verdict: the noise model does not describe every record (see section 1)");
-  else {
+  std::string text;
+  if (is_withheld(overall)) {
+    text = tr("no verdict: the noise model does not describe every record (see section 1)");
+  } else {
     const auto& v0 = at(a[order.front()], "verdict");
     const json& classes = at(overall, "classes").is_array() ? at(overall, "classes") : at(v0, "classes");
-    words = verdict_in_words(overall, classes);
+    std::string words = verdict_in_words(overall, classes);
     if (words.empty()) words = trf("class {}", class_text(at(overall, "class")));
+    text = trf("by GOST RV 52339-2005 the gyro is of {}.", words);
   }
-  return fmt::format("<p id=\"conclusion\"><b>{}</b> {}</p>\n", tr("Conclusion:"),
-                     esc(trf("by GOST RV 52339-2005 the gyro is of {}.", words)));
+  return fmt::format("<p id=\"conclusion\"><b>{}</b> {}</p>\n", tr("Conclusion:"), esc(text));
 }
 
 /// The first page as a test protocol: approval, number and date, what was tested, how, with which
