@@ -85,7 +85,7 @@ class ReportOfGl2d : public ::testing::Test {
 }  // namespace
 
 TEST_F(ReportOfGl2d, IsOneWellFormedPageWithEverySection) {
-  EXPECT_NE(report_.out.find("report written to " + (dir() / "out" / "report.html").string() + " (5 run(s))"),
+  EXPECT_NE(report_.out.find("report written to " + (dir() / "out" / "report.html").string() + " (5 runs)"),
             std::string::npos)
       << report_.out;
   ASSERT_NE(html_.find("<html"), std::string::npos);

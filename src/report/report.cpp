@@ -681,9 +681,15 @@ std::string conventions_rows(const json& conventions) {
            "“< x”: not resolved, x is the 95 % upper bound")},
        {"rounding", N_("rounding"),
         N_("the uncertainty to two significant digits when its first digit is 1 or 2, else to one; the value and "
-           "its interval to the same digit (JCGM 100:2008, the GUM, 7.2.6)")}}};
+           "its interval to the same digit ({}, 7.2.6)")}}};
   std::string h;
-  for (const auto& [key, name, text] : kConventions) h += kv_row(tr(name), esc(tr(text)));
+  for (const auto& [key, name, text] : kConventions) {
+    const std::string shown = esc(tr(text));
+    // The standard is named as typed: no decimal comma goes into "34100.3".
+    h += kv_row(tr(name), std::string_view(key) == "rounding"
+                              ? fmt::format(fmt::runtime(shown), typed(tr(N_("JCGM 100:2008, the GUM"))))
+                              : shown);
+  }
   if (conventions.is_object())
     for (const auto& item : conventions.items()) {
       const std::string& k = item.key();  // a structured binding, clang 14 (the fuzz build) cannot capture
