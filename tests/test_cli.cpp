@@ -78,7 +78,7 @@ TEST(Cli, EachCommandsHelpAndAnUnknownCommand) {
     EXPECT_EQ(r.status, 0) << cmd;
     EXPECT_NE(r.out.find(std::string("rwcalc ") + cmd), std::string::npos) << cmd << "\n" << r.out;
   }
-  auto r = run_cli({"analyse", "x.csv"});
+  auto r = run_cli({"analyz", "x.csv"});  // ("analyse" is analyze spelt the British way)
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("rwcalc --help"), std::string::npos) << r.err;
   // An option before the command: every command is set up, and the option is honoured.
