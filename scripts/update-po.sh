@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The message catalogue: extracts every message marked tr(), trf() or N_() in the sources into
+# The message catalogue: extracts every message marked tr(), trf(), trn(), trnf() or N_() in the sources into
 # po/rwcalc.pot and merges it into po/ru.po (new messages get an empty msgstr to translate; those
 # no longer in the code become obsolete "#~" entries). Needs gettext (xgettext, msgmerge).
 # Usage: scripts/update-po.sh [--check]   (--check: only compare, change nothing; status 1 when
@@ -11,8 +11,9 @@ pot="$(mktemp "${TMPDIR:-/tmp}/rwcalc-pot.XXXXXX")"
 trap 'rm -f "$pot" "$pot.po"' EXIT
 mapfile -t sources < <(find src include -name '*.cpp' -o -name '*.hpp' | LC_ALL=C sort)
 xgettext --language=C++ --from-code=UTF-8 --no-wrap --sort-by-file --package-name=rwcalc \
-  --keyword=tr --keyword=trf --keyword=N_ \
-  --flag=tr:1:no-c-format --flag=trf:1:no-c-format --flag=N_:1:no-c-format \
+  --keyword=tr --keyword=trf --keyword=N_ --keyword=trn:1,2 --keyword=trnf:1,2 \
+  --flag=tr:1:no-c-format --flag=trf:1:no-c-format --flag=N_:1:no-c-format --flag=trn:1:no-c-format \
+  --flag=trn:2:no-c-format --flag=trnf:1:no-c-format --flag=trnf:2:no-c-format \
   -o "$pot" "${sources[@]}"
 if [[ "${1:-}" == --check ]]; then
   status=0

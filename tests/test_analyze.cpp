@@ -91,8 +91,8 @@ TEST(AnalyzeCli, JsonHasTheIssueKeysAndCoversTheTruth) {
 TEST(AnalyzeCli, ReportStatesUnitsConventionsAndVerdict) {
   const auto r = run_cli({"analyze", gl2d("gl2d_m25C.csv.gz"), "--earth-rate", "12.0", "--b-estimate", "sigma-min"});
   ASSERT_EQ(r.status, 0) << r.err;
-  for (const char* s : {"°/√h", "°/h", "arcsec", "√3·Q", "Verdict", "B from sigma-min", "N direct",
-                        "expected vertical Earth rate 12.0000 °/h (given)"})
+  for (const char* s : {"°/√h", "°/h", "arcsec", "√3·Q", "Verdict", "B from the minimum of the Allan deviation",
+                        "N direct", "expected vertical Earth rate 12.0000 °/h (given)"})
     EXPECT_NE(r.out.find(s), std::string::npos) << s;
   EXPECT_EQ(r.out.find("nan"), std::string::npos);
 }

@@ -112,7 +112,11 @@ TEST_P(OutliersCli, ReportShowsTheOutliersOfRecordingsAndOfSavedResults) {
   auto r = run_exe({"report", rec_->spiked, "-o", (tmp.path() / "rec").string(), "--no-figures", "--outliers", action});
   ASSERT_EQ(r.status, 0) << r.err;
   check_html(tmp.path() / "rec");
-  EXPECT_NE(slurp(tmp.path() / "rec" / "report.html").find("<tr><th>outliers</th><td>" + action + "</td></tr>"),
+  // The settings name the action in words (its option value is "keep", "remove" or "replace").
+  const std::string action_words = action == "keep"     ? "kept in the analysis"
+                                   : action == "remove" ? "removed"
+                                                        : "replaced by the median of their neighbours";
+  EXPECT_NE(slurp(tmp.path() / "rec" / "report.html").find("<tr><th>outliers</th><td>" + action_words + "</td></tr>"),
             std::string::npos)
       << "the settings table does not name the outlier action";
   // The same from the saved analysis JSON, which carries the outlier summary.

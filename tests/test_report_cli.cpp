@@ -85,7 +85,7 @@ class ReportOfGl2d : public ::testing::Test {
 }  // namespace
 
 TEST_F(ReportOfGl2d, IsOneWellFormedPageWithEverySection) {
-  EXPECT_NE(report_.out.find("report written to " + (dir() / "out" / "report.html").string() + " (5 run(s))"),
+  EXPECT_NE(report_.out.find("report written to " + (dir() / "out" / "report.html").string() + " (5 runs)"),
             std::string::npos)
       << report_.out;
   ASSERT_NE(html_.find("<html"), std::string::npos);
@@ -161,9 +161,9 @@ TEST_F(ReportOfGl2d, SettingsAndVersionAreStated) {
   for (auto at = s.find("<th>B estimate"); at != std::string::npos; at = s.find("<th>B estimate", at + 1)) ++b_rows;
   EXPECT_EQ(b_rows, 1u) << s;
   EXPECT_NE(s.find("<tr><th>tolerance on B (%)</th><td>50</td></tr>"), std::string::npos) << s;
-  EXPECT_NE(s.find("<tr><th>input</th><td>pulses</td></tr>"), std::string::npos) << s;
+  EXPECT_NE(s.find("<tr><th>input</th><td>pulse increments</td></tr>"), std::string::npos) << s;
   EXPECT_NE(s.find("<tr><th>latitude (°)</th><td>55.75</td></tr>"), std::string::npos) << s;
-  EXPECT_NE(s.find("<tr><th>B estimate</th><td>fit</td></tr>"), std::string::npos) << s;
+  EXPECT_NE(s.find("<tr><th>B estimate</th><td>the five-term fit</td></tr>"), std::string::npos) << s;
   EXPECT_NE(s.find("gl2d_m50C.csv.gz"), std::string::npos) << s;
   EXPECT_NE(html_.find(" UTC"), std::string::npos) << "the generated time stamp";
 }

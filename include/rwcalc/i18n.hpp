@@ -33,6 +33,18 @@ void set_language(Language lang);
 /// argument may be a temporary.
 [[nodiscard]] std::string tr(const std::string& english);
 
+/// The form of a message for the count n (GNU gettext's ngettext): English singular for 1 and plural
+/// otherwise; Russian by the catalogue's three forms (1 рабочий прогон, 2 прогона, 5 прогонов).
+[[nodiscard]] const char* trn(const char* singular, const char* plural, unsigned long long n);
+/// Which of the three Russian forms n takes (0: 1, 21, 101; 1: 2–4, 22–24; 2: 0, 5–20, 25…).
+[[nodiscard]] int russian_plural_form(unsigned long long n);
+
+/// trn() as a format string, formatted with the arguments (n among them where the text shows it).
+template <typename... Args>
+[[nodiscard]] std::string trnf(const char* singular, const char* plural, unsigned long long n, Args&&... args) {
+  return fmt::format(fmt::runtime(trn(singular, plural, n)), std::forward<Args>(args)...);
+}
+
 /// Marks a text for the catalogue where it is defined, translated later where it is shown with
 /// tr() (the label of a JSON field, which itself stays English): GNU gettext's N_().
 constexpr const char* N_(const char* english) { return english; }
@@ -81,7 +93,9 @@ class LanguageScope {
 namespace i18n_detail {
 /// The catalogue's entries (msgid → msgstr, untranslated ones left out), for the tests.
 struct Entry {
-  std::string id, text;
+  std::string id, text;                 ///< a plural entry: the singular msgid and the first form
+  std::string plural_id = {};           ///< msgid_plural; empty for a message without plural forms
+  std::vector<std::string> forms = {};  ///< msgstr[0], msgstr[1], … of a plural entry
 };
 [[nodiscard]] const std::vector<Entry>& russian_entries();
 /// Parse the text of a .po file (msgid/msgstr with their continuation lines and C escapes).

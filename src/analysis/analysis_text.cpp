@@ -8,6 +8,7 @@
 
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/i18n.hpp"
+#include "rwcalc/option_words.hpp"
 
 namespace rwcalc {
 
@@ -174,11 +175,13 @@ std::string format_report(const AnalysisResult& r) {
   s += tr("Cross-checks (the paper's methods as unbiased estimators; 95 % intervals)\n");
   const auto& d = r.direct;
   if (d.N.valid)
-    s +=
-        trf("  N direct (overlapping angle increments, {:g}..{:g} s, exact Q/N/B expectations): {}{} °/√h [{}, {}] "
-            "(bootstrap, {} replicates); vs AV fit {:+.1f} sigma\n",
-            d.points.front().t_s, d.points.back().t_s, d.N.resolved ? "" : "< ", num(d.N.value, 3), num(d.N.low, 3),
-            num(d.N.high, 3), d.replicates, r.N_direct_discrepancy_sigma);
+    s += trnf(
+        "  N direct (overlapping angle increments, {:g}..{:g} s, exact Q/N/B expectations): {}{} °/√h [{}, {}] "
+        "(bootstrap, {} replicate); vs AV fit {:+.1f} sigma\n",
+        "  N direct (overlapping angle increments, {:g}..{:g} s, exact Q/N/B expectations): {}{} °/√h [{}, {}] "
+        "(bootstrap, {} replicates); vs AV fit {:+.1f} sigma\n",
+        d.replicates, d.points.front().t_s, d.points.back().t_s, d.N.resolved ? "" : "< ", num(d.N.value, 3),
+        num(d.N.low, 3), num(d.N.high, 3), d.replicates, r.N_direct_discrepancy_sigma);
   else
     s += tr("  N direct: record too short\n");
   if (d.straight.valid) {
@@ -197,11 +200,14 @@ std::string format_report(const AnalysisResult& r) {
   else
     s += tr("  B from 100-s averages: record too short\n");
   if (r.avg100.spread.valid && r.avg100.expected > 0)
-    s +=
-        trf("  spread of {:g}-s mean rates ({} blocks): {} ± {} °/h; expected from the fitted model {} ± {} °/h; "
-            "{:+.1f} sigma\n",
-            r.avg100.block_s, r.avg100.blocks, num(r.avg100.spread.value, 3), num(r.avg100.spread.sigma, 2),
-            num(r.avg100.expected, 3), num(r.avg100.expected_sigma, 2), r.B_100s_vs_model_sigma);
+    s += trnf(
+        "  spread of {:g}-s mean rates ({} block): {} ± {} °/h; expected from the fitted model {} ± {} °/h; "
+        "{:+.1f} sigma\n",
+        "  spread of {:g}-s mean rates ({} blocks): {} ± {} °/h; expected from the fitted model {} ± {} °/h; "
+        "{:+.1f} sigma\n",
+        r.avg100.blocks, r.avg100.block_s, r.avg100.blocks, num(r.avg100.spread.value, 3),
+        num(r.avg100.spread.sigma, 2), num(r.avg100.expected, 3), num(r.avg100.expected_sigma, 2),
+        r.B_100s_vs_model_sigma);
   s += "\n";
 
   s += r.verdict_applies ? format_verdict(r) : trf("Verdict: not given ({})\n\n", r.not_applied_reason);
@@ -212,10 +218,37 @@ std::string format_report(const AnalysisResult& r) {
   return s;
 }
 
+std::string option_value_words(std::string_view option, const std::string& value) {
+  struct Words {
+    const char* option;
+    const char* value;
+    const char* words;
+  };
+  static constexpr Words kWords[] = {
+      {"--b-estimate", "fit", N_("the five-term fit")},
+      {"--b-estimate", "sigma-min", N_("the minimum of the Allan deviation")},
+      {"--b-estimate", "avg100", N_("the 100-s averages")},
+      {"--input", "pulses", N_("pulse increments")},
+      {"--input", "counter", N_("a wrapping counter")},
+      {"--input", "angle", N_("cumulative angle")},
+      {"--input", "rate", N_("rate samples")},
+      {"--input", "increment", N_("angle or velocity increments")},
+      {"--outliers", "keep", N_("kept in the analysis")},
+      {"--outliers", "remove", N_("removed")},
+      {"--outliers", "replace", N_("replaced by the median of their neighbours")},
+      {"--readout", "auto", N_("chosen by the data (counter or white)")},
+      {"--readout", "counter", N_("a plain counter's sawtooth")},
+      {"--readout", "white", N_("white angle noise (dithered counter)")},
+  };
+  for (const auto& w : kWords)
+    if (option == w.option && value == w.value) return tr(w.words);
+  return value;
+}
+
 static std::string format_verdict(const AnalysisResult& r) {
   std::string s;
   const auto& v = r.verdict;
-  s += trf("Verdict ({}; B from {}{})\n", tr(v.table_name), v.b_estimate,
+  s += trf("Verdict ({}; B from {}{})\n", tr(v.table_name), option_value_words("--b-estimate", v.b_estimate),
            v.tolerance_pct > 0 ? trf("; heading-gyro tolerance +{:g} % on B", v.tolerance_pct)
                                : std::string(tr("; strict limits")));
   if (v.withheld)  // no class and no probability from a rejected fit

@@ -39,6 +39,7 @@ void add_outlier_options(CLI::App& app, std::string& action, double& threshold) 
                  tr("Isolated outliers are always detected and reported (sample, time, line); then: keep "
                     "(default: analyse the data as read), remove (drop them; later samples move one period "
                     "earlier), or replace (by the median of the nearest good neighbours; keeps every sample)"))
+      ->option_text("keep|remove|replace")
       ->capture_default_str()
       ->group(tr("Outliers"));
   app.add_option("--outlier-threshold", threshold,
@@ -70,6 +71,7 @@ void AnalyzeArgs::add_to(CLI::App& app) {
   app.add_option("--readout", readout,
                  tr("Read-out model of pulse counts: auto (the better of the two), counter (a plain counter's "
                     "sawtooth plus white angle noise Q) or white (Q alone: a dithered counter)"))
+      ->option_text("auto|counter|white")
       ->capture_default_str()
       ->group(tr("Fit"));
   app.add_option("--tau", tau,
@@ -93,6 +95,7 @@ void AnalyzeArgs::add_to(CLI::App& app) {
                   "input (default: only for pulse or counter input, a ring-laser gyro's)"))
       ->group(tr("Earth rate"));
   app.add_option("--b-estimate", b_estimate, tr("B estimate the verdict uses: fit, sigma-min or avg100"))
+      ->option_text("fit|sigma-min|avg100")
       ->capture_default_str()
       ->group(tr("Verdict"));
   app.add_option("--tolerance", tolerance_pct,

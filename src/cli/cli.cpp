@@ -62,9 +62,10 @@ constexpr const char* kDescription =
 struct Command {
   const char* name;
   void (*add)(CLI::App&, Runner&);
+  const char* alias = nullptr;  ///< another spelling the command answers to (set by its register_*)
 };
 constexpr Command kCommands[] = {
-    {"allan", register_allan},       {"analyze", register_analyze},
+    {"allan", register_allan},       {"analyze", register_analyze, "analyse"},
     {"batch", register_batch},       {"merge", register_merge},
     {"simulate", register_simulate}, {"diagnose", register_diagnose},
     {"imu", register_imu},           {"report", register_report},
@@ -166,7 +167,7 @@ void build_app(CLI::App& app, Runner& runner, int argc, const char* const* argv)
   };
   if (argc > 1)
     for (const auto& c : kCommands)
-      if (std::string_view(argv[1]) == c.name) {
+      if (std::string_view(argv[1]) == c.name || (c.alias && std::string_view(argv[1]) == c.alias)) {
         c.add(app, runner);
         add_common_options(*app.get_subcommand(c.name));
         translate_groups();

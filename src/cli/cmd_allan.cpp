@@ -10,7 +10,6 @@
 
 #include "rwcalc/segments.hpp"
 #include "analyze_args.hpp"
-#include "rwcalc/printable.hpp"
 #include "commands.hpp"
 #include "numeric_options.hpp"
 #include "rwcalc/allan.hpp"
@@ -18,6 +17,7 @@
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
+#include "rwcalc/printable.hpp"
 #include "rwcalc/reader.hpp"
 
 namespace rwcalc::cli {
@@ -179,6 +179,7 @@ void register_allan(CLI::App& app, Runner& runner) {
   sub->add_option("--estimator", args->estimator,
                   tr("oadev (fully overlapping Allan, default), adev (non-overlapping), mdev (modified), "
                      "ohdev (overlapping Hadamard) or hdev (non-overlapping Hadamard)"))
+      ->option_text("oadev|adev|mdev|ohdev|hdev")
       ->capture_default_str();
   sub->add_option("--tau", args->tau,
                   tr("τ grid: octave, decade (1,2,4 per decade), dense[:P] (P per decade), all, or a list of "

@@ -39,6 +39,7 @@ void register_analyze(CLI::App& app, Runner& runner) {
   auto* sub = app.add_subcommand(
       "analyze", tr("Noise coefficients (Q, N, B, K, R) with 95 % intervals, the paper's cross-checks (direct N, "
                     "100-s averages), Earth rate and bias, and the GOST RV 52339 class verdict with its probability"));
+  sub->alias("analyse");  // the British spelling, which the documents use too
   sub->add_option("FILE", cmd->file, tr("Recording to analyse ('-' for standard input)"))->required();
   cmd->input.add_to(*sub);
   cmd->analysis.add_to(*sub);
@@ -46,7 +47,8 @@ void register_analyze(CLI::App& app, Runner& runner) {
   sub->add_flag("--json", cmd->json, tr("Print the JSON object instead of the report"));
   sub->add_option("--output-unit", cmd->output_unit,
                   tr("Show the results in this unit: deg/h, deg/s, rad/s (gyro); m/s^2, g, mg, ug (accelerometer). "
-                     "Given, or for an accelerometer column, the report is the channel's table in these units and SI"));
+                     "Given, or for an accelerometer column, the report is the channel's table in these units and SI"))
+      ->option_text("deg/h|deg/s|rad/s|m/s^2|g|mg|ug");
   add_output_options(*sub, cmd->output, cmd->force);
   cmd->plot.add_to(*sub, N_("the Allan deviation with its confidence bars, the fitted model, each term's line and the "
                             "class limits for B"));

@@ -20,6 +20,8 @@
 #include "rwcalc/diagnose.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
+#include "rwcalc/lab_profile.hpp"
+#include "rwcalc/option_words.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/plot.hpp"
 #include "rwcalc/printable.hpp"
@@ -44,7 +46,10 @@ struct ReportCmd {
   std::string title;
   std::string lab;
   std::string gyro;
+  std::string lab_profile;
+  std::string protocol_number;
   bool pdf = false;
+  bool docx = false;
   bool diagnose = false;
   std::size_t diagnose_runs = 50;
   std::uint64_t diagnose_seed = 1;
@@ -113,7 +118,8 @@ json settings_of(const ReportCmd& c, const std::vector<std::string>& recordings,
   if (!saved.empty()) s[N_("saved results")] = saved;
   if (recordings.empty()) return s;  // the analysis options below apply to recordings only
   const auto& in = c.input;
-  s[N_("input")] = in.input.empty() ? std::string("pulses") : in.input;  // unless a column name implies rate or angle
+  // "pulses" unless a column name implies rate or angle
+  s[N_("input")] = option_value_words("--input", in.input.empty() ? std::string("pulses") : in.input);
   if (!in.column.empty()) s[N_("column")] = in.column;
   if (in.rate_hz) s[N_("rate (Hz)")] = *in.rate_hz;
   if (in.scale_arcsec) s[N_("pulse weight (″)")] = *in.scale_arcsec;
@@ -131,24 +137,63 @@ json settings_of(const ReportCmd& c, const std::vector<std::string>& recordings,
     s[N_("Earth rate (°/h)")] = *a.earth_rate;
   else
     s[N_("latitude (°)")] = a.latitude_deg;
-  s[N_("B estimate")] = a.b_estimate;
+  s[N_("B estimate")] = option_value_words("--b-estimate", a.b_estimate);
   s[N_("tolerance on B (%)")] = a.tolerance_pct;
   s[N_("class table")] = a.limits_file.empty() ? std::string(tr("GOST RV 52339 (built in)")) : a.limits_file;
   s[N_("averaging block (s)")] = a.block_s;
   s[N_("direct method t range (s)")] = a.direct_range;
-  s[N_("outliers")] = a.outliers;
+  s[N_("outliers")] = option_value_words("--outliers", a.outliers);
   s[N_("outlier threshold (robust σ)")] = a.outlier_threshold;
   if (c.temperature) s[N_("temperature (°C)")] = *c.temperature;
   return s;
 }
 
-std::string utc_now() {
+/// The local time as the report's language writes it, with its offset from UTC: "27.11.2026 14:05
+/// UTC+03:00" in Russian, "2026-11-27 14:05 UTC+03:00" in English; and the local date.
+std::string local_now(CalendarDate& date) {
   const auto now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
   std::tm tm{};
-  gmtime_r(&now, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S UTC", &tm);
-  return buf;
+  tzset();  // localtime_r need not read TZ itself
+  localtime_r(&now, &tm);
+  date = {tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday};
+  const long offset_min = tm.tm_gmtoff / 60;
+  return fmt::format("{} {:02}:{:02}:{:02} UTC{}{:02}:{:02}", date_text(date), tm.tm_hour, tm.tm_min, tm.tm_sec,
+                     offset_min < 0 ? '-' : '+', std::labs(offset_min) / 60, std::labs(offset_min) % 60);
+}
+
+/// Writes DIR/report.pdf and DIR/report.docx as asked, after the HTML; a tool that is not installed
+/// is an error for its output (exit status 3) once the other has been written.
+void write_printed_copies(const ReportCmd& c, const std::string& html, Io& io) {
+  std::vector<std::string> missing;
+  if (c.pdf) {
+    const std::string pdf = (fs::path(c.dir) / "report.pdf").string();
+    const bool printed = [&] {
+      const Progress progress(trf("printing {}", printable(pdf)), 0, io.progress);  // erased before the message
+      return print_to_pdf(html, pdf, c.force);
+    }();
+    if (printed)
+      io.out << trf("PDF written to {}\n", printable(pdf));
+    else
+      missing.push_back(
+          tr("--pdf: no headless Chromium found (chromium, chromium-browser or google-chrome in PATH, "
+             "or RWCALC_CHROMIUM; Debian: apt-get install chromium); the HTML report prints to PDF "
+             "from any browser"));
+  }
+  if (c.docx) {
+    const std::string docx = (fs::path(c.dir) / "report.docx").string();
+    const bool converted = [&] {
+      const Progress progress(trf("converting {}", printable(docx)), 0, io.progress);
+      return convert_to_docx(html, docx, c.force);
+    }();
+    if (converted)
+      io.out << trf("DOCX written to {}\n", printable(docx));
+    else
+      missing.push_back(tr("--docx: pandoc not found (in PATH, or RWCALC_PANDOC; Debian: apt-get install pandoc)"));
+  }
+  if (missing.empty()) return;
+  std::string message;
+  for (const auto& m : missing) message += (message.empty() ? "" : "; ") + m;
+  throw OutputError(trf("{} (the HTML report is written: {})", message, printable(html)));
 }
 
 /// The runs (recordings analysed here, then the saved ones), their diagnoses and the overall verdict.
@@ -158,8 +203,7 @@ ReportInput report_input(const ReportCmd& c, const std::vector<std::string>& rec
   SavedResults saved;
   for (const auto& f : saved_files) load_saved_result(f, saved);
   std::vector<json> diagnoses;
-  if (c.diagnose)
-    diagnoses = diagnose_recordings(recordings, read, opt, c.diagnose_runs, c.diagnose_seed, io.progress);
+  if (c.diagnose) diagnoses = diagnose_recordings(recordings, read, opt, c.diagnose_runs, c.diagnose_seed, io.progress);
   ReportInput in;
   if (!recordings.empty()) in.analyses = analyze_files(recordings, read, opt);
   for (auto& a : saved.analyses) in.analyses.push_back(std::move(a.run));
@@ -210,7 +254,10 @@ int run_report(const ReportCmd& c, Io& io) {
   if (fs::is_directory(c.dir, ec)) {
     check_output_targets({{"-o", (fs::path(c.dir) / "report.html").string()}}, c.force);
     if (c.pdf) check_output_targets({{"--pdf", (fs::path(c.dir) / "report.pdf").string()}}, c.force);
+    if (c.docx) check_output_targets({{"--docx", (fs::path(c.dir) / "report.docx").string()}}, c.force);
   }
+  std::optional<LabProfile> profile;
+  if (!c.lab_profile.empty()) profile = read_lab_profile(c.lab_profile);  // its errors before the analysis
   if (!c.no_figures) require_gnuplot();
 
   const ReportInput in = report_input(c, recordings, saved_files, read, opt, io);
@@ -221,22 +268,14 @@ int run_report(const ReportCmd& c, Io& io) {
   ro.gyro = c.gyro;
   ro.settings = settings_of(c, recordings, saved_files);
   ro.figures = !c.no_figures;
-  ro.generated = utc_now();
+  ro.generated = local_now(ro.protocol_date);
+  ro.profile = std::move(profile);
+  ro.protocol_number = c.protocol_number;
   const auto path = write_report(c.dir, in, ro, c.force);
-  io.out << localize_numbers(trf("report written to {} ({} run(s){})\n", as_typed(path), in.analyses.size(),
-                                 c.no_figures ? tr(", no figures") : ""));
-  if (c.pdf) {
-    const std::string pdf = (fs::path(c.dir) / "report.pdf").string();
-    const bool printed = [&] {
-      const Progress progress(trf("printing {}", printable(pdf)), 0, io.progress);  // erased before the message
-      return print_to_pdf(path, pdf, c.force);
-    }();
-    if (printed)
-      io.out << trf("PDF written to {}\n", printable(pdf));
-    else
-      print_message(io.err, tr("note: --pdf: no headless Chromium found (chromium, chromium-browser or google-chrome "
-                               "in PATH, or RWCALC_CHROMIUM); the HTML report prints to PDF from any browser"));
-  }
+  io.out << localize_numbers(trnf("report written to {} ({} run{})\n", "report written to {} ({} runs{})\n",
+                                  in.analyses.size(), as_typed(path), in.analyses.size(),
+                                  c.no_figures ? tr(", no figures") : ""));
+  write_printed_copies(c, path, io);
   return 0;
 }
 
@@ -258,18 +297,34 @@ void register_report(CLI::App& app, Runner& runner) {
   cmd->analysis.add_to(*sub);
   add_temperature_option(*sub, cmd->temperature, tr("Temperature, °C (only with a single recording)"));
   sub->add_option("--title", cmd->title, tr("Title of the report"));
-  sub->add_option("--lab", cmd->lab, tr("The testing laboratory, for the title block"));
+  auto* lab = sub->add_option("--lab", cmd->lab, tr("The testing laboratory, for the title block"));
   sub->add_option("--gyro", cmd->gyro, tr("The gyro's type or name, for the title block (e.g. GL-2D)"));
-  sub->add_flag("--pdf", cmd->pdf, tr("Also print DIR/report.pdf with a headless Chromium, when one is installed"));
+  auto* profile = sub->add_option("--lab-profile", cmd->lab_profile,
+                                  tr("Lay the first page out as a test protocol, with the laboratory, approver, "
+                                     "performer, checker, customer, test method, measuring instruments and ambient "
+                                     "conditions of this YAML file (keys: docs/test-protocol.md)"))
+                      ->check(CLI::ExistingFile)
+                      ->excludes(lab);
+  sub->add_option("--protocol-number", cmd->protocol_number,
+                  tr("The protocol's number, e.g. 17/2026 (with --lab-profile)"))
+      ->needs(profile);
+  sub->add_flag("--pdf", cmd->pdf,
+                tr("Also print DIR/report.pdf with a headless Chromium (exit status 3 when none is installed; the "
+                   "HTML is written)"));
+  sub->add_flag("--docx", cmd->docx,
+                tr("Also write DIR/report.docx, an editable copy, with pandoc (exit status 3 when it is not installed; "
+                   "the HTML is written)"));
   sub->add_flag("--diagnose", cmd->diagnose, tr("Also diagnose each recording (what the noise model misses)"));
-  sub->add_option("--diagnose-runs", cmd->diagnose_runs, tr("Accepted for earlier scripts; the diagnosis simulates no records"))
+  sub->add_option("--diagnose-runs", cmd->diagnose_runs,
+                  tr("Accepted for earlier scripts; the diagnosis simulates no records"))
       ->check(whole_in(10, 100000))
       ->capture_default_str();
-  sub->add_option("--diagnose-seed", cmd->diagnose_seed, tr("Recorded only: no finding of the diagnosis depends on a seed"))
+  sub->add_option("--diagnose-seed", cmd->diagnose_seed,
+                  tr("Recorded only: no finding of the diagnosis depends on a seed"))
       ->check(whole_in(0, UINT64_MAX))
       ->capture_default_str();
   sub->add_flag("--no-figures", cmd->no_figures, tr("Tables only (needs no gnuplot)"));
-  sub->add_flag("--force", cmd->force, tr("Replace an existing report.html"));
+  sub->add_flag("--force", cmd->force, tr("Replace an existing report.html, report.pdf and report.docx"));
   sub->callback([cmd, &runner] { runner = [cmd](Io& io) -> int { return run_report(*cmd, io); }; });
 }
 

@@ -31,8 +31,7 @@ void SourceArgs::add_to(CLI::App& app) {
 }
 
 void SourceArgs::apply(ReadOptions& o) const {
-  if (!time.empty() && !time_column.empty())
-    throw UsageError(tr("give --time or --time-column, not both"));
+  if (!time.empty() && !time_column.empty()) throw UsageError(tr("give --time or --time-column, not both"));
   o.time_column = time == "receive" ? "%time" : time_column;  // stamp: the default choice
   o.topic = topic;
 }
@@ -50,6 +49,7 @@ void InputArgs::add_to(CLI::App& app) {
                     "rate (rate samples in --rate-unit), increment (per-sample angle or velocity increments in "
                     "--angle-unit: an IMU's delta theta or delta v). Default: implied by a unit suffix of the column's "
                     "name (gyro_x_dps: rate), else pulses"))
+      ->option_text("pulses|counter|angle|rate|increment")
       ->group(tr("Input"));
   app.add_option("--column", column, tr("Column to read: a header name or a 1-based index"))->group(tr("Input"));
   app.add_option("--rate", rate_hz,
@@ -67,11 +67,13 @@ void InputArgs::add_to(CLI::App& app) {
   app.add_option("--angle-unit", angle_unit,
                  tr("Unit of angle input: arcsec, deg, rad, s (clock phase), or m/s (an accelerometer's cumulative "
                     "velocity). Default: the column name's suffix (_deg, _rad, _arcsec, _mps), else arcsec"))
+      ->option_text("arcsec|deg|rad|s|m/s")
       ->group(tr("Input"));
   app.add_option("--rate-unit", rate_unit,
                  tr("Unit of rate input: deg/h, deg/s, rad/s, 1 (dimensionless clock frequency), or an "
                     "accelerometer's m/s^2, g, mg, ug. Default: the column name's suffix (_dps, _dph, _rads, _g, "
                     "_mps2, ...), else deg/h"))
+      ->option_text("deg/h|deg/s|rad/s|1|m/s^2|g|mg|ug")
       ->group(tr("Input"));
   app.add_option("--time-tolerance", time_tolerance,
                  tr("Time-column steps off the sample period by more than this fraction of it are reported as "

@@ -1,6 +1,7 @@
 // The message catalogue: po/ru.po compiled in (generated/catalog_ru.cpp), read once on first use.
 #include "rwcalc/i18n.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <unordered_map>
@@ -43,8 +44,14 @@ std::string unquote(std::string_view line) {
 struct Catalogue {
   std::vector<i18n_detail::Entry> entries;
   std::unordered_map<std::string, std::string> russian;
+  std::unordered_map<std::string, std::vector<std::string>> russian_plurals;  ///< by the singular msgid
   Catalogue() : entries(i18n_detail::parse_po(embedded_russian_po())) {
-    for (const auto& e : entries) russian.emplace(e.id, e.text);
+    for (const auto& e : entries) {
+      if (e.plural_id.empty())
+        russian.emplace(e.id, e.text);
+      else
+        russian_plurals.emplace(e.id, e.forms);
+    }
   }
 };
 
@@ -171,6 +178,22 @@ const char* tr(const char* english) {
 
 std::string tr(const std::string& english) { return tr(english.c_str()); }
 
+int russian_plural_form(unsigned long long n) {
+  // The catalogue's Plural-Forms: one (1, 21, 101…), few (2–4, 22–24…), many (the rest, 11–14 too).
+  if (n % 10 == 1 && n % 100 != 11) return 0;
+  if (n % 10 >= 2 && n % 10 <= 4 && (n % 100 < 10 || n % 100 >= 20)) return 1;
+  return 2;
+}
+
+const char* trn(const char* singular, const char* plural, unsigned long long n) {
+  if (language() == Language::English) return n == 1 ? singular : plural;
+  const auto& map = catalogue().russian_plurals;
+  const auto it = map.find(singular);
+  const auto form = static_cast<std::size_t>(russian_plural_form(n));
+  if (it == map.end() || form >= it->second.size()) return n == 1 ? singular : plural;
+  return it->second[form].c_str();
+}
+
 std::string marked_as_typed(std::string_view encoded) {
   std::string s;
   s.reserve(encoded.size() + kTypedOpen.size() + kTypedClose.size());
@@ -229,12 +252,21 @@ const std::vector<Entry>& russian_entries() { return catalogue().entries; }
 
 std::vector<Entry> parse_po(std::string_view po) {
   std::vector<Entry> out;
-  std::string id, text, *field = nullptr;
+  std::string id, text, plural_id, *field = nullptr;
+  std::vector<std::string> forms;
   bool fuzzy = false, next_fuzzy = false;
   auto finish = [&] {
-    if (!id.empty() && !text.empty() && !fuzzy) out.push_back({id, text});
+    // A plural entry counts when every form is translated; its first form stands as its text.
+    const bool complete = plural_id.empty() ? !text.empty()
+                                            : !forms.empty() && std::none_of(forms.begin(), forms.end(),
+                                                                             [](const auto& f) { return f.empty(); });
+    if (!id.empty() && complete && !fuzzy)
+      out.push_back(
+          {id, plural_id.empty() ? text : forms.front(), plural_id, plural_id.empty() ? decltype(forms){} : forms});
     id.clear();
     text.clear();
+    plural_id.clear();
+    forms.clear();
   };
   for (std::size_t at = 0; at < po.size();) {
     std::size_t eol = po.find('\n', at);
@@ -245,8 +277,13 @@ std::vector<Entry> parse_po(std::string_view po) {
       finish();
       fuzzy = std::exchange(next_fuzzy, false);
       field = &id;
+    } else if (line.starts_with("msgid_plural ")) {
+      field = &plural_id;
     } else if (line.starts_with("msgstr ")) {
       field = &text;
+    } else if (line.starts_with("msgstr[")) {
+      forms.emplace_back();
+      field = &forms.back();
     } else if (!line.starts_with("\"")) {
       if (line.starts_with("#,") && line.find("fuzzy") != std::string_view::npos) next_fuzzy = true;
       if (!line.starts_with("#~")) continue;  // comments; obsolete entries end the one before

@@ -8,8 +8,8 @@
 namespace rwcalc::html {
 
 /// The report's stylesheet (the contents of its <style>): screen and A4 print layout with the page
-/// number, in the current language.
-[[nodiscard]] std::string stylesheet();
+/// number, in the current language; `page_prefix` (CSS string text) goes before "Page N of M".
+[[nodiscard]] std::string stylesheet(const std::string& page_prefix = "");
 /// Outside text escaped for HTML content and quoted attributes, control characters made visible.
 [[nodiscard]] std::string text(std::string_view s);
 /// The same, shown as typed (no decimal comma put into it).

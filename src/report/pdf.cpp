@@ -1,6 +1,5 @@
 // The report as PDF: printed by a headless Chromium, when one is installed (optional).
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <cstdlib>
 #include <cstring>
@@ -24,19 +23,8 @@ namespace fs = std::filesystem;
 
 /// RWCALC_CHROMIUM, else the first of the usual names found in PATH; empty when none.
 std::string find_chromium() {
-  if (const char* named = std::getenv("RWCALC_CHROMIUM"); named && *named) return named;
-  const char* path = std::getenv("PATH");
-  if (!path) return {};
-  for (const char* name : {"chromium", "chromium-browser", "google-chrome", "google-chrome-stable"}) {
-    std::string dirs = path;
-    for (std::size_t at = 0; at <= dirs.size();) {
-      const std::size_t end = std::min(dirs.find(':', at), dirs.size());
-      const fs::path candidate = fs::path(dirs.substr(at, end - at)) / name;
-      if (end > at && access(candidate.c_str(), X_OK) == 0) return candidate.string();
-      at = end + 1;
-    }
-  }
-  return {};
+  return detail::find_program("RWCALC_CHROMIUM",
+                              {"chromium", "chromium-browser", "google-chrome", "google-chrome-stable"});
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"
+#include "rwcalc/quantity_text.hpp"
 
 namespace rwcalc {
 
@@ -68,8 +69,8 @@ std::vector<AllanRow> allan_rows(const json& allan) {
   return rows;
 }
 
-/// A number for display: 4 significant digits.
-std::string show(double v) { return fmt::format("{:.4g}", v); }
+/// A number for display: 4 significant digits, a power of ten written out (never e-notation).
+std::string show(double v) { return number_text(v, 4); }
 
 /// A title, label or key entry as a gnuplot string, in the chosen language's number style.
 std::string label_text(std::string_view text) { return gnuplot_string(localize_numbers(std::string(text))); }
@@ -471,8 +472,8 @@ std::string band_label(const char* what, const json& model, const std::vector<Ba
   }
   const auto level = num(model, "band_level");
   const std::string percent = level ? fmt::format("{:g} % ", *level * 100) : std::string();
-  std::string s = std::string_view(what) == "base" ? trf("base model: {}band", percent)
-                                                   : trf("extended model: {}band", percent);
+  std::string s =
+      std::string_view(what) == "base" ? trf("base model: {}band", percent) : trf("extended model: {}band", percent);
   if (measured > 0) s += trf(", {} of {} τ inside", inside, measured);
   return s;
 }

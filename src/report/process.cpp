@@ -150,3 +150,22 @@ ScratchDir::~ScratchDir() {
 }
 
 }  // namespace rwcalc::detail
+
+namespace rwcalc::detail {
+
+std::string find_program(const char* env, std::initializer_list<const char*> names) {
+  if (const char* named = std::getenv(env); named && *named) return named;
+  const char* path = std::getenv("PATH");
+  if (!path) return {};
+  const std::string dirs = path;
+  for (const char* name : names)
+    for (std::size_t at = 0; at <= dirs.size();) {
+      const std::size_t end = std::min(dirs.find(':', at), dirs.size());
+      const fs::path candidate = fs::path(dirs.substr(at, end - at)) / name;
+      if (end > at && access(candidate.c_str(), X_OK) == 0) return candidate.string();
+      at = end + 1;
+    }
+  return {};
+}
+
+}  // namespace rwcalc::detail

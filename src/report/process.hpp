@@ -4,6 +4,7 @@
 // its own, within a time limit, and neither it, what it started, nor its scratch directory
 // outlives rwcalc (core/cleanup.hpp).
 #include <filesystem>
+#include <initializer_list>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -24,6 +25,10 @@ struct ProcessResult {
 /// The time a helper may take, s: RWCALC_HELPER_TIMEOUT when set (a positive number; anything
 /// else is a UsageError), else 300.
 double helper_timeout_s();
+
+/// The helper program named by the environment variable `env` when it is set and not empty, else
+/// the first of `names` found executable in PATH; empty when none.
+std::string find_program(const char* env, std::initializer_list<const char*> names);
 
 /// Run `command args…` with stdin from /dev/null and stdout+stderr captured in `log`; in the
 /// directory `cwd` when it is not empty. The helper leads a new process group. One still running

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <filesystem>
 #include <optional>
 
@@ -13,9 +14,11 @@
 #include "json_view.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
+#include "rwcalc/option_words.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/plot.hpp"
 #include "rwcalc/printable.hpp"
+#include "rwcalc/quantity_text.hpp"
 
 namespace rwcalc {
 
@@ -74,24 +77,29 @@ std::string esc(std::string_view text) {
 /// as typed: no decimal comma is put into it (as_typed, i18n.hpp).
 std::string typed(std::string_view text) { return marked_as_typed(esc(text)); }
 
-std::string g(double v, int digits = 3) { return fmt::format("{:.{}g}", v, digits); }
+/// A number without uncertainty, never in e-notation (quantity_text.hpp).
+std::string g(double v, int digits = 3) { return number_text(v, digits); }
 
 /// A unit label of units.hpp in the report's language (°/h → °/ч).
 std::string unit(const char* label) { return tr(label); }
 
 constexpr const char* kNotAvailable = "<span class=\"na\">—</span>";
 
-/// A coefficient cell: "value ± σ" with the 95 % interval below, or "< bound" when unresolved.
+/// A coefficient cell: "value ± u" rounded by the GUM rule with the 95 % interval below, rounded to
+/// the same digit, or "< bound" when unresolved.
 std::string coef_cell(const json& c) {
   const auto v = num(c, "value");
   if (!v) return kNotAvailable;
   const auto& resolved = at(c, "resolved");
   if (resolved.is_boolean() && !resolved.get<bool>())
-    return fmt::format("&lt; {} <span class=\"ci\">{}</span>", g(*v), tr("95 % upper bound"));
-  std::string s = g(*v);
-  if (const auto sigma = num(c, "sigma"); sigma && *sigma > 0) s += fmt::format(" ± {}", g(*sigma, 2));
+    return fmt::format("&lt; {} <span class=\"ci\">{}</span>", g(*v, 2), tr("95 % upper bound"));
+  const auto sigma = num(c, "sigma");
+  const bool has_sigma = sigma && *sigma > 0 && std::isfinite(*sigma);
+  std::string s = has_sigma ? value_with_uncertainty(*v, *sigma) : g(*v);
   const auto lo = num(c, "low95"), hi = num(c, "high95");
-  if (lo && hi) s += fmt::format(" <span class=\"ci\">[{}, {}]</span>", g(*lo), g(*hi));
+  if (lo && hi)
+    s += fmt::format(" <span class=\"ci\">{}</span>", has_sigma ? interval_at(*lo, *hi, gum_last_digit(*sigma))
+                                                                : fmt::format("[{}, {}]", g(*lo), g(*hi)));
   return s;
 }
 
@@ -228,12 +236,26 @@ figure img {{ width: 100%; max-width: 960px; height: auto; border: 1px solid #ee
 figcaption {{ color: #444; font-size: 0.92em; }}
 footer {{ margin-top: 2em; color: #777; font-size: 0.85em; border-top: 1px solid #ddd; padding-top: 0.5em; }}
 @page {{ size: A4; margin: 16mm 14mm 18mm 16mm;
-        @bottom-center {{ content: "{0} " counter(page) " {1} " counter(pages); font-size: 9pt; color: #555;
+        @bottom-center {{ content: "{2}{0} " counter(page) " {1} " counter(pages); font-size: 9pt; color: #555;
                           font-family: "DejaVu Sans", "Liberation Sans", Helvetica, Arial, sans-serif; }} }}
+section.protocol {{ margin-bottom: 1.5em; }}
+section.protocol h1 {{ text-align: center; font-size: 1.4em; margin: 0.6em 0 0.1em; text-transform: uppercase; }}
+.protocol-date, .subject {{ text-align: center; margin: 0.1em 0; }}
+.approval {{ margin: 0 0 0.5em auto; width: 45%; }}
+.approval p {{ margin: 0.15em 0; }}
+.approved {{ font-weight: bold; letter-spacing: 0.08em; }}
+span.sign {{ display: inline-block; width: 9em; border-bottom: 1px solid #222; }}
+#protocol-block {{ width: 100%; }}
+#protocol-block th {{ width: 28%; font-weight: normal; color: #555; background: none; }}
+table.protocol {{ width: 100%; }}
+table.signatures {{ margin-top: 1.5em; border: none; width: 100%; }}
+table.signatures th, table.signatures td {{ border: none; background: none; padding: 0.8em 0.6em 0.2em 0; }}
+table.signatures td.sign {{ border-bottom: 1px solid #222; width: 25%; }}
 @media print {{
   body {{ max-width: none; margin: 0; padding: 0; font-size: 10.5px; }}
-  h2 {{ page-break-after: avoid; }}
-  table, figure, .verdict, header.title {{ page-break-inside: avoid; }}
+  h2, h3, caption {{ page-break-after: avoid; break-after: avoid; }}
+  section.protocol {{ break-after: page; font-size: 10px; }}
+  table, figure, .verdict, header.title, .approval, table.signatures {{ page-break-inside: avoid; }}
   figure img {{ max-width: 100%; border: none; }}
   a {{ color: inherit; text-decoration: none; }}
 }}
@@ -259,8 +281,8 @@ std::string run_row(const json& run, const std::vector<std::string>& cells, std:
 }
 
 std::string table1(const std::vector<json>& a, const std::vector<std::size_t>& order, Numbering& numbering) {
-  std::string s = numbering.table("table1", tr("Noise coefficients per temperature: value ± standard error [95 % "
-                                               "interval]"));
+  std::string s = numbering.table("table1", tr("Noise coefficients per temperature: value ± standard uncertainty "
+                                               "[coverage interval, p = 0.95]"));
   s +=
       trf("<tr><th>run</th><th>temperature</th><th>N by Allan variance ({0})</th><th>N direct method ({0})</th>"
           "<th>B by Allan variance ({1})</th><th>B by 100-s averaging ({1})</th></tr>\n",
@@ -293,7 +315,7 @@ std::string table2(const std::vector<json>& a, const std::vector<std::size_t>& o
     }
     if (const auto& changed = at(v, "tolerance_changed"); changed.is_boolean() && changed.get<bool>())
       statement += fmt::format(" <span class=\"note\">{}</span>",
-                               trf("changed by the +{:g} % B tolerance", num(v, "tolerance_pct").value_or(0.0)));
+                               trf("changed by the +{} % B tolerance", g(num(v, "tolerance_pct").value_or(0.0))));
     s += run_row(run,
                  // The cross-checks' classes too depend on the rejected fit (the terms they take off).
                  {verdict_class(v, "class_N"),
@@ -354,7 +376,7 @@ std::string outliers_html(const json& outliers) {
   if (!count_value) return kNotAvailable;
   const auto count = static_cast<std::size_t>(*count_value);
   const auto z = num(outliers, "threshold_robust_z");
-  const std::string threshold = z ? trf(" (threshold {:g} robust σ)", *z) : std::string();
+  const std::string threshold = z ? trf(" (threshold {} robust σ)", g(*z)) : std::string();
   if (count == 0) return tr("none found") + threshold;
   std::string s =
       fmt::format("<b>{}</b>{}; {}", trf("{} found", count), threshold, outlier_action_html(outliers, count));
@@ -366,7 +388,8 @@ std::string outliers_html(const json& outliers) {
       const auto line = num(p, "line"), time = num(p, "time_s"), value = num(p, "value_deg_per_h");
       s += listed++ ? ", " : ": ";
       s += line ? trf("line {:.0f}", *line) : trf("line {}", kNotAvailable);
-      if (time) s += trf(" (t = {:g} s", *time) + (value ? fmt::format(", {:.6g} {})", *value, unit(lbl::rate)) : ")");
+      if (time)
+        s += trf(" (t = {} s", g(*time, 6)) + (value ? fmt::format(", {} {})", g(*value, 6), unit(lbl::rate)) : ")");
     }
   }
   if (count > listed) s += (listed ? ", " : ": ") + trf("… {} more in the JSON results", count - listed);
@@ -387,7 +410,7 @@ std::string segments_text(const json& segments) {
   std::string gaps, lengths;
   for (const auto& gap : at(segments, "gaps"))
     if (const auto line = num(gap, "line"), missing = num(gap, "missing_s"); line && missing)
-      gaps += trf("{}{:.6g} s missing before line {:.0f}", gaps.empty() ? "" : ", ", *missing, *line);
+      gaps += trf("{}{} s missing before line {:.0f}", gaps.empty() ? "" : ", ", g(*missing, 6), *line);
   for (const auto& d : at(segments, "durations_s"))
     if (const auto v = num(d)) lengths += fmt::format("{}{:.1f}", lengths.empty() ? "" : ", ", *v);
   return trf(
@@ -408,7 +431,7 @@ std::string data_table(const json& run, std::size_t index, Numbering& numbering)
     s += kv_row(tr("file size, SHA-256"),
                 trf("{:.0f} bytes, <code>{}</code>", num(input, "file_bytes").value_or(0), esc(sha)));
   if (const auto n = num(run, "samples")) s += kv_row(tr("samples"), fmt::format("{:.0f}", *n));
-  if (const auto r = num(run, "rate_hz")) s += kv_row(tr("sample rate"), trf("{:g} Hz", *r));
+  if (const auto r = num(run, "rate_hz")) s += kv_row(tr("sample rate"), trf("{} Hz", g(*r, 6)));
   if (const auto d = num(run, "duration_s")) s += kv_row(tr("duration"), trf("{:.1f} s ({:.2f} h)", *d, *d / 3600));
   if (const auto text = segments_text(at(run, "segments")); !text.empty()) s += kv_row(tr("segments"), esc(text));
   s += kv_row(tr("temperature"), temperature_text(run));
@@ -429,7 +452,7 @@ constexpr const char* kModelFormula = "σ²(τ) = 3Q²/τ² + N²/τ + (2 ln 2/�
 std::string fit_table(const json& fit, std::size_t index, Numbering& numbering) {
   std::string s = numbering.table(fmt::format("run{}-fit", index + 1),
                                   trf("Allan-variance fit <span class=\"formula\">{}</span>", kModelFormula), "run");
-  s += tr("<tr><th>term</th><th>value ± standard error [95 %]</th><th>unit</th></tr>\n");
+  s += tr("<tr><th>term</th><th>value ± standard uncertainty [coverage interval, p = 0.95]</th><th>unit</th></tr>\n");
   static constexpr std::array<std::array<const char*, 3>, 5> kCoefficientRows{
       {{"Q_arcsec", N_("Q quantization noise"), lbl::angle},
        {"N_deg_per_sqrt_h", N_("N angle random walk"), lbl::arw},
@@ -443,10 +466,10 @@ std::string fit_table(const json& fit, std::size_t index, Numbering& numbering) 
     s += fmt::format("<tr><td>{}</td><td colspan=\"2\">{}</td></tr>\n", tr(name), html);
   };
   if (const auto c = num(fit, "chi2_per_dof")) {
-    std::string gof = trf("χ²/dof = {:.3g}", *c);
-    if (const auto p = num(fit, "p_value")) gof += fmt::format(", p = {:.3g}", *p);
+    std::string gof = trf("χ²/dof = {}", g(*c));
+    if (const auto p = num(fit, "p_value")) gof += fmt::format(", p = {}", g(*p));
     if (const auto lo = num(fit, "tau_min_s"), hi = num(fit, "tau_max_s"); lo && hi)
-      gof += trf("; τ fitted {:g}–{:g} s", *lo, *hi);
+      gof += trf("; τ fitted {}–{} s", g(*lo, 6), g(*hi, 6));
     row(N_("goodness of fit"), gof);
   }
   if (const auto& range = at(fit, "range"); range.is_object()) row(N_("fit range"), esc(str(range, "reason")));
@@ -615,9 +638,9 @@ std::string verdict_html(const std::vector<json>& a, const std::vector<std::size
   h += "</ul>\n";
   if (const auto t = num(v0, "tolerance_pct"); t && *t > 0)
     h += fmt::format("<p class=\"note\">{}</p>\n",
-                     trf("The seed paper's heading-gyro rule is applied: a B up to {:g} % above a class limit is "
+                     trf("The seed paper's heading-gyro rule is applied: a B up to {} % above a class limit is "
                          "accepted for that class.",
-                         *t));
+                         g(*t)));
   h += "<p class=\"meta\">" +
        std::string(tr("P is the probability, from the estimates' uncertainty, that the true class is the one stated; "
                       "where it is low the runner-up class is named."));
@@ -644,7 +667,7 @@ std::string batch_figures_html(const std::vector<json>& a, Numbering& numbering)
 /// The conventions of the results, typeset (the JSON's "conventions" say the same in ASCII);
 /// a convention this list does not know is shown as the JSON gives it.
 std::string conventions_rows(const json& conventions) {
-  static constexpr std::array<std::array<const char*, 3>, 7> kConventions{
+  static constexpr std::array<std::array<const char*, 3>, 8> kConventions{
       {{"Q", N_("Q, quantization noise"),
         N_("σ²(τ) = 3Q²/τ², Q the rms white angle error (IEEE 952); the paper's "
            "eq. (2) gives √3·Q")},
@@ -654,9 +677,20 @@ std::string conventions_rows(const json& conventions) {
        {"K", N_("K, rate random walk"), N_("σ²(τ) = K²τ/3; K = σ(τ = 3 h)")},
        {"R", N_("R, rate ramp"), N_("σ²(τ) = R²τ²/2")},
        {"deviation_unit", N_("unit of the Allan deviation"), N_("°/h (1″/s = 1 °/h)")},
-       {"intervals", N_("intervals"), N_("95 % profile likelihood; “< x”: not resolved, x is the 95 % upper bound")}}};
+       {"intervals", N_("intervals"),
+        N_("value ± standard uncertainty u; the coverage interval for p = 0.95 from the profile likelihood; "
+           "“< x”: not resolved, x is the 95 % upper bound")},
+       {"rounding", N_("rounding"),
+        N_("the uncertainty to two significant digits when its first digit is 1 or 2, else to one; the value and "
+           "its interval to the same digit ({}, 7.2.6)")}}};
   std::string h;
-  for (const auto& [key, name, text] : kConventions) h += kv_row(tr(name), esc(tr(text)));
+  for (const auto& [key, name, text] : kConventions) {
+    const std::string shown = esc(tr(text));
+    // The standard is named as typed: no decimal comma goes into "34100.3".
+    h += kv_row(tr(name), std::string_view(key) == "rounding"
+                              ? fmt::format(fmt::runtime(shown), typed(tr(N_("JCGM 100:2008, the GUM"))))
+                              : shown);
+  }
   if (conventions.is_object())
     for (const auto& item : conventions.items()) {
       const std::string& k = item.key();  // a structured binding, clang 14 (the fuzz build) cannot capture
@@ -675,7 +709,7 @@ std::string settings_html(const ReportOptions& options, const json& first, Numbe
     for (const auto& [k, v] : options.settings.items()) h += kv_row(tr(k), json_value_html(v));
   if (auto b = str(at(first, "verdict"), "b_estimate");
       !b.empty() && !(have_settings && options.settings.contains("B estimate")))
-    h += kv_row(tr("B estimate"), esc(b));
+    h += kv_row(tr("B estimate"), esc(option_value_words("--b-estimate", b)));
   h += "</table>\n" + numbering.table("conventions-table", tr("Conventions of the results"));
   return h + conventions_rows(at(first, "conventions")) + "</table>\n";
 }
@@ -708,9 +742,127 @@ std::string title_block(const std::vector<json>& a, const ReportOptions& options
   return h + "</table>\n</header>\n";
 }
 
+/// A person's signature line: the role, the position, a line to sign on, the name.
+std::string signature_row(const char* role, const ProtocolPerson& p) {
+  return fmt::format("<tr><th>{}</th><td>{}</td><td class=\"sign\">&nbsp;</td><td>{}</td></tr>\n", tr(role),
+                     typed(p.position), typed(p.name));
+}
+
+/// The approval block at the top right of a protocol: approved by whom, signed and dated by hand.
+std::string approval_block(const LabProfile& p) {
+  return fmt::format(
+      "<div class=\"approval\" id=\"approval\">\n<p class=\"approved\">{}</p>\n<p>{}</p>\n<p>{}</p>\n"
+      "<p class=\"sign-line\"><span class=\"sign\">&nbsp;</span> {}</p>\n<p>{}</p>\n</div>\n",
+      tr("APPROVED"), typed(p.approver.position), typed(p.laboratory), typed(p.approver.name), tr("date ____________"));
+}
+
+std::string instruments_table(const LabProfile& p) {
+  std::string h = fmt::format("<table id=\"instruments\" class=\"protocol\">\n<caption>{}</caption>\n",
+                              tr("Measuring instruments"));
+  h +=
+      tr("<tr><th>No.</th><th>type</th><th>serial number</th><th>verified on</th><th>verification valid until</th>"
+         "<th>certificate</th></tr>\n");
+  std::size_t k = 0;
+  for (const auto& m : p.instruments)
+    h += fmt::format(
+        "<tr><td class=\"num\">{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
+        "<td>{}</td></tr>\n",
+        ++k, typed(m.type), typed(m.serial), date_text(m.verified),
+        m.valid_until ? date_text(*m.valid_until) : std::string(kNotAvailable),
+        m.certificate.empty() ? std::string(kNotAvailable) : typed(m.certificate));
+  if (p.instruments.empty())
+    h += fmt::format("<tr><td colspan=\"6\">{}</td></tr>\n", tr("none listed in the lab profile"));
+  return h + "</table>\n";
+}
+
+std::string conditions_table(const LabProfile& p) {
+  std::string h =
+      fmt::format("<table id=\"conditions\" class=\"protocol\">\n<caption>{}</caption>\n", tr("Ambient conditions"));
+  h += tr("<tr><th>quantity</th><th>value ± standard uncertainty</th><th>unit</th></tr>\n");
+  for (const auto& c : p.conditions)
+    h += fmt::format("<tr><td>{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n", typed(c.quantity),
+                     c.uncertainty ? value_with_uncertainty(c.value, *c.uncertainty) : g(c.value, 6), typed(c.unit));
+  if (p.conditions.empty())
+    h += fmt::format("<tr><td colspan=\"3\">{}</td></tr>\n", tr("none listed in the lab profile"));
+  return h + "</table>\n";
+}
+
+/// The protocol's results in brief: per run N and B with their uncertainty and the class.
+std::string protocol_results(const std::vector<json>& a, const std::vector<std::size_t>& order) {
+  std::string h = fmt::format("<table id=\"protocol-results\" class=\"protocol\">\n<caption>{}</caption>\n",
+                              tr("Results (in full: Tables 1 and 2 and the sections below)"));
+  h += trf("<tr><th>run</th><th>temperature</th><th>N ({0})</th><th>B ({1})</th><th>class</th></tr>\n",
+           "<span class=\"unit\">" + unit(lbl::arw) + "</span>", "<span class=\"unit\">" + unit(lbl::rate) + "</span>");
+  for (auto i : order)
+    h += run_row(a[i], {coef_cell(at(at(a[i], "fit"), "N_deg_per_sqrt_h")),
+                        coef_cell(at(at(a[i], "fit"), "B_deg_per_h")), verdict_class(at(a[i], "verdict"), "class")});
+  return h + "</table>\n";
+}
+
+/// The conclusion of a protocol: the verdict in words, or why there is none.
+std::string protocol_conclusion(const std::vector<json>& a, const std::vector<std::size_t>& order,
+                                const json& overall) {
+  std::string text;
+  if (is_withheld(overall)) {
+    text = tr("no verdict: the noise model does not describe every record (see section 1)");
+  } else {
+    const auto& v0 = at(a[order.front()], "verdict");
+    const json& classes = at(overall, "classes").is_array() ? at(overall, "classes") : at(v0, "classes");
+    std::string words = verdict_in_words(overall, classes);
+    if (words.empty()) words = trf("class {}", class_text(at(overall, "class")));
+    text = trf("by GOST RV 52339-2005 the gyro is of {}.", words);
+  }
+  return fmt::format("<p id=\"conclusion\"><b>{}</b> {}</p>\n", tr("Conclusion:"), esc(text));
+}
+
+/// The first page as a test protocol: approval, number and date, what was tested, how, with which
+/// instruments and under which conditions, the results and the conclusion, the signature lines.
+std::string protocol_block(const std::vector<json>& a, const std::vector<std::size_t>& order, const json& overall,
+                           const ReportOptions& options, const std::string& title) {
+  const LabProfile& p = *options.profile;
+  std::string h = "<section class=\"protocol\" id=\"protocol\">\n" + approval_block(p);
+  h += fmt::format(
+      "<h1 id=\"protocol-number\">{}</h1>\n<p class=\"protocol-date\">{}</p>\n<p class=\"subject\">{}</p>\n",
+      trf("Test protocol No. {}",
+          options.protocol_number.empty() ? std::string("________") : typed(options.protocol_number)),
+      trf("of {}", date_text(options.protocol_date)), typed(title));
+  h += "<table id=\"protocol-block\">\n";
+  auto row = [&](const char* name, const std::string& html) {
+    h += kv_row(tr(name), html.empty() ? std::string(kNotAvailable) : html);
+  };
+  row(N_("laboratory"), typed(p.laboratory));
+  row(N_("address"), typed(p.address));
+  if (!p.accreditation.empty()) row(N_("accreditation"), typed(p.accreditation));
+  row(N_("customer"), typed(p.customer));
+  const auto serials = identification_values(a, "serial");
+  row(N_("object of the test"), (options.gyro.empty() ? std::string(tr("gyro")) : typed(options.gyro)) +
+                                    (serials.empty() ? std::string() : trf(", serial No. {}", serials)));
+  row(N_("test method"), typed(p.method));
+  row(N_("test date"), identification_values(a, "test_date"));
+  row(N_("runs"), trnf("{} recording (its size and SHA-256 under “Runs”)",
+                       "{} recordings (each one's size and SHA-256 under “Runs”)", a.size(), a.size()));
+  row(N_("report generated"), esc(options.generated) + " · " + esc(version_line()));
+  h += "</table>\n" + instruments_table(p) + conditions_table(p) + protocol_results(a, order) +
+       protocol_conclusion(a, order, overall);
+  h += fmt::format("<table id=\"signatures\" class=\"signatures\">\n{}{}</table>\n",
+                   signature_row(N_("Tests performed by"), p.performer), signature_row(N_("Checked by"), p.checker));
+  return h + "</section>\n";
+}
+
+/// Text for a CSS string: everything but letters, digits, blanks and bytes of UTF-8 sequences as
+/// a CSS escape, so that no quote, backslash or "</style>" leaves the string.
+std::string css_string(std::string_view text) {
+  std::string out;
+  for (unsigned char c : printable(text))
+    out += std::isalnum(c) || c == ' ' || c >= 0x80 ? std::string(1, static_cast<char>(c)) : fmt::format("\\{:x} ", c);
+  return out;
+}
+
 }  // namespace
 
-std::string html::stylesheet() { return fmt::format(fmt::runtime(kStyle), tr("Page"), tr("of")); }
+std::string html::stylesheet(const std::string& page_prefix) {
+  return fmt::format(fmt::runtime(kStyle), tr("Page"), tr("of"), page_prefix);
+}
 std::string html::text(std::string_view s) { return esc(s); }
 std::string html::typed(std::string_view s) { return rwcalc::typed(s); }
 std::string html::coefficient_cell(const json& c) { return coef_cell(c); }
@@ -734,8 +886,11 @@ std::string report_html(const ReportInput& input, const ReportOptions& options) 
       "<!DOCTYPE html>\n<html lang=\"{0}\">\n<head>\n<meta charset=\"utf-8\"/>\n"
       "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"/>\n"
       "<meta name=\"generator\" content=\"rwcalc {1}\"/>\n<title>{2}</title>\n<style>{3}</style>\n</head>\n<body>\n",
-      language_code(), RWCALC_VERSION, typed(title), html::stylesheet());
-  h += title_block(a, options, title) + verdict_html(a, order, overall, numbering);
+      language_code(), RWCALC_VERSION, typed(title),
+      html::stylesheet(options.profile ? css_string(trf("Test protocol No. {}", options.protocol_number)) + " · "
+                                       : ""));
+  h += options.profile ? protocol_block(a, order, overall, options, title) : title_block(a, options, title);
+  h += verdict_html(a, order, overall, numbering);
   // One statement each: the tables are numbered in the order they are made.
   h += numbering.section("tables", tr("Tables 1 and 2"));
   h += table1(a, order, numbering);
