@@ -2,8 +2,9 @@
 // B in 0.003–0.02 °/h), 30-min records at 400 Hz from the independent generator
 // (tests/independent_gyro.hpp) with a plain counter and with the GL-2D's randomised read-out: in every
 // bin of stated probability of the overall class with at least 30 statements, the share right is
-// within 0.07 of the mean stated probability (docs/calibration.md). RWCALC_CLASS_RECORDS sets the
-// count of each set (default 400).
+// within 0.07 of the mean stated probability, or within 2.5 Monte-Carlo standard errors where a bin of
+// 30–150 statements cannot resolve 0.07 (docs/calibration.md). RWCALC_CLASS_RECORDS sets the count of
+// each set (default 400).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -46,16 +47,16 @@ void check_calibration(bool dither, std::uint64_t seed0) {
   const char* name = dither ? "GL-2D randomised read-out" : "plain counter";
   for (std::size_t k = 0; k + 1 < edges.size(); ++k) {
     int cnt = 0, hit = 0;
-    double ps = 0;
+    double ps = 0, var = 0;
     for (const Statement& st : out)
-      if (st.p >= edges[k] && st.p < edges[k + 1]) ++cnt, ps += st.p, hit += st.right;
+      if (st.p >= edges[k] && st.p < edges[k + 1]) ++cnt, ps += st.p, var += st.p * (1.0 - st.p), hit += st.right;
     if (cnt == 0) continue;
     const double pm = ps / cnt, share = static_cast<double>(hit) / cnt;
     std::printf(
         "class probabilities, %s, %d records: stated %.2f..%.2f: %d statements, mean P %.3f, share right %.3f\n", name,
         count, edges[k], std::min(edges[k + 1], 1.0), cnt, pm, share);
     if (cnt >= 30) {
-      EXPECT_NEAR(share, pm, 0.07) << name << ", bin " << k;
+      EXPECT_NEAR(share, pm, std::max(0.07, 2.5 * std::sqrt(var) / cnt)) << name << ", bin " << k;
     }
   }
 }

@@ -149,7 +149,7 @@ TEST(Fit, CoefficientsAreAveragedOverTheSetsWithAndWithoutK) {
 
   // K well above its detection limit: the set without K has no weight and K is resolved.
   Truth strong;
-  strong.K = 0.02;
+  strong.K = 0.1;
   const FitResult g = fit_noise(octave_points(strong));
   EXPECT_GT(g.k_weight, 0.999);
   EXPECT_TRUE(g[Term::K].resolved);
