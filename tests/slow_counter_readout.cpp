@@ -108,7 +108,7 @@ TEST(CounterReadout, SimulatorDefaultReadoutTwoHourRecords) {
 
 TEST(CounterReadout, IndependentGeneratorPlainCounter) {
   // One record in 48 (N 0.00055, B 0.0073 °/h) settles with N at 0 and B 1.4× the truth, stated class 3
-  // at P = 0.97 (docs/analysis.md, "The counter read-out"): 5 % are allowed.
+  // at P = 0.97 (docs/calibration.md, "The counter read-out"): 5 % are allowed.
   check_set("frequency-domain generator, plain counter, 30 min at 400 Hz", records(40), true, 0.05,
             [](double n, double b, std::uint64_t seed) {
               return independent_record(n, b, 1800.0, 400.0, false, seed);
