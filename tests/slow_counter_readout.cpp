@@ -1,21 +1,18 @@
 // The counter read-out in the fit (docs/analysis.md, "The counter read-out"), on two generators:
 // rwcalc's simulator with its default read-out (a plain counter) and a second one written here in the
 // frequency domain (FFT-shaped flicker, white rate, its own counter with or without dither), which
-// shares no code with the simulator or the fit. Each record: fit accepted (p ≥ 0.001), the read-out
-// the fit chose, N and B inside their 95 % intervals, and a verdict that is right or stated below
-// P = 0.9. RWCALC_COUNTER_RECORDS scales every set (the docs' table comes from larger counts).
+// shares no code with the simulator or the fit (tests/independent_gyro.hpp). Each record: fit accepted (p ≥ 0.001), the
+// read-out the fit chose, N and B inside their 95 % intervals, and a verdict that is right or stated below P = 0.9.
+// RWCALC_COUNTER_RECORDS scales every set (the docs' table comes from larger counts).
 #include <gtest/gtest.h>
 
-#include <unsupported/Eigen/FFT>
-
-#include <array>
 #include <cmath>
-#include <complex>
 #include <cstdint>
 #include <cstdlib>
 #include <random>
 #include <vector>
 
+#include "independent_gyro.hpp"
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/noise_model.hpp"
 #include "rwcalc/parallel.hpp"
@@ -26,71 +23,18 @@
 namespace rwcalc {
 namespace {
 
-constexpr double kQ = 0.92;  // GL-2D pulse weight, ″
-
 struct Outcome {
   bool accepted = false, counter = false, n_in = false, b_in = false, verdict_ok = false, k_resolved = false;
   double p_class = 0;  // stated probability of the overall class
   bool class_right = false;
 };
 
-/// Rate noise per sample (″/s) of two-sided PSD psd(f) ((″/s)²/Hz): Gaussian Fourier coefficients of
-/// variance L·psd(f)/τ0 on a circle of L ≥ 4n points, the first n kept (the lowest frequency is then
-/// below 1/(4T): the flicker's AV at τ = T/4 is within 1.3 % of its floor).
-std::vector<double> shaped_noise(std::size_t n, double tau0, double b, test::Normal& g) {
-  std::size_t len = 1;
-  while (len < 4 * n) len <<= 1;
-  std::vector<std::complex<double>> spec(len, 0.0);
-  const double ld = static_cast<double>(len);
-  for (std::size_t j = 1; j <= len / 2; ++j) {
-    const double f = static_cast<double>(j) / (ld * tau0);
-    const double psd = b * b / (2.0 * M_PI * f);  // IEEE 952 two-sided flicker rate
-    if (j == len / 2) {
-      spec[j] = std::sqrt(ld * psd / tau0) * g();
-    } else {
-      const double sd = std::sqrt(ld * psd / tau0 / 2.0);
-      spec[j] = {sd * g(), sd * g()};
-      spec[len - j] = std::conj(spec[j]);
-    }
-  }
-  Eigen::FFT<double> fft;
-  std::vector<double> x;
-  fft.inv(x, spec);
-  x.resize(n);
-  return x;
-}
-
-/// A pulse record from the frequency-domain generator: Earth rate, white rate N (°/√h), flicker B
-/// (°/h), counted by ⌊θ/q + φ⌋ with one random phase (plain counter) or a fresh one per sample
-/// (dither of up to a pulse).
 Recording independent_record(double n, double b, double seconds, double rate_hz, bool dither, std::uint64_t seed) {
-  test::Normal g(seed);
-  std::mt19937_64 u(seed ^ 0x9e3779b97f4a7c15ULL);
-  auto uniform = [&] { return (static_cast<double>(u() >> 11) + 0.5) * 0x1.0p-53; };
-  const double tau0 = 1.0 / rate_hz;
-  const auto count = static_cast<std::size_t>(std::llround(seconds * rate_hz));
-  const std::vector<double> flicker = shaped_noise(count, tau0, b, g);
-  const double arw = 60.0 * n * std::sqrt(tau0);  // ″ per sample
-  const double earth = earth_rate_at(55.75);
-  const double phase = uniform();
-  Recording rec;
-  rec.source = "independent";
-  rec.rate_hz = rate_hz;
-  rec.phase.tau0_s = tau0;
-  rec.phase.arcsec_per_count = kQ;
-  rec.phase.counts.resize(count + 1);
-  double theta = 0;  // ″
-  auto counted = [&](double angle) {
-    return static_cast<std::int64_t>(std::floor(angle / kQ + (dither ? uniform() : phase)));
-  };
-  const std::int64_t c0 = counted(0.0);
-  rec.phase.counts[0] = 0;
-  for (std::size_t k = 0; k < count; ++k) {
-    theta += (earth + flicker[k]) * tau0 + arw * g();
-    rec.phase.counts[k + 1] = counted(theta) - c0;
-  }
-  rec.samples = count;
-  return rec;
+  test::IndependentSettings s;
+  s.seconds = seconds;
+  s.rate_hz = rate_hz;
+  s.dither = dither;
+  return test::independent_record({n, b, 0.0}, s, seed);
 }
 
 Outcome judge(const Recording& rec, double n, double b) {
@@ -164,7 +108,7 @@ TEST(CounterReadout, SimulatorDefaultReadoutTwoHourRecords) {
 
 TEST(CounterReadout, IndependentGeneratorPlainCounter) {
   // One record in 48 (N 0.00055, B 0.0073 °/h) settles with N at 0 and B 1.4× the truth, stated class 3
-  // at P = 0.97 (docs/analysis.md, "The counter read-out"): 5 % are allowed.
+  // at P = 0.97 (docs/calibration.md, "The counter read-out"): 5 % are allowed.
   check_set("frequency-domain generator, plain counter, 30 min at 400 Hz", records(40), true, 0.05,
             [](double n, double b, std::uint64_t seed) {
               return independent_record(n, b, 1800.0, 400.0, false, seed);
@@ -174,36 +118,6 @@ TEST(CounterReadout, IndependentGeneratorPlainCounter) {
 TEST(CounterReadout, IndependentGeneratorDitheredCounter) {
   check_set("frequency-domain generator, dithered counter, 30 min at 400 Hz", records(24), false, 0.0,
             [](double n, double b, std::uint64_t seed) { return independent_record(n, b, 1800.0, 400.0, true, seed); });
-}
-
-// Class probabilities over gyros spread across the class range (N log-uniform in 0.0003–0.004 °/√h,
-// B in 0.003–0.02 °/h), plain counter: in every bin of stated probability with at least 30
-// statements the share right is within 0.07 of the mean stated probability.
-// RWCALC_COUNTER_CALIBRATION_RECORDS sets the count (default 60).
-TEST(CounterReadout, ClassProbabilitiesAcrossTheClassRange) {
-  const char* e = std::getenv("RWCALC_COUNTER_CALIBRATION_RECORDS");
-  const int count = e ? std::max(8, std::atoi(e)) : 60;
-  std::vector<Outcome> out(static_cast<std::size_t>(count));
-  parallel_for(out.size(), [&](std::size_t i) {
-    std::mt19937_64 g(9000 + i);
-    std::uniform_real_distribution<double> u(0.0, 1.0);
-    const double n = 0.0003 * std::pow(0.004 / 0.0003, u(g)), b = 0.003 * std::pow(0.02 / 0.003, u(g));
-    out[i] = judge(independent_record(n, b, 1800.0, 400.0, false, 9100 + i), n, b);
-  });
-  const std::array<double, 5> edges{0.0, 0.5, 0.7, 0.9, 1.0001};
-  for (std::size_t k = 0; k + 1 < edges.size(); ++k) {
-    int cnt = 0, hit = 0;
-    double ps = 0;
-    for (const Outcome& o : out)
-      if (o.p_class >= edges[k] && o.p_class < edges[k + 1]) ++cnt, ps += o.p_class, hit += o.class_right;
-    if (cnt == 0) continue;
-    const double pm = ps / cnt, share = static_cast<double>(hit) / cnt;
-    std::printf("class probabilities, %d records: stated %.2f..%.2f: %d statements, mean P %.3f, share right %.3f\n",
-                count, edges[k], std::min(edges[k + 1], 1.0), cnt, pm, share);
-    if (cnt >= 30) {
-      EXPECT_NEAR(share, pm, 0.07) << "bin " << k;
-    }
-  }
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 // Coverage of analyze's per-τ 68.3 % bounds (EDF under the fitted model) on seeded GL-2D-like
 // records: the bounds must hold the true Allan deviation of the simulated model in 60–76 % of the
 // records at every octave τ. Stable32's bounds (`rwcalc allan`) on the same records are printed
-// beside them for docs/analysis.md ("Per-τ bounds"). The short records are 30 min at 100 Hz with a
+// beside them for docs/calibration.md ("Per-τ bounds"). The short records are 30 min at 100 Hz with a
 // 0.2″ pulse (as tests/slow_coverage_fit.cpp: the cross-overs sit where they do in a 2-h 400-Hz run).
 #include <gtest/gtest.h>
 

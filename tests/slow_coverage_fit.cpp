@@ -1,6 +1,6 @@
 // Coverage of the fitted N and B intervals and calibration of the verdict probabilities, on seeded
 // records from the project's simulator (exact Kasdin flicker, white dither-like read-out). Two sets
-// (docs/analysis.md, "Calibration"):
+// (docs/calibration.md):
 // - short: 30 min at 100 Hz with a pulse weight scaled so that the quantization/ARW/flicker
 //   cross-overs sit at the same fractions of the record as in a 2-h 400 Hz GL-2D run;
 // - full: 2 h at 400 Hz with the GL-2D pulse weight 0.92″ (16× the samples, so N rests on far more

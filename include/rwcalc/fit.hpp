@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string_view>
@@ -107,6 +108,11 @@ struct FitResult {
   /// The counter read-out's AV is part of the model (Q is then the white angle noise beyond it);
   /// false: the read-out is the white term Q.
   bool counter_readout = false;
+  /// With the term selection: the term set that differs from this one in K, and the weight of the set
+  /// with K in the average of the two (docs/term-choice.md). The coefficients, their intervals and cdf
+  /// are the average's; c, the model, the goodness of fit and cov_c are this (the selected) set's.
+  std::shared_ptr<const FitResult> k_alternative;
+  double k_weight = 0;
 
   [[nodiscard]] const Coefficient& operator[](Term t) const { return coef[static_cast<int>(t)]; }
   /// Model σ² at τ (s), (°/h)².
@@ -122,7 +128,8 @@ struct FitResult {
   /// coefficients whose Gaussian AV covariance (av_covariance) stands for the points' variance.
   [[nodiscard]] Eigen::Matrix<double, kTermCount, 1> covariance_c() const;
   /// Confidence distribution of a coefficient: P(true value ≤ `value`, IEEE unit) = Φ(sign·√(ΔD/φ))
-  /// from the scaled profile deviance; cdf(low) = (1−conf)/2 and cdf(high) = (1+conf)/2.
+  /// from the scaled profile deviance, averaged over the two term sets (k_alternative, k_weight);
+  /// cdf(low) = (1−conf)/2 and cdf(high) = (1+conf)/2.
   [[nodiscard]] double cdf(Term t, double value) const;
   /// Correlation of the log-estimates of two terms (0 when either is not active).
   [[nodiscard]] double log_correlation(Term a, Term b) const;

@@ -475,6 +475,7 @@ json fit_json(const AnalysisResult& r) {
           {"edf_cap", f.options.edf_cap},
           {"phi_N", f.phi[static_cast<std::size_t>(Term::N)]},
           {"phi_B", f.phi[static_cast<std::size_t>(Term::B)]},
+          {"K_weight", f.k_alternative ? json(f.k_weight) : json(nullptr)},
           {"confidence", f.options.confidence},
           {"readout", !f.options.counter  ? "floating"
                       : f.counter_readout ? "counter"

@@ -443,7 +443,7 @@ double gamma_continuous(const PointPair& pp, const Structure& s, double h) {
 double graded_gamma_sq_sum(const PointPair& pp, const Structure& s) {
   const std::int64_t mx = std::max(pp.ma, pp.mb);
   std::array<std::int64_t, 11> knots{-(2 * pp.mb + 4 * mx), 2 * pp.ma + 4 * mx + 1};
-  for (int q = 0; q < 9; ++q) knots[static_cast<std::size_t>(2 + q)] = pp.kink(q / 3, q % 3);
+  for (int q = 0; q < 9; ++q) knots[2 + static_cast<std::size_t>(q)] = pp.kink(q / 3, q % 3);
   std::sort(knots.begin(), knots.end());
   const std::int64_t s0 = std::max<std::int64_t>(1, std::min(pp.ma, pp.mb) / 16);
   double total = 0;
@@ -688,6 +688,82 @@ Coefficient coefficient_interval(int i, const Stage& sel, const Stage& full, boo
   return co;
 }
 
+/// One term set's confidence distribution of a coefficient: Φ(sign·√(ΔD/φ)) from its scaled profile
+/// deviance; a K the set leaves out is 0 (a point mass there).
+double member_cdf(const FitResult& f, Term t, double value) {
+  const int i = idx(t);
+  const auto ui = static_cast<std::size_t>(i);
+  if (!f.coef[ui].enabled || (t == Term::K && !f.options.enabled[ui])) return value >= 0 ? 1.0 : 0.0;
+  if (!(value > 0)) return 0.0;
+  if (!std::isfinite(value)) return 1.0;
+  const Problem pr = make_problem(f.used, f.options);
+  Vec5 d_hat;
+  for (int k = 0; k < P; ++k) d_hat[k] = f.c[k] / pr.scale[k];
+  const Profiler prof{pr, d_hat, f.deviance};
+  const double v = c_from_coefficient(t, value) / pr.scale[i];
+  const double dd = prof.delta(i, v);
+  const double r = std::sqrt(dd / f.phi[ui]);
+  return boost::math::cdf(boost::math::normal_distribution<double>(), v >= d_hat[i] ? r : -r);
+}
+
+/// The p-quantile of a confidence distribution F between a and b (F(a) ≤ p ≤ F(b)).
+template <class F>
+double quantile_between(F&& cdf, double p, double a, double b) {
+  if (!(b > a)) return a;
+  const double fa = cdf(a) - p, fb = cdf(b) - p;
+  if (!(fa < 0)) return a;
+  if (!(fb > 0)) return b;
+  return find_root([&](double x) { return cdf(x) - p; }, a, fa, b, fb);
+}
+
+/// The coefficient of term t averaged over the two term sets with weights w and 1 − w: the mixture
+/// of their confidence distributions, its quantiles for the interval, the weighted mean for the
+/// estimate and the mixture's standard deviation for sigma.
+Coefficient averaged(const FitResult& avg, Term t, const Coefficient& a, const Coefficient& b, double w_b, double z) {
+  Coefficient co = a;
+  const double alpha = (1.0 - avg.options.confidence) / 2.0;
+  auto cdf = [&](double x) { return avg.cdf(t, x); };
+  co.estimate = (1.0 - w_b) * a.estimate + w_b * b.estimate;
+  co.resolved = cdf(std::numeric_limits<double>::min()) < alpha;
+  co.low = co.resolved ? quantile_between(cdf, alpha, std::min(a.low, b.low), std::max(a.low, b.low)) : 0.0;
+  co.high = quantile_between(cdf, 1.0 - alpha, std::min(a.high, b.high), std::max(a.high, b.high));
+  co.value = co.resolved ? co.estimate : co.high;
+  const double da = a.estimate - co.estimate, db = b.estimate - co.estimate;
+  co.sigma = co.resolved ? std::sqrt((1.0 - w_b) * (a.sigma * a.sigma + da * da) + w_b * (b.sigma * b.sigma + db * db))
+                         : co.high / (2.0 * z);
+  return co;
+}
+
+/// Averages `res` (the selected term set) with `other` (the same set with K toggled): weights from
+/// the scaled deviances with the AIC's penalty of one parameter, w(K) = 1/(1 + e^(1 − ΔD/(2φ_K))).
+/// N, B (and Q, R where both sets keep them) take the mixture of the two confidence distributions;
+/// K is resolved only when the mixture's lower bound, which carries the K-free set's point mass at
+/// 0, is above 0 (docs/term-choice.md).
+void average_over_k(FitResult& res, FitResult other, double phi_k, double z) {
+  const auto uk = static_cast<std::size_t>(idx(Term::K));
+  const bool has_k = res.options.enabled[uk];
+  const double d_on = has_k ? res.deviance : other.deviance, d_off = has_k ? other.deviance : res.deviance;
+  const double gain = std::max(0.0, d_off - d_on) / phi_k;
+  res.k_weight = 1.0 / (1.0 + std::exp(1.0 - gain / 2.0));
+  const double w_other = has_k ? 1.0 - res.k_weight : res.k_weight;
+  const std::array<Coefficient, P> own = res.coef;
+  res.k_alternative = std::make_shared<const FitResult>(std::move(other));
+  const FitResult& alt = *res.k_alternative;
+  for (int i = 0; i < P; ++i) {
+    const auto ui = static_cast<std::size_t>(i);
+    if (i == idx(Term::K) || !own[ui].enabled || !res.options.enabled[ui] || !alt.options.enabled[ui]) continue;
+    res.coef[ui] = averaged(res, kAllTerms[ui], own[ui], alt.coef[ui], w_other, z);
+  }
+  Coefficient& k = res.coef[uk];
+  if (k.enabled && k.resolved &&
+      !(res.cdf(Term::K, std::numeric_limits<double>::min()) < (1.0 - res.options.confidence) / 2.0)) {
+    k.resolved = false;
+    k.low = 0;
+    k.value = k.high;
+    k.sigma = k.high / (2.0 * z);
+  }
+}
+
 }  // namespace
 
 std::string_view term_name(Term t) {
@@ -758,18 +834,10 @@ double FitResult::log_correlation(Term a, Term b) const {
 }
 
 double FitResult::cdf(Term t, double value) const {
-  const int i = idx(t);
-  if (!coef[static_cast<std::size_t>(i)].enabled) return value >= 0 ? 1.0 : 0.0;
-  if (!(value > 0)) return 0.0;
-  if (!std::isfinite(value)) return 1.0;
-  const Problem pr = make_problem(used, options);
-  Vec5 d_hat;
-  for (int k = 0; k < P; ++k) d_hat[k] = c[k] / pr.scale[k];
-  const Profiler prof{pr, d_hat, deviance};
-  const double v = c_from_coefficient(t, value) / pr.scale[i];
-  const double dd = prof.delta(i, v);
-  const double r = std::sqrt(dd / phi[static_cast<std::size_t>(i)]);
-  return boost::math::cdf(boost::math::normal_distribution<double>(), v >= d_hat[i] ? r : -r);
+  const double own = member_cdf(*this, t, value);
+  if (!k_alternative) return own;
+  const double w_other = options.enabled[static_cast<std::size_t>(idx(Term::K))] ? 1.0 - k_weight : k_weight;
+  return (1.0 - w_other) * own + w_other * member_cdf(*k_alternative, t, value);
 }
 
 Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix<double, kTermCount, 1>& c,
@@ -795,69 +863,121 @@ namespace {
 /// χ²₁ at 0.999: how much better the counter's fit must be to be chosen over the white one.
 constexpr double kCounterMargin = 10.83;
 
-/// The fit with the read-out model of options.readout (Auto taken as White).
-FitResult fit_given(std::span<const FitPoint> points, const FitOptions& options) {
-  FitResult res;
-  res.counter_readout = options.counter && options.readout == Readout::Counter;
-  res.used = points_in_range(points, options);
-  const double z = boost::math::quantile(boost::math::normal_distribution<double>(), 0.5 + options.confidence / 2.0);
-  const double chi2_1 = boost::math::quantile(boost::math::chi_squared_distribution<double>(1.0), options.confidence);
-  auto has_terms = [](const FitPoint& p) { return p.m > 0 && p.terms > 0; };
-  res.model_covariance = options.model_covariance && std::all_of(res.used.begin(), res.used.end(), has_terms);
-  FitOptions opt;  // edf_cap: the one in force (estimated when options.edf_cap is 0)
-  const Stage full = fit_full_model(res.used, options, res.model_covariance, opt);
+/// What every term set fitted to one record shares: the points, the full model, the points'
+/// covariance and each term's inflation in the full model.
+struct FitBase {
+  std::vector<FitPoint> used;
+  FitOptions options;  // as given
+  FitOptions opt;      // with the EDF cap in force
+  Stage full;
   Eigen::MatrixXd sigma_y;
-  if (res.model_covariance)
-    sigma_y = point_covariance(res.used, covariance_terms(full.coefficients(), options), full.model(), opt.edf_cap);
+  std::array<double, P> phi_full{1, 1, 1, 1, 1};
+  bool model_covariance = false;
+  double z = 0, chi2_1 = 0;
+};
 
+FitBase fit_base(std::span<const FitPoint> points, const FitOptions& options) {
+  FitBase b;
+  b.options = options;
+  b.used = points_in_range(points, options);
+  b.z = boost::math::quantile(boost::math::normal_distribution<double>(), 0.5 + options.confidence / 2.0);
+  b.chi2_1 = boost::math::quantile(boost::math::chi_squared_distribution<double>(1.0), options.confidence);
+  auto has_terms = [](const FitPoint& p) { return p.m > 0 && p.terms > 0; };
+  b.model_covariance = options.model_covariance && std::all_of(b.used.begin(), b.used.end(), has_terms);
+  b.full = fit_full_model(b.used, options, b.model_covariance, b.opt);
+  if (b.model_covariance)
+    b.sigma_y =
+        point_covariance(b.used, covariance_terms(b.full.coefficients(), options), b.full.model(), b.opt.edf_cap);
   // Inflation of every enabled term in the full model (at the boundary too).
   std::vector<int> full_set;
   for (int i = 0; i < P; ++i)
     if (options.enabled[static_cast<std::size_t>(i)]) full_set.push_back(i);
-  const Sandwich sw_full = sandwich(full.pr, full.fit.d, full_set, sigma_y, options);
-  std::array<double, P> phi_full{1, 1, 1, 1, 1};
-  for (std::size_t q = 0; q < full_set.size(); ++q) phi_full[static_cast<std::size_t>(full_set[q])] = sw_full.phi[q];
+  const Sandwich sw_full = sandwich(b.full.pr, b.full.fit.d, full_set, b.sigma_y, options);
+  for (std::size_t q = 0; q < full_set.size(); ++q) b.phi_full[static_cast<std::size_t>(full_set[q])] = sw_full.phi[q];
+  return b;
+}
 
-  std::array<bool, P> dropped{};
-  IrlsResult best = full.fit;
-  res.options = opt;
-  if (options.select_terms)
-    std::tie(res.options, best) = select_terms(res.used, opt, full.fit, phi_full, chi2_1, dropped);
+/// The fit of one term set (`set`: the enabled terms, `dropped` those the selection left out, reported
+/// from the full model), started from `start`, with every coefficient's interval from its profile.
+FitResult fit_term_set(const FitBase& b, const FitOptions& set, const std::array<bool, P>& dropped, const Vec5& start) {
+  FitResult res;
+  res.counter_readout = b.options.counter && b.options.readout == Readout::Counter;
+  res.used = b.used;
+  res.model_covariance = b.model_covariance;
+  res.options = set;
   Stage sel{make_problem(res.used, res.options), {}};
-  sel.fit = irls(sel.pr, sel.pr.enabled_mask, best.d, false);
+  sel.fit = irls(sel.pr, sel.pr.enabled_mask, start, false);
   require_converged(sel.fit);
-  res.iterations = sel.fit.iterations + full.fit.iterations;
+  res.iterations = sel.fit.iterations + b.full.fit.iterations;
   res.deviance = sel.fit.dev;
   res.c = sel.coefficients();
   const Eigen::VectorXd mu = sel.model();
   res.model.assign(mu.data(), mu.data() + mu.size());
   goodness_of_fit(sel, res);
-  term_covariance(sel, sigma_y, options, phi_full, dropped, res);
+  term_covariance(sel, b.sigma_y, b.options, b.phi_full, dropped, res);
   res.corr_NQ = res.log_correlation(Term::N, Term::Q);
   res.corr_NB = res.log_correlation(Term::N, Term::B);
   // Each term's interval is a profile of its own (a counter read-out's the costliest): in parallel.
   parallel_for(static_cast<std::size_t>(P), [&](std::size_t ui) {
     auto& co = res.coef[ui];
-    if (!options.enabled[ui]) {
+    if (!b.options.enabled[ui]) {
       co.enabled = false;
       co.in_model = res.options.enabled[ui];
       return;
     }
-    co = coefficient_interval(static_cast<int>(ui), sel, full, dropped[ui], res, z, chi2_1);
+    co = coefficient_interval(static_cast<int>(ui), sel, b.full, dropped[ui], res, b.z, b.chi2_1);
   });
   for (std::size_t ui = 0; ui < static_cast<std::size_t>(P); ++ui) {
     const auto& co = res.coef[ui];
-    if (!options.enabled[ui]) continue;
+    if (!b.options.enabled[ui]) continue;
     if (!std::isfinite(co.value) || !std::isfinite(co.sigma) || !std::isfinite(co.low) || !std::isfinite(co.high))
       throw AnalysisError(trf("the data do not bound the {} coefficient", term_name(kAllTerms[ui])));
   }
   return res;
 }
 
+/// The selected term set's fit with the read-out model of options.readout (Auto taken as White), and
+/// what its average over K needs.
+struct Selected {
+  FitBase base;
+  std::array<bool, P> dropped{};
+  Vec5 d;  // the selected set's optimum, scaled
+  FitResult res;
+};
+
+Selected fit_selected(std::span<const FitPoint> points, const FitOptions& options) {
+  Selected s{fit_base(points, options), {}, {}, {}};
+  FitOptions set = s.base.opt;
+  IrlsResult best = s.base.full.fit;
+  if (options.select_terms)
+    std::tie(set, best) = select_terms(s.base.used, s.base.opt, best, s.base.phi_full, s.base.chi2_1, s.dropped);
+  s.d = best.d;
+  s.res = fit_term_set(s.base, set, s.dropped, best.d);
+  return s;
+}
+
+/// With the term selection, the selected set's coefficients averaged with the set that differs in K.
+FitResult averaged_over_k(Selected s) {
+  const FitBase& b = s.base;
+  const auto uk = static_cast<std::size_t>(idx(Term::K));
+  if (!b.options.select_terms || !b.options.enabled[uk] || !b.options.droppable[uk]) return std::move(s.res);
+  FitOptions other = s.res.options;
+  other.enabled[uk] = !other.enabled[uk];
+  std::array<bool, P> other_dropped = s.dropped;
+  other_dropped[uk] = !other.enabled[uk];
+  Vec5 start = s.d;
+  start[idx(Term::K)] = other.enabled[uk] ? b.full.fit.d[idx(Term::K)] : 0.0;
+  try {
+    average_over_k(s.res, fit_term_set(b, other, other_dropped, start), b.phi_full[uk], b.z);
+  } catch (const AnalysisError&) {  // the other set cannot be fitted: the selected one stands alone
+  }
+  return std::move(s.res);
+}
+
 }  // namespace
 
 FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options) {
-  if (!options.counter || options.readout != Readout::Auto) return fit_given(points, options);
+  if (!options.counter || options.readout != Readout::Auto) return averaged_over_k(fit_selected(points, options));
   // A counter with or without dither. The white model (the simpler, and a dithered counter's) stands
   // unless the counter's fits better by more than χ²₁ at 0.001 (10.83, the level at which a fit is
   // rejected): on dithered records the two differ by chance by a few units, on a plain counter's
@@ -865,13 +985,13 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
   FitOptions white = options, counter = options;
   white.readout = Readout::White;
   counter.readout = Readout::Counter;
-  FitResult w = fit_given(points, white);
+  Selected w = fit_selected(points, white);
   try {
-    FitResult c = fit_given(points, counter);
-    if (c.chi2 + kCounterMargin < w.chi2) return c;
+    Selected c = fit_selected(points, counter);
+    if (c.res.chi2 + kCounterMargin < w.res.chi2) return averaged_over_k(std::move(c));
   } catch (const AnalysisError&) {  // the white model stands
   }
-  return w;
+  return averaged_over_k(std::move(w));
 }
 
 SlopeReadout slope_readout(const AllanResult& allan) {

@@ -44,7 +44,7 @@ std::size_t outcome_index(const std::optional<int>& cls, const ClassTable& t) {
 /// sits at or near 0 has a point mass there (half the distribution when the estimate is 0); a gyro
 /// always has some ARW and flicker, so that mass is a statement about the data's resolution, not a
 /// chance of a noiseless gyro, and left in place it made "class 1 (P=0.94)" verdicts on unresolved
-/// B right 83 % of the time (docs/analysis.md, Calibration). Resolved estimates have no mass at 0
+/// B right 83 % of the time (docs/calibration.md). Resolved estimates have no mass at 0
 /// and are unchanged.
 std::function<double(double)> positive_part(const EstimateInput& e) {
   const double at_zero = e.cdf(std::numeric_limits<double>::min());
