@@ -18,6 +18,7 @@
 // phase; the Allan result of an accepted record is finite; outlier positions are in range.
 #include <zlib.h>
 
+#include <unistd.h>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -25,7 +26,6 @@
 #include <cstdlib>
 #include <string>
 #include <string_view>
-#include <unistd.h>
 
 #include "rwcalc/allan.hpp"
 #include "rwcalc/error.hpp"
@@ -68,10 +68,14 @@ bool read_bag(std::string_view body, std::uint8_t b2, rwcalc::Recording& rec) {
   if (::write(fd, body.data(), body.size()) != static_cast<ssize_t>(body.size())) std::abort();
   ::close(fd);
   rwcalc::ReadOptions o;
-  static const char* const kBagColumns[] = {"field.angular_velocity.x",    "field.angular_velocity.y",
-                                            "field.angular_velocity.z",    "field.linear_acceleration.x",
-                                            "field.linear_acceleration.y", "field.linear_acceleration.z",
-                                            "%time",                       "1"};
+  static const char* const kBagColumns[] = {"field.angular_velocity.x",
+                                            "field.angular_velocity.y",
+                                            "field.angular_velocity.z",
+                                            "field.linear_acceleration.x",
+                                            "field.linear_acceleration.y",
+                                            "field.linear_acceleration.z",
+                                            "%time",
+                                            "1"};
   o.column = kBagColumns[b2 & 7];
   if (b2 & 8) o.time_column = "%time";
   bool ok = true;

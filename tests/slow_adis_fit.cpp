@@ -91,8 +91,8 @@ TEST(SlowAdis, FitMatchesTheWelchWhiteLevelOnEveryRunAndAxis) {
       const double n = j["fit"]["N_deg_per_sqrt_h"]["value"].get<double>();
       const double welch = welch_white_level(rates[static_cast<std::size_t>(axis)], 100.0);
       const double chi2 = j["fit"]["chi2_per_dof"].get<double>();
-      std::printf("run %d %s: N %.4f, Welch %.4f (%+.2f %%), chi2/dof %.2f, fit from %g s (%s)\n", run,
-                  column.c_str(), n, welch, 100.0 * (n / welch - 1.0), chi2, j["fit"]["tau_min_s"].get<double>(),
+      std::printf("run %d %s: N %.4f, Welch %.4f (%+.2f %%), chi2/dof %.2f, fit from %g s (%s)\n", run, column.c_str(),
+                  n, welch, 100.0 * (n / welch - 1.0), chi2, j["fit"]["tau_min_s"].get<double>(),
                   j["fit"]["range"]["chosen_by"].get<std::string>().c_str());
       EXPECT_NEAR(n / welch, 1.0, 0.03) << run << column;
       EXPECT_LE(chi2, 3.0) << run << column;

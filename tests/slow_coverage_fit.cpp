@@ -143,8 +143,7 @@ void check_calibration(const char* what, const std::vector<Outcome>& out, P p_of
 void check_set(const RecordSet& set, const std::vector<Outcome>& out) {
   check_coverage(set, out);
   check_calibration(
-      "overall class", out, [](const Outcome& o) { return o.p_class; },
-      [](const Outcome& o) { return o.class_right; });
+      "overall class", out, [](const Outcome& o) { return o.p_class; }, [](const Outcome& o) { return o.class_right; });
   check_calibration(
       "P(B <= 0.008)", out, [](const Outcome& o) { return std::max(o.p_b2, 1 - o.p_b2); },
       [](const Outcome& o) { return (o.p_b2 >= 0.5) == o.b2_true; });

@@ -337,8 +337,9 @@ TEST(RosCsv, RostopicEchoFindsItsSixChannelsAndPrefersTheHeaderStamp) {
 
 TEST(RosCsv, PlotJugglerTimeAndSlashedFieldNames) {
   TempDir dir;
-  std::string s = "__time,/imu/angular_velocity/x,/imu/angular_velocity/y,/imu/angular_velocity/z,"
-                  "/imu/linear_acceleration/x,/imu/linear_acceleration/y,/imu/linear_acceleration/z\n";
+  std::string s =
+      "__time,/imu/angular_velocity/x,/imu/angular_velocity/y,/imu/angular_velocity/z,"
+      "/imu/linear_acceleration/x,/imu/linear_acceleration/y,/imu/linear_acceleration/z\n";
   for (std::size_t k = 0; k < imu().size(); ++k) {
     const ImuSample& m = imu()[k];
     s += fmt::format("{:.6f},{},{},{},{},{},{}\n", 1.7e9 + static_cast<double>(k) / kRate, m.gyro[0], m.gyro[1],
@@ -354,8 +355,9 @@ TEST(RosCsv, PlotJugglerTimeAndSlashedFieldNames) {
 
 TEST(RosCsv, Ros2SecAndNanosecAreOneStamp) {
   TempDir dir;
-  std::string s = "header.stamp.sec,header.stamp.nanosec,header.frame_id,angular_velocity.x,angular_velocity.y,"
-                  "angular_velocity.z,linear_acceleration.x,linear_acceleration.y,linear_acceleration.z\n";
+  std::string s =
+      "header.stamp.sec,header.stamp.nanosec,header.frame_id,angular_velocity.x,angular_velocity.y,"
+      "angular_velocity.z,linear_acceleration.x,linear_acceleration.y,linear_acceleration.z\n";
   for (const ImuSample& m : imu())
     s += fmt::format("{},{},imu_link,{},{},{},{},{},{}\n", m.stamp_ns / 1'000'000'000, m.stamp_ns % 1'000'000'000,
                      m.gyro[0], m.gyro[1], m.gyro[2], m.accel[0], m.accel[1], m.accel[2]);
@@ -385,8 +387,9 @@ TEST(RosCsv, UnitSuffixesFindAllSixChannelsWithRate) {
   ASSERT_EQ(j["channels"].size(), 6U);
   EXPECT_EQ(j["channels"][0]["sensor"], "gyro");
   EXPECT_EQ(j["channels"][5]["sensor"], "accelerometer");
-  EXPECT_TRUE(has(r.err, "channels from the column names: gyro gyro_x_dps, gyro_y_dps, gyro_z_dps; accelerometer "
-                         "acc_x_g, acc_y_g, acc_z_g"))
+  EXPECT_TRUE(has(r.err,
+                  "channels from the column names: gyro gyro_x_dps, gyro_y_dps, gyro_z_dps; accelerometer "
+                  "acc_x_g, acc_y_g, acc_z_g"))
       << r.err;
 }
 

@@ -81,11 +81,16 @@ TEST(CliErrors, AnEmptyOutputNameIsAUsageErrorNamingTheOption) {
     std::string option;
   };
   const std::vector<Case> cases{
-      {{"analyze", rec, "-o", ""}, "--output"},          {{"analyze", rec, "--plot", ""}, "--plot"},
-      {{"analyze", rec, "--plot-script", ""}, "--plot-script"}, {{"batch", rec, "-o", ""}, "--output"},
-      {{"batch", rec, "--plot", ""}, "--plot"},           {{"merge", lines, "-o", ""}, "--output"},
-      {{"simulate", "-o", ""}, "--output"},               {{"simulate", "-o", rec, "--truth", ""}, "--truth"},
-      {{"diagnose", rec, "-o", ""}, "--output"},          {{"diagnose", rec, "--plot-script", ""}, "--plot-script"},
+      {{"analyze", rec, "-o", ""}, "--output"},
+      {{"analyze", rec, "--plot", ""}, "--plot"},
+      {{"analyze", rec, "--plot-script", ""}, "--plot-script"},
+      {{"batch", rec, "-o", ""}, "--output"},
+      {{"batch", rec, "--plot", ""}, "--plot"},
+      {{"merge", lines, "-o", ""}, "--output"},
+      {{"simulate", "-o", ""}, "--output"},
+      {{"simulate", "-o", rec, "--truth", ""}, "--truth"},
+      {{"diagnose", rec, "-o", ""}, "--output"},
+      {{"diagnose", rec, "--plot-script", ""}, "--plot-script"},
       {{"imu", rec, "--gyro", "pulses", "-o", ""}, "--output"},
       {{"imu", rec, "--gyro", "pulses", "--kalibr", ""}, "--kalibr"},
       {{"imu", rec, "--gyro", "pulses", "--report", ""}, "--report"},

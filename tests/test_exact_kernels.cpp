@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "allan/allan_kernels.hpp"
-#include "rwcalc/narrow_counts.hpp"
 #include "rwcalc/allan.hpp"
+#include "rwcalc/narrow_counts.hpp"
 #include "test_support.hpp"
 
 namespace {

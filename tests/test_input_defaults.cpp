@@ -1,7 +1,7 @@
 // The reader makes no silent choices for IMU files: rate and angle input need a sample rate; time
 // columns are read in s, ms, us or ns (by name or by the stamps' magnitude); jitter is accepted and
-// reported, a gap refused (or, with --gaps segments, the record split at it); a unit suffix of the column name chooses the unit (and the input kind)
-// that no option gave, and every such choice is said on standard error and in the JSON.
+// reported, a gap refused (or, with --gaps segments, the record split at it); a unit suffix of the column name chooses
+// the unit (and the input kind) that no option gave, and every such choice is said on standard error and in the JSON.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -224,9 +224,8 @@ TEST(InputDefaults, AGapIsAnErrorWithTheLineAndTheMissingDuration) {
 TEST(InputDefaults, GapsSegmentsRecoverTheCoefficientsOfARecordWithAChunkCutOut) {
   TempDir dir;
   const auto sim = dir.path() / "sim.csv";
-  ASSERT_EQ(run_cli({"simulate", "-o", sim.string(), "--duration", "14400", "--rate", "10", "--scale", "0.2",
-                     "--arw", "0.15", "--bias-instability", "3", "--white-readout", "--output-lowpass", "0.001",
-                     "--seed", "3"})
+  ASSERT_EQ(run_cli({"simulate", "-o", sim.string(), "--duration", "14400", "--rate", "10", "--scale", "0.2", "--arw",
+                     "0.15", "--bias-instability", "3", "--white-readout", "--output-lowpass", "0.001", "--seed", "3"})
                 .status,
             0);
   std::istringstream in(slurp(sim));
@@ -276,8 +275,7 @@ TEST(InputDefaults, SerialOperatorDateAndConditionsFromMetadataOrOptions) {
   const auto f = dir.write("run.csv", body);
   const auto text = run_cli({"analyze", f.string(), "--operator", "Petrov", "--test-date", "2026-11-27"});
   ASSERT_EQ(text.status, 0) << text.err;
-  EXPECT_NE(text.out.find("gyro and test: serial GL2D-0421; operator Petrov; test date 2026-11-27"),
-            std::string::npos)
+  EXPECT_NE(text.out.find("gyro and test: serial GL2D-0421; operator Petrov; test date 2026-11-27"), std::string::npos)
       << text.out;
   EXPECT_NE(text.err.find("operator 'Petrov' from the command line, not the file's 'Ivanov'"), std::string::npos)
       << text.err;

@@ -241,7 +241,7 @@ TEST(Outliers, PhaseSeriesScanEqualsVectorScan) {
   for (std::size_t i = 0; i < n; ++i) {
     std::int64_t c = pulses(rng);
     if (i % 99991 == 17 || i == 1 || i == n - 1) c += 60;  // glitches, two at the very ends
-    if (i == 500000) c += 20000;  // beyond the 13 bits of the counts' candidate screen
+    if (i == 500000) c += 20000;                           // beyond the 13 bits of the counts' candidate screen
     counts.counts.push_back(counts.counts.back() + c);
   }
   rwcalc::PhaseSeries floating;

@@ -45,7 +45,8 @@ TEST(Progress, BytesInTheUnitOfTheTotalAndShareAlone) {
   // Standard input: the size is not known, the bytes read so far are.
   EXPECT_EQ(Progress::format_line("reading <stdin>", 2'500'000, 0, 1.0, Measure::Bytes),
             "reading <stdin>: 2.5 MB, 1.0 s");
-  EXPECT_EQ(Progress::format_line("simulating", 35, 100, 7.0, Measure::Percent), "simulating: 35%, 7.0 s, ~13.0 s left");
+  EXPECT_EQ(Progress::format_line("simulating", 35, 100, 7.0, Measure::Percent),
+            "simulating: 35%, 7.0 s, ~13.0 s left");
 }
 
 TEST(Progress, ACountBeyondItsEstimatedTotalIsShownAlone) {

@@ -59,8 +59,7 @@ TEST(ReaderMetadataKeys, TwoSpellingsOfOneKeyMustAgree) {
 
 TEST(ReaderMetadataKeys, OtherKeysAreKeptAsWrittenAndIdentificationKeysCanonical) {
   const auto r = read_recording_text(
-      "# Bench_ID = B-12\n# Operator = Fomin\n# Test-Date: 2021-05-01\n# GL-2D bench run: static\npulses\n1\n2\n",
-      "m");
+      "# Bench_ID = B-12\n# Operator = Fomin\n# Test-Date: 2021-05-01\n# GL-2D bench run: static\npulses\n1\n2\n", "m");
   EXPECT_EQ(r.metadata.at("Bench_ID"), "B-12");
   EXPECT_EQ(r.metadata.at("operator"), "Fomin");  // an identification key, under its own spelling
   EXPECT_EQ(r.metadata.at("test_date"), "2021-05-01");
@@ -265,7 +264,8 @@ TEST(ReaderOnePass, TheEarliestLinesErrorWhateverTheThreads) {
     EXPECT_EQ(e.first, 5u) << threads;
     EXPECT_NE(e.second.find("acc_y_g"), std::string::npos) << e.second;
     EXPECT_EQ(e.second, error_of(fmt::format("time_s,gyro_x_dps,acc_y_g\n0,1,2\n0.01,1,2\n0.02,1,2\n0.03,1,x\n"),
-                                 column("acc_y_g")).first);
+                                 column("acc_y_g"))
+                            .first);
   }
   const std::string same_line = tmp.write("both.csv", "a,b,c\n1,2,3\n1,2,3\nx,y,3\n").string();
   for (const char* threads : {"1", "2"}) {

@@ -9,9 +9,9 @@
 #include <fstream>
 #include <sstream>
 
-#include "rwcalc/sha256.hpp"
 #include "io/text_source.hpp"
 #include "rwcalc/reader.hpp"
+#include "rwcalc/sha256.hpp"
 #include "test_support.hpp"
 
 namespace rwcalc {

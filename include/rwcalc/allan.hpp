@@ -4,8 +4,9 @@
 #endif
 /// @file allan.hpp
 /// Allan-type variances of a PhaseSeries: fully overlapping AVAR (the workhorse), non-overlapping
-/// AVAR, modified AVAR and the Hadamard variance (overlapping and not), on a chosen τ grid, with noise identification, equivalent degrees of
-/// freedom and χ² confidence bounds as Stable32 computes them (NIST SP 1065; Greenhall & Riley 2003).
+/// AVAR, modified AVAR and the Hadamard variance (overlapping and not), on a chosen τ grid, with noise identification,
+/// equivalent degrees of freedom and χ² confidence bounds as Stable32 computes them (NIST SP 1065; Greenhall & Riley
+/// 2003).
 ///
 /// For exact pulse data the second differences are formed in modular int64 arithmetic and their
 /// squares summed exactly, the pulse weight applied at the end: any counter offset gives the same

@@ -44,9 +44,9 @@ class NarrowCounts {
   /// The extremes of x' over the groups that cover [from, from + len).
   [[nodiscard]] Range range(std::size_t from, std::size_t len) const;
 
-  std::int64_t slope_ = 0;           // a: x'_k = C_k − C_0 − a·k (modulo 2^64)
+  std::int64_t slope_ = 0;                // a: x'_k = C_k − C_0 − a·k (modulo 2^64)
   std::unique_ptr<std::uint16_t[]> low_;  // x'_k modulo 2^16 (written once: not zeroed first)
-  std::vector<std::int64_t> min_, max_;  // of x' over each group of kGroup points
+  std::vector<std::int64_t> min_, max_;   // of x' over each group of kGroup points
 };
 
 }  // namespace rwcalc::detail

@@ -48,7 +48,7 @@ Real sx_expanded(Real at, Real u, int alpha) {
   if (alpha == 2) return 0;  // −|t| is linear away from 0
   const bool has_log = alpha == 1 || alpha == -1 || alpha == -3;
   const int q = 3 - alpha;  // sw = t^q·ln|t| (q even) or |t|^q (q odd)
-  Real even_poly = 0;                             // Σ_{j≥1} C(q, 2j)·u^(2j−2)
+  Real even_poly = 0;       // Σ_{j≥1} C(q, 2j)·u^(2j−2)
   Real binom = 1, upow = 1;
   for (int j = 1; 2 * j <= q; ++j) {
     binom = binom * (q - 2 * j + 2) * (q - 2 * j + 1) / ((2 * j - 1) * (2 * j));

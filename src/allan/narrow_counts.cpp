@@ -48,7 +48,9 @@ void narrow_increment_sums(const std::uint16_t* __restrict a, const std::uint16_
 }  // namespace
 
 NarrowCounts::NarrowCounts(const std::int64_t* c, std::size_t points)
-    : low_(std::make_unique_for_overwrite<std::uint16_t[]>(points)), min_((points + kGroup - 1) / kGroup), max_(min_.size()) {
+    : low_(std::make_unique_for_overwrite<std::uint16_t[]>(points)),
+      min_((points + kGroup - 1) / kGroup),
+      max_(min_.size()) {
   if (points == 0) return;
   const auto c0 = static_cast<std::uint64_t>(c[0]);
   if (points > 1) {  // the mean step, whole: a trend of many counts per point would widen every bound
@@ -93,8 +95,8 @@ std::optional<std::uint64_t> NarrowCounts::second_diff_sumsq(std::size_t k0, std
   return narrow_second_diff_sumsq(p, p + m, p + 2 * m, len);
 }
 
-bool NarrowCounts::increment_sums(std::size_t k0, std::size_t len, std::size_t t, std::int64_t shift,
-                                  std::int64_t& s1, std::uint64_t& s2) const {
+bool NarrowCounts::increment_sums(std::size_t k0, std::size_t len, std::size_t t, std::int64_t shift, std::int64_t& s1,
+                                  std::uint64_t& s2) const {
   if (len == 0) {
     s1 = 0, s2 = 0;
     return true;

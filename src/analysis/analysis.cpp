@@ -11,14 +11,14 @@
 #include <optional>
 
 #include "fit_range.hpp"
-#include "rwcalc/segments.hpp"
-#include "spectral_lines.hpp"
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/printable.hpp"
 #include "rwcalc/progress.hpp"
+#include "rwcalc/segments.hpp"
 #include "rwcalc/units.hpp"
+#include "spectral_lines.hpp"
 
 namespace rwcalc {
 

@@ -12,10 +12,10 @@
 #include <numeric>
 #include <optional>
 
-#include "rwcalc/output_filter.hpp"
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
+#include "rwcalc/output_filter.hpp"
 #include "rwcalc/parallel.hpp"
 #include "rwcalc/printable.hpp"
 

@@ -38,8 +38,8 @@ AllanResult allan_of_record(const Recording& rec, const AllanOptions& options) {
   if (rec.segments.size() < 2) return compute_allan(rec.phase, options);
   struct Pool {
     AllanPoint p;
-    double sum = 0;             // Σ n·σ² over the segments
-    std::size_t longest = 0;    // points of the longest segment that has the τ (its α)
+    double sum = 0;           // Σ n·σ² over the segments
+    std::size_t longest = 0;  // points of the longest segment that has the τ (its α)
   };
   std::map<std::int64_t, Pool> pooled;
   AllanResult out;

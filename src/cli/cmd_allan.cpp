@@ -8,7 +8,6 @@
 #include <nlohmann/json.hpp>
 #include <ostream>
 
-#include "rwcalc/segments.hpp"
 #include "analyze_args.hpp"
 #include "commands.hpp"
 #include "numeric_options.hpp"
@@ -19,6 +18,7 @@
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/printable.hpp"
 #include "rwcalc/reader.hpp"
+#include "rwcalc/segments.hpp"
 
 namespace rwcalc::cli {
 

@@ -5,8 +5,8 @@
 
 #include <cstdint>
 
-#include "utf8.hpp"
 #include "rwcalc/printable.hpp"
+#include "utf8.hpp"
 
 namespace rwcalc {
 

@@ -18,8 +18,8 @@
 #include <optional>
 #include <random>
 
-#include "rwcalc/cleanup.hpp"
 #include "output_detail.hpp"
+#include "rwcalc/cleanup.hpp"
 #include "rwcalc/error.hpp"
 
 namespace rwcalc {

@@ -61,8 +61,7 @@ std::string amount(std::uint64_t done, std::uint64_t total, Progress::Measure me
       if (total == 0) return fmt::format("{:.1f} {}", d, tr(unit.name));
       return fmt::format("{:.1f}/{:.1f} {} ({})", d, static_cast<double>(total) / unit.bytes, tr(unit.name), percent);
     }
-    case Progress::Measure::Percent:
-      return percent;
+    case Progress::Measure::Percent: return percent;
   }
   return {};
 }

@@ -6,9 +6,9 @@
 #include <limits>
 
 #include "models.hpp"
-#include "rwcalc/output_filter.hpp"
 #include "rwcalc/allan.hpp"
 #include "rwcalc/confidence.hpp"
+#include "rwcalc/output_filter.hpp"
 #include "rwcalc/units.hpp"
 
 namespace rwcalc::diag {

@@ -18,11 +18,11 @@
 #include "fast_line.hpp"
 #include "lowpass.hpp"
 #include "models.hpp"
-#include "signal.hpp"
 #include "rwcalc/allan.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/progress.hpp"
 #include "rwcalc/units.hpp"
+#include "signal.hpp"
 
 namespace rwcalc {
 

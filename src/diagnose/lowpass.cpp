@@ -5,8 +5,8 @@
 #include <cmath>
 #include <limits>
 
-#include "signal.hpp"
 #include "rwcalc/output_filter.hpp"
+#include "signal.hpp"
 
 namespace rwcalc::diag {
 

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <limits>
 
-#include "signal.hpp"
 #include "rwcalc/error.hpp"
+#include "signal.hpp"
 
 namespace rwcalc::diag {
 

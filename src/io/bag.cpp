@@ -18,9 +18,9 @@
 
 #include <fmt/format.h>
 
-#include "rwcalc/sha256.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
+#include "rwcalc/sha256.hpp"
 
 namespace rwcalc::detail {
 
@@ -54,7 +54,8 @@ T load(const char* p, bool swap) {
   std::memcpy(&v, p, sizeof v);
   if (swap) {
     auto u = std::bit_cast<std::conditional_t<sizeof(T) == 8, std::uint64_t, std::uint32_t>>(v);
-    u = sizeof(T) == 8 ? static_cast<decltype(u)>(__builtin_bswap64(u)) : static_cast<decltype(u)>(__builtin_bswap32(static_cast<std::uint32_t>(u)));
+    u = sizeof(T) == 8 ? static_cast<decltype(u)>(__builtin_bswap64(u))
+                       : static_cast<decltype(u)>(__builtin_bswap32(static_cast<std::uint32_t>(u)));
     v = std::bit_cast<T>(u);
   }
   return v;
@@ -72,8 +73,7 @@ void read_vectors(ImuMessage& m, const char* doubles, bool swap) {
 }
 
 std::int64_t stamp_of(std::int64_t sec, std::uint32_t nsec, const std::string& file, const Place& offset) {
-  if (nsec >= 1'000'000'000U)
-    fail_message(file, offset, trf("header.stamp has {} nanoseconds, not below 10^9", nsec));
+  if (nsec >= 1'000'000'000U) fail_message(file, offset, trf("header.stamp has {} nanoseconds, not below 10^9", nsec));
   return sec * 1'000'000'000 + nsec;
 }
 
@@ -88,7 +88,8 @@ ImuMessage decode_ros1_imu(std::string_view b, const std::string& file, const Pl
   if (b.size() - 16 < len || b.size() - 16 - len < kImuDoubles * 8)
     fail_message(file, offset, trf("{} bytes, too short for a frame_id of {} bytes and the 37 numbers", b.size(), len));
   ImuMessage m;
-  m.stamp_ns = stamp_of(load<std::uint32_t>(b.data() + 4, false), load<std::uint32_t>(b.data() + 8, false), file, offset);
+  m.stamp_ns =
+      stamp_of(load<std::uint32_t>(b.data() + 4, false), load<std::uint32_t>(b.data() + 8, false), file, offset);
   read_vectors(m, b.data() + 16 + len, false);
   return m;
 }
@@ -99,8 +100,9 @@ ImuMessage decode_ros1_imu(std::string_view b, const std::string& file, const Pl
 ImuMessage decode_cdr_imu(std::string_view b, const std::string& file, const Place& offset) {
   if (b.size() < 16) fail_message(file, offset, trf("{} bytes, too short for a header", b.size()));
   if (b[0] != 0 || (b[1] != 0 && b[1] != 1))
-    fail_message(file, offset, trf("not plain CDR: encapsulation bytes {:02x} {:02x}", static_cast<unsigned char>(b[0]),
-                                   static_cast<unsigned char>(b[1])));
+    fail_message(file, offset,
+                 trf("not plain CDR: encapsulation bytes {:02x} {:02x}", static_cast<unsigned char>(b[0]),
+                     static_cast<unsigned char>(b[1])));
   const bool swap = (b[1] == 1) != (std::endian::native == std::endian::little);
   const char* d = b.data() + 4;
   const std::size_t n = b.size() - 4;
@@ -186,8 +188,9 @@ std::string storage_of_bag_directory(const std::string& dir) {
   if (files.size() == 1) return files.front();
   std::string list;
   for (const auto& f : files) list += (list.empty() ? "" : ", ") + f;
-  throw InputError(dir, 0, files.empty() ? std::string(tr("a ROS 2 bag directory without a .db3 or .mcap file"))
-                                         : trf("a ROS 2 bag split into {} files ({}): give one of them", files.size(), list));
+  throw InputError(dir, 0,
+                   files.empty() ? std::string(tr("a ROS 2 bag directory without a .db3 or .mcap file"))
+                                 : trf("a ROS 2 bag split into {} files ({}): give one of them", files.size(), list));
 }
 
 }  // namespace
@@ -222,16 +225,17 @@ void BagStream::select(const std::string& wanted) {
     if (it == all.end())
       throw InputError(name_, 0, trf("no topic '{}' in this {}; its topics: {}", wanted, format(), topic_list(all)));
     if (!is_imu_type(it->type))
-      throw InputError(name_, 0, trf("topic '{}' holds {}, not sensor_msgs/Imu; the Imu topics: {}", wanted, it->type,
-                                     topic_list(imu)));
+      throw InputError(name_, 0,
+                       trf("topic '{}' holds {}, not sensor_msgs/Imu; the Imu topics: {}", wanted, it->type,
+                           topic_list(imu)));
     topic_ = *it;
   } else if (imu.size() == 1) {
     topic_ = imu.front();
   } else if (imu.empty()) {
     throw InputError(name_, 0, trf("no sensor_msgs/Imu topic in this {}; its topics: {}", format(), topic_list(all)));
   } else {
-    throw InputError(name_, 0, trf("{} sensor_msgs/Imu topics: choose one with --topic ({})", imu.size(),
-                                   topic_list(imu)));
+    throw InputError(name_, 0,
+                     trf("{} sensor_msgs/Imu topics: choose one with --topic ({})", imu.size(), topic_list(imu)));
   }
   start(topic_);
 }
@@ -269,7 +273,9 @@ std::string Place::str() const {
 }
 
 void ByteCursor::fail(std::string_view what) const {
-  throw InputError(file_, 0, trf("{} at {}: ends before its {} ({} bytes left)", tr(std::string(record_)), where(), what, left()));
+  throw InputError(file_, 0,
+                   trf("{} at {}: ends before its {} ({} bytes left)", tr(std::string(record_)), where(), what,
+                       left()));
 }
 
 std::string decompress_chunk(std::string_view compression, std::string_view data, std::uint64_t size,
@@ -283,8 +289,9 @@ std::string decompress_chunk(std::string_view compression, std::string_view data
   std::size_t got = 0;
   if (compression == "bz2") {
     auto len = static_cast<unsigned>(size);
-    const int r = BZ2_bzBuffToBuffDecompress(out.data(), &len, const_cast<char*>(data.data()),
-                                             static_cast<unsigned>(std::min<std::size_t>(data.size(), 0xFFFFFFFFU)), 0, 0);
+    const int r =
+        BZ2_bzBuffToBuffDecompress(out.data(), &len, const_cast<char*>(data.data()),
+                                   static_cast<unsigned>(std::min<std::size_t>(data.size(), 0xFFFFFFFFU)), 0, 0);
     if (r != BZ_OK) bad(trf("corrupt or larger than stated (bzip2 status {})", r));
     got = len;
   } else if (compression == "zstd") {

@@ -3,8 +3,8 @@
 // of one sensor_msgs/Imu topic, each its stamps and six channels, in the order they were recorded.
 // Every byte is untrusted: anything malformed is an InputError naming the file, the byte offset (or
 // the row) and what was wrong.
-#include <cstddef>
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -24,9 +24,9 @@ struct ImuMessage {
 /// its CSV export: the header stamp, the receive time, then the six channels.
 inline constexpr std::string_view kBagStampColumn = "field.header.stamp";
 inline constexpr std::string_view kBagReceiveColumn = "%time";
-inline constexpr std::string_view kImuFieldColumns[6] = {
-    "field.angular_velocity.x",    "field.angular_velocity.y",    "field.angular_velocity.z",
-    "field.linear_acceleration.x", "field.linear_acceleration.y", "field.linear_acceleration.z"};
+inline constexpr std::string_view kImuFieldColumns[6] = {"field.angular_velocity.x",    "field.angular_velocity.y",
+                                                         "field.angular_velocity.z",    "field.linear_acceleration.x",
+                                                         "field.linear_acceleration.y", "field.linear_acceleration.z"};
 
 struct BagTopic {
   std::string name, type;

@@ -14,8 +14,15 @@ namespace rwcalc::detail {
 
 namespace {
 
-enum McapOp : std::uint8_t { kMcapFooter = 0x02, kMcapSchema = 0x03, kMcapChannel = 0x04, kMcapMessage = 0x05,
-                             kMcapChunk = 0x06, kMcapStatistics = 0x0B, kMcapDataEnd = 0x0F };
+enum McapOp : std::uint8_t {
+  kMcapFooter = 0x02,
+  kMcapSchema = 0x03,
+  kMcapChannel = 0x04,
+  kMcapMessage = 0x05,
+  kMcapChunk = 0x06,
+  kMcapStatistics = 0x0B,
+  kMcapDataEnd = 0x0F
+};
 constexpr std::size_t kMcapMagicBytes = 8, kFooterBytes = 1 + 8 + 8 + 8 + 4;
 
 struct McapRecord {
@@ -69,7 +76,8 @@ class McapFile final : public BagStream {
 
 // A schema or channel record, wherever it is (summary, data, chunk).
 void McapFile::definition(const McapRecord& r, const ByteCursor& where) {
-  ByteCursor c(r.body, where.place(r.at).at, name(), r.op == kMcapSchema ? N_("MCAP schema record") : N_("MCAP channel record"));
+  ByteCursor c(r.body, where.place(r.at).at, name(),
+               r.op == kMcapSchema ? N_("MCAP schema record") : N_("MCAP channel record"));
   if (r.op == kMcapSchema) {
     const auto id = c.get<std::uint16_t>(tr("id"));
     schemas_[id] = std::string(c.string32(tr("name")));

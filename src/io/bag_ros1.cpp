@@ -15,8 +15,14 @@ namespace rwcalc::detail {
 
 namespace {
 
-enum Ros1Op : std::uint8_t { kMessage = 0x02, kBagHeader = 0x03, kIndex = 0x04, kChunk = 0x05, kChunkInfo = 0x06,
-                             kConnection = 0x07 };
+enum Ros1Op : std::uint8_t {
+  kMessage = 0x02,
+  kBagHeader = 0x03,
+  kIndex = 0x04,
+  kChunk = 0x05,
+  kChunkInfo = 0x06,
+  kConnection = 0x07
+};
 
 // One record: its header fields and its data.
 struct Ros1Record {
@@ -156,8 +162,10 @@ bool Ros1Bag::next(std::vector<ImuMessage>& batch) {
     Ros1Record r;
     recs.next(r);
     pos_ = recs.cursor().offset();
-    if (r.op == kChunk) read_chunk(recs, r, batch);
-    else if (r.op == kMessage) take_message(recs, r, batch);
+    if (r.op == kChunk)
+      read_chunk(recs, r, batch);
+    else if (r.op == kMessage)
+      take_message(recs, r, batch);
   }
   release(pos_);
   return !batch.empty();

@@ -92,7 +92,8 @@ bool Ros2Sqlite::next(std::vector<ImuMessage>& batch) {
     if (rc != SQLITE_ROW) fail_db(tr("cannot read the messages table"));
     const Place place{static_cast<std::uint64_t>(sqlite3_column_int64(rows_, 0)), ~std::uint64_t{0}, true};
     const void* blob = sqlite3_column_blob(rows_, 2);
-    const std::string_view data(static_cast<const char*>(blob), blob ? static_cast<std::size_t>(sqlite3_column_bytes(rows_, 2)) : 0);
+    const std::string_view data(static_cast<const char*>(blob),
+                                blob ? static_cast<std::size_t>(sqlite3_column_bytes(rows_, 2)) : 0);
     ImuMessage m = decode_cdr_imu(data, name(), place);
     m.receive_ns = sqlite3_column_int64(rows_, 1);
     batch.push_back(m);

@@ -254,7 +254,8 @@ std::size_t Layout::named_column(const std::string& want, std::string_view optio
   const auto named = columns_where(header, [&](std::string_view h) { return iequals(h, want); });
   if (named.empty())
     throw InputError(file, header_line,
-                     trf("no column named '{}' ({}); the columns are {}", want, option, column_list(all_columns(ncols))));
+                     trf("no column named '{}' ({}); the columns are {}", want, option,
+                         column_list(all_columns(ncols))));
   if (named.size() > 1)
     throw InputError(file, header_line,
                      trf("{} columns are named '{}' (columns {}); choose one by its index with --column", named.size(),
@@ -267,8 +268,8 @@ std::size_t Layout::named_column(const std::string& want, std::string_view optio
 void Layout::choose_times(const ReadOptions& o, std::vector<std::size_t>& times, const std::string& file) {
   if (!o.time_column.empty()) {
     if (header.empty())
-      throw InputError(file, layout_line, trf("--time-column '{}' names a column but the file has no header row",
-                                              o.time_column));
+      throw InputError(file, layout_line,
+                       trf("--time-column '{}' names a column but the file has no header row", o.time_column));
     const std::size_t t = named_column(o.time_column, "--time-column", file);
     if (t == value_col)
       throw InputError(file, header_line, trf("--time-column '{}' is the column of the samples", o.time_column));
@@ -420,8 +421,8 @@ const UnitSuffix* ros_field_unit(std::string_view column) {
   const std::string_view stem = column.substr(0, n - 2);
   for (const UnitSuffix* u : {&kRosGyro, &kRosAccel})
     if (stem.size() >= u->suffix.size() && iequals(stem.substr(stem.size() - u->suffix.size()), u->suffix) &&
-        (stem.size() == u->suffix.size() || std::string_view("./_").find(stem[stem.size() - u->suffix.size() - 1]) !=
-                                                std::string_view::npos))
+        (stem.size() == u->suffix.size() ||
+         std::string_view("./_").find(stem[stem.size() - u->suffix.size() - 1]) != std::string_view::npos))
       return u;
   return nullptr;
 }

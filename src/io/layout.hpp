@@ -98,7 +98,8 @@ struct Layout {
   void choose_by_name(const ReadOptions& o, bool value_given, const std::string& file);
   void choose_given(const std::string& want, std::size_t where, const std::string& file);
   void choose_times(const ReadOptions& o, std::vector<std::size_t>& times, const std::string& file);
-  [[nodiscard]] std::size_t named_column(const std::string& want, std::string_view option, const std::string& file) const;
+  [[nodiscard]] std::size_t named_column(const std::string& want, std::string_view option,
+                                         const std::string& file) const;
 };
 
 std::string_view delim_name(Delim d);

@@ -63,8 +63,10 @@ struct RateSource {
     } else if (phase->exact()) {
       const std::int64_t* c = phase->counts.data();
       for (std::size_t i = from; i < to; ++i) {
-        const auto d = static_cast<std::int64_t>(static_cast<std::uint64_t>(c[i + 1]) - static_cast<std::uint64_t>(c[i]));
-        out[i - from] = d >= -kTabled && d <= kTabled ? count_rate[static_cast<std::size_t>(d + kTabled)] : phase->rate(i);
+        const auto d =
+            static_cast<std::int64_t>(static_cast<std::uint64_t>(c[i + 1]) - static_cast<std::uint64_t>(c[i]));
+        out[i - from] =
+            d >= -kTabled && d <= kTabled ? count_rate[static_cast<std::size_t>(d + kTabled)] : phase->rate(i);
       }
     } else {
       const double* x = phase->values.data();
@@ -133,8 +135,8 @@ OutlierScale scale_of(const RateSource& src) {
   std::vector<double> residuals(strided_below(src.n, stride));  // in record order, each chunk its own stretch
   parallel_for(part_resolution.size(), [&](std::size_t c) {
     const std::size_t from = c * kChunk;
-    part_resolution[c] = scale_part(src, from, std::min(src.n, from + kChunk), stride,
-                                    residuals.data() + strided_below(from, stride));
+    part_resolution[c] =
+        scale_part(src, from, std::min(src.n, from + kChunk), stride, residuals.data() + strided_below(from, stride));
   });
   const double resolution = *std::min_element(part_resolution.begin(), part_resolution.end());
   // The median |residual|: the value of rank size/2, whatever the order the parts came in.

@@ -18,8 +18,6 @@
 
 #include "bag.hpp"
 #include "line_parser.hpp"
-#include "sample_memory.hpp"
-#include "text_source.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/limits.hpp"
 #include "rwcalc/memory.hpp"
@@ -27,6 +25,8 @@
 #include "rwcalc/printable.hpp"
 #include "rwcalc/progress.hpp"
 #include "rwcalc/units.hpp"
+#include "sample_memory.hpp"
+#include "text_source.hpp"
 
 namespace rwcalc {
 
@@ -51,9 +51,9 @@ struct TimeTrack {
   std::vector<Step> lows, highs;
   std::vector<Step> long_steps;  // over 1.25 median steps: the candidate gaps of `--gaps segments`
   double max_no_gap = -std::numeric_limits<double>::infinity();  // the longest step below 1.5 median
-  double tolerance = 0.01;  // fraction of the median step
-  double median = 0;        // of the first steps; 0 until known
-  double shift = 0;         // the first step: Σ(dt − shift) and Σ(dt − shift)² keep their digits
+  double tolerance = 0.01;                                       // fraction of the median step
+  double median = 0;                                             // of the first steps; 0 until known
+  double shift = 0;  // the first step: Σ(dt − shift) and Σ(dt − shift)² keep their digits
   long double sum1 = 0, sum2 = 0;
   std::size_t off = 0;  // steps off the median by more than the tolerance
   bool median_known = false;
@@ -329,8 +329,7 @@ void Reader::read_bag(detail::BagStream& bag) {
       }
       progress.advance(bag.taken() - std::min(bag.taken(), progress.done()));
     }
-    if (samples_ == 0)
-      fail(0, trf("topic '{}' of this {} has no messages", bag.topic().name, bag.format()));
+    if (samples_ == 0) fail(0, trf("topic '{}' of this {} has no messages", bag.topic().name, bag.format()));
   } catch (const detail::CeilingReached&) {
     Reader& full = reached_ ? *reached_ : *this;
     full.refuse_memory_bag(bag);
@@ -340,7 +339,9 @@ void Reader::read_bag(detail::BagStream& bag) {
 void Reader::bag_message(const detail::ImuMessage& m) {
   ++line_;
   const auto field = [&m](std::size_t col) {
-    return col == 0 ? static_cast<double>(m.stamp_ns) : col == 1 ? static_cast<double>(m.receive_ns) : m.values[col - 2];
+    return col == 0   ? static_cast<double>(m.stamp_ns)
+           : col == 1 ? static_cast<double>(m.receive_ns)
+                      : m.values[col - 2];
   };
   Sample s;
   s.real = field(layout_.value_col);
@@ -391,14 +392,15 @@ std::size_t Reader::take_lines(std::string& buf, bool at_end) {
   if (!eol_ && !decide_line_end(std::string_view(buf).substr(p), at_end)) return p;
   const std::size_t end = eol_ == '\r' ? mac_limit(buf, p, at_end) : buf.size();
   while (p < end) {
-    if (eol_ == '\n' && samples_ > 0 && !new_run_ && integer_mode() && followers_.empty()) {  // one integer column's lines, in bulk
+    if (eol_ == '\n' && samples_ > 0 && !new_run_ && integer_mode() &&
+        followers_.empty()) {  // one integer column's lines, in bulk
       // Room first, within the memory ceiling: a line takes at least 2 bytes; the bulk read stops
       // where the room does, and the next pass asks for more (CeilingReached when none is left).
       memory_.make_room(ints_, (end - p) / 2 + 1);
       const std::size_t before = ints_.size();
-      p = static_cast<std::size_t>(parser_.plain_integer_lines(buf.data() + p, buf.data() + end, line_, ints_,
-                                                               ints_.capacity() - before) -
-                                   buf.data());
+      p = static_cast<std::size_t>(
+          parser_.plain_integer_lines(buf.data() + p, buf.data() + end, line_, ints_, ints_.capacity() - before) -
+          buf.data());
       samples_ += ints_.size() - before;
       if (p == end) break;
     }
@@ -654,8 +656,9 @@ void Reader::check_rates(const PhaseSeries& ph, const std::vector<double>& x, do
                              "squares would overflow")
                         : N_("rate out of range: {} {}{} is beyond ±{:g} {}, where the variances the noise fit squares "
                              "would overflow"),
-             detail::quoted(fmt::format("{:g}", x[i])), increments ? to_string(in().angle_unit) : to_string(in().rate_unit),
-             as_rate, kMaxDataRate, ph.deviation_unit()));
+             detail::quoted(fmt::format("{:g}", x[i])),
+             increments ? to_string(in().angle_unit) : to_string(in().rate_unit), as_rate, kMaxDataRate,
+             ph.deviation_unit()));
   }
 }
 
@@ -875,14 +878,17 @@ struct Pass {
   }
   void read() {
     if (!bag) return readers.front()->read(*src);
-    parallel_for(2, [&](std::size_t i) { i == 0 ? readers.front()->read_bag(*bag) : void(bag_sha256 = bag->sha256()); });
+    parallel_for(2,
+                 [&](std::size_t i) { i == 0 ? readers.front()->read_bag(*bag) : void(bag_sha256 = bag->sha256()); });
   }
   Recording finish(std::size_t i, const std::string& source) {
     Recording rec = readers[i]->finish();
     rec.source = source;
     rec.file_bytes = bag ? bag->size() : src->raw_bytes();
     rec.sha256 = bag ? bag_sha256 : src->sha256();
-    if (bag) rec.notes.insert(rec.notes.begin(), trf("{} topic '{}' ({})", bag->format(), bag->topic().name, bag->topic().type));
+    if (bag)
+      rec.notes.insert(rec.notes.begin(),
+                       trf("{} topic '{}' ({})", bag->format(), bag->topic().name, bag->topic().type));
     return rec;
   }
 };

@@ -11,8 +11,8 @@
 #include <optional>
 #include <unordered_map>
 
-#include "rwcalc/json_input.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/json_input.hpp"
 #include "rwcalc/reader.hpp"
 
 namespace rwcalc {

@@ -10,8 +10,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "rwcalc/narrow_counts.hpp"
 #include "rwcalc/confidence.hpp"
+#include "rwcalc/narrow_counts.hpp"
 #include "rwcalc/noise_model.hpp"
 #include "rwcalc/parallel.hpp"
 #include "rwcalc/random.hpp"

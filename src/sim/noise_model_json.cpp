@@ -11,9 +11,9 @@
 #include <utility>
 #include <vector>
 
-#include "rwcalc/json_input.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
+#include "rwcalc/json_input.hpp"
 #include "rwcalc/noise_model.hpp"
 
 namespace rwcalc {
@@ -31,7 +31,7 @@ double num(const Value& object, const char* key, double fallback = 0.0) {
 
 /// How `simulate --from` takes the fitted coefficients, and what it says about them.
 struct CoefficientPolicy {
-  bool upper_bounds = false;                ///< unresolved terms at their 95 % upper bounds
+  bool upper_bounds = false;                  ///< unresolved terms at their 95 % upper bounds
   std::vector<std::string>* notes = nullptr;  ///< one line per term left out or at its bound
 };
 

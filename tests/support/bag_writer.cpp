@@ -9,11 +9,11 @@
 
 #include <algorithm>
 #include <cstring>
-#include <tuple>
 #include <fstream>
 #include <map>
 #include <random>
 #include <stdexcept>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -100,8 +100,8 @@ std::string compress(const std::string& how, const std::string& plain) {
   if (how == "bz2") {
     std::string out(plain.size() + plain.size() / 100 + 600, '\0');
     auto len = static_cast<unsigned>(out.size());
-    if (BZ2_bzBuffToBuffCompress(out.data(), &len, const_cast<char*>(plain.data()),
-                                 static_cast<unsigned>(plain.size()), 9, 0, 0) != BZ_OK)
+    if (BZ2_bzBuffToBuffCompress(out.data(), &len, const_cast<char*>(plain.data()), static_cast<unsigned>(plain.size()),
+                                 9, 0, 0) != BZ_OK)
       throw std::runtime_error("bz2");
     out.resize(len);
     return out;
@@ -131,13 +131,15 @@ void write_file(const std::filesystem::path& path, const std::string& bytes) {
 std::vector<std::tuple<std::int64_t, std::size_t, std::size_t>> interleaved(const std::vector<BagTopicSpec>& topics) {
   std::vector<std::tuple<std::int64_t, std::size_t, std::size_t>> all;
   for (std::size_t t = 0; t < topics.size(); ++t)
-    for (std::size_t i = 0; i < topics[t].messages.size(); ++i) all.emplace_back(topics[t].messages[i].receive_ns, t, i);
+    for (std::size_t i = 0; i < topics[t].messages.size(); ++i)
+      all.emplace_back(topics[t].messages[i].receive_ns, t, i);
   std::stable_sort(all.begin(), all.end());
   return all;
 }
 
 std::string type_of(const BagTopicSpec& t, bool ros2) {
-  return t.imu ? (ros2 ? "sensor_msgs/msg/Imu" : "sensor_msgs/Imu") : (ros2 ? "std_msgs/msg/String" : "std_msgs/String");
+  return t.imu ? (ros2 ? "sensor_msgs/msg/Imu" : "sensor_msgs/Imu")
+               : (ros2 ? "std_msgs/msg/String" : "std_msgs/String");
 }
 
 }  // namespace
@@ -184,8 +186,9 @@ void write_ros1_bag(const std::filesystem::path& path, const std::vector<BagTopi
       ++counts[static_cast<std::uint32_t>(t)];
     }
     const std::uint64_t chunk_pos = header_bytes + body.size();
-    body += record(op(5) + field("compression", compression) + field_of("size", static_cast<std::uint32_t>(plain.size())),
-                   compress(compression, plain));
+    body +=
+        record(op(5) + field("compression", compression) + field_of("size", static_cast<std::uint32_t>(plain.size())),
+               compress(compression, plain));
     std::string data;
     for (const auto& [c, n] : counts) put(data, c), put(data, n);
     infos += record(op(6) + field_of("ver", std::uint32_t{1}) + field_of("chunk_pos", chunk_pos) +
@@ -324,10 +327,11 @@ void write_mcap(const std::filesystem::path& path, const std::vector<BagTopicSpe
 }
 
 std::string rostopic_csv(const std::vector<ImuSample>& samples) {
-  std::string s = "%time,field.header.seq,field.header.stamp,field.header.frame_id,field.orientation.x,"
-                  "field.orientation.y,field.orientation.z,field.orientation.w,field.angular_velocity.x,"
-                  "field.angular_velocity.y,field.angular_velocity.z,field.linear_acceleration.x,"
-                  "field.linear_acceleration.y,field.linear_acceleration.z\n";
+  std::string s =
+      "%time,field.header.seq,field.header.stamp,field.header.frame_id,field.orientation.x,"
+      "field.orientation.y,field.orientation.z,field.orientation.w,field.angular_velocity.x,"
+      "field.angular_velocity.y,field.angular_velocity.z,field.linear_acceleration.x,"
+      "field.linear_acceleration.y,field.linear_acceleration.z\n";
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const ImuSample& m = samples[i];
     s += fmt::format("{},{},{},{},0.0,0.0,0.0,1.0,{},{},{},{},{},{}\n", m.receive_ns, i, m.stamp_ns, kFrame, m.gyro[0],
