@@ -268,7 +268,7 @@ TEST_P(ProtocolReport, ARussianReportShowsNoEnglishButNamesAndIdentifiers) {
 
 TEST(QuantityText, UncertaintyToOneOrTwoDigitsAndTheValueToTheSameDigit) {
   const LanguageScope en(Language::English);
-  EXPECT_EQ(rwcalc::value_with_uncertainty(0.000845, 2.1e-5), "0.000851 ± 0.000021");
+  EXPECT_EQ(rwcalc::value_with_uncertainty(0.000845, 2.1e-5), "0.000845 ± 0.000021");
   EXPECT_EQ(rwcalc::value_with_uncertainty(0.007, 0.00087), "0.0070 ± 0.0009");  // 0.87: one digit
   EXPECT_EQ(rwcalc::value_with_uncertainty(0.00703, 0.00123), "0.0070 ± 0.0012");
   EXPECT_EQ(rwcalc::value_with_uncertainty(12345.0, 230.0), "12350 ± 230");
