@@ -94,9 +94,10 @@ std::string input_line(const nlohmann::json& in) {
 
 }  // namespace
 
-static std::string format_verdict(const AnalysisResult& r);
+namespace {
 
-std::string format_report(const AnalysisResult& r) {
+/// The record: source, warnings, samples, input, segments, temperature, mean rate, outliers.
+std::string data_section(const AnalysisResult& r) {
   std::string s;
   s += trf("rwcalc analyze: {}\n\n", as_typed(r.source));
   s += format_warnings(r.warnings);
@@ -117,7 +118,12 @@ std::string format_report(const AnalysisResult& r) {
     s += trf("  mean rate {:.4f} °/h, the bias (no Earth rate subtracted)\n  {}\n\n", r.mean_rate_deg_per_h,
              r.not_applied_reason);
   s += format_outliers(r.outliers);
+  return s;
+}
 
+/// The Allan deviation table with the fitted model beside it.
+std::string allan_section(const AnalysisResult& r) {
+  std::string s;
   s += trf("Allan deviation ({}, bounds at {:g} %{}; * = used in the fit)\n", to_string(r.allan.estimator),
            100.0 * r.allan.confidence, r.model_bounds ? tr(" from the fitted model's EDF; α of its leading term") : "");
   s += fmt::format("  {:>11} {:>12} {:>12} {:>12} {:>10} {:>4} {:>12}\n", tr("tau (s)"), tr("sigma (°/h)"),
@@ -129,7 +135,12 @@ std::string format_report(const AnalysisResult& r) {
                      p.dev_low, p.dev_high, p.edf, p.alpha, std::sqrt(r.fit.model_var(p.tau_s)), used ? " *" : "");
   }
   s += "\n";
+  return s;
+}
 
+/// The noise coefficients of the fit, its range, read-out and goodness of fit.
+std::string fit_section(const AnalysisResult& r) {
+  std::string s;
   const auto& f = r.fit;
   s +=
       trf("Noise coefficients (Gamma-deviance fit of {} octave points, tau {:g}..{:g} s; 95 % profile "
@@ -152,7 +163,12 @@ std::string format_report(const AnalysisResult& r) {
            f.dof, f.p_value, f.corr_NQ, f.corr_NB);
   s += trf("  (variance inflation for correlated AV points and few EDF: N x{:.2f}, B x{:.2f})\n\n",
            f.phi[static_cast<std::size_t>(Term::N)], f.phi[static_cast<std::size_t>(Term::B)]);
+  return s;
+}
 
+/// The classic single-term slope lines.
+std::string slope_section(const AnalysisResult& r) {
+  std::string s;
   s += tr("Classic slope-line readout (single-term lines; biased where terms overlap)\n");
   s += r.slope.N
            ? trf("  N = {} °/√h (−½ line through tau = {:.3g} s, read at 1 h)\n", num(*r.slope.N, 3), r.slope.tau_N_s)
@@ -171,7 +187,12 @@ std::string format_report(const AnalysisResult& r) {
            ? trf("  K = {} °/h/√h (+½ line through tau = {:.3g} s, read at 3 h)\n", num(*r.slope.K, 3), r.slope.tau_K_s)
            : std::string(tr("  K: no part of the curve has slope +½\n"));
   s += "\n";
+  return s;
+}
 
+/// The paper's cross-checks as unbiased estimators.
+std::string cross_check_section(const AnalysisResult& r) {
+  std::string s;
   s += tr("Cross-checks (the paper's methods as unbiased estimators; 95 % intervals)\n");
   const auto& d = r.direct;
   if (d.N.valid)
@@ -209,7 +230,20 @@ std::string format_report(const AnalysisResult& r) {
         num(r.avg100.spread.sigma, 2), num(r.avg100.expected, 3), num(r.avg100.expected_sigma, 2),
         r.B_100s_vs_model_sigma);
   s += "\n";
+  return s;
+}
 
+}  // namespace
+
+static std::string format_verdict(const AnalysisResult& r);
+
+std::string format_report(const AnalysisResult& r) {
+  std::string s;
+  s += data_section(r);
+  s += allan_section(r);
+  s += fit_section(r);
+  s += slope_section(r);
+  s += cross_check_section(r);
   s += r.verdict_applies ? format_verdict(r) : trf("Verdict: not given ({})\n\n", r.not_applied_reason);
   s +=
       tr("Conventions: Q = rms white angle error, sigma² = 3Q²/tau² (IEEE 952; the paper's eq. (2) Q is √3·Q);\n"
