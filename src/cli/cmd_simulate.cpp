@@ -451,24 +451,10 @@ int run_simulate(const SimulateArgs& a, const CLI::App& sub, Io& io) {
 
 }  // namespace
 
-void register_simulate(CLI::App& app, Runner& runner) {
-  auto args = std::make_shared<SimulateArgs>();
-  auto* sub = app.add_subcommand(
-      "simulate",
-      tr("Simulate a gyro pulse record (exact discrete-time noise terms, counted in whole pulses) and write it as a "
-         "GL-2D pulse file (.gz compresses). Rates are in deg/h (= arcsec/s)."));
-  auto& a = *args;
-  sub->add_option("-o,--output", a.output, tr("Output pulse file (FILE.csv or FILE.csv.gz; - for stdout)"))
-      ->check(output_name())
-      ->required();
-  sub->add_option("--truth", a.truth, tr("Also write the ground truth (model JSON, seed, settings) to this file"))
-      ->check(output_name());
-  sub->add_option("--from", a.from,
-                  tr("Take the model from 'rwcalc analyze --json' or 'rwcalc diagnose --json' output: the fitted model "
-                     "(terms at their estimates; terms the fit left out or did not resolve are left out)"));
-  sub->add_flag("--upper-bounds", a.upper_bounds,
-                tr("With --from: put the terms the fit did not resolve in at their 95 % upper bounds (a pessimistic "
-                   "model, not the fitted one)"));
+namespace {
+
+/// The record: its length, rate, pulse weight, seed, metadata and layout.
+void add_record_options(CLI::App* sub, SimulateArgs& a) {
   sub->add_option("--duration", a.duration_s, tr("Record length, s"))
       ->check(real_in(0.0, 1e9, "s", Ends::OpenLow))
       ->capture_default_str()
@@ -501,6 +487,10 @@ void register_simulate(CLI::App& app, Runner& runner) {
       ->check(CLI::IsMember({"pulses", "imu"}))
       ->capture_default_str()
       ->group(tr("Record"));
+}
+
+/// --layout imu: the six axes' noise levels, output steps and accelerometer unit.
+void add_imu_layout_options(CLI::App* sub, SimulateArgs& a) {
   sub->add_option("--gyro-noise", a.gyro_noise,
                   tr("--layout imu: the gyros' N:B:K (deg/sqrt(h), deg/h, deg/h/sqrt(h)), once for every axis or "
                      "three times for x,y,z"))
@@ -524,6 +514,10 @@ void register_simulate(CLI::App& app, Runner& runner) {
       ->check(CLI::IsMember({"m/s^2", "g"}))
       ->capture_default_str()
       ->group(tr("IMU layout"));
+}
+
+/// The five-term model, the bias, the Earth rate and the read-out.
+void add_noise_term_options(CLI::App* sub, SimulateArgs& a) {
   sub->add_option("--arw", a.arw, tr("Angle random walk N, deg/sqrt(h)"))
       ->check(real_in(0.0, kMaxRateDegPerH, "deg/sqrt(h)"))
       ->group(tr("Noise terms"));
@@ -551,6 +545,10 @@ void register_simulate(CLI::App& app, Runner& runner) {
   sub->add_option("--white-angle", a.white_angle, tr("Extra white angle noise before counting, rms arcsec"))
       ->check(real_in(0.0, 1e12, "arcsec"))
       ->group(tr("Noise terms"));
+}
+
+/// The effects beyond the five-term model (the diagnosis' extended terms).
+void add_extended_term_options(CLI::App* sub, SimulateArgs& a) {
   sub->add_option("--sinusoid", a.sinusoids,
                   tr("Sinusoidal rate F_HZ:AMP_DEG_PER_H[:PHASE_RAD] (Hz, deg/h, rad); repeatable"))
       ->group(tr("Extended terms"));
@@ -580,6 +578,32 @@ void register_simulate(CLI::App& app, Runner& runner) {
          tr("Temperature during the record: ramp:START_C:END_C (linear) or cycle:AMP_C:PERIOD_S (about --temperature); "
             "bias = coef*(T(t) - T_nominal), T_nominal = --temperature (ramp: else START_C; cycle: else 0)"))
       ->group(tr("Extended terms"));
+}
+
+}  // namespace
+
+void register_simulate(CLI::App& app, Runner& runner) {
+  auto args = std::make_shared<SimulateArgs>();
+  auto* sub = app.add_subcommand(
+      "simulate",
+      tr("Simulate a gyro pulse record (exact discrete-time noise terms, counted in whole pulses) and write it as a "
+         "GL-2D pulse file (.gz compresses). Rates are in deg/h (= arcsec/s)."));
+  auto& a = *args;
+  sub->add_option("-o,--output", a.output, tr("Output pulse file (FILE.csv or FILE.csv.gz; - for stdout)"))
+      ->check(output_name())
+      ->required();
+  sub->add_option("--truth", a.truth, tr("Also write the ground truth (model JSON, seed, settings) to this file"))
+      ->check(output_name());
+  sub->add_option("--from", a.from,
+                  tr("Take the model from 'rwcalc analyze --json' or 'rwcalc diagnose --json' output: the fitted model "
+                     "(terms at their estimates; terms the fit left out or did not resolve are left out)"));
+  sub->add_flag("--upper-bounds", a.upper_bounds,
+                tr("With --from: put the terms the fit did not resolve in at their 95 % upper bounds (a pessimistic "
+                   "model, not the fitted one)"));
+  add_record_options(sub, a);
+  add_imu_layout_options(sub, a);
+  add_noise_term_options(sub, a);
+  add_extended_term_options(sub, a);
   sub->callback(
       [&runner, args, sub] { runner = [args, sub](Io& io) -> int { return run_simulate(*args, *sub, io); }; });
 }
