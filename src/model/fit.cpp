@@ -897,9 +897,17 @@ FitBase fit_base(std::span<const FitPoint> points, const FitOptions& options) {
   return b;
 }
 
-/// The fit of one term set (`set`: the enabled terms, `dropped` those the selection left out, reported
-/// from the full model), started from `start`, with every coefficient's interval from its profile.
-FitResult fit_term_set(const FitBase& b, const FitOptions& set, const std::array<bool, P>& dropped, const Vec5& start) {
+/// One term set's fit (`set`: the enabled terms, `dropped` those the selection left out, reported from
+/// the full model) before its coefficients' intervals: what choosing between fits reads (χ²), and the
+/// stage the intervals' profiles start from.
+struct SetFit {
+  Stage sel;
+  FitResult res;
+  std::array<bool, P> dropped{};
+};
+
+/// The fit of one term set started from `start`, its intervals not yet taken (add_intervals).
+SetFit fit_term_set(const FitBase& b, const FitOptions& set, const std::array<bool, P>& dropped, const Vec5& start) {
   FitResult res;
   res.counter_readout = b.options.counter && b.options.readout == Readout::Counter;
   res.used = b.used;
@@ -917,6 +925,15 @@ FitResult fit_term_set(const FitBase& b, const FitOptions& set, const std::array
   term_covariance(sel, b.sigma_y, b.options, b.phi_full, dropped, res);
   res.corr_NQ = res.log_correlation(Term::N, Term::Q);
   res.corr_NB = res.log_correlation(Term::N, Term::B);
+  return {std::move(sel), std::move(res), dropped};
+}
+
+/// Every coefficient's interval from its profile: the costly part of a fit, taken only for the fit
+/// that is reported (or averaged).
+FitResult add_intervals(const FitBase& b, SetFit f) {
+  const Stage& sel = f.sel;
+  const auto& dropped = f.dropped;
+  FitResult& res = f.res;
   // Each term's interval is a profile of its own (a counter read-out's the costliest): in parallel.
   parallel_for(static_cast<std::size_t>(P), [&](std::size_t ui) {
     auto& co = res.coef[ui];
@@ -933,45 +950,46 @@ FitResult fit_term_set(const FitBase& b, const FitOptions& set, const std::array
     if (!std::isfinite(co.value) || !std::isfinite(co.sigma) || !std::isfinite(co.low) || !std::isfinite(co.high))
       throw AnalysisError(trf("the data do not bound the {} coefficient", term_name(kAllTerms[ui])));
   }
-  return res;
+  return std::move(res);
 }
 
 /// The selected term set's fit with the read-out model of options.readout (Auto taken as White), and
 /// what its average over K needs.
 struct Selected {
   FitBase base;
-  std::array<bool, P> dropped{};
   Vec5 d;  // the selected set's optimum, scaled
-  FitResult res;
+  SetFit fit;
 };
 
 Selected fit_selected(std::span<const FitPoint> points, const FitOptions& options) {
-  Selected s{fit_base(points, options), {}, {}, {}};
-  FitOptions set = s.base.opt;
-  IrlsResult best = s.base.full.fit;
+  FitBase base = fit_base(points, options);
+  FitOptions set = base.opt;
+  IrlsResult best = base.full.fit;
+  std::array<bool, P> dropped{};
   if (options.select_terms)
-    std::tie(set, best) = select_terms(s.base.used, s.base.opt, best, s.base.phi_full, s.base.chi2_1, s.dropped);
-  s.d = best.d;
-  s.res = fit_term_set(s.base, set, s.dropped, best.d);
-  return s;
+    std::tie(set, best) = select_terms(base.used, base.opt, best, base.phi_full, base.chi2_1, dropped);
+  SetFit fit = fit_term_set(base, set, dropped, best.d);
+  return {std::move(base), best.d, std::move(fit)};
 }
 
 /// With the term selection, the selected set's coefficients averaged with the set that differs in K.
 FitResult averaged_over_k(Selected s) {
   const FitBase& b = s.base;
+  const std::array<bool, P> dropped = s.fit.dropped;
+  FitResult res = add_intervals(b, std::move(s.fit));
   const auto uk = static_cast<std::size_t>(idx(Term::K));
-  if (!b.options.select_terms || !b.options.enabled[uk] || !b.options.droppable[uk]) return std::move(s.res);
-  FitOptions other = s.res.options;
+  if (!b.options.select_terms || !b.options.enabled[uk] || !b.options.droppable[uk]) return res;
+  FitOptions other = res.options;
   other.enabled[uk] = !other.enabled[uk];
-  std::array<bool, P> other_dropped = s.dropped;
+  std::array<bool, P> other_dropped = dropped;
   other_dropped[uk] = !other.enabled[uk];
   Vec5 start = s.d;
   start[idx(Term::K)] = other.enabled[uk] ? b.full.fit.d[idx(Term::K)] : 0.0;
   try {
-    average_over_k(s.res, fit_term_set(b, other, other_dropped, start), b.phi_full[uk], b.z);
+    average_over_k(res, add_intervals(b, fit_term_set(b, other, other_dropped, start)), b.phi_full[uk], b.z);
   } catch (const AnalysisError&) {  // the other set cannot be fitted: the selected one stands alone
   }
-  return std::move(s.res);
+  return res;
 }
 
 }  // namespace
@@ -985,10 +1003,11 @@ FitResult fit_noise(std::span<const FitPoint> points, const FitOptions& options)
   FitOptions white = options, counter = options;
   white.readout = Readout::White;
   counter.readout = Readout::Counter;
+  // Only the chosen model's intervals are profiled: the choice reads the two fits' χ² alone.
   Selected w = fit_selected(points, white);
   try {
     Selected c = fit_selected(points, counter);
-    if (c.res.chi2 + kCounterMargin < w.res.chi2) return averaged_over_k(std::move(c));
+    if (c.fit.res.chi2 + kCounterMargin < w.fit.res.chi2) return averaged_over_k(std::move(c));
   } catch (const AnalysisError&) {  // the white model stands
   }
   return averaged_over_k(std::move(w));
