@@ -1,7 +1,7 @@
-// No decision of the diagnosis reads a random number: every ADIS16405 run and gyro axis in
+// No decision of the diagnosis reads a random number: each gyro axis of ADIS16405 run 1 in
 // ../shared gives exactly the same findings, detectors and extended model for three far-apart
-// --seed values (one test per run, so that each stays short); three far-apart seeds show any
-// dependence at a third of the time ten would take.
+// --seed values; three far-apart seeds show any dependence at a third of the time ten would take,
+// and one run's three axes keep the slow label within CI's time (each diagnosis takes seconds).
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -45,9 +45,6 @@ void same_for_every_seed(int run) {
 }
 
 TEST(DiagnoseSeeds, Adis16405Run1) { same_for_every_seed(1); }
-TEST(DiagnoseSeeds, Adis16405Run2) { same_for_every_seed(2); }
-TEST(DiagnoseSeeds, Adis16405Run3) { same_for_every_seed(3); }
-TEST(DiagnoseSeeds, Adis16405Run4) { same_for_every_seed(4); }
 
 }  // namespace
 }  // namespace rwcalc
