@@ -1,14 +1,20 @@
 // Reading: parse the text of a 2-h 400 Hz GL-2D pulse file already in memory (the floor of
 // `rwcalc analyze` is reading and parsing ~6 MB), the same read from a file, and the cumulative
-// sums it ends with.
+// sums it ends with; the short decimals of IMU text read by read_decimal against std::from_chars.
 #include <benchmark/benchmark.h>
 
+#include <charconv>
 #include <filesystem>
 #include <fstream>
 #include <numeric>
+#include <random>
+#include <string>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "bench_inputs.hpp"
+#include "io/decimal.hpp"
 #include "rwcalc/reader.hpp"
 
 namespace {
@@ -86,5 +92,45 @@ void BM_PrefixSumOfCounts2h(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(c.size()));
 }
 BENCHMARK(BM_PrefixSumOfCounts2h)->Unit(benchmark::kMillisecond);
+
+// One million fields as the ADIS16405 IMU text holds them (gyro "-0.35", accelerometer
+// "-1.01565"), each ended by a comma.
+const std::string& imu_fields() {
+  static const std::string text = [] {
+    std::mt19937_64 rng(3);
+    std::string t;
+    for (int i = 0; i < 1'000'000; ++i)
+      t += i % 2 ? fmt::format("-{}.{:05d},", rng() % 2, rng() % 100000)
+                 : fmt::format("{}.{},", rng() % 3, rng() % 20 * 5);
+    return t;
+  }();
+  return text;
+}
+
+template <class Read>
+void read_fields(benchmark::State& state, const Read& read) {
+  const std::string& t = imu_fields();
+  for (auto _ : state) {
+    double sum = 0;
+    for (const char* p = t.data(); p < t.data() + t.size();) {
+      double v = 0;
+      p = read(p, t.data() + t.size(), v).ptr + 1;
+      sum += v;
+    }
+    benchmark::DoNotOptimize(sum);
+  }
+  state.SetItemsProcessed(state.iterations() * 1'000'000);
+}
+
+// The stage the reader's bulk reading of decimal columns spends most of its time in.
+void BM_ReadDecimalImuFields(benchmark::State& state) {
+  read_fields(state, [](const char* p, const char* e, double& v) { return rwcalc::detail::read_decimal(p, e, v); });
+}
+BENCHMARK(BM_ReadDecimalImuFields)->Unit(benchmark::kMillisecond);
+
+void BM_FromCharsImuFields(benchmark::State& state) {
+  read_fields(state, [](const char* p, const char* e, double& v) { return std::from_chars(p, e, v); });
+}
+BENCHMARK(BM_FromCharsImuFields)->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -1,6 +1,6 @@
 // Each line is split at the delimiter and its selected fields read with std::from_chars (exact int64
-// for pulses and counters, correctly rounded doubles otherwise). A data line of the known layout is
-// taken as soon as its fields read; any other is looked at in the order that decides its error.
+// for pulses and counters; correctly rounded doubles otherwise, through read_decimal). A data line of the known layout
+// is taken as soon as its fields read; any other is looked at in the order that decides its error.
 #include "line_parser.hpp"
 
 #include <algorithm>
@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "decimal.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/parallel.hpp"
@@ -106,6 +107,24 @@ bool plain_value(const char*& p, const char* end, std::int64_t& v) {
   return true;
 }
 
+// [p, end) read by `run(from, to, out)`, which appends the lines it takes to `out` and returns where
+// it stopped; with `split`, in two halves on two cores, cut after a line end: the second half's
+// lines (gathered in `second`) count only if the first half reached them, so the lines taken and
+// where the reading stops are those of one pass.
+template <class T, class Run>
+const char* in_halves(const char* p, const char* end, bool split, std::vector<T>& out, std::vector<T>& second,
+                      const Run& run) {
+  const auto half = static_cast<std::size_t>(end - p) / 2;
+  const auto* cut = split ? static_cast<const char*>(std::memchr(p + half, '\n', half)) : nullptr;
+  if (!cut) return run(p, end, out);
+  const char* stop[2] = {};
+  second.clear();
+  parallel_for(2, [&](std::size_t h) { stop[h] = h == 0 ? run(p, cut + 1, out) : run(cut + 1, end, second); });
+  if (stop[0] != cut + 1) return stop[0];
+  out.insert(out.end(), second.begin(), second.end());
+  return stop[1];
+}
+
 }  // namespace
 
 // The one integer column of pulses or a counter, which plain_integer and plain_integer_lines read.
@@ -145,30 +164,118 @@ const char* LineParser::plain_integer_lines(const char* p, const char* end, std:
                                             std::vector<std::int64_t>& out, std::size_t max_lines) {
   if (!plain_layout()) return p;
   const std::size_t before = out.size();
-  // A long stretch with room for every line it can hold (each takes 2 bytes or more) is read in two
-  // halves on two cores, cut after a line end: the second half's lines count only if the first half
-  // reached them, so the lines taken and where the reading stops are those of one pass.
-  const char* cut =
-      end - p >= kSplitBytes && max_lines > static_cast<std::size_t>(end - p) / 2
-          ? static_cast<const char*>(std::memchr(p + (end - p) / 2, '\n', static_cast<std::size_t>(end - p) / 2))
-          : nullptr;
-  if (!cut) {
-    p = plain_run(p, end, out, max_lines);
-  } else {
-    const char* stop[2] = {};
-    second_half_.clear();
-    parallel_for(2, [&](std::size_t half) {
-      stop[half] = half == 0 ? plain_run(p, cut + 1, out, max_lines) : plain_run(cut + 1, end, second_half_, max_lines);
-    });
-    p = stop[0];
-    if (stop[0] == cut + 1) {
-      out.insert(out.end(), second_half_.begin(), second_half_.end());
-      p = stop[1];
-    }
-  }
+  // Every line takes 2 bytes or more: with room for that many, the halves cannot pass max_lines.
+  const bool split = end - p >= kSplitBytes && max_lines > static_cast<std::size_t>(end - p) / 2;
+  p = in_halves(p, end, split, out, second_half_, [&](const char* from, const char* to, std::vector<std::int64_t>& o) {
+    return plain_run(from, to, o, max_lines);
+  });
   line += out.size() - before;
   content_lines_ += out.size() - before;
   return p;
+}
+
+namespace {
+
+constexpr bool blank(char c) noexcept { return c == ' ' || c == '\t'; }
+
+// A field no column wants, from q to its end (the delimiter, a blank when blank-separated, the line
+// end); nullptr at a byte that sends the line the general way (a CR inside it, a foreign delimiter).
+const char* skip_field(const char* q, const char* end, char d, bool blanks) noexcept {
+  for (; q < end; ++q) {
+    const char c = *q;
+    if (c == '\n' || (blanks ? blank(c) : c == d)) return q;
+    if (c == '\r') return q + 1 < end && q[1] == '\n' ? q : nullptr;
+    if (c == ';' || c == '\t') return nullptr;
+  }
+  return q;
+}
+
+// One line of `slot_of_col.size()` fields from q on, its wanted fields' values onto `out`: where the
+// next line starts, or nullptr when the general way must take the line (it may still accept it, as
+// with blanks around a field or a leading plus, or report it). A value is the whole field read by
+// read_decimal, as the general way reads it: the bytes that end a field (delimiter, blank, CR, LF)
+// cannot continue a number, so the value read up to them is the field's own.
+const char* decimal_line(const char* q, const char* end, char d, bool blanks, const std::vector<int>& slot_of_col,
+                         std::vector<double>& out) {
+  if (blanks)
+    while (q < end && blank(*q)) ++q;
+  if (q == end || *q == '#' || blank(*q)) return nullptr;
+  for (std::size_t c = 0; c < slot_of_col.size(); ++c) {
+    if (c > 0) {
+      if (q == end || (blanks ? !blank(*q) : *q != d)) return nullptr;
+      ++q;
+      if (blanks)
+        while (q < end && blank(*q)) ++q;
+    }
+    if (slot_of_col[c] < 0) {
+      if (!(q = skip_field(q, end, d, blanks))) return nullptr;
+      continue;
+    }
+    double v = 0;
+    const auto r = read_decimal(q, end, v);
+    if (r.ec != std::errc() || !std::isfinite(v)) return nullptr;
+    out.push_back(v);
+    q = r.ptr;
+  }
+  if (blanks)
+    while (q < end && blank(*q)) ++q;
+  else if (blank(q[-1]))  // a blank ending the line: the general way
+    return nullptr;
+  if (q < end && *q == '\r') ++q;
+  return q < end && *q == '\n' ? q + 1 : nullptr;
+}
+
+}  // namespace
+
+// The lines of [p, end) while they are common data lines, onto `out`; returns where the first other
+// line starts.
+const char* LineParser::decimal_run(const char* p, const char* end, const std::vector<int>& slot_of_col,
+                                    std::vector<double>& out, std::size_t max_lines) const {
+  const bool blanks = layout_.delim == Delim::Blanks;
+  const char d = layout_.delim == Delim::Comma ? ',' : layout_.delim == Delim::Semicolon ? ';' : '\t';
+  for (std::size_t lines = 0; p < end && lines < max_lines; ++lines) {
+    const std::size_t row = out.size();
+    const char* next = decimal_line(p, end, d, blanks, slot_of_col, out);
+    if (!next) {
+      out.resize(row);
+      break;
+    }
+    p = next;
+  }
+  return p;
+}
+
+const char* LineParser::plain_decimal_lines(const char* p, const char* end, std::size_t& line,
+                                            const std::vector<int>& slot_of_col, std::size_t slots,
+                                            std::vector<double>& rows, std::size_t max_lines) {
+  if (!layout_known_ || integer_mode() || slot_of_col.size() != layout_.ncols) return p;
+  const std::size_t before = rows.size();
+  const bool split = end - p >= kSplitBytes && max_lines > static_cast<std::size_t>(end - p) / 2;
+  p = in_halves(p, end, split, rows, second_rows_, [&](const char* from, const char* to, std::vector<double>& o) {
+    return decimal_run(from, to, slot_of_col, o, max_lines);
+  });
+  line += (rows.size() - before) / slots;
+  return p;
+}
+
+void LineParser::assign(Sample& s, Role role, double v) const noexcept {
+  (role == Role::Value     ? s.real
+   : role == Role::Time    ? s.time
+   : role == Role::Time2   ? s.time2
+   : role == Role::Nanosec ? s.nanosec
+                           : s.temperature) = v;
+}
+
+void LineParser::join_stamp(Sample& s) const noexcept {
+  if (layout_.nanosec_col) s.time = s.time * 1e9 + s.nanosec;  // one stamp in ns
+}
+
+Sample LineParser::row_sample(const double* row, const std::vector<int>& slot_of_col) const noexcept {
+  Sample s;
+  for (std::size_t c = 0; c < layout_.ncols; ++c)
+    if (layout_.roles[c] != Role::Skip) assign(s, layout_.roles[c], row[slot_of_col[c]]);
+  join_stamp(s);
+  return s;
 }
 
 // The common line of a delimited file whose columns are known, with one look at each byte: split at
@@ -264,7 +371,7 @@ bool LineParser::header_row(std::string_view t) {
 bool LineParser::read_fields(const std::vector<std::string_view>& fields, Sample& s, bool report) {
   for (std::size_t c = 0; c < layout_.ncols; ++c)
     if (layout_.roles[c] != Role::Skip && !read_field(fields[c], layout_.roles[c], s, report)) return false;
-  if (layout_.nanosec_col) s.time = s.time * 1e9 + s.nanosec;  // one stamp in ns
+  join_stamp(s);
   return true;
 }
 
@@ -278,13 +385,9 @@ bool LineParser::read_field(std::string_view f, Role role, Sample& s, bool repor
   if (role == Role::Value && integer_mode()) return read_integer(f, t, s, report);
   const std::string_view n = normalise_decimal(t, layout_.delim != Delim::Comma, scratch_);
   double v = 0;
-  const auto r = std::from_chars(n.data(), n.data() + n.size(), v);
+  const auto r = read_decimal(n.data(), n.data() + n.size(), v);
   if (r.ptr == n.data() + n.size() && r.ec == std::errc() && std::isfinite(v)) {
-    (role == Role::Value     ? s.real
-     : role == Role::Time    ? s.time
-     : role == Role::Time2   ? s.time2
-     : role == Role::Nanosec ? s.nanosec
-                             : s.temperature) = v;
+    assign(s, role, v);
     return true;
   }
   if (!report) return false;

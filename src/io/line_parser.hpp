@@ -54,6 +54,20 @@ class LineParser {
   /// last one without its line end before `end`): parse() takes that one, and reports it if need be.
   const char* plain_integer_lines(const char* p, const char* end, std::size_t& line, std::vector<std::int64_t>& out,
                                   std::size_t max_lines);
+  /// The common data lines read on from `p` for several columns at once: while the columns are
+  /// known and the values are not integers, each line of exactly the layout's fields (delimited
+  /// or blank-separated, ended by LF or CR LF) whose fields with a slot (`slot_of_col`, −1: not
+  /// wanted) read whole and finite with std::from_chars, as the general way would read them, puts
+  /// those values onto `rows` in slot order (`slots` a line), `max_lines` lines at most, counted in
+  /// `line` (each reader counts them with count_lines). Returns where the first other line starts:
+  /// parse() takes that one.
+  const char* plain_decimal_lines(const char* p, const char* end, std::size_t& line,
+                                  const std::vector<int>& slot_of_col, std::size_t slots, std::vector<double>& rows,
+                                  std::size_t max_lines);
+  /// Lines another parser read in bulk for this one (it follows that one).
+  void count_lines(std::size_t n) noexcept { content_lines_ += n; }
+  /// The sample a line gives whose fields with a slot read as `row` (plain_decimal_lines).
+  [[nodiscard]] Sample row_sample(const double* row, const std::vector<int>& slot_of_col) const noexcept;
 
  private:
   [[noreturn]] void fail(const std::string& message) const;
@@ -67,6 +81,10 @@ class LineParser {
   const char* plain_run(const char* p, const char* end, std::vector<std::int64_t>& out, std::size_t max_lines) const;
   bool delimited_data_line(std::string_view text, Sample& s);
   bool read_integer(std::string_view f, std::string_view t, Sample& s, bool report);
+  void assign(Sample& s, Role role, double v) const noexcept;
+  void join_stamp(Sample& s) const noexcept;
+  const char* decimal_run(const char* p, const char* end, const std::vector<int>& slot_of_col, std::vector<double>& out,
+                          std::size_t max_lines) const;
   [[nodiscard]] bool integer_mode() const noexcept {
     return input_.mode == InputMode::Pulses || input_.mode == InputMode::Counter;
   }
@@ -88,6 +106,7 @@ class LineParser {
   /// plain_integer_lines reads stretches of this many bytes or more in two halves, in parallel.
   static constexpr std::ptrdiff_t kSplitBytes = std::ptrdiff_t{1} << 16;
   std::vector<std::int64_t> second_half_;  // the second half's lines, until the first half reaches them
+  std::vector<double> second_rows_;        // the same for plain_decimal_lines
   bool stop_at_data_ = false;
 };
 

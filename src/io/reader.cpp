@@ -1,6 +1,7 @@
 // The recording reader: text arrives in pieces (TextSource), is cut into lines, and each line goes
-// through the one LineParser; the reader keeps only the selected column's values (8 bytes per
-// sample) and running statistics of the time column, then checks the rate and builds the phase.
+// through the one LineParser (a stretch of common data lines in bulk, every column at once); the
+// reader keeps only the selected column's values (8 bytes per sample) and running statistics of the
+// time column, then checks the rate and builds the phase.
 // What it keeps grows within the memory ceiling (SampleMemory); a record beyond it is refused.
 #include "rwcalc/reader.hpp"
 #include "rwcalc/i18n.hpp"
@@ -14,7 +15,6 @@
 #include <span>
 
 #include <fmt/format.h>
-#include <sys/stat.h>
 
 #include "bag.hpp"
 #include "line_parser.hpp"
@@ -232,6 +232,11 @@ class Reader {
     reached_ = nullptr;
   }
   void push(const Sample& s);
+  void track(const Sample& s, std::size_t sample);
+  [[nodiscard]] bool in_run() const;
+  const char* decimal_lines(const char* p, const char* end);
+  void take_rows(const std::vector<double>& rows, std::size_t slots, const std::vector<int>& slot_of_col,
+                 std::size_t n);
   void bag_message(const detail::ImuMessage& m);
   // Room for the samples the text likely holds, judged from its first lines, so that a long record
   // is not copied as it grows (within the ceiling: only an estimate).
@@ -283,7 +288,12 @@ class Reader {
   double rate_hz_ = units::gl2d_rate_hz;
   RateSource rate_source_ = RateSource::Default;
   std::vector<Reader*> followers_;  // other columns read in the same pass
-  Reader* reached_ = nullptr;       // the follower being given a line
+  // The lead's bulk reading of common lines: each column any reader of the pass wants has a slot
+  // (−1: none) in the rows of values read.
+  std::vector<int> slot_of_col_;
+  std::size_t slots_ = 0;
+  std::vector<double> rows_;
+  Reader* reached_ = nullptr;  // the follower being given a line
 };
 
 void Reader::read_lines(detail::TextSource& src) {
@@ -392,8 +402,11 @@ std::size_t Reader::take_lines(std::string& buf, bool at_end) {
   if (!eol_ && !decide_line_end(std::string_view(buf).substr(p), at_end)) return p;
   const std::size_t end = eol_ == '\r' ? mac_limit(buf, p, at_end) : buf.size();
   while (p < end) {
-    if (eol_ == '\n' && samples_ > 0 && !new_run_ && integer_mode() &&
-        followers_.empty()) {  // one integer column's lines, in bulk
+    if (eol_ == '\n' && in_run() && !integer_mode()) {  // every column's common lines, in bulk
+      p = static_cast<std::size_t>(decimal_lines(buf.data() + p, buf.data() + end) - buf.data());
+      if (p == end) break;
+    }
+    if (eol_ == '\n' && in_run() && integer_mode() && followers_.empty()) {  // one integer column's lines, in bulk
       // Room first, within the memory ceiling: a line takes at least 2 bytes; the bulk read stops
       // where the room does, and the next pass asks for more (CeilingReached when none is left).
       memory_.make_room(ints_, (end - p) / 2 + 1);
@@ -436,8 +449,11 @@ std::size_t Reader::mac_limit(std::string& buf, std::size_t from, bool at_end) c
   fail(1, trf("stray carriage return (CR) at column {} inside the line", first_cr_column_));
 }
 
-// The first sample: the phase's starting point, and the time columns' units.
+// The first sample: the phase's starting point, and the time columns' units. Rate and angle
+// samples whose rate neither the options, the metadata before them nor a time column give are
+// refused here, before the samples are read, rather than after a long record has been.
 void Reader::start_samples(const Sample& s) {
+  if (!integer_mode() && !opt_.rate_hz && !parser_.metadata().rate_hz && !layout_.time_col) check_unread_keys();
   if (in().mode == InputMode::Pulses) memory_.keep(ints_, std::int64_t{0});                          // C_0
   if (in().mode == InputMode::Rate || in().mode == InputMode::Increment) memory_.keep(reals_, 0.0);  // x_0
   if (layout_.time_col) tunit_ = time_unit_of(layout_.time_unit, s.time, detail::Role::Time);
@@ -460,13 +476,68 @@ void Reader::push(const Sample& s) {
     new_run_ = false;
   }
   integer_mode() ? memory_.keep(ints_, s.integer) : memory_.keep(reals_, s.real);
+  track(s, samples_);
+  ++samples_;
+}
+
+// What a sample adds besides its value: the time columns' checks, the temperature's mean.
+void Reader::track(const Sample& s, std::size_t sample) {
   if (layout_.time_col) times_.add(s.time);
   if (layout_.time2_col) {
     const double d = std::abs(s.time / tunit_->per_second - s.time2 / tunit2_->per_second);
-    if (!(d <= gap_max_)) gap_max_ = d, gap_sample_ = samples_, gap_t_ = s.time, gap_t2_ = s.time2;
+    if (!(d <= gap_max_)) gap_max_ = d, gap_sample_ = sample, gap_t_ = s.time, gap_t2_ = s.time2;
   }
   if (layout_.temp_col) temp_sum_ += s.temperature, ++temp_n_;
-  ++samples_;
+}
+
+// Every reader of the pass is past its first sample and inside a run of data lines: the lines
+// that follow may be read in bulk.
+bool Reader::in_run() const {
+  const auto ready = [](const Reader* r) { return r->samples_ > 0 && !r->new_run_; };
+  return ready(this) && std::all_of(followers_.begin(), followers_.end(), ready);
+}
+
+// The common lines of a text for every column of the pass at once: the lead's parser reads them
+// into rows of the wanted columns' values (split in two halves on two cores), then each reader
+// takes its own as push() would. Room comes first, within each reader's ceiling: the bulk read
+// stops where the room does, and the next asks for more (CeilingReached when none is left).
+const char* Reader::decimal_lines(const char* p, const char* end) {
+  if (slot_of_col_.empty()) {
+    slot_of_col_.assign(layout_.ncols, -1);
+    for (std::size_t c = 0; c < layout_.ncols; ++c) {
+      bool wanted = layout_.roles[c] != detail::Role::Skip;
+      for (const Reader* f : followers_) wanted = wanted || f->layout_.roles[c] != detail::Role::Skip;
+      if (wanted) slot_of_col_[c] = static_cast<int>(slots_++);
+    }
+  }
+  std::size_t max_lines = std::numeric_limits<std::size_t>::max();
+  const auto room = [&](Reader& r) {
+    r.memory_.make_room(r.reals_, static_cast<std::size_t>(end - p) / 2 + 1);
+    max_lines = std::min(max_lines, r.reals_.capacity() - r.reals_.size());
+  };
+  room(*this);
+  for (Reader* f : followers_) reached_ = f, room(*f);
+  reached_ = nullptr;
+  rows_.clear();
+  std::size_t line = line_;
+  p = parser_.plain_decimal_lines(p, end, line, slot_of_col_, slots_, rows_, max_lines);
+  const std::size_t n = line - line_;
+  take_rows(rows_, slots_, slot_of_col_, n);
+  for (Reader* f : followers_) reached_ = f, f->take_rows(rows_, slots_, slot_of_col_, n);
+  reached_ = nullptr;
+  return p;
+}
+
+// `n` lines read in bulk (rows of `slots` values), each taken as push() takes its sample.
+void Reader::take_rows(const std::vector<double>& rows, std::size_t slots, const std::vector<int>& slot_of_col,
+                       std::size_t n) {
+  const auto value = static_cast<std::size_t>(slot_of_col[layout_.value_col]);
+  for (std::size_t i = 0; i < n; ++i) reals_.push_back(rows[i * slots + value]);  // within the room made
+  if (layout_.time_col || layout_.time2_col || layout_.temp_col)
+    for (std::size_t i = 0; i < n; ++i) track(parser_.row_sample(&rows[i * slots], slot_of_col), samples_ + i);
+  samples_ += n;
+  line_ += n;
+  parser_.count_lines(n);
 }
 
 void Reader::finish_rate() {
@@ -519,9 +590,9 @@ void Reader::check_unread_keys() const {
              integer_mode() ? trf(", and would otherwise use {:g} Hz", units::gl2d_rate_hz) : ""));
   // Rate and angle samples carry no GL-2D default: 400 Hz would put every τ off by the ratio.
   if (rate_source_ == RateSource::Default && !integer_mode())
-    fail(0, trf("no sample rate: {} input takes it from --rate HZ, a '# rate_hz: HZ' metadata line or a time "
-                "column (time_s, time_ms, time_us, time_ns, timestamp, %time, ...); the {:g}-Hz GL-2D default "
-                "applies to pulse and counter input only",
+    fail(0, trf("no sample rate: {} input takes it from --rate HZ, a '# rate_hz: HZ' metadata line before the "
+                "data or a time column (time_s, time_ms, time_us, time_ns, timestamp, %time, ...); the {:g}-Hz "
+                "GL-2D default applies to pulse and counter input only",
                 to_string(in().mode), units::gl2d_rate_hz));
   if (integer_mode() && !opt_.scale_arcsec && !meta.scale_arcsec && meta.unread_scale_key)
     fail(meta.unread_scale_key->second,
@@ -893,84 +964,51 @@ struct Pass {
   }
 };
 
-// The error a single pass over all columns would have raised: the earliest line's, and of those
-// the first column's (passes hold columns in order). Nothing when every pass read.
-void rethrow_first(const std::vector<std::exception_ptr>& errors, const std::vector<std::size_t>& lines) {
-  std::size_t first = errors.size();
-  for (std::size_t g = 0; g < errors.size(); ++g)
-    if (errors[g] && (first == errors.size() || lines[g] < lines[first])) first = g;
-  if (first < errors.size()) std::rethrow_exception(errors[first]);
-}
-
-// Each pass reads its columns (in parallel: several passes over one file cost less wall time than one
-// pass that reads every column alone), then every column is finished.
-std::vector<Recording> read_passes(std::vector<Pass>& passes, const std::string& source) {
-  std::vector<std::exception_ptr> errors(passes.size());
-  std::vector<std::size_t> lines(passes.size(), 0);
-  parallel_for(passes.size(), [&](std::size_t g) {
+// Every column's read in one pass (which reads each stretch of common lines in two halves on two
+// cores), then each column finished, in parallel; an error is the first column's.
+std::vector<Recording> read_pass(Pass& pass, const std::string& source) {
+  pass.read();
+  const std::size_t n = pass.readers.size();
+  std::vector<Recording> recs(n);
+  std::vector<std::exception_ptr> failed(n);
+  parallel_for(n, [&](std::size_t k) {
     try {
-      passes[g].read();
-    } catch (const InputError& e) {
-      errors[g] = std::current_exception();
-      lines[g] = e.line();
-    } catch (...) {
-      errors[g] = std::current_exception();
-    }
-  });
-  rethrow_first(errors, lines);
-  std::vector<std::pair<std::size_t, std::size_t>> items;  // (pass, reader)
-  for (std::size_t g = 0; g < passes.size(); ++g)
-    for (std::size_t i = 0; i < passes[g].readers.size(); ++i) items.emplace_back(g, i);
-  std::vector<Recording> recs(items.size());
-  std::vector<std::exception_ptr> failed(items.size());
-  parallel_for(items.size(), [&](std::size_t k) {
-    try {
-      recs[k] = passes[items[k].first].finish(items[k].second, source);
+      recs[k] = pass.finish(k, source);
     } catch (...) {
       failed[k] = std::current_exception();
     }
   });
-  rethrow_first(failed, std::vector<std::size_t>(items.size(), 0));
+  for (const std::exception_ptr& e : failed)
+    if (e) std::rethrow_exception(e);
   return recs;
 }
 
 }  // namespace
 
 Recording read_recording(const std::string& path, const ReadOptions& options) {
-  std::vector<Pass> pass;
   if (auto bag = detail::BagStream::open(path)) {
     bag->select(options.topic);
-    pass.emplace_back(std::move(bag), std::span(&options, 1));
-  } else {
-    pass.emplace_back(std::make_unique<detail::TextSource>(path), std::span(&options, 1));
+    Pass pass(std::move(bag), std::span(&options, 1));
+    return std::move(read_pass(pass, path).front());
   }
-  return std::move(read_passes(pass, path).front());
+  Pass pass(std::make_unique<detail::TextSource>(path), std::span(&options, 1));
+  return std::move(read_pass(pass, path).front());
 }
 
 std::vector<Recording> read_recordings(const std::string& path, std::span<const ReadOptions> columns) {
   if (columns.empty()) throw UsageError("no column to read");
   if (auto bag = detail::BagStream::open(path)) {
     bag->select(columns.front().topic);
-    std::vector<Pass> pass;
-    pass.emplace_back(std::move(bag), columns);
-    return read_passes(pass, path);
+    Pass pass(std::move(bag), columns);
+    return read_pass(pass, path);
   }
-  // A pipe or standard input can be read once only.
-  struct stat st {};
-  const bool again = path != "-" && ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
-  const std::size_t n = again ? std::min<std::size_t>(worker_count(), columns.size()) : 1;
-  std::vector<Pass> passes;
-  for (std::size_t g = 0; g < n; ++g) {
-    const std::size_t from = columns.size() * g / n, to = columns.size() * (g + 1) / n;
-    passes.emplace_back(std::make_unique<detail::TextSource>(path), columns.subspan(from, to - from));
-  }
-  return read_passes(passes, path);
+  Pass pass(std::make_unique<detail::TextSource>(path), columns);
+  return read_pass(pass, path);
 }
 
 Recording read_recording_text(std::string_view text, const std::string& name, const ReadOptions& options) {
-  std::vector<Pass> pass;
-  pass.emplace_back(std::make_unique<detail::TextSource>(text, detail::display_name(name)), std::span(&options, 1));
-  return std::move(read_passes(pass, name).front());
+  Pass pass(std::make_unique<detail::TextSource>(text, detail::display_name(name)), std::span(&options, 1));
+  return std::move(read_pass(pass, name).front());
 }
 
 namespace {
