@@ -188,6 +188,21 @@ TEST(Imu, EitherKindMayBeAbsentButOneIsNeeded) {
   EXPECT_TRUE(has(none.err, "give --gyro COLS and/or --accel COLS")) << none.err;
 }
 
+// No rate (no --rate, rate_hz line or time column): refused at the first data line, before the
+// samples are read, so a bad line further on is never reached and nothing is written.
+TEST(Imu, NoRateIsRefusedBeforeTheSamplesAreRead) {
+  TempDir dir;
+  const auto f = dir.write("imu.csv", imu_csv(kHeader) + "1,2,3,4,5,oops\n");
+  const auto r = run_cli({"imu", f.string(), "--json"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(has(r.err, "no sample rate")) << r.err;
+  EXPECT_FALSE(has(r.err, "oops")) << r.err;
+  EXPECT_TRUE(r.out.empty());
+  const auto bad = run_cli({"imu", f.string(), "--rate", "100", "--json"});  // with a rate, the bad line
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_TRUE(has(bad.err, fmt::format(":{}:", kSamples + 2)) && has(bad.err, "oops")) << bad.err;
+}
+
 TEST(Imu, AColumnOfTheWrongKindIsAnError) {
   TempDir dir;
   const auto f = dir.write("imu.csv", imu_csv(kHeader));
