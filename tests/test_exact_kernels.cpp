@@ -21,6 +21,8 @@
 namespace {
 
 using namespace rwcalc::detail;
+using rwcalc::i128;
+using rwcalc::u128;
 using rwcalc::test::ScopedEnv;
 
 /// C[k+2m] − 2C[k+m] + C[k] as the exact integer, then taken modulo 2^64 into the int64 range

@@ -17,9 +17,9 @@
 #include <optional>
 #include <vector>
 
-namespace rwcalc::detail {
+#include "rwcalc/exact_sums.hpp"
 
-__extension__ typedef __int128 i128;
+namespace rwcalc::detail {
 
 class NarrowCounts {
  public:

@@ -245,7 +245,7 @@ std::vector<double> all_grid_fft_sums(const PhaseSeries& x, const CountData& dat
 std::vector<double> overlapping_sweep(const PhaseSeries& x, const CountData& data,
                                       const std::vector<std::int64_t>& ms) {
   if (!x.exact()) return detail::second_diff_sumsq_sweep(x.values.data(), x.points(), ms);
-  const std::vector<detail::u128> exact = detail::second_diff_sumsq_sweep(data.c, x.points(), ms);
+  const std::vector<u128> exact = detail::second_diff_sumsq_sweep(data.c, x.points(), ms);
   return {exact.begin(), exact.end()};
 }
 

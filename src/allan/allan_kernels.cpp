@@ -14,10 +14,8 @@ namespace rwcalc::detail {
 namespace {
 
 constexpr int kLanes = 8;  // accumulators of the floating sums (their order fixes the rounding)
-// Terms per block of the exact sums: with every |d| ≤ 2^26 a block's squares (≤ 2^52 each) sum
-// below 2^62, so one uint64 holds the block exactly; a block with a larger d is redone in 128 bits.
-constexpr std::int64_t kBlock = 1024;
-constexpr std::uint64_t kHalfRange = std::uint64_t{1} << 26;
+// Terms per block of the exact sums (exact_sums.hpp).
+constexpr auto kBlock = static_cast<std::int64_t>(kExactBlock);
 // Terms per stretch of the sweep that one parallel_for item takes (a multiple of kBlock).
 constexpr std::int64_t kStretch = std::int64_t{1} << 16;
 // Terms per block of the floating sweep: a block's three streams of every m stay in the core's
@@ -39,19 +37,12 @@ inline std::uint64_t difference(const std::int64_t* c, std::int64_t k, std::int6
 /// Σ (d-th difference at k = i·stride)², i < len (len ≤ kBlock), exactly.
 template <int Order>
 u128 block_sumsq(const std::int64_t* c, std::int64_t len, std::int64_t m, std::int64_t stride) {
-  std::uint64_t sum = 0, range = 0;
-  for (std::int64_t i = 0; i < len; ++i) {
-    const std::uint64_t d = difference<Order>(c, i * stride, m);
-    range |= d + kHalfRange;  // below 2^27 for every d iff −2^26 ≤ d < 2^26
-    sum += d * d;             // d² modulo 2^64: the square of the signed d
-  }
-  if ((range >> 27) == 0) return sum;
-  u128 exact = 0;
-  for (std::int64_t i = 0; i < len; ++i) {
-    const auto d = static_cast<std::int64_t>(difference<Order>(c, i * stride, m));
-    exact += static_cast<u128>(static_cast<i128>(d) * d);
-  }
-  return exact;
+  ExactSums s;
+  const auto d = [c, m, stride](std::size_t i) {
+    return difference<Order>(c, static_cast<std::int64_t>(i) * stride, m);
+  };
+  add_exact_sums<SumKinds::Squares>(static_cast<std::size_t>(len), 0, d, s);
+  return s.squares;
 }
 
 template <int Order>

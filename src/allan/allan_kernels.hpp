@@ -9,10 +9,9 @@
 #include <span>
 #include <vector>
 
-namespace rwcalc::detail {
+#include "rwcalc/exact_sums.hpp"
 
-__extension__ typedef unsigned __int128 u128;  // exact sums of squared int64 differences
-__extension__ typedef __int128 i128;
+namespace rwcalc::detail {
 
 /// Σ_{i<n} (C[k+2m] − 2C[k+m] + C[k])², k = i·stride (1: overlapping; m: non-overlapping), exactly.
 u128 second_diff_sumsq(const std::int64_t* c, std::int64_t n, std::int64_t m, std::int64_t stride);

@@ -10,13 +10,11 @@
 #include <vector>
 
 #include "rwcalc/confidence.hpp"
+#include "rwcalc/exact_sums.hpp"
 
 namespace rwcalc {
 
 namespace {
-
-__extension__ typedef unsigned __int128 u128;
-__extension__ typedef __int128 i128;
 
 // Stable32 uses the lag-1 autocorrelation when at least this many points remain at τ.
 constexpr std::size_t kMinAcfPoints = 30;
@@ -141,41 +139,18 @@ double r1_from_exact(const ExactLag1& s, std::size_t len, std::int64_t z_first, 
   return static_cast<double>(num / static_cast<long double>(den));
 }
 
-/// Terms per block: while every |z| ≤ 2^26 a block's Σz² and Σz·z' stay below 2^62, so it is summed
-/// in 64 bits and flushed into the 128-bit totals; a block with a larger z is summed in 128 bits.
-constexpr std::size_t kBlock = 1024;
 /// Difference levels whose sums one gather of the decimated phase feeds at most.
 constexpr int kLevelsAtOnce = 2;
 
-/// The exact sums of one level over a block: z (n values, and z[n] the next one, 0 at the record's
-/// end, where `pairs` = n − 1). False when some |z| ≥ kZLimit (the 128-bit sums could then overflow).
-bool add_block(const std::int64_t* z, std::size_t n, std::size_t pairs, u128 (&s)[3]) {
-  // Sums modulo 2^64 in unsigned arithmetic (no signed overflow on any input), used only when small:
-  // then they are the true int64 sums.
-  std::uint64_t a = 0, b = 0, c = 0;
-  std::uint64_t small = 0;  // below 2^27 iff every −2^26 ≤ z < 2^26: then no int64 sum overflows
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto zi = static_cast<std::uint64_t>(z[i]);
-    small |= zi + (kZLimit >> 8);
-    a += zi;
-    b += zi * zi;
-    c += zi * static_cast<std::uint64_t>(z[i + 1]);
-  }
-  if (small < (kZLimit >> 7)) {
-    s[0] += static_cast<u128>(static_cast<i128>(static_cast<std::int64_t>(a)));
-    s[1] += static_cast<u128>(static_cast<i128>(static_cast<std::int64_t>(b)));
-    s[2] += static_cast<u128>(static_cast<i128>(static_cast<std::int64_t>(c)));
-    return true;
-  }
+/// The exact sums of one level over a block: z (n values, and z[n] the next one where `pairs` = n;
+/// `pairs` = n − 1 at the record's end). False when some |z| ≥ kZLimit (the 128-bit sums could then
+/// overflow).
+bool add_block(const std::int64_t* z, std::size_t n, std::size_t pairs, ExactSums& s) {
+  const auto v = [z](std::size_t i) { return static_cast<std::uint64_t>(z[i]); };
+  if (add_exact_sums<SumKinds::WithLag>(n, pairs, v, s)) return true;
   std::uint64_t range = 0;
   for (std::size_t i = 0; i < n; ++i) range |= static_cast<std::uint64_t>(z[i]) + kZLimit;
-  if (range >= 2 * kZLimit) return false;
-  for (std::size_t i = 0; i < n; ++i) {
-    s[0] += static_cast<u128>(static_cast<i128>(z[i]));
-    s[1] += static_cast<u128>(static_cast<i128>(z[i]) * z[i]);
-    if (i < pairs) s[2] += static_cast<u128>(static_cast<i128>(z[i]) * z[i + 1]);
-  }
-  return true;
+  return range < 2 * kZLimit;
 }
 
 /// r1 of the difference levels first … first + r1.size() − 1 (at most kLevelsAtOnce) of p(0) …
@@ -187,19 +162,19 @@ void lag1_exact(const P& p, std::size_t count, int first, std::span<std::optiona
   const auto levels = static_cast<std::size_t>(std::min<std::ptrdiff_t>(std::ssize(r1), kLevelsAtOnce));
   const auto lv0 = static_cast<std::size_t>(first);
   struct Level {
-    u128 s[3] = {};
+    ExactSums s;
     std::int64_t z_first = 0, z_last = 0;
     bool exact = true;
   } lev[kLevelsAtOnce];
-  std::int64_t g[kBlock + 1 + 3 + kLevelsAtOnce], z[kBlock + 1 + 3 + kLevelsAtOnce];
+  std::int64_t g[kExactBlock + 1 + 3 + kLevelsAtOnce], z[kExactBlock + 1 + 3 + kLevelsAtOnce];
   const std::size_t longest = count > lv0 ? count - lv0 : 0;
-  for (std::size_t k0 = 0; k0 < longest; k0 += kBlock) {
-    const std::size_t have = std::min(kBlock + 1 + lv0 + levels - 1, count - k0);
+  for (std::size_t k0 = 0; k0 < longest; k0 += kExactBlock) {
+    const std::size_t have = std::min(kExactBlock + 1 + lv0 + levels - 1, count - k0);
     for (std::size_t i = 0; i < have; ++i) g[i] = static_cast<std::int64_t>(p(k0 + i));
     for (std::size_t l = 0; l < levels; ++l) {
       const std::size_t lv = lv0 + l, len = count > lv ? count - lv : 0;
       if (k0 >= len || !lev[l].exact) continue;
-      const std::size_t n = std::min(kBlock, len - k0), pairs = k0 + n < len ? n : n - 1;
+      const std::size_t n = std::min(kExactBlock, len - k0), pairs = k0 + n < len ? n : n - 1;
       const std::size_t width = std::min(n + 1, len - k0);  // z values used: with the successor if any
       for (std::size_t i = 0; i < width + lv; ++i) z[i] = g[i];
       for (std::size_t d = 0; d < lv; ++d)
@@ -218,7 +193,8 @@ void lag1_exact(const P& p, std::size_t count, int first, std::span<std::optiona
     } else if (count >= kExactMaxPoints || !lev[l].exact) {
       r1[l] = std::nullopt;
     } else {
-      const ExactLag1 e{static_cast<i128>(lev[l].s[0]), static_cast<i128>(lev[l].s[1]), static_cast<i128>(lev[l].s[2])};
+      const ExactLag1 e{static_cast<i128>(lev[l].s.sum), static_cast<i128>(lev[l].s.squares),
+                        static_cast<i128>(lev[l].s.lag)};
       r1[l] = r1_from_exact(e, count - lv, lev[l].z_first, lev[l].z_last);
     }
   }

@@ -13,6 +13,7 @@
 #include <optional>
 
 #include "rwcalc/confidence.hpp"
+#include "rwcalc/deviance.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/output_filter.hpp"
@@ -344,13 +345,10 @@ FitMisfit fit_misfit(const AnalysisResult& r) {
   FitMisfit m;
   const auto& pts = r.fit.used;
   if (!r.fit_rejected() || pts.empty()) return m;
-  // Each point's signed share of the fit's Gamma deviance, ν(x/m − 1 − ln(x/m)), in standard errors.
+  // Each point's signed share of the fit's Gamma deviance, in standard errors.
   std::vector<double> z(pts.size());
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    const double q = pts[i].var / r.fit.model_var(pts[i].tau_s);
-    z[i] = q > 0 && pts[i].edf > 0 ? std::copysign(std::sqrt(pts[i].edf * std::max(0.0, q - 1 - std::log(q))), q - 1)
-                                   : 0.0;
-  }
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    z[i] = deviance_residual(pts[i].var, r.fit.model_var(pts[i].tau_s), pts[i].edf);
   // The run of neighbouring points departing on one side with the largest deviance.
   double best = -1;
   for (std::size_t lo = 0; lo < pts.size();) {

@@ -8,6 +8,7 @@
 #include "models.hpp"
 #include "rwcalc/allan.hpp"
 #include "rwcalc/confidence.hpp"
+#include "rwcalc/deviance.hpp"
 #include "rwcalc/output_filter.hpp"
 #include "rwcalc/units.hpp"
 
@@ -120,8 +121,7 @@ double band_misfit(const std::vector<BandPoint>& band) {
   std::size_t n = 0;
   for (const auto& b : band) {
     if (!(b.mean_var > 0 && b.dev > 0 && b.edf > 0)) continue;
-    const double ratio = b.dev * b.dev / b.mean_var;
-    sum += diag::band_nu(b.edf) * (ratio - 1.0 - std::log(ratio));
+    sum += gamma_deviance(b.dev * b.dev, b.mean_var, diag::band_nu(b.edf));
     ++n;
   }
   return n ? sum / static_cast<double>(n) : 0.0;

@@ -184,12 +184,6 @@ double subspace_angle(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return s / static_cast<double>(sv.size());
 }
 
-/// Golden-section maximum of f on [lo, hi].
-template <class F>
-double golden_max(const F& f, double lo, double hi, int iters) {
-  return golden_min([&f](double x) { return -f(x); }, lo, hi, iters);
-}
-
 /// −2 ln L of the current model at its best: its own profile, or the profile restarted from the
 /// candidate's levels when that one is lower (the levels' likelihood can have more than one
 /// maximum, and a candidate must not win only because its fit found the better one).

@@ -3,8 +3,8 @@
 
 #include <array>
 #include <cmath>
-#include <limits>
 
+#include "rwcalc/nnls.hpp"
 #include "rwcalc/output_filter.hpp"
 #include "signal.hpp"
 
@@ -12,31 +12,17 @@ namespace rwcalc::diag {
 
 namespace {
 
-/// Non-negative weighted least squares of y on up to three columns (all subsets; small p).
+/// Non-negative weighted least squares of y on three columns: χ² and the coefficients.
 double nn_fit3(const std::vector<double>& y, const std::vector<double>& w,
                const std::array<std::vector<double>, 3>& cols, std::array<double, 3>& coef) {
-  double best = std::numeric_limits<double>::infinity();
-  coef = {0, 0, 0};
-  for (int mask = 1; mask < 8; ++mask) {
-    std::vector<std::vector<double>> cs;
-    std::vector<std::size_t> idx;
-    for (std::size_t c = 0; c < 3; ++c)
-      if (mask & (1 << c)) {
-        cs.push_back(cols[c]);
-        idx.push_back(c);
-      }
-    const WlsOut o = wls(y, w, cs);
-    bool ok = true;
-    for (Eigen::Index k = 0; k < o.coef.size(); ++k) ok = ok && o.coef(k) >= 0 && std::isfinite(o.coef(k));
-    if (!ok || !(o.chi2 < best)) continue;
-    best = o.chi2;
-    coef = {0, 0, 0};
-    for (std::size_t k = 0; k < idx.size(); ++k) coef[idx[k]] = o.coef(static_cast<Eigen::Index>(k));
-  }
-  if (std::isfinite(best)) return best;
-  best = 0;
-  for (std::size_t i = 0; i < y.size(); ++i) best += w[i] * y[i] * y[i];
-  return best;
+  const auto n = static_cast<Eigen::Index>(y.size());
+  Eigen::MatrixXd g(n, 3);
+  for (Eigen::Index c = 0; c < 3; ++c)
+    g.col(c) = Eigen::Map<const Eigen::VectorXd>(cols[static_cast<std::size_t>(c)].data(), n);
+  const NnlsFit fit =
+      nnls(g, Eigen::Map<const Eigen::VectorXd>(y.data(), n), Eigen::Map<const Eigen::VectorXd>(w.data(), n), 0b111);
+  coef = {fit.x[0], fit.x[1], fit.x[2]};
+  return fit.chi2;
 }
 
 }  // namespace

@@ -36,30 +36,6 @@ std::vector<double> block_rates(const Decimated& d, std::size_t per_block) {
   return r;
 }
 
-WlsOut wls(const std::vector<double>& y, const std::vector<double>& w, const std::vector<std::vector<double>>& cols) {
-  const auto n = static_cast<Eigen::Index>(y.size());
-  const auto p = static_cast<Eigen::Index>(cols.size());
-  Eigen::MatrixXd X(n, p);
-  Eigen::VectorXd Y(n), W(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    for (Eigen::Index c = 0; c < p; ++c) X(i, c) = cols[static_cast<std::size_t>(c)][static_cast<std::size_t>(i)];
-    Y(i) = y[static_cast<std::size_t>(i)];
-    W(i) = w[static_cast<std::size_t>(i)];
-  }
-  WlsOut o;
-  if (p == 0) {  // nothing free (every term at its bound): the residuals are the data
-    o.chi2 = (Y.array().square() * W.array()).sum();
-    return o;
-  }
-  const Eigen::MatrixXd XtW = X.transpose() * W.asDiagonal();
-  const Eigen::MatrixXd A = XtW * X;
-  o.inv = A.completeOrthogonalDecomposition().pseudoInverse();
-  o.coef = o.inv * (XtW * Y);
-  const Eigen::VectorXd r = Y - X * o.coef;
-  o.chi2 = (r.array().square() * W.array()).sum();
-  return o;
-}
-
 double deterministic_angle(const NoiseModel& m, double t) {
   double a = 0;
   for (const auto& s : m.sinusoids) {

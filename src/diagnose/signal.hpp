@@ -1,13 +1,13 @@
 #pragma once
 /// @file signal.hpp
 /// What the diagnosis reads: the angle decimated to about 10 Hz and its block rates, a model's
-/// deterministic terms, least-squares and one-dimensional search helpers.
-#include <Eigen/Dense>
+/// deterministic terms, the refinement of a line's frequency.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <vector>
 
+#include "rwcalc/minimise.hpp"
 #include "rwcalc/series.hpp"
 #include "rwcalc/simulate.hpp"
 
@@ -30,34 +30,10 @@ std::size_t per_block_for(const Decimated& d, double seconds);
 /// Angle (″) at time t of a model's deterministic terms (sinusoids, steps, warm-ups), from t = 0.
 double deterministic_angle(const NoiseModel& m, double t);
 
-/// Weighted least squares of y on columns: χ², coefficients and (XᵀWX)⁺.
-struct WlsOut {
-  double chi2 = 0;
-  Eigen::VectorXd coef;
-  Eigen::MatrixXd inv;
-};
-WlsOut wls(const std::vector<double>& y, const std::vector<double>& w, const std::vector<std::vector<double>>& cols);
-
 /// The attenuation sinc(πf·tb) of a line of frequency f by means over blocks of tb.
 inline double block_attenuation(double f, double tb) {
   const double x = kPi * f * tb;
   return x > 1e-9 ? std::sin(x) / x : 1.0;
-}
-
-/// `iters` golden-section steps towards a minimum of f in [lo, hi] (one evaluation each); the
-/// better of the last two points.
-template <class F>
-double golden_min(const F& f, double lo, double hi, int iters) {
-  const double g = 0.3819660112501051;
-  double x1 = lo + g * (hi - lo), x2 = hi - g * (hi - lo), f1 = f(x1), f2 = f(x2);
-  for (int i = 0; i < iters; ++i) {
-    if (f1 < f2) {
-      hi = x2, x2 = x1, f2 = f1, x1 = lo + g * (hi - lo), f1 = f(x1);
-    } else {
-      lo = x1, x1 = x2, f1 = f2, x2 = hi - g * (hi - lo), f2 = f(x2);
-    }
-  }
-  return f1 < f2 ? x1 : x2;
 }
 
 /// A line's frequency near f0: the best of f0 + i·step (|i| ≤ half_steps, 0 < f < f_max) by the

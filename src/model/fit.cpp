@@ -9,15 +9,17 @@
 #include <bit>
 #include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/normal.hpp>
-#include <boost/math/special_functions/digamma.hpp>
 #include <cmath>
 #include <memory>
 #include <numbers>
 #include <tuple>
 #include <utility>
 
+#include "rwcalc/deviance.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/nnls.hpp"
 #include "rwcalc/parallel.hpp"
+#include "rwcalc/structure_function.hpp"
 
 namespace rwcalc {
 
@@ -25,7 +27,6 @@ namespace {
 
 constexpr int P = kTermCount;
 using Vec5 = Eigen::Matrix<double, P, 1>;
-using Mat5 = Eigen::Matrix<double, P, P>;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 /// AV of flicker per B²: 2 ln2/π.
 constexpr double kFlickerFactor = 2.0 * std::numbers::ln2 / std::numbers::pi;
@@ -139,69 +140,21 @@ double deviance(const Problem& pr, const Eigen::VectorXd& mu) {
   double d = 0;
   for (Eigen::Index r = 0; r < mu.size(); ++r) {
     if (!(mu[r] > 0)) return kInf;
-    const double q = pr.y[r] / mu[r];
-    d += pr.nu[r] * (q - 1.0 - std::log(q));
+    d += gamma_deviance(pr.y[r], mu[r], pr.nu[r]);
   }
   return d;
 }
 
-/// Unconstrained weighted LS on the support `s` (normal equations a·d = b, Jacobi-scaled).
-/// Writes the solution into `d` and its objective (−bᵀd) into `obj`; false when singular or when
-/// any component is not strictly positive.
-bool solve_support(const Mat5& a, const Vec5& b, unsigned s, Vec5& d, double& obj) {
-  const int k = std::popcount(s);
-  std::array<int, P> ids{};
-  int n = 0;
-  for (int i = 0; i < P; ++i)
-    if (s & (1u << i)) ids[static_cast<std::size_t>(n++)] = i;
-  using SmallMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, P, P>;
-  using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, P, 1>;
-  SmallMat as(k, k);
-  SmallVec bs(k);
-  SmallVec dsc(k);
-  for (int r = 0; r < k; ++r) {
-    const double diag = a(ids[static_cast<std::size_t>(r)], ids[static_cast<std::size_t>(r)]);
-    if (!(diag > 0)) return false;
-    dsc[r] = 1.0 / std::sqrt(diag);
-  }
-  for (int r = 0; r < k; ++r) {
-    bs[r] = b[ids[static_cast<std::size_t>(r)]] * dsc[r];
-    for (int q = 0; q < k; ++q)
-      as(r, q) = a(ids[static_cast<std::size_t>(r)], ids[static_cast<std::size_t>(q)]) * dsc[r] * dsc[q];
-  }
-  const Eigen::LLT<SmallMat> llt(as);
-  if (llt.info() != Eigen::Success || llt.rcond() < 1e-13) return false;
-  const SmallVec z = llt.solve(bs);
-  const SmallVec cs = z.cwiseProduct(dsc);
-  if (!cs.allFinite() || (cs.array() <= 0).any()) return false;
-  obj = -bs.dot(z);
-  for (int r = 0; r < k; ++r) d[ids[static_cast<std::size_t>(r)]] = cs[r];
-  return true;
-}
-
 /// Weighted least squares min Σ w (y − G d)² over d_free ≥ 0, the other components fixed at
-/// `base`. Exact: enumerates the supports (at most 2⁵) and keeps the best feasible unconstrained
-/// solution on its support, which is the NNLS optimum.
+/// `base`.
 Vec5 nnls(const Problem& pr, const Eigen::VectorXd& w, unsigned free_mask, const Vec5& base) {
   Vec5 fixed = base;
   for (int i = 0; i < P; ++i)
     if (free_mask & (1u << i)) fixed[i] = 0;
-  const Eigen::VectorXd target = pr.y - pr.offset - pr.g * fixed;
-  const Eigen::MatrixXd gw = pr.g.array().colwise() * w.array();
-  const Mat5 a = pr.g.transpose() * gw;
-  const Vec5 b = gw.transpose() * target;
-
-  Vec5 best = fixed;
-  double best_obj = 0;  // objective relative to tᵀWt; the empty support gives 0
-  for (unsigned s = free_mask; s != 0; s = (s - 1) & free_mask) {
-    Vec5 cand = fixed;
-    double obj = 0;
-    if (solve_support(a, b, s, cand, obj) && obj < best_obj) {
-      best_obj = obj;
-      best = cand;
-    }
-  }
-  return best;
+  const NnlsFit fit = rwcalc::nnls(pr.g, pr.y - pr.offset - pr.g * fixed, w, free_mask);
+  for (int i = 0; i < P; ++i)
+    if (free_mask & (1u << i)) fixed[i] = fit.x[i];
+  return fixed;
 }
 
 struct IrlsResult {
@@ -257,12 +210,6 @@ IrlsResult irls(const Problem& pr, unsigned free_mask, const Vec5& start, bool f
   res.dev = dev;
   res.iterations = it;
   return res;
-}
-
-/// Small-sample (Bartlett) factor E[ν(x − 1 − ln x)] for x ~ χ²_ν/ν, so that Σ d_j/b(ν_j) ≈ χ².
-double bartlett(double nu) {
-  if (nu > 1e3) return 1.0 + 1.0 / (3.0 * nu);
-  return -nu * (boost::math::digamma(nu / 2.0) - std::log(nu / 2.0));
 }
 
 /// Illinois false position for f(a)·f(b) < 0; returns the root to a relative tolerance.
@@ -417,15 +364,12 @@ struct PointPair {
   [[nodiscard]] double count(double h) const { return std::max(0.0, std::min(na, nb - h) - std::max(0.0, -h)); }
 };
 
-/// Generalized structure function of the continuous terms, ″², at lag u samples (S(0) = 0):
-/// S(u) = c1·t − (c2/π)·t²·ln t − c3·t³/6, t = u·τ0.
+/// Structure function of the continuous terms (N, B, K; structure_function.hpp), ″², at lag u
+/// samples (S(0) = 0).
 struct Structure {
-  double tau0, c1, c2, c3;
-  [[nodiscard]] double operator()(double u) const {
-    if (u <= 0) return 0.0;
-    const double t = u * tau0;
-    return t * (c1 - t * (c2 / std::numbers::pi * std::log(t) + c3 * t / 6.0));
-  }
+  double tau0;
+  std::array<double, 5> c;  // only N, B, K: white angle noise is added at its exact lags
+  [[nodiscard]] double operator()(double u) const { return structure_function(c, u * tau0); }
 };
 
 /// Cov(z^a_i, z^b_{i+h}) of the continuous terms: −½ Σ a_k b_l S(|o_k − h − p_l|).
@@ -615,10 +559,9 @@ void goodness_of_fit(const Stage& st, FitResult& res) {
   res.dof = static_cast<int>(st.pr.y.size()) - active;
   const Eigen::VectorXd mu = st.model();
   double chi2 = 0;
-  for (Eigen::Index r = 0; r < st.pr.y.size(); ++r) {
-    const double q = st.pr.y[r] / mu[r];
-    chi2 += st.pr.nu[r] * (q - 1.0 - std::log(q)) / bartlett(st.pr.nu[r]);
-  }
+  // Each deviance over its small-sample (Bartlett) mean, so that the sum is ≈ χ².
+  for (Eigen::Index r = 0; r < st.pr.y.size(); ++r)
+    chi2 += gamma_deviance(st.pr.y[r], mu[r], st.pr.nu[r]) / gamma_deviance_mean(st.pr.nu[r]);
   res.chi2 = chi2;
   res.chi2_per_dof = res.dof > 0 ? chi2 / res.dof : 0.0;
   const boost::math::chi_squared_distribution<double> dist(std::max(res.dof, 1));
@@ -845,7 +788,7 @@ Eigen::MatrixXd av_covariance(std::span<const FitPoint> pts, const Eigen::Matrix
   const auto j = static_cast<Eigen::Index>(pts.size());
   Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(j, j);
   if (j == 0) return cov;
-  const Structure s{pts[0].tau_s / static_cast<double>(pts[0].m), c[1], c[2], c[3]};
+  const Structure s{pts[0].tau_s / static_cast<double>(pts[0].m), {0.0, c[1], c[2], c[3], 0.0}};
   // Row a of the upper triangle and its mirror: rows write disjoint entries.
   parallel_for(static_cast<std::size_t>(j), [&](std::size_t a) {
     const std::size_t end = diagonal_only ? a + 1 : pts.size();

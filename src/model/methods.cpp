@@ -11,28 +11,26 @@
 #include <numbers>
 
 #include "rwcalc/confidence.hpp"
+#include "rwcalc/exact_sums.hpp"
 #include "rwcalc/narrow_counts.hpp"
 #include "rwcalc/noise_model.hpp"
 #include "rwcalc/parallel.hpp"
 #include "rwcalc/random.hpp"
 #include "rwcalc/simulate.hpp"
+#include "rwcalc/structure_function.hpp"
 
 namespace rwcalc {
 
 namespace {
 
-__extension__ typedef __int128 i128;
-
 constexpr double kZ95 = 1.959963984540054;
 constexpr double kFlicker = 2.0 * std::numbers::ln2 / std::numbers::pi;  // AV of B at unit B²
 using Vec3 = Eigen::Vector3d;
 
-/// Generalized structure functions E[(θ(s+u) − θ(s))²] at unit coefficient, u in s (u > 0): white
-/// angle 2 (per sample variance Q²), white rate u, flicker rate −u² ln u/π (its u² part depends on
-/// the low-frequency cut-off and cancels from every mean-removed statistic).
+/// Structure functions of white angle, white rate and flicker rate at unit coefficient, u in s.
 Vec3 structure(double u) {
-  if (!(u > 0)) return Vec3::Zero();
-  return {2.0, u, -u * u * std::log(u) / std::numbers::pi};
+  const std::array<double, 5> d = term_structure_functions(u);
+  return {d[0], d[1], d[2]};
 }
 
 /// Sample variance (divisor n − 1) of `v`, n ≥ 2.
@@ -46,38 +44,25 @@ double sample_variance(const std::vector<double>& v) {
 }
 
 /// Σe and Σe² of e_k = C_{k+t} − C_k − shift, k in [k0, k1): in 16-bit lanes where the counts'
-/// bounds allow (narrow_counts.hpp), else int64 sums while every |e| < 2^24 (blocks of 2^14 cannot
-/// overflow then), 128-bit ones for a block with a larger one.
+/// bounds allow (narrow_counts.hpp), else exactly in 64- or 128-bit blocks (exact_sums.hpp).
 void add_increment_sums(const std::int64_t* c, const detail::NarrowCounts& narrow, std::size_t t, std::int64_t shift,
-                        std::size_t k0, std::size_t k1, i128& s1, i128& s2) {
+                        std::size_t k0, std::size_t k1, ExactSums& sums) {
   for (std::size_t from = k0; from < k1; from += detail::NarrowCounts::kMaxTerms) {
     const std::size_t to = std::min(k1, from + detail::NarrowCounts::kMaxTerms);
     std::int64_t n1 = 0;
     std::uint64_t n2 = 0;
     if (!narrow.increment_sums(from, to - from, t, shift, n1, n2)) break;
-    s1 += n1;
-    s2 += n2;
+    sums.sum += static_cast<u128>(static_cast<i128>(n1));
+    sums.squares += n2;
     k0 = to;
   }
-  if (k0 == k1) return;
-  std::uint64_t b1 = 0, b2 = 0, big = 0;  // modular: exact whenever no |e| reaches 2^24
-  for (std::size_t k = k0; k < k1; ++k) {
-    const std::uint64_t e =
-        static_cast<std::uint64_t>(c[k + t]) - static_cast<std::uint64_t>(c[k]) - static_cast<std::uint64_t>(shift);
-    big |= e + (std::uint64_t{1} << 24);
-    b1 += e;
-    b2 += e * e;
-  }
-  if (big < (std::uint64_t{1} << 25)) {
-    s1 += static_cast<std::int64_t>(b1);
-    s2 += static_cast<std::int64_t>(b2);
-    return;
-  }
-  for (std::size_t k = k0; k < k1; ++k) {
-    const auto e = static_cast<std::int64_t>(static_cast<std::uint64_t>(c[k + t]) - static_cast<std::uint64_t>(c[k]) -
-                                             static_cast<std::uint64_t>(shift));
-    s1 += e;
-    s2 += static_cast<i128>(e) * e;
+  for (std::size_t from = k0; from < k1; from += kExactBlock) {
+    const std::int64_t* b = c + from;
+    const auto e = [b, t, shift](std::size_t k) {
+      return static_cast<std::uint64_t>(b[k + t]) - static_cast<std::uint64_t>(b[k]) -
+             static_cast<std::uint64_t>(shift);
+    };
+    add_exact_sums<SumKinds::ValuesAndSquares>(std::min(kExactBlock, k1 - from), 0, e, sums);
   }
 }
 
@@ -114,21 +99,20 @@ std::vector<double> overlapping_variances(const PhaseSeries& x, const std::vecto
     const double s = std::round(total * static_cast<double>(ts[i]) / static_cast<double>(n));
     shift[i] = std::abs(s) < 0x1p62 ? static_cast<std::int64_t>(s) : 0;
   }
-  std::vector<std::vector<std::array<i128, 2>>> part(chunks, std::vector<std::array<i128, 2>>(ts.size()));
+  std::vector<std::vector<ExactSums>> part(chunks, std::vector<ExactSums>(ts.size()));
   parallel_for(chunks, [&](std::size_t ci) {
     for (std::size_t k0 = ci * kChunk; k0 < std::min(n, (ci + 1) * kChunk); k0 += kBlock)
       for (std::size_t i = 0; i < ts.size(); ++i) {
         const std::size_t k1 = std::min({k0 + kBlock, (ci + 1) * kChunk, n - ts[i] + 1});
-        if (k1 > k0)
-          add_increment_sums(x.counts.data(), narrow, ts[i], shift[i], k0, k1, part[ci][i][0], part[ci][i][1]);
+        if (k1 > k0) add_increment_sums(x.counts.data(), narrow, ts[i], shift[i], k0, k1, part[ci][i]);
       }
   });
   const double q2 = x.arcsec_per_count * x.arcsec_per_count;
   for (std::size_t i = 0; i < ts.size(); ++i) {
     i128 s1 = 0, s2 = 0;
     for (const auto& p : part) {
-      s1 += p[i][0];
-      s2 += p[i][1];
+      s1 += static_cast<i128>(p[i].sum);
+      s2 += static_cast<i128>(p[i].squares);
     }
     const std::size_t m = n - ts[i] + 1;
     const i128 mss = s2 * static_cast<i128>(m) - s1 * s1;  // M·Σ(d − d̄)², exact
@@ -546,13 +530,9 @@ BlockSpreadResult block_spread(const PhaseSeries& x, double block_s) {
 
 double expected_block_variance(const Eigen::Matrix<double, kTermCount, 1>& c, double tau, std::size_t blocks) {
   if (blocks < 2) return 0;
-  // Generalized structure function of the angle, ″², for each term (fit-scale c):
-  //   Q: 2c (u > 0)   N: c·u   B: −(c/π)·u²·ln u   K: −c·u³/6   R: −c·u⁴/12
-  auto s = [&](double u) {
-    if (u <= 0) return 0.0;
-    return 2.0 * c[0] + c[1] * u - c[2] / std::numbers::pi * u * u * std::log(u) - c[3] * u * u * u / 6.0 -
-           c[4] * u * u * u * u / 12.0;
-  };
+  // The structure function of the angle, ″² (fit-scale c).
+  const std::array<double, 5> ca{c[0], c[1], c[2], c[3], c[4]};
+  auto s = [&](double u) { return structure_function(ca, u); };
   const auto mm = static_cast<double>(blocks);
   double sum = 0;
   for (std::size_t l = 1; l < blocks; ++l) {
