@@ -3,8 +3,8 @@
 // (tests/independent_gyro.hpp) with a plain counter and with the GL-2D's randomised read-out: in every
 // bin of stated probability of the overall class with at least 30 statements, the share right is
 // within 0.07 of the mean stated probability, or within 2.5 Monte-Carlo standard errors where a bin of
-// 30–150 statements cannot resolve 0.07 (docs/calibration.md). RWCALC_CLASS_RECORDS sets the count of
-// each set (default 400).
+// 30–150 statements cannot resolve 0.07 (docs/calibration.md). Each set has 80 records, 400 under
+// RWCALC_ACCEPTANCE=1 (tests/support/population.hpp); RWCALC_CLASS_RECORDS sets the count.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "independent_gyro.hpp"
+#include "population.hpp"
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/parallel.hpp"
 #include "test_support.hpp"
@@ -29,8 +30,7 @@ struct Statement {
 };
 
 void check_calibration(bool dither, std::uint64_t seed0) {
-  const char* e = std::getenv("RWCALC_CLASS_RECORDS");
-  const int count = e ? std::max(8, std::atoi(e)) : 400;
+  const int count = test::population("RWCALC_CLASS_RECORDS", 80, 400);
   std::vector<Statement> out(static_cast<std::size_t>(count));
   parallel_for(out.size(), [&](std::size_t i) {
     std::mt19937_64 g(seed0 + i);

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "independent_gyro.hpp"
+#include "population.hpp"
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/noise_model.hpp"
 #include "rwcalc/parallel.hpp"
@@ -57,10 +58,9 @@ Outcome judge(const Recording& rec, double n, double b) {
   return out;
 }
 
-int records(int fallback) {
-  const char* e = std::getenv("RWCALC_COUNTER_RECORDS");
-  return e ? std::max(4, std::atoi(e)) : fallback;
-}
+/// `ci` records by default, `acceptance` under RWCALC_ACCEPTANCE=1 (tests/support/population.hpp);
+/// RWCALC_COUNTER_RECORDS sets the count.
+int records(int ci, int acceptance) { return test::population("RWCALC_COUNTER_RECORDS", ci, acceptance, 4); }
 
 /// Runs `count` records (N in 0.0005–0.001 °/√h, B in 0.005–0.01 °/h, drawn per record) in parallel
 /// and checks the set; `wrong_share` of the records may state a wrong class at P ≥ 0.9.
@@ -98,7 +98,7 @@ void check_set(const char* name, int count, bool counter_expected, double wrong_
 }
 
 TEST(CounterReadout, SimulatorDefaultReadoutTwoHourRecords) {
-  check_set("simulate's default read-out, 2 h at 400 Hz", records(24), true, 0.0,
+  check_set("simulate's default read-out, 2 h at 400 Hz", records(8, 24), true, 0.0,
             [](double n, double b, std::uint64_t seed) {
               SimulationSettings s;
               s.seed = seed;
@@ -109,14 +109,14 @@ TEST(CounterReadout, SimulatorDefaultReadoutTwoHourRecords) {
 TEST(CounterReadout, IndependentGeneratorPlainCounter) {
   // One record in 48 (N 0.00055, B 0.0073 °/h) settles with N at 0 and B 1.4× the truth, stated class 3
   // at P = 0.97 (docs/calibration.md, "The counter read-out"): 5 % are allowed.
-  check_set("frequency-domain generator, plain counter, 30 min at 400 Hz", records(40), true, 0.05,
+  check_set("frequency-domain generator, plain counter, 30 min at 400 Hz", records(12, 48), true, 0.05,
             [](double n, double b, std::uint64_t seed) {
               return independent_record(n, b, 1800.0, 400.0, false, seed);
             });
 }
 
 TEST(CounterReadout, IndependentGeneratorDitheredCounter) {
-  check_set("frequency-domain generator, dithered counter, 30 min at 400 Hz", records(24), false, 0.0,
+  check_set("frequency-domain generator, dithered counter, 30 min at 400 Hz", records(8, 24), false, 0.0,
             [](double n, double b, std::uint64_t seed) { return independent_record(n, b, 1800.0, 400.0, true, seed); });
 }
 

@@ -5,8 +5,9 @@
 //   cross-overs sit at the same fractions of the record as in a 2-h 400 Hz GL-2D run;
 // - full: 2 h at 400 Hz with the GL-2D pulse weight 0.92″ (16× the samples, so N rests on far more
 //   degrees of freedom and any long-τ misfit weighs more in standardised units).
-// RWCALC_COVERAGE_RECORDS and RWCALC_COVERAGE_FULL_RECORDS override the counts (the docs' tables
-// come from 480 and 300 records); the bounds follow from the binomial spread at the count run.
+// The docs' tables come from 480 and 300 records (RWCALC_ACCEPTANCE=1 runs 480 and 60,
+// tests/support/population.hpp); RWCALC_COVERAGE_RECORDS and RWCALC_COVERAGE_FULL_RECORDS set the
+// counts. The bounds follow from the binomial spread at the count run.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -16,6 +17,7 @@
 #include <random>
 #include <thread>
 
+#include "population.hpp"
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/simulate.hpp"
 #include "test_support.hpp"
@@ -41,11 +43,6 @@ struct RecordSet {
 // N scaled by 1/2 for the 4× shorter record keeps the ARW/flicker cross-over at T/20.
 constexpr RecordSet kShort{"30-min 100-Hz", 1800.0, 100.0, 0.2, 0.0004, 0.0011, 1000};
 constexpr RecordSet kFull{"2-h 400-Hz", 7200.0, 400.0, 0.92, 0.0008, 0.0022, 50000};
-
-int env_count(const char* name, int fallback) {
-  const char* e = std::getenv(name);
-  return e ? std::max(20, std::atoi(e)) : fallback;
-}
 
 double probit(double p) {
   return boost::math::quantile(boost::math::normal_distribution<double>(), std::clamp(p, 1e-15, 1.0 - 1e-15));
@@ -157,11 +154,11 @@ void check_set(const RecordSet& set, const std::vector<Outcome>& out) {
 }
 
 TEST(SlowCoverage, IntervalsAndVerdictProbabilitiesOnShortRecords) {
-  check_set(kShort, run_set(kShort, env_count("RWCALC_COVERAGE_RECORDS", 480)));
+  check_set(kShort, run_set(kShort, test::population("RWCALC_COVERAGE_RECORDS", 100, 480, 20)));
 }
 
 TEST(SlowCoverage, IntervalsAndVerdictProbabilitiesOnFullLengthRecords) {
-  check_set(kFull, run_set(kFull, env_count("RWCALC_COVERAGE_FULL_RECORDS", 60)));
+  check_set(kFull, run_set(kFull, test::population("RWCALC_COVERAGE_FULL_RECORDS", 12, 60, 12)));
 }
 
 }  // namespace

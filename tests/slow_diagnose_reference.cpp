@@ -4,8 +4,8 @@
 // own whitening (one generalised eigen-decomposition) and the noise profiled (overall scale and the
 // flicker's share). Its threshold is its own 99 % quantile on clean records, so that both tests work
 // at a 1 % false-alarm rate. Records: GL-2D-like (N 0.001 °/√h, B 0.005 °/h) at 10 Hz with the
-// white read-out, whose noise is exactly the model's. About 3 min of CPU: 200 clean records for the
-// reference's quantile and 64 diagnoses.
+// white read-out, whose noise is exactly the model's. 200 clean records for the reference's quantile
+// and 24 diagnoses (64 under RWCALC_ACCEPTANCE=1, tests/support/population.hpp).
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
@@ -17,6 +17,7 @@
 #include <numbers>
 #include <vector>
 
+#include "population.hpp"
 #include "rwcalc/diagnose.hpp"
 #include "rwcalc/simulate.hpp"
 
@@ -174,8 +175,10 @@ double ninety(const std::vector<double>& mults, const std::vector<double>& frac)
 
 // Slow lines (3–5 cycles) at 3–4.5× the flicker floor: rwcalc's 90 % amplitude for naming the line
 // (frequency within 0.5/T, amplitude within 30 %) beside the reference's at the same 1 %
-// false-alarm rate, and no line named a Gauss–Markov term. Measured: reference 3.30×, rwcalc 3.85×
-// (ratio 1.167); the bound asserted is 1.2, above the 1.15 aimed at, which is not yet reached.
+// false-alarm rate, and no line named a Gauss–Markov term. Measured on the acceptance's 16 records per
+// amplitude: reference 3.30×, rwcalc 3.85× (ratio 1.167); the bound asserted there is 1.2, above the
+// 1.15 aimed at, which is not yet reached. The default 6 records per amplitude resolve the 90 % point
+// to about a third of a step: 1.3 is asserted.
 TEST(DiagnoseReference, SlowLinesWithinFifteenPercentOfTheReferenceAmplitude) {
   const Reference ref(static_cast<Eigen::Index>(kT / kTb) - 2);
   // The reference's threshold: its 99 % quantile over 200 clean records.
@@ -184,7 +187,7 @@ TEST(DiagnoseReference, SlowLinesWithinFifteenPercentOfTheReferenceAmplitude) {
   std::sort(clean.begin(), clean.end());
   const double threshold = 0.5 * (clean[197] + clean[198]);
   const std::vector<double> mults = {3.0, 3.5, 4.0, 4.5};
-  const int n = 16;
+  const int n = test::population("RWCALC_REFERENCE_LINES", 6, 16);
   std::vector<double> ref_frac, rw_frac;
   int gauss_markov = 0;
   for (const double mult : mults) {
@@ -218,6 +221,6 @@ TEST(DiagnoseReference, SlowLinesWithinFifteenPercentOfTheReferenceAmplitude) {
       "reference threshold {:.2f} (99 % of 200 clean records); 90 % amplitude: reference {:.2f}x, rwcalc {:.2f}x "
       "(ratio {:.3f}); Gauss-Markov named in {} line records\n",
       threshold, a_ref, a_rw, a_rw / a_ref, gauss_markov);
-  EXPECT_LE(a_rw, 1.2 * a_ref);
+  EXPECT_LE(a_rw, (n >= 16 ? 1.2 : 1.3) * a_ref);
   EXPECT_EQ(gauss_markov, 0);
 }

@@ -3,7 +3,8 @@
 // N″² is traded against B² in the regression: 2-h records at 400 Hz with the 0.92″ pulse and the
 // white (dithered) read-out, B drawn in 0.005–0.01 °/h; on rwcalc's simulator and on the independent
 // generator (tests/independent_gyro.hpp) through the whole analysis with the GL-2D's randomised
-// read-out. RWCALC_DIRECT_N_RECORDS sets the count (the docs' figures come from 120).
+// read-out. 12 records each, 120 under RWCALC_ACCEPTANCE=1 (the docs' figures;
+// tests/support/population.hpp); RWCALC_DIRECT_N_RECORDS sets the count.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "independent_gyro.hpp"
+#include "population.hpp"
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/methods.hpp"
 #include "rwcalc/parallel.hpp"
@@ -24,10 +26,7 @@ namespace {
 
 constexpr double kN = 0.00045;
 
-int record_count() {
-  const char* e = std::getenv("RWCALC_DIRECT_N_RECORDS");
-  return e ? std::max(8, std::atoi(e)) : 64;
-}
+int record_count() { return test::population("RWCALC_DIRECT_N_RECORDS", 12, 120); }
 
 TEST(DirectN, CoverageAtTheSmallestNWithTheGl2dReadout) {
   const int count = record_count();

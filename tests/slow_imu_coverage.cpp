@@ -3,7 +3,8 @@
 // term and sensor kind (with every term kept; the default term selection is measured beside it). Each axis is an exact
 // simulator record (white noise N, flicker B, rate or acceleration random walk K, a fine white read-out) written as a
 // rate column: gyros in deg/s, accelerometers in m/s^2 (the simulated angle in ″ read as velocity in 1/3600 m/s,
-// units.hpp). RWCALC_IMU_COVERAGE_CASES overrides the count of cases (default 50).
+// units.hpp). 12 cases, 50 under RWCALC_ACCEPTANCE=1 (tests/support/population.hpp), whose figures
+// docs/imu.md quotes; RWCALC_IMU_COVERAGE_CASES sets the count.
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
@@ -13,6 +14,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "population.hpp"
 #include "rwcalc/simulate.hpp"
 #include "test_support.hpp"
 
@@ -61,10 +63,9 @@ std::string imu_file(std::uint64_t seed) {
   return s;
 }
 
-int cases() {
-  const char* e = std::getenv("RWCALC_IMU_COVERAGE_CASES");
-  return e ? std::max(10, std::atoi(e)) : 50;
-}
+constexpr int kAcceptanceCases = 50;
+
+int cases() { return population("RWCALC_IMU_COVERAGE_CASES", 12, kAcceptanceCases, 10); }
 
 // Resolved cases and how many of them hold the truth, per "kind term"; with each term's median
 // estimate/truth among them.
@@ -117,6 +118,11 @@ double coverage_of(Tally& t, const std::string& name, int n_cases, const char* l
   return coverage;
 }
 
+/// A coverage bound at the acceptance's 3 × 50 axis-cases, widened for fewer resolved ones.
+double bound(double at_acceptance, Tally& t, const std::string& name) {
+  return at_acceptance - share_allowance(at_acceptance, t.counts[name].first, 3 * kAcceptanceCases);
+}
+
 // Every term kept (--all-terms): each resolved coefficient holds the truth in ≥ 90 % of the cases.
 TEST(ImuCoverage, ResolvedCoefficientsHoldTheTruthInTheirIntervals) {
   const int n = cases();
@@ -124,7 +130,7 @@ TEST(ImuCoverage, ResolvedCoefficientsHoldTheTruthInTheirIntervals) {
   for (const char* name : {"gyro N", "gyro B", "gyro K", "accelerometer N", "accelerometer B", "accelerometer K"}) {
     const double coverage = coverage_of(t, name, n, "all-terms");
     if (t.counts[name].first >= 20) {
-      EXPECT_GE(coverage, 0.90) << name;
+      EXPECT_GE(coverage, bound(0.90, t, name)) << name;
     }
   }
   for (const char* must : {"gyro N", "gyro B", "accelerometer N", "accelerometer B"})
@@ -141,10 +147,11 @@ TEST(ImuCoverage, DefaultTermSelection) {
   for (const char* name : {"gyro N", "gyro K", "accelerometer N", "accelerometer K"}) {
     const double coverage = coverage_of(t, name, n, "default");
     if (t.counts[name].first >= 20) {
-      EXPECT_GE(coverage, 0.85) << name;
+      EXPECT_GE(coverage, bound(0.85, t, name)) << name;
     }
   }
-  for (const char* name : {"gyro B", "accelerometer B"}) EXPECT_GE(coverage_of(t, name, n, "default"), 0.80) << name;
+  for (const char* name : {"gyro B", "accelerometer B"})
+    EXPECT_GE(coverage_of(t, name, n, "default"), bound(0.80, t, name)) << name;
 }
 
 }  // namespace

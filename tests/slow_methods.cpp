@@ -1,8 +1,8 @@
 // Bias and coverage of the cross-check estimators (direct N, B from the 100-s averages, σ_min)
 // and the verdicts they give, on seeded full-length GL-2D-like records: 2 h at 400 Hz, 0.92″
 // pulses with the white (dither-like) read-out, Moscow Earth rate, N and B drawn across the
-// paper's range. RWCALC_METHODS_RECORDS overrides the record count (the figures in
-// docs/analysis.md come from 240 records).
+// paper's range. 48 records, 240 under RWCALC_ACCEPTANCE=1 (the figures in docs/analysis.md;
+// tests/support/population.hpp); RWCALC_METHODS_RECORDS sets the count.
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <random>
 
+#include "population.hpp"
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/parallel.hpp"
 #include "rwcalc/simulate.hpp"
@@ -18,10 +19,7 @@
 namespace rwcalc {
 namespace {
 
-int records() {
-  const char* e = std::getenv("RWCALC_METHODS_RECORDS");
-  return e ? std::max(20, std::atoi(e)) : 48;
-}
+int records() { return test::population("RWCALC_METHODS_RECORDS", 48, 240, 20); }
 
 struct Outcome {
   double n_ratio = 0, b_ratio = 0, straight_ratio = 0, straight_expected = 0, min_ratio = 0, min_expected = 0;
