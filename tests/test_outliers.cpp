@@ -229,7 +229,7 @@ namespace {
 // The scan of a phase series (rates computed stretch by stretch) is the scan of its rates as a
 // vector, bit for bit: scale, indices, values and z, on exact counts (whose candidates are screened
 // on the counts, in a stretch with a count beyond 13 bits through the rates) and on a floating
-// phase, with RWCALC_THREADS=1 and =2.
+// phase with a rate offset (as the reader keeps a rate record's mean), with RWCALC_THREADS=1 and =2.
 TEST(Outliers, PhaseSeriesScanEqualsVectorScan) {
   std::mt19937_64 rng(21);
   std::poisson_distribution<int> pulses(2.5);
@@ -247,9 +247,13 @@ TEST(Outliers, PhaseSeriesScanEqualsVectorScan) {
   rwcalc::PhaseSeries floating;
   floating.tau0_s = 0.01;
   floating.kind = rwcalc::PhaseKind::Gyro;
+  // A rate record as the reader keeps it: the phase from 0 (its differences then carry every bit)
+  // and the mean rate apart. Computed as (x[i+1] - x[i])/τ0 + offset, a quarter of these rates
+  // would differ from PhaseSeries::rate in the last bit.
+  floating.rate_offset = 15.0411 * 0.7071;
   auto y = gaussian(300001, 0.4, 22);
   for (std::size_t i = 0; i < y.size(); i += 7919) y[i] += 30.0;
-  floating.values.assign(1, 5.0);
+  floating.values.assign(1, 0.0);
   for (double v : y) floating.values.push_back(floating.values.back() + v * floating.tau0_s);
 
   for (const rwcalc::PhaseSeries* ph : {&counts, &floating}) {

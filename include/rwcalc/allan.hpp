@@ -20,6 +20,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "rwcalc/series.hpp"
+#include "rwcalc/validate.hpp"
 
 namespace rwcalc {
 
@@ -73,6 +74,9 @@ struct AllanOptions {
   /// Where the progress line of the per-τ noise identification and bounds goes (progress.hpp; long
   /// on the `all` grid); nullptr: none.
   std::FILE* progress = nullptr;
+
+  /// The first rule these options break, in words (validate.hpp); nothing when they are valid.
+  [[nodiscard]] Violation validate() const;
 };
 
 struct AllanPoint {

@@ -17,6 +17,7 @@
 #include "rwcalc/outlier_screen.hpp"
 #include "rwcalc/reader.hpp"
 #include "rwcalc/sensor.hpp"
+#include "rwcalc/validate.hpp"
 #include "rwcalc/verdict.hpp"
 
 namespace rwcalc {
@@ -49,6 +50,9 @@ struct AnalysisOptions {
   /// Where progress lines go (progress.hpp): analyze() shows how far the analysis is, analyze_files
   /// and analyze_imu how many runs or channels are done; nullptr: none.
   std::FILE* progress = nullptr;
+
+  /// The first rule these options break, in words (validate.hpp); nothing when they are valid.
+  [[nodiscard]] Violation validate() const;
 };
 
 /// Something the reader must know about a result: a stable code, a sentence, and a command that

@@ -16,6 +16,7 @@
 
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/simulate.hpp"
+#include "rwcalc/validate.hpp"
 
 namespace rwcalc {
 
@@ -28,6 +29,9 @@ struct DiagnoseOptions {
   double band_level = 0.95;      ///< central probability of the band (2.5–97.5 %)
   double alpha = 0.01;           ///< false-alarm level of each detector family
   Progress* progress = nullptr;  ///< unused: the diagnosis takes about a second
+
+  /// The first rule these options break, in words (validate.hpp); nothing when they are valid.
+  [[nodiscard]] Violation validate() const;
 };
 
 /// The effects the diagnosis can name, in the order they are named and estimated.

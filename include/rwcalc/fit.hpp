@@ -19,6 +19,8 @@
 
 #include "rwcalc/allan.hpp"
 #include "rwcalc/counter_readout.hpp"
+#include "rwcalc/termination.hpp"
+#include "rwcalc/validate.hpp"
 
 namespace rwcalc {
 
@@ -29,8 +31,6 @@ inline constexpr std::array<Term, kTermCount> kAllTerms{Term::Q, Term::N, Term::
 
 /// "Q", "N", "B", "K", "R".
 std::string_view term_name(Term t);
-/// "arcsec", "deg/sqrt(h)", "deg/h", "deg/h/sqrt(h)", "deg/h^2".
-std::string_view term_unit(Term t);
 /// AV per unit of the fit-scale c at τ (s): {3/τ², 1/τ, 2 ln2/π, τ/3, τ²/2}, (°/h)².
 double term_basis(Term t, double tau_s);
 /// Q = √c, N = √c/60, B = √c, K = 60√c, R = 3600√c (c uses seconds, the coefficients hours).
@@ -74,9 +74,15 @@ struct FitOptions {
   /// The record's counter (pulse counts only); without it the read-out is white (Q).
   std::optional<CounterReadout> counter;
   Readout readout = Readout::Auto;  ///< with `counter`: which read-out model
+  /// Most iterations of each reweighted least-squares fit (Fisher scoring; a few dozen suffice):
+  /// a fit that takes them all reports TerminationStatus::IterationLimit.
+  int max_iterations = 300;
+
+  /// The first rule these options break, in words (validate.hpp); nothing when they are valid.
+  [[nodiscard]] Violation validate() const;
 };
 
-/// One fitted coefficient in its IEEE unit (see term_unit).
+/// One fitted coefficient in its IEEE unit (Q ″, N °/√h, B °/h, K °/h/√h, R °/h²; coefficient_from_c).
 struct Coefficient {
   bool enabled = true;    ///< fitted at all
   bool in_model = true;   ///< kept by the term selection (else reported as a full-model upper bound)
@@ -86,6 +92,8 @@ struct Coefficient {
   double sigma = 0;       ///< standard error (delta method); for an upper bound high/(2·1.96)
   double low = 0;         ///< lower confidence bound (profile likelihood), ≥ 0
   double high = 0;        ///< upper confidence bound
+  /// How the profile searches for the bounds ended (their root-finding iterations).
+  Termination termination;
 };
 
 struct FitResult {
@@ -101,7 +109,8 @@ struct FitResult {
   double corr_NB = 0;                                 ///< correlation of the N² and B² estimates
   std::array<double, kTermCount> phi{1, 1, 1, 1, 1};  ///< variance inflation of each term
   bool model_covariance = false;                      ///< the model-based AV covariance was used
-  int iterations = 0;
+  /// How the reported fit's iterations ended: the full model's fit and the selected term set's.
+  Termination termination;
   FitOptions options;
   std::vector<FitPoint> used;  ///< the points fitted (τ ascending; edf = the EDF the fit used)
   std::vector<double> model;   ///< model σ² at those points, (°/h)²

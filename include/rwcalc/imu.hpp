@@ -14,6 +14,7 @@
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/reader.hpp"
 #include "rwcalc/sensor.hpp"
+#include "rwcalc/validate.hpp"
 
 namespace rwcalc {
 
@@ -28,6 +29,9 @@ struct ImuOptions {
   /// from it and the class verdict given (AnalysisOptions::earth_rate, verdict_wanted).
   std::string vertical_gyro;
   AnalysisOptions analysis;
+
+  /// The first rule these options break, in words (validate.hpp); nothing when they are valid.
+  [[nodiscard]] Violation validate() const;
 };
 
 struct ImuChannel {
@@ -77,6 +81,9 @@ struct NoiseFileOptions {
   bool all_axes = false;
   double inflate = 1;     ///< every value written is this many times the measured one (≥ 1), said in the file
   bool discrete = false;  ///< discrete-time values: N·√rate, K/√rate (takes_discrete formats only)
+
+  /// The first rule these options break, in words (validate.hpp); nothing when they are valid.
+  [[nodiscard]] Violation validate() const;
 };
 
 /// The rostopic as the noise file writes it (one YAML double-quoted scalar, encode.hpp); UsageError

@@ -9,6 +9,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "rwcalc/validate.hpp"
+
 namespace rwcalc {
 
 struct ImuPageOptions {
@@ -16,6 +18,9 @@ struct ImuPageOptions {
   std::string noise_file = "imu.yaml";  ///< the Kalibr noise file beside the page
   std::string json_file = "imu.json";   ///< the whole result beside the page
   std::string text_file = "imu.txt";    ///< the text tables beside the page
+
+  /// The first rule these options break, in words (validate.hpp); nothing when they are valid.
+  [[nodiscard]] Violation validate() const;
 };
 
 /// The page from `rwcalc imu --json`'s object (channels, noise, conventions).

@@ -15,6 +15,7 @@
 
 #include "rwcalc/noise_model.hpp"
 #include "rwcalc/pulse_writer.hpp"
+#include "rwcalc/validate.hpp"
 
 namespace rwcalc {
 
@@ -34,6 +35,9 @@ struct ImuLayout {
   double gyro_lsb_dps = 0.05;             ///< the gyro output step, °/s
   double accel_lsb_mg = 3.33;             ///< the accelerometer output step, mg
   AccelColumnUnit accel_unit = AccelColumnUnit::MetrePerSecond2;
+
+  /// The first rule these options break, in words (validate.hpp); nothing when they are valid.
+  [[nodiscard]] Violation validate() const;
 };
 
 /// Levels like the ADIS16405's (docs/imu.md, runs 1–4; its output steps 0.05 °/s and 3.33 mg),

@@ -13,6 +13,7 @@
 
 #include "rwcalc/fit.hpp"
 #include "rwcalc/series.hpp"
+#include "rwcalc/validate.hpp"
 
 namespace rwcalc {
 
@@ -22,6 +23,9 @@ struct MethodOptions {
   int direct_points = 12;         ///< interval lengths, log-spaced
   int bootstrap_replicates = 64;  ///< parametric-bootstrap replicates of the direct N interval
   double block_s = 100.0;         ///< block of the averaging method
+
+  /// The first rule these options break, in words (validate.hpp); nothing when they are valid.
+  [[nodiscard]] Violation validate() const;
 };
 
 struct MethodEstimate {

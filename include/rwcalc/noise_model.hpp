@@ -13,6 +13,8 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "rwcalc/validate.hpp"
+
 namespace rwcalc {
 
 /// How whole pulses are counted from the sensed angle.
@@ -85,6 +87,9 @@ struct NoiseModel {
   /// floating angle (diagnose's `lowpass` finding).
   double output_lowpass_tc_s = 0.0;
   std::optional<TemperatureBias> temperature_bias;
+
+  /// The first rule these options break, in words (validate.hpp); nothing when they are valid.
+  [[nodiscard]] Violation validate() const;
 };
 
 /// Length, sampling and read-out of a simulated record.
@@ -96,12 +101,16 @@ struct SimulationSettings {
   std::optional<double> temperature_c;  ///< nominal temperature (metadata; temperature bias), °C
   [[nodiscard]] std::size_t samples() const;
   [[nodiscard]] double tau0_s() const { return 1.0 / rate_hz; }
+
+  /// The first rule these options break, in words (validate.hpp); nothing when they are valid.
+  [[nodiscard]] Violation validate() const;
 };
 
 /// Vertical component of Earth's rotation at a latitude: Ω_E·sin(lat), °/h.
 [[nodiscard]] double earth_rate_at(double latitude_deg);
 
-/// Throws UsageError for an invalid value (negative σ, zero time constant, non-finite, < 2 samples).
+/// Throws UsageError with the first violation of the model's or the settings' rules (negative σ,
+/// zero time constant, non-finite, < 2 samples).
 void validate(const NoiseModel& model, const SimulationSettings& settings);
 
 /// Quantization Q of the read-out, ″: q/√6 (white), q/√12 (counting: the sawtooth's level).

@@ -16,6 +16,8 @@
 #include <string_view>
 #include <vector>
 
+#include "rwcalc/validate.hpp"
+
 namespace rwcalc {
 
 /// Output format of a figure, by the output file's extension (.svg, .png, .pdf).
@@ -33,6 +35,9 @@ struct PlotOptions {
   int width_px = 960;   ///< canvas width (PDF: 96 px per inch)
   int height_px = 720;  ///< canvas height of one panel
   bool force = false;   ///< overwrite existing output files
+
+  /// The first rule these options break, in words (validate.hpp); nothing when they are valid.
+  [[nodiscard]] Violation validate() const;
 };
 
 struct PlotResult {

@@ -25,6 +25,7 @@
 
 #include "rwcalc/memory.hpp"
 #include "rwcalc/series.hpp"
+#include "rwcalc/validate.hpp"
 
 namespace rwcalc {
 
@@ -84,6 +85,9 @@ struct ReadOptions {
   /// Where the reading's progress line goes (progress.hpp: the bytes read of the input's size);
   /// nullptr: none.
   std::FILE* progress = nullptr;
+
+  /// The first rule these options break, in words (validate.hpp); nothing when they are valid.
+  [[nodiscard]] Violation validate() const;
 };
 
 /// Where the sample rate came from (reported in outputs).

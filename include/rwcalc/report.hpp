@@ -14,6 +14,7 @@
 
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/lab_profile.hpp"
+#include "rwcalc/validate.hpp"
 
 namespace rwcalc {
 
@@ -35,6 +36,9 @@ struct ReportOptions {
   std::optional<LabProfile> profile;
   std::string protocol_number;  ///< "17/2026"; shown as typed
   CalendarDate protocol_date;   ///< the protocol's date (the day the report is made)
+
+  /// The first rule these options break, in words (validate.hpp); nothing when they are valid.
+  [[nodiscard]] Violation validate() const;
 };
 
 /// The HTML page. Throws AnalysisError without analyses, OutputError when a figure fails.

@@ -12,6 +12,8 @@
 #include <string_view>
 #include <vector>
 
+#include "rwcalc/validate.hpp"
+
 #include "rwcalc/i18n.hpp"
 
 namespace rwcalc {
@@ -48,6 +50,9 @@ struct VerdictOptions {
   /// accepted for that class (0: strict).
   double tolerance_pct = 0;
   double decisive = 0.9;  ///< a stated class less probable than this is given with its runner-up
+
+  /// The first rule these options break, in words (validate.hpp); nothing when they are valid.
+  [[nodiscard]] Violation validate() const;
 };
 
 /// An estimate's reported value (the upper bound when not resolved) and its distribution.

@@ -163,22 +163,14 @@ std::vector<std::int64_t> cluster_sizes(const TauGrid& grid, Estimator est, std:
 
 namespace {
 
-/// The counts of an exact record as int64 (the series' own, or a copy when it holds them in
-/// another form) and, for the modified variance, their modular prefix sums.
+/// The counts of an exact record and, for the modified variance, their modular prefix sums.
 struct CountData {
-  std::vector<std::int64_t> copy;
   const std::int64_t* c = nullptr;
   std::vector<std::uint64_t> prefix;
 
   CountData(const PhaseSeries& x, Estimator est) {
     if (!x.exact()) return;
-    if (!x.counts.empty()) {
-      c = x.counts.data();
-    } else {
-      copy.resize(x.points());
-      for (std::size_t k = 0; k < copy.size(); ++k) copy[k] = x.count(k);
-      c = copy.data();
-    }
+    c = x.counts.data();
     if (est == Estimator::Modified) prefix = detail::count_prefix_sums(c, x.points());
   }
 };
@@ -283,12 +275,9 @@ std::vector<double> grid_variances(const PhaseSeries& x, const CountData& data, 
 }
 
 void check_options(const PhaseSeries& x, const AllanOptions& options) {
-  if (!(options.confidence > 0 && options.confidence < 1))
-    throw UsageError(trf("--confidence must lie strictly between 0 and 1, got {}", options.confidence));
+  require_valid(options);
   if (!(x.tau0_s > 0) || !std::isfinite(x.tau0_s))
     throw UsageError(trf("sample period must be positive, got {} s", x.tau0_s));
-  if (!options.noise_id && (options.alpha < -2 || options.alpha > 2))
-    throw UsageError(trf("noise exponent alpha must lie in -2..2, got {}", options.alpha));
   if (max_cluster_size(options.estimator, x.points()) < 1)
     throw AnalysisError(trf("the record has {} phase point(s); the {} needs at least {}", x.points(),
                             variance_name(options.estimator), 3));

@@ -25,8 +25,9 @@ namespace rwcalc {
 namespace {
 
 nlohmann::json coef_json(const Coefficient& c) {
-  return {{"value", c.value},       {"sigma", c.sigma},       {"low95", c.low},         {"high95", c.high},
-          {"resolved", c.resolved}, {"estimate", c.estimate}, {"in_model", c.in_model}, {"fitted", c.enabled}};
+  return {{"value", c.value},       {"sigma", c.sigma},       {"low95", c.low},
+          {"high95", c.high},       {"resolved", c.resolved}, {"estimate", c.estimate},
+          {"in_model", c.in_model}, {"fitted", c.enabled},    {"termination", to_json(c.termination)}};
 }
 
 nlohmann::json method_json(const MethodEstimate& m) {
@@ -398,6 +399,7 @@ void cross_checks(const PhaseSeries& x, const AnalysisOptions& options, Analysis
 }  // namespace
 
 AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
+  require_valid(options);
   const std::optional<SensorKind> sensor = sensor_kind(read.phase.kind);
   if (!sensor)
     throw UsageError(
@@ -465,6 +467,7 @@ json fit_json(const AnalysisResult& r) {
           {"chi2", f.chi2},
           {"dof", f.dof},
           {"p_value", f.p_value},
+          {"termination", to_json(f.termination)},
           {"corr_NQ", f.corr_NQ},
           {"corr_NB", f.corr_NB},
           {"points", f.used.size()},

@@ -447,8 +447,36 @@ void withhold_verdict(AnalysisResult& r) {
                      trf("rwcalc diagnose {} [input options]", shell_word(r.source)));
 }
 
+namespace {
+
+/// Why an iteration ended before its convergence test held, one phrase.
+std::string stop_reason(const Termination& t) {
+  return t.status == TerminationStatus::IterationLimit
+             ? trf("it took its most iterations ({}) before its test of convergence held", t.iterations)
+             : trf("no step lowered its objective after {} iterations", t.iterations);
+}
+
+/// The warnings of a fit or an interval search that did not converge (none when all did).
+void termination_warnings(const FitResult& f, std::vector<AnalysisWarning>& w) {
+  if (!f.termination.converged())
+    w.push_back({"fit_not_converged",
+                 trf("The noise-model fit did not converge: {}. The coefficients are those of its last iteration.",
+                     stop_reason(f.termination)),
+                 ""});
+  for (const Term t : kAllTerms)
+    if (const Coefficient& c = f[t]; c.enabled && !c.termination.converged())
+      w.push_back({"interval_not_converged",
+                   trf("The search for the {} coefficient's confidence bounds did not converge: {}. Its interval "
+                       "is the last one reached.",
+                       term_name(t), stop_reason(c.termination)),
+                   ""});
+}
+
+}  // namespace
+
 std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r) {
   std::vector<AnalysisWarning> w;
+  termination_warnings(r.fit, w);
   const std::string src = shell_word(r.source);
   const FitRangeChoice& fr = r.fit_range;
   if (r.verdict.withheld && r.verdict_applies)

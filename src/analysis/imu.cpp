@@ -159,14 +159,12 @@ std::string earth_and_verdict(const AnalysisResult& r) {
 using namespace imu_impl;
 
 ImuResult analyze_imu(const std::string& path, const ImuOptions& options) {
+  require_valid(options);
   std::vector<ChannelSpec> specs;
   for (const auto& c : options.gyro_columns) specs.push_back({c, SensorKind::Gyro});
   for (const auto& c : options.accel_columns) specs.push_back({c, SensorKind::Accelerometer});
   std::string found;  // the channels the column names gave, when none was given
   if (specs.empty()) specs = channels_by_name(path, options.read, found);
-  if (!options.vertical_gyro.empty() && std::find(options.gyro_columns.begin(), options.gyro_columns.end(),
-                                                  options.vertical_gyro) == options.gyro_columns.end())
-    throw UsageError(trf("--vertical-gyro {}: not one of the --gyro columns", options.vertical_gyro));
   ImuResult out;
   out.source = path;
   out.gyro_units = output_units(SensorKind::Gyro, options.gyro_output_unit);
@@ -212,6 +210,7 @@ nlohmann::json channel_json(const AnalysisResult& r, const UnitSet& shown) {
   fit["chi2_per_dof"] = f.chi2_per_dof;
   fit["p_value"] = f.p_value;
   fit["dof"] = f.dof;
+  fit["termination"] = to_json(f.termination);
   fit["tau_min_s"] = f.used.empty() ? 0.0 : f.used.front().tau_s;
   fit["tau_max_s"] = f.used.empty() ? 0.0 : f.used.back().tau_s;
   fit["range_reason"] = r.fit_range.reason();
@@ -629,6 +628,7 @@ std::string written_unit(SensorKind kind, Term term, bool discrete) {
 }  // namespace imu_impl
 
 std::string noise_file(const ImuResult& r, const NoiseFileOptions& options) {
+  require_valid(options);
   const auto& first = r.channels.front().result;
   const FormatSpec& spec = spec_of(options.format);
   const bool worst = options.combine == AxisCombination::Worst;

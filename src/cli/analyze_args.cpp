@@ -26,10 +26,8 @@ std::pair<double, double> parse_range(const std::string& spec, const char* what,
       throw UsageError(trf("{}: '{}' is not a non-negative number of seconds", what, s));
     return v;
   };
-  const double a = num(spec.substr(0, colon), lo_default);
-  const double b = num(spec.substr(colon + 1), hi_default);
-  if (!(a < b)) throw UsageError(trf("{}: TMIN must be below TMAX (got '{}')", what, spec));
-  return {a, b};
+  // Their order is the options' rule (FitOptions, MethodOptions::validate).
+  return {num(spec.substr(0, colon), lo_default), num(spec.substr(colon + 1), hi_default)};
 }
 
 }  // namespace
@@ -134,8 +132,6 @@ AnalysisOptions AnalyzeArgs::options() const {
     if (p == std::string::npos) throw UsageError(trf("--terms: unknown term '{}' (use Q, N, B, K, R)", c));
     o.fit.enabled[p] = true;
   }
-  if (!o.fit.enabled[1] || !o.fit.enabled[2])
-    throw UsageError(tr("--terms must include N and B (the verdict needs both)"));
   o.fit.select_terms = !keep_all_terms;
   if (readout == "auto")
     o.fit.readout = Readout::Auto;
@@ -156,11 +152,11 @@ AnalysisOptions AnalyzeArgs::options() const {
   if (!limits_file.empty()) o.verdict.table = ClassTable::load(limits_file);
   o.methods.block_s = block_s;
   const auto [dl, dh] = parse_range(direct_range, "--direct-range", 1.0, 100.0);
-  if (!(dl > 0)) throw UsageError(tr("--direct-range: TMIN must be positive"));
   o.methods.direct_t_min_s = dl;
   o.methods.direct_t_max_s = dh;
   o.outlier_action = parse_outlier_action(outliers);
   o.outlier_threshold = outlier_threshold;
+  require_valid(o);  // the library's rules, before any file is read
   return o;
 }
 

@@ -67,14 +67,6 @@ struct ImuCmd {
       o.accel_increment_unit = AngleUnit::MetrePerSecond;
     else if (!accel_unit.empty())
       o.accel_unit = parse_rate_unit(accel_unit);
-    if ((o.gyro_unit && (is_accelerometer_unit(*o.gyro_unit) || *o.gyro_unit == RateUnit::Unitless)))
-      throw UsageError(trf(
-          "--gyro-unit {} is not a gyro unit: expected deg/h, deg/s, rad/s (rates) or arcsec, deg, rad (increments)",
-          gyro_unit));
-    if (o.accel_unit && !is_accelerometer_unit(*o.accel_unit))
-      throw UsageError(
-          trf("--accel-unit {} is not an accelerometer unit: expected m/s^2, g, mg, ug (rates) or m/s (increments)",
-              accel_unit));
     // Each --output-unit belongs to the kind whose unit it is.
     for (const auto& u : shown_units) {
       try {
@@ -86,6 +78,7 @@ struct ImuCmd {
       }
     }
     o.analysis = analysis.options();
+    require_valid(o);  // before the file is read
     return o;
   }
 
@@ -100,11 +93,7 @@ struct ImuCmd {
     k.all_axes = keys_from_all_axes;
     k.inflate = inflate;
     k.discrete = discrete_wanted;
-    if (discrete_wanted && !takes_discrete(format))
-      throw UsageError(
-          trf("--discrete: --noise-format {} takes continuous-time values only (its reader converts "
-              "them); --discrete is for vins-fusion",
-              noise_format));
+    require_valid(k);
     return k;
   }
 };

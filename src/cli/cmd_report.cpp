@@ -246,8 +246,6 @@ int run_report(const ReportCmd& c, Io& io) {
     throw UsageError(tr("--diagnose needs recordings; saved diagnoses are given as 'rwcalc diagnose --json' files"));
   ReadOptions read = c.input.options();
   read.progress = io.progress;
-  if (c.diagnose && c.diagnose_runs < 10)
-    throw UsageError(tr("--diagnose-runs: at least 10 simulated records are needed"));
   // Fail before the analysis: a report.html that cannot be written (existing without --force, a
   // directory…; a missing DIR is created later), no gnuplot for the figures.
   std::error_code ec;

@@ -221,13 +221,7 @@ void apply_settings(const SimulateArgs& a, const Take& take, SimulationSettings&
   if (take("--scale")) s.scale_arcsec = a.scale_arcsec;
   if (a.temperature_c) s.temperature_c = a.temperature_c;
   s.seed = a.seed;
-  if (!std::isfinite(s.duration_s) || s.duration_s <= 0)
-    throw UsageError(trf("--duration must be > 0 s, got {}", s.duration_s));
-  if (!std::isfinite(s.rate_hz) || s.rate_hz <= 0) throw UsageError(trf("--rate must be > 0 Hz, got {}", s.rate_hz));
-  if (!std::isfinite(s.scale_arcsec) || s.scale_arcsec <= 0)
-    throw UsageError(trf("--scale must be > 0 arcsec, got {}", s.scale_arcsec));
-  if (s.samples() < 2)
-    throw UsageError(trf("--duration {} s at --rate {} Hz gives fewer than 2 samples", s.duration_s, s.rate_hz));
+  require_valid(s);  // the library's rules, before the model is checked against the record's range
 }
 
 TemperatureBias temperature_bias(double coefficient, const std::string& profile) {
@@ -289,25 +283,20 @@ void add_extended_terms(const SimulateArgs& a, NoiseModel& m) {
 
 /// The noise model from the options taken (`m` holds that of --from, if any).
 void apply_model(const SimulateArgs& a, const Take& take, NoiseModel& m) {
-  auto nonneg = [](const char* opt, double v) {
-    if (!std::isfinite(v) || v < 0) throw UsageError(trf("{} must be >= 0, got {}", opt, v));
-    return v;
-  };
-  if (take("--arw")) m.arw_deg_per_sqrt_h = nonneg("--arw", a.arw);
-  if (take("--bias-instability")) m.bias_instability_deg_per_h = nonneg("--bias-instability", a.bi);
-  if (take("--rrw")) m.rrw_deg_per_h_per_sqrt_h = nonneg("--rrw", a.rrw);
+  // The options' ranges are checked as they are parsed (numeric_options.hpp), the whole model below.
+  if (take("--arw")) m.arw_deg_per_sqrt_h = a.arw;
+  if (take("--bias-instability")) m.bias_instability_deg_per_h = a.bi;
+  if (take("--rrw")) m.rrw_deg_per_h_per_sqrt_h = a.rrw;
   if (take("--ramp")) m.ramp_deg_per_h2 = a.ramp;
   if (take("--bias")) m.bias_deg_per_h = a.bias;
-  if (take("--latitude") || take("--no-earth-rate")) {
-    if (!std::isfinite(a.latitude) || std::abs(a.latitude) > 90.0)
-      throw UsageError(trf("--latitude must be within -90..90 deg, got {}", a.latitude));
+  if (take("--latitude") || take("--no-earth-rate"))
     m.earth_rate_deg_per_h = a.no_earth_rate ? 0.0 : earth_rate_at(a.latitude);
-  }
   if (a.white_readout) m.readout = ReadoutMode::White;
-  if (take("--white-angle")) m.white_angle_arcsec = nonneg("--white-angle", a.white_angle);
-  if (take("--lowpass")) m.lowpass_tc_s = nonneg("--lowpass", a.lowpass);
-  if (take("--output-lowpass")) m.output_lowpass_tc_s = nonneg("--output-lowpass", a.output_lowpass);
+  if (take("--white-angle")) m.white_angle_arcsec = a.white_angle;
+  if (take("--lowpass")) m.lowpass_tc_s = a.lowpass;
+  if (take("--output-lowpass")) m.output_lowpass_tc_s = a.output_lowpass;
   add_extended_terms(a, m);
+  require_valid(m);
 }
 
 void write_truth(const std::string& path, const NoiseModel& m, const SimulationSettings& sr, const std::string& record,

@@ -10,17 +10,6 @@
 
 namespace rwcalc::cli {
 
-namespace {
-
-std::string range_text(double lo, double hi, const std::string& unit, Ends ends) {
-  const bool open_lo = ends == Ends::OpenLow || ends == Ends::Open;
-  const bool open_hi = ends == Ends::OpenHigh || ends == Ends::Open;
-  return fmt::format("{}{:g}, {:g}{}{}{}", open_lo ? '(' : '[', lo, hi, open_hi ? ')' : ']', unit.empty() ? "" : " ",
-                     unit);
-}
-
-}  // namespace
-
 CLI::Validator real_in(double lo, double hi, const std::string& unit, Ends ends) {
   const std::string range = range_text(lo, hi, unit, ends);
   auto check = [lo, hi, ends, range](std::string& text) -> std::string {

@@ -10,16 +10,14 @@
 #include <string>
 
 #include "rwcalc/limits.hpp"
+#include "rwcalc/validate.hpp"
 
 namespace rwcalc::cli {
 
 /// Name every numeric check carries (the tests look for it on every numeric option).
 inline constexpr const char* kNumberCheck = "NUMBER_CHECK";
 
-/// Whether an end of a range is included.
-enum class Ends { Closed, OpenLow, OpenHigh, Open };
-
-/// A finite real number within [lo, hi] (ends as given), `unit` for the message ("s", "Hz"…).
+/// A finite real number within [lo, hi] (ends as given: rwcalc::Ends), `unit` for the message ("s", "Hz"…).
 CLI::Validator real_in(double lo, double hi, const std::string& unit, Ends ends = Ends::Closed);
 
 /// A whole number (decimal digits, an optional '-') within [lo, hi].

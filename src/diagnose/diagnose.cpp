@@ -322,6 +322,7 @@ void extend(const Blocks& b, const GlsModel& m, const Outside& out, bool fast_na
 }  // namespace
 
 DiagnoseResult diagnose(const Recording& read, const DiagnoseOptions& opt) {
+  require_valid(opt);
   const auto t_start = std::chrono::steady_clock::now();
   OutlierReport outliers;
   Recording edited;

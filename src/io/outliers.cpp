@@ -47,8 +47,9 @@ inline double median6(double a, double b, double c, double d, double e, double f
 }
 
 // The rates of a record, read through windows: from a vector, or computed from a phase series
-// as Recording::rates() computes them (no copy of the whole record). Both give the same doubles.
-// Pulse counts take few values: their rates come from a table of the small ones (the same doubles).
+// by PhaseSeries::rate, as Recording::rates() computes them (no copy of the whole record), so both
+// give the same doubles, whatever the phase's rate offset. Pulse counts take few values: their
+// rates come from a table of the small ones (the same doubles).
 struct RateSource {
   static constexpr std::int64_t kTabled = 64;  // counts per sample tabled either side of 0
   const std::vector<double>* vector = nullptr;
@@ -69,8 +70,7 @@ struct RateSource {
             d >= -kTabled && d <= kTabled ? count_rate[static_cast<std::size_t>(d + kTabled)] : phase->rate(i);
       }
     } else {
-      const double* x = phase->values.data();
-      for (std::size_t i = from; i < to; ++i) out[i - from] = (x[i + 1] - x[i]) / phase->tau0_s + phase->rate_offset;
+      for (std::size_t i = from; i < to; ++i) out[i - from] = phase->rate(i);
     }
   }
 };

@@ -905,7 +905,7 @@ void Reader::note_time_column(Recording& rec) const {
   if (!by_name)
     rec.notes.push_back(trf("time column '{}' in {} (by magnitude: {})", *rec.time_column, tunit_->unit,
                             std::abs(t0) >= 1e8 ? trf("the first stamp {:.4g} is Unix time in {}", t0, tunit_->unit)
-                                                : std::string("the stamps start near 0")));
+                                                : tr("the stamps start near 0")));
   if (times_.n >= 2 && times_.median > 0) rec.jitter = times_.jitter();
   if (rec.jitter.steps > 0)
     rec.notes.push_back(
@@ -913,17 +913,6 @@ void Reader::note_time_column(Recording& rec) const {
             "by up to {:.3g} % of the period (rms {:.2g} %)",
             rec.jitter.steps, rec.jitter.steps == 1 ? "" : "s", 100 * opt_.time_tolerance,
             100 * rec.jitter.max_fraction, 100 * rec.jitter.rms_fraction));
-}
-
-void validate(const ReadOptions& o) {
-  if (o.rate_hz && !(std::isfinite(*o.rate_hz) && *o.rate_hz > 0))
-    throw UsageError(trf("--rate must be a positive number of Hz, got {}", *o.rate_hz));
-  if (o.scale_arcsec && !(std::isfinite(*o.scale_arcsec) && *o.scale_arcsec > 0))
-    throw UsageError(trf("--scale must be a positive number of arcsec, got {}", *o.scale_arcsec));
-  if (o.counter_bits < 1 || o.counter_bits > 64)
-    throw UsageError(trf("--counter-bits must be 1..64, got {}", o.counter_bits));
-  if (!(o.time_tolerance >= 0 && o.time_tolerance < 1))
-    throw UsageError(trf("--time-tolerance must be in [0, 1), got {}", o.time_tolerance));
 }
 
 // One pass over a text for some columns: the first reader leads, the others follow it line by line.
@@ -942,7 +931,7 @@ struct Pass {
   }
   void add(const std::string& name, std::span<const ReadOptions> columns) {
     for (const ReadOptions& o : columns) {
-      validate(o);
+      require_valid(o);
       readers.push_back(std::make_unique<Reader>(name, o));
       if (readers.size() > 1) readers.front()->lead(*readers.back());
     }

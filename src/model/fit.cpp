@@ -60,10 +60,12 @@ struct Problem {
   std::shared_ptr<const CounterPart> counter;  // the counter read-out (FitOptions::readout), or none
   Vec5 scale = Vec5::Ones();
   unsigned enabled_mask = 0;
+  int max_iterations = 300;  // FitOptions::max_iterations
 };
 
 Problem make_problem(std::span<const FitPoint> pts, const FitOptions& o) {
   Problem pr;
+  pr.max_iterations = o.max_iterations;
   const auto j = static_cast<Eigen::Index>(pts.size());
   pr.g.resize(j, P);
   pr.y.resize(j);
@@ -160,7 +162,7 @@ Vec5 nnls(const Problem& pr, const Eigen::VectorXd& w, unsigned free_mask, const
 struct IrlsResult {
   Vec5 d;
   double dev = kInf;
-  int iterations = 0;
+  Termination termination;
 };
 
 /// Iteratively reweighted NNLS with weights ν/μ² (Fisher scoring of the Gamma likelihood with
@@ -184,8 +186,11 @@ IrlsResult irls(const Problem& pr, unsigned free_mask, const Vec5& start, bool f
       dev = deviance(pr, mu);
     }
   }
+  // Converged: the deviance and the parameters both settled; no progress: no step, halved down to
+  // 2⁻⁵⁰, lowered the deviance while the full step still moved the parameters.
+  TerminationStatus status = std::isfinite(dev) ? TerminationStatus::IterationLimit : TerminationStatus::NoProgress;
   int it = 0;
-  for (; it < 300 && std::isfinite(dev); ++it) {
+  for (; it < pr.max_iterations && std::isfinite(dev); ++it) {
     const Eigen::VectorXd w = pr.nu.array() / mu.array().square();
     const Vec5 d_new = nnls(linearised(pr, d), w, free_mask, d);
     double step = 1.0;
@@ -198,30 +203,49 @@ IrlsResult irls(const Problem& pr, unsigned free_mask, const Vec5& start, bool f
       mu_try = mean_of(pr, d_try);
       dev_try = deviance(pr, mu_try);
     }
-    if (!(dev_try <= dev)) break;
+    if (!(dev_try <= dev)) {
+      // At the optimum the full step only rounds: it moves the parameters less than the test allows.
+      const bool settled = (d_new - d).norm() / (1e-300 + d.norm()) < 1e-7;
+      status = settled ? TerminationStatus::Converged : TerminationStatus::NoProgress;
+      ++it;
+      break;
+    }
     const double gain = dev - dev_try;
     const double move = (d_try - d).norm() / (1e-300 + d_try.norm());
     d = d_try;
     mu = mu_try;
     dev = dev_try;
-    if (gain <= 1e-12 * (1.0 + dev) && move < 1e-7) break;
+    if (gain <= 1e-12 * (1.0 + dev) && move < 1e-7) {
+      status = TerminationStatus::Converged;
+      ++it;
+      break;
+    }
   }
   res.d = d;
   res.dev = dev;
-  res.iterations = it;
+  res.termination = {status, it};
   return res;
 }
 
-/// Illinois false position for f(a)·f(b) < 0; returns the root to a relative tolerance.
+/// Illinois false position for f(a)·f(b) < 0; returns the root to a relative tolerance, adding its
+/// iterations (and the limit, when it takes all 100) to `t`.
 template <class F>
-double find_root(F&& f, double a, double fa, double b, double fb) {
+double find_root(F&& f, double a, double fa, double b, double fb, Termination& t) {
   double c = b;
   int side = 0;
-  for (int it = 0; it < 100; ++it) {
+  int it = 0;
+  auto done = [&](TerminationStatus s) {
+    t = combine(t, {s, it});
+    return c;
+  };
+  for (; it < 100; ++it) {
     c = (a * fb - b * fa) / (fb - fa);
     if (!std::isfinite(c)) c = 0.5 * (a + b);
     const double fc = f(c);
-    if (fc == 0 || std::abs(b - a) <= 1e-6 * std::max(std::abs(a), std::abs(b))) break;
+    if (fc == 0 || std::abs(b - a) <= 1e-6 * std::max(std::abs(a), std::abs(b))) {
+      ++it;
+      return done(TerminationStatus::Converged);
+    }
     if ((fc > 0) == (fb > 0)) {
       b = c;
       fb = fc;
@@ -233,9 +257,12 @@ double find_root(F&& f, double a, double fa, double b, double fb) {
       if (side == +1) fb *= 0.5;
       side = +1;
     }
-    if (std::abs(b - a) <= 1e-6 * std::max(std::abs(a), std::abs(b))) break;
+    if (std::abs(b - a) <= 1e-6 * std::max(std::abs(a), std::abs(b))) {
+      ++it;
+      return done(TerminationStatus::Converged);
+    }
   }
-  return c;
+  return done(TerminationStatus::IterationLimit);
 }
 
 /// Everything needed to evaluate profiles of a finished fit.
@@ -255,7 +282,7 @@ struct Profiler {
 };
 
 /// Upper confidence root of term i on the scale t = √d, given a finished fit.
-double upper_root(const Profiler& prof, int i, double t_hat, double step, double thr) {
+double upper_root(const Profiler& prof, int i, double t_hat, double step, double thr, Termination& search) {
   auto g = [&](double t) { return std::sqrt(prof.delta(i, t * t)) - std::sqrt(thr); };
   if (!(step > 0)) step = std::max(t_hat, 1.0);
   double t_hi = t_hat + step;
@@ -265,7 +292,7 @@ double upper_root(const Profiler& prof, int i, double t_hat, double step, double
     g_hi = g(t_hi);
   }
   if (!(g_hi > 0)) return kInf;
-  return find_root(g, t_hat, -std::sqrt(thr), t_hi, g_hi);
+  return find_root(g, t_hat, -std::sqrt(thr), t_hi, g_hi, search);
 }
 
 /// Fisher-scale step of term i for bracketing its upper bound: √(z·sd(d_i)) at d_i = 0.
@@ -466,12 +493,9 @@ void require_converged(const IrlsResult& r) {
 
 /// The points in the fit range with enough EDF, τ ascending; throws when too few remain.
 std::vector<FitPoint> points_in_range(std::span<const FitPoint> points, const FitOptions& options) {
-  if (!(options.dispersion > 0) || !(options.confidence > 0 && options.confidence < 1) || !(options.edf_cap >= 0) ||
-      !(options.edf_inflation >= 0))
-    throw UsageError(tr("fit options: dispersion and EDF cap must be positive, confidence in (0, 1)"));
+  require_valid(options);
   int n_enabled = 0;
   for (bool e : options.enabled) n_enabled += e ? 1 : 0;
-  if (n_enabled == 0) throw UsageError(tr("fit: no term enabled"));
   std::vector<FitPoint> used;
   for (const auto& p : points) {
     if (!(p.tau_s >= options.tau_min_s && p.tau_s <= options.tau_max_s)) continue;
@@ -613,7 +637,7 @@ Coefficient coefficient_interval(int i, const Stage& sel, const Stage& full, boo
     auto g = [&](double t) { return std::sqrt(prof.delta(i, t * t)) - std::sqrt(thr); };
     const double g0 = g(0.0);
     if (g0 > 0) {
-      t_low = find_root(g, 0.0, g0, t_hat, -std::sqrt(thr));
+      t_low = find_root(g, 0.0, g0, t_hat, -std::sqrt(thr), co.termination);
       co.resolved = true;
     }
   }
@@ -623,7 +647,7 @@ Coefficient coefficient_interval(int i, const Stage& sel, const Stage& full, boo
   else if (t_hat > 0 && res.cov_c(i, i) > 0)
     step = std::max(step, z * std::sqrt(res.cov_c(i, i)) / st.pr.scale[i] / (2.0 * t_hat));
   co.low = co.resolved ? kf * t_low : 0.0;
-  co.high = kf * upper_root(prof, i, t_hat, step, thr);
+  co.high = kf * upper_root(prof, i, t_hat, step, thr, co.termination);
   co.value = co.resolved ? co.estimate : co.high;
   // Delta method for a resolved term: coefficient = k√c → sd = k·sd(c)/(2√c).
   co.sigma =
@@ -651,12 +675,12 @@ double member_cdf(const FitResult& f, Term t, double value) {
 
 /// The p-quantile of a confidence distribution F between a and b (F(a) ≤ p ≤ F(b)).
 template <class F>
-double quantile_between(F&& cdf, double p, double a, double b) {
+double quantile_between(F&& cdf, double p, double a, double b, Termination& t) {
   if (!(b > a)) return a;
   const double fa = cdf(a) - p, fb = cdf(b) - p;
   if (!(fa < 0)) return a;
   if (!(fb > 0)) return b;
-  return find_root([&](double x) { return cdf(x) - p; }, a, fa, b, fb);
+  return find_root([&](double x) { return cdf(x) - p; }, a, fa, b, fb, t);
 }
 
 /// The coefficient of term t averaged over the two term sets with weights w and 1 − w: the mixture
@@ -664,12 +688,14 @@ double quantile_between(F&& cdf, double p, double a, double b) {
 /// estimate and the mixture's standard deviation for sigma.
 Coefficient averaged(const FitResult& avg, Term t, const Coefficient& a, const Coefficient& b, double w_b, double z) {
   Coefficient co = a;
+  co.termination = combine(a.termination, b.termination);
   const double alpha = (1.0 - avg.options.confidence) / 2.0;
   auto cdf = [&](double x) { return avg.cdf(t, x); };
   co.estimate = (1.0 - w_b) * a.estimate + w_b * b.estimate;
   co.resolved = cdf(std::numeric_limits<double>::min()) < alpha;
-  co.low = co.resolved ? quantile_between(cdf, alpha, std::min(a.low, b.low), std::max(a.low, b.low)) : 0.0;
-  co.high = quantile_between(cdf, 1.0 - alpha, std::min(a.high, b.high), std::max(a.high, b.high));
+  co.low =
+      co.resolved ? quantile_between(cdf, alpha, std::min(a.low, b.low), std::max(a.low, b.low), co.termination) : 0.0;
+  co.high = quantile_between(cdf, 1.0 - alpha, std::min(a.high, b.high), std::max(a.high, b.high), co.termination);
   co.value = co.resolved ? co.estimate : co.high;
   const double da = a.estimate - co.estimate, db = b.estimate - co.estimate;
   co.sigma = co.resolved ? std::sqrt((1.0 - w_b) * (a.sigma * a.sigma + da * da) + w_b * (b.sigma * b.sigma + db * db))
@@ -712,11 +738,6 @@ void average_over_k(FitResult& res, FitResult other, double phi_k, double z) {
 std::string_view term_name(Term t) {
   static constexpr std::array<std::string_view, P> n{"Q", "N", "B", "K", "R"};
   return n[static_cast<std::size_t>(idx(t))];
-}
-
-std::string_view term_unit(Term t) {
-  static constexpr std::array<std::string_view, P> u{"arcsec", "deg/sqrt(h)", "deg/h", "deg/h/sqrt(h)", "deg/h^2"};
-  return u[static_cast<std::size_t>(idx(t))];
 }
 
 double term_basis(Term t, double tau_s) {
@@ -859,7 +880,7 @@ SetFit fit_term_set(const FitBase& b, const FitOptions& set, const std::array<bo
   Stage sel{make_problem(res.used, res.options), {}};
   sel.fit = irls(sel.pr, sel.pr.enabled_mask, start, false);
   require_converged(sel.fit);
-  res.iterations = sel.fit.iterations + b.full.fit.iterations;
+  res.termination = combine(b.full.fit.termination, sel.fit.termination);
   res.deviance = sel.fit.dev;
   res.c = sel.coefficients();
   const Eigen::VectorXd mu = sel.model();

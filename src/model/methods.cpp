@@ -342,6 +342,7 @@ BootstrapSd bootstrap_n2_sd(const DirectNResult& r, const std::vector<std::size_
 }  // namespace
 
 DirectNResult direct_n(const PhaseSeries& x, const MethodOptions& o, const FitResult* fit) {
+  require_valid(o);
   DirectNResult r;
   const std::size_t n = x.points() > 0 ? x.points() - 1 : 0;
   const double t_total = static_cast<double>(n) * x.tau0_s;

@@ -212,10 +212,8 @@ double bivariate_normal_cdf(double a, double b, double rho) {
 std::string class_label(const std::optional<int>& c) { return c ? fmt::format("{}", *c) : std::string(tr("none")); }
 
 Verdict decide(const EstimateInput& B, const EstimateInput& N, double rho_BN, const VerdictOptions& options) {
+  require_valid(options);
   const ClassTable& t = options.table;
-  if (t.classes.empty()) throw UsageError(tr("the class table is empty"));
-  if (!(options.tolerance_pct >= 0) || !std::isfinite(options.tolerance_pct))
-    throw UsageError(tr("--tolerance must be a non-negative percentage"));
   Verdict v;
   v.table_name = t.name;
   for (const auto& c : t.classes) v.class_numbers.push_back(c.cls);

@@ -175,6 +175,7 @@ std::string title_block(const json& imu) {
 }  // namespace imu_page
 
 std::string imu_report_html(const nlohmann::json& imu, const ImuPageOptions& o) {
+  require_valid(o);
   using namespace imu_page;
   const std::string title = trf("IMU noise: {}", std::filesystem::path(str(imu, "source")).filename().string());
   std::string h = fmt::format(

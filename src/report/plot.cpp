@@ -331,7 +331,7 @@ Figure batch_allan_figure(const json& runs, const PlotOptions& options) {
   PlotCommand plot;
   Bounds bounds;
   bool gyro = true;
-  std::string ylabel = fmt::format("Allan deviation σ(τ) ({})", lbl::rate);
+  std::string ylabel = trf("Allan deviation σ(τ) ({})", tr(lbl::rate));
   for (std::size_t i = 0; i < order.size(); ++i) {
     const auto& run = runs[order[i]];
     const auto rows = allan_rows(at(run, "allan"));
@@ -458,7 +458,7 @@ std::vector<BandRow> band_rows(const json& band) {
 std::string diagnosis_ylabel(const json& diagnosis) {
   const auto u = diagnosis.find("units");
   if (u == diagnosis.end() || !u->is_object() || !u->contains("band") || !(*u)["band"].is_string())
-    return fmt::format("Allan deviation σ(τ) ({})", lbl::rate);
+    return trf("Allan deviation σ(τ) ({})", tr(lbl::rate));
   const std::string band = (*u)["band"].get<std::string>();
   return trf("Allan deviation σ(τ) ({})", band == "ug" ? std::string("µg") : band);
 }
@@ -537,12 +537,14 @@ Figure diagnosis_figure(const json& diagnosis, const PlotOptions& options) {
 }
 
 PlotResult plot_analysis(const json& analysis, const PlotOptions& options) {
+  require_valid(options);
   PlotResult r;
   write_outputs({analysis_figure(analysis, options)}, options, r);
   return r;
 }
 
 PlotResult plot_batch(const json& batch, const PlotOptions& options) {
+  require_valid(options);
   const auto& runs = batch.is_array() ? batch : at(batch, "runs");
   if (!runs.is_array() || runs.empty())
     throw AnalysisError(tr("the batch has no runs (\"runs\": [analysis objects]): nothing to plot"));
@@ -552,18 +554,19 @@ PlotResult plot_batch(const json& batch, const PlotOptions& options) {
     figures.push_back(std::move(direct));
   else
     r.notes.emplace_back(
-        "no run carries the direct-method curve (methods.N_direct_deg_per_sqrt_h.curve): "
-        "the angle-variance panel (Fig. 2) is left out");
+        tr("no run carries the direct-method curve (methods.N_direct_deg_per_sqrt_h.curve): "
+           "the angle-variance panel (Fig. 2) is left out"));
   write_outputs(figures, options, r);
   return r;
 }
 
 PlotResult plot_diagnosis(const json& diagnosis, const PlotOptions& options) {
+  require_valid(options);
   PlotResult r;
   if (const auto& ext = band_of(diagnosis, true); !ext.is_array() || ext.empty())
     r.notes.emplace_back(
-        "the diagnosis has no extended model band (band_extended or extended_model.band): only the base model is "
-        "drawn");
+        tr("the diagnosis has no extended model band (band_extended or extended_model.band): only the base model "
+           "is drawn"));
   write_outputs({diagnosis_figure(diagnosis, options)}, options, r);
   return r;
 }

@@ -12,6 +12,7 @@
 namespace rwcalc {
 
 PlotResult plot_imu(const nlohmann::json& imu, const PlotOptions& options) {
+  require_valid(options);
   std::vector<Figure> figures;
   constexpr std::string_view kGyro = "gyro";
   for (const std::string_view kind : {kGyro, std::string_view("accelerometer")}) {

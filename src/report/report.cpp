@@ -868,8 +868,9 @@ std::string html::typed(std::string_view s) { return rwcalc::typed(s); }
 std::string html::coefficient_cell(const json& c) { return coef_cell(c); }
 
 std::string report_html(const ReportInput& input, const ReportOptions& options) {
+  require_valid(options);
   const auto& a = input.analyses;
-  if (a.empty()) throw AnalysisError(tr(tr("a report needs at least one analysed run")));
+  if (a.empty()) throw AnalysisError(tr("a report needs at least one analysed run"));
   const auto order = view::by_temperature(a);
   json overall = input.overall;
   if (!overall.is_object())
@@ -923,6 +924,7 @@ std::string report_html(const ReportInput& input, const ReportOptions& options) 
 }
 
 std::string write_report(const std::string& dir, const ReportInput& input, const ReportOptions& options, bool force) {
+  require_valid(options);  // before the directory is made
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec || !std::filesystem::is_directory(dir))

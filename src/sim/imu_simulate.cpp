@@ -48,17 +48,17 @@ int decimals_of(double step) {
   return std::max(0, 5 - static_cast<int>(std::floor(std::log10(step))));
 }
 
-void check_layout(const ImuLayout& l) {
-  auto finite_nonneg = [](double v) { return std::isfinite(v) && v >= 0; };
-  for (const auto* kind : {&l.gyro, &l.accel})
-    for (const auto& a : *kind)
-      if (!finite_nonneg(a.n) || !finite_nonneg(a.b) || !finite_nonneg(a.k))
-        throw UsageError(tr("the IMU layout's noise terms must be finite and >= 0"));
-  if (!(std::isfinite(l.gyro_lsb_dps) && l.gyro_lsb_dps > 0) || !(std::isfinite(l.accel_lsb_mg) && l.accel_lsb_mg > 0))
-    throw UsageError(tr("the IMU layout's output steps must be finite and > 0"));
-}
-
 }  // namespace
+
+Violation ImuLayout::validate() const {
+  auto ok = [](double v) { return std::isfinite(v) && v >= 0; };
+  for (const auto* kind : {&gyro, &accel})
+    for (const auto& a : *kind)
+      if (!ok(a.n) || !ok(a.b) || !ok(a.k)) return tr("the IMU layout's noise terms must be finite and >= 0");
+  if (!(std::isfinite(gyro_lsb_dps) && gyro_lsb_dps > 0) || !(std::isfinite(accel_lsb_mg) && accel_lsb_mg > 0))
+    return tr("the IMU layout's output steps must be finite and > 0");
+  return std::nullopt;
+}
 
 ImuLayout adis16405_like_layout() {
   ImuLayout l;
@@ -137,7 +137,7 @@ Metadata imu_metadata(const ImuLayout& l, const SimulationSettings& s) {
 
 void write_imu_record(const ImuLayout& l, const SimulationSettings& settings, const Metadata& metadata,
                       const std::string& path, bool force, std::FILE* progress) {
-  check_layout(l);
+  require_valid(l);
   const std::size_t n = settings.samples();
   // Each axis' output steps per sample: the differences of its counts.
   std::array<std::vector<std::int64_t>, 6> steps;

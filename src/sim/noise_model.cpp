@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "rwcalc/error.hpp"
@@ -31,15 +32,11 @@ double gm_avar_factor(double x) {
   return 1.0 - (3.0 - 4.0 * std::exp(-x) + std::exp(-2.0 * x)) / (2.0 * x);
 }
 
-void check_finite_nonneg(double v, const char* what) {
-  if (!std::isfinite(v) || v < 0.0) throw UsageError(trf("{} must be a finite value >= 0, got {}", what, v));
-}
-void check_finite(double v, const char* what) {
-  if (!std::isfinite(v)) throw UsageError(trf("{} must be finite, got {}", what, v));
-}
-void check_positive(double v, const char* what) {
-  if (!std::isfinite(v) || v <= 0.0) throw UsageError(trf("{} must be a finite value > 0, got {}", what, v));
-}
+constexpr double kUnbounded = std::numeric_limits<double>::infinity();
+
+Violation finite_nonneg(const char* what, double v) { return check_in(what, v, 0.0, kUnbounded, "", Ends::OpenHigh); }
+Violation finite(const char* what, double v) { return check_in(what, v, -kUnbounded, kUnbounded, "", Ends::Open); }
+Violation positive(const char* what, double v) { return check_in(what, v, 0.0, kUnbounded, "", Ends::Open); }
 
 }  // namespace
 
@@ -56,49 +53,58 @@ double readout_q_arcsec(ReadoutMode mode, double scale_arcsec) {
   return mode == ReadoutMode::White ? scale_arcsec / std::sqrt(6.0) : scale_arcsec / std::sqrt(12.0);
 }
 
-void validate(const NoiseModel& m, const SimulationSettings& s) {
-  check_positive(s.duration_s, "duration_s");
-  check_positive(s.rate_hz, "rate_hz");
-  check_positive(s.scale_arcsec, "scale_arcsec");
-  if (s.samples() < 2)
-    throw UsageError(trf("the record must hold at least 2 samples (duration {} s at {} Hz)", s.duration_s, s.rate_hz));
-  if (s.samples() > (std::size_t{1} << 31)) throw UsageError(tr("the record is too long (more than 2^31 samples)"));
-  if (s.temperature_c) check_finite(*s.temperature_c, "temperature_c");
-  check_finite_nonneg(m.arw_deg_per_sqrt_h, "arw_deg_per_sqrt_h");
-  check_finite_nonneg(m.bias_instability_deg_per_h, "bias_instability_deg_per_h");
-  check_finite_nonneg(m.rrw_deg_per_h_per_sqrt_h, "rrw_deg_per_h_per_sqrt_h");
-  check_finite(m.ramp_deg_per_h2, "ramp_deg_per_h2");
-  check_finite(m.bias_deg_per_h, "bias_deg_per_h");
-  check_finite(m.earth_rate_deg_per_h, "earth_rate_deg_per_h");
-  check_finite_nonneg(m.white_angle_arcsec, "white_angle_arcsec");
-  check_finite_nonneg(m.lowpass_tc_s, "lowpass_tc_s");
-  check_finite_nonneg(m.output_lowpass_tc_s, "output_lowpass_tc_s");
-  for (const auto& x : m.sinusoids) {
-    check_positive(x.f_hz, "sinusoid frequency_hz");
-    check_finite(x.amp_deg_per_h, "sinusoid amplitude_deg_per_h");
-    check_finite(x.phase_rad, "sinusoid phase_rad");
-  }
-  for (const auto& x : m.gauss_markov) {
-    check_finite_nonneg(x.sigma_deg_per_h, "gauss_markov sigma_deg_per_h");
-    check_positive(x.tc_s, "gauss_markov correlation_time_s");
-  }
-  for (const auto& x : m.bias_steps) {
-    check_finite_nonneg(x.t_s, "bias_step time_s");
-    check_finite(x.size_deg_per_h, "bias_step size_deg_per_h");
-  }
-  for (const auto& x : m.warmups) {
-    check_finite(x.amp_deg_per_h, "warmup amplitude_deg_per_h");
-    check_positive(x.tc_s, "warmup time_constant_s");
-  }
-  if (m.temperature_bias) {
-    const auto& tb = *m.temperature_bias;
-    check_finite(tb.coefficient_deg_per_h_per_c, "temperature_bias coefficient_deg_per_h_per_c");
-    check_finite(tb.profile.start_c, "temperature profile start_c");
-    check_finite(tb.profile.end_c, "temperature profile end_c");
-    check_finite(tb.profile.amp_c, "temperature profile amp_c");
-    if (tb.profile.kind == TemperatureProfile::Kind::Cycle)
-      check_positive(tb.profile.period_s, "temperature profile period_s");
-  }
+Violation SimulationSettings::validate() const {
+  if (Violation v = first_of({positive("duration_s", duration_s), positive("rate_hz", rate_hz),
+                              positive("scale_arcsec", scale_arcsec),
+                              temperature_c ? finite("temperature_c", *temperature_c) : std::nullopt}))
+    return v;
+  if (samples() < 2)
+    return trf("the record must hold at least 2 samples (duration {} s at {} Hz)", duration_s, rate_hz);
+  if (samples() > (std::size_t{1} << 31)) return tr("the record is too long (more than 2^31 samples)");
+  return std::nullopt;
+}
+
+Violation NoiseModel::validate() const {
+  if (Violation v = first_of({finite_nonneg("arw_deg_per_sqrt_h", arw_deg_per_sqrt_h),
+                              finite_nonneg("bias_instability_deg_per_h", bias_instability_deg_per_h),
+                              finite_nonneg("rrw_deg_per_h_per_sqrt_h", rrw_deg_per_h_per_sqrt_h),
+                              finite("ramp_deg_per_h2", ramp_deg_per_h2), finite("bias_deg_per_h", bias_deg_per_h),
+                              finite("earth_rate_deg_per_h", earth_rate_deg_per_h),
+                              finite_nonneg("white_angle_arcsec", white_angle_arcsec),
+                              finite_nonneg("lowpass_tc_s", lowpass_tc_s),
+                              finite_nonneg("output_lowpass_tc_s", output_lowpass_tc_s)}))
+    return v;
+  for (const auto& x : sinusoids)
+    if (Violation v = first_of({positive("sinusoid frequency_hz", x.f_hz),
+                                finite("sinusoid amplitude_deg_per_h", x.amp_deg_per_h),
+                                finite("sinusoid phase_rad", x.phase_rad)}))
+      return v;
+  for (const auto& x : gauss_markov)
+    if (Violation v = first_of({finite_nonneg("gauss_markov sigma_deg_per_h", x.sigma_deg_per_h),
+                                positive("gauss_markov correlation_time_s", x.tc_s)}))
+      return v;
+  for (const auto& x : bias_steps)
+    if (Violation v =
+            first_of({finite_nonneg("bias_step time_s", x.t_s), finite("bias_step size_deg_per_h", x.size_deg_per_h)}))
+      return v;
+  for (const auto& x : warmups)
+    if (Violation v = first_of(
+            {finite("warmup amplitude_deg_per_h", x.amp_deg_per_h), positive("warmup time_constant_s", x.tc_s)}))
+      return v;
+  if (!temperature_bias) return std::nullopt;
+  const auto& tb = *temperature_bias;
+  return first_of({finite("temperature_bias coefficient_deg_per_h_per_c", tb.coefficient_deg_per_h_per_c),
+                   finite("temperature profile start_c", tb.profile.start_c),
+                   finite("temperature profile end_c", tb.profile.end_c),
+                   finite("temperature profile amp_c", tb.profile.amp_c),
+                   tb.profile.kind == TemperatureProfile::Kind::Cycle
+                       ? positive("temperature profile period_s", tb.profile.period_s)
+                       : std::nullopt});
+}
+
+void validate(const NoiseModel& model, const SimulationSettings& settings) {
+  require_valid(settings);
+  require_valid(model);
 }
 
 double flicker_avar(double b, std::size_t m) {
