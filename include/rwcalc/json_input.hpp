@@ -88,6 +88,20 @@ class Value {
   std::string path_;
 };
 
+/// The version of the schema of the JSON rwcalc writes (docs/result.schema.json): every document
+/// carries it as "schema_version". Version 2 named units as fields (keys carry none).
+inline constexpr int kResultSchemaVersion = 2;
+
+/// Refuses a document of rwcalc's results written under another schema version (or none, as
+/// before version 2): InputError naming the file and line, the version found and what to do.
+void require_schema_version(const Value& root);
+
+/// Refuses an analysis whose numbers are not in a gyro's usual units ("units": rate deg/h, Q arcsec,
+/// N deg/sqrt(h), B deg/h, K deg/h/sqrt(h), R deg/h^2; what `analyze` of a gyro writes without
+/// --output-unit), which `consumer` ("--from", "the report") needs: InputError naming the key, the
+/// unit found and what to do. An object without "units" (made by hand) is taken as in those units.
+void require_gyro_units(const Value& analysis, std::string_view consumer);
+
 /// The whole file; InputError when it cannot be opened or read.
 std::string read_file(const std::string& path);
 

@@ -8,6 +8,7 @@
 #include "rwcalc/diagnose.hpp"
 #include "rwcalc/fit.hpp"
 #include "rwcalc/i18n.hpp"
+#include "rwcalc/json_input.hpp"
 #include "rwcalc/printable.hpp"
 #include "rwcalc/sensor.hpp"
 #include "rwcalc/units.hpp"
@@ -214,6 +215,7 @@ void accelerometer_json(const DiagnoseResult& r, const Shown& sh, json& j) {
 json to_json(const DiagnoseResult& r) {
   const Shown sh(r);
   json j;
+  j["schema_version"] = json_input::kResultSchemaVersion;
   j["source"] = r.analysis.source;
   j["samples"] = r.analysis.samples;
   j["rate_hz"] = r.settings.rate_hz;
