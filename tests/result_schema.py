@@ -138,8 +138,10 @@ def main():
     old = json.loads(json.dumps(gyro))
     del old["schema_version"]
     (tmp / "old.json").write_text(json.dumps(old), encoding="utf-8")
+    (tmp / "old.jsonl").write_text(json.dumps(old) + "\n", encoding="utf-8")
     for args in (["report", str(tmp / "old.json"), "-o", str(tmp / "out")],
-                 ["simulate", "-o", str(tmp / "sim.csv"), "--from", str(tmp / "old.json")]):
+                 ["simulate", "-o", str(tmp / "sim.csv"), "--from", str(tmp / "old.json")],
+                 ["merge", str(tmp / "old.jsonl")]):
         err = run(*args, status=2).stderr
         if str(tmp / "old.json") not in err or "schema_version" not in err or "write the result again" not in err:
             fail(f"rwcalc {args[0]} of a version-1 result: {err.strip()}")
