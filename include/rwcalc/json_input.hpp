@@ -2,7 +2,7 @@
 // Reading JSON that rwcalc is given (saved results, class tables, models). JSON from another
 // machine is untrusted: every value is read through a typed accessor that checks its type and
 // domain and otherwise throws an InputError naming the file, the value's line and key path, e.g.
-//   report.json:12: "fit.N_deg_per_sqrt_h.value" must be a number, got string
+//   report.json:12: "fit.N.value" must be a number, got string
 #include <cstddef>
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -49,7 +49,7 @@ class Document {
   std::unordered_map<std::string, std::size_t> lines_;
 };
 
-/// One value of a Document with its key path ("" for the root, "runs[2].fit.B_deg_per_h").
+/// One value of a Document with its key path ("" for the root, "runs[2].fit.B").
 class Value {
  public:
   Value(const Document& doc, const nlohmann::json& value, std::string path)
