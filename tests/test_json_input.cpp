@@ -386,7 +386,7 @@ TEST_F(JsonInput, SimulateFromChecksEveryValueNamingTheLine) {
            {"/rate_hz", "\"fast\"", "\"rate_hz\" must be a number, got string"},  // was silently ignored
            {"/duration_s", "-5", "\"duration_s\" must be a positive number"},
            {"/temperature_c", "1e300", "\"temperature_c\" must be a temperature"},
-           {"/fit/N_deg_per_sqrt_h/value", "[]", "\"fit.N_deg_per_sqrt_h.value\" must be a number, got array"},
+           {"/fit/N/value", "[]", "\"fit.N.value\" must be a number, got array"},
            {"/fit", "\"none\"", "\"fit\" must be an object, got string"},
        }) {
     std::size_t line = 0;
