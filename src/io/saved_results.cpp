@@ -353,11 +353,11 @@ void parse_saved_result(std::string_view text, const std::string& file, SavedRes
         fmt::format("must be a JSON object from 'rwcalc analyze --json', 'batch --json' or 'diagnose --json', "
                     "got {}",
                     json_input::type_name(root.json())));
-  json_input::require_schema_version(root);
   const json& j = root.json();
   const Checker shown(RunKeys::Shown);
   // A batch has an array of runs; a diagnosis also has "runs", the size of its ensemble.
   if (has(j, "runs") && j.at("runs").is_array()) {
+    json_input::require_schema_version(root);
     const auto runs = root.at("runs").elements();
     if (runs.empty()) root.at("runs").fail("must hold at least one run");
     for (const auto& r : runs) shown.run(r);
@@ -373,10 +373,12 @@ void parse_saved_result(std::string_view text, const std::string& file, SavedRes
     for (std::size_t i = 0; i < lines.size(); ++i) into.analyses.push_back({std::move(all["runs"][i]), file, lines[i]});
     if (overall) into.overalls.push_back(std::move(*overall));
   } else if (has(j, "allan") || has(j, "verdict")) {
+    json_input::require_schema_version(root);
     shown.run(root);
     (void)root.at("allan");
     into.analyses.push_back({doc.take(), file, 1});
   } else if (has(j, "band") || has(j, "base_model") || has(j, "findings")) {
+    json_input::require_schema_version(root);
     check_diagnosis(root);
     into.diagnoses.push_back({doc.take(), file, 1});
   } else {

@@ -242,7 +242,9 @@ std::string axis_name(const json& a) {
 
 std::string default_analysis_title(const json& a) {
   std::string t = tr("Allan deviation");
-  if (const auto src = run_name(a); !src.empty()) t += trf(" of {}", src);
+  // A gyro in its usual units is a run of the batch, named by its file; any other channel by its column.
+  const bool usual = view::str(at(a, "units"), "rate").empty() || view::str(at(a, "units"), "rate") == "deg/h";
+  if (const auto src = usual ? run_name(a) : axis_name(a); !src.empty()) t += trf(" of {}", src);
   if (const auto temp = view::temperature_label(at(a, "temperature_c")); !temp.empty()) t += trf(" at {}", temp);
   return t;
 }

@@ -694,7 +694,9 @@ std::string conventions_rows(const json& conventions) {
   if (conventions.is_object())
     for (const auto& item : conventions.items()) {
       const std::string& k = item.key();  // a structured binding, clang 14 (the fuzz build) cannot capture
-      if (std::none_of(kConventions.begin(), kConventions.end(), [&](const auto& c) { return k == c[0]; }))
+      // "units" says where the JSON names its units (docs/result-json.md); the report names each unit itself.
+      if (k != "units" &&
+          std::none_of(kConventions.begin(), kConventions.end(), [&](const auto& c) { return k == c[0]; }))
         h += kv_row(k, json_value_html(item.value()));
     }
   return h;
