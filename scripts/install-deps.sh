@@ -5,12 +5,13 @@
 # compiler supported (Ubuntu 22.04's); libyaml-dev: the lab profile of report --lab-profile; pandoc:
 # report --docx and its tests (optional at run time; chromium, which prints report --pdf, is left
 # out for its size, about 290 MB: `apt-get install chromium poppler-utils` runs the PDF tests too).
-# clang-format, clang-tidy: the style checks (scripts/lint.sh).
+# clang-format, clang-tidy: the style checks (scripts/lint.sh). python3-jsonschema: the test
+# result_schema validates every JSON output against docs/result.schema.json.
 set -euo pipefail
 PACKAGES=(cmake g++ make libeigen3-dev libcli11-dev libfmt-dev nlohmann-json3-dev zlib1g-dev libssl-dev libboost-dev
           libgtest-dev libbenchmark-dev gnuplot-nox python3-numpy time dpkg-dev man-db gettext python3-yaml
           libsqlite3-dev libbz2-dev liblz4-dev libzstd-dev g++-11 libyaml-dev pandoc
-          clang-format clang-tidy)
+          clang-format clang-tidy python3-jsonschema)
 missing=()
 for p in "${PACKAGES[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done
 ((${#missing[@]})) || exit 0

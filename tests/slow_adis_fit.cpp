@@ -88,7 +88,7 @@ TEST(SlowAdis, FitMatchesTheWelchWhiteLevelOnEveryRunAndAxis) {
                               "--column", column, "--earth-rate", "0", "--json"});
       ASSERT_EQ(r.status, 0) << r.err;
       const json j = json::parse(r.out);
-      const double n = j["fit"]["N_deg_per_sqrt_h"]["value"].get<double>();
+      const double n = j["fit"]["N"]["value"].get<double>();
       const double welch = welch_white_level(rates[static_cast<std::size_t>(axis)], 100.0);
       const double chi2 = j["fit"]["chi2_per_dof"].get<double>();
       std::printf("run %d %s: N %.4f, Welch %.4f (%+.2f %%), chi2/dof %.2f, fit from %g s (%s)\n", run, column.c_str(),

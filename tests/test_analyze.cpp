@@ -67,25 +67,25 @@ TEST(AnalyzeCli, JsonHasTheIssueKeysAndCoversTheTruth) {
   EXPECT_EQ(j["rate_hz"], 400.0);
   EXPECT_NEAR(j["duration_s"].get<double>(), 7200.0, 1e-9);
   EXPECT_EQ(j["temperature_c"], 25.0);
-  EXPECT_NEAR(j["earth_rate_deg_per_h"].get<double>(), 12.433, 1e-3);
+  EXPECT_NEAR(j["earth_rate"].get<double>(), 12.433, 1e-3);
   // The simulated run senses exactly the Earth rate: the bias is within the noise of a 2-h mean.
-  EXPECT_NEAR(j["mean_rate_deg_per_h"].get<double>(), 12.433, 0.01);
-  for (const char* k : {"Q_arcsec", "N_deg_per_sqrt_h", "B_deg_per_h", "K_deg_per_h_per_sqrt_h", "R_deg_per_h2"})
+  EXPECT_NEAR(j["mean_rate"].get<double>(), 12.433, 0.01);
+  for (const char* k : {"Q", "N", "B", "K", "R"})
     for (const char* f : {"value", "sigma", "low95", "high95", "resolved"})
       EXPECT_TRUE(j["fit"][k].contains(f)) << k << f;
   EXPECT_TRUE(j["fit"].contains("chi2_per_dof"));
-  EXPECT_TRUE(j["methods"]["N_direct_deg_per_sqrt_h"].contains("value"));
-  EXPECT_TRUE(j["methods"]["B_100s_deg_per_h"].contains("value"));
+  EXPECT_TRUE(j["methods"]["N_direct"].contains("value"));
+  EXPECT_TRUE(j["methods"]["B_100s"].contains("value"));
   for (const char* k : {"class_B", "class_N", "class", "p_class"}) EXPECT_TRUE(j["verdict"].contains(k)) << k;
   EXPECT_GT(j["allan"]["points"].size(), 15u);
   // Truth of the run's N inside the reported interval; Q (q/√6 for the white read-out) too.
   const json t = truth("gl2d_p25C");
   const double n = t["model"]["arw_deg_per_sqrt_h"];
-  EXPECT_LE(j["fit"]["N_deg_per_sqrt_h"]["low95"].get<double>(), n);
-  EXPECT_GE(j["fit"]["N_deg_per_sqrt_h"]["high95"].get<double>(), n);
-  EXPECT_NEAR(j["fit"]["Q_arcsec"]["value"].get<double>() / t["quantization_q_arcsec"].get<double>(), 1.0, 0.02);
+  EXPECT_LE(j["fit"]["N"]["low95"].get<double>(), n);
+  EXPECT_GE(j["fit"]["N"]["high95"].get<double>(), n);
+  EXPECT_NEAR(j["fit"]["Q"]["value"].get<double>() / t["quantization_q_arcsec"].get<double>(), 1.0, 0.02);
   // K and R are absent in the truth: reported as upper bounds.
-  EXPECT_FALSE(j["fit"]["R_deg_per_h2"]["resolved"].get<bool>());
+  EXPECT_FALSE(j["fit"]["R"]["resolved"].get<bool>());
 }
 
 TEST(AnalyzeCli, ReportStatesUnitsConventionsAndVerdict) {

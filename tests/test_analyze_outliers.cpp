@@ -49,7 +49,7 @@ TEST(AnalyzeOutliers, PlantedSpikeIsReportedAtItsSampleTimeAndLine) {
   EXPECT_EQ(o["positions"][0]["index"], kSpike);
   EXPECT_EQ(o["positions"][0]["line"], kSpike + 4);
   EXPECT_NEAR(o["positions"][0]["time_s"].get<double>(), kSpike / 400.0, 1e-9);
-  EXPECT_NEAR(o["positions"][0]["value_deg_per_h"].get<double>(), 60 * 0.92 * 400, 1e-6);
+  EXPECT_NEAR(o["positions"][0]["value"].get<double>(), 60 * 0.92 * 400, 1e-6);
   EXPECT_EQ(j["samples"], kN);
 
   r = run_cli({"analyze", path});
@@ -62,7 +62,7 @@ TEST(AnalyzeOutliers, PlantedSpikeIsReportedAtItsSampleTimeAndLine) {
   j = json::parse(r.out);
   EXPECT_EQ(j["outliers"]["removed"], 1);
   EXPECT_EQ(j["samples"], kN - 1);
-  const double mean_removed = j["mean_rate_deg_per_h"];
+  const double mean_removed = j["mean_rate"];
 
   r = run_cli({"analyze", path, "--json", "--outliers", "replace"});
   ASSERT_EQ(r.status, 0) << r.err;
@@ -70,8 +70,8 @@ TEST(AnalyzeOutliers, PlantedSpikeIsReportedAtItsSampleTimeAndLine) {
   EXPECT_EQ(j["outliers"]["replaced"], 1);
   EXPECT_EQ(j["samples"], kN);
   // Both leave the spike's ~57 extra pulses (52″ over 1200 s) out of the mean rate; keep does not.
-  const double mean_kept = json::parse(run_cli({"analyze", path, "--json"}).out)["mean_rate_deg_per_h"];
-  const double mean_replaced = j["mean_rate_deg_per_h"];
+  const double mean_kept = json::parse(run_cli({"analyze", path, "--json"}).out)["mean_rate"];
+  const double mean_replaced = j["mean_rate"];
   EXPECT_GT(mean_kept - mean_replaced, 50 * 0.92 / 1200.0);  // ″/s = °/h
   EXPECT_LT(mean_kept - mean_replaced, 60 * 0.92 / 1200.0);
   EXPECT_NEAR(mean_removed, mean_replaced, 0.005);
@@ -98,12 +98,12 @@ TEST(AnalyzeOutliers, Adis16405Run4GyroXSingleSpikeFoundAtItsPosition) {
   EXPECT_LE(count, 20u);
   bool found = false;
   for (const auto& p : o["positions"]) {
-    EXPECT_GT(std::abs(p["value_deg_per_h"].get<double>()), 2.0 * 3600) << p.dump();  // > 5.7 sigma of the record
+    EXPECT_GT(std::abs(p["value"].get<double>()), 2.0 * 3600) << p.dump();  // > 5.7 sigma of the record
     if (p["index"] != 404608) continue;
     found = true;
     EXPECT_EQ(p["line"], 404608 + 4);  // two comment lines and the header come first
     EXPECT_NEAR(p["time_s"].get<double>(), 4046.08, 1e-9);
-    EXPECT_NEAR(p["value_deg_per_h"].get<double>(), 8.400001 * 3600, 1e-6);
+    EXPECT_NEAR(p["value"].get<double>(), 8.400001 * 3600, 1e-6);
     EXPECT_GT(p["robust_z"].get<double>(), 8.0);
   }
   EXPECT_TRUE(found) << "the known glitch at sample 404608 was not reported: " << o.dump(1);

@@ -322,8 +322,8 @@ TEST(RosCsv, RostopicEchoFindsItsSixChannelsAndPrefersTheHeaderStamp) {
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j["channels"].size(), 6U);
-  EXPECT_EQ(j["channels"][0]["source"], "field.angular_velocity.x");
-  EXPECT_EQ(j["channels"][5]["source"], "field.linear_acceleration.z");
+  EXPECT_EQ(j["channels"][0]["column"], "field.angular_velocity.x");
+  EXPECT_EQ(j["channels"][5]["column"], "field.linear_acceleration.z");
   EXPECT_DOUBLE_EQ(j["rate_hz"].get<double>(), kRate);
   EXPECT_TRUE(has(r.err, "time from 'field.header.stamp' (the sensor's stamp), not '%time'")) << r.err;
   EXPECT_TRUE(has(r.err, "rate unit rad/s from the column name 'field.angular_velocity.x'")) << r.err;

@@ -73,7 +73,7 @@ TEST(CounterReadout, SimulateDefaultOutputIsFittedWithTheCounter) {
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j.at("fit").at("readout"), "counter");
   EXPECT_GE(j.at("fit").at("p_value").get<double>(), 0.001);
-  const auto& n = j.at("fit").at("N_deg_per_sqrt_h");
+  const auto& n = j.at("fit").at("N");
   EXPECT_LE(n.at("low95").get<double>(), 0.0009);
   EXPECT_GE(n.at("high95").get<double>(), 0.0009);
   // The white model alone, asked for, is rejected on the same record.

@@ -52,7 +52,7 @@ TEST(FitTermination, ConvergedFitSaysSoOnlyInItsData) {
   const json j = to_json(r);
   EXPECT_EQ(j.at("fit").at("termination").at("status"), "converged");
   EXPECT_EQ(j.at("fit").at("termination").at("iterations"), r.fit.termination.iterations);
-  EXPECT_EQ(j.at("fit").at("N_deg_per_sqrt_h").at("termination").at("status"), "converged");
+  EXPECT_EQ(j.at("fit").at("N").at("termination").at("status"), "converged");
   const std::string text = format_report(r);
   EXPECT_EQ(text.find("did not converge"), std::string::npos) << text;
 }

@@ -113,7 +113,7 @@ TEST(FitWarnings, OutputFilterMovesTheRangeUnlessTheUserGivesOne) {
   // 3 standard errors (over the full range the fit gives 0.0025, 25 % high).
   EXPECT_NEAR(j["fit"]["range"]["filter_time_constant_s"].get<double>(), 0.02, 0.004);
   EXPECT_GE(j["fit"]["tau_min_s"].get<double>(), 0.16);
-  const auto& n = j["fit"]["N_deg_per_sqrt_h"];
+  const auto& n = j["fit"]["N"];
   EXPECT_NEAR(n["value"].get<double>(), 0.002, 3.0 * n["sigma"].get<double>());
   const auto text = run_cli({"analyze", rec, "--input", "angle"});
   EXPECT_NE(text.out.find("fit range: tau >= "), std::string::npos);
@@ -165,12 +165,12 @@ TEST(FitWarnings, SpectralLineIsTakenOffTheFitAndSaid) {
   const json p = json::parse(plain.out);
   EXPECT_TRUE(p["fit"]["range"]["spectral_lines"].empty());
   EXPECT_EQ(warning(p, "spectral_line"), nullptr);
-  const json& n = j["fit"]["N_deg_per_sqrt_h"];
-  const json& n0 = p["fit"]["N_deg_per_sqrt_h"];
+  const json& n = j["fit"]["N"];
+  const json& n0 = p["fit"]["N"];
   const double width = n0["high95"].get<double>() - n0["low95"].get<double>();
   EXPECT_NEAR(n["value"].get<double>(), n0["value"].get<double>(), 0.25 * width);
-  EXPECT_NEAR(j["fit"]["B_deg_per_h"]["value"].get<double>(), p["fit"]["B_deg_per_h"]["value"].get<double>(),
-              0.1 * p["fit"]["B_deg_per_h"]["value"].get<double>());
+  EXPECT_NEAR(j["fit"]["B"]["value"].get<double>(), p["fit"]["B"]["value"].get<double>(),
+              0.1 * p["fit"]["B"]["value"].get<double>());
   EXPECT_LT(j["fit"]["chi2_per_dof"].get<double>(), 2.0);
 }
 
@@ -191,11 +191,8 @@ TEST(FitWarnings, AllanBoundsOfAnalyzeComeFromTheModel) {
 /// Relative variance of the fitted model's σ²(τ) from its coefficients' standard errors (delta method,
 /// correlations left out): the simulated record follows an estimated model.
 double model_log_variance(const json& fit, double tau) {
-  const std::pair<Term, const char*> keys[] = {{Term::Q, "Q_arcsec"},
-                                               {Term::N, "N_deg_per_sqrt_h"},
-                                               {Term::B, "B_deg_per_h"},
-                                               {Term::K, "K_deg_per_h_per_sqrt_h"},
-                                               {Term::R, "R_deg_per_h2"}};
+  const std::pair<Term, const char*> keys[] = {
+      {Term::Q, "Q"}, {Term::N, "N"}, {Term::B, "B"}, {Term::K, "K"}, {Term::R, "R"}};
   double total = 0, v = 0;
   std::vector<std::pair<double, double>> parts;
   for (const auto& [t, key] : keys) {
@@ -242,7 +239,7 @@ TEST(SimulateFrom, FittedModelReproducesTheMeasuredAllanDeviation) {
   ASSERT_EQ(run_cli({"analyze", source_path("data/gl2d/gl2d_p25C.csv.gz").string(), "--json", "-o", analysis}).status,
             0);
   const json a = json::parse(slurp(analysis));
-  ASSERT_FALSE(a["fit"]["K_deg_per_h_per_sqrt_h"]["in_model"].get<bool>());
+  ASSERT_FALSE(a["fit"]["K"]["in_model"].get<bool>());
   auto round_trip = [&](bool upper) {
     const std::string sim = (dir.path() / (upper ? "u.csv.gz" : "s.csv.gz")).string();
     std::vector<std::string> args{"simulate", "--from", analysis, "-o", sim, "--seed", "3"};
@@ -306,7 +303,7 @@ TEST(FitWarnings, AShortTauLineTheCheckMissesMovesTheRangeUntilTheFitIsAccepted)
   EXPECT_EQ(range["rejected_from_tau_s"].get<double>(), 0.08);
   EXPECT_GT(range["tau_min_s"].get<double>(), 0.08);
   EXPECT_NE(range["reason"].get<std::string>().find("the fit from 0.08 s was rejected"), std::string::npos);
-  EXPECT_NEAR(j["fit"]["N_deg_per_sqrt_h"]["value"].get<double>() / 2.4, 1.0, 0.03);
+  EXPECT_NEAR(j["fit"]["N"]["value"].get<double>() / 2.4, 1.0, 0.03);
 }
 
 TEST(FitWarnings, ARejectedFitNamesWhereItDeparts) {

@@ -329,12 +329,14 @@ TEST(RussianCli, ImuJsonReportAndNoiseFile) {
   ASSERT_EQ(ru.status, 0) << ru.err;
   auto a = nlohmann::json::parse(en.out), b = nlohmann::json::parse(ru.out);
   // Keys, numbers, units and the terms' names stay English; free text (the fit range's reason, why
-  // no verdict, the input notes) is in the chosen language.
+  // no verdict, the verdict's statements, the input notes) is in the chosen language.
   for (auto* j : {&a, &b})
     for (auto& c : (*j)["channels"]) {
-      c["fit"].erase("range_reason");
+      c["fit"]["range"].erase("reason");
       c.erase("not_applied_reason");
       c["input"].erase("notes");
+      if (c["verdict"].is_object())
+        for (const char* k : {"statement", "statement_B", "statement_N"}) c["verdict"].erase(k);
     }
   EXPECT_EQ(a["channels"], b["channels"]);
   EXPECT_EQ(a["noise"], b["noise"]);

@@ -133,7 +133,7 @@ TEST(InputDefaults, DpsSuffixMeansDegreesPerSecondAndImpliesRateInput) {
   const auto r = run_cli({"analyze", f.string(), "--column", "gyro_x_dps", "--rate", "100", "--json"});
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
-  EXPECT_NEAR(j["mean_rate_deg_per_h"].get<double>(), 3600.0, 0.01);  // 1 °/h if read as °/h
+  EXPECT_NEAR(j["mean_rate"].get<double>(), 3600.0, 0.01);  // 1 °/h if read as °/h
   EXPECT_EQ(j["input"]["kind"], "rate");
   EXPECT_EQ(j["input"]["unit"], "deg/s");
   EXPECT_EQ(j["input"]["column"], "gyro_x_dps");
@@ -243,7 +243,7 @@ TEST(InputDefaults, GapsSegmentsRecoverTheCoefficientsOfARecordWithAChunkCutOut)
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["segments"]["count"], 2);
   EXPECT_NEAR(j["segments"]["gaps"][0]["missing_s"].get<double>(), 600.0, 1e-6);
-  for (const auto& [key, truth] : {std::pair{"N_deg_per_sqrt_h", 0.15}, std::pair{"B_deg_per_h", 3.0}}) {
+  for (const auto& [key, truth] : {std::pair{"N", 0.15}, std::pair{"B", 3.0}}) {
     const auto& c = j["fit"][key];
     EXPECT_TRUE(c["resolved"].get<bool>()) << key;
     EXPECT_LE(c["low95"].get<double>(), truth) << key << " " << c.dump();

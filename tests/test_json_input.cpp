@@ -140,10 +140,10 @@ TEST_F(JsonInput, ReportRefusesCraftedValuesNamingFileLineAndKey) {
     const char* what;
   };
   const std::vector<Case> cases{
-      {"/fit/N_deg_per_sqrt_h/value", "1e400", "fit.N_deg_per_sqrt_h.value", "beyond the range of a double"},
-      {"/fit/N_deg_per_sqrt_h/value", "\"0.001\"", "fit.N_deg_per_sqrt_h.value", "must be a number, got string"},
-      {"/fit/B_deg_per_h/sigma", "-1", "fit.B_deg_per_h.sigma", "must be a number >= 0"},
-      {"/fit/B_deg_per_h/resolved", "1", "fit.B_deg_per_h.resolved", "must be true or false"},
+      {"/fit/N/value", "1e400", "fit.N.value", "beyond the range of a double"},
+      {"/fit/N/value", "\"0.001\"", "fit.N.value", "must be a number, got string"},
+      {"/fit/B/sigma", "-1", "fit.B.sigma", "must be a number >= 0"},
+      {"/fit/B/resolved", "1", "fit.B.resolved", "must be true or false"},
       {"/source", "5", "source", "must be a string, got 5"},
       {"/temperature_c", "\"warm\"", "temperature_c", "got string"},
       {"/temperature_c", "-300", "temperature_c", "a temperature"},
@@ -170,9 +170,8 @@ TEST_F(JsonInput, ReportRefusesCraftedValuesNamingFileLineAndKey) {
   // The same in a batch file: the path runs through "runs[1]".
   std::size_t line = 0;
   const auto file =
-      dir_->write("crafted.json", with_value(read_json(batch_), "/runs/1/fit/B_deg_per_h/value", "\"big\"", line))
-          .string();
-  expect_input_error(report({file}), file, line, {"\"runs[1].fit.B_deg_per_h.value\" must be a number"});
+      dir_->write("crafted.json", with_value(read_json(batch_), "/runs/1/fit/B/value", "\"big\"", line)).string();
+  expect_input_error(report({file}), file, line, {"\"runs[1].fit.B.value\" must be a number"});
 }
 
 TEST_F(JsonInput, ReportRefusesInputIdentificationAndSegmentsOfTheWrongType) {
@@ -257,7 +256,7 @@ TEST_F(JsonInput, MergeRefusesCraftedLinesNamingFileAndLine) {
       {"/verdict/N", 4, "\"verdict.N\" must be an object, got 4"},
       {"/source", 17, "\"source\" must be a string, got 17"},
       {"/temperature_c", json::array(), "\"temperature_c\" must be a number"},
-      {"/fit/N_deg_per_sqrt_h/resolved", "yes", "must be true or false, got string"},
+      {"/fit/N/resolved", "yes", "must be true or false, got string"},
       {"/outliers/count", 1.5, "\"outliers.count\" must be an integer"},
   };
   for (const auto& c : cases) {
@@ -323,7 +322,7 @@ TEST_F(JsonInput, MergeRefusesARunGivenTwiceAndDedupeKeepsOneOfIdenticalLines) {
   EXPECT_EQ(json::parse(deduped.out)["runs"].size(), 2u);
   // Two lines of the same run that differ are refused with --dedupe too.
   auto changed = lines[0];
-  changed["fit"]["N_deg_per_sqrt_h"]["value"] = 0.5;
+  changed["fit"]["N"]["value"] = 0.5;
   const auto differ = dir_->write("differ.jsonl", join_lines({lines[0], lines[1], changed})).string();
   for (bool dedupe : {false, true}) {
     std::vector<std::string> args{"merge", differ};
@@ -387,7 +386,7 @@ TEST_F(JsonInput, SimulateFromChecksEveryValueNamingTheLine) {
            {"/rate_hz", "\"fast\"", "\"rate_hz\" must be a number, got string"},  // was silently ignored
            {"/duration_s", "-5", "\"duration_s\" must be a positive number"},
            {"/temperature_c", "1e300", "\"temperature_c\" must be a temperature"},
-           {"/fit/N_deg_per_sqrt_h/value", "[]", "\"fit.N_deg_per_sqrt_h.value\" must be a number, got array"},
+           {"/fit/N/value", "[]", "\"fit.N.value\" must be a number, got array"},
            {"/fit", "\"none\"", "\"fit\" must be an object, got string"},
        }) {
     std::size_t line = 0;
@@ -442,9 +441,9 @@ TEST_F(JsonInput, SimulateFromRefusesDocumentsThatHoldNoGyroModel) {
   refused(truth.string(), truth.string() + ":1: ", {"holds no model", "\"model\""});
   // An analysis whose fit lacks a coefficient, and one of an accelerometer.
   json a = read_json(analysis_);
-  a["fit"].erase("N_deg_per_sqrt_h");
+  a["fit"].erase("N");
   const auto no_n = dir_->write("no-n.json", a.dump(2)).string();
-  refused(no_n, no_n + ":", {"\"fit\" lacks the key \"N_deg_per_sqrt_h\""});
+  refused(no_n, no_n + ":", {"\"fit\" lacks the key \"N\""});
   std::size_t line = 0;
   const auto accel =
       dir_->write("accel.json", with_value(read_json(analysis_), "/sensor", "\"accelerometer\"", line)).string();

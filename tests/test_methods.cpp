@@ -233,16 +233,16 @@ TEST(CrossChecksCli, ShippedRunCarriesTheUnbiasedEstimatorsInTextAndJson) {
   const auto j = nlohmann::json::parse(js.out);
   const auto& m = j.at("methods");
   // The shipped run's truth (scripts/make-gl2d-data.sh): N 0.00081 °/√h, B 0.0073 °/h.
-  const auto& n = m.at("N_direct_deg_per_sqrt_h");
+  const auto& n = m.at("N_direct");
   EXPECT_LE(n.at("low95").get<double>(), 0.00081);
   EXPECT_GE(n.at("high95").get<double>(), 0.00081);
-  const auto& b = m.at("B_100s_deg_per_h");
+  const auto& b = m.at("B_100s");
   EXPECT_LE(b.at("low95").get<double>(), 0.0073);
   EXPECT_GE(b.at("high95").get<double>(), 0.0073);
   EXPECT_GT(b.at("edf").get<double>(), 1.0);
-  EXPECT_GT(m.at("N_straight_line_paper_deg_per_sqrt_h").at("bias_factor").get<double>(), 1.2);
-  EXPECT_FALSE(m.at("spread_100s_deg_per_h").contains("discrepancy_sigma"));
-  EXPECT_GT(m.at("spread_100s_deg_per_h").at("expected").get<double>(), 0.0);
+  EXPECT_GT(m.at("N_straight_line_paper").at("bias_factor").get<double>(), 1.2);
+  EXPECT_FALSE(m.at("spread_100s").contains("discrepancy_sigma"));
+  EXPECT_GT(m.at("spread_100s").at("expected").get<double>(), 0.0);
   const auto& s = j.at("slope_readout");
   EXPECT_LE(s.at("tau_min_s").get<double>(), j.at("duration_s").get<double>() / 10.0);
   EXPECT_GE(s.at("B_bias_factor").get<double>(), 1.0);

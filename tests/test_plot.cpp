@@ -235,7 +235,7 @@ TEST(PlotRender, BatchWithoutDirectCurvesSkipsFigureTwoWithANote) {
   o.output = (dir.path() / "batch.svg").string();
   const auto r = rwcalc::plot_batch(fixture_batch(/*with_direct_curve=*/false), o);
   ASSERT_EQ(r.notes.size(), 1u);
-  EXPECT_NE(r.notes[0].find("methods.N_direct_deg_per_sqrt_h.curve"), std::string::npos) << r.notes[0];
+  EXPECT_NE(r.notes[0].find("methods.N_direct.curve"), std::string::npos) << r.notes[0];
   const auto svg = slurp(o.output);
   EXPECT_EQ(xml_problem(svg), "");
   EXPECT_EQ(svg_series(svg).size(), 8u);

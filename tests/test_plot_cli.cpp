@@ -38,7 +38,7 @@ std::string gl2d(const std::string& name) { return source_path("data/gl2d/" + na
 /// term that is resolved or has a 95 % bound, one floor per class limit of B.
 std::size_t expected_analysis_series(const json& a) {
   std::size_t n = 2;
-  for (const char* k : {"Q_arcsec", "N_deg_per_sqrt_h", "B_deg_per_h", "K_deg_per_h_per_sqrt_h", "R_deg_per_h2"}) {
+  for (const char* k : {"Q", "N", "B", "K", "R"}) {
     const auto& c = a["fit"][k];
     const bool resolved = c["resolved"].get<bool>();
     const double v = c["value"].get<double>();
@@ -56,14 +56,14 @@ TEST(AnalyzeJson, CarriesTheDirectMethodCurveAndItsRegression) {
   const auto r = run_cli({"analyze", gl2d("gl2d_p50C.csv.gz"), "--json"});
   ASSERT_EQ(r.status, 0) << r.err;
   const json j = json::parse(r.out);
-  const auto& d = j["methods"]["N_direct_deg_per_sqrt_h"];
+  const auto& d = j["methods"]["N_direct"];
   ASSERT_TRUE(d.contains("curve"));
   const auto& curve = d["curve"];
   ASSERT_GE(curve.size(), 3u);
   const double duration = j["duration_s"];
   double t_prev = 0;
   for (const auto& p : curve) {
-    const double t = p["t_s"], v = p["var_arcsec2"];
+    const double t = p["t_s"], v = p["var"];
     const auto k = p["intervals"].get<std::size_t>();
     EXPECT_GT(t, t_prev);
     t_prev = t;
@@ -72,7 +72,7 @@ TEST(AnalyzeJson, CarriesTheDirectMethodCurveAndItsRegression) {
     const double tau0 = 1.0 / j["rate_hz"].get<double>();
     EXPECT_NEAR(static_cast<double>(k) * tau0 + t, duration + tau0, 1e-6);
     // The regression (exact Q, N, B expectations) passes through every point within 10 %.
-    EXPECT_NEAR(p["model_arcsec2"].get<double>() / v, 1.0, 0.1) << "t = " << t;
+    EXPECT_NEAR(p["model"].get<double>() / v, 1.0, 0.1) << "t = " << t;
   }
   // Within the requested range (default 1..100 s).
   EXPECT_NEAR(curve.front()["t_s"].get<double>(), d["t_min_s"].get<double>(), 1e-12);
@@ -80,10 +80,10 @@ TEST(AnalyzeJson, CarriesTheDirectMethodCurveAndItsRegression) {
   EXPECT_LE(curve.back()["t_s"].get<double>(), 100.0 + 1e-9);
   // N″² in ″²/s of the regression: N = √N″² / 60 (N in °/√h), the value the tables print.
   ASSERT_TRUE(d["resolved"].get<bool>());
-  EXPECT_NEAR(std::sqrt(d["N2_arcsec2_per_s"].get<double>()) / 60.0, d["value"].get<double>(), 1e-12);
+  EXPECT_NEAR(std::sqrt(d["N2"].get<double>()) / 60.0, d["value"].get<double>(), 1e-12);
   // The line drawn with the points is the paper's straight line, whose N is √slope / 60.
-  const auto& paper = j["methods"]["N_straight_line_paper_deg_per_sqrt_h"];
-  const double slope = d["slope_arcsec2_per_s"];
+  const auto& paper = j["methods"]["N_straight_line_paper"];
+  const double slope = d["slope"];
   EXPECT_NEAR(std::sqrt(slope) / 60.0, paper["value"].get<double>(), 1e-12);
   EXPECT_GT(paper["bias_factor"].get<double>(), 1.0);
 }
@@ -157,7 +157,7 @@ TEST(BatchPlot, FiveTemperaturesOverlaidAndTheDirectMethodPanel) {
   EXPECT_EQ(r.err.find("note:"), std::string::npos) << "Fig. 2 must not be left out: " << r.err;
   const json b = json::parse(slurp(json_path));
   ASSERT_EQ(b["runs"].size(), 5u);
-  for (const auto& run : b["runs"]) EXPECT_GE(run["methods"]["N_direct_deg_per_sqrt_h"]["curve"].size(), 3u);
+  for (const auto& run : b["runs"]) EXPECT_GE(run["methods"]["N_direct"]["curve"].size(), 3u);
   const auto svg = slurp(svg_path);
   ASSERT_EQ(xml_problem(svg), "");
   const auto ids = svg_series(svg);

@@ -88,16 +88,16 @@ inline nlohmann::json fixture_analysis(const FixtureCoefficients& c, unsigned se
                       {"dev_high", dev * (1 + 1.4 * rel)}});
   }
   json direct = fixture_coefficient(c.N, 0.2);
-  direct["intercept_arcsec2"] = 2 * c.Q * c.Q;
+  direct["intercept"] = 2 * c.Q * c.Q;
   if (with_direct_curve) {
     json curve = json::array();
     const double slope = std::pow(60 * c.N, 2), intercept = 2 * c.Q * c.Q;
     for (int i = 1; i <= 20; ++i) {
       const double t = 10.0 * i;
-      curve.push_back({{"t_s", t}, {"var_arcsec2", (intercept + slope * t) * (1 + 0.1 * z(rng))}});
+      curve.push_back({{"t_s", t}, {"var", (intercept + slope * t) * (1 + 0.1 * z(rng))}});
     }
     direct["curve"] = curve;
-    direct["slope_arcsec2_per_s"] = slope;
+    direct["slope"] = slope;
   }
   const auto class_of = [](double v, double l1, double l2, double l3) -> json {
     if (v <= l1) return 1;
@@ -129,24 +129,24 @@ inline nlohmann::json fixture_analysis(const FixtureCoefficients& c, unsigned se
                   {"B", param(c.B, "deg/h", class_B, {0.005, 0.008, 0.015})},
                   {"N", param(c.N, "deg/sqrt(h)", class_N, {0.0010, 0.0015, 0.0030})}};
   return {
+      {"schema_version", 2},
       {"source", "gl2d_" + std::to_string(static_cast<int>(c.temperature_c)) + "C.csv"},
       {"samples", samples},
       {"rate_hz", rate},
       {"duration_s", samples / rate},
       {"temperature_c", c.temperature_c},
-      {"mean_rate_deg_per_h", 12.44},
-      {"earth_rate_deg_per_h", 12.43},
+      {"mean_rate", 12.44},
+      {"earth_rate", 12.43},
       {"allan",
        {{"estimator", "overlapping"}, {"unit", "deg/h"}, {"tau0_s", tau0}, {"confidence", 0.683}, {"points", points}}},
       {"fit",
-       {{"Q_arcsec", fixture_coefficient(c.Q, 0.02)},
-        {"N_deg_per_sqrt_h", fixture_coefficient(c.N, 0.15)},
-        {"B_deg_per_h", fixture_coefficient(c.B, 0.2)},
-        {"K_deg_per_h_per_sqrt_h",
-         c.K_resolved ? fixture_coefficient(c.K, 0.4) : fixture_coefficient(0, 0, false, 2 * c.K)},
-        {"R_deg_per_h2", fixture_coefficient(0, 0, false)},  // unresolved, no bound: not drawn
+       {{"Q", fixture_coefficient(c.Q, 0.02)},
+        {"N", fixture_coefficient(c.N, 0.15)},
+        {"B", fixture_coefficient(c.B, 0.2)},
+        {"K", c.K_resolved ? fixture_coefficient(c.K, 0.4) : fixture_coefficient(0, 0, false, 2 * c.K)},
+        {"R", fixture_coefficient(0, 0, false)},  // unresolved, no bound: not drawn
         {"chi2_per_dof", 1.08}}},
-      {"methods", {{"N_direct_deg_per_sqrt_h", direct}, {"B_100s_deg_per_h", fixture_coefficient(c.B * 0.95, 0.25)}}},
+      {"methods", {{"N_direct", direct}, {"B_100s", fixture_coefficient(c.B * 0.95, 0.25)}}},
       {"verdict", verdict}};
 }
 
@@ -167,7 +167,7 @@ inline nlohmann::json fixture_batch(bool with_direct_curve = true) {
   }
   // Input order is not temperature order: the figures and tables must sort.
   std::swap(runs[0], runs[3]);
-  return {{"runs", runs}, {"overall", {{"class_B", 2}, {"class_N", 1}, {"class", 2}}}};
+  return {{"schema_version", 2}, {"runs", runs}, {"overall", {{"class_B", 2}, {"class_N", 1}, {"class", 2}}}};
 }
 
 /// A diagnosis of a run with a sinusoid the base model misses: the measurement leaves the base
@@ -197,7 +197,8 @@ inline nlohmann::json fixture_diagnosis(bool with_extended = true, bool nested =
                         {"band_high", ext * (1 + w)},
                         {"median", ext}});
   }
-  json d = {{"source", "gl2d_25C.csv"},
+  json d = {{"schema_version", 2},
+            {"source", "gl2d_25C.csv"},
             {"units", {{"dev", "deg/h"}, {"tau", "s"}, {"band", "2.5-97.5 % quantiles of the simulated ADEV"}}},
             {"base_model", {{"misfit_per_point", 14.2}}},
             {"findings", json::array({{{"effect", "sinusoid"},

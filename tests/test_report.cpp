@@ -113,9 +113,8 @@ TEST(Report, UnresolvedAndMissingValuesAreStatedNotZero) {
   in.analyses.resize(1);
   in.overall = nullptr;
   auto& run = in.analyses[0];
-  run["methods"]["B_100s_deg_per_h"] = nullptr;  // too short for 100-s blocks
-  run["fit"]["N_deg_per_sqrt_h"] = {
-      {"value", 0.0012}, {"sigma", 0.0003}, {"low95", 0.0}, {"high95", 0.0012}, {"resolved", false}};
+  run["methods"]["B_100s"] = nullptr;  // too short for 100-s blocks
+  run["fit"]["N"] = {{"value", 0.0012}, {"sigma", 0.0003}, {"low95", 0.0}, {"high95", 0.0012}, {"resolved", false}};
   const auto html = rwcalc::report_html(in, no_figures());
   const auto row = row_of(html, "table1", "gl2d_25C.csv");
   EXPECT_NE(row.find("&lt; 0.0012 <span class=\"ci\">95 % upper bound</span>"), std::string::npos) << row;

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "rwcalc/error.hpp"
+#include "rwcalc/json_input.hpp"
 #include "rwcalc/pulse_writer.hpp"
 #include "rwcalc/random.hpp"
 #include "rwcalc/simulate.hpp"
@@ -237,18 +238,19 @@ TEST(Simulate, BadOptionValuesAreUsageErrorsNamingTheOption) {
 
 TEST(Simulate, FromAnalysisJsonTakesFitAndRecordSettings) {
   TempDir dir;
-  nlohmann::json j = {{"samples", 4000},
+  nlohmann::json j = {{"schema_version", json_input::kResultSchemaVersion},
+                      {"samples", 4000},
                       {"rate_hz", 200.0},
                       {"duration_s", 20.0},
                       {"temperature_c", -25.0},
-                      {"mean_rate_deg_per_h", 13.0},
-                      {"earth_rate_deg_per_h", 12.43},
+                      {"mean_rate", 13.0},
+                      {"earth_rate", 12.43},
                       {"fit",
-                       {{"Q_arcsec", {{"value", 0.5}}},
-                        {"N_deg_per_sqrt_h", {{"value", 0.001}}},
-                        {"B_deg_per_h", {{"value", 0.008}}},
-                        {"K_deg_per_h_per_sqrt_h", {{"value", 0.0}, {"resolved", false}}},
-                        {"R_deg_per_h2", nullptr}}}};
+                       {{"Q", {{"value", 0.5}}},
+                        {"N", {{"value", 0.001}}},
+                        {"B", {{"value", 0.008}}},
+                        {"K", {{"value", 0.0}, {"resolved", false}}},
+                        {"R", nullptr}}}};
   SimulationSettings s;
   const NoiseModel m = model_from_analysis_json(j, "a.json", s);
   EXPECT_DOUBLE_EQ(m.arw_deg_per_sqrt_h, 0.001);
@@ -263,7 +265,10 @@ TEST(Simulate, FromAnalysisJsonTakesFitAndRecordSettings) {
   EXPECT_EQ(s.temperature_c, -25.0);
 
   // Diagnose output: the extended model with its findings.
-  nlohmann::json d = {{"base_model", j}, {"extended_model", j}, {"findings", nlohmann::json::array()}};
+  nlohmann::json d = {{"schema_version", json_input::kResultSchemaVersion},
+                      {"base_model", j},
+                      {"extended_model", j},
+                      {"findings", nlohmann::json::array()}};
   d["extended_model"]["terms"] = {{{"effect", "sinusoid"}, {"frequency_hz", 0.0125}, {"amplitude_deg_per_h", 0.03}},
                                   {{"effect", "bias_step"}, {"time_s", 5.0}, {"size_deg_per_h", -0.01}}};
   const NoiseModel e = model_from_analysis_json(d, "d.json", s);

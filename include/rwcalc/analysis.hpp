@@ -170,7 +170,11 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& options = {}
 /// and its source, the time column and its unit, the jitter, and the reader's notes and warnings.
 nlohmann::json input_json(const Recording& rec);
 
-/// The JSON object of `rwcalc analyze --json` (keys in docs/analysis.md).
+/// The JSON object of an analysis (`rwcalc analyze --json`, each run of `batch`, each channel of
+/// `imu`), its numbers in the `shown` units: one schema for every sensor kind and unit
+/// (docs/result-json.md, docs/result.schema.json).
+nlohmann::json to_json(const AnalysisResult& r, const UnitSet& shown);
+/// The same in the sensor's usual units (output_units(r.sensor)).
 nlohmann::json to_json(const AnalysisResult& r);
 
 /// The readable report.
@@ -192,5 +196,7 @@ double vertical_earth_rate(double latitude_deg);
 
 /// JSON of an Allan result (the object `rwcalc allan --json` prints).
 nlohmann::json allan_json(const AllanResult& a);
+/// The same with the deviations in `unit`, `factor` times the result's.
+nlohmann::json allan_json(const AllanResult& a, double factor, const std::string& unit);
 
 }  // namespace rwcalc

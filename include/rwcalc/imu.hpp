@@ -50,10 +50,8 @@ struct ImuResult {
 /// Throws UsageError when no column is given or a column's unit is of the other sensor kind.
 ImuResult analyze_imu(const std::string& path, const ImuOptions& options);
 
-/// The JSON of one channel: column, sensor kind, input, units, mean, Allan deviation and the fit's
-/// coefficients in the shown units and in SI, with their meaning for the kind.
-nlohmann::json channel_json(const AnalysisResult& r, const UnitSet& shown);
-/// `rwcalc imu --json`: source, rate, the `channels` list and the noise densities per axis.
+/// `rwcalc imu --json`: source, rate, the `channels` list (each an analysis object, analysis.hpp
+/// to_json) and the noise densities per axis.
 nlohmann::json to_json(const ImuResult& r);
 /// The readable report: one table per sensor kind, each axis' coefficients with 95 % intervals.
 std::string format_imu(const ImuResult& r);

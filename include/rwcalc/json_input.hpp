@@ -2,7 +2,7 @@
 // Reading JSON that rwcalc is given (saved results, class tables, models). JSON from another
 // machine is untrusted: every value is read through a typed accessor that checks its type and
 // domain and otherwise throws an InputError naming the file, the value's line and key path, e.g.
-//   report.json:12: "fit.N_deg_per_sqrt_h.value" must be a number, got string
+//   report.json:12: "fit.N.value" must be a number, got string
 #include <cstddef>
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -49,7 +49,7 @@ class Document {
   std::unordered_map<std::string, std::size_t> lines_;
 };
 
-/// One value of a Document with its key path ("" for the root, "runs[2].fit.B_deg_per_h").
+/// One value of a Document with its key path ("" for the root, "runs[2].fit.B").
 class Value {
  public:
   Value(const Document& doc, const nlohmann::json& value, std::string path)
@@ -87,6 +87,20 @@ class Value {
   const nlohmann::json* value_;
   std::string path_;
 };
+
+/// The version of the schema of the JSON rwcalc writes (docs/result.schema.json): every document
+/// carries it as "schema_version". Version 2 named units as fields (keys carry none).
+inline constexpr int kResultSchemaVersion = 2;
+
+/// Refuses a document of rwcalc's results written under another schema version (or none, as
+/// before version 2): InputError naming the file and line, the version found and what to do.
+void require_schema_version(const Value& root);
+
+/// Refuses an analysis whose numbers are not in a gyro's usual units ("units": rate deg/h, Q arcsec,
+/// N deg/sqrt(h), B deg/h, K deg/h/sqrt(h), R deg/h^2; what `analyze` of a gyro writes without
+/// --output-unit), which `consumer` ("--from", "the report") needs: InputError naming the key, the
+/// unit found and what to do. An object without "units" (made by hand) is taken as in those units.
+void require_gyro_units(const Value& analysis, std::string_view consumer);
 
 /// The whole file; InputError when it cannot be opened or read.
 std::string read_file(const std::string& path);

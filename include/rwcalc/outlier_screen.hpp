@@ -45,7 +45,8 @@ const Recording& screen_outliers(const Recording& read, OutlierAction action, do
 /// the rates are in °/h, or, given a unit label (an accelerometer's "µg"), in it: the report's
 /// values (phase unit per second) times `factor`.
 std::string format_outliers(const OutlierReport& report, std::string_view unit = {}, double factor = 1);
-nlohmann::json to_json(const OutlierReport& report);
+/// The outlier summary; the rates (the scale, each position's value) `rate_factor` times the report's.
+nlohmann::json to_json(const OutlierReport& report, double rate_factor = 1);
 
 /// Parse "keep", "remove" or "replace" (UsageError otherwise).
 OutlierAction parse_outlier_action(std::string_view s);

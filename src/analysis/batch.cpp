@@ -10,6 +10,7 @@
 
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
+#include "rwcalc/json_input.hpp"
 #include "rwcalc/parallel.hpp"
 #include "rwcalc/printable.hpp"
 #include "rwcalc/progress.hpp"
@@ -97,10 +98,10 @@ struct Series {
 
 const std::vector<Series>& series_list() {
   static const std::vector<Series> s{
-      {"N_fit", N_("N (AV fit)"), N_("deg/sqrt(h)"), {"fit", "N_deg_per_sqrt_h"}},
-      {"N_direct", N_("N (direct)"), N_("deg/sqrt(h)"), {"methods", "N_direct_deg_per_sqrt_h"}},
-      {"B_fit", N_("B (AV fit)"), N_("deg/h"), {"fit", "B_deg_per_h"}},
-      {"B_100s", N_("B (100-s avg)"), N_("deg/h"), {"methods", "B_100s_deg_per_h"}},
+      {"N_fit", N_("N (AV fit)"), N_("deg/sqrt(h)"), {"fit", "N"}},
+      {"N_direct", N_("N (direct)"), N_("deg/sqrt(h)"), {"methods", "N_direct"}},
+      {"B_fit", N_("B (AV fit)"), N_("deg/h"), {"fit", "B"}},
+      {"B_100s", N_("B (100-s avg)"), N_("deg/h"), {"methods", "B_100s"}},
   };
   return s;
 }
@@ -291,6 +292,7 @@ json summarize_runs(std::vector<json> runs, const std::string& source) {
     for (const auto& s : series_list()) trends[s.key] = trend(runs, s);
     // Built key by key so that the runs are moved in, not deep-copied as an initializer list would.
     json out = json::object();
+    out["schema_version"] = json_input::kResultSchemaVersion;
     out["runs"] = std::move(runs);
     out["overall"] = std::move(overall);
     out["trends"] = std::move(trends);
@@ -313,9 +315,9 @@ std::string format_batch_text(const json& summary) {
   s += fmt::format("  {:>6}  {:<22} {:<30} {:<22} {:<30} {}\n", tr("T, °C"), tr("N (AV), °/√h"), tr("N direct, °/√h"),
                    tr("B (AV), °/h"), tr("B 100-s avg, °/h"), tr("file"));
   for (const auto& r : runs)
-    s += fmt::format("  {:>6}  {:<22} {:<30} {:<22} {:<30} {}\n", temp_cell(r), cell(r, {"fit", "N_deg_per_sqrt_h"}),
-                     interval_cell(r, {"methods", "N_direct_deg_per_sqrt_h"}), cell(r, {"fit", "B_deg_per_h"}),
-                     interval_cell(r, {"methods", "B_100s_deg_per_h"}), as_typed(r.at("source").get<std::string>()));
+    s += fmt::format("  {:>6}  {:<22} {:<30} {:<22} {:<30} {}\n", temp_cell(r), cell(r, {"fit", "N"}),
+                     interval_cell(r, {"methods", "N_direct"}), cell(r, {"fit", "B"}),
+                     interval_cell(r, {"methods", "B_100s"}), as_typed(r.at("source").get<std::string>()));
   s += tr("\nTable 2: class per parameter (probability of the stated class)\n");
   s += fmt::format("  {:>6}  {:<30} {:<30} {}\n", tr("T, °C"), tr("by N"), tr("by B"), tr("overall"));
   for (const auto& r : runs) {
@@ -372,10 +374,10 @@ std::string format_batch_markdown(const json& summary) {
   s += "|---|---|---|---|---|---|---|---|\n";
   for (const auto& r : runs) {
     const auto& v = r.at("verdict");
-    s += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", temp_cell(r), cell(r, {"fit", "N_deg_per_sqrt_h"}),
-                     interval_cell(r, {"methods", "N_direct_deg_per_sqrt_h"}), cell(r, {"fit", "B_deg_per_h"}),
-                     interval_cell(r, {"methods", "B_100s_deg_per_h"}), v.value("statement_N", ""),
-                     v.value("statement_B", ""), v.value("statement", ""));
+    s += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", temp_cell(r), cell(r, {"fit", "N"}),
+                     interval_cell(r, {"methods", "N_direct"}), cell(r, {"fit", "B"}),
+                     interval_cell(r, {"methods", "B_100s"}), v.value("statement_N", ""), v.value("statement_B", ""),
+                     v.value("statement", ""));
   }
   s += fmt::format("| {} | | | | | {} | {} | {} |\n", tr("overall"), ov.at("N").at("statement").get<std::string>(),
                    ov.at("B").at("statement").get<std::string>(), ov.at("statement").get<std::string>());

@@ -104,28 +104,6 @@ std::size_t display_width(std::string_view s) {
 
 std::string imu_num(double v, int sig = 4) { return fmt::format("{:.{}g}", v, sig); }
 
-nlohmann::json shown_coef(const Coefficient& c, const ShownUnit& u) {
-  return {{"value", c.value * u.factor}, {"low95", c.low * u.factor},
-          {"high95", c.high * u.factor}, {"sigma", c.sigma * u.factor},
-          {"resolved", c.resolved},      {"in_model", c.in_model},
-          {"fitted", c.enabled},         {"unit", u.ascii}};
-}
-
-nlohmann::json allan_shown(const AllanResult& a, const ShownUnit& u) {
-  nlohmann::json pts = nlohmann::json::array();
-  for (const auto& p : a.points)
-    pts.push_back({{"m", p.m},
-                   {"tau_s", p.tau_s},
-                   {"edf", p.edf},
-                   {"dev", p.dev * u.factor},
-                   {"dev_low", p.dev_low * u.factor},
-                   {"dev_high", p.dev_high * u.factor}});
-  return {{"estimator", std::string(to_string(a.estimator))},
-          {"unit", u.ascii},
-          {"confidence", a.confidence},
-          {"points", pts}};
-}
-
 // "2.41 [2.39, 2.43]" or "< 0.031" (unresolved: the 95 % upper bound), "-" when not fitted.
 std::string cell(const Coefficient& c, double factor) {
   if (!c.enabled) return "-";
@@ -195,59 +173,6 @@ ImuResult analyze_imu(const std::string& path, const ImuOptions& options) {
     progress.advance();
   });
   return out;
-}
-
-nlohmann::json channel_json(const AnalysisResult& r, const UnitSet& shown) {
-  const UnitSet si = si_units(r.sensor);
-  nlohmann::json fit = nlohmann::json::object();
-  for (const Term t : kAllTerms) {
-    nlohmann::json c = shown_coef(r.fit[t], shown[t]);
-    c["meaning"] = std::string(term_meaning(r.sensor, t));
-    c["si"] = shown_coef(r.fit[t], si[t]);
-    fit[std::string(term_name(t))] = std::move(c);
-  }
-  const auto& f = r.fit;
-  fit["chi2_per_dof"] = f.chi2_per_dof;
-  fit["p_value"] = f.p_value;
-  fit["dof"] = f.dof;
-  fit["termination"] = to_json(f.termination);
-  fit["tau_min_s"] = f.used.empty() ? 0.0 : f.used.front().tau_s;
-  fit["tau_max_s"] = f.used.empty() ? 0.0 : f.used.back().tau_s;
-  fit["range_reason"] = r.fit_range.reason();
-  fit["intervals_scaled"] = r.fit_range.intervals_scaled;
-  nlohmann::json lines = nlohmann::json::array();
-  for (const auto& l : r.fit_range.lines)
-    lines.push_back({{"frequency_hz", l.f_hz},
-                     {"rms", {{"value", l.rms * shown.deviation.factor}, {"unit", shown.deviation.ascii}}},
-                     {"rms_si", {{"value", l.rms * si.deviation.factor}, {"unit", si.deviation.ascii}}},
-                     {"peak_over_local_level", l.peak_ratio},
-                     {"max_share_of_av", l.max_share},
-                     {"tau_at_max_share_s", l.tau_at_max_s}});
-  fit["spectral_lines"] = std::move(lines);
-  fit["line_points_left_out"] = r.fit_range.line_points_left_out;
-  fit["misfit"] = misfit_json(r);
-  nlohmann::json warnings = nlohmann::json::array();
-  for (const auto& w : r.warnings) warnings.push_back({{"code", w.code}, {"message", w.message}});
-  nlohmann::json allan = allan_shown(r.allan, shown.deviation);
-  // The deviation's unit per SI unit: what the figure scales the fit's SI model by.
-  allan["unit_per_si"] = shown.deviation.factor / si_units(r.sensor).deviation.factor;
-  return {{"source", r.column},
-          {"file", r.source},
-          {"column", r.column},
-          {"sensor", std::string(to_string(r.sensor))},
-          {"input", r.input},
-          {"samples", r.samples},
-          {"rate_hz", r.rate_hz},
-          {"duration_s", r.duration_s},
-          {"segments", segments_json(r)},
-          {"mean", {{"value", r.mean_rate_deg_per_h * shown.deviation.factor}, {"unit", shown.deviation.ascii}}},
-          {"earth_rate_subtracted",
-           r.earth_rate_applied ? nlohmann::json(r.earth_rate_deg_per_h * shown.deviation.factor) : nullptr},
-          {"verdict", r.verdict_applies ? to_json(r.verdict) : nlohmann::json(nullptr)},
-          {"not_applied_reason", r.not_applied_reason},
-          {"allan", std::move(allan)},
-          {"fit", std::move(fit)},
-          {"warnings", std::move(warnings)}};
 }
 
 std::string format_channel(const AnalysisResult& r, const UnitSet& shown) {
@@ -440,12 +365,13 @@ nlohmann::json noise_json(const std::vector<AxisNoise>& axes, SensorKind kind) {
 nlohmann::json to_json(const ImuResult& r) {
   nlohmann::json channels = nlohmann::json::array();
   for (const auto& c : r.channels)
-    channels.push_back(channel_json(c.result, c.kind == SensorKind::Gyro ? r.gyro_units : r.accel_units));
+    channels.push_back(to_json(c.result, c.kind == SensorKind::Gyro ? r.gyro_units : r.accel_units));
   nlohmann::json noise = nlohmann::json::object();
   for (const SensorKind k : {SensorKind::Gyro, SensorKind::Accelerometer})
     if (const auto axes = axis_noise(r, k); !axes.empty()) noise[std::string(to_string(k))] = noise_json(axes, k);
   const auto& first = r.channels.front().result;
-  return {{"source", r.source},
+  return {{"schema_version", json_input::kResultSchemaVersion},
+          {"source", r.source},
           {"input", first.input},
           {"samples", first.samples},
           {"rate_hz", first.rate_hz},

@@ -95,17 +95,17 @@ const Recording& screen_outliers(const Recording& read, OutlierAction action, do
   return edited;
 }
 
-nlohmann::json to_json(const OutlierReport& o) {
+nlohmann::json to_json(const OutlierReport& o, double rate_factor) {
   nlohmann::json pos = nlohmann::json::array();
   for (const auto& p : o.positions)
     pos.push_back({{"index", p.index},
                    {"time_s", p.time_s},
                    {"line", p.line},
-                   {"value_deg_per_h", p.value},
+                   {"value", p.value * rate_factor},
                    {"robust_z", p.robust_z}});
   return {{"action", std::string(to_string(o.action))},
           {"threshold_robust_z", o.threshold},
-          {"scale_deg_per_h", o.scale_deg_per_h},
+          {"scale", o.scale_deg_per_h * rate_factor},
           {"count", o.count},
           {"removed", o.removed},
           {"replaced", o.replaced},

@@ -16,6 +16,7 @@
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
+#include "rwcalc/json_input.hpp"
 #include "rwcalc/printable.hpp"
 #include "rwcalc/reader.hpp"
 #include "rwcalc/segments.hpp"
@@ -87,7 +88,8 @@ std::string allan_json_text(const AllanResult& r, const Recording& rec, const Re
   if (!r.points.empty()) out += "\n  ]";
   out += ",\n  \"rate_hz\": ";
   append_number(out, rec.rate_hz);
-  out += fmt::format(",\n  \"samples\": {},\n  \"source\": {},\n  \"tau0_s\": ", rec.samples,
+  out += fmt::format(",\n  \"samples\": {},\n  \"schema_version\": {},\n  \"source\": {},\n  \"tau0_s\": ", rec.samples,
+                     json_input::kResultSchemaVersion,
                      nlohmann::json(rec.source).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
   append_number(out, r.tau0_s);
   out += fmt::format(",\n  \"unit\": {}\n}}\n", nlohmann::json(r.unit).dump());

@@ -65,26 +65,17 @@ void register_analyze(CLI::App& app, Runner& runner) {
       const Recording rec = read_recording(cmd->file, read);
       print_input_notes(io.err, rec);
       const AnalysisResult res = analyze(rec, opt);
-      if (res.sensor != SensorKind::Gyro || !cmd->output_unit.empty()) {
-        const UnitSet shown = output_units(res.sensor, cmd->output_unit);
-        const nlohmann::json j = channel_json(res, shown);
-        require_finite(j, rec.source);
-        cmd->plot.draw_analysis(j, cmd->force, io);
-        emit(io,
-             cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"
-                       : localize_numbers(format_channel(res, shown)),
-             cmd->output, cmd->force);
-        return 0;
-      }
-      const std::string text = [&] {
-        const nlohmann::json j = to_json(res);
-        require_finite(j, rec.source);
-        if (!cmd->json && !cmd->plot.any()) return localize_numbers(format_report(res));
-        cmd->plot.draw_analysis(j, cmd->force, io);
-        // A file name that is not UTF-8 is written with U+FFFD for its invalid bytes, not refused.
-        return cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"
-                         : localize_numbers(format_report(res));
-      }();
+      // One JSON schema for every sensor kind and unit; the readable report is the classic one for
+      // a gyro in its usual units, else the channel's table in the units asked for.
+      const UnitSet shown = output_units(res.sensor, cmd->output_unit);
+      const bool classic = res.sensor == SensorKind::Gyro && cmd->output_unit.empty();
+      const nlohmann::json j = to_json(res, shown);
+      require_finite(j, rec.source);
+      if (cmd->plot.any()) cmd->plot.draw_analysis(j, cmd->force, io);
+      // A file name that is not UTF-8 is written with U+FFFD for its invalid bytes, not refused.
+      const std::string text = cmd->json ? j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"
+                               : classic ? localize_numbers(format_report(res))
+                                         : localize_numbers(format_channel(res, shown));
       emit(io, text, cmd->output, cmd->force);
       return 0;
     };

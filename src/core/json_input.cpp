@@ -10,6 +10,7 @@
 #include <iterator>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
@@ -189,6 +190,35 @@ Document::Document(std::string_view text, std::string file, std::size_t first_li
   LocatingHandler handler(root_, text, read_to, file_, first_line, lines_);
   const TrackedIterator begin(text.data(), &read_to), end(text.data() + text.size(), &read_to);
   json::sax_parse(begin, end, &handler);
+}
+
+void require_schema_version(const Value& root) {
+  const auto v = root.find("schema_version");
+  if (v && v->json().is_number_integer() && v->json().get<std::int64_t>() == kResultSchemaVersion) return;
+  const std::string todo =
+      trf("this rwcalc reads result schema version {} (docs/result.schema.json): write the result again with it "
+          "(e.g. `rwcalc analyze --json`)",
+          kResultSchemaVersion);
+  if (!v)
+    root.fail(
+        trf("has no \"schema_version\" (a result of an rwcalc before schema version 2, which named "
+            "units in its keys); {}",
+            todo));
+  v->fail(trf("is {}; {}", v->json().dump(), todo));
+}
+
+void require_gyro_units(const Value& analysis, std::string_view consumer) {
+  static constexpr std::pair<const char*, const char*> kUsual[] = {{"rate", "deg/h"},      {"Q", "arcsec"},
+                                                                   {"N", "deg/sqrt(h)"},   {"B", "deg/h"},
+                                                                   {"K", "deg/h/sqrt(h)"}, {"R", "deg/h^2"}};
+  const auto units = analysis.find("units");
+  if (!units) return;
+  for (const auto& [family, usual] : kUsual)
+    if (const auto u = units->at(family); u.string() != usual)
+      u.fail(
+          trf("is \"{}\": {} takes the analysis of a gyro in its usual units (\"{}\"); analyse the record "
+              "again without --output-unit",
+              u.string(), consumer, usual));
 }
 
 std::string read_file(const std::string& path) {

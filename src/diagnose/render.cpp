@@ -8,6 +8,7 @@
 #include "rwcalc/diagnose.hpp"
 #include "rwcalc/fit.hpp"
 #include "rwcalc/i18n.hpp"
+#include "rwcalc/json_input.hpp"
 #include "rwcalc/printable.hpp"
 #include "rwcalc/sensor.hpp"
 #include "rwcalc/units.hpp"
@@ -189,8 +190,6 @@ void accelerometer_json(const DiagnoseResult& r, const Shown& sh, json& j) {
                 {"band", u.deviation.ascii},
                 {"models",
                  "simulator keys in fit-scale units: m/s in place of deg (deg/h = m/s/h, arcsec = m/s/3600)"}};
-  j["outliers"] = shown_params(j["outliers"], sh);
-  for (auto& p : j["outliers"]["positions"]) p = shown_params(p, sh);
   j.erase("scale_arcsec_per_pulse");
   j["simulation_quantum_m_per_s"] = r.settings.scale_arcsec / units::velocity_units_per_mps;
   const auto& f = r.analysis.fit;
@@ -214,6 +213,7 @@ void accelerometer_json(const DiagnoseResult& r, const Shown& sh, json& j) {
 json to_json(const DiagnoseResult& r) {
   const Shown sh(r);
   json j;
+  j["schema_version"] = json_input::kResultSchemaVersion;
   j["source"] = r.analysis.source;
   j["samples"] = r.analysis.samples;
   j["rate_hz"] = r.settings.rate_hz;
@@ -224,7 +224,7 @@ json to_json(const DiagnoseResult& r) {
   j["seed"] = r.seed;
   j["false_alarm_level_per_detector"] = r.alpha;
   j["method"] = "likelihood";
-  j["outliers"] = to_json(r.analysis.outliers);
+  j["outliers"] = to_json(r.analysis.outliers, sh.level(1.0));  // in units.level for an accelerometer
   json base = model_json(r.base, r.base_band, r.band_level, r.gain.misfit_base, r.gain.coverage_base, sh);
   // Not under "fit": model_from_analysis_json would read those coefficients instead of this model.
   base["fitted_coefficients"] = {{"Q_arcsec", r.analysis.fit[Term::Q].estimate},

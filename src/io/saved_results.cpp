@@ -104,11 +104,12 @@ void Checker::estimate(const Value& e) const {
   optional(e, "estimate", as_number);
   optional(e, "in_model", as_boolean);
   optional(e, "fitted", as_boolean);
+  optional(e, "unit", as_string);
 }
 
 void Checker::fit(const Value& f) const {
   f.object();
-  for (const char* key : {"Q_arcsec", "N_deg_per_sqrt_h", "B_deg_per_h", "K_deg_per_h_per_sqrt_h", "R_deg_per_h2"})
+  for (const char* key : {"Q", "N", "B", "K", "R"})
     if (const auto c = f.find(key)) estimate(*c);
   for (const char* key : {"chi2_per_dof", "chi2", "tau_min_s", "tau_max_s"}) optional(f, key, as_non_negative);
   optional(f, "p_value", as_probability);
@@ -117,12 +118,12 @@ void Checker::fit(const Value& f) const {
 
 void Checker::methods(const Value& m) const {
   m.object();
-  if (const auto sl = m.find("N_straight_line_paper_deg_per_sqrt_h")) {
+  if (const auto sl = m.find("N_straight_line_paper")) {
     sl->object();
     for (const char* k : {"value", "bias_factor"}) optional(*sl, k, as_non_negative);
-    for (const char* k : {"intercept_arcsec2", "slope_arcsec2_per_s"}) optional(*sl, k, as_number);
+    for (const char* k : {"intercept", "slope"}) optional(*sl, k, as_number);
   }
-  for (const char* key : {"N_direct_deg_per_sqrt_h", "B_100s_deg_per_h", "spread_100s_deg_per_h"}) {
+  for (const char* key : {"N_direct", "B_100s", "spread_100s"}) {
     const auto e = m.find(key);
     if (!e) continue;
     estimate(*e);
@@ -133,7 +134,7 @@ void Checker::methods(const Value& m) const {
         p.object();
         (void)p.at("t_s").positive();
         optional(p, "intervals", as_count);
-        optional(p, "var_arcsec2", as_non_negative);
+        optional(p, "var", as_non_negative);
       }
     for (const char* k : {"t_min_s", "t_max_s", "block_s"}) optional(*e, k, as_non_negative);
     optional(*e, "blocks", as_count);
@@ -269,7 +270,9 @@ void Checker::run(const Value& r) const {
   optional(r, "samples", as_count);
   optional(r, "rate_hz", as_positive);
   optional(r, "duration_s", as_non_negative);
-  for (const char* key : {"mean_rate_deg_per_h", "earth_rate_deg_per_h", "bias_deg_per_h"}) optional(r, key, as_number);
+  for (const char* key : {"mean_rate", "earth_rate", "bias"}) optional(r, key, as_number);
+  // The tables and the class limits are a gyro's, in its usual units.
+  json_input::require_gyro_units(r, tr("the report (and merge)"));
   if (const auto l = r.find("latitude_deg")) (void)l->number_in(-90, 90, "a latitude in [-90, 90]");
   if (const auto a = r.find("allan")) allan(*a);
   if (const auto f = member(r, "fit")) fit(*f);
@@ -354,6 +357,7 @@ void parse_saved_result(std::string_view text, const std::string& file, SavedRes
   const Checker shown(RunKeys::Shown);
   // A batch has an array of runs; a diagnosis also has "runs", the size of its ensemble.
   if (has(j, "runs") && j.at("runs").is_array()) {
+    json_input::require_schema_version(root);
     const auto runs = root.at("runs").elements();
     if (runs.empty()) root.at("runs").fail("must hold at least one run");
     for (const auto& r : runs) shown.run(r);
@@ -369,10 +373,12 @@ void parse_saved_result(std::string_view text, const std::string& file, SavedRes
     for (std::size_t i = 0; i < lines.size(); ++i) into.analyses.push_back({std::move(all["runs"][i]), file, lines[i]});
     if (overall) into.overalls.push_back(std::move(*overall));
   } else if (has(j, "allan") || has(j, "verdict")) {
+    json_input::require_schema_version(root);
     shown.run(root);
     (void)root.at("allan");
     into.analyses.push_back({doc.take(), file, 1});
   } else if (has(j, "band") || has(j, "base_model") || has(j, "findings")) {
+    json_input::require_schema_version(root);
     check_diagnosis(root);
     into.diagnoses.push_back({doc.take(), file, 1});
   } else {
@@ -399,6 +405,7 @@ std::vector<SavedRun> parse_json_lines(std::string_view text, const std::string&
       throw InputError(file, no,
                        trf("not an analyze object but {}; write the lines with `rwcalc batch --jsonl`",
                            json_input::type_name(root.json())));
+    json_input::require_schema_version(root);
     if (!root.json().contains("verdict"))
       throw InputError(file, no,
                        tr("not an analyze object (no \"verdict\"); write the lines with `rwcalc batch --jsonl`"));

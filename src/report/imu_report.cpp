@@ -88,10 +88,10 @@ std::string kind_table(const std::vector<const json*>& axes, bool gyro, int numb
       tr("term"));
   for (const auto* a : axes) s += fmt::format("<th class=\"axis\">{}</th>", html::typed(str(*a, "column")));
   s += "</tr>\n";
-  const auto& first_mean = at(*axes.front(), "mean");
-  s += row(fmt::format("{} <span class=\"unit\">({})</span>", tr("mean"), unit_label(str(first_mean, "unit"))), axes,
+  const auto& first_units = at(*axes.front(), "units");
+  s += row(fmt::format("{} <span class=\"unit\">({})</span>", tr("mean"), unit_label(str(first_units, "rate"))), axes,
            [](const json& a) {
-             const auto v = num(at(a, "mean"), "value");
+             const auto v = num(a, "mean_rate");
              return v ? g(*v) : std::string("—");
            });
   for (const auto& t : kTermRows) {

@@ -172,11 +172,11 @@ struct Term {
   const char *key, *var, *fn, *label, *unit, *colour;  // fit key, gnuplot variable and function
 };
 constexpr std::array<Term, 5> kTerms{{
-    {"Q_arcsec", "Q", "sQ", N_("quantization Q"), lbl::angle, "#7b3294"},
-    {"N_deg_per_sqrt_h", "N", "sN", N_("angle random walk N"), lbl::arw, "#1f77b4"},
-    {"B_deg_per_h", "B", "sB", N_("bias instability B"), lbl::rate, "#2ca02c"},
-    {"K_deg_per_h_per_sqrt_h", "K", "sK", N_("rate random walk K"), lbl::rrw, "#ff7f0e"},
-    {"R_deg_per_h2", "R", "sR", N_("rate ramp R"), lbl::ramp, "#8c564b"},
+    {"Q", "Q", "sQ", N_("quantization Q"), lbl::angle, "#7b3294"},
+    {"N", "N", "sN", N_("angle random walk N"), lbl::arw, "#1f77b4"},
+    {"B", "B", "sB", N_("bias instability B"), lbl::rate, "#2ca02c"},
+    {"K", "K", "sK", N_("rate random walk K"), lbl::rrw, "#ff7f0e"},
+    {"R", "R", "sR", N_("rate ramp R"), lbl::ramp, "#8c564b"},
 }};
 
 void append_allan_block(std::string& s, const std::string& name, const std::vector<AllanRow>& rows) {
@@ -227,18 +227,24 @@ void add_class_floors(const json& analysis, std::string& vars, PlotCommand& plot
   }
 }
 
-/// What names a run in a title or a key, as typed: an IMU channel by its column as named (a column
-/// name is no path: "accel/x" keeps its '/'), any other run by the file name of its source.
+/// What names a run in a title or a key, as typed: the file name of its source.
 std::string run_name(const json& a) {
-  if (std::string column = view::str(a, "column"); !column.empty()) return as_typed(column);
-  std::string src = view::str(a, "source");
-  if (src.empty()) src = view::str(a, "file");
+  const std::string src = view::str(a, "source");
   return src.empty() ? src : as_typed(std::filesystem::path(src).filename().string());
+}
+
+/// What names an IMU axis in a key, as typed: its column as named (a column name is no path:
+/// "accel/x" keeps its '/'), else its run's name.
+std::string axis_name(const json& a) {
+  if (std::string column = view::str(a, "column"); !column.empty()) return as_typed(column);
+  return run_name(a);
 }
 
 std::string default_analysis_title(const json& a) {
   std::string t = tr("Allan deviation");
-  if (const auto src = run_name(a); !src.empty()) t += trf(" of {}", src);
+  // A gyro in its usual units is a run of the batch, named by its file; any other channel by its column.
+  const bool usual = view::str(at(a, "units"), "rate").empty() || view::str(at(a, "units"), "rate") == "deg/h";
+  if (const auto src = usual ? run_name(a) : axis_name(a); !src.empty()) t += trf(" of {}", src);
   if (const auto temp = view::temperature_label(at(a, "temperature_c")); !temp.empty()) t += trf(" at {}", temp);
   return t;
 }
@@ -366,7 +372,7 @@ Figure batch_direct_figure(const json& runs, const PlotOptions& options) {
   double tmax = 0, vmax = 0;
   for (std::size_t i = 0; i < order.size(); ++i) {
     const auto& run = runs[order[i]];
-    const auto& direct = at(at(run, "methods"), "N_direct_deg_per_sqrt_h");
+    const auto& direct = at(at(run, "methods"), "N_direct");
     const auto& curve = at(direct, "curve");
     if (!curve.is_array() || curve.empty()) continue;
     const auto name = fmt::format("direct{}", i + 1);
@@ -374,7 +380,7 @@ Figure batch_direct_figure(const json& runs, const PlotOptions& options) {
     double run_tmax = 0;
     bool any = false;
     for (const auto& p : curve) {
-      const auto t = num(p, "t_s"), v = num(p, "var_arcsec2");
+      const auto t = num(p, "t_s"), v = num(p, "var");
       if (!t || !v) continue;
       block += fmt::format("{:.10g} {:.10g}\n", *t, *v);
       vmax = std::max(vmax, *v);
@@ -388,12 +394,10 @@ Figure batch_direct_figure(const json& runs, const PlotOptions& options) {
     const auto n_val = num(direct, "value");
     const auto& resolved = at(direct, "resolved");
     const bool n_resolved = !resolved.is_boolean() || resolved.get<bool>();
-    auto slope = num(direct, "slope_arcsec2_per_s");
-    if (!slope) slope = num(direct, "slope");
+    auto slope = num(direct, "slope");
     // Without a stated slope it follows from N: the angle variance of ARW is a + (60·N)²·t.
     if (!slope && n_val && n_resolved) slope = std::pow(60 * *n_val, 2);
-    auto intercept = num(direct, "intercept_arcsec2");
-    if (!intercept) intercept = num(direct, "intercept");
+    const auto intercept = num(direct, "intercept");
     // One key entry per run: the points carry the label, the line shares their colour.
     std::string label = run_label(run, i);
     if (n_val) label += fmt::format(": N {} {} {}", n_resolved ? "=" : "<", show(*n_val), tr(lbl::arw));
@@ -554,7 +558,7 @@ PlotResult plot_batch(const json& batch, const PlotOptions& options) {
     figures.push_back(std::move(direct));
   else
     r.notes.emplace_back(
-        tr("no run carries the direct-method curve (methods.N_direct_deg_per_sqrt_h.curve): "
+        tr("no run carries the direct-method curve (methods.N_direct.curve): "
            "the angle-variance panel (Fig. 2) is left out"));
   write_outputs(figures, options, r);
   return r;
@@ -609,13 +613,13 @@ Figure imu_axes_figure(const json& channels, const PlotOptions& options) {
     append_allan_block(body, name, rows);
     for (const auto& r : rows) bounds.x(r.tau), bounds.y(r.low, r.high);
     plot.add(fmt::format("${} u 1:2:3:4 w yerrorbars pt {} ps 0.6 lw 1.2 lc rgb '{}' t {}", name,
-                         kPointTypes[i % kPointTypes.size()], colour, label_text(run_name(c))));
+                         kPointTypes[i % kPointTypes.size()], colour, label_text(axis_name(c))));
     if (const auto fn = std::string("model_") + name, model = imu_model_function(c, fn); !model.empty()) {
       body += model;
       const auto chi2 = num(at(c, "fit"), "chi2_per_dof");
       plot.add(fmt::format("{}(x) w l lw 1.6 lc rgb '{}' t {}", fn, colour,
-                           label_text(chi2 ? trf("{}: fitted model (χ²/dof = {:.3g})", run_name(c), *chi2)
-                                           : trf("{}: fitted model", run_name(c)))));
+                           label_text(chi2 ? trf("{}: fitted model (χ²/dof = {:.3g})", axis_name(c), *chi2)
+                                           : trf("{}: fitted model", axis_name(c)))));
     }
     ++i;
   }

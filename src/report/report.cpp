@@ -290,8 +290,8 @@ std::string table1(const std::vector<json>& a, const std::vector<std::size_t>& o
   for (auto i : order) {
     const auto& fit = at(a[i], "fit");
     const auto& methods = at(a[i], "methods");
-    s += run_row(a[i], {coef_cell(at(fit, "N_deg_per_sqrt_h")), coef_cell(at(methods, "N_direct_deg_per_sqrt_h")),
-                        coef_cell(at(fit, "B_deg_per_h")), coef_cell(at(methods, "B_100s_deg_per_h"))});
+    s += run_row(a[i], {coef_cell(at(fit, "N")), coef_cell(at(methods, "N_direct")), coef_cell(at(fit, "B")),
+                        coef_cell(at(methods, "B_100s"))});
   }
   return s + "</table>\n";
 }
@@ -319,9 +319,9 @@ std::string table2(const std::vector<json>& a, const std::vector<std::size_t>& o
     s += run_row(run,
                  // The cross-checks' classes too depend on the rejected fit (the terms they take off).
                  {verdict_class(v, "class_N"),
-                  is_withheld(v) ? tr("no verdict") : class_by_value(at(methods, "N_direct_deg_per_sqrt_h"), run, "N"),
+                  is_withheld(v) ? tr("no verdict") : class_by_value(at(methods, "N_direct"), run, "N"),
                   verdict_class(v, "class_B"),
-                  is_withheld(v) ? tr("no verdict") : class_by_value(at(methods, "B_100s_deg_per_h"), run, "B"),
+                  is_withheld(v) ? tr("no verdict") : class_by_value(at(methods, "B_100s"), run, "B"),
                   "<b>" + verdict_class(v, "class") + "</b>"},
                  "<td>" + statement + "</td>");
   }
@@ -385,7 +385,7 @@ std::string outliers_html(const json& outliers) {
   if (positions.is_array()) {
     for (const auto& p : positions) {
       if (listed == kReportOutlierPositions) break;
-      const auto line = num(p, "line"), time = num(p, "time_s"), value = num(p, "value_deg_per_h");
+      const auto line = num(p, "line"), time = num(p, "time_s"), value = num(p, "value");
       s += listed++ ? ", " : ": ";
       s += line ? trf("line {:.0f}", *line) : trf("line {}", kNotAvailable);
       if (time)
@@ -438,9 +438,9 @@ std::string data_table(const json& run, std::size_t index, Numbering& numbering)
   auto rate = [&](const char* key, const char* name, int digits) {
     if (const auto v = num(run, key)) s += kv_row(tr(name), fmt::format("{} {}", g(*v, digits), unit(lbl::rate)));
   };
-  rate("mean_rate_deg_per_h", N_("mean rate"), 5);
-  rate("earth_rate_deg_per_h", N_("expected Earth rate"), 5);
-  rate("bias_deg_per_h", N_("bias (mean − Earth rate)"), 4);
+  rate("mean_rate", N_("mean rate"), 5);
+  rate("earth_rate", N_("expected Earth rate"), 5);
+  rate("bias", N_("bias (mean − Earth rate)"), 4);
   s += fmt::format("<tr id=\"run{}-outliers\"><th>{}</th><td>{}</td></tr>\n", index + 1, tr("outliers"),
                    outliers_html(at(run, "outliers")));
   return s + "</table>\n";
@@ -454,11 +454,11 @@ std::string fit_table(const json& fit, std::size_t index, Numbering& numbering) 
                                   trf("Allan-variance fit <span class=\"formula\">{}</span>", kModelFormula), "run");
   s += tr("<tr><th>term</th><th>value ± standard uncertainty [coverage interval, p = 0.95]</th><th>unit</th></tr>\n");
   static constexpr std::array<std::array<const char*, 3>, 5> kCoefficientRows{
-      {{"Q_arcsec", N_("Q quantization noise"), lbl::angle},
-       {"N_deg_per_sqrt_h", N_("N angle random walk"), lbl::arw},
-       {"B_deg_per_h", N_("B bias instability"), lbl::rate},
-       {"K_deg_per_h_per_sqrt_h", N_("K rate random walk"), lbl::rrw},
-       {"R_deg_per_h2", N_("R rate ramp"), lbl::ramp}}};
+      {{"Q", N_("Q quantization noise"), lbl::angle},
+       {"N", N_("N angle random walk"), lbl::arw},
+       {"B", N_("B bias instability"), lbl::rate},
+       {"K", N_("K rate random walk"), lbl::rrw},
+       {"R", N_("R rate ramp"), lbl::ramp}}};
   for (const auto& [key, name, u] : kCoefficientRows)
     s += fmt::format("<tr><td>{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n", tr(name), coef_cell(at(fit, key)),
                      unit(u));
@@ -694,7 +694,9 @@ std::string conventions_rows(const json& conventions) {
   if (conventions.is_object())
     for (const auto& item : conventions.items()) {
       const std::string& k = item.key();  // a structured binding, clang 14 (the fuzz build) cannot capture
-      if (std::none_of(kConventions.begin(), kConventions.end(), [&](const auto& c) { return k == c[0]; }))
+      // "units" says where the JSON names its units (docs/result-json.md); the report names each unit itself.
+      if (k != "units" &&
+          std::none_of(kConventions.begin(), kConventions.end(), [&](const auto& c) { return k == c[0]; }))
         h += kv_row(k, json_value_html(item.value()));
     }
   return h;
@@ -794,8 +796,8 @@ std::string protocol_results(const std::vector<json>& a, const std::vector<std::
   h += trf("<tr><th>run</th><th>temperature</th><th>N ({0})</th><th>B ({1})</th><th>class</th></tr>\n",
            "<span class=\"unit\">" + unit(lbl::arw) + "</span>", "<span class=\"unit\">" + unit(lbl::rate) + "</span>");
   for (auto i : order)
-    h += run_row(a[i], {coef_cell(at(at(a[i], "fit"), "N_deg_per_sqrt_h")),
-                        coef_cell(at(at(a[i], "fit"), "B_deg_per_h")), verdict_class(at(a[i], "verdict"), "class")});
+    h += run_row(a[i], {coef_cell(at(at(a[i], "fit"), "N")), coef_cell(at(at(a[i], "fit"), "B")),
+                        verdict_class(at(a[i], "verdict"), "class")});
   return h + "</table>\n";
 }
 

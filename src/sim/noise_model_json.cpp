@@ -51,16 +51,19 @@ double fitted(const Value& fit, const char* key, const CoefficientPolicy& policy
   const double value = num(*v, "value");
   if (in_model && resolved) return num(*v, "estimate", value);
   const double estimate = in_model ? num(*v, "estimate") : 0.0;
+  // The notes name the term with its unit, as the analysis gave it: "N (deg/sqrt(h))".
+  const auto unit = v->find("unit");
+  const std::string name = unit ? fmt::format("{} ({})", key, unit->string()) : std::string(key);
   auto note = [&](std::string line) {
     if (policy.notes) policy.notes->push_back(std::move(line));
   };
   if (policy.upper_bounds && value > estimate) {
-    note(trf("{} = {:g}: its 95 % upper bound (not resolved; --upper-bounds)", key, value));
+    note(trf("{} = {:g}: its 95 % upper bound (not resolved; --upper-bounds)", name, value));
     return value;
   }
   if (value > 0)
-    note(estimate > 0 ? trf("{} = {:g}: its estimate (not resolved; 95 % upper bound {:g})", key, estimate, value)
-                      : trf("{} left out ({}; 95 % upper bound {:g}; --upper-bounds takes it)", key,
+    note(estimate > 0 ? trf("{} = {:g}: its estimate (not resolved; 95 % upper bound {:g})", name, estimate, value)
+                      : trf("{} left out ({}; 95 % upper bound {:g}; --upper-bounds takes it)", name,
                             in_model ? tr("not resolved") : tr("left out of the model by the fit"), value));
   return estimate;
 }
@@ -206,8 +209,7 @@ void to_json(json& j, const SimulationSettings& s) {
 namespace {
 
 /// The fitted coefficients of a gyro's analysis, in the order the model takes them.
-constexpr const char* kCoefficientKeys[] = {"Q_arcsec", "N_deg_per_sqrt_h", "B_deg_per_h", "K_deg_per_h_per_sqrt_h",
-                                            "R_deg_per_h2"};
+constexpr const char* kCoefficientKeys[] = {"Q", "N", "B", "K", "R"};
 
 /// A key of a noise model object's terms.
 bool term_key(std::string_view key) {
@@ -234,6 +236,8 @@ void require_model(const Value& j) {
     if (const auto sensor = j.find("sensor"); sensor && sensor->string() != "gyro")
       sensor->fail(
           trf("is \"{}\": --from takes the analysis of a gyro (simulate writes gyro pulse records)", sensor->string()));
+    json_input::require_schema_version(j);
+    json_input::require_gyro_units(j, "--from");
     for (const char* key : kCoefficientKeys) (void)fit->at(key);
     return;
   }
@@ -265,6 +269,7 @@ NoiseModel model_from_analysis(const Value& j, SimulationSettings& settings, con
   };
   const Value root = model("extended_model").value_or(model("base_model").value_or(j));
   const bool nested = &root.json() != &j.json();
+  if (nested) json_input::require_schema_version(j);  // a diagnosis, rwcalc's result
   if (!nested) require_model(j);
   // The record's settings, from the model or else the top level.
   auto setting = [&](const char* key) {
@@ -279,18 +284,18 @@ NoiseModel model_from_analysis(const Value& j, SimulationSettings& settings, con
   NoiseModel m;
   if (const auto fit = root.find("fit")) {
     fit->object();
-    m.arw_deg_per_sqrt_h = fitted(*fit, "N_deg_per_sqrt_h", policy);
-    m.bias_instability_deg_per_h = fitted(*fit, "B_deg_per_h", policy);
-    m.rrw_deg_per_h_per_sqrt_h = fitted(*fit, "K_deg_per_h_per_sqrt_h", policy);
-    m.ramp_deg_per_h2 = fitted(*fit, "R_deg_per_h2", policy);
+    m.arw_deg_per_sqrt_h = fitted(*fit, "N", policy);
+    m.bias_instability_deg_per_h = fitted(*fit, "B", policy);
+    m.rrw_deg_per_h_per_sqrt_h = fitted(*fit, "K", policy);
+    m.ramp_deg_per_h2 = fitted(*fit, "R", policy);
     // The fitted Q is white angle noise: a white read-out contributes q/√6 of it, the rest
     // is added as extra white angle noise before counting.
     m.readout = ReadoutMode::White;
-    const double q_fit = fitted(*fit, "Q_arcsec", policy);
+    const double q_fit = fitted(*fit, "Q", policy);
     const double q_read = readout_q_arcsec(ReadoutMode::White, settings.scale_arcsec);
     if (q_fit > q_read) m.white_angle_arcsec = std::sqrt(q_fit * q_fit - q_read * q_read);
-    const double earth = num(root, "earth_rate_deg_per_h", num(j, "earth_rate_deg_per_h"));
-    const double mean = num(root, "mean_rate_deg_per_h", num(j, "mean_rate_deg_per_h", earth));
+    const double earth = num(root, "earth_rate", num(j, "earth_rate"));
+    const double mean = num(root, "mean_rate", num(j, "mean_rate", earth));
     m.earth_rate_deg_per_h = earth;
     m.bias_deg_per_h = mean - earth;
     // Extra terms: a model object's own "terms", and diagnose findings.
