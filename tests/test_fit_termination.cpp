@@ -47,8 +47,11 @@ TEST(FitTermination, ConvergedFitSaysSoOnlyInItsData) {
   EXPECT_EQ(r.fit.termination.status, TerminationStatus::Converged);
   EXPECT_GT(r.fit.termination.iterations, 0);
   EXPECT_LT(r.fit.termination.iterations, 2 * FitOptions{}.max_iterations);
-  for (const Term t : kAllTerms)
-    if (r.fit[t].enabled) EXPECT_TRUE(r.fit[t].termination.converged()) << term_name(t);
+  for (const Term t : kAllTerms) {
+    if (r.fit[t].enabled) {
+      EXPECT_TRUE(r.fit[t].termination.converged()) << term_name(t);
+    }
+  }
   const json j = to_json(r);
   EXPECT_EQ(j.at("fit").at("termination").at("status"), "converged");
   EXPECT_EQ(j.at("fit").at("termination").at("iterations"), r.fit.termination.iterations);
