@@ -145,14 +145,14 @@ TEST(ImuAdis, SixChannelsWithNoiseDensitiesAtTheWelchWhiteLevel) {
       if (c >= 3) {
         // The accelerometers carry a line near 0.55 Hz (up to 55 % of the AV at 0.64 s): found,
         // its AV taken off the fit's points, and said (without that, N read 12–30 % high).
-        const auto& lines = ch["fit"]["spectral_lines"];
+        const auto& lines = ch["fit"]["range"]["spectral_lines"];
         ASSERT_FALSE(lines.empty()) << "run " << run << " " << ch["column"];
         EXPECT_NEAR(lines[0]["frequency_hz"].get<double>(), 0.55, 0.03) << "run " << run << " " << ch["column"];
         bool said = false;
         for (const auto& w : ch["warnings"]) said = said || w["code"] == "spectral_line";
         EXPECT_TRUE(said) << "run " << run << " " << ch["column"];
       } else {
-        EXPECT_TRUE(ch["fit"]["spectral_lines"].empty()) << "run " << run << " " << ch["column"];
+        EXPECT_TRUE(ch["fit"]["range"]["spectral_lines"].empty()) << "run " << run << " " << ch["column"];
       }
     }
     const std::string y = slurp(yaml);
