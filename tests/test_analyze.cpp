@@ -26,15 +26,8 @@ json truth(const std::string& run) {
 // The passes of an analysis (Allan sums, fit, outlier scan) give the same bits whatever the number
 // of threads: a simulated hour with an outlier, analysed with RWCALC_THREADS=1 and =2.
 TEST(Analyze, ThreadCountDoesNotChangeTheResult) {
-  SimulationSettings s;
-  s.duration_s = 3600;
-  s.rate_hz = 400;
-  Recording rec;
-  rec.source = "sim";
-  rec.rate_hz = 400;
-  Simulator(test::gl2d_model(), s, SimulationPath::Ensemble).run(77, rec.phase);
+  Recording rec = test::gl2d_hour(77);
   for (std::size_t i = 123456; i < rec.phase.counts.size(); ++i) rec.phase.counts[i] += 90;  // one outlier
-  rec.samples = rec.phase.points() - 1;
   auto analysed = [&](const char* threads) {
     const test::ScopedEnv env("RWCALC_THREADS", threads);
     return to_json(analyze(rec, {})).dump();

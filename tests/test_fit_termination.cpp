@@ -18,19 +18,6 @@ namespace {
 
 using nlohmann::json;
 
-/// A simulated hour of the GL-2D-like model at 400 Hz.
-Recording gl2d_hour() {
-  SimulationSettings s;
-  s.duration_s = 3600;
-  s.rate_hz = 400;
-  Recording rec;
-  rec.source = "sim";
-  rec.rate_hz = 400;
-  Simulator(test::gl2d_model(), s, SimulationPath::Ensemble).run(11, rec.phase);
-  rec.samples = rec.phase.points() - 1;
-  return rec;
-}
-
 TEST(FitTermination, CombineKeepsTheWorseStatusAndAddsIterations) {
   using S = TerminationStatus;
   EXPECT_EQ(combine({S::Converged, 3}, {S::NoProgress, 4}).status, S::NoProgress);
@@ -43,7 +30,7 @@ TEST(FitTermination, CombineKeepsTheWorseStatusAndAddsIterations) {
 }
 
 TEST(FitTermination, ConvergedFitSaysSoOnlyInItsData) {
-  const AnalysisResult r = analyze(gl2d_hour(), {});
+  const AnalysisResult r = analyze(test::gl2d_hour(11), {});
   EXPECT_EQ(r.fit.termination.status, TerminationStatus::Converged);
   EXPECT_GT(r.fit.termination.iterations, 0);
   EXPECT_LT(r.fit.termination.iterations, 2 * FitOptions{}.max_iterations);
@@ -63,7 +50,7 @@ TEST(FitTermination, ConvergedFitSaysSoOnlyInItsData) {
 TEST(FitTermination, IterationLimitIsReportedEverywhere) {
   AnalysisOptions o;
   o.fit.max_iterations = 1;  // Fisher scoring from the data's start needs several
-  const AnalysisResult r = analyze(gl2d_hour(), o);
+  const AnalysisResult r = analyze(test::gl2d_hour(11), o);
   EXPECT_EQ(r.fit.termination.status, TerminationStatus::IterationLimit);
   EXPECT_GE(r.fit.termination.iterations, 1);
   const json j = to_json(r);

@@ -171,6 +171,18 @@ NoiseModel gl2d_model() {
   return m;
 }
 
+Recording gl2d_hour(std::uint64_t seed) {
+  SimulationSettings s;
+  s.duration_s = 3600;
+  s.rate_hz = 400;
+  Recording rec;
+  rec.source = "sim";
+  rec.rate_hz = 400;
+  Simulator(gl2d_model(), s, SimulationPath::Ensemble).run(seed, rec.phase);
+  rec.samples = rec.phase.points() - 1;
+  return rec;
+}
+
 Recording simulated_gyro(double n, double b, const SimulationSettings& settings, ReadoutMode readout) {
   NoiseModel m;
   m.arw_deg_per_sqrt_h = n;

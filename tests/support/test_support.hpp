@@ -109,4 +109,7 @@ class ScopedEnv {
 /// Earth rate, white read-out) for tests that need a realistic record.
 NoiseModel gl2d_model();
 
+/// An hour of gl2d_model() at 400 Hz from the ensemble path, seeded by `seed` (source "sim").
+Recording gl2d_hour(std::uint64_t seed);
+
 }  // namespace rwcalc::test
