@@ -10,6 +10,8 @@ Intel processors. So a recorded output is compared as numbers:
 - floating numbers within a relative tolerance, 1e-9 by default. The machine-to-machine
   differences seen are below 1e-11 relative (an EDF of 378.7285420604458 against
   378.72854206092734); a genuine change of a result moves it by far more than 1e-9.
+- a likelihood-ratio `statistic` (a difference of two large −2 ln L) within 1e-6 absolute and its
+  `p_value` within 1e-6 relative; an `iterations` count within 3 or 10 %;
 - a number printed rounded (text tables, CSV, notes) may also differ by one unit in its last
   printed digit: two machines can round a value that sits on a rounding boundary differently.
 
@@ -117,6 +119,24 @@ def iterations_agree(want, got, path):
         raise Difference(f"{path}: recorded {want!r} iterations, got {got!r}")
 
 
+# A likelihood-ratio statistic is the difference of two −2 ln L of the whole record (10^4–10^6 each,
+# so its last bits are those of the terms): another processor's rounding moves a statistic of 0.35
+# by 4e-10 (1e-9 of it). Compared to 1e-6 absolute, and its p-value to 1e-6 relative; the decisions
+# they lead to (fired, named) are compared exactly.
+LIKELIHOOD_RATIO_KEYS = {"statistic": 1e-6, "p_value": 0.0}
+
+
+def likelihood_ratio_agrees(key, want, got, rel, path):
+    if DISCRETE or not isinstance(want, float) or not isinstance(got, (int, float)):
+        return compare_json(want, got, rel, path)
+    if key == "p_value":
+        ok = float_agrees(want, float(got), max(rel, 1e-6))
+    else:
+        ok = abs(want - got) <= LIKELIHOOD_RATIO_KEYS[key] or float_agrees(want, float(got), rel)
+    if not ok:
+        raise Difference(f"{path}: recorded {want!r}, got {got!r}")
+
+
 def float_agrees(a, b, rel):
     if DISCRETE or a == b or (math.isnan(a) and math.isnan(b)):
         return True
@@ -189,6 +209,8 @@ def compare_json(want, got, rel, path="$"):
         for k in want:
             if k in ITERATION_KEYS:
                 iterations_agree(want[k], got[k], f"{path}.{k}")
+            elif k in LIKELIHOOD_RATIO_KEYS:
+                likelihood_ratio_agrees(k, want[k], got[k], rel, f"{path}.{k}")
             elif not (DISCRETE and k in INPUT_FILE_KEYS):
                 compare_json(want[k], got[k], rel, f"{path}.{k}")
     elif isinstance(want, list):
