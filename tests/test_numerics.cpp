@@ -1,8 +1,9 @@
 // The numerics layer against known answers: the Gamma deviance and its mean (closed forms and a
 // quadrature over the χ² law), the structure function (the IEEE 952 Allan variance of each term
 // from it), non-negative least squares (a worked case, the Karush–Kuhn–Tucker conditions on random
-// problems), golden-section minimisation (its cost and accuracy), and the exact integer sums
-// against 128-bit brute force on both sides of the 64-bit path's bound.
+// problems), golden-section minimisation (its cost and accuracy), Nelder–Mead (its minimum and how
+// it says it stopped), and the exact integer sums against 128-bit brute force on both sides of the
+// 64-bit path's bound.
 #include <gtest/gtest.h>
 
 #include <boost/math/distributions/chi_squared.hpp>
@@ -179,6 +180,29 @@ TEST(GoldenSection, FindsTheMinimumAtItsFixedCost) {
   // A monotone function: towards the lower end, the bracket 0.618^iters of the interval.
   const double x = golden_min([](double v) { return v; }, 0.0, 1.0, 20);
   EXPECT_LT(x, std::pow(0.6180339887498949, 20));
+}
+
+TEST(NelderMead, ConvergesOnRosenbrocksValleyAndSaysSo) {
+  int evals = 0;
+  const auto rosenbrock = [&](const std::vector<double>& x) {
+    ++evals;
+    return 100.0 * std::pow(x[1] - x[0] * x[0], 2) + std::pow(1.0 - x[0], 2);
+  };
+  const SimplexMinimum m = nelder_mead(rosenbrock, {-1.2, 1.0}, 0.5, 5000, 1e-14);
+  EXPECT_EQ(m.termination.status, TerminationStatus::Converged);
+  EXPECT_EQ(m.termination.iterations, evals);
+  EXPECT_LT(evals, 5000);
+  EXPECT_NEAR(m.x[0], 1.0, 1e-3);
+  EXPECT_NEAR(m.x[1], 1.0, 2e-3);
+}
+
+TEST(NelderMead, StopsAtItsEvaluationLimitAndSaysSo) {
+  const auto bowl = [](const std::vector<double>& x) { return x[0] * x[0] + 4.0 * x[1] * x[1] + 9.0 * x[2] * x[2]; };
+  const SimplexMinimum m = nelder_mead(bowl, {3.0, -2.0, 1.0}, 1.0, 12, 1e-12);
+  EXPECT_EQ(m.termination.status, TerminationStatus::IterationLimit);
+  EXPECT_GE(m.termination.iterations, 12);
+  // The best vertex seen so far is returned, never worse than the start.
+  EXPECT_LE(bowl(m.x), bowl({3.0, -2.0, 1.0}));
 }
 
 struct Brute {

@@ -16,6 +16,7 @@
 
 #include "rwcalc/analysis.hpp"
 #include "rwcalc/simulate.hpp"
+#include "rwcalc/termination.hpp"
 #include "rwcalc/validate.hpp"
 
 namespace rwcalc {
@@ -98,7 +99,8 @@ struct DiagnoseResult {
   std::uint64_t seed = 0;
   double band_level = 0.95;
   double alpha = 0.01;
-  double seconds = 0;  ///< wall time of the diagnosis, s
+  double seconds = 0;       ///< wall time of the diagnosis, s
+  Termination termination;  ///< the likelihood fits of the base and the final model, both searches
 };
 
 /// Run the diagnosis. Throws UsageError for clock data, AnalysisError when the record is too

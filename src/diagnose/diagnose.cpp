@@ -341,6 +341,7 @@ DiagnoseResult diagnose(const Recording& read, const DiagnoseOptions& opt) {
   const Outside out = outside_tests(rec.phase, b, opt.alpha);
   bool fast_named = false;
   const GlsModel final_model = select_effects(b, h0, out, opt.alpha, r, fast_named, opt.progress);
+  r.termination = combine(h0.fit.termination, final_model.fit.termination);
   extend(b, final_model, out, fast_named, r);
   test_lowpass(rec.phase, out, r);
   bands_and_gain(rec.phase, b, h0, final_model, r);

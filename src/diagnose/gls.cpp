@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 
+#include "rwcalc/minimise.hpp"
+
 namespace rwcalc::diag {
 
 namespace {
@@ -224,63 +226,6 @@ Profile evaluate(const Blocks& b, const Hypothesis& h, const std::vector<double>
 
 namespace {
 
-/// Nelder–Mead minimisation of f over R^d from x0 with initial steps `step`.
-template <class F>
-std::vector<double> nelder_mead(const F& f, const std::vector<double>& x0, double step, int max_evals, double ftol) {
-  const std::size_t d = x0.size();
-  std::vector<std::vector<double>> s(d + 1, x0);
-  std::vector<double> fv(d + 1);
-  for (std::size_t i = 0; i < d; ++i) s[i + 1][i] += step;
-  for (std::size_t i = 0; i <= d; ++i) fv[i] = f(s[i]);
-  int evals = static_cast<int>(d + 1);
-  std::vector<std::size_t> idx(d + 1);
-  while (evals < max_evals) {
-    for (std::size_t i = 0; i <= d; ++i) idx[i] = i;
-    std::sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) { return fv[a] < fv[b]; });
-    const std::size_t best = idx[0], worst = idx[d], second = idx[d - 1];
-    if (std::abs(fv[worst] - fv[best]) < ftol) break;
-    std::vector<double> c(d, 0.0);
-    for (std::size_t i = 0; i <= d; ++i)
-      if (i != worst)
-        for (std::size_t j = 0; j < d; ++j) c[j] += s[i][j] / static_cast<double>(d);
-    auto along = [&](double t) {
-      std::vector<double> x(d);
-      for (std::size_t j = 0; j < d; ++j) x[j] = c[j] + t * (s[worst][j] - c[j]);
-      return x;
-    };
-    auto xr = along(-1.0);
-    const double fr = f(xr);
-    ++evals;
-    if (fr < fv[best]) {
-      auto xe = along(-2.0);
-      const double fe = f(xe);
-      ++evals;
-      if (fe < fr)
-        s[worst] = xe, fv[worst] = fe;
-      else
-        s[worst] = xr, fv[worst] = fr;
-    } else if (fr < fv[second]) {
-      s[worst] = xr, fv[worst] = fr;
-    } else {
-      auto xc = along(fr < fv[worst] ? -0.5 : 0.5);
-      const double fc = f(xc);
-      ++evals;
-      if (fc < std::min(fr, fv[worst])) {
-        s[worst] = xc, fv[worst] = fc;
-      } else {  // shrink towards the best
-        for (std::size_t i = 0; i <= d; ++i) {
-          if (i == best) continue;
-          for (std::size_t j = 0; j < d; ++j) s[i][j] = s[best][j] + 0.5 * (s[i][j] - s[best][j]);
-          fv[i] = f(s[i]);
-          ++evals;
-        }
-      }
-    }
-  }
-  const auto it = std::min_element(fv.begin(), fv.end());
-  return s[static_cast<std::size_t>(it - fv.begin())];
-}
-
 /// Log-levels below the reference's by more than this are a term switched off (e^{−40}).
 constexpr double kLogFloor = -40.0;
 
@@ -316,9 +261,13 @@ Profile profile(const Blocks& b, const Hypothesis& h, const std::vector<double>&
   if (u0.empty()) return fit_at(u0);
   const auto f = [&](const std::vector<double>& u) { return fit_at(u).m2ll; };
   // Two rounds: a restart from the first optimum escapes a collapsed simplex.
-  auto u = nelder_mead(f, u0, 1.0, 300, 1e-4);
-  u = nelder_mead(f, u, 0.3, 150, 1e-5);
-  return fit_at(u);
+  // The first round's end is only a start: the second's test decides, over both rounds' evaluations.
+  const SimplexMinimum first = nelder_mead(f, u0, 1.0, 300, 1e-4);
+  const SimplexMinimum second = nelder_mead(f, first.x, 0.3, 150, 1e-5);
+  Profile p = fit_at(second.x);
+  p.termination = second.termination;
+  p.termination.iterations += first.termination.iterations;
+  return p;
 }
 
 }  // namespace rwcalc::diag

@@ -11,6 +11,8 @@
 #include <cstddef>
 #include <vector>
 
+#include "rwcalc/termination.hpp"
+
 namespace rwcalc::diag {
 
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
@@ -53,7 +55,8 @@ struct Profile {
   std::vector<double> level;  ///< per term (Hypothesis::terms), unit levels as term_autocov's
   Eigen::VectorXd beta;
   Eigen::MatrixXd beta_cov;
-  std::vector<double> r;  ///< the fitted autocovariance of z
+  std::vector<double> r;    ///< the fitted autocovariance of z
+  Termination termination;  ///< how the search over the levels stopped
 };
 
 /// The block means a record's likelihood reads.

@@ -277,6 +277,7 @@ json to_json(const DiagnoseResult& r) {
                {"holdout_misfit_base", finite_or_null(r.gain.holdout_misfit_base)},
                {"holdout_misfit_extended", finite_or_null(r.gain.holdout_misfit_extended)}};
   j["seconds"] = r.seconds;
+  j["termination"] = to_json(r.termination);
   if (sh.accel) accelerometer_json(r, sh, j);
   return clean_json(j);
 }
@@ -347,6 +348,11 @@ std::string format_report(const DiagnoseResult& r) {
                               detector_name(d.effect), d.statistic, d.threshold, d.p_value,
                               d.named ? tr("FOUND") : (d.fired ? tr("fired, not named") : tr("not found")),
                               d.note.empty() ? "" : " (" + d.note + ")");
+  if (!r.termination.converged())
+    s +=
+        trf("  warning: the search over the noise levels stopped at its limit of {} evaluations before "
+            "converging; the statistics above may be too small\n",
+            r.termination.iterations);
   s += tr("\nFindings:\n");
   if (r.findings.empty()) s += tr("  none: the base model explains the measurement\n");
   s += format_findings(r.findings, sh);
