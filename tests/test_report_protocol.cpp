@@ -131,17 +131,16 @@ Protocol make_protocol(const char* lang, const fs::path& dir) {
 
 class ProtocolReport : public ::testing::TestWithParam<const char*> {
  protected:
-  static void SetUpTestSuite() {
-    if (!installed("gnuplot")) return;
-    for (const char* lang : {"ru", "en"}) protocols()[lang] = make_protocol(lang, dir().path() / lang);
-  }
   static TempDir& dir() {
     static TempDir d;
     return d;
   }
-  static std::map<std::string, Protocol>& protocols() {
-    static std::map<std::string, Protocol> p;
-    return p;
+  /// The protocol in `lang`, made on first use: each test runs in a process of its own, and a
+  /// protocol takes about 12 s of CPU to make, so a test makes only the language it reads.
+  static const Protocol& protocol(const std::string& lang) {
+    static std::map<std::string, Protocol> made;
+    if (!made.contains(lang)) made[lang] = make_protocol(lang.c_str(), dir().path() / lang);
+    return made[lang];
   }
 };
 
@@ -197,7 +196,7 @@ void expect_protocol_text(const std::string& raw, const std::string& lang, const
 TEST_P(ProtocolReport, HtmlPdfAndDocxCarryTheProtocolWithNumbersAsMetrologyWritesThem) {
   if (!installed("gnuplot")) GTEST_SKIP() << "gnuplot not found: the report's figures need it";
   const std::string lang = GetParam();
-  const Protocol& p = protocols()[lang];
+  const Protocol& p = protocol(lang);
   // A tool that is not installed is an error for its output (3), the HTML written all the same.
   const bool tools = installed("chromium") && installed("pandoc");
   EXPECT_EQ(p.status, tools ? 0 : 3) << p.err;
@@ -232,6 +231,7 @@ INSTANTIATE_TEST_SUITE_P(Languages, ProtocolReport, ::testing::Values("ru", "en"
 TEST_P(ProtocolReport, ARussianReportShowsNoEnglishButNamesAndIdentifiers) {
   if (std::string(GetParam()) != "ru") GTEST_SKIP() << "Russian only";
   if (!installed("gnuplot")) GTEST_SKIP() << "gnuplot not found: the report's figures need it";
+  protocol("ru");
   std::string html = slurp(dir().path() / "ru" / "report.html");
   // The figures' text (inline SVG as base64) is part of what a reader sees.
   std::string figures = command_output(
