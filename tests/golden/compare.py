@@ -123,17 +123,17 @@ def iterations_agree(want, got, path):
 # so its last bits are those of the terms): another processor's rounding moves a statistic of 0.35
 # by 4e-10 (1e-9 of it). Compared to 1e-6 absolute, and its p-value to 1e-6 relative; the decisions
 # they lead to (fired, named) are compared exactly.
-LIKELIHOOD_RATIO_KEYS = {"statistic": 1e-6, "p_value": 0.0}
+STATISTIC_ABS = 1e-6
+P_VALUE_REL = 1e-6
+LIKELIHOOD_RATIO_KEYS = {"statistic", "p_value"}
 
 
 def likelihood_ratio_agrees(key, want, got, rel, path):
     if DISCRETE or not isinstance(want, float) or not isinstance(got, (int, float)):
         return compare_json(want, got, rel, path)
-    if key == "p_value":
-        ok = float_agrees(want, float(got), max(rel, 1e-6))
-    else:
-        ok = abs(want - got) <= LIKELIHOOD_RATIO_KEYS[key] or float_agrees(want, float(got), rel)
-    if not ok:
+    if key == "statistic" and abs(want - got) <= STATISTIC_ABS:
+        return
+    if not float_agrees(want, float(got), max(rel, P_VALUE_REL) if key == "p_value" else rel):
         raise Difference(f"{path}: recorded {want!r}, got {got!r}")
 
 
