@@ -37,7 +37,28 @@ Real sw(Real t, int alpha) {
 constexpr Real kInfinite = std::numeric_limits<Real>::infinity();
 
 // log1p(u)'s Taylor coefficient of u^n, (−1)^(n+1)/n (0 for n < 1).
-Real log1p_coefficient(int n) { return n < 1 ? 0 : (n % 2 ? 1 : -1) / static_cast<Real>(n); }
+constexpr Real log1p_coefficient(int n) { return n < 1 ? 0 : (n % 2 ? 1 : -1) / static_cast<Real>(n); }
+
+constexpr int kLogSeriesTerms = 12;  // even k = 2 … 24: u^22 < 2e-20 at u ≤ 1/8
+
+// c_k, the coefficient of u^k in (1 + u)^q·ln(1 + u), for the even k of the series, by q. They depend
+// on q alone, and an `all` grid evaluates the series some 10^8 times: made once, at compile time.
+using LogSeries = std::array<Real, kLogSeriesTerms>;
+constexpr LogSeries log_series(int q) {
+  LogSeries c{};
+  for (int t = 0; t < kLogSeriesTerms; ++t) {
+    const int k = 2 * t + 2;
+    Real b = 1;  // C(q, i)
+    for (int i = 0; i <= q; ++i) {
+      c[static_cast<std::size_t>(t)] += b * log1p_coefficient(k - i);
+      b = b * (q - i) / (i + 1);
+    }
+  }
+  return c;
+}
+// Indexed by q = 3 − α for the α whose sw has a logarithm (+1, −1, −3: q = 2, 4, 6).
+constexpr std::array<LogSeries, 7> kLogSeries = {LogSeries{},   LogSeries{}, log_series(2), LogSeries{},
+                                                 log_series(4), LogSeries{}, log_series(6)};
 
 // sx for |t| ≥ 8/f, where f²·(2·sw(t) − sw(t − 1/f) − sw(t + 1/f)) would lose about 2·log10(f·|t|)
 // digits (11 at f = 524288): the difference is expanded in u = 1/(f·|t|) ≤ 1/8 and summed without
@@ -58,14 +79,9 @@ Real sx_expanded(Real at, Real u, int alpha) {
   Real scale = 1;  // |t|^(q−2)
   for (int i = 2; i < q; ++i) scale *= at;
   if (!has_log) return -2 * scale * even_poly;
-  Real series = 0;  // Σ_{even k≥2} c_k·u^(k−2); |c_k| ≤ 2^q/(k − q), u ≤ 1/8: u^22 < 2e-20
+  Real series = 0;  // Σ_{even k≥2} c_k·u^(k−2); |c_k| ≤ 2^q/(k − q)
   upow = 1;
-  for (int k = 2; k <= 24; k += 2) {
-    Real c = 0, b = 1;  // b = C(q, i)
-    for (int i = 0; i <= q; ++i) {
-      c += b * log1p_coefficient(k - i);
-      b = b * (q - i) / (i + 1);
-    }
+  for (const Real c : kLogSeries[static_cast<std::size_t>(q)]) {
     series += c * upow;
     upow *= u * u;
   }
