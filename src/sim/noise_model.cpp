@@ -6,7 +6,9 @@
 
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <numbers>
+#include <unordered_map>
 
 #include "rwcalc/error.hpp"
 #include "rwcalc/units.hpp"
@@ -107,11 +109,11 @@ void validate(const NoiseModel& model, const SimulationSettings& settings) {
   require_valid(model);
 }
 
-double flicker_avar(double b, std::size_t m) {
-  // AV(m) = (2B²/(π m²)) ∫_0^{π/2} sin⁴(mu)/sin³(u) du: the discrete Kasdin spectrum
-  // B²τ0/(2 sin πfτ0) through the Allan transfer function of m-sample means.
-  const double floor = 2.0 * b * b * std::numbers::ln2 / std::numbers::pi;
-  if (m > (std::size_t{1} << 16)) return floor;
+namespace {
+
+/// ∫_0^{π/2} sin⁴(mu)/sin³(u) du by 8-point Gauss–Legendre on 8m panels (the integrand has about m
+/// oscillations): 128·m sines.
+double kasdin_flicker_integral(std::size_t m) {
   static constexpr double kX[8] = {-0.9602898564975363, -0.7966664774136267, -0.5255324099163290, -0.1834346424956498,
                                    0.1834346424956498,  0.5255324099163290,  0.7966664774136267,  0.9602898564975363};
   static constexpr double kW[8] = {0.1012285362903763, 0.2223810344533745, 0.3137066378926775, 0.3626837833783620,
@@ -129,7 +131,33 @@ double flicker_avar(double b, std::size_t m) {
       sum += kW[i] * (s * s * s * s) / (su * su * su);
     }
   }
-  return 2.0 * b * b / (std::numbers::pi * md * md) * sum * 0.5 * h;
+  return sum * 0.5 * h;
+}
+
+/// The integral depends on m alone, and the diagnosis asks for the same few m thousands of times
+/// (each at up to 8 M sines): each m is integrated once per process.
+double kasdin_flicker_integral_once(std::size_t m) {
+  static std::mutex mutex;
+  static std::unordered_map<std::size_t, double> known;
+  {
+    const std::lock_guard lock(mutex);
+    if (const auto it = known.find(m); it != known.end()) return it->second;
+  }
+  const double value = kasdin_flicker_integral(m);
+  const std::lock_guard lock(mutex);
+  known.emplace(m, value);
+  return value;
+}
+
+}  // namespace
+
+double flicker_avar(double b, std::size_t m) {
+  // AV(m) = (2B²/(π m²)) ∫_0^{π/2} sin⁴(mu)/sin³(u) du: the discrete Kasdin spectrum
+  // B²τ0/(2 sin πfτ0) through the Allan transfer function of m-sample means.
+  const double floor = 2.0 * b * b * std::numbers::ln2 / std::numbers::pi;
+  if (m > (std::size_t{1} << 16)) return floor;
+  const double md = static_cast<double>(m);
+  return 2.0 * b * b / (std::numbers::pi * md * md) * kasdin_flicker_integral_once(m);
 }
 
 double theoretical_avar(const NoiseModel& model, double tau0, double q, std::size_t m) {
