@@ -5,7 +5,7 @@
 // flicker's share). Its threshold is its own 99 % quantile on clean records, so that both tests work
 // at a 1 % false-alarm rate. Records: GL-2D-like (N 0.001 °/√h, B 0.005 °/h) at 10 Hz with the
 // white read-out, whose noise is exactly the model's. 200 clean records for the reference's quantile
-// and 24 diagnoses (64 under RWCALC_ACCEPTANCE=1, tests/support/population.hpp).
+// and 18 diagnoses (48 under RWCALC_ACCEPTANCE=1, tests/support/population.hpp).
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
@@ -178,7 +178,9 @@ double ninety(const std::vector<double>& mults, const std::vector<double>& frac)
 // false-alarm rate, and no line named a Gauss–Markov term. Measured on the acceptance's 16 records per
 // amplitude: reference 3.30×, rwcalc 3.85× (ratio 1.167); the bound asserted there is 1.2, above the
 // 1.15 aimed at, which is not yet reached. The default 6 records per amplitude resolve the 90 % point
-// to about a third of a step: 1.3 is asserted.
+// to about a third of a step: 1.3 is asserted. rwcalc is not run at 3×, where it names fewer than 90 %
+// in every measurement so far: if it ever names 90 % at 3.5×, 3.5× is taken as its 90 % amplitude, an
+// upper bound, so the assertion can only be stricter for it.
 TEST(DiagnoseReference, SlowLinesWithinFifteenPercentOfTheReferenceAmplitude) {
   const Reference ref(static_cast<Eigen::Index>(kT / kTb) - 2);
   // The reference's threshold: its 99 % quantile over 200 clean records.
@@ -188,7 +190,8 @@ TEST(DiagnoseReference, SlowLinesWithinFifteenPercentOfTheReferenceAmplitude) {
   const double threshold = 0.5 * (clean[197] + clean[198]);
   const std::vector<double> mults = {3.0, 3.5, 4.0, 4.5};
   const int n = test::population("RWCALC_REFERENCE_LINES", 6, 16);
-  std::vector<double> ref_frac, rw_frac;
+  constexpr double kRwcalcFrom = 3.5;
+  std::vector<double> ref_frac, rw_frac, rw_mults;
   int gauss_markov = 0;
   for (const double mult : mults) {
     int ref_named = 0, rw_named = 0;
@@ -199,6 +202,7 @@ TEST(DiagnoseReference, SlowLinesWithinFifteenPercentOfTheReferenceAmplitude) {
       const PhaseSeries x = record(m, 9500 + static_cast<std::uint64_t>(i));
       const auto r = ref.test(x);
       ref_named += r.lr > threshold && std::abs(r.f - f) < 0.5 / kT && std::abs(r.amp / amp - 1) < 0.3;
+      if (mult < kRwcalcFrom) continue;
       Recording rec;
       rec.source = "reference-case";
       rec.phase = x;
@@ -213,10 +217,15 @@ TEST(DiagnoseReference, SlowLinesWithinFifteenPercentOfTheReferenceAmplitude) {
       }
     }
     ref_frac.push_back(double(ref_named) / n);
+    if (mult < kRwcalcFrom) {
+      std::cout << fmt::format("{:.1f}x floor: reference {}/{}\n", mult, ref_named, n);
+      continue;
+    }
+    rw_mults.push_back(mult);
     rw_frac.push_back(double(rw_named) / n);
     std::cout << fmt::format("{:.1f}x floor: reference {}/{}, rwcalc {}/{}\n", mult, ref_named, n, rw_named, n);
   }
-  const double a_ref = ninety(mults, ref_frac), a_rw = ninety(mults, rw_frac);
+  const double a_ref = ninety(mults, ref_frac), a_rw = ninety(rw_mults, rw_frac);
   std::cout << fmt::format(
       "reference threshold {:.2f} (99 % of 200 clean records); 90 % amplitude: reference {:.2f}x, rwcalc {:.2f}x "
       "(ratio {:.3f}); Gauss-Markov named in {} line records\n",
