@@ -106,7 +106,7 @@ TEST(Catalogue, ReadsContinuationLinesEscapesAndSkipsFuzzyAndObsoleteEntries) {
 }
 
 TEST(Catalogue, TranslatesOnlyInRussianAndFallsBackToEnglish) {
-  const char* table = "Table {}";
+  constexpr const char* table = "Table {}";
   EXPECT_STREQ(rwcalc::tr(table), table);
   const LanguageScope ru(Language::Russian);
   EXPECT_STREQ(rwcalc::tr(table), "Таблица {}");

@@ -49,11 +49,21 @@ template <typename... Args>
 /// tr() (the label of a JSON field, which itself stays English): GNU gettext's N_().
 constexpr const char* N_(const char* english) { return english; }
 
-/// fmt::format with a translated format string; the catalogue test checks that each translation
-/// has the same replacement fields as its English original.
+/// fmt::format with a translated format string. The English text is checked against the arguments
+/// at compile time (a replacement field without its argument, or of the wrong type, does not
+/// compile); the catalogue test checks that each translation has the same replacement fields.
 template <typename... Args>
-[[nodiscard]] std::string trf(const char* english, Args&&... args) {
-  return fmt::format(fmt::runtime(tr(english)), std::forward<Args>(args)...);
+[[nodiscard]] std::string trf(fmt::format_string<Args...> english, Args&&... args) {
+  return fmt::format(fmt::runtime(tr(fmt::string_view(english).data())), std::forward<Args>(args)...);
+}
+
+/// trf() of one of two messages chosen at run time (a message per case, so that each translates
+/// whole), both checked at compile time.
+template <typename... Args>
+[[nodiscard]] std::string trf_either(bool first, fmt::format_string<Args...> if_first,
+                                     fmt::format_string<Args...> otherwise, Args&&... args) {
+  const fmt::string_view english = first ? fmt::string_view(if_first) : fmt::string_view(otherwise);
+  return fmt::format(fmt::runtime(tr(english.data())), std::forward<Args>(args)...);
 }
 
 /// Outside text inside human-readable text (a file or column name, a serial number, an operator,

@@ -176,9 +176,8 @@ ImuResult analyze_imu(const std::string& path, const ImuOptions& options) {
 }
 
 std::string format_channel(const AnalysisResult& r, const UnitSet& shown) {
-  std::string s = trf(r.sensor == SensorKind::Gyro ? N_("rwcalc gyro: {}, column '{}'\n\n")
-                                                   : N_("rwcalc accelerometer: {}, column '{}'\n\n"),
-                      as_typed(r.source), as_typed(r.column));
+  std::string s = trf_either(r.sensor == SensorKind::Gyro, N_("rwcalc gyro: {}, column '{}'\n\n"),
+                             N_("rwcalc accelerometer: {}, column '{}'\n\n"), as_typed(r.source), as_typed(r.column));
   s += format_warnings(r.warnings);
   s += trf("Data\n  {} samples at {:g} Hz, {:.1f} s ({:.2f} h); mean {} {}; {}\n", r.samples, r.rate_hz, r.duration_s,
            r.duration_s / 3600.0, imu_num(r.mean_rate_deg_per_h * shown.deviation.factor, 6),
@@ -226,11 +225,11 @@ std::string kind_table(const std::vector<const ImuChannel*>& axes, const UnitSet
       width = std::max({width, a->column.size(), cell(a->result.fit[t], u[t].factor).size(),
                         cell(a->result.fit[t], si[t].factor).size()});
   const int kWidth = static_cast<int>(width + 2);
-  std::string s = trf(kind == SensorKind::Gyro
-                          ? N_("Gyro ({} axes; {};\n  95 % profile intervals; < : not resolved, 95 % upper bound)\n")
-                          : N_("Accelerometer ({} axes; {};\n  95 % profile intervals; < : not resolved, 95 % upper "
-                               "bound)\n"),
-                      axes.size(), units_line(u));
+  std::string s =
+      trf_either(kind == SensorKind::Gyro,
+                 N_("Gyro ({} axes; {};\n  95 % profile intervals; < : not resolved, 95 % upper bound)\n"),
+                 N_("Accelerometer ({} axes; {};\n  95 % profile intervals; < : not resolved, 95 % upper bound)\n"),
+                 axes.size(), units_line(u));
   // The row heads' column fits the longest (the Russian term names are longer than the English).
   std::vector<std::string> heads{tr("mean")};
   for (const Term t : kAllTerms) heads.push_back(fmt::format("{} {}", term_name(t), localized_meaning(kind, t)));

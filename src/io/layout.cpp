@@ -441,20 +441,19 @@ Unit choose_unit(std::optional<Unit> given, std::optional<Unit> named, Unit fall
                  std::string_view option, std::string_view column, InputChoice& c) {
   const bool angle = what == "angle";  // a message per kind, so that each translates whole
   if (given && named && *given != *named)
-    c.warnings.push_back(trf(angle ? N_("the column name '{}' says angle in {}, but {} {} is used as given")
-                                   : N_("the column name '{}' says rate in {}, but {} {} is used as given"),
-                             column, to_string(*named), option, to_string(*given)));
+    c.warnings.push_back(trf_either(angle, N_("the column name '{}' says angle in {}, but {} {} is used as given"),
+                                    N_("the column name '{}' says rate in {}, but {} {} is used as given"), column,
+                                    to_string(*named), option, to_string(*given)));
   if (given) return *given;
   if (named) {
-    c.notes.push_back(
-        trf(angle ? N_("angle unit {} from the column name '{}'") : N_("rate unit {} from the column name '{}'"),
-            to_string(*named), column));
+    c.notes.push_back(trf_either(angle, N_("angle unit {} from the column name '{}'"),
+                                 N_("rate unit {} from the column name '{}'"), to_string(*named), column));
     return *named;
   }
   c.notes.push_back(
-      trf(angle ? N_("angle unit {} (the default: no {} and no unit suffix such as _dps in the column name)")
-                : N_("rate unit {} (the default: no {} and no unit suffix such as _dps in the column name)"),
-          to_string(fallback), option));
+      trf_either(angle, N_("angle unit {} (the default: no {} and no unit suffix such as _dps in the column name)"),
+                 N_("rate unit {} (the default: no {} and no unit suffix such as _dps in the column name)"),
+                 to_string(fallback), option));
   return fallback;
 }
 

@@ -723,13 +723,14 @@ void Reader::check_rates(const PhaseSeries& ph, const std::vector<double>& x, do
       continue;
     const std::string as_rate = f == 1 ? "" : fmt::format(" ({:g} {})", rate, ph.deviation_unit());
     fail(line_of_sample(i - 1),
-         trf(increments ? N_("increment out of range: {} {}{} is beyond ±{:g} {}, where the variances the noise fit "
-                             "squares would overflow")
-                        : N_("rate out of range: {} {}{} is beyond ±{:g} {}, where the variances the noise fit squares "
-                             "would overflow"),
-             detail::quoted(fmt::format("{:g}", x[i])),
-             increments ? to_string(in().angle_unit) : to_string(in().rate_unit), as_rate, kMaxDataRate,
-             ph.deviation_unit()));
+         trf_either(increments,
+                    N_("increment out of range: {} {}{} is beyond ±{:g} {}, where the variances the noise fit "
+                       "squares would overflow"),
+                    N_("rate out of range: {} {}{} is beyond ±{:g} {}, where the variances the noise fit squares "
+                       "would overflow"),
+                    detail::quoted(fmt::format("{:g}", x[i])),
+                    increments ? to_string(in().angle_unit) : to_string(in().rate_unit), as_rate, kMaxDataRate,
+                    ph.deviation_unit()));
   }
 }
 
@@ -1071,9 +1072,9 @@ std::string_view input_unit(const Recording& rec) {
 
 std::string describe_input(const Recording& rec) {
   if (rec.mode == InputMode::Pulses || rec.mode == InputMode::Counter)
-    return trf(rec.mode == InputMode::Pulses ? N_("column '{}': pulse counts, {:g} arcsec per pulse")
-                                             : N_("column '{}': counter readings, {:g} arcsec per count"),
-               rec.column_name, rec.phase.arcsec_per_count);
+    return trf_either(rec.mode == InputMode::Pulses, N_("column '{}': pulse counts, {:g} arcsec per pulse"),
+                      N_("column '{}': counter readings, {:g} arcsec per count"), rec.column_name,
+                      rec.phase.arcsec_per_count);
   return trf("column '{}': {} samples in {}", rec.column_name, to_string(rec.mode), input_unit(rec));
 }
 

@@ -33,8 +33,8 @@ PlotResult plot_imu(const nlohmann::json& imu, const PlotOptions& options) {
     if (runs.empty()) continue;
     PlotOptions o = options;
     if (o.title.empty())
-      o.title = trf(kind == kGyro ? N_("Gyro axes of {}") : N_("Accelerometer axes of {}"),
-                    std::filesystem::path(imu.value("source", "")).filename().string());
+      o.title = trf_either(kind == kGyro, N_("Gyro axes of {}"), N_("Accelerometer axes of {}"),
+                           std::filesystem::path(imu.value("source", "")).filename().string());
     Figure f = imu_axes_figure(runs, o);
     f.name = fmt::format("imu-{}", kind);
     figures.push_back(std::move(f));

@@ -137,9 +137,9 @@ ProcessResult run_process(const std::string& command, const std::vector<std::str
   return r;
 }
 
-ScratchDir::ScratchDir(std::string_view name, const char* failure) {
+ScratchDir::ScratchDir(std::string_view name, fmt::format_string<std::string> failure) {
   std::string templ = (fs::temp_directory_path() / (std::string(name) + "XXXXXX")).string();
-  if (mkdtemp(templ.data()) == nullptr) throw OutputError(trf(failure, std::strerror(errno)));
+  if (mkdtemp(templ.data()) == nullptr) throw OutputError(trf(failure, std::string(std::strerror(errno))));
   path_ = templ;
   on_signal_.emplace(path_.string(), RemoveOnSignal::Kind::Tree);
 }

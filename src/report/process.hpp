@@ -3,6 +3,8 @@
 // no file name or title is ever interpreted as a command. Each helper runs in a process group of
 // its own, within a time limit, and neither it, what it started, nor its scratch directory
 // outlives rwcalc (core/cleanup.hpp).
+#include <fmt/format.h>
+
 #include <filesystem>
 #include <initializer_list>
 #include <optional>
@@ -44,7 +46,7 @@ class ScratchDir {
  public:
   /// `failure`: the message (a msgid with one {} for the reason) of the OutputError thrown when
   /// the directory cannot be made.
-  ScratchDir(std::string_view name, const char* failure);
+  ScratchDir(std::string_view name, fmt::format_string<std::string> failure);
   ~ScratchDir();
   ScratchDir(const ScratchDir&) = delete;
   ScratchDir& operator=(const ScratchDir&) = delete;
