@@ -6,7 +6,9 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 
+#include "rwcalc/analysis.hpp"
 #include "rwcalc/error.hpp"
+#include "rwcalc/simulate.hpp"
 #include "rwcalc/verdict.hpp"
 #include "test_support.hpp"
 
@@ -15,6 +17,27 @@ namespace {
 
 /// An estimate known exactly (step confidence distribution).
 EstimateInput exact(double v) { return lognormal_estimate(v, 0.0); }
+
+// The verdict under other options from one analysis is the one analyze gives with those options:
+// each B estimate, and a tolerance, on a 30-min GL-2D-like record.
+TEST(Verdict, UnderOtherOptionsIsWhatAnalyzeDecidesWithThem) {
+  SimulationSettings s;
+  s.duration_s = 1800;
+  s.rate_hz = 100;
+  s.seed = 20261203;
+  const Recording rec = test::simulated_gyro(0.0009, 0.008, s);
+  const AnalysisResult base = analyze(rec);
+  for (const BEstimate b : {BEstimate::Fit, BEstimate::SigmaMin, BEstimate::Avg100}) {
+    AnalysisOptions o;
+    o.verdict.b_estimate = b;
+    o.verdict.tolerance_pct = b == BEstimate::Avg100 ? 50 : 0;
+    const Verdict direct = analyze(rec, o).verdict, again = verdict_under(base, o);
+    EXPECT_EQ(again.statement(), direct.statement()) << to_string(b);
+    EXPECT_EQ(again.cls, direct.cls) << to_string(b);
+    ASSERT_EQ(again.p_meets.size(), direct.p_meets.size());
+    for (std::size_t i = 0; i < direct.p_meets.size(); ++i) EXPECT_EQ(again.p_meets[i], direct.p_meets[i]);
+  }
+}
 
 TEST(Verdict, ClassBoundariesOfTheGostTable) {
   const VerdictOptions o;

@@ -166,6 +166,11 @@ struct AnalysisResult {
 /// or without noise.
 AnalysisResult analyze(const Recording& rec, const AnalysisOptions& options = {});
 
+/// The class verdict of an analysed gyro record under other verdict options (another B estimate,
+/// class table or tolerance in `options.verdict`), as analyze would have decided it, without
+/// analysing again: withheld, as there, when the fit is rejected. analyze's own verdict is this.
+[[nodiscard]] Verdict verdict_under(const AnalysisResult& r, const AnalysisOptions& options);
+
 /// What was read and how (the `input` object of analyze and allan JSON): column, kind, unit, rate
 /// and its source, the time column and its unit, the jitter, and the reader's notes and warnings.
 nlohmann::json input_json(const Recording& rec);

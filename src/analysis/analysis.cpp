@@ -351,6 +351,12 @@ void cross_checks(const PhaseSeries& x, const AnalysisOptions& options, Analysis
 
 }  // namespace
 
+Verdict verdict_under(const AnalysisResult& r, const AnalysisOptions& options) {
+  Verdict v = verdict_of(r, options);
+  if (r.fit_rejected()) withhold_verdict(r, v);
+  return v;
+}
+
 AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   require_valid(options);
   const std::optional<SensorKind> sensor = sensor_kind(read.phase.kind);
@@ -384,8 +390,7 @@ AnalysisResult analyze(const Recording& read, const AnalysisOptions& options) {
   progress.advance(kAllanAndFit);
   if (options.cross_checks) {
     cross_checks(contiguous, options, r);
-    if (r.sensor == SensorKind::Gyro) r.verdict = verdict_of(r, options);  // made, shown only if it applies
-    if (r.sensor == SensorKind::Gyro && r.fit_rejected()) withhold_verdict(r);
+    if (r.sensor == SensorKind::Gyro) r.verdict = verdict_under(r, options);  // made, shown only if it applies
   }
   if (options.fit_checks) r.warnings = fit_warnings(r);
   return r;

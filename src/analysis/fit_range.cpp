@@ -434,7 +434,7 @@ std::string range_clause(const FitRangeChoice& c) {
 
 std::string FitRangeChoice::reason() const { return range_clause(*this) + lines_clause(*this); }
 
-void withhold_verdict(AnalysisResult& r) {
+void withhold_verdict(const AnalysisResult& r, Verdict& v) {
   const FitRangeChoice& fr = r.fit_range;
   const std::string tried =
       fr.source == FitRangeChoice::Source::Option ? std::string(tr("over the range given by --fit-range"))
@@ -442,9 +442,9 @@ void withhold_verdict(AnalysisResult& r) {
           ? std::string(tr("over every octave point, the pulse read-out taken as white angle noise (Q)"))
           : std::string(tr("after the short-tau check (output filter, short-tau structure) and the spectral-line "
                            "search"));
-  r.verdict.withhold(trf("the fit is rejected: chi2/dof = {:.3g} on {} degrees of freedom (p = {:.2g} < {:g}), {}",
-                         r.fit.chi2_per_dof, r.fit.dof, r.fit.p_value, kFitRejectedP, tried),
-                     trf("rwcalc diagnose {} [input options]", shell_word(r.source)));
+  v.withhold(trf("the fit is rejected: chi2/dof = {:.3g} on {} degrees of freedom (p = {:.2g} < {:g}), {}",
+                 r.fit.chi2_per_dof, r.fit.dof, r.fit.p_value, kFitRejectedP, tried),
+             trf("rwcalc diagnose {} [input options]", shell_word(r.source)));
 }
 
 namespace {

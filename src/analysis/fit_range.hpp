@@ -62,7 +62,7 @@ nlohmann::json misfit_json(const AnalysisResult& r);
 
 /// A rejected fit gives no class: the verdict is withheld with the reason (the goodness of fit, the
 /// range and what the short-τ check and the line search took off) and the command to run next.
-void withhold_verdict(AnalysisResult& r);
+void withhold_verdict(const AnalysisResult& r, Verdict& v);
 
 /// The warnings of a result's fit range and goodness of fit (a withheld verdict's first).
 std::vector<AnalysisWarning> fit_warnings(const AnalysisResult& r);
