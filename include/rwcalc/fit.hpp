@@ -123,7 +123,7 @@ struct FitResult {
   std::shared_ptr<const FitResult> k_alternative;
   double k_weight = 0;
 
-  [[nodiscard]] const Coefficient& operator[](Term t) const { return coef[static_cast<int>(t)]; }
+  [[nodiscard]] const Coefficient& operator[](Term t) const { return coef[static_cast<std::size_t>(t)]; }
   /// Model σ² at τ (s), (°/h)².
   [[nodiscard]] double model_var(double tau_s) const;
   /// The counter read-out's part of model_var at τ (s), (°/h)² (0 unless counter_readout).

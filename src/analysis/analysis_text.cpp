@@ -201,8 +201,9 @@ std::string cross_check_section(const AnalysisResult& r) {
         "(bootstrap, {} replicate); vs AV fit {:+.1f} sigma\n",
         "  N direct (overlapping angle increments, {:g}..{:g} s, exact Q/N/B expectations): {}{} °/√h [{}, {}] "
         "(bootstrap, {} replicates); vs AV fit {:+.1f} sigma\n",
-        d.replicates, d.points.front().t_s, d.points.back().t_s, d.N.resolved ? "" : "< ", num(d.N.value, 3),
-        num(d.N.low, 3), num(d.N.high, 3), d.replicates, r.N_direct_discrepancy_sigma);
+        static_cast<unsigned long long>(d.replicates), d.points.front().t_s, d.points.back().t_s,
+        d.N.resolved ? "" : "< ", num(d.N.value, 3), num(d.N.low, 3), num(d.N.high, 3), d.replicates,
+        r.N_direct_discrepancy_sigma);
   else
     s += tr("  N direct: record too short\n");
   if (d.straight.valid) {

@@ -114,7 +114,7 @@ void install_handler() {
     sa.sa_handler = remove_registered_and_reraise;
     sigemptyset(&sa.sa_mask);
     for (const int other : kSignals) sigaddset(&sa.sa_mask, other);
-    sa.sa_flags = SA_RESETHAND;
+    sa.sa_flags = static_cast<int>(SA_RESETHAND);
     (void)sigaction(sig, &sa, nullptr);
   }
   // A write beyond the file-size limit then fails (EFBIG) and is reported, instead of ending rwcalc
