@@ -27,20 +27,21 @@ python3 - "$out" <<'PY'
 import json, sys, pathlib
 out = pathlib.Path(sys.argv[1])
 def fmt_finding(f):
-    e = f["effect"]; u = f.get("uncertainty", {})
-    def v(k, unit, d=3):
-        s = f"{f[k]:.{d}g}"
-        if k in u: s += f" ± {u[k]:.2g}"
-        return s + f" {unit}"
+    e = f["effect"]; p = f["parameters"]
+    labels = {"deg/h": "°/h"}
+    def v(k, d=3):
+        s = f"{p[k]['value']:.{d}g}"
+        if p[k]["standard_uncertainty"] is not None: s += f" ± {p[k]['standard_uncertainty']:.2g}"
+        return s + " " + labels.get(p[k]["unit"], p[k]["unit"])
     if e == "sinusoid":
         ev = f.get("evidence", {})
-        s = f"sinusoid {v('frequency_hz','Hz')}, {v('amplitude_deg_per_h','°/h')}"
+        s = f"sinusoid {v('frequency')}, {v('amplitude')}"
         if ev.get("coherent") is False: s += f" (broadened, width {ev['width_hz']:.2g} Hz)"
         return s
-    if e == "gauss_markov": return f"Gauss–Markov σ {v('sigma_deg_per_h','°/h')}, Tc {v('correlation_time_s','s')}"
-    if e == "bias_step": return f"bias step {v('size_deg_per_h','°/h')} at {v('time_s','s')}"
-    if e == "warmup_transient": return f"warm-up {v('amplitude_deg_per_h','°/h')}, τw {v('time_constant_s','s')}"
-    if e == "lowpass": return f"low-pass τf {v('time_constant_s','s')}"
+    if e == "gauss_markov": return f"Gauss–Markov σ {v('sigma')}, Tc {v('correlation_time')}"
+    if e == "bias_step": return f"bias step {v('size')} at {v('time')}"
+    if e == "warmup_transient": return f"warm-up {v('amplitude')}, τw {v('time_constant')}"
+    if e == "lowpass": return f"low-pass τf {v('time_constant')}"
     return e
 print("| run | axis | base misfit | base coverage | named effects | extended misfit | extended coverage | holdout misfit base → extended |")
 print("|---|---|---|---|---|---|---|---|")

@@ -78,7 +78,14 @@ def main():
     docs["imu --json"] = run("imu", IMU, "--json")
     docs["diagnose gyro"] = run("diagnose", GL2D[0], "--json", "--runs", "20")
     docs["diagnose accelerometer"] = run("diagnose", IMU, "--column", "acc_x_g", "--json", "--runs", "20")
+    # A record with a line and a step, so that findings and their parameters are checked too.
+    effects = tmp / "effects.csv.gz"
+    run("simulate", "-o", str(effects), "--duration", "7200", "--rate", "40", "--arw", "0.001", "--bias-instability",
+        "0.005", "--sinusoid", "0.0006:0.03", "--bias-step", "3000:0.06", "--seed", "5")
+    docs["diagnose with findings"] = run("diagnose", str(effects), "--json")
     docs = {k: json.loads(r.stdout) for k, r in docs.items()}
+    if [f["effect"] for f in docs["diagnose with findings"]["findings"]] != ["sinusoid", "bias_step"]:
+        fail("diagnose of a record with a line and a step did not name both")
     run("imu", IMU, "--report", str(tmp / "report"))
     docs["imu --report imu.json"] = json.loads((tmp / "report" / "imu.json").read_text(encoding="utf-8"))
     lines = [json.loads(x) for x in jsonl.splitlines() if x.strip()]

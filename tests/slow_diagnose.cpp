@@ -54,9 +54,9 @@ const Finding* finding(const DiagnoseResult& r, Effect e) {
   return nullptr;
 }
 
-bool covers(const Finding& f, const char* key, double truth) {
-  const auto& iv = f.evidence["interval95"][key];
-  return iv[0].get<double>() <= truth && truth <= iv[1].get<double>();
+bool covers(const Finding& f, const char* name, double truth) {
+  const FindingParameter& p = f.parameter(name);
+  return p.low95 <= truth && truth <= p.high95;
 }
 
 /// At least `share` of `n` cases, set for the acceptance's `acceptance` cases and widened for fewer.
@@ -85,10 +85,10 @@ TEST(DiagnoseAcceptance, SlowLinesAtThreeAndAHalfFloors) {
     gauss_markov += finding(r, Effect::GaussMarkov) != nullptr;
     const Finding* s = finding(r, Effect::Sinusoid);
     if (!s) continue;
-    const double fh = s->params["frequency_hz"].get<double>(), ah = s->params["amplitude_deg_per_h"].get<double>();
+    const double fh = s->parameter("frequency").value, ah = s->parameter("amplitude").value;
     named += std::abs(fh - f) < 0.5 / kT && std::abs(ah / amp - 1) < 0.3;
     gain += r.gain.holdout_misfit_extended < r.gain.holdout_misfit_base;
-    cover_f += covers(*s, "frequency_hz", f);
+    cover_f += covers(*s, "frequency", f);
   }
   std::cout << fmt::format(
       "slow lines at 3.5x: {}/{} named in tolerance, {} Gauss-Markov, {} with out-of-sample "
@@ -146,8 +146,8 @@ TEST(DiagnoseAcceptance, StepIntervalsCover) {
     const Finding* s = finding(r, Effect::BiasStep);
     if (!s) continue;
     ++named;
-    cover_t += covers(*s, "time_s", t);
-    cover_s += covers(*s, "size_deg_per_h", size);
+    cover_t += covers(*s, "time", t);
+    cover_s += covers(*s, "size", size);
   }
   std::cout << fmt::format("steps: {}/{} named, time interval covers {}, size interval covers {}\n", named, n, cover_t,
                            cover_s);

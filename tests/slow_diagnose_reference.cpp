@@ -212,7 +212,7 @@ TEST(DiagnoseReference, SlowLinesWithinFifteenPercentOfTheReferenceAmplitude) {
       for (const auto& fd : d.findings) {
         gauss_markov += fd.effect == Effect::GaussMarkov;
         if (fd.effect != Effect::Sinusoid) continue;
-        const double fh = fd.params["frequency_hz"].get<double>(), ah = fd.params["amplitude_deg_per_h"].get<double>();
+        const double fh = fd.parameter("frequency").value, ah = fd.parameter("amplitude").value;
         rw_named += std::abs(fh - f) < 0.5 / kT && std::abs(ah / amp - 1) < 0.3;
       }
     }

@@ -69,10 +69,13 @@ TEST(DiagnoseAccelerometer, NamesTheSinusoidInAccelerometerUnits) {
   ASSERT_EQ(j["findings"].size(), 1u) << j["findings"].dump();
   const auto& s = j["findings"][0];
   EXPECT_EQ(s["effect"], "sinusoid");
-  EXPECT_NEAR(s["frequency_hz"].get<double>(), kSinHz, 1e-3);
-  ASSERT_TRUE(s.contains("amplitude_ug")) << s.dump();
-  EXPECT_FALSE(s.contains("amplitude_deg_per_h"));
-  const double amp = s["amplitude_ug"].get<double>(), sigma = s["uncertainty"]["amplitude_ug"].get<double>();
+  // The same keys as a gyro's finding, the unit a field: µg for the accelerometer's amplitude.
+  const auto& sp = s["parameters"];
+  EXPECT_NEAR(sp["frequency"]["value"].get<double>(), kSinHz, 1e-3);
+  EXPECT_EQ(sp["amplitude"]["unit"], "ug") << s.dump();
+  const double amp = sp["amplitude"]["value"].get<double>(),
+               sigma = sp["amplitude"]["standard_uncertainty"].get<double>();
+  EXPECT_NEAR(sp["amplitude"]["interval95"][1].get<double>(), amp + 1.96 * sigma, 1e-9 * amp);
   EXPECT_GT(sigma, 0.0);
   EXPECT_LT(std::abs(amp - kSinAmp * kMicroGPerMpsH), std::max(4 * sigma, 0.1 * kSinAmp * kMicroGPerMpsH))
       << amp << " ± " << sigma << " µg";
@@ -100,8 +103,8 @@ TEST(DiagnoseAccelerometer, ReportStatesColumnKindAndUnits) {
   const auto f = dir.write("acc.csv", accel_csv(true, 21)).string();
   const auto r = run_cli({"diagnose", f, "--runs", "12", "--seed", "3"});
   ASSERT_EQ(r.status, 0) << r.err;
-  for (const char* want : {"column 'acc_x_mps2' of an accelerometer read in m/s^2", "levels in µg", "amplitude_ug",
-                           "µg;", "m/s/√h", "white velocity", "no Earth rate"})
+  for (const char* want : {"column 'acc_x_mps2' of an accelerometer read in m/s^2", "levels in µg",
+                           "amplitude = ", "µg;", "m/s/√h", "white velocity", "no Earth rate"})
     EXPECT_NE(r.out.find(want), std::string::npos) << want << "\n" << r.out;
   for (const char* never : {"°/h", "Earth rate 0", "pulse weight", "″"})
     EXPECT_EQ(r.out.find(never), std::string::npos) << never << "\n" << r.out;

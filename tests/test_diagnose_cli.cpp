@@ -67,9 +67,17 @@ TEST_F(DiagnoseCli, JsonHasTheDocumentedKeysAndFindsTheSinusoid) {
   ASSERT_EQ(j["findings"].size(), 1u) << j["findings"].dump();
   const auto& f = j["findings"][0];
   EXPECT_EQ(f["effect"], "sinusoid");
-  EXPECT_NEAR(f["frequency_hz"].get<double>(), 0.05, 1e-3);
-  EXPECT_NEAR(f["amplitude_deg_per_h"].get<double>(), 0.3, 0.06);
-  EXPECT_GT(f["uncertainty"]["amplitude_deg_per_h"].get<double>(), 0.0);
+  const auto& fp = f["parameters"];
+  EXPECT_NEAR(fp["frequency"]["value"].get<double>(), 0.05, 1e-3);
+  EXPECT_EQ(fp["frequency"]["unit"], "Hz");
+  const auto& amp = fp["amplitude"];
+  EXPECT_NEAR(amp["value"].get<double>(), 0.3, 0.06);
+  EXPECT_EQ(amp["unit"], "deg/h");
+  EXPECT_GT(amp["standard_uncertainty"].get<double>(), 0.0);
+  EXPECT_LT(amp["interval95"][0].get<double>(), amp["value"].get<double>());
+  EXPECT_GT(amp["interval95"][1].get<double>(), amp["value"].get<double>());
+  EXPECT_EQ(fp["phase"]["unit"], "rad");
+  EXPECT_TRUE(fp["phase"]["standard_uncertainty"].is_null());
   EXPECT_GT(f["evidence"]["statistic"].get<double>(), f["evidence"]["threshold"].get<double>());
   ASSERT_EQ(j["extended_model"]["sinusoids"].size(), 1u);
   EXPECT_LT(j["gain"]["misfit_extended"].get<double>(), j["gain"]["misfit_base"].get<double>());
@@ -103,8 +111,8 @@ TEST_F(DiagnoseCli, ReportCarriesUnitsAndTheFinding) {
   const auto r = run_cli({"diagnose", record_, "--runs", "10"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("  sinusoid:"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("frequency_hz = 0.05"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find(" Hz"), std::string::npos);
+  EXPECT_NE(r.out.find("frequency = 0.05"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(" Hz; amplitude = "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("°/h"), std::string::npos);
   EXPECT_NE(r.out.find("out-of-sample −2 ln L per block"), std::string::npos);
   EXPECT_EQ(r.out.find("nan"), std::string::npos);
@@ -183,9 +191,11 @@ TEST(DiagnoseCliLowpass, OutputChainFilterIsNamedAndSimulatedBack) {
   for (const auto& f : j["findings"])
     if (f["effect"] == "lowpass") lp = &f;
   ASSERT_NE(lp, nullptr) << j["findings"].dump();
-  EXPECT_NEAR((*lp)["time_constant_s"].get<double>(), 0.05, 0.0125);
-  EXPECT_GT((*lp)["uncertainty"]["time_constant_s"].get<double>(), 0.0);
-  EXPECT_NEAR(j["extended_model"]["output_lowpass_tc_s"].get<double>(), (*lp)["time_constant_s"].get<double>(), 1e-12);
+  const auto& tc = (*lp)["parameters"]["time_constant"];
+  EXPECT_NEAR(tc["value"].get<double>(), 0.05, 0.0125);
+  EXPECT_EQ(tc["unit"], "s");
+  EXPECT_GT(tc["standard_uncertainty"].get<double>(), 0.0);
+  EXPECT_NEAR(j["extended_model"]["output_lowpass_tc_s"].get<double>(), tc["value"].get<double>(), 1e-12);
   EXPECT_LT(j["gain"]["misfit_extended"].get<double>(), j["gain"]["misfit_base"].get<double>());
   const auto again = (dir.path() / "again.csv").string();
   r = run_cli({"simulate", "--from", out, "-o", again, "--duration", "1200"});

@@ -168,8 +168,9 @@ TEST(DiagnoseGls, SlowLineFoundAndEstimated) {
   EXPECT_LT(c.p, 1e-3);
   EXPECT_GT(c.lr, c.threshold);
   const TermEstimate e = estimate_det(b, c.model, 0);
-  EXPECT_NEAR(e.params["frequency_hz"].get<double>(), f, 0.5 / 7200);
-  EXPECT_NEAR(e.params["amplitude_deg_per_h"].get<double>(), amp, 0.3 * amp);
+  const Finding found{Effect::Sinusoid, e.parameters, {}};
+  EXPECT_NEAR(found.parameter("frequency").value, f, 0.5 / 7200);
+  EXPECT_NEAR(found.parameter("amplitude").value, amp, 0.3 * amp);
   const Blocks clean = blocks_of(gl2d_like(), 7200, 5);
   EXPECT_GT(search_slow_line(clean, null_model(clean), 0.01, 2.5 / 7200, 12.0 / 7200, Effect::Sinusoid).p, 0.01);
 }
@@ -182,11 +183,13 @@ TEST(DiagnoseGls, StepFoundAndEstimated) {
   const Candidate c = search_step(b, null_model(b), 0.01);
   EXPECT_LT(c.p, 1e-3);
   const TermEstimate e = estimate_det(b, c.model, 0);
-  EXPECT_NEAR(e.params["time_s"].get<double>(), 3000, 100);
-  EXPECT_NEAR(e.params["size_deg_per_h"].get<double>(), 0.05, 0.015);
-  const auto& ti = e.interval95["time_s"];
-  EXPECT_LE(ti[0].get<double>(), e.params["time_s"].get<double>());
-  EXPECT_GE(ti[1].get<double>(), e.params["time_s"].get<double>());
+  const Finding step{Effect::BiasStep, e.parameters, {}};
+  const FindingParameter& time = step.parameter("time");
+  EXPECT_NEAR(time.value, 3000, 100);
+  EXPECT_NEAR(step.parameter("size").value, 0.05, 0.015);
+  EXPECT_LE(time.low95, time.value);
+  EXPECT_GE(time.high95, time.value);
+  EXPECT_NEAR(time.standard_uncertainty, (time.high95 - time.low95) / 3.92, 1e-12);
 }
 
 // A warm-up transient: found, its time constant near the truth.

@@ -185,9 +185,8 @@ TEST(ReportFigures, EveryFigureIsInlineValidSvgWithItsSeries) {
   for (int n = 1; n <= 8; ++n) EXPECT_NE(html.find(fmt::format("<b>Figure {}.</b>", n)), std::string::npos) << n;
   for (const char* id : {"id=\"run2-diagnosis\"", "id=\"run2-findings\"", "id=\"run2-gain\""})
     EXPECT_NE(html.find(id), std::string::npos) << id;
-  EXPECT_NE(html.find("amplitude_deg_per_h = 0.03 °/h; evidence = PSD line 40 times the background; "
-                      "frequency_hz = 0.0125 Hz"),
-            std::string::npos);
+  // A finding's parameters with their uncertainties and the units their "unit" fields name.
+  EXPECT_NE(html.find("amplitude = 0.0300 ± 0.0021 °/h; frequency = 0.0125 Hz"), std::string::npos);
 }
 
 TEST(ReportFigures, SingleRunHasNoOverlayAndMissingCurvesAreSaid) {

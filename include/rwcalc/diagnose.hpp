@@ -9,6 +9,7 @@
 /// gain in and out of sample (docs/diagnosis.md). No decision reads a random number.
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
@@ -68,13 +69,27 @@ struct DetectorResult {
   std::string note;            ///< why it was not named although it fired, or not tested
 };
 
-/// A named effect: parameters (JSON keys as simulate's model reads them), 1σ uncertainties and
-/// evidence.
+/// What a finding's parameter measures; it sets the unit the parameter is shown in (a rate in °/h
+/// for a gyro, in the level unit of an accelerometer, sensor.hpp).
+enum class Quantity { Frequency, Rate, Time, Phase };
+
+/// One estimated parameter of a named effect, in the fit's units (°/h for a rate, Hz, s, rad).
+struct FindingParameter {
+  std::string name;  ///< "frequency", "amplitude", "phase", "time", "size", "time_constant", "sigma", …
+  Quantity quantity = Quantity::Rate;
+  double value = 0;
+  double standard_uncertainty = std::numeric_limits<double>::quiet_NaN();  ///< NaN: not estimated
+  double low95 = std::numeric_limits<double>::quiet_NaN();                 ///< 95 % interval; NaN: not estimated
+  double high95 = std::numeric_limits<double>::quiet_NaN();                ///<
+};
+
+/// A named effect: its parameters and the evidence (statistic, threshold, p-value, the test).
 struct Finding {
   Effect effect = Effect::Sinusoid;
-  nlohmann::json params;       ///< e.g. {"frequency_hz": …, "amplitude_deg_per_h": …}
-  nlohmann::json uncertainty;  ///< same keys, standard errors
-  nlohmann::json evidence;     ///< statistic, threshold, where it shows
+  std::vector<FindingParameter> parameters;
+  nlohmann::json evidence;
+  /// The parameter called `name`; std::out_of_range when the effect has none of that name.
+  [[nodiscard]] const FindingParameter& parameter(std::string_view name) const;
 };
 
 struct Gain {

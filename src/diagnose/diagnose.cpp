@@ -194,10 +194,12 @@ void test_lowpass(const PhaseSeries& x, const Outside& out, DiagnoseResult& r) {
   d.fired = d.named = lp.p <= r.alpha;
   r.detectors.push_back(d);
   if (!d.named) return;
-  Finding f{Effect::Lowpass, {{"time_constant_s", lp.tf}}, {{"time_constant_s", (lp.tf_high - lp.tf_low) / 3.92}}, {}};
-  f.evidence = {{"statistic", d.statistic}, {"threshold", d.threshold},
-                {"p_value", d.p_value},     {"false_alarm_level", r.alpha},
-                {"detector", d.test},       {"interval95", {{"time_constant_s", {lp.tf_low, lp.tf_high}}}}};
+  Finding f{Effect::Lowpass, {from_interval("time_constant", Quantity::Time, lp.tf, lp.tf_low, lp.tf_high)}, {}};
+  f.evidence = {{"statistic", d.statistic},
+                {"threshold", d.threshold},
+                {"p_value", d.p_value},
+                {"false_alarm_level", r.alpha},
+                {"detector", d.test}};
   if (r.findings.empty()) r.extended = r.base;
   r.extended.output_lowpass_tc_s = lp.tf;
   r.extended.arw_deg_per_sqrt_h = std::sqrt(lp.white_rate) / units::sqrt_s_per_sqrt_h;
@@ -264,26 +266,22 @@ void extend(const Blocks& b, const GlsModel& m, const Outside& out, bool fast_na
   if (fast_named) {
     const FastLine& l = *out.fast;
     Finding f{Effect::Line,
-              {{"frequency_hz", l.f_hz}, {"amplitude_deg_per_h", l.amp}, {"phase_rad", l.phase}},
-              {{"frequency_hz", l.f_sigma}, {"amplitude_deg_per_h", l.amp_sigma}},
+              {from_sigma("frequency", Quantity::Frequency, l.f_hz, l.f_sigma),
+               from_sigma("amplitude", Quantity::Rate, l.amp, l.amp_sigma),
+               {"phase", Quantity::Phase, l.phase}},
               {}};
-    f.evidence["interval95"] = {{"frequency_hz", {l.f_hz - 1.96 * l.f_sigma, l.f_hz + 1.96 * l.f_sigma}},
-                                {"amplitude_deg_per_h", {l.amp - 1.96 * l.amp_sigma, l.amp + 1.96 * l.amp_sigma}}};
     r.extended.sinusoids.push_back({l.f_hz, l.amp, l.phase});
     r.findings.push_back(std::move(f));
   }
   for (std::size_t j = 0; j < m.det.size(); ++j) {
-    const TermEstimate e = estimate_det(b, m, j);
-    Finding f{m.det[j].effect, e.params, e.uncertainty, {}};
-    f.evidence["interval95"] = e.interval95;
-    const auto& p = e.params;
+    Finding f{m.det[j].effect, estimate_det(b, m, j).parameters, {}};
+    const auto v = [&f](std::string_view name) { return f.parameter(name).value; };
     if (f.effect == Effect::BiasStep)
-      r.extended.bias_steps.push_back({p["time_s"].get<double>(), p["size_deg_per_h"].get<double>()});
+      r.extended.bias_steps.push_back({v("time"), v("size")});
     else if (f.effect == Effect::Warmup)
-      r.extended.warmups.push_back({p["amplitude_deg_per_h"].get<double>(), p["time_constant_s"].get<double>()});
+      r.extended.warmups.push_back({v("amplitude"), v("time_constant")});
     else
-      r.extended.sinusoids.push_back(
-          {p["frequency_hz"].get<double>(), p["amplitude_deg_per_h"].get<double>(), p["phase_rad"].get<double>()});
+      r.extended.sinusoids.push_back({v("frequency"), v("amplitude"), v("phase")});
     r.findings.push_back(std::move(f));
   }
   for (std::size_t c = 0; c < m.cov.size(); ++c) {
@@ -292,10 +290,8 @@ void extend(const Blocks& b, const GlsModel& m, const Outside& out, bool fast_na
       case CovKind::B: r.extended.bias_instability_deg_per_h = std::sqrt(lv / kFlickerFloorPerB2); break;
       case CovKind::K: r.extended.rrw_deg_per_h_per_sqrt_h = std::sqrt(3.0 * lv) * units::sqrt_s_per_sqrt_h; break;
       case CovKind::GM: {
-        const TermEstimate e = estimate_gm(b, m, c);
-        Finding f{Effect::GaussMarkov, e.params, e.uncertainty, {}};
-        f.evidence["interval95"] = e.interval95;
-        r.extended.gauss_markov.push_back({e.params["sigma_deg_per_h"].get<double>(), m.cov[c].tc_s});
+        Finding f{Effect::GaussMarkov, estimate_gm(b, m, c).parameters, {}};
+        r.extended.gauss_markov.push_back({f.parameter("sigma").value, m.cov[c].tc_s});
         r.findings.push_back(std::move(f));
         break;
       }

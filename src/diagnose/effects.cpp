@@ -373,6 +373,14 @@ double det_m2ll(const Blocks& b, const GlsModel& m, std::size_t index, double x)
 
 }  // namespace
 
+FindingParameter from_sigma(std::string name, Quantity q, double value, double sigma) {
+  return {std::move(name), q, value, sigma, value - 1.96 * sigma, value + 1.96 * sigma};
+}
+
+FindingParameter from_interval(std::string name, Quantity q, double value, double low, double high) {
+  return {std::move(name), q, value, (high - low) / 3.92, low, high};
+}
+
 TermEstimate estimate_det(const Blocks& b, const GlsModel& m, std::size_t index) {
   Eigen::Index off = 0;
   for (std::size_t j = 0; j < index; ++j) off += det_columns(b, m.det[j]).cols();
@@ -387,24 +395,20 @@ TermEstimate estimate_det(const Blocks& b, const GlsModel& m, std::size_t index)
     const Eigen::Vector2d grad(a / amp, bb / amp);
     const double amp_sigma = std::sqrt(grad.dot(cov.block(off, off, 2, 2) * grad));
     const auto [flo, fhi] = profile_interval(g, t.nl, 0.02 / T, 0.5 * t.nl, 2.0 * t.nl);
-    e.params = {{"frequency_hz", t.nl}, {"amplitude_deg_per_h", amp}, {"phase_rad", std::atan2(-bb, a)}};
-    e.uncertainty = {{"frequency_hz", (fhi - flo) / 3.92}, {"amplitude_deg_per_h", amp_sigma}};
-    e.interval95 = {{"frequency_hz", {flo, fhi}},
-                    {"amplitude_deg_per_h", {amp - 1.96 * amp_sigma, amp + 1.96 * amp_sigma}}};
+    e.parameters = {from_interval("frequency", Quantity::Frequency, t.nl, flo, fhi),
+                    from_sigma("amplitude", Quantity::Rate, amp, amp_sigma),
+                    {"phase", Quantity::Phase, std::atan2(-bb, a)}};
   } else if (t.effect == Effect::BiasStep) {
     const double size = beta(off), ss = std::sqrt(cov(off, off));
     const auto [tlo, thi] = profile_interval(g, t.nl, 0.05 * b.tb, b.t0, b.t0 + T);
-    e.params = {{"time_s", t.nl}, {"size_deg_per_h", size}};
-    e.uncertainty = {{"time_s", (thi - tlo) / 3.92}, {"size_deg_per_h", ss}};
-    e.interval95 = {{"time_s", {tlo, thi}}, {"size_deg_per_h", {size - 1.96 * ss, size + 1.96 * ss}}};
+    e.parameters = {from_interval("time", Quantity::Time, t.nl, tlo, thi),
+                    from_sigma("size", Quantity::Rate, size, ss)};
   } else {
     const double amp = beta(off), as = std::sqrt(cov(off, off));
     const auto gl = [&](double lx) { return g(std::exp(lx)); };
     const auto [llo, lhi] = profile_interval(gl, std::log(t.nl), 0.02, std::log(0.5 * b.tb), std::log(20 * T));
-    e.params = {{"amplitude_deg_per_h", amp}, {"time_constant_s", t.nl}};
-    e.uncertainty = {{"amplitude_deg_per_h", as}, {"time_constant_s", (std::exp(lhi) - std::exp(llo)) / 3.92}};
-    e.interval95 = {{"amplitude_deg_per_h", {amp - 1.96 * as, amp + 1.96 * as}},
-                    {"time_constant_s", {std::exp(llo), std::exp(lhi)}}};
+    e.parameters = {from_sigma("amplitude", Quantity::Rate, amp, as),
+                    from_interval("time_constant", Quantity::Time, t.nl, std::exp(llo), std::exp(lhi))};
   }
   return e;
 }
@@ -433,10 +437,8 @@ TermEstimate estimate_gm(const Blocks& b, const GlsModel& m, std::size_t ci) {
   const auto [tlo, thi] = profile_interval(g_tc, std::log(tc), 0.05, std::log(0.5 * b.tb), std::log(10 * b.duration()));
   const double s = std::sqrt(var), slo = std::exp(0.5 * vlo), shi = std::exp(0.5 * vhi);
   TermEstimate e;
-  e.params = {{"sigma_deg_per_h", s}, {"correlation_time_s", tc}};
-  e.uncertainty = {{"sigma_deg_per_h", (shi - slo) / 3.92},
-                   {"correlation_time_s", (std::exp(thi) - std::exp(tlo)) / 3.92}};
-  e.interval95 = {{"sigma_deg_per_h", {slo, shi}}, {"correlation_time_s", {std::exp(tlo), std::exp(thi)}}};
+  e.parameters = {from_interval("sigma", Quantity::Rate, s, slo, shi),
+                  from_interval("correlation_time", Quantity::Time, tc, std::exp(tlo), std::exp(thi))};
   return e;
 }
 

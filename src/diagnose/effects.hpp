@@ -65,11 +65,15 @@ Candidate search_step(const Blocks& b, const GlsModel& cur, double alpha);
 Candidate search_transient(const Blocks& b, const GlsModel& cur, double alpha);
 Candidate search_gauss_markov(const Blocks& b, const GlsModel& cur, double alpha);
 
-/// A named term's parameters (simulator keys), standard errors and 95 % profile intervals, under
-/// the final model.
+/// A named term's parameters with standard errors and 95 % profile intervals, under the final
+/// model.
 struct TermEstimate {
-  nlohmann::json params, uncertainty, interval95;
+  std::vector<FindingParameter> parameters;
 };
+/// A parameter with a symmetric 95 % interval, value ± 1.96σ.
+FindingParameter from_sigma(std::string name, Quantity q, double value, double sigma);
+/// A parameter with a profile interval [low, high]; its standard uncertainty is the width / 3.92.
+FindingParameter from_interval(std::string name, Quantity q, double value, double low, double high);
 TermEstimate estimate_det(const Blocks& b, const GlsModel& m, std::size_t index);
 TermEstimate estimate_gm(const Blocks& b, const GlsModel& m, std::size_t cov_index);
 

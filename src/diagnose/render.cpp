@@ -46,30 +46,6 @@ std::string key_suffix(std::string a) {
   return out;
 }
 
-/// A finding's parameters as shown: for an accelerometer, every °/h figure (amplitude, step, σ)
-/// becomes the level unit and every °/h² figure (ramp) the ramp unit, key and value.
-json shown_params(const json& p, const Shown& sh) {
-  if (!sh.accel || !p.is_object()) return p;
-  json out = json::object();
-  for (const auto& [k, v] : p.items()) {
-    // The drift's curvature (°/h³) scales as the ramp does: m/s/h³ beside m/s/h².
-    if (k.ends_with("_deg_per_h3") && v.is_number()) {
-      out[k.substr(0, k.rfind("_deg_per_h3")) + "_m_per_s_per_h3"] = v.get<double>() * sh.units[Term::R].factor;
-      continue;
-    }
-    const ShownUnit* u = k.ends_with("_deg_per_h2")  ? &sh.units[Term::R]
-                         : k.ends_with("_deg_per_h") ? &sh.units.deviation
-                                                     : nullptr;
-    if (!u || !v.is_number()) {
-      out[k] = v;
-      continue;
-    }
-    const std::string stem = k.substr(0, k.rfind(k.ends_with("_deg_per_h2") ? "_deg_per_h2" : "_deg_per_h"));
-    out[stem + "_" + key_suffix(u->ascii)] = v.get<double>() * u->factor;
-  }
-  return out;
-}
-
 /// A simulated model with its band and how well the measurement sits in it.
 json model_json(const NoiseModel& model, const std::vector<BandPoint>& band, double level, double misfit,
                 double coverage, const Shown& sh) {
@@ -119,36 +95,50 @@ json coefficients_json(const NoiseModel& m, const Shown& sh) {
           {"R_" + key_suffix(u[Term::R].ascii), m.ramp_deg_per_h2 * u[Term::R].factor}};
 }
 
-std::string unit_of(const std::string& key, const Shown& sh) {
-  if (sh.accel)
-    for (const ShownUnit* u : {&sh.units[Term::R], &sh.units.deviation}) {
-      const std::string suffix = key_suffix(u->ascii);
-      if (key.size() > suffix.size() && key.ends_with(suffix) && key[key.size() - suffix.size() - 1] == '_')
-        return localized_label(*u);
-    }
-  if (key.ends_with("_hz")) return tr("Hz");
-  if (key.ends_with("_deg_per_h2")) return tr("°/h²");
-  if (key.ends_with("_deg_per_h3")) return tr("°/h³");
-  if (key.ends_with("_m_per_s_per_h3")) return "m/s/h³";
-  if (key.ends_with("_deg_per_h")) return tr("°/h");
-  if (key.ends_with("_s")) return tr("s");
-  if (key.ends_with("_rad")) return tr("rad");
-  return "";
+/// A finding parameter's unit as shown: its ASCII name (JSON), its label (text) and the factor
+/// from the fit's units.
+struct ParameterUnit {
+  std::string ascii, label;
+  double factor = 1;
+};
+
+ParameterUnit unit_of(Quantity q, const Shown& sh) {
+  switch (q) {
+    case Quantity::Frequency: return {"Hz", tr("Hz"), 1};
+    case Quantity::Time: return {"s", tr("s"), 1};
+    case Quantity::Phase: return {"rad", tr("rad"), 1};
+    case Quantity::Rate: break;
+  }
+  if (sh.accel) return {sh.units.deviation.ascii, localized_label(sh.units.deviation), sh.units.deviation.factor};
+  return {"deg/h", tr("°/h"), 1};
 }
 
-/// One line per finding: its parameters with their standard errors and units.
+/// A finding's parameters under their names, each with its value, unit, standard uncertainty and
+/// 95 % interval (null where not estimated): one shape for every sensor and unit.
+json parameters_json(const Finding& f, const Shown& sh) {
+  json out = json::object();
+  for (const auto& p : f.parameters) {
+    const ParameterUnit u = unit_of(p.quantity, sh);
+    const auto shown = [&](double x) { return std::isnan(x) ? json(nullptr) : json(x * u.factor); };
+    out[p.name] = {{"value", p.value * u.factor},
+                   {"unit", u.ascii},
+                   {"standard_uncertainty", shown(p.standard_uncertainty)},
+                   {"interval95",
+                    std::isnan(p.low95) ? json(nullptr) : json::array({shown(p.low95), shown(p.high95)})}};
+  }
+  return out;
+}
+
+/// One line per finding: its parameters with their standard uncertainties and units.
 std::string format_findings(const std::vector<Finding>& fs, const Shown& sh) {
   std::string s;
   for (const auto& f : fs) {
     s += fmt::format("  {}:", finding_name(f.effect));
-    const json params = shown_params(f.params, sh), uncertainty = shown_params(f.uncertainty, sh);
-    for (const auto& [k, v] : params.items()) {
-      if (v.is_boolean()) s += fmt::format(" {} = {};", k, v.get<bool>());
-      if (!v.is_number()) continue;
-      const double u = uncertainty.contains(k) ? uncertainty[k].get<double>() : -1;
-      s += fmt::format(" {} = {:.4g}", k, v.get<double>());
-      if (u >= 0) s += fmt::format(" ± {:.2g}", u);
-      s += fmt::format(" {};", unit_of(k, sh));
+    for (const auto& p : f.parameters) {
+      const ParameterUnit u = unit_of(p.quantity, sh);
+      s += fmt::format(" {} = {:.4g}", p.name, p.value * u.factor);
+      if (!std::isnan(p.standard_uncertainty)) s += fmt::format(" ± {:.2g}", p.standard_uncertainty * u.factor);
+      s += fmt::format(" {};", u.label);
     }
     s.pop_back();
     s += "\n";
@@ -252,12 +242,9 @@ json to_json(const DiagnoseResult& r) {
   const auto findings_json = [&sh](const std::vector<Finding>& fs) {
     json fnd = json::array();
     for (const auto& f : fs) {
-      json o = {{"effect", std::string(finding_name(f.effect))}};
-      const json params = shown_params(f.params, sh);
-      for (const auto& [k, v] : params.items()) o[k] = v;
-      o["uncertainty"] = shown_params(f.uncertainty, sh);
-      o["evidence"] = shown_params(f.evidence, sh);
-      fnd.push_back(o);
+      fnd.push_back({{"effect", std::string(finding_name(f.effect))},
+                     {"parameters", parameters_json(f, sh)},
+                     {"evidence", f.evidence}});
     }
     return fnd;
   };

@@ -30,16 +30,17 @@ std::string base64_encode(std::string_view bytes) {
   out.reserve((bytes.size() + 2) / 3 * 4);
   std::size_t i = 0;
   for (; i + 2 < bytes.size(); i += 3) {
-    const unsigned v = (static_cast<unsigned char>(bytes[i]) << 16) | (static_cast<unsigned char>(bytes[i + 1]) << 8) |
-                       static_cast<unsigned char>(bytes[i + 2]);
+    const unsigned v = (unsigned{static_cast<unsigned char>(bytes[i])} << 16) |
+                       (unsigned{static_cast<unsigned char>(bytes[i + 1])} << 8) |
+                       unsigned{static_cast<unsigned char>(bytes[i + 2])};
     out += kAlphabet[(v >> 18) & 63];
     out += kAlphabet[(v >> 12) & 63];
     out += kAlphabet[(v >> 6) & 63];
     out += kAlphabet[v & 63];
   }
   if (i < bytes.size()) {
-    unsigned v = static_cast<unsigned char>(bytes[i]) << 16;
-    if (i + 1 < bytes.size()) v |= static_cast<unsigned char>(bytes[i + 1]) << 8;
+    unsigned v = unsigned{static_cast<unsigned char>(bytes[i])} << 16;
+    if (i + 1 < bytes.size()) v |= unsigned{static_cast<unsigned char>(bytes[i + 1])} << 8;
     out += kAlphabet[(v >> 18) & 63];
     out += kAlphabet[(v >> 12) & 63];
     out += i + 1 < bytes.size() ? kAlphabet[(v >> 6) & 63] : '=';
@@ -516,22 +517,23 @@ std::string run_summary(const json& run, std::size_t index, Numbering& numbering
   return s;
 }
 
-/// A number of a finding with the unit its key names as a suffix (frequency_hz, time_s…).
-std::string number_with_unit_key(std::string_view key, const json& v) {
-  static constexpr std::array<std::pair<const char*, const char*>, 9> kUnits{{{"_deg_per_h_per_sqrt_h", lbl::rrw},
-                                                                              {"_deg_per_sqrt_h", lbl::arw},
-                                                                              {"_deg_per_h2", lbl::ramp},
-                                                                              {"_deg_per_h", lbl::rate},
-                                                                              {"_arcsec", lbl::angle},
-                                                                              {"_hz", N_("Hz")},
-                                                                              {"_s", N_("s")},
-                                                                              {"_c", lbl::celsius},
-                                                                              {"_pct", "%"}}};
-  if (!v.is_number()) return json_value_html(v);
-  for (const auto& [suffix, u] : kUnits)
-    if (key.size() > std::string_view(suffix).size() && key.ends_with(suffix))
-      return fmt::format("{} {}", g(v.get<double>(), 4), unit(u));
-  return g(v.get<double>(), 4);
+/// A finding parameter's unit, from its ASCII name in the diagnosis's JSON, in the report's language.
+std::string finding_unit(const std::string& ascii) {
+  static constexpr std::array<std::pair<const char*, const char*>, 4> kLabels{
+      {{"deg/h", lbl::rate}, {"Hz", N_("Hz")}, {"s", N_("s")}, {"rad", N_("rad")}}};
+  for (const auto& [a, label] : kLabels)
+    if (ascii == a) return unit(label);
+  return esc(ascii);  // an accelerometer's level unit (ug, m/s/h …) as the diagnosis named it
+}
+
+/// One parameter of a finding (docs/diagnosis.md, JSON): "value ± u unit" rounded by the GUM rule.
+std::string finding_parameter_html(const json& p) {
+  const auto& v = at(p, "value");
+  if (!v.is_number()) return kNotAvailable;
+  const auto& u = at(p, "standard_uncertainty");
+  const std::string number =
+      u.is_number() ? value_with_uncertainty(v.get<double>(), u.get<double>()) : g(v.get<double>(), 4);
+  return fmt::format("{} {}", number, finding_unit(str(p, "unit")));
 }
 
 std::string findings_html(const json& findings, std::size_t index, Numbering& numbering) {
@@ -541,10 +543,9 @@ std::string findings_html(const json& findings, std::size_t index, Numbering& nu
   s += tr("<tr><th>effect</th><th>parameters</th></tr>\n");
   for (const auto& f : findings) {
     std::string params;
-    if (f.is_object())
-      for (const auto& [k, v] : f.items())
-        if (k != "effect" && !v.is_object() && !v.is_array())
-          params += fmt::format("{}{} = {}", params.empty() ? "" : "; ", esc(k), number_with_unit_key(k, v));
+    if (const auto& ps = at(f, "parameters"); ps.is_object())
+      for (const auto& [k, p] : ps.items())
+        params += fmt::format("{}{} = {}", params.empty() ? "" : "; ", esc(k), finding_parameter_html(p));
     s += fmt::format("<tr><td>{}</td><td>{}</td></tr>\n", esc(str(f, "effect")), params);
   }
   return s + "</table>\n";
@@ -855,8 +856,10 @@ std::string protocol_block(const std::vector<json>& a, const std::vector<std::si
 /// a CSS escape, so that no quote, backslash or "</style>" leaves the string.
 std::string css_string(std::string_view text) {
   std::string out;
-  for (unsigned char c : printable(text))
+  for (const char ch : printable(text)) {
+    const auto c = static_cast<unsigned char>(ch);
     out += std::isalnum(c) || c == ' ' || c >= 0x80 ? std::string(1, static_cast<char>(c)) : fmt::format("\\{:x} ", c);
+  }
   return out;
 }
 
