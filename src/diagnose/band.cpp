@@ -2,6 +2,7 @@
 // (band.hpp).
 #include "band.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -20,8 +21,18 @@ namespace {
 double band_nu(double edf) { return 1.0 / (1.0 / edf + 1.0 / 1000.0); }
 
 /// The model's AV at cluster size m; with an output-chain low-pass its white angle and rate noise
-/// pass through the filter.
-double model_avar(const NoiseModel& model, double tau0, double scale, std::size_t m) {
+/// pass through the filter. A pulse record's read-out (white angle, and a plain counter's sawtooth,
+/// which depends on the record's mean rate) is the five-term fit's own, FitResult::readout_var: the
+/// simulator's model of a counting read-out has no term for the sawtooth, and a band without it
+/// missed the short-τ AV of a clean undithered record by up to 50 times.
+double model_avar(const NoiseModel& model, const FitResult& fit, bool pulses, double tau0, double scale,
+                  std::size_t m) {
+  if (pulses) {
+    NoiseModel noise = model;
+    noise.white_angle_arcsec = 0;
+    noise.readout = ReadoutMode::Counting;  // no read-out term of its own
+    return theoretical_avar(noise, tau0, scale, m) + fit.readout_var(static_cast<double>(m) * tau0);
+  }
   if (!(model.output_lowpass_tc_s > 0)) return theoretical_avar(model, tau0, scale, m);
   NoiseModel rest = model;
   rest.arw_deg_per_sqrt_h = rest.white_angle_arcsec = 0;
@@ -33,12 +44,13 @@ double model_avar(const NoiseModel& model, double tau0, double scale, std::size_
 /// The band of `model` at the measured points (σ per τ in `dev`): the model's σ times the χ²
 /// quantiles of a variance with the point's EDF.
 std::vector<BandPoint> model_band(const std::vector<AllanPoint>& pts, const std::vector<double>& dev,
-                                  const NoiseModel& model, const PhaseSeries& x, double scale, double level) {
+                                  const NoiseModel& model, const FitResult& fit, const PhaseSeries& x, double scale,
+                                  double level) {
   std::vector<BandPoint> band;
   for (std::size_t i = 0; i < pts.size(); ++i) {
     const auto& p = pts[i];
     if (!(dev[i] > 0) || !(p.edf > 0)) continue;
-    const double var = model_avar(model, x.tau0_s, scale, static_cast<std::size_t>(p.m));
+    const double var = model_avar(model, fit, x.exact(), x.tau0_s, scale, static_cast<std::size_t>(p.m));
     const DevInterval ci = chi2_interval(1.0, p.edf, level);
     BandPoint b;
     b.tau_s = p.tau_s;
@@ -91,13 +103,22 @@ void bands_and_gain(const PhaseSeries& x, const Blocks& b, const GlsModel& base,
   const auto& pts = r.analysis.allan.points;
   std::vector<double> dev, dev_clean;
   for (const auto& p : pts) dev.push_back(p.dev);
-  r.base_band = model_band(pts, dev, r.base, x, r.settings.scale_arcsec, r.band_level);
+  r.base_band = model_band(pts, dev, r.base, r.analysis.fit, x, r.settings.scale_arcsec, r.band_level);
   if (r.findings.empty()) {
     r.extended_band = r.base_band;
   } else {
     const PhaseSeries c = cleaned(x, r.extended);
-    for (const auto& p : pts) dev_clean.push_back(std::sqrt(allan_variance(c, p.m, Estimator::Overlapping)));
-    r.extended_band = model_band(pts, dev_clean, noise_only(r.extended), x, r.settings.scale_arcsec, r.band_level);
+    std::vector<double> var_clean;
+    for (const auto& p : pts) var_clean.push_back(allan_variance(c, p.m, Estimator::Overlapping));
+    // A Gauss–Markov term or an output low-pass is noise the five terms cannot hold: that model
+    // keeps the likelihood's levels (diagnose.cpp, extend).
+    const bool noise_named = std::any_of(r.findings.begin(), r.findings.end(), [](const Finding& f) {
+      return f.effect == Effect::GaussMarkov || f.effect == Effect::Lowpass;
+    });
+    const FitResult refit = noise_named ? r.analysis.fit : refit_noise(r.analysis, var_clean, r.extended);
+    for (const double v : var_clean) dev_clean.push_back(std::sqrt(v));
+    r.extended_band =
+        model_band(pts, dev_clean, noise_only(r.extended), refit, x, r.settings.scale_arcsec, r.band_level);
   }
   r.gain.misfit_base = band_misfit(r.base_band);
   r.gain.misfit_extended = band_misfit(r.extended_band);

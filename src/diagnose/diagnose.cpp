@@ -30,7 +30,6 @@ using namespace diag;
 
 namespace {
 
-constexpr double kPulseFitTauMin = 20.0;  ///< s, start of the base fit for pulse data
 constexpr double kBlockSeconds = 10.0;    ///< block length of the likelihood, s (longer for long records)
 constexpr std::size_t kMaxBlocks = 1000;  ///< the likelihood's cost grows as blocks²
 constexpr double kSlowCycles = 12.0;      ///< the slow-line band ends at 12 cycles per record
@@ -56,14 +55,13 @@ const Recording& screened(const Recording& read, const DiagnoseOptions& opt, Out
   return rec;
 }
 
-/// The five-term fit of the record and its base model. Pulse data: the counting read-out's
-/// structured short-τ AV would distort the fit, which starts at 20 s.
+/// The five-term fit of the record and its base model, over the τ `analyze` fits: a pulse record's
+/// read-out (a plain counter's sawtooth or white angle noise) is part of that fit's model.
 void fit_base(const Recording& rec, const DiagnoseOptions& opt, DiagnoseResult& r, OutlierReport outliers) {
   AnalysisOptions aopt = opt.analysis;
   aopt.outlier_action = OutlierAction::Keep;
   if (!aopt.earth_rate) aopt.earth_rate = rec.mode == InputMode::Pulses || rec.mode == InputMode::Counter;
   const PhaseSeries& x = rec.phase;
-  if (x.exact() && aopt.fit.tau_min_s <= 0) aopt.fit.tau_min_s = kPulseFitTauMin;
   r.analysis = analyze_for_base(rec, aopt);
   r.analysis.outliers = std::move(outliers);
   r.settings.rate_hz = 1.0 / x.tau0_s;

@@ -45,6 +45,17 @@ NoiseModel base_model(const AnalysisResult& a, const PhaseSeries& x) {
   return m;
 }
 
+FitResult refit_noise(const AnalysisResult& a, const std::vector<double>& cleaned_var, NoiseModel& extended) {
+  std::vector<FitPoint> pts = fit_points(a.allan);
+  for (std::size_t i = 0; i < pts.size(); ++i) pts[i].var = cleaned_var[i];
+  FitResult f = fit_noise(pts, a.fit.options);
+  extended.arw_deg_per_sqrt_h = term_value(f, Term::N);
+  extended.bias_instability_deg_per_h = term_value(f, Term::B);
+  extended.rrw_deg_per_h_per_sqrt_h = term_value(f, Term::K);
+  extended.ramp_deg_per_h2 = term_value(f, Term::R);
+  return f;
+}
+
 double sim_scale(const PhaseSeries& x, const AnalysisResult& a) {
   if (x.exact()) return x.arcsec_per_count;
   // Coarse enough that a record of the data's extent stays within 2^50 pulses (data of huge rates;
