@@ -108,15 +108,16 @@ void bands_and_gain(const PhaseSeries& x, const Blocks& b, const GlsModel& base,
     r.extended_band = r.base_band;
   } else {
     const PhaseSeries c = cleaned(x, r.extended);
-    std::vector<double> var_clean;
-    for (const auto& p : pts) var_clean.push_back(allan_variance(c, p.m, Estimator::Overlapping));
+    std::vector<double> var_clean(pts.size());
+    for (std::size_t i = 0; i < pts.size(); ++i) var_clean[i] = allan_variance(c, pts[i].m, Estimator::Overlapping);
     // A Gauss–Markov term or an output low-pass is noise the five terms cannot hold: that model
     // keeps the likelihood's levels (diagnose.cpp, extend).
     const bool noise_named = std::any_of(r.findings.begin(), r.findings.end(), [](const Finding& f) {
       return f.effect == Effect::GaussMarkov || f.effect == Effect::Lowpass;
     });
     const FitResult refit = noise_named ? r.analysis.fit : refit_noise(r.analysis, var_clean, r.extended);
-    for (const double v : var_clean) dev_clean.push_back(std::sqrt(v));
+    dev_clean.resize(var_clean.size());
+    for (std::size_t i = 0; i < var_clean.size(); ++i) dev_clean[i] = std::sqrt(var_clean[i]);
     r.extended_band =
         model_band(pts, dev_clean, noise_only(r.extended), refit, x, r.settings.scale_arcsec, r.band_level);
   }
