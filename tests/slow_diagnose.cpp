@@ -194,7 +194,7 @@ bool warmup_in_tolerance(const DiagnoseResult& r, double amp) {
 // with a step at once: named within tolerance in at least 90 % of records. (Gauss–Markov terms and
 // the output low-pass: docs/diagnosis.md.)
 TEST(DiagnoseAcceptance, EveryEffectNamedWithinTolerance) {
-  const int n = test::population("RWCALC_DIAGNOSE_EFFECTS", 6, 20);
+  const int n = test::population("RWCALC_DIAGNOSE_EFFECTS", 4, 20);
   Tally warmup, drift, fast_line, two;
   for (int i = 0; i < n; ++i) {
     const auto seed = 7000 + static_cast<std::uint64_t>(i);
