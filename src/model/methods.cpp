@@ -1,6 +1,7 @@
 // The paper's cross-checks as unbiased estimators: direct N from the overlapping angle-increment
 // variances, B from the 100-s averages and from the ADEV minimum, the spread of block means.
 #include "rwcalc/methods.hpp"
+#include "rwcalc/normal_quantile.hpp"
 
 #include <algorithm>
 #include <array>
@@ -23,7 +24,6 @@ namespace rwcalc {
 
 namespace {
 
-constexpr double kZ95 = 1.959963984540054;
 constexpr double kFlicker = 2.0 * std::numbers::ln2 / std::numbers::pi;  // AV of B at unit B²
 using Vec3 = Eigen::Vector3d;
 

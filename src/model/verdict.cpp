@@ -14,6 +14,7 @@
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/json_input.hpp"
+#include "rwcalc/normal_quantile.hpp"
 
 namespace rwcalc {
 
@@ -178,8 +179,8 @@ EstimateInput lognormal_estimate(double value, double sigma) {
   e.value = value;
   e.resolved = true;
   const double s = value > 0 ? sigma / value : 0.0;
-  e.low = value * std::exp(-1.959963984540054 * s);
-  e.high = value * std::exp(1.959963984540054 * s);
+  e.low = value * std::exp(-kZ95 * s);
+  e.high = value * std::exp(kZ95 * s);
   e.cdf = [value, s](double x) {
     if (!(x > 0)) return 0.0;
     if (!(s > 0)) return x >= value ? 1.0 : 0.0;
