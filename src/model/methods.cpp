@@ -523,9 +523,9 @@ BlockSpreadResult block_spread(const PhaseSeries& x, double block_s) {
   e.value = std::sqrt(sample_variance(y));
   e.sigma = e.value / std::sqrt(2.0 * static_cast<double>(k - 1));
   e.estimate = e.value;
-  e.low = e.value * std::exp(-kZ95 * e.sigma / e.value);
-  e.high = e.value * std::exp(kZ95 * e.sigma / e.value);
-  if (!(e.value > 0)) e.low = e.high = 0;
+  const LogNormalInterval i = lognormal_interval95(e.value, e.sigma);
+  e.low = i.low;
+  e.high = i.high;
   return r;
 }
 

@@ -179,8 +179,9 @@ EstimateInput lognormal_estimate(double value, double sigma) {
   e.value = value;
   e.resolved = true;
   const double s = value > 0 ? sigma / value : 0.0;
-  e.low = value * std::exp(-kZ95 * s);
-  e.high = value * std::exp(kZ95 * s);
+  const LogNormalInterval i = lognormal_interval95(value, sigma);
+  e.low = i.low;
+  e.high = i.high;
   e.cdf = [value, s](double x) {
     if (!(x > 0)) return 0.0;
     if (!(s > 0)) return x >= value ? 1.0 : 0.0;
