@@ -9,6 +9,7 @@
 /// is 1 or 2, else to one, and the value to the same decimal place. The decimal point is written
 /// as a point; localize_html() (i18n.hpp) turns it into the Russian comma in the report.
 #include <string>
+#include <string_view>
 
 namespace rwcalc {
 
@@ -31,6 +32,10 @@ namespace rwcalc {
 
 /// "[lo, hi]" rounded to the decimal place 10^last_digit (that of the value's uncertainty).
 [[nodiscard]] std::string interval_at(double lo, double hi, int last_digit);
+
+/// A unit's ASCII name as JSON writes it ("deg/sqrt(h)", "ug") as a document prints it ("°/√h",
+/// "µg"), in the current language; a name it does not know, unchanged. Not encoded for HTML.
+[[nodiscard]] std::string unit_text(std::string_view ascii);
 
 /// "·10⁻⁵" (Russian) or " × 10⁻⁵" (English): the factor written after a mantissa.
 [[nodiscard]] std::string power_of_ten(int exponent);

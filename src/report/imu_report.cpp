@@ -13,6 +13,7 @@
 #include "html.hpp"
 #include "json_view.hpp"
 #include "rwcalc/i18n.hpp"
+#include "rwcalc/quantity_text.hpp"
 #include "rwcalc/version.hpp"
 
 namespace rwcalc {
@@ -40,29 +41,8 @@ constexpr std::array<TermRow, 5> kTermRows{{
 
 std::string g(double v) { return fmt::format("{:.4g}", v); }
 
-/// A unit's ASCII name (JSON) as printed: deg/sqrt(h) → °/√h, in the page's language.
-std::string unit_label(std::string_view ascii) {
-  static constexpr std::array<std::array<const char*, 2>, 17> kLabels{{{"deg/h", N_("°/h")},
-                                                                       {"deg/s", N_("°/s")},
-                                                                       {"deg/sqrt(h)", N_("°/√h")},
-                                                                       {"deg/h/sqrt(h)", N_("°/h/√h")},
-                                                                       {"deg/h^2", N_("°/h²")},
-                                                                       {"arcsec", N_("″")},
-                                                                       {"ug", N_("µg")},
-                                                                       {"m/s^2", N_("m/s²")},
-                                                                       {"m/s/sqrt(h)", N_("m/s/√h")},
-                                                                       {"m/s/h/sqrt(h)", N_("m/s/h/√h")},
-                                                                       {"m/s/h^2", N_("m/s/h²")},
-                                                                       {"rad/s/sqrt(Hz)", N_("rad/s/√Hz")},
-                                                                       {"rad/s^2/sqrt(Hz)", N_("rad/s²/√Hz")},
-                                                                       {"m/s^2/sqrt(Hz)", N_("m/s²/√Hz")},
-                                                                       {"m/s^3/sqrt(Hz)", N_("m/s³/√Hz")},
-                                                                       {"m/s", N_("m/s")},
-                                                                       {"rad", N_("rad")}}};
-  for (const auto& [ascii_name, label] : kLabels)
-    if (ascii == ascii_name) return tr(label);
-  return html::text(ascii);
-}
+/// A unit's ASCII name (JSON) as printed, encoded for the page.
+std::string unit_label(std::string_view ascii) { return html::text(unit_text(ascii)); }
 
 std::vector<const json*> channels_of(const json& imu, std::string_view kind) {
   std::vector<const json*> out;

@@ -464,7 +464,7 @@ std::string diagnosis_ylabel(const json& diagnosis) {
   if (u == diagnosis.end() || !u->is_object() || !u->contains("band") || !(*u)["band"].is_string())
     return trf("Allan deviation σ(τ) ({})", tr(lbl::rate));
   const std::string band = (*u)["band"].get<std::string>();
-  return trf("Allan deviation σ(τ) ({})", band == "ug" ? std::string("µg") : band);
+  return trf("Allan deviation σ(τ) ({})", unit_text(band));
 }
 
 std::string band_label(const char* what, const json& model, const std::vector<BandRow>& rows) {

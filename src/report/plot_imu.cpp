@@ -8,6 +8,7 @@
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/plot.hpp"
+#include "rwcalc/quantity_text.hpp"
 
 namespace rwcalc {
 
@@ -23,11 +24,7 @@ PlotResult plot_imu(const nlohmann::json& imu, const PlotOptions& options) {
       // The axis label in the unit's printed form, in the current language; as a non-gyro unit it
       // also keeps the class limits (a ring-laser table) out of a figure of several axes.
       const std::string unit = c.at("allan").value("unit", "");
-      run["allan"]["unit"] = tr(unit == "deg/h"   ? "°/h"
-                                : unit == "deg/s" ? "°/s"
-                                : unit == "ug"    ? "µg"
-                                : unit == "m/s^2" ? "m/s²"
-                                                  : unit);
+      run["allan"]["unit"] = unit_text(unit);
       runs.push_back(std::move(run));
     }
     if (runs.empty()) continue;

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 
@@ -100,6 +101,31 @@ std::string interval_at(double lo, double hi, int last_digit) {
   const double scale = std::pow(10.0, p);
   return fmt::format("[{}, {}]{}", fixed(lo / scale, p - last_digit), fixed(hi / scale, p - last_digit),
                      power_of_ten(p));
+}
+
+std::string unit_text(std::string_view ascii) {
+  static constexpr std::array<std::array<const char*, 2>, 19> kLabels{{{"deg/h", N_("°/h")},
+                                                                       {"Hz", N_("Hz")},
+                                                                       {"s", N_("s")},
+                                                                       {"deg/s", N_("°/s")},
+                                                                       {"deg/sqrt(h)", N_("°/√h")},
+                                                                       {"deg/h/sqrt(h)", N_("°/h/√h")},
+                                                                       {"deg/h^2", N_("°/h²")},
+                                                                       {"arcsec", N_("″")},
+                                                                       {"ug", N_("µg")},
+                                                                       {"m/s^2", N_("m/s²")},
+                                                                       {"m/s/sqrt(h)", N_("m/s/√h")},
+                                                                       {"m/s/h/sqrt(h)", N_("m/s/h/√h")},
+                                                                       {"m/s/h^2", N_("m/s/h²")},
+                                                                       {"rad/s/sqrt(Hz)", N_("rad/s/√Hz")},
+                                                                       {"rad/s^2/sqrt(Hz)", N_("rad/s²/√Hz")},
+                                                                       {"m/s^2/sqrt(Hz)", N_("m/s²/√Hz")},
+                                                                       {"m/s^3/sqrt(Hz)", N_("m/s³/√Hz")},
+                                                                       {"m/s", N_("m/s")},
+                                                                       {"rad", N_("rad")}}};
+  for (const auto& [ascii_name, label] : kLabels)
+    if (ascii == ascii_name) return tr(label);
+  return std::string(ascii);
 }
 
 }  // namespace rwcalc

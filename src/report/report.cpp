@@ -518,13 +518,7 @@ std::string run_summary(const json& run, std::size_t index, Numbering& numbering
 }
 
 /// A finding parameter's unit, from its ASCII name in the diagnosis's JSON, in the report's language.
-std::string finding_unit(const std::string& ascii) {
-  static constexpr std::array<std::pair<const char*, const char*>, 4> kLabels{
-      {{"deg/h", lbl::rate}, {"Hz", N_("Hz")}, {"s", N_("s")}, {"rad", N_("rad")}}};
-  for (const auto& [a, label] : kLabels)
-    if (ascii == a) return unit(label);
-  return esc(ascii);  // an accelerometer's level unit (ug, m/s/h …) as the diagnosis named it
-}
+std::string finding_unit(const std::string& ascii) { return esc(unit_text(ascii)); }
 
 /// One parameter of a finding (docs/diagnosis.md, JSON): "value ± u unit" rounded by the GUM rule.
 std::string finding_parameter_html(const json& p) {
