@@ -3,8 +3,9 @@
 // their 95 % intervals in 93–97 % of the records, the probits of the truth must spread by at most
 // 1.10, the estimates' mean ratio to the truth must be within ±2 %, and K may be reported resolved
 // in at most 5 % of the records without one (docs/term-choice.md). The acceptance populations are
-// 300 and 200 records (RWCALC_ACCEPTANCE=1, tests/support/population.hpp); RWCALC_TERM_RECORDS and
-// RWCALC_TERM_SHORT_RECORDS set the counts.
+// 300 and 1000 records (RWCALC_ACCEPTANCE=1, tests/support/population.hpp): a 30-min record's B
+// scatters by about 45 %, so its mean ratio is known to ±1.4 % from 1000 records and only to ±3 % from
+// 200. RWCALC_TERM_RECORDS and RWCALC_TERM_SHORT_RECORDS set the counts.
 #include <gtest/gtest.h>
 
 #include <boost/math/distributions/normal.hpp>
@@ -109,10 +110,9 @@ Summary summarise(const std::vector<Outcome>& out, int which) {  // which: 0 K-f
   return s;
 }
 
-/// Bounds a set is checked against: the acceptance figures, and for B on 30-min records what holds
-/// there (docs/term-choice.md, "What is not met").
+/// Bounds a set is checked against: the acceptance figures, and for B's mean ratio on 30-min records
+/// what holds there (docs/term-choice.md, "Limits").
 struct Bounds {
-  double b_cover_max = 0.97;
   double b_ratio_min = 0.98;
 };
 
@@ -141,12 +141,11 @@ void report_and_check(const char* name, const std::vector<Outcome>& out, int acc
   // The probit spread's sampling standard deviation is about 1/√(2n).
   const double spread_tol = test::mean_allowance(1.0 / std::sqrt(2.0), n, acceptance);
   for (std::size_t i = 0; i < 2; ++i) {
-    const bool b = i == 1;
     const double ratio_tol = test::mean_allowance(all.ratio_sd[i], n, acceptance);
     EXPECT_GE(all.cover[i], 0.93 - cover_tol) << name << " term " << i;
-    EXPECT_LE(all.cover[i], (b ? bounds.b_cover_max : 0.97) + cover_tol) << name << " term " << i;
+    EXPECT_LE(all.cover[i], 0.97 + cover_tol) << name << " term " << i;
     EXPECT_LE(all.spread[i], 1.10 + spread_tol) << name << " term " << i;
-    EXPECT_GE(all.mean_ratio[i], (b ? bounds.b_ratio_min : 0.98) - ratio_tol) << name << " term " << i;
+    EXPECT_GE(all.mean_ratio[i], (i == 1 ? bounds.b_ratio_min : 0.98) - ratio_tol) << name << " term " << i;
     EXPECT_LE(all.mean_ratio[i], 1.02 + ratio_tol) << name << " term " << i;
   }
   EXPECT_LE(k_false, 0.05 * k_free + test::share_allowance(0.05, k_free, acceptance / 2) * k_free) << name;
@@ -157,11 +156,10 @@ TEST(TermChoice, TwoHourRecordsWithAndWithoutK) {
 }
 
 TEST(TermChoice, ThirtyMinuteRecordsWithAndWithoutK) {
-  // B on 30-min records: covered in 0.975 and 14 % low on average; without K in the model at all it is
-  // still 6 % low on the K-free records (the flicker rests on the last three octaves: the square root of
-  // a B² with ν ≈ 5 is 5 % low by itself).
-  report_and_check("30 min at 400 Hz", run_set(test::population("RWCALC_TERM_SHORT_RECORDS", 40, 200), 1800.0, 62000),
-                   200, {0.98, 0.84});
+  // B on 30-min records is 7 % low on average (0.932 ± 0.014 over the 1000): the set with K takes part of
+  // the floor where the two cannot be told apart in 30 min.
+  report_and_check("30 min at 400 Hz", run_set(test::population("RWCALC_TERM_SHORT_RECORDS", 40, 1000), 1800.0, 62000),
+                   1000, {0.90});
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <random>
 #include <vector>
 
+#include "rwcalc/deviance.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/fit.hpp"
 
@@ -67,9 +68,14 @@ TEST(Fit, RecoversExactCoefficientsFromNoiselessPoints) {
   FitOptions all_terms;
   all_terms.select_terms = false;
   const FitResult f = fit_noise(pts, all_terms);
+  // The fit's c are the truth's; each estimate is its root with the root's bias taken out, which
+  // moves it up by at most 1/chi_root_mean(kRootMinEdf) (+25 %).
   for (Term t : kAllTerms) {
     SCOPED_TRACE(std::string(term_name(t)));
-    EXPECT_NEAR(f[t].estimate / tr.coef(t), 1.0, 1e-6);
+    const double root = coefficient_from_c(t, f.c[static_cast<int>(t)]);
+    EXPECT_NEAR(root / tr.coef(t), 1.0, 1e-6);
+    EXPECT_GE(f[t].estimate, root);
+    EXPECT_LE(f[t].estimate, root / chi_root_mean(kRootMinEdf) * (1.0 + 1e-12));
   }
   EXPECT_NEAR(f.chi2, 0.0, 1e-8);
   EXPECT_TRUE(f[Term::N].resolved);
@@ -83,14 +89,14 @@ TEST(Fit, RecoversExactCoefficientsFromNoiselessPoints) {
   EXPECT_FALSE(sel[Term::K].in_model);
   EXPECT_FALSE(sel[Term::R].in_model);
   EXPECT_GT(sel[Term::K].value, tr.K);
-  EXPECT_NEAR(sel[Term::B].estimate / tr.B, 1.0, 0.01);
+  EXPECT_NEAR(coefficient_from_c(Term::B, sel.c[static_cast<int>(Term::B)]) / tr.B, 1.0, 0.01);
   // A clearly present K is kept and recovered.
   Truth strong = tr;
   strong.K = 0.03;
   const FitResult fk = fit_noise(octave_points(strong));
   EXPECT_TRUE(fk[Term::K].in_model);
   EXPECT_TRUE(fk[Term::K].resolved);
-  EXPECT_NEAR(fk[Term::K].estimate / strong.K, 1.0, 0.01);
+  EXPECT_NEAR(coefficient_from_c(Term::K, fk.c[static_cast<int>(Term::K)]) / strong.K, 1.0, 0.01);
   // Intervals bracket the estimate and are positive.
   for (Term t : kAllTerms) {
     EXPECT_LE(f[t].low, f[t].estimate);
@@ -153,7 +159,7 @@ TEST(Fit, CoefficientsAreAveragedOverTheSetsWithAndWithoutK) {
   const FitResult g = fit_noise(octave_points(strong));
   EXPECT_GT(g.k_weight, 0.999);
   EXPECT_TRUE(g[Term::K].resolved);
-  EXPECT_NEAR(g[Term::K].estimate, strong.K, 1e-3 * strong.K);
+  EXPECT_NEAR(coefficient_from_c(Term::K, g.c[static_cast<int>(Term::K)]), strong.K, 1e-3 * strong.K);
 
   // Without the term selection nothing is averaged.
   FitOptions all;
@@ -244,7 +250,7 @@ TEST(Fit, FitRangeAndDisabledTerms) {
   const FitResult g = fit_noise(pts, o2);
   EXPECT_FALSE(g[Term::R].enabled);
   EXPECT_EQ(g.c[static_cast<int>(Term::R)], 0.0);
-  EXPECT_NEAR(g[Term::N].estimate / 0.001, 1.0, 1e-3);
+  EXPECT_NEAR(coefficient_from_c(Term::N, g.c[static_cast<int>(Term::N)]) / 0.001, 1.0, 1e-3);
 }
 
 TEST(FitErrors, TooFewPointsConstantDataAndEmptyRange) {

@@ -87,7 +87,7 @@ struct Coefficient {
   bool enabled = true;    ///< fitted at all
   bool in_model = true;   ///< kept by the term selection (else reported as a full-model upper bound)
   bool resolved = false;  ///< the lower confidence bound is above 0
-  double estimate = 0;    ///< maximum-likelihood estimate (may be 0: driven to the boundary)
+  double estimate = 0;    ///< √ĉ of the fit, its square root's bias taken out (0: driven to the boundary)
   double value = 0;       ///< the estimate if resolved, else the upper bound (print "< value")
   double sigma = 0;       ///< standard error (delta method); for an upper bound high/(2·1.96)
   double low = 0;         ///< lower confidence bound (profile likelihood), ≥ 0

@@ -631,7 +631,10 @@ Coefficient coefficient_interval(int i, const Stage& sel, const Stage& full, boo
   const Profiler prof{st.pr, st.fit.d, st.fit.dev};
   const double kf = kCoefScale[ui] * std::sqrt(st.pr.scale[i]);  // coefficient = kf·t
   const double t_hat = std::sqrt(st.fit.d[i]);
-  co.estimate = kf * t_hat;
+  // The coefficient is the square root of a fitted c, itself unbiased but noisy: √ĉ falls short by
+  // E√(χ²_ν/ν) (8 % at the ν ≈ 3 of B on a 30-min record), which the estimate takes out
+  // (docs/term-choice.md); the profile interval is that of √c itself.
+  co.estimate = dropped ? kf * t_hat : kCoefScale[ui] * mean_unbiased_root(res.c[i], res.cov_c(i, i));
   double t_low = 0;
   if (!dropped && t_hat > 0) {
     auto g = [&](double t) { return std::sqrt(prof.delta(i, t * t)) - std::sqrt(thr); };

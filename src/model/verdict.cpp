@@ -68,7 +68,7 @@ ParameterVerdict decide_one(const std::string& name, const std::string& unit, co
   }
   const auto cdf = positive_part(e);
   // The stated class is the one holding the median of the confidence distribution (for a resolved
-  // estimate, the estimate itself; for an upper bound, usually the best class consistent with it).
+  // estimate, about the fit's √ĉ; for an upper bound, usually the best class consistent with it).
   auto median_class = [&](const std::vector<double>& limits) -> std::optional<int> {
     for (std::size_t k = 0; k < limits.size(); ++k)
       if (cdf(limits[k]) >= 0.5) return t.classes[k].cls;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <boost/math/special_functions/digamma.hpp>
+#include <boost/math/special_functions/gamma.hpp>
 #include <cmath>
 
 namespace rwcalc {
@@ -21,6 +22,19 @@ double deviance_residual(double observed, double model, double nu) {
 double gamma_deviance_mean(double nu) {
   if (nu > 1e3) return 1.0 + 1.0 / (3.0 * nu);  // the series: ψ and ln cancel to rounding
   return -nu * (boost::math::digamma(nu / 2.0) - std::log(nu / 2.0));
+}
+
+double chi_root_mean(double nu) {
+  if (!(nu > 0)) return 1.0;
+  if (nu > 1e8) return 1.0 - 1.0 / (4.0 * nu);
+  // Γ(ν/2)/Γ(ν/2 + ½) as one ratio (Boost: accurate at large ν, and no global sign like lgamma's).
+  return std::sqrt(2.0 / nu) / boost::math::tgamma_delta_ratio(nu / 2.0, 0.5);
+}
+
+double mean_unbiased_root(double v, double var_v) {
+  if (!(v > 0)) return 0.0;
+  const double nu = var_v > 0 ? 2.0 * v * v / var_v : 0.0;
+  return nu >= kRootMinEdf ? std::sqrt(v) / chi_root_mean(nu) : std::sqrt(v);
 }
 
 }  // namespace rwcalc
