@@ -11,6 +11,7 @@
 #include <iterator>
 #include <nlohmann/json.hpp>
 
+#include "rwcalc/normal_quantile.hpp"
 #include "rwcalc/simulate.hpp"
 #include "rwcalc/units.hpp"
 #include "test_support.hpp"
@@ -75,7 +76,7 @@ TEST(DiagnoseAccelerometer, NamesTheSinusoidInAccelerometerUnits) {
   EXPECT_EQ(sp["amplitude"]["unit"], "ug") << s.dump();
   const double amp = sp["amplitude"]["value"].get<double>(),
                sigma = sp["amplitude"]["standard_uncertainty"].get<double>();
-  EXPECT_NEAR(sp["amplitude"]["interval95"][1].get<double>(), amp + 1.96 * sigma, 1e-9 * amp);
+  EXPECT_NEAR(sp["amplitude"]["interval95"][1].get<double>(), amp + rwcalc::kZ95 * sigma, 1e-9 * amp);
   EXPECT_GT(sigma, 0.0);
   EXPECT_LT(std::abs(amp - kSinAmp * kMicroGPerMpsH), std::max(4 * sigma, 0.1 * kSinAmp * kMicroGPerMpsH))
       << amp << " ± " << sigma << " µg";

@@ -10,6 +10,7 @@
 #include "diagnose/effects.hpp"
 #include "diagnose/gls.hpp"
 #include "diagnose/signal.hpp"
+#include "rwcalc/normal_quantile.hpp"
 #include "rwcalc/simulate.hpp"
 
 using namespace rwcalc;
@@ -189,7 +190,7 @@ TEST(DiagnoseGls, StepFoundAndEstimated) {
   EXPECT_NEAR(step.parameter("size").value, 0.05, 0.015);
   EXPECT_LE(time.low95, time.value);
   EXPECT_GE(time.high95, time.value);
-  EXPECT_NEAR(time.standard_uncertainty, (time.high95 - time.low95) / 3.92, 1e-12);
+  EXPECT_NEAR(time.standard_uncertainty, (time.high95 - time.low95) / (2.0 * kZ95), 1e-12);
 }
 
 // A warm-up transient: found, its time constant near the truth.

@@ -9,6 +9,8 @@
 #include <functional>
 #include <limits>
 
+#include "rwcalc/normal_quantile.hpp"
+
 namespace rwcalc::diag {
 
 namespace {
@@ -374,11 +376,11 @@ double det_m2ll(const Blocks& b, const GlsModel& m, std::size_t index, double x)
 }  // namespace
 
 FindingParameter from_sigma(std::string name, Quantity q, double value, double sigma) {
-  return {std::move(name), q, value, sigma, value - 1.96 * sigma, value + 1.96 * sigma};
+  return {std::move(name), q, value, sigma, value - kZ95 * sigma, value + kZ95 * sigma};
 }
 
 FindingParameter from_interval(std::string name, Quantity q, double value, double low, double high) {
-  return {std::move(name), q, value, (high - low) / 3.92, low, high};
+  return {std::move(name), q, value, (high - low) / (2.0 * kZ95), low, high};
 }
 
 TermEstimate estimate_det(const Blocks& b, const GlsModel& m, std::size_t index) {

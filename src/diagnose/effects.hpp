@@ -70,9 +70,9 @@ Candidate search_gauss_markov(const Blocks& b, const GlsModel& cur, double alpha
 struct TermEstimate {
   std::vector<FindingParameter> parameters;
 };
-/// A parameter with a symmetric 95 % interval, value ± 1.96σ.
+/// A parameter with a symmetric 95 % interval, value ± kZ95·σ.
 FindingParameter from_sigma(std::string name, Quantity q, double value, double sigma);
-/// A parameter with a profile interval [low, high]; its standard uncertainty is the width / 3.92.
+/// A parameter with a profile interval [low, high]; its standard uncertainty is the width / (2·kZ95).
 FindingParameter from_interval(std::string name, Quantity q, double value, double low, double high);
 TermEstimate estimate_det(const Blocks& b, const GlsModel& m, std::size_t index);
 TermEstimate estimate_gm(const Blocks& b, const GlsModel& m, std::size_t cov_index);
