@@ -89,7 +89,7 @@ struct Coefficient {
   bool resolved = false;  ///< the lower confidence bound is above 0
   double estimate = 0;    ///< √ĉ of the fit, its square root's bias taken out (0: driven to the boundary)
   double value = 0;       ///< the estimate if resolved, else the upper bound (print "< value")
-  double sigma = 0;       ///< standard error (delta method); for an upper bound high/(2·1.96)
+  double sigma = 0;       ///< standard error (delta method); for an upper bound high/(2z), z the interval's quantile
   double low = 0;         ///< lower confidence bound (profile likelihood), ≥ 0
   double high = 0;        ///< upper confidence bound
   /// How the profile searches for the bounds ended (their root-finding iterations).

@@ -20,24 +20,38 @@ namespace {
 /// A band point's weight in the misfit: its EDF with a 1000-EDF model floor.
 double band_nu(double edf) { return 1.0 / (1.0 / edf + 1.0 / 1000.0); }
 
-/// The model's AV at cluster size m; with an output-chain low-pass its white angle and rate noise
-/// pass through the filter. A pulse record's read-out (white angle, and a plain counter's sawtooth,
-/// which depends on the record's mean rate) is the five-term fit's own, FitResult::readout_var: the
-/// simulator's model of a counting read-out has no term for the sawtooth, and a band without it
-/// missed the short-τ AV of a clean undithered record by up to 50 times.
-double model_avar(const NoiseModel& model, const FitResult& fit, bool pulses, double tau0, double scale,
-                  std::size_t m) {
+/// What a band computes the model's AV from, prepared once per band: the part theoretical_avar
+/// gives (`rest`), and what is added to it. A pulse record's read-out (white angle, and a plain
+/// counter's sawtooth, which depends on the record's mean rate) is the five-term fit's own,
+/// FitResult::readout_var: the simulator's model of a counting read-out has no term for the sawtooth,
+/// and a band without it missed the short-τ AV of a clean undithered record by up to 50 times. With
+/// an output-chain low-pass, white angle and rate noise pass through the filter.
+struct BandModel {
+  NoiseModel rest;
+  const NoiseModel& model;
+  const FitResult& fit;
+  bool pulses = false;
+};
+
+BandModel band_model(const NoiseModel& model, const FitResult& fit, bool pulses) {
+  BandModel b{model, model, fit, pulses};
   if (pulses) {
-    NoiseModel noise = model;
-    noise.white_angle_arcsec = 0;
-    noise.readout = ReadoutMode::Counting;  // no read-out term of its own
-    return theoretical_avar(noise, tau0, scale, m) + fit.readout_var(static_cast<double>(m) * tau0);
+    b.rest.white_angle_arcsec = 0;
+    b.rest.readout = ReadoutMode::Counting;  // no read-out term of its own
+  } else if (model.output_lowpass_tc_s > 0) {
+    b.rest.arw_deg_per_sqrt_h = b.rest.white_angle_arcsec = 0;
   }
-  if (!(model.output_lowpass_tc_s > 0)) return theoretical_avar(model, tau0, scale, m);
-  NoiseModel rest = model;
-  rest.arw_deg_per_sqrt_h = rest.white_angle_arcsec = 0;
+  return b;
+}
+
+/// The model's AV at cluster size m.
+double model_avar(const BandModel& b, double tau0, double scale, std::size_t m) {
+  const double rest = theoretical_avar(b.rest, tau0, scale, m);
+  if (b.pulses) return rest + b.fit.readout_var(static_cast<double>(m) * tau0);
+  const NoiseModel& model = b.model;
+  if (!(model.output_lowpass_tc_s > 0)) return rest;
   const double n = model.arw_deg_per_sqrt_h * units::sqrt_s_per_sqrt_h, tf = model.output_lowpass_tc_s;
-  return theoretical_avar(rest, tau0, scale, m) + n * n * output_lowpass_rate_avar(m, tau0, tf) +
+  return rest + n * n * output_lowpass_rate_avar(m, tau0, tf) +
          model.white_angle_arcsec * model.white_angle_arcsec * output_lowpass_angle_avar(m, tau0, tf);
 }
 
@@ -47,10 +61,11 @@ std::vector<BandPoint> model_band(const std::vector<AllanPoint>& pts, const std:
                                   const NoiseModel& model, const FitResult& fit, const PhaseSeries& x, double scale,
                                   double level) {
   std::vector<BandPoint> band;
+  const BandModel bm = band_model(model, fit, x.exact());
   for (std::size_t i = 0; i < pts.size(); ++i) {
     const auto& p = pts[i];
     if (!(dev[i] > 0) || !(p.edf > 0)) continue;
-    const double var = model_avar(model, fit, x.exact(), x.tau0_s, scale, static_cast<std::size_t>(p.m));
+    const double var = model_avar(bm, x.tau0_s, scale, static_cast<std::size_t>(p.m));
     const DevInterval ci = chi2_interval(1.0, p.edf, level);
     BandPoint b;
     b.tau_s = p.tau_s;
