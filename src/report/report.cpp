@@ -739,113 +739,6 @@ std::string title_block(const std::vector<json>& a, const ReportOptions& options
   return h + "</table>\n</header>\n";
 }
 
-/// A person's signature line: the role, the position, a line to sign on, the name.
-std::string signature_row(const char* role, const ProtocolPerson& p) {
-  return fmt::format("<tr><th>{}</th><td>{}</td><td class=\"sign\">&nbsp;</td><td>{}</td></tr>\n", tr(role),
-                     typed(p.position), typed(p.name));
-}
-
-/// The approval block at the top right of a protocol: approved by whom, signed and dated by hand.
-std::string approval_block(const LabProfile& p) {
-  return fmt::format(
-      "<div class=\"approval\" id=\"approval\">\n<p class=\"approved\">{}</p>\n<p>{}</p>\n<p>{}</p>\n"
-      "<p class=\"sign-line\"><span class=\"sign\">&nbsp;</span> {}</p>\n<p>{}</p>\n</div>\n",
-      tr("APPROVED"), typed(p.approver.position), typed(p.laboratory), typed(p.approver.name), tr("date ____________"));
-}
-
-std::string instruments_table(const LabProfile& p) {
-  std::string h = fmt::format("<table id=\"instruments\" class=\"protocol\">\n<caption>{}</caption>\n",
-                              tr("Measuring instruments"));
-  h +=
-      tr("<tr><th>No.</th><th>type</th><th>serial number</th><th>verified on</th><th>verification valid until</th>"
-         "<th>certificate</th></tr>\n");
-  std::size_t k = 0;
-  for (const auto& m : p.instruments)
-    h += fmt::format(
-        "<tr><td class=\"num\">{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
-        "<td>{}</td></tr>\n",
-        ++k, typed(m.type), typed(m.serial), date_text(m.verified),
-        m.valid_until ? date_text(*m.valid_until) : std::string(kNotAvailable),
-        m.certificate.empty() ? std::string(kNotAvailable) : typed(m.certificate));
-  if (p.instruments.empty())
-    h += fmt::format("<tr><td colspan=\"6\">{}</td></tr>\n", tr("none listed in the lab profile"));
-  return h + "</table>\n";
-}
-
-std::string conditions_table(const LabProfile& p) {
-  std::string h =
-      fmt::format("<table id=\"conditions\" class=\"protocol\">\n<caption>{}</caption>\n", tr("Ambient conditions"));
-  h += tr("<tr><th>quantity</th><th>value ± standard uncertainty</th><th>unit</th></tr>\n");
-  for (const auto& c : p.conditions)
-    h += fmt::format("<tr><td>{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n", typed(c.quantity),
-                     c.uncertainty ? value_with_uncertainty(c.value, *c.uncertainty) : g(c.value, 6), typed(c.unit));
-  if (p.conditions.empty())
-    h += fmt::format("<tr><td colspan=\"3\">{}</td></tr>\n", tr("none listed in the lab profile"));
-  return h + "</table>\n";
-}
-
-/// The protocol's results in brief: per run N and B with their uncertainty and the class.
-std::string protocol_results(const std::vector<json>& a, const std::vector<std::size_t>& order) {
-  std::string h = fmt::format("<table id=\"protocol-results\" class=\"protocol\">\n<caption>{}</caption>\n",
-                              tr("Results (in full: Tables 1 and 2 and the sections below)"));
-  h += trf("<tr><th>run</th><th>temperature</th><th>N ({0})</th><th>B ({1})</th><th>class</th></tr>\n",
-           "<span class=\"unit\">" + unit(lbl::arw) + "</span>", "<span class=\"unit\">" + unit(lbl::rate) + "</span>");
-  for (auto i : order)
-    h += run_row(a[i], {coef_cell(at(at(a[i], "fit"), "N")), coef_cell(at(at(a[i], "fit"), "B")),
-                        verdict_class(at(a[i], "verdict"), "class")});
-  return h + "</table>\n";
-}
-
-/// The conclusion of a protocol: the verdict in words, or why there is none.
-std::string protocol_conclusion(const std::vector<json>& a, const std::vector<std::size_t>& order,
-                                const json& overall) {
-  std::string text;
-  if (is_withheld(overall)) {
-    text = tr("no verdict: the noise model does not describe every record (see section 1)");
-  } else {
-    const auto& v0 = at(a[order.front()], "verdict");
-    const json& classes = at(overall, "classes").is_array() ? at(overall, "classes") : at(v0, "classes");
-    std::string words = verdict_in_words(overall, classes);
-    if (words.empty()) words = trf("class {}", class_text(at(overall, "class")));
-    text = trf("by GOST RV 52339-2005 the gyro is of {}.", words);
-  }
-  return fmt::format("<p id=\"conclusion\"><b>{}</b> {}</p>\n", tr("Conclusion:"), esc(text));
-}
-
-/// The first page as a test protocol: approval, number and date, what was tested, how, with which
-/// instruments and under which conditions, the results and the conclusion, the signature lines.
-std::string protocol_block(const std::vector<json>& a, const std::vector<std::size_t>& order, const json& overall,
-                           const ReportOptions& options, const std::string& title) {
-  const LabProfile& p = *options.profile;
-  std::string h = "<section class=\"protocol\" id=\"protocol\">\n" + approval_block(p);
-  h += fmt::format(
-      "<h1 id=\"protocol-number\">{}</h1>\n<p class=\"protocol-date\">{}</p>\n<p class=\"subject\">{}</p>\n",
-      trf("Test protocol No. {}",
-          options.protocol_number.empty() ? std::string("________") : typed(options.protocol_number)),
-      trf("of {}", date_text(options.protocol_date)), typed(title));
-  h += "<table id=\"protocol-block\">\n";
-  auto row = [&](const char* name, const std::string& html) {
-    h += kv_row(tr(name), html.empty() ? std::string(kNotAvailable) : html);
-  };
-  row(N_("laboratory"), typed(p.laboratory));
-  row(N_("address"), typed(p.address));
-  if (!p.accreditation.empty()) row(N_("accreditation"), typed(p.accreditation));
-  row(N_("customer"), typed(p.customer));
-  const auto serials = identification_values(a, "serial");
-  row(N_("object of the test"), (options.gyro.empty() ? std::string(tr("gyro")) : typed(options.gyro)) +
-                                    (serials.empty() ? std::string() : trf(", serial No. {}", serials)));
-  row(N_("test method"), typed(p.method));
-  row(N_("test date"), identification_values(a, "test_date"));
-  row(N_("runs"), trnf("{} recording (its size and SHA-256 under “Runs”)",
-                       "{} recordings (each one's size and SHA-256 under “Runs”)", a.size(), a.size()));
-  row(N_("report generated"), esc(options.generated) + " · " + esc(version_line()));
-  h += "</table>\n" + instruments_table(p) + conditions_table(p) + protocol_results(a, order) +
-       protocol_conclusion(a, order, overall);
-  h += fmt::format("<table id=\"signatures\" class=\"signatures\">\n{}{}</table>\n",
-                   signature_row(N_("Tests performed by"), p.performer), signature_row(N_("Checked by"), p.checker));
-  return h + "</section>\n";
-}
-
 /// Text for a CSS string: everything but letters, digits, blanks and bytes of UTF-8 sequences as
 /// a CSS escape, so that no quote, backslash or "</style>" leaves the string.
 std::string css_string(std::string_view text) {
@@ -865,6 +758,20 @@ std::string html::stylesheet(const std::string& page_prefix) {
 std::string html::text(std::string_view s) { return esc(s); }
 std::string html::typed(std::string_view s) { return rwcalc::typed(s); }
 std::string html::coefficient_cell(const json& c) { return coef_cell(c); }
+std::string html::not_available() { return kNotAvailable; }
+std::string html::kv_row(std::string_view key, const std::string& value_html) {
+  return rwcalc::kv_row(key, value_html);
+}
+std::string html::run_row(const json& run, const std::vector<std::string>& cells) {
+  return rwcalc::run_row(run, cells);
+}
+std::string html::verdict_class(const json& v, std::string_view key) { return rwcalc::verdict_class(v, key); }
+bool html::is_withheld(const json& v) { return rwcalc::is_withheld(v); }
+std::string html::verdict_in_words(const json& v, const json& classes) { return rwcalc::verdict_in_words(v, classes); }
+std::string html::class_text(const json& c) { return rwcalc::class_text(c); }
+std::string html::identification_values(const std::vector<json>& a, const char* key) {
+  return rwcalc::identification_values(a, key);
+}
 
 std::string report_html(const ReportInput& input, const ReportOptions& options) {
   require_valid(options);
@@ -889,7 +796,7 @@ std::string report_html(const ReportInput& input, const ReportOptions& options) 
       language_code(), RWCALC_VERSION, typed(title),
       html::stylesheet(options.profile ? css_string(trf("Test protocol No. {}", options.protocol_number)) + " · "
                                        : ""));
-  h += options.profile ? protocol_block(a, order, overall, options, title) : title_block(a, options, title);
+  h += options.profile ? html::protocol_block(a, order, overall, options, title) : title_block(a, options, title);
   h += verdict_html(a, order, overall, numbering);
   // One statement each: the tables are numbered in the order they are made.
   h += numbering.section("tables", tr("Tables 1 and 2"));
