@@ -30,5 +30,10 @@ inline constexpr double kRootMinEdf = 1.0;
 /// variance): the root of an unbiased estimate v ≥ 0 with its bias taken out where ν ≥ kRootMinEdf
 /// (at most 1/0.798 = +25 %); the plain √v below that and where var_v ≤ 0.
 double mean_unbiased_root(double v, double var_v);
+/// The same with ν = 2·level²/var_v: the EDF read at `level`, an estimate of the same variance less
+/// noisy than v itself. With v in its place the factor follows v's own noise (largest where v is low
+/// by chance) and under-corrects: a 30-min record's sign-free B² (relative scatter 0.64) comes out
+/// 2.5 % low, read at the bounded fit's B² 1.9 % (docs/term-choice.md).
+double mean_unbiased_root(double v, double var_v, double level);
 
 }  // namespace rwcalc

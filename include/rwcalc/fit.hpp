@@ -87,11 +87,12 @@ struct Coefficient {
   bool enabled = true;    ///< fitted at all
   bool in_model = true;   ///< kept by the term selection (else reported as a full-model upper bound)
   bool resolved = false;  ///< the lower confidence bound is above 0
-  double estimate = 0;    ///< √ĉ of the fit, its square root's bias taken out (0: driven to the boundary)
-  double value = 0;       ///< the estimate if resolved, else the upper bound (print "< value")
-  double sigma = 0;       ///< standard error (delta method); for an upper bound high/(2z), z the interval's quantile
-  double low = 0;         ///< lower confidence bound (profile likelihood), ≥ 0
-  double high = 0;        ///< upper confidence bound
+  /// √ĉ, its square root's bias taken out (0: ĉ ≤ 0); B averaged over K: ĉ is the set with K's sign-free c
+  double estimate = 0;
+  double value = 0;  ///< the estimate if resolved, else the upper bound (print "< value")
+  double sigma = 0;  ///< standard error (delta method); for an upper bound high/(2z), z the interval's quantile
+  double low = 0;    ///< lower confidence bound (profile likelihood), ≥ 0
+  double high = 0;   ///< upper confidence bound
   /// How the profile searches for the bounds ended (their root-finding iterations).
   Termination termination;
 };
@@ -122,6 +123,10 @@ struct FitResult {
   /// are the average's; c, the model, the goodness of fit and cov_c are this (the selected) set's.
   std::shared_ptr<const FitResult> k_alternative;
   double k_weight = 0;
+  /// The set with K: its c with every term's sign free and their variances (point estimates that no
+  /// bound biases; docs/term-choice.md).
+  Eigen::Matrix<double, kTermCount, 1> sign_free_c = Eigen::Matrix<double, kTermCount, 1>::Zero();
+  Eigen::Matrix<double, kTermCount, 1> sign_free_var = Eigen::Matrix<double, kTermCount, 1>::Zero();
 
   [[nodiscard]] const Coefficient& operator[](Term t) const { return coef[static_cast<std::size_t>(t)]; }
   /// Model σ² at τ (s), (°/h)².

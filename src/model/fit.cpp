@@ -12,6 +12,7 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <tuple>
 #include <utility>
 
@@ -526,6 +527,40 @@ void term_covariance(const Stage& st, const Eigen::MatrixXd& sigma_y, const FitO
   }
 }
 
+/// The set's variance-like coefficients with the signs of K and B free, and their sandwich variances:
+/// one Fisher-scoring step from the bounded optimum, weighted by the model `mu_w`. K's bound biases B
+/// (a K ≥ 0 that cannot be told from flicker takes part of B² whether or not the record has K); the
+/// step's equations are linear in the data, and unbiased when their weights do not follow the data:
+/// `mu_w` is the K-free set's model, as the set with K bends to its last, least certain points. The
+/// other terms move where they are inside their bounds; one held at 0 stays there (Q or R below 0
+/// would stand for a filter's roll-off or a drift that are not noise; docs/term-choice.md).
+void sign_free_estimates(const Stage& st, const Eigen::VectorXd& mu_w, const Eigen::MatrixXd& sigma_y,
+                         const FitOptions& options, FitResult& res) {
+  std::vector<int> set;
+  for (int i = 0; i < P; ++i)
+    if (res.options.enabled[static_cast<std::size_t>(i)] &&
+        (st.fit.d[i] > 0 || kAllTerms[static_cast<std::size_t>(i)] == Term::K ||
+         kAllTerms[static_cast<std::size_t>(i)] == Term::B))
+      set.push_back(i);
+  const auto k = static_cast<Eigen::Index>(set.size());
+  const Eigen::VectorXd mu = st.model();
+  const Eigen::MatrixXd design = design_at(st.pr, st.fit.d);
+  Eigen::MatrixXd g(design.rows(), k);
+  for (Eigen::Index q = 0; q < k; ++q) g.col(q) = design.col(set[static_cast<std::size_t>(q)]);
+  const Eigen::VectorXd w = st.pr.nu.array() / mu_w.array().square();
+  const Eigen::MatrixXd gw = g.array().colwise() * w.array();
+  const Eigen::VectorXd step = (g.transpose() * gw).ldlt().solve(gw.transpose() * (st.pr.y - mu));
+  const Sandwich sw = sandwich(st.pr, st.fit.d, set, sigma_y, options);
+  res.sign_free_c.setZero();
+  res.sign_free_var.setZero();
+  for (Eigen::Index q = 0; q < k; ++q) {
+    const int i = set[static_cast<std::size_t>(q)];
+    const double sc = st.pr.scale[i];
+    res.sign_free_c[i] = (st.fit.d[i] + step[q]) * sc;
+    res.sign_free_var[i] = sw.cov(q, q) * sw.extra[static_cast<std::size_t>(q)] * sc * sc;
+  }
+}
+
 /// One term's profile-likelihood interval on t = √d (a dropped term: the full model's upper bound).
 Coefficient coefficient_interval(int i, const Stage& sel, const Stage& full, bool dropped, const FitResult& res,
                                  double z, double chi2_1) {
@@ -594,20 +629,22 @@ double quantile_between(F&& cdf, double p, double a, double b, Termination& t) {
 }
 
 /// The coefficient of term t averaged over the two term sets with weights w and 1 − w: the mixture
-/// of their confidence distributions, its quantiles for the interval, the weighted mean for the
-/// estimate and the mixture's standard deviation for sigma.
-Coefficient averaged(const FitResult& avg, Term t, const Coefficient& a, const Coefficient& b, double w_b, double z) {
+/// of their confidence distributions, its quantiles for the interval and its standard deviation for
+/// sigma; the estimate is given (average_over_k).
+Coefficient averaged(const FitResult& avg, Term t, const Coefficient& a, const Coefficient& b, double w_b,
+                     double estimate, double z) {
   Coefficient co = a;
   co.termination = combine(a.termination, b.termination);
   const double alpha = (1.0 - avg.options.confidence) / 2.0;
   auto cdf = [&](double x) { return avg.cdf(t, x); };
-  co.estimate = (1.0 - w_b) * a.estimate + w_b * b.estimate;
+  co.estimate = estimate;
   co.resolved = cdf(std::numeric_limits<double>::min()) < alpha;
   co.low =
       co.resolved ? quantile_between(cdf, alpha, std::min(a.low, b.low), std::max(a.low, b.low), co.termination) : 0.0;
   co.high = quantile_between(cdf, 1.0 - alpha, std::min(a.high, b.high), std::max(a.high, b.high), co.termination);
   co.value = co.resolved ? co.estimate : co.high;
-  const double da = a.estimate - co.estimate, db = b.estimate - co.estimate;
+  const double mean = (1.0 - w_b) * a.estimate + w_b * b.estimate;
+  const double da = a.estimate - mean, db = b.estimate - mean;
   co.sigma = co.resolved ? std::sqrt((1.0 - w_b) * (a.sigma * a.sigma + da * da) + w_b * (b.sigma * b.sigma + db * db))
                          : co.high / (2.0 * z);
   return co;
@@ -616,6 +653,8 @@ Coefficient averaged(const FitResult& avg, Term t, const Coefficient& a, const C
 /// Averages `res` (the selected term set) with `other` (the same set with K toggled): weights from
 /// the scaled deviances with the AIC's penalty of one parameter, w(K) = 1/(1 + e^(1 − ΔD/(2φ_K))).
 /// N, B (and Q, R where both sets keep them) take the mixture of the two confidence distributions;
+/// B's estimate is the set with K's sign-free c (unbiased whether or not the record has K; an average
+/// of the two sets' estimates is not, as its weights follow the data), its root's bias taken out;
 /// K is resolved only when the mixture's lower bound, which carries the K-free set's point mass at
 /// 0, is above 0 (docs/term-choice.md).
 void average_over_k(FitResult& res, FitResult other, double phi_k, double z) {
@@ -628,10 +667,21 @@ void average_over_k(FitResult& res, FitResult other, double phi_k, double z) {
   const std::array<Coefficient, P> own = res.coef;
   res.k_alternative = std::make_shared<const FitResult>(std::move(other));
   const FitResult& alt = *res.k_alternative;
+  const FitResult& with_k = has_k ? res : alt;
   for (int i = 0; i < P; ++i) {
     const auto ui = static_cast<std::size_t>(i);
     if (i == idx(Term::K) || !own[ui].enabled || !res.options.enabled[ui] || !alt.options.enabled[ui]) continue;
-    res.coef[ui] = averaged(res, kAllTerms[ui], own[ui], alt.coef[ui], w_other, z);
+    // B from the sign-free step (a singular one, where the points cannot separate the terms, leaves
+    // the members' weighted mean); N, Q and R from that mean: both members fit them from the same
+    // short-τ points, and the step's weights, the K-free set's, would move N where the model describes
+    // the points only roughly (1–4 % on ADIS16405 accelerometer axes).
+    const bool sign_free =
+        i == idx(Term::B) && std::isfinite(with_k.sign_free_c[i]) && std::isfinite(with_k.sign_free_var[i]);
+    const double estimate = sign_free
+                                ? kCoefScale[ui] * mean_unbiased_root(with_k.sign_free_c[i], with_k.sign_free_var[i],
+                                                                      std::max(with_k.c[i], 0.0))
+                                : (1.0 - w_other) * own[ui].estimate + w_other * alt.coef[ui].estimate;
+    res.coef[ui] = averaged(res, kAllTerms[ui], own[ui], alt.coef[ui], w_other, estimate, z);
   }
   Coefficient& k = res.coef[uk];
   if (k.enabled && k.resolved &&
@@ -831,20 +881,26 @@ Selected fit_selected(std::span<const FitPoint> points, const FitOptions& option
 /// With the term selection, the selected set's coefficients averaged with the set that differs in K.
 FitResult averaged_over_k(Selected s) {
   const FitBase& b = s.base;
-  const std::array<bool, P> dropped = s.fit.dropped;
-  FitResult res = add_intervals(b, std::move(s.fit));
   const auto uk = static_cast<std::size_t>(idx(Term::K));
-  if (!b.options.select_terms || !b.options.enabled[uk] || !b.options.droppable[uk]) return res;
-  FitOptions other = res.options;
+  if (!b.options.select_terms || !b.options.enabled[uk] || !b.options.droppable[uk])
+    return add_intervals(b, std::move(s.fit));
+  FitOptions other = s.fit.res.options;
   other.enabled[uk] = !other.enabled[uk];
-  std::array<bool, P> other_dropped = dropped;
+  std::array<bool, P> other_dropped = s.fit.dropped;
   other_dropped[uk] = !other.enabled[uk];
   Vec5 start = s.d;
   start[idx(Term::K)] = other.enabled[uk] ? b.full.fit.d[idx(Term::K)] : 0.0;
+  std::optional<FitResult> alt;
   try {
-    average_over_k(res, add_intervals(b, fit_term_set(b, other, other_dropped, start)), b.phi_full[uk], b.z);
+    SetFit fit = fit_term_set(b, other, other_dropped, start);
+    SetFit& with_k = other.enabled[uk] ? fit : s.fit;
+    const SetFit& without_k = other.enabled[uk] ? s.fit : fit;
+    sign_free_estimates(with_k.sel, without_k.sel.model(), b.sigma_y, b.options, with_k.res);
+    alt = add_intervals(b, std::move(fit));
   } catch (const AnalysisError&) {  // the other set cannot be fitted: the selected one stands alone
   }
+  FitResult res = add_intervals(b, std::move(s.fit));
+  if (alt) average_over_k(res, std::move(*alt), b.phi_full[uk], b.z);
   return res;
 }
 

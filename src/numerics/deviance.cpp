@@ -31,9 +31,11 @@ double chi_root_mean(double nu) {
   return std::sqrt(2.0 / nu) / boost::math::tgamma_delta_ratio(nu / 2.0, 0.5);
 }
 
-double mean_unbiased_root(double v, double var_v) {
+double mean_unbiased_root(double v, double var_v) { return mean_unbiased_root(v, var_v, v); }
+
+double mean_unbiased_root(double v, double var_v, double level) {
   if (!(v > 0)) return 0.0;
-  const double nu = var_v > 0 ? 2.0 * v * v / var_v : 0.0;
+  const double nu = var_v > 0 && level > 0 ? 2.0 * level * level / var_v : 0.0;
   return nu >= kRootMinEdf ? std::sqrt(v) / chi_root_mean(nu) : std::sqrt(v);
 }
 
