@@ -51,13 +51,24 @@ TEST(PlotFormat, ChosenByExtensionCaseInsensitive) {
   }
 }
 
+TEST(PlotScript, TheModelLineIsTheFittedCurveNotTheEstimate) {
+  // B's estimate (bias taken out, averaged over K) and the fitted curve's B differ; the figure draws
+  // the curve the fit put through the points. Results saved without `model_value` fall back to the estimate.
+  json a = k_unresolved_analysis();
+  a["fit"]["B"]["estimate"] = 0.0079;
+  a["fit"]["B"]["model_value"] = 0.0071;
+  EXPECT_NE(rwcalc::analysis_figure(a, {}).script.find("\nB = 0.0071   #"), std::string::npos);
+  a["fit"]["B"].erase("model_value");
+  EXPECT_NE(rwcalc::analysis_figure(a, {}).script.find("\nB = 0.0079   #"), std::string::npos);
+}
+
 TEST(PlotScript, AnalysisFigureHasDataModelTermsAndClassFloors) {
   const auto f = rwcalc::analysis_figure(k_unresolved_analysis(), {});
   // measured, model, Q, N, B, K bound, three class floors; R (no bound) is left out.
   EXPECT_EQ(f.series, 9);
   EXPECT_NE(f.script.find("$allan << EOD"), std::string::npos);
   EXPECT_NE(f.script.find("K_up95 = 0.0008"), std::string::npos) << f.script;
-  // The model curve uses the fit's own estimates: an unresolved term left out of it counts 0.
+  // The model curve: an unresolved term left out of it counts 0.
   EXPECT_NE(f.script.find("\nK = 0   #"), std::string::npos);
   EXPECT_NE(f.script.find("\nN = 0.0009   #"), std::string::npos);
   EXPECT_NE(f.script.find("rate random walk K < 0.0008 °/h/√h (95 %)"), std::string::npos);

@@ -90,6 +90,10 @@ struct Coefficient {
   /// √ĉ, its square root's bias taken out (0: ĉ ≤ 0); B averaged over K: ĉ is the set with K's sign-free c
   double estimate = 0;
   double value = 0;  ///< the estimate if resolved, else the upper bound (print "< value")
+  /// The coefficient of the fitted model curve: the selected term set's √ĉ as fitted (0 for a term
+  /// the selection left out). The curve a figure draws through the points; not the estimate, which
+  /// has its root's bias taken out and, for B averaged over K, comes from another set.
+  double curve = 0;
   double sigma = 0;  ///< standard error (delta method); for an upper bound high/(2z), z the interval's quantile
   double low = 0;    ///< lower confidence bound (profile likelihood), ≥ 0
   double high = 0;   ///< upper confidence bound

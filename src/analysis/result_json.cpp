@@ -40,7 +40,8 @@ json coef_json(const Coefficient& c, const ShownUnit& u) {
   const double f = u.factor;
   return {{"value", c.value * f},   {"sigma", c.sigma * f},   {"low95", c.low * f},
           {"high95", c.high * f},   {"resolved", c.resolved}, {"estimate", c.estimate * f},
-          {"in_model", c.in_model}, {"fitted", c.enabled},    {"unit", u.ascii}};
+          {"in_model", c.in_model}, {"fitted", c.enabled},    {"model_value", c.curve * f},
+          {"unit", u.ascii}};
 }
 
 json method_json(const MethodEstimate& m, const ShownUnit& u) {

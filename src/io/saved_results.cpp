@@ -102,6 +102,7 @@ void Checker::estimate(const Value& e) const {
   if (combined_) (void)e.at("high95");
   for (const char* key : {"low95", "high95"}) optional(e, key, as_non_negative);
   optional(e, "estimate", as_number);
+  optional(e, "model_value", as_non_negative);
   optional(e, "in_model", as_boolean);
   optional(e, "fitted", as_boolean);
   optional(e, "unit", as_string);

@@ -577,6 +577,7 @@ Coefficient coefficient_interval(int i, const Stage& sel, const Stage& full, boo
   // E√(χ²_ν/ν) (8 % at the ν ≈ 3 of B on a 30-min record), which the estimate takes out
   // (docs/term-choice.md); the profile interval is that of √c itself.
   co.estimate = dropped ? kf * t_hat : kCoefScale[ui] * mean_unbiased_root(res.c[i], res.cov_c(i, i));
+  co.curve = dropped ? 0.0 : coefficient_from_c(kAllTerms[ui], res.c[i]);
   double t_low = 0;
   if (!dropped && t_hat > 0) {
     auto g = [&](double t) { return std::sqrt(prof.delta(i, t * t)) - std::sqrt(thr); };

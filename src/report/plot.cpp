@@ -26,7 +26,8 @@ namespace lbl = units::label;
 namespace {
 
 /// A fitted coefficient as the figure draws it. When not resolved, `value` is the 95 % upper
-/// bound; `model` is what the fitted model curve uses (0 for a term left out).
+/// bound; `model` is what the fitted model curve uses: `model_value` (0 for a term left out), or from
+/// results saved without it the estimate.
 struct Coefficient {
   std::optional<double> value, high95;
   double model = 0;
@@ -41,6 +42,8 @@ Coefficient coefficient(const json& fit, std::string_view key) {
   const auto& in_model = at(c, "in_model");
   if (in_model.is_boolean() && !in_model.get<bool>())
     r.model = 0;
+  else if (const auto curve = num(c, "model_value"))
+    r.model = *curve;
   else if (const auto est = num(c, "estimate"))
     r.model = *est;
   else
