@@ -127,10 +127,6 @@ struct FitResult {
   /// are the average's; c, the model, the goodness of fit and cov_c are this (the selected) set's.
   std::shared_ptr<const FitResult> k_alternative;
   double k_weight = 0;
-  /// The set with K: its c with every term's sign free and their variances (point estimates that no
-  /// bound biases; docs/term-choice.md).
-  Eigen::Matrix<double, kTermCount, 1> sign_free_c = Eigen::Matrix<double, kTermCount, 1>::Zero();
-  Eigen::Matrix<double, kTermCount, 1> sign_free_var = Eigen::Matrix<double, kTermCount, 1>::Zero();
 
   [[nodiscard]] const Coefficient& operator[](Term t) const { return coef[static_cast<std::size_t>(t)]; }
   /// Model σ² at τ (s), (°/h)².

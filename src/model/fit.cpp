@@ -527,38 +527,35 @@ void term_covariance(const Stage& st, const Eigen::MatrixXd& sigma_y, const FitO
   }
 }
 
-/// The set's variance-like coefficients with the signs of K and B free, and their sandwich variances:
-/// one Fisher-scoring step from the bounded optimum, weighted by the model `mu_w`. K's bound biases B
-/// (a K ≥ 0 that cannot be told from flicker takes part of B² whether or not the record has K); the
-/// step's equations are linear in the data, and unbiased when their weights do not follow the data:
-/// `mu_w` is the K-free set's model, as the set with K bends to its last, least certain points. The
-/// other terms move where they are inside their bounds; one held at 0 stays there (Q or R below 0
-/// would stand for a filter's roll-off or a drift that are not noise; docs/term-choice.md).
-void sign_free_estimates(const Stage& st, const Eigen::VectorXd& mu_w, const Eigen::MatrixXd& sigma_y,
-                         const FitOptions& options, FitResult& res) {
+/// B's estimate from the set with K (stage `st`) with the signs of K and B free: one Fisher-scoring
+/// step from the bounded optimum, weighted by the model `mu_w`, and its root's bias taken out with the
+/// EDF read at the bounded B² (deviance.hpp); NaN where the step is singular. K's bound biases B (a K ≥ 0
+/// that cannot be told from flicker takes part of B² whether or not the record has K); the step's
+/// equations are linear in the data, and unbiased when their weights do not follow the data: `mu_w` is
+/// the K-free set's model, as the set with K bends to its last, least certain points. The other terms
+/// move where they are inside their bounds; one held at 0 stays there (Q or R below 0 would stand for
+/// a filter's roll-off or a drift that are not noise; docs/term-choice.md).
+double sign_free_b(const Stage& st, const Eigen::VectorXd& mu_w, const Eigen::MatrixXd& sigma_y,
+                   const FitOptions& options) {
+  const int ib = idx(Term::B);
   std::vector<int> set;
   for (int i = 0; i < P; ++i)
-    if (res.options.enabled[static_cast<std::size_t>(i)] &&
-        (st.fit.d[i] > 0 || kAllTerms[static_cast<std::size_t>(i)] == Term::K ||
-         kAllTerms[static_cast<std::size_t>(i)] == Term::B))
+    if (options.enabled[static_cast<std::size_t>(i)] && (st.fit.d[i] > 0 || i == ib || i == idx(Term::K)))
       set.push_back(i);
   const auto k = static_cast<Eigen::Index>(set.size());
-  const Eigen::VectorXd mu = st.model();
   const Eigen::MatrixXd design = design_at(st.pr, st.fit.d);
   Eigen::MatrixXd g(design.rows(), k);
   for (Eigen::Index q = 0; q < k; ++q) g.col(q) = design.col(set[static_cast<std::size_t>(q)]);
   const Eigen::VectorXd w = st.pr.nu.array() / mu_w.array().square();
   const Eigen::MatrixXd gw = g.array().colwise() * w.array();
-  const Eigen::VectorXd step = (g.transpose() * gw).ldlt().solve(gw.transpose() * (st.pr.y - mu));
+  const Eigen::VectorXd step = (g.transpose() * gw).ldlt().solve(gw.transpose() * (st.pr.y - st.model()));
+  const auto qb = static_cast<Eigen::Index>(std::find(set.begin(), set.end(), ib) - set.begin());
   const Sandwich sw = sandwich(st.pr, st.fit.d, set, sigma_y, options);
-  res.sign_free_c.setZero();
-  res.sign_free_var.setZero();
-  for (Eigen::Index q = 0; q < k; ++q) {
-    const int i = set[static_cast<std::size_t>(q)];
-    const double sc = st.pr.scale[i];
-    res.sign_free_c[i] = (st.fit.d[i] + step[q]) * sc;
-    res.sign_free_var[i] = sw.cov(q, q) * sw.extra[static_cast<std::size_t>(q)] * sc * sc;
-  }
+  const double sc = st.pr.scale[ib];
+  const double c = (st.fit.d[ib] + step[qb]) * sc;
+  const double var = sw.cov(qb, qb) * sw.extra[static_cast<std::size_t>(qb)] * sc * sc;
+  if (!std::isfinite(c) || !std::isfinite(var)) return std::numeric_limits<double>::quiet_NaN();
+  return kCoefScale[static_cast<std::size_t>(ib)] * mean_unbiased_root(c, var, st.fit.d[ib] * sc);
 }
 
 /// One term's profile-likelihood interval on t = √d (a dropped term: the full model's upper bound).
@@ -654,11 +651,11 @@ Coefficient averaged(const FitResult& avg, Term t, const Coefficient& a, const C
 /// Averages `res` (the selected term set) with `other` (the same set with K toggled): weights from
 /// the scaled deviances with the AIC's penalty of one parameter, w(K) = 1/(1 + e^(1 − ΔD/(2φ_K))).
 /// N, B (and Q, R where both sets keep them) take the mixture of the two confidence distributions;
-/// B's estimate is the set with K's sign-free c (unbiased whether or not the record has K; an average
-/// of the two sets' estimates is not, as its weights follow the data), its root's bias taken out;
+/// B's estimate is `b_estimate`, the set with K's sign-free one (sign_free_b: unbiased whether or not
+/// the record has K; an average of the two sets' estimates is not, as its weights follow the data);
 /// K is resolved only when the mixture's lower bound, which carries the K-free set's point mass at
 /// 0, is above 0 (docs/term-choice.md).
-void average_over_k(FitResult& res, FitResult other, double phi_k, double z) {
+void average_over_k(FitResult& res, FitResult other, double b_estimate, double phi_k, double z) {
   const auto uk = static_cast<std::size_t>(idx(Term::K));
   const bool has_k = res.options.enabled[uk];
   const double d_on = has_k ? res.deviance : other.deviance, d_off = has_k ? other.deviance : res.deviance;
@@ -668,7 +665,6 @@ void average_over_k(FitResult& res, FitResult other, double phi_k, double z) {
   const std::array<Coefficient, P> own = res.coef;
   res.k_alternative = std::make_shared<const FitResult>(std::move(other));
   const FitResult& alt = *res.k_alternative;
-  const FitResult& with_k = has_k ? res : alt;
   for (int i = 0; i < P; ++i) {
     const auto ui = static_cast<std::size_t>(i);
     if (i == idx(Term::K) || !own[ui].enabled || !res.options.enabled[ui] || !alt.options.enabled[ui]) continue;
@@ -676,11 +672,8 @@ void average_over_k(FitResult& res, FitResult other, double phi_k, double z) {
     // the members' weighted mean); N, Q and R from that mean: both members fit them from the same
     // short-τ points, and the step's weights, the K-free set's, would move N where the model describes
     // the points only roughly (1–4 % on ADIS16405 accelerometer axes).
-    const bool sign_free =
-        i == idx(Term::B) && std::isfinite(with_k.sign_free_c[i]) && std::isfinite(with_k.sign_free_var[i]);
-    const double estimate = sign_free
-                                ? kCoefScale[ui] * mean_unbiased_root(with_k.sign_free_c[i], with_k.sign_free_var[i],
-                                                                      std::max(with_k.c[i], 0.0))
+    const double estimate = i == idx(Term::B) && std::isfinite(b_estimate)
+                                ? b_estimate
                                 : (1.0 - w_other) * own[ui].estimate + w_other * alt.coef[ui].estimate;
     res.coef[ui] = averaged(res, kAllTerms[ui], own[ui], alt.coef[ui], w_other, estimate, z);
   }
@@ -892,16 +885,17 @@ FitResult averaged_over_k(Selected s) {
   Vec5 start = s.d;
   start[idx(Term::K)] = other.enabled[uk] ? b.full.fit.d[idx(Term::K)] : 0.0;
   std::optional<FitResult> alt;
+  double b_estimate = 0;
   try {
     SetFit fit = fit_term_set(b, other, other_dropped, start);
-    SetFit& with_k = other.enabled[uk] ? fit : s.fit;
+    const SetFit& with_k = other.enabled[uk] ? fit : s.fit;
     const SetFit& without_k = other.enabled[uk] ? s.fit : fit;
-    sign_free_estimates(with_k.sel, without_k.sel.model(), b.sigma_y, b.options, with_k.res);
+    b_estimate = sign_free_b(with_k.sel, without_k.sel.model(), b.sigma_y, with_k.res.options);
     alt = add_intervals(b, std::move(fit));
   } catch (const AnalysisError&) {  // the other set cannot be fitted: the selected one stands alone
   }
   FitResult res = add_intervals(b, std::move(s.fit));
-  if (alt) average_over_k(res, std::move(*alt), b.phi_full[uk], b.z);
+  if (alt) average_over_k(res, std::move(*alt), b_estimate, b.phi_full[uk], b.z);
   return res;
 }
 
