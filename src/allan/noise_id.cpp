@@ -20,6 +20,27 @@ namespace {
 constexpr std::size_t kMinAcfPoints = 30;
 constexpr int kMaxDifferences = 2;  // d_max for Allan-type (two-sample) variances
 
+/// The decimated points whose lag-1 sums decide the noise type: all of them up to kAcfMaxPoints,
+/// beyond that kAcfRuns runs of consecutive points spread evenly from the record's start to its
+/// end, pairs taken within a run. The decision is a class, not an estimate: r1's standard error is
+/// about 1/√points, 0.004 at this size against boundaries 1/3 and 3/5 apart, so more points would
+/// change a type only where the record sits on a boundary, while the sums over every point were the
+/// costliest part of an octave sweep (docs/performance.md). Runs cover the whole record, so a
+/// warm-up or a drift weighs as in the record.
+constexpr std::size_t kAcfMaxPoints = std::size_t{1} << 16;
+constexpr std::size_t kAcfRuns = 16;
+
+struct AcfRuns {
+  std::size_t count = 0;  // decimated points of the series
+  std::size_t runs = 1;
+  std::size_t width = 0;  // points per run
+  explicit AcfRuns(std::size_t points)
+      : count(points),
+        runs(points > kAcfMaxPoints ? kAcfRuns : 1),
+        width(points > kAcfMaxPoints ? kAcfMaxPoints / kAcfRuns : points) {}
+  std::size_t start(std::size_t r) const { return runs == 1 ? 0 : r * (count - width) / (runs - 1); }
+};
+
 /// Decimated phase p_k = x_{k·m} − x_0, k = 0 … ⌊(N−1)/m⌋, in arbitrary units (the ACF and the
 /// B1 ratio do not depend on scale); offset-free and exact for counts.
 std::vector<double> decimated_phase(const PhaseSeries& x, std::int64_t m) {
@@ -57,40 +78,51 @@ inline double difference(const P& p, int level, std::size_t i) {
 }
 
 /// Lag-1 autocorrelation r1 = Σ(z_i − z̄)(z_{i+1} − z̄) / Σ(z_i − z̄)² (Riley & Greenhall eq. 2) of
-/// the Level-th difference z of the `count` decimated phase points p(0) … p(count − 1) from
-/// floating sums, without forming z or p: the mean of a difference follows from its end points,
-/// and the sums run in four lanes (whose order fixes the rounding).
+/// the Level-th difference z of the decimated phase points p(0) … p(count − 1), over the runs of
+/// AcfRuns (pairs within a run), from floating sums, without forming z or p: the mean of a
+/// difference follows from its end points, and the sums run in four lanes (whose order fixes the
+/// rounding).
 template <int Level, class P>
-double lag1_floating(const P& p, std::size_t count) {
-  if (count <= static_cast<std::size_t>(Level) + 1) return 0.0;
-  const std::size_t len = count - static_cast<std::size_t>(Level);  // points of z
+double lag1_floating(const P& p, const AcfRuns& runs) {
+  constexpr auto kLevel = static_cast<std::size_t>(Level);
+  if (runs.width <= kLevel + 1) return 0.0;
+  const std::size_t len = runs.width - kLevel;  // points of z per run
+  const double total = static_cast<double>(len * runs.runs);
   double mean = 0;
   if constexpr (Level == 0) {
     double lane[4] = {};
-    std::size_t i = 0;
-    for (; i + 4 <= len; i += 4)
-      for (int j = 0; j < 4; ++j) lane[j] += p(i + static_cast<std::size_t>(j));
-    for (; i < len; ++i) lane[0] += p(i);
-    mean = (lane[0] + lane[1] + lane[2] + lane[3]) / static_cast<double>(len);
+    for (std::size_t r = 0; r < runs.runs; ++r) {
+      const std::size_t s = runs.start(r);
+      std::size_t i = 0;
+      for (; i + 4 <= len; i += 4)
+        for (int j = 0; j < 4; ++j) lane[j] += p(s + i + static_cast<std::size_t>(j));
+      for (; i < len; ++i) lane[0] += p(s + i);
+    }
+    mean = (lane[0] + lane[1] + lane[2] + lane[3]) / total;
   } else {
-    mean = (difference(p, Level - 1, len) - difference(p, Level - 1, 0)) / static_cast<double>(len);
+    for (std::size_t r = 0; r < runs.runs; ++r)
+      mean += difference(p, Level - 1, runs.start(r) + len) - difference(p, Level - 1, runs.start(r));
+    mean /= total;
   }
   double num[4] = {}, den[4] = {};
-  std::size_t i = 0;
-  // Pairs (z_i, z_{i+1}) for i < len − 1; den over all i < len.
-  for (; i + 4 < len; i += 4) {
-    for (int j = 0; j < 4; ++j) {
-      const auto k = i + static_cast<std::size_t>(j);
-      const double a = difference(p, Level, k) - mean;
-      const double b = difference(p, Level, k + 1) - mean;
-      den[j] += a * a;
-      num[j] += a * b;
+  for (std::size_t r = 0; r < runs.runs; ++r) {
+    const std::size_t s = runs.start(r);
+    std::size_t i = 0;
+    // Pairs (z_i, z_{i+1}) for i < len − 1; den over all i < len.
+    for (; i + 4 < len; i += 4) {
+      for (int j = 0; j < 4; ++j) {
+        const auto k = s + i + static_cast<std::size_t>(j);
+        const double a = difference(p, Level, k) - mean;
+        const double b = difference(p, Level, k + 1) - mean;
+        den[j] += a * a;
+        num[j] += a * b;
+      }
     }
-  }
-  for (; i < len; ++i) {
-    const double a = difference(p, Level, i) - mean;
-    den[0] += a * a;
-    if (i + 1 < len) num[0] += a * (difference(p, Level, i + 1) - mean);
+    for (; i < len; ++i) {
+      const double a = difference(p, Level, s + i) - mean;
+      den[0] += a * a;
+      if (i + 1 < len) num[0] += a * (difference(p, Level, s + i + 1) - mean);
+    }
   }
   const double n_sum = num[0] + num[1] + num[2] + num[3];
   const double d_sum = den[0] + den[1] + den[2] + den[3];
@@ -98,12 +130,12 @@ double lag1_floating(const P& p, std::size_t count) {
 }
 
 template <class P>
-double lag1_floating(const P& p, std::size_t count, int level) {
+double lag1_floating(const P& p, const AcfRuns& runs, int level) {
   switch (level) {
-    case 0: return lag1_floating<0>(p, count);
-    case 1: return lag1_floating<1>(p, count);
-    case 2: return lag1_floating<2>(p, count);
-    default: return lag1_floating<3>(p, count);
+    case 0: return lag1_floating<0>(p, runs);
+    case 1: return lag1_floating<1>(p, runs);
+    case 2: return lag1_floating<2>(p, runs);
+    default: return lag1_floating<3>(p, runs);
   }
 }
 
@@ -123,17 +155,19 @@ struct ExactLag1 {
 constexpr std::uint64_t kZLimit = std::uint64_t{1} << 34;
 constexpr std::size_t kExactMaxPoints = std::size_t{1} << 28;
 
-/// r1 = Σ(z_k − z̄)(z_{k+1} − z̄) / Σ(z_k − z̄)² from the exact sums, with z̄ = S1/n:
-/// n·num = U − S1²/n, U = n·Slag − S1² + S1·(z_0 + z_{n−1});  n·den = n·S2 − S1²
-/// (integers but for the fraction of S1²/n, which is added last).
-double r1_from_exact(const ExactLag1& s, std::size_t len, std::int64_t z_first, std::int64_t z_last) {
+/// r1 = Σ(z_k − z̄)(z_{k+1} − z̄) / Σ(z_k − z̄)² from the exact sums over R runs of n points in
+/// all, pairs within a run, z̄ = S1/n and E the sum of every run's first and last z:
+/// n·num = U − R·S1²/n, U = n·Slag − S1² + S1·E;  n·den = n·S2 − S1²
+/// (integers but for the fraction of R·S1²/n, which is added last).
+double r1_from_exact(const ExactLag1& s, std::size_t len, i128 ends, std::size_t runs) {
   const auto n = static_cast<i128>(len);
   const i128 s1sq = s.s1 * s.s1;
   const i128 den = n * s.s2 - s1sq;
   if (den <= 0) return 0.0;
-  const i128 u = n * s.lag - s1sq + s.s1 * (static_cast<i128>(z_first) + z_last);
-  const i128 q = s1sq / n;
-  const i128 rem = s1sq % n;
+  const i128 u = n * s.lag - s1sq + s.s1 * ends;
+  const i128 rs1sq = static_cast<i128>(runs) * s1sq;
+  const i128 q = rs1sq / n;
+  const i128 rem = rs1sq % n;
   const long double num =
       static_cast<long double>(u - q) - static_cast<long double>(rem) / static_cast<long double>(len);
   return static_cast<double>(num / static_cast<long double>(den));
@@ -153,19 +187,19 @@ bool add_block(const std::int64_t* z, std::size_t n, std::size_t pairs, ExactSum
   return range < 2 * kZLimit;
 }
 
-/// r1 of the difference levels first … first + r1.size() − 1 (at most kLevelsAtOnce) of p(0) …
-/// p(count − 1) from exact sums, the decimated phase gathered once for all of them; nothing for a
-/// level whose sums could leave 128 bits (they run modulo 2^128 and are used only when every
-/// |z| < kZLimit). The differences of a block are taken modulo 2^64: exact while |z| < 2^63.
+/// Exact sums of one difference level over the runs read so far.
+struct ExactLevel {
+  ExactSums s;
+  i128 ends = 0;      // Σ over runs of the first and the last z
+  std::size_t n = 0;  // z values
+  bool exact = true;
+};
+
+/// Adds to lev the exact sums of the difference levels lv0 … lv0 + levels − 1 of one run,
+/// p(0) … p(count − 1), the run gathered once for all of them. The differences of a block are
+/// taken modulo 2^64: exact while |z| < 2^63.
 template <class P>
-void lag1_exact(const P& p, std::size_t count, int first, std::span<std::optional<double>> r1) {
-  const auto levels = static_cast<std::size_t>(std::min<std::ptrdiff_t>(std::ssize(r1), kLevelsAtOnce));
-  const auto lv0 = static_cast<std::size_t>(first);
-  struct Level {
-    ExactSums s;
-    std::int64_t z_first = 0, z_last = 0;
-    bool exact = true;
-  } lev[kLevelsAtOnce];
+void add_run(const P& p, std::size_t count, std::size_t lv0, std::size_t levels, ExactLevel* lev) {
   std::int64_t g[kExactBlock + 1 + 3 + kLevelsAtOnce], z[kExactBlock + 1 + 3 + kLevelsAtOnce];
   const std::size_t longest = count > lv0 ? count - lv0 : 0;
   for (std::size_t k0 = 0; k0 < longest; k0 += kExactBlock) {
@@ -180,22 +214,37 @@ void lag1_exact(const P& p, std::size_t count, int first, std::span<std::optiona
       for (std::size_t d = 0; d < lv; ++d)
         for (std::size_t i = 0; i < width + lv - d - 1; ++i)
           z[i] = static_cast<std::int64_t>(static_cast<std::uint64_t>(z[i + 1]) - static_cast<std::uint64_t>(z[i]));
-      if (width == n) z[n] = 0;  // the record's last block: no successor
+      if (width == n) z[n] = 0;  // the run's last block: no successor
       lev[l].exact = add_block(z, n, pairs, lev[l].s);
-      if (k0 == 0) lev[l].z_first = z[0];
-      lev[l].z_last = z[n - 1];
+      if (k0 == 0) lev[l].ends += z[0];
+      if (k0 + n == len) lev[l].ends += z[n - 1];
+      lev[l].n += n;
     }
+  }
+}
+
+/// r1 of the difference levels first … first + r1.size() − 1 (at most kLevelsAtOnce) of p(0) …
+/// p(count − 1) over the runs of AcfRuns from exact sums; nothing for a level whose sums could
+/// leave 128 bits (they run modulo 2^128 and are used only when every |z| < kZLimit).
+template <class P>
+void lag1_exact(const P& p, const AcfRuns& runs, int first, std::span<std::optional<double>> r1) {
+  const auto levels = static_cast<std::size_t>(std::min<std::ptrdiff_t>(std::ssize(r1), kLevelsAtOnce));
+  const auto lv0 = static_cast<std::size_t>(first);
+  ExactLevel lev[kLevelsAtOnce];
+  for (std::size_t r = 0; r < runs.runs; ++r) {
+    const std::size_t s = runs.start(r);
+    add_run([&p, s](std::size_t k) { return p(s + k); }, runs.width, lv0, levels, lev);
   }
   for (std::size_t l = 0; l < levels; ++l) {
     const std::size_t lv = lv0 + l;
-    if (count <= lv + 1) {
+    if (runs.width <= lv + 1) {
       r1[l] = 0.0;
-    } else if (count >= kExactMaxPoints || !lev[l].exact) {
+    } else if (runs.width * runs.runs >= kExactMaxPoints || !lev[l].exact) {
       r1[l] = std::nullopt;
     } else {
       const ExactLag1 e{static_cast<i128>(lev[l].s.sum), static_cast<i128>(lev[l].s.squares),
                         static_cast<i128>(lev[l].s.lag)};
-      r1[l] = r1_from_exact(e, count - lv, lev[l].z_first, lev[l].z_last);
+      r1[l] = r1_from_exact(e, lev[l].n, lev[l].ends, runs.runs);
     }
   }
 }
@@ -203,22 +252,23 @@ void lag1_exact(const P& p, std::size_t count, int first, std::span<std::optiona
 /// r1 of the levels first … first + r1.size() − 1 (at most kLevelsAtOnce) of the phase decimated by m.
 void lag1_autocorrelations(const PhaseSeries& x, std::int64_t m, std::size_t count, int first, std::span<double> r1) {
   const auto um = static_cast<std::size_t>(m);
+  const AcfRuns runs(count);
   if (x.exact()) {
     const auto c0 = static_cast<std::uint64_t>(x.count(0));
     auto p = [&x, c0, um](std::size_t k) { return static_cast<std::uint64_t>(x.count(k * um)) - c0; };
     std::optional<double> exact[kLevelsAtOnce];
     const std::size_t levels = std::min<std::size_t>(r1.size(), kLevelsAtOnce);
-    lag1_exact(p, count, first, std::span(exact, levels));
+    lag1_exact(p, runs, first, std::span(exact, levels));
     for (std::size_t l = 0; l < levels; ++l)
       r1[l] = exact[l]
                   ? *exact[l]
                   : lag1_floating([&p](std::size_t k) { return static_cast<double>(static_cast<std::int64_t>(p(k))); },
-                                  count, first + static_cast<int>(l));
+                                  runs, first + static_cast<int>(l));
     return;
   }
   const double* v = x.values.data();
   for (std::size_t l = 0; l < r1.size(); ++l)
-    r1[l] = lag1_floating([v, um](std::size_t k) { return v[k * um] - v[0]; }, count, first + static_cast<int>(l));
+    r1[l] = lag1_floating([v, um](std::size_t k) { return v[k * um] - v[0]; }, runs, first + static_cast<int>(l));
 }
 
 /// Lag-1 ACF method on the phase decimated by m, starting at difference level `base` (0: phase
