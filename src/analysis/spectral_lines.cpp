@@ -24,10 +24,13 @@ constexpr std::size_t kFirstBin = 16;
 /// Bins each side of a line kept with it: the Hann window's main lobe.
 constexpr std::size_t kLobeBins = 2;
 
-/// Records that hold this many whole windows step a whole window at a time: Hann windows without
-/// overlap give ν = 2 per window (half-overlapping ones about 1.9 per window, at twice the
-/// transforms), so ν ≥ 128 here, far above the ν ≥ 25 the threshold is set for.
-constexpr std::size_t kWholeStepWindows = 64;
+/// Records that hold this many whole windows take exactly this many, without overlap, spread
+/// evenly from the record's start to its end: Hann windows without overlap give ν = 2 per window
+/// (half-overlapping ones about 1.9 per window, at twice the transforms), so ν = 128, far above
+/// the ν ≥ 25 the threshold is set for (a noise bin reaches 10× its level with a chance below
+/// 10⁻²⁰), and a day-long record no longer pays a transform for every 2^16 samples. A feature
+/// near 10× may fall on either side, as it may between two records of one sensor.
+constexpr std::size_t kSpreadWindows = 64;
 
 std::size_t window_length(std::size_t n) {
   std::size_t w = kMaxWindow;
@@ -36,10 +39,11 @@ std::size_t window_length(std::size_t n) {
 }
 
 /// One-sided Welch PSD of the rate, Hann windows of `w` samples, each less its mean, half
-/// overlapping (whole windows apart on a record of kWholeStepWindows or more).
+/// overlapping (kSpreadWindows spread over a record that holds that many whole windows).
 std::vector<double> welch_rate_psd(const PhaseSeries& x, std::size_t w) {
   const std::size_t n = x.points() - 1;
-  const std::size_t step = n / w >= kWholeStepWindows ? w : w / 2;
+  const bool spread = n / w >= kSpreadWindows;
+  const std::size_t count = spread ? kSpreadWindows : (n - w) / (w / 2) + 1;
   std::vector<double> hann(w), seg(w), psd(w / 2 + 1, 0.0);
   double u = 0;
   for (std::size_t i = 0; i < w; ++i) {
@@ -47,8 +51,8 @@ std::vector<double> welch_rate_psd(const PhaseSeries& x, std::size_t w) {
     u += hann[i] * hann[i];
   }
   detail::RealPowerSpectrum fft(w);
-  std::size_t windows = 0;
-  for (std::size_t start = 0; start + w <= n; start += step, ++windows) {
+  for (std::size_t window = 0; window < count; ++window) {
+    const std::size_t start = spread ? window * (n - w) / (kSpreadWindows - 1) : window * (w / 2);
     double mean = 0;
     for (std::size_t i = 0; i < w; ++i) mean += (seg[i] = x.rate(start + i));
     mean /= static_cast<double>(w);
@@ -56,7 +60,7 @@ std::vector<double> welch_rate_psd(const PhaseSeries& x, std::size_t w) {
     fft.add(seg.data(), w, psd.data());
   }
   const double fs = 1.0 / x.tau0_s;
-  for (double& s : psd) s *= 2.0 / (fs * u * static_cast<double>(windows));
+  for (double& s : psd) s *= 2.0 / (fs * u * static_cast<double>(count));
   return psd;
 }
 
