@@ -66,29 +66,68 @@ void add_increment_sums(const std::int64_t* c, const detail::NarrowCounts& narro
   }
 }
 
+/// Σd and Σd² of the increments d_k = x_{k+t} − x_k − shift, k0 ≤ k < k1, of a floating phase, in
+/// four lanes (a single running sum is bound by the adder's latency). The rate offset's part of
+/// x.diff is the same for every k: added as x.diff adds it.
+void add_floating_increment_sums(const PhaseSeries& x, std::size_t t, double shift, std::size_t k0, std::size_t k1,
+                                 double (&s1)[4], double (&s2)[4]) {
+  const double* v = x.values.data();
+  const double offset = x.rate_offset * static_cast<double>(t) * x.tau0_s;
+  std::size_t k = k0;
+  for (; k + 4 <= k1; k += 4)
+    for (std::size_t j = 0; j < 4; ++j) {
+      const double d = (v[k + j + t] - v[k + j] + offset) - shift;
+      s1[j] += d;
+      s2[j] += d * d;
+    }
+  for (; k < k1; ++k) {
+    const double d = (v[k + t] - v[k] + offset) - shift;
+    s1[0] += d;
+    s2[0] += d * d;
+  }
+}
+
+/// Sample variances of the overlapping increments of a floating phase (overlapping_variances), the
+/// mean rate taken out first.
+std::vector<double> floating_overlapping_variances(const PhaseSeries& x, const std::vector<std::size_t>& ts) {
+  const std::size_t n = x.points() - 1;
+  constexpr std::size_t kBlock = std::size_t{1} << 13, kChunk = kBlock * 64;
+  const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  struct Lanes {
+    double s1[4] = {}, s2[4] = {};
+  };
+  std::vector<std::vector<Lanes>> part(chunks, std::vector<Lanes>(ts.size()));
+  std::vector<double> shift(ts.size());
+  for (std::size_t i = 0; i < ts.size(); ++i)
+    shift[i] = x.diff(n, 0) * static_cast<double>(ts[i]) / static_cast<double>(n);
+  parallel_for(chunks, [&](std::size_t ci) {
+    for (std::size_t k0 = ci * kChunk; k0 < std::min(n, (ci + 1) * kChunk); k0 += kBlock)
+      for (std::size_t i = 0; i < ts.size(); ++i) {
+        const std::size_t k1 = std::min({k0 + kBlock, (ci + 1) * kChunk, n - ts[i] + 1});
+        if (k1 > k0) add_floating_increment_sums(x, ts[i], shift[i], k0, k1, part[ci][i].s1, part[ci][i].s2);
+      }
+  });
+  std::vector<double> out(ts.size());
+  for (std::size_t i = 0; i < ts.size(); ++i) {
+    double s1 = 0, s2 = 0;
+    for (const auto& p : part)
+      for (std::size_t j = 0; j < 4; ++j) s1 += p[i].s1[j], s2 += p[i].s2[j];
+    const auto m = static_cast<double>(n - ts[i] + 1);
+    out[i] = (s2 - s1 * s1 / m) / (m - 1.0);
+  }
+  return out;
+}
+
 /// Sample variances of the M = n − t + 1 overlapping increments x_{k+t} − x_k for every t in ts,
-/// ″². Pulse counts: exact integer sums of the increments less the mean rate's whole counts (the
-/// variance does not see the shift, and the small values fit narrow sums), all lengths in one sweep
-/// over the record in short blocks (the longest interval's window stays in cache); integer sums
-/// make the result independent of the split between threads. Floating phases: the mean rate taken
-/// out first.
+/// ″², all lengths in one sweep over the record in short blocks (the longest interval's window
+/// stays in cache), chunks of the record in parallel and their sums added in chunk order (the
+/// result does not depend on the number of threads). Pulse counts: exact integer sums of the
+/// increments less the mean rate's whole counts (the variance does not see the shift, and the small
+/// values fit narrow sums). Floating phases: floating_overlapping_variances.
 std::vector<double> overlapping_variances(const PhaseSeries& x, const std::vector<std::size_t>& ts) {
+  if (!x.exact()) return floating_overlapping_variances(x, ts);
   const std::size_t n = x.points() - 1;
   std::vector<double> out(ts.size());
-  if (!x.exact()) {
-    parallel_for(ts.size(), [&](std::size_t i) {
-      const std::size_t t = ts[i], m = n - t + 1;
-      const double shift = x.diff(n, 0) * static_cast<double>(t) / static_cast<double>(n);
-      double s1 = 0, s2 = 0;
-      for (std::size_t k = 0; k < m; ++k) {
-        const double d = x.diff(k + t, k) - shift;
-        s1 += d;
-        s2 += d * d;
-      }
-      out[i] = (s2 - s1 * s1 / static_cast<double>(m)) / (static_cast<double>(m) - 1.0);
-    });
-    return out;
-  }
   constexpr std::size_t kBlock = std::size_t{1} << 14, kChunk = kBlock * 32;
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
   const detail::NarrowCounts narrow(x.counts.data(), x.points());
