@@ -21,10 +21,12 @@ double structure_function(const std::array<double, 5>& c, double u) {
 
 std::array<double, 5> term_structure_functions(double u) {
   std::array<double, 5> d{};
-  for (std::size_t i = 0; i < d.size() && u > 0; ++i) {
+  if (!(u > 0)) return d;
+  const double log_u = std::log(u);  // once for the five terms
+  for (std::size_t i = 0; i < d.size(); ++i) {
     std::array<double, 5> unit{};
     unit[i] = 1.0;
-    d[i] = structure_at(unit, u, std::log(u));
+    d[i] = structure_at(unit, u, log_u);
   }
   return d;
 }
