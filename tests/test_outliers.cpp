@@ -104,6 +104,32 @@ TEST(Outliers, EveryPlantedSpikeFoundAndNothingElse) {
   EXPECT_EQ(rwcalc::remove_outliers(y, out).size(), y.size() - out.size());
 }
 
+// The screen skips the median of a sample inside [greatest − limit, least + limit] of its six
+// neighbours; what it flags must be exactly what the median of every sample flags. Heavy tails and
+// low limits put many samples near the edge.
+TEST(Outliers, ScreenFlagsWhatTheMedianOfEverySampleFlags) {
+  std::mt19937_64 rng(31);
+  std::student_t_distribution<double> t(2.0);
+  std::vector<double> y(300000);
+  for (auto& v : y) v = t(rng);
+  for (double limit : {0.5, 2.0, 6.0}) {
+    rwcalc::OutlierScale scale;
+    scale.scale = 1.0;
+    const auto out = find_outliers(y, limit, scale);
+    std::set<std::size_t> found;
+    for (const auto& o : out) found.insert(o.index);
+    std::size_t flagged = 0;
+    for (std::size_t i = 3; i + 3 < y.size(); ++i) {
+      std::vector<double> v{y[i - 3], y[i - 2], y[i - 1], y[i + 1], y[i + 2], y[i + 3]};
+      std::sort(v.begin(), v.end());
+      const bool outlier = std::abs(y[i] - 0.5 * (v[2] + v[3])) > limit;
+      flagged += outlier;
+      EXPECT_EQ(found.count(i) == 1, outlier) << "sample " << i << " limit " << limit;
+    }
+    EXPECT_GT(flagged, 100u) << "limit " << limit;  // the case is not empty
+  }
+}
+
 TEST(Outliers, TooShortOrConstantRecordsHaveNone) {
   EXPECT_TRUE(find_outliers(std::vector<double>{1, 100, 1, 1}).empty());
   EXPECT_TRUE(find_outliers(std::vector<double>(1000, 3.0)).empty());

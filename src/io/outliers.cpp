@@ -69,8 +69,10 @@ struct RateSource {
         out[i - from] =
             d >= -kTabled && d <= kTabled ? count_rate[static_cast<std::size_t>(d + kTabled)] : phase->rate(i);
       }
-    } else {
-      for (std::size_t i = from; i < to; ++i) out[i - from] = phase->rate(i);
+    } else {  // PhaseSeries::rate, its rate offset's part the same for every sample
+      const double* v = phase->values.data();
+      const double offset = phase->rate_offset * 1.0 * phase->tau0_s, tau0 = phase->tau0_s;
+      for (std::size_t i = from; i < to; ++i) out[i - from] = (v[i + 1] - v[i] + offset) / tau0;
     }
   }
 };
@@ -179,15 +181,33 @@ std::optional<std::vector<char>> count_candidates(const RateSource& src, std::si
   return maybe;
 }
 
+/// Rates: the samples of [from, to) that may lie beyond `limit`. The median of six neighbours lies
+/// between their least and greatest, so a sample within [greatest − limit, least + limit] has a
+/// residual within ±limit (also as rounded: the floating subtraction is monotonic) and cannot be an
+/// outlier; that is almost every sample, found without the median's sorting network.
+std::vector<char> rate_candidates(const Window& w, std::size_t from, std::size_t to, double limit) {
+  std::vector<char> maybe(to - from, 1);
+  const std::size_t lo = std::max<std::size_t>(from, 3), hi = std::min(to, w.n - 3);  // interior samples
+  for (std::size_t i = lo; i < hi; ++i) {
+    const double a = w.at(i - 3), b = w.at(i - 2), c = w.at(i - 1), d = w.at(i + 1), e = w.at(i + 2), f = w.at(i + 3);
+    const double least = std::min(std::min(std::min(a, b), std::min(c, d)), std::min(e, f));
+    const double greatest = std::max(std::max(std::max(a, b), std::max(c, d)), std::max(e, f));
+    const double y = w.at(i);
+    maybe[i - from] = static_cast<char>(!(y - least <= limit && greatest - y <= limit));
+  }
+  return maybe;
+}
+
 std::vector<Outlier> outliers_of(const RateSource& src, double threshold, const OutlierScale& s) {
   if (src.n < kMinSamples || !(s.scale > 0)) return {};  // a constant record has no outliers
   const double limit = threshold * s.scale;
   std::vector<std::vector<Outlier>> parts(chunks_of(src.n));
   parallel_for(parts.size(), [&](std::size_t c) {
     const std::size_t from = c * kChunk, to = std::min(src.n, from + kChunk);
-    const std::optional<std::vector<char>> maybe = count_candidates(src, from, to, limit);
+    std::optional<std::vector<char>> maybe = count_candidates(src, from, to, limit);
     if (maybe && std::find(maybe->begin(), maybe->end(), 1) == maybe->end()) return;
     const Window w(src, from, to);
+    if (!maybe) maybe = rate_candidates(w, from, to, limit);
     for (std::size_t i = from; i < to; ++i) {
       if (maybe && !(*maybe)[i - from]) continue;
       const double r = w.residual(i);
