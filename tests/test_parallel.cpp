@@ -88,6 +88,55 @@ TEST(ParallelFor, OneThreadRunsInOrderOnTheCaller) {
   for (std::size_t i = 0; i < order.size(); ++i) EXPECT_EQ(order[i], i);
 }
 
+TEST(RunBeside, BothStagesRunTheSecondOnAnotherThreadAndMainMayLoop) {
+  const ScopedEnv env("RWCALC_THREADS", "2");
+  const auto self = std::this_thread::get_id();
+  std::thread::id main_id, beside_id;
+  std::atomic<int> items{0};
+  rwcalc::run_beside(
+      [&] {
+        main_id = std::this_thread::get_id();
+        rwcalc::parallel_for(8, [&](std::size_t) { ++items; });
+      },
+      [&] { beside_id = std::this_thread::get_id(); });
+  EXPECT_EQ(main_id, self);
+  EXPECT_NE(beside_id, self);
+  EXPECT_EQ(items.load(), 8);
+}
+
+TEST(RunBeside, MainsErrorComesFirstAndBesidesIsNotLost) {
+  const ScopedEnv env("RWCALC_THREADS", "2");
+  bool beside_ran = false;
+  try {
+    rwcalc::run_beside([] { throw std::runtime_error("main"); },
+                       [&] {
+                         beside_ran = true;
+                         throw std::runtime_error("beside");
+                       });
+    ADD_FAILURE() << "nothing thrown";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), "main");
+  }
+  EXPECT_TRUE(beside_ran);  // joined before the error left
+  EXPECT_THROW(rwcalc::run_beside([] {}, [] { throw std::runtime_error("beside"); }), std::runtime_error);
+}
+
+TEST(RunBeside, OneThreadRunsMainThenBesideOnTheCaller) {
+  const ScopedEnv env("RWCALC_THREADS", "1");
+  const auto self = std::this_thread::get_id();
+  std::vector<int> order;
+  rwcalc::run_beside(
+      [&] {
+        EXPECT_EQ(std::this_thread::get_id(), self);
+        order.push_back(1);
+      },
+      [&] {
+        EXPECT_EQ(std::this_thread::get_id(), self);
+        order.push_back(2);
+      });
+  EXPECT_EQ(order, (std::vector<int>{1, 2}));
+}
+
 TEST(WorkerCount, ReadsRwcalcThreadsAndIgnoresBadValues) {
   {
     const ScopedEnv env("RWCALC_THREADS", "3");

@@ -14,6 +14,12 @@ namespace rwcalc {
 /// the calling thread: the outer loop already has the cores busy.
 void parallel_for(std::size_t n, const std::function<void(std::size_t)>& fn);
 
+/// main() on this thread while beside() runs on another (a two-stage pipeline: the next piece of a
+/// file read while this one is parsed); returns when both have run. main may use parallel_for.
+/// main's exception is rethrown before beside's. With one worker (RWCALC_THREADS=1) or inside a
+/// parallel_for's items, main then beside on this thread.
+void run_beside(const std::function<void()>& main, const std::function<void()>& beside);
+
 /// Threads a parallel_for may use: RWCALC_THREADS from the environment when set to a whole number
 /// from 1 to 4096 (tests use it to show that results do not depend on it), else the hardware's.
 unsigned worker_count();

@@ -1,4 +1,5 @@
-// The library's only thread pool: threads started per loop, items handed out by an atomic index.
+// The library's only thread pool: threads started per loop, items handed out by an atomic index;
+// and the one two-stage pipeline, its second stage on a thread started per call.
 #include "rwcalc/parallel.hpp"
 
 #include <algorithm>
@@ -75,6 +76,33 @@ void parallel_for(std::size_t n, const std::function<void(std::size_t)>& fn) {
     work();
   }  // the jthreads join here
   if (error) std::rethrow_exception(error);
+}
+
+void run_beside(const std::function<void()>& main, const std::function<void()>& beside) {
+  if (inside_parallel_for || worker_count() <= 1) {
+    main();
+    beside();
+    return;
+  }
+  std::exception_ptr beside_error;
+  {
+    std::jthread helper;
+    try {
+      helper = std::jthread([&] {
+        try {
+          beside();
+        } catch (...) {
+          beside_error = std::current_exception();
+        }
+      });
+    } catch (const std::system_error&) {
+      main();  // no thread to be had: one after the other
+      beside();
+      return;
+    }
+    main();  // on an exception the helper joins as the jthread goes
+  }
+  if (beside_error) std::rethrow_exception(beside_error);
 }
 
 }  // namespace rwcalc

@@ -195,7 +195,8 @@ class Reader {
     } catch (const detail::CeilingReached&) {
       Reader& full = reached_ ? *reached_ : *this;
       full.text_taken_ = text_taken_;
-      full.refuse_memory(src);
+      full.text_estimate_ = text_estimate_;
+      full.refuse_memory();
     }
   }
   void read_bag(detail::BagStream& bag);
@@ -214,7 +215,7 @@ class Reader {
   [[nodiscard]] bool integer_mode() const { return in().mode == InputMode::Pulses || in().mode == InputMode::Counter; }
   [[nodiscard]] std::size_t line_of_sample(std::size_t k) const { return line_in_runs(runs_, k); }
   void read_lines(detail::TextSource& src);
-  [[noreturn]] void refuse_memory(const detail::TextSource& src) const;
+  [[noreturn]] void refuse_memory() const;
   [[noreturn]] void refuse_memory_bag(const detail::BagStream& bag) const;
   std::size_t take_lines(std::string& buf, bool at_end);
   bool decide_line_end(std::string_view s, bool at_end);
@@ -268,7 +269,8 @@ class Reader {
   const ReadOptions& opt_;
   const MemoryCeiling ceiling_;
   detail::SampleMemory memory_;
-  std::size_t text_taken_ = 0;  // bytes of text cut into lines so far
+  std::size_t text_taken_ = 0;     // bytes of text cut into lines so far
+  std::size_t text_estimate_ = 0;  // the text's likely length as of the pieces cut into lines
   const detail::Layout& layout_ = parser_.layout();
   bool started_ = false;
   char eol_ = 0;  // the line end: LF, or CR for classic Mac text (no LF but maybe a last one); 0 undecided
@@ -299,17 +301,27 @@ class Reader {
 void Reader::read_lines(detail::TextSource& src) {
   Progress progress(trf("reading {}", printable(src.name())), src.stored_size(), opt_.progress,
                     Progress::Measure::Bytes);
-  std::string buf;
-  for (bool more = true, first = true; more;) {
-    more = src.read(buf);
+  std::string buf, next;
+  // The next piece is read, checked and digested beside the parsing of this one (src is touched
+  // by that stage alone while it runs); its error, if any, comes after this piece's.
+  for (bool more = src.read(buf), first = true;;) {
     progress.advance(src.taken_bytes() - progress.done());
-    const std::size_t taken = take_lines(buf, !more);
+    text_estimate_ = src.size_estimate();  // as of the pieces parsed, not the one read ahead
+    const auto estimate = static_cast<double>(text_estimate_);
+    bool ahead = false;
+    std::size_t taken = 0;
+    run_beside([&] { taken = take_lines(buf, !more); },
+               [&] {
+                 next.clear();
+                 ahead = more && src.read(next);
+               });
     text_taken_ += taken;
-    const auto lines = static_cast<double>(line_);
-    if (first && parser_.layout_known())
-      reserve(static_cast<double>(src.size_estimate()) / static_cast<double>(taken) * lines);
+    if (first && parser_.layout_known()) reserve(estimate / static_cast<double>(taken) * static_cast<double>(line_));
     first = first && !parser_.layout_known();
     buf.erase(0, taken);
+    if (!more) break;
+    buf += next;
+    more = ahead;
   }
   if (!buf.empty()) line(buf);  // the last line, without a line end
 }
@@ -367,9 +379,8 @@ void Reader::bag_message(const detail::ImuMessage& m) {
 
 // The samples kept have reached the ceiling: the memory the whole record needs, judged from the
 // input's size (the text read so far held `held` bytes of samples), else only "more than".
-void Reader::refuse_memory(const detail::TextSource& src) const {
-  const double part =
-      static_cast<double>(src.size_estimate()) / static_cast<double>(std::max<std::size_t>(text_taken_, 1));
+void Reader::refuse_memory() const {
+  const double part = static_cast<double>(text_estimate_) / static_cast<double>(std::max<std::size_t>(text_taken_, 1));
   const double needed = static_cast<double>(memory_.held()) * part;
   const std::string ceiling =
       trf("the memory ceiling of {} ({})", format_memory(static_cast<double>(ceiling_.bytes)), ceiling_.origin);
