@@ -19,9 +19,9 @@ struct SpectralLineFound {
 
 /// The lines of the rate x'(t): bins whose one-sided Welch PSD (Hann windows of the largest power of
 /// two up to 2^16 samples that leaves at least 15 half-overlapping windows; 64 without overlap,
-/// spread evenly over the record, where it holds 64 whole windows or more) exceeds 10 times the local level (the median over the
-/// octave below to the octave above), with the window's main lobe (2 bins each side). None for
-/// records shorter than 15 windows of 256 samples.
+/// spread evenly over the record, where it holds 64 whole windows or more) exceeds 10 times the
+/// local level (the median over the octave below to the octave above), with the window's main
+/// lobe (2 bins each side). None for records shorter than 15 windows of 256 samples.
 std::vector<SpectralLineFound> find_spectral_lines(const PhaseSeries& x);
 
 /// The lines' Allan variance at τ: Σ excess·2 sin⁴(πfτ)/(πfτ)² (the AV of a stationary process of
