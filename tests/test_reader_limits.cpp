@@ -114,6 +114,31 @@ TEST(HostileInput, GzipOfNulBytesAfterGoodLinesNamesTheirLine) {
   }
 }
 
+TEST(HostileInput, ABadLineIsNamedBeforeBinaryDataInThePieceReadAheadOfIt) {
+  // The next 256-kB piece is read (and checked) while this one is parsed: a bad line here is still
+  // the error, not the binary data of the piece after it.
+  std::string text = "pulses\n";
+  for (int i = 0; i < 40000; ++i) text += "1\n";
+  text += "abc\n";                                                    // line 40002
+  while (text.size() < (std::size_t{1} << 18) + 1000) text += "2\n";  // the NULs in the second piece
+  text += std::string(1000, '\0');
+  try {
+    (void)rwcalc::read_recording_text(text, "mem.csv");
+    FAIL() << "accepted";
+  } catch (const rwcalc::InputError& e) {
+    EXPECT_EQ(e.line(), 40002u) << e.what();
+    EXPECT_EQ(std::string(e.what()).find("binary data"), std::string::npos) << e.what();
+  }
+  // Without the bad line, the binary data are the error.
+  text.replace(text.find("abc"), 3, "1\n1");
+  try {
+    (void)rwcalc::read_recording_text(text, "mem.csv");
+    FAIL() << "accepted";
+  } catch (const rwcalc::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("binary data"), std::string::npos) << e.what();
+  }
+}
+
 TEST(HostileInput, DevZeroAndDevUrandomEndQuicklyWithBinaryData) {
   for (const std::string dev : {"/dev/zero", "/dev/urandom"}) {
     const auto r = run_limited("", {"allan", dev});
