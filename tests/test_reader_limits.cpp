@@ -101,17 +101,28 @@ TEST(HostileInput, GzipOfNulBytesIsRefusedAtLineOneWithLittleMemory) {
   EXPECT_EQ(piped.err.rfind("rwcalc: error: <stdin>:1: binary data (byte 0x00 at column 1)", 0), 0u) << piped.err;
 }
 
+/// The error reading `text` as the file `name` gives: its line and words ("accepted", line 0, when
+/// the text is read without one).
+struct ReadFailure {
+  std::size_t line = 0;
+  std::string what = "accepted";
+};
+ReadFailure read_failure(const std::string& text, const char* name) {
+  try {
+    (void)rwcalc::read_recording_text(text, name);
+  } catch (const rwcalc::InputError& e) {
+    return {e.line(), e.what()};
+  }
+  return {};
+}
+
 TEST(HostileInput, GzipOfNulBytesAfterGoodLinesNamesTheirLine) {
   // Good lines first, then the NUL bytes in a later member: the line and column of the first one.
   const std::string head = "pulses\n1\n2\n3";
   const std::string text = gzip_repeated(head, 1) + gzip_repeated(std::string(std::size_t{1} << 20, '\0'), 200);
-  try {
-    (void)rwcalc::read_recording_text(text, "mem.gz");
-    FAIL() << "accepted";
-  } catch (const rwcalc::InputError& e) {
-    EXPECT_EQ(e.line(), 4u) << e.what();
-    EXPECT_NE(std::string(e.what()).find("binary data (byte 0x00 at column 2)"), std::string::npos) << e.what();
-  }
+  const ReadFailure f = read_failure(text, "mem.gz");
+  EXPECT_EQ(f.line, 4u) << f.what;
+  EXPECT_NE(f.what.find("binary data (byte 0x00 at column 2)"), std::string::npos) << f.what;
 }
 
 TEST(HostileInput, ABadLineIsNamedBeforeBinaryDataInThePieceReadAheadOfIt) {
@@ -122,21 +133,13 @@ TEST(HostileInput, ABadLineIsNamedBeforeBinaryDataInThePieceReadAheadOfIt) {
   text += "abc\n";                                                    // line 40002
   while (text.size() < (std::size_t{1} << 18) + 1000) text += "2\n";  // the NULs in the second piece
   text += std::string(1000, '\0');
-  try {
-    (void)rwcalc::read_recording_text(text, "mem.csv");
-    FAIL() << "accepted";
-  } catch (const rwcalc::InputError& e) {
-    EXPECT_EQ(e.line(), 40002u) << e.what();
-    EXPECT_EQ(std::string(e.what()).find("binary data"), std::string::npos) << e.what();
-  }
+  const ReadFailure bad_line = read_failure(text, "mem.csv");
+  EXPECT_EQ(bad_line.line, 40002u) << bad_line.what;
+  EXPECT_EQ(bad_line.what.find("binary data"), std::string::npos) << bad_line.what;
   // Without the bad line, the binary data are the error.
   text.replace(text.find("abc"), 3, "1\n1");
-  try {
-    (void)rwcalc::read_recording_text(text, "mem.csv");
-    FAIL() << "accepted";
-  } catch (const rwcalc::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("binary data"), std::string::npos) << e.what();
-  }
+  const ReadFailure binary = read_failure(text, "mem.csv");
+  EXPECT_NE(binary.what.find("binary data"), std::string::npos) << binary.what;
 }
 
 TEST(HostileInput, DevZeroAndDevUrandomEndQuicklyWithBinaryData) {

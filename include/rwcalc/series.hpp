@@ -36,8 +36,11 @@ struct PhaseSeries {
   /// Phase at index i in phase units.
   [[nodiscard]] double at(std::size_t i) const noexcept {
     return exact() ? static_cast<double>(count(i)) * arcsec_per_count
-                   : values[i] + rate_offset * static_cast<double>(i) * tau0_s;
+                   : values[i] + offset_phase(static_cast<double>(i));
   }
+  /// The rate offset's part of the floating phase over `lag` samples, rate_offset·lag·τ0: the same
+  /// for every pair of samples that far apart, so a loop over many pairs adds it as a constant.
+  [[nodiscard]] double offset_phase(double lag) const noexcept { return rate_offset * lag * tau0_s; }
   /// Phase difference x_j − x_i in phase units, exact for counts.
   [[nodiscard]] double diff(std::size_t j, std::size_t i) const noexcept {
     if (!counts.empty()) {
@@ -45,7 +48,7 @@ struct PhaseSeries {
           static_cast<std::int64_t>(static_cast<std::uint64_t>(counts[j]) - static_cast<std::uint64_t>(counts[i]));
       return static_cast<double>(d) * arcsec_per_count;
     }
-    return values[j] - values[i] + rate_offset * (static_cast<double>(j) - static_cast<double>(i)) * tau0_s;
+    return values[j] - values[i] + offset_phase(static_cast<double>(j) - static_cast<double>(i));
   }
   /// Record length T = (points − 1)·τ0, s.
   [[nodiscard]] double duration_s() const noexcept {
@@ -59,5 +62,12 @@ struct PhaseSeries {
   /// Rate sample i (0-based, i < points−1) in deviation units: (x_{i+1} − x_i)/τ0.
   [[nodiscard]] double rate(std::size_t i) const noexcept { return diff(i + 1, i) / tau0_s; }
 };
+
+/// First index of run r (0 … runs − 1) of `runs` runs of `width` consecutive samples spread evenly
+/// over `points` samples, the first at the start and the last ending at the end: a sample of a long
+/// record, bounded in size, that covers the whole of it.
+constexpr std::size_t spread_run_start(std::size_t r, std::size_t runs, std::size_t points, std::size_t width) {
+  return runs <= 1 ? 0 : r * (points - width) / (runs - 1);
+}
 
 }  // namespace rwcalc

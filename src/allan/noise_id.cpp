@@ -38,7 +38,7 @@ struct AcfRuns {
       : count(points),
         runs(points > kAcfMaxPoints ? kAcfRuns : 1),
         width(points > kAcfMaxPoints ? kAcfMaxPoints / kAcfRuns : points) {}
-  std::size_t start(std::size_t r) const { return runs == 1 ? 0 : r * (count - width) / (runs - 1); }
+  std::size_t start(std::size_t r) const { return spread_run_start(r, runs, count, width); }
 };
 
 /// Decimated phase p_k = x_{k·m} − x_0, k = 0 … ⌊(N−1)/m⌋, in arbitrary units (the ACF and the

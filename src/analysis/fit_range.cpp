@@ -219,7 +219,7 @@ double measured_variance_ratio(const PhaseSeries& x, std::int64_t m) {
   std::vector<double> d(4 * std::min(run, kRatioChunk));
   std::vector<std::uint64_t> lattice;
   for (std::size_t r = 0; r < runs; ++r) {
-    const std::size_t from = sampled ? r * (n - span) / (runs - 1) : 0;
+    const std::size_t from = spread_run_start(r, runs, n, span);
     for (std::size_t i0 = 0; i0 < run; i0 += d.size() / 4) {
       const std::size_t len = std::min(d.size() / 4, run - i0);
       lattice_differences(x, from + i0 * step, step, um, len, lattice, d.data());

@@ -52,7 +52,7 @@ std::vector<double> welch_rate_psd(const PhaseSeries& x, std::size_t w) {
   }
   detail::RealPowerSpectrum fft(w);
   for (std::size_t window = 0; window < count; ++window) {
-    const std::size_t start = spread ? window * (n - w) / (kSpreadWindows - 1) : window * (w / 2);
+    const std::size_t start = spread ? spread_run_start(window, kSpreadWindows, n, w) : window * (w / 2);
     double mean = 0;
     for (std::size_t i = 0; i < w; ++i) mean += (seg[i] = x.rate(start + i));
     mean /= static_cast<double>(w);

@@ -71,7 +71,7 @@ struct RateSource {
       }
     } else {  // PhaseSeries::rate, its rate offset's part the same for every sample
       const double* v = phase->values.data();
-      const double offset = phase->rate_offset * 1.0 * phase->tau0_s, tau0 = phase->tau0_s;
+      const double offset = phase->offset_phase(1.0), tau0 = phase->tau0_s;
       for (std::size_t i = from; i < to; ++i) out[i - from] = (v[i + 1] - v[i] + offset) / tau0;
     }
   }

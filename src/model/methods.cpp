@@ -67,12 +67,11 @@ void add_increment_sums(const std::int64_t* c, const detail::NarrowCounts& narro
 }
 
 /// Σd and Σd² of the increments d_k = x_{k+t} − x_k − shift, k0 ≤ k < k1, of a floating phase, in
-/// four lanes (a single running sum is bound by the adder's latency). The rate offset's part of
-/// x.diff is the same for every k: added as x.diff adds it.
+/// four lanes (a single running sum is bound by the adder's latency), as x.diff forms them.
 void add_floating_increment_sums(const PhaseSeries& x, std::size_t t, double shift, std::size_t k0, std::size_t k1,
                                  double (&s1)[4], double (&s2)[4]) {
   const double* v = x.values.data();
-  const double offset = x.rate_offset * static_cast<double>(t) * x.tau0_s;
+  const double offset = x.offset_phase(static_cast<double>(t));
   std::size_t k = k0;
   for (; k + 4 <= k1; k += 4)
     for (std::size_t j = 0; j < 4; ++j) {
@@ -87,25 +86,37 @@ void add_floating_increment_sums(const PhaseSeries& x, std::size_t t, double shi
   }
 }
 
-/// Sample variances of the overlapping increments of a floating phase (overlapping_variances), the
-/// mean rate taken out first.
-std::vector<double> floating_overlapping_variances(const PhaseSeries& x, const std::vector<std::size_t>& ts) {
-  const std::size_t n = x.points() - 1;
-  constexpr std::size_t kBlock = std::size_t{1} << 13, kChunk = kBlock * 64;
+/// The sums of every length's increments over the record, in one sweep of short blocks (the longest
+/// interval's window stays in cache), chunks of the record in parallel: add(sums, t, k0, k1) adds
+/// the terms k0 ≤ k < k1 of length t. One Sums per chunk and length, for the caller to add in
+/// chunk order (the result does not depend on the number of threads).
+template <class Sums, class Add>
+std::vector<std::vector<Sums>> sweep_increments(std::size_t n, const std::vector<std::size_t>& ts, const Add& add) {
+  constexpr std::size_t kBlock = std::size_t{1} << 14, kChunk = kBlock * 32;
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
-  struct Lanes {
-    double s1[4] = {}, s2[4] = {};
-  };
-  std::vector<std::vector<Lanes>> part(chunks, std::vector<Lanes>(ts.size()));
-  std::vector<double> shift(ts.size());
-  for (std::size_t i = 0; i < ts.size(); ++i)
-    shift[i] = x.diff(n, 0) * static_cast<double>(ts[i]) / static_cast<double>(n);
+  std::vector<std::vector<Sums>> part(chunks, std::vector<Sums>(ts.size()));
   parallel_for(chunks, [&](std::size_t ci) {
     for (std::size_t k0 = ci * kChunk; k0 < std::min(n, (ci + 1) * kChunk); k0 += kBlock)
       for (std::size_t i = 0; i < ts.size(); ++i) {
         const std::size_t k1 = std::min({k0 + kBlock, (ci + 1) * kChunk, n - ts[i] + 1});
-        if (k1 > k0) add_floating_increment_sums(x, ts[i], shift[i], k0, k1, part[ci][i].s1, part[ci][i].s2);
+        if (k1 > k0) add(part[ci][i], i, k0, k1);
       }
+  });
+  return part;
+}
+
+/// Sample variances of the overlapping increments of a floating phase (overlapping_variances), the
+/// mean rate taken out first.
+std::vector<double> floating_overlapping_variances(const PhaseSeries& x, const std::vector<std::size_t>& ts) {
+  const std::size_t n = x.points() - 1;
+  struct Lanes {
+    double s1[4] = {}, s2[4] = {};
+  };
+  std::vector<double> shift(ts.size());
+  for (std::size_t i = 0; i < ts.size(); ++i)
+    shift[i] = x.diff(n, 0) * static_cast<double>(ts[i]) / static_cast<double>(n);
+  const auto part = sweep_increments<Lanes>(n, ts, [&](Lanes& l, std::size_t i, std::size_t k0, std::size_t k1) {
+    add_floating_increment_sums(x, ts[i], shift[i], k0, k1, l.s1, l.s2);
   });
   std::vector<double> out(ts.size());
   for (std::size_t i = 0; i < ts.size(); ++i) {
@@ -119,17 +130,12 @@ std::vector<double> floating_overlapping_variances(const PhaseSeries& x, const s
 }
 
 /// Sample variances of the M = n − t + 1 overlapping increments x_{k+t} − x_k for every t in ts,
-/// ″², all lengths in one sweep over the record in short blocks (the longest interval's window
-/// stays in cache), chunks of the record in parallel and their sums added in chunk order (the
-/// result does not depend on the number of threads). Pulse counts: exact integer sums of the
-/// increments less the mean rate's whole counts (the variance does not see the shift, and the small
-/// values fit narrow sums). Floating phases: floating_overlapping_variances.
+/// ″², by sweep_increments. Pulse counts: exact integer sums of the increments less the mean
+/// rate's whole counts (the variance does not see the shift, and the small values fit narrow
+/// sums). Floating phases: floating_overlapping_variances.
 std::vector<double> overlapping_variances(const PhaseSeries& x, const std::vector<std::size_t>& ts) {
   if (!x.exact()) return floating_overlapping_variances(x, ts);
   const std::size_t n = x.points() - 1;
-  std::vector<double> out(ts.size());
-  constexpr std::size_t kBlock = std::size_t{1} << 14, kChunk = kBlock * 32;
-  const std::size_t chunks = (n + kChunk - 1) / kChunk;
   const detail::NarrowCounts narrow(x.counts.data(), x.points());
   const auto total = static_cast<double>(
       static_cast<std::int64_t>(static_cast<std::uint64_t>(x.count(n)) - static_cast<std::uint64_t>(x.count(0))));
@@ -138,15 +144,12 @@ std::vector<double> overlapping_variances(const PhaseSeries& x, const std::vecto
     const double s = std::round(total * static_cast<double>(ts[i]) / static_cast<double>(n));
     shift[i] = std::abs(s) < 0x1p62 ? static_cast<std::int64_t>(s) : 0;
   }
-  std::vector<std::vector<ExactSums>> part(chunks, std::vector<ExactSums>(ts.size()));
-  parallel_for(chunks, [&](std::size_t ci) {
-    for (std::size_t k0 = ci * kChunk; k0 < std::min(n, (ci + 1) * kChunk); k0 += kBlock)
-      for (std::size_t i = 0; i < ts.size(); ++i) {
-        const std::size_t k1 = std::min({k0 + kBlock, (ci + 1) * kChunk, n - ts[i] + 1});
-        if (k1 > k0) add_increment_sums(x.counts.data(), narrow, ts[i], shift[i], k0, k1, part[ci][i]);
-      }
-  });
+  const auto part =
+      sweep_increments<ExactSums>(n, ts, [&](ExactSums& sums, std::size_t i, std::size_t k0, std::size_t k1) {
+        add_increment_sums(x.counts.data(), narrow, ts[i], shift[i], k0, k1, sums);
+      });
   const double q2 = x.arcsec_per_count * x.arcsec_per_count;
+  std::vector<double> out(ts.size());
   for (std::size_t i = 0; i < ts.size(); ++i) {
     i128 s1 = 0, s2 = 0;
     for (const auto& p : part) {
