@@ -22,6 +22,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include "io/text_source.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/reader.hpp"
 #include "test_support.hpp"
@@ -126,12 +127,12 @@ TEST(HostileInput, GzipOfNulBytesAfterGoodLinesNamesTheirLine) {
 }
 
 TEST(HostileInput, ABadLineIsNamedBeforeBinaryDataInThePieceReadAheadOfIt) {
-  // The next 256-kB piece is read (and checked) while this one is parsed: a bad line here is still
-  // the error, not the binary data of the piece after it.
+  // The next piece is read (and checked) while this one is parsed: a bad line here is still the
+  // error, not the binary data of the piece after it.
   std::string text = "pulses\n";
   for (int i = 0; i < 40000; ++i) text += "1\n";
-  text += "abc\n";                                                    // line 40002
-  while (text.size() < (std::size_t{1} << 18) + 1000) text += "2\n";  // the NULs in the second piece
+  text += "abc\n";                                                         // line 40002
+  while (text.size() < rwcalc::detail::kPieceBytes + 1000) text += "2\n";  // the NULs in the second piece
   text += std::string(1000, '\0');
   const ReadFailure bad_line = read_failure(text, "mem.csv");
   EXPECT_EQ(bad_line.line, 40002u) << bad_line.what;

@@ -378,10 +378,12 @@ void Reader::bag_message(const detail::ImuMessage& m) {
 }
 
 // The samples kept have reached the ceiling: the memory the whole record needs, judged from the
-// input's size (the text read so far held `held` bytes of samples), else only "more than".
+// input's size (the text read so far gave the samples kept), else only "more than". The room made
+// ahead of a piece is not counted: it is not the record's.
 void Reader::refuse_memory() const {
   const double part = static_cast<double>(text_estimate_) / static_cast<double>(std::max<std::size_t>(text_taken_, 1));
-  const double needed = static_cast<double>(memory_.held()) * part;
+  const std::size_t kept = ints_.size() * sizeof(std::int64_t) + reals_.size() * sizeof(double);
+  const double needed = static_cast<double>(kept) * part;
   const std::string ceiling =
       trf("the memory ceiling of {} ({})", format_memory(static_cast<double>(ceiling_.bytes)), ceiling_.origin);
   const std::string remedy = trf("give {} SIZE if the machine has the memory, or cut the record", kMaxMemoryOption);

@@ -200,6 +200,7 @@ bool TextSource::inflate_piece(std::string& out) {
     in_member_ = in_member_ || magic_seen_ == 2;
     const int rc = inflate(&zs_, Z_NO_FLUSH);
     if (rc == Z_STREAM_END) {
+      members_in_ += zs_.total_in;
       inflateReset(&zs_);
       in_member_ = false;
       magic_seen_ = 0;

@@ -14,7 +14,8 @@ namespace rwcalc::detail {
 /// The longest line taken, in bytes without its line end: a stream without line ends is refused
 /// as soon as it passes this, so it cannot fill the memory.
 constexpr std::size_t kMaxLineBytes = std::size_t{1} << 20;
-/// Bytes handed out at a time; far below kMaxLineBytes.
+/// Bytes handed out at a time; far below kMaxLineBytes. Larger pieces (2 MiB) read a day-long IMU
+/// text more slowly: a piece's values no longer stay in the core's cache until they are taken.
 constexpr std::size_t kPieceBytes = std::size_t{1} << 18;
 
 /// Name used in messages for a path ("<stdin>" for "-").
@@ -63,9 +64,10 @@ class TextSource {
   /// 0 when unknown (a pipe). An estimate only.
   [[nodiscard]] std::size_t size_estimate() const noexcept {
     if (!gzip_) return bytes_;
-    return zs_.total_in ? static_cast<std::size_t>(static_cast<double>(bytes_) / static_cast<double>(zs_.total_in) *
-                                                   static_cast<double>(zs_.total_out))
-                        : 0;
+    const std::size_t in = members_in_ + zs_.total_in;  // zlib counts the current member only
+    return in ? static_cast<std::size_t>(static_cast<double>(bytes_) / static_cast<double>(in) *
+                                         static_cast<double>(inflated_))
+              : 0;
   }
 
  private:
@@ -88,7 +90,8 @@ class TextSource {
   z_stream zs_{};
   bool in_member_ = true;       // between a gzip member's first byte and its end
   std::size_t magic_seen_ = 0;  // bytes of the next member's magic seen since a member ended
-  std::size_t inflated_ = 0;
+  std::size_t inflated_ = 0;    // text inflated, every member
+  std::size_t members_in_ = 0;  // compressed bytes of the members ended
   TextCheck check_;
   Sha256 hash_;
   std::size_t raw_total_ = 0;
