@@ -9,7 +9,10 @@
 #      `rwcalc imu` of a 24-h 200-Hz ROS 1 bag in at most 2× the time of its rostopic CSV.
 #   3. the default 50-run `rwcalc diagnose` of the 2-h record takes at most 1.5× the NumPy
 #      baseline, side by side as in 1.
-# Other rows (dense grid, `allan`, `--tau all`, the `cat` floor) are figures without a target. It builds the `bench` preset if needed, generates the inputs with `rwcalc simulate`
+# Other rows (dense grid, `allan`, `--tau all`, the `cat` floor, and with --allantools the floor of
+# analyze's ratio: bench/floor_oadev.cpp, read + octave OADEV and nothing else, the fastest way
+# measured) are figures without a target. It builds the `bench` preset if needed, generates the
+# inputs with `rwcalc simulate`
 # (cached under the build directory) and times whole processes (median of --repeat runs: wall
 # clock from bash's EPOCHREALTIME, user+sys CPU from its `time`; peak RSS from /usr/bin/time -v).
 # On a shared machine the CPU column is the load-independent figure; the ratio of target 1 is
@@ -234,6 +237,22 @@ elif [[ -z "$py" ]]; then
 else
   analyze_vs "$speed_name" "$py" "$here/bench/numpy_oavar.py" "$run2h" --grid octave
 fi
+# The floor of that ratio: bench/floor_oadev.cpp (read + octave OADEV, nothing else, the fastest
+# way measured) side by side with AllanTools; analyze does all that and more.
+floor_vs_allantools() {
+  local name="floor: bench/floor_oadev.cpp (read + octave OADEV only) vs AllanTools' own oadev" l
+  if ! "${CXX:-g++}" -O2 -std=c++20 -pthread "$here/bench/floor_oadev.cpp" -o "$tmp/floor_oadev" 2>"$tmp/err.txt"; then
+    row "$name" "analyze's ceiling" "not built: $(head -c 200 "$tmp/err.txt")" "" "" "" ""
+    return
+  fi
+  l=$(loadavg)
+  side_by_side "$repeat" "$tmp/floor_oadev" "$run2h" -- "$py" "$here/bench/allantools_oadev.py" "$allantools" "$run2h"
+  if ((status)); then row "$name" "analyze's ceiling" "$(failed)" "" "" "" "$l"; return; fi
+  row "$name" "analyze's ceiling" \
+    "$(printf '%.1f× (%s vs %s)' "$(calc "$b_s / $a_s")" "$(fmt_t "$a_s")" "$(fmt_t "$b_s")")" \
+    "$(printf '%.1f× (%s vs %s)' "$(calc "$b_c / $a_c")" "$(fmt_t "$a_c")" "$(fmt_t "$b_c")")" \
+    "$(fmt_mb "$rss_mb")" "" "$l"
+}
 at_name="analyze 2-h 400 Hz vs AllanTools' own oadev (read + octave OADEV, whole processes)"
 if [[ -n "$allantools" ]]; then
   if [[ ! -f "$allantools/allantools/__init__.py" ]]; then
@@ -242,6 +261,7 @@ if [[ -n "$allantools" ]]; then
     row "$at_name" "≥ 25× faster" "skipped (AllanTools needs python3 with numpy and scipy)" "" "" "" ""
   elif available analyze; then
     analyze_vs "$at_name" "$py" "$here/bench/allantools_oadev.py" "$allantools" "$run2h"
+    floor_vs_allantools
   fi
 fi
 if available analyze; then
