@@ -8,12 +8,13 @@
 # report --docx and its tests (optional at run time; chromium, which prints report --pdf, is left
 # out for its size, about 290 MB: `apt-get install chromium poppler-utils` runs the PDF tests too).
 # clang-format, clang-tidy: the style checks (scripts/lint.sh). python3-jsonschema: the test
-# result_schema validates every JSON output against docs/result.schema.json.
+# result_schema validates every JSON output against docs/result.schema.json. libfftw3-dev: the
+# simulator's flicker FFT (single precision, libfftw3f).
 set -euo pipefail
 PACKAGES=(cmake g++ make ninja-build libeigen3-dev libcli11-dev libfmt-dev nlohmann-json3-dev zlib1g-dev libssl-dev libboost-dev
           libgtest-dev libbenchmark-dev gnuplot-nox python3-numpy time dpkg-dev man-db gettext python3-yaml
           libsqlite3-dev libbz2-dev liblz4-dev libzstd-dev g++-11 libyaml-dev pandoc
-          clang-format clang-tidy python3-jsonschema)
+          clang-format clang-tidy python3-jsonschema libfftw3-dev)
 missing=()
 for p in "${PACKAGES[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done
 ((${#missing[@]})) || exit 0

@@ -66,9 +66,9 @@ class Simulator {
   [[nodiscard]] const NoiseModel& model() const noexcept;
 
   /// Peak bytes a simulator of this model and length holds beyond a few MiB: the flicker
-  /// (bias-instability) term's FFT over twice the record, about 104 bytes per sample (176 for
-  /// lengths whose FFT size is not a multiple of 4); 0 without that term. simulate compares it with
-  /// the memory ceiling before it starts.
+  /// (bias-instability) term's single-precision FFT over twice the record, its buffer and plan,
+  /// about 21 bytes per sample (17 measured); 0 without that term. simulate compares it with the
+  /// memory ceiling before it starts.
   [[nodiscard]] static std::size_t memory_bytes(const NoiseModel& model, const SimulationSettings& settings,
                                                 SimulationPath path = SimulationPath::Exact);
 

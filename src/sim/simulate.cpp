@@ -9,8 +9,9 @@
 #include <complex>
 #include <limits>
 #include <numbers>
-#include <unsupported/Eigen/FFT>
 
+#include "flicker_circulant.hpp"
+#include "real_fft.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/random.hpp"
 #include "rwcalc/units.hpp"
@@ -48,7 +49,7 @@ double gm_angle_var_factor(double x) {
 
 inline std::int64_t floor_to_int(double x) noexcept { return static_cast<std::int64_t>(std::floor(x)); }
 
-// Smallest 2^a·3^b·5^c ≥ n that is even (kissfft handles radices 2, 3, 5 efficiently).
+// Smallest 2^a·3^b·5^c ≥ n that is even (FFTW transforms them with codelets of radices 2, 3, 5).
 std::size_t good_fft_size(std::size_t n) {
   std::size_t best = std::numeric_limits<std::size_t>::max();
   for (std::size_t p5 = 1; p5 < 2 * n + 10; p5 *= 5)
@@ -171,11 +172,10 @@ struct Simulator::Impl {
   std::size_t flicker_hold = 1;  // samples each flicker rate value is held for (D)
   double tau0 = 0.0;
   double q = 0.0;
-  // Flicker: the Kasdin filter's spectrum, computed once per length.
+  // Flicker: one buffer for the drawn spectrum, its transform (the increments) and the rates of unit
+  // B (floats; flicker_rates() below).
   std::size_t fft_size = 0;
-  Eigen::FFT<double> fft;
-  std::vector<std::complex<double>> filter_spectrum, spectrum;
-  std::vector<double> flicker;
+  std::unique_ptr<detail::RealInverseFft> flicker_fft;
   double level_sd = 0.0;  // standard deviation of the first flicker rate per B
   std::vector<GmStep> gm_steps;
   // Sinusoids: cos and sin of (j + 1)·ωτ0 for j < kBlock, per line (deterministic_block).
@@ -196,7 +196,6 @@ struct Simulator::Impl {
     }
     tau0 = settings.tau0_s();
     q = settings.scale_arcsec;
-    fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
     if (model.bias_instability_deg_per_h > 0) prepare_flicker();
     for (const auto& l : model.sinusoids) {
       LineSteps t;
@@ -229,17 +228,10 @@ struct Simulator::Impl {
     // circulant embedding of length L ≥ 2n has eigenvalues λ ≥ 0 (all γ(h ≠ 0) < 0, Craigmile
     // 2003), so filtering white noise by √λ gives increments with exactly that covariance
     // (Davies–Harte). A filter cut at the record length instead adds a spurious rate random walk
-    // (AV +7 % at τ = T/4, +18 % at T/2).
+    // (AV +7 % at τ = T/4, +18 % at T/2). The eigenvalues are computed bin by bin as the spectrum
+    // is drawn (detail::FlickerCirculant), so only the transform's buffer is held.
     fft_size = good_fft_size(2 * flicker_n);
-    const std::size_t half = fft_size / 2;
-    std::vector<double> acf(fft_size, 0.0);
-    for (std::size_t h = 0; h <= half; ++h) {
-      const double hd = static_cast<double>(h);
-      acf[h] = 4.0 / (std::numbers::pi * (1.0 - 4.0 * hd * hd));
-      if (h > 0 && h < half) acf[fft_size - h] = acf[h];
-    }
-    fft.fwd(filter_spectrum, acf);
-    for (auto& l : filter_spectrum) l = std::sqrt(std::max(l.real(), 0.0));
+    flicker_fft = std::make_unique<detail::RealInverseFft>(fft_size);
     // Level of the first rate value: the spread a Kasdin filter of n taps gives it (Σ h_k²).
     double hk = 1.0;
     level_sd = 1.0;
@@ -248,31 +240,44 @@ struct Simulator::Impl {
       level_sd += hk * hk;
     }
     level_sd = std::sqrt(level_sd);
-    spectrum.resize(filter_spectrum.size());
-    flicker.resize(fft_size);
   }
 
-  // Flicker rate samples, ″/s, by filtering white noise whose DFT is drawn directly (independent
-  // complex normal bins) into the rate's increments, summed. On the Ensemble path the Kasdin
-  // sequence is at τd = D·τ0 (Q_d = B² keeps the low-frequency PSD B²/(πf)), each value held over
-  // D samples.
+  // Flicker rate samples of unit B (″/s per °/h of B), by filtering white noise whose DFT is drawn directly
+  // (independent complex normal bins) into the rate's increments, summed. On the Ensemble path the Kasdin sequence is
+  // at τd = D·τ0 (Q_d = B² keeps the low-frequency PSD B²/(πf)), each value held over D samples.
+  //
+  // The spectrum and its transform are single precision: the transform's rounding error is white,
+  // about 1e-13 of the increments' mean power (float's 6e-8, squared, times the FFT's log L growth),
+  // far below the smallest eigenvalue that shapes the flicker (λ_1 ≈ π/H: 1.5e-7 for 6 h at 1 kHz),
+  // so the covariance stays exact to well within the statistics of any record. The eigenvalues
+  // themselves are computed in double (FlickerCirculant), and the rates summed in double.
   void make_flicker(std::uint64_t seed) {
     Rng rng(seed, kFlickerStream);
-    const double b = model.bias_instability_deg_per_h;  // Q_d = B²
+    const detail::FlickerCirculant circulant(fft_size);
+    // Standard deviations of unit B with the transform's 1/L folded in: L·λ_k/L² for the real
+    // bins 0 and L/2, half of it for each of the other bins' real and imaginary parts.
     const double len = static_cast<double>(fft_size);
-    const double s_edge = b * std::sqrt(len);
-    const double s_mid = b * std::sqrt(len / 2.0);
+    const auto sd = [&](std::size_t k, double parts) {
+      return std::sqrt(std::max(circulant.eigenvalue(k), 0.0) / (parts * len));
+    };
     const std::size_t half = fft_size / 2;
-    spectrum[0] = filter_spectrum[0] * s_edge * rng.normal();
+    std::complex<float>* bins = flicker_fft->spectrum();
+    bins[0] = static_cast<float>(sd(0, 1.0) * rng.normal());
     for (std::size_t k = 1; k < half; ++k) {
+      const double s = sd(k, 2.0);
       const double re = rng.normal(), im = rng.normal();
-      spectrum[k] = filter_spectrum[k] * std::complex<double>(s_mid * re, s_mid * im);
+      bins[k] = {static_cast<float>(s * re), static_cast<float>(s * im)};
     }
-    spectrum[half] = filter_spectrum[half] * s_edge * rng.normal();
-    fft.inv(flicker.data(), spectrum.data(), static_cast<Eigen::Index>(fft_size));
-    // Rates from the increments (flicker[0]'s increment is not used).
-    flicker[0] = b * level_sd * rng.normal();
-    for (std::size_t k = 1; k < flicker_n; ++k) flicker[k] += flicker[k - 1];
+    bins[half] = static_cast<float>(sd(half, 1.0) * rng.normal());
+    flicker_fft->run();
+    // Rates from the increments (the first one's increment is not used), summed in double.
+    float* rates = flicker_fft->values();
+    double rate = level_sd * rng.normal();
+    rates[0] = static_cast<float>(rate);
+    for (std::size_t k = 1; k < flicker_n; ++k) {
+      rate += rates[k];
+      rates[k] = static_cast<float>(rate);
+    }
   }
 
   // A realisation is generated in blocks of kBlock samples: each term adds its angle increments
@@ -373,9 +378,11 @@ struct Simulator::Impl {
   // Flicker values held over flicker_hold samples each: the one at b for the rest of its hold,
   // then whole holds.
   void flicker_block(std::size_t b, std::size_t len, double* x) const {
+    const float* rates = flicker_fft->values();
+    const double unit_step = model.bias_instability_deg_per_h * tau0;
     std::size_t v = b / flicker_hold, left = flicker_hold - b % flicker_hold;
     for (std::size_t j = 0; j < len; ++v, left = flicker_hold) {
-      const double step = flicker[v] * tau0;
+      const double step = unit_step * rates[v];
       for (const std::size_t end = std::min(len, j + left); j < end; ++j) x[j] += step;
     }
   }
@@ -547,12 +554,8 @@ std::size_t Simulator::memory_bytes(const NoiseModel& model, const SimulationSet
     const std::size_t hold = std::min(flicker_decimation(settings.rate_hz), n);
     n = (n + hold - 1) / hold;
   }
-  const std::size_t size = good_fft_size(2 * n);
-  // Bytes per FFT point: the filter's spectrum, the drawn spectrum (each L/2 + 1 complex values)
-  // and the flicker (L doubles) held for the record, 24; Eigen's kissfft for a real transform of L
-  // points, when 4 divides L: a plan of L/2 twiddles each way, L/4 real twiddles and an L/2 buffer,
-  // 28; else a complex transform of L points each way and two L-point buffers, 64.
-  return size * (24 + (size % 4 == 0 ? 28 : 64));
+  // The one buffer of the flicker's spectrum, increments and rates, and FFTW's plan.
+  return detail::RealInverseFft::memory_bytes(good_fft_size(2 * n));
 }
 
 PhaseSeries simulate(const NoiseModel& model, const SimulationSettings& settings) {
