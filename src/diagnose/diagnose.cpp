@@ -12,6 +12,8 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <tuple>
+#include <vector>
 
 #include "band.hpp"
 #include "effects.hpp"
@@ -217,10 +219,41 @@ void merge_fast(DetectorResult& d, const Candidate& c, const std::optional<FastL
   }
 }
 
+/// Two effects at once can each hide the other: a slow line and a step together raise the profiled
+/// noise levels against which either alone is tested (a 0.06 °/h step beside a line at 5× the
+/// flicker floor: p 0.023 and 0.072 alone). When no family fires, the two with the smallest p-values
+/// (each within kPairScreen·α, fitted to the block means rather than found in the periodogram) are
+/// searched each against the model holding the other's candidate; both are named when each is then
+/// within α. Under the null the pair needs two conditional p-values within α, far rarer than one.
+constexpr double kPairScreen = 10.0;
+
+struct NamedPair {
+  std::size_t first = 0, second = 0;
+  Candidate first_given_second, second_given_first;
+};
+
+std::optional<NamedPair> pair_of(const std::vector<Effect>& families, const std::vector<Candidate>& cands,
+                                 const std::vector<DetectorResult>& verdicts, const std::vector<bool>& usable,
+                                 const Blocks& b, double alpha) {
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < families.size(); ++i)
+    if (usable[i] && verdicts[i].p_value <= kPairScreen * alpha) order.push_back(i);
+  if (order.size() < 2) return std::nullopt;
+  std::partial_sort(order.begin(), order.begin() + 2, order.end(),
+                    [&](std::size_t x, std::size_t y) { return verdicts[x].p_value < verdicts[y].p_value; });
+  NamedPair pair{order[0], order[1], {}, {}};
+  pair.second_given_first = search(families[pair.second], b, cands[pair.first].model, alpha);
+  if (!(pair.second_given_first.p <= alpha)) return std::nullopt;
+  pair.first_given_second = search(families[pair.first], b, cands[pair.second].model, alpha);
+  if (!(pair.first_given_second.p <= alpha)) return std::nullopt;
+  return pair;
+}
+
 /// Forward selection: every family searched against the current model, the one with the smallest
 /// p-value bound named when that bound is within its false-alarm level, and the search repeated
-/// against the model that includes it; the families' verdicts are their last ones. Returns the
-/// final model; `fast_named` tells whether the line family was named from the periodogram.
+/// against the model that includes it (or, when none fires, two named at once: pair_of); the
+/// families' verdicts are their last ones. Returns the final model; `fast_named` tells whether the
+/// line family was named from the periodogram.
 GlsModel select_effects(const Blocks& b, GlsModel cur, const Outside& out, double alpha, DiagnoseResult& r,
                         bool& fast_named, Progress* progress) {
   const std::vector<Effect> families = {Effect::Sinusoid, Effect::Line, Effect::BiasStep, Effect::Warmup,
@@ -243,7 +276,22 @@ GlsModel select_effects(const Blocks& b, GlsModel cur, const Outside& out, doubl
       if (verdicts[i].fired && (best == families.size() || verdicts[i].p_value < verdicts[best].p_value)) best = i;
     }
     if (progress) progress->advance();
-    if (best == families.size()) break;
+    if (best == families.size()) {
+      std::vector<bool> usable(families.size());
+      for (std::size_t i = 0; i < families.size(); ++i) usable[i] = !named[i] && !fast[i];
+      const std::optional<NamedPair> pair = pair_of(families, cands, verdicts, usable, b, alpha);
+      if (!pair) break;
+      for (const auto& [i, c, other] : {std::tuple{pair->first, pair->first_given_second, pair->second},
+                                        std::tuple{pair->second, pair->second_given_first, pair->first}}) {
+        named[i] = true;
+        verdicts[i] = verdict(c, false, alpha);
+        verdicts[i].fired = verdicts[i].named = true;
+        verdicts[i].note =
+            trf("named with the {}: each is significant given the other", detector_name(families[other]));
+      }
+      cur = pair->second_given_first.model;
+      continue;
+    }
     named[best] = true;
     verdicts[best].named = true;
     if (fast[best])
