@@ -176,11 +176,11 @@ double ninety(const std::vector<double>& mults, const std::vector<double>& frac)
 // Slow lines (3–5 cycles) at 3–4.5× the flicker floor: rwcalc's 90 % amplitude for naming the line
 // (frequency within 0.5/T, amplitude within 30 %) beside the reference's at the same 1 %
 // false-alarm rate, and no line named a Gauss–Markov term. Measured on the acceptance's 16 records per
-// amplitude: reference 3.30×, rwcalc 3.85× (ratio 1.167); the bound asserted there is 1.2, above the
-// 1.15 aimed at, which is not yet reached. The default 6 records per amplitude resolve the 90 % point
-// to about a third of a step: 1.3 is asserted. rwcalc is not run at 3×, where it names fewer than 90 %
-// in every measurement so far: if it ever names 90 % at 3.5×, 3.5× is taken as its 90 % amplitude, an
-// upper bound, so the assertion can only be stricter for it.
+// amplitude: reference 3.30×, rwcalc 3.70× (ratio 1.121), and 1.15 is asserted there. The default 6
+// records per amplitude resolve the 90 % point to about a third of a step: 1.3 is asserted. rwcalc
+// is not run at 3×, where it names fewer than 90 % in every measurement so far: if it ever names
+// 90 % at 3.5×, 3.5× is taken as its 90 % amplitude, an upper bound, so the assertion can only be
+// stricter for it.
 TEST(DiagnoseReference, SlowLinesWithinFifteenPercentOfTheReferenceAmplitude) {
   const Reference ref(static_cast<Eigen::Index>(kT / kTb) - 2);
   // The reference's threshold: its 99 % quantile over 200 clean records.
@@ -230,6 +230,6 @@ TEST(DiagnoseReference, SlowLinesWithinFifteenPercentOfTheReferenceAmplitude) {
       "reference threshold {:.2f} (99 % of 200 clean records); 90 % amplitude: reference {:.2f}x, rwcalc {:.2f}x "
       "(ratio {:.3f}); Gauss-Markov named in {} line records\n",
       threshold, a_ref, a_rw, a_rw / a_ref, gauss_markov);
-  EXPECT_LE(a_rw, (n >= 16 ? 1.2 : 1.3) * a_ref);
+  EXPECT_LE(a_rw, (n >= 16 ? 1.15 : 1.3) * a_ref);
   EXPECT_EQ(gauss_markov, 0);
 }
