@@ -163,6 +163,12 @@ double fast_flicker_avar(double b, std::size_t m, std::size_t decimation) {
   return (4.0 * b * b / std::numbers::pi) * total / static_cast<double>(d) / (2.0 * md * md);
 }
 
+// A simulator that draws many short records (the direct-N bootstrap: 64 of a few thousand bins)
+// keeps its bins' standard deviations rather than compute each eigenvalue (about 40 ns) again for
+// every record; a long record's flicker, drawn once, computes them as it goes (a table would be as
+// large as the transform's buffer). 2^20 bins: 8 MiB.
+constexpr std::size_t kTabledBins = std::size_t{1} << 20;
+
 struct Simulator::Impl {
   NoiseModel model;
   SimulationSettings settings;
@@ -176,7 +182,8 @@ struct Simulator::Impl {
   // B (floats; flicker_rates() below).
   std::size_t fft_size = 0;
   std::unique_ptr<detail::RealInverseFft> flicker_fft;
-  double level_sd = 0.0;  // standard deviation of the first flicker rate per B
+  std::vector<double> bin_sd;  // bin_sd_of every bin, when the table is short (kTabledBins)
+  double level_sd = 0.0;       // standard deviation of the first flicker rate per B
   std::vector<GmStep> gm_steps;
   // Sinusoids: cos and sin of (j + 1)·ωτ0 for j < kBlock, per line (deterministic_block).
   struct LineSteps {
@@ -232,6 +239,10 @@ struct Simulator::Impl {
     // is drawn (detail::FlickerCirculant), so only the transform's buffer is held.
     fft_size = good_fft_size(2 * flicker_n);
     flicker_fft = std::make_unique<detail::RealInverseFft>(fft_size);
+    if (fft_size / 2 + 1 <= kTabledBins) {
+      const detail::FlickerCirculant circulant(fft_size);
+      for (std::size_t k = 0; k <= fft_size / 2; ++k) bin_sd.push_back(bin_sd_of(circulant, k));
+    }
     // Level of the first rate value: the spread a Kasdin filter of n taps gives it (Σ h_k²).
     double hk = 1.0;
     level_sd = 1.0;
@@ -240,6 +251,13 @@ struct Simulator::Impl {
       level_sd += hk * hk;
     }
     level_sd = std::sqrt(level_sd);
+  }
+
+  // Standard deviation of bin k's real (and imaginary) part, of unit B with the transform's 1/L
+  // folded in: L·λ_k/L² for the real bins 0 and L/2, half of it for each part of the others.
+  [[nodiscard]] double bin_sd_of(const detail::FlickerCirculant& circulant, std::size_t k) const {
+    const double parts = k == 0 || k == fft_size / 2 ? 1.0 : 2.0;
+    return std::sqrt(std::max(circulant.eigenvalue(k), 0.0) / (parts * static_cast<double>(fft_size)));
   }
 
   // Flicker rate samples of unit B (″/s per °/h of B), by filtering white noise whose DFT is drawn directly
@@ -254,21 +272,16 @@ struct Simulator::Impl {
   void make_flicker(std::uint64_t seed) {
     Rng rng(seed, kFlickerStream);
     const detail::FlickerCirculant circulant(fft_size);
-    // Standard deviations of unit B with the transform's 1/L folded in: L·λ_k/L² for the real
-    // bins 0 and L/2, half of it for each of the other bins' real and imaginary parts.
-    const double len = static_cast<double>(fft_size);
-    const auto sd = [&](std::size_t k, double parts) {
-      return std::sqrt(std::max(circulant.eigenvalue(k), 0.0) / (parts * len));
-    };
+    const auto sd = [&](std::size_t k) { return bin_sd.empty() ? bin_sd_of(circulant, k) : bin_sd[k]; };
     const std::size_t half = fft_size / 2;
     std::complex<float>* bins = flicker_fft->spectrum();
-    bins[0] = static_cast<float>(sd(0, 1.0) * rng.normal());
+    bins[0] = static_cast<float>(sd(0) * rng.normal());
     for (std::size_t k = 1; k < half; ++k) {
-      const double s = sd(k, 2.0);
+      const double s = sd(k);
       const double re = rng.normal(), im = rng.normal();
       bins[k] = {static_cast<float>(s * re), static_cast<float>(s * im)};
     }
-    bins[half] = static_cast<float>(sd(half, 1.0) * rng.normal());
+    bins[half] = static_cast<float>(sd(half) * rng.normal());
     flicker_fft->run();
     // Rates from the increments (the first one's increment is not used), summed in double.
     float* rates = flicker_fft->values();
@@ -554,8 +567,10 @@ std::size_t Simulator::memory_bytes(const NoiseModel& model, const SimulationSet
     const std::size_t hold = std::min(flicker_decimation(settings.rate_hz), n);
     n = (n + hold - 1) / hold;
   }
-  // The one buffer of the flicker's spectrum, increments and rates, and FFTW's plan.
-  return detail::RealInverseFft::memory_bytes(good_fft_size(2 * n));
+  // The one buffer of the flicker's spectrum, increments and rates, FFTW's plan, and a short
+  // transform's table of bin standard deviations.
+  const std::size_t size = good_fft_size(2 * n), bins = size / 2 + 1;
+  return detail::RealInverseFft::memory_bytes(size) + (bins <= kTabledBins ? bins * sizeof(double) : 0);
 }
 
 PhaseSeries simulate(const NoiseModel& model, const SimulationSettings& settings) {
