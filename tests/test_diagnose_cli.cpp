@@ -61,8 +61,8 @@ TEST_F(DiagnoseCli, JsonHasTheDocumentedKeysAndFindsTheSinusoid) {
       EXPECT_LE(row["median"].get<double>(), row["band_high"].get<double>());
     }
   }
-  for (const char* k : {"misfit_base", "misfit_extended", "coverage_base", "coverage_extended", "holdout_misfit_base",
-                        "holdout_misfit_extended"})
+  for (const char* k : {"misfit_base", "misfit_extended", "coverage_base", "coverage_extended", "likelihood_in_sample",
+                        "likelihood_holdout"})
     ASSERT_TRUE(j["gain"][k].is_number()) << k;
   ASSERT_EQ(j["findings"].size(), 1u) << j["findings"].dump();
   const auto& f = j["findings"][0];
@@ -114,7 +114,7 @@ TEST_F(DiagnoseCli, ReportCarriesUnitsAndTheFinding) {
   EXPECT_NE(r.out.find("frequency = 0.05"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find(" Hz; amplitude = "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("°/h"), std::string::npos);
-  EXPECT_NE(r.out.find("out-of-sample −2 ln L per block"), std::string::npos);
+  EXPECT_NE(r.out.find("likelihood gain on held-out runs (−2Δ ln L)"), std::string::npos);
   EXPECT_EQ(r.out.find("nan"), std::string::npos);
 }
 
@@ -197,6 +197,8 @@ TEST(DiagnoseCliLowpass, OutputChainFilterIsNamedAndSimulatedBack) {
   EXPECT_GT(tc["standard_uncertainty"].get<double>(), 0.0);
   EXPECT_NEAR(j["extended_model"]["output_lowpass_tc_s"].get<double>(), tc["value"].get<double>(), 1e-12);
   EXPECT_LT(j["gain"]["misfit_extended"].get<double>(), j["gain"]["misfit_base"].get<double>());
+  EXPECT_GT(j["gain"]["likelihood_in_sample"].get<double>(), 0.0);
+  EXPECT_GT(j["gain"]["likelihood_holdout"].get<double>(), 0.0);
   const auto again = (dir.path() / "again.csv").string();
   r = run_cli({"simulate", "--from", out, "-o", again, "--duration", "1200"});
   ASSERT_EQ(r.status, 0) << r.err;

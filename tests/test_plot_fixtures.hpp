@@ -213,8 +213,8 @@ inline nlohmann::json fixture_diagnosis(bool with_extended = true, bool nested =
               {"misfit_extended", 1.1},
               {"coverage_base", 0.55},
               {"coverage_extended", 1.0},
-              {"holdout_misfit_base", 12.0},
-              {"holdout_misfit_extended", 1.4}}}};
+              {"likelihood_in_sample", 12.0},
+              {"likelihood_holdout", 1.4}}}};
   if (nested) {
     d["base_model"]["band"] = base_band;
     if (with_extended) d["extended_model"]["band"] = ext_band;

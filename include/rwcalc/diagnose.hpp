@@ -95,9 +95,13 @@ struct Finding {
 struct Gain {
   double misfit_base = 0, misfit_extended = 0;      ///< EDF-weighted AV misfit (≈ 1 when the model fits)
   double coverage_base = 0, coverage_extended = 0;  ///< share of measured τ inside the band
-  /// Out of sample (fit on one block, predict a neighbour); NaN (JSON null) when nothing was
-  /// named, the extended model then being the base.
-  double holdout_misfit_base = 0, holdout_misfit_extended = 0;
+  /// −2 Δ ln L of the base against the extended model over the tests that named the terms, less 2
+  /// per parameter the extended model adds (Akaike): positive when the extended model is the better
+  /// description. NaN (JSON null) when nothing was named, the extended model then being the base.
+  double likelihood_in_sample = 0;
+  /// The same on held-out data, uncharged: each half of the record scored given the other half
+  /// by the models fitted on that other half, summed over the two halves.
+  double likelihood_holdout = 0;
 };
 
 struct DiagnoseResult {

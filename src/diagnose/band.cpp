@@ -1,10 +1,8 @@
-// The bands of σ per τ from the models' theoretical AV, and the gain in and out of sample
-// (band.hpp).
+// The bands of σ per τ from the models' theoretical AV and their misfit (band.hpp).
 #include "band.hpp"
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "models.hpp"
 #include "rwcalc/allan.hpp"
@@ -88,33 +86,9 @@ NoiseModel noise_only(NoiseModel m) {
   return m;
 }
 
-/// Half `h` (0, 1) of the block means.
-Blocks half(const Blocks& b, int h) {
-  const std::size_t n = b.y.size() / 2;
-  Blocks out;
-  out.tb = b.tb;
-  out.t0 = b.t0 + (h ? static_cast<double>(n) * b.tb : 0.0);
-  out.y.assign(b.y.begin() + (h ? static_cast<std::ptrdiff_t>(n) : 0),
-               h ? b.y.end() : b.y.begin() + static_cast<std::ptrdiff_t>(n));
-  out.z = second_differences(out.y);
-  return out;
-}
-
-/// −2 ln L per block of `test` under `m` fitted on `fit` (terms whose columns vanish on `fit`,
-/// such as a step outside it, are left out of both).
-double predicted(const Blocks& fit, const Blocks& test, const GlsModel& m) {
-  GlsModel f;
-  f.cov = m.cov;
-  for (const auto& d : m.det)
-    if (det_columns(fit, d).squaredNorm() > 1e-12 * static_cast<double>(fit.n())) f.det.push_back(d);
-  refit(fit, f, m, 1e-12);
-  return m2ll_fixed(test, hypothesis_of(test, f.det, f.cov), f.fit.level, f.fit.beta) / static_cast<double>(test.n());
-}
-
 }  // namespace
 
-void bands_and_gain(const PhaseSeries& x, const Blocks& b, const GlsModel& base, const GlsModel& extended,
-                    DiagnoseResult& r) {
+void bands(const PhaseSeries& x, DiagnoseResult& r) {
   const auto& pts = r.analysis.allan.points;
   std::vector<double> dev, dev_clean;
   for (const auto& p : pts) dev.push_back(p.dev);
@@ -140,13 +114,6 @@ void bands_and_gain(const PhaseSeries& x, const Blocks& b, const GlsModel& base,
   r.gain.misfit_extended = band_misfit(r.extended_band);
   r.gain.coverage_base = band_coverage(r.base_band);
   r.gain.coverage_extended = band_coverage(r.extended_band);
-  if (r.findings.empty()) {
-    r.gain.holdout_misfit_base = r.gain.holdout_misfit_extended = std::numeric_limits<double>::quiet_NaN();
-    return;
-  }
-  const Blocks h0 = half(b, 0), h1 = half(b, 1);
-  r.gain.holdout_misfit_base = 0.5 * (predicted(h0, h1, base) + predicted(h1, h0, base));
-  r.gain.holdout_misfit_extended = 0.5 * (predicted(h0, h1, extended) + predicted(h1, h0, extended));
 }
 
 }  // namespace rwcalc::diag

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -18,6 +19,7 @@
 #include "band.hpp"
 #include "effects.hpp"
 #include "fast_line.hpp"
+#include "gain.hpp"
 #include "lowpass.hpp"
 #include "models.hpp"
 #include "rwcalc/allan.hpp"
@@ -114,21 +116,31 @@ struct Outside {
   std::string lowpass_skip;  ///< why the low-pass is not tested (empty: it is)
 };
 
-Outside outside_tests(const PhaseSeries& x, const Blocks& b, double alpha) {
-  Outside o;
-  const bool pulses = x.exact() || on_lattice(x);
-  const double f_min = 0.4 / b.tb;
+/// The rate samples the periodogram reads, `dt` s apart: a pulse record's decimated angle
+/// differenced, otherwise the rate per sample.
+std::vector<double> periodogram_rates(const PhaseSeries& x, bool pulses, double& dt) {
   std::vector<double> y;
-  double dt = x.tau0_s, f_max = 0.49 / x.tau0_s;
   if (pulses) {
     const Decimated d = decimate(x);
     dt = d.tau_d;
-    f_max = std::min(0.25, 0.49 / dt);
     for (std::size_t j = 0; j + 1 < d.theta.size(); ++j) y.push_back((d.theta[j + 1] - d.theta[j]) / dt);
   } else {
+    dt = x.tau0_s;
     y.resize(x.points() - 1);
     for (std::size_t k = 0; k + 1 < x.points(); ++k) y[k] = x.rate(k);
   }
+  return y;
+}
+
+bool counts_pulses(const PhaseSeries& x) { return x.exact() || on_lattice(x); }
+
+Outside outside_tests(const PhaseSeries& x, const Blocks& b, double alpha) {
+  Outside o;
+  const bool pulses = counts_pulses(x);
+  const double f_min = 0.4 / b.tb;
+  double dt = 0;
+  std::vector<double> y = periodogram_rates(x, pulses, dt);
+  const double f_max = pulses ? std::min(0.25, 0.49 / dt) : 0.49 / dt;
   if (f_max > 2 * f_min) o.fast = fast_line_search(std::move(y), dt, f_min, f_max, 0.5 * alpha);
   if (pulses) o.lowpass_skip = tr("not tested: pulse counts cannot have passed through an output-chain filter");
   return o;
@@ -361,6 +373,51 @@ void extend(const Blocks& b, const GlsModel& m, const Outside& out, bool fast_na
       }
 }
 
+/// The low-pass out of sample (lowpass.hpp): the short-τ octave AV of each half of the record less
+/// its named lines.
+double lowpass_holdout(const PhaseSeries& c, const std::vector<AllanPoint>& pts) {
+  const std::size_t n = c.points() / 2;
+  std::array<PhaseSeries, 2> half{c, c};
+  half[0].values.resize(n);
+  half[1].values.erase(half[1].values.begin(), half[1].values.begin() + static_cast<std::ptrdiff_t>(n));
+  const double duration = half[0].duration_s(), tau_cut = std::min(20.0, duration / 100.0);
+  std::vector<std::int64_t> m;
+  std::array<std::vector<double>, 2> v;
+  std::vector<double> edf;
+  for (const auto& p : pts) {
+    if (static_cast<double>(p.m) * c.tau0_s > tau_cut) continue;
+    m.push_back(p.m);
+    edf.push_back(0.5 * p.edf);
+    for (std::size_t h = 0; h < 2; ++h) v[h].push_back(allan_variance(half[h], p.m, Estimator::Overlapping));
+  }
+  return output_lowpass_holdout(m, v, edf, c.tau0_s, duration);
+}
+
+/// The extended model's likelihood gain over every test that named a term: the block means' (gain.hpp),
+/// the periodogram's for a line above their band, the short-τ Allan variance's for the low-pass.
+void likelihood_gain(const PhaseSeries& x, const Blocks& b, const GlsModel& base, const GlsModel& extended,
+                     const Outside& out, bool fast_named, DiagnoseResult& r) {
+  if (r.findings.empty()) {
+    r.gain.likelihood_in_sample = r.gain.likelihood_holdout = std::numeric_limits<double>::quiet_NaN();
+    return;
+  }
+  LikelihoodGain g;
+  if (!extended.det.empty() || extended.cov.size() != base.cov.size()) g = block_gain(b, base, extended);
+  if (fast_named) {
+    double dt = 0;
+    const std::vector<double> y = periodogram_rates(x, counts_pulses(x), dt);
+    g.in_sample += out.fast->lr - 6.0;  // frequency, amplitude, phase
+    g.holdout += fast_line_holdout(y, dt, *out.fast);
+  }
+  for (const auto& d : r.detectors)
+    if (d.effect == Effect::Lowpass && d.named) {
+      g.in_sample += d.statistic - 2.0;  // the time constant
+      g.holdout += lowpass_holdout(cleaned(x, r.extended), r.analysis.allan.points);
+    }
+  r.gain.likelihood_in_sample = g.in_sample;
+  r.gain.likelihood_holdout = g.holdout;
+}
+
 }  // namespace
 
 DiagnoseResult diagnose(const Recording& read, const DiagnoseOptions& opt) {
@@ -386,7 +443,8 @@ DiagnoseResult diagnose(const Recording& read, const DiagnoseOptions& opt) {
   r.termination = combine(h0.fit.termination, final_model.fit.termination);
   extend(b, final_model, out, fast_named, r);
   test_lowpass(rec.phase, out, r);
-  bands_and_gain(rec.phase, b, h0, final_model, r);
+  bands(rec.phase, r);
+  likelihood_gain(rec.phase, b, h0, final_model, out, fast_named, r);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return r;
 }

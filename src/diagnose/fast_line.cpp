@@ -23,14 +23,15 @@ double bin_tail(double u, double K) {
   return boost::math::ibeta(K * W, K, W / (W + u));
 }
 
-/// The least-squares line a·cos 2πft + b·sin 2πft in y (mean removed) and its explained sum of
-/// squares (the 2×2 normal equations, the phase stepped by rotation).
-double line_fit(const std::vector<double>& y, double dt, double f, double& a, double& b) {
+/// The least-squares line a·cos 2πft + b·sin 2πft in y[0 … n) (sample k the mean over
+/// [t0 + k·dt, t0 + (k+1)·dt), t0 from the record's start) and its explained sum of squares (the
+/// 2×2 normal equations, the phase stepped by rotation).
+double line_fit(const double* y, std::size_t n, double dt, double t0, double f, double& a, double& b) {
   const std::complex<double> step = std::polar(1.0, 2.0 * kPi * f * dt);
-  std::complex<double> e = std::polar(1.0, 2.0 * kPi * f * 0.5 * dt);  // sample k: the mean over [k, k+1)·dt
+  std::complex<double> e = std::polar(1.0, 2.0 * kPi * f * (t0 + 0.5 * dt));
   double cc = 0, ss = 0, cs = 0, yc = 0, ys = 0;
-  for (const double v : y) {
-    const double c = e.real(), s = e.imag();
+  for (std::size_t k = 0; k < n; ++k) {
+    const double c = e.real(), s = e.imag(), v = y[k];
     cc += c * c, ss += s * s, cs += c * s, yc += v * c, ys += v * s;
     e *= step;
   }
@@ -39,6 +40,10 @@ double line_fit(const std::vector<double>& y, double dt, double f, double& a, do
   a = (ss * yc - cs * ys) / det;
   b = (cc * ys - cs * yc) / det;
   return a * yc + b * ys;
+}
+
+double line_fit(const std::vector<double>& y, double dt, double f, double& a, double& b) {
+  return line_fit(y.data(), y.size(), dt, 0.0, f, a, b);
 }
 
 }  // namespace
@@ -108,14 +113,55 @@ FastLine fast_line_search(std::vector<double> y, double dt, double f_min, double
   double a = 0, b = 0;
   const auto fit = [&](double f, double& ca, double& cb) { return line_fit(y, dt, f, ca, cb); };
   r.f_hz = refine_frequency(fit, static_cast<double>(kbest) * df, df, 1, 30, 0.5 / dt);
-  fit(r.f_hz, a, b);
+  const double ess = fit(r.f_hz, a, b);
   r.amp = std::hypot(a, b) / block_attenuation(r.f_hz, dt);  // a sample is the mean over dt
   r.phase = std::atan2(-b, a);
   // Standard errors of a line in noise of the local level (per-sample variance σ² at f).
   const double nn = static_cast<double>(n);
   r.amp_sigma = std::sqrt(2.0 * best_level / nn);
+  r.level = best_level;
+  r.lr = best_level > 0 ? ess / best_level : 0.0;
   r.f_sigma = r.amp > 0 ? std::sqrt(24.0 * best_level / (r.amp * r.amp * nn * nn * nn)) / (2.0 * kPi * dt) : 0.0;
   return r;
+}
+
+double fast_line_holdout(const std::vector<double>& y, double dt, const FastLine& l) {
+  const std::size_t n = y.size() / 2;
+  if (n < 16 || !(l.level > 0)) return 0.0;
+  // Each half less its own mean (a nuisance), and its first sample's time.
+  std::vector<double> half[2] = {{y.begin(), y.begin() + static_cast<std::ptrdiff_t>(n)},
+                                 {y.begin() + static_cast<std::ptrdiff_t>(n), y.end()}};
+  const double t0[2] = {0.0, static_cast<double>(n) * dt};
+  for (auto& h : half) {
+    double mean = 0;
+    for (const double v : h) mean += v / static_cast<double>(h.size());
+    for (double& v : h) v -= mean;
+  }
+  double gain = 0;
+  for (int train = 0; train < 2; ++train) {
+    const auto& fit_y = half[train];
+    auto fit = [&](double f, double& ca, double& cb) {
+      return line_fit(fit_y.data(), fit_y.size(), dt, t0[train], f, ca, cb);
+    };
+    // Within the half's resolution of the record's frequency: the half's own estimate.
+    const double step = 0.5 / (static_cast<double>(fit_y.size()) * dt);
+    const double f = refine_frequency(fit, l.f_hz, step, 1, 30, 0.5 / dt);
+    double a = 0, b = 0;
+    fit(f, a, b);
+    const auto& test = half[1 - train];
+    std::vector<double> rest(test);
+    const std::complex<double> rot = std::polar(1.0, 2.0 * kPi * f * dt);
+    std::complex<double> e = std::polar(1.0, 2.0 * kPi * f * (t0[1 - train] + 0.5 * dt));
+    for (double& v : rest) {
+      v -= a * e.real() + b * e.imag();
+      e *= rot;
+    }
+    double ca = 0, cb = 0;
+    const double before = line_fit(test.data(), test.size(), dt, t0[1 - train], f, ca, cb);
+    const double after = line_fit(rest.data(), rest.size(), dt, t0[1 - train], f, ca, cb);
+    gain += (before - after) / l.level;
+  }
+  return gain;
 }
 
 }  // namespace rwcalc::diag

@@ -2,6 +2,7 @@
 /// @file lowpass.hpp
 /// The output-chain low-pass: the χ² drop of the short-τ octave AV when white angle and rate noise
 /// (and a floor) pass through a first-order filter, and its null law.
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -23,5 +24,13 @@ struct OutputLowpassEstimate {
 /// points (time constants an octave apart are the distinct alternatives).
 OutputLowpassEstimate output_lowpass_detect(const std::vector<std::int64_t>& m, const std::vector<double>& v,
                                             const std::vector<double>& edf, double tau0, double duration, double alpha);
+
+/// The low-pass out of sample: the octave AV of each half of the record (`v`, the same cluster
+/// sizes `m`, EDF `edf` of a half, `duration` a half's) predicted by the filter and levels fitted to
+/// the other half, against the same fitted without the filter: the χ² the filter saves, summed over
+/// the halves (scaled by the fitted half's χ² per degree of freedom when above 1). NaN when a half
+/// has fewer than 5 points.
+double output_lowpass_holdout(const std::vector<std::int64_t>& m, const std::array<std::vector<double>, 2>& v,
+                              const std::vector<double>& edf, double tau0, double duration);
 
 }  // namespace rwcalc::diag

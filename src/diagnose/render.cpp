@@ -261,8 +261,8 @@ json to_json(const DiagnoseResult& r) {
                {"misfit_extended", r.gain.misfit_extended},
                {"coverage_base", r.gain.coverage_base},
                {"coverage_extended", r.gain.coverage_extended},
-               {"holdout_misfit_base", finite_or_null(r.gain.holdout_misfit_base)},
-               {"holdout_misfit_extended", finite_or_null(r.gain.holdout_misfit_extended)}};
+               {"likelihood_in_sample", finite_or_null(r.gain.likelihood_in_sample)},
+               {"likelihood_holdout", finite_or_null(r.gain.likelihood_holdout)}};
   j["seconds"] = r.seconds;
   j["termination"] = to_json(r.termination);
   if (sh.accel) accelerometer_json(r, sh, j);
@@ -363,12 +363,14 @@ std::string format_report(const DiagnoseResult& r) {
                    r.gain.misfit_extended);
   s += fmt::format("  {:<44} {:>9.1f}% {:>9.1f}%\n", tr("measured τ inside the model's band"),
                    100 * r.gain.coverage_base, 100 * r.gain.coverage_extended);
-  if (std::isnan(r.gain.holdout_misfit_base))
-    s += fmt::format("  {:<44} {:>21}\n", tr("out-of-sample −2 ln L per block (dimensionless)"),
-                     tr("not needed: none named"));
-  else
-    s += fmt::format("  {:<44} {:>10.3f} {:>10.3f}\n", tr("out-of-sample −2 ln L per block (dimensionless)"),
-                     r.gain.holdout_misfit_base, r.gain.holdout_misfit_extended);
+  if (std::isnan(r.gain.likelihood_in_sample)) {
+    s += fmt::format("  {:<44} {:>21}\n", tr("likelihood gain (−2Δ ln L)"), tr("not needed: none named"));
+  } else {
+    s += fmt::format("  {:<44} {:>10} {:>10.1f}\n", tr("likelihood gain in sample (−2Δ ln L − 2k)"), "",
+                     r.gain.likelihood_in_sample);
+    s += fmt::format("  {:<44} {:>10} {:>10.1f}\n", tr("likelihood gain on held-out runs (−2Δ ln L)"), "",
+                     r.gain.likelihood_holdout);
+  }
   s += trf("\n  ({:.1f} s)\n", r.seconds);
   return s;
 }

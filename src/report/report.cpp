@@ -549,11 +549,9 @@ std::string gain_html(const json& gain, std::size_t index, Numbering& numbering)
   if (!gain.is_object()) return {};
   std::string s = numbering.table(fmt::format("run{}-gain", index + 1), tr("Gain of the extended model"));
   s += tr("<tr><th>measure</th><th>base model</th><th>extended model</th></tr>\n");
-  static constexpr std::array<std::array<const char*, 3>, 3> kRows{
+  static constexpr std::array<std::array<const char*, 3>, 2> kRows{
       {{N_("Allan-variance misfit (EDF-weighted)"), "misfit_base", "misfit_extended"},
-       {N_("share of measured τ inside the simulated band"), "coverage_base", "coverage_extended"},
-       {N_("out-of-sample misfit (fit on one part, predict the other)"), "holdout_misfit_base",
-        "holdout_misfit_extended"}}};
+       {N_("share of measured τ inside the simulated band"), "coverage_base", "coverage_extended"}}};
   auto cell = [&](const char* key) {
     const auto v = num(gain, key);
     return v ? g(*v, 4) : std::string(kNotAvailable);
@@ -561,6 +559,12 @@ std::string gain_html(const json& gain, std::size_t index, Numbering& numbering)
   for (const auto& [name, base, ext] : kRows)
     s += fmt::format("<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>\n", tr(name), cell(base),
                      cell(ext));
+  // The likelihood gains are of the extended model over the base: one figure each.
+  static constexpr std::array<std::array<const char*, 2>, 2> kGains{
+      {{N_("likelihood gain in sample (−2Δ ln L − 2k)"), "likelihood_in_sample"},
+       {N_("likelihood gain on held-out runs (−2Δ ln L)"), "likelihood_holdout"}}};
+  for (const auto& [name, key] : kGains)
+    s += fmt::format("<tr><td>{}</td><td class=\"num\">—</td><td class=\"num\">{}</td></tr>\n", tr(name), cell(key));
   return s + "</table>\n";
 }
 
