@@ -199,6 +199,15 @@ bool warmup_in_tolerance(const DiagnoseResult& r, double amp) {
 TEST(DiagnoseAcceptance, EveryEffectNamedWithinTolerance) {
   const int n = test::population("RWCALC_DIAGNOSE_EFFECTS", 4, 20);
   Tally warmup, drift, fast_line, two;
+  int tc_named = 0, tc_covered = 0;
+  const auto tc_cover = [&](const DiagnoseResult& r, double tc) {
+    if (const Finding* w = finding(r, Effect::Warmup)) {
+      ++tc_named;
+      tc_covered += covers(*w, "time_constant", tc);
+      std::cout << fmt::format(" tc {:.0f}: {:.0f} [{:.0f}, {:.0f}]", tc, w->parameter("time_constant").value,
+                               w->parameter("time_constant").low95, w->parameter("time_constant").high95);
+    }
+  };
   for (int i = 0; i < n; ++i) {
     const auto seed = 7000 + static_cast<std::uint64_t>(i);
     const double tc = 300 + 600 * spread(i), amp = 0.1 * (i % 2 ? 1 : -1);
@@ -206,9 +215,11 @@ TEST(DiagnoseAcceptance, EveryEffectNamedWithinTolerance) {
     w.warmups.push_back({amp, tc});
     const DiagnoseResult rw = run_case(w, seed);
     warmup.add(rw, warmup_in_tolerance(rw, amp));
+    tc_cover(rw, tc);
     w.ramp_deg_per_h2 = 0.01;
     const DiagnoseResult rd = run_case(w, seed + 100);
     drift.add(rd, warmup_in_tolerance(rd, amp));
+    tc_cover(rd, tc);
 
     NoiseModel l = gl2d();
     const double f = 0.02 * std::pow(10.0, spread(i + 5));
@@ -230,6 +241,7 @@ TEST(DiagnoseAcceptance, EveryEffectNamedWithinTolerance) {
                     std::abs(tb->parameter("time").value - step_t) < 30 &&
                     near(tb->parameter("size").value, 0.06, 0.3));
   }
+  std::cout << fmt::format("\ntime constant's 95 % interval covers {} of {}\n", tc_covered, tc_named);
   warmup.check("warm-up");
   drift.check("exponential + linear drift");
   fast_line.check("line above the slow band");
