@@ -366,11 +366,28 @@ std::pair<double, double> profile_interval(const std::function<double(double)>& 
   return {side(-1.0), side(1.0)};
 }
 
-/// −2 ln L of the model with det term `index`'s parameter at x (levels held, coefficients fitted).
+/// −2 ln L of the model with det term `index`'s parameter at x, its coefficients fitted and the
+/// flicker and random-walk levels re-profiled (a golden-section sweep over each one's logarithm
+/// from the fitted value; the overall scale in closed form). A term's form trades against those
+/// levels (a long warm-up against a ramp's curvature): held, they made the profile narrow and the
+/// interval of a warm-up's time constant missed the truth in 5 of 39 records.
 double det_m2ll(const Blocks& b, const GlsModel& m, std::size_t index, double x) {
   auto det = m.det;
   det[index].nl = x;
-  return evaluate(b, hypothesis_of(b, det, m.cov), m.fit.level).m2ll;
+  const Hypothesis h = hypothesis_of(b, det, m.cov);
+  std::vector<double> lv = m.fit.level;
+  double best = evaluate(b, h, lv).m2ll;
+  for (std::size_t j = 0; j < lv.size(); ++j) {
+    if (!(m.cov[j].kind == CovKind::B || m.cov[j].kind == CovKind::K) || !(lv[j] > 0)) continue;
+    const auto f = [&](double l) {
+      auto t = lv;
+      t[j] = std::exp(l);
+      return evaluate(b, h, t).m2ll;
+    };
+    const double l0 = std::log(lv[j]), l = golden_min(f, l0 - 3.0, l0 + 3.0, 10), v = f(l);
+    if (v < best) best = v, lv[j] = std::exp(l);
+  }
+  return best;
 }
 
 }  // namespace
