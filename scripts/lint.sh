@@ -3,12 +3,12 @@
 # the project's clang-tidy set (.clang-tidy) in the library and main. Needs a built build directory
 # (its compile_commands.json, and ninja's record of each unit's headers for --changed).
 #   scripts/lint.sh [BUILD_DIR] [--format-only | --changed | --record]      (default: build)
-# --changed: clang-tidy only over the units that read a file changed since the commit in
-#   .ci/tidy-baseline (the last whole run that passed; every unit when that commit is not an
-#   ancestor, or .clang-tidy or this script changed since). CI runs this: the whole set takes about
-#   175 s of the two cores, more than its budget leaves, and a unit that reads no changed file
-#   cannot have a new finding.
-# --record: the whole run, and on success HEAD written to .ci/tidy-baseline (commit it).
+# --changed: clang-tidy only over the units that read a file changed since the last whole run
+#   that passed (.ci/tidy-baseline: every tracked file's blob hash then; every unit when .clang-tidy
+#   or this script changed since). CI runs this: the whole set takes about 175 s of the two cores,
+#   more than its budget leaves, and a unit that reads no changed file cannot have a new finding.
+# --record: the whole run on a tree without uncommitted changes, and on success the files' hashes
+#   written to .ci/tidy-baseline (commit it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
@@ -20,18 +20,31 @@ fi
 echo "clang-format: $(git ls-files '*.cpp' '*.hpp' | wc -l) files"
 git ls-files -z '*.cpp' '*.hpp' | xargs -0 clang-format --dry-run --Werror
 [[ $mode == --format-only ]] && exit 0
+if [[ $mode == --record ]] && ! git diff --quiet HEAD; then
+  echo "lint.sh: --record needs the changes committed (the baseline names the committed files)" >&2
+  exit 2
+fi
 
 # The files changed since the baseline (committed or not), as absolute paths; "all" when every unit
-# must be checked.
+# must be checked. The baseline is each tracked file's blob hash at the last whole run, so a shallow
+# clone, which has no history, compares as well as a full one.
 changed_files() {
-  local base
-  base=$(cat .ci/tidy-baseline 2>/dev/null || true)
-  if [[ -z $base ]] || ! git merge-base --is-ancestor "$base" HEAD 2>/dev/null ||
-    ! git diff --quiet "$base" -- .clang-tidy scripts/lint.sh; then
+  local manifest=.ci/tidy-baseline
+  if [[ ! -f $manifest ]]; then
     echo all
     return
   fi
-  { git diff --name-only "$base"; git ls-files --others --exclude-standard; } | sed "s|^|$PWD/|" | sort -u
+  local changed
+  changed=$({
+    git ls-files -s | awk 'NR == FNR { hash[$2] = $1; next } hash[$4] != $2 { print $4 }' "$manifest" -
+    git diff --name-only
+    git ls-files --others --exclude-standard
+  } | sort -u)
+  if grep -qxE '\.clang-tidy|scripts/lint\.sh' <<<"$changed"; then
+    echo all
+    return
+  fi
+  [[ -z $changed ]] || sed "s|^|$PWD/|" <<<"$changed"
 }
 
 # The library is compiled one unit per layer (unity build): checking those units reads every source
@@ -69,6 +82,6 @@ if ((${#units[@]})); then
     --extra-arg=-Wno-unknown-warning-option
 fi
 if [[ $mode == --record ]]; then
-  git rev-parse HEAD > .ci/tidy-baseline
-  echo "lint.sh: .ci/tidy-baseline is now $(cat .ci/tidy-baseline); commit it"
+  git ls-files -s | awk '$4 != ".ci/tidy-baseline" { print $2, $4 }' > .ci/tidy-baseline
+  echo "lint.sh: .ci/tidy-baseline holds the files of $(git rev-parse --short HEAD); commit it"
 fi
