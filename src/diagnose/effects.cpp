@@ -400,6 +400,29 @@ FindingParameter from_interval(std::string name, Quantity q, double value, doubl
   return {std::move(name), q, value, (high - low) / (2.0 * kZ95), low, high};
 }
 
+namespace {
+
+/// The term's coefficients (its columns' GLS coefficients) with its nonlinear parameter at x.
+Eigen::VectorXd coefficients_at(const Blocks& b, const GlsModel& m, std::size_t index, Eigen::Index off, double x) {
+  auto det = m.det;
+  det[index].nl = x;
+  const Profile p = evaluate(b, hypothesis_of(b, det, m.cov), m.fit.level);
+  return p.beta.segment(off, det_columns(b, det[index]).cols());
+}
+
+/// The standard uncertainty of a size `size_of(coefficients)` that takes in its nonlinear
+/// parameter's: the GLS one at the fitted value, σ_β, and half the size's change across that
+/// parameter's 95 % interval [lo, hi] over 1.96 (the law of total variance, to first order). At the
+/// fitted value alone an amplitude's interval held the truth in 15 of 19 records.
+template <class Size>
+double size_sigma(const Blocks& b, const GlsModel& m, std::size_t index, Eigen::Index off, double sigma_beta, double lo,
+                  double hi, const Size& size_of) {
+  const double across = size_of(coefficients_at(b, m, index, off, hi)) - size_of(coefficients_at(b, m, index, off, lo));
+  return std::hypot(sigma_beta, across / (2.0 * kZ95));
+}
+
+}  // namespace
+
 TermEstimate estimate_det(const Blocks& b, const GlsModel& m, std::size_t index) {
   Eigen::Index off = 0;
   for (std::size_t j = 0; j < index; ++j) off += det_columns(b, m.det[j]).cols();
@@ -408,25 +431,27 @@ TermEstimate estimate_det(const Blocks& b, const GlsModel& m, std::size_t index)
   const auto& cov = m.fit.beta_cov;
   const auto g = [&](double x) { return det_m2ll(b, m, index, x); };
   const double T = b.duration();
+  const auto first = [](const Eigen::VectorXd& c) { return c(0); };
   TermEstimate e;
   if (t.effect == Effect::Sinusoid || t.effect == Effect::Line) {
     const double a = beta(off), bb = beta(off + 1), amp = std::hypot(a, bb);
     const Eigen::Vector2d grad(a / amp, bb / amp);
-    const double amp_sigma = std::sqrt(grad.dot(cov.block(off, off, 2, 2) * grad));
     const auto [flo, fhi] = profile_interval(g, t.nl, 0.02 / T, 0.5 * t.nl, 2.0 * t.nl);
+    const double amp_sigma = size_sigma(b, m, index, off, std::sqrt(grad.dot(cov.block(off, off, 2, 2) * grad)), flo,
+                                        fhi, [](const Eigen::VectorXd& c) { return std::hypot(c(0), c(1)); });
     e.parameters = {from_interval("frequency", Quantity::Frequency, t.nl, flo, fhi),
                     from_sigma("amplitude", Quantity::Rate, amp, amp_sigma),
                     {"phase", Quantity::Phase, std::atan2(-bb, a)}};
   } else if (t.effect == Effect::BiasStep) {
-    const double size = beta(off), ss = std::sqrt(cov(off, off));
     const auto [tlo, thi] = profile_interval(g, t.nl, 0.05 * b.tb, b.t0, b.t0 + T);
+    const double ss = size_sigma(b, m, index, off, std::sqrt(cov(off, off)), tlo, thi, first);
     e.parameters = {from_interval("time", Quantity::Time, t.nl, tlo, thi),
-                    from_sigma("size", Quantity::Rate, size, ss)};
+                    from_sigma("size", Quantity::Rate, beta(off), ss)};
   } else {
-    const double amp = beta(off), as = std::sqrt(cov(off, off));
     const auto gl = [&](double lx) { return g(std::exp(lx)); };
     const auto [llo, lhi] = profile_interval(gl, std::log(t.nl), 0.02, std::log(0.5 * b.tb), std::log(20 * T));
-    e.parameters = {from_sigma("amplitude", Quantity::Rate, amp, as),
+    const double as = size_sigma(b, m, index, off, std::sqrt(cov(off, off)), std::exp(llo), std::exp(lhi), first);
+    e.parameters = {from_sigma("amplitude", Quantity::Rate, beta(off), as),
                     from_interval("time_constant", Quantity::Time, t.nl, std::exp(llo), std::exp(lhi))};
   }
   return e;
