@@ -67,7 +67,8 @@ if [[ $mode == --changed ]]; then
     src=${e%%$'\t'*} obj=${e#*$'\t'}
     if [[ $changed == all ]]; then
       units+=("$src")
-    elif ninja -C "$build" -t deps "$obj" | sed -n 's/^    //p' | grep -qxFf <(echo "$changed"); then
+    # grep reads to the end (no -q): under pipefail an early exit would fail ninja with SIGPIPE.
+    elif ninja -C "$build" -t deps "$obj" | sed -n 's/^    //p' | grep -xFf <(echo "$changed") >/dev/null; then
       units+=("$src")
     fi
   done
