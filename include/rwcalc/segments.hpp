@@ -11,6 +11,10 @@
 
 namespace rwcalc {
 
+/// Phase points first … last (inclusive) of `x`, its sample period, kind, pulse weight and rate
+/// offset kept; only those points are copied.
+PhaseSeries phase_slice(const PhaseSeries& x, std::size_t first, std::size_t last);
+
 /// Each segment's phase series (one series, the record's, when it has no gap). A segment of n samples
 /// holds n + 1 phase points when the phase starts from 0 before the first sample (rate, increment and
 /// pulse input), n otherwise.

@@ -9,22 +9,25 @@
 
 namespace rwcalc {
 
+PhaseSeries phase_slice(const PhaseSeries& x, std::size_t first, std::size_t last) {
+  PhaseSeries p;
+  p.tau0_s = x.tau0_s;
+  p.kind = x.kind;
+  p.arcsec_per_count = x.arcsec_per_count;
+  p.rate_offset = x.rate_offset;
+  const auto from = static_cast<std::ptrdiff_t>(first), to = static_cast<std::ptrdiff_t>(last) + 1;
+  if (x.exact())
+    p.counts.assign(x.counts.begin() + from, x.counts.begin() + to);
+  else
+    p.values.assign(x.values.begin() + from, x.values.begin() + to);
+  return p;
+}
+
 std::vector<PhaseSeries> segment_phases(const Recording& rec) {
   if (rec.segments.size() < 2) return {rec.phase};
   const std::size_t lead = rec.phase.points() - rec.samples;  // 1: a phase point before the first sample
   std::vector<PhaseSeries> out;
-  for (const auto& s : rec.segments) {
-    PhaseSeries p = rec.phase;
-    const std::size_t from = s.first, to = s.first + s.samples - 1 + lead;  // inclusive
-    if (p.exact()) {
-      p.counts.assign(rec.phase.counts.begin() + static_cast<std::ptrdiff_t>(from),
-                      rec.phase.counts.begin() + static_cast<std::ptrdiff_t>(to) + 1);
-    } else {
-      p.values.assign(rec.phase.values.begin() + static_cast<std::ptrdiff_t>(from),
-                      rec.phase.values.begin() + static_cast<std::ptrdiff_t>(to) + 1);
-    }
-    out.push_back(std::move(p));
-  }
+  for (const auto& s : rec.segments) out.push_back(phase_slice(rec.phase, s.first, s.first + s.samples - 1 + lead));
   return out;
 }
 

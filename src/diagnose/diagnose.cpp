@@ -25,6 +25,7 @@
 #include "rwcalc/allan.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/progress.hpp"
+#include "rwcalc/segments.hpp"
 #include "rwcalc/units.hpp"
 #include "signal.hpp"
 
@@ -377,9 +378,7 @@ void extend(const Blocks& b, const GlsModel& m, const Outside& out, bool fast_na
 /// its named lines.
 double lowpass_holdout(const PhaseSeries& c, const std::vector<AllanPoint>& pts) {
   const std::size_t n = c.points() / 2;
-  std::array<PhaseSeries, 2> half{c, c};
-  half[0].values.resize(n);
-  half[1].values.erase(half[1].values.begin(), half[1].values.begin() + static_cast<std::ptrdiff_t>(n));
+  const std::array<PhaseSeries, 2> half{phase_slice(c, 0, n - 1), phase_slice(c, n, c.points() - 1)};
   const double duration = half[0].duration_s(), tau_cut = std::min(20.0, duration / 100.0);
   std::vector<std::int64_t> m;
   std::array<std::vector<double>, 2> v;
