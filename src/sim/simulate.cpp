@@ -274,14 +274,12 @@ struct Simulator::Impl {
     const detail::FlickerCirculant circulant(fft_size);
     const auto sd = [&](std::size_t k) { return bin_sd.empty() ? bin_sd_of(circulant, k) : bin_sd[k]; };
     const std::size_t half = fft_size / 2;
-    std::complex<float>* bins = flicker_fft->spectrum();
-    bins[0] = static_cast<float>(sd(0) * rng.normal());
-    for (std::size_t k = 1; k < half; ++k) {
+    flicker_fft->set_spectrum([&](std::size_t k) {
       const double s = sd(k);
+      if (k == 0 || k == half) return std::complex<float>(static_cast<float>(s * rng.normal()), 0.0F);
       const double re = rng.normal(), im = rng.normal();
-      bins[k] = {static_cast<float>(s * re), static_cast<float>(s * im)};
-    }
-    bins[half] = static_cast<float>(sd(half) * rng.normal());
+      return std::complex<float>(static_cast<float>(s * re), static_cast<float>(s * im));
+    });
     flicker_fft->run();
     // Rates from the increments (the first one's increment is not used), summed in double.
     float* rates = flicker_fft->values();
