@@ -192,6 +192,40 @@ bool warmup_in_tolerance(const DiagnoseResult& r, double amp) {
 
 }  // namespace
 
+// A Gauss–Markov rate of σ 0.3 °/h (90 times the flicker floor) and Tc 25–60 s: named alone (no other
+// effect beside it) with σ within 30 % in at least 90 % of records, each with a positive gain. Tc,
+// like a warm-up's time constant, scatters widely (σ² and Tc trade against each other): its interval's
+// coverage is printed. A longer Tc or a weaker term looks like flicker and random walk to 10-s block
+// means (docs/diagnosis.md).
+TEST(DiagnoseAcceptance, GaussMarkovNamedWithinTolerance) {
+  const int n = test::population("RWCALC_DIAGNOSE_EFFECTS", 4, 20);
+  Tally gm;
+  int sigma_covered = 0, tc_covered = 0;
+  for (int i = 0; i < n; ++i) {
+    const double tc = 25 + 35 * spread(i + 3), sigma = 0.3;
+    NoiseModel m = gl2d();
+    m.gauss_markov.push_back({sigma, tc});
+    const DiagnoseResult r = run_case(m, 7400 + static_cast<std::uint64_t>(i));
+    const Finding* g = finding(r, Effect::GaussMarkov);
+    const bool ok = g && r.findings.size() == 1 && near(g->parameter("sigma").value, sigma, 0.3);
+    gm.add(r, ok);
+    if (!ok) {
+      std::cout << fmt::format("  record {} (Tc {:.1f} s) not in tolerance:", i, tc);
+      for (const Finding& f : r.findings) {
+        std::cout << ' ' << finding_name(f.effect);
+        for (const FindingParameter& p : f.parameters) std::cout << fmt::format(" {} {:.3g}", p.name, p.value);
+      }
+      std::cout << '\n';
+    }
+    if (!g) continue;
+    sigma_covered += covers(*g, "sigma", sigma);
+    tc_covered += covers(*g, "correlation_time", tc);
+  }
+  std::cout << fmt::format("Gauss-Markov: 95 % intervals cover σ in {}, Tc in {} of the named\n", sigma_covered,
+                           tc_covered);
+  gm.check("Gauss-Markov term");
+}
+
 // The effects beside slow lines and steps, each at a level its detector resolves on a 2-h record:
 // a warm-up (0.1 °/h, 30 times the flicker floor, τ 300–900 s), the same on a ramp of 0.01 °/h² (an
 // exponential + linear drift), a line above the slow band (0.02–0.2 Hz, 0.1 °/h), and a slow line

@@ -350,7 +350,7 @@ void extend(const Blocks& b, const GlsModel& m, const Outside& out, bool fast_na
       case CovKind::K: r.extended.rrw_deg_per_h_per_sqrt_h = std::sqrt(3.0 * lv) * units::sqrt_s_per_sqrt_h; break;
       case CovKind::GM: {
         Finding f{Effect::GaussMarkov, estimate_gm(b, m, c).parameters, {}};
-        r.extended.gauss_markov.push_back({f.parameter("sigma").value, m.cov[c].tc_s});
+        r.extended.gauss_markov.push_back({f.parameter("sigma").value, f.parameter("correlation_time").value});
         r.findings.push_back(std::move(f));
         break;
       }

@@ -459,26 +459,38 @@ TermEstimate estimate_det(const Blocks& b, const GlsModel& m, std::size_t index)
 
 TermEstimate estimate_gm(const Blocks& b, const GlsModel& m, std::size_t ci) {
   const Hypothesis h = hypothesis_of(b, m.det, m.cov);
-  const double var = m.fit.level[ci], tc = m.cov[ci].tc_s;
-  // σ²: its own profile with the other levels held; Tc: with the variance re-fitted at each Tc.
-  const auto g_var = [&](double lv) {
-    auto l = m.fit.level;
-    l[ci] = std::exp(lv);
-    return evaluate(b, h, l).m2ll;
-  };
-  const auto g_tc = [&](double lt) {
+  const double grid_var = m.fit.level[ci];
+  // The variance that maximises the likelihood at correlation time tc, the other levels held.
+  const auto best_var = [&](double tc) {
     Hypothesis ht = h;
-    ht.terms[ci].tc_s = std::exp(lt);
+    ht.terms[ci].tc_s = tc;
     auto l = m.fit.level;
     const auto f = [&](double lv) {
       l[ci] = std::exp(lv);
       return -evaluate(b, ht, l).m2ll;
     };
-    l[ci] = std::exp(golden_max(f, std::log(var) - 5, std::log(var) + 5, 25));
-    return evaluate(b, ht, l).m2ll;
+    l[ci] = std::exp(golden_max(f, std::log(grid_var) - 5, std::log(grid_var) + 5, 25));
+    return std::pair{l, evaluate(b, ht, l).m2ll};
+  };
+  // Tc: the search's grid point refined within its cell (the grid steps by 1.6), then the profile
+  // with the variance re-fitted at each Tc.
+  const auto g_tc = [&](double lt) { return best_var(std::exp(lt)).second; };
+  const double lt0 = std::log(m.cov[ci].tc_s), cell = std::log(1.6);
+  const double lt = golden_min(g_tc, lt0 - cell, lt0 + cell, 20);
+  const double tc = std::exp(lt);
+  // Every level profiled again at that Tc: the flicker and random-walk levels trade against σ².
+  Hypothesis hv = h;
+  hv.terms[ci].tc_s = tc;
+  const auto levels = profile(b, hv, best_var(tc).first).level;
+  const double var = levels[ci];
+  // σ²: its own profile at that Tc with the other levels held.
+  const auto g_var = [&](double lv) {
+    auto l = levels;
+    l[ci] = std::exp(lv);
+    return evaluate(b, hv, l).m2ll;
   };
   const auto [vlo, vhi] = profile_interval(g_var, std::log(var), 0.05, std::log(var) - 30, std::log(var) + 10);
-  const auto [tlo, thi] = profile_interval(g_tc, std::log(tc), 0.05, std::log(0.5 * b.tb), std::log(10 * b.duration()));
+  const auto [tlo, thi] = profile_interval(g_tc, lt, 0.05, std::log(0.5 * b.tb), std::log(10 * b.duration()));
   const double s = std::sqrt(var), slo = std::exp(0.5 * vlo), shi = std::exp(0.5 * vhi);
   TermEstimate e;
   e.parameters = {from_interval("sigma", Quantity::Rate, s, slo, shi),
