@@ -344,7 +344,7 @@ Candidate search_gauss_markov(const Blocks& b, const GlsModel& cur, double alpha
 namespace {
 
 /// The 95 % profile interval of a parameter x whose −2 ln L is g(x) (minimum at x0): where g rises
-/// by 3.84, found by steps of `step` outwards and bisection; clipped to [lo, hi].
+/// by 3.84, found by steps of `step` outwards and bisection to a 40th of `step`; clipped to [lo, hi].
 std::pair<double, double> profile_interval(const std::function<double(double)>& g, double x0, double step, double lo,
                                            double hi) {
   const double g0 = g(x0), target = g0 + 3.841458820694124;
@@ -357,7 +357,7 @@ std::pair<double, double> profile_interval(const std::function<double(double)>& 
       if (x == lo || x == hi) return x;
     }
     double out = x;
-    for (int i = 0; i < 40; ++i) {
+    for (int i = 0; i < 40 && std::abs(out - inside) > step / 40; ++i) {
       const double mid = 0.5 * (inside + out);
       (g(mid) > target ? out : inside) = mid;
     }
@@ -366,15 +366,12 @@ std::pair<double, double> profile_interval(const std::function<double(double)>& 
   return {side(-1.0), side(1.0)};
 }
 
-/// −2 ln L of the model with det term `index`'s parameter at x, its coefficients fitted and the
-/// flicker and random-walk levels re-profiled (a golden-section sweep over each one's logarithm
-/// from the fitted value; the overall scale in closed form). A term's form trades against those
-/// levels (a long warm-up against a ramp's curvature): held, they made the profile narrow and the
-/// interval of a warm-up's time constant missed the truth in 5 of 39 records.
-double det_m2ll(const Blocks& b, const GlsModel& m, std::size_t index, double x) {
-  auto det = m.det;
-  det[index].nl = x;
-  const Hypothesis h = hypothesis_of(b, det, m.cov);
+/// −2 ln L of hypothesis `h` on `b` with the flicker and random-walk levels re-profiled from m's (a
+/// golden-section sweep over each one's logarithm from the fitted value; the overall scale in
+/// closed form). A term's form or size trades against those levels (a long warm-up against a ramp's
+/// curvature, a slow line against the flicker): held, they made the profile narrow and the interval
+/// of a warm-up's time constant missed the truth in 5 of 39 records.
+double reprofiled_m2ll(const Blocks& b, const Hypothesis& h, const GlsModel& m) {
   std::vector<double> lv = m.fit.level;
   double best = evaluate(b, h, lv).m2ll;
   for (std::size_t j = 0; j < lv.size(); ++j) {
@@ -388,6 +385,27 @@ double det_m2ll(const Blocks& b, const GlsModel& m, std::size_t index, double x)
     if (v < best) best = v, lv[j] = std::exp(l);
   }
   return best;
+}
+
+/// The same with det term `index`'s nonlinear parameter at x, its coefficients fitted.
+double det_m2ll(const Blocks& b, const GlsModel& m, std::size_t index, double x) {
+  auto det = m.det;
+  det[index].nl = x;
+  return reprofiled_m2ll(b, hypothesis_of(b, det, m.cov), m);
+}
+
+/// The same with the coefficients of columns off … off + fixed.size() − 1 held at `fixed` (their
+/// part moved into the data), the others fitted: a size's profile.
+double fixed_size_m2ll(const Blocks& b, const GlsModel& m, Eigen::Index off, const Eigen::VectorXd& fixed) {
+  Hypothesis h = hypothesis_of(b, m.det, m.cov);
+  const Eigen::Index k = fixed.size(), rest = h.x.cols() - k;
+  Blocks moved = b;
+  moved.z -= h.x.middleCols(off, k) * fixed;
+  Eigen::MatrixXd x(h.x.rows(), rest);
+  for (Eigen::Index c = 0, j = 0; c < h.x.cols(); ++c)
+    if (c < off || c >= off + k) x.col(j++) = h.x.col(c);
+  h.x = std::move(x);
+  return reprofiled_m2ll(moved, h, m);
 }
 
 }  // namespace
@@ -410,15 +428,21 @@ Eigen::VectorXd coefficients_at(const Blocks& b, const GlsModel& m, std::size_t 
   return p.beta.segment(off, det_columns(b, det[index]).cols());
 }
 
-/// The standard uncertainty of a size `size_of(coefficients)` that takes in its nonlinear
-/// parameter's: the GLS one at the fitted value, σ_β, and half the size's change across that
-/// parameter's 95 % interval [lo, hi] over 1.96 (the law of total variance, to first order). At the
-/// fitted value alone an amplitude's interval held the truth in 15 of 19 records.
-template <class Size>
-double size_sigma(const Blocks& b, const GlsModel& m, std::size_t index, Eigen::Index off, double sigma_beta, double lo,
-                  double hi, const Size& size_of) {
-  const double across = size_of(coefficients_at(b, m, index, off, hi)) - size_of(coefficients_at(b, m, index, off, lo));
-  return std::hypot(sigma_beta, across / (2.0 * kZ95));
+/// The 95 % interval of a size: the profile of `fixed(v)` (the term's coefficients at size v), the
+/// flicker and random-walk levels re-profiled, from value ∓ 20·σ_β; each side widened by half the
+/// size's change across the nonlinear parameter's 95 % interval [lo, hi] (added in quadrature, the
+/// law of total variance to first order). With the GLS σ_β at the fitted value and levels alone, a
+/// slow line's amplitude and a step's size beside each other held the truth in 15 of 19 records.
+template <class Fixed, class Size>
+std::pair<double, double> size_interval(const Blocks& b, const GlsModel& m, std::size_t index, Eigen::Index off,
+                                        double value, double sigma_beta, double lo, double hi, double floor,
+                                        const Fixed& fixed, const Size& size_of) {
+  const auto g = [&](double v) { return fixed_size_m2ll(b, m, off, fixed(v)); };
+  const auto [plo, phi] =
+      profile_interval(g, value, 0.25 * sigma_beta, std::max(floor, value - 20 * sigma_beta), value + 20 * sigma_beta);
+  const double across =
+      0.5 * std::abs(size_of(coefficients_at(b, m, index, off, hi)) - size_of(coefficients_at(b, m, index, off, lo)));
+  return {value - std::hypot(value - plo, across), value + std::hypot(phi - value, across)};
 }
 
 }  // namespace
@@ -433,25 +457,32 @@ TermEstimate estimate_det(const Blocks& b, const GlsModel& m, std::size_t index)
   const double T = b.duration();
   const auto first = [](const Eigen::VectorXd& c) { return c(0); };
   TermEstimate e;
+  const double lowest = -std::numeric_limits<double>::infinity();
+  const auto one = [](double v) { return Eigen::VectorXd::Constant(1, v); };
   if (t.effect == Effect::Sinusoid || t.effect == Effect::Line) {
     const double a = beta(off), bb = beta(off + 1), amp = std::hypot(a, bb);
-    const Eigen::Vector2d grad(a / amp, bb / amp);
+    const Eigen::Vector2d unit(a / amp, bb / amp);
     const auto [flo, fhi] = profile_interval(g, t.nl, 0.02 / T, 0.5 * t.nl, 2.0 * t.nl);
-    const double amp_sigma = size_sigma(b, m, index, off, std::sqrt(grad.dot(cov.block(off, off, 2, 2) * grad)), flo,
-                                        fhi, [](const Eigen::VectorXd& c) { return std::hypot(c(0), c(1)); });
+    // The amplitude's profile at the fitted phase.
+    const auto [alo, ahi] = size_interval(
+        b, m, index, off, amp, std::sqrt(unit.dot(cov.block(off, off, 2, 2) * unit)), flo, fhi, 0.0,
+        [&](double v) { return Eigen::VectorXd(v * unit); },
+        [](const Eigen::VectorXd& c) { return std::hypot(c(0), c(1)); });
     e.parameters = {from_interval("frequency", Quantity::Frequency, t.nl, flo, fhi),
-                    from_sigma("amplitude", Quantity::Rate, amp, amp_sigma),
+                    from_interval("amplitude", Quantity::Rate, amp, alo, ahi),
                     {"phase", Quantity::Phase, std::atan2(-bb, a)}};
   } else if (t.effect == Effect::BiasStep) {
     const auto [tlo, thi] = profile_interval(g, t.nl, 0.05 * b.tb, b.t0, b.t0 + T);
-    const double ss = size_sigma(b, m, index, off, std::sqrt(cov(off, off)), tlo, thi, first);
+    const auto [slo, shi] =
+        size_interval(b, m, index, off, beta(off), std::sqrt(cov(off, off)), tlo, thi, lowest, one, first);
     e.parameters = {from_interval("time", Quantity::Time, t.nl, tlo, thi),
-                    from_sigma("size", Quantity::Rate, beta(off), ss)};
+                    from_interval("size", Quantity::Rate, beta(off), slo, shi)};
   } else {
     const auto gl = [&](double lx) { return g(std::exp(lx)); };
     const auto [llo, lhi] = profile_interval(gl, std::log(t.nl), 0.02, std::log(0.5 * b.tb), std::log(20 * T));
-    const double as = size_sigma(b, m, index, off, std::sqrt(cov(off, off)), std::exp(llo), std::exp(lhi), first);
-    e.parameters = {from_sigma("amplitude", Quantity::Rate, beta(off), as),
+    const auto [alo, ahi] = size_interval(b, m, index, off, beta(off), std::sqrt(cov(off, off)), std::exp(llo),
+                                          std::exp(lhi), lowest, one, first);
+    e.parameters = {from_interval("amplitude", Quantity::Rate, beta(off), alo, ahi),
                     from_interval("time_constant", Quantity::Time, t.nl, std::exp(llo), std::exp(lhi))};
   }
   return e;
