@@ -206,3 +206,21 @@ TEST(DiagnoseCliLowpass, OutputChainFilterIsNamedAndSimulatedBack) {
   EXPECT_NE(text.find("# output_lowpass_tc_s: "), std::string::npos);
   EXPECT_NE(text.find("\nangle\n"), std::string::npos);
 }
+
+// The base model names the read-out the record was counted with, also below one pulse per sample
+// (0.34 pulses at 40 Hz), where a plain counter's σ(τ0) is as large as a dithered one's and only
+// the fit's counter model tells them apart.
+TEST(DiagnoseReadOut, BaseModelNamesTheReadOutBelowOnePulsePerSample) {
+  TempDir dir;
+  for (const bool white : {false, true}) {
+    const auto f = (dir.path() / (white ? "white.csv" : "counting.csv")).string();
+    std::vector<std::string> sim = {"simulate", "-o",     f,       "--duration", "1800",
+                                    "--rate",   "40",     "--arw", "0.001",      "--bias-instability",
+                                    "0.005",    "--seed", "11"};
+    if (white) sim.emplace_back("--white-readout");
+    ASSERT_EQ(run_cli(sim).status, 0);
+    const auto r = run_cli({"diagnose", f, "--json"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(json::parse(r.out).at("base_model").at("readout"), white ? "white" : "counting") << f;
+  }
+}

@@ -29,11 +29,13 @@ NoiseModel base_model(const AnalysisResult& a, const PhaseSeries& x) {
   m.bias_deg_per_h = a.mean_rate_deg_per_h - a.earth_rate_deg_per_h;
   const double q_fit = term_value(a.fit, Term::Q);
   if (x.exact()) {
-    // A dithered (white) read-out gives σ(τ0) ≈ 0.71·q/τ0, plain counting of a few pulses per
-    // sample far less (0.18·q/τ0 at 13.5 pulses/s and 400 Hz): 0.45·q/τ0 separates them.
+    // The fit's read-out when it modelled a plain counter. Otherwise: a dithered (white) read-out
+    // gives σ(τ0) ≈ 0.71·q/τ0, plain counting of a few pulses per sample far less (0.18·q/τ0 at
+    // 13.5 pulses/s and 400 Hz): 0.45·q/τ0 separates them. Below one pulse per sample counting gives
+    // more (0.58·q/τ0 at 0.34 pulses, 40 Hz), and only the fit tells it.
     const double q = x.arcsec_per_count;
-    const bool white =
-        !a.allan.points.empty() && a.allan.points.front().m == 1 && a.allan.points.front().dev * x.tau0_s / q > 0.45;
+    const bool white = !a.fit.counter_readout && !a.allan.points.empty() && a.allan.points.front().m == 1 &&
+                       a.allan.points.front().dev * x.tau0_s / q > 0.45;
     m.readout = white ? ReadoutMode::White : ReadoutMode::Counting;
     // Extra white angle noise only when the fitted Q clearly exceeds the read-out's own level.
     const double q_read = readout_q_arcsec(m.readout, q);
