@@ -299,10 +299,17 @@ Candidate search_transient(const Blocks& b, const GlsModel& cur, double alpha) {
   return c;
 }
 
+namespace {
+
+/// The Gauss–Markov search's step in Tc, and the cell its estimate is refined in.
+constexpr double kGmGridStep = 1.6;
+
+}  // namespace
+
 Candidate search_gauss_markov(const Blocks& b, const GlsModel& cur, double alpha) {
   const double T = b.duration();
   std::vector<double> grid;
-  for (double tc = 2 * b.tb; tc <= T / 3; tc *= 1.6) grid.push_back(tc);
+  for (double tc = 2 * b.tb; tc <= T / 3; tc *= kGmGridStep) grid.push_back(tc);
   // The flicker level is the scale of a Gauss–Markov variance that shows against the noise.
   double v0 = 1e-12;
   for (std::size_t j = 0; j < cur.cov.size(); ++j)
@@ -394,18 +401,28 @@ double det_m2ll(const Blocks& b, const GlsModel& m, std::size_t index, double x)
   return reprofiled_m2ll(b, hypothesis_of(b, det, m.cov), m);
 }
 
-/// The same with the coefficients of columns off … off + fixed.size() − 1 held at `fixed` (their
-/// part moved into the data), the others fitted: a size's profile.
-double fixed_size_m2ll(const Blocks& b, const GlsModel& m, Eigen::Index off, const Eigen::VectorXd& fixed) {
-  Hypothesis h = hypothesis_of(b, m.det, m.cov);
-  const Eigen::Index k = fixed.size(), rest = h.x.cols() - k;
+/// The model's hypothesis split for a size's profile: the columns off … off + k − 1 held (their
+/// part moved into the data), the others fitted.
+struct HeldColumns {
+  Hypothesis rest;
+  Eigen::MatrixXd held;
+};
+HeldColumns hold_columns(const Blocks& b, const GlsModel& m, Eigen::Index off, Eigen::Index k) {
+  HeldColumns s{hypothesis_of(b, m.det, m.cov), {}};
+  const Eigen::MatrixXd& x = s.rest.x;
+  s.held = x.middleCols(off, k);
+  Eigen::MatrixXd kept(x.rows(), x.cols() - k);
+  for (Eigen::Index c = 0, j = 0; c < x.cols(); ++c)
+    if (c < off || c >= off + k) kept.col(j++) = x.col(c);
+  s.rest.x = std::move(kept);
+  return s;
+}
+
+/// The same with the held columns' coefficients at `fixed`, the others fitted: a size's profile.
+double fixed_size_m2ll(const Blocks& b, const GlsModel& m, const HeldColumns& s, const Eigen::VectorXd& fixed) {
   Blocks moved = b;
-  moved.z -= h.x.middleCols(off, k) * fixed;
-  Eigen::MatrixXd x(h.x.rows(), rest);
-  for (Eigen::Index c = 0, j = 0; c < h.x.cols(); ++c)
-    if (c < off || c >= off + k) x.col(j++) = h.x.col(c);
-  h.x = std::move(x);
-  return reprofiled_m2ll(moved, h, m);
+  moved.z -= s.held * fixed;
+  return reprofiled_m2ll(moved, s.rest, m);
 }
 
 }  // namespace
@@ -437,7 +454,8 @@ template <class Fixed, class Size>
 std::pair<double, double> size_interval(const Blocks& b, const GlsModel& m, std::size_t index, Eigen::Index off,
                                         double value, double sigma_beta, double lo, double hi, double floor,
                                         const Fixed& fixed, const Size& size_of) {
-  const auto g = [&](double v) { return fixed_size_m2ll(b, m, off, fixed(v)); };
+  const HeldColumns held = hold_columns(b, m, off, fixed(value).size());
+  const auto g = [&](double v) { return fixed_size_m2ll(b, m, held, fixed(v)); };
   const auto [plo, phi] =
       profile_interval(g, value, 0.25 * sigma_beta, std::max(floor, value - 20 * sigma_beta), value + 20 * sigma_beta);
   const double across =
@@ -503,10 +521,10 @@ TermEstimate estimate_gm(const Blocks& b, const GlsModel& m, std::size_t ci) {
     l[ci] = std::exp(golden_max(f, std::log(grid_var) - 5, std::log(grid_var) + 5, 25));
     return std::pair{l, evaluate(b, ht, l).m2ll};
   };
-  // Tc: the search's grid point refined within its cell (the grid steps by 1.6), then the profile
+  // Tc: the search's grid point refined within its grid cell, then the profile
   // with the variance re-fitted at each Tc.
   const auto g_tc = [&](double lt) { return best_var(std::exp(lt)).second; };
-  const double lt0 = std::log(m.cov[ci].tc_s), cell = std::log(1.6);
+  const double lt0 = std::log(m.cov[ci].tc_s), cell = std::log(kGmGridStep);
   const double lt = golden_min(g_tc, lt0 - cell, lt0 + cell, 20);
   const double tc = std::exp(lt);
   // Every level profiled again at that Tc: the flicker and random-walk levels trade against σ².
