@@ -19,6 +19,7 @@
 #include "rwcalc/fit.hpp"
 #include "rwcalc/minimise.hpp"
 #include "rwcalc/nnls.hpp"
+#include "rwcalc/sample_variance.hpp"
 #include "rwcalc/structure_function.hpp"
 
 namespace {
@@ -201,6 +202,16 @@ TEST(Nnls, MeetsTheKarushKuhnTuckerConditions) {
     }
     EXPECT_NEAR(f.chi2, (w.array() * (y - g * f.x).array().square()).sum(), 1e-12);
   }
+}
+
+// The divisor n − 1, and no digits lost to a common level far above the spread (the one-pass
+// Σx² − n·x̄² would return 0 or a negative number here).
+TEST(SampleVariance, UnbiasedAndFreeOfTheCommonLevel) {
+  const std::vector<double> v = {2, 4, 4, 4, 5, 5, 7, 9};
+  EXPECT_DOUBLE_EQ(sample_variance(v), 32.0 / 7.0);
+  std::vector<double> shifted = v;
+  for (double& x : shifted) x += 1e9;
+  EXPECT_NEAR(sample_variance(shifted), 32.0 / 7.0, 1e-6);
 }
 
 TEST(GoldenSection, FindsTheMinimumAtItsFixedCost) {

@@ -11,6 +11,7 @@
 
 #include "rwcalc/confidence.hpp"
 #include "rwcalc/exact_sums.hpp"
+#include "rwcalc/sample_variance.hpp"
 
 namespace rwcalc {
 
@@ -310,15 +311,6 @@ int b1_mu(double measured, double n) {
     if (measured > boundary) return mu;
   }
   return -2;
-}
-
-double sample_variance(const std::vector<double>& y) {
-  double mean = 0;
-  for (double v : y) mean += v;
-  mean /= static_cast<double>(y.size());
-  double s = 0;
-  for (double v : y) s += (v - mean) * (v - mean);
-  return s / static_cast<double>(y.size() - 1);
 }
 
 double nonoverlapping_avar(const std::vector<double>& y) {

@@ -17,6 +17,7 @@
 #include "rwcalc/noise_model.hpp"
 #include "rwcalc/parallel.hpp"
 #include "rwcalc/random.hpp"
+#include "rwcalc/sample_variance.hpp"
 #include "rwcalc/simulate.hpp"
 #include "rwcalc/structure_function.hpp"
 
@@ -31,16 +32,6 @@ using Vec3 = Eigen::Vector3d;
 Vec3 structure(double u) {
   const std::array<double, 5> d = term_structure_functions(u);
   return {d[0], d[1], d[2]};
-}
-
-/// Sample variance (divisor n − 1) of `v`, n ≥ 2.
-double sample_variance(const std::vector<double>& v) {
-  double mean = 0;
-  for (double x : v) mean += x;
-  mean /= static_cast<double>(v.size());
-  double ss = 0;
-  for (double x : v) ss += (x - mean) * (x - mean);
-  return ss / static_cast<double>(v.size() - 1);
 }
 
 /// Σe and Σe² of e_k = C_{k+t} − C_k − shift, k in [k0, k1): in 16-bit lanes where the counts'
