@@ -93,9 +93,21 @@ TEST(DiagnoseAcceptance, SlowLinesAtThreeAndAHalfFloors) {
       std::cout << '\n';
     }
     const Finding* s = finding(r, Effect::Sinusoid);
+    const bool ok = s && std::abs(s->parameter("frequency").value - f) < 0.5 / kT &&
+                    std::abs(s->parameter("amplitude").value / amp - 1) < 0.3;
+    if (!ok) {
+      std::cout << fmt::format("  record {} (f {:.3g} Hz) not in tolerance:", i, f);
+      for (const Finding& e : r.findings) {
+        std::cout << ' ' << finding_name(e.effect);
+        for (const FindingParameter& p : e.parameters) std::cout << fmt::format(" {} {:.3g}", p.name, p.value);
+      }
+      std::cout << ", statistic/threshold";
+      for (const auto& d : r.detectors)
+        std::cout << fmt::format(" {} {:.1f}/{:.1f}", detector_name(d.effect), d.statistic, d.threshold);
+      std::cout << '\n';
+    }
     if (!s) continue;
-    const double fh = s->parameter("frequency").value, ah = s->parameter("amplitude").value;
-    named += std::abs(fh - f) < 0.5 / kT && std::abs(ah / amp - 1) < 0.3;
+    named += ok;
     gain += r.gain.likelihood_holdout > 0;
     cover_f += covers(*s, "frequency", f);
   }

@@ -171,7 +171,7 @@ TEST(DiagnoseGls, SlowLineFoundAndEstimated) {
   const Candidate c = search_slow_line(b, h, 0.01, 2.5 / 7200, 12.0 / 7200, Effect::Sinusoid);
   EXPECT_LT(c.p, 1e-3);
   EXPECT_GT(c.lr, c.threshold);
-  const TermEstimate e = estimate_det(b, c.model, 0);
+  const TermEstimate e = estimate_det(b, c.model).at(0);
   const Finding found{Effect::Sinusoid, e.parameters, {}};
   EXPECT_NEAR(found.parameter("frequency").value, f, 0.5 / 7200);
   EXPECT_NEAR(found.parameter("amplitude").value, amp, 0.3 * amp);
@@ -186,7 +186,7 @@ TEST(DiagnoseGls, StepFoundAndEstimated) {
   const Blocks b = blocks_of(m, 7200, 7);
   const Candidate c = search_step(b, null_model(b), 0.01);
   EXPECT_LT(c.p, 1e-3);
-  const TermEstimate e = estimate_det(b, c.model, 0);
+  const TermEstimate e = estimate_det(b, c.model).at(0);
   const Finding step{Effect::BiasStep, e.parameters, {}};
   const FindingParameter& time = step.parameter("time");
   EXPECT_NEAR(time.value, 3000, 100);

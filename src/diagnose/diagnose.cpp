@@ -332,8 +332,9 @@ void extend(const Blocks& b, const GlsModel& m, const Outside& out, bool fast_na
     r.extended.sinusoids.push_back({l.f_hz, l.amp, l.phase});
     r.findings.push_back(std::move(f));
   }
+  std::vector<TermEstimate> estimates = estimate_det(b, m);
   for (std::size_t j = 0; j < m.det.size(); ++j) {
-    Finding f{m.det[j].effect, estimate_det(b, m, j).parameters, {}};
+    Finding f{m.det[j].effect, std::move(estimates[j].parameters), {}};
     const auto v = [&f](std::string_view name) { return f.parameter(name).value; };
     if (f.effect == Effect::BiasStep)
       r.extended.bias_steps.push_back({v("time"), v("size")});

@@ -74,7 +74,8 @@ struct TermEstimate {
 FindingParameter from_sigma(std::string name, Quantity q, double value, double sigma);
 /// A parameter with a profile interval [low, high]; its standard uncertainty is the width / (2·kZ95).
 FindingParameter from_interval(std::string name, Quantity q, double value, double low, double high);
-TermEstimate estimate_det(const Blocks& b, const GlsModel& m, std::size_t index);
+/// Every deterministic term's, in the order of m.det.
+std::vector<TermEstimate> estimate_det(const Blocks& b, const GlsModel& m);
 TermEstimate estimate_gm(const Blocks& b, const GlsModel& m, std::size_t cov_index);
 
 }  // namespace rwcalc::diag

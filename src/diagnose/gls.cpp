@@ -195,6 +195,7 @@ Profile scaled_fit(const Blocks& b, const Hypothesis& h, const std::vector<doubl
     return p;
   }
   Eigen::VectorXd res = w.v.col(0);
+  double logdet_xtx = 0;  // ln det XᵀR⁻¹X
   if (k) {
     const Eigen::MatrixXd xw = w.v.rightCols(k);
     const Eigen::MatrixXd xtx = xw.transpose() * xw;
@@ -202,10 +203,13 @@ Profile scaled_fit(const Blocks& b, const Hypothesis& h, const std::vector<doubl
     p.beta = ldlt.solve(xw.transpose() * res);
     res -= xw * p.beta;
     p.beta_cov = ldlt.solve(Eigen::MatrixXd::Identity(k, k));
+    logdet_xtx = ldlt.vectorD().array().log().sum();
   }
-  const double rss = res.squaredNorm(), nn = static_cast<double>(n);
+  const double rss = res.squaredNorm(), nn = static_cast<double>(n), nr = static_cast<double>(n - k);
   const double s = rss / nn;
   p.m2ll = nn * std::log(s) + w.logdet + nn;
+  // REML: n − k degrees of freedom for the scale, and ln det XᵀΣ⁻¹X for the coefficients.
+  p.restricted_m2ll = nr * std::log(rss / nr) + w.logdet + logdet_xtx + nr;
   if (k) p.beta_cov *= s;
   p.r = r;
   for (double& x : p.r) x *= s;

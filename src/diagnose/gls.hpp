@@ -55,6 +55,9 @@ struct Profile {
   std::vector<double> level;  ///< per term (Hypothesis::terms), unit levels as term_autocov's
   Eigen::VectorXd beta;
   Eigen::MatrixXd beta_cov;
+  /// −2 ln of the restricted likelihood (REML: the regressors' coefficients integrated out, up to
+  /// a constant). Profiled on it, the levels are not pulled down by the power the regressors take.
+  double restricted_m2ll = 0;
   std::vector<double> r;    ///< the fitted autocovariance of z
   Termination termination;  ///< how the search over the levels stopped
 };
