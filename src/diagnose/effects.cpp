@@ -378,9 +378,10 @@ std::pair<double, double> profile_interval(const std::function<double(double)>& 
 /// closed form). A term's form or size trades against those levels (a long warm-up against a ramp's
 /// curvature, a slow line against the flicker): held, they made the profile narrow and the interval
 /// of a warm-up's time constant missed the truth in 5 of 39 records. The likelihood is the
-/// restricted one (the coefficients integrated out): a line and a step together take the lowest
-/// frequencies' power from the random-walk and flicker levels, and profiled on the plain likelihood
-/// the intervals of their parameters were 1.2–1.5 times too narrow.
+/// restricted one (the coefficients integrated out): the deterministic terms take power from the
+/// lowest frequencies, and profiled on the plain likelihood the levels gave it up (a slow line's
+/// frequency beside a step held the truth in 62 of 72 records, 64 on the restricted one; a second
+/// and third sweep over the levels change no count).
 double reprofiled_m2ll(const Blocks& b, const Hypothesis& h, const GlsModel& m) {
   std::vector<double> lv = m.fit.level;
   double best = evaluate(b, h, lv).restricted_m2ll;
