@@ -68,6 +68,20 @@ double at_least(double share, int n, int acceptance) {
 /// A fraction in [0, 1) drawn by the golden ratio: the cases spread evenly, no random stream.
 double spread(int i) { return i * 0.6180339887498949 - std::floor(i * 0.6180339887498949); }
 
+/// A case out of tolerance, for the log: what was named, and each detector's statistic against its
+/// threshold.
+void print_case(const std::string& what, const DiagnoseResult& r) {
+  std::cout << "  " << what << " not in tolerance:";
+  for (const Finding& e : r.findings) {
+    std::cout << ' ' << finding_name(e.effect);
+    for (const FindingParameter& p : e.parameters) std::cout << fmt::format(" {} {:.3g}", p.name, p.value);
+  }
+  std::cout << ", statistic/threshold";
+  for (const auto& d : r.detectors)
+    std::cout << fmt::format(" {} {:.1f}/{:.1f}", detector_name(d.effect), d.statistic, d.threshold);
+  std::cout << '\n';
+}
+
 }  // namespace
 
 // Slow lines of 3–5 cycles at 3.5× the flicker floor: named with frequency within 0.5/T and
@@ -95,17 +109,7 @@ TEST(DiagnoseAcceptance, SlowLinesAtThreeAndAHalfFloors) {
     const Finding* s = finding(r, Effect::Sinusoid);
     const bool ok = s && std::abs(s->parameter("frequency").value - f) < 0.5 / kT &&
                     std::abs(s->parameter("amplitude").value / amp - 1) < 0.3;
-    if (!ok) {
-      std::cout << fmt::format("  record {} (f {:.3g} Hz) not in tolerance:", i, f);
-      for (const Finding& e : r.findings) {
-        std::cout << ' ' << finding_name(e.effect);
-        for (const FindingParameter& p : e.parameters) std::cout << fmt::format(" {} {:.3g}", p.name, p.value);
-      }
-      std::cout << ", statistic/threshold";
-      for (const auto& d : r.detectors)
-        std::cout << fmt::format(" {} {:.1f}/{:.1f}", detector_name(d.effect), d.statistic, d.threshold);
-      std::cout << '\n';
-    }
+    if (!ok) print_case(fmt::format("record {} (f {:.3g} Hz)", i, f), r);
     if (!s) continue;
     named += ok;
     gain += r.gain.likelihood_holdout > 0;
@@ -229,14 +233,7 @@ TEST(DiagnoseAcceptance, GaussMarkovNamedWithinTolerance) {
     const Finding* g = finding(r, Effect::GaussMarkov);
     const bool ok = g && r.findings.size() == 1 && near(g->parameter("sigma").value, sigma, 0.3);
     gm.add(r, ok);
-    if (!ok) {
-      std::cout << fmt::format("  record {} (Tc {:.1f} s) not in tolerance:", i, tc);
-      for (const Finding& f : r.findings) {
-        std::cout << ' ' << finding_name(f.effect);
-        for (const FindingParameter& p : f.parameters) std::cout << fmt::format(" {} {:.3g}", p.name, p.value);
-      }
-      std::cout << '\n';
-    }
+    if (!ok) print_case(fmt::format("record {} (Tc {:.1f} s)", i, tc), r);
     if (!g) continue;
     sigma_covered += covers(*g, "sigma", sigma);
     tc_covered += covers(*g, "correlation_time", tc);
