@@ -477,13 +477,13 @@ std::vector<std::pair<double, double>> nonlinear_intervals(const Blocks& b, cons
   return out;
 }
 
-/// The term's coefficients (its columns' GLS coefficients) with term `moved`'s nonlinear parameter
-/// at x (its axis' space).
-Eigen::VectorXd coefficients_at(const Blocks& b, const GlsModel& m, std::size_t index, std::size_t moved, double x) {
+/// The GLS coefficients of columns off … off + k − 1 with term `moved`'s nonlinear parameter at x
+/// (its axis' space).
+Eigen::VectorXd coefficients_at(const Blocks& b, const GlsModel& m, Eigen::Index off, Eigen::Index k, std::size_t moved,
+                                double x) {
   auto det = m.det;
   det[moved].nl = nonlinear_axis(b, det[moved]).from(x);
-  const Profile p = evaluate(b, hypothesis_of(b, det, m.cov), m.fit.level);
-  return p.beta.segment(column_offset(b, m, index), det_columns(b, det[index]).cols());
+  return evaluate(b, hypothesis_of(b, det, m.cov), m.fit.level).beta.segment(off, k);
 }
 
 /// The 95 % interval of a size: the profile of `fixed(v)` (the term's coefficients at size v), the
@@ -494,17 +494,18 @@ Eigen::VectorXd coefficients_at(const Blocks& b, const GlsModel& m, std::size_t 
 /// value and levels alone, a slow line's amplitude and a step's size beside each other held the
 /// truth in 15 of 19 records.
 template <class Fixed, class Size>
-std::pair<double, double> size_interval(const Blocks& b, const GlsModel& m, std::size_t index, double value,
+std::pair<double, double> size_interval(const Blocks& b, const GlsModel& m, Eigen::Index off, double value,
                                         double sigma_beta, const std::vector<std::pair<double, double>>& nl,
                                         double floor, const Fixed& fixed, const Size& size_of) {
-  const HeldColumns held = hold_columns(b, m, column_offset(b, m, index), fixed(value).size());
+  const Eigen::Index k = fixed(value).size();
+  const HeldColumns held = hold_columns(b, m, off, k);
   const auto g = [&](double v) { return fixed_size_m2ll(b, m, held, fixed(v)); };
   const auto [plo, phi] =
       profile_interval(g, value, 0.25 * sigma_beta, std::max(floor, value - 20 * sigma_beta), value + 20 * sigma_beta);
   double across2 = 0;
   for (std::size_t i = 0; i < m.det.size(); ++i) {
-    const double d = 0.5 * (size_of(coefficients_at(b, m, index, i, nl[i].second)) -
-                            size_of(coefficients_at(b, m, index, i, nl[i].first)));
+    const double d = 0.5 * (size_of(coefficients_at(b, m, off, k, i, nl[i].second)) -
+                            size_of(coefficients_at(b, m, off, k, i, nl[i].first)));
     across2 += d * d;
   }
   const double across = std::sqrt(across2);
@@ -529,18 +530,18 @@ TermEstimate estimate_det(const Blocks& b, const GlsModel& m, std::size_t index,
     const Eigen::Vector2d unit(a / amp, bb / amp);
     // The amplitude's profile at the fitted phase.
     const auto [alo, ahi] = size_interval(
-        b, m, index, amp, std::sqrt(unit.dot(cov.block(off, off, 2, 2) * unit)), nl, 0.0,
+        b, m, off, amp, std::sqrt(unit.dot(cov.block(off, off, 2, 2) * unit)), nl, 0.0,
         [&](double v) { return Eigen::VectorXd(v * unit); },
         [](const Eigen::VectorXd& c) { return std::hypot(c(0), c(1)); });
     e.parameters = {from_interval("frequency", Quantity::Frequency, t.nl, xlo, xhi),
                     from_interval("amplitude", Quantity::Rate, amp, alo, ahi),
                     {"phase", Quantity::Phase, std::atan2(-bb, a)}};
   } else if (t.effect == Effect::BiasStep) {
-    const auto [slo, shi] = size_interval(b, m, index, beta(off), std::sqrt(cov(off, off)), nl, lowest, one, first);
+    const auto [slo, shi] = size_interval(b, m, off, beta(off), std::sqrt(cov(off, off)), nl, lowest, one, first);
     e.parameters = {from_interval("time", Quantity::Time, t.nl, xlo, xhi),
                     from_interval("size", Quantity::Rate, beta(off), slo, shi)};
   } else {
-    const auto [alo, ahi] = size_interval(b, m, index, beta(off), std::sqrt(cov(off, off)), nl, lowest, one, first);
+    const auto [alo, ahi] = size_interval(b, m, off, beta(off), std::sqrt(cov(off, off)), nl, lowest, one, first);
     e.parameters = {from_interval("amplitude", Quantity::Rate, beta(off), alo, ahi),
                     from_interval("time_constant", Quantity::Time, t.nl, xlo, xhi)};
   }
