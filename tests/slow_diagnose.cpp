@@ -86,11 +86,8 @@ void print_case(const std::string& what, const DiagnoseResult& r) {
 
 // Slow lines of 3–5 cycles at 3.5× the flicker floor: named with frequency within 0.5/T and
 // amplitude within 30 % in at least 90 % of records, with a positive out-of-sample gain. The line
-// is never named as a Gauss–Markov term. A Gauss–Markov term named beside it falls short of the
-// acceptance's "never": 2 of the 20 records (Tc 20 and 33 s, σ 0.011 °/h), both from the counting
-// read-out, whose sawtooth sampled at the block edges is correlated over a block or two where the
-// likelihood's Q term is white (the same records with a white read-out: statistics 0.6 and 1.9
-// against 9.7; docs/diagnosis.md).
+// is never named as a Gauss–Markov term, nor is one named beside it: the counting read-out's
+// sawtooth, correlated over a block or two, is in the Gauss–Markov test's null (docs/diagnosis.md).
 TEST(DiagnoseAcceptance, SlowLinesAtThreeAndAHalfFloors) {
   const int n = test::population("RWCALC_DIAGNOSE_LINES", 8, 20);
   int named = 0, gauss_markov = 0, gain = 0, cover_f = 0;
@@ -120,7 +117,7 @@ TEST(DiagnoseAcceptance, SlowLinesAtThreeAndAHalfFloors) {
       "gain, frequency interval covers {}\n",
       named, n, gauss_markov, gain, cover_f);
   EXPECT_GE(named, at_least(0.9, n, 20));
-  EXPECT_LE(gauss_markov, 2);
+  EXPECT_EQ(gauss_markov, 0);
   EXPECT_GE(gain, named - 1);
 }
 
@@ -300,8 +297,12 @@ TEST(DiagnoseAcceptance, EveryEffectNamedWithinTolerance) {
     cover("step beside a line", tb, "time", step_t);
     cover("step beside a line", tb, "size", 0.06);
   }
-  for (const auto& [what, c] : coverage)
+  // The acceptance's 90–98 % of the named cases, resolved from 60 on (RWCALC_DIAGNOSE_EFFECTS=80).
+  for (const auto& [what, c] : coverage) {
     std::cout << fmt::format("{}: 95 % interval covers the truth in {} of {}\n", what, c.first, c.second);
+    EXPECT_GE(c.first, at_least(0.9, c.second, 60)) << what;
+    EXPECT_LE(c.first, c.second * (0.98 + test::share_allowance(0.98, c.second, 60))) << what;
+  }
   warmup.check("warm-up");
   drift.check("exponential + linear drift");
   fast_line.check("line above the slow band");

@@ -3,8 +3,11 @@
 // bounds and known effects recovered.
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
 #include <cmath>
 #include <iostream>
+#include <limits>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -12,7 +15,9 @@
 #include "diagnose/fast_line.hpp"
 #include "diagnose/gain.hpp"
 #include "diagnose/gls.hpp"
+#include "diagnose/level_spread.hpp"
 #include "diagnose/signal.hpp"
+#include "independent_gyro.hpp"
 #include "rwcalc/normal_quantile.hpp"
 #include "rwcalc/simulate.hpp"
 
@@ -265,4 +270,98 @@ TEST(DiagnoseGain, FastLineHoldoutKnowsARealLineFromNoise) {
   }
   std::cout << "spurious lines lose " << lose << " of 12\n";
   EXPECT_GE(lose, 9) << lose << " of 12";
+}
+
+// One white level read from n values: Whittle's information is (n − 1)/(2ℓ²) (the zero frequency,
+// where every term of z is nil, left out), so a variance proportional to the level has n − 1
+// degrees of freedom, and one that does not move with the levels has infinitely many.
+TEST(DiagnoseLevelSpread, WhiteLevelHasTheInformationOfEveryValue) {
+  Blocks b;
+  b.y.assign(403, 0.0);
+  b.z = second_differences(b.y);
+  Hypothesis h;
+  h.terms = {{CovKind::Q}};
+  const double level = 2.5, n = static_cast<double>(b.n());
+  const LevelSpread s = level_spread(b, h, {level});
+  EXPECT_NEAR(s.cov(0, 0) / (2 * level * level / (n - 1)), 1.0, 1e-9);
+  EXPECT_NEAR(effective_dof(s, [](const std::vector<double>& lv) { return 3 * lv[0]; }), n - 1, 1e-6 * n);
+  EXPECT_TRUE(std::isinf(effective_dof(s, [](const std::vector<double>&) { return 3.0; })));
+}
+
+// A known level (a counter's) is not estimated: its row is zero, the other level keeps its spread.
+TEST(DiagnoseLevelSpread, KnownLevelHasNoSpread) {
+  Blocks b;
+  b.y.assign(203, 0.0);
+  b.z = second_differences(b.y);
+  Hypothesis h;
+  h.terms = {{CovKind::Q}, {CovKind::N}};
+  h.terms[1].known_level = 0.01;
+  const LevelSpread s = level_spread(b, h, {0.02, 0.01});
+  EXPECT_GT(s.cov(0, 0), 0);
+  EXPECT_EQ(s.cov(1, 1), 0);
+  EXPECT_EQ(s.cov(0, 1), 0);
+}
+
+// The stated spread is the levels' scatter over records of a generator that shares no code with
+// rwcalc (tests/independent_gyro.hpp): white rate noise and a dithered counter (white angle noise of
+// q²/6), comparable shares of Var z, profiled on 100 one-hour records; each level's standard deviation
+// across them within 20 % of the stated one (the sample's own is ±7 %).
+TEST(DiagnoseLevelSpread, StatedSpreadIsTheScatterOverRecords) {
+  test::IndependentSettings set;
+  set.seconds = 3600;
+  set.rate_hz = 10;
+  set.dither = true;
+  const std::vector<double> truth = {set.q_arcsec * set.q_arcsec / 6, 0.0036};
+  std::vector<std::vector<double>> fitted(2);
+  Eigen::Vector2d stated = Eigen::Vector2d::Zero();
+  const int records = 100;
+  for (int i = 0; i < records; ++i) {
+    const Recording rec = test::independent_record({0.001, 0, 0}, set, 900 + static_cast<std::uint64_t>(i));
+    const Decimated d = decimate(rec.phase);
+    Blocks b;
+    b.y = block_rates(d, per_block_for(d, 10));
+    b.z = second_differences(b.y);
+    const Hypothesis h = hypothesis_of(b, {}, {{CovKind::Q}, {CovKind::N}});
+    const Profile p = profile(b, h, truth);
+    const LevelSpread s = level_spread(b, h, p.level);
+    for (int t = 0; t < 2; ++t) {
+      fitted[static_cast<std::size_t>(t)].push_back(p.level[static_cast<std::size_t>(t)]);
+      stated(t) += std::sqrt(s.cov(t, t)) / records;
+    }
+  }
+  for (int t = 0; t < 2; ++t) {
+    const auto& v = fitted[static_cast<std::size_t>(t)];
+    double mean = 0, ss = 0;
+    for (const double x : v) mean += x / records;
+    for (const double x : v) ss += (x - mean) * (x - mean);
+    const double sd = std::sqrt(ss / (records - 1));
+    std::cout << fmt::format("level {}: mean {:.4g} (truth {:.4g}), scatter {:.3g}, stated {:.3g}\n", t, mean,
+                             truth[static_cast<std::size_t>(t)], sd, stated(t));
+    EXPECT_NEAR(sd / stated(t), 1.0, 0.2) << t;
+  }
+}
+
+// Student's t²: the χ²₁ cutoff for many degrees of freedom, t²(0.975, 10) = 2.228139² for ten.
+TEST(DiagnoseLevelSpread, CutoffIsStudentsT) {
+  EXPECT_NEAR(profile_cutoff(std::numeric_limits<double>::infinity()), 3.841458820694124, 1e-12);
+  EXPECT_NEAR(profile_cutoff(10), 2.228138851986 * 2.228138851986, 1e-9);
+  EXPECT_NEAR(profile_cutoff(1e5), 3.841458820694124, 1e-3);
+}
+
+// A counter's sawtooth advancing by a fraction s of a pulse a block, noiseless, has the correlation
+// 1 − 6s(1 − s) at one block (s = ½: −½, s = ¼: −⅛); noise in the advance damps it toward white.
+TEST(DiagnoseGls, CounterSawtoothHasItsKnownCorrelation) {
+  const auto c_half = counter_correlation(std::vector<double>(50, 0.5), 0.0, 3);
+  const auto c_quarter = counter_correlation(std::vector<double>(50, 0.25), 0.0, 3);
+  ASSERT_GE(c_half.size(), 2U);
+  EXPECT_NEAR(c_half[1], -0.5, 0.01);
+  EXPECT_NEAR(c_quarter[1], -0.125, 0.01);
+  const auto c_noisy = counter_correlation(std::vector<double>(50, 0.25), 0.05, 3);
+  EXPECT_GT(c_noisy[1], c_quarter[1]);
+  EXPECT_LT(std::abs(c_noisy[1]), 0.125);
+  // Uncorrelated, the term is white angle noise: Q's covariance.
+  CovTerm white{CovKind::Counter};
+  white.correlation = std::make_shared<const std::vector<double>>(std::vector<double>{1.0});
+  const auto rc = term_autocov(white, 8, 10), rq = term_autocov({CovKind::Q}, 8, 10);
+  for (std::size_t m = 0; m < 8; ++m) EXPECT_NEAR(rc[m], rq[m], 1e-15) << m;
 }

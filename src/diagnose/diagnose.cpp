@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <tuple>
@@ -87,6 +88,37 @@ Blocks make_blocks(const PhaseSeries& x) {
   b.y = block_rates(d, per);
   b.z = second_differences(b.y);
   return b;
+}
+
+/// Blocks either side of a block whose mean rate gives the counter's local advance: the line or
+/// bias wander that moves it (a slow line of 3.5 flicker floors by ±0.13 pulse a block on GL-2D-like
+/// records) stays, the block means' own noise (≈ 0.45 pulse) averages to ≈ 0.06.
+constexpr std::size_t kAdvanceHalfWindow = 30;
+
+/// The angle error at the block edges: a plain counter's sawtooth, of variance q²/12 (known, not
+/// profiled), correlated across blocks by its phase's advance (the local mean rate) and spread by
+/// the base model's white rate and white angle over a block (the AV fit resolves N; the blocks
+/// alone trade it against Q). Taken as white (Q), its correlation was named a Gauss–Markov term of
+/// Tc 20–33 s beside 2 of 20 slow lines; with its level free, it took a line.
+std::optional<CovTerm> counter_term(const NoiseModel& base, double q_arcsec, const Blocks& b) {
+  const std::size_t nb = b.y.size();
+  if (!(q_arcsec > 0) || base.readout != ReadoutMode::Counting || nb == 0) return std::nullopt;
+  std::vector<double> prefix(nb + 1, 0.0);  // °/h, that is ″/s
+  for (std::size_t k = 0; k < nb; ++k) prefix[k + 1] = prefix[k] + b.y[k];
+  std::vector<double> advance(nb);
+  for (std::size_t k = 0; k < nb; ++k) {
+    const std::size_t lo = k > kAdvanceHalfWindow ? k - kAdvanceHalfWindow : 0;
+    const std::size_t hi = std::min(nb, k + kAdvanceHalfWindow + 1);
+    const double pulses = std::abs(prefix[hi] - prefix[lo]) / static_cast<double>(hi - lo) * b.tb / q_arcsec;
+    advance[k] = pulses - std::floor(pulses);
+  }
+  const double n = base.arw_deg_per_sqrt_h * units::sqrt_s_per_sqrt_h;  // ″/√s
+  const double spread =
+      (n * n * b.tb + 2.0 * base.white_angle_arcsec * base.white_angle_arcsec) / (q_arcsec * q_arcsec);
+  CovTerm t{CovKind::Counter};
+  t.correlation = std::make_shared<const std::vector<double>>(counter_correlation(advance, spread, b.n() + 3));
+  t.known_level = q_arcsec * q_arcsec / 12.0;
+  return t;
 }
 
 /// The base model's levels in the likelihood's units (gls.hpp), each at least a small share of the
@@ -432,11 +464,12 @@ DiagnoseResult diagnose(const Recording& read, const DiagnoseOptions& opt) {
   r.band_level = opt.band_level;
   r.alpha = opt.alpha;
   fit_base(rec, opt, r, std::move(outliers));
-  const Blocks b = make_blocks(rec.phase);
+  Blocks b = make_blocks(rec.phase);
   GlsModel h0;
   h0.cov = {{CovKind::Q}, {CovKind::N}, {CovKind::B}, {CovKind::K}};
   const double q = rec.phase.exact() ? rec.phase.arcsec_per_count : 0.0;
   h0.fit = profile(b, hypothesis_of(b, {}, h0.cov), start_levels(r.base, q, b, h0.cov));
+  b.counter = counter_term(r.base, q, b);
   const Outside out = outside_tests(rec.phase, b, opt.alpha);
   bool fast_named = false;
   const GlsModel final_model = select_effects(b, h0, out, opt.alpha, r, fast_named, opt.progress);

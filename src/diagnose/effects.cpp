@@ -1,6 +1,7 @@
 // The effects' scans, their null laws and estimates (effects.hpp): every statistic is a
 // likelihood ratio of the block means with the noise levels profiled (gls.hpp).
 #include "effects.hpp"
+#include "level_spread.hpp"
 #include "signal.hpp"
 
 #include <fmt/format.h>
@@ -304,18 +305,20 @@ namespace {
 /// The Gauss–Markov search's step in Tc, and the cell its estimate is refined in.
 constexpr double kGmGridStep = 1.6;
 
-}  // namespace
+struct GmPeak {
+  double tc = 0, level = 0;
+};
 
-Candidate search_gauss_markov(const Blocks& b, const GlsModel& cur, double alpha) {
-  const double T = b.duration();
-  std::vector<double> grid;
-  for (double tc = 2 * b.tb; tc <= T / 3; tc *= kGmGridStep) grid.push_back(tc);
+/// The correlation time of `grid` whose Gauss–Markov term, at its best level with the model's
+/// levels held, raises the likelihood most.
+GmPeak gm_peak(const Blocks& b, const GlsModel& cur, const std::vector<double>& grid) {
   // The flicker level is the scale of a Gauss–Markov variance that shows against the noise.
   double v0 = 1e-12;
   for (std::size_t j = 0; j < cur.cov.size(); ++j)
     if (cur.cov[j].kind == CovKind::B) v0 = std::max(v0, cur.fit.level[j]);
   const Hypothesis h0 = hypothesis_of(b, cur.det, cur.cov);
-  double best = -1, best_tc = grid.front(), best_level = v0;
+  double best = -1;
+  GmPeak peak{grid.front(), v0};
   for (const double tc : grid) {
     Hypothesis h = h0;
     h.terms.push_back({CovKind::GM, tc});
@@ -327,15 +330,43 @@ Candidate search_gauss_markov(const Blocks& b, const GlsModel& cur, double alpha
     };
     const double lg = golden_max(f, std::log(v0 * 1e-3), std::log(v0 * 1e3), 16);
     const double lr = cur.fit.m2ll + f(lg);
-    if (lr > best) best = lr, best_tc = tc, best_level = std::exp(lg);
+    if (lr > best) best = lr, peak = {tc, std::exp(lg)};
   }
+  return peak;
+}
+
+GlsModel with_gm(const Blocks& b, const GlsModel& cur, const GmPeak& peak) {
+  GlsModel m{cur.det, cur.cov, {}};
+  m.cov.push_back({CovKind::GM, peak.tc});
+  refit(b, m, cur, peak.level);
+  return m;
+}
+
+}  // namespace
+
+Candidate search_gauss_markov(const Blocks& b, const GlsModel& cur, double alpha) {
+  const double T = b.duration();
+  std::vector<double> grid;
+  for (double tc = 2 * b.tb; tc <= T / 3; tc *= kGmGridStep) grid.push_back(tc);
+  // A plain counter's read-out error is correlated across blocks by its sawtooth (Blocks::counter):
+  // taken as white, that correlation passes for a Gauss–Markov term of Tc 20–30 s. The test holds
+  // it in both hypotheses; the other families keep the white read-out, with which the slow lines
+  // have their power (the correlated term lowers their statistics by about 2.5).
+  GlsModel null = cur;
+  if (b.counter) {
+    null.cov.push_back(*b.counter);
+    // Q keeps what the counter's error leaves of it.
+    std::vector<double> start = cur.fit.level;
+    start[0] = std::max(start[0] - b.counter->known_level, 0.05 * start[0]);
+    start.push_back(b.counter->known_level);
+    null.fit = profile(b, hypothesis_of(b, null.det, null.cov), start);
+  }
+  const GmPeak peak = gm_peak(b, null, grid);
+  const GlsModel alt = with_gm(b, null, peak);
   Candidate c;
   c.effect = Effect::GaussMarkov;
-  c.model.det = cur.det;
-  c.model.cov = cur.cov;
-  c.model.cov.push_back({CovKind::GM, best_tc});
-  refit(b, c.model, cur, best_level);
-  c.lr = std::max(0.0, best_null(b, cur, c.model) - c.model.fit.m2ll);
+  c.model = b.counter ? with_gm(b, cur, peak) : alt;
+  c.lr = std::max(0.0, best_null(b, null, alt) - alt.fit.m2ll);
   const double m = static_cast<double>(grid.size());
   c.p = std::min(1.0, m * 0.5 * chi2_sf(c.lr, 1));
   double lo = 0, hi = 400;
@@ -354,7 +385,7 @@ namespace {
 /// by 3.84, found by steps of `step` outwards and bisection to a 40th of `step`; clipped to [lo, hi].
 std::pair<double, double> profile_interval(const std::function<double(double)>& g, double x0, double step, double lo,
                                            double hi) {
-  const double g0 = g(x0), target = g0 + 3.841458820694124;
+  const double g0 = g(x0), target = g0 + kChi2Cut95;
   auto side = [&](double dir) {
     double inside = x0, x = x0;
     for (int i = 0; i < 60; ++i) {
@@ -470,10 +501,46 @@ std::pair<double, double> nonlinear_interval(const Blocks& b, const GlsModel& m,
   return profile_interval(g, ax.to(m.det[index].nl), ax.step, ax.lo, ax.hi);
 }
 
-/// Every term's nonlinear interval (in its axis' space).
-std::vector<std::pair<double, double>> nonlinear_intervals(const Blocks& b, const GlsModel& m) {
+/// An interval found at χ²₁'s cutoff widened to `cutoff` about x0, the profile taken as quadratic
+/// between the two.
+std::pair<double, double> widened(const std::pair<double, double>& iv, double x0, double cutoff) {
+  const double k = std::sqrt(cutoff / kChi2Cut95);
+  return {x0 - k * (x0 - iv.first), x0 + k * (iv.second - x0)};
+}
+
+/// The variance of term `index`'s nonlinear parameter (its axis' space) at the levels `lv`: the
+/// secant curvature of −2 ln L_R over ±d about the estimate, every coefficient fitted.
+double nonlinear_variance(const Blocks& b, const GlsModel& m, std::size_t index, double d,
+                          const std::vector<double>& lv) {
+  const NonlinearAxis ax = nonlinear_axis(b, m.det[index]);
+  const double u0 = ax.to(m.det[index].nl);
+  const auto g = [&](double u) {
+    auto det = m.det;
+    det[index].nl = ax.from(u);
+    return evaluate_exact(b, hypothesis_of(b, det, m.cov), lv).restricted_m2ll;
+  };
+  const double curvature = g(u0 + d) + g(u0 - d) - 2 * g(u0);
+  return curvature > 0 ? 2 * d * d / curvature : std::numeric_limits<double>::quiet_NaN();
+}
+
+/// Every term's nonlinear interval (in its axis' space), at the cutoff of its variance's degrees
+/// of freedom over the levels' spread.
+std::vector<std::pair<double, double>> nonlinear_intervals(const Blocks& b, const GlsModel& m,
+                                                           const LevelSpread& spread) {
   std::vector<std::pair<double, double>> out;
-  for (std::size_t j = 0; j < m.det.size(); ++j) out.push_back(nonlinear_interval(b, m, j));
+  for (std::size_t j = 0; j < m.det.size(); ++j) {
+    const NonlinearAxis ax = nonlinear_axis(b, m.det[j]);
+    const double u0 = ax.to(m.det[j].nl);
+    auto iv = nonlinear_interval(b, m, j);
+    const double d = 0.25 * (iv.second - iv.first);
+    if (d > 0) {
+      const double dof =
+          effective_dof(spread, [&](const std::vector<double>& lv) { return nonlinear_variance(b, m, j, d, lv); });
+      iv = widened(iv, u0, profile_cutoff(dof));
+      iv = {std::max(iv.first, ax.lo), std::min(iv.second, ax.hi)};
+    }
+    out.push_back(iv);
+  }
   return out;
 }
 
@@ -496,12 +563,14 @@ Eigen::VectorXd coefficients_at(const Blocks& b, const GlsModel& m, Eigen::Index
 template <class Fixed, class Size>
 std::pair<double, double> size_interval(const Blocks& b, const GlsModel& m, Eigen::Index off, double value,
                                         double sigma_beta, const std::vector<std::pair<double, double>>& nl,
-                                        double floor, const Fixed& fixed, const Size& size_of) {
+                                        double floor, double cutoff, const Fixed& fixed, const Size& size_of) {
   const Eigen::Index k = fixed(value).size();
   const HeldColumns held = hold_columns(b, m, off, k);
   const auto g = [&](double v) { return fixed_size_m2ll(b, m, held, fixed(v)); };
-  const auto [plo, phi] =
-      profile_interval(g, value, 0.25 * sigma_beta, std::max(floor, value - 20 * sigma_beta), value + 20 * sigma_beta);
+  auto [plo, phi] = widened(profile_interval(g, value, 0.25 * sigma_beta, std::max(floor, value - 20 * sigma_beta),
+                                             value + 20 * sigma_beta),
+                            value, cutoff);
+  plo = std::max(plo, floor);
   double across2 = 0;
   for (std::size_t i = 0; i < m.det.size(); ++i) {
     const double d = 0.5 * (size_of(coefficients_at(b, m, off, k, i, nl[i].second)) -
@@ -514,8 +583,16 @@ std::pair<double, double> size_interval(const Blocks& b, const GlsModel& m, Eige
 
 /// One term's parameters, its and the others' nonlinear intervals given.
 TermEstimate estimate_det(const Blocks& b, const GlsModel& m, std::size_t index,
-                          const std::vector<std::pair<double, double>>& nl) {
+                          const std::vector<std::pair<double, double>>& nl, const LevelSpread& spread) {
   const Eigen::Index off = column_offset(b, m, index);
+  const Hypothesis h = hypothesis_of(b, m.det, m.cov);
+  // The cutoff of a size a·β (β the term's coefficients) by its variance's degrees of freedom.
+  const auto cutoff_of = [&](const Eigen::VectorXd& a) {
+    const double dof = effective_dof(spread, [&](const std::vector<double>& lv) {
+      return a.dot(evaluate_exact(b, h, lv).beta_cov.block(off, off, a.size(), a.size()) * a);
+    });
+    return profile_cutoff(dof);
+  };
   const DetTerm& t = m.det[index];
   const auto& beta = m.fit.beta;
   const auto& cov = m.fit.beta_cov;
@@ -530,18 +607,20 @@ TermEstimate estimate_det(const Blocks& b, const GlsModel& m, std::size_t index,
     const Eigen::Vector2d unit(a / amp, bb / amp);
     // The amplitude's profile at the fitted phase.
     const auto [alo, ahi] = size_interval(
-        b, m, off, amp, std::sqrt(unit.dot(cov.block(off, off, 2, 2) * unit)), nl, 0.0,
+        b, m, off, amp, std::sqrt(unit.dot(cov.block(off, off, 2, 2) * unit)), nl, 0.0, cutoff_of(unit),
         [&](double v) { return Eigen::VectorXd(v * unit); },
         [](const Eigen::VectorXd& c) { return std::hypot(c(0), c(1)); });
     e.parameters = {from_interval("frequency", Quantity::Frequency, t.nl, xlo, xhi),
                     from_interval("amplitude", Quantity::Rate, amp, alo, ahi),
                     {"phase", Quantity::Phase, std::atan2(-bb, a)}};
   } else if (t.effect == Effect::BiasStep) {
-    const auto [slo, shi] = size_interval(b, m, off, beta(off), std::sqrt(cov(off, off)), nl, lowest, one, first);
+    const auto [slo, shi] =
+        size_interval(b, m, off, beta(off), std::sqrt(cov(off, off)), nl, lowest, cutoff_of(one(1.0)), one, first);
     e.parameters = {from_interval("time", Quantity::Time, t.nl, xlo, xhi),
                     from_interval("size", Quantity::Rate, beta(off), slo, shi)};
   } else {
-    const auto [alo, ahi] = size_interval(b, m, off, beta(off), std::sqrt(cov(off, off)), nl, lowest, one, first);
+    const auto [alo, ahi] =
+        size_interval(b, m, off, beta(off), std::sqrt(cov(off, off)), nl, lowest, cutoff_of(one(1.0)), one, first);
     e.parameters = {from_interval("amplitude", Quantity::Rate, beta(off), alo, ahi),
                     from_interval("time_constant", Quantity::Time, t.nl, xlo, xhi)};
   }
@@ -551,9 +630,10 @@ TermEstimate estimate_det(const Blocks& b, const GlsModel& m, std::size_t index,
 }  // namespace
 
 std::vector<TermEstimate> estimate_det(const Blocks& b, const GlsModel& m) {
-  const auto nl = nonlinear_intervals(b, m);
+  const LevelSpread spread = level_spread(b, hypothesis_of(b, m.det, m.cov), m.fit.level);
+  const auto nl = nonlinear_intervals(b, m, spread);
   std::vector<TermEstimate> out;
-  for (std::size_t j = 0; j < m.det.size(); ++j) out.push_back(estimate_det(b, m, j, nl));
+  for (std::size_t j = 0; j < m.det.size(); ++j) out.push_back(estimate_det(b, m, j, nl, spread));
   return out;
 }
 

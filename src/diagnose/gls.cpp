@@ -41,6 +41,26 @@ double flicker_lag(std::size_t m) {
 
 }  // namespace
 
+std::vector<double> counter_correlation(const std::vector<double>& advance, double spread, std::size_t lags) {
+  constexpr double pi = 3.141592653589793;
+  constexpr int kHarmonics = 64;  // beyond, m⁻² leaves under 2 % of c(0) even undamped
+  std::vector<double> c = {1.0};
+  for (std::size_t u = 1; u < lags; ++u) {
+    const double damp = 2 * pi * pi * static_cast<double>(u) * spread;
+    if (damp > 30) break;  // e^{−30}: every harmonic is gone
+    double sum = 0;
+    for (int m = 1; m <= kHarmonics; ++m) {
+      const double md = m, e = std::exp(-damp * md * md) / (md * md);
+      if (e < 1e-17) break;
+      double mean_cos = 0;
+      for (const double a : advance) mean_cos += std::cos(2 * pi * md * static_cast<double>(u) * a);
+      sum += e * mean_cos / static_cast<double>(advance.size());
+    }
+    c.push_back(6.0 * sum / (pi * pi));
+  }
+  return c;
+}
+
 std::vector<double> term_autocov(const CovTerm& t, std::size_t n, double tb) {
   std::vector<double> r(n, 0.0);
   const double tb2 = tb * tb;
@@ -48,6 +68,12 @@ std::vector<double> term_autocov(const CovTerm& t, std::size_t n, double tb) {
     case CovKind::Q:  // G(0) = 1 ″², 0 beyond
       for (std::size_t m = 0; m < std::min<std::size_t>(n, 4); ++m) r[m] = static_cast<double>(kR[m]) / tb2;
       break;
+    case CovKind::Counter: {  // G(u) = c(u) ″²
+      const std::vector<double>& c = *t.correlation;
+      const auto g = [&](std::size_t u) { return u < c.size() ? static_cast<long double>(c[u]) : 0.0L; };
+      for (std::size_t m = 0; m < std::min(n, c.size() + 3); ++m) r[m] = static_cast<double>(lag_sum(m, g)) / tb2;
+      break;
+    }
     case CovKind::N:  // AV 1/τ: G(τ) = −τ/2
       for (std::size_t m = 0; m < std::min<std::size_t>(n, 4); ++m)
         r[m] = static_cast<double>(lag_sum(m, [&](std::size_t u) { return -0.5L * u * tb; })) / tb2;
@@ -83,7 +109,8 @@ std::vector<double> term_autocov(const CovTerm& t, std::size_t n, double tb) {
 
 double term_avar(const CovTerm& t, double tau) {
   switch (t.kind) {
-    case CovKind::Q: return 3.0 / (tau * tau);
+    case CovKind::Q:
+    case CovKind::Counter: return 3.0 / (tau * tau);
     case CovKind::N: return 1.0 / tau;
     case CovKind::B: return 1.0;
     case CovKind::K: return tau;
@@ -181,9 +208,10 @@ double m2ll_fixed(const Blocks& b, const Hypothesis& h, const std::vector<double
 
 namespace {
 
-/// −2 ln L of z with the overall scale s of `r` profiled: n ln(RSS/n) + ln det Σ(r) + n ln… The
-/// returned profile's levels are s times the given ones.
-Profile scaled_fit(const Blocks& b, const Hypothesis& h, const std::vector<double>& r) {
+/// −2 ln L of z with the overall scale s of `r` profiled: n ln(RSS/n) + ln det Σ(r) + n; with
+/// `free_scale` false, s = 1: RSS + ln det Σ(r). The returned profile's levels are s times the given
+/// ones.
+Profile scaled_fit(const Blocks& b, const Hypothesis& h, const std::vector<double>& r, bool free_scale) {
   Profile p;
   const Eigen::Index n = static_cast<Eigen::Index>(b.n()), k = h.x.cols();
   Eigen::MatrixXd v(n, 1 + k);
@@ -206,10 +234,10 @@ Profile scaled_fit(const Blocks& b, const Hypothesis& h, const std::vector<doubl
     logdet_xtx = ldlt.vectorD().array().log().sum();
   }
   const double rss = res.squaredNorm(), nn = static_cast<double>(n), nr = static_cast<double>(n - k);
-  const double s = rss / nn;
-  p.m2ll = nn * std::log(s) + w.logdet + nn;
+  const double s = free_scale ? rss / nn : 1.0;
+  p.m2ll = free_scale ? nn * std::log(s) + w.logdet + nn : rss + w.logdet;
   // REML: n − k degrees of freedom for the scale, and ln det XᵀΣ⁻¹X for the coefficients.
-  p.restricted_m2ll = nr * std::log(rss / nr) + w.logdet + logdet_xtx + nr;
+  p.restricted_m2ll = free_scale ? nr * std::log(rss / nr) + w.logdet + logdet_xtx + nr : rss + w.logdet + logdet_xtx;
   if (k) p.beta_cov *= s;
   p.r = r;
   for (double& x : p.r) x *= s;
@@ -219,12 +247,25 @@ Profile scaled_fit(const Blocks& b, const Hypothesis& h, const std::vector<doubl
 
 }  // namespace
 
+bool has_known_level(const std::vector<CovTerm>& terms) {
+  return std::any_of(terms.begin(), terms.end(), [](const CovTerm& t) { return t.known_level > 0; });
+}
+
 Profile evaluate(const Blocks& b, const Hypothesis& h, const std::vector<double>& level) {
-  const auto r = total_autocov(b, h.terms, level);
-  Profile p = scaled_fit(b, h, r);
+  std::vector<double> lv = level;
+  for (std::size_t t = 0; t < h.terms.size(); ++t)
+    if (h.terms[t].known_level > 0) lv[t] = h.terms[t].known_level;
+  const bool free_scale = !has_known_level(h.terms);
+  Profile p = scaled_fit(b, h, total_autocov(b, h.terms, lv), free_scale);
   const double s = p.level.empty() ? 1.0 : p.level[0];
-  p.level = level;
+  p.level = lv;
   for (double& l : p.level) l *= s;
+  return p;
+}
+
+Profile evaluate_exact(const Blocks& b, const Hypothesis& h, const std::vector<double>& level) {
+  Profile p = scaled_fit(b, h, total_autocov(b, h.terms, level), false);
+  p.level = level;
   return p;
 }
 
@@ -240,12 +281,20 @@ Profile profile(const Blocks& b, const Hypothesis& h, const std::vector<double>&
   std::vector<std::vector<double>> unit(nt);
   for (std::size_t t = 0; t < nt; ++t) unit[t] = term_autocov(h.terms[t], b.n(), b.tb);
   // The reference term (level 1, the scale profiled) is the one with the largest share of Var z.
-  std::size_t ref = 0;
-  for (std::size_t t = 1; t < nt; ++t)
-    if (start[t] * unit[t][0] > start[ref] * unit[ref][0]) ref = t;
+  // With a known level there is no free scale: no reference, every other level searched.
+  const bool free_scale = !has_known_level(h.terms);
+  std::size_t ref = nt;
+  if (free_scale) {
+    ref = 0;
+    for (std::size_t t = 1; t < nt; ++t)
+      if (start[t] * unit[t][0] > start[ref] * unit[ref][0]) ref = t;
+  }
+  const double ref_start = free_scale ? start[ref] : 1.0;
+  const auto searched = [&](std::size_t t) { return t != ref && !(h.terms[t].known_level > 0); };
   auto levels_of = [&](const std::vector<double>& u) {
     std::vector<double> lv(nt);
-    for (std::size_t t = 0, j = 0; t < nt; ++t) lv[t] = t == ref ? 1.0 : std::exp(std::clamp(u[j++], kLogFloor, 40.0));
+    for (std::size_t t = 0, j = 0; t < nt; ++t)
+      lv[t] = t == ref ? 1.0 : searched(t) ? std::exp(std::clamp(u[j++], kLogFloor, 40.0)) : h.terms[t].known_level;
     return lv;
   };
   auto fit_at = [&](const std::vector<double>& u) {
@@ -253,7 +302,7 @@ Profile profile(const Blocks& b, const Hypothesis& h, const std::vector<double>&
     std::vector<double> r(b.n(), 0.0);
     for (std::size_t t = 0; t < nt; ++t)
       for (std::size_t m = 0; m < r.size(); ++m) r[m] += lv[t] * unit[t][m];
-    Profile p = scaled_fit(b, h, r);
+    Profile p = scaled_fit(b, h, r, free_scale);
     const double s = p.level.empty() ? 1.0 : p.level[0];
     p.level = lv;
     for (double& l : p.level) l *= s;
@@ -261,7 +310,7 @@ Profile profile(const Blocks& b, const Hypothesis& h, const std::vector<double>&
   };
   std::vector<double> u0;
   for (std::size_t t = 0; t < nt; ++t)
-    if (t != ref) u0.push_back(std::log(std::max(start[t], 1e-300) / start[ref]));
+    if (searched(t)) u0.push_back(std::log(std::max(start[t], 1e-300) / ref_start));
   if (u0.empty()) return fit_at(u0);
   const auto f = [&](const std::vector<double>& u) { return fit_at(u).m2ll; };
   // Two rounds: a restart from the first optimum escapes a collapsed simplex.

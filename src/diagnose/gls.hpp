@@ -9,6 +9,8 @@
 /// nuisance; the levels are profiled (maximised) under every hypothesis.
 #include <Eigen/Dense>
 #include <cstddef>
+#include <memory>
+#include <optional>
 #include <vector>
 
 #include "rwcalc/termination.hpp"
@@ -18,15 +20,28 @@ namespace rwcalc::diag {
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 /// A covariance term of the block means: its kind, and its correlation time for a Gauss–Markov one.
-enum class CovKind { Q, N, B, K, GM };
+/// Counter: a plain counter's read-out error at the block edges, the sawtooth of the angle, whose
+/// correlation across blocks (counter_correlation) the term carries.
+enum class CovKind { Q, N, B, K, GM, Counter };
 struct CovTerm {
   CovKind kind = CovKind::N;
   double tc_s = 0;  ///< Gauss–Markov correlation time, s
+  /// Counter: the error's correlation c(u) at lags u = 0, 1, … (c(0) = 1, 0 beyond the last).
+  std::shared_ptr<const std::vector<double>> correlation;
+  /// > 0: the term's level is known, not profiled (a counter's error variance q²/12, ″²). With a
+  /// known level the overall scale is no longer free: every other level is searched on its own.
+  double known_level = 0;
 };
+[[nodiscard]] bool has_known_level(const std::vector<CovTerm>& terms);
 
-/// Autocovariance r[0 … n−1] of z at unit level: Q (white angle variance 1 ″²), N (AV 1/τ (°/h)²·s),
+/// Autocovariance r[0 … n−1] of z at unit level: Q and Counter (angle error variance 1 ″²), N (AV 1/τ (°/h)²·s),
 /// B (AV 1 (°/h)², the flicker floor's), K (AV τ (°/h)²/s), GM (variance 1 (°/h)²); blocks of tb s.
 std::vector<double> term_autocov(const CovTerm& t, std::size_t n, double tb);
+/// A counter's error correlation c(u), u = 0 … lags − 1 (until negligible): the sawtooth's phase
+/// advances by `advance[k]` of a pulse per block near block k (the local mean rate; c is their
+/// average) plus Gaussian noise of variance `spread` pulses² a block (white rate and angle noise):
+/// c(u) = (6/π²) Σ_m m⁻² cos(2πmu·advance) e^{−2π²m²u·spread}.
+std::vector<double> counter_correlation(const std::vector<double>& advance, double spread, std::size_t lags);
 /// Its AV at τ (same unit levels), to turn profiled levels into the model's coefficients.
 double term_avar(const CovTerm& t, double tau);
 
@@ -68,12 +83,18 @@ struct Blocks {
   double t0 = 0;          ///< start of the first block from the record's start, s
   std::vector<double> y;  ///< block-mean rates, °/h
   Eigen::VectorXd z;      ///< their second differences
+  /// A plain counter's read-out error at the block edges (its correlation from the record's mean
+  /// rate, its level q²/12 known); empty for other records.
+  std::optional<CovTerm> counter;
   [[nodiscard]] std::size_t n() const { return static_cast<std::size_t>(z.size()); }
   [[nodiscard]] double duration() const { return tb * static_cast<double>(y.size()); }
 };
 
 /// −2 ln L at fixed levels, with the regressors' GLS coefficients.
 Profile evaluate(const Blocks& b, const Hypothesis& h, const std::vector<double>& level);
+/// The same at exactly `level`, the overall scale not profiled: the likelihood as a function of
+/// every level, whose curvature is the levels' information (level_spread.hpp).
+Profile evaluate_exact(const Blocks& b, const Hypothesis& h, const std::vector<double>& level);
 /// Maximise over the levels (Nelder–Mead on their logarithms, the overall scale in closed form),
 /// starting from `start` (one per term, > 0).
 Profile profile(const Blocks& b, const Hypothesis& h, const std::vector<double>& start);
