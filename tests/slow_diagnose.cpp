@@ -90,7 +90,7 @@ void print_case(const std::string& what, const DiagnoseResult& r) {
 // sawtooth, correlated over a block or two, is in the Gauss–Markov test's null (docs/diagnosis.md).
 TEST(DiagnoseAcceptance, SlowLinesAtThreeAndAHalfFloors) {
   const int n = test::population("RWCALC_DIAGNOSE_LINES", 8, 20);
-  int named = 0, gauss_markov = 0, gain = 0, cover_f = 0;
+  int named = 0, gauss_markov = 0, gain = 0, cover_f = 0, cover_a = 0;
   for (int i = 0; i < n; ++i) {
     NoiseModel m = gl2d();
     const double f = (3.0 + 2.0 * spread(i)) / kT, amp = 3.5 * kFloor;
@@ -111,11 +111,12 @@ TEST(DiagnoseAcceptance, SlowLinesAtThreeAndAHalfFloors) {
     named += ok;
     gain += r.gain.likelihood_holdout > 0;
     cover_f += covers(*s, "frequency", f);
+    cover_a += covers(*s, "amplitude", amp);
   }
   std::cout << fmt::format(
       "slow lines at 3.5x: {}/{} named in tolerance, {} Gauss-Markov, {} with out-of-sample "
-      "gain, frequency interval covers {}\n",
-      named, n, gauss_markov, gain, cover_f);
+      "gain, frequency interval covers {}, amplitude interval {}\n",
+      named, n, gauss_markov, gain, cover_f, cover_a);
   EXPECT_GE(named, at_least(0.9, n, 20));
   EXPECT_EQ(gauss_markov, 0);
   EXPECT_GE(gain, named - 1);
@@ -238,6 +239,42 @@ TEST(DiagnoseAcceptance, GaussMarkovNamedWithinTolerance) {
   std::cout << fmt::format("Gauss-Markov: 95 % intervals cover σ in {}, Tc in {} of the named\n", sigma_covered,
                            tc_covered);
   gm.check("Gauss-Markov term");
+}
+
+// An output-chain low-pass of τf 0.02–0.1 s on GL-2D-like noise with a dithered read-out, 30 min
+// at 200 Hz as a floating angle (the filter is tested on floating data only): named alone with τf
+// within 30 % in at least 90 % of records, each with a positive gain in sample and held out. Its 95 %
+// interval's coverage is printed, not required: it falls short (52 of 80, docs/diagnosis.md).
+TEST(DiagnoseAcceptance, OutputLowpassNamedWithinTolerance) {
+  const int n = test::population("RWCALC_DIAGNOSE_EFFECTS", 4, 20);
+  Tally lowpass;
+  int covered = 0, found = 0;
+  for (int i = 0; i < n; ++i) {
+    const double tf = 0.02 + 0.08 * spread(i + 11);
+    NoiseModel m = gl2d();
+    m.readout = ReadoutMode::White;
+    m.output_lowpass_tc_s = tf;
+    SimulationSettings s;
+    s.duration_s = 1800;
+    s.rate_hz = 200;
+    s.scale_arcsec = 0.92;
+    s.seed = 8100 + static_cast<std::uint64_t>(i);
+    Recording rec;
+    rec.source = fmt::format("simulated-{}", s.seed);
+    rec.phase = simulate(m, s);
+    rec.rate_hz = s.rate_hz;
+    rec.samples = rec.phase.points() - 1;
+    const DiagnoseResult r = diagnose(rec, DiagnoseOptions{});
+    const Finding* f = finding(r, Effect::Lowpass);
+    const bool ok = f && r.findings.size() == 1 && near(f->parameter("time_constant").value, tf, 0.3);
+    lowpass.add(r, ok);
+    if (!ok) print_case(fmt::format("record {} (τf {:.3f} s)", i, tf), r);
+    if (!f) continue;
+    ++found;
+    covered += covers(*f, "time_constant", tf);
+  }
+  std::cout << fmt::format("output low-pass: 95 % interval covers τf in {} of {}\n", covered, found);
+  lowpass.check("output low-pass");
 }
 
 // The effects beside slow lines and steps, each at a level its detector resolves on a 2-h record:
