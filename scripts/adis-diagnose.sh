@@ -43,7 +43,7 @@ def fmt_finding(f):
     if e == "warmup_transient": return f"warm-up {v('amplitude')}, τw {v('time_constant')}"
     if e == "lowpass": return f"low-pass τf {v('time_constant')}"
     return e
-print("| run | axis | base misfit | base coverage | named effects | extended misfit | extended coverage | holdout misfit base → extended |")
+print("| run | axis | base misfit | base coverage | named effects | extended misfit | extended coverage | held-out gain −2Δ ln L |")
 print("|---|---|---|---|---|---|---|---|")
 for run in (1, 2, 3, 4):
     for axis in "xyz":
@@ -52,7 +52,7 @@ for run in (1, 2, 3, 4):
         names = "; ".join(fmt_finding(f) for f in j["findings"]) or "none"
         print(f"| {run} | {axis.upper()} | {g['misfit_base']:.2f} | {100*g['coverage_base']:.0f} % | {names} | "
               f"{g['misfit_extended']:.2f} | {100*g['coverage_extended']:.0f} % | "
-              + (f"{g['holdout_misfit_base']:.3f} → {g['holdout_misfit_extended']:.3f} |" if g['holdout_misfit_base'] is not None else "— |"))
+              + (f"{g['likelihood_holdout']:.1f} |" if g.get('likelihood_holdout') is not None else "— |"))
 # Which findings repeat across runs and axes: each detector's verdict per run, with its statistic
 # against its threshold (docs/diagnosis.md).
 print()
