@@ -581,11 +581,10 @@ std::pair<double, double> size_interval(const Blocks& b, const GlsModel& m, Eige
   return {value - std::hypot(value - plo, across), value + std::hypot(phi - value, across)};
 }
 
-/// One term's parameters, its and the others' nonlinear intervals given.
-TermEstimate estimate_det(const Blocks& b, const GlsModel& m, std::size_t index,
+/// One term's parameters, the model's hypothesis `h` and every term's nonlinear interval given.
+TermEstimate estimate_det(const Blocks& b, const GlsModel& m, const Hypothesis& h, std::size_t index,
                           const std::vector<std::pair<double, double>>& nl, const LevelSpread& spread) {
   const Eigen::Index off = column_offset(b, m, index);
-  const Hypothesis h = hypothesis_of(b, m.det, m.cov);
   // The cutoff of a size a·β (β the term's coefficients) by its variance's degrees of freedom.
   const auto cutoff_of = [&](const Eigen::VectorXd& a) {
     const double dof = effective_dof(spread, [&](const std::vector<double>& lv) {
@@ -630,10 +629,11 @@ TermEstimate estimate_det(const Blocks& b, const GlsModel& m, std::size_t index,
 }  // namespace
 
 std::vector<TermEstimate> estimate_det(const Blocks& b, const GlsModel& m) {
-  const LevelSpread spread = level_spread(b, hypothesis_of(b, m.det, m.cov), m.fit.level);
+  const Hypothesis h = hypothesis_of(b, m.det, m.cov);
+  const LevelSpread spread = level_spread(b, h, m.fit.level);
   const auto nl = nonlinear_intervals(b, m, spread);
   std::vector<TermEstimate> out;
-  for (std::size_t j = 0; j < m.det.size(); ++j) out.push_back(estimate_det(b, m, j, nl, spread));
+  for (std::size_t j = 0; j < m.det.size(); ++j) out.push_back(estimate_det(b, m, h, j, nl, spread));
   return out;
 }
 
