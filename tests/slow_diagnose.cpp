@@ -253,8 +253,8 @@ TEST(DiagnoseAcceptance, GaussMarkovNamedWithinTolerance) {
 
 // An output-chain low-pass of τf 0.02–0.1 s on GL-2D-like noise with a dithered read-out, 30 min
 // at 200 Hz as a floating angle (the filter is tested on floating data only): named alone with τf
-// within 30 % in at least 90 % of records, each with a positive gain in sample and held out. Its 95 %
-// interval's coverage is printed, not required: it falls short (52 of 80, docs/diagnosis.md).
+// within 30 % in at least 90 % of records, each with a positive gain in sample and held out; its 95 %
+// interval holds τf in 90–98 % of the named cases (checked from 18 named on, as below).
 TEST(DiagnoseAcceptance, OutputLowpassNamedWithinTolerance) {
   const int n = test::population("RWCALC_DIAGNOSE_EFFECTS", 4, 20);
   Tally lowpass;
@@ -284,6 +284,10 @@ TEST(DiagnoseAcceptance, OutputLowpassNamedWithinTolerance) {
     covered += covers(*f, "time_constant", tf);
   }
   std::cout << fmt::format("output low-pass: 95 % interval covers τf in {} of {}\n", covered, found);
+  if (found >= kCoverageCases) {
+    EXPECT_GE(covered, at_least(0.9, found, 60));
+    EXPECT_LE(covered, found * (0.98 + test::share_allowance(0.98, found, 60)));
+  }
   lowpass.check("output low-pass");
 }
 

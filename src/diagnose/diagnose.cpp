@@ -149,6 +149,13 @@ struct Outside {
   std::string lowpass_skip;  ///< why the low-pass is not tested (empty: it is)
 };
 
+/// The rate samples of a record, τ0 apart.
+std::vector<double> rates(const PhaseSeries& x) {
+  std::vector<double> y(x.points() - 1);
+  for (std::size_t k = 0; k < y.size(); ++k) y[k] = x.rate(k);
+  return y;
+}
+
 /// The rate samples the periodogram reads, `dt` s apart: a pulse record's decimated angle
 /// differenced, otherwise the rate per sample.
 std::vector<double> periodogram_rates(const PhaseSeries& x, bool pulses, double& dt) {
@@ -159,8 +166,7 @@ std::vector<double> periodogram_rates(const PhaseSeries& x, bool pulses, double&
     for (std::size_t j = 0; j + 1 < d.theta.size(); ++j) y.push_back((d.theta[j + 1] - d.theta[j]) / dt);
   } else {
     dt = x.tau0_s;
-    y.resize(x.points() - 1);
-    for (std::size_t k = 0; k + 1 < x.points(); ++k) y[k] = x.rate(k);
+    y = rates(x);
   }
   return y;
 }
@@ -223,7 +229,7 @@ void test_lowpass(const PhaseSeries& x, const Outside& out, DiagnoseResult& r) {
     v.push_back(clean ? p.var : allan_variance(c, p.m, Estimator::Overlapping));
     edf.push_back(p.edf);
   }
-  const OutputLowpassEstimate lp = output_lowpass_detect(m, v, edf, x.tau0_s, x.duration_s(), r.alpha);
+  OutputLowpassEstimate lp = output_lowpass_detect(m, v, edf, x.tau0_s, x.duration_s(), r.alpha);
   if (lp.points < 5) {
     d.note = tr("not tested: fewer than 5 Allan points below 20 s");
     r.detectors.push_back(d);
@@ -237,14 +243,15 @@ void test_lowpass(const PhaseSeries& x, const Outside& out, DiagnoseResult& r) {
       "angle and rate noise pass through a first-order low-pass, scaled by the fit's χ²/dof; null law: χ²₁, "
       "Bonferroni over the octave points";
   d.fired = d.named = lp.p <= r.alpha;
+  if (d.named && !output_lowpass_estimate(rates(c), m, v, edf, x.tau0_s, x.duration_s(), lp)) {
+    d.named = false;
+    d.note = tr("not named: the record is too short for the rate spectrum its time constant is read from");
+  }
   r.detectors.push_back(d);
   if (!d.named) return;
   Finding f{Effect::Lowpass, {from_interval("time_constant", Quantity::Time, lp.tf, lp.tf_low, lp.tf_high)}, {}};
-  f.evidence = {{"statistic", d.statistic},
-                {"threshold", d.threshold},
-                {"p_value", d.p_value},
-                {"false_alarm_level", r.alpha},
-                {"detector", d.test}};
+  f.evidence = {{"statistic", d.statistic},     {"threshold", d.threshold}, {"p_value", d.p_value},
+                {"false_alarm_level", r.alpha}, {"detector", d.test},       {"spectrum_dispersion", lp.dispersion}};
   if (r.findings.empty()) r.extended = r.base;
   r.extended.output_lowpass_tc_s = lp.tf;
   r.extended.arw_deg_per_sqrt_h = std::sqrt(lp.white_rate) / units::sqrt_s_per_sqrt_h;

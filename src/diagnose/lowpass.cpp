@@ -4,7 +4,11 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numeric>
 
+#include "rwcalc/deviance.hpp"
+#include "rwcalc/fft.hpp"
+#include "rwcalc/minimise.hpp"
 #include "rwcalc/nnls.hpp"
 #include "rwcalc/output_filter.hpp"
 #include "signal.hpp"
@@ -85,19 +89,133 @@ double chi2_at(const ShortTau& p, double tf, const std::array<double, 3>& coef) 
   return chi2;
 }
 
-/// The time constant of the best fit, from a grid in ln tf refined by golden section.
-double best_time_constant(const ShortTau& p) {
-  const double lo = std::log(p.tau0 / 4.0), hi = std::log(std::max(p.tau_cut / 4.0, p.tau0));
+/// The rate's Welch periodogram: Hann-windowed non-overlapping segments of L samples (a power of
+/// two, L·τ0 ≥ τ_cut), every third bin from the fourth, each the mean of K segments' |X|²/Σw²:
+/// S(ω)·Gamma(K)/K for a Gaussian rate. A Hann bin is ½X_k − ¼(X_{k−1} + X_{k+1}) of the plain
+/// transform's: bins two apart share one of those (their powers correlate by 1/36: τf's errors
+/// were 1.12 times the stated spread over 80 records), bins three apart none (1.03).
+struct RateSpectrum {
+  std::vector<double> omega, p;  ///< bin frequency, rad per sample; periodogram, (rate unit)²
+  double k = 0;                  ///< segments averaged
+};
+
+RateSpectrum rate_spectrum(const std::vector<double>& y, double tau0, double tau_cut) {
+  RateSpectrum s;
+  std::size_t len = 16;
+  while (static_cast<double>(len) * tau0 < tau_cut) len *= 2;
+  const std::size_t segments = y.size() / len;
+  if (segments < 8) return s;
+  std::vector<double> w(len), x(len), sum(len / 2 + 1, 0.0);
+  double w2 = 0;
+  for (std::size_t t = 0; t < len; ++t) {
+    w[t] = 0.5 - 0.5 * std::cos(2.0 * kPi * static_cast<double>(t) / static_cast<double>(len));
+    w2 += w[t] * w[t];
+  }
+  detail::RealPowerSpectrum fft(len);
+  for (std::size_t seg = 0; seg < segments; ++seg) {
+    const double* first = y.data() + seg * len;
+    const double mean = std::accumulate(first, first + len, 0.0) / static_cast<double>(len);
+    for (std::size_t t = 0; t < len; ++t) x[t] = w[t] * (first[t] - mean);
+    fft.add(x.data(), len, sum.data());
+  }
+  s.k = static_cast<double>(segments);
+  for (std::size_t b = 4; b + 2 <= len / 2; b += 3) {
+    s.omega.push_back(2.0 * kPi * static_cast<double>(b) / static_cast<double>(len));
+    s.p.push_back(sum[b] / (w2 * s.k));
+  }
+  return s;
+}
+
+/// The rate spectrum's model at time constant tf, per unit level: white angle noise (the rate's
+/// 2 − 2 cos ω), white rate and flicker (1/ω), each through the filter's |H|² =
+/// (1 − φ)²/(1 − 2φ cos ω + φ²), φ = e^{−τ0/tf} (the AR(1) of output_filter.hpp).
+Eigen::MatrixXd spectrum_columns(const RateSpectrum& s, double tau0, double tf) {
+  const double phi = tf > 0 ? std::exp(-tau0 / tf) : 0.0;
+  Eigen::MatrixXd g(static_cast<Eigen::Index>(s.p.size()), 3);
+  for (Eigen::Index i = 0; i < g.rows(); ++i) {
+    const double c = std::cos(s.omega[static_cast<std::size_t>(i)]);
+    const double h2 = (1 - phi) * (1 - phi) / (1 - 2 * phi * c + phi * phi);
+    g(i, 0) = h2 * (2 - 2 * c);
+    g(i, 1) = h2;
+    g(i, 2) = h2 / s.omega[static_cast<std::size_t>(i)];
+  }
+  for (Eigen::Index c = 0; c < 3; ++c) g.col(c) /= g.col(c).maxCoeff();
+  return g;
+}
+
+/// The weighted least-squares levels of the spectrum's columns, the white angle noise's (column 0,
+/// the one the filter is read from) held at 0 when it comes out negative, the others free.
+Eigen::VectorXd weighted_levels(const Eigen::MatrixXd& g, const Eigen::VectorXd& p, const Eigen::VectorXd& w) {
+  const auto solve = [&](const Eigen::MatrixXd& cols) {
+    const Eigen::MatrixXd gw = cols.transpose() * w.asDiagonal();
+    return Eigen::VectorXd((gw * cols).ldlt().solve(gw * p));
+  };
+  Eigen::VectorXd x = solve(g);
+  if (x[0] < 0) x << 0.0, solve(g.rightCols(2));
+  return x;
+}
+
+/// The Whittle deviance Σ 2K(P/S − 1 − ln P/S) of the periodogram at tf, the levels at its minimum
+/// (a Gamma fit with identity link, by iteratively reweighted least squares). The white rate and
+/// flicker levels may go negative while the spectrum stays positive: held at 0, the white rate (a
+/// small term under the read-out's) bent the profile and biased τf by half its standard error. The
+/// white angle level may not: negative, its rate spectrum 2 − 2 cos ω falls with frequency as the
+/// filter's does, and a real sensor's roll-off (the ADIS16405's) was fitted without a filter. The
+/// non-negative fit where the spectrum is not positive.
+double whittle_deviance(const RateSpectrum& s, double tau0, double tf) {
+  const Eigen::MatrixXd g = spectrum_columns(s, tau0, tf);
+  const Eigen::Map<const Eigen::VectorXd> p(s.p.data(), static_cast<Eigen::Index>(s.p.size()));
+  Eigen::VectorXd model = p;
+  for (int it = 0; it < 8; ++it) {
+    const Eigen::VectorXd w = model.array().square().inverse();
+    Eigen::VectorXd next = g * weighted_levels(g, p, w);
+    if (!(next.minCoeff() > 0)) next = g * nnls(g, p, w, 0b111).x;
+    if (!(next.minCoeff() > 0)) break;
+    const bool done = ((next - model).array() / model.array()).abs().maxCoeff() < 1e-9;
+    model = next;
+    if (done) break;
+  }
+  double d = 0;
+  for (Eigen::Index i = 0; i < p.size(); ++i) d += gamma_deviance(p[i], model[i], 2 * s.k);
+  return d;
+}
+
+/// The minimum of f(ln tf) on [lo, hi]: a grid of 80 refined by golden section; `none` is f at tf
+/// = 0 (no filter), which wins unless some tf does better.
+template <class F>
+double argmin_log_tf(const F& f, double lo, double hi, double none) {
   const int grid = 80;
-  double best = fit_at(p, 0.0, nullptr), best_l = lo;
+  double best = none, best_l = lo;
   for (int g = 0; g <= grid; ++g) {
-    const double l = lo + (hi - lo) * g / grid, c = fit_at(p, std::exp(l), nullptr);
+    const double l = lo + (hi - lo) * g / grid, c = f(l);
     if (c < best) best = c, best_l = l;
   }
   const double step = (hi - lo) / grid;
-  const auto f = [&](double l) { return fit_at(p, std::exp(l), nullptr); };
   const double l_hat = golden_min(f, best_l - step, best_l + step, 30);
-  return std::exp(f(l_hat) > best ? best_l : l_hat);
+  return f(l_hat) > best ? best_l : l_hat;
+}
+
+/// Where f(ln tf) first rises above `target` from its minimum at l_hat in direction dir (±1).
+template <class F>
+double profile_side(const F& f, double l_hat, double target, double dir) {
+  double in = l_hat, out = l_hat;
+  for (int i = 1; i <= 60; ++i) {
+    out = l_hat + dir * 0.02 * std::pow(1.4, i);
+    if (f(out) > target || std::abs(out - l_hat) > 15) break;
+    in = out;
+  }
+  for (int i = 0; i < 40; ++i) {
+    const double mid = 0.5 * (in + out);
+    (f(mid) > target ? out : in) = mid;
+  }
+  return std::exp(0.5 * (in + out));
+}
+
+/// The time constant of the best fit to the octave AV.
+double best_time_constant(const ShortTau& p) {
+  const double lo = std::log(p.tau0 / 4.0), hi = std::log(std::max(p.tau_cut / 4.0, p.tau0));
+  const auto f = [&](double l) { return fit_at(p, std::exp(l), nullptr); };
+  return std::exp(argmin_log_tf(f, lo, hi, fit_at(p, 0.0, nullptr)));
 }
 
 }  // namespace
@@ -110,12 +228,9 @@ OutputLowpassEstimate output_lowpass_detect(const std::vector<std::int64_t>& m, 
   e.points = static_cast<double>(pts.y.size());
   if (pts.y.size() < 5) return e;
   const double chi0 = fit_at(pts, 0.0, nullptr);
-  const double lo = std::log(tau0 / 4.0), hi = std::log(std::max(pts.tau_cut / 4.0, tau0));
-  const auto f = [&](double l) { return fit_at(pts, std::exp(l), nullptr); };
-  const double l_hat = std::log(best_time_constant(pts));
+  e.tf = best_time_constant(pts);
   std::array<double, 3> sc{};
-  e.chi2 = fit_at(pts, std::exp(l_hat), &sc);
-  e.tf = std::exp(l_hat);
+  e.chi2 = fit_at(pts, e.tf, &sc);
   e.white_angle2 = sc[0];
   e.white_rate = sc[1];
   // Overdispersion: the octave points are correlated and the model is approximate.
@@ -125,24 +240,32 @@ OutputLowpassEstimate output_lowpass_detect(const std::vector<std::int64_t>& m, 
   double a = 0, b = 400;
   for (int it = 0; it < 100; ++it) (e.points * std::erfc(std::sqrt(0.25 * (a + b))) > alpha ? a : b) = 0.5 * (a + b);
   e.threshold = b;
-  // 95 % profile interval in ln tf: where the scaled χ² rises by 3.84.
-  const double target = e.chi2 + 3.841458820694124 * scale;
-  auto side = [&](double dir) {
-    double in = l_hat, out = l_hat;
-    for (int i = 1; i <= 60; ++i) {
-      out = l_hat + dir * 0.02 * std::pow(1.4, i);
-      if (f(out) > target || out < lo - 5 || out > hi + 5) break;
-      in = out;
-    }
-    for (int i = 0; i < 40; ++i) {
-      const double mid = 0.5 * (in + out);
-      (f(mid) > target ? out : in) = mid;
-    }
-    return std::exp(0.5 * (in + out));
-  };
-  e.tf_low = side(-1.0);
-  e.tf_high = side(1.0);
   return e;
+}
+
+bool output_lowpass_estimate(const std::vector<double>& rate, const std::vector<std::int64_t>& m,
+                             const std::vector<double>& v, const std::vector<double>& edf, double tau0, double duration,
+                             OutputLowpassEstimate& e) {
+  const ShortTau pts = short_tau(m, v, edf, tau0, duration);
+  const RateSpectrum spec = rate_spectrum(rate, tau0, pts.tau_cut);
+  if (pts.y.size() < 5 || spec.p.size() < 16) return false;
+  const double lo = std::log(tau0 / 4.0), hi = std::log(std::max(pts.tau_cut / 4.0, tau0));
+  const auto f = [&](double l) { return whittle_deviance(spec, tau0, std::exp(l)); };
+  const double l_hat = argmin_log_tf(f, lo, hi, whittle_deviance(spec, tau0, 0.0));
+  const double d = f(l_hat);
+  // Overdispersion: the deviance per bin against its mean for a spectrum the model describes.
+  const double dof = static_cast<double>(spec.p.size()) - 4.0;
+  e.dispersion = d / (dof * gamma_deviance_mean(2.0 * spec.k));
+  const double scale = std::max(1.0, e.dispersion);
+  const double target = d + 3.841458820694124 * scale;
+  e.tf = std::exp(l_hat);
+  e.tf_low = profile_side(f, l_hat, target, -1.0);
+  e.tf_high = profile_side(f, l_hat, target, 1.0);
+  std::array<double, 3> sc{};
+  e.chi2 = fit_at(pts, e.tf, &sc);
+  e.white_angle2 = sc[0];
+  e.white_rate = sc[1];
+  return true;
 }
 
 double output_lowpass_holdout(const std::vector<std::int64_t>& m, const std::array<std::vector<double>, 2>& v,
