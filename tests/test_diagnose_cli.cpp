@@ -175,7 +175,7 @@ TEST(DiagnoseCliErrors, BadInputUsageAndShortRecords) {
 
 // An output-chain low-pass (τf = 0.05 s) on a dithered read-out at 100 Hz: `simulate` writes the
 // filtered angle, `diagnose --input angle` names `lowpass` with its time constant, and
-// `simulate --from` carries it in the extended model.
+// `simulate --from` carries it in the extended model; its interval holds the truth.
 TEST(DiagnoseCliLowpass, OutputChainFilterIsNamedAndSimulatedBack) {
   TempDir dir;
   const auto rec = (dir.path() / "lp.csv").string();
@@ -195,6 +195,10 @@ TEST(DiagnoseCliLowpass, OutputChainFilterIsNamedAndSimulatedBack) {
   EXPECT_NEAR(tc["value"].get<double>(), 0.05, 0.0125);
   EXPECT_EQ(tc["unit"], "s");
   EXPECT_GT(tc["standard_uncertainty"].get<double>(), 0.0);
+  EXPECT_LT(tc["interval95"][0].get<double>(), 0.05);
+  EXPECT_GT(tc["interval95"][1].get<double>(), 0.05);
+  // The simulated rate spectrum is the first-order filter's: its deviance per bin is its mean.
+  EXPECT_NEAR((*lp)["evidence"]["spectrum_dispersion"].get<double>(), 1.0, 0.15);
   EXPECT_NEAR(j["extended_model"]["output_lowpass_tc_s"].get<double>(), tc["value"].get<double>(), 1e-12);
   EXPECT_LT(j["gain"]["misfit_extended"].get<double>(), j["gain"]["misfit_base"].get<double>());
   EXPECT_GT(j["gain"]["likelihood_in_sample"].get<double>(), 0.0);
