@@ -1,4 +1,5 @@
-// The figures: gnuplot scripts generated from the analysis, batch and diagnosis JSON objects.
+// The figures: gnuplot scripts generated from the analysis, batch and diagnosis results as the
+// report shows them (shown_results.hpp); the public calls read the JSON into those first.
 #include "rwcalc/plot.hpp"
 
 #include <fmt/format.h>
@@ -10,17 +11,16 @@
 #include <limits>
 #include <optional>
 
-#include "json_view.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/output.hpp"
 #include "rwcalc/quantity_text.hpp"
+#include "rwcalc/units.hpp"
+#include "shown_figures.hpp"
 
 namespace rwcalc {
 
 using nlohmann::json;
-using view::at;
-using view::num;
 namespace lbl = units::label;
 
 namespace {
@@ -28,24 +28,21 @@ namespace {
 /// A fitted coefficient as the figure draws it. When not resolved, `value` is the 95 % upper
 /// bound; `model` is what the fitted model curve uses: `model_value` (0 for a term left out), or from
 /// results saved without it the estimate.
-struct Coefficient {
+struct Drawn {
   std::optional<double> value, high95;
   double model = 0;
   bool resolved = false;
 };
 
-Coefficient coefficient(const json& fit, std::string_view key) {
-  const auto& c = at(fit, key);
-  Coefficient r{num(c, "value"), num(c, "high95")};
-  const auto& res = at(c, "resolved");
-  r.resolved = res.is_boolean() ? res.get<bool>() : r.value.has_value();
-  const auto& in_model = at(c, "in_model");
-  if (in_model.is_boolean() && !in_model.get<bool>())
+Drawn drawn(const shown::CoefficientValues& c) {
+  Drawn r{c.value, c.high95};
+  r.resolved = c.resolved.value_or(r.value.has_value());
+  if (c.in_model && !*c.in_model)
     r.model = 0;
-  else if (const auto curve = num(c, "model_value"))
-    r.model = *curve;
-  else if (const auto est = num(c, "estimate"))
-    r.model = *est;
+  else if (c.model_value)
+    r.model = *c.model_value;
+  else if (c.estimate)
+    r.model = *c.estimate;
   else
     r.model = r.resolved ? r.value.value_or(0.0) : 0.0;
   return r;
@@ -57,14 +54,12 @@ struct AllanRow {
 
 /// The usable Allan points (τ > 0, σ > 0) by τ; bounds default to σ (a zero lower bound cannot
 /// be drawn on a log axis).
-std::vector<AllanRow> allan_rows(const json& allan) {
+std::vector<AllanRow> allan_rows(const shown::Allan& allan) {
   std::vector<AllanRow> rows;
-  const auto& pts = at(allan, "points");
-  if (!pts.is_array()) return rows;
-  for (const auto& p : pts) {
-    const auto tau = num(p, "tau_s"), dev = num(p, "dev");
+  for (const auto& p : allan.points) {
+    const auto tau = p.tau_s, dev = p.dev;
     if (!tau || !dev || *tau <= 0 || *dev <= 0) continue;
-    AllanRow r{*tau, *dev, num(p, "dev_low").value_or(*dev), num(p, "dev_high").value_or(*dev)};
+    AllanRow r{*tau, *dev, p.dev_low.value_or(*dev), p.dev_high.value_or(*dev)};
     if (r.low <= 0) r.low = r.dev;
     rows.push_back(r);
   }
@@ -145,13 +140,10 @@ Figure loglog_figure(const char* name, const PlotOptions& options, const std::st
   return f;
 }
 
-bool is_gyro(const json& allan) {
-  const auto unit = view::str(allan, "unit");
-  return unit.empty() || unit == "deg/h";
-}
+bool is_gyro(const shown::Allan& allan) { return allan.unit.empty() || allan.unit == "deg/h"; }
 
-std::string allan_ylabel(const json& allan) {
-  const auto unit = view::str(allan, "unit");
+std::string allan_ylabel(const shown::Allan& allan) {
+  const auto& unit = allan.unit;
   if (is_gyro(allan)) return trf("Allan deviation σ(τ) ({})", tr(lbl::rate));
   if (unit == "1") return tr("Allan deviation σ(τ)");
   return trf("Allan deviation σ(τ) ({})", unit);
@@ -171,15 +163,16 @@ constexpr const char* kTermFunctions =
     "sK(t, c) = c * sqrt(t / 3) / 60\n"
     "sR(t, c) = c * t / (sqrt(2) * 3600)\n";
 
-struct Term {
-  const char *key, *var, *fn, *label, *unit, *colour;  // fit key, gnuplot variable and function
+struct TermLine {
+  shown::Term term;
+  const char *var, *fn, *label, *unit, *colour;  // gnuplot variable and function
 };
-constexpr std::array<Term, 5> kTerms{{
-    {"Q", "Q", "sQ", N_("quantization Q"), lbl::angle, "#7b3294"},
-    {"N", "N", "sN", N_("angle random walk N"), lbl::arw, "#1f77b4"},
-    {"B", "B", "sB", N_("bias instability B"), lbl::rate, "#2ca02c"},
-    {"K", "K", "sK", N_("rate random walk K"), lbl::rrw, "#ff7f0e"},
-    {"R", "R", "sR", N_("rate ramp R"), lbl::ramp, "#8c564b"},
+constexpr std::array<TermLine, 5> kTermLines{{
+    {shown::Term::Q, "Q", "sQ", N_("quantization Q"), lbl::angle, "#7b3294"},
+    {shown::Term::N, "N", "sN", N_("angle random walk N"), lbl::arw, "#1f77b4"},
+    {shown::Term::B, "B", "sB", N_("bias instability B"), lbl::rate, "#2ca02c"},
+    {shown::Term::K, "K", "sK", N_("rate random walk K"), lbl::rrw, "#ff7f0e"},
+    {shown::Term::R, "R", "sR", N_("rate ramp R"), lbl::ramp, "#8c564b"},
 }};
 
 void append_allan_block(std::string& s, const std::string& name, const std::vector<AllanRow>& rows) {
@@ -189,12 +182,12 @@ void append_allan_block(std::string& s, const std::string& name, const std::vect
 }
 
 /// The fitted model and each term's line; an unresolved term is only bounded: its bound, dashed.
-void add_model(const json& fit, std::string& vars, PlotCommand& plot) {
+void add_model(const shown::Fit& fit, std::string& vars, PlotCommand& plot) {
   vars += "# Coefficients of the fitted model (0 for a term the fit left out):\n";
   std::string model = "model(t) = sqrt(0";
   std::vector<std::string> term_lines;
-  for (const auto& t : kTerms) {
-    const auto c = coefficient(fit, t.key);
+  for (const auto& t : kTermLines) {
+    const auto c = drawn(fit[t.term]);
     vars += fmt::format("{} = {:.8g}   # {}\n", t.var, c.model, t.unit);
     model += fmt::format(" + {}(t, {})**2", t.fn, t.var);
     const double v = c.value.value_or(0.0);
@@ -209,19 +202,19 @@ void add_model(const json& fit, std::string& vars, PlotCommand& plot) {
     }
   }
   vars += model + ")\n";
-  const auto chi2 = num(fit, "chi2_per_dof");
+  const auto chi2 = fit.chi2_per_dof;
   plot.add(fmt::format("model(x) w l lw 2.2 lc rgb '#000000' t {}",
                        label_text(chi2 ? trf("fitted model (χ²/dof = {:.3g})", *chi2) : tr("fitted model"))));
   for (auto& l : term_lines) plot.add(std::move(l));
 }
 
 /// The term functions and the class-limit floor lines 0.6643·B_limit, which the y range includes.
-void add_class_floors(const json& analysis, std::string& vars, PlotCommand& plot, Bounds& bounds) {
+void add_class_floors(const shown::Analysis& analysis, std::string& vars, PlotCommand& plot, Bounds& bounds) {
   static constexpr std::array<const char*, 3> kDash{"2", "4", "5"};  // dots (3) mark upper bounds
-  const auto t = num(at(analysis, "verdict"), "tolerance_pct");
+  const auto t = analysis.verdict.tolerance_pct;
   const std::string tolerance = t && *t > 0 ? trf(" (+{:g} % tolerance)", *t) : std::string();
   std::size_t i = 0;
-  for (const auto& [cls, b] : view::class_limits(analysis, "B")) {
+  for (const auto& [cls, b] : shown::class_limits(analysis.verdict, 'B')) {
     vars += fmt::format("B_class{} = {:.6g}   # {}, class {} limit for B\n", cls, b, lbl::rate, cls);
     plot.add(fmt::format("sB(x, B_class{0}) w l lw 1.3 dt {1} lc rgb '#d62728' t {2}", cls, kDash[i++ % kDash.size()],
                          label_text(trf("class {0} limit B = {1} {2}{3} (floor {4} {2})", cls, show(b), tr(lbl::rate),
@@ -231,29 +224,29 @@ void add_class_floors(const json& analysis, std::string& vars, PlotCommand& plot
 }
 
 /// What names a run in a title or a key, as typed: the file name of its source.
-std::string run_name(const json& a) {
-  const std::string src = view::str(a, "source");
+std::string run_name(const shown::Analysis& a) {
+  const std::string& src = a.source;
   return src.empty() ? src : as_typed(std::filesystem::path(src).filename().string());
 }
 
 /// What names an IMU axis in a key, as typed: its column as named (a column name is no path:
 /// "accel/x" keeps its '/'), else its run's name.
-std::string axis_name(const json& a) {
-  if (std::string column = view::str(a, "column"); !column.empty()) return as_typed(column);
+std::string axis_name(const shown::Analysis& a) {
+  if (!a.column.empty()) return as_typed(a.column);
   return run_name(a);
 }
 
-std::string default_analysis_title(const json& a) {
+std::string default_analysis_title(const shown::Analysis& a) {
   std::string t = tr("Allan deviation");
   // A gyro in its usual units is a run of the batch, named by its file; any other channel by its column.
-  const bool usual = view::str(at(a, "units"), "rate").empty() || view::str(at(a, "units"), "rate") == "deg/h";
+  const bool usual = a.rate_unit.empty() || a.rate_unit == "deg/h";
   if (const auto src = usual ? run_name(a) : axis_name(a); !src.empty()) t += trf(" of {}", src);
-  if (const auto temp = view::temperature_label(at(a, "temperature_c")); !temp.empty()) t += trf(" at {}", temp);
+  if (const auto temp = shown::temperature_label(a.temperature_c); !temp.empty()) t += trf(" at {}", temp);
   return t;
 }
 
-std::string run_label(const json& run, std::size_t index) {
-  const auto t = view::temperature_label(at(run, "temperature_c"));
+std::string run_label(const shown::Analysis& run, std::size_t index) {
+  const auto t = shown::temperature_label(run.temperature_c);
   const auto src = run_name(run);
   if (!t.empty()) return src.empty() ? t : fmt::format("{} ({})", t, src);
   return src.empty() ? trf("run {}", index + 1) : src;
@@ -277,14 +270,14 @@ void write_outputs(const std::vector<Figure>& figures, const PlotOptions& option
 
 constexpr std::array<int, 8> kPointTypes{7, 5, 9, 11, 13, 15, 4, 6};
 
-std::vector<std::size_t> sorted_runs(const json& runs) {
-  return runs.is_array() ? view::by_temperature(runs) : std::vector<std::size_t>{};
-}
-
 }  // namespace
 
 std::string temperature_colour(const json& temperature_c, std::size_t index) {
-  if (const auto temp = num(temperature_c)) {
+  return shown::temperature_colour(shown::read_temperature(temperature_c), index);
+}
+
+std::string shown::temperature_colour(std::optional<double> temp, std::size_t index) {
+  if (temp) {
     // Cold-to-hot anchors at the paper's test temperatures; linear in RGB between them.
     struct Anchor {
       double t;
@@ -310,7 +303,11 @@ std::string temperature_colour(const json& temperature_c, std::size_t index) {
 }
 
 Figure analysis_figure(const json& analysis, const PlotOptions& options) {
-  const auto& allan = at(analysis, "allan");
+  return shown::analysis_figure(shown::read_analysis(analysis), options);
+}
+
+Figure shown::analysis_figure(const Analysis& analysis, const PlotOptions& options) {
+  const auto& allan = analysis.allan;
   const auto rows = allan_rows(allan);
   if (rows.empty())
     throw AnalysisError(
@@ -321,12 +318,12 @@ Figure analysis_figure(const json& analysis, const PlotOptions& options) {
   std::string body;
   append_allan_block(body, "allan", rows);
   PlotCommand plot;
-  const auto conf = num(allan, "confidence");
+  const auto conf = allan.confidence;
   plot.add(fmt::format("$allan u 1:2:3:4 w yerrorbars pt 7 ps 0.55 lw 1.2 lc rgb '#222222' t {}",
                        label_text(conf ? trf("measured σ(τ), {:g} % bounds", *conf * 100) : tr("measured σ(τ)"))));
   if (is_gyro(allan)) {
     body += kTermFunctions;
-    if (const auto& fit = at(analysis, "fit"); fit.is_object()) add_model(fit, body, plot);
+    if (analysis.fit.present) add_model(analysis.fit, body, plot);
     add_class_floors(analysis, body, plot, bounds);
   }
   return loglog_figure("allan", options,
@@ -335,7 +332,11 @@ Figure analysis_figure(const json& analysis, const PlotOptions& options) {
 }
 
 Figure batch_allan_figure(const json& runs, const PlotOptions& options) {
-  const auto order = sorted_runs(runs);
+  return shown::batch_allan_figure(shown::read_runs(runs), options);
+}
+
+Figure shown::batch_allan_figure(const std::vector<Analysis>& runs, const PlotOptions& options) {
+  const auto order = by_temperature(runs);
   std::string blocks;
   PlotCommand plot;
   Bounds bounds;
@@ -343,15 +344,15 @@ Figure batch_allan_figure(const json& runs, const PlotOptions& options) {
   std::string ylabel = trf("Allan deviation σ(τ) ({})", tr(lbl::rate));
   for (std::size_t i = 0; i < order.size(); ++i) {
     const auto& run = runs[order[i]];
-    const auto rows = allan_rows(at(run, "allan"));
+    const auto rows = allan_rows(run.allan);
     if (rows.empty()) continue;
-    gyro = gyro && is_gyro(at(run, "allan"));
-    ylabel = allan_ylabel(at(run, "allan"));
+    gyro = gyro && is_gyro(run.allan);
+    ylabel = allan_ylabel(run.allan);
     const auto name = fmt::format("run{}", i + 1);
     append_allan_block(blocks, name, rows);
     for (const auto& r : rows) bounds.x(r.tau), bounds.y(r.low, r.high);
     plot.add(fmt::format("${} u 1:2:3:4 w yerrorlines pt {} ps 0.6 lw 1.4 lc rgb '{}' t {}", name,
-                         kPointTypes[i % kPointTypes.size()], temperature_colour(at(run, "temperature_c"), i),
+                         kPointTypes[i % kPointTypes.size()], temperature_colour(run.temperature_c, i),
                          label_text(run_label(run, i))));
   }
   if (plot.elements.empty())
@@ -366,7 +367,11 @@ Figure batch_allan_figure(const json& runs, const PlotOptions& options) {
 }
 
 Figure batch_direct_figure(const json& runs, const PlotOptions& options) {
-  const auto order = sorted_runs(runs);
+  return shown::batch_direct_figure(shown::read_runs(runs), options);
+}
+
+Figure shown::batch_direct_figure(const std::vector<Analysis>& runs, const PlotOptions& options) {
+  const auto order = by_temperature(runs);
   Figure f;
   f.name = "batch-direct";
   f.height_px = options.height_px;
@@ -375,32 +380,25 @@ Figure batch_direct_figure(const json& runs, const PlotOptions& options) {
   double tmax = 0, vmax = 0;
   for (std::size_t i = 0; i < order.size(); ++i) {
     const auto& run = runs[order[i]];
-    const auto& direct = at(at(run, "methods"), "N_direct");
-    const auto& curve = at(direct, "curve");
-    if (!curve.is_array() || curve.empty()) continue;
+    const auto& direct = run.n_direct;
+    if (direct.curve.empty()) continue;  // the curve's points with both values
     const auto name = fmt::format("direct{}", i + 1);
-    std::string block = fmt::format("${} << EOD\n# t_s var_arcsec2\n", name);
+    blocks += fmt::format("${} << EOD\n# t_s var_arcsec2\n", name);
     double run_tmax = 0;
-    bool any = false;
-    for (const auto& p : curve) {
-      const auto t = num(p, "t_s"), v = num(p, "var");
-      if (!t || !v) continue;
-      block += fmt::format("{:.10g} {:.10g}\n", *t, *v);
-      vmax = std::max(vmax, *v);
-      run_tmax = std::max(run_tmax, *t);
-      any = true;
+    for (const auto& [t, v] : direct.curve) {
+      blocks += fmt::format("{:.10g} {:.10g}\n", t, v);
+      vmax = std::max(vmax, v);
+      run_tmax = std::max(run_tmax, t);
     }
-    if (!any) continue;
-    blocks += block + "EOD\n";
+    blocks += "EOD\n";
     tmax = std::max(tmax, run_tmax);
-    const auto colour = temperature_colour(at(run, "temperature_c"), i);
-    const auto n_val = num(direct, "value");
-    const auto& resolved = at(direct, "resolved");
-    const bool n_resolved = !resolved.is_boolean() || resolved.get<bool>();
-    auto slope = num(direct, "slope");
+    const auto colour = temperature_colour(run.temperature_c, i);
+    const auto n_val = direct.value;
+    const bool n_resolved = direct.resolved.value_or(true);
+    auto slope = direct.slope;
     // Without a stated slope it follows from N: the angle variance of ARW is a + (60·N)²·t.
     if (!slope && n_val && n_resolved) slope = std::pow(60 * *n_val, 2);
-    const auto intercept = num(direct, "intercept");
+    const auto intercept = direct.intercept;
     // One key entry per run: the points carry the label, the line shares their colour.
     std::string label = run_label(run, i);
     if (n_val) label += fmt::format(": N {} {} {}", n_resolved ? "=" : "<", show(*n_val), tr(lbl::arw));
@@ -442,42 +440,31 @@ struct BandRow {
   double median = 0;  ///< the ensemble's median σ (0 when not given)
 };
 
-/// The band of the base or the extended model: `base_model.band` / `extended_model.band`, or the
-/// top-level `band` / `band_extended` that `rwcalc diagnose --json` writes.
-const json& band_of(const json& diagnosis, bool extended) {
-  const auto& nested = at(at(diagnosis, extended ? "extended_model" : "base_model"), "band");
-  return nested.is_array() ? nested : at(diagnosis, extended ? "band_extended" : "band");
-}
-
-std::vector<BandRow> band_rows(const json& band) {
+std::vector<BandRow> band_rows(const std::optional<std::vector<shown::BandPoint>>& band) {
   std::vector<BandRow> rows;
-  if (!band.is_array()) return rows;
-  for (const auto& p : band) {
-    const auto tau = num(p, "tau_s"), lo = num(p, "band_low"), hi = num(p, "band_high");
+  if (!band) return rows;
+  for (const auto& p : *band) {
+    const auto tau = p.tau_s, lo = p.band_low, hi = p.band_high;
     if (!tau || !lo || !hi || *tau <= 0 || *lo <= 0 || *hi <= 0) continue;
-    rows.push_back({*tau, num(p, "dev").value_or(0.0), *lo, *hi, num(p, "median").value_or(0.0)});
+    rows.push_back({*tau, p.dev.value_or(0.0), *lo, *hi, p.median.value_or(0.0)});
   }
   std::sort(rows.begin(), rows.end(), [](const BandRow& a, const BandRow& b) { return a.tau < b.tau; });
   return rows;
 }
 
 /// °/h, or the unit the diagnosis names for its band (an accelerometer's: "units": {"band": "ug"}).
-std::string diagnosis_ylabel(const json& diagnosis) {
-  const auto u = diagnosis.find("units");
-  if (u == diagnosis.end() || !u->is_object() || !u->contains("band") || !(*u)["band"].is_string())
-    return trf("Allan deviation σ(τ) ({})", tr(lbl::rate));
-  const std::string band = (*u)["band"].get<std::string>();
-  return trf("Allan deviation σ(τ) ({})", unit_text(band));
+std::string diagnosis_ylabel(const shown::Diagnosis& diagnosis) {
+  if (!diagnosis.band_unit) return trf("Allan deviation σ(τ) ({})", tr(lbl::rate));
+  return trf("Allan deviation σ(τ) ({})", unit_text(*diagnosis.band_unit));
 }
 
-std::string band_label(const char* what, const json& model, const std::vector<BandRow>& rows) {
+std::string band_label(const char* what, std::optional<double> level, const std::vector<BandRow>& rows) {
   int inside = 0, measured = 0;
   for (const auto& r : rows) {
     if (r.dev <= 0) continue;
     ++measured;
     inside += (r.dev >= r.low && r.dev <= r.high) ? 1 : 0;
   }
-  const auto level = num(model, "band_level");
   const std::string percent = level ? fmt::format("{:g} % ", *level * 100) : std::string();
   std::string s =
       std::string_view(what) == "base" ? trf("base model: {}band", percent) : trf("extended model: {}band", percent);
@@ -485,12 +472,10 @@ std::string band_label(const char* what, const json& model, const std::vector<Ba
   return s;
 }
 
-std::string diagnosis_title(const json& diagnosis) {
+std::string diagnosis_title(const shown::Diagnosis& diagnosis) {
   std::vector<std::string> effects;
-  const auto& findings = at(diagnosis, "findings");
-  if (findings.is_array())
-    for (const auto& f : findings)
-      if (auto e = view::str(f, "effect"); !e.empty()) effects.push_back(e);
+  for (const auto& f : diagnosis.findings)
+    if (!f.effect.empty()) effects.push_back(f.effect);
   return tr("Measurement against the noise model's band") +
          (effects.empty() ? std::string(tr(" (no finding)")) : trf(" (findings: {})", fmt::join(effects, ", ")));
 }
@@ -498,8 +483,12 @@ std::string diagnosis_title(const json& diagnosis) {
 }  // namespace
 
 Figure diagnosis_figure(const json& diagnosis, const PlotOptions& options) {
-  const auto base = band_rows(band_of(diagnosis, false));
-  const auto ext = band_rows(band_of(diagnosis, true));
+  return shown::diagnosis_figure(shown::read_diagnosis(diagnosis), options);
+}
+
+Figure shown::diagnosis_figure(const Diagnosis& diagnosis, const PlotOptions& options) {
+  const auto base = band_rows(diagnosis.band);
+  const auto ext = band_rows(diagnosis.band_extended);
   if (base.empty())
     throw AnalysisError(
         "the diagnosis has no band (band or base_model.band, with tau_s, band_low, "
@@ -518,14 +507,14 @@ Figure diagnosis_figure(const json& diagnosis, const PlotOptions& options) {
   };
   add_band("base", base);
   plot.add(fmt::format("$base u 1:3:4 w filledcurves fs transparent solid 0.30 noborder lc rgb '#1f77b4' t {}",
-                       label_text(band_label("base", at(diagnosis, "base_model"), base))));
+                       label_text(band_label("base", diagnosis.band_level, base))));
   if (std::all_of(base.begin(), base.end(), [](const BandRow& r) { return r.median > 0; }))
     plot.add("$base u 1:5 w l lw 1.2 dt 2 lc rgb '#1f77b4' t " + label_text(tr("base model: median")));
   if (!ext.empty()) {
     add_band("extended", ext);
     plot.add(fmt::format(
         "$extended u 1:3:4 w filledcurves fs transparent pattern 5 border lc rgb '#e6550d' lc rgb '#e6550d' t {}",
-        label_text(band_label("extended", at(diagnosis, "extended_model"), ext))));
+        label_text(band_label("extended", diagnosis.band_level_extended, ext))));
   }
   // The τ where the measurement leaves the base band are marked so that they stand out.
   std::string outside;
@@ -546,18 +535,17 @@ Figure diagnosis_figure(const json& diagnosis, const PlotOptions& options) {
 PlotResult plot_analysis(const json& analysis, const PlotOptions& options) {
   require_valid(options);
   PlotResult r;
-  write_outputs({analysis_figure(analysis, options)}, options, r);
+  write_outputs({shown::analysis_figure(shown::read_analysis(analysis), options)}, options, r);
   return r;
 }
 
 PlotResult plot_batch(const json& batch, const PlotOptions& options) {
   require_valid(options);
-  const auto& runs = batch.is_array() ? batch : at(batch, "runs");
-  if (!runs.is_array() || runs.empty())
-    throw AnalysisError(tr("the batch has no runs (\"runs\": [analysis objects]): nothing to plot"));
+  const auto runs = shown::read_runs(shown::batch_runs(batch));
+  if (runs.empty()) throw AnalysisError(tr("the batch has no runs (\"runs\": [analysis objects]): nothing to plot"));
   PlotResult r;
-  std::vector<Figure> figures{batch_allan_figure(runs, options)};
-  if (auto direct = batch_direct_figure(runs, options); direct.series > 0)
+  std::vector<Figure> figures{shown::batch_allan_figure(runs, options)};
+  if (auto direct = shown::batch_direct_figure(runs, options); direct.series > 0)
     figures.push_back(std::move(direct));
   else
     r.notes.emplace_back(
@@ -570,11 +558,12 @@ PlotResult plot_batch(const json& batch, const PlotOptions& options) {
 PlotResult plot_diagnosis(const json& diagnosis, const PlotOptions& options) {
   require_valid(options);
   PlotResult r;
-  if (const auto& ext = band_of(diagnosis, true); !ext.is_array() || ext.empty())
+  const auto d = shown::read_diagnosis(diagnosis);
+  if (!d.band_extended || d.band_extended->empty())
     r.notes.emplace_back(
         tr("the diagnosis has no extended model band (band_extended or extended_model.band): only the base model "
            "is drawn"));
-  write_outputs({diagnosis_figure(diagnosis, options)}, options, r);
+  write_outputs({shown::diagnosis_figure(d, options)}, options, r);
   return r;
 }
 
@@ -583,15 +572,14 @@ namespace {
 /// The fitted model of an IMU axis as a gnuplot function `fn(t)` of τ (s) giving σ in the axis'
 /// shown unit: the IEEE 952 sum over the SI coefficients (fit.X.si; a term left out is 0) times
 /// allan.unit_per_si (the axis' unit per SI unit). Empty without SI coefficients or the factor.
-std::string imu_model_function(const json& channel, const std::string& fn) {
-  const auto factor = num(at(channel, "allan"), "unit_per_si");
-  const auto& fit = at(channel, "fit");
-  if (!factor || !fit.is_object()) return {};
+std::string imu_model_function(const shown::Analysis& channel, const std::string& fn) {
+  const auto factor = channel.allan.unit_per_si;
+  const auto& fit = channel.fit;
+  if (!factor || !fit.present) return {};
   std::array<double, 5> c{};
-  constexpr std::array<const char*, 5> kKeys{"Q", "N", "B", "K", "R"};
-  for (std::size_t k = 0; k < kKeys.size(); ++k) {
-    if (!at(at(fit, kKeys[k]), "si").is_object()) return {};
-    c[k] = coefficient(at(fit, kKeys[k]), "si").model;
+  for (std::size_t k = 0; k < fit.terms.size(); ++k) {
+    if (!fit.terms[k].si) return {};
+    c[k] = drawn(*fit.terms[k].si).model;
   }
   return fmt::format(
       "{0}(t) = {1:.10g} * sqrt(3 * {2:.10g}**2 / t**2 + {3:.10g}**2 / t + 2 * log(2) / pi * {4:.10g}**2"
@@ -602,16 +590,20 @@ std::string imu_model_function(const json& channel, const std::string& fn) {
 }  // namespace
 
 Figure imu_axes_figure(const json& channels, const PlotOptions& options) {
+  return shown::imu_axes_figure(shown::read_runs(channels), options);
+}
+
+Figure shown::imu_axes_figure(const std::vector<Analysis>& channels, const PlotOptions& options) {
   std::string body = "# Each axis' fitted model: sigma in the axis' unit from its SI coefficients (Q, N, B, K, R)\n";
   PlotCommand plot;
   Bounds bounds;
   std::string ylabel;
   std::size_t i = 0;
   for (const auto& c : channels) {
-    const auto rows = allan_rows(at(c, "allan"));
+    const auto rows = allan_rows(c.allan);
     if (rows.empty()) continue;
-    ylabel = allan_ylabel(at(c, "allan"));
-    const std::string colour = temperature_colour(nullptr, i);
+    ylabel = allan_ylabel(c.allan);
+    const std::string colour = temperature_colour(std::nullopt, i);
     const auto name = fmt::format("axis{}", i + 1);
     append_allan_block(body, name, rows);
     for (const auto& r : rows) bounds.x(r.tau), bounds.y(r.low, r.high);
@@ -619,7 +611,7 @@ Figure imu_axes_figure(const json& channels, const PlotOptions& options) {
                          kPointTypes[i % kPointTypes.size()], colour, label_text(axis_name(c))));
     if (const auto fn = std::string("model_") + name, model = imu_model_function(c, fn); !model.empty()) {
       body += model;
-      const auto chi2 = num(at(c, "fit"), "chi2_per_dof");
+      const auto chi2 = c.fit.chi2_per_dof;
       plot.add(fmt::format("{}(x) w l lw 1.6 lc rgb '{}' t {}", fn, colour,
                            label_text(chi2 ? trf("{}: fitted model (χ²/dof = {:.3g})", axis_name(c), *chi2)
                                            : trf("{}: fitted model", axis_name(c)))));

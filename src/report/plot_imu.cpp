@@ -1,4 +1,5 @@
-// The figures of `rwcalc imu`: one panel per sensor kind, every axis' Allan deviation and fitted model in it.
+// The figures of `rwcalc imu`: one panel per sensor kind, every axis' Allan deviation and fitted model in it,
+// from the result as the report shows it (shown_results.hpp).
 #include <fmt/format.h>
 
 #include <filesystem>
@@ -9,30 +10,31 @@
 #include "rwcalc/output.hpp"
 #include "rwcalc/plot.hpp"
 #include "rwcalc/quantity_text.hpp"
+#include "shown_figures.hpp"
 
 namespace rwcalc {
 
 PlotResult plot_imu(const nlohmann::json& imu, const PlotOptions& options) {
   require_valid(options);
+  const auto shown_imu = shown::read_imu(imu);
   std::vector<Figure> figures;
   constexpr std::string_view kGyro = "gyro";
   for (const std::string_view kind : {kGyro, std::string_view("accelerometer")}) {
-    nlohmann::json runs = nlohmann::json::array();
-    for (const auto& c : imu.at("channels")) {
-      if (c.value("sensor", "") != kind) continue;
-      nlohmann::json run = c;
+    std::vector<shown::Analysis> runs;
+    for (const auto& c : shown_imu.channels) {
+      if (c.sensor != kind) continue;
+      shown::Analysis run = c;
       // The axis label in the unit's printed form, in the current language; as a non-gyro unit it
       // also keeps the class limits (a ring-laser table) out of a figure of several axes.
-      const std::string unit = c.at("allan").value("unit", "");
-      run["allan"]["unit"] = unit_text(unit);
+      run.allan.unit = unit_text(c.allan.unit);
       runs.push_back(std::move(run));
     }
     if (runs.empty()) continue;
     PlotOptions o = options;
     if (o.title.empty())
       o.title = trf_either(kind == kGyro, N_("Gyro axes of {}"), N_("Accelerometer axes of {}"),
-                           std::filesystem::path(imu.value("source", "")).filename().string());
-    Figure f = imu_axes_figure(runs, o);
+                           std::filesystem::path(shown_imu.source).filename().string());
+    Figure f = shown::imu_axes_figure(runs, o);
     f.name = fmt::format("imu-{}", kind);
     figures.push_back(std::move(f));
   }
