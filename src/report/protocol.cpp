@@ -7,20 +7,19 @@
 #include <vector>
 
 #include "html.hpp"
-#include "json_view.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/lab_profile.hpp"
 #include "rwcalc/quantity_text.hpp"
 #include "rwcalc/report.hpp"
 #include "rwcalc/units.hpp"
 #include "rwcalc/version.hpp"
+#include "shown_results.hpp"
 
 namespace rwcalc {
 
 namespace {
 
-using json = nlohmann::json;
-using view::at;
+using shown::Analysis;
 namespace lbl = units::label;
 
 /// A person's signature line: the role, the position, a line to sign on, the name.
@@ -71,30 +70,30 @@ std::string conditions_table(const LabProfile& p) {
 }
 
 /// The protocol's results in brief: per run N and B with their uncertainty and the class.
-std::string protocol_results(const std::vector<json>& a, const std::vector<std::size_t>& order) {
+std::string protocol_results(const std::vector<Analysis>& a, const std::vector<std::size_t>& order) {
   std::string h = fmt::format("<table id=\"protocol-results\" class=\"protocol\">\n<caption>{}</caption>\n",
                               tr("Results (in full: Tables 1 and 2 and the sections below)"));
   h += trf("<tr><th>run</th><th>temperature</th><th>N ({0})</th><th>B ({1})</th><th>class</th></tr>\n",
            "<span class=\"unit\">" + std::string(tr(lbl::arw)) + "</span>",
            "<span class=\"unit\">" + std::string(tr(lbl::rate)) + "</span>");
   for (auto i : order)
-    h += html::run_row(a[i], {html::coefficient_cell(at(at(a[i], "fit"), "N")),
-                              html::coefficient_cell(at(at(a[i], "fit"), "B")),
-                              html::verdict_class(at(a[i], "verdict"), "class")});
+    h += html::run_row(a[i], {html::coefficient_cell(a[i].fit[shown::Term::N]),
+                              html::coefficient_cell(a[i].fit[shown::Term::B]),
+                              html::verdict_class(a[i].verdict, a[i].verdict.cls)});
   return h + "</table>\n";
 }
 
 /// The conclusion of a protocol: the verdict in words, or why there is none.
-std::string protocol_conclusion(const std::vector<json>& a, const std::vector<std::size_t>& order,
-                                const json& overall) {
+std::string protocol_conclusion(const std::vector<Analysis>& a, const std::vector<std::size_t>& order,
+                                const shown::Verdict& overall) {
   std::string text;
-  if (html::is_withheld(overall)) {
+  if (overall.withheld) {
     text = tr("no verdict: the noise model does not describe every record (see section 1)");
   } else {
-    const auto& v0 = at(a[order.front()], "verdict");
-    const json& classes = at(overall, "classes").is_array() ? at(overall, "classes") : at(v0, "classes");
+    const auto& v0 = a[order.front()].verdict;
+    const auto& classes = overall.classes ? overall.classes : v0.classes;
     std::string words = html::verdict_in_words(overall, classes);
-    if (words.empty()) words = trf("class {}", html::class_text(at(overall, "class")));
+    if (words.empty()) words = trf("class {}", html::class_text(overall.cls));
     text = trf("by GOST RV 52339-2005 the gyro is of {}.", words);
   }
   return fmt::format("<p id=\"conclusion\"><b>{}</b> {}</p>\n", tr("Conclusion:"), html::text(text));
@@ -104,8 +103,9 @@ std::string protocol_conclusion(const std::vector<json>& a, const std::vector<st
 /// instruments and under which conditions, the results and the conclusion, the signature lines.
 }  // namespace
 
-std::string html::protocol_block(const std::vector<json>& a, const std::vector<std::size_t>& order, const json& overall,
-                                 const ReportOptions& options, const std::string& title) {
+std::string html::protocol_block(const std::vector<Analysis>& a, const std::vector<std::size_t>& order,
+                                 const shown::Verdict& overall, const ReportOptions& options,
+                                 const std::string& title) {
   const LabProfile& p = *options.profile;
   std::string h = "<section class=\"protocol\" id=\"protocol\">\n" + approval_block(p);
   h += fmt::format(
@@ -121,11 +121,11 @@ std::string html::protocol_block(const std::vector<json>& a, const std::vector<s
   row(N_("address"), html::typed(p.address));
   if (!p.accreditation.empty()) row(N_("accreditation"), html::typed(p.accreditation));
   row(N_("customer"), html::typed(p.customer));
-  const auto serials = html::identification_values(a, "serial");
+  const auto serials = html::identification_values(a, shown::Id::Serial);
   row(N_("object of the test"), (options.gyro.empty() ? std::string(tr("gyro")) : html::typed(options.gyro)) +
                                     (serials.empty() ? std::string() : trf(", serial No. {}", serials)));
   row(N_("test method"), html::typed(p.method));
-  row(N_("test date"), html::identification_values(a, "test_date"));
+  row(N_("test date"), html::identification_values(a, shown::Id::TestDate));
   row(N_("runs"), trnf("{} recording (its size and SHA-256 under “Runs”)",
                        "{} recordings (each one's size and SHA-256 under “Runs”)", a.size(), a.size()));
   row(N_("report generated"), html::text(options.generated) + " · " + html::text(version_line()));

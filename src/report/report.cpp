@@ -1,4 +1,5 @@
-// The HTML test report: tables from the analysis JSON, figures by gnuplot, all in one file.
+// The HTML test report: tables from the analysis results as they are shown (shown_results.hpp, read
+// from the JSON at the entry), figures by gnuplot, all in one file.
 #include "rwcalc/report.hpp"
 #include "rwcalc/version.hpp"
 
@@ -11,7 +12,6 @@
 #include <optional>
 
 #include "html.hpp"
-#include "json_view.hpp"
 #include "rwcalc/error.hpp"
 #include "rwcalc/i18n.hpp"
 #include "rwcalc/option_words.hpp"
@@ -19,6 +19,9 @@
 #include "rwcalc/plot.hpp"
 #include "rwcalc/printable.hpp"
 #include "rwcalc/quantity_text.hpp"
+#include "rwcalc/units.hpp"
+#include "shown_figures.hpp"
+#include "shown_results.hpp"
 
 namespace rwcalc {
 
@@ -51,9 +54,11 @@ std::string base64_encode(std::string_view bytes) {
 
 namespace {
 
-using view::at;
-using view::num;
-using view::str;
+using shown::Analysis;
+using shown::ClassValue;
+using shown::Id;
+using shown::Term;
+using shown::Verdict;
 namespace lbl = units::label;
 
 /// Text for HTML, in element content and in quoted attribute values alike: the markup
@@ -88,48 +93,43 @@ constexpr const char* kNotAvailable = "<span class=\"na\">—</span>";
 
 /// A coefficient cell: "value ± u" rounded by the GUM rule with the 95 % interval below, rounded to
 /// the same digit, or "< bound" when unresolved.
-std::string coef_cell(const json& c) {
-  const auto v = num(c, "value");
+std::string coef_cell(const shown::CoefficientValues& c) {
+  const auto v = c.value;
   if (!v) return kNotAvailable;
-  const auto& resolved = at(c, "resolved");
-  if (resolved.is_boolean() && !resolved.get<bool>())
+  if (c.resolved && !*c.resolved)
     return fmt::format("&lt; {} <span class=\"ci\">{}</span>", g(*v, 2), tr("95 % upper bound"));
-  const auto sigma = num(c, "sigma");
+  const auto sigma = c.sigma;
   const bool has_sigma = sigma && *sigma > 0 && std::isfinite(*sigma);
   std::string s = has_sigma ? value_with_uncertainty(*v, *sigma) : g(*v);
-  const auto lo = num(c, "low95"), hi = num(c, "high95");
+  const auto lo = c.low95, hi = c.high95;
   if (lo && hi)
     s += fmt::format(" <span class=\"ci\">{}</span>", has_sigma ? interval_at(*lo, *hi, gum_last_digit(*sigma))
                                                                 : fmt::format("[{}, {}]", g(*lo), g(*hi)));
   return s;
 }
 
-std::string temperature_text(const json& run) {
-  const auto t = view::temperature_label(at(run, "temperature_c"));
+std::string temperature_text(const Analysis& run) {
+  const auto t = shown::temperature_label(run.temperature_c);
   return t.empty() ? tr("not given") : t;
 }
 
-std::string class_text(const json& c) {
-  if (c.is_number_integer()) return fmt::format("{}", c.get<int>());
-  if (c.is_null()) return tr("outside");
+std::string class_text(const ClassValue& c) {
+  switch (c.kind) {
+    case ClassValue::Kind::Number: return fmt::format("{}", c.number);
+    case ClassValue::Kind::Outside: return tr("outside");
+    case ClassValue::Kind::NotAvailable: break;
+  }
   return kNotAvailable;
 }
 
-/// Whether a verdict (a run's or the overall one) is withheld: its fit rejected, no class stated.
-bool is_withheld(const json& v) {
-  const auto& w = at(v, "withheld");
-  return w.is_boolean() && w.get<bool>();
-}
-
-/// A verdict's class cell: "no verdict" when it is withheld, else the class under `key`.
-std::string verdict_class(const json& v, std::string_view key) {
-  return is_withheld(v) ? std::string(tr("no verdict")) : class_text(at(v, key));
+/// A verdict's class cell: "no verdict" when it is withheld (its fit rejected), else the class `c`.
+std::string verdict_class(const Verdict& v, const ClassValue& c) {
+  return v.withheld ? std::string(tr("no verdict")) : class_text(c);
 }
 
 /// The verdict's statement, else its class (plain text).
-std::string statement_text(const json& v) {
-  const auto st = str(v, "statement");
-  return st.empty() ? trf("class {}", class_text(at(v, "class"))) : st;
+std::string statement_text(const Verdict& v) {
+  return v.statement.empty() ? trf("class {}", class_text(v.cls)) : v.statement;
 }
 
 /// "; by B: …; by N: …" from two statements, each left out when absent.
@@ -139,18 +139,17 @@ std::string by_parameter(const std::string& b, const std::string& n) {
 
 /// A verdict in words: the class, its probability in per cent and, when that is not decisive
 /// (below 90 %), the runner-up; from the verdict's "class", "p_is" and "classes" (empty without).
-std::string verdict_in_words(const json& v, const json& classes_json) {
-  const auto& p_is = at(v, "p_is");
-  if (!p_is.is_array() || !classes_json.is_array() || p_is.size() != classes_json.size() + 1) return {};
-  const auto classes = classes_json.get<std::vector<int>>();
-  const auto& c = at(v, "class");
+std::string verdict_in_words(const Verdict& v, const std::optional<std::vector<int>>& classes_given) {
+  if (!v.p_is || !classes_given || v.p_is->size() != classes_given->size() + 1) return {};
+  const auto& classes = *classes_given;
+  const auto& p_is = *v.p_is;
   std::size_t s = classes.size();
   for (std::size_t k = 0; k < classes.size(); ++k)
-    if (c.is_number_integer() && classes[k] == c.get<int>()) s = k;
+    if (v.cls.kind == ClassValue::Kind::Number && classes[k] == v.cls.number) s = k;
   auto name = [&](std::size_t k) {
     return k < classes.size() ? trf("accuracy class {}", classes[k]) : trf("outside class {}", classes.back());
   };
-  auto pct = [&](std::size_t k) { return 100.0 * p_is[k].get<double>(); };
+  auto pct = [&](std::size_t k) { return 100.0 * p_is[k]; };
   // Rounding must not turn 99.7 % into a certainty, nor 0.3 % into an impossibility.
   auto words = [&](std::size_t k) {
     const double p = pct(k);
@@ -165,16 +164,15 @@ std::string verdict_in_words(const json& v, const json& classes_json) {
   return w + trf("; the next most probable: {} ({})", name(r), words(r));
 }
 
-std::string source_name(const json& a) {
-  const auto s = str(a, "source");
-  return s.empty() ? std::string(tr("(unnamed run)")) : std::filesystem::path(s).filename().string();
+std::string source_name(const Analysis& a) {
+  return a.source.empty() ? std::string(tr("(unnamed run)")) : std::filesystem::path(a.source).filename().string();
 }
 
 /// The class an estimate's reported value falls in (no probability): for the cross-check methods.
-std::string class_by_value(const json& estimate, const json& run, const char* parameter) {
-  const auto v = num(estimate, "value");
+std::string class_by_value(const shown::CoefficientValues& estimate, const Analysis& run, char parameter) {
+  const auto v = estimate.value;
   if (!v) return kNotAvailable;
-  for (const auto& [cls, limit] : view::class_limits(run, parameter))
+  for (const auto& [cls, limit] : shown::class_limits(run.verdict, parameter))
     if (*v <= limit) return fmt::format("{}", cls);
   return tr("outside");
 }
@@ -262,26 +260,37 @@ table.signatures td.sign {{ border-bottom: 1px solid #222; width: 25%; }}
 }}
 )";
 
-/// Worst (highest) class over runs; null when any run is outside the table or unclassified.
-json worst_class(const std::vector<json>& analyses, const char* key) {
+/// Worst (highest) class over runs; outside when any run is outside the table or unclassified.
+ClassValue worst_class(const std::vector<Analysis>& analyses, ClassValue Verdict::*which) {
   int worst = 0;
   for (const auto& a : analyses) {
-    const auto& c = at(at(a, "verdict"), key);
-    if (!c.is_number_integer()) return nullptr;
-    worst = std::max(worst, c.get<int>());
+    const auto& c = a.verdict.*which;
+    if (c.kind != ClassValue::Kind::Number) return {};
+    worst = std::max(worst, c.number);
   }
-  return worst > 0 ? json(worst) : json(nullptr);
+  return worst > 0 ? ClassValue{ClassValue::Kind::Number, worst} : ClassValue{};
+}
+
+/// The overall verdict without a batch's: the worst class of the runs, withheld when a run's is.
+Verdict worst_verdict(const std::vector<Analysis>& a) {
+  Verdict v;
+  v.present = true;
+  v.class_B = worst_class(a, &Verdict::class_B);
+  v.class_N = worst_class(a, &Verdict::class_N);
+  v.cls = worst_class(a, &Verdict::cls);
+  v.withheld = std::any_of(a.begin(), a.end(), [](const Analysis& r) { return r.verdict.withheld; });
+  return v;
 }
 
 /// A table row: the run and its temperature, then the cells (class="num"; bold when asked).
-std::string run_row(const json& run, const std::vector<std::string>& cells, std::string_view tail = "") {
+std::string run_row(const Analysis& run, const std::vector<std::string>& cells, std::string_view tail = "") {
   std::string s =
       fmt::format("<tr><td>{}</td><td class=\"num\">{}</td>", typed(source_name(run)), temperature_text(run));
   for (const auto& c : cells) s += fmt::format("<td class=\"num\">{}</td>", c);
   return s + std::string(tail) + "</tr>\n";
 }
 
-std::string table1(const std::vector<json>& a, const std::vector<std::size_t>& order, Numbering& numbering) {
+std::string table1(const std::vector<Analysis>& a, const std::vector<std::size_t>& order, Numbering& numbering) {
   std::string s = numbering.table("table1", tr("Noise coefficients per temperature: value ± standard uncertainty "
                                                "[coverage interval, p = 0.95]"));
   s +=
@@ -289,15 +298,14 @@ std::string table1(const std::vector<json>& a, const std::vector<std::size_t>& o
           "<th>B by Allan variance ({1})</th><th>B by 100-s averaging ({1})</th></tr>\n",
           "<span class=\"unit\">" + unit(lbl::arw) + "</span>", "<span class=\"unit\">" + unit(lbl::rate) + "</span>");
   for (auto i : order) {
-    const auto& fit = at(a[i], "fit");
-    const auto& methods = at(a[i], "methods");
-    s += run_row(a[i], {coef_cell(at(fit, "N")), coef_cell(at(methods, "N_direct")), coef_cell(at(fit, "B")),
-                        coef_cell(at(methods, "B_100s"))});
+    const auto& fit = a[i].fit;
+    s += run_row(a[i],
+                 {coef_cell(fit[Term::N]), coef_cell(a[i].n_direct), coef_cell(fit[Term::B]), coef_cell(a[i].b_100s)});
   }
   return s + "</table>\n";
 }
 
-std::string table2(const std::vector<json>& a, const std::vector<std::size_t>& order, const json& overall,
+std::string table2(const std::vector<Analysis>& a, const std::vector<std::size_t>& order, const Verdict& overall,
                    Numbering& numbering) {
   std::string s = numbering.table("table2", tr("Accuracy class per parameter (1 best; “outside”: beyond the last "
                                                "class)"));
@@ -307,30 +315,25 @@ std::string table2(const std::vector<json>& a, const std::vector<std::size_t>& o
          "<th>verdict with probability</th></tr>\n");
   for (auto i : order) {
     const auto& run = a[i];
-    const auto& v = at(run, "verdict");
-    const auto& methods = at(run, "methods");
-    std::string statement = esc(str(v, "statement"));
-    if (statement.empty()) {
-      const auto p = num(v, "p_class");
-      statement = p ? trf("class {} (P = {:.2f})", class_text(at(v, "class")), *p) : kNotAvailable;
-    }
-    if (const auto& changed = at(v, "tolerance_changed"); changed.is_boolean() && changed.get<bool>())
+    const auto& v = run.verdict;
+    std::string statement = esc(v.statement);
+    if (statement.empty())
+      statement = v.p_class ? trf("class {} (P = {:.2f})", class_text(v.cls), *v.p_class) : kNotAvailable;
+    if (v.tolerance_changed)
       statement += fmt::format(" <span class=\"note\">{}</span>",
-                               trf("changed by the +{} % B tolerance", g(num(v, "tolerance_pct").value_or(0.0))));
+                               trf("changed by the +{} % B tolerance", g(v.tolerance_pct.value_or(0.0))));
     s += run_row(run,
                  // The cross-checks' classes too depend on the rejected fit (the terms they take off).
-                 {verdict_class(v, "class_N"),
-                  is_withheld(v) ? tr("no verdict") : class_by_value(at(methods, "N_direct"), run, "N"),
-                  verdict_class(v, "class_B"),
-                  is_withheld(v) ? tr("no verdict") : class_by_value(at(methods, "B_100s"), run, "B"),
-                  "<b>" + verdict_class(v, "class") + "</b>"},
+                 {verdict_class(v, v.class_N), v.withheld ? tr("no verdict") : class_by_value(run.n_direct, run, 'N'),
+                  verdict_class(v, v.class_B), v.withheld ? tr("no verdict") : class_by_value(run.b_100s, run, 'B'),
+                  "<b>" + verdict_class(v, v.cls) + "</b>"},
                  "<td>" + statement + "</td>");
   }
   s += fmt::format(
       "<tr><th colspan=\"2\">{}</th><td class=\"num\"><b>{}</b></td><td></td><td class=\"num\"><b>{}</b></td><td></td>"
       "<td class=\"num\"><b>{}</b></td><td>{}</td></tr>\n",
-      tr("over the temperature range"), verdict_class(overall, "class_N"), verdict_class(overall, "class_B"),
-      verdict_class(overall, "class"), tr("worst case over the runs"));
+      tr("over the temperature range"), verdict_class(overall, overall.class_N),
+      verdict_class(overall, overall.class_B), verdict_class(overall, overall.cls), tr("worst case over the runs"));
   return s + "</table>\n<p class=\"meta\">" +
          tr("Classes by N direct and by B 100-s compare the reported value with the class limits only (no "
             "probability); the verdict uses the estimates named in the settings.") +
@@ -355,163 +358,158 @@ std::string json_value_html(const json& v) {
 }
 
 /// What was done with the outliers, in words.
-std::string outlier_action_html(const json& outliers, std::size_t count) {
-  const std::string action = str(outliers, "action");
+std::string outlier_action_html(const shown::Outliers& outliers, std::size_t count) {
+  const std::string& action = outliers.action;
   if (action == "keep") return tr("kept in the analysis (--outliers remove or replace leaves them out)");
   if (action == "remove")
     return trf("{:.0f} removed before the analysis (later samples move one period earlier)",
-               num(outliers, "removed").value_or(static_cast<double>(count)));
+               outliers.removed.value_or(static_cast<double>(count)));
   if (action == "replace")
     return trf("{:.0f} replaced by the median of their nearest good neighbours before the analysis",
-               num(outliers, "replaced").value_or(static_cast<double>(count)));
+               outliers.replaced.value_or(static_cast<double>(count)));
   return trf("action {}", action.empty() ? std::string(kNotAvailable) : esc(action));
 }
 
 constexpr std::size_t kReportOutlierPositions = 10;  ///< positions listed per run (the JSON has more)
 
 /// The outlier line of a run or a diagnosis: count, action and the first positions.
-std::string outliers_html(const json& outliers) {
-  if (!outliers.is_object())
+std::string outliers_html(const shown::Outliers& outliers) {
+  if (!outliers.present)
     return fmt::format("<span class=\"na\">{}</span>", tr("not in these results (no outlier summary)"));
-  const auto count_value = num(outliers, "count");
+  const auto count_value = outliers.count;
   if (!count_value) return kNotAvailable;
   const auto count = static_cast<std::size_t>(*count_value);
-  const auto z = num(outliers, "threshold_robust_z");
+  const auto z = outliers.threshold_robust_z;
   const std::string threshold = z ? trf(" (threshold {} robust σ)", g(*z)) : std::string();
   if (count == 0) return tr("none found") + threshold;
   std::string s =
       fmt::format("<b>{}</b>{}; {}", trf("{} found", count), threshold, outlier_action_html(outliers, count));
-  const auto& positions = at(outliers, "positions");
   std::size_t listed = 0;
-  if (positions.is_array()) {
-    for (const auto& p : positions) {
-      if (listed == kReportOutlierPositions) break;
-      const auto line = num(p, "line"), time = num(p, "time_s"), value = num(p, "value");
-      s += listed++ ? ", " : ": ";
-      s += line ? trf("line {:.0f}", *line) : trf("line {}", kNotAvailable);
-      if (time)
-        s += trf(" (t = {} s", g(*time, 6)) + (value ? fmt::format(", {} {})", g(*value, 6), unit(lbl::rate)) : ")");
-    }
+  for (const auto& p : outliers.positions) {
+    if (listed == kReportOutlierPositions) break;
+    const auto line = p.line, time = p.time_s, value = p.value;
+    s += listed++ ? ", " : ": ";
+    s += line ? trf("line {:.0f}", *line) : trf("line {}", kNotAvailable);
+    if (time)
+      s += trf(" (t = {} s", g(*time, 6)) + (value ? fmt::format(", {} {})", g(*value, 6), unit(lbl::rate)) : ")");
   }
   if (count > listed) s += (listed ? ", " : ": ") + trf("… {} more in the JSON results", count - listed);
   return s;
 }
 
-/// The identification keys of the input metadata, with their labels.
-constexpr std::array<std::pair<const char*, const char*>, 4> kIdentification{{{"serial", N_("gyro serial")},
-                                                                              {"operator", N_("operator")},
-                                                                              {"test_date", N_("test date")},
-                                                                              {"conditions", N_("test conditions")}}};
+/// The identification of the input metadata, with its labels.
+constexpr std::array<std::pair<Id, const char*>, 4> kIdentification{{{Id::Serial, N_("gyro serial")},
+                                                                     {Id::Operator, N_("operator")},
+                                                                     {Id::TestDate, N_("test date")},
+                                                                     {Id::Conditions, N_("test conditions")}}};
 
 /// A record read with --gaps segments: how many segments, the gaps between them and their lengths
 /// (the text report's line); empty for a record in one piece.
-std::string segments_text(const json& segments) {
-  const auto n = num(segments, "count");
+std::string segments_text(const shown::Segments& segments) {
+  const auto n = segments.count;
   if (!n || *n < 2) return {};
   std::string gaps, lengths;
-  for (const auto& gap : at(segments, "gaps"))
-    if (const auto line = num(gap, "line"), missing = num(gap, "missing_s"); line && missing)
+  for (const auto& gap : segments.gaps)
+    if (const auto line = gap.line, missing = gap.missing_s; line && missing)
       gaps += trf("{}{} s missing before line {:.0f}", gaps.empty() ? "" : ", ", g(*missing, 6), *line);
-  for (const auto& d : at(segments, "durations_s"))
-    if (const auto v = num(d)) lengths += fmt::format("{}{:.1f}", lengths.empty() ? "" : ", ", *v);
+  for (const auto& d : segments.durations_s)
+    if (const auto v = d) lengths += fmt::format("{}{:.1f}", lengths.empty() ? "" : ", ", *v);
   return trf(
       "{:.0f} segments, split at the time column's gaps by --gaps segments ({}); lengths {} s. The Allan "
       "variance pools them (no difference spans a gap); the cross-checks use the longest",
       *n, gaps, lengths);
 }
 
-std::string data_table(const json& run, std::size_t index, Numbering& numbering) {
+std::string data_table(const Analysis& run, std::size_t index, Numbering& numbering) {
   std::string s = numbering.table(fmt::format("run{}-data", index + 1),
                                   trf("Data and identification: {}", typed(source_name(run))), "run");
-  s += kv_row(tr("file"), typed(str(run, "source")));
-  const json& input = at(run, "input");
-  if (const json& id = at(input, "identification"); id.is_object())
-    for (const auto& [key, label] : kIdentification)
-      if (const auto v = str(id, key); !v.empty()) s += kv_row(tr(label), typed(v));
-  if (const auto sha = str(input, "sha256"); !sha.empty())
+  s += kv_row(tr("file"), typed(run.source));
+  for (const auto& [id, label] : kIdentification)
+    if (const auto& v = run[id]; !v.empty()) s += kv_row(tr(label), typed(v));
+  if (!run.sha256.empty())
     s += kv_row(tr("file size, SHA-256"),
-                trf("{:.0f} bytes, <code>{}</code>", num(input, "file_bytes").value_or(0), esc(sha)));
-  if (const auto n = num(run, "samples")) s += kv_row(tr("samples"), fmt::format("{:.0f}", *n));
-  if (const auto r = num(run, "rate_hz")) s += kv_row(tr("sample rate"), trf("{} Hz", g(*r, 6)));
-  if (const auto d = num(run, "duration_s")) s += kv_row(tr("duration"), trf("{:.1f} s ({:.2f} h)", *d, *d / 3600));
-  if (const auto text = segments_text(at(run, "segments")); !text.empty()) s += kv_row(tr("segments"), esc(text));
+                trf("{:.0f} bytes, <code>{}</code>", run.file_bytes.value_or(0), esc(run.sha256)));
+  if (const auto n = run.samples) s += kv_row(tr("samples"), fmt::format("{:.0f}", *n));
+  if (const auto r = run.rate_hz) s += kv_row(tr("sample rate"), trf("{} Hz", g(*r, 6)));
+  if (const auto d = run.duration_s) s += kv_row(tr("duration"), trf("{:.1f} s ({:.2f} h)", *d, *d / 3600));
+  if (const auto text = segments_text(run.segments); !text.empty()) s += kv_row(tr("segments"), esc(text));
   s += kv_row(tr("temperature"), temperature_text(run));
-  auto rate = [&](const char* key, const char* name, int digits) {
-    if (const auto v = num(run, key)) s += kv_row(tr(name), fmt::format("{} {}", g(*v, digits), unit(lbl::rate)));
+  auto rate = [&](std::optional<double> v, const char* name, int digits) {
+    if (v) s += kv_row(tr(name), fmt::format("{} {}", g(*v, digits), unit(lbl::rate)));
   };
-  rate("mean_rate", N_("mean rate"), 5);
-  rate("earth_rate", N_("expected Earth rate"), 5);
-  rate("bias", N_("bias (mean − Earth rate)"), 4);
+  rate(run.mean_rate, N_("mean rate"), 5);
+  rate(run.earth_rate, N_("expected Earth rate"), 5);
+  rate(run.bias, N_("bias (mean − Earth rate)"), 4);
   s += fmt::format("<tr id=\"run{}-outliers\"><th>{}</th><td>{}</td></tr>\n", index + 1, tr("outliers"),
-                   outliers_html(at(run, "outliers")));
+                   outliers_html(run.outliers));
   return s + "</table>\n";
 }
 
 /// The five-term model, typeset.
 constexpr const char* kModelFormula = "σ²(τ) = 3Q²/τ² + N²/τ + (2 ln 2/π)·B² + K²τ/3 + R²τ²/2";
 
-std::string fit_table(const json& fit, std::size_t index, Numbering& numbering) {
+std::string fit_table(const shown::Fit& fit, std::size_t index, Numbering& numbering) {
   std::string s = numbering.table(fmt::format("run{}-fit", index + 1),
                                   trf("Allan-variance fit <span class=\"formula\">{}</span>", kModelFormula), "run");
   s += tr("<tr><th>term</th><th>value ± standard uncertainty [coverage interval, p = 0.95]</th><th>unit</th></tr>\n");
-  static constexpr std::array<std::array<const char*, 3>, 5> kCoefficientRows{
-      {{"Q", N_("Q quantization noise"), lbl::angle},
-       {"N", N_("N angle random walk"), lbl::arw},
-       {"B", N_("B bias instability"), lbl::rate},
-       {"K", N_("K rate random walk"), lbl::rrw},
-       {"R", N_("R rate ramp"), lbl::ramp}}};
-  for (const auto& [key, name, u] : kCoefficientRows)
-    s += fmt::format("<tr><td>{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n", tr(name), coef_cell(at(fit, key)),
+  struct CoefficientRow {
+    Term term;
+    const char *name, *unit;
+  };
+  static constexpr std::array<CoefficientRow, 5> kCoefficientRows{{{Term::Q, N_("Q quantization noise"), lbl::angle},
+                                                                   {Term::N, N_("N angle random walk"), lbl::arw},
+                                                                   {Term::B, N_("B bias instability"), lbl::rate},
+                                                                   {Term::K, N_("K rate random walk"), lbl::rrw},
+                                                                   {Term::R, N_("R rate ramp"), lbl::ramp}}};
+  for (const auto& [term, name, u] : kCoefficientRows)
+    s += fmt::format("<tr><td>{}</td><td class=\"num\">{}</td><td>{}</td></tr>\n", tr(name), coef_cell(fit[term]),
                      unit(u));
   auto row = [&](const char* name, const std::string& html) {
     s += fmt::format("<tr><td>{}</td><td colspan=\"2\">{}</td></tr>\n", tr(name), html);
   };
-  if (const auto c = num(fit, "chi2_per_dof")) {
+  if (const auto c = fit.chi2_per_dof) {
     std::string gof = trf("χ²/dof = {}", g(*c));
-    if (const auto p = num(fit, "p_value")) gof += fmt::format(", p = {}", g(*p));
-    if (const auto lo = num(fit, "tau_min_s"), hi = num(fit, "tau_max_s"); lo && hi)
+    if (const auto p = fit.p_value) gof += fmt::format(", p = {}", g(*p));
+    if (const auto lo = fit.tau_min_s, hi = fit.tau_max_s; lo && hi)
       gof += trf("; τ fitted {}–{} s", g(*lo, 6), g(*hi, 6));
     row(N_("goodness of fit"), gof);
   }
-  if (const auto& range = at(fit, "range"); range.is_object()) row(N_("fit range"), esc(str(range, "reason")));
-  if (const auto& scaled = at(fit, "intervals_scaled"); scaled.is_boolean() && scaled.get<bool>())
-    row(N_("intervals"),
-        trf("scaled by √(χ²/dof) = {}: the model is rejected", g(num(fit, "interval_scale").value_or(1.0))));
+  if (fit.range_reason) row(N_("fit range"), esc(*fit.range_reason));
+  if (fit.intervals_scaled)
+    row(N_("intervals"), trf("scaled by √(χ²/dof) = {}: the model is rejected", g(fit.interval_scale.value_or(1.0))));
   return s + "</table>\n";
 }
 
 /// The run's warnings (analysis JSON "warnings": code, message, suggested command), if any.
-std::string warnings_html(const json& run) {
-  const auto& w = at(run, "warnings");
-  if (!w.is_array() || w.empty()) return {};
+std::string warnings_html(const Analysis& run) {
+  if (run.warnings.empty()) return {};
   std::string s = fmt::format("<div class=\"warning\"><b>{}</b><ul>\n", tr("Warnings"));
-  for (const auto& x : w) {
-    s += fmt::format("<li><b>{}</b>: {}", esc(str(x, "code")), esc(str(x, "message")));
-    if (const std::string c = str(x, "command"); !c.empty()) s += fmt::format(" <code>{}</code>", typed(c));
+  for (const auto& x : run.warnings) {
+    s += fmt::format("<li><b>{}</b>: {}", esc(x.code), esc(x.message));
+    if (!x.command.empty()) s += fmt::format(" <code>{}</code>", typed(x.command));
     s += "</li>\n";
   }
   return s + "</ul></div>\n";
 }
 
 /// A withheld verdict: the statement, why, and the command to run next.
-std::string withheld_html(const json& v) {
+std::string withheld_html(const Verdict& v) {
   std::string s = fmt::format("<p>{} <b>{}</b>.</p>\n", tr("Verdict:"), esc(statement_text(v)));
-  if (const auto why = str(v, "reason"); !why.empty()) s += fmt::format("<p>{}</p>\n", esc(trf("Why: {}.", why)));
-  if (const auto c = str(v, "command"); !c.empty())
-    s += fmt::format("<p>{} <code>{}</code></p>\n", tr("Run next:"), typed(c));
+  if (!v.reason.empty()) s += fmt::format("<p>{}</p>\n", esc(trf("Why: {}.", v.reason)));
+  if (!v.command.empty()) s += fmt::format("<p>{} <code>{}</code></p>\n", tr("Run next:"), typed(v.command));
   return s;
 }
 
-std::string run_summary(const json& run, std::size_t index, Numbering& numbering) {
+std::string run_summary(const Analysis& run, std::size_t index, Numbering& numbering) {
   std::string s = warnings_html(run);
   s += data_table(run, index, numbering);  // one statement each: the tables are numbered in order
-  s += fit_table(at(run, "fit"), index, numbering);
-  if (const auto& v = at(run, "verdict"); is_withheld(v)) {
+  s += fit_table(run.fit, index, numbering);
+  if (const auto& v = run.verdict; v.withheld) {
     s += withheld_html(v);
-  } else if (v.is_object()) {
+  } else if (v.present) {
     s += fmt::format("<p>{} <b>{}</b>{}.</p>\n", tr("Verdict:"), esc(statement_text(v)),
-                     by_parameter(str(v, "statement_B"), str(v, "statement_N")));
-    if (const auto words = verdict_in_words(v, at(v, "classes")); !words.empty())
+                     by_parameter(v.statement_B, v.statement_N));
+    if (const auto words = verdict_in_words(v, v.classes); !words.empty())
       s += fmt::format("<p>{}</p>\n", esc(trf("In words: {}.", words)));
   }
   return s;
@@ -521,71 +519,74 @@ std::string run_summary(const json& run, std::size_t index, Numbering& numbering
 std::string finding_unit(const std::string& ascii) { return esc(unit_text(ascii)); }
 
 /// One parameter of a finding (docs/diagnosis.md, JSON): "value ± u unit" rounded by the GUM rule.
-std::string finding_parameter_html(const json& p) {
-  const auto& v = at(p, "value");
-  if (!v.is_number()) return kNotAvailable;
-  const auto& u = at(p, "standard_uncertainty");
+std::string finding_parameter_html(const shown::FindingParameter& p) {
+  if (!p.value) return kNotAvailable;
   const std::string number =
-      u.is_number() ? value_with_uncertainty(v.get<double>(), u.get<double>()) : g(v.get<double>(), 4);
-  return fmt::format("{} {}", number, finding_unit(str(p, "unit")));
+      p.standard_uncertainty ? value_with_uncertainty(*p.value, *p.standard_uncertainty) : g(*p.value, 4);
+  return fmt::format("{} {}", number, finding_unit(p.unit));
 }
 
-std::string findings_html(const json& findings, std::size_t index, Numbering& numbering) {
-  if (!findings.is_array() || findings.empty())
+std::string findings_html(const std::vector<shown::Finding>& findings, std::size_t index, Numbering& numbering) {
+  if (findings.empty())
     return fmt::format("<p>{}</p>\n", tr("No finding: the five-term model's simulations explain the measurement."));
   std::string s = numbering.table(fmt::format("run{}-findings", index + 1), tr("Findings"));
   s += tr("<tr><th>effect</th><th>parameters</th></tr>\n");
   for (const auto& f : findings) {
     std::string params;
-    if (const auto& ps = at(f, "parameters"); ps.is_object())
-      for (const auto& [k, p] : ps.items())
-        params += fmt::format("{}{} = {}", params.empty() ? "" : "; ", esc(k), finding_parameter_html(p));
-    s += fmt::format("<tr><td>{}</td><td>{}</td></tr>\n", esc(str(f, "effect")), params);
+    for (const auto& p : f.parameters)
+      params += fmt::format("{}{} = {}", params.empty() ? "" : "; ", esc(p.name), finding_parameter_html(p));
+    s += fmt::format("<tr><td>{}</td><td>{}</td></tr>\n", esc(f.effect), params);
   }
   return s + "</table>\n";
 }
 
-std::string gain_html(const json& gain, std::size_t index, Numbering& numbering) {
-  if (!gain.is_object()) return {};
+std::string gain_html(const std::optional<shown::Gain>& gain, std::size_t index, Numbering& numbering) {
+  if (!gain) return {};
   std::string s = numbering.table(fmt::format("run{}-gain", index + 1), tr("Gain of the extended model"));
   s += tr("<tr><th>measure</th><th>base model</th><th>extended model</th></tr>\n");
-  static constexpr std::array<std::array<const char*, 3>, 2> kRows{
-      {{N_("Allan-variance misfit (EDF-weighted)"), "misfit_base", "misfit_extended"},
-       {N_("share of measured τ inside the simulated band"), "coverage_base", "coverage_extended"}}};
-  auto cell = [&](const char* key) {
-    const auto v = num(gain, key);
+  using Value = std::optional<double> shown::Gain::*;
+  struct Row {
+    const char* name;
+    Value base, extended;
+  };
+  static constexpr std::array<Row, 2> kRows{
+      {{N_("Allan-variance misfit (EDF-weighted)"), &shown::Gain::misfit_base, &shown::Gain::misfit_extended},
+       {N_("share of measured τ inside the simulated band"), &shown::Gain::coverage_base,
+        &shown::Gain::coverage_extended}}};
+  auto cell = [&](Value value) {
+    const auto v = (*gain).*value;
     return v ? g(*v, 4) : std::string(kNotAvailable);
   };
   for (const auto& [name, base, ext] : kRows)
     s += fmt::format("<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>\n", tr(name), cell(base),
                      cell(ext));
   // The likelihood gains are of the extended model over the base: one figure each.
-  static constexpr std::array<std::array<const char*, 2>, 2> kGains{
-      {{N_("likelihood gain in sample (−2Δ ln L − 2k)"), "likelihood_in_sample"},
-       {N_("likelihood gain on held-out runs (−2Δ ln L)"), "likelihood_holdout"}}};
+  static constexpr std::array<std::pair<const char*, Value>, 2> kGains{
+      {{N_("likelihood gain in sample (−2Δ ln L − 2k)"), &shown::Gain::likelihood_in_sample},
+       {N_("likelihood gain on held-out runs (−2Δ ln L)"), &shown::Gain::likelihood_holdout}}};
   for (const auto& [name, key] : kGains)
     s += fmt::format("<tr><td>{}</td><td class=\"num\">—</td><td class=\"num\">{}</td></tr>\n", tr(name), cell(key));
   return s + "</table>\n";
 }
 
-std::string diagnosis_html(const json& d, std::size_t index, const json& run, Numbering& numbering) {
+std::string diagnosis_html(const shown::Diagnosis& d, std::size_t index, const Analysis& run, Numbering& numbering) {
   std::string s =
       fmt::format("<h3 id=\"run{}-diagnosis\">{}</h3>\n", index + 1, tr("Diagnosis: what the noise model misses"));
   s += fmt::format("<p id=\"run{}-diagnosis-outliers\">{}</p>\n", index + 1,
-                   trf("Outliers of the diagnosed record: {}.", outliers_html(at(d, "outliers"))));
-  s += findings_html(at(d, "findings"), index, numbering);
-  s += gain_html(at(d, "gain"), index, numbering);
-  if (numbering.figures_enabled && (at(at(d, "base_model"), "band").is_array() || at(d, "band").is_array()))
+                   trf("Outliers of the diagnosed record: {}.", outliers_html(d.outliers)));
+  s += findings_html(d.findings, index, numbering);
+  s += gain_html(d.gain, index, numbering);
+  if (numbering.figures_enabled && d.band)
     s += numbering.figure(
-        fmt::format("fig-run{}-diagnosis", index + 1), {diagnosis_figure(d, PlotOptions{})},
+        fmt::format("fig-run{}-diagnosis", index + 1), {shown::diagnosis_figure(d, PlotOptions{})},
         trf("{}: measured Allan deviation against the simulated bands of the base and the extended model",
             source_name(run)));
   return s;
 }
 
 /// No verdict over the runs (a run's fit is rejected): said first, with each run's reason and command.
-std::string withheld_verdict_html(const std::vector<json>& a, const std::vector<std::size_t>& order,
-                                  const json& overall) {
+std::string withheld_verdict_html(const std::vector<Analysis>& a, const std::vector<std::size_t>& order,
+                                  const Verdict& overall) {
   std::string h =
       fmt::format("<p class=\"verdict\">{}</p>\n",
                   a.size() == 1
@@ -593,19 +594,17 @@ std::string withheld_verdict_html(const std::vector<json>& a, const std::vector<
                                        "class and no probability is stated."))
                       : trf("<b>No verdict</b> over the temperature range: the noise model does not describe {} of "
                             "the {} records, so no class and no probability is stated.",
-                            std::count_if(a.begin(), a.end(),
-                                          [](const json& r) { return is_withheld(at(r, "verdict")); }),
+                            std::count_if(a.begin(), a.end(), [](const Analysis& r) { return r.verdict.withheld; }),
                             a.size()));
-  if (const auto st = str(overall, "statement"); !st.empty() && a.size() > 1)
+  if (const auto& st = overall.statement; !st.empty() && a.size() > 1)
     h += fmt::format("<p id=\"verdict-probability\">{} <b>{}</b>.</p>\n", tr("Over all runs:"), esc(st));
   h += "<ul>\n";
   for (auto i : order) {
-    const auto& v = at(a[i], "verdict");
+    const auto& v = a[i].verdict;
     h += fmt::format("<li>{} ({}): {}", typed(source_name(a[i])), temperature_text(a[i]), esc(statement_text(v)));
-    if (is_withheld(v)) {
-      h += esc(fmt::format(" ({})", str(v, "reason")));
-      if (const auto c = str(v, "command"); !c.empty())
-        h += fmt::format("; {} <code>{}</code>", tr("run next:"), typed(c));
+    if (v.withheld) {
+      h += esc(fmt::format(" ({})", v.reason));
+      if (!v.command.empty()) h += fmt::format("; {} <code>{}</code>", tr("run next:"), typed(v.command));
     }
     h += "</li>\n";
   }
@@ -613,29 +612,29 @@ std::string withheld_verdict_html(const std::vector<json>& a, const std::vector<
 }
 
 /// The verdict first: it is what the report is for.
-std::string verdict_html(const std::vector<json>& a, const std::vector<std::size_t>& order, const json& overall,
+std::string verdict_html(const std::vector<Analysis>& a, const std::vector<std::size_t>& order, const Verdict& overall,
                          Numbering& numbering) {
   std::string h = numbering.section("verdict", tr("Verdict"));
-  if (is_withheld(overall)) return h + withheld_verdict_html(a, order, overall);
+  if (overall.withheld) return h + withheld_verdict_html(a, order, overall);
   h += fmt::format("<p class=\"verdict\">{}</p>\n",
                    trf("Overall class over {}: <b>{}</b> (by B: {}, by N: {}).",
-                       a.size() == 1 ? tr("the run") : tr("the temperature range"), class_text(at(overall, "class")),
-                       class_text(at(overall, "class_B")), class_text(at(overall, "class_N"))));
-  const auto& v0 = at(a[order.front()], "verdict");
-  const json& classes = at(overall, "classes").is_array() ? at(overall, "classes") : at(v0, "classes");
+                       a.size() == 1 ? tr("the run") : tr("the temperature range"), class_text(overall.cls),
+                       class_text(overall.class_B), class_text(overall.class_N)));
+  const auto& v0 = a[order.front()].verdict;
+  const auto& classes = overall.classes ? overall.classes : v0.classes;
   if (const auto words = verdict_in_words(overall, classes); !words.empty())
     h += fmt::format("<p id=\"verdict-words\">{}</p>\n",
                      trf("In words: the gyro is of {} by GOST RV 52339-2005.", esc(words)));
   // A batch's combined verdict states its probability (the product of the runs' probabilities).
-  if (const auto st = str(overall, "statement"); !st.empty())
+  if (const auto& st = overall.statement; !st.empty())
     h += fmt::format("<p id=\"verdict-probability\">{} <b>{}</b>{}.</p>\n", tr("Over all runs:"), esc(st),
-                     by_parameter(str(at(overall, "B"), "statement"), str(at(overall, "N"), "statement")));
+                     by_parameter(overall.by_B_statement, overall.by_N_statement));
   h += "<ul>\n";
   for (auto i : order)
     h += fmt::format("<li>{} ({}): {}</li>\n", typed(source_name(a[i])), temperature_text(a[i]),
-                     esc(statement_text(at(a[i], "verdict"))));
+                     esc(statement_text(a[i].verdict)));
   h += "</ul>\n";
-  if (const auto t = num(v0, "tolerance_pct"); t && *t > 0)
+  if (const auto t = v0.tolerance_pct; t && *t > 0)
     h += fmt::format("<p class=\"note\">{}</p>\n",
                      trf("The seed paper's heading-gyro rule is applied: a B up to {} % above a class limit is "
                          "accepted for that class.",
@@ -643,17 +642,16 @@ std::string verdict_html(const std::vector<json>& a, const std::vector<std::size
   h += "<p class=\"meta\">" +
        std::string(tr("P is the probability, from the estimates' uncertainty, that the true class is the one stated; "
                       "where it is low the runner-up class is named."));
-  if (auto table = str(v0, "table"); !table.empty()) h += " " + trf("Class table: {}.", typed(tr(table)));
+  if (const auto& table = v0.table; !table.empty()) h += " " + trf("Class table: {}.", typed(tr(table)));
   return h + "</p>\n";
 }
 
-std::string batch_figures_html(const std::vector<json>& a, Numbering& numbering) {
-  const json runs(a);
+std::string batch_figures_html(const std::vector<Analysis>& a, Numbering& numbering) {
   std::string h = numbering.section("figures", tr("Figures over the temperature range"));
-  h += numbering.figure("fig-batch-allan", {batch_allan_figure(runs, PlotOptions{})},
+  h += numbering.figure("fig-batch-allan", {shown::batch_allan_figure(a, PlotOptions{})},
                         tr("Allan deviation at each temperature with 68 % confidence bars and the class limits for B "
                            "drawn at their floor levels 0.6643·B"));
-  if (auto direct = batch_direct_figure(runs, PlotOptions{}); direct.series > 0)
+  if (auto direct = shown::batch_direct_figure(a, PlotOptions{}); direct.series > 0)
     return h + numbering.figure("fig-batch-direct", {direct},
                                 trf("Direct method: variance of the angle accumulated over t, Earth rate removed, "
                                     "with the regression line per temperature (slope (60·N)² {}/s)",
@@ -664,62 +662,54 @@ std::string batch_figures_html(const std::vector<json>& a, Numbering& numbering)
 }
 
 /// The conventions of the results, typeset (the JSON's "conventions" say the same in ASCII);
-/// a convention this list does not know is shown as the JSON gives it.
-std::string conventions_rows(const json& conventions) {
-  static constexpr std::array<std::array<const char*, 3>, 8> kConventions{
-      {{"Q", N_("Q, quantization noise"),
-        N_("σ²(τ) = 3Q²/τ², Q the rms white angle error (IEEE 952); the paper's "
-           "eq. (2) gives √3·Q")},
-       {"N", N_("N, angle random walk"), N_("σ²(τ) = N²/τ; N = σ(τ = 1 h)")},
-       {"B", N_("B, bias instability"),
-        N_("σ² = (2 ln 2/π)·B², floor 0.6643·B (the paper prints B where B² is meant)")},
-       {"K", N_("K, rate random walk"), N_("σ²(τ) = K²τ/3; K = σ(τ = 3 h)")},
-       {"R", N_("R, rate ramp"), N_("σ²(τ) = R²τ²/2")},
-       {"deviation_unit", N_("unit of the Allan deviation"), N_("°/h (1″/s = 1 °/h)")},
-       {"intervals", N_("intervals"),
+/// a convention the schema does not define is shown as the JSON gives it.
+std::string conventions_rows(const Analysis& first) {
+  static constexpr std::array<std::array<const char*, 2>, 8> kConventions{
+      {{N_("Q, quantization noise"), N_("σ²(τ) = 3Q²/τ², Q the rms white angle error (IEEE 952); the paper's "
+                                        "eq. (2) gives √3·Q")},
+       {N_("N, angle random walk"), N_("σ²(τ) = N²/τ; N = σ(τ = 1 h)")},
+       {N_("B, bias instability"), N_("σ² = (2 ln 2/π)·B², floor 0.6643·B (the paper prints B where B² is meant)")},
+       {N_("K, rate random walk"), N_("σ²(τ) = K²τ/3; K = σ(τ = 3 h)")},
+       {N_("R, rate ramp"), N_("σ²(τ) = R²τ²/2")},
+       {N_("unit of the Allan deviation"), N_("°/h (1″/s = 1 °/h)")},
+       {N_("intervals"),
         N_("value ± standard uncertainty u; the coverage interval for p = 0.95 from the profile likelihood; "
            "“< x”: not resolved, x is the 95 % upper bound")},
-       {"rounding", N_("rounding"),
+       {N_("rounding"),
         N_("the uncertainty to two significant digits when its first digit is 1 or 2, else to one; the value and "
            "its interval to the same digit ({}, 7.2.6)")}}};
   std::string h;
-  for (const auto& [key, name, text] : kConventions) {
-    const std::string shown = esc(tr(text));
-    // The standard is named as typed: no decimal comma goes into "34100.3".
-    h += kv_row(tr(name), std::string_view(key) == "rounding"
-                              ? fmt::format(fmt::runtime(shown), typed(tr(N_("JCGM 100:2008, the GUM"))))
-                              : shown);
+  for (std::size_t k = 0; k < kConventions.size(); ++k) {
+    const auto& [name, text] = kConventions[k];
+    const std::string typeset = esc(tr(text));
+    // The last, rounding, names its standard as typed: no decimal comma goes into "34100.3".
+    h += kv_row(tr(name), k + 1 == kConventions.size()
+                              ? fmt::format(fmt::runtime(typeset), typed(tr(N_("JCGM 100:2008, the GUM"))))
+                              : typeset);
   }
-  if (conventions.is_object())
-    for (const auto& item : conventions.items()) {
-      const std::string& k = item.key();  // a structured binding, clang 14 (the fuzz build) cannot capture
-      // "units" says where the JSON names its units (docs/result-json.md); the report names each unit itself.
-      if (k != "units" &&
-          std::none_of(kConventions.begin(), kConventions.end(), [&](const auto& c) { return k == c[0]; }))
-        h += kv_row(k, json_value_html(item.value()));
-    }
+  for (const auto& [key, value] : first.other_conventions) h += kv_row(key, json_value_html(value));
   return h;
 }
 
-std::string settings_html(const ReportOptions& options, const json& first, Numbering& numbering) {
+std::string settings_html(const ReportOptions& options, const Analysis& first, Numbering& numbering) {
   std::string h = numbering.section("settings", tr("Settings and conventions"));
   h += numbering.table("settings-table", tr("Settings of the analysis"));
   h += kv_row(tr("rwcalc version"), esc(version_line()));
   const bool have_settings = options.settings.is_object();
   if (have_settings)
     for (const auto& [k, v] : options.settings.items()) h += kv_row(tr(k), json_value_html(v));
-  if (auto b = str(at(first, "verdict"), "b_estimate");
+  if (const auto& b = first.verdict.b_estimate;
       !b.empty() && !(have_settings && options.settings.contains("B estimate")))
     h += kv_row(tr("B estimate"), esc(option_value_words("--b-estimate", b)));
   h += "</table>\n" + numbering.table("conventions-table", tr("Conventions of the results"));
-  return h + conventions_rows(at(first, "conventions")) + "</table>\n";
+  return h + conventions_rows(first) + "</table>\n";
 }
 
-/// The distinct values of an identification key over the runs, in run order, joined by "; ".
-std::string identification_values(const std::vector<json>& a, const char* key) {
+/// The distinct values of an identification over the runs, in run order, joined by "; ".
+std::string identification_values(const std::vector<Analysis>& a, Id id) {
   std::vector<std::string> seen;
   for (const auto& run : a)
-    if (const auto v = str(at(at(run, "input"), "identification"), key); !v.empty())
+    if (const auto& v = run[id]; !v.empty())
       if (std::find(seen.begin(), seen.end(), v) == seen.end()) seen.push_back(v);
   std::string s;
   for (const auto& v : seen) s += (s.empty() ? "" : "; ") + typed(v);
@@ -727,17 +717,17 @@ std::string identification_values(const std::vector<json>& a, const char* key) {
 }
 
 /// The title block: what a filed report names first (laboratory, gyro, serial, test, date).
-std::string title_block(const std::vector<json>& a, const ReportOptions& options, const std::string& title) {
+std::string title_block(const std::vector<Analysis>& a, const ReportOptions& options, const std::string& title) {
   std::string h = fmt::format("<header class=\"title\">\n<h1>{}</h1>\n<table id=\"title-block\">\n", typed(title));
   auto row = [&](const char* name, const std::string& html) {
     h += kv_row(tr(name), html.empty() ? std::string(kNotAvailable) : html);
   };
   row(N_("laboratory"), options.lab.empty() ? std::string() : typed(options.lab));
   row(N_("gyro"), options.gyro.empty() ? std::string() : typed(options.gyro));
-  row(N_("gyro serial"), identification_values(a, "serial"));
-  row(N_("test date"), identification_values(a, "test_date"));
-  row(N_("operator"), identification_values(a, "operator"));
-  row(N_("test conditions"), identification_values(a, "conditions"));
+  row(N_("gyro serial"), identification_values(a, Id::Serial));
+  row(N_("test date"), identification_values(a, Id::TestDate));
+  row(N_("operator"), identification_values(a, Id::Operator));
+  row(N_("test conditions"), identification_values(a, Id::Conditions));
   row(N_("runs"), trf("{} (each recording's size and SHA-256 under “Runs”)", a.size()));
   row(N_("report generated"), esc(options.generated) + " · " + esc(version_line()));
   return h + "</table>\n</header>\n";
@@ -761,34 +751,30 @@ std::string html::stylesheet(const std::string& page_prefix) {
 }
 std::string html::text(std::string_view s) { return esc(s); }
 std::string html::typed(std::string_view s) { return rwcalc::typed(s); }
-std::string html::coefficient_cell(const json& c) { return coef_cell(c); }
+std::string html::coefficient_cell(const shown::CoefficientValues& c) { return coef_cell(c); }
 std::string html::not_available() { return kNotAvailable; }
 std::string html::kv_row(std::string_view key, const std::string& value_html) {
   return rwcalc::kv_row(key, value_html);
 }
-std::string html::run_row(const json& run, const std::vector<std::string>& cells) {
+std::string html::run_row(const Analysis& run, const std::vector<std::string>& cells) {
   return rwcalc::run_row(run, cells);
 }
-std::string html::verdict_class(const json& v, std::string_view key) { return rwcalc::verdict_class(v, key); }
-bool html::is_withheld(const json& v) { return rwcalc::is_withheld(v); }
-std::string html::verdict_in_words(const json& v, const json& classes) { return rwcalc::verdict_in_words(v, classes); }
-std::string html::class_text(const json& c) { return rwcalc::class_text(c); }
-std::string html::identification_values(const std::vector<json>& a, const char* key) {
-  return rwcalc::identification_values(a, key);
+std::string html::verdict_class(const Verdict& v, const ClassValue& c) { return rwcalc::verdict_class(v, c); }
+std::string html::verdict_in_words(const Verdict& v, const std::optional<std::vector<int>>& classes) {
+  return rwcalc::verdict_in_words(v, classes);
+}
+std::string html::class_text(const ClassValue& c) { return rwcalc::class_text(c); }
+std::string html::identification_values(const std::vector<Analysis>& a, Id id) {
+  return rwcalc::identification_values(a, id);
 }
 
 std::string report_html(const ReportInput& input, const ReportOptions& options) {
   require_valid(options);
-  const auto& a = input.analyses;
-  if (a.empty()) throw AnalysisError(tr("a report needs at least one analysed run"));
-  const auto order = view::by_temperature(a);
-  json overall = input.overall;
-  if (!overall.is_object())
-    overall = {{"class_B", worst_class(a, "class_B")},
-               {"class_N", worst_class(a, "class_N")},
-               {"class", worst_class(a, "class")},
-               {"withheld",
-                std::any_of(a.begin(), a.end(), [](const json& r) { return is_withheld(at(r, "verdict")); })}};
+  if (input.analyses.empty()) throw AnalysisError(tr("a report needs at least one analysed run"));
+  const auto a = shown::read_analyses(input.analyses);
+  const auto diagnoses = shown::read_diagnoses(input.diagnoses);
+  const auto order = shown::by_temperature(a);
+  const Verdict overall = shown::read_overall(input.overall).value_or(worst_verdict(a));
   Numbering numbering{options.figures};
   // The default title is the program's text, translated; a title given is the user's own.
   const std::string title = options.title == ReportOptions{}.title ? tr(options.title) : options.title;
@@ -817,12 +803,11 @@ std::string report_html(const ReportInput& input, const ReportOptions& options) 
                      trf("{} at {}", typed(source_name(run)), temperature_text(run)));
     h += run_summary(run, i, numbering);
     if (options.figures)
-      h += numbering.figure(fmt::format("fig-run{}-allan", i + 1), {analysis_figure(run, PlotOptions{})},
+      h += numbering.figure(fmt::format("fig-run{}-allan", i + 1), {shown::analysis_figure(run, PlotOptions{})},
                             trf("{}: Allan deviation with confidence bars, the fitted model and its terms, and the "
                                 "class limits for B",
                                 source_name(run)));
-    if (i < input.diagnoses.size() && input.diagnoses[i].is_object())
-      h += diagnosis_html(input.diagnoses[i], i, run, numbering);
+    if (i < diagnoses.size() && diagnoses[i]) h += diagnosis_html(*diagnoses[i], i, run, numbering);
   }
   if (!options.figures)
     h += fmt::format("<p class=\"note\">{}</p>\n", tr("Figures were left out of this report (--no-figures)."));
