@@ -17,6 +17,12 @@ if [[ ! -f $build/compile_commands.json ]]; then
   echo "lint.sh: no $build/compile_commands.json; configure first (cmake --preset release)" >&2
   exit 2
 fi
+# A relative include that leaves its folder reaches another layer's private header, which no include
+# path lets it see (docs/architecture.md): refused.
+if git grep -nE '^[[:space:]]*#[[:space:]]*include[[:space:]]*"\.\./' -- src include; then
+  echo "lint.sh: the includes above leave their layer's folder (include a public header instead)" >&2
+  exit 1
+fi
 echo "clang-format: $(git ls-files '*.cpp' '*.hpp' | wc -l) files"
 git ls-files -z '*.cpp' '*.hpp' | xargs -0 clang-format --dry-run --Werror
 [[ $mode == --format-only ]] && exit 0
