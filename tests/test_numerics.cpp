@@ -169,6 +169,13 @@ TEST(Nnls, WorkedCase) {
   const NnlsFit none = nnls(g, Eigen::Vector4d(-1, -2, -1, -2), Eigen::Vector4d(1, 2, 1, 2), 0b11);
   EXPECT_EQ(none.x, Eigen::Vector2d::Zero());
   EXPECT_NEAR(none.chi2, 1 + 8 + 1 + 8, 1e-13);
+  // The slope allowed either sign: the falling line itself, while a negative mean still is not.
+  const NnlsFit falling = nnls(g, y, Eigen::Vector4d::Ones(), 0b11, 0b10);
+  EXPECT_NEAR(falling.x[0], 3.0, 1e-13);
+  EXPECT_NEAR(falling.x[1], -1.0, 1e-13);
+  const NnlsFit below = nnls(g, Eigen::Vector4d(-1, -2, -3, -4), Eigen::Vector4d::Ones(), 0b11, 0b10);
+  EXPECT_EQ(below.x[0], 0.0);
+  EXPECT_NEAR(below.x[1], -20.0 / 14.0, 1e-13);  // Σty/Σt² through the origin
 }
 
 TEST(Nnls, MeetsTheKarushKuhnTuckerConditions) {
@@ -185,12 +192,17 @@ TEST(Nnls, MeetsTheKarushKuhnTuckerConditions) {
       w[r] = weight(rng);
     }
     const unsigned free = trial % 2 ? 0b11111u : 0b10110u;
-    const NnlsFit f = nnls(g, y, w, free);
+    const unsigned sign_free = trial % 4 < 2 ? 0u : 0b00110u;  // columns of either sign, in both sets
+    const NnlsFit f = nnls(g, y, w, free, sign_free);
     // The gradient of ½Σw(y − Gx)²: 0 where x > 0, ≥ 0 where x = 0; fixed columns stay 0.
     const Eigen::VectorXd grad = g.transpose() * (w.asDiagonal() * (g * f.x - y));
     for (Eigen::Index i = 0; i < p; ++i) {
       if (!(free & (1u << i))) {
         EXPECT_EQ(f.x[i], 0.0);
+        continue;
+      }
+      if (sign_free & (1u << i)) {
+        EXPECT_NEAR(grad[i], 0.0, 1e-9) << "trial " << trial;
         continue;
       }
       EXPECT_GE(f.x[i], 0.0);

@@ -143,18 +143,6 @@ Eigen::MatrixXd spectrum_columns(const RateSpectrum& s, double tau0, double tf) 
   return g;
 }
 
-/// The weighted least-squares levels of the spectrum's columns, the white angle noise's (column 0,
-/// the one the filter is read from) held at 0 when it comes out negative, the others free.
-Eigen::VectorXd weighted_levels(const Eigen::MatrixXd& g, const Eigen::VectorXd& p, const Eigen::VectorXd& w) {
-  const auto solve = [&](const Eigen::MatrixXd& cols) {
-    const Eigen::MatrixXd gw = cols.transpose() * w.asDiagonal();
-    return Eigen::VectorXd((gw * cols).ldlt().solve(gw * p));
-  };
-  Eigen::VectorXd x = solve(g);
-  if (x[0] < 0) x << 0.0, solve(g.rightCols(2));
-  return x;
-}
-
 /// The Whittle deviance Σ 2K(P/S − 1 − ln P/S) of the periodogram at tf, the levels at its minimum
 /// (a Gamma fit with identity link, by iteratively reweighted least squares). The white rate and
 /// flicker levels may go negative while the spectrum stays positive: held at 0, the white rate (a
@@ -168,7 +156,7 @@ double whittle_deviance(const RateSpectrum& s, double tau0, double tf) {
   Eigen::VectorXd model = p;
   for (int it = 0; it < 8; ++it) {
     const Eigen::VectorXd w = model.array().square().inverse();
-    Eigen::VectorXd next = g * weighted_levels(g, p, w);
+    Eigen::VectorXd next = g * nnls(g, p, w, 0b111, 0b110).x;
     if (!(next.minCoeff() > 0)) next = g * nnls(g, p, w, 0b111).x;
     if (!(next.minCoeff() > 0)) break;
     const bool done = ((next - model).array() / model.array()).abs().maxCoeff() < 1e-9;
