@@ -9,7 +9,6 @@
 
 #include <boost/math/special_functions/beta.hpp>
 
-#include "rwcalc/fft.hpp"
 #include "signal.hpp"
 
 namespace rwcalc::diag {
@@ -64,21 +63,7 @@ FastLine fast_line_search(std::vector<double> y, double dt, double f_min, double
   std::size_t k_lo = std::max<std::size_t>(static_cast<std::size_t>(std::ceil(f_min / df)), 2 * stride);
   const std::size_t k_hi = std::min(static_cast<std::size_t>(f_max / df), half - 2 * stride);
   if (k_lo >= k_hi || (2 * static_cast<std::size_t>(kLevelBins) + 2) * stride >= half) return r;
-  std::vector<double> P(half + 1, 0.0), buf(len);
-  double w2 = 0;
-  for (std::size_t i = 0; i < len; ++i) {
-    const double w = 0.5 - 0.5 * std::cos(2.0 * kPi * (static_cast<double>(i) + 0.5) / static_cast<double>(len));
-    w2 += w * w;
-  }
-  detail::RealPowerSpectrum spectrum(nfft);
-  for (std::size_t sg = 0; sg < segs; ++sg) {
-    for (std::size_t i = 0; i < len; ++i)
-      buf[i] = (0.5 - 0.5 * std::cos(2.0 * kPi * (static_cast<double>(i) + 0.5) / static_cast<double>(len))) *
-               y[sg * len + i];
-    spectrum.add(buf.data(), len, P.data());
-  }
-  // E P = σ² for white noise of variance σ²
-  for (double& p : P) p /= w2 * static_cast<double>(segs);
+  const std::vector<double> P = hann_periodogram(y, len, nfft);
   // C[k] = P[k] + C[k − stride]: the sum of P[a], P[a + stride], …, P[b] in O(1).
   std::vector<double> C(P);
   for (std::size_t k = stride; k < C.size(); ++k) C[k] += C[k - stride];

@@ -5,9 +5,9 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <utility>
 
 #include "rwcalc/deviance.hpp"
-#include "rwcalc/fft.hpp"
 #include "rwcalc/minimise.hpp"
 #include "rwcalc/nnls.hpp"
 #include "rwcalc/output_filter.hpp"
@@ -92,36 +92,26 @@ double chi2_at(const ShortTau& p, double tf, const std::array<double, 3>& coef) 
 /// The rate's Welch periodogram: Hann-windowed non-overlapping segments of L samples (a power of
 /// two, L·τ0 ≥ τ_cut), every third bin from the fourth, each the mean of K segments' |X|²/Σw²:
 /// S(ω)·Gamma(K)/K for a Gaussian rate. A Hann bin is ½X_k − ¼(X_{k−1} + X_{k+1}) of the plain
-/// transform's: bins two apart share one of those (their powers correlate by 1/36: τf's errors
+/// transform's (up to phases): bins two apart share one of those (their powers correlate by 1/36: τf's errors
 /// were 1.12 times the stated spread over 80 records), bins three apart none (1.03).
 struct RateSpectrum {
   std::vector<double> omega, p;  ///< bin frequency, rad per sample; periodogram, (rate unit)²
   double k = 0;                  ///< segments averaged
 };
 
-RateSpectrum rate_spectrum(const std::vector<double>& y, double tau0, double tau_cut) {
+RateSpectrum rate_spectrum(std::vector<double> y, double tau0, double tau_cut) {
   RateSpectrum s;
   std::size_t len = 16;
   while (static_cast<double>(len) * tau0 < tau_cut) len *= 2;
-  const std::size_t segments = y.size() / len;
+  const std::size_t segments = y.size() / len;  // whole segments: hann_periodogram's average
   if (segments < 8) return s;
-  std::vector<double> w(len), x(len), sum(len / 2 + 1, 0.0);
-  double w2 = 0;
-  for (std::size_t t = 0; t < len; ++t) {
-    w[t] = 0.5 - 0.5 * std::cos(2.0 * kPi * static_cast<double>(t) / static_cast<double>(len));
-    w2 += w[t] * w[t];
-  }
-  detail::RealPowerSpectrum fft(len);
-  for (std::size_t seg = 0; seg < segments; ++seg) {
-    const double* first = y.data() + seg * len;
-    const double mean = std::accumulate(first, first + len, 0.0) / static_cast<double>(len);
-    for (std::size_t t = 0; t < len; ++t) x[t] = w[t] * (first[t] - mean);
-    fft.add(x.data(), len, sum.data());
-  }
+  const double mean = std::accumulate(y.begin(), y.end(), 0.0) / static_cast<double>(y.size());
+  for (double& v : y) v -= mean;
+  const std::vector<double> sum = hann_periodogram(y, len, len);
   s.k = static_cast<double>(segments);
   for (std::size_t b = 4; b + 2 <= len / 2; b += 3) {
     s.omega.push_back(2.0 * kPi * static_cast<double>(b) / static_cast<double>(len));
-    s.p.push_back(sum[b] / (w2 * s.k));
+    s.p.push_back(sum[b]);
   }
   return s;
 }
@@ -231,11 +221,10 @@ OutputLowpassEstimate output_lowpass_detect(const std::vector<std::int64_t>& m, 
   return e;
 }
 
-bool output_lowpass_estimate(const std::vector<double>& rate, const std::vector<std::int64_t>& m,
-                             const std::vector<double>& v, const std::vector<double>& edf, double tau0, double duration,
-                             OutputLowpassEstimate& e) {
+bool output_lowpass_estimate(std::vector<double> rate, const std::vector<std::int64_t>& m, const std::vector<double>& v,
+                             const std::vector<double>& edf, double tau0, double duration, OutputLowpassEstimate& e) {
   const ShortTau pts = short_tau(m, v, edf, tau0, duration);
-  const RateSpectrum spec = rate_spectrum(rate, tau0, pts.tau_cut);
+  const RateSpectrum spec = rate_spectrum(std::move(rate), tau0, pts.tau_cut);
   if (pts.y.size() < 5 || spec.p.size() < 16) return false;
   const double lo = std::log(tau0 / 4.0), hi = std::log(std::max(pts.tau_cut / 4.0, tau0));
   const auto f = [&](double l) { return whittle_deviance(spec, tau0, std::exp(l)); };

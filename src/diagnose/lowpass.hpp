@@ -33,9 +33,8 @@ OutputLowpassEstimate output_lowpass_detect(const std::vector<std::int64_t>& m, 
 /// χ²₁(0.95) times its overdispersion (deviance per bin over its mean, when above 1). The white
 /// levels in `e` are then the octave AV's at that time constant. False (e unchanged) when the
 /// record is too short for 8 segments of the spectrum.
-bool output_lowpass_estimate(const std::vector<double>& rate, const std::vector<std::int64_t>& m,
-                             const std::vector<double>& v, const std::vector<double>& edf, double tau0, double duration,
-                             OutputLowpassEstimate& e);
+bool output_lowpass_estimate(std::vector<double> rate, const std::vector<std::int64_t>& m, const std::vector<double>& v,
+                             const std::vector<double>& edf, double tau0, double duration, OutputLowpassEstimate& e);
 
 /// The low-pass out of sample: the octave AV of each half of the record (`v`, the same cluster
 /// sizes `m`, EDF `edf` of a half, `duration` a half's) predicted by the filter and levels fitted to

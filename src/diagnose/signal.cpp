@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "rwcalc/fft.hpp"
+
 namespace rwcalc::diag {
 
 std::size_t per_block_for(const Decimated& d, double seconds) {
@@ -45,6 +47,24 @@ double deterministic_angle(const NoiseModel& m, double t) {
   for (const auto& st : m.bias_steps) a += st.size_deg_per_h * std::max(0.0, t - st.t_s);
   for (const auto& w : m.warmups) a += w.amp_deg_per_h * w.tc_s * -std::expm1(-t / w.tc_s);
   return a;
+}
+
+std::vector<double> hann_periodogram(const std::vector<double>& y, std::size_t len, std::size_t nfft) {
+  const std::size_t segs = len ? y.size() / len : 0;
+  std::vector<double> P(nfft / 2 + 1, 0.0), w(len), buf(len);
+  double w2 = 0;
+  for (std::size_t i = 0; i < len; ++i) {
+    w[i] = 0.5 - 0.5 * std::cos(2.0 * kPi * (static_cast<double>(i) + 0.5) / static_cast<double>(len));
+    w2 += w[i] * w[i];
+  }
+  if (segs == 0) return P;
+  detail::RealPowerSpectrum spectrum(nfft);
+  for (std::size_t sg = 0; sg < segs; ++sg) {
+    for (std::size_t i = 0; i < len; ++i) buf[i] = w[i] * y[sg * len + i];
+    spectrum.add(buf.data(), len, P.data());
+  }
+  for (double& p : P) p /= w2 * static_cast<double>(segs);
+  return P;
 }
 
 }  // namespace rwcalc::diag

@@ -23,6 +23,10 @@ struct Decimated {
 };
 std::size_t decimation(double rate_hz);  ///< D: a power of two, 10 Hz ≤ rate/D < 20 Hz; 1 below 20 Hz
 Decimated decimate(const PhaseSeries& x);
+/// The Hann-windowed periodogram of y averaged over its ⌊n/len⌋ segments of `len` samples, each
+/// zero-padded to `nfft` (a power of two, at least len and 4): P[k], k = 0 … nfft/2, scaled so that
+/// E P = σ² for white noise of variance σ². Removing y's mean is the caller's.
+std::vector<double> hann_periodogram(const std::vector<double>& y, std::size_t len, std::size_t nfft);
 /// Mean rates over blocks of `per_block` decimated periods (about `seconds`: per_block_for), °/h.
 std::vector<double> block_rates(const Decimated& d, std::size_t per_block);
 std::size_t per_block_for(const Decimated& d, double seconds);
